@@ -1,0 +1,20 @@
+/* Weak placeholders for subcommands that have not landed; the real one overrides it.
+ * Each owner deletes its line when its command lands. */
+#include <stdio.h>
+
+#include "cli/cli.h"
+
+#define LBK_WEAK_COMMAND(fn, name)                                                   \
+    __attribute__((weak)) int fn(int argc, char **argv)                               \
+    {                                                                                 \
+        (void)argc; (void)argv;                                                       \
+        fprintf(stderr, "lbk %s: not available in this build\n", name);               \
+        return LBK_EXIT_INTERNAL;                                                     \
+    }
+
+LBK_WEAK_COMMAND(lbk_cmd_bake, "bake")
+LBK_WEAK_COMMAND(lbk_cmd_inspect, "inspect")
+LBK_WEAK_COMMAND(lbk_cmd_validate, "validate")
+LBK_WEAK_COMMAND(lbk_cmd_diff, "diff")
+LBK_WEAK_COMMAND(lbk_cmd_convert, "convert")
+LBK_WEAK_COMMAND(lbk_cmd_export, "export")

@@ -1,0 +1,50 @@
+/* Validation: every check of spec/validation.md, reported with a stable ID. */
+#ifndef LBK_VALIDATE_H
+#define LBK_VALIDATE_H
+
+#include "lbk/container.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum lbk_severity {
+    LBK_SEVERITY_WARNING = 0, /* the file is usable; something is unusual */
+    LBK_SEVERITY_ERROR = 1,   /* a section is unusable; the file is invalid */
+    LBK_SEVERITY_FATAL = 2    /* the file cannot be read at all; later checks were skipped */
+} lbk_severity;
+
+typedef struct lbk_issue {
+    uint32_t id;           /* stable number from spec/validation.md */
+    lbk_severity severity;
+    uint32_t section_type; /* 0 for header/table issues */
+    uint64_t offset;       /* byte offset in the file (for compressed sections: of the section start) */
+    char message[160];     /* English, one line, includes the offending values */
+} lbk_issue;
+
+/* Called once per issue, in file order; return non-zero to stop validating. */
+typedef int (*lbk_issue_callback)(void *user, const lbk_issue *issue);
+
+typedef struct lbk_validate_options {
+    const lbk_allocator *allocator;
+    uint64_t max_decoded_bytes; /* as lbk_read_options; 0: default */
+} lbk_validate_options;
+
+typedef struct lbk_validate_summary {
+    uint32_t fatal, errors, warnings;
+} lbk_validate_summary;
+
+/* Runs every check on a byte buffer. Returns LBK_OK when the checks ran (whatever they found);
+ * the summary tells whether the file is valid (fatal == 0 && errors == 0). */
+LBK_API lbk_result lbk_validate_memory(const void *data, size_t size, const lbk_validate_options *options,
+                                       lbk_issue_callback callback, void *user, lbk_validate_summary *summary);
+LBK_API lbk_result lbk_validate_file(const char *path, const lbk_validate_options *options,
+                                     lbk_issue_callback callback, void *user, lbk_validate_summary *summary);
+
+/* The registry: severity and message template of an ID; NULL if unknown. */
+LBK_API const char *lbk_issue_template(uint32_t id, lbk_severity *severity);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

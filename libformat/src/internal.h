@@ -1,0 +1,120 @@
+/* Private helpers shared by the liblbk sources. Not installed. */
+#ifndef LBK_INTERNAL_H
+#define LBK_INTERNAL_H
+
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "lbk/validate.h"
+
+/* ---- little-endian access (the file is LE whatever the host is) -------------------------- */
+static inline uint16_t lbk_rd16(const uint8_t *p) { return (uint16_t)(p[0] | (p[1] << 8)); }
+static inline uint32_t lbk_rd32(const uint8_t *p)
+{
+    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
+}
+static inline uint64_t lbk_rd64(const uint8_t *p) { return (uint64_t)lbk_rd32(p) | ((uint64_t)lbk_rd32(p + 4) << 32); }
+static inline float lbk_rdf32(const uint8_t *p)
+{
+    uint32_t u = lbk_rd32(p);
+    float f;
+    memcpy(&f, &u, 4);
+    return f;
+}
+static inline void lbk_wr16(uint8_t *p, uint16_t v) { p[0] = (uint8_t)v; p[1] = (uint8_t)(v >> 8); }
+static inline void lbk_wr32(uint8_t *p, uint32_t v)
+{
+    p[0] = (uint8_t)v; p[1] = (uint8_t)(v >> 8); p[2] = (uint8_t)(v >> 16); p[3] = (uint8_t)(v >> 24);
+}
+static inline void lbk_wr64(uint8_t *p, uint64_t v) { lbk_wr32(p, (uint32_t)v); lbk_wr32(p + 4, (uint32_t)(v >> 32)); }
+static inline void lbk_wrf32(uint8_t *p, float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, 4);
+    lbk_wr32(p, u);
+}
+
+/* ---- overflow-checked size math: return false on overflow, *out untouched --------------- */
+static inline bool lbk_add_u64(uint64_t a, uint64_t b, uint64_t *out)
+{
+    if (a > UINT64_MAX - b) return false;
+    *out = a + b;
+    return true;
+}
+static inline bool lbk_mul_u64(uint64_t a, uint64_t b, uint64_t *out)
+{
+    if (a != 0 && b > UINT64_MAX / a) return false;
+    *out = a * b;
+    return true;
+}
+/* a + b*c */
+static inline bool lbk_madd_u64(uint64_t a, uint64_t b, uint64_t c, uint64_t *out)
+{
+    uint64_t t;
+    return lbk_mul_u64(b, c, &t) && lbk_add_u64(a, t, out);
+}
+/* Does [off, off+len) lie inside [0, size)? */
+static inline bool lbk_range_ok(uint64_t off, uint64_t len, uint64_t size)
+{
+    return off <= size && len <= size - off;
+}
+static inline uint64_t lbk_align_up(uint64_t v, uint64_t a) { return (v + a - 1) & ~(a - 1); }
+
+/* ---- allocation through the optional caller allocator ------------------------------------ */
+void *lbk_alloc(const lbk_allocator *a, size_t size);
+void *lbk_calloc(const lbk_allocator *a, size_t count, size_t size); /* overflow-checked, zeroed */
+void lbk_dealloc(const lbk_allocator *a, void *p);
+
+/* ---- validation context ---------------------------------------------------------------------
+ * validate.c walks the sections in dependency order (META, REPT, LMAP, GLG, LLG, OCTP, OBJS, DLS,
+ * DOOR) and hands each section validator this context. A validator reports through lbk_vreport,
+ * and fills in the facts later sections cross-check against. A fact stays zero when its section is
+ * absent or unusable; *_ok flags say whether the section parsed. */
+typedef struct lbk_vctx {
+    lbk_issue_callback callback;
+    void *user;
+    lbk_validate_summary *summary;
+    int stop;                      /* set when the callback asked to stop */
+    const lbk_allocator *allocator;
+    uint32_t section_type;         /* section being validated */
+    uint64_t section_offset;       /* its file offset, for issue offsets */
+    int section_compressed;        /* offsets inside compressed sections report the section start */
+
+    /* facts from earlier sections */
+    int lmap_ok;
+    uint32_t lmap_page_count;
+    const uint16_t *lmap_page_width;  /* host-endian copies owned by validate.c, lmap_page_count each */
+    const uint16_t *lmap_page_height;
+    uint64_t lmap_texel_count;
+    int glg_ok;
+    uint32_t glg_probe_count;
+    int llg_ok;
+    uint32_t llg_count;
+    uint64_t llg_probe_count;
+    int objs_ok;
+    uint32_t object_count;
+    int dls_ok;
+    uint32_t dls_set_count;
+} lbk_vctx;
+
+/* Reports issue `id` (its severity comes from the registry) at byte `offset_in_section` of the
+ * current section (or at an absolute file offset when the section type is 0). printf-style. */
+void lbk_vreport(lbk_vctx *ctx, uint32_t id, uint64_t offset_in_section, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+
+/* Per-section validators: each checks every rule of its section in spec/validation.md.
+ * `data` are the decoded bytes. They never read outside [data, data+size). */
+void lbk_validate_meta(lbk_vctx *ctx, const uint8_t *data, size_t size);
+void lbk_validate_rept(lbk_vctx *ctx, const uint8_t *data, size_t size);
+void lbk_validate_lmap(lbk_vctx *ctx, const uint8_t *data, size_t size);
+void lbk_validate_glg(lbk_vctx *ctx, const uint8_t *data, size_t size);
+void lbk_validate_llg(lbk_vctx *ctx, const uint8_t *data, size_t size);
+void lbk_validate_octp(lbk_vctx *ctx, const uint8_t *data, size_t size);
+void lbk_validate_objs(lbk_vctx *ctx, const uint8_t *data, size_t size);
+void lbk_validate_dls(lbk_vctx *ctx, const uint8_t *data, size_t size);
+void lbk_validate_door(lbk_vctx *ctx, const uint8_t *data, size_t size);
+
+#endif
