@@ -12,7 +12,6 @@
         return LBK_EXIT_INTERNAL;                                                     \
     }
 
-LBK_WEAK_COMMAND(lbk_cmd_bake, "bake")
 LBK_WEAK_COMMAND(lbk_cmd_inspect, "inspect")
 LBK_WEAK_COMMAND(lbk_cmd_validate, "validate")
 LBK_WEAK_COMMAND(lbk_cmd_diff, "diff")
