@@ -82,6 +82,8 @@ typedef struct lbk_vctx {
     uint32_t section_type;         /* section being validated */
     uint64_t section_offset;       /* its file offset, for issue offsets */
     int section_compressed;        /* offsets inside compressed sections report the section start */
+    uint32_t present_types[64];    /* every type listed in the section table, usable or not */
+    uint32_t present_count;
 
     /* facts from earlier sections */
     int lmap_ok;
@@ -99,6 +101,14 @@ typedef struct lbk_vctx {
     int dls_ok;
     uint32_t dls_set_count;
 } lbk_vctx;
+
+/* Is a section of this type listed in the table (whether or not it turned out usable)? */
+static inline bool lbk_vctx_has_section(const lbk_vctx *ctx, uint32_t type)
+{
+    for (uint32_t i = 0; i < ctx->present_count; i++)
+        if (ctx->present_types[i] == type) return true;
+    return false;
+}
 
 /* Reports issue `id` (its severity comes from the registry) at byte `offset_in_section` of the
  * current section (or at an absolute file offset when the section type is 0). printf-style. */

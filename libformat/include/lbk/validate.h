@@ -22,7 +22,9 @@ typedef struct lbk_issue {
     char message[160];     /* English, one line, includes the offending values */
 } lbk_issue;
 
-/* Called once per issue, in file order; return non-zero to stop validating. */
+/* Called once per issue, in the order the checks run: header, section table and padding, section
+ * checksums in file order, then each section's decode and content checks in dependency order
+ * (META, REPT, LMAP, GLG, LLG, OCTP, OBJS, DLS, DOOR; spec/validation.md). Return non-zero to stop. */
 typedef int (*lbk_issue_callback)(void *user, const lbk_issue *issue);
 
 typedef struct lbk_validate_options {
@@ -43,6 +45,11 @@ LBK_API lbk_result lbk_validate_file(const char *path, const lbk_validate_option
 
 /* The registry: severity and message template of an ID; NULL if unknown. */
 LBK_API const char *lbk_issue_template(uint32_t id, lbk_severity *severity);
+/* Enumerates the registry: number of IDs, and the ID at a position (ascending; 0 past the end). */
+LBK_API uint32_t lbk_issue_registry_size(void);
+LBK_API uint32_t lbk_issue_registry_id(uint32_t index);
+/* Section type an ID belongs to (0: header and section table); 0 if unknown. */
+LBK_API uint32_t lbk_issue_section(uint32_t id);
 
 #ifdef __cplusplus
 }

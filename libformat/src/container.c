@@ -1,0 +1,421 @@
+/* The container reader (mmap or caller buffer, lazy decode) and writer (canonical layout,
+ * deterministic bytes, atomic file write). Layout rules: spec/container.md §2–§4; the checks
+ * themselves live in framing.c so the reader and the validator share them. */
+#define ZSTD_STATIC_LINKING_ONLY /* ZSTD_createCCtx_advanced: route zstd's memory through the caller */
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <xxhash.h>
+#include <zstd.h>
+#include <zstd_errors.h>
+
+#include "framing.h"
+
+#define LBK_DEFAULT_ZSTD_LEVEL 19
+
+static lbk_allocator copy_allocator(const lbk_allocator *a)
+{
+    lbk_allocator out = {0};
+    if (a && a->alloc && a->free) out = *a;
+    return out;
+}
+
+/* ---- reader ------------------------------------------------------------------------------ */
+
+struct lbk_reader {
+    lbk_allocator alloc;
+    const uint8_t *bytes;
+    size_t size;
+    int mapped;
+    int skip_checksums;
+    uint64_t budget_left; /* decoded bytes the reader may still allocate */
+    lbk_framing fr;
+    const uint8_t *data[LBK_MAX_SECTIONS]; /* decoded (or in-place) bytes once accessed */
+    void *owned[LBK_MAX_SECTIONS];
+};
+
+typedef struct open_state {
+    lbk_result result;
+} open_state;
+
+static int reader_report(void *user, uint32_t id, lbk_result r, uint32_t type, uint64_t offset, const char *fmt,
+                         va_list ap)
+{
+    (void)id; (void)type; (void)offset; (void)fmt; (void)ap;
+    if (r == LBK_OK) return 0; /* a warning: the file is still readable */
+    ((open_state *)user)->result = r;
+    return 1;
+}
+
+static lbk_result open_common(const uint8_t *data, size_t size, int mapped, const lbk_read_options *options,
+                              lbk_reader **out)
+{
+    lbk_allocator alloc = copy_allocator(options ? options->allocator : NULL);
+    open_state st = {LBK_OK};
+    lbk_reader *r = lbk_calloc(&alloc, 1, sizeof *r);
+    if (!r) return LBK_ERR_OUT_OF_MEMORY;
+    lbk_framing_parse(data, size, &r->fr, reader_report, &st);
+    if (st.result == LBK_OK && !r->fr.header_ok) st.result = LBK_ERR_CORRUPT; /* cannot happen; be safe */
+    if (st.result != LBK_OK) {
+        lbk_dealloc(&alloc, r);
+        return st.result;
+    }
+    r->alloc = alloc;
+    r->bytes = data;
+    r->size = size;
+    r->mapped = mapped;
+    r->skip_checksums = options ? options->skip_checksums : 0;
+    r->budget_left = (options && options->max_decoded_bytes) ? options->max_decoded_bytes
+                                                             : lbk_default_decode_cap(size);
+    *out = r;
+    return LBK_OK;
+}
+
+lbk_result lbk_reader_open_memory(const void *data, size_t size, const lbk_read_options *options, lbk_reader **out)
+{
+    if (!out || (!data && size)) return LBK_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    return open_common(data, size, 0, options, out);
+}
+
+lbk_result lbk_reader_open_file(const char *path, const lbk_read_options *options, lbk_reader **out)
+{
+    if (!out || !path) return LBK_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    const uint8_t *data;
+    size_t size;
+    lbk_result res = lbk_map_file(path, &data, &size);
+    if (res != LBK_OK) return res;
+    res = open_common(data, size, 1, options, out);
+    if (res != LBK_OK) lbk_unmap_file(data, size);
+    return res;
+}
+
+void lbk_reader_close(lbk_reader *r)
+{
+    if (!r) return;
+    for (uint32_t i = 0; i < LBK_MAX_SECTIONS; i++) lbk_dealloc(&r->alloc, r->owned[i]);
+    if (r->mapped) lbk_unmap_file(r->bytes, r->size);
+    lbk_allocator alloc = r->alloc;
+    lbk_dealloc(&alloc, r);
+}
+
+const lbk_header_info *lbk_reader_header(const lbk_reader *r) { return r ? &r->fr.header : NULL; }
+
+const void *lbk_reader_bytes(const lbk_reader *r, size_t *size)
+{
+    if (!r) return NULL;
+    if (size) *size = r->size;
+    return r->bytes;
+}
+
+uint32_t lbk_reader_section_count(const lbk_reader *r) { return r ? r->fr.count : 0; }
+
+lbk_result lbk_reader_section_info(const lbk_reader *r, uint32_t index, lbk_section_info *out)
+{
+    if (!r || !out) return LBK_ERR_INVALID_ARGUMENT;
+    if (index >= r->fr.count) return LBK_ERR_NOT_FOUND;
+    *out = r->fr.sections[index];
+    return LBK_OK;
+}
+
+lbk_result lbk_reader_find_section(const lbk_reader *r, uint32_t type, uint32_t *index)
+{
+    if (!r || !index) return LBK_ERR_INVALID_ARGUMENT;
+    for (uint32_t i = 0; i < r->fr.count; i++)
+        if (r->fr.sections[i].type == type) {
+            *index = i;
+            return LBK_OK;
+        }
+    return LBK_ERR_NOT_FOUND;
+}
+
+lbk_result lbk_reader_section_data(lbk_reader *r, uint32_t index, const void **data, size_t *size)
+{
+    if (!r || !data || !size) return LBK_ERR_INVALID_ARGUMENT;
+    *data = NULL;
+    *size = 0;
+    if (index >= r->fr.count) return LBK_ERR_NOT_FOUND;
+    const lbk_section_info *s = &r->fr.sections[index];
+    if (!r->fr.usable[index]) return LBK_ERR_CORRUPT;
+    if (!r->data[index]) {
+        uint32_t issue;
+        const uint8_t *d;
+        void *owned;
+        lbk_result res = lbk_section_load(r->bytes, s, &r->alloc, r->skip_checksums, &r->budget_left, &d, &owned,
+                                          &issue);
+        if (res != LBK_OK) return res;
+        r->data[index] = d;
+        r->owned[index] = owned;
+    }
+    *data = r->data[index];
+    *size = (size_t)s->decoded_size;
+    return LBK_OK;
+}
+
+lbk_result lbk_reader_section_by_type(lbk_reader *r, uint32_t type, const void **data, size_t *size)
+{
+    uint32_t index;
+    if (data) *data = NULL;
+    if (size) *size = 0;
+    lbk_result res = lbk_reader_find_section(r, type, &index);
+    if (res != LBK_OK) return res;
+    return lbk_reader_section_data(r, index, data, size);
+}
+
+/* ---- writer ------------------------------------------------------------------------------ */
+
+typedef struct writer_section {
+    uint32_t type, flags, compression;
+    uint8_t *stored;
+    uint64_t stored_size, decoded_size, checksum;
+} writer_section;
+
+struct lbk_writer {
+    lbk_allocator alloc;
+    uint32_t alignment;
+    uint32_t count;
+    writer_section s[LBK_MAX_SECTIONS];
+};
+
+lbk_result lbk_writer_create(const lbk_write_options *options, lbk_writer **out)
+{
+    if (!out) return LBK_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    uint32_t a = options && options->section_alignment ? options->section_alignment : LBK_DEFAULT_ALIGNMENT;
+    if (a < LBK_MIN_ALIGNMENT || a > LBK_MAX_ALIGNMENT || (a & (a - 1))) return LBK_ERR_INVALID_ARGUMENT;
+    lbk_allocator alloc = copy_allocator(options ? options->allocator : NULL);
+    lbk_writer *w = lbk_calloc(&alloc, 1, sizeof *w);
+    if (!w) return LBK_ERR_OUT_OF_MEMORY;
+    w->alloc = alloc;
+    w->alignment = a;
+    *out = w;
+    return LBK_OK;
+}
+
+void lbk_writer_destroy(lbk_writer *w)
+{
+    if (!w) return;
+    for (uint32_t i = 0; i < w->count; i++) lbk_dealloc(&w->alloc, w->s[i].stored);
+    lbk_allocator alloc = w->alloc;
+    lbk_dealloc(&alloc, w);
+}
+
+static void *zstd_alloc(void *user, size_t size) { return lbk_alloc((const lbk_allocator *)user, size); }
+static void zstd_free(void *user, void *p) { lbk_dealloc((const lbk_allocator *)user, p); }
+
+static lbk_result compress(lbk_writer *w, const void *data, size_t size, int level, uint8_t **out, size_t *out_size)
+{
+    ZSTD_customMem mem = {zstd_alloc, zstd_free, &w->alloc};
+    size_t bound = ZSTD_compressBound(size);
+    if (ZSTD_isError(bound)) return LBK_ERR_LIMIT;
+    uint8_t *tmp = lbk_alloc(&w->alloc, bound);
+    if (!tmp) return LBK_ERR_OUT_OF_MEMORY;
+    ZSTD_CCtx *cctx = ZSTD_createCCtx_advanced(mem);
+    if (!cctx) {
+        lbk_dealloc(&w->alloc, tmp);
+        return LBK_ERR_OUT_OF_MEMORY;
+    }
+    /* One frame with the content size and no zstd checksum (the section checksum covers it). */
+    size_t n = ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, level);
+    if (!ZSTD_isError(n)) n = ZSTD_CCtx_setParameter(cctx, ZSTD_c_contentSizeFlag, 1);
+    if (!ZSTD_isError(n)) n = ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 0);
+    if (!ZSTD_isError(n)) n = ZSTD_compress2(cctx, tmp, bound, data, size);
+    ZSTD_freeCCtx(cctx);
+    if (ZSTD_isError(n)) {
+        lbk_dealloc(&w->alloc, tmp);
+        return ZSTD_getErrorCode(n) == ZSTD_error_memory_allocation ? LBK_ERR_OUT_OF_MEMORY : LBK_ERR_INVALID_ARGUMENT;
+    }
+    /* Keep only the bytes used: the bound can be much larger than the frame. */
+    uint8_t *exact = lbk_alloc(&w->alloc, n);
+    if (!exact) {
+        lbk_dealloc(&w->alloc, tmp);
+        return LBK_ERR_OUT_OF_MEMORY;
+    }
+    memcpy(exact, tmp, n);
+    lbk_dealloc(&w->alloc, tmp);
+    *out = exact;
+    *out_size = n;
+    return LBK_OK;
+}
+
+lbk_result lbk_writer_add_section(lbk_writer *w, uint32_t type, const void *data, size_t size,
+                                  const lbk_section_options *options)
+{
+    if (!w || !data || size == 0 || !lbk_fourcc_printable(type)) return LBK_ERR_INVALID_ARGUMENT;
+    uint32_t flags = options ? options->flags : 0;
+    uint32_t compression = options ? options->compression : LBK_COMPRESSION_NONE;
+    int level = options && options->zstd_level ? options->zstd_level : LBK_DEFAULT_ZSTD_LEVEL;
+    if ((flags & ~LBK_SECTION_FLAG_REQUIRED) || compression > LBK_COMPRESSION_ZSTD) return LBK_ERR_INVALID_ARGUMENT;
+    if (level > ZSTD_maxCLevel() || level < ZSTD_minCLevel()) return LBK_ERR_INVALID_ARGUMENT;
+    for (uint32_t i = 0; i < w->count; i++)
+        if (w->s[i].type == type) return LBK_ERR_INVALID_ARGUMENT;
+    if (w->count >= LBK_MAX_SECTIONS) return LBK_ERR_LIMIT;
+
+    writer_section *s = &w->s[w->count];
+    uint8_t *stored;
+    size_t stored_size;
+    if (compression == LBK_COMPRESSION_ZSTD) {
+        lbk_result r = compress(w, data, size, level, &stored, &stored_size);
+        if (r != LBK_OK) return r;
+    } else {
+        stored = lbk_alloc(&w->alloc, size);
+        if (!stored) return LBK_ERR_OUT_OF_MEMORY;
+        memcpy(stored, data, size);
+        stored_size = size;
+    }
+    s->type = type;
+    s->flags = flags;
+    s->compression = compression;
+    s->stored = stored;
+    s->stored_size = stored_size;
+    s->decoded_size = size;
+    s->checksum = XXH3_64bits(stored, stored_size);
+    w->count++;
+    return LBK_OK;
+}
+
+/* Sections in canonical order, and the file size their placement gives (§3.3). */
+static lbk_result layout(const lbk_writer *w, uint32_t order[LBK_MAX_SECTIONS], uint64_t offsets[LBK_MAX_SECTIONS],
+                         uint64_t *file_size)
+{
+    for (uint32_t i = 0; i < w->count; i++) order[i] = i;
+    for (uint32_t i = 1; i < w->count; i++) /* insertion sort: at most 64 entries */
+        for (uint32_t j = i; j > 0 && lbk_section_order_key(w->s[order[j - 1]].type) >
+                                          lbk_section_order_key(w->s[order[j]].type);
+             j--) {
+            uint32_t t = order[j];
+            order[j] = order[j - 1];
+            order[j - 1] = t;
+        }
+    uint64_t end = LBK_HEADER_SIZE + (uint64_t)LBK_SECTION_ENTRY_SIZE * w->count;
+    for (uint32_t i = 0; i < w->count; i++) {
+        offsets[i] = lbk_align_up(end, w->alignment);
+        if (offsets[i] < end || !lbk_add_u64(offsets[i], w->s[order[i]].stored_size, &end)) return LBK_ERR_LIMIT;
+    }
+    if (end > SIZE_MAX) return LBK_ERR_LIMIT;
+    *file_size = end;
+    return LBK_OK;
+}
+
+lbk_result lbk_writer_to_memory(lbk_writer *w, void **out, size_t *size)
+{
+    if (!w || !out || !size) return LBK_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    *size = 0;
+    if (w->count == 0) return LBK_ERR_INVALID_ARGUMENT; /* §2: section_count >= 1 */
+    uint32_t order[LBK_MAX_SECTIONS];
+    uint64_t offsets[LBK_MAX_SECTIONS], file_size;
+    lbk_result r = layout(w, order, offsets, &file_size);
+    if (r != LBK_OK) return r;
+    uint8_t *f = lbk_calloc(&w->alloc, 1, (size_t)file_size); /* zero: padding and reserved bytes */
+    if (!f) return LBK_ERR_OUT_OF_MEMORY;
+
+    uint32_t required = 0;
+    for (uint32_t i = 0; i < w->count; i++) {
+        const writer_section *s = &w->s[order[i]];
+        uint8_t *e = f + LBK_HEADER_SIZE + (size_t)LBK_SECTION_ENTRY_SIZE * i;
+        lbk_wr32(e + LBK_ENT_TYPE, s->type);
+        lbk_wr32(e + LBK_ENT_FLAGS, s->flags);
+        lbk_wr32(e + LBK_ENT_COMPRESSION, s->compression);
+        lbk_wr64(e + LBK_ENT_OFFSET, offsets[i]);
+        lbk_wr64(e + LBK_ENT_STORED_SIZE, s->stored_size);
+        lbk_wr64(e + LBK_ENT_DECODED_SIZE, s->decoded_size);
+        lbk_wr64(e + LBK_ENT_CHECKSUM, s->checksum);
+        memcpy(f + offsets[i], s->stored, (size_t)s->stored_size);
+        if (s->compression == LBK_COMPRESSION_ZSTD) required |= LBK_FEATURE_ZSTD;
+    }
+    memcpy(f, lbk_magic, 8);
+    lbk_wr16(f + LBK_HDR_VERSION_MAJOR, LBK_VERSION_MAJOR);
+    lbk_wr16(f + LBK_HDR_VERSION_MINOR, LBK_VERSION_MINOR);
+    lbk_wr32(f + LBK_HDR_HEADER_SIZE, LBK_HEADER_SIZE);
+    lbk_wr64(f + LBK_HDR_FILE_SIZE, file_size);
+    lbk_wr32(f + LBK_HDR_REQUIRED_FEATURES, required);
+    lbk_wr32(f + LBK_HDR_OPTIONAL_FEATURES, 0);
+    lbk_wr32(f + LBK_HDR_SECTION_COUNT, w->count);
+    lbk_wr32(f + LBK_HDR_SECTION_ALIGNMENT, w->alignment);
+    lbk_wr64(f + LBK_HDR_TABLE_OFFSET, LBK_HEADER_SIZE);
+    lbk_wr64(f + LBK_HDR_TABLE_CHECKSUM,
+             XXH3_64bits(f + LBK_HEADER_SIZE, (size_t)LBK_SECTION_ENTRY_SIZE * w->count));
+    lbk_wr64(f + LBK_HDR_HEADER_CHECKSUM, XXH3_64bits(f, LBK_HDR_HEADER_CHECKSUM));
+    *out = f;
+    *size = (size_t)file_size;
+    return LBK_OK;
+}
+
+static int write_all(int fd, const uint8_t *p, size_t n)
+{
+    while (n) {
+        ssize_t k = write(fd, p, n > ((size_t)1 << 30) ? ((size_t)1 << 30) : n);
+        if (k < 0) {
+            if (errno == EINTR) continue;
+            return -1;
+        }
+        p += k;
+        n -= (size_t)k;
+    }
+    return 0;
+}
+
+/* fsync of the directory makes the rename itself durable. */
+static int sync_parent_dir(const char *path, const lbk_allocator *alloc)
+{
+    const char *slash = strrchr(path, '/');
+    size_t len = slash ? (size_t)(slash - path) : 1;
+    if (slash && len == 0) len = 1; /* "/name": the root */
+    char *dir = lbk_alloc(alloc, len + 1);
+    if (!dir) return -1;
+    if (slash) memcpy(dir, path, len);
+    else dir[0] = '.';
+    dir[len] = '\0';
+    int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    lbk_dealloc(alloc, dir);
+    if (fd < 0) return -1;
+    int rc = fsync(fd);
+    /* Some file systems cannot fsync a directory; the data itself is already durable. */
+    if (rc != 0 && (errno == EINVAL || errno == EROFS)) rc = 0;
+    close(fd);
+    return rc;
+}
+
+lbk_result lbk_writer_to_file(lbk_writer *w, const char *path)
+{
+    if (!w || !path || !*path) return LBK_ERR_INVALID_ARGUMENT;
+    void *bytes;
+    size_t size;
+    lbk_result r = lbk_writer_to_memory(w, &bytes, &size);
+    if (r != LBK_OK) return r;
+
+    static const char suffix[] = ".tmp-XXXXXX"; /* same directory: rename stays atomic */
+    size_t plen = strlen(path);
+    char *tmp = lbk_alloc(&w->alloc, plen + sizeof suffix);
+    if (!tmp) {
+        lbk_dealloc(&w->alloc, bytes);
+        return LBK_ERR_OUT_OF_MEMORY;
+    }
+    memcpy(tmp, path, plen);
+    memcpy(tmp + plen, suffix, sizeof suffix);
+    r = LBK_ERR_IO;
+    int fd = mkstemp(tmp);
+    if (fd >= 0) {
+        int ok = write_all(fd, bytes, size) == 0 && fchmod(fd, 0644) == 0 && fsync(fd) == 0;
+        int saved = errno;
+        if (close(fd) != 0 && ok) {
+            ok = 0;
+            saved = errno;
+        }
+        if (ok && rename(tmp, path) == 0) {
+            r = sync_parent_dir(path, &w->alloc) == 0 ? LBK_OK : LBK_ERR_IO;
+        } else {
+            if (ok) saved = errno;
+            unlink(tmp);
+            errno = saved;
+        }
+    }
+    lbk_dealloc(&w->alloc, tmp);
+    lbk_dealloc(&w->alloc, bytes);
+    return r;
+}
