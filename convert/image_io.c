@@ -33,6 +33,12 @@ static int find_name(const char *const *names, int count, const char *name)
 
 /* ---- EXR ---------------------------------------------------------------------------------- */
 
+static void exr_silent(exr_const_context_t ctx, int code, const char *msg)
+{
+    (void)ctx; (void)code; (void)msg; /* errors are reported through the return value */
+}
+
+
 int tl_exr_write(const char *path, int width, int height, int channel_count, const char *const *names,
                  const float *pixels, char err[TL_ERR_LEN])
 {
@@ -40,6 +46,7 @@ int tl_exr_write(const char *path, int width, int height, int channel_count, con
         return fail(err, "%s: nothing to write (%dx%d, %d channels)", path, width, height, channel_count);
     exr_context_t ctx = NULL;
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = exr_silent;
     exr_result_t rv = exr_start_write(&ctx, path, EXR_INTERMEDIATE_TEMP_FILE, &init);
     if (rv != EXR_ERR_SUCCESS) return fail(err, "%s: cannot create EXR (%s)", path, exr_get_default_error_message(rv));
     int part = 0;
@@ -83,11 +90,6 @@ int tl_exr_write(const char *path, int width, int height, int channel_count, con
     if (rv == EXR_ERR_SUCCESS) rv = fin;
     if (rv != EXR_ERR_SUCCESS) return fail(err, "%s: EXR write failed (%s)", path, exr_get_default_error_message(rv));
     return 0;
-}
-
-static void exr_silent(exr_const_context_t ctx, int code, const char *msg)
-{
-    (void)ctx; (void)code; (void)msg; /* errors are reported through the return value */
 }
 
 static int exr_open_read(const char *path, exr_context_t *ctx, char err[TL_ERR_LEN])
