@@ -16,6 +16,8 @@ extern "C" {
 typedef struct bk_image {          /* linear RGBA float, row 0 at the top (v = 0) */
     int width, height;
     float *rgba;
+    float mean[4];                 /* average over all texels (import fills it; the albedo
+                                      average is what most of the baker needs) */
 } bk_image;
 
 typedef struct bk_material {
@@ -71,7 +73,9 @@ typedef struct bk_scene {
     size_t object_count;    bk_object *objects;
     size_t light_count;     bk_light *lights;
     size_t image_count;     bk_image *images;
-    /* sky: uniform radiance, or an equirectangular image when sky_image >= 0 */
+    /* sky: uniform radiance, or an equirectangular image when sky_image >= 0 (then sky holds the
+     * image's mean radiance, for information: it is not a multiplier). The image maps direction
+     * d (y up) to u = 0.5 + atan2(d.x, -d.z)/(2π), v = acos(d.y)/π (row 0 = straight up). */
     float sky[3];
     int sky_image;
     /* provenance */
@@ -79,7 +83,21 @@ typedef struct bk_scene {
     float bounds_min[3], bounds_max[3];
 } bk_scene;
 
+/* Frees every array and image (all malloc'ed) and zeroes the struct. NULL is fine. */
 void bk_scene_free(bk_scene *scene);
+/* bounds_min/bounds_max over all vertices (and point/spot light positions); an empty scene gets
+ * min = max = 0. */
+void bk_scene_compute_bounds(bk_scene *scene);
+/* XXH3-64 over the raw bytes of `positions` (3 floats per vertex) followed by `indices`. */
+uint64_t bk_geometry_hash(const float *positions, size_t vertex_count, const uint32_t *indices,
+                          size_t index_count);
+/* 1 when something emits: a punctual light with non-zero colour, a material with non-zero emission
+ * used by at least one triangle, or a sky that is non-zero (uniform) or an image. The baker
+ * refuses a scene without light unless the CLI supplies --sky. */
+int bk_scene_has_light(const bk_scene *scene);
+/* Structural check of a scene made by hand or by import: indices in range, finite data, unit
+ * normals (±1e-3), image sizes. Returns 0 when valid, else writes the first problem to err. */
+int bk_scene_check(const bk_scene *scene, char *err, size_t err_len);
 
 #ifdef __cplusplus
 }
