@@ -100,6 +100,13 @@ typedef struct lbk_vctx {
     uint32_t object_count;
     int dls_ok;
     uint32_t dls_set_count;
+    /* DLS facts for DOOR, set by lbk_validate_dls when dls_ok: one allocation (dls_facts, freed by
+     * validate.c) holding each set's kind, and the members of set s at
+     * dls_members[dls_member_offset[s] .. dls_member_offset[s + 1]). */
+    void *dls_facts;
+    const uint8_t *dls_set_kind;
+    const uint32_t *dls_member_offset;
+    const uint32_t *dls_members;
 } lbk_vctx;
 
 /* Is a section of this type listed in the table (whether or not it turned out usable)? */

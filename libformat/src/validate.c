@@ -175,6 +175,7 @@ lbk_result lbk_validate_memory(const void *data, size_t size, const lbk_validate
 done:
     lbk_dealloc(&alloc, (void *)ctx.lmap_page_width);
     lbk_dealloc(&alloc, (void *)ctx.lmap_page_height);
+    lbk_dealloc(&alloc, ctx.dls_facts);
     lbk_dealloc(&alloc, fr);
     return result;
 }

@@ -1,0 +1,236 @@
+/* Dynamic light sets (seed 001 §3): per-set sparse contributions to lightmap texels and SH9 probes,
+ * grouped into combination clusters with the seed's packed prefix indices, and the reference
+ * runtime that applies L = L_B + Σ_j ω_j S_j. Normative layout: spec/container.md §12.
+ *
+ * Three parts:
+ *   - the builder (lbk_dls_build): sets + sparse per-set entries → DLS section bytes;
+ *   - the view (lbk_dls_view_open): a checked, read-only view of DLS section bytes;
+ *   - the runtime (lbk_dls_runtime_create / lbk_dls_apply): final texels and probes for weights.
+ * Doors (lbk/door.h) are DLS sets of kinds 1–3 whose weights follow the door's opening. */
+#ifndef LBK_DLS_H
+#define LBK_DLS_H
+
+#include "lbk/lbk.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* What a set's contribution is. The weight each kind gets at apply time: see lbk_dls_apply. */
+typedef enum lbk_dls_set_kind {
+    LBK_DLS_KIND_LIGHTS = 0,        /* a dynamic light set: the lights' direct + bounced light */
+    LBK_DLS_KIND_DOOR_OPEN = 1,     /* light that flows through a door when it is open (weight ω) */
+    LBK_DLS_KIND_DOOR_CLOSED = 2,   /* light bouncing off the closed door (weight 1 − ω) */
+    LBK_DLS_KIND_COMBINATION = 3,   /* extra light of a combination state (weight Π member weights) */
+    LBK_DLS_KIND_COUNT_
+} lbk_dls_set_kind;
+
+/* Where an entry lands. Target indices: texels are numbered pages in order, row-major within a
+ * page (as LMAP numbers them); GLG probes by GLG probe index; LLG probes by index into the
+ * concatenated LLG probe array. */
+typedef enum lbk_dls_space {
+    LBK_DLS_SPACE_TEXEL = 0, /* payload: 8-byte AHD texel (lbk_ahd_texel_store layout) */
+    LBK_DLS_SPACE_GLG = 1,   /* payload: 28-byte SH9 probe (lbk_sh9_pack layout) */
+    LBK_DLS_SPACE_LLG = 2,   /* payload: 28-byte SH9 probe */
+    LBK_DLS_SPACE_COUNT_
+} lbk_dls_space;
+
+/* Cluster forms (one dispatch each), spec §12.5. */
+typedef enum lbk_dls_form {
+    LBK_DLS_FORM_DEDICATED = 0, /* one combination of 1–8 sets; k entries per target */
+    LBK_DLS_FORM_PACKED = 1,    /* class (1): small combinations (≤ 128 targets), same k ≤ 4 */
+    LBK_DLS_FORM_PREFIX2 = 2,   /* class (2): 5–8 entries per target, 2-bit prefix, u16 base / 16 */
+    LBK_DLS_FORM_PREFIX3 = 3,   /* class (2): 9–16 entries per target, 3-bit prefix, u16 base / 8 */
+    LBK_DLS_FORM_PREFIX8 = 4,   /* class (3): 17–255 entries per target, 8-bit prefix, u32 base / 16 */
+    LBK_DLS_FORM_COUNT_
+} lbk_dls_form;
+
+#define LBK_DLS_TEXEL_PAYLOAD 8u
+#define LBK_DLS_PROBE_PAYLOAD 28u
+#define LBK_DLS_MAX_DEDICATED_SETS 8u
+#define LBK_DLS_MAX_PACKED_SETS 4u        /* class (1) handles fewer than 5 overlaps */
+#define LBK_DLS_SMALL_COMBINATION 128u    /* targets: at most this many → class (1)/(2) */
+#define LBK_DLS_MAX_OVERLAPS 255u         /* per target; more → LBK_ERR_OVERLAPS */
+#define LBK_DLS_MAX_CLUSTER_SETS 255u     /* per cluster (slots are u8) */
+#define LBK_DLS_PREFIX16_MAX_ENTRIES 65535u /* class (2) bases are u16 */
+#define LBK_DLS_NO_SET 0xFFFFFFFFu
+
+/* ---- building -------------------------------------------------------------------------- */
+
+/* One set's entries in one target space. targets: distinct indices < the space's target count,
+ * in any order; payloads: count × payload size (8 or 28 bytes), entry i for targets[i]. */
+typedef struct lbk_dls_sparse {
+    uint64_t count;
+    const uint32_t *targets;
+    const void *payloads;
+} lbk_dls_sparse;
+
+typedef struct lbk_dls_set_desc {
+    const char *name;                 /* UTF-8, non-empty, unique among the sets */
+    uint32_t kind;                    /* lbk_dls_set_kind */
+    uint32_t light_count;             /* names of the lights whose light the set holds */
+    const char *const *light_names;
+    uint32_t member_count;            /* combinations: ≥ 2 distinct non-combination set indices */
+    const uint32_t *members;
+    lbk_dls_sparse entries[LBK_DLS_SPACE_COUNT_]; /* indexed by lbk_dls_space */
+} lbk_dls_set_desc;
+
+typedef struct lbk_dls_build_desc {
+    uint32_t set_count;
+    const lbk_dls_set_desc *sets;
+    /* Size of each target space: LMAP texels, GLG probes, LLG probes (≤ 2^32 each). */
+    uint64_t target_count[LBK_DLS_SPACE_COUNT_];
+} lbk_dls_build_desc;
+
+typedef struct lbk_dls_build_options {
+    const lbk_allocator *allocator;   /* NULL: malloc/free; also allocates the output */
+    /* Packed (class 1) and prefix clusters grow by adding the combination that adds the fewest
+     * new sets until they hold this many targets; past it only combinations adding no set join.
+     * 0: 256. */
+    uint32_t min_dispatch_targets;
+    /* Cap on the targets of one class (1) packed cluster. 0: 4096. */
+    uint32_t packed_max_targets;
+} lbk_dls_build_options;
+
+/* Statistics for `lbk inspect` (Table 1 of seed 001). */
+#define LBK_DLS_HISTOGRAM_BINS 18 /* [0] untouched targets, [1..16] that many sets, [17] more */
+typedef struct lbk_dls_stats {
+    uint32_t set_count;
+    uint32_t sets_by_kind[LBK_DLS_KIND_COUNT_];
+    uint32_t cluster_count;
+    uint32_t clusters_by_form[LBK_DLS_FORM_COUNT_];
+    uint32_t packed_subgroups;                      /* class (1) sub-groups over all clusters */
+    uint64_t target_count[LBK_DLS_SPACE_COUNT_];    /* size of each space */
+    uint64_t touched[LBK_DLS_SPACE_COUNT_];         /* targets with at least one entry */
+    uint64_t targets_by_form[LBK_DLS_FORM_COUNT_];
+    uint64_t entries[LBK_DLS_SPACE_COUNT_];
+    uint64_t histogram[LBK_DLS_SPACE_COUNT_][LBK_DLS_HISTOGRAM_BINS];
+    uint64_t section_bytes;
+    uint64_t payload_bytes;     /* the entries' 8/28-byte payloads */
+    uint64_t ancillary_bytes;   /* everything else: section_bytes − payload_bytes */
+    /* The per-target index data of each space: cluster records and set lists, runs, sub-group
+     * records, prefix words, bases and slots of the clusters of that space. */
+    uint64_t index_bytes[LBK_DLS_SPACE_COUNT_];
+    double index_bits_per_target[LBK_DLS_SPACE_COUNT_]; /* 8 × index_bytes / touched (0 if none) */
+} lbk_dls_stats;
+
+/* Builds the DLS section. Deterministic: the output depends only on the content of desc (the
+ * order of each set's entries does not matter). Errors: LBK_ERR_INVALID_ARGUMENT (bad kind,
+ * name, members, duplicate target in a set), LBK_ERR_RANGE (target ≥ target_count),
+ * LBK_ERR_OVERLAPS (a target touched by more than 255 sets), LBK_ERR_LIMIT, LBK_ERR_OUT_OF_MEMORY.
+ * *out is allocated with options->allocator; free it with lbk_free. stats may be NULL. */
+LBK_API lbk_result lbk_dls_build(const lbk_dls_build_desc *desc, const lbk_dls_build_options *options,
+                                 void **out, size_t *out_size, lbk_dls_stats *stats);
+
+/* ---- reading --------------------------------------------------------------------------- */
+
+typedef struct lbk_dls_view lbk_dls_view;
+
+/* Checks every structural rule of spec/container.md §12 (the DLS rules of spec/validation.md
+ * except the cross-section ones) and returns LBK_ERR_CORRUPT / LBK_ERR_TRUNCATED if any fails.
+ * The bytes are not copied and must outlive the view. */
+LBK_API lbk_result lbk_dls_view_open(const void *data, size_t size, const lbk_allocator *allocator,
+                                     lbk_dls_view **out);
+LBK_API void lbk_dls_view_close(lbk_dls_view *view);
+
+typedef struct lbk_dls_set_info {
+    const char *name;       /* not NUL-terminated */
+    uint32_t name_length;
+    uint32_t kind;
+    uint32_t light_count;
+    uint32_t member_count;
+} lbk_dls_set_info;
+
+typedef struct lbk_dls_cluster_info {
+    uint32_t form;          /* lbk_dls_form */
+    uint32_t space;         /* lbk_dls_space */
+    uint32_t set_count;     /* dedicated: the combination; others: union of the sub-groups' sets */
+    uint32_t overlaps;      /* entries per target for dedicated and packed; 0 for prefix forms */
+    uint32_t target_count;
+    uint32_t entry_count;
+    uint32_t run_count;
+    uint32_t subgroup_count; /* packed only */
+} lbk_dls_cluster_info;
+
+LBK_API uint32_t lbk_dls_set_count(const lbk_dls_view *view);
+LBK_API lbk_result lbk_dls_set_get(const lbk_dls_view *view, uint32_t set, lbk_dls_set_info *out);
+LBK_API lbk_result lbk_dls_set_light(const lbk_dls_view *view, uint32_t set, uint32_t i, const char **name,
+                                     uint32_t *length);
+LBK_API lbk_result lbk_dls_set_member(const lbk_dls_view *view, uint32_t set, uint32_t i, uint32_t *member);
+/* LBK_ERR_NOT_FOUND when no set has that name. */
+LBK_API lbk_result lbk_dls_find_set(const lbk_dls_view *view, const char *name, uint32_t *set);
+/* Target space sizes the section was built for. */
+LBK_API uint64_t lbk_dls_target_count(const lbk_dls_view *view, uint32_t space);
+LBK_API uint32_t lbk_dls_cluster_count(const lbk_dls_view *view);
+LBK_API lbk_result lbk_dls_cluster_get(const lbk_dls_view *view, uint32_t cluster, lbk_dls_cluster_info *out);
+LBK_API lbk_result lbk_dls_cluster_set(const lbk_dls_view *view, uint32_t cluster, uint32_t i, uint32_t *set);
+
+/* Decodes a cluster target by target, in payload order: for each target its index, its entry
+ * count, the set index of each entry and the entries' payloads (count × payload size, in set
+ * order). Return non-zero from fn to stop early. */
+typedef int (*lbk_dls_target_fn)(void *user, uint32_t target, uint32_t count, const uint32_t *sets,
+                                 const uint8_t *payloads);
+LBK_API lbk_result lbk_dls_cluster_decode(const lbk_dls_view *view, uint32_t cluster, lbk_dls_target_fn fn,
+                                          void *user);
+
+LBK_API lbk_result lbk_dls_compute_stats(const lbk_dls_view *view, lbk_dls_stats *out);
+
+/* ---- reference runtime ----------------------------------------------------------------- */
+
+struct lbk_door_view;
+typedef struct lbk_dls_runtime lbk_dls_runtime;
+
+/* Texels are planar like an LMAP page pair, over the global texel index: irradiance_z[i] is the
+ * R11G11B10F word (host order), rgba[4i..4i+3] the second plane. Probes are 28-byte packed SH9.
+ * A space with no DLS entries may be NULL (its output is then not written). The output buffers
+ * are caller-owned and must persist unchanged between lbk_dls_apply calls: apply rewrites only
+ * the targets whose sets changed (call lbk_dls_runtime_invalidate after touching them). Outputs
+ * must not overlap the bases. */
+typedef struct lbk_dls_runtime_desc {
+    const lbk_dls_view *dls;
+    const struct lbk_door_view *doors; /* optional: door weights drive the kind 1/2 sets */
+    const uint32_t *base_irradiance_z; const uint8_t *base_rgba; /* lbk_dls_target_count(TEXEL) */
+    const uint8_t *base_glg;  /* 28 × GLG probes */
+    const uint8_t *base_llg;  /* 28 × LLG probes */
+    uint32_t *out_irradiance_z; uint8_t *out_rgba;
+    uint8_t *out_glg;
+    uint8_t *out_llg;
+    const lbk_allocator *allocator;
+} lbk_dls_runtime_desc;
+
+typedef struct lbk_dls_apply_stats {
+    uint32_t clusters_applied;  /* decoded, weighted, summed, re-encoded */
+    uint32_t clusters_copied;   /* every weight of the cluster 0: base copied */
+    uint32_t clusters_skipped;  /* no weight of the cluster changed */
+    uint64_t targets_written;   /* by clusters and by base copies of untouched targets */
+} lbk_dls_apply_stats;
+
+/* Checks that the views agree (door sets exist and have the right kinds) and that every needed
+ * buffer is present. The views and buffers must outlive the runtime. */
+LBK_API lbk_result lbk_dls_runtime_create(const lbk_dls_runtime_desc *desc, lbk_dls_runtime **out);
+LBK_API void lbk_dls_runtime_destroy(lbk_dls_runtime *runtime);
+/* The next apply rewrites every target. */
+LBK_API void lbk_dls_runtime_invalidate(lbk_dls_runtime *runtime);
+
+/* Computes L = L_B + Σ_j w_j S_j into the output buffers, cluster by cluster (decode base and
+ * entries to the additive linear forms lbk_ahd_linear / lbk_sh9_rgb, weight, sum, re-encode).
+ * Effective weight w_j of set j:
+ *   kind 0 (lights):      set_weights[j];
+ *   kind 1 (door open):   door_weights[p] if door p of the DOOR view names j, else set_weights[j];
+ *   kind 2 (door closed): 1 − door_weights[p] if door p names j, else set_weights[j];
+ *   kind 3 (combination): the product of its members' effective weights.
+ * set_weights has lbk_dls_set_count entries (NULL: all 0; entries of kind-3 sets are ignored),
+ * door_weights one per door (NULL: all doors closed, ω = 0). Weights must be finite.
+ * The first call (and the first after invalidate) writes every target: untouched ones get the
+ * base bytes. Later calls skip each cluster none of whose sets' effective weights changed; a
+ * cluster whose weights are all 0 gets exactly the base bytes. stats may be NULL. */
+LBK_API lbk_result lbk_dls_apply(lbk_dls_runtime *runtime, const float *set_weights, const float *door_weights,
+                                 lbk_dls_apply_stats *stats);
+/* The effective weights apply would use (lbk_dls_set_count floats). */
+LBK_API lbk_result lbk_dls_effective_weights(const lbk_dls_runtime *runtime, const float *set_weights,
+                                             const float *door_weights, float *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
