@@ -88,7 +88,9 @@ typedef struct lbk_vctx {
     /* facts from earlier sections */
     int lmap_ok;
     uint32_t lmap_page_count;
-    const uint16_t *lmap_page_width;  /* host-endian copies owned by validate.c, lmap_page_count each */
+    /* host-endian copies, lmap_page_count each: allocated by lbk_validate_lmap with ctx->allocator,
+     * freed by validate.c with lbk_dealloc at the end */
+    const uint16_t *lmap_page_width;
     const uint16_t *lmap_page_height;
     uint64_t lmap_texel_count;
     int glg_ok;

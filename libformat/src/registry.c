@@ -105,10 +105,45 @@ static const issue_row registry[] = {
     {414, ERROR, LBK_SECTION_OBJS, "OBJS lightmap rectangles of two objects overlap"},
 
     /* ---- 500–599 LMAP (codec helper) ----------------------------------------------------- */
+    {500, ERROR, LBK_SECTION_LMAP, "LMAP shorter than its 16-byte header"},
+    {501, ERROR, LBK_SECTION_LMAP, "LMAP reserved field is not zero"},
+    {502, ERROR, LBK_SECTION_LMAP, "LMAP page_count is zero or the page table runs past the section"},
+    {503, ERROR, LBK_SECTION_LMAP, "LMAP page width or height outside 1..16384"},
+    {504, ERROR, LBK_SECTION_LMAP, "LMAP texel_count differs from the sum of page areas"},
+    {505, ERROR, LBK_SECTION_LMAP, "LMAP page first_texel differs from the running texel count"},
+    {506, ERROR, LBK_SECTION_LMAP, "LMAP plane offset differs from the packed 16-byte-aligned layout"},
+    {507, ERROR, LBK_SECTION_LMAP, "LMAP section size differs from the end of the last plane"},
+    {508, ERROR, LBK_SECTION_LMAP, "LMAP non-zero padding byte between planes"},
+    {509, ERROR, LBK_SECTION_LMAP, "LMAP irradiance texel has an Inf/NaN channel (exponent 31)"},
+    {510, WARNING, LBK_SECTION_LMAP, "LMAP highlight direction shorter than 1/2 (decodes as +Z)"},
 
     /* ---- 600–699 GLG (codec helper) ------------------------------------------------------ */
+    {600, ERROR, LBK_SECTION_GLG, "GLG shorter than its 32-byte header"},
+    {601, ERROR, LBK_SECTION_GLG, "GLG header reserved bytes are not zero"},
+    {602, ERROR, LBK_SECTION_GLG, "GLG has fewer than 4 probes or no tetrahedra"},
+    {603, ERROR, LBK_SECTION_GLG, "GLG section size differs from the layout of its counts"},
+    {604, ERROR, LBK_SECTION_GLG, "GLG non-zero padding byte"},
+    {605, ERROR, LBK_SECTION_GLG, "GLG probe position is NaN or infinite"},
+    {606, ERROR, LBK_SECTION_GLG, "GLG tetrahedron vertex index out of range or repeated"},
+    {607, ERROR, LBK_SECTION_GLG, "GLG tetrahedron is not positively oriented (volume <= 0)"},
+    {608, ERROR, LBK_SECTION_GLG, "GLG neighbour index out of range"},
+    {609, ERROR, LBK_SECTION_GLG, "GLG adjacency not symmetric or neighbour does not share the face"},
+    {610, WARNING, LBK_SECTION_GLG, "GLG probe belongs to no tetrahedron"},
 
     /* ---- 700–799 LLG (codec helper) ------------------------------------------------------ */
+    {700, ERROR, LBK_SECTION_LLG, "LLG shorter than its 32-byte header"},
+    {701, ERROR, LBK_SECTION_LLG, "LLG reserved field is not zero"},
+    {702, ERROR, LBK_SECTION_LLG, "LLG grid_count is zero or the grid table runs past the section"},
+    {703, ERROR, LBK_SECTION_LLG, "LLG section size differs from the layout of its counts"},
+    {704, ERROR, LBK_SECTION_LLG, "LLG non-zero padding byte"},
+    {705, ERROR, LBK_SECTION_LLG, "LLG box centre, axis or half extent is NaN or infinite"},
+    {706, ERROR, LBK_SECTION_LLG, "LLG box axes are not orthonormal"},
+    {707, ERROR, LBK_SECTION_LLG, "LLG box half extent is not positive"},
+    {708, ERROR, LBK_SECTION_LLG, "LLG lattice dimension outside 2..64"},
+    {709, ERROR, LBK_SECTION_LLG, "LLG grid probe_offset differs from the running probe count"},
+    {710, ERROR, LBK_SECTION_LLG, "LLG grid vertex_offset differs from the running vertex count"},
+    {711, ERROR, LBK_SECTION_LLG, "LLG header probe or vertex count differs from the grids"},
+    {712, ERROR, LBK_SECTION_LLG, "LLG vertex visibility reserved byte is not zero"},
 
     /* ---- 800–899 DLS (dls helper) -------------------------------------------------------- */
     {800, ERROR, LBK_SECTION_DLS, "DLS shorter than its 96-byte header"},
@@ -165,6 +200,15 @@ static const issue_row registry[] = {
     {926, ERROR, LBK_SECTION_DOOR, "DOOR has no elements"},
 
     /* ---- 1000–1099 OCTP (codec helper) --------------------------------------------------- */
+    {1000, ERROR, LBK_SECTION_OCTP, "OCTP shorter than its 16-byte header"},
+    {1001, ERROR, LBK_SECTION_OCTP, "OCTP header reserved bytes are not zero"},
+    {1002, ERROR, LBK_SECTION_OCTP, "OCTP has no probes"},
+    {1003, ERROR, LBK_SECTION_OCTP, "OCTP section size differs from 16 + 1024 x probe_count"},
+    {1004, ERROR, LBK_SECTION_OCTP, "OCTP irradiance texel has an Inf/NaN channel (exponent 31)"},
+    {1005, ERROR, LBK_SECTION_OCTP, "OCTP depth moment is NaN, infinite or negative"},
+    {1006, ERROR, LBK_SECTION_OCTP, "OCTP border texel differs from the interior texel it copies"},
+    {1007, ERROR, LBK_SECTION_OCTP, "OCTP probe position is NaN or infinite"},
+    {1008, ERROR, LBK_SECTION_OCTP, "OCTP probe reserved bytes are not zero"},
 };
 
 const char *lbk_issue_template(uint32_t id, lbk_severity *severity)

@@ -1,0 +1,84 @@
+/* LLG section: local light grids — per object an oriented box with a regular lattice of SH9
+ * radiance probes, plus per-vertex self-visibility of the object (seed 001 §2.2).
+ * Layout: spec/container.md §11.
+ *
+ * Lattice: dims (nx, ny, nz), each 2..64. Probe (i, j, k) sits at
+ *     centre + Σ_a axis_a · half_extent_a · (2·idx_a / (n_a − 1) − 1)
+ * and is stored at probe_offset + i + nx·(j + ny·k) of the section's shared probe array.
+ * Sampling a world point p: local l_a = ((p − centre)·axis_a) / half_extent_a, clamped to
+ * [−1, 1] (points outside the box take the value at the nearest box point), lattice coordinate
+ * g_a = (l_a + 1)/2 · (n_a − 1), trilinear blend of the 8 unpacked probes around g.
+ *
+ * Per-vertex self-visibility, 4 bytes per vertex of the object, in the object's vertex order:
+ *   byte 0  unorm8 visibility V (fraction of the hemisphere around the normal not blocked by
+ *           the object itself), byte 1–2 bent normal b as unorm8((u+1)/2), unorm8((v+1)/2) of
+ *           its octahedral coordinates (lbk/octa.h) in the grid frame (components along
+ *           axis0, axis1, axis2), byte 3 reserved 0.
+ * Apply: E_vertex = V · E_sh(b_world), b_world = Σ_a b_a·axis_a, with E_sh the SH irradiance
+ * (lbk_sh9_irradiance) of the trilinearly interpolated radiance at the vertex position. Because
+ * the data are in the box frame, instances of a model share them. */
+#ifndef LBK_LLG_H
+#define LBK_LLG_H
+
+#include "lbk/sh.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define LBK_LLG_HEADER_SIZE 32u
+#define LBK_LLG_GRID_SIZE 96u
+#define LBK_LLG_MIN_DIM 2u
+#define LBK_LLG_MAX_DIM 64u
+
+typedef struct lbk_llg_vertex {
+    float visibility;     /* [0, 1] */
+    float bent_normal[3]; /* unit, grid frame */
+} lbk_llg_vertex;
+
+typedef struct lbk_llg_grid_desc {
+    float centre[3];
+    float axes[3][3];       /* orthonormal rows: axis0, axis1, axis2 */
+    float half_extent[3];   /* > 0 */
+    uint32_t dims[3];       /* 2..64 each */
+    const lbk_sh9_rgb *probes;        /* dims[0]·dims[1]·dims[2], i fastest */
+    const lbk_llg_vertex *vertices;   /* vertex_count (may be 0) */
+    uint32_t vertex_count;
+} lbk_llg_grid_desc;
+
+/* Serialises grids (deterministic). Free the buffer with lbk_free. */
+LBK_API lbk_result lbk_llg_build(const lbk_llg_grid_desc *grids, uint32_t grid_count, const lbk_allocator *allocator,
+                                 void **out, size_t *size);
+
+typedef struct lbk_llg_view {
+    const uint8_t *data;
+    size_t size;
+    uint32_t grid_count;
+    uint64_t probe_count, vertex_count;
+    const uint8_t *probes;   /* probe_count × 28 */
+    const uint8_t *vertices; /* vertex_count × 4 */
+} lbk_llg_view;
+
+typedef struct lbk_llg_grid {
+    float centre[3], axes[3][3], half_extent[3];
+    uint32_t dims[3];
+    uint64_t probe_offset, vertex_offset;
+    uint32_t vertex_count;
+} lbk_llg_grid;
+
+/* Structure only (sizes, offsets, reserved bytes); lbk_validate checks the frames. */
+LBK_API lbk_result lbk_llg_open(const void *data, size_t size, lbk_llg_view *out);
+LBK_API lbk_result lbk_llg_get_grid(const lbk_llg_view *view, uint32_t index, lbk_llg_grid *out);
+LBK_API void lbk_llg_probe_position(const lbk_llg_grid *grid, uint32_t i, uint32_t j, uint32_t k, float out[3]);
+/* Trilinear radiance SH at world position p. */
+LBK_API lbk_result lbk_llg_sample(const lbk_llg_view *view, uint32_t grid, const float p[3], lbk_sh9_rgb *out);
+LBK_API void lbk_llg_vertex_encode(const lbk_llg_vertex *v, uint8_t out[4]);
+LBK_API void lbk_llg_vertex_decode(const uint8_t in[4], lbk_llg_vertex *v);
+/* E = V · E_sh(bent normal in world) at world position p for vertex `vertex` of grid `grid`. */
+LBK_API lbk_result lbk_llg_vertex_irradiance(const lbk_llg_view *view, uint32_t grid, uint32_t vertex, const float p[3],
+                                             float rgb[3]);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
