@@ -7,8 +7,4 @@
 
 LBK_WEAK_VALIDATOR(lbk_validate_meta)
 LBK_WEAK_VALIDATOR(lbk_validate_rept)
-LBK_WEAK_VALIDATOR(lbk_validate_lmap)
-LBK_WEAK_VALIDATOR(lbk_validate_glg)
-LBK_WEAK_VALIDATOR(lbk_validate_llg)
-LBK_WEAK_VALIDATOR(lbk_validate_octp)
 LBK_WEAK_VALIDATOR(lbk_validate_objs)
