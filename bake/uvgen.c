@@ -458,6 +458,7 @@ static lbk_result project_piece(gen_ctx *g, const uint32_t *tris, size_t count, 
     /* landscape: turn by 90° (a rotation, not a mirror) when taller than wide */
     int turn = (mxy - mny) > (mxx - mnx) * (1.0 + 1e-9);
     double w = (mxx - mnx) * scale, hh = (mxy - mny) * scale;
+    const double w_unturned = w;
     if (turn) {
         double t = w;
         w = hh;
@@ -472,7 +473,7 @@ static lbk_result project_piece(gen_ctx *g, const uint32_t *tris, size_t count, 
             double x = (f.c * x0 + f.s * y0 - mnx) * scale, y = (-f.s * x0 + f.c * y0 - mny) * scale;
             if (turn) {
                 /* (x, y) → (y, w - x): a quarter turn that keeps everything in [0,w]×[0,h] */
-                double nx = y, ny = w - x;
+                double nx = y, ny = w_unturned - x;
                 x = nx;
                 y = ny;
             }
