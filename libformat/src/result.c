@@ -1,4 +1,6 @@
 /* Names and descriptions of lbk_result codes, and printable four-character codes. */
+#include <xxhash.h>
+
 #include "internal.h"
 
 static const struct {
@@ -43,3 +45,5 @@ void lbk_fourcc_string(uint32_t type, char out[5])
     }
     out[4] = '\0';
 }
+
+uint64_t lbk_hash64(const void *data, size_t size) { return XXH3_64bits(data, size); }

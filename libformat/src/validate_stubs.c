@@ -5,6 +5,3 @@
 #define LBK_WEAK_VALIDATOR(name) \
     __attribute__((weak)) void name(lbk_vctx *ctx, const uint8_t *data, size_t size) { (void)ctx; (void)data; (void)size; }
 
-LBK_WEAK_VALIDATOR(lbk_validate_meta)
-LBK_WEAK_VALIDATOR(lbk_validate_rept)
-LBK_WEAK_VALIDATOR(lbk_validate_objs)

@@ -75,6 +75,15 @@ typedef struct lbk_allocator {
 /* Writes the 4 characters of a type code plus a NUL into out[5]; non-printable bytes become '?'. */
 LBK_API void lbk_fourcc_string(uint32_t type, char out[5]);
 
+/* A byte string that is not NUL-terminated: views into a container point at its string blobs. */
+typedef struct lbk_string {
+    const char *data;
+    size_t size;
+} lbk_string;
+
+/* XXH3-64 (seed 0) of a byte range: the hash the format uses for checksums and provenance. */
+LBK_API uint64_t lbk_hash64(const void *data, size_t size);
+
 #ifdef __cplusplus
 }
 #endif
