@@ -1,0 +1,941 @@
+/* Series-expansion light transport; see transport.h and TRANSPORT.md. */
+#include "transport.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#define TP_PI 3.14159265358979323846
+#define TP_Q_MAX 0.999      /* largest per-bounce ratio the tail formula trusts (factor ≤ 999) */
+#define TP_MAX_SUB 16       /* at most 16×16 cells per triangle side */
+#define TP_LIGHT_POINTS 16  /* points per cell that test punctual lights in bounce 1 */
+
+/* ---- counter-based random numbers --------------------------------------------------------- */
+
+static uint64_t mix64(uint64_t z)
+{
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+typedef struct { uint64_t s; } tp_rng;
+
+enum { DOM_CELL = 1, DOM_RECV = 2 };
+
+/* Keyed by everything that identifies one item's samples: never by thread or time. */
+static tp_rng rng_make(uint64_t seed, uint64_t domain, uint64_t half, uint64_t pass, uint64_t bounce, uint64_t item)
+{
+    uint64_t h = mix64(seed ^ 0x6C626B7472616E73ull);
+    h = mix64(h ^ (domain << 56) ^ (half << 48) ^ (pass << 32) ^ bounce);
+    h = mix64(h ^ item * 0x9E3779B97F4A7C15ull);
+    tp_rng r = {h};
+    return r;
+}
+
+static double rng_next(tp_rng *r)
+{
+    r->s += 0x9E3779B97F4A7C15ull;
+    return (double)(mix64(r->s) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* Randomly shifted rank-1 lattice {(j/S, j·g/S) + shift} mod 1, g ≈ 0.618·S coprime with S
+ * (Fibonacci-like): the first coordinate is an exactly stratified grid, which gives the
+ * provable furnace bound of TRANSPORT.md; the random shift keeps every estimate unbiased, so the
+ * two halves stay independent and the error estimate honest. */
+static uint32_t lattice_generator(uint32_t S)
+{
+    uint32_t g = (uint32_t)(0.6180339887498949 * S) | 1u;
+    for (;; g += 2) {
+        uint32_t a = g, b = S;
+        while (b) { uint32_t t = a % b; a = b; b = t; }
+        if (a == 1 || S <= 1) return g;
+    }
+}
+
+static void lattice(uint32_t j, uint32_t S, uint32_t g, double s1, double s2, double *u1, double *u2)
+{
+    double a = (double)j / S + s1, b = (double)(uint32_t)(((uint64_t)j * g) % S) / S + s2;
+    *u1 = a - floor(a);
+    *u2 = b - floor(b);
+}
+
+/* ---- small vector helpers ------------------------------------------------------------------ */
+
+static double lum(const double c[3]) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
+
+static void onb(const double n[3], double t[3], double b[3])
+{
+    /* Duff et al. 2017, branchless orthonormal basis */
+    double s = n[2] >= 0 ? 1.0 : -1.0;
+    double a = -1.0 / (s + n[2]);
+    double bb = n[0] * n[1] * a;
+    t[0] = 1 + s * n[0] * n[0] * a; t[1] = s * bb; t[2] = -s * n[0];
+    b[0] = bb; b[1] = s + n[1] * n[1] * a; b[2] = -n[1];
+}
+
+static void sh9_basis(const double d[3], double y[9])
+{
+    double x = d[0], yy = d[1], z = d[2];
+    y[0] = 0.282094791773878;
+    y[1] = 0.488602511902920 * yy;
+    y[2] = 0.488602511902920 * z;
+    y[3] = 0.488602511902920 * x;
+    y[4] = 1.092548430592079 * x * yy;
+    y[5] = 1.092548430592079 * yy * z;
+    y[6] = 0.315391565252520 * (3 * z * z - 1);
+    y[7] = 1.092548430592079 * x * z;
+    y[8] = 0.546274215296040 * (x * x - yy * yy);
+}
+
+static int finite3d(const double v[3]) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
+
+/* ---- the run context ----------------------------------------------------------------------- */
+
+typedef struct tp_cell {
+    uint32_t tri;
+    uint16_t sub, m;
+    uint8_t side;
+    float n[3];        /* side normal, zero for degenerate triangles */
+    float area;
+    float albedo[3];
+    float le[3];       /* emitted radiance (after the light-set filter) */
+} tp_cell;
+
+typedef struct tp_ctx {
+    const bk_scene *scene;
+    const bk_tracer *tracer;
+    const bk_transport_options *opt;
+    uint64_t seed;
+    int threads;
+    /* cache */
+    size_t cell_count;
+    tp_cell *cells;
+    uint32_t *tri_first;   /* first cell of each triangle */
+    uint8_t *tri_m;
+    uint8_t *tri_sides;
+    float *tri_shrink;     /* barycentric shrink toward the centroid: keeps points off edges */
+    /* light selection */
+    const bk_light **lights;
+    size_t light_count;
+    int use_sky;
+    float scene_scale;
+    /* per chain (half) state; [h] */
+    float *l_prev[2], *l_cur[2], *l_sum[2];
+    /* current job */
+    int half, pass, bounce, rays;
+    uint32_t lat_g;        /* lattice generator for `rays` */
+    /* receivers */
+    const bk_receiver *recv;
+    size_t recv_count;
+    float *punct_lum;      /* luminance of punctual E per receiver (for the error estimate) */
+    double *x_acc[2];      /* per receiver, per half: Σ_p w_p·lum(E_p) */
+    const bk_transport_output *out;
+    double pass_weight;
+    /* counters: per thread, summed after each parallel step */
+    uint64_t *thread_rays, *thread_nonfinite;
+} tp_ctx;
+
+/* ---- parallel-for --------------------------------------------------------------------------- */
+
+typedef void (*tp_fn)(tp_ctx *c, size_t begin, size_t end, int thread);
+
+typedef struct tp_job {
+    tp_ctx *c;
+    tp_fn fn;
+    size_t end, chunk;
+    atomic_size_t next;
+} tp_job;
+
+typedef struct tp_worker { tp_job *job; int thread; } tp_worker;
+
+static void *worker_main(void *arg)
+{
+    tp_worker *w = (tp_worker *)arg;
+    tp_job *j = w->job;
+    for (;;) {
+        size_t b = atomic_fetch_add(&j->next, j->chunk);
+        if (b >= j->end) break;
+        size_t e = b + j->chunk < j->end ? b + j->chunk : j->end;
+        j->fn(j->c, b, e, w->thread);
+    }
+    return NULL;
+}
+
+/* Which thread runs an item never changes its result: items are independent and write only
+ * their own outputs, so dynamic chunking is deterministic. */
+static void parallel_range(tp_ctx *c, size_t begin, size_t end, size_t chunk, tp_fn fn)
+{
+    if (end <= begin) return;
+    size_t n = end - begin;
+    tp_job job;
+    job.c = c; job.fn = fn; job.end = end; job.chunk = chunk ? chunk : 1;
+    atomic_init(&job.next, begin);
+    int t = c->threads;
+    if ((size_t)t > (n + job.chunk - 1) / job.chunk) t = (int)((n + job.chunk - 1) / job.chunk);
+    if (t < 1) t = 1;
+    /* one pthread per worker and call: a call is at least a whole bounce or receiver block */
+    pthread_t tids[256];
+    tp_worker ws[256];
+    int started = 0;
+    for (int i = 1; i < t && i < 256; i++) {
+        ws[i].job = &job; ws[i].thread = i;
+        if (pthread_create(&tids[i], NULL, worker_main, &ws[i]) != 0) break;
+        started = i;
+    }
+    ws[0].job = &job; ws[0].thread = 0;
+    worker_main(&ws[0]);
+    for (int i = 1; i <= started; i++) pthread_join(tids[i], NULL);
+}
+
+static void parallel_for(tp_ctx *c, size_t n, size_t chunk, tp_fn fn) { parallel_range(c, 0, n, chunk, fn); }
+
+/* ---- scene lookups -------------------------------------------------------------------------- */
+
+static void tri_vertices(const tp_ctx *c, uint32_t tri, double v[3][3])
+{
+    const uint32_t *ix = c->scene->tris + 3 * (size_t)tri;
+    for (int i = 0; i < 3; i++) {
+        uint32_t k = ix[i] < c->scene->vertex_count ? ix[i] : 0;
+        for (int a = 0; a < 3; a++) v[i][a] = c->scene->positions[3 * (size_t)k + a];
+    }
+}
+
+static void sample_image(const bk_image *img, double u, double v, double out[3])
+{
+    if (!img || !img->rgba || img->width <= 0 || img->height <= 0 || !isfinite(u) || !isfinite(v)) {
+        out[0] = out[1] = out[2] = 1;
+        return;
+    }
+    /* glTF default sampler: repeat; nearest texel is enough for cell-sized averages */
+    double fu = u - floor(u), fv = v - floor(v);
+    long x = (long)(fu * img->width), y = (long)(fv * img->height);
+    if (x >= img->width) x = img->width - 1;
+    if (y >= img->height) y = img->height - 1;
+    const float *p = img->rgba + 4 * ((size_t)y * (size_t)img->width + (size_t)x);
+    for (int k = 0; k < 3; k++) out[k] = isfinite(p[k]) && p[k] > 0 ? p[k] : 0;
+}
+
+static const bk_image *image_at(const bk_scene *s, int idx)
+{
+    return (idx >= 0 && (size_t)idx < s->image_count) ? &s->images[idx] : NULL;
+}
+
+/* Equirectangular sky, +Y up: u = 0.5 + atan2(x, −z)/2π, v = acos(y)/π (v = 0 at the zenith,
+ * the image's top row). */
+static void sky_radiance(const tp_ctx *c, const double d[3], double out[3])
+{
+    const bk_scene *s = c->scene;
+    if (!c->use_sky) { out[0] = out[1] = out[2] = 0; return; }
+    const bk_image *img = image_at(s, s->sky_image);
+    if (s->sky_image >= 0 && img && img->rgba) {
+        double u = 0.5 + atan2(d[0], -d[2]) / (2 * TP_PI);
+        double y = d[1] < -1 ? -1 : d[1] > 1 ? 1 : d[1];
+        double v = acos(y) / TP_PI;
+        sample_image(img, u, v, out);
+        return;
+    }
+    for (int k = 0; k < 3; k++) out[k] = isfinite(s->sky[k]) && s->sky[k] > 0 ? s->sky[k] : 0;
+}
+
+static int in_light_set(const tp_ctx *c, const char *set)
+{
+    const char *want = c->opt->light_set ? c->opt->light_set : "";
+    return strncmp(set, want, 63) == 0;
+}
+
+/* Irradiance-at-normal-incidence from one punctual light at p (KHR_lights_punctual falloff,
+ * range window and smooth spot cone). Returns 0 when the light cannot contribute. */
+static int light_eval(const bk_light *l, const double p[3], double val[3], double dir[3], double *dist)
+{
+    double att;
+    if (l->type == BK_LIGHT_DIRECTIONAL) {
+        double n = sqrt((double)l->direction[0] * l->direction[0] + (double)l->direction[1] * l->direction[1] +
+                        (double)l->direction[2] * l->direction[2]);
+        if (!(n > 0) || !isfinite(n)) return 0;
+        for (int k = 0; k < 3; k++) dir[k] = -l->direction[k] / n;
+        *dist = INFINITY;
+        att = 1;
+    } else {
+        double d[3] = {l->position[0] - p[0], l->position[1] - p[1], l->position[2] - p[2]};
+        double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        if (!(d2 > 0) || !isfinite(d2)) return 0;
+        double r = sqrt(d2);
+        for (int k = 0; k < 3; k++) dir[k] = d[k] / r;
+        *dist = r;
+        att = 1.0 / d2;
+        if (l->range > 0) {
+            double q = r / l->range;
+            double w = 1 - q * q * q * q;
+            if (w <= 0) return 0;
+            att *= w > 1 ? 1 : w;
+        }
+        if (l->type == BK_LIGHT_SPOT) {
+            double ln = sqrt((double)l->direction[0] * l->direction[0] + (double)l->direction[1] * l->direction[1] +
+                             (double)l->direction[2] * l->direction[2]);
+            if (!(ln > 0)) return 0;
+            double cd = -(dir[0] * l->direction[0] + dir[1] * l->direction[1] + dir[2] * l->direction[2]) / ln;
+            double co = cos(l->outer_cone), ci = cos(l->inner_cone);
+            double scale = 1.0 / fmax(0.001, ci - co);
+            double t = (cd - co) * scale;
+            t = t < 0 ? 0 : t > 1 ? 1 : t;
+            att *= t * t;
+            if (att <= 0) return 0;
+        }
+    }
+    for (int k = 0; k < 3; k++) val[k] = (isfinite(l->color[k]) && l->color[k] > 0 ? l->color[k] : 0) * att;
+    if (!finite3d(val) || (val[0] <= 0 && val[1] <= 0 && val[2] <= 0)) return 0;
+    return 1;
+}
+
+static int light_visible(const tp_ctx *c, const float org[3], const double dir[3], double dist)
+{
+    float d[3];
+    float tmax;
+    if (isinf(dist)) {
+        for (int k = 0; k < 3; k++) d[k] = (float)dir[k];
+        tmax = INFINITY;
+    } else {
+        /* aim at the light itself from the offset origin; stop just short of it */
+        for (int k = 0; k < 3; k++) d[k] = (float)(dir[k] * dist);
+        tmax = 1.0f - 1e-5f;
+    }
+    return !bk_tracer_occluded(c->tracer, org, d, 0.0f, tmax);
+}
+
+/* Cell reached by a hit, or -1 when the hit side carries no radiance (back of a one-sided
+ * surface). */
+static long hit_cell(const tp_ctx *c, const bk_hit *h)
+{
+    if (h->tri >= c->scene->tri_count) return -1;
+    int side = h->front ? 0 : 1;
+    if (side >= c->tri_sides[h->tri]) return -1;
+    int m = c->tri_m[h->tri];
+    double a = h->u * m, b = h->v * m;
+    int i = (int)floor(a), j = (int)floor(b);
+    if (j < 0) j = 0;
+    if (j > m - 1) j = m - 1;
+    if (i < 0) i = 0;
+    if (i > m - 1 - j) i = m - 1 - j;
+    int upper = (a - i) + (b - j) > 1 && i + j < m - 1;
+    long sub = (long)j * (2 * m - j) + 2 * i + upper;
+    return (long)c->tri_first[h->tri] + (long)side * m * m + sub;
+}
+
+/* Random point in a cell, kept off the triangle's edges. */
+static void cell_point(const tp_ctx *c, const tp_cell *cell, tp_rng *r, double p[3])
+{
+    int m = cell->m, s = cell->sub, j = 0;
+    while (j < m - 1 && s >= 2 * (m - j) - 1) { s -= 2 * (m - j) - 1; j++; }
+    int i = s / 2, upper = s & 1;
+    double c0[2], c1[2], c2[2];
+    if (!upper) {
+        c0[0] = i; c0[1] = j; c1[0] = i + 1; c1[1] = j; c2[0] = i; c2[1] = j + 1;
+    } else {
+        c0[0] = i + 1; c0[1] = j; c1[0] = i + 1; c1[1] = j + 1; c2[0] = i; c2[1] = j + 1;
+    }
+    double r1 = rng_next(r), r2 = rng_next(r);
+    double sq = sqrt(r1);
+    double w0 = 1 - sq, w1 = sq * (1 - r2), w2 = sq * r2;
+    double u = (w0 * c0[0] + w1 * c1[0] + w2 * c2[0]) / m;
+    double v = (w0 * c0[1] + w1 * c1[1] + w2 * c2[1]) / m;
+    double k = c->tri_shrink[cell->tri];
+    u = 1.0 / 3 + (u - 1.0 / 3) * k;
+    v = 1.0 / 3 + (v - 1.0 / 3) * k;
+    double vv[3][3];
+    tri_vertices(c, cell->tri, vv);
+    for (int a = 0; a < 3; a++) p[a] = (1 - u - v) * vv[0][a] + u * vv[1][a] + v * vv[2][a];
+}
+
+/* ---- cache: one bounce for a range of cells ------------------------------------------------ */
+
+static void cache_bounce(tp_ctx *c, size_t begin, size_t end, int thread)
+{
+    const int h = c->half, k = c->bounce, R = c->rays;
+    const float *prev = c->l_prev[h];
+    float *cur = c->l_cur[h];
+    uint64_t rays = 0, bad = 0;
+    for (size_t ci = begin; ci < end; ci++) {
+        const tp_cell *cell = &c->cells[ci];
+        double e[3] = {0, 0, 0};
+        if (cell->n[0] == 0 && cell->n[1] == 0 && cell->n[2] == 0) goto store;
+        if (cell->albedo[0] <= 0 && cell->albedo[1] <= 0 && cell->albedo[2] <= 0) goto store;
+        tp_rng rng = rng_make(c->seed, DOM_CELL, (uint64_t)h, (uint64_t)c->pass, (uint64_t)k, ci);
+        double n[3] = {cell->n[0], cell->n[1], cell->n[2]}, t[3], b[3];
+        onb(n, t, b);
+        float nf[3] = {cell->n[0], cell->n[1], cell->n[2]};
+        float scale = bk_tracer_tri_scale(c->tracer, cell->tri);
+        double s1 = rng_next(&rng), s2 = rng_next(&rng);
+        int light_points = (k == 1 && c->light_count) ? (R < TP_LIGHT_POINTS ? R : TP_LIGHT_POINTS) : 0;
+        double ep[3] = {0, 0, 0};
+        for (int j = 0; j < R; j++) {
+            double p[3];
+            cell_point(c, cell, &rng, p);
+            float pf[3] = {(float)p[0], (float)p[1], (float)p[2]}, o[3];
+            bk_offset_ray_origin_scaled(pf, nf, scale, o);
+            /* cosine-distributed direction */
+            double u1, u2;
+            lattice((uint32_t)j, (uint32_t)R, c->lat_g, s1, s2, &u1, &u2);
+            double rr = sqrt(u1), phi = 2 * TP_PI * u2;
+            double lx = rr * cos(phi), ly = rr * sin(phi), lz = sqrt(fmax(0.0, 1 - u1));
+            double d[3];
+            for (int a = 0; a < 3; a++) d[a] = lx * t[a] + ly * b[a] + lz * n[a];
+            float df[3] = {(float)d[0], (float)d[1], (float)d[2]};
+            bk_hit hit;
+            double L[3] = {0, 0, 0};
+            rays++;
+            if (bk_tracer_intersect(c->tracer, o, df, 0.0f, INFINITY, &hit)) {
+                long hc = hit_cell(c, &hit);
+                if (hc >= 0) {
+                    if (k == 1)
+                        for (int a = 0; a < 3; a++) L[a] = c->cells[hc].le[a];
+                    else
+                        for (int a = 0; a < 3; a++) L[a] = prev[3 * hc + a];
+                }
+            } else if (k == 1) {
+                sky_radiance(c, d, L);
+            }
+            if (!finite3d(L)) { bad++; continue; }
+            for (int a = 0; a < 3; a++) e[a] += L[a];
+            if (j < light_points) {
+                for (size_t li = 0; li < c->light_count; li++) {
+                    double val[3], ld[3], dist;
+                    if (!light_eval(c->lights[li], p, val, ld, &dist)) continue;
+                    double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
+                    if (cs <= 0) continue;
+                    rays++;
+                    if (!light_visible(c, o, ld, dist)) continue;
+                    for (int a = 0; a < 3; a++) ep[a] += val[a] * cs;
+                }
+            }
+        }
+        for (int a = 0; a < 3; a++) {
+            e[a] *= TP_PI / R;
+            if (light_points) e[a] += ep[a] / light_points;
+        }
+    store:
+        for (int a = 0; a < 3; a++) {
+            double v = cell->albedo[a] / TP_PI * e[a];
+            if (!isfinite(v) || v < 0) { bad++; v = 0; }
+            cur[3 * ci + a] = (float)v;
+        }
+    }
+    c->thread_rays[thread] += rays;
+    c->thread_nonfinite[thread] += bad;
+}
+
+static double cell_power(const tp_ctx *c, const float *l)
+{
+    double p = 0;
+    for (size_t i = 0; i < c->cell_count; i++) {
+        double v[3] = {l[3 * i], l[3 * i + 1], l[3 * i + 2]};
+        p += c->cells[i].area * lum(v);
+    }
+    return p;
+}
+
+typedef struct tp_chain_result { int bounces; double q, tail_energy, total_energy; } tp_chain_result;
+
+/* Fills l_sum[h] with the total outgoing radiance per cell (emission + all bounces + tail). */
+static tp_chain_result run_chain(tp_ctx *c, int h, int pass, int rays, double tol, int max_bounces)
+{
+    tp_chain_result res = {0, 0, 0, 0};
+    size_t n = c->cell_count;
+    float *sum = c->l_sum[h];
+    for (size_t i = 0; i < n; i++)
+        for (int a = 0; a < 3; a++) sum[3 * i + a] = c->cells[i].le[a];
+    c->half = h;
+    c->pass = pass;
+    c->rays = rays;
+    c->lat_g = lattice_generator((uint32_t)rays);
+    double pw[3] = {0, 0, 0}; /* energies of the last three bounces */
+    double indirect = 0, q = 0;
+    int k;
+    for (k = 1; k <= max_bounces; k++) {
+        c->bounce = k;
+        parallel_for(c, n, 64, cache_bounce);
+        double p = cell_power(c, c->l_cur[h]);
+        for (size_t i = 0; i < 3 * n; i++) sum[i] += c->l_cur[h][i];
+        indirect += p;
+        pw[0] = pw[1]; pw[1] = pw[2]; pw[2] = p;
+        float *tmp = c->l_prev[h]; c->l_prev[h] = c->l_cur[h]; c->l_cur[h] = tmp;
+        if (k >= 2) q = pw[1] > 0 ? pw[2] / pw[1] : 0;
+        if (!(p > 0) || p <= 1e-7 * indirect) break;
+        if (k >= 4) {
+            double q1 = pw[1] / pw[0], q2 = pw[2] / pw[1];
+            double qq = fmin(q2, TP_Q_MAX);
+            double sigma = fabs(q2 - q1);
+            double tail = p * qq / (1 - qq);
+            double frac = tail / (indirect + tail);
+            /* relative error of the total caused by an error sigma in q (d tail / dq) */
+            double unc = qq > 1e-3 ? frac * sigma / (qq * (1 - qq)) : frac;
+            if (unc <= tol) break;
+        }
+    }
+    if (k > max_bounces) k = max_bounces;
+    q = q < 0 ? 0 : q > TP_Q_MAX ? TP_Q_MAX : q;
+    if (!isfinite(q)) q = 0;
+    /* tail of the Neumann series: L_K·(q + q² + ...) = L_K·q/(1−q), shaped like the last bounce */
+    double f = q / (1 - q);
+    const float *last = c->l_prev[h];
+    for (size_t i = 0; i < 3 * n; i++) sum[i] += (float)(last[i] * f);
+    res.bounces = k;
+    res.q = q;
+    res.tail_energy = pw[2] * f;
+    res.total_energy = indirect + pw[2] * f;
+    return res;
+}
+
+/* ---- receivers ------------------------------------------------------------------------------- */
+
+static void recv_offset_origin(const tp_ctx *c, const bk_receiver *r, float o[3])
+{
+    if (r->normal[0] == 0 && r->normal[1] == 0 && r->normal[2] == 0) {
+        memcpy(o, r->position, 3 * sizeof(float));
+        return;
+    }
+    bk_offset_ray_origin_scaled(r->position, r->normal, c->scene_scale, o);
+}
+
+static void recv_normal(const bk_receiver *r, double n[3], int *sphere)
+{
+    double l = sqrt((double)r->normal[0] * r->normal[0] + (double)r->normal[1] * r->normal[1] +
+                    (double)r->normal[2] * r->normal[2]);
+    *sphere = !(l > 0);
+    for (int k = 0; k < 3; k++) n[k] = *sphere ? 0 : r->normal[k] / l;
+    if (*sphere) n[2] = 1;
+}
+
+static void recv_punctual(tp_ctx *c, size_t begin, size_t end, int thread)
+{
+    /* Punctual light is noise-free: computed once, then into the outputs / error scalars. */
+    uint64_t rays = 0;
+    for (size_t i = begin; i < end; i++) {
+        const bk_receiver *r = &c->recv[i];
+        double n[3];
+        int sphere;
+        recv_normal(r, n, &sphere);
+        float o[3];
+        recv_offset_origin(c, r, o);
+        double p[3] = {r->position[0], r->position[1], r->position[2]};
+        double e[3] = {0, 0, 0}, sh[3][9];
+        memset(sh, 0, sizeof sh);
+        for (size_t li = 0; li < c->light_count; li++) {
+            double val[3], ld[3], dist;
+            if (!light_eval(c->lights[li], p, val, ld, &dist)) continue;
+            double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
+            if (!sphere && cs <= 0) continue;
+            rays++;
+            if (!light_visible(c, o, ld, dist)) continue;
+            double y[9];
+            sh9_basis(ld, y);
+            for (int a = 0; a < 3; a++) {
+                e[a] += sphere ? val[a] : val[a] * cs;
+                for (int kk = 0; kk < 9; kk++) sh[a][kk] += val[a] * y[kk];
+            }
+        }
+        if (c->punct_lum) {
+            c->punct_lum[i] = (float)lum(e);
+            continue;
+        }
+        const bk_transport_output *out = c->out;
+        for (int a = 0; a < 3; a++) {
+            for (int kk = 0; kk < 9; kk++) {
+                out->radiance[i].c[a][kk] += (float)sh[a][kk];
+                if (out->direct) out->direct[i].c[a][kk] += (float)sh[a][kk];
+            }
+            if (out->irradiance) out->irradiance[3 * i + a] += (float)e[a];
+        }
+    }
+    c->thread_rays[thread] += rays;
+}
+
+static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
+{
+    const int S = c->rays;
+    const double w = c->pass_weight;
+    const bk_transport_output *out = c->out;
+    uint64_t rays = 0, bad = 0;
+    for (size_t i = begin; i < end; i++) {
+        const bk_receiver *r = &c->recv[i];
+        double n[3], t[3], b[3];
+        int sphere;
+        recv_normal(r, n, &sphere);
+        onb(n, t, b);
+        float o[3];
+        recv_offset_origin(c, r, o);
+        double sh_t[3][9], sh_d[3][9], e_t[3];
+        memset(sh_t, 0, sizeof sh_t);
+        memset(sh_d, 0, sizeof sh_d);
+        memset(e_t, 0, sizeof e_t);
+        for (int h = 0; h < 2; h++) {
+            tp_rng rng = rng_make(c->seed, DOM_RECV, (uint64_t)h, (uint64_t)c->pass, 0, i);
+            double s1 = rng_next(&rng), s2 = rng_next(&rng);
+            const float *sum = c->l_sum[h];
+            double e[3] = {0, 0, 0};
+            /* uniform over the hemisphere (texels) or sphere (probes): the SH projection needs
+             * a pdf that does not vanish at the horizon */
+            const double solid = sphere ? 4 * TP_PI : 2 * TP_PI;
+            for (int j = 0; j < S; j++) {
+                double u1, u2;
+                lattice((uint32_t)j, (uint32_t)S, c->lat_g, s1, s2, &u1, &u2);
+                double z = sphere ? 1 - 2 * u1 : u1;
+                double rr = sqrt(fmax(0.0, 1 - z * z)), phi = 2 * TP_PI * u2;
+                double lx = rr * cos(phi), ly = rr * sin(phi);
+                double d[3];
+                for (int a = 0; a < 3; a++) d[a] = lx * t[a] + ly * b[a] + z * n[a];
+                float df[3] = {(float)d[0], (float)d[1], (float)d[2]};
+                bk_hit hit;
+                double L[3] = {0, 0, 0}, Ld[3] = {0, 0, 0};
+                rays++;
+                if (bk_tracer_intersect(c->tracer, o, df, 0.0f, INFINITY, &hit)) {
+                    long hc = hit_cell(c, &hit);
+                    if (hc >= 0)
+                        for (int a = 0; a < 3; a++) {
+                            L[a] = sum[3 * hc + a];
+                            Ld[a] = c->cells[hc].le[a];
+                        }
+                } else {
+                    sky_radiance(c, d, L);
+                    memcpy(Ld, L, sizeof L);
+                }
+                if (!finite3d(L) || !finite3d(Ld)) { bad++; continue; }
+                double y[9];
+                sh9_basis(d, y);
+                double cs = sphere ? 1 : z;
+                for (int a = 0; a < 3; a++) {
+                    e[a] += L[a] * cs;
+                    for (int kk = 0; kk < 9; kk++) {
+                        sh_t[a][kk] += L[a] * y[kk] * solid;
+                        sh_d[a][kk] += Ld[a] * y[kk] * solid;
+                    }
+                }
+            }
+            for (int a = 0; a < 3; a++) e[a] *= solid / S;
+            /* error scalar: irradiance for texels, fluence/4 for probes (equal under uniform
+             * radiance, so texels and probes weigh alike in the relative RMSE) */
+            c->x_acc[h][i] += w * (lum(e) + c->punct_lum[i]) * (sphere ? 0.25 : 1.0);
+            for (int a = 0; a < 3; a++) e_t[a] += e[a];
+        }
+        /* both halves: 2S samples; weight w for this pass */
+        const double ws = w / (2.0 * S);
+        for (int a = 0; a < 3; a++) {
+            for (int kk = 0; kk < 9; kk++) {
+                out->radiance[i].c[a][kk] += (float)(sh_t[a][kk] * ws);
+                if (out->direct) out->direct[i].c[a][kk] += (float)(sh_d[a][kk] * ws);
+            }
+            if (out->irradiance) out->irradiance[3 * i + a] += (float)(e_t[a] * w * 0.5);
+        }
+    }
+    c->thread_rays[thread] += rays;
+    c->thread_nonfinite[thread] += bad;
+}
+
+/* ---- setup ------------------------------------------------------------------------------------ */
+
+static int online_cores(void)
+{
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n < 1 ? 1 : n > 256 ? 256 : (int)n;
+}
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static void free_ctx(tp_ctx *c)
+{
+    free(c->cells); free(c->tri_first); free(c->tri_m); free(c->tri_sides); free(c->tri_shrink);
+    free(c->lights);
+    for (int h = 0; h < 2; h++) { free(c->l_prev[h]); free(c->l_cur[h]); free(c->l_sum[h]); free(c->x_acc[h]); }
+    free(c->punct_lum);
+    free(c->thread_rays); free(c->thread_nonfinite);
+}
+
+static lbk_result build_cells(tp_ctx *c)
+{
+    const bk_scene *s = c->scene;
+    size_t nt = s->tri_count;
+    size_t max_cells = c->opt->max_cells > 0 ? (size_t)c->opt->max_cells : 32768;
+    c->tri_first = calloc(nt ? nt : 1, sizeof *c->tri_first);
+    c->tri_m = calloc(nt ? nt : 1, 1);
+    c->tri_sides = calloc(nt ? nt : 1, 1);
+    c->tri_shrink = calloc(nt ? nt : 1, sizeof(float));
+    if (!c->tri_first || !c->tri_m || !c->tri_sides || !c->tri_shrink) return LBK_ERR_OUT_OF_MEMORY;
+    double total = 0;
+    for (size_t i = 0; i < nt; i++) {
+        uint32_t mi = s->tri_material ? s->tri_material[i] : 0;
+        int ds = mi < s->material_count ? s->materials[mi].double_sided : 0;
+        c->tri_sides[i] = ds ? 2 : 1;
+        total += (double)bk_tracer_tri_area(c->tracer, (uint32_t)i) * c->tri_sides[i];
+    }
+    double cell_area = total > 0 ? total / (double)max_cells : 0;
+    size_t count = 0;
+    for (size_t i = 0; i < nt; i++) {
+        double a = bk_tracer_tri_area(c->tracer, (uint32_t)i);
+        int m = 1;
+        if (cell_area > 0 && a > 0) {
+            double per_side = a / cell_area;
+            double r = floor(sqrt(per_side));
+            m = r < 1 ? 1 : r > TP_MAX_SUB ? TP_MAX_SUB : (int)r;
+        }
+        c->tri_m[i] = (uint8_t)m;
+        if (count > UINT32_MAX - 2 * TP_MAX_SUB * TP_MAX_SUB) return LBK_ERR_LIMIT;
+        c->tri_first[i] = (uint32_t)count;
+        count += (size_t)c->tri_sides[i] * m * m;
+        /* keep sample points ≥ 16 ulps of the coordinates (and ≥ 0.1 % of the triangle) inside
+         * every edge: see the edge limitation in tracer.h */
+        double v[3][3];
+        tri_vertices(c, (uint32_t)i, v);
+        double longest = 0;
+        for (int e = 0; e < 3; e++) {
+            double l2 = 0;
+            for (int k = 0; k < 3; k++) l2 += (v[(e + 1) % 3][k] - v[e][k]) * (v[(e + 1) % 3][k] - v[e][k]);
+            longest = fmax(longest, sqrt(l2));
+        }
+        double alt = longest > 0 ? 2 * a / longest : 0;
+        double ulp = bk_tracer_tri_scale(c->tracer, (uint32_t)i) * 1.1920928955078125e-07;
+        double eps = alt > 0 ? fmax(16 * ulp / alt, 1e-3) : 1e-3;
+        if (eps > 0.3) eps = 0.3;
+        c->tri_shrink[i] = (float)(1 - 3 * eps);
+    }
+    c->cell_count = count;
+    c->cells = calloc(count ? count : 1, sizeof *c->cells);
+    if (!c->cells) return LBK_ERR_OUT_OF_MEMORY;
+    for (size_t i = 0; i < nt; i++) {
+        uint32_t mi = s->tri_material ? s->tri_material[i] : 0;
+        const bk_material *mat = mi < s->material_count ? &s->materials[mi] : NULL;
+        uint32_t oi = s->tri_object ? s->tri_object[i] : 0;
+        const char *set = (oi < s->object_count) ? s->objects[oi].light_set : "";
+        int emits = in_light_set(c, set);
+        float n[3];
+        bk_tracer_tri_normal(c->tracer, (uint32_t)i, n);
+        float area = bk_tracer_tri_area(c->tracer, (uint32_t)i);
+        int m = c->tri_m[i];
+        const uint32_t *ix = s->tris + 3 * i;
+        for (int sub = 0; sub < m * m; sub++) {
+            /* material values at the cell's centroid (uv0) */
+            int j = 0, ss = sub;
+            while (j < m - 1 && ss >= 2 * (m - j) - 1) { ss -= 2 * (m - j) - 1; j++; }
+            int ii = ss / 2, up = ss & 1;
+            double cu = up ? (3.0 * ii + 2) / (3.0 * m) : (3.0 * ii + 1) / (3.0 * m);
+            double cv = up ? (3.0 * j + 2) / (3.0 * m) : (3.0 * j + 1) / (3.0 * m);
+            double uv[2] = {0, 0};
+            if (s->uv0)
+                for (int k = 0; k < 2; k++) {
+                    double t0 = ix[0] < s->vertex_count ? s->uv0[2 * (size_t)ix[0] + k] : 0;
+                    double t1 = ix[1] < s->vertex_count ? s->uv0[2 * (size_t)ix[1] + k] : 0;
+                    double t2 = ix[2] < s->vertex_count ? s->uv0[2 * (size_t)ix[2] + k] : 0;
+                    uv[k] = (1 - cu - cv) * t0 + cu * t1 + cv * t2;
+                }
+            float albedo[3] = {0, 0, 0}, le[3] = {0, 0, 0};
+            if (mat) {
+                double ta[3] = {1, 1, 1}, te[3] = {1, 1, 1};
+                if (mat->albedo_tex >= 0) sample_image(image_at(s, mat->albedo_tex), uv[0], uv[1], ta);
+                if (mat->emission_tex >= 0) sample_image(image_at(s, mat->emission_tex), uv[0], uv[1], te);
+                for (int k = 0; k < 3; k++) {
+                    double al = mat->albedo[k] * ta[k];
+                    /* albedo ≥ 1 would make the series diverge: clamp just below */
+                    albedo[k] = (float)(isfinite(al) ? (al < 0 ? 0 : al > 0.999 ? 0.999 : al) : 0);
+                    double em = emits ? mat->emission[k] * te[k] : 0;
+                    le[k] = (float)(isfinite(em) && em > 0 ? em : 0);
+                }
+            }
+            if (c->opt->albedo_hook) {
+                c->opt->albedo_hook(c->opt->user, (uint32_t)i, albedo);
+                for (int k = 0; k < 3; k++)
+                    albedo[k] = isfinite(albedo[k]) ? (albedo[k] < 0 ? 0 : albedo[k] > 0.999f ? 0.999f : albedo[k]) : 0;
+            }
+            for (int side = 0; side < c->tri_sides[i]; side++) {
+                tp_cell *cell = &c->cells[c->tri_first[i] + (size_t)side * m * m + sub];
+                cell->tri = (uint32_t)i;
+                cell->sub = (uint16_t)sub;
+                cell->m = (uint16_t)m;
+                cell->side = (uint8_t)side;
+                for (int k = 0; k < 3; k++) cell->n[k] = side ? -n[k] : n[k];
+                cell->area = area / (float)(m * m);
+                memcpy(cell->albedo, albedo, sizeof albedo);
+                memcpy(cell->le, le, sizeof le);
+            }
+        }
+    }
+    return LBK_OK;
+}
+
+/* ---- the run ---------------------------------------------------------------------------------- */
+
+lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, const bk_receiver *receivers,
+                            size_t count, const bk_transport_options *options,
+                            const bk_transport_output *output, bk_transport_stats *stats)
+{
+    double t0 = now_seconds();
+    bk_transport_options defaults;
+    memset(&defaults, 0, sizeof defaults);
+    const bk_transport_options *opt = options ? options : &defaults;
+    if (stats) memset(stats, 0, sizeof *stats);
+    if (!scene || !tracer || !output || (count > 0 && (!receivers || !output->radiance))) return LBK_ERR_INVALID_ARGUMENT;
+    if (bk_tracer_tri_count(tracer) != scene->tri_count) return LBK_ERR_INVALID_ARGUMENT;
+    if (scene->tri_count > 0 && !scene->tris) return LBK_ERR_INVALID_ARGUMENT;
+    for (size_t i = 0; i < count; i++) {
+        const bk_receiver *r = &receivers[i];
+        for (int k = 0; k < 3; k++)
+            if (!isfinite(r->position[k]) || !isfinite(r->normal[k])) return LBK_ERR_INVALID_ARGUMENT;
+    }
+
+    tp_ctx c;
+    memset(&c, 0, sizeof c);
+    c.scene = scene;
+    c.tracer = tracer;
+    c.opt = opt;
+    c.seed = opt->seed;
+    c.threads = opt->threads > 0 ? (opt->threads > 256 ? 256 : opt->threads) : online_cores();
+    c.recv = receivers;
+    c.recv_count = count;
+    c.out = output;
+    const int max_bounces = opt->max_bounces > 0 ? opt->max_bounces : 64;
+    const double max_samples = opt->max_samples > 0 ? opt->max_samples : 4096;
+    const double target = opt->target_error == 0 ? 0.01 : opt->target_error;
+    const int s0 = opt->first_pass_samples > 0 ? opt->first_pass_samples : 16;
+    const double tail_tol = fmax(0.1 * (target > 0 ? target : 0.001), 1e-5);
+
+    lbk_result res = LBK_OK;
+    c.thread_rays = calloc((size_t)c.threads, sizeof(uint64_t));
+    c.thread_nonfinite = calloc((size_t)c.threads, sizeof(uint64_t));
+    if (!c.thread_rays || !c.thread_nonfinite) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
+
+    /* scale of the coordinates: offsets for receivers, which carry no triangle */
+    for (size_t i = 0; i < scene->tri_count; i++) {
+        float sc = bk_tracer_tri_scale(tracer, (uint32_t)i);
+        if (sc > c.scene_scale) c.scene_scale = sc;
+    }
+    const int base_bake = !(opt->light_set && opt->light_set[0]);
+    c.use_sky = base_bake && !opt->no_sky;
+    if (!opt->no_punctual && scene->light_count) {
+        c.lights = calloc(scene->light_count, sizeof *c.lights);
+        if (!c.lights) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
+        for (size_t i = 0; i < scene->light_count; i++)
+            if (in_light_set(&c, scene->lights[i].light_set)) c.lights[c.light_count++] = &scene->lights[i];
+    }
+    res = build_cells(&c);
+    if (res != LBK_OK) goto done;
+    size_t nc = c.cell_count ? c.cell_count : 1;
+    for (int h = 0; h < 2; h++) {
+        c.l_prev[h] = calloc(3 * nc, sizeof(float));
+        c.l_cur[h] = calloc(3 * nc, sizeof(float));
+        c.l_sum[h] = calloc(3 * nc, sizeof(float));
+        c.x_acc[h] = calloc(count ? count : 1, sizeof(double));
+        if (!c.l_prev[h] || !c.l_cur[h] || !c.l_sum[h] || !c.x_acc[h]) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
+    }
+    c.punct_lum = calloc(count ? count : 1, sizeof(float));
+    if (!c.punct_lum) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
+
+    for (size_t i = 0; i < count; i++) {
+        memset(&output->radiance[i], 0, sizeof output->radiance[i]);
+        if (output->direct) memset(&output->direct[i], 0, sizeof output->direct[i]);
+        if (output->irradiance) output->irradiance[3 * i] = output->irradiance[3 * i + 1] = output->irradiance[3 * i + 2] = 0;
+    }
+    if (c.light_count) parallel_for(&c, count, 64, recv_punctual); /* luminance only, for the error */
+
+    double weight_sum = 0, spp = 0, err = 0, last_pass_time = 0;
+    int pass = 0, stop = BK_STOP_BUDGET;
+    tp_chain_result chain[2] = {{0, 0, 0, 0}, {0, 0, 0, 0}};
+    for (;; pass++) {
+        double pass_start = now_seconds();
+        /* both halves' caches */
+        /* cache rays: about as many as the receivers trace this pass (over ~4 bounces), within
+         * [min(4·2^(p/2), cap), cap], cap = cache_rays·2^p; both estimates shrink together */
+        int sp = pass < 20 ? pass : 20;
+        double cap = fmin((double)(opt->cache_rays > 0 ? opt->cache_rays : 16) * ldexp(1.0, sp), 65536.0);
+        double lo = fmin(cap, 4.0 * ldexp(1.0, sp / 2));
+        double want = ceil((double)s0 * ldexp(1.0, sp) * (double)count / (4.0 * (double)nc));
+        int cache_rays = (int)fmax(lo, fmin(cap, want));
+        for (int h = 0; h < 2; h++) {
+            chain[h] = run_chain(&c, h, pass, cache_rays, tail_tol, max_bounces);
+            if (opt->progress) {
+                double f = fmax(spp / max_samples, opt->time_limit > 0 ? (now_seconds() - t0) / opt->time_limit : 0);
+                opt->progress(opt->user, "cache", f > 1 ? 1 : f);
+            }
+        }
+        /* final gather at the receivers, in blocks so progress can be reported */
+        c.pass = pass;
+        c.rays = s0 << (pass < 20 ? pass : 20);
+        c.lat_g = lattice_generator((uint32_t)c.rays);
+        c.pass_weight = ldexp(1.0, pass);
+        size_t block = count / 8 + 1;
+        for (size_t b = 0; b < count; b += block) {
+            size_t e = b + block < count ? b + block : count;
+            parallel_range(&c, b, e, 16, recv_gather);
+            if (opt->progress) {
+                double f = fmax((spp + 2.0 * c.rays * (double)e / (double)(count ? count : 1)) / max_samples,
+                                opt->time_limit > 0 ? (now_seconds() - t0) / opt->time_limit : 0);
+                opt->progress(opt->user, "gather", f > 1 ? 1 : f);
+            }
+        }
+        weight_sum += c.pass_weight;
+        spp += 2.0 * c.rays;
+        /* error: two independent half estimates per receiver (TRANSPORT.md) */
+        double num = 0, den = 0;
+        for (size_t i = 0; i < count; i++) {
+            double a = c.x_acc[0][i] / weight_sum, b = c.x_acc[1][i] / weight_sum;
+            num += 0.25 * (a - b) * (a - b);
+            double m = 0.5 * (a + b);
+            den += m * m;
+        }
+        err = den > 0 ? sqrt(num / den) : 0;
+        last_pass_time = now_seconds() - pass_start;
+        if (opt->report) {
+            bk_transport_sample smp = {now_seconds() - t0, spp, err, chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces, pass};
+            opt->report(opt->user, &smp);
+        }
+        if (target > 0 && err <= target) { stop = BK_STOP_TARGET; break; }
+        double next_spp = spp + 2.0 * (s0 << (pass + 1 < 20 ? pass + 1 : 20));
+        if (next_spp > max_samples || pass >= 24) { stop = BK_STOP_BUDGET; break; }
+        /* the next pass costs about twice this one: start it only if it can finish in time */
+        if (opt->time_limit > 0 && now_seconds() - t0 + 2.1 * last_pass_time > opt->time_limit) { stop = BK_STOP_TIME; break; }
+    }
+
+    /* normalise the pass-weighted sums, then add the noise-free punctual light */
+    for (size_t i = 0; i < count; i++) {
+        float inv = (float)(1.0 / weight_sum);
+        for (int a = 0; a < 3; a++) {
+            for (int k = 0; k < 9; k++) {
+                output->radiance[i].c[a][k] *= inv;
+                if (output->direct) output->direct[i].c[a][k] *= inv;
+            }
+            if (output->irradiance) output->irradiance[3 * i + a] *= inv;
+        }
+    }
+    if (c.light_count) {
+        float *pl = c.punct_lum;
+        c.punct_lum = NULL; /* recv_punctual now writes into the outputs */
+        parallel_for(&c, count, 64, recv_punctual);
+        c.punct_lum = pl;
+    }
+
+    if (stats) {
+        stats->seconds = now_seconds() - t0;
+        stats->passes = pass + 1;
+        stats->samples_per_receiver = spp;
+        stats->est_rel_rmse = err;
+        stats->bounces = chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces;
+        stats->q = 0.5 * (chain[0].q + chain[1].q);
+        double tot = chain[0].total_energy + chain[1].total_energy;
+        stats->tail_fraction = tot > 0 ? (chain[0].tail_energy + chain[1].tail_energy) / tot : 0;
+        stats->cells = c.cell_count;
+        for (int t = 0; t < c.threads; t++) {
+            stats->rays += c.thread_rays[t];
+            stats->nonfinite += c.thread_nonfinite[t];
+        }
+        stats->stop = stop;
+    }
+done:
+    free_ctx(&c);
+    return res;
+}
