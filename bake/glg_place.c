@@ -387,3 +387,13 @@ lbk_result bk_glg_build(const bk_scene *scene, const bk_tracer *tracer,
     out->status = BK_GLG_OK;
     return LBK_OK;
 }
+
+void bk_glg_visibility_unorm8(const bk_glg *g, uint8_t (*out)[4])
+{
+    for (size_t t = 0; t < g->tet_count; t++)
+        for (int i = 0; i < 4; i++) {
+            float v = g->face_visibility[4 * t + (size_t)i];
+            v = v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f;   /* NaN -> 0 */
+            out[t][i] = (uint8_t)lrintf(v * 255.0f);
+        }
+}

@@ -74,4 +74,7 @@ void bk_glg_free(bk_glg *glg);
 void bk_glg_face_visibility(const bk_tracer *tracer, const float *positions, size_t tet_count,
                             const uint32_t *tets, int level, int threads, float *vis);
 
+/* Face visibility in the GLG section's encoding (lbk/glg.h): unorm8, round(v · 255). */
+void bk_glg_visibility_unorm8(const bk_glg *glg, uint8_t (*out)[4]);
+
 #endif

@@ -13,6 +13,8 @@
 #include "bake/glg_place.h"
 #include "bake/llg_place.h"
 #include "bake/tracer.h"
+#include "lbk/container.h"
+#include "lbk/glg.h"
 #include "support/probe_scenes.h"
 
 /* A closed room [0,10]x[0,6]x[0,8] (walls facing inward) holding a solid block
@@ -142,6 +144,27 @@ static void test_glg_cap_and_build(void **state)
         }
     }
     assert_true(vol > 0.0 && vol < 10.0 * 6.0 * 8.0);
+    /* the container's GLG builder accepts the mesh as is (orientation, adjacency, visibility) */
+    uint8_t (*vis8)[4] = malloc(g.tet_count * sizeof *vis8);
+    lbk_sh9_rgb *sh = calloc(g.probe_count, sizeof *sh);
+    bk_glg_visibility_unorm8(&g, vis8);
+    for (size_t t = 0; t < g.tet_count; t++)
+        for (int i = 0; i < 4; i++)
+            assert_int_equal(vis8[t][i], (int)lrintf(g.face_visibility[4 * t + (size_t)i] * 255.0f));
+    lbk_glg_desc desc = {(uint32_t)g.probe_count, (uint32_t)g.tet_count, (const float (*)[3])g.positions, sh,
+                         (const uint32_t (*)[4])g.tets, (const uint32_t (*)[4])g.neighbours,
+                         (const uint8_t (*)[4])vis8};
+    void *bytes = NULL;
+    size_t size = 0;
+    assert_int_equal(lbk_glg_build(&desc, NULL, &bytes, &size), LBK_OK);
+    lbk_glg_view view;
+    assert_int_equal(lbk_glg_open(bytes, size, &view), LBK_OK);
+    assert_int_equal(view.tetra_count, g.tet_count);
+    /* the stored tetras are ours unchanged (already positively oriented) */
+    assert_memory_equal(view.mesh.tetras, g.tets, 16 * g.tet_count);
+    lbk_free(NULL, bytes);
+    free(sh);
+    free(vis8);
     bk_glg_free(&g);
     bk_tracer_destroy(tr);
     psc_free(&s);
