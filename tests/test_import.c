@@ -17,6 +17,7 @@
 
 #include "bake/import.h"
 #include "bake/scene.h"
+#include "support/scene_builders.h"
 
 /* ---- helpers ----------------------------------------------------------------------------- */
 
@@ -1061,6 +1062,74 @@ static void test_draco_corrupt(void **state)
     assert_true(strstr(err, "Draco") != NULL || strstr(err, "KHR_draco") != NULL);
 }
 
+/* ---- scene utilities and the C builders -------------------------------------------------- */
+
+static void test_scene_utilities(void **state)
+{
+    (void)state;
+    bk_scene s;
+    sb_closed_box(&s, 2.0f, 0.5f, 1.0f, 3);
+    assert_valid(&s);
+    assert_int_equal(s.tri_count, 6 * 2 * 9);
+    for (int k = 0; k < 3; k++) {
+        assert_float_equal(s.bounds_min[k], -1.0f, 0.0f);
+        assert_float_equal(s.bounds_max[k], 1.0f, 0.0f);
+    }
+    /* every face looks at the centre, and its winding agrees with its normal */
+    for (size_t t = 0; t < s.tri_count; t++) {
+        const float *a = &s.positions[3 * s.tris[3 * t]], *b = &s.positions[3 * s.tris[3 * t + 1]],
+                    *c = &s.positions[3 * s.tris[3 * t + 2]], *n = &s.normals[3 * s.tris[3 * t]];
+        float e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        float g[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+        float cx = (a[0] + b[0] + c[0]) / 3, cy = (a[1] + b[1] + c[1]) / 3, cz = (a[2] + b[2] + c[2]) / 3;
+        assert_true(-(n[0] * cx + n[1] * cy + n[2] * cz) > 0.0f);
+        assert_true(g[0] * n[0] + g[1] * n[1] + g[2] * n[2] > 0.0f);
+    }
+    assert_true(bk_scene_has_light(&s)); /* emissive walls */
+    uint64_t h3 = s.objects[0].geometry_hash;
+    bk_scene_free(&s);
+    assert_int_equal(s.sky_image, -1);
+    assert_null(s.positions);
+
+    sb_closed_box(&s, 2.0f, 0.5f, 0.0f, 3);
+    assert_int_equal(s.objects[0].geometry_hash, h3); /* same geometry, other material */
+    assert_false(bk_scene_has_light(&s));
+    s.sky[1] = 0.1f;
+    assert_true(bk_scene_has_light(&s));
+    s.sky[1] = 0.0f;
+    /* bk_scene_check finds an index out of range and a non-unit normal */
+    char err[256];
+    s.tris[5] = (uint32_t)s.vertex_count;
+    assert_int_not_equal(bk_scene_check(&s, err, sizeof err), 0);
+    assert_non_null(strstr(err, "triangle 1"));
+    s.tris[5] = 0;
+    s.normals[0] = 2.0f;
+    assert_int_not_equal(bk_scene_check(&s, err, sizeof err), 0);
+    assert_non_null(strstr(err, "vertex 0"));
+    bk_scene_free(&s);
+
+    sb_closed_box(&s, 2.0f, 0.5f, 0.0f, 4);
+    assert_true(s.objects[0].geometry_hash != h3);
+    bk_scene_free(&s);
+
+    sb_plane_point_light(&s, 5.0f, 2.0f, 100.0f, 0.8f, 2);
+    assert_valid(&s);
+    assert_int_equal(s.tri_count, 8);
+    assert_int_equal(s.light_count, 1);
+    assert_float_equal(s.bounds_max[1], 2.0f, 0.0f); /* the light is inside the bounds */
+    assert_float_equal(s.normals[1], 1.0f, 0.0f);
+    assert_true(bk_scene_has_light(&s));
+    s.lights[0].color[0] = s.lights[0].color[1] = s.lights[0].color[2] = 0.0f;
+    assert_false(bk_scene_has_light(&s));
+    bk_scene_free(&s);
+
+    /* the hash is XXH3-64 of the raw position bytes then the index bytes */
+    float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    uint32_t idx[3] = {0, 1, 2}, idx2[3] = {0, 2, 1};
+    assert_true(bk_geometry_hash(pos, 3, idx, 3) != bk_geometry_hash(pos, 3, idx2, 3));
+    assert_int_equal(bk_geometry_hash(pos, 3, idx, 3), bk_geometry_hash(pos, 3, idx, 3));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1080,6 +1149,7 @@ int main(void)
         cmocka_unit_test(test_malformed_structure),
         cmocka_unit_test(test_malformed_glb),
         cmocka_unit_test(test_draco_corrupt),
+        cmocka_unit_test(test_scene_utilities),
     };
     return cmocka_run_group_tests(tests, setup_tmp, teardown_tmp);
 }
