@@ -660,6 +660,34 @@ static void test_registry_sorted(void **state)
     assert_string_equal(cc, "@AB?");
 }
 
+/* spec/validation.md lists every registered ID with the same severity (tests run from the
+ * repository root). */
+static void test_registry_matches_spec(void **state)
+{
+    (void)state;
+    FILE *f = fopen("spec/validation.md", "r");
+    assert_non_null(f);
+    static char seen[2000];
+    memset(seen, 0, sizeof seen);
+    char line[512];
+    while (fgets(line, sizeof line, f)) {
+        unsigned id;
+        char sev[16];
+        if (sscanf(line, "| %u | %15[a-z] |", &id, sev) != 2 || id >= sizeof seen) continue;
+        lbk_severity expect;
+        const char *msg = lbk_issue_template(id, &expect);
+        if (!msg) fail_msg("spec/validation.md lists ID %u which the registry lacks", id);
+        const char *names[] = {"warning", "error", "fatal"};
+        if (strcmp(sev, names[expect])) fail_msg("ID %u: spec says %s, registry says %s", id, sev, names[expect]);
+        seen[id] = 1;
+    }
+    fclose(f);
+    for (uint32_t i = 0; i < lbk_issue_registry_size(); i++) {
+        uint32_t id = lbk_issue_registry_id(i);
+        if (id >= sizeof seen || !seen[id]) fail_msg("registry ID %u is missing from spec/validation.md", id);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -674,6 +702,7 @@ int main(void)
         cmocka_unit_test(test_atomic_file_write),
         cmocka_unit_test(test_validator_framing_ids),
         cmocka_unit_test(test_registry_sorted),
+        cmocka_unit_test(test_registry_matches_spec),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
