@@ -105,6 +105,7 @@ $(BUILD)/lbk-asan: $(BUILD)/asan/$(TOOL_MAIN:.c=.o) $(TOOL_ASAN) $(LIB_ASAN)
 
 # ---- tests (ASan + UBSan) ------------------------------------------------------------------
 TEST_SUPPORT_OBJ := $(TEST_SUPPORT:%.c=$(BUILD)/asan/%.o)
+$(TEST_SUPPORT_OBJ): TOOL_INC += -Itests
 $(BUILD)/tests/%: tests/%.c $(TEST_SUPPORT_OBJ) $(TOOL_ASAN) $(LIB_ASAN)
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) -O1 -g $(SAN) $(WARN) $(TOOL_INC) -Itests -c $< -o $@.o
