@@ -15,7 +15,7 @@
 #include "bake/tracer.h"
 #include "lbk/container.h"
 #include "lbk/glg.h"
-#include "support/probe_scenes.h"
+#include "tests/support/probe_scenes.h"
 
 /* A closed room [0,10]x[0,6]x[0,8] (walls facing inward) holding a solid block
  * [2,2.8]x[0,1]x[1,2] (faces outward). */

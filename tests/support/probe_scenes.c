@@ -1,4 +1,4 @@
-#include "support/probe_scenes.h"
+#include "tests/support/probe_scenes.h"
 
 #include <math.h>
 #include <stdio.h>
