@@ -85,6 +85,9 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
     }
 
     tl_convert_status st = TL_CONVERT_OK;
+    tl_texel_remap remap;
+    memset(&remap, 0, sizeof remap);
+    int have_remap = 0;
     uint32_t n = lbk_reader_section_count(rd);
     for (uint32_t i = 0; i < n && st == TL_CONVERT_OK; i++) {
         lbk_section_info si;
@@ -105,20 +108,25 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
         }
         void *rewritten = NULL;
         size_t rewritten_size = 0;
+        int ls = TL_CONVERT_OK;
         if (si.type == LBK_SECTION_LMAP) {
             tl_lmap_layout_options lo = {p->lmap_row_pitch_alignment, p->lmap_page_alignment, opt->from_exr_dir};
             uint32_t imported = 0;
-            int ls = tl_lmap_rewrite(data, size, &lo, &rewritten, &rewritten_size, &imported, err);
-            if (ls != TL_CONVERT_OK) {
-                st = (tl_convert_status)ls;
-                break;
-            }
+            tl_texel_remap_free(&remap);
+            ls = tl_lmap_rewrite(data, size, &lo, &rewritten, &rewritten_size, &imported, &remap, err);
             report->pages_imported = imported;
-            if (rewritten) {
-                cs->relaid = 1;
-                data = rewritten;
-                size = rewritten_size;
-            }
+            have_remap = ls == TL_CONVERT_OK;
+        } else if (si.type == LBK_SECTION_DLS && have_remap && !remap.identity) {
+            ls = tl_dls_remap_texels(data, size, &remap, &rewritten, &rewritten_size, err);
+        }
+        if (ls != TL_CONVERT_OK) {
+            st = (tl_convert_status)ls;
+            break;
+        }
+        if (rewritten) {
+            cs->relaid = 1;
+            data = rewritten;
+            size = rewritten_size;
         }
         lbk_section_options so = {0};
         so.flags = si.flags;
@@ -139,6 +147,7 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
     }
     lbk_writer_destroy(w);
     lbk_reader_close(rd);
+    tl_texel_remap_free(&remap);
     if (st != TL_CONVERT_OK) {
         lbk_free(NULL, bytes);
         return st;

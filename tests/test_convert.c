@@ -14,6 +14,8 @@
 #include "convert/file_util.h"
 #include "convert/profile.h"
 #include "lbk/container.h"
+#include "lbk/dls.h"
+#include "lbk/lightmap.h"
 #include "lbk/validate.h"
 #include "support/tools_fixtures.h"
 
@@ -222,8 +224,8 @@ static void test_convert_deterministic_and_idempotent(void **state)
     tf_blob_free(&in);
 }
 
-/* Every section that ships decodes to the same bytes as the input's (apart from LMAP whose
- * layout a profile may change: that one must decode to the same lighting, see test_lmap_*). */
+/* Every section that ships decodes to the same bytes as the input's, apart from LMAP and DLS whose
+ * layout the row pitch may change (test_row_pitch_widening checks those decode the same). */
 static void test_round_trip_same_content(void **state)
 {
     (void)state;
@@ -248,7 +250,7 @@ static void test_round_trip_same_content(void **state)
         }
         assert_int_equal(lbk_reader_find_section(ro, si.type, &j), LBK_OK);
         shipped++;
-        if (si.type == LBK_SECTION_LMAP) continue;
+        if (si.type == LBK_SECTION_LMAP || si.type == LBK_SECTION_DLS) continue;
         const void *a, *b;
         size_t an, bn;
         assert_int_equal(lbk_reader_section_data(ri, i, &a, &an), LBK_OK);
@@ -318,6 +320,124 @@ static void test_bad_input_and_invalid_pack(void **state)
     tf_blob_free(&in);
 }
 
+typedef struct dls_entries {
+    uint64_t targets[1024];
+    uint8_t payload[1024][8];
+    uint32_t count;
+} dls_entries;
+
+static int grab(void *user, uint32_t target, uint32_t count, const uint32_t *sets, const uint8_t *payloads)
+{
+    dls_entries *e = user;
+    (void)sets;
+    assert_int_equal(count, 1);
+    assert_true(e->count < 1024);
+    e->targets[e->count] = target;
+    memcpy(e->payload[e->count], payloads, 8);
+    e->count++;
+    return 0;
+}
+
+static void texel_entries(const void *file, size_t size, dls_entries *out)
+{
+    memset(out, 0, sizeof *out);
+    lbk_reader *rd = NULL;
+    assert_int_equal(lbk_reader_open_memory(file, size, NULL, &rd), LBK_OK);
+    const void *d;
+    size_t n;
+    assert_int_equal(lbk_reader_section_by_type(rd, LBK_SECTION_DLS, &d, &n), LBK_OK);
+    lbk_dls_view *v = NULL;
+    assert_int_equal(lbk_dls_view_open(d, n, NULL, &v), LBK_OK);
+    for (uint32_t c = 0; c < lbk_dls_cluster_count(v); c++) {
+        lbk_dls_cluster_info ci;
+        assert_int_equal(lbk_dls_cluster_get(v, c, &ci), LBK_OK);
+        if (ci.space == LBK_DLS_SPACE_TEXEL) assert_int_equal(lbk_dls_cluster_decode(v, c, grab, out), LBK_OK);
+    }
+    lbk_dls_view_close(v);
+    lbk_reader_close(rd);
+}
+
+/* row_pitch_alignment 256 widens the 16-texel page to 64 texels: zero texels on the right, the
+ * original texels in place, later-page texel indices and DLS targets renumbered with them. */
+static void test_row_pitch_widening(void **state)
+{
+    (void)state;
+    tf_options fo = {0};
+    fo.page0_width = 40; /* page 0 40 wide → 64; page 1 16 → 64 */
+    tf_blob in = tf_build_scene(TF_SCENE_FULL, &fo);
+    tl_profile p = profile_from("name = t\nalignment = 64\n[sections]\ndefault = none\n[lmap]\nrow_pitch_alignment = 256\n");
+    void *out;
+    size_t out_size;
+    convert_ok(in.data, in.size, &p, &out, &out_size);
+    lbk_reader *ri = NULL, *ro = NULL;
+    assert_int_equal(lbk_reader_open_memory(in.data, in.size, NULL, &ri), LBK_OK);
+    assert_int_equal(lbk_reader_open_memory(out, out_size, NULL, &ro), LBK_OK);
+    const void *a, *b;
+    size_t an, bn;
+    assert_int_equal(lbk_reader_section_by_type(ri, LBK_SECTION_LMAP, &a, &an), LBK_OK);
+    assert_int_equal(lbk_reader_section_by_type(ro, LBK_SECTION_LMAP, &b, &bn), LBK_OK);
+    lbk_lmap_view va, vb;
+    assert_int_equal(lbk_lmap_open(a, an, &va), LBK_OK);
+    assert_int_equal(lbk_lmap_open(b, bn, &vb), LBK_OK);
+    assert_int_equal(vb.page_count, 2);
+    assert_int_equal(vb.texel_count, 64 * 32 + 64 * 16);
+    for (uint32_t pg = 0; pg < 2; pg++) {
+        lbk_lmap_page pa, pb;
+        assert_int_equal(lbk_lmap_get_page(&va, pg, &pa), LBK_OK);
+        assert_int_equal(lbk_lmap_get_page(&vb, pg, &pb), LBK_OK);
+        assert_int_equal(pb.width, 64);
+        assert_int_equal((4 * pb.width) % 256, 0);
+        assert_int_equal(pb.height, pa.height);
+        for (uint32_t y = 0; y < pb.height; y++)
+            for (uint32_t x = 0; x < pb.width; x++) {
+                lbk_ahd_texel ta, tb;
+                assert_int_equal(lbk_lmap_page_texel(&pb, x, y, &tb), LBK_OK);
+                if (x < pa.width) {
+                    assert_int_equal(lbk_lmap_page_texel(&pa, x, y, &ta), LBK_OK);
+                    assert_int_equal(ta.irradiance_z, tb.irradiance_z);
+                    assert_memory_equal(ta.rgba, tb.rgba, 4);
+                } else {
+                    assert_int_equal(tb.irradiance_z, 0);
+                }
+            }
+    }
+    static dls_entries ea, eb;
+    texel_entries(in.data, in.size, &ea);
+    texel_entries(out, out_size, &eb);
+    assert_int_equal(ea.count, 256);
+    assert_int_equal(eb.count, 256);
+    for (uint32_t i = 0; i < ea.count; i++) {
+        /* old index on page 1 (16 wide, first texel 40·32) → new (64 wide, first texel 64·32) */
+        uint64_t local = ea.targets[i] - 40 * 32, want = 64 * 32 + (local / 16) * 64 + local % 16;
+        int found = 0;
+        for (uint32_t j = 0; j < eb.count; j++)
+            if (eb.targets[j] == want) {
+                assert_memory_equal(ea.payload[i], eb.payload[j], 8);
+                found = 1;
+            }
+        assert_true(found);
+    }
+    lbk_reader_close(ri);
+    lbk_reader_close(ro);
+    free(out);
+    tf_blob_free(&in);
+}
+
+/* page_alignment can only be checked (format 1.0 packs planes at 16 bytes): a clear error. */
+static void test_page_alignment_checked(void **state)
+{
+    (void)state;
+    tf_blob in = tf_build_scene(TF_SCENE_LMAP_ONLY, NULL);
+    tl_profile p = profile_from("name = t\nalignment = 64\n[sections]\ndefault = none\n[lmap]\npage_alignment = 4096\n");
+    char err[TL_ERR_LEN] = "";
+    void *out = NULL;
+    size_t out_size;
+    tl_convert_options o = {&p, NULL};
+    assert_int_equal(tl_convert_memory(in.data, in.size, &o, &out, &out_size, NULL, err), TL_CONVERT_UNSUPPORTED);
+    assert_non_null(strstr(err, "not multiples of page_alignment 4096"));
+    tf_blob_free(&in);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -329,6 +449,8 @@ int main(void)
         cmocka_unit_test(test_round_trip_same_content),
         cmocka_unit_test(test_user_profile_file),
         cmocka_unit_test(test_bad_input_and_invalid_pack),
+        cmocka_unit_test(test_row_pitch_widening),
+        cmocka_unit_test(test_page_alignment_checked),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

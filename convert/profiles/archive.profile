@@ -9,4 +9,3 @@ default = zstd:22
 
 [lmap]
 row_pitch_alignment = 0
-page_alignment      = 0

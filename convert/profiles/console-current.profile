@@ -22,6 +22,6 @@ DLS  = none
 OCTP = none
 
 [lmap]
-# D3D12_TEXTURE_DATA_PITCH_ALIGNMENT (256) and 512-byte placement alignment of texture copies.
+# D3D12_TEXTURE_DATA_PITCH_ALIGNMENT: rows of a buffer-to-texture copy start every 256 bytes,
+# so pages whose width is not a multiple of 64 texels are widened (see README.md).
 row_pitch_alignment = 256
-page_alignment      = 512

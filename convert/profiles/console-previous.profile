@@ -15,4 +15,3 @@ REPT = drop
 [lmap]
 # GNM/D3D11.X linear texture rows: 256-byte pitch alignment.
 row_pitch_alignment = 256
-page_alignment      = 256

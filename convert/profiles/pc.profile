@@ -12,6 +12,5 @@ META = drop
 REPT = drop
 
 [lmap]
-# D3D12 / Vulkan buffer-to-texture copies want 256-byte row pitch, 512-byte placement.
+# D3D12 buffer-to-texture copies want a 256-byte row pitch (Vulkan is satisfied by it too).
 row_pitch_alignment = 256
-page_alignment      = 512
