@@ -648,6 +648,85 @@ static void write_exr(const char *name, int w, int h, float scale)
     fclose(f);
 }
 
+/* float → half for the small exact values used here (normal numbers only). */
+static uint16_t to_half(float f)
+{
+    uint32_t b;
+    memcpy(&b, &f, 4);
+    if (f == 0.0f) return 0;
+    uint32_t sign = (b >> 16) & 0x8000u, exp = ((b >> 23) & 0xffu) - 127u + 15u, man = (b >> 13) & 0x3ffu;
+    return (uint16_t)(sign | (exp << 10) | man);
+}
+
+/* A tiled (ONE_LEVEL, tw×th tiles), uncompressed EXR with HALF channels B, G, R, same pixel values
+ * as write_exr; w, h need not be multiples of the tile size (partial edge tiles). */
+static void write_tiled_exr(const char *name, int w, int h, int tw, int th)
+{
+    char p[512];
+    tmp_path(p, sizeof p, name);
+    FILE *f = fopen(p, "wb");
+    assert_non_null(f);
+    put_u32(f, 20000630u);
+    put_u32(f, 2u | 0x200u); /* single-part tiled */
+    const char *chans[3] = {"B", "G", "R"};
+    put_attr(f, "channels", "chlist", 3 * (2 + 16) + 1);
+    for (int c = 0; c < 3; c++) {
+        fwrite(chans[c], 1, 2, f);
+        put_u32(f, 1); /* HALF */
+        unsigned char lin[4] = {0, 0, 0, 0};
+        fwrite(lin, 1, 4, f);
+        put_u32(f, 1);
+        put_u32(f, 1);
+    }
+    fputc(0, f);
+    put_attr(f, "compression", "compression", 1);
+    fputc(0, f);
+    int32_t box[4] = {0, 0, w - 1, h - 1};
+    put_attr(f, "dataWindow", "box2i", 16);
+    fwrite(box, 4, 4, f);
+    put_attr(f, "displayWindow", "box2i", 16);
+    fwrite(box, 4, 4, f);
+    put_attr(f, "lineOrder", "lineOrder", 1);
+    fputc(0, f);
+    float one = 1.0f, zero2[2] = {0, 0};
+    put_attr(f, "pixelAspectRatio", "float", 4);
+    fwrite(&one, 4, 1, f);
+    put_attr(f, "screenWindowCenter", "v2f", 8);
+    fwrite(zero2, 4, 2, f);
+    put_attr(f, "screenWindowWidth", "float", 4);
+    fwrite(&one, 4, 1, f);
+    put_attr(f, "tiles", "tiledesc", 9);
+    put_u32(f, (uint32_t)tw);
+    put_u32(f, (uint32_t)th);
+    fputc(0, f); /* ONE_LEVEL, round down */
+    fputc(0, f);
+    int nx = (w + tw - 1) / tw, ny = (h + th - 1) / th;
+    long table = ftell(f);
+    uint64_t off = (uint64_t)table + (uint64_t)nx * ny * 8;
+    for (int ty = 0; ty < ny; ty++)
+        for (int tx = 0; tx < nx; tx++) {
+            fwrite(&off, 8, 1, f);
+            int cw = (tx + 1) * tw > w ? w - tx * tw : tw, ch = (ty + 1) * th > h ? h - ty * th : th;
+            off += 20 + (uint64_t)cw * ch * 3 * 2;
+        }
+    for (int ty = 0; ty < ny; ty++)
+        for (int tx = 0; tx < nx; tx++) {
+            int cw = (tx + 1) * tw > w ? w - tx * tw : tw, ch = (ty + 1) * th > h ? h - ty * th : th;
+            put_u32(f, (uint32_t)tx);
+            put_u32(f, (uint32_t)ty);
+            put_u32(f, 0);
+            put_u32(f, 0);
+            put_u32(f, (uint32_t)(cw * ch * 3 * 2));
+            for (int y = ty * th; y < ty * th + ch; y++)
+                for (int c = 0; c < 3; c++)
+                    for (int x = tx * tw; x < tx * tw + cw; x++) {
+                        uint16_t v = to_half(c == 2 ? (float)(x + 1) : c == 1 ? (float)(y + 1) : 0.5f);
+                        fwrite(&v, 2, 1, f);
+                    }
+        }
+    fclose(f);
+}
+
 static void test_sky_exr(void **state)
 {
     (void)state;
@@ -691,6 +770,26 @@ static void test_sky_exr(void **state)
     opt.max_image_pixels = 16;
     assert_int_not_equal(import_tmp("sky_exr.gltf", &s, &opt, err, sizeof err), 0);
     assert_non_null(strstr(err, "cap"));
+
+    /* tiled, half floats, 5×3 in 2×2 tiles (partial tiles on the right and bottom) */
+    write_tiled_exr("tiled.exr", 5, 3, 2, 2);
+    write_quad_gltf_scene_extras("sky_tiled.gltf", "{\"mesh\":0}", "0", "{\"lbk_sky\":\"tiled.exr\"}");
+    rc = import_tmp("sky_tiled.gltf", &s, NULL, err, sizeof err);
+    if (rc) printf("%s\n", err);
+    assert_int_equal(rc, 0);
+    assert_int_equal(s.images[0].width, 5);
+    assert_int_equal(s.images[0].height, 3);
+    for (int y = 0; y < 3; y++)
+        for (int x = 0; x < 5; x++) {
+            const float *q = &s.images[0].rgba[4 * (y * 5 + x)];
+            assert_float_equal(q[0], (float)(x + 1), 0.0f);
+            assert_float_equal(q[1], (float)(y + 1), 0.0f);
+            assert_float_equal(q[2], 0.5f, 0.0f);
+            assert_float_equal(q[3], 1.0f, 0.0f);
+        }
+    assert_float_equal(s.sky[0], 3.0f, 1e-6);
+    assert_float_equal(s.sky[1], 2.0f, 1e-6);
+    bk_scene_free(&s);
 
     /* garbage in place of the EXR */
     write_text("junk.exr", "this is not an EXR file at all, sorry");
