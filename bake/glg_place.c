@@ -43,6 +43,8 @@ typedef struct place_ctx {
     uint8_t *verdict;          /* 0 keep, 1 solid, 2 too close; bit 4: pushed */
     int rays;
     float min_distance;
+    float max_push;            /* a probe never moves farther than this from its cell centre */
+    float user_min_distance;   /* option, 0: derived from the cell size */
 } place_ctx;
 
 static int tri_hits_box(const place_ctx *c, uint32_t t, const double centre[3], const double half[3])
@@ -118,6 +120,10 @@ static void test_candidate(void *vctx, size_t i)
         float step = 1.25f * c->min_distance - nearest;
         for (int k = 0; k < 3; k++) p[k] += step * away[k];
         verdict = (uint8_t)(verdict | 16);
+        /* a probe pushed out of its cell would stand in someone else's (or outside the level) */
+        float moved = 0.0f;
+        for (int k = 0; k < 3; k++) moved += (p[k] - c->cand[3 * i + k]) * (p[k] - c->cand[3 * i + k]);
+        if (moved > c->max_push * c->max_push) { verdict = (uint8_t)(verdict | 2); break; }
     }
     memcpy(c->out + 3 * i, p, sizeof p);
     c->verdict[i] = verdict;
@@ -142,6 +148,14 @@ static lbk_result place_once(place_ctx *c, const double lo[3], const double ext[
         dims[k] = d < 1.0 ? 1 : (int64_t)d;
         cell[k] = ext[k] / (double)dims[k];
     }
+    /* clearance and overlap padding from the finest cell actually used, so tiny scenes scale */
+    double finest = DBL_MAX;
+    for (int k = 0; k < 3; k++) if (cell[k] > 0.0 && cell[k] < finest) finest = cell[k];
+    if (finest == DBL_MAX) finest = spacing;
+    finest /= (double)(1 << c->levels);
+    c->min_distance = c->user_min_distance > 0 ? c->user_min_distance : (float)(0.25 * finest);
+    c->pad = fmin((double)c->min_distance, 0.25 * finest);
+    c->max_push = (float)fmax(0.5 * finest, 2.0 * c->min_distance);
     size_t ncell = (size_t)(dims[0] * dims[1] * dims[2]);
     /* bin usable triangles into top cells (CSR) by their padded bounding boxes */
     size_t *start = calloc(ncell + 1, sizeof *start);
@@ -263,9 +277,7 @@ lbk_result bk_glg_place(const bk_scene *scene, const bk_tracer *tracer,
     lbk_result res = LBK_OK;
     for (int attempt = 0; attempt < 200; attempt++) {
         c.levels = levels;
-        double finest = spacing / (double)(1 << levels);
-        c.min_distance = o.min_distance > 0 ? o.min_distance : (float)(0.25 * finest);
-        c.pad = fmin((double)c.min_distance, 0.25 * finest);
+        c.user_min_distance = o.min_distance > 0 && isfinite(o.min_distance) ? o.min_distance : 0.0f;
         c.max_candidates = 8 * cap;
         bk_glg_probes_free(out);
         res = place_once(&c, lo, ext, spacing, threads, out);

@@ -170,6 +170,41 @@ static void test_glg_cap_and_build(void **state)
     psc_free(&s);
 }
 
+/* The room scaled to 10 km, moved 1e5 m away, and shrunk to 1 mm. */
+static void test_glg_extreme_scales(void **state)
+{
+    (void)state;
+    const double scales[3] = {1000.0, 1.0, 1e-4};
+    const double offsets[3] = {0.0, 1e5, 0.0};
+    for (int c = 0; c < 3; c++) {
+        bk_scene s;
+        room_scene(&s);
+        for (size_t v = 0; v < 3 * s.vertex_count; v++) s.positions[v] = (float)(s.positions[v] * scales[c] + offsets[c]);
+        bk_tracer *tr;
+        assert_int_equal(bk_tracer_create(&s, 1, &tr), LBK_OK);
+        bk_glg_options o = {0};
+        o.max_probes = 2000;
+        bk_glg g;
+        assert_int_equal(bk_glg_build(&s, tr, &o, 2, &g), LBK_OK);
+        {
+            /* 1 mm across: one cell, its 8 octants (the clearance scales with the cell) */
+            assert_int_equal(g.status, BK_GLG_OK);
+            assert_true(g.probe_count <= 2000 && g.tet_count > 0);
+            for (size_t i = 0; i < g.probe_count; i++) {
+                float q[3];
+                for (int k = 0; k < 3; k++) q[k] = (float)((g.positions[3 * i + k] - offsets[c]) / scales[c]);
+                assert_true(isfinite(q[0]) && isfinite(q[1]) && isfinite(q[2]));
+                assert_true(box_distance_inside(q, ROOM_LO, ROOM_HI) > 0.0);
+                assert_true(box_distance_outside(q, BLOCK_LO, BLOCK_HI) > 0.0);
+            }
+            for (size_t t = 0; t < 4 * g.tet_count; t++) assert_true(isfinite(g.face_visibility[t]));
+        }
+        bk_glg_free(&g);
+        bk_tracer_destroy(tr);
+        psc_free(&s);
+    }
+}
+
 /* A single floor quad: no volume to fill, so no GLG. */
 static void test_glg_flat_scene(void **state)
 {
@@ -409,6 +444,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_glg_room_placement),
         cmocka_unit_test(test_glg_cap_and_build),
+        cmocka_unit_test(test_glg_extreme_scales),
         cmocka_unit_test(test_glg_flat_scene),
         cmocka_unit_test(test_face_visibility),
         cmocka_unit_test(test_llg_obb_rotated_box),
