@@ -119,6 +119,10 @@ static inline double bk_rtri_closest(const bk_rtri *t, double px, double py, dou
         }
     }
     double x = u * ax + v * bx + ww * qx, y = u * ay + v * by + ww * qy;
+    /* the exact closest point lies in the triangle's bounding box; rounding must not move it
+     * out (a point on a vertical edge at x = 53 must not come back as 52.999999999999993) */
+    x = fmin(fmax(x, fmin(ax, fmin(bx, qx))), fmax(ax, fmax(bx, qx)));
+    y = fmin(fmax(y, fmin(ay, fmin(by, qy))), fmax(ay, fmax(by, qy)));
     if (w) {
         w[0] = u;
         w[1] = t->flipped ? ww : v;
