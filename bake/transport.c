@@ -118,7 +118,7 @@ typedef struct tp_ctx {
     uint32_t *tri_first;   /* first cell of each triangle */
     uint8_t *tri_m;
     uint8_t *tri_sides;
-    float *tri_shrink;     /* barycentric shrink toward the centroid: keeps points off edges */
+    float *tri_edge_eps;   /* smallest barycentric a sample point may have: keeps points off edges */
     /* light selection */
     const bk_light **lights;
     size_t light_count;
@@ -343,9 +343,18 @@ static void cell_point(const tp_ctx *c, const tp_cell *cell, tp_rng *r, double p
     double w0 = 1 - sq, w1 = sq * (1 - r2), w2 = sq * r2;
     double u = (w0 * c0[0] + w1 * c1[0] + w2 * c2[0]) / m;
     double v = (w0 * c0[1] + w1 * c1[1] + w2 * c2[1]) / m;
-    double k = c->tri_shrink[cell->tri];
-    u = 1.0 / 3 + (u - 1.0 / 3) * k;
-    v = 1.0 / 3 + (v - 1.0 / 3) * k;
+    /* clamp into the band-free interior: only points within the band move, and only onto the
+     * band's inner border, so the rest of the triangle is sampled exactly uniformly */
+    double eps = c->tri_edge_eps[cell->tri];
+    if (eps > 0) {
+        double w = 1 - u - v;
+        u = u < eps ? eps : u;
+        v = v < eps ? eps : v;
+        w = w < eps ? eps : w;
+        double sum = u + v + w;
+        u /= sum;
+        v /= sum;
+    }
     double vv[3][3];
     tri_vertices(c, cell->tri, vv);
     for (int a = 0; a < 3; a++) p[a] = (1 - u - v) * vv[0][a] + u * vv[1][a] + v * vv[2][a];
@@ -652,7 +661,7 @@ static double now_seconds(void)
 
 static void free_ctx(tp_ctx *c)
 {
-    free(c->cells); free(c->tri_first); free(c->tri_m); free(c->tri_sides); free(c->tri_shrink);
+    free(c->cells); free(c->tri_first); free(c->tri_m); free(c->tri_sides); free(c->tri_edge_eps);
     free(c->lights);
     for (int h = 0; h < 2; h++) { free(c->l_prev[h]); free(c->l_cur[h]); free(c->l_sum[h]); free(c->x_acc[h]); }
     free(c->punct_lum);
@@ -667,8 +676,8 @@ static lbk_result build_cells(tp_ctx *c)
     c->tri_first = calloc(nt ? nt : 1, sizeof *c->tri_first);
     c->tri_m = calloc(nt ? nt : 1, 1);
     c->tri_sides = calloc(nt ? nt : 1, 1);
-    c->tri_shrink = calloc(nt ? nt : 1, sizeof(float));
-    if (!c->tri_first || !c->tri_m || !c->tri_sides || !c->tri_shrink) return LBK_ERR_OUT_OF_MEMORY;
+    c->tri_edge_eps = calloc(nt ? nt : 1, sizeof(float));
+    if (!c->tri_first || !c->tri_m || !c->tri_sides || !c->tri_edge_eps) return LBK_ERR_OUT_OF_MEMORY;
     double total = 0;
     for (size_t i = 0; i < nt; i++) {
         uint32_t mi = s->tri_material ? s->tri_material[i] : 0;
@@ -690,8 +699,8 @@ static lbk_result build_cells(tp_ctx *c)
         if (count > UINT32_MAX - 2 * TP_MAX_SUB * TP_MAX_SUB) return LBK_ERR_LIMIT;
         c->tri_first[i] = (uint32_t)count;
         count += (size_t)c->tri_sides[i] * m * m;
-        /* keep sample points ≥ 16 ulps of the coordinates (and ≥ 0.1 % of the triangle) inside
-         * every edge: see the edge limitation in tracer.h */
+        /* keep sample points >= 8 ulps of the coordinates inside every edge (the tracer's edge
+         * limitation, tracer.h): a barycentric floor of 8 ulp / altitude */
         double v[3][3];
         tri_vertices(c, (uint32_t)i, v);
         double longest = 0;
@@ -702,9 +711,8 @@ static lbk_result build_cells(tp_ctx *c)
         }
         double alt = longest > 0 ? 2 * a / longest : 0;
         double ulp = bk_tracer_tri_scale(c->tracer, (uint32_t)i) * 1.1920928955078125e-07;
-        double eps = alt > 0 ? fmax(16 * ulp / alt, 1e-3) : 1e-3;
-        if (eps > 0.3) eps = 0.3;
-        c->tri_shrink[i] = (float)(1 - 3 * eps);
+        double eps = alt > 0 && isfinite(alt) ? 8 * ulp / alt : 0;
+        c->tri_edge_eps[i] = (float)(eps > 0.3 ? 0.3 : eps);
     }
     c->cell_count = count;
     c->cells = calloc(count ? count : 1, sizeof *c->cells);
