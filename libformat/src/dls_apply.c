@@ -157,7 +157,11 @@ static void apply_prefix(const lbk_dls_runtime *r, const rt_cluster *c, const fl
             uint32_t n = dls_prefix_field(c->words, pf, ordinal) + pf->bias;
             const uint8_t *slots = c->slots + off;
             const uint8_t *e = c->payload + off * psize;
-            if (c->space == LBK_DLS_SPACE_TEXEL) {
+            bool active = false;
+            for (uint32_t j = 0; j < n; j++) active |= wl[slots[j]] != 0.0f;
+            if (!active) {
+                copy_base(r, c->space, t, 1); /* exactly the base, as for an all-zero dispatch */
+            } else if (c->space == LBK_DLS_SPACE_TEXEL) {
                 lbk_ahd_linear acc;
                 texel_load_linear(r->desc.base_irradiance_z[t], r->desc.base_rgba + 4 * (size_t)t, &acc);
                 for (uint32_t j = 0; j < n; j++)

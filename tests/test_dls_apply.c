@@ -1,0 +1,462 @@
+/* Reference runtime apply: equals a dense per-target sum L_B + Σ w_j S_j (decode, weight, sum,
+ * encode) within the codecs' quantisation on random sets and random weights; incremental applies
+ * that skip unchanged clusters give the bytes of a full apply; all-zero weights give exactly the
+ * base; a set without entries adds no data; door weights drive kinds 1–3. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdbool.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "lbk/ahd.h"
+#include "lbk/dls.h"
+#include "lbk/door.h"
+#include "lbk/sh.h"
+#include "support/dls_fixture.h"
+
+typedef struct scene {
+    dlsfx fx;
+    void *bytes;
+    size_t size;
+    lbk_dls_view *view;
+    uint32_t *base_z, *out_z, *ref_z;
+    uint8_t *base_rgba, *out_rgba, *ref_rgba;
+    uint8_t *base_probe[2], *out_probe[2], *ref_probe[2];
+} scene;
+
+static void random_sets(dlsfx *fx, uint64_t seed, uint32_t nsets)
+{
+    uint64_t rng = seed;
+    dlsfx_init(fx, nsets, 3000, 400, 300);
+    for (uint32_t s = 0; s < nsets; s++)
+        for (uint32_t sp = 0; sp < 3; sp++) {
+            uint32_t span = (uint32_t)fx->desc.target_count[sp];
+            uint32_t len = 10 + (uint32_t)(dlsfx_rand(&rng) % (span / 3));
+            uint32_t start = (uint32_t)(dlsfx_rand(&rng) % (span - len));
+            for (uint32_t t = start; t < start + len; t++)
+                if (dlsfx_rand(&rng) % 6) dlsfx_add(fx, &rng, s, sp, t);
+        }
+}
+
+static void scene_build(scene *sc, uint64_t seed)
+{
+    assert_int_equal(lbk_dls_build(&sc->fx.desc, NULL, &sc->bytes, &sc->size, NULL), LBK_OK);
+    assert_int_equal(lbk_dls_view_open(sc->bytes, sc->size, NULL, &sc->view), LBK_OK);
+    uint64_t rng = seed * 977 + 1;
+    uint64_t nt = sc->fx.desc.target_count[0];
+    sc->base_z = malloc(nt * 4), sc->out_z = calloc(nt, 4), sc->ref_z = calloc(nt, 4);
+    sc->base_rgba = malloc(nt * 4), sc->out_rgba = calloc(nt, 4), sc->ref_rgba = calloc(nt, 4);
+    for (uint64_t t = 0; t < nt; t++) {
+        uint8_t b[8];
+        dlsfx_random_texel(&rng, 2.0f, b);
+        lbk_ahd_texel tx;
+        lbk_ahd_texel_load(b, &tx);
+        sc->base_z[t] = tx.irradiance_z;
+        memcpy(sc->base_rgba + 4 * t, tx.rgba, 4);
+    }
+    for (int p = 0; p < 2; p++) {
+        uint64_t np = sc->fx.desc.target_count[1 + p];
+        sc->base_probe[p] = malloc(np * 28), sc->out_probe[p] = calloc(np, 28), sc->ref_probe[p] = calloc(np, 28);
+        for (uint64_t t = 0; t < np; t++) dlsfx_random_probe(&rng, 2.0f, sc->base_probe[p] + 28 * t);
+    }
+}
+
+static void scene_free(scene *sc)
+{
+    lbk_dls_view_close(sc->view);
+    free(sc->bytes);
+    free(sc->base_z), free(sc->out_z), free(sc->ref_z);
+    free(sc->base_rgba), free(sc->out_rgba), free(sc->ref_rgba);
+    for (int p = 0; p < 2; p++) free(sc->base_probe[p]), free(sc->out_probe[p]), free(sc->ref_probe[p]);
+    dlsfx_free(&sc->fx);
+}
+
+static lbk_dls_runtime *runtime(scene *sc, const lbk_door_view *doors)
+{
+    lbk_dls_runtime_desc d = {.dls = sc->view,
+                              .doors = doors,
+                              .base_irradiance_z = sc->base_z,
+                              .base_rgba = sc->base_rgba,
+                              .base_glg = sc->base_probe[0],
+                              .base_llg = sc->base_probe[1],
+                              .out_irradiance_z = sc->out_z,
+                              .out_rgba = sc->out_rgba,
+                              .out_glg = sc->out_probe[0],
+                              .out_llg = sc->out_probe[1]};
+    lbk_dls_runtime *r;
+    assert_int_equal(lbk_dls_runtime_create(&d, &r), LBK_OK);
+    return r;
+}
+
+/* The dense reference: every target, every set, straight from the builder's input. */
+static void dense_sum(scene *sc, const float *w)
+{
+    const dlsfx *fx = &sc->fx;
+    for (uint32_t sp = 0; sp < 3; sp++) {
+        uint32_t **idx = calloc(fx->set_count, sizeof *idx);
+        for (uint32_t s = 0; s < fx->set_count; s++) idx[s] = dlsfx_index(fx, s, sp);
+        for (uint64_t t = 0; t < fx->desc.target_count[sp]; t++) {
+            bool active = false; /* no weighted contribution: exactly the base bytes */
+            for (uint32_t s = 0; s < fx->set_count; s++) active |= idx[s][t] && w[s] != 0.0f;
+            if (!active) {
+                if (sp == 0) {
+                    sc->ref_z[t] = sc->base_z[t];
+                    memcpy(sc->ref_rgba + 4 * t, sc->base_rgba + 4 * t, 4);
+                } else {
+                    memcpy(sc->ref_probe[sp - 1] + 28 * t, sc->base_probe[sp - 1] + 28 * t, 28);
+                }
+            } else if (sp == 0) {
+                lbk_ahd_texel b = {sc->base_z[t], {0}};
+                memcpy(b.rgba, sc->base_rgba + 4 * t, 4);
+                lbk_ahd_linear acc;
+                lbk_ahd_to_linear(&b, &acc);
+                for (uint32_t s = 0; s < fx->set_count; s++) {
+                    if (!idx[s][t] || w[s] == 0.0f) continue;
+                    lbk_ahd_texel e;
+                    lbk_ahd_texel_load((const uint8_t *)fx->sets[s].entries[0].payloads + 8ull * (idx[s][t] - 1), &e);
+                    lbk_ahd_linear l;
+                    lbk_ahd_to_linear(&e, &l);
+                    lbk_ahd_linear_add_scaled(&acc, &l, w[s]);
+                }
+                lbk_ahd_texel o;
+                lbk_ahd_from_linear(&acc, &o);
+                sc->ref_z[t] = o.irradiance_z;
+                memcpy(sc->ref_rgba + 4 * t, o.rgba, 4);
+            } else {
+                lbk_sh9_rgb acc;
+                lbk_sh9_unpack(sc->base_probe[sp - 1] + 28 * t, &acc);
+                for (uint32_t s = 0; s < fx->set_count; s++) {
+                    if (!idx[s][t] || w[s] == 0.0f) continue;
+                    lbk_sh9_rgb l;
+                    lbk_sh9_unpack((const uint8_t *)fx->sets[s].entries[sp].payloads + 28ull * (idx[s][t] - 1), &l);
+                    lbk_sh9_add_scaled(&acc, &l, w[s]);
+                }
+                lbk_sh9_pack(&acc, sc->ref_probe[sp - 1] + 28 * t);
+            }
+        }
+        for (uint32_t s = 0; s < fx->set_count; s++) free(idx[s]);
+        free(idx);
+    }
+}
+
+/* Output vs reference: byte-identical targets counted; the others must agree within one
+ * quantisation step of the codecs (R11G11B10F: 1/32 relative; snorm8/unorm8: 1/127 of the DC
+ * or irradiance scale). Returns the number of targets outside that bound. */
+static uint64_t compare(const scene *sc, uint64_t *identical, uint64_t *total)
+{
+    uint64_t bad = 0;
+    *identical = *total = 0;
+    static const float normals[4][3] = {{0, 0, 1}, {0.6f, 0, 0.8f}, {0, -0.6f, 0.8f}, {0.57735f, 0.57735f, 0.57735f}};
+    for (uint64_t t = 0; t < sc->fx.desc.target_count[0]; t++) {
+        (*total)++;
+        if (sc->out_z[t] == sc->ref_z[t] && !memcmp(sc->out_rgba + 4 * t, sc->ref_rgba + 4 * t, 4)) {
+            (*identical)++;
+            continue;
+        }
+        lbk_ahd_texel a = {sc->out_z[t], {0}}, b = {sc->ref_z[t], {0}};
+        memcpy(a.rgba, sc->out_rgba + 4 * t, 4);
+        memcpy(b.rgba, sc->ref_rgba + 4 * t, 4);
+        for (int n = 0; n < 4; n++) {
+            float ea[3], eb[3];
+            lbk_ahd_irradiance(&a, normals[n], ea);
+            lbk_ahd_irradiance(&b, normals[n], eb);
+            for (int c = 0; c < 3; c++)
+                if (fabsf(ea[c] - eb[c]) > 0.04f * fabsf(eb[c]) + 1e-4f) { bad++; n = 4; break; }
+        }
+    }
+    for (int p = 0; p < 2; p++)
+        for (uint64_t t = 0; t < sc->fx.desc.target_count[1 + p]; t++) {
+            (*total)++;
+            if (!memcmp(sc->out_probe[p] + 28 * t, sc->ref_probe[p] + 28 * t, 28)) {
+                (*identical)++;
+                continue;
+            }
+            lbk_sh9_rgb a, b;
+            lbk_sh9_unpack(sc->out_probe[p] + 28 * t, &a);
+            lbk_sh9_unpack(sc->ref_probe[p] + 28 * t, &b);
+            for (int c = 0; c < 3; c++) {
+                float scale = fabsf(b.c[c][0]) * 2.3f; /* √5 · DC bounds every coefficient */
+                bool off = false;
+                for (int k = 0; k < 9; k++) off |= fabsf(a.c[c][k] - b.c[c][k]) > 0.02f * scale + 1e-5f;
+                if (off) { bad++; break; }
+            }
+        }
+    return bad;
+}
+
+static void random_weights(uint64_t *rng, float *w, uint32_t n)
+{
+    for (uint32_t s = 0; s < n; s++) {
+        uint64_t r = dlsfx_rand(rng) % 4;
+        w[s] = r == 0 ? 0.0f : r == 1 ? 1.0f : 1.5f * dlsfx_uniform(rng);
+    }
+}
+
+static void test_apply_matches_dense_sum(void **state)
+{
+    (void)state;
+    for (uint64_t seed = 1; seed <= 2; seed++) {
+        scene sc;
+        memset(&sc, 0, sizeof sc);
+        random_sets(&sc.fx, seed, 22);
+        scene_build(&sc, seed);
+        lbk_dls_stats st;
+        lbk_dls_compute_stats(sc.view, &st);
+        /* the random sets reach the dedicated, packed and both class (2) forms */
+        assert_true(st.clusters_by_form[LBK_DLS_FORM_DEDICATED] > 0);
+        assert_true(st.clusters_by_form[LBK_DLS_FORM_PACKED] > 0);
+        assert_true(st.clusters_by_form[LBK_DLS_FORM_PREFIX2] > 0);
+        assert_true(st.clusters_by_form[LBK_DLS_FORM_PREFIX3] > 0);
+        lbk_dls_runtime *r = runtime(&sc, NULL);
+        uint64_t rng = seed;
+        float w[22];
+        for (int round = 0; round < 3; round++) { /* later rounds are incremental applies */
+            random_weights(&rng, w, 22);
+            assert_int_equal(lbk_dls_apply(r, w, NULL, NULL), LBK_OK);
+            dense_sum(&sc, w);
+            uint64_t same, total;
+            assert_int_equal(compare(&sc, &same, &total), 0);
+            assert_true(same * 100 >= total * 99);
+        }
+        lbk_dls_runtime_destroy(r);
+        scene_free(&sc);
+    }
+}
+
+static uint32_t clusters_touching(const lbk_dls_view *v, const bool *changed)
+{
+    uint32_t n = 0;
+    for (uint32_t ci = 0; ci < lbk_dls_cluster_count(v); ci++) {
+        lbk_dls_cluster_info info;
+        lbk_dls_cluster_get(v, ci, &info);
+        bool any = false;
+        for (uint32_t j = 0; j < info.set_count; j++) {
+            uint32_t s;
+            lbk_dls_cluster_set(v, ci, j, &s);
+            any |= changed[s];
+        }
+        n += any;
+    }
+    return n;
+}
+
+static void test_skipping_equals_full_apply(void **state)
+{
+    (void)state;
+    scene sc;
+    memset(&sc, 0, sizeof sc);
+    random_sets(&sc.fx, 5, 22);
+    scene_build(&sc, 5);
+    lbk_dls_runtime *r = runtime(&sc, NULL);
+    uint64_t rng = 42;
+    float w1[22], w2[22];
+    random_weights(&rng, w1, 22);
+    lbk_dls_apply_stats st;
+    assert_int_equal(lbk_dls_apply(r, w1, NULL, &st), LBK_OK);
+    assert_int_equal(st.clusters_skipped, 0);
+    uint64_t all = sc.fx.desc.target_count[0] + sc.fx.desc.target_count[1] + sc.fx.desc.target_count[2];
+    assert_int_equal(st.targets_written, all); /* each target exactly once */
+    memcpy(w2, w1, sizeof w1);
+    bool changed[22] = {0};
+    w2[3] = w1[3] + 0.5f, changed[3] = true;
+    w2[17] = 0.0f, changed[17] = w1[17] != 0.0f;
+    assert_int_equal(lbk_dls_apply(r, w2, NULL, &st), LBK_OK);
+    uint32_t expect = clusters_touching(sc.view, changed);
+    assert_true(expect > 0 && expect < lbk_dls_cluster_count(sc.view));
+    assert_int_equal(st.clusters_applied + st.clusters_copied, expect);
+    assert_int_equal(st.clusters_skipped, lbk_dls_cluster_count(sc.view) - expect);
+    /* the same weights again: everything skipped */
+    assert_int_equal(lbk_dls_apply(r, w2, NULL, &st), LBK_OK);
+    assert_int_equal(st.clusters_skipped, lbk_dls_cluster_count(sc.view));
+    assert_int_equal(st.targets_written, 0);
+
+    uint32_t *inc_z = malloc(sc.fx.desc.target_count[0] * 4);
+    memcpy(inc_z, sc.out_z, sc.fx.desc.target_count[0] * 4);
+    uint8_t *inc_rgba = malloc(sc.fx.desc.target_count[0] * 4);
+    memcpy(inc_rgba, sc.out_rgba, sc.fx.desc.target_count[0] * 4);
+    uint8_t *inc_glg = malloc(sc.fx.desc.target_count[1] * 28);
+    memcpy(inc_glg, sc.out_probe[0], sc.fx.desc.target_count[1] * 28);
+    lbk_dls_runtime_destroy(r);
+    memset(sc.out_z, 0xAB, sc.fx.desc.target_count[0] * 4);
+    r = runtime(&sc, NULL);
+    assert_int_equal(lbk_dls_apply(r, w2, NULL, NULL), LBK_OK);
+    assert_memory_equal(inc_z, sc.out_z, sc.fx.desc.target_count[0] * 4);
+    assert_memory_equal(inc_rgba, sc.out_rgba, sc.fx.desc.target_count[0] * 4);
+    assert_memory_equal(inc_glg, sc.out_probe[0], sc.fx.desc.target_count[1] * 28);
+    /* invalidate: the next apply rewrites every target */
+    lbk_dls_runtime_invalidate(r);
+    assert_int_equal(lbk_dls_apply(r, w2, NULL, &st), LBK_OK);
+    assert_int_equal(st.targets_written, all);
+    free(inc_z), free(inc_rgba), free(inc_glg);
+    lbk_dls_runtime_destroy(r);
+    scene_free(&sc);
+}
+
+static void test_zero_weights_give_exact_base(void **state)
+{
+    (void)state;
+    scene sc;
+    memset(&sc, 0, sizeof sc);
+    random_sets(&sc.fx, 9, 22);
+    scene_build(&sc, 9);
+    lbk_dls_runtime *r = runtime(&sc, NULL);
+    float w[22];
+    uint64_t rng = 1;
+    random_weights(&rng, w, 22);
+    assert_int_equal(lbk_dls_apply(r, w, NULL, NULL), LBK_OK);
+    lbk_dls_apply_stats st;
+    assert_int_equal(lbk_dls_apply(r, NULL, NULL, &st), LBK_OK); /* NULL: all 0 */
+    assert_int_equal(st.clusters_applied, 0);
+    assert_memory_equal(sc.out_z, sc.base_z, sc.fx.desc.target_count[0] * 4);
+    assert_memory_equal(sc.out_rgba, sc.base_rgba, sc.fx.desc.target_count[0] * 4);
+    assert_memory_equal(sc.out_probe[0], sc.base_probe[0], sc.fx.desc.target_count[1] * 28);
+    assert_memory_equal(sc.out_probe[1], sc.base_probe[1], sc.fx.desc.target_count[2] * 28);
+    lbk_dls_runtime_destroy(r);
+    scene_free(&sc);
+}
+
+/* A set with no entries: same clusters, payload and index bytes; applying it at weight 1 changes
+ * nothing. */
+static void test_empty_set_adds_no_data(void **state)
+{
+    (void)state;
+    scene a, b;
+    memset(&a, 0, sizeof a);
+    memset(&b, 0, sizeof b);
+    random_sets(&a.fx, 13, 10);
+    random_sets(&b.fx, 13, 11); /* same first 10 sets (same seed), plus set 10 ... */
+    for (uint32_t sp = 0; sp < 3; sp++) b.fx.sets[10].entries[sp].count = 0; /* ... emptied */
+    scene_build(&a, 13);
+    scene_build(&b, 13);
+    lbk_dls_stats sa, sb;
+    lbk_dls_compute_stats(a.view, &sa);
+    lbk_dls_compute_stats(b.view, &sb);
+    assert_int_equal(sb.set_count, sa.set_count + 1);
+    assert_int_equal(sb.cluster_count, sa.cluster_count);
+    assert_int_equal(sb.payload_bytes, sa.payload_bytes);
+    for (int sp = 0; sp < 3; sp++) assert_int_equal(sb.index_bytes[sp], sa.index_bytes[sp]);
+    for (uint32_t ci = 0; ci < lbk_dls_cluster_count(b.view); ci++) {
+        for (uint32_t j = 0;; j++) {
+            uint32_t s;
+            if (lbk_dls_cluster_set(b.view, ci, j, &s) != LBK_OK) break;
+            assert_int_not_equal(s, 10);
+        }
+    }
+    float wa[10], wb[11];
+    uint64_t rng = 3;
+    random_weights(&rng, wa, 10);
+    memcpy(wb, wa, sizeof wa);
+    wb[10] = 1.0f;
+    lbk_dls_runtime *ra = runtime(&a, NULL), *rb = runtime(&b, NULL);
+    assert_int_equal(lbk_dls_apply(ra, wa, NULL, NULL), LBK_OK);
+    assert_int_equal(lbk_dls_apply(rb, wb, NULL, NULL), LBK_OK);
+    assert_memory_equal(a.out_z, b.out_z, a.fx.desc.target_count[0] * 4);
+    assert_memory_equal(a.out_probe[1], b.out_probe[1], a.fx.desc.target_count[2] * 28);
+    lbk_dls_runtime_destroy(ra);
+    lbk_dls_runtime_destroy(rb);
+    scene_free(&a);
+    scene_free(&b);
+}
+
+/* Sets: 0 lights, 1 door open, 2 door closed (bounce), 3 = {0, 1} combination, 4 lights. */
+static void test_door_weights(void **state)
+{
+    (void)state;
+    scene sc;
+    memset(&sc, 0, sizeof sc);
+    random_sets(&sc.fx, 21, 5);
+    sc.fx.sets[1].kind = LBK_DLS_KIND_DOOR_OPEN;
+    sc.fx.sets[2].kind = LBK_DLS_KIND_DOOR_CLOSED;
+    uint32_t mem[2] = {1, 0};
+    dlsfx_combination(&sc.fx, 3, 2, mem);
+    scene_build(&sc, 21);
+
+    lbk_door_desc door = {.name = "front_door",
+                          .centre = {1, 2, 3},
+                          .axes = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}},
+                          .half_extents = {0.5f, 1.0f, 0.05f},
+                          .open_set = 1,
+                          .closed_set = 2};
+    uint32_t door0 = 0;
+    lbk_door_state_desc state0 = {1, &door0, 3};
+    lbk_door_build_desc dd = {1, &door, 1, &state0};
+    void *db;
+    size_t dsize;
+    assert_int_equal(lbk_door_build(&dd, NULL, &db, &dsize), LBK_OK);
+    lbk_door_view *dv;
+    assert_int_equal(lbk_door_view_open(db, dsize, NULL, &dv), LBK_OK);
+    assert_int_equal(lbk_door_check_dls(dv, sc.view), LBK_OK);
+    lbk_door_info di;
+    assert_int_equal(lbk_door_get(dv, 0, &di), LBK_OK);
+    assert_int_equal(di.name_length, 10);
+    assert_memory_equal(di.name, "front_door", 10);
+    assert_true(di.centre[2] == 3.0f && di.half_extents[2] == 0.05f && di.axes[1][1] == 1.0f);
+    assert_int_equal(di.open_set, 1);
+    assert_int_equal(di.closed_set, 2);
+
+    lbk_dls_runtime *r = runtime(&sc, dv);
+    const float sw[5] = {0.5f, 9.0f, 9.0f, 9.0f, 0.75f}; /* door-driven entries are ignored */
+    const float omega = 0.25f;
+    float eff[5];
+    assert_int_equal(lbk_dls_effective_weights(r, sw, &omega, eff), LBK_OK);
+    assert_true(eff[0] == 0.5f && eff[1] == 0.25f && eff[2] == 0.75f && eff[3] == 0.125f && eff[4] == 0.75f);
+    assert_int_equal(lbk_dls_effective_weights(r, NULL, NULL, eff), LBK_OK); /* closed: bounce at 1 */
+    assert_true(eff[0] == 0.0f && eff[1] == 0.0f && eff[2] == 1.0f && eff[3] == 0.0f);
+    assert_int_equal(lbk_dls_effective_weights(r, sw, &omega, eff), LBK_OK);
+    assert_int_equal(lbk_dls_apply(r, sw, &omega, NULL), LBK_OK);
+    dense_sum(&sc, eff);
+    uint64_t same, total;
+    assert_int_equal(compare(&sc, &same, &total), 0);
+    assert_true(same * 100 >= total * 99);
+    const float bad_w = NAN;
+    assert_int_equal(lbk_dls_apply(r, sw, &bad_w, NULL), LBK_ERR_INVALID_ARGUMENT);
+    lbk_dls_runtime_destroy(r);
+
+    /* A door whose open set is a plain light set disagrees with the DLS. */
+    door.open_set = 0;
+    void *db2;
+    assert_int_equal(lbk_door_build(&dd, NULL, &db2, &dsize), LBK_OK);
+    lbk_door_view *dv2;
+    assert_int_equal(lbk_door_view_open(db2, dsize, NULL, &dv2), LBK_OK);
+    assert_int_equal(lbk_door_check_dls(dv2, sc.view), LBK_ERR_CORRUPT);
+    lbk_dls_runtime_desc rd = {.dls = sc.view, .doors = dv2};
+    lbk_dls_runtime *r2;
+    assert_int_equal(lbk_dls_runtime_create(&rd, &r2), LBK_ERR_CORRUPT);
+    lbk_door_view_close(dv2);
+    free(db2);
+    lbk_door_view_close(dv);
+    free(db);
+    scene_free(&sc);
+}
+
+static void test_missing_buffers_rejected(void **state)
+{
+    (void)state;
+    scene sc;
+    memset(&sc, 0, sizeof sc);
+    random_sets(&sc.fx, 2, 4);
+    scene_build(&sc, 2);
+    lbk_dls_runtime_desc d = {.dls = sc.view, .base_irradiance_z = sc.base_z, .base_rgba = sc.base_rgba,
+                              .out_irradiance_z = sc.out_z, .out_rgba = sc.out_rgba};
+    lbk_dls_runtime *r;
+    assert_int_equal(lbk_dls_runtime_create(&d, &r), LBK_ERR_INVALID_ARGUMENT); /* probes have clusters */
+    scene_free(&sc);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_apply_matches_dense_sum),
+        cmocka_unit_test(test_skipping_equals_full_apply),
+        cmocka_unit_test(test_zero_weights_give_exact_base),
+        cmocka_unit_test(test_empty_set_adds_no_data),
+        cmocka_unit_test(test_door_weights),
+        cmocka_unit_test(test_missing_buffers_rejected),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
