@@ -195,14 +195,16 @@ lbk_result bk_llg_place(const bk_scene *scene, uint32_t object, const bk_llg_opt
     if (cap < 8) cap = 8;
     for (;;) {
         size_t total = 1;
+        int too_long = 0;
         for (int a = 0; a < 3; a++) {
             double d = ceil(2.0 * out->half_extents[a] / spacing - 1e-9) + 1.0;
             if (d < 2.0) d = 2.0;
             if (d > 65535.0) d = 65535.0;
             out->dims[a] = (uint32_t)d;
+            too_long |= out->dims[a] > BK_LLG_MAX_DIM;
             total *= out->dims[a];
         }
-        if (total <= cap) break;
+        if (total <= cap && !too_long) break;
         spacing *= 1.1;  /* lower the resolution until the grid fits */
     }
     out->spacing = (float)spacing;
@@ -281,4 +283,19 @@ done:
     free(sub.positions); free(sub.tris); free(nrm); free(acc); free(toward);
     if (res != LBK_OK) bk_llg_free(out);
     return res;
+}
+
+void bk_llg_vertex_records(const bk_llg *l, lbk_llg_vertex *out)
+{
+    for (size_t v = 0; v < l->vertex_count; v++) {
+        const float *b = l->bent_normals + 3 * v;
+        float g[3], len = 0.0f;
+        for (int a = 0; a < 3; a++) {
+            g[a] = b[0] * l->axes[a][0] + b[1] * l->axes[a][1] + b[2] * l->axes[a][2];
+            len += g[a] * g[a];
+        }
+        len = sqrtf(len);
+        for (int a = 0; a < 3; a++) out[v].bent_normal[a] = len > 0.0f ? g[a] / len : (a == 2 ? 1.0f : 0.0f);
+        out[v].visibility = l->visibility[v];
+    }
 }

@@ -11,6 +11,9 @@
 
 #include "bake/scene.h"
 #include "lbk/lbk.h"
+#include "lbk/llg.h"
+
+#define BK_LLG_MAX_DIM 64u  /* lbk/llg.h: LBK_LLG_MAX_DIM */
 
 typedef struct bk_llg_options {   /* zero-initialised = defaults */
     float spacing;                /* metres between probes; 0: 1.5. An object with
@@ -34,7 +37,7 @@ typedef struct bk_llg {
     float obb_half_extents[3];
     /* the lattice box: same centre/axes, half extents = OBB (floored) + margin */
     float half_extents[3];
-    uint32_t dims[3];             /* probes per axis, >= 2 */
+    uint32_t dims[3];             /* probes per axis, 2..64 (the spacing grows to fit) */
     float spacing;                /* requested spacing after the cap (actual per-axis step is
                                      2·half_extents[a] / (dims[a] - 1) <= spacing) */
     /* per object vertex (ascending global vertex index among its triangles' corners) */
@@ -54,6 +57,10 @@ void bk_llg_free(bk_llg *llg);
 /* Probe (i, j, k) of the lattice, i fastest: centre + Σ_a axes[a]·(−h_a + 2·h_a·idx_a/(dims_a−1)). */
 void bk_llg_probe_position(const bk_llg *llg, uint32_t i, uint32_t j, uint32_t k, float out[3]);
 size_t bk_llg_probe_count(const bk_llg *llg);
+
+/* The per-vertex records of the LLG section (lbk/llg.h): visibility and the bent normal in the
+ * grid frame (components along axes[0..2]), in the order of llg->vertices. out: vertex_count. */
+void bk_llg_vertex_records(const bk_llg *llg, lbk_llg_vertex *out);
 
 /* OBB only (area-weighted PCA), exposed for tests: centre, axes, half extents (tight). */
 lbk_result bk_obb_from_triangles(const bk_scene *scene, uint32_t first_tri, uint32_t tri_count,

@@ -15,6 +15,7 @@
 #include "bake/tracer.h"
 #include "lbk/container.h"
 #include "lbk/glg.h"
+#include "lbk/llg.h"
 #include "tests/support/probe_scenes.h"
 
 /* A closed room [0,10]x[0,6]x[0,8] (walls facing inward) holding a solid block
@@ -336,7 +337,62 @@ static void test_llg_obb_rotated_box(void **state)
         }
     /* 24 box corners as separate vertices per face: 6 faces x 16 grid vertices */
     assert_int_equal(l.vertex_count, 6 * 16);
+    /* the container's LLG builder takes the grid; its probe positions match ours */
+    {
+        lbk_llg_vertex *recs = malloc(l.vertex_count * sizeof *recs);
+        bk_llg_vertex_records(&l, recs);
+        for (size_t v = 0; v < l.vertex_count; v++) {
+            /* grid-frame bent normal maps back to the world one */
+            for (int k = 0; k < 3; k++) {
+                float wv = 0.0f;
+                for (int a = 0; a < 3; a++) wv += recs[v].bent_normal[a] * l.axes[a][k];
+                assert_true(fabsf(wv - l.bent_normals[3 * v + k]) < 1e-5f);
+            }
+        }
+        lbk_sh9_rgb *sh = calloc(bk_llg_probe_count(&l), sizeof *sh);
+        lbk_llg_grid_desc gd;
+        memset(&gd, 0, sizeof gd);
+        memcpy(gd.centre, l.centre, sizeof gd.centre);
+        memcpy(gd.axes, l.axes, sizeof gd.axes);
+        memcpy(gd.half_extent, l.half_extents, sizeof gd.half_extent);
+        memcpy(gd.dims, l.dims, sizeof gd.dims);
+        gd.probes = sh;
+        gd.vertices = recs;
+        gd.vertex_count = (uint32_t)l.vertex_count;
+        void *bytes = NULL;
+        size_t size = 0;
+        assert_int_equal(lbk_llg_build(&gd, 1, NULL, &bytes, &size), LBK_OK);
+        lbk_llg_view view;
+        lbk_llg_grid grid;
+        assert_int_equal(lbk_llg_open(bytes, size, &view), LBK_OK);
+        assert_int_equal(lbk_llg_get_grid(&view, 0, &grid), LBK_OK);
+        for (uint32_t k = 0; k < l.dims[2]; k++) for (uint32_t j = 0; j < l.dims[1]; j++)
+            for (uint32_t i = 0; i < l.dims[0]; i++) {
+                float a[3], b[3];
+                bk_llg_probe_position(&l, i, j, k, a);
+                lbk_llg_probe_position(&grid, i, j, k, b);
+                for (int c = 0; c < 3; c++) assert_true(fabsf(a[c] - b[c]) < 1e-4f);
+            }
+        lbk_free(NULL, bytes);
+        free(sh);
+        free(recs);
+    }
     bk_llg_free(&l);
+    /* a 200 m rod: the per-axis limit of the container (64) also lowers the resolution */
+    {
+        bk_scene r;
+        psc_init(&r);
+        uint32_t rod = psc_object(&r, "rod", BK_LIGHTING_LLG);
+        const float rlo[3] = {0, 0, 0}, rhi[3] = {200, 0.2f, 0.2f};
+        psc_box(&r, rlo, rhi, 1, 0);
+        bk_llg_options ro = {0};
+        ro.visibility_rays = 4;
+        ro.max_probes = 100000;
+        assert_int_equal(bk_llg_place(&r, rod, &ro, 1, &l), LBK_OK);
+        assert_true(l.dims[0] <= 64 && l.dims[0] >= 60);
+        bk_llg_free(&l);
+        psc_free(&r);
+    }
 
     /* cap: at most 20 probes -> the spacing grows */
     o.max_probes = 20;
