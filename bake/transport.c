@@ -57,11 +57,49 @@ static uint32_t lattice_generator(uint32_t S)
     }
 }
 
-static void lattice(uint32_t j, uint32_t S, uint32_t g, double s1, double s2, double *u1, double *u2)
+/* Sample j of the shifted lattice as u1 and the angle 2π·u2 given as (cos, sin): the angles of
+ * the unshifted lattice are S-th roots of unity (a table per sample count), and the shift is
+ * one rotation per item, so no trigonometry runs per ray. */
+typedef struct tp_lattice {
+    uint32_t S, g;
+    double *cos_k, *sin_k; /* cos/sin(2π k/S) */
+} tp_lattice;
+
+static lbk_result lattice_init(tp_lattice *l, uint32_t S)
 {
-    double a = (double)j / S + s1, b = (double)(uint32_t)(((uint64_t)j * g) % S) / S + s2;
+    if (l->S == S) return LBK_OK;
+    free(l->cos_k);
+    free(l->sin_k);
+    l->cos_k = malloc(S * sizeof(double));
+    l->sin_k = malloc(S * sizeof(double));
+    l->S = 0;
+    if (!l->cos_k || !l->sin_k) return LBK_ERR_OUT_OF_MEMORY;
+    for (uint32_t k = 0; k < S; k++) {
+        l->cos_k[k] = cos(2 * 3.14159265358979323846 * k / S);
+        l->sin_k[k] = sin(2 * 3.14159265358979323846 * k / S);
+    }
+    l->S = S;
+    l->g = lattice_generator(S);
+    return LBK_OK;
+}
+
+static void lattice_free(tp_lattice *l) { free(l->cos_k); free(l->sin_k); }
+
+typedef struct tp_shift { double s1, cs, sn; } tp_shift;
+
+static tp_shift lattice_shift(double s1, double s2)
+{
+    tp_shift t = {s1, cos(2 * 3.14159265358979323846 * s2), sin(2 * 3.14159265358979323846 * s2)};
+    return t;
+}
+
+static void lattice(const tp_lattice *l, uint32_t j, const tp_shift *sh, double *u1, double *cphi, double *sphi)
+{
+    double a = (double)j / l->S + sh->s1;
     *u1 = a - floor(a);
-    *u2 = b - floor(b);
+    uint32_t k = (uint32_t)(((uint64_t)j * l->g) % l->S);
+    *cphi = l->cos_k[k] * sh->cs - l->sin_k[k] * sh->sn;
+    *sphi = l->sin_k[k] * sh->cs + l->cos_k[k] * sh->sn;
 }
 
 /* ---- small vector helpers ------------------------------------------------------------------ */
@@ -128,7 +166,7 @@ typedef struct tp_ctx {
     float *l_prev[2], *l_cur[2], *l_sum[2];
     /* current job */
     int half, pass, bounce, rays;
-    uint32_t lat_g;        /* lattice generator for `rays` */
+    tp_lattice lat;        /* for `rays` samples */
     /* receivers */
     const bk_receiver *recv;
     size_t recv_count;
@@ -315,8 +353,8 @@ static long hit_cell(const tp_ctx *c, const bk_hit *h)
     int side = h->front ? 0 : 1;
     if (side >= c->tri_sides[h->tri]) return -1;
     int m = c->tri_m[h->tri];
-    double a = h->u * m, b = h->v * m;
-    int i = (int)floor(a), j = (int)floor(b);
+    float a = h->u * (float)m, b = h->v * (float)m;
+    int i = (int)a, j = (int)b; /* truncation: u, v >= 0 up to rounding, and the clamps below */
     if (j < 0) j = 0;
     if (j > m - 1) j = m - 1;
     if (i < 0) i = 0;
@@ -326,8 +364,15 @@ static long hit_cell(const tp_ctx *c, const bk_hit *h)
     return (long)c->tri_first[h->tri] + (long)side * m * m + sub;
 }
 
-/* Random point in a cell, kept off the triangle's edges. */
-static void cell_point(const tp_ctx *c, const tp_cell *cell, tp_rng *r, double p[3])
+/* A cell's sub-triangle in world space, and the edge band of its triangle, fetched once per
+ * cell and bounce rather than per ray. */
+typedef struct tp_cell_geom {
+    double b[3][2];     /* barycentric (u, v) corners of the sub-triangle */
+    double v[3][3];     /* the triangle's vertices */
+    double eps;
+} tp_cell_geom;
+
+static void cell_geom(const tp_ctx *c, const tp_cell *cell, tp_cell_geom *g)
 {
     int m = cell->m, s = cell->sub, j = 0;
     while (j < m - 1 && s >= 2 * (m - j) - 1) { s -= 2 * (m - j) - 1; j++; }
@@ -338,14 +383,26 @@ static void cell_point(const tp_ctx *c, const tp_cell *cell, tp_rng *r, double p
     } else {
         c0[0] = i + 1; c0[1] = j; c1[0] = i + 1; c1[1] = j + 1; c2[0] = i; c2[1] = j + 1;
     }
+    for (int k = 0; k < 2; k++) {
+        g->b[0][k] = c0[k] / m;
+        g->b[1][k] = c1[k] / m;
+        g->b[2][k] = c2[k] / m;
+    }
+    tri_vertices(c, cell->tri, g->v);
+    g->eps = c->tri_edge_eps[cell->tri];
+}
+
+/* Random point in a cell, kept off the triangle's edges. */
+static void cell_point(const tp_cell_geom *g, tp_rng *r, double p[3])
+{
     double r1 = rng_next(r), r2 = rng_next(r);
     double sq = sqrt(r1);
     double w0 = 1 - sq, w1 = sq * (1 - r2), w2 = sq * r2;
-    double u = (w0 * c0[0] + w1 * c1[0] + w2 * c2[0]) / m;
-    double v = (w0 * c0[1] + w1 * c1[1] + w2 * c2[1]) / m;
+    double u = w0 * g->b[0][0] + w1 * g->b[1][0] + w2 * g->b[2][0];
+    double v = w0 * g->b[0][1] + w1 * g->b[1][1] + w2 * g->b[2][1];
     /* clamp into the band-free interior: only points within the band move, and only onto the
      * band's inner border, so the rest of the triangle is sampled exactly uniformly */
-    double eps = c->tri_edge_eps[cell->tri];
+    double eps = g->eps;
     if (eps > 0) {
         double w = 1 - u - v;
         u = u < eps ? eps : u;
@@ -355,9 +412,7 @@ static void cell_point(const tp_ctx *c, const tp_cell *cell, tp_rng *r, double p
         u /= sum;
         v /= sum;
     }
-    double vv[3][3];
-    tri_vertices(c, cell->tri, vv);
-    for (int a = 0; a < 3; a++) p[a] = (1 - u - v) * vv[0][a] + u * vv[1][a] + v * vv[2][a];
+    for (int a = 0; a < 3; a++) p[a] = (1 - u - v) * g->v[0][a] + u * g->v[1][a] + v * g->v[2][a];
 }
 
 /* ---- cache: one bounce for a range of cells ------------------------------------------------ */
@@ -379,18 +434,21 @@ static void cache_bounce(tp_ctx *c, size_t begin, size_t end, int thread)
         float nf[3] = {cell->n[0], cell->n[1], cell->n[2]};
         float scale = bk_tracer_tri_scale(c->tracer, cell->tri);
         double s1 = rng_next(&rng), s2 = rng_next(&rng);
+        tp_shift shift = lattice_shift(s1, s2);
+        tp_cell_geom geom;
+        cell_geom(c, cell, &geom);
         int light_points = (k == 1 && c->light_count) ? (R < TP_LIGHT_POINTS ? R : TP_LIGHT_POINTS) : 0;
         double ep[3] = {0, 0, 0};
         for (int j = 0; j < R; j++) {
             double p[3];
-            cell_point(c, cell, &rng, p);
+            cell_point(&geom, &rng, p);
             float pf[3] = {(float)p[0], (float)p[1], (float)p[2]}, o[3];
             bk_offset_ray_origin_scaled(pf, nf, scale, o);
             /* cosine-distributed direction */
-            double u1, u2;
-            lattice((uint32_t)j, (uint32_t)R, c->lat_g, s1, s2, &u1, &u2);
-            double rr = sqrt(u1), phi = 2 * TP_PI * u2;
-            double lx = rr * cos(phi), ly = rr * sin(phi), lz = sqrt(fmax(0.0, 1 - u1));
+            double u1, cp, sp;
+            lattice(&c->lat, (uint32_t)j, &shift, &u1, &cp, &sp);
+            double rr = sqrt(u1);
+            double lx = rr * cp, ly = rr * sp, lz = sqrt(fmax(0.0, 1 - u1));
             double d[3];
             for (int a = 0; a < 3; a++) d[a] = lx * t[a] + ly * b[a] + lz * n[a];
             float df[3] = {(float)d[0], (float)d[1], (float)d[2]};
@@ -460,7 +518,7 @@ static tp_chain_result run_chain(tp_ctx *c, int h, int pass, int rays, double to
     c->half = h;
     c->pass = pass;
     c->rays = rays;
-    c->lat_g = lattice_generator((uint32_t)rays);
+    if (lattice_init(&c->lat, (uint32_t)rays) != LBK_OK) { res.bounces = -1; return res; }
     double pw[3] = {0, 0, 0}; /* energies of the last three bounces */
     double indirect = 0, q = 0;
     int k;
@@ -584,17 +642,18 @@ static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
         for (int h = 0; h < 2; h++) {
             tp_rng rng = rng_make(c->seed, DOM_RECV, (uint64_t)h, (uint64_t)c->pass, 0, i);
             double s1 = rng_next(&rng), s2 = rng_next(&rng);
+            tp_shift shift = lattice_shift(s1, s2);
             const float *sum = c->l_sum[h];
             double e[3] = {0, 0, 0};
             /* uniform over the hemisphere (texels) or sphere (probes): the SH projection needs
              * a pdf that does not vanish at the horizon */
             const double solid = sphere ? 4 * TP_PI : 2 * TP_PI;
             for (int j = 0; j < S; j++) {
-                double u1, u2;
-                lattice((uint32_t)j, (uint32_t)S, c->lat_g, s1, s2, &u1, &u2);
+                double u1, cp, sp;
+                lattice(&c->lat, (uint32_t)j, &shift, &u1, &cp, &sp);
                 double z = sphere ? 1 - 2 * u1 : u1;
-                double rr = sqrt(fmax(0.0, 1 - z * z)), phi = 2 * TP_PI * u2;
-                double lx = rr * cos(phi), ly = rr * sin(phi);
+                double rr = sqrt(fmax(0.0, 1 - z * z));
+                double lx = rr * cp, ly = rr * sp;
                 double d[3];
                 for (int a = 0; a < 3; a++) d[a] = lx * t[a] + ly * b[a] + z * n[a];
                 float df[3] = {(float)d[0], (float)d[1], (float)d[2]};
@@ -616,12 +675,12 @@ static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
                 double y[9];
                 sh9_basis(d, y);
                 double cs = sphere ? 1 : z;
+                int has_d = Ld[0] != 0 || Ld[1] != 0 || Ld[2] != 0;
                 for (int a = 0; a < 3; a++) {
                     e[a] += L[a] * cs;
-                    for (int kk = 0; kk < 9; kk++) {
-                        sh_t[a][kk] += L[a] * y[kk] * solid;
-                        sh_d[a][kk] += Ld[a] * y[kk] * solid;
-                    }
+                    for (int kk = 0; kk < 9; kk++) sh_t[a][kk] += L[a] * y[kk];
+                    if (has_d)
+                        for (int kk = 0; kk < 9; kk++) sh_d[a][kk] += Ld[a] * y[kk];
                 }
             }
             for (int a = 0; a < 3; a++) e[a] *= solid / S;
@@ -630,8 +689,8 @@ static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
             c->x_acc[h][i] += w * (lum(e) + c->punct_lum[i]) * (sphere ? 0.25 : 1.0);
             for (int a = 0; a < 3; a++) e_t[a] += e[a];
         }
-        /* both halves: 2S samples; weight w for this pass */
-        const double ws = w / (2.0 * S);
+        /* both halves: 2S samples of pdf 1/solid; weight w for this pass */
+        const double ws = w * (sphere ? 4 * TP_PI : 2 * TP_PI) / (2.0 * S);
         for (int a = 0; a < 3; a++) {
             for (int kk = 0; kk < 9; kk++) {
                 out->radiance[i].c[a][kk] += (float)(sh_t[a][kk] * ws);
@@ -666,6 +725,7 @@ static void free_ctx(tp_ctx *c)
     for (int h = 0; h < 2; h++) { free(c->l_prev[h]); free(c->l_cur[h]); free(c->l_sum[h]); free(c->x_acc[h]); }
     free(c->punct_lum);
     free(c->thread_rays); free(c->thread_nonfinite);
+    lattice_free(&c->lat);
 }
 
 static lbk_result build_cells(tp_ctx *c)
@@ -866,6 +926,7 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
         int cache_rays = (int)fmax(lo, fmin(cap, want));
         for (int h = 0; h < 2; h++) {
             chain[h] = run_chain(&c, h, pass, cache_rays, tail_tol, max_bounces);
+            if (chain[h].bounces < 0) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
             if (opt->progress) {
                 double f = fmax(spp / max_samples, opt->time_limit > 0 ? (now_seconds() - t0) / opt->time_limit : 0);
                 opt->progress(opt->user, "cache", f > 1 ? 1 : f);
@@ -874,7 +935,7 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
         /* final gather at the receivers, in blocks so progress can be reported */
         c.pass = pass;
         c.rays = s0 << (pass < 20 ? pass : 20);
-        c.lat_g = lattice_generator((uint32_t)c.rays);
+        if (lattice_init(&c.lat, (uint32_t)c.rays) != LBK_OK) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
         c.pass_weight = ldexp(1.0, pass);
         size_t block = count / 8 + 1;
         for (size_t b = 0; b < count; b += block) {
