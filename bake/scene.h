@@ -83,7 +83,8 @@ typedef struct bk_scene {
     float bounds_min[3], bounds_max[3];
 } bk_scene;
 
-/* Frees every array and image (all malloc'ed) and zeroes the struct. NULL is fine. */
+/* Frees every array and image (all malloc'ed) and leaves an empty scene (all zero, sky_image
+ * -1). NULL is fine. */
 void bk_scene_free(bk_scene *scene);
 /* bounds_min/bounds_max over all vertices (and point/spot light positions); an empty scene gets
  * min = max = 0. */

@@ -797,8 +797,8 @@ static void test_sky_exr(void **state)
     expect_error("sky_junk.gltf", "junk.exr", NULL);
 }
 
-/* A 4×2 RGBA PNG: row 0 = sRGB 255, row 1 = sRGB 128 (grey), alpha 255. */
-static void write_png(const char *name, int w, int h)
+/* A w×h RGBA PNG in memory (free() it): top half sRGB 255, bottom half sRGB 128 (grey), alpha 255. */
+static void *make_png(int w, int h, size_t *len)
 {
     unsigned char *img = malloc((size_t)w * h * 4);
     for (int y = 0; y < h; y++)
@@ -818,14 +818,99 @@ static void write_png(const char *name, int w, int h)
     ihdr.color_type = SPNG_COLOR_TYPE_TRUECOLOR_ALPHA;
     spng_set_ihdr(ctx, &ihdr);
     assert_int_equal(spng_encode_image(ctx, img, (size_t)w * h * 4, SPNG_FMT_PNG, SPNG_ENCODE_FINALIZE), 0);
-    size_t len = 0;
     int e = 0;
-    void *png = spng_get_png_buffer(ctx, &len, &e);
+    void *png = spng_get_png_buffer(ctx, len, &e);
     assert_int_equal(e, 0);
-    write_file(name, png, len);
-    free(png);
     spng_ctx_free(ctx);
     free(img);
+    return png;
+}
+
+static void write_png(const char *name, int w, int h)
+{
+    size_t len = 0;
+    void *png = make_png(w, h, &len);
+    write_file(name, png, len);
+    free(png);
+}
+
+static void put32le(unsigned char *p, uint32_t v) { memcpy(p, &v, 4); }
+
+/* A .glb whose BIN chunk holds a quad (positions, uint16 indices, uv0) and a PNG that the
+ * material's base colour texture reads through a bufferView. */
+static void test_glb_embedded_texture(void **state)
+{
+    (void)state;
+    size_t png_len = 0;
+    void *png = make_png(4, 2, &png_len);
+    size_t bin_len = 92 + ((png_len + 3) & ~(size_t)3);
+    unsigned char *bin = calloc(1, bin_len);
+    float pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, uv[8] = {0, 1, 1, 1, 1, 0, 0, 0};
+    uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    memcpy(bin, pos, 48);
+    memcpy(bin + 48, idx, 12);
+    memcpy(bin + 60, uv, 32);
+    memcpy(bin + 92, png, png_len);
+    char json[4096];
+    int jl = snprintf(json, sizeof json,
+                      "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":%zu}],"
+                      "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":12},"
+                      "{\"buffer\":0,\"byteOffset\":60,\"byteLength\":32},{\"buffer\":0,\"byteOffset\":92,\"byteLength\":%zu}],"
+                      "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
+                      "{\"bufferView\":1,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"},"
+                      "{\"bufferView\":2,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"}],"
+                      "\"images\":[{\"bufferView\":3,\"mimeType\":\"image/png\"}],\"textures\":[{\"source\":0}],"
+                      "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}}],"
+                      "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":2},\"indices\":1,\"material\":0}]}],"
+                      "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]}",
+                      bin_len, png_len);
+    size_t jpad = ((size_t)jl + 3) & ~(size_t)3;
+    size_t total = 12 + 8 + jpad + 8 + bin_len;
+    unsigned char *glb = malloc(total);
+    memcpy(glb, "glTF", 4);
+    put32le(glb + 4, 2);
+    put32le(glb + 8, (uint32_t)total);
+    put32le(glb + 12, (uint32_t)jpad);
+    memcpy(glb + 16, "JSON", 4);
+    memset(glb + 20, ' ', jpad);
+    memcpy(glb + 20, json, (size_t)jl);
+    put32le(glb + 20 + jpad, (uint32_t)bin_len);
+    memcpy(glb + 24 + jpad, "BIN", 4);
+    memcpy(glb + 28 + jpad, bin, bin_len);
+    write_file("embedded.glb", glb, total);
+    bk_scene s;
+    char err[1024];
+    int rc = import_tmp("embedded.glb", &s, NULL, err, sizeof err);
+    if (rc) printf("%s\n", err);
+    assert_int_equal(rc, 0);
+    assert_valid(&s);
+    assert_int_equal(s.image_count, 1);
+    assert_int_equal(s.materials[0].albedo_tex, 0);
+    assert_int_equal(s.images[0].width, 4);
+    assert_float_equal(s.images[0].rgba[4 * 4], 0.2158605f, 1e-6);
+    /* no NORMAL: flat shading unshares the vertices in triangle order (0 1 2, 0 2 3) */
+    assert_int_equal(s.vertex_count, 6);
+    assert_float_equal(s.uv0[2 * 1], 1.0f, 0.0f);
+    assert_float_equal(s.uv0[2 * 1 + 1], 1.0f, 0.0f);
+    assert_float_equal(s.uv0[2 * 5], 0.0f, 0.0f);
+    assert_float_equal(s.uv0[2 * 5 + 1], 0.0f, 0.0f);
+    assert_float_equal(s.uv0[2 * 3 + 1], 1.0f, 0.0f);
+    bk_scene_free(&s);
+
+    /* the PNG view damaged: a warning, the texture is dropped, the factor stays */
+    memset(glb + 28 + jpad + 92, 0x42, 16);
+    write_file("embedded_bad.glb", glb, total);
+    bk_import_report rep;
+    bk_import_options opt = {0};
+    opt.report = &rep;
+    assert_int_equal(import_tmp("embedded_bad.glb", &s, &opt, err, sizeof err), 0);
+    assert_int_equal(s.materials[0].albedo_tex, -1);
+    assert_int_equal(rep.ignored_textures, 1);
+    assert_int_equal(rep.warnings, 1);
+    bk_scene_free(&s);
+    free(glb);
+    free(bin);
+    free(png);
 }
 
 static void test_textures(void **state)
@@ -1243,6 +1328,7 @@ int main(void)
         cmocka_unit_test(test_sky_extras),
         cmocka_unit_test(test_sky_exr),
         cmocka_unit_test(test_textures),
+        cmocka_unit_test(test_glb_embedded_texture),
         cmocka_unit_test(test_required_extension),
         cmocka_unit_test(test_malformed_accessors),
         cmocka_unit_test(test_malformed_structure),
