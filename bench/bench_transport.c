@@ -92,10 +92,13 @@ static double raw_embree_rays_per_second(const bk_scene *s, size_t nrays)
         double u1 = (double)((x >> 43) & 0xFFFF) / 65536, u2 = fmod(i * 0.618033988749895, 1.0);
         double r = sqrt(u1), ph = 2 * M_PI * u2;
         double d[3] = {r * cos(ph), r * sin(ph), sqrt(1 - u1)};
-        /* any frame will do for timing: rotate (0,0,1) onto n roughly */
+        /* cosine lobe around the front normal (Duff et al. frame), like the cache's rays */
+        double nn[3] = {n[0] / l, n[1] / l, n[2] / l};
+        double sg = nn[2] >= 0 ? 1.0 : -1.0, q = -1.0 / (sg + nn[2]), w = nn[0] * nn[1] * q;
+        double tt[3] = {1 + sg * nn[0] * nn[0] * q, sg * w, -sg * nn[0]}, bb[3] = {w, sg + nn[1] * nn[1] * q, -nn[1]};
         for (int k = 0; k < 3; k++) {
-            rays[6 * i + k] = (float)((1 - a - b) * v0[k] + a * v1[k] + b * v2[k] + 1e-4 * n[k] / l);
-            rays[6 * i + 3 + k] = (float)(n[k] / l * d[2] + (k == 0 ? d[0] : k == 1 ? d[1] : 0) * 0.7);
+            rays[6 * i + k] = (float)((1 - a - b) * v0[k] + a * v1[k] + b * v2[k] + 1e-4 * nn[k]);
+            rays[6 * i + 3 + k] = (float)(d[0] * tt[k] + d[1] * bb[k] + d[2] * nn[k]);
         }
     }
     struct RTCIntersectContext ctx;
