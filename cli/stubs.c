@@ -12,8 +12,6 @@
         return LBK_EXIT_INTERNAL;                                                     \
     }
 
-LBK_WEAK_COMMAND(lbk_cmd_inspect, "inspect")
-LBK_WEAK_COMMAND(lbk_cmd_validate, "validate")
 LBK_WEAK_COMMAND(lbk_cmd_diff, "diff")
 LBK_WEAK_COMMAND(lbk_cmd_convert, "convert")
 LBK_WEAK_COMMAND(lbk_cmd_export, "export")

@@ -12,5 +12,16 @@ for t in "$@"; do
   pass=$((pass + p)); fail=$((fail + f))
   if [ "$st" -ne 0 ]; then failed="$failed $t"; echo "FAIL $t (exit $st)"; tail -n 30 "$log"; else echo "ok   $t ($p cases)"; fi
 done
+# The libFuzzer harness over the seed corpus for a fixed number of inputs (seeded, so runs
+# repeat); inputs it finds go to a scratch directory, never into tests/fuzz/corpus.
+if [ -n "${FUZZ:-}" ] && [ -x "$FUZZ" ]; then
+  runs="${FUZZ_RUNS:-20000}"; scratch="$BUILD/fuzz-scratch"; log="$BUILD/tests/fuzz_container.log"
+  rm -rf "$scratch"; mkdir -p "$scratch" "$BUILD/tests"
+  if "$FUZZ" -runs="$runs" -seed=1 -rss_limit_mb=2048 "$scratch" tests/fuzz/corpus >"$log" 2>&1; then
+    pass=$((pass + 1)); echo "ok   fuzz_container ($runs inputs)"
+  else
+    fail=$((fail + 1)); failed="$failed fuzz_container"; echo "FAIL fuzz_container"; tail -n 30 "$log"
+  fi
+fi
 echo "tests: $pass passed, $fail failed"
 [ -z "$failed" ]
