@@ -58,7 +58,7 @@ void bk_texels_free(bk_texels *tx)
     memset(tx, 0, sizeof *tx);
 }
 
-const bk_receiver *bk_texels_at(const bk_texels *tx, uint32_t page, int x, int y)
+const bk_texel *bk_texels_at(const bk_texels *tx, uint32_t page, int x, int y)
 {
     if (!tx || page >= tx->page_count) return NULL;
     const bk_atlas_page *p = &tx->pages[page];
@@ -76,7 +76,7 @@ void bk_texels_valid_mask(const bk_texels *tx, uint32_t page, uint8_t *mask)
 }
 
 /* Fills a receiver from triangle entry e at texel (x, y); w are barycentric weights. */
-static void make_receiver(const bk_scene *s, const bk_atlas *a, uint32_t e, const double w[3], bk_receiver *r)
+static void make_receiver(const bk_scene *s, const bk_atlas *a, uint32_t e, const double w[3], bk_texel *r)
 {
     uint32_t tri = a->tris[e];
     const float *uv = a->tri_uv + 6 * (size_t)e;
@@ -220,7 +220,7 @@ lbk_result bk_texels_build(const bk_scene *s, const bk_atlas *a, bk_texels *out)
                     bk_rtri_closest(&t, x + 0.5, y + 0.5, w, NULL, NULL);
                     edge = 1;
                 }
-                bk_receiver *rc = &out->receivers[r];
+                bk_texel *rc = &out->receivers[r];
                 make_receiver(s, a, e, w, rc);
                 if (edge) rc->flags |= BK_TEXEL_EDGE;
                 rc->page = (uint32_t)p;
@@ -295,7 +295,7 @@ static void hit_point(const bk_scene *s, const bk_hit *h, float out[3])
     for (int c = 0; c < 3; c++) out[c] = (float)(w0 * p[0][c] + h->u * p[1][c] + h->v * p[2][c]);
 }
 
-static void push_one(push_job *j, bk_receiver *r)
+static void push_one(push_job *j, bk_texel *r)
 {
     const bk_scene *s = j->scene;
     double ng[3], t[3], b[3];

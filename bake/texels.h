@@ -54,7 +54,7 @@ enum bk_texel_flag {
     BK_TEXEL_INSIDE = 8u   /* inside closed geometry: not valid, filled by dilation */
 };
 
-typedef struct bk_receiver {
+typedef struct bk_texel {
     float position[3];     /* world sample point */
     float normal[3];       /* unit shading normal (+Z of the tangent frame) */
     float tangent[3];      /* unit, ⟂ normal, along +u (see the convention above) */
@@ -64,7 +64,7 @@ typedef struct bk_receiver {
     uint32_t page;
     uint16_t x, y;         /* texel in the page */
     uint32_t flags;        /* enum bk_texel_flag */
-} bk_receiver;
+} bk_texel;
 
 typedef struct bk_texels {
     size_t page_count;
@@ -72,7 +72,7 @@ typedef struct bk_texels {
     size_t *page_offset;   /* page_count + 1: start of each page in index */
     int32_t *index;        /* per texel of every page (row-major): receiver, or -1 */
     size_t count;
-    bk_receiver *receivers;/* page-major, then row-major: deterministic order */
+    bk_texel *receivers;/* page-major, then row-major: deterministic order */
 } bk_texels;
 
 /* Rasterises every chart of the atlas. Errors: LBK_ERR_INVALID_ARGUMENT,
@@ -81,7 +81,7 @@ lbk_result bk_texels_build(const bk_scene *scene, const bk_atlas *atlas, bk_texe
 void bk_texels_free(bk_texels *tx);
 
 /* The receiver at texel (x, y) of a page, or NULL when the texel is empty. */
-const bk_receiver *bk_texels_at(const bk_texels *tx, uint32_t page, int x, int y);
+const bk_texel *bk_texels_at(const bk_texels *tx, uint32_t page, int x, int y);
 
 typedef struct bk_pushout_options {
     float reach;           /* search distance in texel sizes; 0: 1.5 */

@@ -96,7 +96,7 @@ static void test_coverage_and_frames(void **state)
                 double w2 = 1.0 - w0 - w1;
                 if (!(w0 > 1e-4 && w1 > 1e-4 && w2 > 1e-4)) continue;
                 strictly_inside++;
-                const bk_receiver *r = bk_texels_at(&tx, (uint32_t)page, x, y);
+                const bk_texel *r = bk_texels_at(&tx, (uint32_t)page, x, y);
                 assert_non_null(r);
                 assert_true(r->flags & BK_TEXEL_VALID);
                 assert_false(r->flags & BK_TEXEL_EDGE);
@@ -111,7 +111,7 @@ static void test_coverage_and_frames(void **state)
     }
     assert_true(strictly_inside > 1000);
     for (size_t i = 0; i < tx.count; i++) {
-        const bk_receiver *r = &tx.receivers[i];
+        const bk_texel *r = &tx.receivers[i];
         assert_float_equal(len3(r->normal), 1.0, 1e-5);
         assert_float_equal(len3(r->tangent), 1.0, 1e-5);
         double d = (double)r->normal[0] * r->tangent[0] + (double)r->normal[1] * r->tangent[1] +
@@ -140,7 +140,7 @@ static void test_tangent_convention(void **state)
     build(&s, 10.0f, &a, &tx);
     size_t checked = 0;
     for (size_t i = 0; i < tx.count; i++) {
-        const bk_receiver *r = &tx.receivers[i], *right = bk_texels_at(&tx, r->page, r->x + 1, r->y),
+        const bk_texel *r = &tx.receivers[i], *right = bk_texels_at(&tx, r->page, r->x + 1, r->y),
                           *down = bk_texels_at(&tx, r->page, r->x, r->y + 1);
         if (!right || !down || (r->flags | right->flags | down->flags) & BK_TEXEL_EDGE) continue;
         float b[3] = {r->normal[1] * r->tangent[2] - r->normal[2] * r->tangent[1],
@@ -227,7 +227,7 @@ static void test_pushout_l_junction(void **state)
     float *before = malloc(tx.count * 3 * sizeof(float));
     assert_non_null(before);
     for (size_t i = 0; i < tx.count; i++) {
-        const bk_receiver *r = &tx.receivers[i];
+        const bk_texel *r = &tx.receivers[i];
         memcpy(before + 3 * i, r->position, 3 * sizeof(float));
         if ((r->object == 0 && r->position[0] < 0) || (r->object == 1 && r->position[1] < 0)) behind++;
     }
@@ -238,7 +238,7 @@ static void test_pushout_l_junction(void **state)
     assert_true(st.pushed >= behind);
     assert_int_equal(st.inside, 0);
     for (size_t i = 0; i < tx.count; i++) {
-        const bk_receiver *r = &tx.receivers[i];
+        const bk_texel *r = &tx.receivers[i];
         assert_true(r->flags & BK_TEXEL_VALID);
         /* nothing behind the wall or below the floor, and nothing moved far */
         assert_true(r->position[0] >= 0.0f);
@@ -289,7 +289,7 @@ static void test_pushout_inside_and_threads(void **state)
     assert_memory_equal(t1.receivers, t3.receivers, t1.count * sizeof *t1.receivers);
     size_t inside = 0;
     for (size_t i = 0; i < t1.count; i++) {
-        const bk_receiver *r = &t1.receivers[i];
+        const bk_texel *r = &t1.receivers[i];
         if (r->object != 0) {
             assert_true(r->flags & BK_TEXEL_VALID);
             continue;
@@ -403,7 +403,7 @@ static void test_dilate_atlas_no_bleed(void **state)
         bk_texels_valid_mask(&tx, p, m);
         for (int y = 0; y < H; y++)
             for (int x = 0; x < W; x++) {
-                const bk_receiver *r = bk_texels_at(&tx, p, x, y);
+                const bk_texel *r = bk_texels_at(&tx, p, x, y);
                 if (r) d[y * W + x] = (float)a.scene_tri_entry[r->tri] >= 0 ? (float)a.tri_chart[a.scene_tri_entry[r->tri]] : -1;
             }
         for (size_t c = 0; c < a.chart_count; c++) {
@@ -423,7 +423,7 @@ static void test_dilate_atlas_no_bleed(void **state)
         /* bilinear footprint: each valid texel's 8 neighbours are filled after dilation */
         for (int y = 0; y < H; y++)
             for (int x = 0; x < W; x++) {
-                const bk_receiver *r = bk_texels_at(&tx, p, x, y);
+                const bk_texel *r = bk_texels_at(&tx, p, x, y);
                 if (!r) continue;
                 for (int dy = -1; dy <= 1; dy++)
                     for (int dx = -1; dx <= 1; dx++) {
