@@ -515,6 +515,11 @@ private:
     std::vector<char> visited_;
 
     void warn(const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+    // Vertex indices are uint32; unshared flat-shaded triangles need 3 vertices each.
+    size_t max_vertices() const
+    {
+        return o_.max_triangles > (UINT32_MAX - 1) / 3 ? (size_t)UINT32_MAX - 1 : o_.max_triangles * 3;
+    }
     void load();
     void check_extensions();
     void decode_images();
@@ -570,12 +575,11 @@ void Importer::load()
 
     bool glb = bytes.size() >= 4 && !memcmp(bytes.data(), "glTF", 4);
     GlbParts g;
-    if (glb) {
-        g = split_glb(bytes, path_);
-        pp_ = prepass(g.json, g.json_len, path_);
-    } else {
-        pp_ = prepass(reinterpret_cast<const char *>(bytes.data()), bytes.size(), path_);
-    }
+    if (glb) g = split_glb(bytes, path_);
+    size_t json_len = glb ? g.json_len : bytes.size();
+    if (json_len > o_.max_json_bytes)
+        fail("%s: %zu bytes of JSON exceeds the %zu-byte JSON cap", file, json_len, o_.max_json_bytes);
+    pp_ = prepass(glb ? g.json : reinterpret_cast<const char *>(bytes.data()), json_len, path_);
 
     tinygltf::TinyGLTF loader;
     FsState fss{o_.max_file_bytes};
@@ -1034,7 +1038,7 @@ void Importer::decode_draco(int mi, int pi, const DracoInfo &di, Prim &p, std::v
     std::unique_ptr<draco::Mesh> mesh = std::move(res).value();
     size_t np = mesh->num_points(), nf = mesh->num_faces();
     if (nf > o_.max_triangles) fail("%s: %s: %zu triangles exceeds the cap of %zu", file, lbl.c_str(), nf, o_.max_triangles);
-    if (np >= UINT32_MAX) fail("%s: %s: too many points", file, lbl.c_str());
+    if (np > max_vertices()) fail("%s: %s: %zu points exceeds the cap of %zu", file, lbl.c_str(), np, max_vertices());
     *nverts = np;
     idx.resize(nf * 3);
     for (size_t f = 0; f < nf; f++) {
@@ -1121,6 +1125,7 @@ void Importer::prepare_prim(int mi, int pi, Prim &p, bool *is_triangles)
         if (attr("POSITION") < 0) fail("%s: %s: has no POSITION attribute", file, lbl.c_str());
         read_accessor(attr("POSITION"), 3, false, &p.pos, nullptr, lbl + " POSITION");
         nv = p.pos.size() / 3;
+        if (nv > max_vertices()) fail("%s: %s: %zu vertices exceeds the cap of %zu", file, lbl.c_str(), nv, max_vertices());
         struct { const char *sem; int comps; std::vector<float> *dst; bool *flag; } opt[] = {
             {"NORMAL", 3, &p.nrm, &p.has_nrm}, {"TEXCOORD_0", 2, &p.uv0, nullptr}, {"TEXCOORD_1", 2, &p.uv1, &p.has_uv1}};
         for (auto &o : opt) {
@@ -1204,8 +1209,9 @@ void Importer::prepare_mesh(int mi)
         for (uint32_t v : p.tris) hash_idx.push_back(base + v);
         md.vertices += p.pos.size() / 3;
         md.triangles += p.tris.size() / 3;
-        if (md.triangles > o_.max_triangles || md.vertices >= UINT32_MAX)
-            fail("%s: mesh %d: more than %zu triangles (the cap)", path_.c_str(), mi, o_.max_triangles);
+        if (md.triangles > o_.max_triangles || md.vertices > max_vertices())
+            fail("%s: mesh %d: more than %zu triangles or %zu vertices (the caps)", path_.c_str(), mi,
+                 o_.max_triangles, max_vertices());
         md.prims.push_back(std::move(p));
     }
     md.hash = bk_geometry_hash(hash_pos.data(), hash_pos.size() / 3, hash_idx.data(), hash_idx.size());
@@ -1244,7 +1250,8 @@ void Importer::emit_geometry()
         total_t += md.triangles;
         if (total_t > o_.max_triangles)
             fail("%s: more than %zu triangles (the cap) at %s", file, o_.max_triangles, node_label(in.node).c_str());
-        if (total_v >= UINT32_MAX) fail("%s: more than 2^32 vertices", file);
+        if (total_v > max_vertices())
+            fail("%s: more than %zu vertices (the cap) at %s", file, max_vertices(), node_label(in.node).c_str());
         kept.push_back(in);
         dets.push_back(det);
     }
@@ -1512,6 +1519,7 @@ extern "C" int bk_import_gltf(const char *path, const bk_import_options *opt, bk
     bk_import_options o = opt ? *opt : bk_import_options{};
     if (!o.max_triangles) o.max_triangles = (size_t)1 << 24;
     if (!o.max_file_bytes) o.max_file_bytes = (size_t)1 << 30;
+    if (!o.max_json_bytes) o.max_json_bytes = (size_t)64 << 20;
     if (!o.max_image_bytes) o.max_image_bytes = (size_t)512 << 20;
     if (o.max_texture_size <= 0) o.max_texture_size = 1024;
     if (o.max_sky_size <= 0) o.max_sky_size = 2048;

@@ -24,8 +24,11 @@ typedef struct bk_import_report {
 /* Zero-initialised = defaults (given in brackets). */
 typedef struct bk_import_options {
     int skip_textures;             /* 1: decode no texture; materials use their factors only */
-    size_t max_triangles;          /* cap on imported triangles [16 Mi] */
+    size_t max_triangles;          /* cap on imported triangles [16 Mi]; vertices are capped at
+                                      3 × max_triangles */
     size_t max_file_bytes;         /* cap on any single file read: .gltf/.glb/.bin/image/EXR [1 GiB] */
+    size_t max_json_bytes;         /* cap on the JSON text (.gltf, or the GLB JSON chunk); parsed
+                                      JSON takes ~20-50× its size in memory [64 MiB] */
     size_t max_image_bytes;        /* cap on the float RGBA kept in scene->images [512 MiB] */
     int max_texture_size;          /* textures are box-filtered down to at most this side [1024] */
     int max_sky_size;              /* the sky EXR is box-filtered down to at most this width [2048] */

@@ -1149,6 +1149,11 @@ static void test_malformed_structure(void **state)
         assert_true(gz * nz > 0.0f); /* flat normals agree with the winding */
     }
     bk_scene_free(&s);
+    /* the JSON size cap */
+    opt.max_json_bytes = 100;
+    assert_int_not_equal(import_tmp("modes.gltf", &s, &opt, err, sizeof err), 0);
+    assert_non_null(strstr(err, "JSON cap"));
+    opt.max_json_bytes = 0;
     /* the primitive count cap */
     opt.max_triangles = 3;
     assert_int_not_equal(import_tmp("modes.gltf", &s, &opt, err, sizeof err), 0);
