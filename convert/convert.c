@@ -137,7 +137,8 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
         if (r != LBK_OK) st = fail(err, TL_CONVERT_INTERNAL, "writing section %u: %s", i, lbk_result_message(r));
     }
     if (st == TL_CONVERT_OK && opt->from_exr_dir && report->pages_imported == 0)
-        st = fail(err, TL_CONVERT_BAD_EXR, "--from-exr: the input has no lightmap pages to import into");
+        st = fail(err, TL_CONVERT_BAD_EXR, "--from-exr %.160s: no page_NNN.exr for any lightmap page of the input",
+                  opt->from_exr_dir);
 
     void *bytes = NULL;
     size_t bytes_size = 0;
