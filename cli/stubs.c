@@ -12,6 +12,3 @@
         return LBK_EXIT_INTERNAL;                                                     \
     }
 
-LBK_WEAK_COMMAND(lbk_cmd_diff, "diff")
-LBK_WEAK_COMMAND(lbk_cmd_convert, "convert")
-LBK_WEAK_COMMAND(lbk_cmd_export, "export")
