@@ -148,6 +148,8 @@ install: all
 	ln -sf liblbk.so.1 $(DESTDIR)$(PREFIX)/lib/liblbk.so
 	install -m 644 libformat/include/lbk/*.h $(DESTDIR)$(PREFIX)/include/lbk/
 	install -m 644 $(BUILD)/lbk.pc $(DESTDIR)$(PREFIX)/lib/pkgconfig/lbk.pc
+	install -d $(DESTDIR)$(PREFIX)/share/lbk/profiles
+	install -m 644 convert/profiles/*.profile $(DESTDIR)$(PREFIX)/share/lbk/profiles/
 
 clean:
 	rm -rf $(BUILD)
