@@ -441,6 +441,63 @@ static void test_dilate_atlas_no_bleed(void **state)
     uvs_free(&s);
 }
 
+/* Extremes: the same furnished room at 1 mm, 10 km, and 1e5 m from the origin. The atlas
+ * keeps its rules and budget, and every receiver is finite with unit vectors after push-out;
+ * valid floor samples never end up under the box. */
+static void test_extreme_scales(void **state)
+{
+    (void)state;
+    const double scales[3] = {1e-3, 1e4, 1.0};
+    const double offsets[3] = {0.0, 0.0, 1e5};
+    for (int v = 0; v < 3; v++) {
+        bk_scene s;
+        uvs_init(&s);
+        uvs_object(&s, "room");
+        float rmn[3] = {-2, 0, -2}, rmx[3] = {2, 2.5f, 2};
+        uvs_box(&s, rmn, rmx, 2, 1, 0);
+        uvs_object(&s, "box");
+        float bmn[3] = {-0.5f, 0, -0.5f}, bmx[3] = {0.5f, 1, 0.5f};
+        uvs_box(&s, bmn, bmx, 1, 0, 0);
+        for (size_t i = 0; i < 3 * s.vertex_count; i++)
+            s.positions[i] = (float)(s.positions[i] * scales[v] + (i % 3 == 0 ? offsets[v] : 0.0));
+        uvs_update_bounds(&s);
+        bk_atlas_options o = {0};
+        o.default_density = 8.0f;
+        o.texel_budget = 1u << 16;
+        bk_atlas a;
+        assert_int_equal(bk_atlas_build(&s, NULL, &o, &a), LBK_OK);
+        assert_true(a.texels > 0);
+        uint64_t rects = 0;
+        for (size_t i = 0; i < a.object_count; i++) rects += (uint64_t)a.objects[i].w * (uint64_t)a.objects[i].h;
+        assert_true(rects <= o.texel_budget);
+        for (size_t i = 0; i < a.tri_count * 6; i++) assert_true(isfinite(a.tri_uv[i]));
+        for (size_t i = 0; i < a.vertex_count * 2; i++)
+            assert_true(a.vertex_uv[i] >= 0.0f && a.vertex_uv[i] <= 1.0f);
+        bk_texels tx;
+        assert_int_equal(bk_texels_build(&s, &a, &tx), LBK_OK);
+        bk_tracer *tr = NULL;
+        assert_int_equal(bk_tracer_create(&s, 1, &tr), LBK_OK);
+        assert_int_equal(bk_texels_push_out(&tx, &s, tr, NULL, NULL), LBK_OK);
+        double half = 0.5 * scales[v];
+        for (size_t i = 0; i < tx.count; i++) {
+            const bk_texel *r = &tx.receivers[i];
+            for (int k = 0; k < 3; k++) assert_true(isfinite(r->position[k]));
+            assert_float_equal(len3(r->normal), 1.0, 1e-5);
+            assert_float_equal(len3(r->tangent), 1.0, 1e-5);
+            assert_true(r->texel_size > 0.0f && isfinite(r->texel_size));
+            if (r->object == 0 && (r->flags & BK_TEXEL_VALID) && r->position[1] < 0.5 * scales[v]) {
+                double x = r->position[0] - offsets[v], z = r->position[2];
+                /* floor texels: never strictly under the box (its footprint minus rounding) */
+                assert_false(fabs(x) < half * 0.98 && fabs(z) < half * 0.98);
+            }
+        }
+        bk_tracer_destroy(tr);
+        bk_texels_free(&tx);
+        bk_atlas_free(&a);
+        uvs_free(&s);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -452,6 +509,7 @@ int main(void)
         cmocka_unit_test(test_pushout_inside_and_threads),
         cmocka_unit_test(test_dilate_ring_values),
         cmocka_unit_test(test_dilate_atlas_no_bleed),
+        cmocka_unit_test(test_extreme_scales),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
