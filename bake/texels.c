@@ -6,6 +6,7 @@
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "bake/uv_math.h"
 #include "bake/uv_raster.h"
@@ -382,7 +383,8 @@ lbk_result bk_texels_push_out(bk_texels *tx, const bk_scene *scene, const bk_tra
     if (stats) memset(stats, 0, sizeof *stats);
     if (!tx || !scene || !tracer) return LBK_ERR_INVALID_ARGUMENT;
     float reach = opt && opt->reach > 0.0f && isfinite(opt->reach) ? opt->reach : 1.5f;
-    int threads = opt && opt->threads > 1 ? opt->threads : 1;
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    int threads = opt && opt->threads > 0 ? opt->threads : (cores > 0 && cores < 1024 ? (int)cores : 1);
     if (threads > 256) threads = 256;
     if ((size_t)threads > tx->count) threads = tx->count ? (int)tx->count : 1;
     /* long rays: beyond the scene's extent */

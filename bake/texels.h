@@ -85,7 +85,7 @@ const bk_texel *bk_texels_at(const bk_texels *tx, uint32_t page, int x, int y);
 
 typedef struct bk_pushout_options {
     float reach;           /* search distance in texel sizes; 0: 1.5 */
-    int threads;           /* 0 or 1: the calling thread only */
+    int threads;           /* 0: all online cores (the result is the same for any count) */
 } bk_pushout_options;
 
 typedef struct bk_pushout_stats {

@@ -281,6 +281,7 @@ static void test_pushout_inside_and_threads(void **state)
     bk_tracer *tr = NULL;
     assert_int_equal(bk_tracer_create(&s, 1, &tr), LBK_OK);
     bk_pushout_options o1 = {0}, o3 = {0};
+    o1.threads = 1;
     o3.threads = 3;
     bk_pushout_stats st;
     assert_int_equal(bk_texels_push_out(&t1, &s, tr, &o1, &st), LBK_OK);
