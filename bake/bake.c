@@ -20,6 +20,7 @@
 #include "bake/glg_place.h"
 #include "bake/import.h"
 #include "bake/llg_place.h"
+#include "bake/octa_bake.h"
 #include "bake/scene.h"
 #include "bake/texels.h"
 #include "bake/tracer.h"
@@ -112,6 +113,12 @@ static void transport_progress(void *user, const char *ph, double fraction)
     (void)ph;
     bake *b = user;
     bk_progress_update(b->progress, fraction);
+}
+
+static void base_albedo(void *user, uint32_t tri, float albedo[3])
+{
+    bake *b = user;
+    bk_set_bakes_base_albedo(&b->sets, &b->scene, tri, albedo);
 }
 
 static void transport_report(void *user, const bk_transport_sample *s)
@@ -336,6 +343,8 @@ static void set_inputs(const bake *b, bk_set_inputs *in)
     in->atlas_margin = b->atlas.margin;
     in->base_radiance = b->radiance;
     bk_bake_transport_options(b->opt, b->pre->max_samples, b->pre->target_error, &in->transport);
+    in->base_samples_per_receiver = b->stats.samples_per_receiver;
+    in->threshold = b->opt->dls_threshold;
     in->progress = b->progress;
 }
 
@@ -349,7 +358,7 @@ static int do_transport(bake *b)
     to.progress = transport_progress;
     to.report = transport_report;
     to.user = b;
-    bk_set_bakes_base_hooks(&b->sets, &b->scene, &to);
+    if (bk_set_bakes_base_hooks(&b->sets, &b->scene, &to)) to.albedo_hook = base_albedo;
     bk_transport_output out;
     memset(&out, 0, sizeof out);
     out.radiance = b->radiance;
@@ -435,6 +444,26 @@ static lbk_result build_glg(bake *b, section_list *sl)
     lbk_result r = lbk_glg_build(&d, NULL, &data, &size);
     free(vis);
     return sections_add(sl, LBK_SECTION_GLG, r, data, size);
+}
+
+static lbk_result build_octp(bake *b, section_list *sl)
+{
+    lbk_octp_probe_desc *p = calloc(b->glg.probe_count, sizeof *p);
+    if (!p) return LBK_ERR_OUT_OF_MEMORY;
+    float diag = 0;
+    for (int a = 0; a < 3; a++) {
+        float e = b->scene.bounds_max[a] - b->scene.bounds_min[a];
+        diag += e * e;
+    }
+    diag = sqrtf(diag);
+    if (!(diag > 0) || !isfinite(diag)) diag = 1;
+    for (size_t i = 0; i < b->glg.probe_count; i++)
+        bk_octa_probe(b->tracer, &b->glg.positions[3 * i], &b->radiance[b->glg_first + i], diag, &p[i]);
+    void *data;
+    size_t size;
+    lbk_result r = lbk_octp_build(p, (uint32_t)b->glg.probe_count, NULL, &data, &size);
+    free(p);
+    return sections_add(sl, LBK_SECTION_OCTP, r, data, size);
 }
 
 static lbk_result build_llg(bake *b, section_list *sl)
@@ -614,6 +643,7 @@ static int do_encode_and_write(bake *b, bk_bake_summary *sum)
     if (!r && b->texels.page_count && b->texel_receivers) r = build_lmap(b, &sl);
     if (!r && b->have_glg) r = build_glg(b, &sl);
     if (!r && b->llg_count) r = build_llg(b, &sl);
+    if (!r && b->opt->octahedral_probes && b->have_glg) r = build_octp(b, &sl);
     if (!r && b->sets.set_count) {
         bk_set_inputs in;
         set_inputs(b, &in);

@@ -20,6 +20,7 @@
 #include "lbk/container.h"
 #include "lbk/lightmap.h"
 #include "lbk/objects.h"
+#include "lbk/octa.h"
 #include "lbk/report.h"
 #include "lbk/validate.h"
 
@@ -332,6 +333,42 @@ static void test_time_limit(void **state)
     lbk_reader_close(r);
 }
 
+/* --octahedral: OCTP probes at the GLG positions; depth moments are distances inside the box
+ * (the Cornell box is about 2 units across, so no probe sees further than its diagonal) and
+ * obey Jensen's inequality m2 >= m1^2. Without the flag there is no OCTP (checked above). */
+static void test_octahedral_probes(void **state)
+{
+    (void)state;
+    char out[512], err[512];
+    snprintf(out, sizeof out, "%s/octa.lbk", tmpdir);
+    bk_bake_options o;
+    test_options(&o, "scenes/cornell_box/CornellBox-Original.gltf", out);
+    o.octahedral_probes = 1;
+    bk_bake_summary sum;
+    assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
+    assert_valid(out);
+    lbk_reader *r;
+    assert_int_equal(lbk_reader_open_file(out, NULL, &r), LBK_OK);
+    const void *data;
+    size_t size;
+    assert_int_equal(lbk_reader_section_by_type(r, LBK_SECTION_OCTP, &data, &size), LBK_OK);
+    lbk_octp_view v;
+    assert_int_equal(lbk_octp_open(data, size, &v), LBK_OK);
+    assert_true(sum.glg_probes > 0);
+    for (uint32_t i = 0; i < (uint32_t)sum.glg_probes; i++) {
+        lbk_octp_probe_desc p;
+        assert_int_equal(lbk_octp_get(&v, i, &p), LBK_OK);
+        for (int k = 0; k < 144; k++) {
+            assert_true(p.depth[k][0] > 0 && p.depth[k][0] < 4.0f);
+            assert_true(p.depth[k][1] >= p.depth[k][0] * p.depth[k][0] * 0.99f);
+        }
+        float lit = 0;
+        for (int k = 0; k < 16; k++) lit += p.irradiance[k][0];
+        assert_true(lit > 0);
+    }
+    lbk_reader_close(r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -344,6 +381,7 @@ int main(void)
         cmocka_unit_test(test_no_light_is_refused),
         cmocka_unit_test(test_target_error_and_reports),
         cmocka_unit_test(test_time_limit),
+        cmocka_unit_test(test_octahedral_probes),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
