@@ -49,6 +49,8 @@ typedef struct lbk_section_info {
 
 /* ---- reading ---------------------------------------------------------------------------- */
 
+/* A reader is not thread-safe: lbk_reader_section_data decodes and caches on first access.
+ * Share one between threads only after every section was accessed once, or lock around it. */
 typedef struct lbk_reader lbk_reader;
 
 typedef struct lbk_read_options {
