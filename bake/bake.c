@@ -338,6 +338,8 @@ static void set_inputs(const bake *b, bk_set_inputs *in)
     in->glg_count = b->llg_first - b->glg_first;
     in->llg_first = b->llg_first;
     in->llg_count = b->receiver_count - b->llg_first;
+    in->llgs = b->llgs;
+    in->llg_grids = b->llg_count;
     in->texel_of_receiver = b->texel_of_receiver;
     in->texels = &b->texels;
     in->atlas_margin = b->atlas.margin;

@@ -27,6 +27,9 @@ typedef struct bk_bake_options {
     const char *revision;         /* stored in META */
     int timestamp;                /* store a timestamp in META (breaks byte-identity) */
     int octahedral_probes;        /* also write OCTP probes at the GLG positions */
+    double dls_threshold;         /* light sets/doors: store a receiver where the set's light exceeds
+                                     this fraction of the mean indirect light of the texels it lights
+                                     directly; 0: 0.01 (seed 001 §3.2); < 0: every non-zero receiver */
 } bk_bake_options;
 
 typedef struct bk_bake_summary {

@@ -8,6 +8,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "bake/llg_place.h"
 #include "bake/progress.h"
 #include "bake/scene.h"
 #include "bake/texels.h"
@@ -30,11 +31,17 @@ typedef struct bk_set_inputs {
     size_t texel_receivers;           /* receivers [0, texel_receivers) are texels */
     size_t glg_first, glg_count;      /* receivers [glg_first, glg_first+glg_count) are GLG probes */
     size_t llg_first, llg_count;      /* then LLG probes, in LLG section order */
+    const bk_llg *llgs;               /* the LLGs those probes belong to (their objects) */
+    size_t llg_grids;
     const uint32_t *texel_of_receiver;/* receiver → index in texels->receivers */
     const bk_texels *texels;          /* page layout: DLS texel index = page_offset[page] + y·w + x */
     int atlas_margin;                 /* dilation passes for set pages */
     const lbk_sh9_rgb *base_radiance; /* the base bake, per receiver */
     bk_transport_options transport;   /* the base bake's options (seed, threads, budgets) */
+    double base_samples_per_receiver; /* what the base bake reached: door bakes use this budget */
+    double threshold;                 /* sparse storage: fraction of the mean indirect light of the
+                                         texels a set lights directly (bake/SETS.md); 0: 0.01;
+                                         < 0: store every receiver with a non-zero contribution */
     bk_progress *progress;
 } bk_set_inputs;
 
@@ -43,8 +50,12 @@ typedef struct bk_set_inputs {
 int bk_set_bakes_prepare(bk_set_bakes *sets, const bk_scene *scene, bk_progress *progress, char *err,
                          size_t err_len);
 /* Sets what the base bake must leave out: the sets' lights (transport's light_set filter does
- * that already) and doors' reflection (albedo 0 in the base, seed §4.1). */
-void bk_set_bakes_base_hooks(bk_set_bakes *sets, const bk_scene *scene, bk_transport_options *base);
+ * that already) and doors' reflection (albedo 0 in the base, seed §4.1). Returns 1 when the
+ * base run needs an albedo hook that calls bk_set_bakes_base_albedo (the caller owns the
+ * transport's user pointer, so it installs the hook), else 0. */
+int bk_set_bakes_base_hooks(bk_set_bakes *sets, const bk_scene *scene, bk_transport_options *base);
+/* The base bake's albedo rule: 0 on door triangles. */
+void bk_set_bakes_base_albedo(const bk_set_bakes *sets, const bk_scene *scene, uint32_t tri, float albedo[3]);
 /* Bakes every set's contribution at the receivers. 0 or an LBK_EXIT_* code. */
 int bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *err, size_t err_len);
 /* The DLS and DOOR section bytes (free with lbk_free); *door is NULL without doors. */

@@ -28,6 +28,9 @@ static void help(FILE *f)
           "  --sky R,G,B | FILE.exr  sky radiance (overrides the scene's lbk_sky)\n"
           "  --no-glg                leave out the global light grid\n"
           "  --octahedral            also write GIBS-style octahedral probes (OCTP)\n"
+          "  --dls-threshold X       light sets and doors store a texel/probe only where their light\n"
+          "                          exceeds X times the mean indirect light of the texels they light\n"
+          "                          directly (default 0.01; 0 keeps every lit receiver)\n"
           "  --threads N             worker threads (default: all cores)\n"
           "  --seed N                random seed (default 1)\n"
           "  --json-report FILE      write the error-against-time report as JSON\n"
@@ -129,6 +132,9 @@ int lbk_cmd_bake(int argc, char **argv)
             o.no_glg = 1;
         } else if (!strcmp(a, "--octahedral")) {
             o.octahedral_probes = 1;
+        } else if (!strcmp(a, "--dls-threshold")) {
+            NEED_NUMBER(0, 1);
+            o.dls_threshold = d > 0 ? d : -1;
         } else if (!strcmp(a, "--threads")) {
             NEED_NUMBER(1, 1024);
             o.threads = (int)d;
