@@ -6,8 +6,8 @@ BUILD=${1:-build}
 LBK="$BUILD/lbk"
 OUT=out/demo
 mkdir -p "$OUT"
-echo "== lbk bake scenes/cornell_box/CornellBox-Original.gltf (preset fast)"
-"$LBK" bake scenes/cornell_box/CornellBox-Original.gltf -o "$OUT/cornell_box.lbk" --preset fast \
+echo "== lbk bake scenes/cornell_box/CornellBox-Original.gltf (preset fast, 64 texels/m: the box is 2 m across)"
+"$LBK" bake scenes/cornell_box/CornellBox-Original.gltf -o "$OUT/cornell_box.lbk" --preset fast --texel-density 64 \
     --json-report "$OUT/cornell_box.report.json"
 echo "== lbk validate"
 "$LBK" validate "$OUT/cornell_box.lbk"
