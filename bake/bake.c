@@ -500,19 +500,52 @@ done:
     return r;
 }
 
+static const bk_object *sort_objects;
+
+static int by_name_then_index(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    int c = strcmp(sort_objects[x].name, sort_objects[y].name);
+    return c ? c : (x > y) - (x < y);
+}
+
+/* OBJS names must be unique for tools to match objects across revisions (spec §8.2): the k-th
+ * repeat of a name in scene order becomes "name#k" (k from 2). */
+static int unique_names(const bk_scene *s, char (*names)[sizeof s->objects[0].name + 24])
+{
+    size_t n = s->object_count;
+    uint32_t *order = malloc((n ? n : 1) * sizeof *order);
+    if (!order) return -1;
+    for (size_t i = 0; i < n; i++) order[i] = (uint32_t)i;
+    sort_objects = s->objects; /* qsort has no user pointer in C11; bake is single-threaded here */
+    qsort(order, n, sizeof *order, by_name_then_index);
+    for (size_t i = 0; i < n; i++) {
+        const char *name = s->objects[order[i]].name;
+        size_t k = 1;
+        while (i >= k && !strcmp(s->objects[order[i - k]].name, name)) k++;
+        if (k == 1)
+            snprintf(names[order[i]], sizeof names[0], "%s", name);
+        else
+            snprintf(names[order[i]], sizeof names[0], "%s#%zu", name, k);
+    }
+    free(order);
+    return 0;
+}
+
 static lbk_result build_objects(bake *b, section_list *sl)
 {
     const bk_scene *s = &b->scene;
     lbk_object *objs = calloc(s->object_count ? s->object_count : 1, sizeof *objs);
+    char(*names)[sizeof s->objects[0].name + 24] = calloc(s->object_count ? s->object_count : 1, sizeof *names);
     float *xyz = NULL;
     size_t xyz_cap = 0;
     lbk_result r = LBK_ERR_OUT_OF_MEMORY;
-    if (!objs) return r;
+    if (!objs || !names || unique_names(s, names)) goto done;
     for (size_t i = 0; i < s->object_count; i++) {
         const bk_object *o = &s->objects[i];
         lbk_object *t = &objs[i];
-        t->name.data = o->name;
-        t->name.size = strlen(o->name);
+        t->name.data = names[i];
+        t->name.size = strlen(names[i]);
         if (o->tri_count > xyz_cap) {
             free(xyz);
             xyz_cap = o->tri_count;
@@ -541,7 +574,7 @@ static lbk_result build_objects(bake *b, section_list *sl)
     r = lbk_objects_build(objs, (uint32_t)s->object_count, NULL, &data, &size);
     r = sections_add(sl, LBK_SECTION_OBJS, r, data, size);
 done:
-    free(objs), free(xyz);
+    free(objs), free(names), free(xyz);
     return r;
 }
 
