@@ -186,7 +186,7 @@ int lbk_cmd_bake(int argc, char **argv)
     bk_progress_done(&progress);
     if (!quiet)
         printf("%s: %llu objects, %llu texels in %llu pages, %llu GLG probes, %llu LLG probes in %llu grids, "
-               "%u light sets, %u doors; estimated error %.2f%%; %llu bytes\n",
+               "%u dynamic sets (light sets and door states), %u doors; estimated error %.2f%%; %llu bytes\n",
                o.output, (unsigned long long)sum.objects, (unsigned long long)sum.texels,
                (unsigned long long)sum.pages, (unsigned long long)sum.glg_probes,
                (unsigned long long)sum.llg_probes, (unsigned long long)sum.llgs, sum.sets, sum.doors,
