@@ -138,6 +138,20 @@ static void transport_report(void *user, const bk_transport_sample *s)
 
 /* ---- phases ---------------------------------------------------------------------------- */
 
+/* A scene whose every triangle has zero area would bake to an empty container: refuse it. */
+static int has_triangle_with_area(const bk_scene *s)
+{
+    for (size_t t = 0; t < s->tri_count; t++) {
+        const float *p[3];
+        for (int k = 0; k < 3; k++) p[k] = s->positions + 3 * (size_t)s->tris[3 * t + k];
+        double e1[3], e2[3];
+        for (int c = 0; c < 3; c++) e1[c] = (double)p[1][c] - p[0][c], e2[c] = (double)p[2][c] - p[0][c];
+        double n0 = e1[1] * e2[2] - e1[2] * e2[1], n1 = e1[2] * e2[0] - e1[0] * e2[2], n2 = e1[0] * e2[1] - e1[1] * e2[0];
+        if (n0 * n0 + n1 * n1 + n2 * n2 > 0) return 1;
+    }
+    return 0;
+}
+
 static int do_import(bake *b)
 {
     phase(b, "import");
@@ -167,6 +181,9 @@ static int do_import(bake *b)
         b->scene.sky_image = -1;
     }
     if (b->scene.tri_count == 0) return fail(b, LBK_EXIT_INPUT, "%s: the scene has no triangles", b->opt->input);
+    if (!has_triangle_with_area(&b->scene))
+        return fail(b, LBK_EXIT_INPUT, "%s: all %zu triangles are degenerate (zero area): nothing to light",
+                    b->opt->input, b->scene.tri_count);
     if (!bk_scene_has_light(&b->scene))
         return fail(b, LBK_EXIT_INPUT,
                     "%s: the scene has no light: no KHR_lights_punctual light, no emissive material "
