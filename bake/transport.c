@@ -25,7 +25,7 @@ static uint64_t mix64(uint64_t z)
 
 typedef struct { uint64_t s; } tp_rng;
 
-enum { DOM_CELL = 1, DOM_RECV = 2 };
+enum { DOM_CELL = 1, DOM_RECV = 2, DOM_CELL_NEE = 3, DOM_RECV_NEE = 4 };
 
 /* Keyed by everything that identifies one item's samples: never by thread or time. */
 static tp_rng rng_make(uint64_t seed, uint64_t domain, uint64_t half, uint64_t pass, uint64_t bounce, uint64_t item)
@@ -102,6 +102,16 @@ static void lattice(const tp_lattice *l, uint32_t j, const tp_shift *sh, double 
     *sphi = l->sin_k[k] * sh->cs + l->cos_k[k] * sh->sn;
 }
 
+/* Sample j of the same lattice as a point of [0,1)² with its own shift (light samples). */
+static void lattice_uv(const tp_lattice *l, uint32_t j, double t1, double t2, double *a, double *b)
+{
+    double x = (double)j / l->S + t1;
+    uint32_t k = (uint32_t)(((uint64_t)j * l->g) % l->S);
+    double y = (double)k / l->S + t2;
+    *a = x - floor(x);
+    *b = y - floor(y);
+}
+
 /* ---- small vector helpers ------------------------------------------------------------------ */
 
 static double lum(const double c[3]) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
@@ -141,8 +151,17 @@ typedef struct tp_cell {
     float n[3];        /* side normal, zero for degenerate triangles */
     float area;
     float albedo[3];
-    float le[3];       /* emitted radiance (after the light-set filter) */
+    float le[3];       /* emitted radiance at the centroid (after the light-set filter) */
+    float nee_parea;   /* light-sampling density per unit area of points in this cell (both
+                          sides alike), 0 when next-event estimation never picks it */
 } tp_cell;
+
+/* A sub-triangle of an emissive triangle that light samples pick (one per (tri, sub), shared
+ * by both sides of a double-sided emitter). */
+typedef struct tp_emitter {
+    uint32_t tri;
+    uint32_t cell;      /* its side-0 cell */
+} tp_emitter;
 
 typedef struct tp_ctx {
     const bk_scene *scene;
@@ -157,6 +176,13 @@ typedef struct tp_ctx {
     uint8_t *tri_m;
     uint8_t *tri_sides;
     float *tri_edge_eps;   /* smallest barycentric a sample point may have: keeps points off edges */
+    float *tri_le;         /* 3 per triangle: emission factor after the light-set filter */
+    int32_t *tri_le_tex;   /* emission texture per triangle, -1 none */
+    /* next-event estimation: emitter sub-triangles picked by power through a CDF */
+    int nee;
+    size_t em_count;
+    tp_emitter *em;
+    double *em_cdf;        /* inclusive, em_cdf[em_count-1] = 1 */
     /* light selection */
     const bk_light **lights;
     size_t light_count;
@@ -175,7 +201,7 @@ typedef struct tp_ctx {
     const bk_transport_output *out;
     double pass_weight;
     /* counters: per thread, summed after each parallel step */
-    uint64_t *thread_rays, *thread_nonfinite;
+    uint64_t *thread_rays, *thread_shadow, *thread_nonfinite;
 } tp_ctx;
 
 /* ---- parallel-for --------------------------------------------------------------------------- */
@@ -392,10 +418,10 @@ static void cell_geom(const tp_ctx *c, const tp_cell *cell, tp_cell_geom *g)
     g->eps = c->tri_edge_eps[cell->tri];
 }
 
-/* Random point in a cell, kept off the triangle's edges. */
-static void cell_point(const tp_cell_geom *g, tp_rng *r, double p[3])
+/* The point of a cell for (r1, r2) in [0,1)², uniform over its area, kept off the triangle's
+ * edges; bu, bv (optional) get its barycentrics in the whole triangle. */
+static void cell_point_at(const tp_cell_geom *g, double r1, double r2, double p[3], double *bu, double *bv)
 {
-    double r1 = rng_next(r), r2 = rng_next(r);
     double sq = sqrt(r1);
     double w0 = 1 - sq, w1 = sq * (1 - r2), w2 = sq * r2;
     double u = w0 * g->b[0][0] + w1 * g->b[1][0] + w2 * g->b[2][0];
@@ -413,6 +439,140 @@ static void cell_point(const tp_cell_geom *g, tp_rng *r, double p[3])
         v /= sum;
     }
     for (int a = 0; a < 3; a++) p[a] = (1 - u - v) * g->v[0][a] + u * g->v[1][a] + v * g->v[2][a];
+    if (bu) *bu = u;
+    if (bv) *bv = v;
+}
+
+/* Random point in a cell, kept off the triangle's edges. */
+static void cell_point(const tp_cell_geom *g, tp_rng *r, double p[3])
+{
+    double r1 = rng_next(r), r2 = rng_next(r);
+    cell_point_at(g, r1, r2, p, NULL, NULL);
+}
+
+/* ---- emitters: next-event estimation and its MIS weights ------------------------------------ */
+
+/* Emitted radiance of triangle `tri` at barycentrics (u, v): the factor times the emission
+ * texture at the point's uv0, for both strategies alike (gather hits and light samples must
+ * see the same emitter or MIS would be biased). */
+static void emission_at(const tp_ctx *c, uint32_t tri, double u, double v, double out[3])
+{
+    const float *f = c->tri_le + 3 * (size_t)tri;
+    if (f[0] == 0 && f[1] == 0 && f[2] == 0) { out[0] = out[1] = out[2] = 0; return; }
+    int32_t tex = c->tri_le_tex[tri];
+    if (tex < 0) {
+        for (int k = 0; k < 3; k++) out[k] = f[k];
+        return;
+    }
+    const bk_scene *s = c->scene;
+    double te[3] = {1, 1, 1};
+    if (s->uv0) {
+        const uint32_t *ix = s->tris + 3 * (size_t)tri;
+        double uv[2];
+        for (int k = 0; k < 2; k++) {
+            double t0 = ix[0] < s->vertex_count ? s->uv0[2 * (size_t)ix[0] + k] : 0;
+            double t1 = ix[1] < s->vertex_count ? s->uv0[2 * (size_t)ix[1] + k] : 0;
+            double t2 = ix[2] < s->vertex_count ? s->uv0[2 * (size_t)ix[2] + k] : 0;
+            uv[k] = (1 - u - v) * t0 + u * t1 + v * t2;
+        }
+        sample_image(image_at(s, tex), uv[0], uv[1], te);
+    } else {
+        sample_image(image_at(s, tex), 0, 0, te);
+    }
+    for (int k = 0; k < 3; k++) {
+        double em = f[k] * te[k];
+        out[k] = isfinite(em) && em > 0 ? em : 0;
+    }
+}
+
+/* Which gather pdf a light sample is weighed against. */
+enum { PG_COSINE = 0, PG_HEMISPHERE = 1, PG_SPHERE = 2 };
+
+static double gather_pdf(int kind, double cos_p)
+{
+    return kind == PG_COSINE ? cos_p / TP_PI : kind == PG_HEMISPHERE ? 1 / (2 * TP_PI) : 1 / (4 * TP_PI);
+}
+
+/* Power heuristic (β = 2), one sample of each strategy per gather ray. */
+static double mis_power(double mine, double other)
+{
+    double a = mine * mine, b = other * other;
+    return a + b > 0 ? a / (a + b) : 0;
+}
+
+/* MIS weight of a gather ray (unit direction d, gather pdf pg) that hit cell hc at distance t:
+ * the light-sampling pdf of that point in solid angle is p_area·t²/|cos θ_light|. */
+static double mis_gather(const tp_ctx *c, const bk_hit *h, long hc, const double d[3], double pg)
+{
+    if (!c->nee) return 1;
+    double pa = c->cells[hc].nee_parea;
+    if (!(pa > 0)) return 1;
+    double cl = fabs(d[0] * h->ng[0] + d[1] * h->ng[1] + d[2] * h->ng[2]);
+    if (!(cl > 0)) return 1;
+    double t = h->t, pl = pa * t * t / cl;
+    return mis_power(pg, pl);
+}
+
+/* The emitter whose CDF interval holds u, and u's relative position inside it (which then
+ * places the point, so stratified u stay stratified over the emitter's area). */
+static size_t em_pick(const tp_ctx *c, double u, double *rem)
+{
+    size_t lo = 0, hi = c->em_count - 1;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (c->em_cdf[mid] > u) hi = mid;
+        else lo = mid + 1;
+    }
+    double a = lo ? c->em_cdf[lo - 1] : 0, b = c->em_cdf[lo];
+    double r = b > a ? (u - a) / (b - a) : 0.5;
+    *rem = r < 0 ? 0 : r > 0.9999999999999999 ? 0.9999999999999999 : r;
+    return lo;
+}
+
+/* One light sample for origin o (unit normal n; ignored for PG_SPHERE) from (u0, u1) in
+ * [0,1)²: picks an emitter sub-triangle by power, a uniform point on it, and traces a shadow
+ * ray. Returns 1 and fills the unit direction d, cos_p = d·n and val = Le·w_L/p_L (radiance
+ * over its solid-angle pdf, MIS-weighted) when the sample carries light. */
+static int nee_sample(const tp_ctx *c, const float o[3], const double n[3], int kind, double u0, double u1,
+                      double d[3], double *cos_p, double val[3], uint64_t *shadow)
+{
+    double rem;
+    const tp_emitter *em = &c->em[em_pick(c, u0, &rem)];
+    const tp_cell *cell = &c->cells[em->cell];
+    tp_cell_geom g;
+    cell_geom(c, cell, &g);
+    double x[3], bu, bv;
+    cell_point_at(&g, rem, u1, x, &bu, &bv);
+    double dv[3] = {x[0] - o[0], x[1] - o[1], x[2] - o[2]};
+    double dist2 = dv[0] * dv[0] + dv[1] * dv[1] + dv[2] * dv[2];
+    if (!(dist2 > 0) || !isfinite(dist2)) return 0;
+    double dist = sqrt(dist2);
+    for (int a = 0; a < 3; a++) d[a] = dv[a] / dist;
+    double cp = kind == PG_SPHERE ? 1 : d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
+    if (!(cp > 0)) return 0;
+    float ng[3];
+    bk_tracer_tri_normal(c->tracer, em->tri, ng);
+    double cl = -(d[0] * ng[0] + d[1] * ng[1] + d[2] * ng[2]);
+    int side = cl > 0 ? 0 : 1; /* the side facing the origin */
+    if (side >= c->tri_sides[em->tri]) return 0;
+    cl = fabs(cl);
+    if (!(cl > 1e-12)) return 0;
+    double le[3];
+    emission_at(c, em->tri, bu, bv, le);
+    if (le[0] <= 0 && le[1] <= 0 && le[2] <= 0) return 0;
+    double pl = cell->nee_parea * dist2 / cl;
+    if (!(pl > 0) || !isfinite(pl)) return 0;
+    double w = mis_power(pl, gather_pdf(kind, cp));
+    /* shadow ray to the point moved off the emitter toward the origin, stopped just short */
+    float xf[3] = {(float)x[0], (float)x[1], (float)x[2]}, xo[3];
+    float ns[3] = {side ? -ng[0] : ng[0], side ? -ng[1] : ng[1], side ? -ng[2] : ng[2]};
+    bk_offset_ray_origin_scaled(xf, ns, bk_tracer_tri_scale(c->tracer, em->tri), xo);
+    float sd[3] = {xo[0] - o[0], xo[1] - o[1], xo[2] - o[2]};
+    (*shadow)++;
+    if (bk_tracer_occluded(c->tracer, o, sd, 0.0f, 1.0f - 1e-5f)) return 0;
+    *cos_p = cp;
+    for (int a = 0; a < 3; a++) val[a] = le[a] * w / pl;
+    return 1;
 }
 
 /* ---- cache: one bounce for a range of cells ------------------------------------------------ */
@@ -422,7 +582,7 @@ static void cache_bounce(tp_ctx *c, size_t begin, size_t end, int thread)
     const int h = c->half, k = c->bounce, R = c->rays;
     const float *prev = c->l_prev[h];
     float *cur = c->l_cur[h];
-    uint64_t rays = 0, bad = 0;
+    uint64_t rays = 0, shadow = 0, bad = 0;
     for (size_t ci = begin; ci < end; ci++) {
         const tp_cell *cell = &c->cells[ci];
         double e[3] = {0, 0, 0};
@@ -438,7 +598,14 @@ static void cache_bounce(tp_ctx *c, size_t begin, size_t end, int thread)
         tp_cell_geom geom;
         cell_geom(c, cell, &geom);
         int light_points = (k == 1 && c->light_count) ? (R < TP_LIGHT_POINTS ? R : TP_LIGHT_POINTS) : 0;
-        double ep[3] = {0, 0, 0};
+        double ep[3] = {0, 0, 0}, en[3] = {0, 0, 0};
+        const int nee = k == 1 && c->nee;
+        double t1 = 0, t2 = 0;
+        if (nee) {
+            tp_rng nr = rng_make(c->seed, DOM_CELL_NEE, (uint64_t)h, (uint64_t)c->pass, 0, ci);
+            t1 = rng_next(&nr);
+            t2 = rng_next(&nr);
+        }
         for (int j = 0; j < R; j++) {
             double p[3];
             cell_point(&geom, &rng, p);
@@ -458,13 +625,28 @@ static void cache_bounce(tp_ctx *c, size_t begin, size_t end, int thread)
             if (bk_tracer_intersect(c->tracer, o, df, 0.0f, INFINITY, &hit)) {
                 long hc = hit_cell(c, &hit);
                 if (hc >= 0) {
-                    if (k == 1)
-                        for (int a = 0; a < 3; a++) L[a] = c->cells[hc].le[a];
-                    else
+                    if (k == 1) {
+                        emission_at(c, hit.tri, hit.u, hit.v, L);
+                        if (L[0] > 0 || L[1] > 0 || L[2] > 0) {
+                            double w = mis_gather(c, &hit, hc, d, lz / TP_PI);
+                            for (int a = 0; a < 3; a++) L[a] *= w;
+                        }
+                    } else {
                         for (int a = 0; a < 3; a++) L[a] = prev[3 * hc + a];
+                    }
                 }
             } else if (k == 1) {
                 sky_radiance(c, d, L);
+            }
+            if (nee) {
+                double u0, v0, ld[3], cq, val[3];
+                lattice_uv(&c->lat, (uint32_t)j, t1, t2, &u0, &v0);
+                if (nee_sample(c, o, n, PG_COSINE, u0, v0, ld, &cq, val, &shadow)) {
+                    if (finite3d(val))
+                        for (int a = 0; a < 3; a++) en[a] += val[a] * cq;
+                    else
+                        bad++;
+                }
             }
             if (!finite3d(L)) { bad++; continue; }
             for (int a = 0; a < 3; a++) e[a] += L[a];
@@ -474,14 +656,14 @@ static void cache_bounce(tp_ctx *c, size_t begin, size_t end, int thread)
                     if (!light_eval(c->lights[li], p, val, ld, &dist)) continue;
                     double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
                     if (cs <= 0) continue;
-                    rays++;
+                    shadow++;
                     if (!light_visible(c, o, ld, dist)) continue;
                     for (int a = 0; a < 3; a++) ep[a] += val[a] * cs;
                 }
             }
         }
         for (int a = 0; a < 3; a++) {
-            e[a] *= TP_PI / R;
+            e[a] = e[a] * (TP_PI / R) + en[a] / R;
             if (light_points) e[a] += ep[a] / light_points;
         }
     store:
@@ -491,7 +673,8 @@ static void cache_bounce(tp_ctx *c, size_t begin, size_t end, int thread)
             cur[3 * ci + a] = (float)v;
         }
     }
-    c->thread_rays[thread] += rays;
+    c->thread_rays[thread] += rays + shadow;
+    c->thread_shadow[thread] += shadow;
     c->thread_nonfinite[thread] += bad;
 }
 
@@ -507,14 +690,14 @@ static double cell_power(const tp_ctx *c, const float *l)
 
 typedef struct tp_chain_result { int bounces; double q, tail_energy, total_energy; } tp_chain_result;
 
-/* Fills l_sum[h] with the total outgoing radiance per cell (emission + all bounces + tail). */
+/* Fills l_sum[h] with the reflected outgoing radiance per cell (all bounces + tail; emission is
+ * added where a gather ray hits it, with its MIS weight). */
 static tp_chain_result run_chain(tp_ctx *c, int h, int pass, int rays, double tol, int max_bounces)
 {
     tp_chain_result res = {0, 0, 0, 0};
     size_t n = c->cell_count;
     float *sum = c->l_sum[h];
-    for (size_t i = 0; i < n; i++)
-        for (int a = 0; a < 3; a++) sum[3 * i + a] = c->cells[i].le[a];
+    memset(sum, 0, 3 * (n ? n : 1) * sizeof *sum);
     c->half = h;
     c->pass = pass;
     c->rays = rays;
@@ -619,6 +802,23 @@ static void recv_punctual(tp_ctx *c, size_t begin, size_t end, int thread)
         }
     }
     c->thread_rays[thread] += rays;
+    c->thread_shadow[thread] += rays;
+}
+
+/* One sample of a receiver's estimate: radiance L (direct part Ld) from unit direction d with
+ * cosine factor cs (1 for probes) into the irradiance and the SH projections. */
+static void accumulate(const double d[3], double cs, const double L[3], const double Ld[3], double e[3],
+                       double sh_t[3][9], double sh_d[3][9])
+{
+    double y[9];
+    sh9_basis(d, y);
+    int has_d = Ld[0] != 0 || Ld[1] != 0 || Ld[2] != 0;
+    for (int a = 0; a < 3; a++) {
+        e[a] += L[a] * cs;
+        for (int kk = 0; kk < 9; kk++) sh_t[a][kk] += L[a] * y[kk];
+        if (has_d)
+            for (int kk = 0; kk < 9; kk++) sh_d[a][kk] += Ld[a] * y[kk];
+    }
 }
 
 static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
@@ -626,7 +826,7 @@ static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
     const int S = c->rays;
     const double w = c->pass_weight;
     const bk_transport_output *out = c->out;
-    uint64_t rays = 0, bad = 0;
+    uint64_t rays = 0, shadow = 0, bad = 0;
     for (size_t i = begin; i < end; i++) {
         const bk_receiver *r = &c->recv[i];
         double n[3], t[3], b[3];
@@ -648,6 +848,13 @@ static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
             /* uniform over the hemisphere (texels) or sphere (probes): the SH projection needs
              * a pdf that does not vanish at the horizon */
             const double solid = sphere ? 4 * TP_PI : 2 * TP_PI;
+            const int pg_kind = sphere ? PG_SPHERE : PG_HEMISPHERE;
+            double t1 = 0, t2 = 0;
+            if (c->nee) {
+                tp_rng nr = rng_make(c->seed, DOM_RECV_NEE, (uint64_t)h, (uint64_t)c->pass, 0, i);
+                t1 = rng_next(&nr);
+                t2 = rng_next(&nr);
+            }
             for (int j = 0; j < S; j++) {
                 double u1, cp, sp;
                 lattice(&c->lat, (uint32_t)j, &shift, &u1, &cp, &sp);
@@ -662,25 +869,30 @@ static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
                 rays++;
                 if (bk_tracer_intersect(c->tracer, o, df, 0.0f, INFINITY, &hit)) {
                     long hc = hit_cell(c, &hit);
-                    if (hc >= 0)
-                        for (int a = 0; a < 3; a++) {
-                            L[a] = sum[3 * hc + a];
-                            Ld[a] = c->cells[hc].le[a];
+                    if (hc >= 0) {
+                        emission_at(c, hit.tri, hit.u, hit.v, Ld);
+                        if (Ld[0] > 0 || Ld[1] > 0 || Ld[2] > 0) {
+                            double wg = mis_gather(c, &hit, hc, d, 1 / solid);
+                            for (int a = 0; a < 3; a++) Ld[a] *= wg;
                         }
+                        for (int a = 0; a < 3; a++) L[a] = sum[3 * hc + a] + Ld[a];
+                    }
                 } else {
                     sky_radiance(c, d, L);
                     memcpy(Ld, L, sizeof L);
                 }
-                if (!finite3d(L) || !finite3d(Ld)) { bad++; continue; }
-                double y[9];
-                sh9_basis(d, y);
-                double cs = sphere ? 1 : z;
-                int has_d = Ld[0] != 0 || Ld[1] != 0 || Ld[2] != 0;
-                for (int a = 0; a < 3; a++) {
-                    e[a] += L[a] * cs;
-                    for (int kk = 0; kk < 9; kk++) sh_t[a][kk] += L[a] * y[kk];
-                    if (has_d)
-                        for (int kk = 0; kk < 9; kk++) sh_d[a][kk] += Ld[a] * y[kk];
+                if (!finite3d(L) || !finite3d(Ld)) bad++;
+                else accumulate(d, sphere ? 1 : z, L, Ld, e, sh_t, sh_d);
+                if (c->nee) {
+                    /* one light sample per gather ray; its value Le·w/p is turned into the gather's
+                     * units (radiance, later × solid/S) by 1/solid */
+                    double u0, uu1, ld[3], cl, val[3];
+                    lattice_uv(&c->lat, (uint32_t)j, t1, t2, &u0, &uu1);
+                    if (nee_sample(c, o, n, pg_kind, u0, uu1, ld, &cl, val, &shadow)) {
+                        for (int a = 0; a < 3; a++) val[a] /= solid;
+                        if (!finite3d(val)) bad++;
+                        else accumulate(ld, cl, val, val, e, sh_t, sh_d);
+                    }
                 }
             }
             for (int a = 0; a < 3; a++) e[a] *= solid / S;
@@ -699,7 +911,8 @@ static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
             if (out->irradiance) out->irradiance[3 * i + a] += (float)(e_t[a] * w * 0.5);
         }
     }
-    c->thread_rays[thread] += rays;
+    c->thread_rays[thread] += rays + shadow;
+    c->thread_shadow[thread] += shadow;
     c->thread_nonfinite[thread] += bad;
 }
 
@@ -721,6 +934,8 @@ static double now_seconds(void)
 static void free_ctx(tp_ctx *c)
 {
     free(c->cells); free(c->tri_first); free(c->tri_m); free(c->tri_sides); free(c->tri_edge_eps);
+    free(c->tri_le); free(c->tri_le_tex); free(c->em); free(c->em_cdf);
+    free(c->thread_shadow);
     free(c->lights);
     for (int h = 0; h < 2; h++) { free(c->l_prev[h]); free(c->l_cur[h]); free(c->l_sum[h]); free(c->x_acc[h]); }
     free(c->punct_lum);
@@ -737,7 +952,10 @@ static lbk_result build_cells(tp_ctx *c)
     c->tri_m = calloc(nt ? nt : 1, 1);
     c->tri_sides = calloc(nt ? nt : 1, 1);
     c->tri_edge_eps = calloc(nt ? nt : 1, sizeof(float));
-    if (!c->tri_first || !c->tri_m || !c->tri_sides || !c->tri_edge_eps) return LBK_ERR_OUT_OF_MEMORY;
+    c->tri_le = calloc(3 * (nt ? nt : 1), sizeof(float));
+    c->tri_le_tex = calloc(nt ? nt : 1, sizeof(int32_t));
+    if (!c->tri_first || !c->tri_m || !c->tri_sides || !c->tri_edge_eps || !c->tri_le || !c->tri_le_tex)
+        return LBK_ERR_OUT_OF_MEMORY;
     double total = 0;
     for (size_t i = 0; i < nt; i++) {
         uint32_t mi = s->tri_material ? s->tri_material[i] : 0;
@@ -788,6 +1006,14 @@ static lbk_result build_cells(tp_ctx *c)
         float area = bk_tracer_tri_area(c->tracer, (uint32_t)i);
         int m = c->tri_m[i];
         const uint32_t *ix = s->tris + 3 * i;
+        c->tri_le_tex[i] = -1;
+        if (mat && emits && area > 0) {
+            for (int k = 0; k < 3; k++) {
+                double em = mat->emission[k];
+                c->tri_le[3 * i + k] = (float)(isfinite(em) && em > 0 ? em : 0);
+            }
+            if (mat->emission_tex >= 0 && image_at(s, mat->emission_tex)) c->tri_le_tex[i] = mat->emission_tex;
+        }
         for (int sub = 0; sub < m * m; sub++) {
             /* material values at the cell's centroid (uv0) */
             int j = 0, ss = sub;
@@ -837,6 +1063,58 @@ static lbk_result build_cells(tp_ctx *c)
     return LBK_OK;
 }
 
+/* The light-sampling distribution: every emitting sub-triangle with probability proportional
+ * to its power area·lum(Le) (Le at its centroid, as the cells carry it), a point uniform on it.
+ * A point's density per unit area is then lum(Le_cell)/P_total, stored in both side cells so a
+ * gather hit can weigh itself against it. */
+static lbk_result build_emitters(tp_ctx *c)
+{
+    const bk_transport_options *opt = c->opt;
+    c->nee = 0;
+    if (opt->nee < 0) return LBK_OK;
+    size_t n = 0;
+    double power = 0, em_area = 0, total_area = 0;
+    for (size_t i = 0; i < c->scene->tri_count; i++) total_area += bk_tracer_tri_area(c->tracer, (uint32_t)i);
+    for (size_t ci = 0; ci < c->cell_count; ci++) {
+        const tp_cell *cell = &c->cells[ci];
+        if (cell->side != 0 || !(cell->area > 0)) continue;
+        double le[3] = {cell->le[0], cell->le[1], cell->le[2]};
+        double p = cell->area * lum(le);
+        if (!(p > 0) || !isfinite(p)) continue;
+        n++;
+        power += p;
+        em_area += cell->area;
+    }
+    if (n == 0 || !(power > 0) || !isfinite(power)) return LBK_OK;
+    /* auto: emitters covering half the surface are hit by gather rays about as often as light
+     * samples would find them; gathering alone keeps the furnace exact (TRANSPORT.md) */
+    if (opt->nee == 0 && em_area >= 0.5 * total_area) return LBK_OK;
+    c->em = malloc(n * sizeof *c->em);
+    c->em_cdf = malloc(n * sizeof *c->em_cdf);
+    if (!c->em || !c->em_cdf) return LBK_ERR_OUT_OF_MEMORY;
+    double run = 0;
+    size_t k = 0;
+    for (size_t ci = 0; ci < c->cell_count; ci++) {
+        tp_cell *cell = &c->cells[ci];
+        if (cell->side != 0 || !(cell->area > 0)) continue;
+        double le[3] = {cell->le[0], cell->le[1], cell->le[2]};
+        double p = cell->area * lum(le);
+        if (!(p > 0) || !isfinite(p)) continue;
+        run += p;
+        c->em[k].tri = cell->tri;
+        c->em[k].cell = (uint32_t)ci;
+        c->em_cdf[k] = run / power;
+        float pa = (float)(lum(le) / power);
+        cell->nee_parea = pa;
+        if (c->tri_sides[cell->tri] > 1) c->cells[ci + (size_t)cell->m * cell->m].nee_parea = pa;
+        k++;
+    }
+    c->em_cdf[n - 1] = 1.0;
+    c->em_count = n;
+    c->nee = 1;
+    return LBK_OK;
+}
+
 /* ---- the run ---------------------------------------------------------------------------------- */
 
 lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, const bk_receiver *receivers,
@@ -876,7 +1154,8 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
     lbk_result res = LBK_OK;
     c.thread_rays = calloc((size_t)c.threads, sizeof(uint64_t));
     c.thread_nonfinite = calloc((size_t)c.threads, sizeof(uint64_t));
-    if (!c.thread_rays || !c.thread_nonfinite) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
+    c.thread_shadow = calloc((size_t)c.threads, sizeof(uint64_t));
+    if (!c.thread_rays || !c.thread_nonfinite || !c.thread_shadow) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
 
     /* scale of the coordinates: offsets for receivers, which carry no triangle */
     for (size_t i = 0; i < scene->tri_count; i++) {
@@ -892,6 +1171,8 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
             if (in_light_set(&c, scene->lights[i].light_set)) c.lights[c.light_count++] = &scene->lights[i];
     }
     res = build_cells(&c);
+    if (res != LBK_OK) goto done;
+    res = build_emitters(&c);
     if (res != LBK_OK) goto done;
     size_t nc = c.cell_count ? c.cell_count : 1;
     for (int h = 0; h < 2; h++) {
@@ -1000,9 +1281,11 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
         stats->cells = c.cell_count;
         for (int t = 0; t < c.threads; t++) {
             stats->rays += c.thread_rays[t];
+            stats->shadow_rays += c.thread_shadow[t];
             stats->nonfinite += c.thread_nonfinite[t];
         }
         stats->stop = stop;
+        stats->nee = c.nee;
     }
 done:
     free_ctx(&c);

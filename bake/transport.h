@@ -4,12 +4,12 @@
  *
  * Summary: a radiosity cache of surface cells (each triangle side split into m² sub-triangles
  * by area, independent of lightmap UVs) is filled bounce by bounce: bounce 1 = punctual direct
- * (shadow rays) + emission and sky seen by cosine-distributed gather rays; bounce k = albedo/π
- * × irradiance gathered from bounce k−1 with fresh rays. Bounces stop when the per-bounce energy
- * ratio q has settled; the rest of the Neumann series is added per cell as L_K·q/(1−q).
- * Receivers then gather the cache's total radiance (final gather) plus punctual direct light.
- * Emitters and sky are reached by gather rays only (no next-event estimation), so nothing is
- * counted twice. Progressive passes double the samples; each pass runs two independent halves
+ * (shadow rays) + emission (gather rays and next-event estimation, combined by multiple
+ * importance sampling) + sky (gather rays); bounce k = albedo/π × irradiance gathered from
+ * bounce k−1 with fresh rays. Bounces stop when the per-bounce energy ratio q has settled; the
+ * rest of the Neumann series is added per cell as L_K·q/(1−q). Receivers then gather the cache's
+ * radiance (final gather, emitters again by MIS of gather hits and light samples) plus punctual
+ * direct light. Progressive passes double the samples; each pass runs two independent halves
  * (own cache, own receiver rays), whose difference estimates the error.
  *
  * Determinism: every random number comes from a counter-based hash of (seed, half, pass,
@@ -61,6 +61,10 @@ typedef struct bk_transport_options {
                                 always gets at least one cell per side */
     int cache_rays;          /* gather rays per cell per bounce in pass 0 (doubles per pass); 0: 16 */
     int first_pass_samples;  /* gather rays per receiver per half in pass 0 (doubles); 0: 16 */
+    /* Next-event estimation of emissive triangles (one light sample per gather ray, combined
+     * with the gather hits by the power heuristic): 0 auto = on unless the emitters cover half
+     * the scene's surface or more (gather rays find them anyway; TRANSPORT.md), 1 on, -1 off. */
+    int nee;
     /* Called once per cache cell with the triangle's textured albedo; may change it (e.g. 0 for
      * doors in base bakes). Must be deterministic. NULL: none. */
     void (*albedo_hook)(void *user, uint32_t tri, float albedo[3]);
@@ -91,6 +95,8 @@ typedef struct bk_transport_stats {
     double tail_fraction;    /* share of the cache's indirect energy that came from the tail */
     size_t cells;
     uint64_t rays;           /* rays traced (gather + shadow) */
+    uint64_t shadow_rays;    /* of which shadow rays (punctual lights and light samples) */
+    int nee;                 /* 1 when emitters were light-sampled (next-event estimation) */
     uint64_t nonfinite;      /* sample values that were NaN/Inf and were dropped (should be 0) */
     int stop;                /* enum bk_transport_stop */
 } bk_transport_stats;

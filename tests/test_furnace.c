@@ -56,7 +56,7 @@ static void make_receivers(bk_receiver *r, int n)
 
 typedef struct furnace_run {
     double max_texel_err, max_probe_err, true_rmse, est_rmse, direct_err, q, tail;
-    int bounces;
+    int bounces, nee;
     uint64_t nonfinite;
 } furnace_run;
 
@@ -66,7 +66,7 @@ static void zero_albedo(void *user, uint32_t tri, float albedo[3])
     albedo[0] = albedo[1] = albedo[2] = 0;
 }
 
-static furnace_run run_furnace(double rho, double le, int hook)
+static furnace_run run_furnace(double rho, double le, int hook, int nee)
 {
     bk_scene s;
     tsc_init(&s);
@@ -90,6 +90,7 @@ static furnace_run run_furnace(double rho, double le, int hook)
     opt.first_pass_samples = S0;
     opt.max_cells = 768;
     if (hook) opt.albedo_hook = zero_albedo;
+    opt.nee = nee;
     bk_transport_stats st;
     assert_int_equal(bk_transport_run(&s, t, r, N_RECV, &opt, &out, &st), LBK_OK);
     assert_int_equal(st.passes, PASSES);
@@ -127,6 +128,7 @@ static furnace_run run_furnace(double rho, double le, int hook)
     fr.tail = st.tail_fraction;
     fr.bounces = st.bounces;
     fr.nonfinite = st.nonfinite;
+    fr.nee = st.nee;
     bk_tracer_destroy(t);
     tsc_free(&s);
     return fr;
@@ -134,7 +136,7 @@ static furnace_run run_furnace(double rho, double le, int hook)
 
 static void check(double rho)
 {
-    furnace_run fr = run_furnace(rho, 1.0, 0);
+    furnace_run fr = run_furnace(rho, 1.0, 0, 0);
     double b = texel_bound();
     assert_true(b < 0.0061);
     print_message("rho %.2f: max texel err %.5f (bound %.5f), max probe err %.2g, true rmse %.5f est %.5f, q %.6f tail %.3f bounces %d\n",
@@ -142,6 +144,8 @@ static void check(double rho)
     assert_true(fr.max_texel_err <= b);
     assert_true(fr.max_probe_err <= 1e-5);
     assert_int_equal(fr.nonfinite, 0);
+    /* emitters cover the whole box: the automatic choice gathers them (the derived bound) */
+    assert_int_equal(fr.nee, 0);
     /* the tail is what makes this work: q is rho, and the series was not truncated */
     assert_true(fabs(fr.q - rho) < 1e-4);
     assert_true(fr.bounces < 64);
@@ -161,9 +165,23 @@ static void test_furnace_099(void **state) { (void)state; check(0.99); }
 static void test_furnace_albedo_hook(void **state)
 {
     (void)state;
-    furnace_run fr = run_furnace(0.9, 2.5, 1);
+    furnace_run fr = run_furnace(0.9, 2.5, 1, 0);
     assert_true(fr.max_texel_err <= texel_bound());
     assert_true(fr.max_probe_err <= 1e-5);
+}
+
+/* Next-event estimation forced on: the cache and the receivers are no longer exact (light
+ * samples vary in distance and angle), but stay unbiased and honestly estimated. */
+static void test_furnace_nee_forced(void **state)
+{
+    (void)state;
+    furnace_run fr = run_furnace(0.9, 1.0, 0, 1);
+    print_message("nee forced, rho 0.90: max texel err %.5f, max probe err %.5f, true rmse %.5f est %.5f, q %.5f\n",
+                  fr.max_texel_err, fr.max_probe_err, fr.true_rmse, fr.est_rmse, fr.q);
+    assert_int_equal(fr.nee, 1);
+    assert_int_equal(fr.nonfinite, 0);
+    assert_true(fr.est_rmse <= 2 * fr.true_rmse && fr.est_rmse >= 0.5 * fr.true_rmse);
+    assert_true(fabs(fr.q - 0.9) < 0.01);
 }
 
 int main(void)
@@ -173,6 +191,7 @@ int main(void)
         cmocka_unit_test(test_furnace_090),
         cmocka_unit_test(test_furnace_099),
         cmocka_unit_test(test_furnace_albedo_hook),
+        cmocka_unit_test(test_furnace_nee_forced),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
