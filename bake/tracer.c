@@ -227,11 +227,40 @@ int bk_tracer_occluded(const bk_tracer *t, const float org[3], const float dir[3
 void bk_tracer_intersect_n(const bk_tracer *t, size_t n, const float *org, const float *dir, float tmin,
                            const float *tmax, bk_hit *hits)
 {
-    for (size_t i = 0; i < n; i++) {
-        if (!bk_tracer_intersect(t, org + 3 * i, dir + 3 * i, tmin, tmax[i], &hits[i])) {
-            memset(&hits[i], 0, sizeof hits[i]);
+    /* Embree's stream entry point, incoherent mode: one call per chunk instead of per ray */
+    enum { CHUNK = 64 };
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    struct RTCRayHit rh[CHUNK];
+    uint32_t map[CHUNK];
+    for (size_t b = 0; b < n; b += CHUNK) {
+        size_t m = n - b < CHUNK ? n - b : CHUNK, k = 0;
+        for (size_t i = b; i < b + m; i++) {
+            float tm = tmax ? tmax[i] : INFINITY;
             hits[i].tri = UINT32_MAX;
+            if (!ray_ok(org + 3 * i, dir + 3 * i, tmin, tm)) continue;
+            setup_ray(&rh[k].ray, org + 3 * i, dir + 3 * i, tmin, tm);
+            rh[k].hit.geomID = RTC_INVALID_GEOMETRY_ID;
+            rh[k].hit.primID = RTC_INVALID_GEOMETRY_ID;
+            rh[k].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+            map[k++] = (uint32_t)i;
         }
+        if (k) rtcIntersect1M(t->rtc_scene, &ctx, rh, (unsigned)k, sizeof rh[0]);
+        for (size_t j = 0; j < k; j++) {
+            bk_hit *h = &hits[map[j]];
+            if (rh[j].hit.geomID == RTC_INVALID_GEOMETRY_ID || rh[j].hit.primID >= t->tri_count) {
+                memset(h, 0, sizeof *h);
+                h->tri = UINT32_MAX;
+                continue;
+            }
+            fill_hit(t, &rh[j], dir + 3 * (size_t)map[j], h);
+        }
+        for (size_t i = b; i < b + m; i++)
+            if (hits[i].tri == UINT32_MAX) {
+                memset(&hits[i], 0, sizeof hits[i]);
+                hits[i].tri = UINT32_MAX;
+            }
     }
 }
 

@@ -13,6 +13,7 @@
 #define TP_Q_MAX 0.999      /* largest per-bounce ratio the tail formula trusts (factor ≤ 999) */
 #define TP_MAX_SUB 16       /* at most 16×16 cells per triangle side */
 #define TP_LIGHT_POINTS 16  /* points per cell that test punctual lights in bounce 1 */
+#define TP_BATCH 64         /* rays generated, then traced as one stream, then shaded */
 
 /* ---- counter-based random numbers --------------------------------------------------------- */
 
@@ -63,6 +64,7 @@ static uint32_t lattice_generator(uint32_t S)
 typedef struct tp_lattice {
     uint32_t S, g;
     double *cos_k, *sin_k; /* cos/sin(2π k/S) */
+    uint32_t *k_of_j;      /* j·g mod S (a table: a 64-bit division per ray is not free) */
 } tp_lattice;
 
 static lbk_result lattice_init(tp_lattice *l, uint32_t S)
@@ -70,20 +72,23 @@ static lbk_result lattice_init(tp_lattice *l, uint32_t S)
     if (l->S == S) return LBK_OK;
     free(l->cos_k);
     free(l->sin_k);
+    free(l->k_of_j);
     l->cos_k = malloc(S * sizeof(double));
     l->sin_k = malloc(S * sizeof(double));
+    l->k_of_j = malloc(S * sizeof(uint32_t));
     l->S = 0;
-    if (!l->cos_k || !l->sin_k) return LBK_ERR_OUT_OF_MEMORY;
+    if (!l->cos_k || !l->sin_k || !l->k_of_j) return LBK_ERR_OUT_OF_MEMORY;
     for (uint32_t k = 0; k < S; k++) {
         l->cos_k[k] = cos(2 * 3.14159265358979323846 * k / S);
         l->sin_k[k] = sin(2 * 3.14159265358979323846 * k / S);
     }
     l->S = S;
     l->g = lattice_generator(S);
+    for (uint32_t j = 0; j < S; j++) l->k_of_j[j] = (uint32_t)(((uint64_t)j * l->g) % S);
     return LBK_OK;
 }
 
-static void lattice_free(tp_lattice *l) { free(l->cos_k); free(l->sin_k); }
+static void lattice_free(tp_lattice *l) { free(l->cos_k); free(l->sin_k); free(l->k_of_j); }
 
 typedef struct tp_shift { double s1, cs, sn; } tp_shift;
 
@@ -97,7 +102,7 @@ static void lattice(const tp_lattice *l, uint32_t j, const tp_shift *sh, double 
 {
     double a = (double)j / l->S + sh->s1;
     *u1 = a - floor(a);
-    uint32_t k = (uint32_t)(((uint64_t)j * l->g) % l->S);
+    uint32_t k = l->k_of_j[j];
     *cphi = l->cos_k[k] * sh->cs - l->sin_k[k] * sh->sn;
     *sphi = l->sin_k[k] * sh->cs + l->cos_k[k] * sh->sn;
 }
@@ -106,7 +111,7 @@ static void lattice(const tp_lattice *l, uint32_t j, const tp_shift *sh, double 
 static void lattice_uv(const tp_lattice *l, uint32_t j, double t1, double t2, double *a, double *b)
 {
     double x = (double)j / l->S + t1;
-    uint32_t k = (uint32_t)(((uint64_t)j * l->g) % l->S);
+    uint32_t k = l->k_of_j[j];
     double y = (double)k / l->S + t2;
     *a = x - floor(x);
     *b = y - floor(y);
@@ -606,59 +611,73 @@ static void cache_bounce(tp_ctx *c, size_t begin, size_t end, int thread)
             t1 = rng_next(&nr);
             t2 = rng_next(&nr);
         }
-        for (int j = 0; j < R; j++) {
-            double p[3];
-            cell_point(&geom, &rng, p);
-            float pf[3] = {(float)p[0], (float)p[1], (float)p[2]}, o[3];
-            bk_offset_ray_origin_scaled(pf, nf, scale, o);
-            /* cosine-distributed direction */
-            double u1, cp, sp;
-            lattice(&c->lat, (uint32_t)j, &shift, &u1, &cp, &sp);
-            double rr = sqrt(u1);
-            double lx = rr * cp, ly = rr * sp, lz = sqrt(fmax(0.0, 1 - u1));
-            double d[3];
-            for (int a = 0; a < 3; a++) d[a] = lx * t[a] + ly * b[a] + lz * n[a];
-            float df[3] = {(float)d[0], (float)d[1], (float)d[2]};
-            bk_hit hit;
-            double L[3] = {0, 0, 0};
-            rays++;
-            if (bk_tracer_intersect(c->tracer, o, df, 0.0f, INFINITY, &hit)) {
-                long hc = hit_cell(c, &hit);
-                if (hc >= 0) {
-                    if (k == 1) {
-                        emission_at(c, hit.tri, hit.u, hit.v, L);
-                        if (L[0] > 0 || L[1] > 0 || L[2] > 0) {
-                            double w = mis_gather(c, &hit, hc, d, lz / TP_PI);
-                            for (int a = 0; a < 3; a++) L[a] *= w;
+        for (int j0 = 0; j0 < R; j0 += TP_BATCH) {
+            const int m = R - j0 < TP_BATCH ? R - j0 : TP_BATCH;
+            float org[3 * TP_BATCH], dir[3 * TP_BATCH];
+            double dd[TP_BATCH][3], pts[TP_BATCH][3];
+            bk_hit hits[TP_BATCH];
+            for (int jj = 0; jj < m; jj++) {
+                double *p = pts[jj];
+                cell_point(&geom, &rng, p);
+                float pf[3] = {(float)p[0], (float)p[1], (float)p[2]};
+                bk_offset_ray_origin_scaled(pf, nf, scale, org + 3 * jj);
+                /* cosine-distributed direction */
+                double u1, cp, sp;
+                lattice(&c->lat, (uint32_t)(j0 + jj), &shift, &u1, &cp, &sp);
+                double rr = sqrt(u1);
+                double lx = rr * cp, ly = rr * sp, lz = sqrt(fmax(0.0, 1 - u1));
+                for (int a = 0; a < 3; a++) {
+                    dd[jj][a] = lx * t[a] + ly * b[a] + lz * n[a];
+                    dir[3 * jj + a] = (float)dd[jj][a];
+                }
+            }
+            bk_tracer_intersect_n(c->tracer, (size_t)m, org, dir, 0.0f, NULL, hits);
+            rays += (uint64_t)m;
+            for (int jj = 0; jj < m; jj++) {
+                const int j = j0 + jj;
+                const double *d = dd[jj];
+                const float *o = org + 3 * jj;
+                const bk_hit *hit = &hits[jj];
+                double L[3] = {0, 0, 0};
+                if (hit->tri != UINT32_MAX) {
+                    long hc = hit_cell(c, hit);
+                    if (hc >= 0) {
+                        if (k == 1) {
+                            emission_at(c, hit->tri, hit->u, hit->v, L);
+                            if (L[0] > 0 || L[1] > 0 || L[2] > 0) {
+                                double lz = d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
+                                double w = mis_gather(c, hit, hc, d, lz / TP_PI);
+                                for (int a = 0; a < 3; a++) L[a] *= w;
+                            }
+                        } else {
+                            for (int a = 0; a < 3; a++) L[a] = prev[3 * hc + a];
                         }
-                    } else {
-                        for (int a = 0; a < 3; a++) L[a] = prev[3 * hc + a];
+                    }
+                } else if (k == 1) {
+                    sky_radiance(c, d, L);
+                }
+                if (!finite3d(L)) bad++;
+                else for (int a = 0; a < 3; a++) e[a] += L[a];
+                if (nee) {
+                    double u0, v0, ld[3], cq, val[3];
+                    lattice_uv(&c->lat, (uint32_t)j, t1, t2, &u0, &v0);
+                    if (nee_sample(c, o, n, PG_COSINE, u0, v0, ld, &cq, val, &shadow)) {
+                        if (finite3d(val))
+                            for (int a = 0; a < 3; a++) en[a] += val[a] * cq;
+                        else
+                            bad++;
                     }
                 }
-            } else if (k == 1) {
-                sky_radiance(c, d, L);
-            }
-            if (nee) {
-                double u0, v0, ld[3], cq, val[3];
-                lattice_uv(&c->lat, (uint32_t)j, t1, t2, &u0, &v0);
-                if (nee_sample(c, o, n, PG_COSINE, u0, v0, ld, &cq, val, &shadow)) {
-                    if (finite3d(val))
-                        for (int a = 0; a < 3; a++) en[a] += val[a] * cq;
-                    else
-                        bad++;
-                }
-            }
-            if (!finite3d(L)) { bad++; continue; }
-            for (int a = 0; a < 3; a++) e[a] += L[a];
-            if (j < light_points) {
-                for (size_t li = 0; li < c->light_count; li++) {
-                    double val[3], ld[3], dist;
-                    if (!light_eval(c->lights[li], p, val, ld, &dist)) continue;
-                    double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
-                    if (cs <= 0) continue;
-                    shadow++;
-                    if (!light_visible(c, o, ld, dist)) continue;
-                    for (int a = 0; a < 3; a++) ep[a] += val[a] * cs;
+                if (j < light_points) {
+                    for (size_t li = 0; li < c->light_count; li++) {
+                        double val[3], ld[3], dist;
+                        if (!light_eval(c->lights[li], pts[jj], val, ld, &dist)) continue;
+                        double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
+                        if (cs <= 0) continue;
+                        shadow++;
+                        if (!light_visible(c, o, ld, dist)) continue;
+                        for (int a = 0; a < 3; a++) ep[a] += val[a] * cs;
+                    }
                 }
             }
         }
@@ -855,43 +874,56 @@ static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
                 t1 = rng_next(&nr);
                 t2 = rng_next(&nr);
             }
-            for (int j = 0; j < S; j++) {
-                double u1, cp, sp;
-                lattice(&c->lat, (uint32_t)j, &shift, &u1, &cp, &sp);
-                double z = sphere ? 1 - 2 * u1 : u1;
-                double rr = sqrt(fmax(0.0, 1 - z * z));
-                double lx = rr * cp, ly = rr * sp;
-                double d[3];
-                for (int a = 0; a < 3; a++) d[a] = lx * t[a] + ly * b[a] + z * n[a];
-                float df[3] = {(float)d[0], (float)d[1], (float)d[2]};
-                bk_hit hit;
-                double L[3] = {0, 0, 0}, Ld[3] = {0, 0, 0};
-                rays++;
-                if (bk_tracer_intersect(c->tracer, o, df, 0.0f, INFINITY, &hit)) {
-                    long hc = hit_cell(c, &hit);
-                    if (hc >= 0) {
-                        emission_at(c, hit.tri, hit.u, hit.v, Ld);
-                        if (Ld[0] > 0 || Ld[1] > 0 || Ld[2] > 0) {
-                            double wg = mis_gather(c, &hit, hc, d, 1 / solid);
-                            for (int a = 0; a < 3; a++) Ld[a] *= wg;
-                        }
-                        for (int a = 0; a < 3; a++) L[a] = sum[3 * hc + a] + Ld[a];
+            for (int j0 = 0; j0 < S; j0 += TP_BATCH) {
+                const int m = S - j0 < TP_BATCH ? S - j0 : TP_BATCH;
+                float org[3 * TP_BATCH], dir[3 * TP_BATCH];
+                double dd[TP_BATCH][3], zz[TP_BATCH];
+                bk_hit hits[TP_BATCH];
+                for (int jj = 0; jj < m; jj++) {
+                    double u1, cp, sp;
+                    lattice(&c->lat, (uint32_t)(j0 + jj), &shift, &u1, &cp, &sp);
+                    double z = sphere ? 1 - 2 * u1 : u1;
+                    double rr = sqrt(fmax(0.0, 1 - z * z));
+                    double lx = rr * cp, ly = rr * sp;
+                    zz[jj] = z;
+                    for (int a = 0; a < 3; a++) {
+                        dd[jj][a] = lx * t[a] + ly * b[a] + z * n[a];
+                        dir[3 * jj + a] = (float)dd[jj][a];
+                        org[3 * jj + a] = o[a];
                     }
-                } else {
-                    sky_radiance(c, d, L);
-                    memcpy(Ld, L, sizeof L);
                 }
-                if (!finite3d(L) || !finite3d(Ld)) bad++;
-                else accumulate(d, sphere ? 1 : z, L, Ld, e, sh_t, sh_d);
-                if (c->nee) {
-                    /* one light sample per gather ray; its value Le·w/p is turned into the gather's
-                     * units (radiance, later × solid/S) by 1/solid */
-                    double u0, uu1, ld[3], cl, val[3];
-                    lattice_uv(&c->lat, (uint32_t)j, t1, t2, &u0, &uu1);
-                    if (nee_sample(c, o, n, pg_kind, u0, uu1, ld, &cl, val, &shadow)) {
-                        for (int a = 0; a < 3; a++) val[a] /= solid;
-                        if (!finite3d(val)) bad++;
-                        else accumulate(ld, cl, val, val, e, sh_t, sh_d);
+                bk_tracer_intersect_n(c->tracer, (size_t)m, org, dir, 0.0f, NULL, hits);
+                rays += (uint64_t)m;
+                for (int jj = 0; jj < m; jj++) {
+                    const double *d = dd[jj];
+                    const bk_hit *hit = &hits[jj];
+                    double L[3] = {0, 0, 0}, Ld[3] = {0, 0, 0};
+                    if (hit->tri != UINT32_MAX) {
+                        long hc = hit_cell(c, hit);
+                        if (hc >= 0) {
+                            emission_at(c, hit->tri, hit->u, hit->v, Ld);
+                            if (Ld[0] > 0 || Ld[1] > 0 || Ld[2] > 0) {
+                                double wg = mis_gather(c, hit, hc, d, 1 / solid);
+                                for (int a = 0; a < 3; a++) Ld[a] *= wg;
+                            }
+                            for (int a = 0; a < 3; a++) L[a] = sum[3 * hc + a] + Ld[a];
+                        }
+                    } else {
+                        sky_radiance(c, d, L);
+                        memcpy(Ld, L, sizeof L);
+                    }
+                    if (!finite3d(L) || !finite3d(Ld)) bad++;
+                    else accumulate(d, sphere ? 1 : zz[jj], L, Ld, e, sh_t, sh_d);
+                    if (c->nee) {
+                        /* one light sample per gather ray; its value Le·w/p is turned into the
+                         * gather's units (radiance, later × solid/S) by 1/solid */
+                        double u0, uu1, ld[3], cl, val[3];
+                        lattice_uv(&c->lat, (uint32_t)(j0 + jj), t1, t2, &u0, &uu1);
+                        if (nee_sample(c, o, n, pg_kind, u0, uu1, ld, &cl, val, &shadow)) {
+                            for (int a = 0; a < 3; a++) val[a] /= solid;
+                            if (!finite3d(val)) bad++;
+                            else accumulate(ld, cl, val, val, e, sh_t, sh_d);
+                        }
                     }
                 }
             }

@@ -651,6 +651,41 @@ static void test_nee_unbiased_and_quieter(void **state)
     tsc_free(&s);
 }
 
+/* The stream path (rtcIntersect1M in chunks) returns exactly what single calls return. */
+static void test_stream_equals_single(void **state)
+{
+    (void)state;
+    bk_scene s;
+    nee_room(&s);
+    bk_tracer *t = NULL;
+    assert_int_equal(bk_tracer_create(&s, 0, &t), LBK_OK);
+    enum { N = 1000 };
+    float *org = malloc(3 * N * sizeof(float)), *dir = malloc(3 * N * sizeof(float)), *tmax = malloc(N * sizeof(float));
+    bk_hit *hs = malloc(N * sizeof *hs);
+    for (int i = 0; i < N; i++) {
+        double a = fmod(i * 0.618033988749895, 1.0), b = fmod(i * 0.754877666246693, 1.0);
+        double ph = 2 * M_PI * fmod(i * 0.5698402909980532, 1.0), z = 2 * b - 1, rr = sqrt(1 - z * z);
+        org[3 * i] = (float)(0.1 + 3.8 * a); org[3 * i + 1] = (float)(0.1 + 2.8 * b); org[3 * i + 2] = (float)(0.1 + 2.3 * a * b);
+        dir[3 * i] = (float)(rr * cos(ph)); dir[3 * i + 1] = (float)(rr * sin(ph)); dir[3 * i + 2] = (float)z;
+        tmax[i] = i % 7 == 0 ? 0.5f : INFINITY;
+    }
+    dir[3 * 5] = NAN; /* a bad ray misses in both */
+    bk_tracer_intersect_n(t, N, org, dir, 0.0f, tmax, hs);
+    int hits = 0;
+    for (int i = 0; i < N; i++) {
+        bk_hit h;
+        int hit = bk_tracer_intersect(t, org + 3 * i, dir + 3 * i, 0.0f, tmax[i], &h);
+        assert_int_equal(hit, hs[i].tri != UINT32_MAX);
+        if (!hit) continue;
+        hits++;
+        assert_true(h.tri == hs[i].tri && h.t == hs[i].t && h.u == hs[i].u && h.v == hs[i].v && h.front == hs[i].front);
+    }
+    assert_true(hits > N / 2);
+    free(org); free(dir); free(tmax); free(hs);
+    bk_tracer_destroy(t);
+    tsc_free(&s);
+}
+
 static void test_invalid_arguments(void **state)
 {
     (void)state;
@@ -684,6 +719,7 @@ int main(void)
         cmocka_unit_test(test_closed_box_no_leak),
         cmocka_unit_test(test_light_sets),
         cmocka_unit_test(test_nee_unbiased_and_quieter),
+        cmocka_unit_test(test_stream_equals_single),
         cmocka_unit_test(test_intensity_extremes),
         cmocka_unit_test(test_scale_and_offset_extremes),
         cmocka_unit_test(test_degenerate_triangles_and_duplicate_vertices),
