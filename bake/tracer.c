@@ -248,13 +248,8 @@ void bk_tracer_intersect_n(const bk_tracer *t, size_t n, const float *org, const
         }
         if (k) rtcIntersect1M(t->rtc_scene, &ctx, rh, (unsigned)k, sizeof rh[0]);
         for (size_t j = 0; j < k; j++) {
-            bk_hit *h = &hits[map[j]];
-            if (rh[j].hit.geomID == RTC_INVALID_GEOMETRY_ID || rh[j].hit.primID >= t->tri_count) {
-                memset(h, 0, sizeof *h);
-                h->tri = UINT32_MAX;
-                continue;
-            }
-            fill_hit(t, &rh[j], dir + 3 * (size_t)map[j], h);
+            if (rh[j].hit.geomID == RTC_INVALID_GEOMETRY_ID || rh[j].hit.primID >= t->tri_count) continue;
+            fill_hit(t, &rh[j], dir + 3 * (size_t)map[j], &hits[map[j]]);
         }
         for (size_t i = b; i < b + m; i++)
             if (hits[i].tri == UINT32_MAX) {

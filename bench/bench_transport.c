@@ -14,13 +14,6 @@
 #include "bake/transport.h"
 #include "tests/support/transport_scenes.c" /* the C scene builders the tests use */
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
 /* CPU time of the calling thread: the rays/s comparison runs both sides on this one thread,
  * and on a shared machine wall time would mostly measure the other tenants. */
 static double cpu_now(void)
