@@ -4,24 +4,13 @@
  * bytes, and converting a pack again with the same profile reproduces it. */
 #include "convert/convert.h"
 
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "convert/error_util.h"
 #include "convert/lmap_layout.h"
 #include "lbk/validate.h"
-
-static tl_convert_status fail(char err[TL_ERR_LEN], tl_convert_status st, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-static tl_convert_status fail(char err[TL_ERR_LEN], tl_convert_status st, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err, TL_ERR_LEN, fmt, ap);
-    va_end(ap);
-    return st;
-}
 
 typedef struct first_issue {
     int have;
@@ -73,7 +62,7 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
     if (validate_bytes(in, in_size, "input", err)) return TL_CONVERT_BAD_INPUT;
     lbk_reader *rd = NULL;
     lbk_result r = lbk_reader_open_memory(in, in_size, NULL, &rd);
-    if (r != LBK_OK) return fail(err, TL_CONVERT_BAD_INPUT, "input: %s", lbk_result_message(r));
+    if (r != LBK_OK) return tl_fail(err, TL_CONVERT_BAD_INPUT, "input: %s", lbk_result_message(r));
 
     lbk_write_options wo = {0};
     wo.section_alignment = p->alignment;
@@ -81,7 +70,7 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
     r = lbk_writer_create(&wo, &w);
     if (r != LBK_OK) {
         lbk_reader_close(rd);
-        return fail(err, TL_CONVERT_INTERNAL, "writer: %s", lbk_result_message(r));
+        return tl_fail(err, TL_CONVERT_INTERNAL, "writer: %s", lbk_result_message(r));
     }
 
     tl_convert_status st = TL_CONVERT_OK;
@@ -94,7 +83,7 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
         const void *data = NULL;
         size_t size = 0;
         if ((r = lbk_reader_section_info(rd, i, &si)) != LBK_OK || (r = lbk_reader_section_data(rd, i, &data, &size)) != LBK_OK) {
-            st = fail(err, TL_CONVERT_BAD_INPUT, "input section %u: %s", i, lbk_result_message(r));
+            st = tl_fail(err, TL_CONVERT_BAD_INPUT, "input section %u: %s", i, lbk_result_message(r));
             break;
         }
         tl_convert_section *cs = &report->sections[report->section_count++];
@@ -134,17 +123,17 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
         so.zstd_level = rule.zstd_level;
         r = lbk_writer_add_section(w, si.type, data, size, &so);
         free(rewritten);
-        if (r != LBK_OK) st = fail(err, TL_CONVERT_INTERNAL, "writing section %u: %s", i, lbk_result_message(r));
+        if (r != LBK_OK) st = tl_fail(err, TL_CONVERT_INTERNAL, "writing section %u: %s", i, lbk_result_message(r));
     }
     if (st == TL_CONVERT_OK && opt->from_exr_dir && report->pages_imported == 0)
-        st = fail(err, TL_CONVERT_BAD_EXR, "--from-exr %.160s: no page_NNN.exr for any lightmap page of the input",
+        st = tl_fail(err, TL_CONVERT_BAD_EXR, "--from-exr %.160s: no page_NNN.exr for any lightmap page of the input",
                   opt->from_exr_dir);
 
     void *bytes = NULL;
     size_t bytes_size = 0;
     if (st == TL_CONVERT_OK) {
         r = lbk_writer_to_memory(w, &bytes, &bytes_size);
-        if (r != LBK_OK) st = fail(err, TL_CONVERT_INTERNAL, "serialising the pack: %s", lbk_result_message(r));
+        if (r != LBK_OK) st = tl_fail(err, TL_CONVERT_INTERNAL, "serialising the pack: %s", lbk_result_message(r));
     }
     lbk_writer_destroy(w);
     lbk_reader_close(rd);

@@ -2,26 +2,16 @@
 #include "convert/export.h"
 
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include <cjson/cJSON.h>
 
+#include "convert/error_util.h"
 #include "convert/file_util.h"
 #include "convert/lmap_layout.h"
 #include "lbk/pixel.h"
-
-static int fail(char err[TL_ERR_LEN], const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static int fail(char err[TL_ERR_LEN], const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err, TL_ERR_LEN, fmt, ap);
-    va_end(ap);
-    return -1;
-}
 
 void tl_export_object_stem(const char *name, uint32_t index, char *out, size_t size)
 {
@@ -89,7 +79,7 @@ static int write_page_exrs(const char *dir, uint32_t p, const page_images *im, t
     if (tl_exr_write(path, (int)im->w, (int)im->h, 3, RGB, im->dom, err)) return -1;
     const size_t n = (size_t)im->w * im->h;
     float *ahd = malloc(n * 7 * sizeof(float));
-    if (!ahd) return fail(err, "out of memory");
+    if (!ahd) return tl_fail(err, -1, "out of memory");
     for (size_t i = 0; i < n; i++) {
         memcpy(ahd + 7 * i, im->ez + 3 * i, 3 * sizeof(float));
         memcpy(ahd + 7 * i + 3, im->p1 + 4 * i, 4 * sizeof(float));
@@ -104,7 +94,7 @@ static int write_page_exrs(const char *dir, uint32_t p, const page_images *im, t
 static int write_png(const char *path, uint32_t w, uint32_t h, const float *rgb, float exposure, char err[TL_ERR_LEN])
 {
     uint8_t *px = malloc((size_t)w * h * 3);
-    if (!px) return fail(err, "out of memory");
+    if (!px) return tl_fail(err, -1, "out of memory");
     tl_tonemap(rgb, (size_t)w * h, 3, exposure, px);
     int rc = tl_png_write_rgb8(path, (int)w, (int)h, px, err);
     free(px);
@@ -171,7 +161,7 @@ static int write_probe_listings(const char *dir, const probe_row *rows, size_t n
     /* CSV: one line per probe; %.9g round-trips every float */
     size_t cap = 1024 + n * 1200, len = 0;
     char *csv = malloc(cap);
-    if (!csv) return fail(err, "out of memory");
+    if (!csv) return tl_fail(err, -1, "out of memory");
     len += (size_t)snprintf(csv + len, cap - len, "source,grid,index,x,y,z");
     for (int a = 0; a < TL_PROBE_NORMALS; a++)
         len += (size_t)snprintf(csv + len, cap - len, ",E_%s_r,E_%s_g,E_%s_b", AXIS[a], AXIS[a], AXIS[a]);
@@ -210,7 +200,7 @@ static int write_probe_listings(const char *dir, const probe_row *rows, size_t n
     char *json = rc ? NULL : cJSON_Print(root);
     cJSON_Delete(root);
     if (rc) return -1;
-    if (!json) return fail(err, "out of memory");
+    if (!json) return tl_fail(err, -1, "out of memory");
     snprintf(path, sizeof path, "%s/probes.json", dir);
     rc = tl_write_text(path, json, err);
     free(json);
@@ -261,7 +251,7 @@ static int write_glg_plot(const char *dir, const tl_bake *b, const probe_row *ro
     float *lum = malloc((n + 1) * 3 * sizeof(float));
     if (!img || !lum) {
         free(img), free(lum);
-        return fail(err, "out of memory");
+        return tl_fail(err, -1, "out of memory");
     }
     for (uint32_t t = 0; t < b->glg.tetra_count; t++) {
         uint32_t v[4];
@@ -325,7 +315,7 @@ int tl_export(const tl_bake *b, const tl_export_options *o, tl_export_stats *st,
     if (o->png_dir && np) {
         uint64_t total = b->lmap.texel_count;
         float *all = malloc((size_t)total * 3 * sizeof(float) + 1);
-        if (!all) return fail(err, "out of memory");
+        if (!all) return tl_fail(err, -1, "out of memory");
         uint64_t k = 0;
         for (uint32_t p = 0; p < np; p++) {
             lbk_lmap_page pg;
@@ -342,7 +332,7 @@ int tl_export(const tl_bake *b, const tl_export_options *o, tl_export_stats *st,
     uint32_t no = b->has_objs ? b->objs.count : 0;
     if (o->per_object && no) {
         objs = calloc(no, sizeof *objs);
-        if (!objs) return fail(err, "out of memory");
+        if (!objs) return tl_fail(err, -1, "out of memory");
         for (uint32_t i = 0; i < no; i++) lbk_objects_get(&b->objs, i, &objs[i]);
     }
     int rc = 0;
@@ -353,7 +343,7 @@ int tl_export(const tl_bake *b, const tl_export_options *o, tl_export_stats *st,
         memset(&im, 0, sizeof im);
         if (decode_page(&pg, &im)) {
             free_page(&im);
-            rc = fail(err, "out of memory");
+            rc = tl_fail(err, -1, "out of memory");
             break;
         }
         if (o->exr_dir) rc = write_page_exrs(o->exr_dir, p, &im, st, err);
@@ -367,7 +357,7 @@ int tl_export(const tl_bake *b, const tl_export_options *o, tl_export_stats *st,
             if (objs[i].representation != LBK_REPRESENTATION_LIGHTMAP || objs[i].index != p) continue;
             float *rect = crop(&im, &objs[i]);
             if (!rect) {
-                rc = fail(err, "out of memory");
+                rc = tl_fail(err, -1, "out of memory");
                 break;
             }
             char name[129], stem[160], path[4096];
@@ -391,7 +381,7 @@ int tl_export(const tl_bake *b, const tl_export_options *o, tl_export_stats *st,
     if (rc) return rc;
     probe_row *rows = NULL;
     size_t nrows = 0;
-    if (gather_probes(b, &rows, &nrows)) return fail(err, "out of memory");
+    if (gather_probes(b, &rows, &nrows)) return tl_fail(err, -1, "out of memory");
     for (int d = 0; d < 2 && !rc; d++) {
         if (!dirs[d] || nrows == 0) continue;
         if (d == 1 && o->exr_dir && !strcmp(o->exr_dir, o->png_dir)) continue; /* same directory: once */

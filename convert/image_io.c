@@ -3,7 +3,6 @@
 
 #include <errno.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,17 +11,7 @@
 #include <OpenEXR/openexr.h>
 #include <spng.h>
 
-static int fail(char err[TL_ERR_LEN], const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static int fail(char err[TL_ERR_LEN], const char *fmt, ...)
-{
-    if (err) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err, TL_ERR_LEN, fmt, ap);
-        va_end(ap);
-    }
-    return -1;
-}
+#include "convert/error_util.h"
 
 static int find_name(const char *const *names, int count, const char *name)
 {
@@ -43,12 +32,12 @@ int tl_exr_write(const char *path, int width, int height, int channel_count, con
                  const float *pixels, char err[TL_ERR_LEN])
 {
     if (width <= 0 || height <= 0 || channel_count <= 0 || !names || !pixels)
-        return fail(err, "%s: nothing to write (%dx%d, %d channels)", path, width, height, channel_count);
+        return tl_fail(err, -1, "%s: nothing to write (%dx%d, %d channels)", path, width, height, channel_count);
     exr_context_t ctx = NULL;
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
     init.error_handler_fn = exr_silent;
     exr_result_t rv = exr_start_write(&ctx, path, EXR_INTERMEDIATE_TEMP_FILE, &init);
-    if (rv != EXR_ERR_SUCCESS) return fail(err, "%s: cannot create EXR (%s)", path, exr_get_default_error_message(rv));
+    if (rv != EXR_ERR_SUCCESS) return tl_fail(err, -1, "%s: cannot create EXR (%s)", path, exr_get_default_error_message(rv));
     int part = 0;
     rv = exr_add_part(ctx, "lbk", EXR_STORAGE_SCANLINE, &part);
     if (rv == EXR_ERR_SUCCESS) rv = exr_initialize_required_attr_simple(ctx, part, width, height, EXR_COMPRESSION_ZIP);
@@ -88,7 +77,7 @@ int tl_exr_write(const char *path, int width, int height, int channel_count, con
     if (enc_live || enc.channels) exr_encoding_destroy(ctx, &enc);
     exr_result_t fin = exr_finish(&ctx);
     if (rv == EXR_ERR_SUCCESS) rv = fin;
-    if (rv != EXR_ERR_SUCCESS) return fail(err, "%s: EXR write failed (%s)", path, exr_get_default_error_message(rv));
+    if (rv != EXR_ERR_SUCCESS) return tl_fail(err, -1, "%s: EXR write failed (%s)", path, exr_get_default_error_message(rv));
     return 0;
 }
 
@@ -99,7 +88,7 @@ static int exr_open_read(const char *path, exr_context_t *ctx, char err[TL_ERR_L
     exr_result_t rv = exr_start_read(ctx, path, &init);
     if (rv != EXR_ERR_SUCCESS) {
         exr_finish(ctx);
-        return fail(err, "%s: cannot read EXR (%s)", path, exr_get_default_error_message(rv));
+        return tl_fail(err, -1, "%s: cannot read EXR (%s)", path, exr_get_default_error_message(rv));
     }
     return 0;
 }
@@ -112,7 +101,7 @@ int tl_exr_channels(const char *path, char names[][32], int max, int *count, cha
     exr_result_t rv = exr_get_channels(ctx, 0, &cl);
     if (rv != EXR_ERR_SUCCESS || !cl) {
         exr_finish(&ctx);
-        return fail(err, "%s: EXR has no channel list", path);
+        return tl_fail(err, -1, "%s: EXR has no channel list", path);
     }
     *count = cl->num_channels;
     for (int i = 0; i < cl->num_channels && i < max; i++) snprintf(names[i], 32, "%s", cl->entries[i].name.str);
@@ -132,16 +121,16 @@ int tl_exr_read(const char *path, int channel_count, const char *const *names, i
     const exr_attr_chlist_t *cl = NULL;
     float *buf = NULL;
     if (exr_get_storage(ctx, 0, &st) != EXR_ERR_SUCCESS || st != EXR_STORAGE_SCANLINE) {
-        fail(err, "%s: only flat scanline EXR files are supported", path);
+        tl_fail(err, -1, "%s: only flat scanline EXR files are supported", path);
         goto out;
     }
     if (exr_get_data_window(ctx, 0, &dw) != EXR_ERR_SUCCESS || dw.min.x != 0 || dw.min.y != 0 || dw.max.x < 0 ||
         dw.max.y < 0 || dw.max.x >= 65536 || dw.max.y >= 65536) {
-        fail(err, "%s: data window must start at (0,0) and be at most 65536 wide and high", path);
+        tl_fail(err, -1, "%s: data window must start at (0,0) and be at most 65536 wide and high", path);
         goto out;
     }
     if (exr_get_channels(ctx, 0, &cl) != EXR_ERR_SUCCESS) {
-        fail(err, "%s: EXR has no channel list", path);
+        tl_fail(err, -1, "%s: EXR has no channel list", path);
         goto out;
     }
     for (int c = 0; c < channel_count; c++) {
@@ -150,19 +139,19 @@ int tl_exr_read(const char *path, int channel_count, const char *const *names, i
             if (!strcmp(cl->entries[i].name.str, names[c])) {
                 found = 1;
                 if (cl->entries[i].x_sampling != 1 || cl->entries[i].y_sampling != 1) {
-                    fail(err, "%s: channel '%s' is subsampled", path, names[c]);
+                    tl_fail(err, -1, "%s: channel '%s' is subsampled", path, names[c]);
                     goto out;
                 }
             }
         if (!found) {
-            fail(err, "%s: channel '%s' is missing", path, names[c]);
+            tl_fail(err, -1, "%s: channel '%s' is missing", path, names[c]);
             goto out;
         }
     }
     const int w = dw.max.x + 1, h = dw.max.y + 1;
     buf = calloc((size_t)w * (size_t)h * (size_t)channel_count, sizeof(float));
     if (!buf) {
-        fail(err, "%s: out of memory for %dx%d pixels", path, w, h);
+        tl_fail(err, -1, "%s: out of memory for %dx%d pixels", path, w, h);
         goto out;
     }
     int32_t lines = 1;
@@ -198,7 +187,7 @@ int tl_exr_read(const char *path, int channel_count, const char *const *names, i
     }
     if (dec_live || dec.channels) exr_decoding_destroy(ctx, &dec);
     if (rv != EXR_ERR_SUCCESS) {
-        fail(err, "%s: EXR read failed (%s)", path, exr_get_default_error_message(rv));
+        tl_fail(err, -1, "%s: EXR read failed (%s)", path, exr_get_default_error_message(rv));
         goto out;
     }
     *width = w;
@@ -216,9 +205,9 @@ out:
 
 int tl_png_write_rgb8(const char *path, int width, int height, const uint8_t *rgb, char err[TL_ERR_LEN])
 {
-    if (width <= 0 || height <= 0) return fail(err, "%s: empty image", path);
+    if (width <= 0 || height <= 0) return tl_fail(err, -1, "%s: empty image", path);
     FILE *f = fopen(path, "wb");
-    if (!f) return fail(err, "%s: %s", path, strerror(errno));
+    if (!f) return tl_fail(err, -1, "%s: %s", path, strerror(errno));
     spng_ctx *ctx = spng_ctx_new(SPNG_CTX_ENCODER);
     int rc = ctx ? 0 : SPNG_EMEM;
     if (!rc) rc = spng_set_png_file(ctx, f);
@@ -233,9 +222,9 @@ int tl_png_write_rgb8(const char *path, int width, int height, const uint8_t *rg
     int close_rc = fclose(f);
     if (rc) {
         remove(path);
-        return fail(err, "%s: PNG encode failed (%s)", path, spng_strerror(rc));
+        return tl_fail(err, -1, "%s: PNG encode failed (%s)", path, spng_strerror(rc));
     }
-    if (close_rc) return fail(err, "%s: %s", path, strerror(errno));
+    if (close_rc) return tl_fail(err, -1, "%s: %s", path, strerror(errno));
     return 0;
 }
 
@@ -243,7 +232,7 @@ int tl_png_read_rgb8(const char *path, int *width, int *height, uint8_t **rgb, c
 {
     *rgb = NULL;
     FILE *f = fopen(path, "rb");
-    if (!f) return fail(err, "%s: %s", path, strerror(errno));
+    if (!f) return tl_fail(err, -1, "%s: %s", path, strerror(errno));
     spng_ctx *ctx = spng_ctx_new(0);
     int rc = ctx ? 0 : SPNG_EMEM;
     if (!rc) rc = spng_set_png_file(ctx, f);
@@ -258,7 +247,7 @@ int tl_png_read_rgb8(const char *path, int *width, int *height, uint8_t **rgb, c
     fclose(f);
     if (rc) {
         free(buf);
-        return fail(err, "%s: PNG decode failed (%s)", path, spng_strerror(rc));
+        return tl_fail(err, -1, "%s: PNG decode failed (%s)", path, spng_strerror(rc));
     }
     *width = (int)ihdr.width;
     *height = (int)ihdr.height;
@@ -332,17 +321,17 @@ int tl_mkdirs(const char *dir, char err[TL_ERR_LEN])
 {
     char buf[4096];
     size_t n = strlen(dir);
-    if (n == 0 || n >= sizeof buf) return fail(err, "bad output directory '%s'", dir);
+    if (n == 0 || n >= sizeof buf) return tl_fail(err, -1, "bad output directory '%s'", dir);
     memcpy(buf, dir, n + 1);
     for (size_t i = 1; i <= n; i++) {
         if (buf[i] == '/' || buf[i] == '\0') {
             char saved = buf[i];
             buf[i] = '\0';
-            if (mkdir(buf, 0777) != 0 && errno != EEXIST) return fail(err, "cannot create directory %s: %s", buf, strerror(errno));
+            if (mkdir(buf, 0777) != 0 && errno != EEXIST) return tl_fail(err, -1, "cannot create directory %s: %s", buf, strerror(errno));
             buf[i] = saved;
         }
     }
     struct stat sb;
-    if (stat(dir, &sb) != 0 || !S_ISDIR(sb.st_mode)) return fail(err, "%s is not a directory", dir);
+    if (stat(dir, &sb) != 0 || !S_ISDIR(sb.st_mode)) return tl_fail(err, -1, "%s is not a directory", dir);
     return 0;
 }

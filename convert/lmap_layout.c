@@ -2,26 +2,16 @@
 #include "convert/lmap_layout.h"
 
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
 #include "convert/convert.h"
+#include "convert/error_util.h"
 #include "lbk/dls.h"
 #include "lbk/lightmap.h"
 #include "lbk/pixel.h"
-
-static int fail(char err[TL_ERR_LEN], int st, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
-static int fail(char err[TL_ERR_LEN], int st, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err, TL_ERR_LEN, fmt, ap);
-    va_end(ap);
-    return st;
-}
 
 void tl_page_exr_path(char *out, size_t size, const char *dir, uint32_t page, const char *suffix)
 {
@@ -68,10 +58,10 @@ static int import_page(const char *dir, uint32_t p, uint32_t w, uint32_t h, lbk_
     int ew, eh;
     float *px = NULL;
     char e2[TL_ERR_LEN];
-    if (tl_exr_read(path, 3, rgb_names, &ew, &eh, &px, e2)) return -fail(err, TL_CONVERT_BAD_EXR, "%s", e2);
+    if (tl_exr_read(path, 3, rgb_names, &ew, &eh, &px, e2)) return -tl_fail(err, TL_CONVERT_BAD_EXR, "%s", e2);
     if ((uint32_t)ew != w || (uint32_t)eh != h) {
         free(px);
-        return -fail(err, TL_CONVERT_BAD_EXR, "%s is %dx%d but page %u is %ux%u", path, ew, eh, p, w, h);
+        return -tl_fail(err, TL_CONVERT_BAD_EXR, "%s is %dx%d but page %u is %ux%u", path, ew, eh, p, w, h);
     }
     for (size_t i = 0; i < (size_t)w * h; i++) {
         float v[3];
@@ -79,7 +69,7 @@ static int import_page(const char *dir, uint32_t p, uint32_t w, uint32_t h, lbk_
             v[c] = px[3 * i + (size_t)c];
             if (!isfinite(v[c])) {
                 free(px);
-                return -fail(err, TL_CONVERT_BAD_EXR, "%s: pixel (%zu, %zu) %s is not finite", path, i % w, i / w,
+                return -tl_fail(err, TL_CONVERT_BAD_EXR, "%s: pixel (%zu, %zu) %s is not finite", path, i % w, i / w,
                              rgb_names[c]);
             }
             if (v[c] < 0) v[c] = 0; /* irradiance cannot be negative; painting tools overshoot */
@@ -90,17 +80,17 @@ static int import_page(const char *dir, uint32_t p, uint32_t w, uint32_t h, lbk_
     tl_page_exr_path(path, sizeof path, dir, p, ".ahd.exr");
     if (access(path, F_OK) != 0) return 1;
     static const char *const p1_names[4] = {"plane1.R", "plane1.G", "plane1.B", "plane1.A"};
-    if (tl_exr_read(path, 4, p1_names, &ew, &eh, &px, e2)) return -fail(err, TL_CONVERT_BAD_EXR, "%s", e2);
+    if (tl_exr_read(path, 4, p1_names, &ew, &eh, &px, e2)) return -tl_fail(err, TL_CONVERT_BAD_EXR, "%s", e2);
     if ((uint32_t)ew != w || (uint32_t)eh != h) {
         free(px);
-        return -fail(err, TL_CONVERT_BAD_EXR, "%s is %dx%d but page %u is %ux%u", path, ew, eh, p, w, h);
+        return -tl_fail(err, TL_CONVERT_BAD_EXR, "%s is %dx%d but page %u is %ux%u", path, ew, eh, p, w, h);
     }
     for (size_t i = 0; i < (size_t)w * h; i++)
         for (int c = 0; c < 4; c++) {
             float v = px[4 * i + (size_t)c];
             if (!isfinite(v)) {
                 free(px);
-                return -fail(err, TL_CONVERT_BAD_EXR, "%s: pixel (%zu, %zu) %s is not finite", path, i % w, i / w,
+                return -tl_fail(err, TL_CONVERT_BAD_EXR, "%s: pixel (%zu, %zu) %s is not finite", path, i % w, i / w,
                              p1_names[c]);
             }
             tex[i].rgba[c] = lbk_float_to_unorm8(v);
@@ -118,7 +108,7 @@ int tl_lmap_rewrite(const void *lmap, size_t size, const tl_lmap_layout_options 
     memset(remap, 0, sizeof *remap);
     lbk_lmap_view v;
     lbk_result r = lbk_lmap_open(lmap, size, &v);
-    if (r != LBK_OK) return fail(err, TL_CONVERT_BAD_INPUT, "LMAP: %s", lbk_result_message(r));
+    if (r != LBK_OK) return tl_fail(err, TL_CONVERT_BAD_INPUT, "LMAP: %s", lbk_result_message(r));
     const uint32_t n = v.page_count;
     remap->page_count = n;
     remap->old_width = calloc(n, sizeof(uint32_t));
@@ -127,7 +117,7 @@ int tl_lmap_rewrite(const void *lmap, size_t size, const tl_lmap_layout_options 
     remap->old_first = calloc(n, sizeof(uint64_t));
     remap->new_first = calloc(n, sizeof(uint64_t));
     if (!remap->old_width || !remap->new_width || !remap->height || !remap->old_first || !remap->new_first)
-        return fail(err, TL_CONVERT_INTERNAL, "out of memory");
+        return tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
     const uint32_t multiple = o->row_pitch_alignment > 4 ? o->row_pitch_alignment / 4 : 1;
     int widen = 0;
     uint64_t first = 0;
@@ -151,7 +141,7 @@ int tl_lmap_rewrite(const void *lmap, size_t size, const tl_lmap_layout_options 
             lbk_lmap_page pg;
             lbk_lmap_get_page(&v, p, &pg);
             if (pg.irradiance_offset % o->page_alignment || pg.rgba_offset % o->page_alignment)
-                return fail(err, TL_CONVERT_UNSUPPORTED,
+                return tl_fail(err, TL_CONVERT_UNSUPPORTED,
                             "page %u planes start at LMAP bytes %llu and %llu, not multiples of page_alignment %u; "
                             "format 1.0 places planes packed at 16-byte alignment",
                             p, (unsigned long long)pg.irradiance_offset, (unsigned long long)pg.rgba_offset,
@@ -163,7 +153,7 @@ int tl_lmap_rewrite(const void *lmap, size_t size, const tl_lmap_layout_options 
     lbk_lmap_page_desc *descs = calloc(n, sizeof *descs);
     lbk_ahd_texel **tex = calloc(n, sizeof *tex);
     int st = TL_CONVERT_OK;
-    if (!descs || !tex) st = fail(err, TL_CONVERT_INTERNAL, "out of memory");
+    if (!descs || !tex) st = tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
     for (uint32_t p = 0; p < n && st == TL_CONVERT_OK; p++) {
         lbk_lmap_page pg;
         lbk_lmap_get_page(&v, p, &pg);
@@ -172,7 +162,7 @@ int tl_lmap_rewrite(const void *lmap, size_t size, const tl_lmap_layout_options 
         tex[p] = calloc((size_t)nw * h, sizeof(lbk_ahd_texel)); /* new columns: zero texels */
         if (!src || !tex[p]) {
             free(src);
-            st = fail(err, TL_CONVERT_INTERNAL, "out of memory");
+            st = tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
             break;
         }
         for (uint32_t y = 0; y < h; y++)
@@ -190,7 +180,7 @@ int tl_lmap_rewrite(const void *lmap, size_t size, const tl_lmap_layout_options 
         void *built = NULL;
         size_t built_size = 0;
         r = lbk_lmap_build(descs, n, NULL, &built, &built_size);
-        if (r != LBK_OK) st = fail(err, TL_CONVERT_INTERNAL, "rebuilding LMAP: %s", lbk_result_message(r));
+        if (r != LBK_OK) st = tl_fail(err, TL_CONVERT_INTERNAL, "rebuilding LMAP: %s", lbk_result_message(r));
         else {
             lbk_lmap_view nv;
             lbk_lmap_open(built, built_size, &nv);
@@ -198,7 +188,7 @@ int tl_lmap_rewrite(const void *lmap, size_t size, const tl_lmap_layout_options 
                 lbk_lmap_page pg;
                 lbk_lmap_get_page(&nv, p, &pg);
                 if (pg.irradiance_offset % o->page_alignment || pg.rgba_offset % o->page_alignment)
-                    st = fail(err, TL_CONVERT_UNSUPPORTED,
+                    st = tl_fail(err, TL_CONVERT_UNSUPPORTED,
                               "page %u planes start at LMAP bytes %llu and %llu, not multiples of page_alignment %u; "
                               "format 1.0 places planes packed at 16-byte alignment",
                               p, (unsigned long long)pg.irradiance_offset, (unsigned long long)pg.rgba_offset,
@@ -206,7 +196,7 @@ int tl_lmap_rewrite(const void *lmap, size_t size, const tl_lmap_layout_options 
             }
             /* hand out malloc'ed memory (lbk_free(NULL) is free, but keep ownership rules simple) */
             if (st == TL_CONVERT_OK && !(*out = malloc(built_size ? built_size : 1)))
-                st = fail(err, TL_CONVERT_INTERNAL, "out of memory");
+                st = tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
             if (st == TL_CONVERT_OK) {
                 memcpy(*out, built, built_size);
                 *out_size = built_size;
@@ -276,7 +266,7 @@ int tl_dls_remap_texels(const void *dls, size_t size, const tl_texel_remap *rema
     *out_size = 0;
     lbk_dls_view *view = NULL;
     lbk_result r = lbk_dls_view_open(dls, size, NULL, &view);
-    if (r != LBK_OK) return fail(err, TL_CONVERT_BAD_INPUT, "DLS: %s", lbk_result_message(r));
+    if (r != LBK_OK) return tl_fail(err, TL_CONVERT_BAD_INPUT, "DLS: %s", lbk_result_message(r));
     const uint32_t ns = lbk_dls_set_count(view);
     int st = TL_CONVERT_OK;
     entry_list *lists = calloc((size_t)ns * LBK_DLS_SPACE_COUNT_ + 1, sizeof *lists);
@@ -284,7 +274,7 @@ int tl_dls_remap_texels(const void *dls, size_t size, const tl_texel_remap *rema
     char **names = calloc((size_t)ns + 1, sizeof *names);
     char ***lights = calloc((size_t)ns + 1, sizeof *lights);
     uint32_t **members = calloc((size_t)ns + 1, sizeof *members);
-    if (!lists || !sets || !names || !lights || !members) st = fail(err, TL_CONVERT_INTERNAL, "out of memory");
+    if (!lists || !sets || !names || !lights || !members) st = tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
     for (uint32_t s = 0; s < ns && st == TL_CONVERT_OK; s++) {
         lbk_dls_set_info si;
         lbk_dls_set_get(view, s, &si);
@@ -292,7 +282,7 @@ int tl_dls_remap_texels(const void *dls, size_t size, const tl_texel_remap *rema
         lights[s] = calloc((size_t)si.light_count + 1, sizeof(char *));
         members[s] = calloc((size_t)si.member_count + 1, sizeof(uint32_t));
         if (!names[s] || !lights[s] || !members[s]) {
-            st = fail(err, TL_CONVERT_INTERNAL, "out of memory");
+            st = tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
             break;
         }
         memcpy(names[s], si.name, si.name_length);
@@ -302,7 +292,7 @@ int tl_dls_remap_texels(const void *dls, size_t size, const tl_texel_remap *rema
             lbk_dls_set_light(view, s, i, &ln, &ll);
             lights[s][i] = calloc(ll + 1, 1);
             if (!lights[s][i]) {
-                st = fail(err, TL_CONVERT_INTERNAL, "out of memory");
+                st = tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
                 break;
             }
             memcpy(lights[s][i], ln, ll);
@@ -321,9 +311,9 @@ int tl_dls_remap_texels(const void *dls, size_t size, const tl_texel_remap *rema
         collect_ctx cc = {lists, ci.space, ci.space == LBK_DLS_SPACE_TEXEL ? LBK_DLS_TEXEL_PAYLOAD : LBK_DLS_PROBE_PAYLOAD,
                           remap, 0};
         r = lbk_dls_cluster_decode(view, c, collect, &cc);
-        if (cc.failed == 1) st = fail(err, TL_CONVERT_BAD_INPUT, "DLS cluster %u has a texel target outside LMAP", c);
-        else if (cc.failed) st = fail(err, TL_CONVERT_INTERNAL, "out of memory");
-        else if (r != LBK_OK) st = fail(err, TL_CONVERT_BAD_INPUT, "DLS cluster %u: %s", c, lbk_result_message(r));
+        if (cc.failed == 1) st = tl_fail(err, TL_CONVERT_BAD_INPUT, "DLS cluster %u has a texel target outside LMAP", c);
+        else if (cc.failed) st = tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
+        else if (r != LBK_OK) st = tl_fail(err, TL_CONVERT_BAD_INPUT, "DLS cluster %u: %s", c, lbk_result_message(r));
     }
     if (st == TL_CONVERT_OK) {
         lbk_dls_build_desc bd;
@@ -340,8 +330,8 @@ int tl_dls_remap_texels(const void *dls, size_t size, const tl_texel_remap *rema
         void *built = NULL;
         size_t built_size = 0;
         r = lbk_dls_build(&bd, NULL, &built, &built_size, NULL);
-        if (r != LBK_OK) st = fail(err, TL_CONVERT_INTERNAL, "rebuilding DLS: %s", lbk_result_message(r));
-        else if (!(*out = malloc(built_size ? built_size : 1))) st = fail(err, TL_CONVERT_INTERNAL, "out of memory");
+        if (r != LBK_OK) st = tl_fail(err, TL_CONVERT_INTERNAL, "rebuilding DLS: %s", lbk_result_message(r));
+        else if (!(*out = malloc(built_size ? built_size : 1))) st = tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
         else {
             memcpy(*out, built, built_size);
             *out_size = built_size;

@@ -7,23 +7,13 @@
 #include <dirent.h>
 #include <errno.h>
 #include <limits.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
+#include "convert/error_util.h"
 #include "lbk/container.h"
-
-static int fail(char err[TL_ERR_LEN], const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static int fail(char err[TL_ERR_LEN], const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err, TL_ERR_LEN, fmt, ap);
-    va_end(ap);
-    return -1;
-}
 
 uint32_t tl_fourcc_parse(const char *s)
 {
@@ -94,8 +84,8 @@ int tl_profile_parse(const char *text, size_t size, const char *origin, tl_profi
         while (end < size && text[end] != '\n') end++;
         line_no++;
         char line[512];
-        if (end - pos >= sizeof line) return fail(err, "%s:%d: line longer than %zu bytes", origin, line_no, sizeof line - 1);
-        if (memchr(text + pos, '\0', end - pos)) return fail(err, "%s:%d: NUL byte in profile", origin, line_no);
+        if (end - pos >= sizeof line) return tl_fail(err, -1, "%s:%d: line longer than %zu bytes", origin, line_no, sizeof line - 1);
+        if (memchr(text + pos, '\0', end - pos)) return tl_fail(err, -1, "%s:%d: NUL byte in profile", origin, line_no);
         memcpy(line, text + pos, end - pos);
         line[end - pos] = '\0';
         pos = end + 1;
@@ -105,54 +95,54 @@ int tl_profile_parse(const char *text, size_t size, const char *origin, tl_profi
         if (!*s) continue;
         if (*s == '[') {
             char *close = strchr(s, ']');
-            if (!close || *trim(close + 1)) return fail(err, "%s:%d: expected [group]", origin, line_no);
+            if (!close || *trim(close + 1)) return tl_fail(err, -1, "%s:%d: expected [group]", origin, line_no);
             *close = '\0';
             char *g = trim(s + 1);
             if (!strcmp(g, "sections")) group = SECTIONS;
             else if (!strcmp(g, "lmap")) group = LMAP;
-            else return fail(err, "%s:%d: unknown group [%s] (known: [sections], [lmap])", origin, line_no, g);
+            else return tl_fail(err, -1, "%s:%d: unknown group [%s] (known: [sections], [lmap])", origin, line_no, g);
             continue;
         }
         char *eq = strchr(s, '=');
-        if (!eq) return fail(err, "%s:%d: expected 'key = value'", origin, line_no);
+        if (!eq) return tl_fail(err, -1, "%s:%d: expected 'key = value'", origin, line_no);
         *eq = '\0';
         char *key = trim(s), *val = trim(eq + 1);
-        if (!*key) return fail(err, "%s:%d: empty key", origin, line_no);
+        if (!*key) return tl_fail(err, -1, "%s:%d: empty key", origin, line_no);
         if (group == TOP) {
             if (!strcmp(key, "name")) {
-                if (have_name++) return fail(err, "%s:%d: duplicate key 'name'", origin, line_no);
+                if (have_name++) return tl_fail(err, -1, "%s:%d: duplicate key 'name'", origin, line_no);
                 size_t n = strlen(val);
-                if (n == 0 || n >= sizeof out->name) return fail(err, "%s:%d: name must be 1..%zu characters", origin, line_no, sizeof out->name - 1);
+                if (n == 0 || n >= sizeof out->name) return tl_fail(err, -1, "%s:%d: name must be 1..%zu characters", origin, line_no, sizeof out->name - 1);
                 for (size_t i = 0; i < n; i++)
                     if (!isalnum((unsigned char)val[i]) && val[i] != '-' && val[i] != '_' && val[i] != '.')
-                        return fail(err, "%s:%d: name may contain only letters, digits, '-', '_' and '.'", origin, line_no);
+                        return tl_fail(err, -1, "%s:%d: name may contain only letters, digits, '-', '_' and '.'", origin, line_no);
                 memcpy(out->name, val, n + 1);
             } else if (!strcmp(key, "description")) {
-                if (have_desc++) return fail(err, "%s:%d: duplicate key 'description'", origin, line_no);
+                if (have_desc++) return tl_fail(err, -1, "%s:%d: duplicate key 'description'", origin, line_no);
                 snprintf(out->description, sizeof out->description, "%s", val);
             } else if (!strcmp(key, "alignment")) {
-                if (have_align++) return fail(err, "%s:%d: duplicate key 'alignment'", origin, line_no);
+                if (have_align++) return tl_fail(err, -1, "%s:%d: duplicate key 'alignment'", origin, line_no);
                 if (parse_u32(val, &out->alignment) || !is_pow2(out->alignment) || out->alignment < LBK_MIN_ALIGNMENT ||
                     out->alignment > LBK_MAX_ALIGNMENT)
-                    return fail(err, "%s:%d: alignment '%s' must be a power of two in [%u, %u]", origin, line_no, val,
+                    return tl_fail(err, -1, "%s:%d: alignment '%s' must be a power of two in [%u, %u]", origin, line_no, val,
                                 LBK_MIN_ALIGNMENT, LBK_MAX_ALIGNMENT);
             } else {
-                return fail(err, "%s:%d: unknown key '%s' (known: name, description, alignment)", origin, line_no, key);
+                return tl_fail(err, -1, "%s:%d: unknown key '%s' (known: name, description, alignment)", origin, line_no, key);
             }
         } else if (group == SECTIONS) {
             tl_section_rule r;
             if (parse_rule(val, &r))
-                return fail(err, "%s:%d: '%s' is not drop, none, zstd or zstd:LEVEL (1..22)", origin, line_no, val);
+                return tl_fail(err, -1, "%s:%d: '%s' is not drop, none, zstd or zstd:LEVEL (1..22)", origin, line_no, val);
             if (!strcmp(key, "default")) {
-                if (have_default++) return fail(err, "%s:%d: duplicate key 'default'", origin, line_no);
+                if (have_default++) return tl_fail(err, -1, "%s:%d: duplicate key 'default'", origin, line_no);
                 out->defaults = r;
                 continue;
             }
             uint32_t type = tl_fourcc_parse(key);
-            if (!type) return fail(err, "%s:%d: '%s' is not a section type (1-4 characters, e.g. LMAP)", origin, line_no, key);
+            if (!type) return tl_fail(err, -1, "%s:%d: '%s' is not a section type (1-4 characters, e.g. LMAP)", origin, line_no, key);
             for (size_t i = 0; i < out->rule_count; i++)
-                if (out->rules[i].type == type) return fail(err, "%s:%d: duplicate rule for section %s", origin, line_no, key);
-            if (out->rule_count == TL_PROFILE_MAX_RULES) return fail(err, "%s:%d: more than %d section rules", origin, line_no, TL_PROFILE_MAX_RULES);
+                if (out->rules[i].type == type) return tl_fail(err, -1, "%s:%d: duplicate rule for section %s", origin, line_no, key);
+            if (out->rule_count == TL_PROFILE_MAX_RULES) return tl_fail(err, -1, "%s:%d: more than %d section rules", origin, line_no, TL_PROFILE_MAX_RULES);
             r.type = type;
             out->rules[out->rule_count++] = r;
         } else {
@@ -161,30 +151,30 @@ int tl_profile_parse(const char *text, size_t size, const char *origin, tl_profi
             uint32_t *dst;
             if (!strcmp(key, "row_pitch_alignment")) seen = &have_pitch, dst = &out->lmap_row_pitch_alignment;
             else if (!strcmp(key, "page_alignment")) seen = &have_page, dst = &out->lmap_page_alignment;
-            else return fail(err, "%s:%d: unknown key '%s' in [lmap] (known: row_pitch_alignment, page_alignment)", origin, line_no, key);
-            if ((*seen)++) return fail(err, "%s:%d: duplicate key '%s'", origin, line_no, key);
+            else return tl_fail(err, -1, "%s:%d: unknown key '%s' in [lmap] (known: row_pitch_alignment, page_alignment)", origin, line_no, key);
+            if ((*seen)++) return tl_fail(err, -1, "%s:%d: duplicate key '%s'", origin, line_no, key);
             if (parse_u32(val, &v) || (v != 0 && (!is_pow2(v) || v > LBK_MAX_ALIGNMENT)))
-                return fail(err, "%s:%d: %s '%s' must be 0 or a power of two up to %u", origin, line_no, key, val, LBK_MAX_ALIGNMENT);
+                return tl_fail(err, -1, "%s:%d: %s '%s' must be 0 or a power of two up to %u", origin, line_no, key, val, LBK_MAX_ALIGNMENT);
             *dst = v;
         }
     }
-    if (!have_name) return fail(err, "%s: missing 'name'", origin);
-    if (!have_align) return fail(err, "%s: missing 'alignment'", origin);
-    if (!have_default) return fail(err, "%s: missing 'default' in [sections]", origin);
+    if (!have_name) return tl_fail(err, -1, "%s: missing 'name'", origin);
+    if (!have_align) return tl_fail(err, -1, "%s: missing 'alignment'", origin);
+    if (!have_default) return tl_fail(err, -1, "%s: missing 'default' in [sections]", origin);
     return 0;
 }
 
 int tl_profile_load_file(const char *path, tl_profile *out, char err[TL_ERR_LEN])
 {
     FILE *f = fopen(path, "rb");
-    if (!f) return fail(err, "cannot open profile %s: %s", path, strerror(errno));
+    if (!f) return tl_fail(err, -1, "cannot open profile %s: %s", path, strerror(errno));
     char buf[65536];
     size_t n = fread(buf, 1, sizeof buf, f);
     int too_big = n == sizeof buf;
     int rerr = ferror(f);
     fclose(f);
-    if (rerr) return fail(err, "cannot read profile %s", path);
-    if (too_big) return fail(err, "profile %s is larger than %zu bytes", path, sizeof buf - 1);
+    if (rerr) return tl_fail(err, -1, "cannot read profile %s", path);
+    if (too_big) return tl_fail(err, -1, "profile %s is larger than %zu bytes", path, sizeof buf - 1);
     return tl_profile_parse(buf, n, path, out, err);
 }
 
@@ -236,7 +226,7 @@ int tl_profile_resolve(const char *name, const char *extra_dir, tl_profile *out,
     size_t ext = strlen(TL_PROFILE_EXT);
     if (strchr(name, '/') || (len > ext && !strcmp(name + len - ext, TL_PROFILE_EXT)))
         return tl_profile_load_file(name, out, err);
-    if (len == 0 || len > 63) return fail(err, "bad profile name '%s'", name);
+    if (len == 0 || len > 63) return tl_fail(err, -1, "bad profile name '%s'", name);
     char dirs[8][PATH_MAX];
     int n = search_dirs(extra_dir, dirs, 8);
     for (int i = 0; i < n; i++) {
@@ -246,7 +236,7 @@ int tl_profile_resolve(const char *name, const char *extra_dir, tl_profile *out,
     }
     char known[160];
     tl_profile_list(extra_dir, known, sizeof known);
-    return fail(err, "unknown profile '%s' (found: %s; or pass a file path)", name, known[0] ? known : "none");
+    return tl_fail(err, -1, "unknown profile '%s' (found: %s; or pass a file path)", name, known[0] ? known : "none");
 }
 
 static int cmp_str(const void *a, const void *b) { return strcmp(*(char *const *)a, *(char *const *)b); }
