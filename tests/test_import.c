@@ -584,8 +584,6 @@ static void test_sky_extras(void **state)
     expect_error("sky_num.gltf", "lbk_sky", NULL);
 }
 
-/* A minimal uncompressed scanline EXR with FLOAT channels B, G, R (alphabetical, as the format
- * requires), w×h, pixel (x, y) = (x + 1, y + 1, 0.5) · scale. */
 static void put_u32(FILE *f, uint32_t v) { fwrite(&v, 4, 1, f); }
 static void put_attr(FILE *f, const char *name, const char *type, uint32_t size)
 {
@@ -594,19 +592,15 @@ static void put_attr(FILE *f, const char *name, const char *type, uint32_t size)
     put_u32(f, size);
 }
 
-static void write_exr(const char *name, int w, int h, float scale)
+/* The header attributes both test EXRs share: channels B, G, R of `pixel_type` (1 HALF, 2 FLOAT),
+ * no compression, data and display window w×h, increasing-y line order, unit pixel aspect. */
+static void put_exr_attrs(FILE *f, int w, int h, uint32_t pixel_type)
 {
-    char p[512];
-    tmp_path(p, sizeof p, name);
-    FILE *f = fopen(p, "wb");
-    assert_non_null(f);
-    put_u32(f, 20000630u);
-    put_u32(f, 2);
     const char *chans[3] = {"B", "G", "R"};
     put_attr(f, "channels", "chlist", 3 * (2 + 16) + 1);
     for (int c = 0; c < 3; c++) {
         fwrite(chans[c], 1, 2, f);
-        put_u32(f, 2); /* FLOAT */
+        put_u32(f, pixel_type);
         unsigned char lin[4] = {0, 0, 0, 0};
         fwrite(lin, 1, 4, f);
         put_u32(f, 1);
@@ -629,6 +623,19 @@ static void write_exr(const char *name, int w, int h, float scale)
     fwrite(zero2, 4, 2, f);
     put_attr(f, "screenWindowWidth", "float", 4);
     fwrite(&one, 4, 1, f);
+}
+
+/* A minimal uncompressed scanline EXR with FLOAT channels B, G, R (alphabetical, as the format
+ * requires), w×h, pixel (x, y) = (x + 1, y + 1, 0.5) · scale. */
+static void write_exr(const char *name, int w, int h, float scale)
+{
+    char p[512];
+    tmp_path(p, sizeof p, name);
+    FILE *f = fopen(p, "wb");
+    assert_non_null(f);
+    put_u32(f, 20000630u);
+    put_u32(f, 2);
+    put_exr_attrs(f, w, h, 2); /* FLOAT */
     fputc(0, f);
     long table = ftell(f);
     uint64_t line_bytes = 8 + (uint64_t)w * 12;
@@ -668,33 +675,7 @@ static void write_tiled_exr(const char *name, int w, int h, int tw, int th)
     assert_non_null(f);
     put_u32(f, 20000630u);
     put_u32(f, 2u | 0x200u); /* single-part tiled */
-    const char *chans[3] = {"B", "G", "R"};
-    put_attr(f, "channels", "chlist", 3 * (2 + 16) + 1);
-    for (int c = 0; c < 3; c++) {
-        fwrite(chans[c], 1, 2, f);
-        put_u32(f, 1); /* HALF */
-        unsigned char lin[4] = {0, 0, 0, 0};
-        fwrite(lin, 1, 4, f);
-        put_u32(f, 1);
-        put_u32(f, 1);
-    }
-    fputc(0, f);
-    put_attr(f, "compression", "compression", 1);
-    fputc(0, f);
-    int32_t box[4] = {0, 0, w - 1, h - 1};
-    put_attr(f, "dataWindow", "box2i", 16);
-    fwrite(box, 4, 4, f);
-    put_attr(f, "displayWindow", "box2i", 16);
-    fwrite(box, 4, 4, f);
-    put_attr(f, "lineOrder", "lineOrder", 1);
-    fputc(0, f);
-    float one = 1.0f, zero2[2] = {0, 0};
-    put_attr(f, "pixelAspectRatio", "float", 4);
-    fwrite(&one, 4, 1, f);
-    put_attr(f, "screenWindowCenter", "v2f", 8);
-    fwrite(zero2, 4, 2, f);
-    put_attr(f, "screenWindowWidth", "float", 4);
-    fwrite(&one, 4, 1, f);
+    put_exr_attrs(f, w, h, 1); /* HALF */
     put_attr(f, "tiles", "tiledesc", 9);
     put_u32(f, (uint32_t)tw);
     put_u32(f, (uint32_t)th);
