@@ -365,6 +365,7 @@ static void set_inputs(const bake *b, bk_set_inputs *in)
     in->base_samples_per_receiver = b->stats.samples_per_receiver;
     in->threshold = b->opt->dls_threshold;
     in->progress = b->progress;
+    in->door_method = b->opt->door_method;
 }
 
 static int do_transport(bake *b)

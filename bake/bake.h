@@ -30,6 +30,8 @@ typedef struct bk_bake_options {
     double dls_threshold;         /* light sets/doors: store a receiver where the set's light exceeds
                                      this fraction of the mean indirect light of the texels it lights
                                      directly; 0: 0.01 (seed 001 §3.2); < 0: every non-zero receiver */
+    int door_method;              /* how doors' open light is baked: 0 difference of full runs (default),
+                                     1 the seed's guided estimator (enum bk_door_method, bake/SETS.md) */
 } bk_bake_options;
 
 typedef struct bk_bake_summary {

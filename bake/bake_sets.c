@@ -4,7 +4,9 @@
  * Sets written, in this order (the DLS set index order):
  *   1. light sets (kind 0), sorted by name: lights and emissive objects with lbk_light_set;
  *   2. per door, sorted by name: "door/<name>/open" (kind 1, S_O) and "door/<name>/closed"
- *      (kind 2, S_C). Objects sharing an lbk_door name form one door.
+ *      (kind 2, S_C). Objects sharing an lbk_door name form one door;
+ *   3. per authored combination state (scene extras lbk_combinations), in authored order:
+ *      "combo/<a>+<b>" (kind 3, the pair's extra light, weight = product of the members').
  * Every set bake uses the base bake's receivers; contributions are differences or separate runs
  * of the same transport code (bake/transport.h). */
 #include "bake/bake_sets.h"
@@ -14,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bake/door_guided.h"
 #include "bake/encode.h"
 #include "cli/cli.h"
 #include "lbk/ahd.h"
@@ -25,7 +28,7 @@
 #define BS_PI 3.14159265358979323846
 
 typedef struct bs_set {
-    char name[96];
+    char name[144];
     uint32_t kind;                 /* lbk_dls_set_kind */
     int door;                      /* kinds 1/2: door index; else -1 */
     int zero;                      /* light set whose lights and emitters are all black */
@@ -36,6 +39,8 @@ typedef struct bs_set {
     uint32_t *targets[LBK_DLS_SPACE_COUNT_];
     uint8_t *payloads[LBK_DLS_SPACE_COUNT_];
     double threshold;              /* absolute luminance threshold used (lux) */
+    uint32_t members[2];           /* kind 3: the member sets */
+    uint32_t member_count;
 } bs_set;
 
 typedef struct bs_door {
@@ -44,12 +49,21 @@ typedef struct bs_door {
     uint32_t open_set, closed_set;
 } bs_door;
 
+/* A combination state: two doors, or a door and a light set (seed §6.2). */
+typedef struct bs_combo {
+    int door[2];                   /* door indices, ascending; door[1] = -1 with a light set */
+    int light_set;                 /* light set index or -1 */
+    uint32_t set;
+} bs_combo;
+
 typedef struct bs_impl {
     bs_set *sets;
     size_t set_count;
     bs_door *doors;
     size_t door_count;
     size_t light_set_count;
+    bs_combo *combos;
+    size_t combo_count;
 } bs_impl;
 
 /* ---- prepare --------------------------------------------------------------------------- */
@@ -152,11 +166,20 @@ int bk_set_bakes_prepare(bk_set_bakes *sets, const bk_scene *scene, bk_progress 
     }
     k = unique_sorted(names, k);
     nd = unique_sorted(doors, nd);
+    size_t nc = scene->combination_count;
+    if (nc && !nd) {
+        snprintf(err, err_len, "lbk_combinations: the scene has no door (lbk_door); a combination state needs one");
+        free(names), free(doors), free(im);
+        return LBK_EXIT_INPUT;
+    }
     if (k + 2 * nd == 0) {
         free(names), free(doors), free(im);
         return 0;
     }
-    im->set_count = k + 2 * nd;
+    im->set_count = k + 2 * nd + nc;
+    im->combo_count = nc;
+    im->combos = calloc(nc ? nc : 1, sizeof *im->combos);
+    if (!im->combos) goto oom;
     im->light_set_count = k;
     im->door_count = nd;
     im->sets = calloc(im->set_count, sizeof *im->sets);
@@ -205,10 +228,63 @@ int bk_set_bakes_prepare(bk_set_bakes *sets, const bk_scene *scene, bk_progress 
             if (!strcmp(im->sets[j].name, so->name) || !strcmp(im->sets[j].name, sc->name)) {
                 snprintf(err, err_len, "light set '%s' has the name lbk gives to door '%s': rename one",
                          im->sets[j].name, doors[p]);
-                free(names), free(doors);
-                sets->impl = im;
-                bk_set_bakes_free(sets);
-                return LBK_EXIT_INPUT;
+                goto bad_input;
+            }
+    }
+    for (size_t ci = 0; ci < nc; ci++) {
+        const bk_combination *cb = &scene->combinations[ci];
+        bs_combo *co = &im->combos[ci];
+        co->door[0] = co->door[1] = co->light_set = -1;
+        int ndoor = 0;
+        for (int m = 0; m < 2; m++) {
+            const char *nm = cb->members[m];
+            int door = -1, ls = -1;
+            for (size_t p = 0; p < nd; p++)
+                if (!strcmp(im->doors[p].name, nm)) door = (int)p;
+            for (size_t j = 0; j < k; j++)
+                if (!strcmp(im->sets[j].name, nm)) ls = (int)j;
+            if (door >= 0 && ls >= 0) {
+                snprintf(err, err_len, "lbk_combinations[%zu]: '%s' names both a door and a light set: rename one", ci, nm);
+                goto bad_input;
+            }
+            if (door < 0 && ls < 0) {
+                snprintf(err, err_len, "lbk_combinations[%zu]: '%s' is neither a door (lbk_door) nor a light set (lbk_light_set)",
+                         ci, nm);
+                goto bad_input;
+            }
+            if (door >= 0) co->door[ndoor++] = door;
+            else if (co->light_set >= 0) {
+                snprintf(err, err_len, "lbk_combinations[%zu]: two light sets add up linearly and have no combination "
+                         "state; pair a light set with a door", ci);
+                goto bad_input;
+            } else co->light_set = ls;
+        }
+        if (ndoor == 2 && co->door[0] == co->door[1]) {
+            snprintf(err, err_len, "lbk_combinations[%zu]: door '%s' paired with itself", ci, cb->members[0]);
+            goto bad_input;
+        }
+        if (ndoor == 2 && co->door[0] > co->door[1]) {
+            int t = co->door[0];
+            co->door[0] = co->door[1], co->door[1] = t;
+        }
+        for (size_t cj = 0; cj < ci; cj++)
+            if (im->combos[cj].door[0] == co->door[0] && im->combos[cj].door[1] == co->door[1] &&
+                im->combos[cj].light_set == co->light_set) {
+                snprintf(err, err_len, "lbk_combinations[%zu]: the same pair as lbk_combinations[%zu]", ci, cj);
+                goto bad_input;
+            }
+        co->set = (uint32_t)(k + 2 * nd + ci);
+        bs_set *st = &im->sets[co->set];
+        snprintf(st->name, sizeof st->name, "combo/%s+%s", cb->members[0], cb->members[1]);
+        st->kind = LBK_DLS_KIND_COMBINATION;
+        st->door = -1;
+        st->members[0] = im->doors[co->door[0]].open_set;
+        st->members[1] = co->door[1] >= 0 ? im->doors[co->door[1]].open_set : (uint32_t)co->light_set;
+        st->member_count = 2;
+        for (size_t j = 0; j < k; j++)
+            if (!strcmp(im->sets[j].name, st->name)) {
+                snprintf(err, err_len, "light set '%s' has the name lbk gives to a combination state: rename it", st->name);
+                goto bad_input;
             }
     }
     free(names), free(doors);
@@ -216,8 +292,14 @@ int bk_set_bakes_prepare(bk_set_bakes *sets, const bk_scene *scene, bk_progress 
     sets->set_count = (uint32_t)im->set_count;
     sets->door_count = (uint32_t)im->door_count;
     if (progress)
-        bk_progress_note(progress, "lbk bake: %zu dynamic light sets, %zu doors", im->light_set_count, im->door_count);
+        bk_progress_note(progress, "lbk bake: %zu dynamic light sets, %zu doors, %zu combination states",
+                         im->light_set_count, im->door_count, im->combo_count);
     return 0;
+bad_input:
+    free(names), free(doors);
+    sets->impl = im;
+    bk_set_bakes_free(sets);
+    return LBK_EXIT_INPUT;
 oom:
     free(names), free(doors);
     sets->impl = im;
@@ -490,14 +572,14 @@ static void run_albedo(void *user, uint32_t tri, float albedo[3])
     if (rc->black_doors && tri_door_black(rc->scene, rc->keep, tri)) albedo[0] = albedo[1] = albedo[2] = 0;
 }
 
-/* A scene without the triangles of one door (arrays are shared with `s` except the triangle
+/* A scene without the triangles of one or two doors (arrays are shared with `s` except the triangle
  * lists; never bk_scene_free it). */
 typedef struct filtered_scene {
     bk_scene scene;
     uint32_t *tris, *tri_material, *tri_object;
 } filtered_scene;
 
-static lbk_result scene_without_door(const bk_scene *s, const char *door, filtered_scene *out)
+static lbk_result scene_without_doors(const bk_scene *s, const char *door, const char *door2, filtered_scene *out)
 {
     memset(out, 0, sizeof *out);
     out->scene = *s;
@@ -512,7 +594,8 @@ static lbk_result scene_without_door(const bk_scene *s, const char *door, filter
     size_t k = 0;
     for (size_t i = 0; i < s->tri_count; i++) {
         uint32_t o = s->tri_object ? s->tri_object[i] : UINT32_MAX;
-        if (o < s->object_count && !strcmp(s->objects[o].door, door)) continue;
+        if (o < s->object_count && (!strcmp(s->objects[o].door, door) || (door2 && !strcmp(s->objects[o].door, door2))))
+            continue;
         memcpy(&out->tris[3 * k], &s->tris[3 * i], 3 * sizeof *out->tris);
         out->tri_material[k] = s->tri_material ? s->tri_material[i] : 0;
         out->tri_object[k] = o;
@@ -568,21 +651,109 @@ static void sh_sub(lbk_sh9_rgb *dst, const lbk_sh9_rgb *b, size_t n)
             for (int k = 0; k < 9; k++) dst[i].c[c][k] -= b[i].c[c][k];
 }
 
+static void sh_add(lbk_sh9_rgb *dst, const lbk_sh9_rgb *b, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        for (int c = 0; c < 3; c++)
+            for (int k = 0; k < 9; k++) dst[i].c[c][k] += b[i].c[c][k];
+}
+
+/* A run over the scene with one or two doors removed (its own tracer). */
+static int run_without(run_ctx *rc, const char *door, const char *door2, const bk_transport_options *opt,
+                       lbk_sh9_rgb *rad, lbk_sh9_rgb *dir, const char *what, char *err, size_t err_len)
+{
+    const bk_set_inputs *in = rc->in;
+    filtered_scene fs;
+    if (scene_without_doors(in->scene, door, door2, &fs)) {
+        snprintf(err, err_len, "out of memory");
+        return LBK_EXIT_INTERNAL;
+    }
+    bk_tracer *tr = NULL;
+    lbk_result r = bk_tracer_create(&fs.scene, in->transport.threads, &tr);
+    if (r) {
+        filtered_free(&fs);
+        snprintf(err, err_len, "ray tracer without door '%s': %s", door, lbk_result_message(r));
+        return LBK_EXIT_INTERNAL;
+    }
+    int code = run_one(rc, &fs.scene, tr, opt, rad, dir, what, err, err_len);
+    bk_tracer_destroy(tr);
+    filtered_free(&fs);
+    return code;
+}
+
+/* S_O of door d by the guided estimator (bake/door_guided.h) into rad/dir. */
+static int guided_open(run_ctx *rc, const bs_door *d, const float *texel_size, const uint8_t *door_texel,
+                       lbk_sh9_rgb *rad, lbk_sh9_rgb *dir, char *err, size_t err_len)
+{
+    const bk_set_inputs *in = rc->in;
+    filtered_scene fs;
+    if (scene_without_doors(in->scene, d->name, NULL, &fs)) {
+        snprintf(err, err_len, "out of memory");
+        return LBK_EXIT_INTERNAL;
+    }
+    bk_tracer *tr = NULL;
+    lbk_result r = bk_tracer_create(&fs.scene, in->transport.threads, &tr);
+    if (r) {
+        filtered_free(&fs);
+        snprintf(err, err_len, "ray tracer without door '%s': %s", d->name, lbk_result_message(r));
+        return LBK_EXIT_INTERNAL;
+    }
+    bk_door_guided_inputs gi;
+    memset(&gi, 0, sizeof gi);
+    gi.scene = &fs.scene;
+    gi.tracer = tr;
+    bk_portal_from_obb(d->centre, (const float (*)[3])d->axes, d->half, &gi.portal);
+    gi.receivers = in->receivers;
+    gi.receiver_count = in->receiver_count;
+    gi.texel_receivers = in->texel_receivers;
+    gi.texel_size = texel_size;
+    gi.not_cache = door_texel;
+    gi.base_radiance = in->base_radiance;
+    gi.seed = in->transport.seed;
+    gi.threads = in->transport.threads;
+    /* the same per-receiver budget the difference runs get */
+    double spp = in->base_samples_per_receiver > 0 ? in->base_samples_per_receiver : 64;
+    gi.samples = (int)fmin(fmax(spp, 16), 4096);
+    gi.use_sky = !in->transport.no_sky;
+    bk_door_guided_stats st;
+    r = bk_door_guided_run(&gi, rad, dir, &st, NULL);
+    bk_tracer_destroy(tr);
+    filtered_free(&fs);
+    rc->run++;
+    if (r) {
+        snprintf(err, err_len, "guided door estimator for '%s': %s", d->name, lbk_result_message(r));
+        return LBK_EXIT_INTERNAL;
+    }
+    if (in->progress)
+        bk_progress_note(in->progress,
+                         "  door '%s' open (guided)        %zu photons → %d boxes, %.0f portal samples, %d bounces "
+                         "(q %.2f); energy direct %.3g, 1st bounce %.3g, later %.3g; %6.1f s",
+                         d->name, st.photons, st.boxes, st.portal_samples, st.bounces, st.q, st.stage_energy[0],
+                         st.stage_energy[1], st.stage_energy[2], st.seconds);
+    return 0;
+}
+
 int bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *err, size_t err_len)
 {
     bs_impl *im = sets->impl;
     if (!im) return 0;
     size_t n = in->receiver_count ? in->receiver_count : 1;
     double fraction = in->threshold == 0 ? BS_DEFAULT_THRESHOLD : in->threshold < 0 ? 0 : in->threshold;
+    const int guided = in->door_method == BK_DOOR_GUIDED;
     run_ctx rc;
     memset(&rc, 0, sizeof rc);
     rc.in = in;
     for (size_t j = 0; j < im->light_set_count; j++) rc.runs += !im->sets[j].zero;
     rc.runs += im->door_count ? 1 + 2 * (int)im->door_count : 0;
+    for (size_t c = 0; c < im->combo_count; c++) rc.runs += im->combos[c].door[1] >= 0 ? 3 : 2;
     lbk_sh9_rgb *rad = malloc(n * sizeof *rad), *dir = malloc(n * sizeof *dir);
     lbk_sh9_rgb *ref = NULL, *ref_dir = NULL;
+    lbk_sh9_rgb **keep = NULL, **keep_dir = NULL; /* open runs of doors in door–door combinations */
+    float *texel_size = NULL;
+    uint8_t *door_texel = NULL;
     int code = 0;
-    char what[160];
+    char what[256];
+    lbk_sh9_rgb *ls_closed = NULL, *ls_closed_dir = NULL;
     if (!rad || !dir) goto oom;
 
     /* Light sets: their lights alone (transport leaves out the sky and every other emitter);
@@ -610,7 +781,18 @@ int bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *err, siz
         fixed.time_limit = 0;
         if (in->base_samples_per_receiver > 0) fixed.max_samples = (int)fmin(in->base_samples_per_receiver, 1 << 24);
         ref = malloc(n * sizeof *ref), ref_dir = malloc(n * sizeof *ref_dir);
-        if (!ref || !ref_dir) goto oom;
+        keep = calloc(im->door_count, sizeof *keep);
+        keep_dir = calloc(im->door_count, sizeof *keep_dir);
+        if (!ref || !ref_dir || !keep || !keep_dir) goto oom;
+        if (guided) {
+            texel_size = calloc(in->texel_receivers ? in->texel_receivers : 1, sizeof *texel_size);
+            door_texel = calloc(in->texel_receivers ? in->texel_receivers : 1, 1);
+            if (!texel_size || !door_texel) goto oom;
+            for (size_t k = 0; k < in->texel_receivers; k++) {
+                texel_size[k] = in->texels->receivers[in->texel_of_receiver[k]].texel_size;
+                door_texel[k] = (uint8_t)is_door_texel(in, k);
+            }
+        }
         /* reference: every door closed with albedo 0, the base's path space (seed §4.1) */
         rc.black_doors = 1;
         rc.keep = NULL;
@@ -618,25 +800,28 @@ int bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *err, siz
         if (code) goto out;
         for (size_t p = 0; p < im->door_count; p++) {
             bs_door *d = &im->doors[p];
-            /* S_O = L(door p removed, others closed and black) − reference */
-            filtered_scene fs;
-            if (scene_without_door(in->scene, d->name, &fs)) goto oom;
-            bk_tracer *tr = NULL;
-            lbk_result r = bk_tracer_create(&fs.scene, in->transport.threads, &tr);
-            if (r) {
-                filtered_free(&fs);
-                snprintf(err, err_len, "ray tracer without door '%s': %s", d->name, lbk_result_message(r));
-                code = LBK_EXIT_INTERNAL;
-                goto out;
+            int keep_it = 0;
+            for (size_t c = 0; c < im->combo_count; c++)
+                keep_it |= im->combos[c].door[1] >= 0 && (im->combos[c].door[0] == (int)p || im->combos[c].door[1] == (int)p);
+            if (guided) {
+                /* S_O by the seed's guided estimator: no full run */
+                code = guided_open(&rc, d, texel_size, door_texel, rad, dir, err, err_len);
+                if (code) goto out;
+            } else {
+                /* S_O = L(door p removed, others closed and black) − reference */
+                rc.keep = NULL;
+                snprintf(what, sizeof what, "door '%s' open", d->name);
+                code = run_without(&rc, d->name, NULL, &fixed, rad, dir, what, err, err_len);
+                if (code) goto out;
+                if (keep_it) {
+                    keep[p] = malloc(n * sizeof **keep), keep_dir[p] = malloc(n * sizeof **keep_dir);
+                    if (!keep[p] || !keep_dir[p]) goto oom;
+                    memcpy(keep[p], rad, n * sizeof *rad);
+                    memcpy(keep_dir[p], dir, n * sizeof *dir);
+                }
+                sh_sub(rad, ref, in->receiver_count);
+                sh_sub(dir, ref_dir, in->receiver_count);
             }
-            rc.keep = NULL;
-            snprintf(what, sizeof what, "door '%s' open", d->name);
-            code = run_one(&rc, &fs.scene, tr, &fixed, rad, dir, what, err, err_len);
-            bk_tracer_destroy(tr);
-            filtered_free(&fs);
-            if (code) goto out;
-            sh_sub(rad, ref, in->receiver_count);
-            sh_sub(dir, ref_dir, in->receiver_count);
             if (emit_set(in, &im->sets[d->open_set], rad, dir, fraction, 1)) goto oom;
 
             /* S_C = L(door p closed with its albedo, others black) − reference */
@@ -648,12 +833,68 @@ int bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *err, siz
             sh_sub(dir, ref_dir, in->receiver_count);
             if (emit_set(in, &im->sets[d->closed_set], rad, dir, fraction, 1)) goto oom;
         }
+
+        /* Combination states (seed §6.2) by inclusion–exclusion of correlated runs:
+         *   doors A, B:        S_AB = L(A, B open) − L(A open) − L(B open) + L(ref);
+         *   door A, light set: S_AX = L_X(A open) − L_X(A closed) (the set's lights alone, other
+         *                      doors closed with their albedo, as the set's own bake).
+         * With both open the runtime then shows base + S_A + S_B + S_AB = L(A, B open). Clamped
+         * like every difference (emit_set). */
+        for (size_t c = 0; c < im->combo_count; c++) {
+            const bs_combo *co = &im->combos[c];
+            bs_set *st = &im->sets[co->set];
+            const bs_door *da = &im->doors[co->door[0]];
+            if (co->door[1] >= 0) {
+                const bs_door *db = &im->doors[co->door[1]];
+                rc.black_doors = 1;
+                rc.keep = NULL;
+                for (int m = 0; m < 2; m++) {
+                    int p = co->door[m];
+                    if (keep[p]) continue;
+                    /* guided mode has no open run yet: the combination needs a correlated one */
+                    keep[p] = malloc(n * sizeof **keep), keep_dir[p] = malloc(n * sizeof **keep_dir);
+                    if (!keep[p] || !keep_dir[p]) goto oom;
+                    snprintf(what, sizeof what, "door '%s' open (for a combination)", im->doors[p].name);
+                    code = run_without(&rc, im->doors[p].name, NULL, &fixed, keep[p], keep_dir[p], what, err, err_len);
+                    if (code) goto out;
+                }
+                snprintf(what, sizeof what, "doors '%s' and '%s' open", da->name, db->name);
+                code = run_without(&rc, da->name, db->name, &fixed, rad, dir, what, err, err_len);
+                if (code) goto out;
+                sh_sub(rad, keep[co->door[0]], in->receiver_count);
+                sh_sub(rad, keep[co->door[1]], in->receiver_count);
+                sh_add(rad, ref, in->receiver_count);
+                sh_sub(dir, keep_dir[co->door[0]], in->receiver_count);
+                sh_sub(dir, keep_dir[co->door[1]], in->receiver_count);
+                sh_add(dir, ref_dir, in->receiver_count);
+            } else {
+                const bs_set *ls = &im->sets[co->light_set];
+                if (ls->zero) continue; /* a black set: nothing to combine, no entries */
+                bk_transport_options opt = fixed;
+                opt.light_set = ls->name;
+                rc.black_doors = 0;
+                snprintf(what, sizeof what, "light set '%s', door '%s' open", ls->name, da->name);
+                code = run_without(&rc, da->name, NULL, &opt, rad, dir, what, err, err_len);
+                if (code) goto out;
+                snprintf(what, sizeof what, "light set '%s' (fixed budget)", ls->name);
+                if (!ls_closed) ls_closed = malloc(n * sizeof *ls_closed), ls_closed_dir = malloc(n * sizeof *ls_closed_dir);
+                if (!ls_closed || !ls_closed_dir) goto oom;
+                code = run_one(&rc, in->scene, in->tracer, &opt, ls_closed, ls_closed_dir, what, err, err_len);
+                if (code) goto out;
+                sh_sub(rad, ls_closed, in->receiver_count);
+                sh_sub(dir, ls_closed_dir, in->receiver_count);
+            }
+            if (emit_set(in, st, rad, dir, fraction, 1)) goto oom;
+        }
     }
     goto out;
 oom:
     snprintf(err, err_len, "out of memory");
     code = LBK_EXIT_INTERNAL;
 out:
+    if (keep)
+        for (size_t p = 0; p < im->door_count; p++) free(keep[p]), free(keep_dir[p]);
+    free(keep), free(keep_dir), free(texel_size), free(door_texel), free(ls_closed), free(ls_closed_dir);
     free(rad), free(dir), free(ref), free(ref_dir);
     return code;
 }
@@ -675,6 +916,8 @@ lbk_result bk_set_bakes_sections(bk_set_bakes *sets, const bk_set_inputs *in, vo
         sd[j].kind = st->kind;
         sd[j].light_count = st->light_count;
         sd[j].light_names = st->light_names;
+        sd[j].member_count = st->member_count;
+        sd[j].members = st->member_count ? st->members : NULL;
         for (int s = 0; s < LBK_DLS_SPACE_COUNT_; s++) {
             sd[j].entries[s].count = st->count[s];
             sd[j].entries[s].targets = st->targets[s];
@@ -708,12 +951,30 @@ lbk_result bk_set_bakes_sections(bk_set_bakes *sets, const bk_set_inputs *in, vo
         dd[p].open_set = d->open_set;
         dd[p].closed_set = d->closed_set;
     }
+    lbk_door_state_desc *states = calloc(im->combo_count ? im->combo_count : 1, sizeof *states);
+    uint32_t *state_doors = calloc(2 * (im->combo_count ? im->combo_count : 1), sizeof *state_doors);
+    if (!states || !state_doors) {
+        free(dd), free(states), free(state_doors);
+        lbk_free(NULL, *dls);
+        *dls = NULL;
+        return LBK_ERR_OUT_OF_MEMORY;
+    }
+    for (size_t c = 0; c < im->combo_count; c++) {
+        const bs_combo *co = &im->combos[c];
+        state_doors[2 * c] = (uint32_t)co->door[0];
+        state_doors[2 * c + 1] = (uint32_t)co->door[1];
+        states[c].door_count = co->door[1] >= 0 ? 2 : 1;
+        states[c].doors = &state_doors[2 * c];
+        states[c].set = co->set;
+    }
     lbk_door_build_desc db;
     memset(&db, 0, sizeof db);
     db.door_count = (uint32_t)im->door_count;
     db.doors = dd;
+    db.state_count = (uint32_t)im->combo_count;
+    db.states = states;
     r = lbk_door_build(&db, NULL, door, door_size);
-    free(dd);
+    free(dd), free(states), free(state_doors);
     if (r) {
         lbk_free(NULL, *dls);
         *dls = NULL;
@@ -730,7 +991,7 @@ void bk_set_bakes_free(bk_set_bakes *sets)
             free(im->sets[j].light_names);
             for (int s = 0; s < LBK_DLS_SPACE_COUNT_; s++) free(im->sets[j].targets[s]), free(im->sets[j].payloads[s]);
         }
-        free(im->sets), free(im->doors), free(im);
+        free(im->sets), free(im->doors), free(im->combos), free(im);
     }
     memset(sets, 0, sizeof *sets);
 }

@@ -16,6 +16,12 @@
 #include "bake/transport.h"
 #include "lbk/sh.h"
 
+/* How a door's open contribution S_O is computed (bake/SETS.md). */
+enum bk_door_method {
+    BK_DOOR_DIFFERENCE = 0, /* L(door removed) − L(doors closed, black): two correlated full runs */
+    BK_DOOR_GUIDED = 1      /* the seed's guided estimator (bake/door_guided.h), no full run */
+};
+
 typedef struct bk_set_bakes {
     uint32_t set_count;   /* DLS sets written (light sets, door open/closed sets, combinations) */
     uint32_t door_count;
@@ -43,9 +49,12 @@ typedef struct bk_set_inputs {
                                          texels a set lights directly (bake/SETS.md); 0: 0.01;
                                          < 0: store every receiver with a non-zero contribution */
     bk_progress *progress;
+    int door_method;                  /* enum bk_door_method */
 } bk_set_inputs;
 
-/* Finds light sets (lights and emissive objects with lbk_light_set) and doors (lbk_door).
+/* Finds light sets (lights and emissive objects with lbk_light_set), doors (lbk_door) and the
+ * combination states the scene asks for (bk_scene.combinations; input errors for unknown names,
+ * two light sets, or a door paired with itself).
  * Returns 0 or an LBK_EXIT_* code with a message in err. */
 int bk_set_bakes_prepare(bk_set_bakes *sets, const bk_scene *scene, bk_progress *progress, char *err,
                          size_t err_len);

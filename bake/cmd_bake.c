@@ -31,6 +31,9 @@ static void help(FILE *f)
           "  --dls-threshold X       light sets and doors store a texel/probe only where their light\n"
           "                          exceeds X times the mean indirect light of the texels they light\n"
           "                          directly (default 0.01; 0 keeps every lit receiver)\n"
+          "  --door-method difference|guided\n"
+          "                          how the light through an open door is baked: differences of\n"
+          "                          full runs (default) or the seed's guided estimator (bake/SETS.md)\n"
           "  --threads N             worker threads (default: all cores)\n"
           "  --seed N                random seed (default 1)\n"
           "  --json-report FILE      write the error-against-time report as JSON\n"
@@ -135,6 +138,14 @@ int lbk_cmd_bake(int argc, char **argv)
         } else if (!strcmp(a, "--dls-threshold")) {
             NEED_NUMBER(0, 1);
             o.dls_threshold = d > 0 ? d : -1;
+        } else if (!strcmp(a, "--door-method")) {
+            NEED_VALUE;
+            if (!strcmp(v, "difference")) o.door_method = 0;
+            else if (!strcmp(v, "guided")) o.door_method = 1;
+            else {
+                fprintf(stderr, "lbk bake: unknown door method '%s' (difference, guided)\n", v);
+                return LBK_EXIT_USAGE;
+            }
         } else if (!strcmp(a, "--threads")) {
             NEED_NUMBER(1, 1024);
             o.threads = (int)d;

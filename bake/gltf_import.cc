@@ -539,6 +539,7 @@ private:
     void emit_geometry();
     void emit_lights();
     void read_sky();
+    void read_combinations();
     std::vector<float> downsample(const float *rgba, int w, int h, int max_side, int *ow, int *oh);
 };
 
@@ -1475,6 +1476,47 @@ void Importer::read_sky()
     for (int k = 0; k < 3; k++) s_->sky[k] = im.mean[k];
 }
 
+// Scene extras lbk_combinations: [[name, name], ...], looked up like lbk_sky (spec/authoring.md).
+void Importer::read_combinations()
+{
+    const char *file = path_.c_str();
+    const tinygltf::Value *v = nullptr;
+    std::string where;
+    int si = m_.defaultScene >= 0 ? m_.defaultScene : 0;
+    if (!m_.scenes.empty() && m_.scenes[(size_t)si].extras.IsObject() &&
+        m_.scenes[(size_t)si].extras.Has("lbk_combinations")) {
+        v = &m_.scenes[(size_t)si].extras.Get("lbk_combinations");
+        where = "scene " + std::to_string(si) + " extras";
+    } else if (m_.extras.IsObject() && m_.extras.Has("lbk_combinations")) {
+        v = &m_.extras.Get("lbk_combinations");
+        where = "root extras";
+    } else if (m_.asset.extras.IsObject() && m_.asset.extras.Has("lbk_combinations")) {
+        v = &m_.asset.extras.Get("lbk_combinations");
+        where = "asset extras";
+    }
+    if (!v) return;
+    if (!v->IsArray() || v->ArrayLen() > 4096)
+        fail("%s: %s: key lbk_combinations must be an array (at most 4096) of [name, name] pairs", file,
+             where.c_str());
+    size_t n = v->ArrayLen();
+    bk_combination *c = alloc_array<bk_combination>(n, 1);
+    memset(c, 0, (n ? n : 1) * sizeof *c);
+    s_->combinations = c;
+    for (size_t i = 0; i < n; i++) {
+        const tinygltf::Value &p = v->Get((int)i);
+        bool ok = p.IsArray() && p.ArrayLen() == 2;
+        for (int k = 0; ok && k < 2; k++) {
+            const tinygltf::Value &e = p.Get(k);
+            ok = e.IsString() && !e.Get<std::string>().empty() && e.Get<std::string>().size() <= 63;
+            if (ok) snprintf(c[i].members[k], sizeof c[i].members[k], "%s", e.Get<std::string>().c_str());
+        }
+        if (!ok)
+            fail("%s: %s: lbk_combinations[%zu] must be a pair of door or light set names (1 to 63 bytes each)", file,
+                 where.c_str(), i);
+    }
+    s_->combination_count = n;
+}
+
 void Importer::run()
 {
     load();
@@ -1486,6 +1528,7 @@ void Importer::run()
     emit_geometry();
     emit_lights();
     read_sky();
+    read_combinations();
     // Tables move into the C struct last, so a failure above frees them with the vectors.
     s_->materials = alloc_array<bk_material>(materials_.size(), 1);
     if (!materials_.empty()) memcpy(s_->materials, materials_.data(), materials_.size() * sizeof(bk_material));

@@ -56,6 +56,12 @@ typedef struct bk_light {
     char light_set[64];            /* "" : static light, baked into the base */
 } bk_light;
 
+/* A combination state (scene extras lbk_combinations, spec/authoring.md; seed 001 §6.2): two
+ * doors, or a door and a light set, whose joint effect gets its own DLS set. */
+typedef struct bk_combination {
+    char members[2][64];           /* lbk_door or lbk_light_set names, as authored */
+} bk_combination;
+
 typedef struct bk_scene {
     /* vertices, world space */
     size_t vertex_count;
@@ -81,6 +87,10 @@ typedef struct bk_scene {
     /* provenance */
     uint64_t source_hash;          /* XXH3-64 of the source file bytes (and its buffers) */
     float bounds_min[3], bounds_max[3];
+    /* combination states to bake (scene extras lbk_combinations); names are checked by the set
+     * bakes (bake/bake_sets.c), not by import */
+    size_t combination_count;
+    bk_combination *combinations;
 } bk_scene;
 
 /* Frees every array and image (all malloc'ed) and leaves an empty scene (all zero, sky_image

@@ -8,9 +8,14 @@
 #include <string.h>
 #include <unistd.h>
 
+#include <math.h>
+
 #include "bake/bake.h"
+#include "lbk/ahd.h"
 #include "lbk/container.h"
 #include "lbk/dls.h"
+#include "lbk/door.h"
+#include "lbk/lightmap.h"
 /* The generator lives with the tests; benches link the tools only, so take its source. */
 #include "tests/support/door_scenes.c"
 
@@ -74,20 +79,166 @@ static int run(const level *lv, const char *dir)
     return 0;
 }
 
-int main(void)
+/* ---- door methods: time and error at equal budget ---------------------------------------- */
+
+typedef struct lit {
+    uint64_t n;
+    double *lum;     /* per texel of the LMAP, in the door's open state (ω = 1) */
+    double seconds;
+} lit;
+
+static double texel_lum(uint32_t z, const uint8_t *rgba)
 {
+    lbk_ahd_texel t;
+    t.irradiance_z = z;
+    memcpy(t.rgba, rgba, 4);
+    const float nz[3] = {0, 0, 1};
+    float e[3];
+    lbk_ahd_irradiance(&t, nz, e);
+    return LBK_LUM_R * e[0] + LBK_LUM_G * e[1] + LBK_LUM_B * e[2];
+}
+
+/* Bakes the level and returns its texels with every door open (base + S_O via lbk_dls_apply;
+ * the plain bake of a level without door sets as it is). */
+static int bake_open(const char *dir, const char *name, const ds_options *o, int samples, int method, uint64_t seed,
+                     lit *out)
+{
+    char gltf[256], path[256], err[512];
+    snprintf(gltf, sizeof gltf, "%s/%s.gltf", dir, name);
+    snprintf(path, sizeof path, "%s/%s.lbk", dir, name);
+    if (ds_write_room_scene(DS_ROOM_GLB, gltf, o, err, sizeof err)) return 1;
+    bk_bake_options bo;
+    memset(&bo, 0, sizeof bo);
+    bo.input = gltf, bo.output = path, bo.seed = seed, bo.target_error = 1e-9, bo.max_samples = samples;
+    bo.door_method = method;
+    bk_progress pr;
+    bk_progress_init(&pr, 1);
+    bk_bake_summary sum;
+    double t0 = bk_now();
+    int rc = bk_bake(&bo, &pr, &sum, err, sizeof err);
+    out->seconds = bk_now() - t0;
+    unlink(gltf);
+    if (rc) {
+        fprintf(stderr, "%s: %s\n", name, err);
+        return 1;
+    }
+    lbk_reader *rd;
+    const void *d;
+    size_t n;
+    lbk_lmap_view lm;
+    if (lbk_reader_open_file(path, NULL, &rd) || lbk_reader_section_by_type(rd, LBK_SECTION_LMAP, &d, &n) ||
+        lbk_lmap_open(d, n, &lm))
+        return 1;
+    out->n = lm.texel_count;
+    uint32_t *z = malloc(out->n * 4), *oz = malloc(out->n * 4);
+    uint8_t *rgba = malloc(out->n * 4), *orgba = malloc(out->n * 4);
+    out->lum = malloc(out->n * sizeof *out->lum);
+    for (uint64_t i = 0; i < out->n; i++) {
+        lbk_ahd_texel t;
+        lbk_lmap_texel(&lm, i, &t, NULL);
+        z[i] = t.irradiance_z;
+        memcpy(&rgba[4 * i], t.rgba, 4);
+    }
+    const void *dd, *doord;
+    size_t dn, doorn;
+    lbk_dls_view *dv = NULL;
+    lbk_door_view *door = NULL;
+    if (lbk_reader_section_by_type(rd, LBK_SECTION_DLS, &dd, &dn) == LBK_OK &&
+        lbk_reader_section_by_type(rd, LBK_SECTION_DOOR, &doord, &doorn) == LBK_OK &&
+        lbk_dls_view_open(dd, dn, NULL, &dv) == LBK_OK && lbk_door_view_open(doord, doorn, NULL, &door) == LBK_OK) {
+        uint64_t ng = lbk_dls_target_count(dv, LBK_DLS_SPACE_GLG), nl = lbk_dls_target_count(dv, LBK_DLS_SPACE_LLG);
+        uint8_t *bg = calloc(ng + 1, 28), *og = calloc(ng + 1, 28), *bl = calloc(nl + 1, 28), *ol = calloc(nl + 1, 28);
+        lbk_dls_runtime_desc rd2;
+        memset(&rd2, 0, sizeof rd2);
+        rd2.dls = dv, rd2.doors = door, rd2.base_irradiance_z = z, rd2.base_rgba = rgba;
+        rd2.base_glg = bg, rd2.base_llg = bl, rd2.out_irradiance_z = oz, rd2.out_rgba = orgba, rd2.out_glg = og,
+        rd2.out_llg = ol;
+        lbk_dls_runtime *rt;
+        float w[64] = {0}, dw[8] = {1, 1, 1, 1, 1, 1, 1, 1};
+        if (lbk_dls_runtime_create(&rd2, &rt) == LBK_OK) {
+            lbk_dls_apply(rt, w, dw, NULL);
+            lbk_dls_runtime_destroy(rt);
+            memcpy(z, oz, out->n * 4);
+            memcpy(rgba, orgba, out->n * 4);
+        }
+        free(bg), free(og), free(bl), free(ol);
+    }
+    for (uint64_t i = 0; i < out->n; i++) out->lum[i] = texel_lum(z[i], &rgba[4 * i]);
+    if (door) lbk_door_view_close(door);
+    if (dv) lbk_dls_view_close(dv);
+    lbk_reader_close(rd);
+    unlink(path);
+    free(z), free(oz), free(rgba), free(orgba);
+    return 0;
+}
+
+/* Relative L1 over the texels the two bakes share (same atlas: same scene geometry). Texel
+ * layouts match because the door panel is the last object and its texels come last. */
+static double rel_l1(const lit *a, const lit *ref, double *ratio)
+{
+    uint64_t n = a->n < ref->n ? a->n : ref->n;
+    double d = 0, sa = 0, sb = 0;
+    for (uint64_t i = 0; i < n; i++) d += fabs(a->lum[i] - ref->lum[i]), sa += a->lum[i], sb += ref->lum[i];
+    *ratio = sb > 0 ? sa / sb : 0;
+    return sb > 0 ? d / sb : 0;
+}
+
+static int door_methods(const char *dir)
+{
+    /* the door level of tests/test_sets.c (door tagged, light outside, sky 0.5), lit only from
+     * outside so S_O is most of the room's light; reference: a bake without the door panel at
+     * 8× the budget */
+    int bad = 0;
+    const float density = 2;
+    ds_options door = {DS_DOOR_TAGGED, DS_INSIDE_NONE, 0, 1, 0.5f, density, 0, 0, 0};
+    ds_options none = {DS_NO_DOOR, DS_INSIDE_NONE, 0, 1, 0.5f, density, 0, 0, 0};
+    ds_options plain = {DS_DOOR_PLAIN, DS_INSIDE_NONE, 0, 1, 0.5f, density, 0, 0, 0};
+    lit ref, base;
+    bad |= bake_open(dir, "door_ref", &none, 1024, 0, 7, &ref);
+    int budgets[3] = {64, 128, 256};
+    printf("door methods (room_with_doors, door open = base + S_O vs a no-door bake at 1024 spp; the time of the "
+           "door sets is the bake minus a bake of the same level with a plain, untagged panel):\n");
+    for (int b = 0; b < 3 && !bad; b++) {
+        lit diff, guid, nodoor;
+        bad |= bake_open(dir, "door_base", &plain, budgets[b], 0, 1, &base);
+        bad |= bake_open(dir, "door_diff", &door, budgets[b], 0, 1, &diff);
+        bad |= bake_open(dir, "door_guided", &door, budgets[b], 1, 1, &guid);
+        bad |= bake_open(dir, "door_nodoor", &none, budgets[b], 0, 2, &nodoor);
+        if (bad) break;
+        double rd, rg, rn;
+        double ed = rel_l1(&diff, &ref, &rd), eg = rel_l1(&guid, &ref, &rg), en = rel_l1(&nodoor, &ref, &rn);
+        printf("  %4d spp: difference L1 %.4f (ratio %.3f) door sets %6.2f s | guided L1 %.4f (ratio %.3f) door sets "
+               "%6.2f s | guided/difference time %.2f | a full no-door bake at this budget: L1 %.4f\n",
+               budgets[b], ed, rd, diff.seconds - base.seconds, eg, rg, guid.seconds - base.seconds,
+               (guid.seconds - base.seconds) / (diff.seconds - base.seconds), en);
+        free(diff.lum), free(guid.lum), free(nodoor.lum), free(base.lum);
+    }
+    free(ref.lum);
+    return bad;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc > 1 && !strcmp(argv[1], "--doors")) {
+        char d2[] = "/tmp/lbk_bench_doors_XXXXXX";
+        if (!mkdtemp(d2)) return 1;
+        int r = door_methods(d2);
+        rmdir(d2);
+        return r;
+    }
     char dir[] = "/tmp/lbk_bench_sets_XXXXXX";
     if (!mkdtemp(dir)) return 1;
     const level levels[] = {
-        {"static (no sets)", {DS_DOOR_PLAIN, DS_INSIDE_STATIC, 0, 1, 0.5f, 4}, 0},
-        {"sets A+B", {DS_DOOR_PLAIN, DS_INSIDE_SETS, 0, 1, 0.5f, 4}, 0},
-        {"door", {DS_DOOR_TAGGED, DS_INSIDE_STATIC, 0, 1, 0.5f, 4}, 0},
-        {"sets A+B+C0 + door", {DS_DOOR_TAGGED, DS_INSIDE_SETS, 1, 1, 0.5f, 4}, 0},
-        {"same, threshold 10%", {DS_DOOR_TAGGED, DS_INSIDE_SETS, 1, 1, 0.5f, 4}, 0.1f},
-        {"same, keep all", {DS_DOOR_TAGGED, DS_INSIDE_SETS, 1, 1, 0.5f, 4}, -1},
+        {"static (no sets)", {DS_DOOR_PLAIN, DS_INSIDE_STATIC, 0, 1, 0.5f, 4, 0, 0, 0}, 0},
+        {"sets A+B", {DS_DOOR_PLAIN, DS_INSIDE_SETS, 0, 1, 0.5f, 4, 0, 0, 0}, 0},
+        {"door", {DS_DOOR_TAGGED, DS_INSIDE_STATIC, 0, 1, 0.5f, 4, 0, 0, 0}, 0},
+        {"sets A+B+C0 + door", {DS_DOOR_TAGGED, DS_INSIDE_SETS, 1, 1, 0.5f, 4, 0, 0, 0}, 0},
+        {"same, threshold 10%", {DS_DOOR_TAGGED, DS_INSIDE_SETS, 1, 1, 0.5f, 4, 0, 0, 0}, 0.1f},
+        {"same, keep all", {DS_DOOR_TAGGED, DS_INSIDE_SETS, 1, 1, 0.5f, 4, 0, 0, 0}, -1},
     };
     int bad = 0;
     for (size_t i = 0; i < sizeof levels / sizeof levels[0]; i++) bad |= run(&levels[i], dir);
+    bad |= door_methods(dir);
     rmdir(dir);
     return bad;
 }

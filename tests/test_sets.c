@@ -247,12 +247,12 @@ static int teardown(void **state)
 static void test_bakes(void **state)
 {
     (void)state;
-    ds_options o = {DS_DOOR_TAGGED, DS_INSIDE_SETS, 1, 1, 0.5f, DENSITY};
+    ds_options o = {DS_DOOR_TAGGED, DS_INSIDE_SETS, 1, 1, 0.5f, DENSITY, 0, 0, 0};
     bake_one(&S, "sets", &o, 1);
-    ds_options o1 = {DS_DOOR_PLAIN, DS_INSIDE_STATIC, 0, 1, 0.5f, DENSITY};
+    ds_options o1 = {DS_DOOR_PLAIN, DS_INSIDE_STATIC, 0, 1, 0.5f, DENSITY, 0, 0, 0};
     bake_one(&R1, "static", &o1, 1);
     bake_one(&R1b, "static_seed2", &o1, 2);
-    ds_options o3 = {DS_NO_DOOR, DS_INSIDE_NONE, 0, 1, 0.5f, DENSITY};
+    ds_options o3 = {DS_NO_DOOR, DS_INSIDE_NONE, 0, 1, 0.5f, DENSITY, 0, 0, 0};
     bake_one(&R3, "nodoor", &o3, 2); /* another seed: independent noise */
     assert_int_equal(S.sum.sets, 5); /* A, B, C, door/north/open, door/north/closed */
     assert_int_equal(S.sum.doors, 1);

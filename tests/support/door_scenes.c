@@ -243,12 +243,15 @@ int ds_write_room_scene(const char *room_glb, const char *out_path, const ds_opt
     if (o->texel_density > 0) cJSON_AddNumberToObject(cJSON_AddObjectToObject(n, "extras"), "lbk_texel_density", o->texel_density);
     cJSON_AddItemToArray(nodes, n);
     cJSON_AddItemToArray(scene_nodes, cJSON_CreateNumber(0));
-    if (o->door != DS_NO_DOOR) {
+    for (int which = 0; which < 2; which++) {
+        int kind = which ? o->outer_door : o->door;
+        if (kind == DS_NO_DOOR) continue;
         n = cJSON_CreateObject();
-        cJSON_AddStringToObject(n, "name", "Door");
+        cJSON_AddStringToObject(n, "name", which ? "OuterDoor" : "Door");
         cJSON_AddNumberToObject(n, "mesh", 1);
+        if (which) cJSON_AddItemToObject(n, "translation", num3(0, 0, -1.51)); /* z from −6.50 to −6.47 */
         cJSON *ex = cJSON_AddObjectToObject(n, "extras");
-        if (o->door == DS_DOOR_TAGGED) cJSON_AddStringToObject(ex, "lbk_door", "north");
+        if (kind == DS_DOOR_TAGGED) cJSON_AddStringToObject(ex, "lbk_door", which ? "outer" : "north");
         if (o->texel_density > 0) cJSON_AddNumberToObject(ex, "lbk_texel_density", o->texel_density);
         cJSON_AddItemToArray(scene_nodes, cJSON_CreateNumber(cJSON_GetArraySize(nodes)));
         cJSON_AddItemToArray(nodes, n);
@@ -261,6 +264,25 @@ int ds_write_room_scene(const char *room_glb, const char *out_path, const ds_opt
         add_light(lights, nodes, scene_nodes, "LampB", 20, 2.5, 3.5, 2.5, sets ? "B" : NULL);
     }
     if (o->zero_set) add_light(lights, nodes, scene_nodes, "LampC", 0, 0, 3.5, -2.5, "C");
+    if (o->sun > 0) {
+        /* directional: the node's −Z is the direction of travel; rotate −Z onto (0, −1, 1)/√2,
+         * i.e. −135° about +X (quaternion (−sin 67.5°, 0, 0, cos 67.5°)) */
+        cJSON *l = cJSON_CreateObject();
+        cJSON_AddStringToObject(l, "name", "Sun");
+        cJSON_AddStringToObject(l, "type", "directional");
+        cJSON_AddItemToObject(l, "color", num3(1, 1, 1));
+        cJSON_AddNumberToObject(l, "intensity", o->sun);
+        int li = cJSON_GetArraySize(lights);
+        cJSON_AddItemToArray(lights, l);
+        cJSON *sn = cJSON_CreateObject();
+        cJSON_AddStringToObject(sn, "name", "Sun");
+        double q[4] = {-0.9238795325112867, 0, 0, 0.3826834323650898};
+        cJSON_AddItemToObject(sn, "rotation", cJSON_CreateDoubleArray(q, 4));
+        cJSON_AddNumberToObject(cJSON_AddObjectToObject(cJSON_AddObjectToObject(sn, "extensions"), "KHR_lights_punctual"),
+                                "light", li);
+        cJSON_AddItemToArray(scene_nodes, cJSON_CreateNumber(cJSON_GetArraySize(nodes)));
+        cJSON_AddItemToArray(nodes, sn);
+    }
     if (cJSON_GetArraySize(lights)) {
         cJSON *ext = cJSON_AddObjectToObject(root, "extensions");
         cJSON_AddItemToObject(cJSON_AddObjectToObject(ext, "KHR_lights_punctual"), "lights", lights);
@@ -269,7 +291,14 @@ int ds_write_room_scene(const char *room_glb, const char *out_path, const ds_opt
     } else {
         cJSON_Delete(lights);
     }
-    if (o->sky > 0) cJSON_AddItemToObject(cJSON_AddObjectToObject(scene, "extras"), "lbk_sky", num3(o->sky, o->sky, o->sky));
+    cJSON *sx = (o->sky > 0 || o->combinations) ? cJSON_AddObjectToObject(scene, "extras") : NULL;
+    if (o->sky > 0) cJSON_AddItemToObject(sx, "lbk_sky", num3(o->sky, o->sky, o->sky));
+    if (o->combinations) {
+        cJSON *pairs = cJSON_AddArrayToObject(sx, "lbk_combinations"), *pr = cJSON_CreateArray();
+        cJSON_AddItemToArray(pr, cJSON_CreateString("north"));
+        cJSON_AddItemToArray(pr, cJSON_CreateString("outer"));
+        cJSON_AddItemToArray(pairs, pr);
+    }
     cJSON_AddItemToArray(cJSON_AddArrayToObject(root, "scenes"), scene);
     cJSON_AddNumberToObject(root, "scene", 0);
 

@@ -8,7 +8,9 @@
  *     through that doorway;
  *   - two point lights inside at (∓2.5, 3.5, 2.5), 20 cd, in light sets "A" and "B" or static;
  *   - a light in set "C" with intensity 0;
- *   - a uniform sky (scene extras lbk_sky) that enters through every open doorway.
+ *   - a uniform sky (scene extras lbk_sky) that enters through every open doorway;
+ *   - a second, free-standing panel "outer" outside the north door, a sun through the north
+ *     doorway, and the lbk_combinations key (see the fields below).
  * Written as a self-contained .gltf (buffer as a base64 data: URI). Used by tests/test_sets.c
  * and bench/bench_sets.c. */
 #ifndef DS_DOOR_SCENES_H
@@ -28,6 +30,12 @@ typedef struct ds_options {
     int outside_light;     /* 1: the light outside the north doorway */
     float sky;             /* uniform sky radiance (nits); 0: none */
     float texel_density;   /* lbk_texel_density on room and door; 0: not written */
+    /* appended for the guided door estimator and combination states (tests/test_doors.c): */
+    int outer_door;        /* enum ds_door: a second panel "outer", free-standing 1.5 m outside the
+                              north door, between it and the outside light (it shadows the doorway) */
+    int combinations;      /* 1: scene extras lbk_combinations [["north", "outer"]] */
+    float sun;             /* lux of a directional light travelling (0, −1, 1)/√2: in through the north
+                              doorway onto the floor (x ±1.25, z from −5 to about −1.7); 0: none */
 } ds_options;
 
 /* Writes the level to out_path. Returns 0, else non-zero with a message in err. */
