@@ -33,18 +33,10 @@ typedef struct dls_chk {
 static void rep(dls_chk *c, uint32_t id, uint64_t off, const char *fmt, ...) __attribute__((format(printf, 4, 5)));
 static void rep(dls_chk *c, uint32_t id, uint64_t off, const char *fmt, ...)
 {
-    lbk_severity sev = LBK_SEVERITY_ERROR;
-    lbk_issue_template(id, &sev);
-    if (sev != LBK_SEVERITY_WARNING) c->errors++;
-    if (!c->ctx) return;
-    /* A damaged array can break one rule per element; a few reports per rule say enough. */
-    if (id >= 800 && id < 900 && c->reported[id - 800]++ >= DLS_REPORTS_PER_ID) return;
-    char msg[160];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
+    lbk_vreport_capped(c->ctx, &c->errors, c->reported, 800, DLS_REPORTS_PER_ID, id, off, fmt, ap);
     va_end(ap);
-    lbk_vreport(c->ctx, id, off, "%s", msg);
 }
 
 static bool stopped(const dls_chk *c) { return c->ctx && c->ctx->stop; }

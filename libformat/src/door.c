@@ -53,17 +53,10 @@ typedef struct door_chk {
 static void rep(door_chk *c, uint32_t id, uint64_t off, const char *fmt, ...) __attribute__((format(printf, 4, 5)));
 static void rep(door_chk *c, uint32_t id, uint64_t off, const char *fmt, ...)
 {
-    lbk_severity sev = LBK_SEVERITY_ERROR;
-    lbk_issue_template(id, &sev);
-    if (sev != LBK_SEVERITY_WARNING) c->errors++;
-    if (!c->ctx) return;
-    if (id >= 900 && id < 1000 && c->reported[id - 900]++ >= 16) return;
-    char msg[160];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
+    lbk_vreport_capped(c->ctx, &c->errors, c->reported, 900, 16, id, off, fmt, ap);
     va_end(ap);
-    lbk_vreport(c->ctx, id, off, "%s", msg);
 }
 
 static const uint8_t *element(const door_chk *c, uint64_t i) { return c->d + c->L.off_elements + i * DOOR_ELEMENT_SIZE; }

@@ -123,6 +123,13 @@ static inline bool lbk_vctx_has_section(const lbk_vctx *ctx, uint32_t type)
  * current section (or at an absolute file offset when the section type is 0). printf-style. */
 void lbk_vreport(lbk_vctx *ctx, uint32_t id, uint64_t offset_in_section, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
+/* For a checker that also runs without a context, only counting (DLS, DOOR): counts issue `id` in
+ * *errors unless the registry makes it a warning; with a context also reports it (message cut at
+ * 159 bytes), but an ID in [first_id, first_id + 100) at most `cap` times (reported[] counts them),
+ * since a damaged array can break one rule per element. */
+void lbk_vreport_capped(lbk_vctx *ctx, uint32_t *errors, uint16_t reported[100], uint32_t first_id, uint16_t cap,
+                        uint32_t id, uint64_t offset_in_section, const char *fmt, va_list ap)
+    __attribute__((format(printf, 8, 0)));
 
 /* Per-section validators: each checks every rule of its section in spec/validation.md.
  * `data` are the decoded bytes. They never read outside [data, data+size). */

@@ -34,6 +34,19 @@ void lbk_vreport(lbk_vctx *ctx, uint32_t id, uint64_t offset_in_section, const c
     va_end(ap);
 }
 
+void lbk_vreport_capped(lbk_vctx *ctx, uint32_t *errors, uint16_t reported[100], uint32_t first_id, uint16_t cap,
+                        uint32_t id, uint64_t offset_in_section, const char *fmt, va_list ap)
+{
+    lbk_severity sev = LBK_SEVERITY_ERROR;
+    lbk_issue_template(id, &sev);
+    if (sev != LBK_SEVERITY_WARNING) (*errors)++;
+    if (!ctx) return;
+    if (id >= first_id && id < first_id + 100 && reported[id - first_id]++ >= cap) return;
+    char msg[160];
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    lbk_vreport(ctx, id, offset_in_section, "%s", msg);
+}
+
 static void vreport_at(lbk_vctx *ctx, uint32_t id, uint32_t type, uint64_t offset, const char *fmt, ...)
     __attribute__((format(printf, 5, 6)));
 static void vreport_at(lbk_vctx *ctx, uint32_t id, uint32_t type, uint64_t offset, const char *fmt, ...)
