@@ -12,6 +12,7 @@
 #include <time.h>
 
 #include "bake/transport.h"
+#include "tests/support/scene_append.c"     /* what the scene builders below build on */
 #include "tests/support/transport_scenes.c" /* the C scene builders the tests use */
 
 /* CPU time of the calling thread: the rays/s comparison runs both sides on this one thread,

@@ -5,12 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static void *grow(void *p, size_t n, size_t size)
-{
-    void *q = realloc(p, (n ? n : 1) * size);
-    if (!q) { fprintf(stderr, "probe_scenes: out of memory\n"); abort(); }
-    return q;
-}
+#include "scene_append.h"
 
 void psc_init(bk_scene *s)
 {
@@ -25,50 +20,17 @@ void psc_init(bk_scene *s)
     psc_object(s, "psc", BK_LIGHTING_AUTO);
 }
 
-void psc_free(bk_scene *s)
-{
-    free(s->positions); free(s->normals); free(s->uv0); free(s->uv1);
-    free(s->tris); free(s->tri_material); free(s->tri_object);
-    free(s->materials); free(s->objects); free(s->lights); free(s->images);
-    memset(s, 0, sizeof *s);
-}
+void psc_free(bk_scene *s) { bk_scene_free(s); }
 
 uint32_t psc_object(bk_scene *s, const char *name, int lighting)
 {
-    s->objects = grow(s->objects, s->object_count + 1, sizeof *s->objects);
-    bk_object *o = &s->objects[s->object_count];
-    memset(o, 0, sizeof *o);
-    snprintf(o->name, sizeof o->name, "%s", name);
-    o->lighting = lighting;
-    o->first_tri = (uint32_t)s->tri_count;
-    for (int k = 0; k < 4; k++) o->local_to_world[5 * k] = 1.0f;
-    return (uint32_t)s->object_count++;
+    sa_object(s, name)->lighting = lighting;
+    return (uint32_t)s->object_count - 1;
 }
 
-static uint32_t vertex(bk_scene *s, const float p[3], const float n[3])
-{
-    size_t v = s->vertex_count++;
-    s->positions = grow(s->positions, 3 * s->vertex_count, sizeof(float));
-    s->normals = grow(s->normals, 3 * s->vertex_count, sizeof(float));
-    s->uv0 = grow(s->uv0, 2 * s->vertex_count, sizeof(float));
-    s->uv1 = grow(s->uv1, 2 * s->vertex_count, sizeof(float));
-    memcpy(s->positions + 3 * v, p, 3 * sizeof(float));
-    memcpy(s->normals + 3 * v, n, 3 * sizeof(float));
-    s->uv0[2 * v] = s->uv0[2 * v + 1] = s->uv1[2 * v] = s->uv1[2 * v + 1] = 0.0f;
-    return (uint32_t)v;
-}
+static uint32_t vertex(bk_scene *s, const float p[3], const float n[3]) { return sa_vertex(s, p, n); }
 
-static void tri_idx(bk_scene *s, uint32_t a, uint32_t b, uint32_t c)
-{
-    size_t t = s->tri_count++;
-    s->tris = grow(s->tris, 3 * s->tri_count, sizeof(uint32_t));
-    s->tri_material = grow(s->tri_material, s->tri_count, sizeof(uint32_t));
-    s->tri_object = grow(s->tri_object, s->tri_count, sizeof(uint32_t));
-    s->tris[3 * t] = a; s->tris[3 * t + 1] = b; s->tris[3 * t + 2] = c;
-    s->tri_material[t] = 0;
-    s->tri_object[t] = (uint32_t)(s->object_count - 1);
-    s->objects[s->object_count - 1].tri_count++;
-}
+static void tri_idx(bk_scene *s, uint32_t a, uint32_t b, uint32_t c) { sa_tri(s, a, b, c, 0); }
 
 static void face_normal(const float a[3], const float b[3], const float c[3], float n[3])
 {
@@ -109,13 +71,8 @@ void psc_quad(bk_scene *s, const float p0[3], const float p1[3], const float p2[
 void psc_box(bk_scene *s, const float mn[3], const float mx[3], int n, int inward)
 {
     float c[8][3];
-    for (int i = 0; i < 8; i++) {
-        c[i][0] = (i & 1) ? mx[0] : mn[0];
-        c[i][1] = (i & 2) ? mx[1] : mn[1];
-        c[i][2] = (i & 4) ? mx[2] : mn[2];
-    }
-    /* outward counter-clockwise faces */
-    static const int f[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+    sa_box_corners(mn, mx, c);
+    const int(*f)[4] = sa_box_faces;
     for (int i = 0; i < 6; i++) {
         if (inward) psc_quad(s, c[f[i][3]], c[f[i][2]], c[f[i][1]], c[f[i][0]], n);
         else psc_quad(s, c[f[i][0]], c[f[i][1]], c[f[i][2]], c[f[i][3]], n);
@@ -164,13 +121,4 @@ void psc_rotate_tris(bk_scene *s, uint32_t first_tri, const double q[4], const f
     }
 }
 
-void psc_update_bounds(bk_scene *s)
-{
-    for (int k = 0; k < 3; k++) { s->bounds_min[k] = INFINITY; s->bounds_max[k] = -INFINITY; }
-    for (size_t v = 0; v < s->vertex_count; v++)
-        for (int k = 0; k < 3; k++) {
-            float x = s->positions[3 * v + k];
-            if (x < s->bounds_min[k]) s->bounds_min[k] = x;
-            if (x > s->bounds_max[k]) s->bounds_max[k] = x;
-        }
-}
+void psc_update_bounds(bk_scene *s) { sa_vertex_bounds(s); }

@@ -5,15 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static void *grow(void *p, size_t count, size_t elem)
-{
-    /* capacity = next power of two >= count; called before each append */
-    size_t cap = 16;
-    while (cap < count) cap *= 2;
-    void *q = realloc(p, cap * elem);
-    if (!q) abort();
-    return q;
-}
+#include "scene_append.h"
 
 void tsc_init(bk_scene *s)
 {
@@ -22,19 +14,11 @@ void tsc_init(bk_scene *s)
     tsc_object(s, "tsc", "", "");
 }
 
-void tsc_free(bk_scene *s)
-{
-    free(s->positions); free(s->normals); free(s->uv0); free(s->uv1);
-    free(s->tris); free(s->tri_material); free(s->tri_object);
-    free(s->materials); free(s->objects); free(s->lights);
-    for (size_t i = 0; i < s->image_count; i++) free(s->images[i].rgba);
-    free(s->images);
-    memset(s, 0, sizeof *s);
-}
+void tsc_free(bk_scene *s) { bk_scene_free(s); }
 
 uint32_t tsc_material(bk_scene *s, float ar, float ag, float ab, float er, float eg, float eb)
 {
-    s->materials = grow(s->materials, s->material_count + 1, sizeof *s->materials);
+    s->materials = sa_grow(s->materials, s->material_count + 1, sizeof *s->materials);
     bk_material *m = &s->materials[s->material_count];
     memset(m, 0, sizeof *m);
     snprintf(m->name, sizeof m->name, "m%zu", s->material_count);
@@ -47,30 +31,10 @@ uint32_t tsc_material(bk_scene *s, float ar, float ag, float ab, float er, float
 
 uint32_t tsc_object(bk_scene *s, const char *name, const char *light_set, const char *door)
 {
-    s->objects = grow(s->objects, s->object_count + 1, sizeof *s->objects);
-    bk_object *o = &s->objects[s->object_count];
-    memset(o, 0, sizeof *o);
-    snprintf(o->name, sizeof o->name, "%s", name);
+    bk_object *o = sa_object(s, name);
     snprintf(o->light_set, sizeof o->light_set, "%s", light_set ? light_set : "");
     snprintf(o->door, sizeof o->door, "%s", door ? door : "");
-    o->first_tri = (uint32_t)s->tri_count;
-    for (int i = 0; i < 16; i++) o->local_to_world[i] = (i % 5 == 0) ? 1.0f : 0.0f;
-    return (uint32_t)s->object_count++;
-}
-
-static uint32_t vertex(bk_scene *s, const float p[3], const float n[3])
-{
-    size_t i = s->vertex_count;
-    s->positions = grow(s->positions, 3 * (i + 1), sizeof(float));
-    s->normals = grow(s->normals, 3 * (i + 1), sizeof(float));
-    s->uv0 = grow(s->uv0, 2 * (i + 1), sizeof(float));
-    s->uv1 = grow(s->uv1, 2 * (i + 1), sizeof(float));
-    memcpy(s->positions + 3 * i, p, 3 * sizeof(float));
-    memcpy(s->normals + 3 * i, n, 3 * sizeof(float));
-    s->uv0[2 * i] = s->uv0[2 * i + 1] = 0;
-    s->uv1[2 * i] = s->uv1[2 * i + 1] = 0;
-    s->vertex_count++;
-    return (uint32_t)i;
+    return (uint32_t)s->object_count - 1;
 }
 
 void tsc_tri(bk_scene *s, const float a[3], const float b[3], const float c[3], uint32_t material)
@@ -83,17 +47,8 @@ void tsc_tri(bk_scene *s, const float a[3], const float b[3], const float c[3], 
     double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     float nf[3] = {0, 0, 1};
     if (l > 0) for (int k = 0; k < 3; k++) nf[k] = (float)(n[k] / l);
-    size_t t = s->tri_count;
-    s->tris = grow(s->tris, 3 * (t + 1), sizeof(uint32_t));
-    s->tri_material = grow(s->tri_material, t + 1, sizeof(uint32_t));
-    s->tri_object = grow(s->tri_object, t + 1, sizeof(uint32_t));
-    s->tris[3 * t + 0] = vertex(s, a, nf);
-    s->tris[3 * t + 1] = vertex(s, b, nf);
-    s->tris[3 * t + 2] = vertex(s, c, nf);
-    s->tri_material[t] = material;
-    s->tri_object[t] = (uint32_t)(s->object_count - 1);
-    s->objects[s->object_count - 1].tri_count++;
-    s->tri_count++;
+    uint32_t ia = sa_vertex(s, a, nf), ib = sa_vertex(s, b, nf), ic = sa_vertex(s, c, nf);
+    sa_tri(s, ia, ib, ic, material);
 }
 
 static void lerp_quad(const float p0[3], const float p1[3], const float p2[3], const float p3[3], double u, double v,
@@ -121,18 +76,9 @@ void tsc_quad(bk_scene *s, const float p0[3], const float p1[3], const float p2[
 
 void tsc_box(bk_scene *s, const float mn[3], const float mx[3], int n, int inward, uint32_t material)
 {
-    /* corners indexed by bits x|y<<1|z<<2 */
     float c[8][3];
-    for (int i = 0; i < 8; i++) {
-        c[i][0] = (i & 1) ? mx[0] : mn[0];
-        c[i][1] = (i & 2) ? mx[1] : mn[1];
-        c[i][2] = (i & 4) ? mx[2] : mn[2];
-    }
-    /* faces counter-clockwise seen from outside */
-    static const int f[6][4] = {
-        {0, 4, 6, 2}, /* -x */ {1, 3, 7, 5}, /* +x */ {0, 1, 5, 4}, /* -y */
-        {2, 6, 7, 3}, /* +y */ {0, 2, 3, 1}, /* -z */ {4, 5, 7, 6}, /* +z */
-    };
+    sa_box_corners(mn, mx, c);
+    const int(*f)[4] = sa_box_faces;
     for (int i = 0; i < 6; i++) {
         if (inward)
             tsc_quad(s, c[f[i][0]], c[f[i][3]], c[f[i][2]], c[f[i][1]], n, material);
@@ -143,7 +89,7 @@ void tsc_box(bk_scene *s, const float mn[3], const float mx[3], int n, int inwar
 
 static bk_light *new_light(bk_scene *s)
 {
-    s->lights = grow(s->lights, s->light_count + 1, sizeof *s->lights);
+    s->lights = sa_grow(s->lights, s->light_count + 1, sizeof *s->lights);
     bk_light *l = &s->lights[s->light_count];
     memset(l, 0, sizeof *l);
     snprintf(l->name, sizeof l->name, "l%zu", s->light_count);
@@ -185,13 +131,7 @@ uint32_t tsc_dir_light(bk_scene *s, const float dir[3], float lux)
 
 void tsc_update_bounds(bk_scene *s)
 {
-    for (int k = 0; k < 3; k++) { s->bounds_min[k] = INFINITY; s->bounds_max[k] = -INFINITY; }
-    for (size_t i = 0; i < s->vertex_count; i++)
-        for (int k = 0; k < 3; k++) {
-            float v = s->positions[3 * i + k];
-            if (v < s->bounds_min[k]) s->bounds_min[k] = v;
-            if (v > s->bounds_max[k]) s->bounds_max[k] = v;
-        }
+    sa_vertex_bounds(s);
     if (s->vertex_count == 0)
         for (int k = 0; k < 3; k++) s->bounds_min[k] = s->bounds_max[k] = 0;
 }

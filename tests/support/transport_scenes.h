@@ -1,6 +1,6 @@
-/* Scene builders for the transport and tracer tests: bk_scene structs made directly in C.
- * Everything allocated here is released by tsc_free (not bk_scene_free, so these tests do not
- * depend on the import code). Every function aborts on allocation failure (tests only). */
+/* Scene builders for the transport and tracer tests: bk_scene structs made directly in C (no
+ * import). Release with tsc_free (bk_scene_free). Every function aborts on allocation failure
+ * (tests only). */
 #ifndef TSC_TRANSPORT_SCENES_H
 #define TSC_TRANSPORT_SCENES_H
 

@@ -5,14 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static void *uvs_grow(void *p, size_t count, size_t elem)
-{
-    size_t cap = 16;
-    while (cap < count) cap *= 2;
-    void *q = realloc(p, cap * elem);
-    if (!q) abort();
-    return q;
-}
+#include "scene_append.h"
 
 void uvs_init(bk_scene *s)
 {
@@ -21,19 +14,11 @@ void uvs_init(bk_scene *s)
     uvs_material(s, 0.5f, 0.0f);
 }
 
-void uvs_free(bk_scene *s)
-{
-    free(s->positions); free(s->normals); free(s->uv0); free(s->uv1);
-    free(s->tris); free(s->tri_material); free(s->tri_object);
-    free(s->materials); free(s->objects); free(s->lights);
-    for (size_t i = 0; i < s->image_count; i++) free(s->images[i].rgba);
-    free(s->images);
-    memset(s, 0, sizeof *s);
-}
+void uvs_free(bk_scene *s) { bk_scene_free(s); }
 
 uint32_t uvs_material(bk_scene *s, float albedo, float emission)
 {
-    s->materials = uvs_grow(s->materials, s->material_count + 1, sizeof *s->materials);
+    s->materials = sa_grow(s->materials, s->material_count + 1, sizeof *s->materials);
     bk_material *m = &s->materials[s->material_count];
     memset(m, 0, sizeof *m);
     snprintf(m->name, sizeof m->name, "uvs%zu", s->material_count);
@@ -47,44 +32,16 @@ uint32_t uvs_material(bk_scene *s, float albedo, float emission)
 
 uint32_t uvs_object(bk_scene *s, const char *name)
 {
-    s->objects = uvs_grow(s->objects, s->object_count + 1, sizeof *s->objects);
-    bk_object *o = &s->objects[s->object_count];
-    memset(o, 0, sizeof *o);
-    snprintf(o->name, sizeof o->name, "%s", name);
-    o->first_tri = (uint32_t)s->tri_count;
-    for (int i = 0; i < 16; i++) o->local_to_world[i] = (i % 5 == 0) ? 1.0f : 0.0f;
-    return (uint32_t)s->object_count++;
+    sa_object(s, name);
+    return (uint32_t)s->object_count - 1;
 }
 
-uint32_t uvs_vertex(bk_scene *s, const float p[3], const float n[3])
-{
-    size_t i = s->vertex_count;
-    s->positions = uvs_grow(s->positions, 3 * (i + 1), sizeof(float));
-    s->normals = uvs_grow(s->normals, 3 * (i + 1), sizeof(float));
-    s->uv0 = uvs_grow(s->uv0, 2 * (i + 1), sizeof(float));
-    s->uv1 = uvs_grow(s->uv1, 2 * (i + 1), sizeof(float));
-    memcpy(s->positions + 3 * i, p, 3 * sizeof(float));
-    memcpy(s->normals + 3 * i, n, 3 * sizeof(float));
-    s->uv0[2 * i] = s->uv0[2 * i + 1] = 0;
-    s->uv1[2 * i] = s->uv1[2 * i + 1] = 0;
-    s->vertex_count++;
-    return (uint32_t)i;
-}
+uint32_t uvs_vertex(bk_scene *s, const float p[3], const float n[3]) { return sa_vertex(s, p, n); }
 
 void uvs_tri_idx(bk_scene *s, uint32_t a, uint32_t b, uint32_t c, uint32_t material)
 {
     if (s->object_count == 0) uvs_object(s, "uvs");
-    size_t t = s->tri_count;
-    s->tris = uvs_grow(s->tris, 3 * (t + 1), sizeof(uint32_t));
-    s->tri_material = uvs_grow(s->tri_material, t + 1, sizeof(uint32_t));
-    s->tri_object = uvs_grow(s->tri_object, t + 1, sizeof(uint32_t));
-    s->tris[3 * t] = a;
-    s->tris[3 * t + 1] = b;
-    s->tris[3 * t + 2] = c;
-    s->tri_material[t] = material;
-    s->tri_object[t] = (uint32_t)s->object_count - 1;
-    s->objects[s->object_count - 1].tri_count++;
-    s->tri_count++;
+    sa_tri(s, a, b, c, material);
 }
 
 static void face_normal(const float a[3], const float b[3], const float c[3], float n[3])
@@ -137,15 +94,9 @@ uint32_t uvs_quad(bk_scene *s, const float p0[3], const float p1[3], const float
 
 void uvs_box(bk_scene *s, const float mn[3], const float mx[3], int n, int inward, uint32_t material)
 {
-    /* corners: bit 0 → x, bit 1 → y, bit 2 → z */
     float c[8][3];
-    for (int i = 0; i < 8; i++) {
-        c[i][0] = (i & 1) ? mx[0] : mn[0];
-        c[i][1] = (i & 2) ? mx[1] : mn[1];
-        c[i][2] = (i & 4) ? mx[2] : mn[2];
-    }
-    /* outward counter-clockwise faces */
-    static const int f[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+    sa_box_corners(mn, mx, c);
+    const int(*f)[4] = sa_box_faces;
     for (int i = 0; i < 6; i++) {
         if (inward)
             uvs_quad(s, c[f[i][0]], c[f[i][3]], c[f[i][2]], c[f[i][1]], n, material, NULL, 1.0f);
@@ -183,16 +134,4 @@ void uvs_sphere(bk_scene *s, const float c[3], float r, int segments, int rings,
 #undef RING
 }
 
-void uvs_update_bounds(bk_scene *s)
-{
-    for (int k = 0; k < 3; k++) {
-        s->bounds_min[k] = INFINITY;
-        s->bounds_max[k] = -INFINITY;
-    }
-    for (size_t v = 0; v < s->vertex_count; v++)
-        for (int k = 0; k < 3; k++) {
-            float x = s->positions[3 * v + (size_t)k];
-            if (x < s->bounds_min[k]) s->bounds_min[k] = x;
-            if (x > s->bounds_max[k]) s->bounds_max[k] = x;
-        }
-}
+void uvs_update_bounds(bk_scene *s) { sa_vertex_bounds(s); }
