@@ -48,8 +48,8 @@ typedef struct preset {
 } preset;
 
 static const preset presets[] = {
-    {"fast", 8.0f, 2.0f, 256, 0.03, 32},
-    {"high", 16.0f, 1.0f, 4096, 0.01, 128},
+    {"fast", 8.0f, 2.0f, 1024, 0.03, 32},
+    {"high", 16.0f, 1.0f, 16384, 0.01, 128},
 };
 
 typedef struct bake {
@@ -81,6 +81,8 @@ typedef struct bake {
     int phase_count;
     double phase_start;
     bk_set_bakes sets;              /* dynamic light sets and doors (bake_sets.c) */
+    float origin[3];                /* world position of the bake frame's origin (recentre()) */
+    uint64_t saturated, flushed;    /* texel channels outside the R11G11B10F range */
 } bake;
 
 static int fail(bake *b, int code, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
@@ -152,6 +154,41 @@ static int has_triangle_with_area(const bk_scene *s)
     return 0;
 }
 
+/* A level far from the origin (1e5 m) leaves floats a 7.8 mm step there, and ray offsets scale
+ * with coordinate magnitude (~6 cm), which brightened such a level by 20 % (test_extremes).
+ * So the bake runs in a frame centred on the level, and every stored position gets the origin
+ * added back. The shift is an integer number of metres, along each axis where the level lies
+ * farther from the origin than twice its extent: then every p − c is exact in float (Sterbenz),
+ * and so is p − c + c, so geometry hashes and written positions are unchanged. */
+static void recentre(bake *b)
+{
+    bk_scene *s = &b->scene;
+    double extent = 0, c[3];
+    int any = 0;
+    for (int k = 0; k < 3; k++) extent = fmax(extent, (double)s->bounds_max[k] - s->bounds_min[k]);
+    for (int k = 0; k < 3; k++) {
+        /* per axis, so a level near the origin along an axis keeps its coordinates there */
+        double mid = 0.5 * ((double)s->bounds_min[k] + s->bounds_max[k]);
+        c[k] = isfinite(mid) && fabs(mid) > 2 * extent ? nearbyint(mid) : 0;
+        any |= c[k] != 0;
+    }
+    if (!any) return;
+    for (size_t v = 0; v < s->vertex_count; v++)
+        for (int k = 0; k < 3; k++) s->positions[3 * v + k] = (float)((double)s->positions[3 * v + k] - c[k]);
+    for (size_t i = 0; i < s->light_count; i++)
+        for (int k = 0; k < 3; k++) s->lights[i].position[k] = (float)((double)s->lights[i].position[k] - c[k]);
+    for (int k = 0; k < 3; k++) {
+        s->bounds_min[k] = (float)((double)s->bounds_min[k] - c[k]);
+        s->bounds_max[k] = (float)((double)s->bounds_max[k] - c[k]);
+        b->origin[k] = (float)c[k];
+    }
+}
+
+static void to_world(const bake *b, const float local[3], float world[3])
+{
+    for (int k = 0; k < 3; k++) world[k] = local[k] + b->origin[k];
+}
+
 static int do_import(bake *b)
 {
     phase(b, "import");
@@ -184,6 +221,7 @@ static int do_import(bake *b)
     if (!has_triangle_with_area(&b->scene))
         return fail(b, LBK_EXIT_INPUT, "%s: all %zu triangles are degenerate (zero area): nothing to light",
                     b->opt->input, b->scene.tri_count);
+    recentre(b);
     if (!bk_scene_has_light(&b->scene))
         return fail(b, LBK_EXIT_INPUT,
                     "%s: the scene has no light: no KHR_lights_punctual light, no emissive material "
@@ -366,6 +404,7 @@ static void set_inputs(const bake *b, bk_set_inputs *in)
     in->threshold = b->opt->dls_threshold;
     in->progress = b->progress;
     in->door_method = b->opt->door_method;
+    memcpy(in->origin, b->origin, sizeof in->origin);
 }
 
 static int do_transport(bake *b)
@@ -427,6 +466,17 @@ static lbk_result build_lmap(bake *b, section_list *sl)
         bk_texel_linear(&tx->receivers[ti], &b->radiance[k], &lin[ti]);
         has[ti] = 1;
     }
+    bk_count_out_of_range(lin, has, nt, &b->saturated, &b->flushed);
+    if (b->saturated)
+        bk_progress_note(b->progress,
+                         "lbk bake: warning: %llu texel channels exceed 65024 lx, the largest R11G11B10F value, "
+                         "and are stored saturated: the light intensities are too high for the format",
+                         (unsigned long long)b->saturated);
+    if (b->flushed)
+        bk_progress_note(b->progress,
+                         "lbk bake: warning: %llu lit texel channels are below 2^-21 lx and are stored as 0: "
+                         "the light intensities are too low for the format",
+                         (unsigned long long)b->flushed);
     r = bk_encode_pages(tx, b->atlas.margin, lin, has, pages);
     if (r) goto done;
     for (size_t p = 0; p < tx->page_count; p++) {
@@ -448,13 +498,18 @@ done:
 static lbk_result build_glg(bake *b, section_list *sl)
 {
     uint8_t(*vis)[4] = calloc(b->glg.tet_count, sizeof *vis);
-    if (!vis) return LBK_ERR_OUT_OF_MEMORY;
+    float(*world)[3] = calloc(b->glg.probe_count, sizeof *world);
+    if (!vis || !world) {
+        free(vis), free(world);
+        return LBK_ERR_OUT_OF_MEMORY;
+    }
     bk_glg_visibility_unorm8(&b->glg, vis);
+    for (size_t i = 0; i < b->glg.probe_count; i++) to_world(b, &b->glg.positions[3 * i], world[i]);
     lbk_glg_desc d;
     memset(&d, 0, sizeof d);
     d.probe_count = (uint32_t)b->glg.probe_count;
     d.tetra_count = (uint32_t)b->glg.tet_count;
-    d.positions = (const float(*)[3])b->glg.positions;
+    d.positions = (const float(*)[3])world;
     d.probes = &b->radiance[b->glg_first];
     d.tetras = (const uint32_t(*)[4])b->glg.tets;
     d.adjacency = (const uint32_t(*)[4])b->glg.neighbours;
@@ -462,7 +517,7 @@ static lbk_result build_glg(bake *b, section_list *sl)
     void *data;
     size_t size;
     lbk_result r = lbk_glg_build(&d, NULL, &data, &size);
-    free(vis);
+    free(vis), free(world);
     return sections_add(sl, LBK_SECTION_GLG, r, data, size);
 }
 
@@ -478,7 +533,10 @@ static lbk_result build_octp(bake *b, section_list *sl)
     diag = sqrtf(diag);
     if (!(diag > 0) || !isfinite(diag)) diag = 1;
     for (size_t i = 0; i < b->glg.probe_count; i++)
+    {
         bk_octa_probe(b->tracer, &b->glg.positions[3 * i], &b->radiance[b->glg_first + i], diag, &p[i]);
+        to_world(b, &b->glg.positions[3 * i], p[i].position);
+    }
     void *data;
     size_t size;
     lbk_result r = lbk_octp_build(p, (uint32_t)b->glg.probe_count, NULL, &data, &size);
@@ -495,7 +553,7 @@ static lbk_result build_llg(bake *b, section_list *sl)
     size_t probe = b->llg_first;
     for (size_t i = 0; i < b->llg_count; i++) {
         const bk_llg *l = &b->llgs[i];
-        memcpy(g[i].centre, l->centre, sizeof g[i].centre);
+        to_world(b, l->centre, g[i].centre);
         memcpy(g[i].axes, l->axes, sizeof g[i].axes);
         memcpy(g[i].half_extent, l->half_extents, sizeof g[i].half_extent);
         memcpy(g[i].dims, l->dims, sizeof g[i].dims);
@@ -572,7 +630,7 @@ static lbk_result build_objects(bake *b, section_list *sl)
         }
         for (uint32_t k = 0; k < o->tri_count; k++)
             for (int c = 0; c < 3; c++)
-                memcpy(&xyz[9 * k + 3 * c], &s->positions[3 * (size_t)s->tris[3 * ((size_t)o->first_tri + k) + c]], 12);
+                to_world(b, &s->positions[3 * (size_t)s->tris[3 * ((size_t)o->first_tri + k) + c]], &xyz[9 * k + 3 * c]);
         t->geometry_hash = lbk_objects_geometry_hash(xyz, o->tri_count);
         t->representation = LBK_REPRESENTATION_NONE;
         int32_t slot = b->atlas.object_slot && i < b->atlas.scene_object_count ? b->atlas.object_slot[i] : -1;
@@ -767,6 +825,8 @@ static int write_json_report(bake *b, const bk_bake_summary *sum)
     cJSON_AddNumberToObject(st, "tail_fraction", b->stats.tail_fraction);
     cJSON_AddNumberToObject(st, "cache_cells", (double)b->stats.cells);
     cJSON_AddNumberToObject(st, "nonfinite_dropped", (double)b->stats.nonfinite);
+    cJSON_AddNumberToObject(st, "texel_channels_saturated", (double)b->saturated);
+    cJSON_AddNumberToObject(st, "texel_channels_flushed", (double)b->flushed);
     cJSON *c = cJSON_AddObjectToObject(root, "counts");
     cJSON_AddNumberToObject(c, "objects", (double)sum->objects);
     cJSON_AddNumberToObject(c, "texels", (double)sum->texels);
@@ -846,6 +906,8 @@ int bk_bake(const bk_bake_options *opt, bk_progress *progress, bk_bake_summary *
         summary->doors = b.sets.door_count;
         summary->final_error = b.stats.est_rel_rmse;
         rc = do_encode_and_write(&b, summary);
+        summary->texel_channels_saturated = b.saturated;
+        summary->texel_channels_flushed = b.flushed;
     }
     if (b.phase_count > 0) b.phase_seconds[b.phase_count - 1] = bk_now() - b.phase_start;
     summary->seconds = bk_now() - start;

@@ -39,6 +39,8 @@ typedef struct bk_bake_summary {
     uint32_t sets, doors;
     double seconds, final_error;
     uint64_t file_bytes;
+    uint64_t texel_channels_saturated; /* above the largest R11G11B10F value (warned) */
+    uint64_t texel_channels_flushed;   /* lit but below its smallest step: stored 0 (warned) */
 } bk_bake_summary;
 
 /* Exit-code style result: 0 ok, else an LBK_EXIT_* code; message in err. */

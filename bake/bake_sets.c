@@ -945,7 +945,7 @@ lbk_result bk_set_bakes_sections(bk_set_bakes *sets, const bk_set_inputs *in, vo
     for (size_t p = 0; p < im->door_count; p++) {
         const bs_door *d = &im->doors[p];
         dd[p].name = d->name;
-        memcpy(dd[p].centre, d->centre, sizeof d->centre);
+        for (int k = 0; k < 3; k++) dd[p].centre[k] = d->centre[k] + in->origin[k];
         memcpy(dd[p].axes, d->axes, sizeof d->axes);
         memcpy(dd[p].half_extents, d->half, sizeof d->half);
         dd[p].open_set = d->open_set;

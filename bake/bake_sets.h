@@ -50,6 +50,8 @@ typedef struct bk_set_inputs {
                                          < 0: store every receiver with a non-zero contribution */
     bk_progress *progress;
     int door_method;                  /* enum bk_door_method */
+    float origin[3];                  /* the bake frame's origin in world space: add it to every
+                                         position written (the scene is recentred, bake.c) */
 } bk_set_inputs;
 
 /* Finds light sets (lights and emissive objects with lbk_light_set), doors (lbk_door) and the

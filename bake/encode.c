@@ -51,3 +51,19 @@ lbk_result bk_encode_pages(const bk_texels *tx, int margin, const lbk_ahd_linear
     return LBK_OK;
 }
 
+
+void bk_count_out_of_range(const lbk_ahd_linear *lin, const uint8_t *has, size_t n, uint64_t *saturated,
+                           uint64_t *flushed)
+{
+    uint64_t sat = 0, low = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (!has[i]) continue;
+        for (int c = 0; c < 3; c++) {
+            float ez = lin[i].c[c][0] + lin[i].c[c][3];
+            sat += ez > 65024.0f;
+            low += ez > 0 && ez < 0x1p-21f;
+        }
+    }
+    *saturated = sat;
+    *flushed = low;
+}

@@ -19,4 +19,10 @@ void bk_texel_linear(const bk_texel *t, const lbk_sh9_rgb *radiance_world, lbk_a
 lbk_result bk_encode_pages(const bk_texels *tx, int margin, const lbk_ahd_linear *lin, const uint8_t *has,
                            lbk_ahd_texel **pages_out);
 
+/* Texel colour channels whose irradiance along the normal lies outside what R11G11B10F holds:
+ * above its largest value 65024 (stored saturated) or positive but below half its smallest step
+ * 2^-20 (stored as 0). `lin`/`has` as for bk_encode_pages; n entries. */
+void bk_count_out_of_range(const lbk_ahd_linear *lin, const uint8_t *has, size_t n, uint64_t *saturated,
+                           uint64_t *flushed);
+
 #endif

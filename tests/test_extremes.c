@@ -405,15 +405,15 @@ static double mean_probe_lum(const float (*dc)[3], size_t n)
  * triangles mixed in): mean texel irradiance and mean GLG probe radiance within the combined
  * estimated error, and the distribution of texel irradiance within twice that. Returns the
  * relative difference of the texel means. */
-static double compare_lighting(const baked *a, const baked *b, const char *what, int strict)
+static double compare_lighting(const baked *a, const baked *b, const char *what, int probes_may_move)
 {
     double tol = hypot(a->est, b->est);
     double ma = mean_texel_lum(a), mb = mean_texel_lum(b);
     double dm = fabs(mb - ma) / ma, dd = distribution_rel_rms(a, b), dp = 0;
     assert_true(ma > 0);
     assert_int_equal(a->has_glg, b->has_glg);
-    if (a->has_glg) {
-        assert_int_equal(a->glg_count, b->glg_count);
+    if (!probes_may_move) assert_int_equal(a->glg_count, b->glg_count);
+    if (a->has_glg && a->glg_count == b->glg_count) {
         double pa = mean_probe_lum(a->glg_dc, a->glg_count), pb = mean_probe_lum(b->glg_dc, b->glg_count);
         dp = fabs(pb - pa) / pa;
     }
@@ -421,11 +421,9 @@ static double compare_lighting(const baked *a, const baked *b, const char *what,
                   "est. %.2f%% / %.2f%%\n",
                   what, a->texel_count, b->texel_count, 100 * (mb / ma - 1), 100 * dd, b->glg_count, 100 * dp,
                   100 * a->est, 100 * b->est);
-    if (strict) {
-        assert_true(dm <= tol);
-        assert_true(dd <= 2 * tol);
-        assert_true(dp <= tol);
-    }
+    assert_true(dm <= tol);
+    assert_true(dd <= 2 * tol);
+    assert_true(dp <= tol);
     return dm;
 }
 
@@ -498,6 +496,9 @@ static void test_intensity_extremes(void **state)
         print_message("  intensity %g: mean ratio %.6g (k = %g), %zu saturated and %zu flushed channels of %zu\n",
                       ks[i], ratio, ks[i], saturated, flushed, 3 * b.texel_count);
         if (ks[i] == 1e-4 || ks[i] == 1e4) assert_float_equal(ratio / ks[i], 1, 0.01);
+        /* the baker warns exactly when the file cannot hold the range */
+        assert_int_equal(b.sum.texel_channels_saturated > 0, saturated > 0);
+        assert_int_equal(b.sum.texel_channels_flushed > 0, flushed > 0);
         if (ks[i] == 1e6) assert_true(saturated > 0);   /* 1e6 cd at 1 m exceeds 65024 lx */
         if (ks[i] == 1e-6) assert_true(flushed > 0);    /* 1e-6 lx is below the smallest step */
         baked_free(&b);
@@ -516,7 +517,7 @@ static void test_scale_extremes(void **state)
         room_spec rs = {scales[i], {0, 0, 0}, 0, 0};
         baked b;
         bake_room(&rs, i ? "scale10km" : "scale1mm", &b);
-        compare_lighting(ref, &b, i ? "10 km" : "1 mm", 1);
+        compare_lighting(ref, &b, i ? "10 km" : "1 mm", 0);
         /* GLG probes sit at the scaled positions */
         for (size_t p = 0; p < b.glg_count; p++)
             for (int c = 0; c < 3; c++)
@@ -527,12 +528,11 @@ static void test_scale_extremes(void **state)
 
 /* ---- 3. far from the origin -------------------------------------------------------------- */
 
-/* At 1e4 m (float step 1 mm) the moved level matches the centred one within the estimate. At
- * 1e5 m floats step by 7.8 mm and ray origins are offset by 8 ulps (6 cm): on this 2 m room with
- * a panel 5 cm under the ceiling that visibly shifts the result (measured +20 %; a point-lit
- * room +6 %; STABILITY.md). It must stay valid and finite, with every probe in place; the
- * difference is printed, and asserted only under LBK_STRICT_FAR=1 (for when the baker works in
- * a level-centred frame). */
+/* The moved level matches the centred one within the estimate, at 1e4 m and at 1e5 m. The baker
+ * works in a level-centred frame (bake.c recentre()); before it did, ray offsets of 8 ulps (6 cm
+ * at 1e5 m) brightened this room by 20 %. At 1e5 m the INPUT is already quantised to 7.8 mm
+ * floats, so the glTF's walls move by up to 4 mm and a probe may cross the clearance rule: the
+ * probe count may differ there, and probe positions are compared when it does not. */
 static void test_far_from_origin(void **state)
 {
     (void)state;
@@ -542,10 +542,9 @@ static void test_far_from_origin(void **state)
         room_spec rs = {1, {offsets[i], 0, -offsets[i]}, 0, 0};
         baked b;
         bake_room(&rs, i ? "far1e5" : "far1e4", &b);
-        int strict = i == 0 || getenv("LBK_STRICT_FAR") != NULL;
-        compare_lighting(ref, &b, i ? "1e5 m off origin" : "1e4 m off origin", strict);
+        compare_lighting(ref, &b, i ? "1e5 m off origin" : "1e4 m off origin", i == 1);
         double step = offsets[i] * 0x1p-23; /* one float ulp at that distance */
-        for (size_t p = 0; p < b.glg_count; p++) {
+        for (size_t p = 0; p < b.glg_count && b.glg_count == ref->glg_count; p++) {
             assert_float_equal(b.glg_pos[p][0] - offsets[i], ref->glg_pos[p][0], 2 * step + 1e-5);
             assert_float_equal(b.glg_pos[p][1], ref->glg_pos[p][1], 1e-5);
             assert_float_equal(b.glg_pos[p][2] + offsets[i], ref->glg_pos[p][2], 2 * step + 1e-5);
@@ -563,7 +562,7 @@ static void test_degenerate_and_duplicates(void **state)
     room_spec rs = {1, {0, 0, 0}, 0, 1};
     baked b;
     bake_room(&rs, "degenerate", &b);
-    compare_lighting(ref, &b, "degenerate + dups", 1);
+    compare_lighting(ref, &b, "degenerate + dups", 0);
     /* and no texel budget blow-up from split charts */
     assert_true(b.texel_count <= 2 * ref->texel_count);
     baked_free(&b);
