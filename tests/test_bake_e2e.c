@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cjson/cJSON.h>
@@ -23,6 +24,7 @@
 #include "lbk/octa.h"
 #include "lbk/report.h"
 #include "lbk/validate.h"
+#include "support/door_scenes.h"
 
 static const char *scenes_dir(void)
 {
@@ -369,6 +371,76 @@ static void test_octahedral_probes(void **state)
     lbk_reader_close(r);
 }
 
+/* Issue 6 on real baker output: every shipped convert profile makes a pack that validates and
+ * diffs equal to its source; export → convert --from-exr gives back the same lighting. On a
+ * level with lightmaps, LLGs, GLG and OCTP, and on one with light sets and a door (DLS, DOOR). */
+static int run_cli(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static int run_cli(const char *fmt, ...)
+{
+    char cmd[2048], args[1800];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(args, sizeof args, fmt, ap);
+    va_end(ap);
+    snprintf(cmd, sizeof cmd, "%s %s >/dev/null 2>&1", getenv("LBK"), args);
+    int st = system(cmd);
+    return st == -1 ? -1 : WEXITSTATUS(st);
+}
+
+static void check_tools_on(const char *lbk)
+{
+    static const char *profiles[] = {"console-current", "console-previous", "pc", "archive"};
+    for (size_t i = 0; i < sizeof profiles / sizeof profiles[0]; i++) {
+        char pack[600];
+        snprintf(pack, sizeof pack, "%s.%s.lbk", lbk, profiles[i]);
+        assert_int_equal(run_cli("convert %s -o %s --profile %s", lbk, pack, profiles[i]), 0);
+        assert_int_equal(run_cli("validate %s", pack), 0);
+        assert_int_equal(run_cli("diff %s %s", lbk, pack), 0);
+    }
+    char dir[600], back[600];
+    snprintf(dir, sizeof dir, "%s.exr", lbk);
+    snprintf(back, sizeof back, "%s.back.lbk", lbk);
+    assert_int_equal(run_cli("export %s --exr %s --png %s", lbk, dir, dir), 0);
+    assert_int_equal(run_cli("convert --from-exr %s %s -o %s --profile archive", dir, lbk, back), 0);
+    assert_int_equal(run_cli("diff %s %s", lbk, back), 0);
+    assert_int_equal(run_cli("inspect %s --json", lbk), 0);
+}
+
+static void test_tools_on_baker_output(void **state)
+{
+    (void)state;
+    if (!getenv("LBK")) {
+        print_message("[  SKIP    ] LBK (path of the lbk binary) is not set; make test sets it\n");
+        skip();
+    }
+    char in[512], out[512], err[512];
+    bk_bake_options o;
+    bk_bake_summary sum;
+    snprintf(in, sizeof in, "%s/cornell_box_bjs/cornellBox-2.80-Eevee-gltf.gltf", scenes_dir());
+    if (access(in, R_OK) != 0) skip();
+    snprintf(out, sizeof out, "%s/tools_bjs.lbk", tmpdir);
+    test_options(&o, in, out);
+    o.max_samples = 32;
+    o.octahedral_probes = 1;
+    assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
+    check_tools_on(out);
+
+    ds_options d;
+    memset(&d, 0, sizeof d);
+    d.door = DS_DOOR_TAGGED;
+    d.inside = DS_INSIDE_SETS;
+    d.outside_light = 1;
+    d.texel_density = 2;
+    snprintf(in, sizeof in, "%s/sets.gltf", tmpdir);
+    assert_int_equal(ds_write_room_scene(DS_ROOM_GLB, in, &d, err, sizeof err), 0);
+    snprintf(out, sizeof out, "%s/tools_sets.lbk", tmpdir);
+    test_options(&o, in, out);
+    o.max_samples = 32;
+    assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
+    assert_true(sum.sets >= 4 && sum.doors == 1);
+    check_tools_on(out);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -382,6 +454,7 @@ int main(void)
         cmocka_unit_test(test_target_error_and_reports),
         cmocka_unit_test(test_time_limit),
         cmocka_unit_test(test_octahedral_probes),
+        cmocka_unit_test(test_tools_on_baker_output),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

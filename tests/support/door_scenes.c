@@ -314,3 +314,11 @@ int ds_write_room_scene(const char *room_glb, const char *out_path, const ds_opt
     if (!ok) return fail(err, err_len, "cannot write the scene");
     return 0;
 }
+
+const char *ds_room_glb(void)
+{
+    static char path[1024]; /* test support: one thread */
+    const char *d = getenv("LBK_SCENES");
+    snprintf(path, sizeof path, "%s/room_with_doors/room.glb", d && *d ? d : "../shared/scenes");
+    return path;
+}

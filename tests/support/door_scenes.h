@@ -18,7 +18,10 @@
 
 #include <stddef.h>
 
-#define DS_ROOM_GLB "/work/shared/scenes/room_with_doors/room.glb"
+/* room_with_doors/room.glb under $LBK_SCENES, else ../shared/scenes (tests run from the repo
+ * root, with shared/ beside the clone as in CI). */
+const char *ds_room_glb(void);
+#define DS_ROOM_GLB ds_room_glb()
 
 enum ds_door { DS_NO_DOOR = 0, DS_DOOR_TAGGED, DS_DOOR_PLAIN };
 enum ds_inside { DS_INSIDE_NONE = 0, DS_INSIDE_SETS, DS_INSIDE_STATIC };
