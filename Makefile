@@ -18,7 +18,7 @@ OPT      ?= -O2 -g
 SAN      := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
 
 LIB_INC  := -Ilibformat/include
-LIB_LIBS := -lzstd -lxxhash
+LIB_LIBS := -lzstd -lxxhash -lm
 # The tools: everything heavy lives here, never in liblbk.
 TOOL_INC := $(LIB_INC) -I. -I/usr/include/draco -I/usr/include/stb
 TOOL_LIBS:= -lembree3 -lOpenEXRCore -lqhull_r -lspng -lcjson -ldraco -lpthread -lm $(LIB_LIBS)
@@ -39,7 +39,7 @@ TOOL_OBJ  := $(filter-out $(BUILD)/rel/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUIL
 LIB_ASAN  := $(LIB_SRC:%.c=$(BUILD)/asan/%.o)
 TOOL_ASAN := $(filter-out $(BUILD)/asan/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUILD)/asan/%.o)) $(TOOL_CXXSRC:%.cc=$(BUILD)/asan/%.o)
 
-.PHONY: all lib deps demo test check bench fuzz install clean help
+.PHONY: all lib deps demo test check bench fuzz install install-check clean help
 all: $(BUILD)/lbk $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc
 
 help:
@@ -94,7 +94,7 @@ $(BUILD)/liblbk.so: $(LIB_PIC)
 	$(CC) -shared -Wl,-soname,liblbk.so.1 -o $@ $^ $(LIB_LIBS)
 $(BUILD)/lbk.pc: Makefile
 	@mkdir -p $(@D)
-	@printf 'prefix=%s\nincludedir=$${prefix}/include\nlibdir=$${prefix}/lib\n\nName: lbk\nDescription: light bake kit container library\nVersion: 1.0.0\nRequires.private: libzstd libxxhash\nCflags: -I$${includedir}\nLibs: -L$${libdir} -llbk\n' '$(PREFIX)' > $@
+	@printf 'prefix=%s\nincludedir=$${prefix}/include\nlibdir=$${prefix}/lib\n\nName: lbk\nDescription: light bake kit container library\nVersion: 1.0.0\nRequires.private: libzstd libxxhash\nCflags: -I$${includedir}\nLibs: -L$${libdir} -llbk\nLibs.private: -lm\n' '$(PREFIX)' > $@
 lib: $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc
 
 # ---- the CLI --------------------------------------------------------------------------------
@@ -111,9 +111,22 @@ $(BUILD)/tests/%: tests/%.c $(TEST_SUPPORT_OBJ) $(TOOL_ASAN) $(LIB_ASAN)
 	$(CC) $(CSTD) -O1 -g $(SAN) $(WARN) $(TOOL_INC) -Itests -c $< -o $@.o
 	$(CXX) $(SAN) -o $@ $@.o $(TEST_SUPPORT_OBJ) $(TOOL_ASAN) $(LIB_ASAN) $(TOOL_LIBS) -lcmocka
 
+# The install check: the library installed into $(BUILD)/inst, a program built against it with
+# pkg-config only, linked once with liblbk.so and once with liblbk.a.
+INST := $(abspath $(BUILD))/inst
+install-check: all
+	@rm -rf $(INST)
+	@$(MAKE) --no-print-directory install PREFIX=$(INST) >/dev/null
+	@mkdir -p $(BUILD)/tests
+	$(CC) $(CSTD) $(WARN) tests/install/install_check.c -o $(BUILD)/tests/install_check_shared \
+	    $$(PKG_CONFIG_PATH=$(INST)/lib/pkgconfig pkg-config --cflags --libs lbk) -Wl,-rpath,$(INST)/lib -lcmocka
+	$(CC) $(CSTD) $(WARN) tests/install/install_check.c -o $(BUILD)/tests/install_check_static \
+	    $$(PKG_CONFIG_PATH=$(INST)/lib/pkgconfig pkg-config --cflags lbk) $(INST)/lib/liblbk.a \
+	    $$(PKG_CONFIG_PATH=$(INST)/lib/pkgconfig pkg-config --static --libs-only-other --libs-only-l lbk | sed 's/-llbk//') -lcmocka
+
 test: deps
-	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BUILD)/lbk-asan $(TESTS:%=$(BUILD)/tests/%) $(BUILD)/fuzz_container
-	@LBK=$(BUILD)/lbk-asan BUILD=$(BUILD) FUZZ=$(BUILD)/fuzz_container sh tests/run.sh $(TESTS)
+	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BUILD)/lbk-asan $(TESTS:%=$(BUILD)/tests/%) $(BUILD)/fuzz_container install-check
+	@LBK=$(BUILD)/lbk-asan BUILD=$(BUILD) FUZZ=$(BUILD)/fuzz_container sh tests/run.sh $(TESTS) install_check_shared install_check_static
 check: test
 
 # ---- fuzzing (clang libFuzzer) --------------------------------------------------------------
@@ -147,7 +160,7 @@ install: all
 	install -m 755 $(BUILD)/liblbk.so $(DESTDIR)$(PREFIX)/lib/liblbk.so.1
 	ln -sf liblbk.so.1 $(DESTDIR)$(PREFIX)/lib/liblbk.so
 	install -m 644 libformat/include/lbk/*.h $(DESTDIR)$(PREFIX)/include/lbk/
-	install -m 644 $(BUILD)/lbk.pc $(DESTDIR)$(PREFIX)/lib/pkgconfig/lbk.pc
+	sed 's|^prefix=.*|prefix=$(PREFIX)|' $(BUILD)/lbk.pc > $(DESTDIR)$(PREFIX)/lib/pkgconfig/lbk.pc
 	install -d $(DESTDIR)$(PREFIX)/share/lbk/profiles
 	install -m 644 convert/profiles/*.profile $(DESTDIR)$(PREFIX)/share/lbk/profiles/
 
