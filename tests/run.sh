@@ -6,11 +6,13 @@ set -u
 pass=0; fail=0; failed=""
 for t in "$@"; do
   log="$BUILD/tests/$t.log"
+  t0=$(date +%s)
   if "$BUILD/tests/$t" >"$log" 2>&1; then st=0; else st=$?; fi
+  secs=$(( $(date +%s) - t0 ))
   p=$(grep -c '^\[       OK \]' "$log"); f=$(grep -c '^\[  FAILED  \]' "$log")
   [ "$st" -ne 0 ] && [ "$f" -eq 0 ] && f=1
   pass=$((pass + p)); fail=$((fail + f))
-  if [ "$st" -ne 0 ]; then failed="$failed $t"; echo "FAIL $t (exit $st)"; tail -n 30 "$log"; else echo "ok   $t ($p cases)"; fi
+  if [ "$st" -ne 0 ]; then failed="$failed $t"; echo "FAIL $t (exit $st)"; tail -n 30 "$log"; else echo "ok   $t ($p cases, ${secs} s)"; fi
 done
 # The libFuzzer harness over the seed corpus for a fixed number of inputs (seeded, so runs
 # repeat); inputs it finds go to a scratch directory, never into tests/fuzz/corpus.
