@@ -1,12 +1,16 @@
 #include "scene_append.h"
 
+#include <malloc.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+/* Called once per appended element: reallocating every time made building a 60k-triangle scene
+ * quadratic under ASan (minutes). The block only moves when it is full, to twice the size. */
 void *sa_grow(void *p, size_t count, size_t elem)
 {
+    if (p && malloc_usable_size(p) >= count * elem) return p;
     size_t cap = 16;
     while (cap < count) cap *= 2;
     void *q = realloc(p, cap * elem);
