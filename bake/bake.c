@@ -576,13 +576,16 @@ done:
     return r;
 }
 
-static const bk_object *sort_objects;
+typedef struct named {
+    const char *name;
+    uint32_t index;
+} named;
 
 static int by_name_then_index(const void *a, const void *b)
 {
-    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
-    int c = strcmp(sort_objects[x].name, sort_objects[y].name);
-    return c ? c : (x > y) - (x < y);
+    const named *x = a, *y = b;
+    int c = strcmp(x->name, y->name);
+    return c ? c : (x->index > y->index) - (x->index < y->index);
 }
 
 /* OBJS names must be unique for tools to match objects across revisions (spec §8.2): the k-th
@@ -590,19 +593,17 @@ static int by_name_then_index(const void *a, const void *b)
 static int unique_names(const bk_scene *s, char (*names)[sizeof s->objects[0].name + 24])
 {
     size_t n = s->object_count;
-    uint32_t *order = malloc((n ? n : 1) * sizeof *order);
+    named *order = malloc((n ? n : 1) * sizeof *order);
     if (!order) return -1;
-    for (size_t i = 0; i < n; i++) order[i] = (uint32_t)i;
-    sort_objects = s->objects; /* qsort has no user pointer in C11; bake is single-threaded here */
+    for (size_t i = 0; i < n; i++) order[i] = (named){s->objects[i].name, (uint32_t)i};
     qsort(order, n, sizeof *order, by_name_then_index);
+    size_t k = 1;
     for (size_t i = 0; i < n; i++) {
-        const char *name = s->objects[order[i]].name;
-        size_t k = 1;
-        while (i >= k && !strcmp(s->objects[order[i - k]].name, name)) k++;
+        k = i > 0 && !strcmp(order[i - 1].name, order[i].name) ? k + 1 : 1;
         if (k == 1)
-            snprintf(names[order[i]], sizeof names[0], "%s", name);
+            snprintf(names[order[i].index], sizeof names[0], "%s", order[i].name);
         else
-            snprintf(names[order[i]], sizeof names[0], "%s#%zu", name, k);
+            snprintf(names[order[i].index], sizeof names[0], "%s#%zu", order[i].name, k);
     }
     free(order);
     return 0;

@@ -25,6 +25,7 @@
 #include "lbk/report.h"
 #include "lbk/validate.h"
 #include "support/door_scenes.h"
+#include "support/gltf_writer.h"
 
 static const char *scenes_dir(void)
 {
@@ -441,6 +442,65 @@ static void test_tools_on_baker_output(void **state)
     check_tools_on(out);
 }
 
+/* Two nodes named "crate" (and a third): OBJS gets "crate", "crate#2", "crate#3" in scene order
+ * (spec §8.2), so the validator has no duplicate-name warning and diff can match them. */
+static int no_warning(void *user, const lbk_issue *issue)
+{
+    (*(int *)user)++;
+    print_message("issue %u: %s\n", issue->id, issue->message);
+    return 0;
+}
+
+static void test_duplicate_names_made_unique(void **state)
+{
+    (void)state;
+    char in[512], out[512], err[512];
+    snprintf(in, sizeof in, "%s/crates.gltf", tmpdir);
+    snprintf(out, sizeof out, "%s/crates.lbk", tmpdir);
+    gw_scene *sc = gw_create();
+    const float grey[3] = {0.5f, 0.5f, 0.5f}, black[3] = {0, 0, 0}, sky[3] = {1, 1, 1};
+    int m = gw_material(sc, grey, black, 0, 0);
+    gw_geom floor_g = {0}, box = {0};
+    const float f0[3] = {-4, 0, 4}, f1[3] = {4, 0, 4}, f2[3] = {4, 0, -4}, f3[3] = {-4, 0, -4};
+    gw_geom_quad(&floor_g, f0, f1, f2, f3, 1);
+    const float mn[3] = {0, 0, 0}, mx[3] = {1, 1, 1};
+    gw_geom_box(&box, mn, mx, 1, 0);
+    gw_mesh(sc, "crate", &box, m, 1, (const double[3]){-2, 0, 0}, "lightmap");
+    gw_mesh(sc, "floor", &floor_g, m, 1, NULL, "lightmap");
+    gw_mesh(sc, "crate", &box, m, 1, (const double[3]){2, 0, 0}, "lightmap");
+    gw_mesh(sc, "crate", &box, m, 1, (const double[3]){0, 0, 2}, "lightmap");
+    gw_sky(sc, sky);
+    assert_int_equal(gw_write(sc, in), 0);
+    gw_geom_free(&floor_g);
+    gw_geom_free(&box);
+    gw_free(sc);
+    bk_bake_options o;
+    bk_bake_summary sum;
+    test_options(&o, in, out);
+    o.max_samples = 32;
+    assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
+    int issues = 0;
+    lbk_validate_summary vs;
+    assert_int_equal(lbk_validate_file(out, NULL, no_warning, &issues, &vs), LBK_OK);
+    assert_int_equal(issues, 0);
+    lbk_reader *r;
+    assert_int_equal(lbk_reader_open_file(out, NULL, &r), LBK_OK);
+    const void *data;
+    size_t size;
+    assert_int_equal(lbk_reader_section_by_type(r, LBK_SECTION_OBJS, &data, &size), LBK_OK);
+    lbk_objects_view v;
+    assert_int_equal(lbk_objects_parse(data, size, &v), LBK_OK);
+    assert_int_equal(v.count, 4);
+    static const char *want[] = {"crate", "floor", "crate#2", "crate#3"};
+    for (uint32_t i = 0; i < 4; i++) {
+        lbk_object ob;
+        assert_int_equal(lbk_objects_get(&v, i, &ob), LBK_OK);
+        assert_int_equal(ob.name.size, strlen(want[i]));
+        assert_memory_equal(ob.name.data, want[i], ob.name.size);
+    }
+    lbk_reader_close(r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -455,6 +515,7 @@ int main(void)
         cmocka_unit_test(test_time_limit),
         cmocka_unit_test(test_octahedral_probes),
         cmocka_unit_test(test_tools_on_baker_output),
+        cmocka_unit_test(test_duplicate_names_made_unique),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
