@@ -1,6 +1,8 @@
 /* Series-expansion light transport; see transport.h and TRANSPORT.md. */
 #include "transport.h"
 
+#include "shading.h"
+
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -117,36 +119,6 @@ static void lattice_uv(const tp_lattice *l, uint32_t j, double t1, double t2, do
     *b = y - floor(y);
 }
 
-/* ---- small vector helpers ------------------------------------------------------------------ */
-
-static double lum(const double c[3]) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
-
-static void onb(const double n[3], double t[3], double b[3])
-{
-    /* Duff et al. 2017, branchless orthonormal basis */
-    double s = n[2] >= 0 ? 1.0 : -1.0;
-    double a = -1.0 / (s + n[2]);
-    double bb = n[0] * n[1] * a;
-    t[0] = 1 + s * n[0] * n[0] * a; t[1] = s * bb; t[2] = -s * n[0];
-    b[0] = bb; b[1] = s + n[1] * n[1] * a; b[2] = -n[1];
-}
-
-static void sh9_basis(const double d[3], double y[9])
-{
-    double x = d[0], yy = d[1], z = d[2];
-    y[0] = 0.282094791773878;
-    y[1] = 0.488602511902920 * yy;
-    y[2] = 0.488602511902920 * z;
-    y[3] = 0.488602511902920 * x;
-    y[4] = 1.092548430592079 * x * yy;
-    y[5] = 1.092548430592079 * yy * z;
-    y[6] = 0.315391565252520 * (3 * z * z - 1);
-    y[7] = 1.092548430592079 * x * z;
-    y[8] = 0.546274215296040 * (x * x - yy * yy);
-}
-
-static int finite3d(const double v[3]) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
-
 /* ---- the run context ----------------------------------------------------------------------- */
 
 typedef struct tp_cell {
@@ -202,7 +174,7 @@ typedef struct tp_ctx {
     const bk_receiver *recv;
     size_t recv_count;
     float *punct_lum;      /* luminance of punctual E per receiver (for the error estimate) */
-    double *x_acc[2];      /* per receiver, per half: Σ_p w_p·lum(E_p) */
+    double *x_acc[2];      /* per receiver, per half: Σ_p w_p·bk_lum(E_p) */
     const bk_transport_output *out;
     double pass_weight;
     /* counters: per thread, summed after each parallel step */
@@ -274,91 +246,16 @@ static void tri_vertices(const tp_ctx *c, uint32_t tri, double v[3][3])
     }
 }
 
-static void sample_image(const bk_image *img, double u, double v, double out[3])
-{
-    if (!img || !img->rgba || img->width <= 0 || img->height <= 0 || !isfinite(u) || !isfinite(v)) {
-        out[0] = out[1] = out[2] = 1;
-        return;
-    }
-    /* glTF default sampler: repeat; nearest texel is enough for cell-sized averages */
-    double fu = u - floor(u), fv = v - floor(v);
-    long x = (long)(fu * img->width), y = (long)(fv * img->height);
-    if (x >= img->width) x = img->width - 1;
-    if (y >= img->height) y = img->height - 1;
-    const float *p = img->rgba + 4 * ((size_t)y * (size_t)img->width + (size_t)x);
-    for (int k = 0; k < 3; k++) out[k] = isfinite(p[k]) && p[k] > 0 ? p[k] : 0;
-}
-
-static const bk_image *image_at(const bk_scene *s, int idx)
-{
-    return (idx >= 0 && (size_t)idx < s->image_count) ? &s->images[idx] : NULL;
-}
-
-/* Equirectangular sky, +Y up: u = 0.5 + atan2(x, −z)/2π, v = acos(y)/π (v = 0 at the zenith,
- * the image's top row). */
 static void sky_radiance(const tp_ctx *c, const double d[3], double out[3])
 {
-    const bk_scene *s = c->scene;
     if (!c->use_sky) { out[0] = out[1] = out[2] = 0; return; }
-    const bk_image *img = image_at(s, s->sky_image);
-    if (s->sky_image >= 0 && img && img->rgba) {
-        double u = 0.5 + atan2(d[0], -d[2]) / (2 * TP_PI);
-        double y = d[1] < -1 ? -1 : d[1] > 1 ? 1 : d[1];
-        double v = acos(y) / TP_PI;
-        sample_image(img, u, v, out);
-        return;
-    }
-    for (int k = 0; k < 3; k++) out[k] = isfinite(s->sky[k]) && s->sky[k] > 0 ? s->sky[k] : 0;
+    bk_sky_radiance(c->scene, d, out);
 }
 
 static int in_light_set(const tp_ctx *c, const char *set)
 {
     const char *want = c->opt->light_set ? c->opt->light_set : "";
     return strncmp(set, want, 63) == 0;
-}
-
-/* Irradiance-at-normal-incidence from one punctual light at p (KHR_lights_punctual falloff,
- * range window and smooth spot cone). Returns 0 when the light cannot contribute. */
-static int light_eval(const bk_light *l, const double p[3], double val[3], double dir[3], double *dist)
-{
-    double att;
-    if (l->type == BK_LIGHT_DIRECTIONAL) {
-        double n = sqrt((double)l->direction[0] * l->direction[0] + (double)l->direction[1] * l->direction[1] +
-                        (double)l->direction[2] * l->direction[2]);
-        if (!(n > 0) || !isfinite(n)) return 0;
-        for (int k = 0; k < 3; k++) dir[k] = -l->direction[k] / n;
-        *dist = INFINITY;
-        att = 1;
-    } else {
-        double d[3] = {l->position[0] - p[0], l->position[1] - p[1], l->position[2] - p[2]};
-        double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-        if (!(d2 > 0) || !isfinite(d2)) return 0;
-        double r = sqrt(d2);
-        for (int k = 0; k < 3; k++) dir[k] = d[k] / r;
-        *dist = r;
-        att = 1.0 / d2;
-        if (l->range > 0) {
-            double q = r / l->range;
-            double w = 1 - q * q * q * q;
-            if (w <= 0) return 0;
-            att *= w > 1 ? 1 : w;
-        }
-        if (l->type == BK_LIGHT_SPOT) {
-            double ln = sqrt((double)l->direction[0] * l->direction[0] + (double)l->direction[1] * l->direction[1] +
-                             (double)l->direction[2] * l->direction[2]);
-            if (!(ln > 0)) return 0;
-            double cd = -(dir[0] * l->direction[0] + dir[1] * l->direction[1] + dir[2] * l->direction[2]) / ln;
-            double co = cos(l->outer_cone), ci = cos(l->inner_cone);
-            double scale = 1.0 / fmax(0.001, ci - co);
-            double t = (cd - co) * scale;
-            t = t < 0 ? 0 : t > 1 ? 1 : t;
-            att *= t * t;
-            if (att <= 0) return 0;
-        }
-    }
-    for (int k = 0; k < 3; k++) val[k] = (isfinite(l->color[k]) && l->color[k] > 0 ? l->color[k] : 0) * att;
-    if (!finite3d(val) || (val[0] <= 0 && val[1] <= 0 && val[2] <= 0)) return 0;
-    return 1;
 }
 
 static int light_visible(const tp_ctx *c, const float org[3], const double dir[3], double dist)
@@ -469,21 +366,9 @@ static void emission_at(const tp_ctx *c, uint32_t tri, double u, double v, doubl
         for (int k = 0; k < 3; k++) out[k] = f[k];
         return;
     }
-    const bk_scene *s = c->scene;
-    double te[3] = {1, 1, 1};
-    if (s->uv0) {
-        const uint32_t *ix = s->tris + 3 * (size_t)tri;
-        double uv[2];
-        for (int k = 0; k < 2; k++) {
-            double t0 = ix[0] < s->vertex_count ? s->uv0[2 * (size_t)ix[0] + k] : 0;
-            double t1 = ix[1] < s->vertex_count ? s->uv0[2 * (size_t)ix[1] + k] : 0;
-            double t2 = ix[2] < s->vertex_count ? s->uv0[2 * (size_t)ix[2] + k] : 0;
-            uv[k] = (1 - u - v) * t0 + u * t1 + v * t2;
-        }
-        sample_image(image_at(s, tex), uv[0], uv[1], te);
-    } else {
-        sample_image(image_at(s, tex), 0, 0, te);
-    }
+    double uv[2], te[3];
+    bk_tri_uv0(c->scene, tri, u, v, uv);
+    bk_sample_image(bk_scene_image(c->scene, tex), uv[0], uv[1], te);
     for (int k = 0; k < 3; k++) {
         double em = f[k] * te[k];
         out[k] = isfinite(em) && em > 0 ? em : 0;
@@ -595,7 +480,7 @@ static void cache_bounce(tp_ctx *c, size_t begin, size_t end, int thread)
         if (cell->albedo[0] <= 0 && cell->albedo[1] <= 0 && cell->albedo[2] <= 0) goto store;
         tp_rng rng = rng_make(c->seed, DOM_CELL, (uint64_t)h, (uint64_t)c->pass, (uint64_t)k, ci);
         double n[3] = {cell->n[0], cell->n[1], cell->n[2]}, t[3], b[3];
-        onb(n, t, b);
+        bk_onb(n, t, b);
         float nf[3] = {cell->n[0], cell->n[1], cell->n[2]};
         float scale = bk_tracer_tri_scale(c->tracer, cell->tri);
         double s1 = rng_next(&rng), s2 = rng_next(&rng);
@@ -656,13 +541,13 @@ static void cache_bounce(tp_ctx *c, size_t begin, size_t end, int thread)
                 } else if (k == 1) {
                     sky_radiance(c, d, L);
                 }
-                if (!finite3d(L)) bad++;
+                if (!bk_finite3(L)) bad++;
                 else for (int a = 0; a < 3; a++) e[a] += L[a];
                 if (nee) {
                     double u0, v0, ld[3], cq, val[3];
                     lattice_uv(&c->lat, (uint32_t)j, t1, t2, &u0, &v0);
                     if (nee_sample(c, o, n, PG_COSINE, u0, v0, ld, &cq, val, &shadow)) {
-                        if (finite3d(val))
+                        if (bk_finite3(val))
                             for (int a = 0; a < 3; a++) en[a] += val[a] * cq;
                         else
                             bad++;
@@ -671,7 +556,7 @@ static void cache_bounce(tp_ctx *c, size_t begin, size_t end, int thread)
                 if (j < light_points) {
                     for (size_t li = 0; li < c->light_count; li++) {
                         double val[3], ld[3], dist;
-                        if (!light_eval(c->lights[li], pts[jj], val, ld, &dist)) continue;
+                        if (!bk_light_eval(c->lights[li], pts[jj], val, ld, &dist)) continue;
                         double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
                         if (cs <= 0) continue;
                         shadow++;
@@ -702,7 +587,7 @@ static double cell_power(const tp_ctx *c, const float *l)
     double p = 0;
     for (size_t i = 0; i < c->cell_count; i++) {
         double v[3] = {l[3 * i], l[3 * i + 1], l[3 * i + 2]};
-        p += c->cells[i].area * lum(v);
+        p += c->cells[i].area * bk_lum(v);
     }
     return p;
 }
@@ -795,20 +680,20 @@ static void recv_punctual(tp_ctx *c, size_t begin, size_t end, int thread)
         memset(sh, 0, sizeof sh);
         for (size_t li = 0; li < c->light_count; li++) {
             double val[3], ld[3], dist;
-            if (!light_eval(c->lights[li], p, val, ld, &dist)) continue;
+            if (!bk_light_eval(c->lights[li], p, val, ld, &dist)) continue;
             double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
             if (!sphere && cs <= 0) continue;
             rays++;
             if (!light_visible(c, o, ld, dist)) continue;
             double y[9];
-            sh9_basis(ld, y);
+            bk_sh9_basis_d(ld, y);
             for (int a = 0; a < 3; a++) {
                 e[a] += sphere ? val[a] : val[a] * cs;
                 for (int kk = 0; kk < 9; kk++) sh[a][kk] += val[a] * y[kk];
             }
         }
         if (c->punct_lum) {
-            c->punct_lum[i] = (float)lum(e);
+            c->punct_lum[i] = (float)bk_lum(e);
             continue;
         }
         const bk_transport_output *out = c->out;
@@ -830,7 +715,7 @@ static void accumulate(const double d[3], double cs, const double L[3], const do
                        double sh_t[3][9], double sh_d[3][9])
 {
     double y[9];
-    sh9_basis(d, y);
+    bk_sh9_basis_d(d, y);
     int has_d = Ld[0] != 0 || Ld[1] != 0 || Ld[2] != 0;
     for (int a = 0; a < 3; a++) {
         e[a] += L[a] * cs;
@@ -851,7 +736,7 @@ static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
         double n[3], t[3], b[3];
         int sphere;
         recv_normal(r, n, &sphere);
-        onb(n, t, b);
+        bk_onb(n, t, b);
         float o[3];
         recv_offset_origin(c, r, o);
         double sh_t[3][9], sh_d[3][9], e_t[3];
@@ -912,7 +797,7 @@ static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
                         sky_radiance(c, d, L);
                         memcpy(Ld, L, sizeof L);
                     }
-                    if (!finite3d(L) || !finite3d(Ld)) bad++;
+                    if (!bk_finite3(L) || !bk_finite3(Ld)) bad++;
                     else accumulate(d, sphere ? 1 : zz[jj], L, Ld, e, sh_t, sh_d);
                     if (c->nee) {
                         /* one light sample per gather ray; its value Le·w/p is turned into the
@@ -921,7 +806,7 @@ static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
                         lattice_uv(&c->lat, (uint32_t)(j0 + jj), t1, t2, &u0, &uu1);
                         if (nee_sample(c, o, n, pg_kind, u0, uu1, ld, &cl, val, &shadow)) {
                             for (int a = 0; a < 3; a++) val[a] /= solid;
-                            if (!finite3d(val)) bad++;
+                            if (!bk_finite3(val)) bad++;
                             else accumulate(ld, cl, val, val, e, sh_t, sh_d);
                         }
                     }
@@ -930,7 +815,7 @@ static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
             for (int a = 0; a < 3; a++) e[a] *= solid / S;
             /* error scalar: irradiance for texels, fluence/4 for probes (equal under uniform
              * radiance, so texels and probes weigh alike in the relative RMSE) */
-            c->x_acc[h][i] += w * (lum(e) + c->punct_lum[i]) * (sphere ? 0.25 : 1.0);
+            c->x_acc[h][i] += w * (bk_lum(e) + c->punct_lum[i]) * (sphere ? 0.25 : 1.0);
             for (int a = 0; a < 3; a++) e_t[a] += e[a];
         }
         /* both halves: 2S samples of pdf 1/solid; weight w for this pass */
@@ -1037,14 +922,13 @@ static lbk_result build_cells(tp_ctx *c)
         bk_tracer_tri_normal(c->tracer, (uint32_t)i, n);
         float area = bk_tracer_tri_area(c->tracer, (uint32_t)i);
         int m = c->tri_m[i];
-        const uint32_t *ix = s->tris + 3 * i;
         c->tri_le_tex[i] = -1;
         if (mat && emits && area > 0) {
             for (int k = 0; k < 3; k++) {
                 double em = mat->emission[k];
                 c->tri_le[3 * i + k] = (float)(isfinite(em) && em > 0 ? em : 0);
             }
-            if (mat->emission_tex >= 0 && image_at(s, mat->emission_tex)) c->tri_le_tex[i] = mat->emission_tex;
+            if (mat->emission_tex >= 0 && bk_scene_image(s, mat->emission_tex)) c->tri_le_tex[i] = mat->emission_tex;
         }
         for (int sub = 0; sub < m * m; sub++) {
             /* material values at the cell's centroid (uv0) */
@@ -1053,25 +937,16 @@ static lbk_result build_cells(tp_ctx *c)
             int ii = ss / 2, up = ss & 1;
             double cu = up ? (3.0 * ii + 2) / (3.0 * m) : (3.0 * ii + 1) / (3.0 * m);
             double cv = up ? (3.0 * j + 2) / (3.0 * m) : (3.0 * j + 1) / (3.0 * m);
-            double uv[2] = {0, 0};
-            if (s->uv0)
-                for (int k = 0; k < 2; k++) {
-                    double t0 = ix[0] < s->vertex_count ? s->uv0[2 * (size_t)ix[0] + k] : 0;
-                    double t1 = ix[1] < s->vertex_count ? s->uv0[2 * (size_t)ix[1] + k] : 0;
-                    double t2 = ix[2] < s->vertex_count ? s->uv0[2 * (size_t)ix[2] + k] : 0;
-                    uv[k] = (1 - cu - cv) * t0 + cu * t1 + cv * t2;
-                }
+            double uv[2];
+            bk_tri_uv0(s, (uint32_t)i, cu, cv, uv);
             float albedo[3] = {0, 0, 0}, le[3] = {0, 0, 0};
             if (mat) {
-                double ta[3] = {1, 1, 1}, te[3] = {1, 1, 1};
-                if (mat->albedo_tex >= 0) sample_image(image_at(s, mat->albedo_tex), uv[0], uv[1], ta);
-                if (mat->emission_tex >= 0) sample_image(image_at(s, mat->emission_tex), uv[0], uv[1], te);
+                double al[3], em[3];
+                bk_material_albedo(s, mat, uv, al);
+                bk_material_emission(s, mat, uv, em);
                 for (int k = 0; k < 3; k++) {
-                    double al = mat->albedo[k] * ta[k];
-                    /* albedo ≥ 1 would make the series diverge: clamp just below */
-                    albedo[k] = (float)(isfinite(al) ? (al < 0 ? 0 : al > 0.999 ? 0.999 : al) : 0);
-                    double em = emits ? mat->emission[k] * te[k] : 0;
-                    le[k] = (float)(isfinite(em) && em > 0 ? em : 0);
+                    albedo[k] = (float)al[k];
+                    le[k] = emits ? (float)em[k] : 0;
                 }
             }
             if (c->opt->albedo_hook) {
@@ -1096,8 +971,8 @@ static lbk_result build_cells(tp_ctx *c)
 }
 
 /* The light-sampling distribution: every emitting sub-triangle with probability proportional
- * to its power area·lum(Le) (Le at its centroid, as the cells carry it), a point uniform on it.
- * A point's density per unit area is then lum(Le_cell)/P_total, stored in both side cells so a
+ * to its power area·bk_lum(Le) (Le at its centroid, as the cells carry it), a point uniform on it.
+ * A point's density per unit area is then bk_lum(Le_cell)/P_total, stored in both side cells so a
  * gather hit can weigh itself against it. */
 static lbk_result build_emitters(tp_ctx *c)
 {
@@ -1111,7 +986,7 @@ static lbk_result build_emitters(tp_ctx *c)
         const tp_cell *cell = &c->cells[ci];
         if (cell->side != 0 || !(cell->area > 0)) continue;
         double le[3] = {cell->le[0], cell->le[1], cell->le[2]};
-        double p = cell->area * lum(le);
+        double p = cell->area * bk_lum(le);
         if (!(p > 0) || !isfinite(p)) continue;
         n++;
         power += p;
@@ -1130,13 +1005,13 @@ static lbk_result build_emitters(tp_ctx *c)
         tp_cell *cell = &c->cells[ci];
         if (cell->side != 0 || !(cell->area > 0)) continue;
         double le[3] = {cell->le[0], cell->le[1], cell->le[2]};
-        double p = cell->area * lum(le);
+        double p = cell->area * bk_lum(le);
         if (!(p > 0) || !isfinite(p)) continue;
         run += p;
         c->em[k].tri = cell->tri;
         c->em[k].cell = (uint32_t)ci;
         c->em_cdf[k] = run / power;
-        float pa = (float)(lum(le) / power);
+        float pa = (float)(bk_lum(le) / power);
         cell->nee_parea = pa;
         if (c->tri_sides[cell->tri] > 1) c->cells[ci + (size_t)cell->m * cell->m].nee_parea = pa;
         k++;
