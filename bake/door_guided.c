@@ -1,6 +1,8 @@
 /* The guided door estimator; see door_guided.h and bake/SETS.md. */
 #include "bake/door_guided.h"
 
+#include "bake/shading.h"
+
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -43,21 +45,6 @@ typedef struct dg_ctx {
 
 static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 static double lumf(const float c[3]) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
-static int finite3(const double v[3]) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
-
-static void sh9_basis(const double d[3], double y[9])
-{
-    double x = d[0], yy = d[1], z = d[2];
-    y[0] = 0.282094791773878;
-    y[1] = 0.488602511902920 * yy;
-    y[2] = 0.488602511902920 * z;
-    y[3] = 0.488602511902920 * x;
-    y[4] = 1.092548430592079 * x * yy;
-    y[5] = 1.092548430592079 * yy * z;
-    y[6] = 0.315391565252520 * (3 * z * z - 1);
-    y[7] = 1.092548430592079 * x * z;
-    y[8] = 0.546274215296040 * (x * x - yy * yy);
-}
 
 /* Irradiance along unit n of the radiance an SH9 projection holds (Ramamoorthi & Hanrahan). */
 static void sh_irradiance(const lbk_sh9_rgb *s, const double n[3], double e[3])
@@ -65,21 +52,12 @@ static void sh_irradiance(const lbk_sh9_rgb *s, const double n[3], double e[3])
     static const double A[9] = {DG_PI, 2 * DG_PI / 3, 2 * DG_PI / 3, 2 * DG_PI / 3, DG_PI / 4,
                                 DG_PI / 4, DG_PI / 4, DG_PI / 4, DG_PI / 4};
     double y[9];
-    sh9_basis(n, y);
+    bk_sh9_basis_d(n, y);
     for (int c = 0; c < 3; c++) {
         double v = 0;
         for (int k = 0; k < 9; k++) v += A[k] * s->c[c][k] * y[k];
         e[c] = v > 0 && isfinite(v) ? v : 0;
     }
-}
-
-static void onb(const double n[3], double t[3], double b[3])
-{
-    double s = n[2] >= 0 ? 1.0 : -1.0;
-    double a = -1.0 / (s + n[2]);
-    double bb = n[0] * n[1] * a;
-    t[0] = 1 + s * n[0] * n[0] * a, t[1] = s * bb, t[2] = -s * n[0];
-    b[0] = bb, b[1] = s + n[1] * n[1] * a, b[2] = -n[1];
 }
 
 typedef struct dg_recv {
@@ -98,7 +76,7 @@ static void recv_setup(const dg_ctx *c, size_t i, dg_recv *r)
         r->p[k] = rc->position[k];
         r->n[k] = r->sphere ? (k == 2) : rc->normal[k] / l;
     }
-    onb(r->n, r->t, r->b);
+    bk_onb(r->n, r->t, r->b);
     if (r->sphere) memcpy(r->o, rc->position, sizeof r->o);
     else bk_offset_ray_origin_scaled(rc->position, rc->normal, c->scene_scale, r->o);
 }
@@ -112,7 +90,7 @@ typedef struct dg_acc {
 static void acc_add(dg_acc *a, const double d[3], double cs, const double L[3], const double Ld[3], double w)
 {
     double y[9];
-    sh9_basis(d, y);
+    bk_sh9_basis_d(d, y);
     for (int c = 0; c < 3; c++) {
         a->e[c] += L[c] * w * cs;
         for (int k = 0; k < 9; k++) a->sh[c][k] += L[c] * w * y[k];
@@ -268,7 +246,7 @@ static void beyond(const dg_ctx *c, const float o[3], const double d[3], int hit
 {
     L[0] = L[1] = L[2] = Ld[0] = Ld[1] = Ld[2] = 0;
     if (!hit) {
-        if (c->in->use_sky) bk_door_sky(c->in->scene, d, L);
+        if (c->in->use_sky) bk_sky_radiance(c->in->scene, d, L);
         memcpy(Ld, L, 3 * sizeof *L);
         return;
     }
@@ -313,7 +291,7 @@ static int punctual_through(const dg_ctx *c, uint32_t li, const double p[3], con
                             const float o[3], double val[3], double dir[3], double *cs, uint64_t *rays)
 {
     double dist;
-    if (!bk_door_light_eval(&c->in->scene->lights[li], p, val, dir, &dist)) return 0;
+    if (!bk_light_eval(&c->in->scene->lights[li], p, val, dir, &dist)) return 0;
     *cs = sphere ? 1 : dot3(dir, n);
     if (!(*cs > 0)) return 0;
     if (!bk_portal_crosses(&c->in->portal, p, dir, isinf(dist) ? 1e30 : dist, NULL)) return 0;
@@ -367,7 +345,7 @@ static void stage0(dg_ctx *c, size_t begin, size_t end, int thread)
                 double pb = ((j / side) + bk_door_rng_next(&rng)) / side;
                 double d[3], w, L[3], Ld[3];
                 if (!portal_sample(c, r.o, r.n, r.sphere, pa, pb, d, &w, L, Ld, &rays)) continue;
-                if (!finite3(L)) continue;
+                if (!bk_finite3(L)) continue;
                 acc_add(&a, d, r.sphere ? 1 : dot3(d, r.n), L, Ld, w / N);
             }
             c->thread_portal[thread] += N;
@@ -399,7 +377,7 @@ static void door_bounce(const dg_ctx *c, const dg_surf *s, bk_door_rng *rng, dou
     }
     double d[3], w, Lp[3], Ld[3];
     double pa = bk_door_rng_next(rng), pb = bk_door_rng_next(rng);
-    if (portal_sample(c, s->yo, s->n, 0, pa, pb, d, &w, Lp, Ld, rays) && finite3(Lp)) {
+    if (portal_sample(c, s->yo, s->n, 0, pa, pb, d, &w, Lp, Ld, rays) && bk_finite3(Lp)) {
         double cs = dot3(d, s->n);
         for (int a = 0; a < 3; a++) e[a] += Lp[a] * w * cs;
     }
@@ -447,7 +425,7 @@ static void stage1(dg_ctx *c, size_t begin, size_t end, int thread)
             if (!surface_at(c, r.o, d, &h, &s)) continue;
             double L[3];
             door_bounce(c, &s, &rng, L, &rays);
-            if (!finite3(L) || !isfinite(wgt)) continue;
+            if (!bk_finite3(L) || !isfinite(wgt)) continue;
             acc_add(&a, d, r.sphere ? 1 : dot3(d, r.n), L, NULL, wgt);
         }
         acc_store(c, i, &a);

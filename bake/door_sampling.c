@@ -2,6 +2,8 @@
  * door_sampling.h and bake/SETS.md. */
 #include "bake/door_sampling.h"
 
+#include "bake/shading.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -42,7 +44,6 @@ static void cross3(const double a[3], const double b[3], double o[3])
     o[2] = a[0] * b[1] - a[1] * b[0];
 }
 static double len3(const double a[3]) { return sqrt(dot3(a, a)); }
-static double lum(const double c[3]) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
 
 /* ---- portal -------------------------------------------------------------------------------- */
 
@@ -114,76 +115,6 @@ double bk_portal_solid_angle(const bk_portal *p, const double x[3])
 
 /* ---- scene lookups ------------------------------------------------------------------------- */
 
-int bk_door_light_eval(const bk_light *l, const double p[3], double val[3], double dir[3], double *dist)
-{
-    double att;
-    if (l->type == BK_LIGHT_DIRECTIONAL) {
-        double dl[3] = {l->direction[0], l->direction[1], l->direction[2]};
-        double n = len3(dl);
-        if (!(n > 0) || !isfinite(n)) return 0;
-        for (int k = 0; k < 3; k++) dir[k] = -dl[k] / n;
-        *dist = INFINITY;
-        att = 1;
-    } else {
-        double d[3] = {l->position[0] - p[0], l->position[1] - p[1], l->position[2] - p[2]};
-        double d2 = dot3(d, d);
-        if (!(d2 > 0) || !isfinite(d2)) return 0;
-        double r = sqrt(d2);
-        for (int k = 0; k < 3; k++) dir[k] = d[k] / r;
-        *dist = r;
-        att = 1.0 / d2;
-        if (l->range > 0) {
-            double q = r / l->range, w = 1 - q * q * q * q;
-            if (w <= 0) return 0;
-            att *= w > 1 ? 1 : w;
-        }
-        if (l->type == BK_LIGHT_SPOT) {
-            double dl[3] = {l->direction[0], l->direction[1], l->direction[2]};
-            double ln = len3(dl);
-            if (!(ln > 0)) return 0;
-            double cd = -dot3(dir, dl) / ln;
-            double co = cos(l->outer_cone), ci = cos(l->inner_cone);
-            double t = (cd - co) / fmax(0.001, ci - co);
-            t = t < 0 ? 0 : t > 1 ? 1 : t;
-            att *= t * t;
-            if (att <= 0) return 0;
-        }
-    }
-    for (int k = 0; k < 3; k++) val[k] = (isfinite(l->color[k]) && l->color[k] > 0 ? l->color[k] : 0) * att;
-    return isfinite(val[0]) && isfinite(val[1]) && isfinite(val[2]) && (val[0] > 0 || val[1] > 0 || val[2] > 0);
-}
-
-static void sample_image(const bk_image *img, double u, double v, double out[3])
-{
-    if (!img || !img->rgba || img->width <= 0 || img->height <= 0 || !isfinite(u) || !isfinite(v)) {
-        out[0] = out[1] = out[2] = 1;
-        return;
-    }
-    double fu = u - floor(u), fv = v - floor(v);
-    long x = (long)(fu * img->width), y = (long)(fv * img->height);
-    if (x >= img->width) x = img->width - 1;
-    if (y >= img->height) y = img->height - 1;
-    const float *q = img->rgba + 4 * ((size_t)y * (size_t)img->width + (size_t)x);
-    for (int k = 0; k < 3; k++) out[k] = isfinite(q[k]) && q[k] > 0 ? q[k] : 0;
-}
-
-static const bk_image *image_at(const bk_scene *s, int idx)
-{
-    return (idx >= 0 && (size_t)idx < s->image_count) ? &s->images[idx] : NULL;
-}
-
-void bk_door_sky(const bk_scene *s, const double d[3], double out[3])
-{
-    const bk_image *img = image_at(s, s->sky_image);
-    if (s->sky_image >= 0 && img && img->rgba) {
-        double u = 0.5 + atan2(d[0], -d[2]) / (2 * DS_PI);
-        double y = d[1] < -1 ? -1 : d[1] > 1 ? 1 : d[1];
-        sample_image(img, u, acos(y) / DS_PI, out);
-        return;
-    }
-    for (int k = 0; k < 3; k++) out[k] = isfinite(s->sky[k]) && s->sky[k] > 0 ? s->sky[k] : 0;
-}
-
 void bk_door_surface(const bk_scene *s, uint32_t tri, double u, double v, const char *light_set, double albedo[3],
                      double emission[3])
 {
@@ -192,31 +123,13 @@ void bk_door_surface(const bk_scene *s, uint32_t tri, double u, double v, const 
     uint32_t mi = s->tri_material ? s->tri_material[tri] : 0;
     if (mi >= s->material_count) return;
     const bk_material *m = &s->materials[mi];
-    double uv[2] = {0, 0};
-    if (s->uv0) {
-        const uint32_t *ix = s->tris + 3 * (size_t)tri;
-        for (int k = 0; k < 2; k++) {
-            double t0 = ix[0] < s->vertex_count ? s->uv0[2 * (size_t)ix[0] + k] : 0;
-            double t1 = ix[1] < s->vertex_count ? s->uv0[2 * (size_t)ix[1] + k] : 0;
-            double t2 = ix[2] < s->vertex_count ? s->uv0[2 * (size_t)ix[2] + k] : 0;
-            uv[k] = (1 - u - v) * t0 + u * t1 + v * t2;
-        }
-    }
-    double ta[3] = {1, 1, 1}, te[3] = {1, 1, 1};
-    if (m->albedo_tex >= 0) sample_image(image_at(s, m->albedo_tex), uv[0], uv[1], ta);
-    for (int k = 0; k < 3; k++) {
-        double a = m->albedo[k] * ta[k];
-        albedo[k] = isfinite(a) ? (a < 0 ? 0 : a > 0.999 ? 0.999 : a) : 0;
-    }
+    double uv[2];
+    bk_tri_uv0(s, tri, u, v, uv);
+    bk_material_albedo(s, m, uv, albedo);
     uint32_t oi = s->tri_object ? s->tri_object[tri] : UINT32_MAX;
     const char *set = oi < s->object_count ? s->objects[oi].light_set : "";
     if (strncmp(set, light_set ? light_set : "", 63)) return;
-    if (m->emission[0] <= 0 && m->emission[1] <= 0 && m->emission[2] <= 0) return;
-    if (m->emission_tex >= 0) sample_image(image_at(s, m->emission_tex), uv[0], uv[1], te);
-    for (int k = 0; k < 3; k++) {
-        double e = m->emission[k] * te[k];
-        emission[k] = isfinite(e) && e > 0 ? e : 0;
-    }
+    bk_material_emission(s, m, uv, emission);
 }
 
 lbk_result bk_door_emitters_build(const bk_scene *s, const bk_tracer *t, const char *light_set, bk_door_emitters *out)
@@ -229,7 +142,7 @@ lbk_result bk_door_emitters_build(const bk_scene *s, const bk_tracer *t, const c
         uint32_t mi = s->tri_material ? s->tri_material[i] : 0;
         if (mi >= s->material_count) continue;
         double f[3] = {s->materials[mi].emission[0], s->materials[mi].emission[1], s->materials[mi].emission[2]};
-        if ((e[0] > 0 || e[1] > 0 || e[2] > 0 || s->materials[mi].emission_tex >= 0) && lum(f) > 0 &&
+        if ((e[0] > 0 || e[1] > 0 || e[2] > 0 || s->materials[mi].emission_tex >= 0) && bk_lum(f) > 0 &&
             bk_tracer_tri_area(t, (uint32_t)i) > 0) {
             /* in the set (e is non-zero only then, unless the texture is black at the centroid) */
             uint32_t oi = s->tri_object ? s->tri_object[i] : UINT32_MAX;
@@ -252,7 +165,7 @@ lbk_result bk_door_emitters_build(const bk_scene *s, const bk_tracer *t, const c
         const char *set = oi < s->object_count ? s->objects[oi].light_set : "";
         if (strncmp(set, light_set ? light_set : "", 63)) continue;
         double f[3] = {s->materials[mi].emission[0], s->materials[mi].emission[1], s->materials[mi].emission[2]};
-        double p = bk_tracer_tri_area(t, (uint32_t)i) * lum(f);
+        double p = bk_tracer_tri_area(t, (uint32_t)i) * bk_lum(f);
         if (!(p > 0) || !isfinite(p)) continue;
         run += p;
         out->tri[out->count] = (uint32_t)i;
@@ -338,7 +251,7 @@ lbk_result bk_shoot_shadow_photons(const bk_scene *scene, const bk_tracer *trace
         double scale = (double)sources * portal->area / (double)count; /* 1 / (p_source · p_point · N) */
         if (pick < nl) {
             double val[3], dir[3], dist;
-            if (!bk_door_light_eval(&scene->lights[lights[pick]], q, val, dir, &dist)) continue;
+            if (!bk_light_eval(&scene->lights[lights[pick]], q, val, dir, &dist)) continue;
             float df[3], tmax;
             if (isinf(dist)) {
                 for (int c = 0; c < 3; c++) df[c] = (float)dir[c];
@@ -349,7 +262,7 @@ lbk_result bk_shoot_shadow_photons(const bk_scene *scene, const bk_tracer *trace
             }
             if (bk_tracer_occluded(tracer, qf, df, 0.0f, tmax)) continue;
             double back[3] = {-dir[0], -dir[1], -dir[2]};
-            float w = (float)(lum(val) * fabs(dot3(dir, portal->n)) * scale);
+            float w = (float)(bk_lum(val) * fabs(dot3(dir, portal->n)) * scale);
             if (land(scene, tracer, q, back, w, lights[pick], &ph[k])) k++;
         } else if (pick == nl && sky) {
             /* a uniform direction on the sphere, the sky seen along it */
@@ -358,9 +271,9 @@ lbk_result bk_shoot_shadow_photons(const bk_scene *scene, const bk_tracer *trace
             float df[3] = {(float)d[0], (float)d[1], (float)d[2]};
             if (bk_tracer_occluded(tracer, qf, df, 0.0f, INFINITY)) continue;
             double L[3];
-            bk_door_sky(scene, d, L);
+            bk_sky_radiance(scene, d, L);
             double back[3] = {-d[0], -d[1], -d[2]};
-            float w = (float)(lum(L) * fabs(dot3(d, portal->n)) * 4 * DS_PI * scale);
+            float w = (float)(bk_lum(L) * fabs(dot3(d, portal->n)) * 4 * DS_PI * scale);
             if (land(scene, tracer, q, back, w, BK_SOURCE_SKY, &ph[k])) k++;
         } else {
             double u = bk_door_rng_next(&rng);
@@ -387,10 +300,10 @@ lbk_result bk_shoot_shadow_photons(const bk_scene *scene, const bk_tracer *trace
             if (bk_tracer_occluded(tracer, qf, df, 0.0f, 1.0f - 1e-4f)) continue;
             double f[3] = {scene->materials[mi].emission[0], scene->materials[mi].emission[1],
                            scene->materials[mi].emission[2]};
-            double parea = lum(f) / em.power; /* density per unit area of the point */
+            double parea = bk_lum(f) / em.power; /* density per unit area of the point */
             if (!(parea > 0)) continue;
             double back[3] = {-dir[0], -dir[1], -dir[2]};
-            float w = (float)(lum(le) * fabs(ce) * fabs(dot3(dir, portal->n)) / (dist * dist) / parea * scale);
+            float w = (float)(bk_lum(le) * fabs(ce) * fabs(dot3(dir, portal->n)) / (dist * dist) / parea * scale);
             if (land(scene, tracer, q, back, w, BK_SOURCE_EMITTERS, &ph[k])) k++;
         }
     }

@@ -42,14 +42,12 @@ typedef struct bk_door_rng { uint64_t s; } bk_door_rng;
 bk_door_rng bk_door_rng_make(uint64_t seed, uint64_t domain, uint64_t a, uint64_t b);
 double bk_door_rng_next(bk_door_rng *r);
 
-/* A punctual light at p (KHR_lights_punctual falloff, range window, smooth spot cone, as
- * transport.c): irradiance at normal incidence val, unit direction towards the light, distance
- * (INFINITY for directional). 0 when it cannot contribute. */
-int bk_door_light_eval(const bk_light *l, const double p[3], double val[3], double dir[3], double *dist);
-/* Sky radiance along unit d (uniform or the equirectangular image, transport.c's mapping). */
-void bk_door_sky(const bk_scene *s, const double d[3], double out[3]);
+/* Punctual lights and the sky are evaluated by bake/shading.h (bk_light_eval, bk_sky_radiance),
+ * the very functions the transport uses, so both estimators see the same lights. */
+
 /* Albedo (clamped to ≤ 0.999) and emitted radiance (0 unless the triangle's object is in
- * light_set; NULL = "" the base) of triangle tri at barycentrics (u, v), textures by uv0. */
+ * light_set; NULL = "" the base) of triangle tri at barycentrics (u, v), textures by uv0 (the
+ * material lookups of bake/shading.h). */
 void bk_door_surface(const bk_scene *s, uint32_t tri, double u, double v, const char *light_set, double albedo[3],
                      double emission[3]);
 /* Emissive triangles of light_set picked by power (area × luminance of the emission factor). */
