@@ -295,17 +295,8 @@ static int punctual_through(const dg_ctx *c, uint32_t li, const double p[3], con
     *cs = sphere ? 1 : dot3(dir, n);
     if (!(*cs > 0)) return 0;
     if (!bk_portal_crosses(&c->in->portal, p, dir, isinf(dist) ? 1e30 : dist, NULL)) return 0;
-    float df[3];
-    float tmax;
-    if (isinf(dist)) {
-        for (int k = 0; k < 3; k++) df[k] = (float)dir[k];
-        tmax = INFINITY;
-    } else {
-        for (int k = 0; k < 3; k++) df[k] = (float)(dir[k] * dist);
-        tmax = 1.0f - 1e-5f;
-    }
     (*rays)++;
-    return !bk_tracer_occluded(c->in->tracer, o, df, 0.0f, tmax);
+    return bk_light_visible(c->in->tracer, o, dir, dist);
 }
 
 /* ---- stage 0: light straight through the door --------------------------------------------------- */

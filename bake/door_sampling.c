@@ -252,15 +252,7 @@ lbk_result bk_shoot_shadow_photons(const bk_scene *scene, const bk_tracer *trace
         if (pick < nl) {
             double val[3], dir[3], dist;
             if (!bk_light_eval(&scene->lights[lights[pick]], q, val, dir, &dist)) continue;
-            float df[3], tmax;
-            if (isinf(dist)) {
-                for (int c = 0; c < 3; c++) df[c] = (float)dir[c];
-                tmax = INFINITY;
-            } else {
-                for (int c = 0; c < 3; c++) df[c] = (float)(dir[c] * dist);
-                tmax = 1.0f - 1e-5f;
-            }
-            if (bk_tracer_occluded(tracer, qf, df, 0.0f, tmax)) continue;
+            if (!bk_light_visible(tracer, qf, dir, dist)) continue;
             double back[3] = {-dir[0], -dir[1], -dir[2]};
             float w = (float)(bk_lum(val) * fabs(dot3(dir, portal->n)) * scale);
             if (land(scene, tracer, q, back, w, lights[pick], &ph[k])) k++;

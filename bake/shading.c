@@ -113,3 +113,17 @@ int bk_light_eval(const bk_light *l, const double p[3], double val[3], double di
     if (!bk_finite3(val) || (val[0] <= 0 && val[1] <= 0 && val[2] <= 0)) return 0;
     return 1;
 }
+
+int bk_light_visible(const bk_tracer *t, const float org[3], const double dir[3], double dist)
+{
+    float d[3];
+    float tmax;
+    if (isinf(dist)) {
+        for (int k = 0; k < 3; k++) d[k] = (float)dir[k];
+        tmax = INFINITY;
+    } else {
+        for (int k = 0; k < 3; k++) d[k] = (float)(dir[k] * dist);
+        tmax = 1.0f - 1e-5f;
+    }
+    return !bk_tracer_occluded(t, org, d, 0.0f, tmax);
+}

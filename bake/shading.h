@@ -10,6 +10,7 @@
 #include <stdint.h>
 
 #include "bake/scene.h"
+#include "bake/tracer.h"
 
 #define BK_PI 3.14159265358979323846
 
@@ -61,5 +62,9 @@ void bk_sky_radiance(const bk_scene *s, const double d[3], double out[3]);
  * square falloff, range window, smooth spot cone), the unit direction towards the light and its
  * distance (INFINITY for directional). Returns 0 when the light cannot contribute. */
 int bk_light_eval(const bk_light *l, const double p[3], double val[3], double dir[3], double *dist);
+/* 1 when nothing in t blocks the shadow ray from org towards a light that bk_light_eval placed
+ * along unit dir at dist (INFINITY: directional). A point light is aimed at itself from the
+ * offset origin and the ray stops just short of it. */
+int bk_light_visible(const bk_tracer *t, const float org[3], const double dir[3], double dist);
 
 #endif

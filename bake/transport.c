@@ -258,21 +258,6 @@ static int in_light_set(const tp_ctx *c, const char *set)
     return strncmp(set, want, 63) == 0;
 }
 
-static int light_visible(const tp_ctx *c, const float org[3], const double dir[3], double dist)
-{
-    float d[3];
-    float tmax;
-    if (isinf(dist)) {
-        for (int k = 0; k < 3; k++) d[k] = (float)dir[k];
-        tmax = INFINITY;
-    } else {
-        /* aim at the light itself from the offset origin; stop just short of it */
-        for (int k = 0; k < 3; k++) d[k] = (float)(dir[k] * dist);
-        tmax = 1.0f - 1e-5f;
-    }
-    return !bk_tracer_occluded(c->tracer, org, d, 0.0f, tmax);
-}
-
 /* Cell reached by a hit, or -1 when the hit side carries no radiance (back of a one-sided
  * surface). */
 static long hit_cell(const tp_ctx *c, const bk_hit *h)
@@ -560,7 +545,7 @@ static void cache_bounce(tp_ctx *c, size_t begin, size_t end, int thread)
                         double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
                         if (cs <= 0) continue;
                         shadow++;
-                        if (!light_visible(c, o, ld, dist)) continue;
+                        if (!bk_light_visible(c->tracer, o, ld, dist)) continue;
                         for (int a = 0; a < 3; a++) ep[a] += val[a] * cs;
                     }
                 }
@@ -684,7 +669,7 @@ static void recv_punctual(tp_ctx *c, size_t begin, size_t end, int thread)
             double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
             if (!sphere && cs <= 0) continue;
             rays++;
-            if (!light_visible(c, o, ld, dist)) continue;
+            if (!bk_light_visible(c->tracer, o, ld, dist)) continue;
             double y[9];
             bk_sh9_basis_d(ld, y);
             for (int a = 0; a < 3; a++) {
