@@ -1,11 +1,10 @@
 /* The guided door estimator; see door_guided.h and bake/SETS.md. */
 #include "bake/door_guided.h"
 
+#include "bake/parallel.h"
 #include "bake/shading.h"
 
 #include <math.h>
-#include <pthread.h>
-#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -458,42 +457,21 @@ static void stage_bounce(dg_ctx *c, size_t begin, size_t end, int thread)
     c->thread_rays[thread] += rays;
 }
 
-/* ---- parallel-for (as transport.c: items independent, results independent of threads) ------- */
+/* ---- parallel-for (bake/parallel.h: items independent, results independent of threads) ----- */
 
 typedef void (*dg_fn)(dg_ctx *c, size_t begin, size_t end, int thread);
-typedef struct dg_job { dg_ctx *c; dg_fn fn; size_t end, chunk; atomic_size_t next; } dg_job;
-typedef struct dg_worker { dg_job *job; int thread; } dg_worker;
+typedef struct dg_call { dg_ctx *c; dg_fn fn; } dg_call;
 
-static void *worker_main(void *arg)
+static void dg_call_run(void *user, size_t begin, size_t end, int thread)
 {
-    dg_worker *w = arg;
-    for (;;) {
-        size_t b = atomic_fetch_add(&w->job->next, w->job->chunk);
-        if (b >= w->job->end) break;
-        size_t e = b + w->job->chunk < w->job->end ? b + w->job->chunk : w->job->end;
-        w->job->fn(w->job->c, b, e, w->thread);
-    }
-    return NULL;
+    const dg_call *k = user;
+    k->fn(k->c, begin, end, thread);
 }
 
 static void parallel_for(dg_ctx *c, size_t n, dg_fn fn)
 {
-    if (!n) return;
-    dg_job job;
-    job.c = c, job.fn = fn, job.end = n, job.chunk = 16;
-    atomic_init(&job.next, 0);
-    int t = c->threads;
-    pthread_t tids[256];
-    dg_worker ws[256];
-    int started = 0;
-    for (int i = 1; i < t && i < 256; i++) {
-        ws[i].job = &job, ws[i].thread = i;
-        if (pthread_create(&tids[i], NULL, worker_main, &ws[i]) != 0) break;
-        started = i;
-    }
-    ws[0].job = &job, ws[0].thread = 0;
-    worker_main(&ws[0]);
-    for (int i = 1; i <= started; i++) pthread_join(tids[i], NULL);
+    dg_call k = {c, fn};
+    bk_parallel_chunks(0, n, 16, c->threads, dg_call_run, &k);
 }
 
 static double now_seconds(void)

@@ -1,11 +1,10 @@
 /* Series-expansion light transport; see transport.h and TRANSPORT.md. */
 #include "transport.h"
 
+#include "parallel.h"
 #include "shading.h"
 
 #include <math.h>
-#include <pthread.h>
-#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -185,52 +184,18 @@ typedef struct tp_ctx {
 
 typedef void (*tp_fn)(tp_ctx *c, size_t begin, size_t end, int thread);
 
-typedef struct tp_job {
-    tp_ctx *c;
-    tp_fn fn;
-    size_t end, chunk;
-    atomic_size_t next;
-} tp_job;
+typedef struct tp_call { tp_ctx *c; tp_fn fn; } tp_call;
 
-typedef struct tp_worker { tp_job *job; int thread; } tp_worker;
-
-static void *worker_main(void *arg)
+static void tp_call_run(void *user, size_t begin, size_t end, int thread)
 {
-    tp_worker *w = (tp_worker *)arg;
-    tp_job *j = w->job;
-    for (;;) {
-        size_t b = atomic_fetch_add(&j->next, j->chunk);
-        if (b >= j->end) break;
-        size_t e = b + j->chunk < j->end ? b + j->chunk : j->end;
-        j->fn(j->c, b, e, w->thread);
-    }
-    return NULL;
+    const tp_call *k = (const tp_call *)user;
+    k->fn(k->c, begin, end, thread);
 }
 
-/* Which thread runs an item never changes its result: items are independent and write only
- * their own outputs, so dynamic chunking is deterministic. */
 static void parallel_range(tp_ctx *c, size_t begin, size_t end, size_t chunk, tp_fn fn)
 {
-    if (end <= begin) return;
-    size_t n = end - begin;
-    tp_job job;
-    job.c = c; job.fn = fn; job.end = end; job.chunk = chunk ? chunk : 1;
-    atomic_init(&job.next, begin);
-    int t = c->threads;
-    if ((size_t)t > (n + job.chunk - 1) / job.chunk) t = (int)((n + job.chunk - 1) / job.chunk);
-    if (t < 1) t = 1;
-    /* one pthread per worker and call: a call is at least a whole bounce or receiver block */
-    pthread_t tids[256];
-    tp_worker ws[256];
-    int started = 0;
-    for (int i = 1; i < t && i < 256; i++) {
-        ws[i].job = &job; ws[i].thread = i;
-        if (pthread_create(&tids[i], NULL, worker_main, &ws[i]) != 0) break;
-        started = i;
-    }
-    ws[0].job = &job; ws[0].thread = 0;
-    worker_main(&ws[0]);
-    for (int i = 1; i <= started; i++) pthread_join(tids[i], NULL);
+    tp_call k = {c, fn};
+    bk_parallel_chunks(begin, end, chunk, c->threads, tp_call_run, &k);
 }
 
 static void parallel_for(tp_ctx *c, size_t n, size_t chunk, tp_fn fn) { parallel_range(c, 0, n, chunk, fn); }
