@@ -209,6 +209,17 @@ static size_t facet_point_ids(qhT *qh, facetT *facet, uint32_t *ids, size_t cap)
     return n;
 }
 
+/* Grows the four per-facet scratch buffers to cap entries together (a huge cospherical cell).
+ * 0 when out of memory; every pointer stays valid (grown or not) for the caller to free. */
+static int scratch_grow(size_t cap, uint32_t **ids, uint32_t **nids, uint32_t **common, angle_item **scratch)
+{
+    uint32_t *a = realloc(*ids, cap * sizeof *a); if (a) *ids = a;
+    uint32_t *b = realloc(*nids, cap * sizeof *b); if (b) *nids = b;
+    uint32_t *c = realloc(*common, cap * sizeof *c); if (c) *common = c;
+    angle_item *s = realloc(*scratch, cap * sizeof *s); if (s) *scratch = s;
+    return a && b && c && s;
+}
+
 static int run_qhull(const double *pts, size_t n, tet_list *out)
 {
     int status = BK_DELAUNAY_OK;
@@ -237,11 +248,7 @@ static int run_qhull(const double *pts, size_t n, tet_list *out)
         size_t k = facet_point_ids(qh, facet, ids, cap);
         if (k > cap) {  /* a huge cospherical cell: grow the scratch buffers and retry */
             cap = k;
-            uint32_t *a = realloc(ids, cap * sizeof *a); if (a) ids = a;
-            uint32_t *b = realloc(nids, cap * sizeof *b); if (b) nids = b;
-            uint32_t *c = realloc(common, cap * sizeof *c); if (c) common = c;
-            angle_item *s = realloc(scratch, cap * sizeof *s); if (s) scratch = s;
-            if (!a || !b || !c || !s) { status = BK_DELAUNAY_NO_MEMORY; goto freeqh; }
+            if (!scratch_grow(cap, &ids, &nids, &common, &scratch)) { status = BK_DELAUNAY_NO_MEMORY; goto freeqh; }
             k = facet_point_ids(qh, facet, ids, cap);
         }
         if (k < 4 || ids[k - 1] >= n) continue;  /* the point at infinity ('Qz') */
@@ -251,11 +258,7 @@ static int run_qhull(const double *pts, size_t n, tet_list *out)
             size_t m = facet_point_ids(qh, neighbor, nids, cap);
             if (m > cap) {
                 cap = m;
-                uint32_t *a = realloc(ids, cap * sizeof *a); if (a) ids = a;
-                uint32_t *b = realloc(nids, cap * sizeof *b); if (b) nids = b;
-                uint32_t *c = realloc(common, cap * sizeof *c); if (c) common = c;
-                angle_item *s = realloc(scratch, cap * sizeof *s); if (s) scratch = s;
-                if (!a || !b || !c || !s) { status = BK_DELAUNAY_NO_MEMORY; goto freeqh; }
+                if (!scratch_grow(cap, &ids, &nids, &common, &scratch)) { status = BK_DELAUNAY_NO_MEMORY; goto freeqh; }
                 k = facet_point_ids(qh, facet, ids, cap);
                 m = facet_point_ids(qh, neighbor, nids, cap);
             }
