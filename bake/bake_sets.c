@@ -658,24 +658,33 @@ static void sh_add(lbk_sh9_rgb *dst, const lbk_sh9_rgb *b, size_t n)
             for (int k = 0; k < 9; k++) dst[i].c[c][k] += b[i].c[c][k];
 }
 
+/* The scene with one or two doors removed (door2 may be NULL) and its own tracer; on success the
+ * caller destroys *tr and frees *fs. */
+static int open_without(const bk_set_inputs *in, const char *door, const char *door2, filtered_scene *fs,
+                        bk_tracer **tr, char *err, size_t err_len)
+{
+    if (scene_without_doors(in->scene, door, door2, fs)) {
+        snprintf(err, err_len, "out of memory");
+        return LBK_EXIT_INTERNAL;
+    }
+    lbk_result r = bk_tracer_create(&fs->scene, in->transport.threads, tr);
+    if (r) {
+        filtered_free(fs);
+        snprintf(err, err_len, "ray tracer without door '%s': %s", door, lbk_result_message(r));
+        return LBK_EXIT_INTERNAL;
+    }
+    return 0;
+}
+
 /* A run over the scene with one or two doors removed (its own tracer). */
 static int run_without(run_ctx *rc, const char *door, const char *door2, const bk_transport_options *opt,
                        lbk_sh9_rgb *rad, lbk_sh9_rgb *dir, const char *what, char *err, size_t err_len)
 {
-    const bk_set_inputs *in = rc->in;
     filtered_scene fs;
-    if (scene_without_doors(in->scene, door, door2, &fs)) {
-        snprintf(err, err_len, "out of memory");
-        return LBK_EXIT_INTERNAL;
-    }
     bk_tracer *tr = NULL;
-    lbk_result r = bk_tracer_create(&fs.scene, in->transport.threads, &tr);
-    if (r) {
-        filtered_free(&fs);
-        snprintf(err, err_len, "ray tracer without door '%s': %s", door, lbk_result_message(r));
-        return LBK_EXIT_INTERNAL;
-    }
-    int code = run_one(rc, &fs.scene, tr, opt, rad, dir, what, err, err_len);
+    int code = open_without(rc->in, door, door2, &fs, &tr, err, err_len);
+    if (code) return code;
+    code = run_one(rc, &fs.scene, tr, opt, rad, dir, what, err, err_len);
     bk_tracer_destroy(tr);
     filtered_free(&fs);
     return code;
@@ -687,17 +696,9 @@ static int guided_open(run_ctx *rc, const bs_door *d, const float *texel_size, c
 {
     const bk_set_inputs *in = rc->in;
     filtered_scene fs;
-    if (scene_without_doors(in->scene, d->name, NULL, &fs)) {
-        snprintf(err, err_len, "out of memory");
-        return LBK_EXIT_INTERNAL;
-    }
     bk_tracer *tr = NULL;
-    lbk_result r = bk_tracer_create(&fs.scene, in->transport.threads, &tr);
-    if (r) {
-        filtered_free(&fs);
-        snprintf(err, err_len, "ray tracer without door '%s': %s", d->name, lbk_result_message(r));
-        return LBK_EXIT_INTERNAL;
-    }
+    int code = open_without(in, d->name, NULL, &fs, &tr, err, err_len);
+    if (code) return code;
     bk_door_guided_inputs gi;
     memset(&gi, 0, sizeof gi);
     gi.scene = &fs.scene;
@@ -716,7 +717,7 @@ static int guided_open(run_ctx *rc, const bs_door *d, const float *texel_size, c
     gi.samples = (int)fmin(fmax(spp, 16), 4096);
     gi.use_sky = !in->transport.no_sky;
     bk_door_guided_stats st;
-    r = bk_door_guided_run(&gi, rad, dir, &st, NULL);
+    lbk_result r = bk_door_guided_run(&gi, rad, dir, &st, NULL);
     bk_tracer_destroy(tr);
     filtered_free(&fs);
     rc->run++;
