@@ -111,10 +111,10 @@ int lbk_cmd_bake(int argc, char **argv)
             NEED_NUMBER(1, 1000);
             o.max_bounces = (int)d;
         } else if (!strcmp(a, "--texel-density")) {
-            NEED_NUMBER(1e-3, 1e4);
+            NEED_NUMBER(1e-6, 1e7);
             o.texel_density = (float)d;
         } else if (!strcmp(a, "--glg-spacing")) {
-            NEED_NUMBER(0.01, 1e5);
+            NEED_NUMBER(1e-6, 1e6);
             o.glg_spacing = (float)d;
         } else if (!strcmp(a, "--sky")) {
             NEED_VALUE;
