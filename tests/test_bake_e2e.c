@@ -260,6 +260,20 @@ static void test_no_light_is_refused(void **state)
     assert_int_not_equal(access(out, F_OK), 0);
 }
 
+/* A missing input is an I/O error (exit 3), not an unusable scene; nothing is written. */
+static void test_missing_input_is_io_error(void **state)
+{
+    (void)state;
+    char out[512], err[512] = "";
+    snprintf(out, sizeof out, "%s/missing.lbk", tmpdir);
+    bk_bake_options o;
+    test_options(&o, "/nonexistent/level.glb", out);
+    bk_bake_summary sum;
+    assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), LBK_EXIT_IO);
+    assert_non_null(strstr(err, "/nonexistent/level.glb"));
+    assert_int_not_equal(access(out, F_OK), 0);
+}
+
 /* --target-error: a loose target stops after the first pass, and the stored report and the
  * JSON report both carry the error-against-work samples. */
 static void test_target_error_and_reports(void **state)
@@ -511,6 +525,7 @@ int main(void)
         cmocka_unit_test(test_water_bottle_draco),
         cmocka_unit_test(test_deterministic_across_threads),
         cmocka_unit_test(test_no_light_is_refused),
+        cmocka_unit_test(test_missing_input_is_io_error),
         cmocka_unit_test(test_target_error_and_reports),
         cmocka_unit_test(test_time_limit),
         cmocka_unit_test(test_octahedral_probes),
