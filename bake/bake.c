@@ -83,7 +83,9 @@ typedef struct bake {
     double phase_start;
     bk_set_bakes sets;              /* dynamic light sets and doors (bake_sets.c) */
     float origin[3];                /* world position of the bake frame's origin (recentre()) */
-    uint64_t saturated, flushed;    /* texel channels outside the R11G11B10F range */
+    uint64_t saturated, flushed;    /* texel channels outside the R11G11B10F range (stored units) */
+    float scale[3];                 /* LMAP, GLG, LLG scales (spec §5.7); DLS payloads use them */
+    float octp_scale;
 } bake;
 
 static int fail(bake *b, int code, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
@@ -470,18 +472,24 @@ static lbk_result build_lmap(bake *b, section_list *sl)
         bk_texel_linear(&tx->receivers[ti], &b->radiance[k], &lin[ti]);
         has[ti] = 1;
     }
-    bk_count_out_of_range(lin, has, nt, &b->saturated, &b->flushed);
+    /* the scale puts the brightest texel (base or any light set) at 2^13..2^14 stored */
+    double set_max[3];
+    bk_set_bakes_max(&b->sets, set_max);
+    const float scale = b->scale[0] = bk_scale_for(fmax(bk_texel_max(lin, has, nt), set_max[0]));
+    const float inv = 1.0f / scale;
+    bk_count_out_of_range(lin, has, nt, inv, &b->saturated, &b->flushed);
     if (b->saturated)
         bk_progress_note(b->progress,
-                         "lbk bake: warning: %llu texel channels exceed 65024 lx, the largest R11G11B10F value, "
-                         "and are stored saturated: the light intensities are too high for the format",
-                         (unsigned long long)b->saturated);
+                         "lbk bake: warning: %llu texel channels exceed 65024 times the lightmap scale %g, the "
+                         "largest R11G11B10F value, and are stored saturated",
+                         (unsigned long long)b->saturated, (double)scale);
     if (b->flushed)
         bk_progress_note(b->progress,
-                         "lbk bake: warning: %llu lit texel channels are below 2^-21 lx and are stored as 0: "
-                         "the light intensities are too low for the format",
-                         (unsigned long long)b->flushed);
-    r = bk_encode_pages(tx, b->atlas.margin, lin, has, pages);
+                         "lbk bake: warning: %llu lit texel channels are below 2^-21 times the lightmap scale %g "
+                         "and are stored as 0: the level's irradiance spans more than the format's range "
+                         "(~7e10) within one lightmap",
+                         (unsigned long long)b->flushed, (double)scale);
+    r = bk_encode_pages(tx, b->atlas.margin, lin, has, inv, pages);
     if (r) goto done;
     for (size_t p = 0; p < tx->page_count; p++) {
         desc[p].width = (uint32_t)tx->pages[p].width;
@@ -490,7 +498,7 @@ static lbk_result build_lmap(bake *b, section_list *sl)
     }
     void *data;
     size_t size;
-    r = lbk_lmap_build(desc, (uint32_t)tx->page_count, NULL, &data, &size);
+    r = lbk_lmap_build(desc, (uint32_t)tx->page_count, scale, NULL, &data, &size);
     r = sections_add(sl, LBK_SECTION_LMAP, r, data, size);
 done:
     if (pages)
@@ -518,6 +526,9 @@ static lbk_result build_glg(bake *b, section_list *sl)
     d.tetras = (const uint32_t(*)[4])b->glg.tets;
     d.adjacency = (const uint32_t(*)[4])b->glg.neighbours;
     d.visibility = (const uint8_t(*)[4])vis;
+    double set_max[3];
+    bk_set_bakes_max(&b->sets, set_max);
+    d.scale = b->scale[1] = bk_scale_for(fmax(bk_probe_max(d.probes, d.probe_count), set_max[1]));
     void *data;
     size_t size;
     lbk_result r = lbk_glg_build(&d, NULL, &data, &size);
@@ -543,7 +554,13 @@ static lbk_result build_octp(bake *b, section_list *sl)
     }
     void *data;
     size_t size;
-    lbk_result r = lbk_octp_build(p, (uint32_t)b->glg.probe_count, NULL, &data, &size);
+    double m = 0;
+    for (size_t i = 0; i < b->glg.probe_count; i++)
+        for (int t = 0; t < 16; t++)
+            for (int c = 0; c < 3; c++)
+                if (p[i].irradiance[t][c] > m && isfinite(p[i].irradiance[t][c])) m = p[i].irradiance[t][c];
+    b->octp_scale = bk_scale_for(m);
+    lbk_result r = lbk_octp_build(p, (uint32_t)b->glg.probe_count, b->octp_scale, NULL, &data, &size);
     free(p);
     return sections_add(sl, LBK_SECTION_OCTP, r, data, size);
 }
@@ -571,7 +588,10 @@ static lbk_result build_llg(bake *b, section_list *sl)
     }
     void *data;
     size_t size;
-    r = lbk_llg_build(g, (uint32_t)b->llg_count, NULL, &data, &size);
+    double set_max[3];
+    bk_set_bakes_max(&b->sets, set_max);
+    b->scale[2] = bk_scale_for(fmax(bk_probe_max(&b->radiance[b->llg_first], b->receiver_count - b->llg_first), set_max[2]));
+    r = lbk_llg_build(g, (uint32_t)b->llg_count, b->scale[2], NULL, &data, &size);
     r = sections_add(sl, LBK_SECTION_LLG, r, data, size);
 done:
     if (verts)
@@ -763,6 +783,7 @@ static int do_encode_and_write(bake *b, bk_bake_summary *sum)
     if (!r && b->sets.set_count) {
         bk_set_inputs in;
         set_inputs(b, &in);
+        memcpy(in.scale, b->scale, sizeof in.scale);
         void *dls = NULL, *door = NULL;
         size_t dls_size = 0, door_size = 0;
         r = bk_set_bakes_sections(&b->sets, &in, &dls, &dls_size, &door, &door_size);

@@ -37,7 +37,9 @@ typedef struct bs_set {
     /* results */
     uint64_t count[LBK_DLS_SPACE_COUNT_];
     uint32_t *targets[LBK_DLS_SPACE_COUNT_];
-    uint8_t *payloads[LBK_DLS_SPACE_COUNT_];
+    /* physical values, encoded with the base section's scale in bk_set_bakes_sections (the scale
+     * depends on every set, spec §12.2): texels lbk_ahd_linear, probes lbk_sh9_rgb */
+    uint8_t *values[LBK_DLS_SPACE_COUNT_];
     double threshold;              /* absolute luminance threshold used (lux) */
     uint32_t members[2];           /* kind 3: the member sets */
     uint32_t member_count;
@@ -368,7 +370,7 @@ static double probe_lum(const lbk_sh9_rgb *s)
 
 typedef struct bs_vec {
     uint32_t *targets;
-    uint8_t *payloads;
+    uint8_t *values;
     size_t count, cap, stride;
 } bs_vec;
 
@@ -379,13 +381,13 @@ static int vec_push(bs_vec *v, uint32_t target, const void *payload)
         uint32_t *t = realloc(v->targets, cap * sizeof *t);
         if (!t) return -1;
         v->targets = t;
-        uint8_t *p = realloc(v->payloads, cap * v->stride);
+        uint8_t *p = realloc(v->values, cap * v->stride);
         if (!p) return -1;
-        v->payloads = p;
+        v->values = p;
         v->cap = cap;
     }
     v->targets[v->count] = target;
-    memcpy(v->payloads + v->count * v->stride, payload, v->stride);
+    memcpy(v->values + v->count * v->stride, payload, v->stride);
     v->count++;
     return 0;
 }
@@ -461,8 +463,8 @@ static lbk_result emit_set(const bk_set_inputs *in, bs_set *st, const lbk_sh9_rg
     free(dl);
 
     lbk_result r = LBK_ERR_OUT_OF_MEMORY;
-    bs_vec tv = {NULL, NULL, 0, 0, LBK_DLS_TEXEL_PAYLOAD}, gv = {NULL, NULL, 0, 0, LBK_DLS_PROBE_PAYLOAD},
-           lv = {NULL, NULL, 0, 0, LBK_DLS_PROBE_PAYLOAD};
+    bs_vec tv = {NULL, NULL, 0, 0, sizeof(lbk_ahd_linear)}, gv = {NULL, NULL, 0, 0, sizeof(lbk_sh9_rgb)},
+           lv = {NULL, NULL, 0, 0, sizeof(lbk_sh9_rgb)};
     /* texels, page by page, dilated like the base (bk_encode_pages) so bilinear filtering at
      * chart borders sees the set's light in the gutter too */
     if (nt && tx->page_count) {
@@ -495,11 +497,7 @@ static lbk_result emit_set(const bk_set_inputs *in, bs_set *st, const lbk_sh9_rg
                 lin_ez(&l, ez);
                 double li = lum3(ez);
                 if (!(li > thr) || !(li > 0)) continue;
-                lbk_ahd_texel t;
-                lbk_ahd_from_linear(&l, &t);
-                uint8_t bytes[LBK_DLS_TEXEL_PAYLOAD];
-                lbk_ahd_texel_store(&t, bytes);
-                if (vec_push(&tv, (uint32_t)(tx->page_offset[p] + i), bytes)) {
+                if (vec_push(&tv, (uint32_t)(tx->page_offset[p] + i), &l)) {
                     free(data), free(mask), free(recv_of_texel);
                     goto done;
                 }
@@ -522,28 +520,26 @@ static lbk_result emit_set(const bk_set_inputs *in, bs_set *st, const lbk_sh9_rg
         sh_clamp(&s);
         double l = probe_lum(&s);
         if (!(l > thr) || !(l > 0)) continue;
-        uint8_t bytes[LBK_DLS_PROBE_PAYLOAD];
-        lbk_sh9_pack(&s, bytes);
         int bad;
         if (k >= in->glg_first && k < in->glg_first + in->glg_count)
-            bad = vec_push(&gv, (uint32_t)(k - in->glg_first), bytes);
+            bad = vec_push(&gv, (uint32_t)(k - in->glg_first), &s);
         else if (k >= in->llg_first && k < in->llg_first + in->llg_count)
-            bad = vec_push(&lv, (uint32_t)(k - in->llg_first), bytes);
+            bad = vec_push(&lv, (uint32_t)(k - in->llg_first), &s);
         else
             continue;
         if (bad) goto done;
     }
     st->count[LBK_DLS_SPACE_TEXEL] = tv.count, st->targets[LBK_DLS_SPACE_TEXEL] = tv.targets;
-    st->payloads[LBK_DLS_SPACE_TEXEL] = tv.payloads;
+    st->values[LBK_DLS_SPACE_TEXEL] = tv.values;
     st->count[LBK_DLS_SPACE_GLG] = gv.count, st->targets[LBK_DLS_SPACE_GLG] = gv.targets;
-    st->payloads[LBK_DLS_SPACE_GLG] = gv.payloads;
+    st->values[LBK_DLS_SPACE_GLG] = gv.values;
     st->count[LBK_DLS_SPACE_LLG] = lv.count, st->targets[LBK_DLS_SPACE_LLG] = lv.targets;
-    st->payloads[LBK_DLS_SPACE_LLG] = lv.payloads;
+    st->values[LBK_DLS_SPACE_LLG] = lv.values;
     tv.targets = gv.targets = lv.targets = NULL;
-    tv.payloads = gv.payloads = lv.payloads = NULL;
+    tv.values = gv.values = lv.values = NULL;
     r = LBK_OK;
 done:
-    free(tv.targets), free(tv.payloads), free(gv.targets), free(gv.payloads), free(lv.targets), free(lv.payloads);
+    free(tv.targets), free(tv.values), free(gv.targets), free(gv.values), free(lv.targets), free(lv.values);
     free(lin), free(lum);
     return r;
 }
@@ -902,6 +898,23 @@ out:
 
 /* ---- sections -------------------------------------------------------------------------- */
 
+void bk_set_bakes_max(const bk_set_bakes *sets, double max[LBK_DLS_SPACE_COUNT_])
+{
+    for (int s = 0; s < LBK_DLS_SPACE_COUNT_; s++) max[s] = 0;
+    const bs_impl *im = sets->impl;
+    if (!im) return;
+    for (size_t j = 0; j < im->set_count; j++) {
+        const bs_set *st = &im->sets[j];
+        double m = bk_texel_max((const lbk_ahd_linear *)st->values[LBK_DLS_SPACE_TEXEL], NULL,
+                                st->count[LBK_DLS_SPACE_TEXEL]);
+        if (m > max[LBK_DLS_SPACE_TEXEL]) max[LBK_DLS_SPACE_TEXEL] = m;
+        for (int s = LBK_DLS_SPACE_GLG; s < LBK_DLS_SPACE_COUNT_; s++) {
+            m = bk_probe_max((const lbk_sh9_rgb *)st->values[s], st->count[s]);
+            if (m > max[s]) max[s] = m;
+        }
+    }
+}
+
 lbk_result bk_set_bakes_sections(bk_set_bakes *sets, const bk_set_inputs *in, void **dls, size_t *dls_size,
                                  void **door, size_t *door_size)
 {
@@ -910,7 +923,42 @@ lbk_result bk_set_bakes_sections(bk_set_bakes *sets, const bk_set_inputs *in, vo
     bs_impl *im = sets->impl;
     if (!im || !im->set_count) return LBK_OK;
     lbk_dls_set_desc *sd = calloc(im->set_count, sizeof *sd);
-    if (!sd) return LBK_ERR_OUT_OF_MEMORY;
+    uint8_t **enc = calloc(im->set_count * LBK_DLS_SPACE_COUNT_, sizeof *enc); /* encoded payloads */
+    if (!sd || !enc) {
+        free(sd), free(enc);
+        return LBK_ERR_OUT_OF_MEMORY;
+    }
+    lbk_result r = LBK_OK;
+    for (size_t j = 0; j < im->set_count && !r; j++)
+        for (int s = 0; s < LBK_DLS_SPACE_COUNT_ && !r; s++) {
+            const bs_set *st = &im->sets[j];
+            const size_t n = st->count[s];
+            if (!n) continue;
+            const size_t stride = s == LBK_DLS_SPACE_TEXEL ? LBK_DLS_TEXEL_PAYLOAD : LBK_DLS_PROBE_PAYLOAD;
+            uint8_t *e = enc[j * LBK_DLS_SPACE_COUNT_ + (size_t)s] = malloc(n * stride);
+            if (!e) {
+                r = LBK_ERR_OUT_OF_MEMORY;
+                break;
+            }
+            /* stored in the scale of the target space's base section (spec §12.2); dividing by a
+             * power of two is exact */
+            const float inv = 1.0f / (in->scale[s] > 0 ? in->scale[s] : 1.0f);
+            for (size_t i = 0; i < n; i++) {
+                if (s == LBK_DLS_SPACE_TEXEL) {
+                    lbk_ahd_linear l;
+                    memset(&l, 0, sizeof l);
+                    lbk_ahd_linear_add_scaled(&l, (const lbk_ahd_linear *)st->values[s] + i, inv);
+                    lbk_ahd_texel t;
+                    lbk_ahd_from_linear(&l, &t);
+                    lbk_ahd_texel_store(&t, e + stride * i);
+                } else {
+                    lbk_sh9_rgb sh;
+                    memset(&sh, 0, sizeof sh);
+                    lbk_sh9_add_scaled(&sh, (const lbk_sh9_rgb *)st->values[s] + i, inv);
+                    lbk_sh9_pack(&sh, e + stride * i);
+                }
+            }
+        }
     for (size_t j = 0; j < im->set_count; j++) {
         const bs_set *st = &im->sets[j];
         sd[j].name = st->name;
@@ -922,7 +970,7 @@ lbk_result bk_set_bakes_sections(bk_set_bakes *sets, const bk_set_inputs *in, vo
         for (int s = 0; s < LBK_DLS_SPACE_COUNT_; s++) {
             sd[j].entries[s].count = st->count[s];
             sd[j].entries[s].targets = st->targets[s];
-            sd[j].entries[s].payloads = st->payloads[s];
+            sd[j].entries[s].payloads = enc[j * LBK_DLS_SPACE_COUNT_ + (size_t)s];
         }
     }
     lbk_dls_build_desc bd;
@@ -934,8 +982,9 @@ lbk_result bk_set_bakes_sections(bk_set_bakes *sets, const bk_set_inputs *in, vo
         tx && tx->page_count && in->texel_receivers ? (uint64_t)tx->page_offset[tx->page_count] : 0;
     bd.target_count[LBK_DLS_SPACE_GLG] = in->glg_count;
     bd.target_count[LBK_DLS_SPACE_LLG] = in->llg_count;
-    lbk_result r = lbk_dls_build(&bd, NULL, dls, dls_size, NULL);
-    free(sd);
+    if (!r) r = lbk_dls_build(&bd, NULL, dls, dls_size, NULL);
+    for (size_t i = 0; i < im->set_count * LBK_DLS_SPACE_COUNT_; i++) free(enc[i]);
+    free(enc), free(sd);
     if (r || !im->door_count) return r;
     lbk_door_desc *dd = calloc(im->door_count, sizeof *dd);
     if (!dd) {
@@ -990,7 +1039,7 @@ void bk_set_bakes_free(bk_set_bakes *sets)
     if (im) {
         for (size_t j = 0; j < im->set_count; j++) {
             free(im->sets[j].light_names);
-            for (int s = 0; s < LBK_DLS_SPACE_COUNT_; s++) free(im->sets[j].targets[s]), free(im->sets[j].payloads[s]);
+            for (int s = 0; s < LBK_DLS_SPACE_COUNT_; s++) free(im->sets[j].targets[s]), free(im->sets[j].values[s]);
         }
         free(im->sets), free(im->doors), free(im->combos), free(im);
     }

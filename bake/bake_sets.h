@@ -52,6 +52,8 @@ typedef struct bk_set_inputs {
     int door_method;                  /* enum bk_door_method */
     float origin[3];                  /* the bake frame's origin in world space: add it to every
                                          position written (the scene is recentred, bake.c) */
+    float scale[3];                   /* sections only: the LMAP, GLG and LLG scales (spec §5.7);
+                                         DLS payloads are stored in them (0: 1) */
 } bk_set_inputs;
 
 /* Finds light sets (lights and emissive objects with lbk_light_set), doors (lbk_door) and the
@@ -69,6 +71,9 @@ int bk_set_bakes_base_hooks(bk_set_bakes *sets, const bk_scene *scene, bk_transp
 void bk_set_bakes_base_albedo(const bk_set_bakes *sets, const bk_scene *scene, uint32_t tri, float albedo[3]);
 /* Bakes every set's contribution at the receivers. 0 or an LBK_EXIT_* code. */
 int bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *err, size_t err_len);
+/* Largest value of any set's entries per DLS space (texels: irradiance along the normal; probes:
+ * SH DC), for choosing the base sections' scales. */
+void bk_set_bakes_max(const bk_set_bakes *sets, double max[3]);
 /* The DLS and DOOR section bytes (free with lbk_free); *door is NULL without doors. */
 lbk_result bk_set_bakes_sections(bk_set_bakes *sets, const bk_set_inputs *in, void **dls, size_t *dls_size,
                                  void **door, size_t *door_size);

@@ -60,7 +60,7 @@ static void build_lmap(uint32_t pages, uint32_t side, void **out, size_t *size)
     fill_texels(t, side, side);
     lbk_lmap_page_desc *p = malloc(sizeof *p * pages);
     for (uint32_t i = 0; i < pages; i++) p[i] = (lbk_lmap_page_desc){side, side, t};
-    CHECK(lbk_lmap_build(p, pages, NULL, out, size));
+    CHECK(lbk_lmap_build(p, pages, 0, NULL, out, size));
     free(p);
     free(t);
 }
@@ -241,7 +241,7 @@ static void overhead(void)
     for (int i = 0; i < GRIDS; i++)
         g[i] = (lbk_llg_grid_desc){{(float)i, 0, 0}, {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {1, 1, 1},
                                    {DIM, DIM, DIM}, probes, NULL, 0};
-    CHECK(lbk_llg_build(g, GRIDS, NULL, &llg, &llg_n));
+    CHECK(lbk_llg_build(g, GRIDS, 0, NULL, &llg, &llg_n));
     free(probes);
     const uint64_t texels = 1024 * 1024, probe_count = GRIDS * DIM * DIM * DIM;
     printf("overhead: 1,048,576 texels (8 B each) + %llu SH9 probes (28 B each) = %.3f MB of payload\n",

@@ -13,9 +13,20 @@
 const float tl_texel_normals[TL_TEXEL_NORMALS][3] = {{0, 0, 1}, {S45, 0, S45}, {-S45, 0, S45}, {0, S45, S45}, {0, -S45, S45}};
 const float tl_probe_normals[TL_PROBE_NORMALS][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
 
-void tl_texel_eval(const lbk_ahd_texel *t, float out[TL_TEXEL_NORMALS][3])
+void tl_texel_eval(const lbk_ahd_texel *t, float scale, float out[TL_TEXEL_NORMALS][3])
 {
-    for (int n = 0; n < TL_TEXEL_NORMALS; n++) lbk_ahd_irradiance(t, tl_texel_normals[n], out[n]);
+    for (int n = 0; n < TL_TEXEL_NORMALS; n++) {
+        lbk_ahd_irradiance(t, tl_texel_normals[n], out[n]);
+        for (int c = 0; c < 3; c++) out[n][c] *= scale;
+    }
+}
+
+void tl_probe_unpack(const uint8_t packed[LBK_SH9_PACKED_SIZE], float scale, lbk_sh9_rgb *sh)
+{
+    lbk_sh9_rgb stored;
+    lbk_sh9_unpack(packed, &stored);
+    memset(sh, 0, sizeof *sh);
+    lbk_sh9_add_scaled(sh, &stored, scale);
 }
 
 void tl_probe_eval(const lbk_sh9_rgb *sh, float out[TL_PROBE_NORMALS][3])

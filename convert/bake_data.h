@@ -51,10 +51,13 @@ void tl_bake_close(tl_bake *bake);
 #define TL_PROBE_NORMALS 6 /* ±X, ±Y, ±Z (world space) */
 extern const float tl_texel_normals[TL_TEXEL_NORMALS][3];
 extern const float tl_probe_normals[TL_PROBE_NORMALS][3];
-/* Decoded irradiance of a texel at the five normals: out[n][channel]. */
-void tl_texel_eval(const lbk_ahd_texel *texel, float out[TL_TEXEL_NORMALS][3]);
-/* Irradiance of a radiance SH at the six axis normals. */
+/* Physical irradiance of a stored texel at the five normals (decoded × the LMAP scale, or the
+ * scale of the base section a DLS payload belongs to): out[n][channel]. */
+void tl_texel_eval(const lbk_ahd_texel *texel, float scale, float out[TL_TEXEL_NORMALS][3]);
+/* Irradiance of a (physical) radiance SH at the six axis normals. */
 void tl_probe_eval(const lbk_sh9_rgb *sh, float out[TL_PROBE_NORMALS][3]);
+/* Physical radiance SH of a packed probe stored in a section (or DLS space) of that scale. */
+void tl_probe_unpack(const uint8_t packed[LBK_SH9_PACKED_SIZE], float scale, lbk_sh9_rgb *sh);
 
 /* Object name as a NUL-terminated string (truncated to size-1 bytes). */
 void tl_string_copy(char *dst, size_t size, lbk_string s);

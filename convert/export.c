@@ -27,7 +27,7 @@ void tl_export_object_stem(const char *name, uint32_t index, char *out, size_t s
 }
 
 /* Decoded planes of one page: ez (+Z irradiance), dom (irradiance at the highlight direction),
- * p0 (plane 0 decoded exactly), p1 (plane 1 bytes / 255), 3/3/3/4 floats per texel. */
+ * p0 (plane 0 decoded exactly × the LMAP scale: physical), p1 (plane 1 bytes / 255), 3/3/3/4 floats per texel. */
 typedef struct page_images {
     uint32_t w, h;
     float *ez, *dom, *p1;
@@ -54,6 +54,8 @@ static int decode_page(const lbk_lmap_page *pg, page_images *im)
             if (len < 0.5f) d[0] = 0, d[1] = 0, d[2] = 1;
             else d[0] /= len, d[1] /= len, d[2] /= len;
             lbk_ahd_irradiance(&t, d, im->dom + 3 * i);
+            /* physical values: stored × the section's scale (a power of two: exact) */
+            for (int c = 0; c < 3; c++) im->ez[3 * i + (size_t)c] *= pg->scale, im->dom[3 * i + (size_t)c] *= pg->scale;
             for (int c = 0; c < 4; c++) im->p1[4 * i + (size_t)c] = t.rgba[c] / 255.0f;
         }
     return 0;
@@ -146,7 +148,7 @@ static int gather_probes(const tl_bake *b, probe_row **rows, size_t *count)
                     r->grid = (int)g;
                     r->index = li;
                     lbk_llg_probe_position(&grid, i, j, k, r->pos);
-                    lbk_sh9_unpack(b->llg.probes + (grid.probe_offset + li) * LBK_SH9_PACKED_SIZE, &r->sh);
+                    tl_probe_unpack(b->llg.probes + (grid.probe_offset + li) * LBK_SH9_PACKED_SIZE, b->llg.scale, &r->sh);
                     tl_probe_eval(&r->sh, r->irr);
                 }
     }
@@ -325,6 +327,7 @@ int tl_export(const tl_bake *b, const tl_export_options *o, tl_export_stats *st,
                                           (uint32_t)pg.irradiance[4 * i + 2] << 16 | (uint32_t)pg.irradiance[4 * i + 3] << 24,
                                       all + 3 * k);
         }
+        for (uint64_t i = 0; i < 3 * total; i++) all[i] *= b->lmap.scale;
         st->exposure = tl_exposure_p99(all, (size_t)total, 3);
         free(all);
     }

@@ -49,7 +49,8 @@ int tl_texel_remap_apply(const tl_texel_remap *r, uint64_t old_index, uint64_t *
 
 /* Replaces plane 0 (and plane 1 when the .ahd.exr exists) of page p from DIR. Returns 1 when
  * the page was imported, 0 when DIR has no file for it, or a negative tl_convert_status. */
-static int import_page(const char *dir, uint32_t p, uint32_t w, uint32_t h, lbk_ahd_texel *tex, char err[TL_ERR_LEN])
+static int import_page(const char *dir, uint32_t p, uint32_t w, uint32_t h, float scale, lbk_ahd_texel *tex,
+                       char err[TL_ERR_LEN])
 {
     char path[4096];
     tl_page_exr_path(path, sizeof path, dir, p, ".exr");
@@ -73,6 +74,7 @@ static int import_page(const char *dir, uint32_t p, uint32_t w, uint32_t h, lbk_
                              rgb_names[c]);
             }
             if (v[c] < 0) v[c] = 0; /* irradiance cannot be negative; painting tools overshoot */
+            v[c] /= scale;           /* the EXR is physical, the section stores value / scale (exact) */
         }
         tex[i].irradiance_z = lbk_pack_r11g11b10f(v);
     }
@@ -168,7 +170,7 @@ int tl_lmap_rewrite(const void *lmap, size_t size, const tl_lmap_layout_options 
         for (uint32_t y = 0; y < h; y++)
             for (uint32_t x = 0; x < w; x++) lbk_lmap_page_texel(&pg, x, y, &src[(size_t)y * w + x]);
         if (o->from_exr_dir) {
-            int got = import_page(o->from_exr_dir, p, w, h, src, err);
+            int got = import_page(o->from_exr_dir, p, w, h, v.scale, src, err);
             if (got < 0) st = -got;
             else *pages_imported += (uint32_t)got;
         }
@@ -179,7 +181,7 @@ int tl_lmap_rewrite(const void *lmap, size_t size, const tl_lmap_layout_options 
     if (st == TL_CONVERT_OK) {
         void *built = NULL;
         size_t built_size = 0;
-        r = lbk_lmap_build(descs, n, NULL, &built, &built_size);
+        r = lbk_lmap_build(descs, n, v.scale, NULL, &built, &built_size);
         if (r != LBK_OK) st = tl_fail(err, TL_CONVERT_INTERNAL, "rebuilding LMAP: %s", lbk_result_message(r));
         else {
             lbk_lmap_view nv;

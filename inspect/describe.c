@@ -1,4 +1,6 @@
 /* Section type → describer. */
+#include <math.h>
+
 #include "inspect/describe.h"
 #include "lbk/lbk.h"
 
@@ -16,4 +18,11 @@ inspect_describe_fn inspect_describer(uint32_t type)
     case LBK_SECTION_DOOR: return inspect_describe_door;
     default: return NULL;
     }
+}
+
+int inspect_scale_log2(float scale)
+{
+    int e;
+    frexpf(scale, &e); /* scale = 1/2 · 2^e exactly */
+    return e - 1;
 }

@@ -13,5 +13,6 @@ void inspect_describe_glg(const uint8_t *data, size_t size, inspect_stats *out)
     out->glg_probes = v.probe_count;
     out->glg_tetrahedra = v.tetra_count;
     out->gpu_bytes = (uint64_t)v.probe_count * (28 + 12) + (uint64_t)v.tetra_count * (16 + 16 + 4);
-    snprintf(out->detail, sizeof out->detail, "%u probes, %u tetrahedra", v.probe_count, v.tetra_count);
+    snprintf(out->detail, sizeof out->detail, "%u probes, %u tetrahedra, scale 2^%d", v.probe_count, v.tetra_count,
+             inspect_scale_log2(v.scale));
 }

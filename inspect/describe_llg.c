@@ -14,6 +14,6 @@ void inspect_describe_llg(const uint8_t *data, size_t size, inspect_stats *out)
     out->llg_probes = v.probe_count;
     out->llg_vertices = v.vertex_count;
     out->gpu_bytes = v.probe_count * 28 + v.vertex_count * 4;
-    snprintf(out->detail, sizeof out->detail, "%u grids, %llu probes, %llu vertices", v.grid_count,
-             (unsigned long long)v.probe_count, (unsigned long long)v.vertex_count);
+    snprintf(out->detail, sizeof out->detail, "%u grids, %llu probes, %llu vertices, scale 2^%d", v.grid_count,
+             (unsigned long long)v.probe_count, (unsigned long long)v.vertex_count, inspect_scale_log2(v.scale));
 }

@@ -12,6 +12,6 @@ void inspect_describe_lmap(const uint8_t *data, size_t size, inspect_stats *out)
     out->lm_pages = v.page_count;
     out->lm_texels = v.texel_count;
     out->gpu_bytes = v.texel_count * 8; /* R11G11B10F plane + RGBA8 plane */
-    snprintf(out->detail, sizeof out->detail, "%u pages, %llu texels (8 B/texel)", v.page_count,
-             (unsigned long long)v.texel_count);
+    snprintf(out->detail, sizeof out->detail, "%u pages, %llu texels (8 B/texel), scale 2^%d", v.page_count,
+             (unsigned long long)v.texel_count, inspect_scale_log2(v.scale));
 }

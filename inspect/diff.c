@@ -80,7 +80,7 @@ static void texel_values(const lbk_lmap_page *pg, uint32_t x, uint32_t y, float 
 {
     lbk_ahd_texel t;
     lbk_lmap_page_texel(pg, x, y, &t);
-    tl_texel_eval(&t, out);
+    tl_texel_eval(&t, pg->scale, out);
 }
 
 /* Bilinear sample of the evaluated values at rect-normalised (u, v) of a rect of page pg. */
@@ -236,9 +236,9 @@ static void compare_object(const tl_bake *a, const tl_bake *b, const lbk_object 
         const uint64_t n = (uint64_t)ga.dims[0] * ga.dims[1] * ga.dims[2];
         for (uint64_t i = 0; i < n; i++) {
             lbk_sh9_rgb sa, sb;
-            lbk_sh9_unpack(a->llg.probes + (ga.probe_offset + i) * LBK_SH9_PACKED_SIZE, &sa);
+            tl_probe_unpack(a->llg.probes + (ga.probe_offset + i) * LBK_SH9_PACKED_SIZE, a->llg.scale, &sa);
             if (same) {
-                lbk_sh9_unpack(b->llg.probes + (gb.probe_offset + i) * LBK_SH9_PACKED_SIZE, &sb);
+                tl_probe_unpack(b->llg.probes + (gb.probe_offset + i) * LBK_SH9_PACKED_SIZE, b->llg.scale, &sb);
             } else {
                 float pos[3];
                 uint32_t ii = (uint32_t)(i % ga.dims[0]), jj = (uint32_t)(i / ga.dims[0] % ga.dims[1]),
@@ -521,16 +521,24 @@ static keyed *sorted_keys(const tl_bake *bk, const set_entries *e)
     return k;
 }
 
-static void eval_payload(uint32_t space, const uint8_t *p, float *out)
+/* The scale DLS payloads of a space are stored in: their base section's (spec §12.2). */
+static float space_scale(const tl_bake *b, uint32_t space)
+{
+    if (space == LBK_DLS_SPACE_TEXEL) return b->has_lmap ? b->lmap.scale : 1.0f;
+    if (space == LBK_DLS_SPACE_GLG) return b->has_glg ? b->glg.scale : 1.0f;
+    return b->has_llg ? b->llg.scale : 1.0f;
+}
+
+static void eval_payload(uint32_t space, const uint8_t *p, float scale, float *out)
 {
     if (space == LBK_DLS_SPACE_TEXEL) {
         lbk_ahd_texel t;
         if (p) lbk_ahd_texel_load(p, &t);
         else memset(&t, 0, sizeof t);
-        tl_texel_eval(&t, (float(*)[3])out);
+        tl_texel_eval(&t, scale, (float(*)[3])out);
     } else {
         lbk_sh9_rgb s;
-        if (p) lbk_sh9_unpack(p, &s);
+        if (p) tl_probe_unpack(p, scale, &s);
         else memset(&s, 0, sizeof s);
         tl_probe_eval(&s, (float(*)[3])out);
     }
@@ -579,8 +587,8 @@ static int compare_set_space(const tl_bake *a, uint32_t sa, const tl_bake *b, ui
             pb = eb.payloads + (size_t)kb[j++].index * eb.payload;
         }
         float va[TL_PROBE_NORMALS * 3], vb[TL_PROBE_NORMALS * 3];
-        eval_payload(space, pa, va);
-        eval_payload(space, pb, vb);
+        eval_payload(space, pa, space_scale(a, space), va);
+        eval_payload(space, pb, space_scale(b, space), vb);
         /* texels: x = position in page, y = row; probes: x = index */
         uint32_t x = space == LBK_DLS_SPACE_TEXEL ? (uint32_t)(key & 0xFFFF) : (uint32_t)key;
         uint32_t y = space == LBK_DLS_SPACE_TEXEL ? (uint32_t)((key >> 16) & 0xFFFF) : 0;

@@ -94,6 +94,45 @@ static void test_self_is_equal(void **state)
     tl_diff_free(&r);
 }
 
+/* The same physical lighting stored with other scales (LMAP and GLG 2^-6 and 2^5, DLS payloads in
+ * them): the diff compares physical values, so the bakes are equal, exactly — dividing by a power
+ * of two before encoding changes no rounding. The section bytes do differ. */
+static void test_other_scale_is_equal(void **state)
+{
+    (void)state;
+    static const int scales[2] = {-6, 5};
+    for (int i = 0; i < 2; i++) {
+        tf_options o;
+        memset(&o, 0, sizeof o);
+        o.scale_log2 = scales[i];
+        tl_diff_result r;
+        run_diff(NULL, &o, 0, 0, 0, &r);
+        assert_int_equal(r.differ, 0);
+        for (size_t k = 0; k < r.object_count; k++) assert_int_equal(r.objects[k].status, TL_DIFF_SAME);
+        const tl_diff_object *floor_ = find_object(&r, "floor");
+        assert_int_equal(floor_->lighting.count, 32 * 32);
+        assert_true(floor_->lighting.max_abs == 0.0);
+        assert_true(r.pages[0].lighting.max_abs == 0.0 && r.pages[1].lighting.max_abs == 0.0);
+        assert_int_equal(r.glg.status, TL_DIFF_SAME);
+        assert_true(r.glg.lighting.max_abs == 0.0);
+        assert_int_equal(r.sets[0].status, TL_DIFF_SAME);
+        assert_int_equal(r.sets[0].lighting[LBK_DLS_SPACE_TEXEL].count, 256);
+        assert_true(r.sets[0].lighting[LBK_DLS_SPACE_TEXEL].max_abs == 0.0);
+        assert_true(r.sets[0].lighting[LBK_DLS_SPACE_GLG].max_abs == 0.0);
+        int lmap_bytes_differ = 0;
+        for (size_t k = 0; k < r.section_count; k++)
+            if (r.sections[k].type == LBK_SECTION_LMAP) lmap_bytes_differ = r.sections[k].status == TL_DIFF_CHANGED;
+        assert_true(lmap_bytes_differ);
+        tl_diff_free(&r);
+        /* and a real change under the other scale is still seen */
+        o.texel_factor = 2.0f, o.texel_page = 1, o.texel_x = 3, o.texel_y = 4;
+        run_diff(NULL, &o, 0, 0, 0, &r);
+        assert_int_equal(r.differ, 1);
+        assert_int_equal(find_object(&r, "crate")->status, TL_DIFF_CHANGED);
+        tl_diff_free(&r);
+    }
+}
+
 /* One texel of the crate (page 1, rect at 0,0) doubled: exactly that object, that page, that
  * texel region; nothing else. */
 static void test_one_texel_changed(void **state)
@@ -146,8 +185,8 @@ static double expected_texel_error(const tf_options *ob, double *ref)
     lbk_lmap_page_texel(&pa, ob->texel_x, ob->texel_y, &ta);
     lbk_lmap_page_texel(&pb, ob->texel_x, ob->texel_y, &tb);
     float va[TL_TEXEL_NORMALS][3], vb[TL_TEXEL_NORMALS][3];
-    tl_texel_eval(&ta, va);
-    tl_texel_eval(&tb, vb);
+    tl_texel_eval(&ta, pa.scale, va);
+    tl_texel_eval(&tb, pb.scale, vb);
     double e = 0;
     *ref = 0;
     for (int n = 0; n < TL_TEXEL_NORMALS; n++)
@@ -423,6 +462,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_self_is_equal),
+        cmocka_unit_test(test_other_scale_is_equal),
         cmocka_unit_test(test_one_texel_changed),
         cmocka_unit_test(test_tolerance_boundaries),
         cmocka_unit_test(test_objects_matched_by_name_and_hash),

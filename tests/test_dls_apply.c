@@ -15,6 +15,7 @@
 
 #include "lbk/ahd.h"
 #include "lbk/dls.h"
+#include "lbk/pixel.h"
 #include "lbk/door.h"
 #include "lbk/sh.h"
 #include "support/dls_fixture.h"
@@ -448,6 +449,96 @@ static void test_missing_buffers_rejected(void **state)
     scene_free(&sc);
 }
 
+/* Multiplies stored texel/probe bytes by 2^e: the same physical lighting in a section of scale
+ * 2^-e (spec §5.7, §12.2). */
+static void rescale_texel(uint8_t b[8], int e)
+{
+    lbk_ahd_texel t;
+    lbk_ahd_texel_load(b, &t);
+    float v[3];
+    lbk_unpack_r11g11b10f(t.irradiance_z, v);
+    for (int c = 0; c < 3; c++) v[c] = ldexpf(v[c], e);
+    t.irradiance_z = lbk_pack_r11g11b10f(v);
+    lbk_ahd_texel_store(&t, b);
+}
+
+static void rescale_probe(uint8_t b[28], int e)
+{
+    lbk_sh9_rgb sh;
+    lbk_sh9_unpack(b, &sh);
+    for (int c = 0; c < 3; c++)
+        for (int k = 0; k < 9; k++) sh.c[c][k] = ldexpf(sh.c[c][k], e);
+    lbk_sh9_pack(&sh, b);
+}
+
+/* DLS payloads live in the scale of their base section, so L = L_B + Σ w S on stored values is
+ * the physical sum in stored units: the same lighting stored 2^8 larger (scale 2^-8) applies to
+ * outputs that are exactly 2^8 × the unscaled apply's, texel for texel and probe for probe. */
+static void test_apply_in_another_scale(void **state)
+{
+    (void)state;
+    scene sc;
+    memset(&sc, 0, sizeof sc);
+    random_sets(&sc.fx, 3, 22);
+    scene_build(&sc, 3);
+    const uint64_t nt = sc.fx.desc.target_count[0], np[2] = {sc.fx.desc.target_count[1], sc.fx.desc.target_count[2]};
+    uint64_t rng = 3;
+    float w[22];
+    random_weights(&rng, w, 22);
+    lbk_dls_runtime *r = runtime(&sc, NULL);
+    assert_int_equal(lbk_dls_apply(r, w, NULL, NULL), LBK_OK);
+    lbk_dls_runtime_destroy(r);
+    uint32_t *z1 = malloc(nt * 4);
+    uint8_t *rgba1 = malloc(nt * 4), *p1[2] = {malloc(np[0] * 28), malloc(np[1] * 28)};
+    memcpy(z1, sc.out_z, nt * 4), memcpy(rgba1, sc.out_rgba, nt * 4);
+    for (int p = 0; p < 2; p++) memcpy(p1[p], sc.out_probe[p], np[p] * 28);
+    /* the same lighting stored ×2^8: bases and every payload */
+    for (uint64_t t = 0; t < nt; t++) {
+        uint8_t b[8];
+        lbk_ahd_texel tx = {sc.base_z[t], {0}};
+        memcpy(tx.rgba, sc.base_rgba + 4 * t, 4);
+        lbk_ahd_texel_store(&tx, b);
+        rescale_texel(b, 8);
+        lbk_ahd_texel_load(b, &tx);
+        sc.base_z[t] = tx.irradiance_z;
+    }
+    for (int p = 0; p < 2; p++)
+        for (uint64_t t = 0; t < np[p]; t++) rescale_probe(sc.base_probe[p] + 28 * t, 8);
+    for (uint32_t s = 0; s < sc.fx.set_count; s++)
+        for (uint32_t sp = 0; sp < 3; sp++)
+            for (uint64_t i = 0; i < sc.fx.sets[s].entries[sp].count; i++) {
+                if (sp == 0) rescale_texel(sc.fx.payloads[s][sp] + 8 * i, 8);
+                else rescale_probe(sc.fx.payloads[s][sp] + 28 * i, 8);
+            }
+    lbk_dls_view_close(sc.view);
+    free(sc.bytes);
+    assert_int_equal(lbk_dls_build(&sc.fx.desc, NULL, &sc.bytes, &sc.size, NULL), LBK_OK);
+    assert_int_equal(lbk_dls_view_open(sc.bytes, sc.size, NULL, &sc.view), LBK_OK);
+    r = runtime(&sc, NULL);
+    assert_int_equal(lbk_dls_apply(r, w, NULL, NULL), LBK_OK);
+    lbk_dls_runtime_destroy(r);
+    uint64_t lit = 0;
+    for (uint64_t t = 0; t < nt; t++) {
+        float a[3], b[3];
+        lbk_unpack_r11g11b10f(z1[t], a);
+        lbk_unpack_r11g11b10f(sc.out_z[t], b);
+        for (int c = 0; c < 3; c++) assert_true(ldexpf(a[c], 8) == b[c]);
+        assert_memory_equal(rgba1 + 4 * t, sc.out_rgba + 4 * t, 4);
+        lit += a[0] > 0;
+    }
+    assert_true(lit > nt / 2);
+    for (int p = 0; p < 2; p++)
+        for (uint64_t t = 0; t < np[p]; t++) {
+            lbk_sh9_rgb a, b;
+            lbk_sh9_unpack(p1[p] + 28 * t, &a);
+            lbk_sh9_unpack(sc.out_probe[p] + 28 * t, &b);
+            for (int c = 0; c < 3; c++)
+                for (int k = 0; k < 9; k++) assert_true(ldexpf(a.c[c][k], 8) == b.c[c][k]);
+        }
+    free(z1), free(rgba1), free(p1[0]), free(p1[1]);
+    scene_free(&sc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -457,6 +548,7 @@ int main(void)
         cmocka_unit_test(test_empty_set_adds_no_data),
         cmocka_unit_test(test_door_weights),
         cmocka_unit_test(test_missing_buffers_rejected),
+        cmocka_unit_test(test_apply_in_another_scale),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

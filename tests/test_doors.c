@@ -184,7 +184,8 @@ static cmp compare_room(const baked *ba, const uint32_t *za, const uint8_t *ra, 
         for (uint32_t x = 0; x < ba->room_rect[3]; x++) {
             uint64_t ia = pa.first_texel + (uint64_t)(ba->room_rect[2] + y) * pa.width + ba->room_rect[1] + x;
             uint64_t ib = pb.first_texel + (uint64_t)(bb->room_rect[2] + y) * pb.width + bb->room_rect[1] + x;
-            double a = texel_lum(za[ia], &ra[4 * ia]), b = texel_lum(zb[ib], &rb[4 * ib]);
+            /* physical: stored × each file's LMAP scale (spec §5.7) */
+            double a = texel_lum(za[ia], &ra[4 * ia]) * pa.scale, b = texel_lum(zb[ib], &rb[4 * ib]) * pb.scale;
             diff += fabs(a - b), sa += a, sb += b;
         }
     cmp c = {sb > 0 ? diff / sb : 0, sb > 0 ? sa / sb : 0};

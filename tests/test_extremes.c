@@ -77,7 +77,8 @@ typedef struct baked {
     uint32_t passes;            /* REPT records = transport passes */
     int has_lmap, has_glg, has_llg;
     size_t texel_count;
-    float (*ez)[3];             /* plane-0 irradiance along the normal, every texel of every page */
+    float (*ez)[3];             /* physical irradiance along the normal (plane 0 × LMAP scale), every texel */
+    float lmap_scale, glg_scale, llg_scale; /* the sections' radiometric scales (spec §5.7) */
     size_t glg_count, tet_count;
     float (*glg_pos)[3];
     float (*glg_dc)[3];         /* L00 of every GLG probe */
@@ -144,6 +145,7 @@ static void decode(const char *path, baked *b)
         lbk_lmap_view v;
         assert_int_equal(lbk_lmap_open(data, size, &v), LBK_OK);
         b->texel_count = (size_t)v.texel_count;
+        b->lmap_scale = v.scale;
         b->ez = calloc(b->texel_count ? b->texel_count : 1, sizeof *b->ez);
         assert_non_null(b->ez);
         static const float normals[5][3] = {{0, 0, 1}, {0.6f, 0, 0.8f}, {0, -0.6f, 0.8f}, {1, 0, 0}, {0, 0, -1}};
@@ -151,6 +153,7 @@ static void decode(const char *path, baked *b)
             lbk_ahd_texel tx;
             assert_int_equal(lbk_lmap_texel(&v, t, &tx, NULL), LBK_OK);
             lbk_unpack_r11g11b10f(tx.irradiance_z, b->ez[t]);
+            for (int c = 0; c < 3; c++) b->ez[t][c] *= v.scale;
             for (int n = 0; n < 5; n++) {
                 float e[3];
                 lbk_ahd_irradiance(&tx, normals[n], e);
@@ -164,6 +167,7 @@ static void decode(const char *path, baked *b)
         lbk_glg_view v;
         assert_int_equal(lbk_glg_open(data, size, &v), LBK_OK);
         b->glg_count = v.probe_count;
+        b->glg_scale = v.scale;
         b->tet_count = v.tetra_count;
         b->glg_pos = calloc(v.probe_count, sizeof *b->glg_pos);
         b->glg_dc = calloc(v.probe_count, sizeof *b->glg_dc);
@@ -192,13 +196,14 @@ static void decode(const char *path, baked *b)
         lbk_llg_view v;
         assert_int_equal(lbk_llg_open(data, size, &v), LBK_OK);
         b->llg_count = (size_t)v.probe_count;
+        b->llg_scale = v.scale;
         b->llg_dc = calloc(b->llg_count ? b->llg_count : 1, sizeof *b->llg_dc);
         assert_non_null(b->llg_dc);
         for (uint64_t p = 0; p < v.probe_count; p++) {
             lbk_sh9_rgb sh;
             lbk_sh9_unpack(v.probes + LBK_SH9_PACKED_SIZE * p, &sh);
             assert_sh_clean(&sh);
-            for (int c = 0; c < 3; c++) b->llg_dc[p][c] = sh.c[c][0];
+            for (int c = 0; c < 3; c++) b->llg_dc[p][c] = sh.c[c][0] * v.scale;
         }
     }
     lbk_reader_close(r);
@@ -448,19 +453,20 @@ static const baked *base(void)
 
 /* ---- 1. light intensity 1e-6 … 1e6 ------------------------------------------------------- */
 
-/* Largest finite per channel: R11G11B10F (texels) and RGB9E5 (probe DC). */
-static const float TEXEL_MAX[3] = {LBK_UF11_MAX, LBK_UF11_MAX, LBK_UF10_MAX};
-
-/* Each stored channel equals the codec applied to k × the unit bake's stored value: relative
- * rounding of both (uf10: 2^-6 each, 2^-5 together), an absolute half step of the smallest
- * denormal (uf10: 2^-20; RGB9E5: 2^-25), and saturation at the maximum. */
-static void assert_scaled_channel(double unit, double k, double got, double max, double denorm_half)
+/* Each decoded physical channel equals k × the unit bake's decoded physical value, within the
+ * relative rounding of both (uf10: 2^-6 each, 2^-5 together) plus, absolutely, `floor` (half the
+ * smallest step of each file, times its scale; for RGB9E5 also the shared-exponent step of the
+ * probe's largest channel). There is no saturation and no flush to zero: each section's scale
+ * (spec §5.7) puts its largest value at 2^13..2^14 stored. */
+static void assert_scaled_channel(double unit, double k, double got, double floor)
 {
-    double want = fmin(k * unit, max);
-    double tol = 0x1p-5 * want + 2 * denorm_half;
-    if (fabs(got - want) > tol) print_message("channel: unit %g × %g = %g, got %g\n", unit, k, want, got);
+    double want = k * unit;
+    double tol = 0x1p-5 * want + floor;
+    if (fabs(got - want) > tol) print_message("channel: unit %g × %g = %g, got %g (tol %g)\n", unit, k, want, got, tol);
     assert_true(fabs(got - want) <= tol);
 }
+
+static double log2_of(float scale) { return log2((double)scale); }
 
 static void test_intensity_extremes(void **state)
 {
@@ -482,25 +488,36 @@ static void test_intensity_extremes(void **state)
         assert_int_equal(b.passes, unit.passes);
         /* the estimate is scale-free */
         assert_float_equal(b.est, unit.est, 1e-3 * unit.est + 1e-6);
-        size_t saturated = 0, flushed = 0;
+        /* the scales follow k: 2^k apart up to one octave (k is not a power of two) */
+        assert_true(fabs(log2_of(b.lmap_scale) - log2_of(unit.lmap_scale) - log2(ks[i])) <= 1.0);
+        assert_true(fabs(log2_of(b.glg_scale) - log2_of(unit.glg_scale) - log2(ks[i])) <= 1.0);
+        size_t zero = 0, top = 0;
+        float peak = 0;
+        const double tfloor = 0x1p-20 * (b.lmap_scale + ks[i] * unit.lmap_scale);
         for (size_t t = 0; t < b.texel_count; t++)
             for (int c = 0; c < 3; c++) {
-                assert_scaled_channel(unit.ez[t][c], ks[i], b.ez[t][c], TEXEL_MAX[c], 0x1p-20);
-                saturated += b.ez[t][c] == TEXEL_MAX[c];
-                flushed += b.ez[t][c] == 0 && unit.ez[t][c] > 0;
+                assert_scaled_channel(unit.ez[t][c], ks[i], b.ez[t][c], tfloor);
+                zero += b.ez[t][c] == 0 && unit.ez[t][c] > 0;
+                top += b.ez[t][c] >= (c == 2 ? LBK_UF10_MAX : LBK_UF11_MAX) * b.lmap_scale;
+                if (b.ez[t][c] / b.lmap_scale > peak) peak = b.ez[t][c] / b.lmap_scale;
             }
-        for (size_t p = 0; p < b.glg_count; p++)
-            for (int c = 0; c < 3; c++) assert_scaled_channel(unit.glg_dc[p][c], ks[i], b.glg_dc[p][c], LBK_RGB9E5_MAX, 0x1p-25);
-        /* inside the codec's normal range the whole chain is linear: mean ratio = k */
+        for (size_t p = 0; p < b.glg_count; p++) {
+            double mx = fmax(unit.glg_dc[p][0], fmax(unit.glg_dc[p][1], unit.glg_dc[p][2]));
+            const double pfloor = 0x1p-9 * ks[i] * mx + 0x1p-25 * (b.glg_scale + ks[i] * unit.glg_scale);
+            for (int c = 0; c < 3; c++) assert_scaled_channel(unit.glg_dc[p][c], ks[i], b.glg_dc[p][c], pfloor);
+        }
+        /* the whole chain is linear: mean ratio = k */
         double ratio = mean_texel_lum(&b) / m1;
-        print_message("  intensity %g: mean ratio %.6g (k = %g), %zu saturated and %zu flushed channels of %zu\n",
-                      ks[i], ratio, ks[i], saturated, flushed, 3 * b.texel_count);
-        if (ks[i] == 1e-4 || ks[i] == 1e4) assert_float_equal(ratio / ks[i], 1, 0.01);
-        /* the baker warns exactly when the file cannot hold the range */
-        assert_int_equal(b.sum.texel_channels_saturated > 0, saturated > 0);
-        assert_int_equal(b.sum.texel_channels_flushed > 0, flushed > 0);
-        if (ks[i] == 1e6) assert_true(saturated > 0);   /* 1e6 cd at 1 m exceeds 65024 lx */
-        if (ks[i] == 1e-6) assert_true(flushed > 0);    /* 1e-6 lx is below the smallest step */
+        print_message("  intensity %g: mean ratio %.6g (k = %g), LMAP scale 2^%.0f, GLG scale 2^%.0f, largest stored "
+                      "texel %g, %zu saturated and %zu flushed channels of %zu\n",
+                      ks[i], ratio, ks[i], log2_of(b.lmap_scale), log2_of(b.glg_scale), (double)peak, top, zero,
+                      3 * b.texel_count);
+        assert_float_equal(ratio / ks[i], 1, 0.01);
+        assert_true(peak >= 0x1p13f && peak < 0x1p14f * (1 + 0x1p-6f)); /* the scale rule */
+        assert_int_equal(top, 0);
+        assert_int_equal(zero, 0);
+        assert_int_equal(b.sum.texel_channels_saturated, 0);
+        assert_int_equal(b.sum.texel_channels_flushed, 0);
         baked_free(&b);
     }
     baked_free(&unit);

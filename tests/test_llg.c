@@ -52,7 +52,7 @@ static void build(void **bytes, size_t *size, lbk_llg_vertex *verts, uint32_t nv
     g.probes = probes;
     g.vertices = verts;
     g.vertex_count = nv;
-    assert_int_equal(lbk_llg_build(&g, 1, NULL, bytes, size), LBK_OK);
+    assert_int_equal(lbk_llg_build(&g, 1, 0, NULL, bytes, size), LBK_OK);
 }
 
 static void to_world(const float l[3], float w[3])
@@ -176,18 +176,18 @@ static void builder_rejects(void **state)
     g.probes = probes;
     void *out;
     size_t size;
-    assert_int_equal(lbk_llg_build(&g, 1, NULL, &out, &size), LBK_OK);
+    assert_int_equal(lbk_llg_build(&g, 1, 0, NULL, &out, &size), LBK_OK);
     lbk_free(NULL, out);
     g.dims[1] = 1;
-    assert_int_equal(lbk_llg_build(&g, 1, NULL, &out, &size), LBK_ERR_INVALID_ARGUMENT);
+    assert_int_equal(lbk_llg_build(&g, 1, 0, NULL, &out, &size), LBK_ERR_INVALID_ARGUMENT);
     g.dims[1] = 65;
-    assert_int_equal(lbk_llg_build(&g, 1, NULL, &out, &size), LBK_ERR_INVALID_ARGUMENT);
+    assert_int_equal(lbk_llg_build(&g, 1, 0, NULL, &out, &size), LBK_ERR_INVALID_ARGUMENT);
     g.dims[1] = 2;
     g.axes[0][0] *= 1.01f; /* not unit */
-    assert_int_equal(lbk_llg_build(&g, 1, NULL, &out, &size), LBK_ERR_INVALID_ARGUMENT);
+    assert_int_equal(lbk_llg_build(&g, 1, 0, NULL, &out, &size), LBK_ERR_INVALID_ARGUMENT);
     memcpy(g.axes, A, sizeof A);
     g.half_extent[2] = 0.0f;
-    assert_int_equal(lbk_llg_build(&g, 1, NULL, &out, &size), LBK_ERR_INVALID_ARGUMENT);
+    assert_int_equal(lbk_llg_build(&g, 1, 0, NULL, &out, &size), LBK_ERR_INVALID_ARGUMENT);
 }
 
 int main(void)

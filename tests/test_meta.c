@@ -463,12 +463,12 @@ static void build_lmap_llg(void **lmap, size_t *lmap_n, void **llg, size_t *llg_
     static lbk_ahd_texel texels[16 * 8];
     for (int i = 0; i < 16 * 8; i++) texels[i] = (lbk_ahd_texel){0, {255, 128, 128, 255}};
     lbk_lmap_page_desc pages[2] = {{16, 8, texels}, {4, 4, texels}};
-    assert_int_equal(lbk_lmap_build(pages, 2, NULL, lmap, lmap_n), LBK_OK);
+    assert_int_equal(lbk_lmap_build(pages, 2, 0, NULL, lmap, lmap_n), LBK_OK);
     static lbk_sh9_rgb probes[8];
     memset(probes, 0, sizeof probes);
     lbk_llg_grid_desc g = {{0, 0, 0}, {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {1, 1, 1}, {2, 2, 2}, probes, NULL, 0};
     lbk_llg_grid_desc grids[2] = {g, g};
-    assert_int_equal(lbk_llg_build(grids, 2, NULL, llg, llg_n), LBK_OK);
+    assert_int_equal(lbk_llg_build(grids, 2, 0, NULL, llg, llg_n), LBK_OK);
 }
 
 static void test_objects_validator_rules(void **state)

@@ -154,7 +154,7 @@ static void test_glg_cap_and_build(void **state)
             assert_int_equal(vis8[t][i], (int)lrintf(g.face_visibility[4 * t + (size_t)i] * 255.0f));
     lbk_glg_desc desc = {(uint32_t)g.probe_count, (uint32_t)g.tet_count, (const float (*)[3])g.positions, sh,
                          (const uint32_t (*)[4])g.tets, (const uint32_t (*)[4])g.neighbours,
-                         (const uint8_t (*)[4])vis8};
+                         (const uint8_t (*)[4])vis8, 0};
     void *bytes = NULL;
     size_t size = 0;
     assert_int_equal(lbk_glg_build(&desc, NULL, &bytes, &size), LBK_OK);
@@ -361,7 +361,7 @@ static void test_llg_obb_rotated_box(void **state)
         gd.vertex_count = (uint32_t)l.vertex_count;
         void *bytes = NULL;
         size_t size = 0;
-        assert_int_equal(lbk_llg_build(&gd, 1, NULL, &bytes, &size), LBK_OK);
+        assert_int_equal(lbk_llg_build(&gd, 1, 0, NULL, &bytes, &size), LBK_OK);
         lbk_llg_view view;
         lbk_llg_grid grid;
         assert_int_equal(lbk_llg_open(bytes, size, &view), LBK_OK);

@@ -115,7 +115,7 @@ static void lmap_fixture(void **out, size_t *size, lbk_ahd_texel *t0, lbk_ahd_te
         t1[i].rgba[3] = 128;
     }
     const lbk_lmap_page_desc pages[2] = {{3, 2, t0}, {5, 4, t1}};
-    assert_int_equal(lbk_lmap_build(pages, 2, NULL, out, size), LBK_OK);
+    assert_int_equal(lbk_lmap_build(pages, 2, 0, NULL, out, size), LBK_OK);
 }
 
 static void lmap_round_trip_and_rules(void **state)
@@ -165,7 +165,7 @@ static void lmap_round_trip_and_rules(void **state)
     /* every rule */
     uint8_t *c;
     expect_only(lbk_validate_lmap, b, 10, 500);
-    c = dup_bytes(b, n); c[5] = 1; expect_only(lbk_validate_lmap, c, n, 501); free(c);
+    c = dup_bytes(b, n); c[5] = 1; expect_only(lbk_validate_lmap, c, n, 511); free(c); /* scale 1 + 2^-15 */
     c = dup_bytes(b, n); c[16 + 32 + 5] = 1; expect_only(lbk_validate_lmap, c, n, 501); free(c);
     c = dup_bytes(b, n); lbk_wr32(c, 0); expect_only(lbk_validate_lmap, c, n, 502); free(c);
     c = dup_bytes(b, n); lbk_wr32(c, 100); expect_only(lbk_validate_lmap, c, n, 502); free(c);
@@ -197,7 +197,7 @@ static void glg_fixture(uint32_t probes, void **out, size_t *size)
     memset(sh, 0, sizeof sh);
     for (int i = 0; i < 9; i++)
         for (int c = 0; c < 3; c++) sh[i].c[c][0] = 1.0f + (float)i;
-    lbk_glg_desc d = {probes, 6, cube_pos, sh, cube_tets, NULL, NULL};
+    lbk_glg_desc d = {probes, 6, cube_pos, sh, cube_tets, NULL, NULL, 0};
     assert_int_equal(lbk_glg_build(&d, NULL, out, size), LBK_OK);
 }
 
@@ -225,6 +225,7 @@ static void glg_rules(void **state)
     uint8_t *c;
     expect_only(lbk_validate_glg, b, 31, 600);
     c = dup_bytes(b, n); c[20] = 1; expect_only(lbk_validate_glg, c, n, 601); free(c);
+    c = dup_bytes(b, n); c[9] = 1; expect_only(lbk_validate_glg, c, n, 611); free(c); /* scale 1 + 2^-15 */
     c = dup_bytes(b, n); lbk_wr32(c, 3); expect_has(lbk_validate_glg, c, n, 602); free(c);
     expect_only(lbk_validate_glg, b, n - 4, 603);
     c = dup_bytes(b, n); lbk_wrf32(c + 32 + 12 * 3 + 4, NAN); expect_only(lbk_validate_glg, c, n, 605); free(c);
@@ -273,7 +274,7 @@ static void llg_fixture(void **out, size_t *size)
     }
     g[1].vertices = verts;
     g[1].vertex_count = 3;
-    assert_int_equal(lbk_llg_build(g, 2, NULL, out, size), LBK_OK);
+    assert_int_equal(lbk_llg_build(g, 2, 0, NULL, out, size), LBK_OK);
 }
 
 static void llg_rules(void **state)
@@ -304,7 +305,8 @@ static void llg_rules(void **state)
     uint8_t *c;
     const size_t g1 = 32 + 96;
     expect_only(lbk_validate_llg, b, 20, 700);
-    c = dup_bytes(b, n); c[5] = 1; expect_only(lbk_validate_llg, c, n, 701); free(c);
+    c = dup_bytes(b, n); c[5] = 1; expect_only(lbk_validate_llg, c, n, 713); free(c); /* scale 1 + 2^-15 */
+    c = dup_bytes(b, n); c[24] = 1; expect_only(lbk_validate_llg, c, n, 701); free(c);
     c = dup_bytes(b, n); c[32 + 66] = 1; expect_only(lbk_validate_llg, c, n, 701); free(c);
     c = dup_bytes(b, n); lbk_wr32(c, 0); expect_only(lbk_validate_llg, c, n, 702); free(c);
     c = dup_bytes(b, n); lbk_wr32(c, 14); expect_only(lbk_validate_llg, c, n, 702); free(c); /* 32 + 14·96 > 1340 */
@@ -334,7 +336,7 @@ static void octp_fixture(lbk_octp_probe_desc *pd, void **out, size_t *size)
             pd[p].depth[i][1] = pd[p].depth[i][0] * pd[p].depth[i][0]; /* rounds */
         }
     }
-    assert_int_equal(lbk_octp_build(pd, 2, NULL, out, size), LBK_OK);
+    assert_int_equal(lbk_octp_build(pd, 2, 0, NULL, out, size), LBK_OK);
 }
 
 static void octa_mapping(void **state)
@@ -400,6 +402,7 @@ static void octp_rules(void **state)
     const size_t p1 = 16 + 1024;
     expect_only(lbk_validate_octp, b, 8, 1000);
     c = dup_bytes(b, n); c[12] = 1; expect_only(lbk_validate_octp, c, n, 1001); free(c);
+    c = dup_bytes(b, n); c[5] = 1; expect_only(lbk_validate_octp, c, n, 1009); free(c);
     c = dup_bytes(b, n); lbk_wr32(c, 0); expect_only(lbk_validate_octp, c, n, 1002); free(c);
     expect_only(lbk_validate_octp, b, n - 1024, 1003);
     /* interior texel (1,1) of probe 1 set to NaN: also its border copies now differ → 1006 */
@@ -439,13 +442,174 @@ static void container_clean(void **state)
     assert_int_equal(lbk_validate_memory(file, fsize, NULL, collect, &is, &sum), LBK_OK);
     assert_int_equal(sum.fatal + sum.errors, 0);
     for (int i = 0; i < is.n; i++) assert_int_equal(is.id[i], 221); /* only: no OBJS section */
-    for (uint32_t id = 500; id <= 510; id++) assert_non_null(lbk_issue_template(id, NULL));
-    for (uint32_t id = 600; id <= 610; id++) assert_non_null(lbk_issue_template(id, NULL));
-    for (uint32_t id = 700; id <= 712; id++) assert_non_null(lbk_issue_template(id, NULL));
-    for (uint32_t id = 1000; id <= 1008; id++) assert_non_null(lbk_issue_template(id, NULL));
+    for (uint32_t id = 500; id <= 511; id++) assert_non_null(lbk_issue_template(id, NULL));
+    for (uint32_t id = 600; id <= 611; id++) assert_non_null(lbk_issue_template(id, NULL));
+    for (uint32_t id = 700; id <= 713; id++) assert_non_null(lbk_issue_template(id, NULL));
+    for (uint32_t id = 1000; id <= 1009; id++) assert_non_null(lbk_issue_template(id, NULL));
     lbk_free(NULL, file);
     lbk_writer_destroy(w);
     for (int i = 0; i < 4; i++) lbk_free(NULL, s[i]);
+}
+
+/* The radiometric scale (spec §5.7): every section round-trips physical values exactly through a
+ * scale ≠ 1 (stored bytes are those of value / scale), builders refuse and validators report a
+ * scale that is not a positive finite power of two. */
+static void scaled_sections(void **state)
+{
+    (void)state;
+    /* LMAP: texels are stored units; the view and lbk_lmap_page_irradiance apply 2^-20 */
+    lbk_ahd_texel t0[6], t1[20];
+    void *b1, *bs;
+    size_t n1, ns;
+    lmap_fixture(&b1, &n1, t0, t1);
+    const lbk_lmap_page_desc pages[2] = {{3, 2, t0}, {5, 4, t1}};
+    assert_int_equal(lbk_lmap_build(pages, 2, 0x1p-20f, NULL, &bs, &ns), LBK_OK);
+    assert_int_equal(ns, n1);
+    assert_memory_equal((uint8_t *)bs + 8, (uint8_t *)b1 + 8, n1 - 8); /* only the scale differs */
+    assert_true(lbk_rdf32((uint8_t *)bs + 4) == 0x1p-20f && lbk_rdf32((uint8_t *)b1 + 4) == 1.0f);
+    lbk_lmap_view lv;
+    lbk_lmap_page pg;
+    assert_int_equal(lbk_lmap_open(bs, ns, &lv), LBK_OK);
+    assert_true(lv.scale == 0x1p-20f);
+    assert_int_equal(lbk_lmap_get_page(&lv, 0, &pg), LBK_OK);
+    assert_true(pg.scale == 0x1p-20f);
+    const float nz[3] = {0, 0.6f, 0.8f};
+    for (uint32_t i = 0; i < 6; i++) {
+        float e[3], want[3];
+        assert_int_equal(lbk_lmap_page_irradiance(&pg, i % 3, i / 3, nz, e), LBK_OK);
+        lbk_ahd_irradiance(&t0[i], nz, want);
+        for (int c = 0; c < 3; c++) assert_true(e[c] == want[c] * 0x1p-20f && want[c] > 0);
+    }
+    issues is;
+    run(lbk_validate_lmap, bs, ns, &is, NULL);
+    assert_int_equal(is.n, 0);
+    void *none;
+    size_t none_n;
+    assert_int_equal(lbk_lmap_build(pages, 2, 3.0f, NULL, &none, &none_n), LBK_ERR_INVALID_ARGUMENT);
+    lbk_free(NULL, b1);
+
+    /* GLG: physical SH in, physical out; the stored probe is value / scale */
+    lbk_sh9_rgb sh[8], got;
+    memset(sh, 0, sizeof sh);
+    for (int i = 0; i < 8; i++)
+        for (int c = 0; c < 3; c++) {
+            sh[i].c[c][0] = 3e5f * (float)(i + 1) * (float)(c + 1);
+            sh[i].c[c][3] = 1e5f * (float)(i + 1); /* within √3·DC */
+        }
+    lbk_glg_desc d = {8, 6, cube_pos, sh, cube_tets, NULL, NULL, 0x1p8f};
+    void *gb;
+    size_t gn;
+    assert_int_equal(lbk_glg_build(&d, NULL, &gb, &gn), LBK_OK);
+    lbk_glg_view gv;
+    assert_int_equal(lbk_glg_open(gb, gn, &gv), LBK_OK);
+    assert_true(gv.scale == 0x1p8f);
+    for (uint32_t i = 0; i < 8; i++) {
+        lbk_sh9_rgb stored, want;
+        memset(&want, 0, sizeof want);
+        lbk_sh9_add_scaled(&want, &sh[i], 0x1p-8f);
+        uint8_t packed[LBK_SH9_PACKED_SIZE];
+        lbk_sh9_pack(&want, packed);
+        assert_memory_equal(gv.probes + LBK_SH9_PACKED_SIZE * i, packed, LBK_SH9_PACKED_SIZE);
+        lbk_sh9_unpack(packed, &stored);
+        assert_int_equal(lbk_glg_probe(&gv, i, NULL, &got), LBK_OK);
+        for (int c = 0; c < 3; c++)
+            for (int k = 0; k < 9; k++) assert_true(got.c[c][k] == stored.c[c][k] * 0x1p8f);
+        /* RGB9E5 DC within 2^-9 of the largest channel (up to 7.2e6: far above 65408, the format maximum at scale 1) */
+        for (int c = 0; c < 3; c++) assert_true(fabsf(got.c[c][0] - sh[i].c[c][0]) <= sh[i].c[2][0] * 0x1p-9f);
+    }
+    const float at7[3] = {1, 1, 1};
+    assert_int_equal(lbk_glg_sample(&gv, at7, NULL, &got, NULL), LBK_OK);
+    assert_true(fabsf(got.c[2][0] - 2.4e6f * 3) <= 2.4e6f * 3 * 0x1p-9f);
+    run(lbk_validate_glg, gb, gn, &is, NULL);
+    assert_int_equal(is.n, 0);
+    lbk_free(NULL, gb);
+    d.scale = -2.0f;
+    assert_int_equal(lbk_glg_build(&d, NULL, &none, &none_n), LBK_ERR_INVALID_ARGUMENT);
+
+    /* LLG: a uniform field sampled and applied to a vertex, physical values at scale 2^-30 */
+    lbk_sh9_rgb lp[8];
+    memset(lp, 0, sizeof lp);
+    for (int i = 0; i < 8; i++)
+        for (int c = 0; c < 3; c++) lp[i].c[c][0] = 1e-7f;
+    const lbk_llg_vertex vert = {1.0f, {0, 0, 1}};
+    lbk_llg_grid_desc g;
+    memset(&g, 0, sizeof g);
+    g.axes[0][0] = g.axes[1][1] = g.axes[2][2] = 1.0f;
+    g.half_extent[0] = g.half_extent[1] = g.half_extent[2] = 1.0f;
+    g.dims[0] = g.dims[1] = g.dims[2] = 2;
+    g.probes = lp;
+    g.vertices = &vert;
+    g.vertex_count = 1;
+    void *lb;
+    size_t ln;
+    assert_int_equal(lbk_llg_build(&g, 1, 0x1p-30f, NULL, &lb, &ln), LBK_OK);
+    lbk_llg_view llv;
+    assert_int_equal(lbk_llg_open(lb, ln, &llv), LBK_OK);
+    assert_true(llv.scale == 0x1p-30f);
+    const float origin[3] = {0.1f, -0.2f, 0.3f};
+    assert_int_equal(lbk_llg_sample(&llv, 0, origin, &got), LBK_OK);
+    for (int c = 0; c < 3; c++) assert_true(fabsf(got.c[c][0] - 1e-7f) <= 1e-7f * 0x1p-9f);
+    float e[3];
+    assert_int_equal(lbk_llg_vertex_irradiance(&llv, 0, 0, origin, e), LBK_OK);
+    const float e_want = (float)(M_PI * 0.282094791773878) * 1e-7f; /* A0·Y0·L0 */
+    for (int c = 0; c < 3; c++) assert_true(fabsf(e[c] - e_want) <= e_want * 0x1p-8f);
+    run(lbk_validate_llg, lb, ln, &is, NULL);
+    assert_int_equal(is.n, 0);
+    lbk_free(NULL, lb);
+
+    /* OCTP: irradiance 2^20 × the fixture's exact values round-trips exactly at scale 2^20 */
+    lbk_octp_probe_desc pd[2], back;
+    void *ob;
+    size_t on;
+    octp_fixture(pd, &ob, &on);
+    lbk_free(NULL, ob);
+    for (int p = 0; p < 2; p++)
+        for (int i = 0; i < 16; i++)
+            for (int k = 0; k < 3; k++) pd[p].irradiance[i][k] *= 0x1p20f;
+    assert_int_equal(lbk_octp_build(pd, 2, 0x1p20f, NULL, &ob, &on), LBK_OK);
+    lbk_octp_view ov;
+    assert_int_equal(lbk_octp_open(ob, on, &ov), LBK_OK);
+    assert_true(ov.scale == 0x1p20f);
+    assert_int_equal(lbk_octp_get(&ov, 1, &back), LBK_OK);
+    assert_memory_equal(back.irradiance, pd[1].irradiance, sizeof back.irradiance);
+    float dir[3], rgb[3];
+    lbk_oct_texel_direction(4, 2, 1, dir);
+    assert_int_equal(lbk_octp_irradiance(&ov, 0, dir, rgb), LBK_OK);
+    for (int k = 0; k < 3; k++) assert_true(fabsf(rgb[k] - pd[0].irradiance[1 * 4 + 2][k]) <= pd[0].irradiance[1 * 4 + 2][k] * 1e-6f);
+    run(lbk_validate_octp, ob, on, &is, NULL);
+    assert_int_equal(is.n, 0);
+
+    /* invalid scales: zero, NaN, +Inf, negative, not a power of two, denormal — each is exactly
+     * the section's scale issue, and the view refuses the bytes */
+    const uint32_t bad[6] = {0x00000000u, 0x7fc00000u, 0x7f800000u, 0xc0000000u, 0x40400000u /* 3 */, 0x00400000u};
+    for (int k = 0; k < 6; k++) {
+        uint8_t *c = dup_bytes(bs, ns);
+        lbk_wr32(c + 4, bad[k]);
+        expect_only(lbk_validate_lmap, c, ns, 511);
+        assert_int_equal(lbk_lmap_open(c, ns, &lv), LBK_ERR_CORRUPT);
+        free(c);
+        c = dup_bytes(ob, on);
+        lbk_wr32(c + 4, bad[k]);
+        expect_only(lbk_validate_octp, c, on, 1009);
+        assert_int_equal(lbk_octp_open(c, on, &ov), LBK_ERR_CORRUPT);
+        free(c);
+    }
+    glg_fixture(8, &gb, &gn);
+    assert_int_equal(lbk_llg_build(&g, 1, 0, NULL, &lb, &ln), LBK_OK);
+    for (int k = 0; k < 6; k++) {
+        uint8_t *c = dup_bytes(gb, gn);
+        lbk_wr32(c + 8, bad[k]);
+        expect_only(lbk_validate_glg, c, gn, 611);
+        assert_int_equal(lbk_glg_open(c, gn, &gv), LBK_ERR_CORRUPT);
+        free(c);
+        c = dup_bytes(lb, ln);
+        lbk_wr32(c + 4, bad[k]);
+        expect_only(lbk_validate_llg, c, ln, 713);
+        assert_int_equal(lbk_llg_open(c, ln, &llv), LBK_ERR_CORRUPT);
+        free(c);
+    }
+    assert_int_equal(lbk_octp_build(pd, 2, NAN, NULL, &none, &none_n), LBK_ERR_INVALID_ARGUMENT);
+    lbk_free(NULL, gb), lbk_free(NULL, lb), lbk_free(NULL, ob), lbk_free(NULL, bs);
 }
 
 int main(void)
@@ -453,6 +617,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(lmap_round_trip_and_rules), cmocka_unit_test(glg_rules), cmocka_unit_test(llg_rules),
         cmocka_unit_test(octa_mapping),              cmocka_unit_test(octp_rules), cmocka_unit_test(container_clean),
+        cmocka_unit_test(scaled_sections),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -44,7 +44,8 @@ typedef struct baked {
     uint32_t *base_z;
     uint8_t *base_rgba;
     uint32_t glg_count;
-    uint8_t *base_glg;
+    uint8_t *base_glg;      /* stored units, as a runtime uploads them */
+    float glg_scale;
     uint32_t llg_count;
     uint8_t *base_llg;
     const void *dls_data, *door_data;
@@ -102,13 +103,9 @@ static void bake_one(baked *b, const char *name, const ds_options *o, uint64_t s
         lbk_glg_view g;
         assert_int_equal(lbk_glg_open(d, n, &g), LBK_OK);
         b->glg_count = g.probe_count;
+        b->glg_scale = g.scale;
         b->base_glg = calloc(b->glg_count + 1, 28);
-        for (uint32_t i = 0; i < b->glg_count; i++) {
-            float p[3];
-            lbk_sh9_rgb sh;
-            assert_int_equal(lbk_glg_probe(&g, i, p, &sh), LBK_OK);
-            lbk_sh9_pack(&sh, &b->base_glg[28 * (size_t)i]);
-        }
+        memcpy(b->base_glg, g.probes, 28 * (size_t)b->glg_count);
     }
     lbk_objects_view ov;
     assert_int_equal(lbk_reader_section_by_type(b->rd, LBK_SECTION_OBJS, &d, &n), LBK_OK);
@@ -210,20 +207,21 @@ static cmp compare_room(const baked *ba, const uint32_t *za, const uint8_t *ra, 
         for (uint32_t x = 0; x < ba->room_rect[3]; x++) {
             uint64_t ia = pa.first_texel + (uint64_t)(ba->room_rect[2] + y) * pa.width + ba->room_rect[1] + x;
             uint64_t ib = pb.first_texel + (uint64_t)(bb->room_rect[2] + y) * pb.width + bb->room_rect[1] + x;
-            double a = texel_lum(za[ia], &ra[4 * ia]), b = texel_lum(zb[ib], &rb[4 * ib]);
+            /* physical: stored × each file's LMAP scale (spec §5.7) */
+            double a = texel_lum(za[ia], &ra[4 * ia]) * pa.scale, b = texel_lum(zb[ib], &rb[4 * ib]) * pb.scale;
             diff += fabs(a - b), sa += a, sb += b;
         }
     cmp c = {sb > 0 ? diff / sb : 0, sb > 0 ? sa / sb : 0, sa, sb};
     return c;
 }
 
-static double glg_sum(const uint8_t *probes, uint32_t n)
+static double glg_sum(const uint8_t *probes, uint32_t n, float scale)
 {
     double s = 0;
     for (uint32_t i = 0; i < n; i++) {
         lbk_sh9_rgb sh;
         lbk_sh9_unpack(&probes[28 * (size_t)i], &sh);
-        s += LBK_LUM_R * sh.c[0][0] + LBK_LUM_G * sh.c[1][0] + LBK_LUM_B * sh.c[2][0];
+        s += (LBK_LUM_R * sh.c[0][0] + LBK_LUM_G * sh.c[1][0] + LBK_LUM_B * sh.c[2][0]) * scale;
     }
     return s;
 }
@@ -378,7 +376,7 @@ static void test_linearity(void **state)
     cmp c = compare_room(&S, on.z, on.rgba, &R1, R1.base_z, R1.base_rgba);
     cmp noise = compare_room(&R1b, R1b.base_z, R1b.base_rgba, &R1, R1.base_z, R1.base_rgba);
     cmp without = compare_room(&S, off.z, off.rgba, &R1, R1.base_z, R1.base_rgba);
-    double ga = glg_sum(on.glg, S.glg_count), gr = glg_sum(R1.base_glg, R1.glg_count);
+    double ga = glg_sum(on.glg, S.glg_count, S.glg_scale), gr = glg_sum(R1.base_glg, R1.glg_count, R1.glg_scale);
     print_message("sets on vs static: L1 %.4f ratio %.4f | seed noise L1 %.4f ratio %.4f | sets off L1 %.4f | "
                   "GLG ratio %.4f\n",
                   c.l1, c.ratio, noise.l1, noise.ratio, without.l1, ga / gr);

@@ -93,6 +93,9 @@ lbk_result lbk_glg_build(const lbk_glg_desc *desc, const lbk_allocator *allocato
     *out = NULL;
     *size = 0;
     const uint32_t P = desc->probe_count, T = desc->tetra_count;
+    float scale;
+    if (!lbk_scale_resolve(desc->scale, &scale)) return LBK_ERR_INVALID_ARGUMENT;
+    const float inv = 1.0f / scale; /* exact: a power of two */
     glg_layout L;
     if (!glg_layout_of(P, T, &L) || L.end > SIZE_MAX) return LBK_ERR_LIMIT;
     for (uint32_t i = 0; i < P; i++)
@@ -145,9 +148,13 @@ lbk_result lbk_glg_build(const lbk_glg_desc *desc, const lbk_allocator *allocato
     }
     lbk_wr32(d, P);
     lbk_wr32(d + 4, T);
+    lbk_wrf32(d + 8, scale);
     for (uint32_t i = 0; i < P; i++) {
         for (int k = 0; k < 3; k++) lbk_wrf32(d + L.pos + 12 * (size_t)i + 4 * k, desc->positions[i][k]);
-        lbk_sh9_pack(&desc->probes[i], d + L.sh + (size_t)LBK_SH9_PACKED_SIZE * i);
+        lbk_sh9_rgb stored;
+        memset(&stored, 0, sizeof stored);
+        lbk_sh9_add_scaled(&stored, &desc->probes[i], inv);
+        lbk_sh9_pack(&stored, d + L.sh + (size_t)LBK_SH9_PACKED_SIZE * i);
     }
     for (uint32_t t = 0; t < T; t++)
         for (int k = 0; k < 4; k++) {
@@ -180,7 +187,8 @@ lbk_result lbk_glg_open(const void *data, size_t size, lbk_glg_view *out)
     const uint8_t *d = data;
     if (size < LBK_GLG_HEADER_SIZE) return LBK_ERR_TRUNCATED;
     const uint32_t P = lbk_rd32(d), T = lbk_rd32(d + 4);
-    if (P < 4 || T == 0 || !zero_range(d, 8, LBK_GLG_HEADER_SIZE)) return LBK_ERR_CORRUPT;
+    if (P < 4 || T == 0 || !lbk_scale_bits_ok(lbk_rd32(d + 8)) || !zero_range(d, 12, LBK_GLG_HEADER_SIZE))
+        return LBK_ERR_CORRUPT;
     glg_layout L;
     if (!glg_layout_of(P, T, &L)) return LBK_ERR_CORRUPT;
     if (L.end > size) return LBK_ERR_TRUNCATED;
@@ -198,6 +206,7 @@ lbk_result lbk_glg_open(const void *data, size_t size, lbk_glg_view *out)
     out->mesh.tetra_count = T;
     out->probes = d + L.sh;
     out->visibility = d + L.vis;
+    out->scale = lbk_rdf32(d + 8);
     return LBK_OK;
 }
 
@@ -207,7 +216,12 @@ lbk_result lbk_glg_probe(const lbk_glg_view *view, uint32_t index, float positio
     if (index >= view->probe_count) return LBK_ERR_RANGE;
     if (position)
         for (int k = 0; k < 3; k++) position[k] = lbk_rdf32(view->mesh.positions + 12 * (size_t)index + 4 * k);
-    if (sh) lbk_sh9_unpack(view->probes + (size_t)LBK_SH9_PACKED_SIZE * index, sh);
+    if (sh) {
+        lbk_sh9_rgb stored;
+        lbk_sh9_unpack(view->probes + (size_t)LBK_SH9_PACKED_SIZE * index, &stored);
+        memset(sh, 0, sizeof *sh);
+        lbk_sh9_add_scaled(sh, &stored, view->scale);
+    }
     return LBK_OK;
 }
 
@@ -231,7 +245,7 @@ lbk_result lbk_glg_sample(const lbk_glg_view *view, const float p[3], uint32_t *
         if (w[i] == 0.0f) continue;
         lbk_sh9_rgb sh;
         lbk_sh9_unpack(view->probes + (size_t)LBK_SH9_PACKED_SIZE * loc.vertices[i], &sh);
-        lbk_sh9_add_scaled(out, &sh, w[i]);
+        lbk_sh9_add_scaled(out, &sh, w[i] * view->scale); /* exact: the scale is a power of two */
     }
     if (info) {
         info->location = loc;
@@ -249,7 +263,8 @@ void lbk_validate_glg(lbk_vctx *ctx, const uint8_t *d, size_t size)
         return;
     }
     const uint32_t P = lbk_rd32(d), T = lbk_rd32(d + 4);
-    lbk_check_zero(ctx, 601, d, 8, LBK_GLG_HEADER_SIZE, "GLG header");
+    lbk_check_scale(ctx, 611, d, 8, "GLG");
+    lbk_check_zero(ctx, 601, d, 12, LBK_GLG_HEADER_SIZE, "GLG header");
     if (P < 4 || T == 0) {
         lbk_vreport(ctx, 602, 0, "GLG has %u probes and %u tetrahedra (needs >= 4 and >= 1)", P, T);
         return;

@@ -27,12 +27,13 @@ static bool lmap_next_page(lmap_cursor *c, uint32_t w, uint32_t h, uint64_t *pla
     return true;
 }
 
-lbk_result lbk_lmap_build(const lbk_lmap_page_desc *pages, uint32_t page_count, const lbk_allocator *allocator,
-                          void **out, size_t *size)
+lbk_result lbk_lmap_build(const lbk_lmap_page_desc *pages, uint32_t page_count, float scale,
+                          const lbk_allocator *allocator, void **out, size_t *size)
 {
     if (!out || !size || !pages || page_count == 0) return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
     *size = 0;
+    if (!lbk_scale_resolve(scale, &scale)) return LBK_ERR_INVALID_ARGUMENT;
     lmap_cursor c = {LBK_LMAP_HEADER_SIZE + (uint64_t)LBK_LMAP_PAGE_ENTRY_SIZE * page_count, 0};
     for (uint32_t p = 0; p < page_count; p++) {
         const lbk_lmap_page_desc *pd = &pages[p];
@@ -45,6 +46,7 @@ lbk_result lbk_lmap_build(const lbk_lmap_page_desc *pages, uint32_t page_count, 
     uint8_t *d = lbk_calloc(allocator, 1, (size_t)c.pos);
     if (!d) return LBK_ERR_OUT_OF_MEMORY;
     lbk_wr32(d, page_count);
+    lbk_wrf32(d + 4, scale);
     lbk_wr64(d + 8, c.texel);
     const uint64_t total = c.texel;
     c.pos = LBK_LMAP_HEADER_SIZE + (uint64_t)LBK_LMAP_PAGE_ENTRY_SIZE * page_count;
@@ -79,7 +81,7 @@ lbk_result lbk_lmap_open(const void *data, size_t size, lbk_lmap_view *out)
     const uint8_t *d = data;
     if (size < LBK_LMAP_HEADER_SIZE) return LBK_ERR_TRUNCATED;
     const uint32_t n = lbk_rd32(d);
-    if (lbk_rd32(d + 4) != 0) return LBK_ERR_CORRUPT;
+    if (!lbk_scale_bits_ok(lbk_rd32(d + 4))) return LBK_ERR_CORRUPT;
     if (n == 0) return LBK_ERR_CORRUPT;
     if (!lbk_range_ok(LBK_LMAP_HEADER_SIZE, (uint64_t)LBK_LMAP_PAGE_ENTRY_SIZE * n, size)) return LBK_ERR_TRUNCATED;
     lmap_cursor c = {LBK_LMAP_HEADER_SIZE + (uint64_t)LBK_LMAP_PAGE_ENTRY_SIZE * n, 0};
@@ -99,6 +101,7 @@ lbk_result lbk_lmap_open(const void *data, size_t size, lbk_lmap_view *out)
     out->size = size;
     out->page_count = n;
     out->texel_count = c.texel;
+    out->scale = lbk_rdf32(d + 4);
     return LBK_OK;
 }
 
@@ -114,6 +117,7 @@ lbk_result lbk_lmap_get_page(const lbk_lmap_view *view, uint32_t index, lbk_lmap
     out->rgba_offset = lbk_rd64(e + PE_PLANE1);
     out->irradiance = view->data + out->irradiance_offset;
     out->rgba = view->data + out->rgba_offset;
+    out->scale = view->scale;
     return LBK_OK;
 }
 
@@ -124,6 +128,17 @@ lbk_result lbk_lmap_page_texel(const lbk_lmap_page *page, uint32_t x, uint32_t y
     const size_t i = (size_t)y * page->width + x;
     out->irradiance_z = lbk_rd32(page->irradiance + 4 * i);
     memcpy(out->rgba, page->rgba + 4 * i, 4);
+    return LBK_OK;
+}
+
+lbk_result lbk_lmap_page_irradiance(const lbk_lmap_page *page, uint32_t x, uint32_t y, const float n[3], float rgb[3])
+{
+    if (!n || !rgb) return LBK_ERR_INVALID_ARGUMENT;
+    lbk_ahd_texel t;
+    lbk_result r = lbk_lmap_page_texel(page, x, y, &t);
+    if (r != LBK_OK) return r;
+    lbk_ahd_irradiance(&t, n, rgb);
+    for (int c = 0; c < 3; c++) rgb[c] *= page->scale;
     return LBK_OK;
 }
 
@@ -158,10 +173,7 @@ void lbk_validate_lmap(lbk_vctx *ctx, const uint8_t *d, size_t size)
     }
     const uint32_t n = lbk_rd32(d);
     bool ok = true;
-    if (lbk_rd32(d + 4) != 0) {
-        lbk_vreport(ctx, 501, 4, "LMAP header reserved field is 0x%08x", lbk_rd32(d + 4));
-        ok = false;
-    }
+    if (!lbk_check_scale(ctx, 511, d, 4, "LMAP")) ok = false;
     if (n == 0 || !lbk_range_ok(LBK_LMAP_HEADER_SIZE, (uint64_t)LBK_LMAP_PAGE_ENTRY_SIZE * n, size)) {
         lbk_vreport(ctx, 502, 0, "LMAP page_count %u does not fit a %zu-byte section", n, size);
         return;

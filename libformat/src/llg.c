@@ -69,12 +69,14 @@ static bool grid_desc_ok(const lbk_llg_grid_desc *g)
     return g->probes && (g->vertex_count == 0 || g->vertices);
 }
 
-lbk_result lbk_llg_build(const lbk_llg_grid_desc *grids, uint32_t grid_count, const lbk_allocator *allocator,
-                         void **out, size_t *size)
+lbk_result lbk_llg_build(const lbk_llg_grid_desc *grids, uint32_t grid_count, float scale,
+                         const lbk_allocator *allocator, void **out, size_t *size)
 {
     if (!grids || !out || !size || grid_count == 0) return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
     *size = 0;
+    if (!lbk_scale_resolve(scale, &scale)) return LBK_ERR_INVALID_ARGUMENT;
+    const float inv = 1.0f / scale; /* exact: a power of two */
     uint64_t probes = 0, vertices = 0;
     for (uint32_t g = 0; g < grid_count; g++) {
         if (!grid_desc_ok(&grids[g])) return LBK_ERR_INVALID_ARGUMENT;
@@ -86,6 +88,7 @@ lbk_result lbk_llg_build(const lbk_llg_grid_desc *grids, uint32_t grid_count, co
     uint8_t *d = lbk_calloc(allocator, 1, (size_t)L.end);
     if (!d) return LBK_ERR_OUT_OF_MEMORY;
     lbk_wr32(d, grid_count);
+    lbk_wrf32(d + 4, scale);
     lbk_wr64(d + 8, probes);
     lbk_wr64(d + 16, vertices);
     uint64_t po = 0, vo = 0;
@@ -102,7 +105,12 @@ lbk_result lbk_llg_build(const lbk_llg_grid_desc *grids, uint32_t grid_count, co
         lbk_wr64(r + GR_VERTEX_OFFSET, vo);
         lbk_wr32(r + GR_VERTEX_COUNT, gd->vertex_count);
         const uint64_t np = (uint64_t)gd->dims[0] * gd->dims[1] * gd->dims[2];
-        for (uint64_t i = 0; i < np; i++) lbk_sh9_pack(&gd->probes[i], d + L.probes + (po + i) * LBK_SH9_PACKED_SIZE);
+        for (uint64_t i = 0; i < np; i++) {
+            lbk_sh9_rgb stored;
+            memset(&stored, 0, sizeof stored);
+            lbk_sh9_add_scaled(&stored, &gd->probes[i], inv);
+            lbk_sh9_pack(&stored, d + L.probes + (po + i) * LBK_SH9_PACKED_SIZE);
+        }
         for (uint32_t i = 0; i < gd->vertex_count; i++) lbk_llg_vertex_encode(&gd->vertices[i], d + L.vertices + (vo + i) * 4);
         po += np;
         vo += gd->vertex_count;
@@ -138,7 +146,7 @@ lbk_result lbk_llg_open(const void *data, size_t size, lbk_llg_view *out)
     if (size < LBK_LLG_HEADER_SIZE) return LBK_ERR_TRUNCATED;
     const uint32_t G = lbk_rd32(d);
     const uint64_t P = lbk_rd64(d + 8), V = lbk_rd64(d + 16);
-    if (G == 0 || lbk_rd32(d + 4) != 0 || lbk_rd64(d + 24) != 0) return LBK_ERR_CORRUPT;
+    if (G == 0 || !lbk_scale_bits_ok(lbk_rd32(d + 4)) || lbk_rd64(d + 24) != 0) return LBK_ERR_CORRUPT;
     llg_layout L;
     if (!llg_layout_of(G, P, V, &L)) return LBK_ERR_CORRUPT;
     if (L.end > size) return LBK_ERR_TRUNCATED;
@@ -162,6 +170,7 @@ lbk_result lbk_llg_open(const void *data, size_t size, lbk_llg_view *out)
     out->vertex_count = V;
     out->probes = d + L.probes;
     out->vertices = d + L.vertices;
+    out->scale = lbk_rdf32(d + 4);
     return LBK_OK;
 }
 
@@ -211,7 +220,7 @@ lbk_result lbk_llg_sample(const lbk_llg_view *view, uint32_t grid, const float p
         const uint64_t idx = g.probe_offset + (i0[0] + di) + (uint64_t)g.dims[0] * ((i0[1] + dj) + (uint64_t)g.dims[1] * (i0[2] + dk));
         lbk_sh9_rgb sh;
         lbk_sh9_unpack(view->probes + idx * LBK_SH9_PACKED_SIZE, &sh);
-        lbk_sh9_add_scaled(out, &sh, w);
+        lbk_sh9_add_scaled(out, &sh, w * view->scale); /* exact: the scale is a power of two */
     }
     return LBK_OK;
 }
@@ -244,7 +253,7 @@ void lbk_validate_llg(lbk_vctx *ctx, const uint8_t *d, size_t size)
     }
     const uint32_t G = lbk_rd32(d);
     const uint64_t P = lbk_rd64(d + 8), V = lbk_rd64(d + 16);
-    if (lbk_rd32(d + 4) != 0) lbk_vreport(ctx, 701, 4, "LLG header reserved field is 0x%08x", lbk_rd32(d + 4));
+    lbk_check_scale(ctx, 713, d, 4, "LLG");
     if (lbk_rd64(d + 24) != 0) lbk_vreport(ctx, 701, 24, "LLG header reserved field is not zero");
     if (G == 0 || !lbk_range_ok(LBK_LLG_HEADER_SIZE, (uint64_t)LBK_LLG_GRID_SIZE * G, size)) {
         lbk_vreport(ctx, 702, 0, "LLG grid_count %u does not fit a %zu-byte section", G, size);

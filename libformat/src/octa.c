@@ -71,12 +71,14 @@ void lbk_oct_texel_direction(uint32_t n, uint32_t i, uint32_t j, float dir[3])
 #define IRR_S (LBK_OCTP_IRR_N + 2u)
 #define DEPTH_S (LBK_OCTP_DEPTH_N + 2u)
 
-lbk_result lbk_octp_build(const lbk_octp_probe_desc *probes, uint32_t count, const lbk_allocator *allocator, void **out,
-                          size_t *size)
+lbk_result lbk_octp_build(const lbk_octp_probe_desc *probes, uint32_t count, float scale, const lbk_allocator *allocator,
+                          void **out, size_t *size)
 {
     if (!probes || !out || !size || count == 0) return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
     *size = 0;
+    if (!lbk_scale_resolve(scale, &scale)) return LBK_ERR_INVALID_ARGUMENT;
+    const float inv = 1.0f / scale; /* exact: a power of two */
     uint64_t total;
     if (!lbk_madd_u64(LBK_OCTP_HEADER_SIZE, count, LBK_OCTP_PROBE_SIZE, &total) || total > SIZE_MAX) return LBK_ERR_LIMIT;
     for (uint32_t p = 0; p < count; p++)
@@ -84,6 +86,7 @@ lbk_result lbk_octp_build(const lbk_octp_probe_desc *probes, uint32_t count, con
     uint8_t *d = lbk_calloc(allocator, 1, (size_t)total);
     if (!d) return LBK_ERR_OUT_OF_MEMORY;
     lbk_wr32(d, count);
+    lbk_wrf32(d + 4, scale);
     for (uint32_t p = 0; p < count; p++) {
         uint8_t *q = d + LBK_OCTP_HEADER_SIZE + (size_t)LBK_OCTP_PROBE_SIZE * p;
         const lbk_octp_probe_desc *pd = &probes[p];
@@ -92,7 +95,8 @@ lbk_result lbk_octp_build(const lbk_octp_probe_desc *probes, uint32_t count, con
                 uint32_t sx, sy;
                 lbk_oct_border_source(LBK_OCTP_IRR_N, x, y, &sx, &sy);
                 const float *c = pd->irradiance[(sy - 1) * LBK_OCTP_IRR_N + (sx - 1)];
-                lbk_wr32(q + LBK_OCTP_IRR_OFFSET + 4 * (y * IRR_S + x), lbk_pack_r11g11b10f(c));
+                const float st[3] = {c[0] * inv, c[1] * inv, c[2] * inv};
+                lbk_wr32(q + LBK_OCTP_IRR_OFFSET + 4 * (y * IRR_S + x), lbk_pack_r11g11b10f(st));
             }
         for (uint32_t y = 0; y < DEPTH_S; y++)
             for (uint32_t x = 0; x < DEPTH_S; x++) {
@@ -119,7 +123,7 @@ lbk_result lbk_octp_open(const void *data, size_t size, lbk_octp_view *out)
     const uint8_t *d = data;
     if (size < LBK_OCTP_HEADER_SIZE) return LBK_ERR_TRUNCATED;
     const uint32_t n = lbk_rd32(d);
-    if (n == 0 || lbk_rd32(d + 4) != 0 || lbk_rd64(d + 8) != 0) return LBK_ERR_CORRUPT;
+    if (n == 0 || !lbk_scale_bits_ok(lbk_rd32(d + 4)) || lbk_rd64(d + 8) != 0) return LBK_ERR_CORRUPT;
     const uint64_t need = LBK_OCTP_HEADER_SIZE + (uint64_t)LBK_OCTP_PROBE_SIZE * n;
     if (need > size) return LBK_ERR_TRUNCATED;
     if (need != size) return LBK_ERR_CORRUPT;
@@ -127,6 +131,7 @@ lbk_result lbk_octp_open(const void *data, size_t size, lbk_octp_view *out)
     out->size = size;
     out->probe_count = n;
     out->probes = d + LBK_OCTP_HEADER_SIZE;
+    out->scale = lbk_rdf32(d + 4);
     return LBK_OK;
 }
 
@@ -136,9 +141,11 @@ lbk_result lbk_octp_get(const lbk_octp_view *view, uint32_t index, lbk_octp_prob
     if (index >= view->probe_count) return LBK_ERR_RANGE;
     const uint8_t *q = view->probes + (size_t)LBK_OCTP_PROBE_SIZE * index;
     for (uint32_t j = 0; j < LBK_OCTP_IRR_N; j++)
-        for (uint32_t i = 0; i < LBK_OCTP_IRR_N; i++)
-            lbk_unpack_r11g11b10f(lbk_rd32(q + LBK_OCTP_IRR_OFFSET + 4 * ((j + 1) * IRR_S + i + 1)),
-                                  out->irradiance[j * LBK_OCTP_IRR_N + i]);
+        for (uint32_t i = 0; i < LBK_OCTP_IRR_N; i++) {
+            float *c = out->irradiance[j * LBK_OCTP_IRR_N + i];
+            lbk_unpack_r11g11b10f(lbk_rd32(q + LBK_OCTP_IRR_OFFSET + 4 * ((j + 1) * IRR_S + i + 1)), c);
+            for (int k = 0; k < 3; k++) c[k] *= view->scale;
+        }
     for (uint32_t j = 0; j < LBK_OCTP_DEPTH_N; j++)
         for (uint32_t i = 0; i < LBK_OCTP_DEPTH_N; i++) {
             const uint8_t *t = q + LBK_OCTP_DEPTH_OFFSET + 4 * ((j + 1) * DEPTH_S + i + 1);
@@ -175,6 +182,7 @@ lbk_result lbk_octp_irradiance(const lbk_octp_view *view, uint32_t index, const 
             lbk_unpack_r11g11b10f(lbk_rd32(q + 4 * ((size_t)(i0[1] + dy) * IRR_S + (size_t)(i0[0] + dx))), c);
             for (int k = 0; k < 3; k++) rgb[k] += w * c[k];
         }
+    for (int k = 0; k < 3; k++) rgb[k] *= view->scale;
     return LBK_OK;
 }
 
@@ -185,7 +193,8 @@ void lbk_validate_octp(lbk_vctx *ctx, const uint8_t *d, size_t size)
         return;
     }
     const uint32_t n = lbk_rd32(d);
-    lbk_check_zero(ctx, 1001, d, 4, LBK_OCTP_HEADER_SIZE, "OCTP header");
+    lbk_check_scale(ctx, 1009, d, 4, "OCTP");
+    lbk_check_zero(ctx, 1001, d, 8, LBK_OCTP_HEADER_SIZE, "OCTP header");
     if (n == 0) {
         lbk_vreport(ctx, 1002, 0, "OCTP has no probes");
         return;

@@ -116,6 +116,7 @@ static const issue_row registry[] = {
     {508, ERROR, LBK_SECTION_LMAP, "LMAP non-zero padding byte between planes"},
     {509, ERROR, LBK_SECTION_LMAP, "LMAP irradiance texel has an Inf/NaN channel (exponent 31)"},
     {510, WARNING, LBK_SECTION_LMAP, "LMAP highlight direction shorter than 1/2 (decodes as +Z)"},
+    {511, ERROR, LBK_SECTION_LMAP, "LMAP scale is not a positive finite power of two"},
 
     /* ---- 600–699 GLG (codec helper) ------------------------------------------------------ */
     {600, ERROR, LBK_SECTION_GLG, "GLG shorter than its 32-byte header"},
@@ -129,6 +130,7 @@ static const issue_row registry[] = {
     {608, ERROR, LBK_SECTION_GLG, "GLG neighbour index out of range"},
     {609, ERROR, LBK_SECTION_GLG, "GLG adjacency not symmetric or neighbour does not share the face"},
     {610, WARNING, LBK_SECTION_GLG, "GLG probe belongs to no tetrahedron"},
+    {611, ERROR, LBK_SECTION_GLG, "GLG scale is not a positive finite power of two"},
 
     /* ---- 700–799 LLG (codec helper) ------------------------------------------------------ */
     {700, ERROR, LBK_SECTION_LLG, "LLG shorter than its 32-byte header"},
@@ -144,6 +146,7 @@ static const issue_row registry[] = {
     {710, ERROR, LBK_SECTION_LLG, "LLG grid vertex_offset differs from the running vertex count"},
     {711, ERROR, LBK_SECTION_LLG, "LLG header probe or vertex count differs from the grids"},
     {712, ERROR, LBK_SECTION_LLG, "LLG vertex visibility reserved byte is not zero"},
+    {713, ERROR, LBK_SECTION_LLG, "LLG scale is not a positive finite power of two"},
 
     /* ---- 800–899 DLS (dls helper) -------------------------------------------------------- */
     {800, ERROR, LBK_SECTION_DLS, "DLS shorter than its 96-byte header"},
@@ -209,6 +212,7 @@ static const issue_row registry[] = {
     {1006, ERROR, LBK_SECTION_OCTP, "OCTP border texel differs from the interior texel it copies"},
     {1007, ERROR, LBK_SECTION_OCTP, "OCTP probe position is NaN or infinite"},
     {1008, ERROR, LBK_SECTION_OCTP, "OCTP probe reserved bytes are not zero"},
+    {1009, ERROR, LBK_SECTION_OCTP, "OCTP scale is not a positive finite power of two"},
 };
 
 const char *lbk_issue_template(uint32_t id, lbk_severity *severity)

@@ -56,4 +56,36 @@ static inline bool lbk_r11g11b10f_special(uint32_t v)
     return (v & 0x7c0u) == 0x7c0u || (v & (0x7c0u << 11)) == (0x7c0u << 11) || (v & (0x3e0u << 22)) == (0x3e0u << 22);
 }
 
+/* Radiometric scale of a lighting section (spec/container.md §5.7): stored value × scale =
+ * physical value. Valid: a positive, normal, finite power of two (sign 0, mantissa 0,
+ * exponent field 1..254), so multiplying or dividing by it is exact and never changes rounding. */
+static inline bool lbk_scale_bits_ok(uint32_t bits)
+{
+    const uint32_t e = bits >> 23;
+    return (bits & 0x007fffffu) == 0 && e >= 1 && e <= 254;
+}
+static inline uint32_t lbk_f32_bits(float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, 4);
+    return u;
+}
+/* A builder's scale argument: 0 means 1; anything else must be a valid scale. */
+static inline bool lbk_scale_resolve(float in, float *out)
+{
+    if (in == 0.0f) in = 1.0f;
+    *out = in;
+    return lbk_scale_bits_ok(lbk_f32_bits(in));
+}
+/* Reports `id` when the scale at byte `offset` of section `what` is invalid; true when valid. */
+static inline bool lbk_check_scale(lbk_vctx *ctx, uint32_t id, const uint8_t *d, uint64_t offset, const char *what)
+{
+    const uint32_t bits = lbk_rd32(d + offset);
+    if (lbk_scale_bits_ok(bits)) return true;
+    float f;
+    memcpy(&f, &bits, 4);
+    lbk_vreport(ctx, id, offset, "%s scale 0x%08x (%g) is not a positive finite power of two", what, bits, (double)f);
+    return false;
+}
+
 #endif

@@ -40,7 +40,7 @@ int main(void)
     const lbk_report rep = {LBK_BAKE_SAMPLE_LIMIT, 0, 2, 0, 0, rec, 2};
     void *lm, *llg, *ob, *me, *re;
     size_t lmn, llgn, obn, men, ren;
-    if (lbk_lmap_build(pages, 2, NULL, &lm, &lmn) || lbk_llg_build(&grid, 1, NULL, &llg, &llgn) ||
+    if (lbk_lmap_build(pages, 2, 0, NULL, &lm, &lmn) || lbk_llg_build(&grid, 1, 0, NULL, &llg, &llgn) ||
         lbk_objects_build(objs, 3, NULL, &ob, &obn) || lbk_meta_build(meta, 2, NULL, &me, &men) ||
         lbk_report_build(&rep, NULL, &re, &ren))
         return 1;

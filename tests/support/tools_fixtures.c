@@ -2,6 +2,7 @@
 #include "tools_fixtures.h"
 
 #include <stdio.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -134,8 +135,11 @@ tf_blob tf_build_scene(int kind, const tf_options *opt_in)
         tex[p] = calloc((size_t)pw[p] * ph[p], sizeof(lbk_ahd_texel));
         for (uint32_t y = 0; y < ph[p]; y++)
             for (uint32_t x = 0; x < pw[p]; x++) {
-                lbk_ahd_linear lin;
+                lbk_ahd_linear lin, stored;
                 tf_texel_linear(p, x, y, &lin);
+                memset(&stored, 0, sizeof stored);
+                lbk_ahd_linear_add_scaled(&stored, &lin, ldexpf(1.0f, -opt.scale_log2));
+                lin = stored;
                 lbk_ahd_texel *t = &tex[p][(size_t)y * pw[p] + x];
                 lbk_ahd_from_linear(&lin, t);
                 if (p == opt.texel_page && x == opt.texel_x && y == opt.texel_y) {
@@ -150,7 +154,7 @@ tf_blob tf_build_scene(int kind, const tf_options *opt_in)
             }
         pages[p] = (lbk_lmap_page_desc){pw[p], ph[p], tex[p]};
     }
-    CHECK(lbk_lmap_build(pages, 2, NULL, &data, &size));
+    CHECK(lbk_lmap_build(pages, 2, ldexpf(1.0f, opt.scale_log2), NULL, &data, &size));
     add(w, LBK_SECTION_LMAP, data, size, LBK_SECTION_FLAG_REQUIRED);
     const uint64_t texel_count = (uint64_t)pw[0] * ph[0] + (uint64_t)pw[1] * ph[1];
 
@@ -169,6 +173,7 @@ tf_blob tf_build_scene(int kind, const tf_options *opt_in)
         g.positions = tf_probe_positions;
         g.probes = sh;
         g.tetras = tetras;
+        g.scale = ldexpf(1.0f, opt.scale_log2);
         CHECK(lbk_glg_build(&g, NULL, &data, &size));
         add(w, LBK_SECTION_GLG, data, size, 0);
 
@@ -182,6 +187,8 @@ tf_blob tf_build_scene(int kind, const tf_options *opt_in)
             memset(&lin, 0, sizeof lin);
             const float up[3] = {0, 0, 1}, c[3] = {0.5f, 0.4f, 0.1f * (float)(i % 7)};
             lbk_ahd_linear_add_light(&lin, up, c);
+            for (int ch = 0; ch < 3; ch++)
+                for (int k = 0; k < 4; k++) lin.c[ch][k] = ldexpf(lin.c[ch][k], -opt.scale_log2);
             lbk_ahd_texel t;
             lbk_ahd_from_linear(&lin, &t);
             lbk_ahd_texel_store(&t, payload + (size_t)i * LBK_DLS_TEXEL_PAYLOAD);
@@ -191,6 +198,8 @@ tf_blob tf_build_scene(int kind, const tf_options *opt_in)
         for (int i = 0; i < 2; i++) {
             lbk_sh9_rgb s;
             tf_probe_sh(10 + (uint32_t)i, &s);
+            for (int ch = 0; ch < 3; ch++)
+                for (int k = 0; k < 9; k++) s.c[ch][k] = ldexpf(s.c[ch][k], -opt.scale_log2);
             lbk_sh9_pack(&s, ppay + i * LBK_DLS_PROBE_PAYLOAD);
         }
         const char *lights[] = {"lamp.bulb"};

@@ -34,6 +34,8 @@ typedef struct tf_options {
     int move_crate_geometry;   /* "crate" gets another geometry hash */
     float probe_scale;         /* multiply GLG probe 3's SH by this when != 0 */
     uint32_t page0_width;      /* 0: 64 */
+    int scale_log2;            /* LMAP and GLG scale 2^scale_log2 (spec §5.7), DLS payloads stored in
+                                  it: the same physical lighting in other stored units */
 } tf_options;
 
 typedef struct tf_blob {

@@ -4,7 +4,11 @@
  * Visibility: per tetra 4 unorm8 values; value i is the fraction of unoccluded rays between
  * probe i of the tetra and sample points on the opposite face (255 = fully visible). Sampling
  * weights probe i by bary_i · vis_i / 255 and renormalises; when every product is 0 the plain
- * barycentrics are used. Outside the hull the walk's clamped barycentrics are used (lbk/tetra.h). */
+ * barycentrics are used. Outside the hull the walk's clamped barycentrics are used (lbk/tetra.h).
+ *
+ * Scale (spec §5.7): packed probe × scale = physical radiance. The builder takes physical SH and
+ * divides by the scale before packing; lbk_glg_probe and lbk_glg_sample return physical SH; the
+ * raw bytes at view->probes are in stored units (as are DLS GLG payloads). */
 #ifndef LBK_GLG_H
 #define LBK_GLG_H
 
@@ -25,6 +29,7 @@ typedef struct lbk_glg_desc {
     const uint32_t (*tetras)[4];      /* tetra_count; either orientation (the builder orients them) */
     const uint32_t (*adjacency)[4];   /* NULL: derived from shared faces */
     const uint8_t (*visibility)[4];   /* NULL: all 255 */
+    float scale;                      /* 0: 1; else a positive normal power of two */
 } lbk_glg_desc;
 
 /* Serialises a GLG (deterministic). Tetras of negative volume are re-oriented by swapping their
@@ -40,10 +45,12 @@ typedef struct lbk_glg_view {
     lbk_tetra_mesh mesh;        /* positions, tetras, adjacency inside data */
     const uint8_t *probes;      /* probe_count × 28 bytes */
     const uint8_t *visibility;  /* tetra_count × 4 bytes */
+    float scale;                /* stored × scale = physical */
 } lbk_glg_view;
 
 /* Structure only (header, sizes, reserved and padding bytes); lbk_validate checks the mesh. */
 LBK_API lbk_result lbk_glg_open(const void *data, size_t size, lbk_glg_view *out);
+/* Position and physical radiance SH (unpacked × scale) of one probe; either may be NULL. */
 LBK_API lbk_result lbk_glg_probe(const lbk_glg_view *view, uint32_t index, float position[3], lbk_sh9_rgb *sh);
 
 typedef struct lbk_glg_sample_info {
@@ -51,7 +58,7 @@ typedef struct lbk_glg_sample_info {
     float weights[4]; /* the visibility-weighted weights actually used, sum 1 */
 } lbk_glg_sample_info;
 
-/* Radiance SH at p: locate (starting at *hint if hint is non-NULL; the found tetra is written
+/* Physical radiance SH at p: locate (starting at *hint if hint is non-NULL; the found tetra is written
  * back for the next call), weight, and blend the four unpacked probes. */
 LBK_API lbk_result lbk_glg_sample(const lbk_glg_view *view, const float p[3], uint32_t *hint, lbk_sh9_rgb *out,
                                   lbk_glg_sample_info *info);

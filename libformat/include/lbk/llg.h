@@ -16,7 +16,12 @@
  *           axis0, axis1, axis2), byte 3 reserved 0.
  * Apply: E_vertex = V · E_sh(b_world), b_world = Σ_a b_a·axis_a, with E_sh the SH irradiance
  * (lbk_sh9_irradiance) of the trilinearly interpolated radiance at the vertex position. Because
- * the data are in the box frame, instances of a model share them. */
+ * the data are in the box frame, instances of a model share them.
+ *
+ * Scale (spec §5.7): one f32 power of two in the header; packed probe × scale = physical
+ * radiance. The builder takes physical SH and divides before packing; lbk_llg_sample and
+ * lbk_llg_vertex_irradiance return physical values; the raw bytes at view->probes (and DLS LLG
+ * payloads) are in stored units. */
 #ifndef LBK_LLG_H
 #define LBK_LLG_H
 
@@ -46,9 +51,10 @@ typedef struct lbk_llg_grid_desc {
     uint32_t vertex_count;
 } lbk_llg_grid_desc;
 
-/* Serialises grids (deterministic). Free the buffer with lbk_free. */
-LBK_API lbk_result lbk_llg_build(const lbk_llg_grid_desc *grids, uint32_t grid_count, const lbk_allocator *allocator,
-                                 void **out, size_t *size);
+/* Serialises grids (deterministic). scale: 0 means 1, else a positive normal power of two (the
+ * probes are divided by it before packing). Free the buffer with lbk_free. */
+LBK_API lbk_result lbk_llg_build(const lbk_llg_grid_desc *grids, uint32_t grid_count, float scale,
+                                 const lbk_allocator *allocator, void **out, size_t *size);
 
 typedef struct lbk_llg_view {
     const uint8_t *data;
@@ -57,6 +63,7 @@ typedef struct lbk_llg_view {
     uint64_t probe_count, vertex_count;
     const uint8_t *probes;   /* probe_count × 28 */
     const uint8_t *vertices; /* vertex_count × 4 */
+    float scale;             /* stored × scale = physical */
 } lbk_llg_view;
 
 typedef struct lbk_llg_grid {
@@ -70,7 +77,7 @@ typedef struct lbk_llg_grid {
 LBK_API lbk_result lbk_llg_open(const void *data, size_t size, lbk_llg_view *out);
 LBK_API lbk_result lbk_llg_get_grid(const lbk_llg_view *view, uint32_t index, lbk_llg_grid *out);
 LBK_API void lbk_llg_probe_position(const lbk_llg_grid *grid, uint32_t i, uint32_t j, uint32_t k, float out[3]);
-/* Trilinear radiance SH at world position p. */
+/* Trilinear physical radiance SH at world position p. */
 LBK_API lbk_result lbk_llg_sample(const lbk_llg_view *view, uint32_t grid, const float p[3], lbk_sh9_rgb *out);
 LBK_API void lbk_llg_vertex_encode(const lbk_llg_vertex *v, uint8_t out[4]);
 LBK_API void lbk_llg_vertex_decode(const uint8_t in[4], lbk_llg_vertex *v);

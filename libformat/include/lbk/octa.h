@@ -16,7 +16,11 @@
  * bilinear filtering wraps across the octahedron's edges (DDGI convention): with S = N + 1,
  *   top    (x, 0)   ← (S − x, 1)        bottom (x, S)   ← (S − x, N)      for 1 ≤ x ≤ N
  *   left   (0, y)   ← (1, S − y)        right  (S, y)   ← (N, S − y)      for 1 ≤ y ≤ N
- *   corners (0,0) ← (N,N), (S,0) ← (1,N), (0,S) ← (N,1), (S,S) ← (1,1). */
+ *   corners (0,0) ← (N,N), (S,0) ← (1,N), (0,S) ← (N,1), (S,S) ← (1,1).
+ *
+ * Scale (spec §5.7): the section header holds one f32 power of two; stored irradiance × scale =
+ * physical irradiance. lbk_octp_build takes physical irradiance and divides before encoding;
+ * lbk_octp_get and lbk_octp_irradiance return physical irradiance. Depth moments are unscaled. */
 #ifndef LBK_OCTA_H
 #define LBK_OCTA_H
 
@@ -49,20 +53,22 @@ typedef struct lbk_octp_probe_desc {
     float depth[12 * 12][2];     /* interior: mean distance, mean squared distance (≥ 0) */
 } lbk_octp_probe_desc;
 
-LBK_API lbk_result lbk_octp_build(const lbk_octp_probe_desc *probes, uint32_t count, const lbk_allocator *allocator,
-                                  void **out, size_t *size);
+/* scale: 0 means 1, else a positive normal power of two. */
+LBK_API lbk_result lbk_octp_build(const lbk_octp_probe_desc *probes, uint32_t count, float scale,
+                                  const lbk_allocator *allocator, void **out, size_t *size);
 
 typedef struct lbk_octp_view {
     const uint8_t *data;
     size_t size;
     uint32_t probe_count;
     const uint8_t *probes; /* probe_count × 1024 bytes */
+    float scale;           /* stored irradiance × scale = physical */
 } lbk_octp_view;
 
 LBK_API lbk_result lbk_octp_open(const void *data, size_t size, lbk_octp_view *out);
-/* Decodes one probe's interior back into the builder form. */
+/* Decodes one probe's interior back into the builder form (physical irradiance). */
 LBK_API lbk_result lbk_octp_get(const lbk_octp_view *view, uint32_t index, lbk_octp_probe_desc *out);
-/* Bilinear irradiance lookup in direction dir (uses the border, never reads outside the probe). */
+/* Bilinear physical irradiance lookup in direction dir (uses the border, never reads outside the probe). */
 LBK_API lbk_result lbk_octp_irradiance(const lbk_octp_view *view, uint32_t index, const float dir[3], float rgb[3]);
 
 #ifdef __cplusplus
