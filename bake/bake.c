@@ -853,6 +853,12 @@ static int write_json_report(bake *b, const bk_bake_summary *sum)
     cJSON_AddNumberToObject(st, "nonfinite_dropped", (double)b->stats.nonfinite);
     cJSON_AddNumberToObject(st, "texel_channels_saturated", (double)b->saturated);
     cJSON_AddNumberToObject(st, "texel_channels_flushed", (double)b->flushed);
+    /* the radiometric scale of each lighting section written (spec §5.7); 0: section absent */
+    cJSON *sc = cJSON_AddObjectToObject(root, "scales");
+    cJSON_AddNumberToObject(sc, "lmap", sum->texels ? b->scale[0] : 0);
+    cJSON_AddNumberToObject(sc, "glg", sum->glg_probes ? b->scale[1] : 0);
+    cJSON_AddNumberToObject(sc, "llg", sum->llgs ? b->scale[2] : 0);
+    cJSON_AddNumberToObject(sc, "octp", b->opt->octahedral_probes && sum->glg_probes ? b->octp_scale : 0);
     cJSON *c = cJSON_AddObjectToObject(root, "counts");
     cJSON_AddNumberToObject(c, "objects", (double)sum->objects);
     cJSON_AddNumberToObject(c, "texels", (double)sum->texels);

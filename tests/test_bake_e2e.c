@@ -320,6 +320,15 @@ static void test_target_error_and_reports(void **state)
     assert_true(cJSON_GetObjectItem(s0, "seconds")->valuedouble > 0);
     assert_float_equal(cJSON_GetObjectItem(s0, "est_rel_rmse")->valuedouble, rec.texel_rel_rmse, 1e-6);
     assert_string_equal(cJSON_GetObjectItem(root, "status")->valuestring, "target reached");
+    /* the scales are the ones in the file: LMAP's as the lightmap view reports it */
+    double lmap_scale = cJSON_GetObjectItem(cJSON_GetObjectItem(root, "scales"), "lmap")->valuedouble;
+    assert_true(lmap_scale > 0 && frexp(lmap_scale, &(int){0}) == 0.5); /* a power of two */
+    assert_int_equal(lbk_reader_open_file(out, NULL, &r), LBK_OK);
+    assert_int_equal(lbk_reader_section_by_type(r, LBK_SECTION_LMAP, &data, &size), LBK_OK);
+    lbk_lmap_view lv;
+    assert_int_equal(lbk_lmap_open(data, size, &lv), LBK_OK);
+    assert_float_equal(lv.scale, lmap_scale, 0);
+    lbk_reader_close(r);
     cJSON_Delete(root);
     free(text);
 }
