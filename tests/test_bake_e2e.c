@@ -173,31 +173,18 @@ static void bake_and_check(const expect *e)
     lbk_reader_close(r);
 }
 
-static void test_cornell_box(void **state)
+/* One shared scene per case: the expectation is the case's initial state (see main). */
+static void test_shared_scene(void **state)
 {
-    (void)state;
-    expect e = {"cornell_box/CornellBox-Original.gltf", NULL, 1, 1, 0, 0};
-    bake_and_check(&e);
+    bake_and_check(*state);
 }
-static void test_cornell_box_bjs(void **state)
-{
-    (void)state;
-    expect e = {"cornell_box_bjs/cornellBox-2.80-Eevee-gltf.gltf", NULL, 1, 1, 1, 1};
-    bake_and_check(&e);
-}
-static void test_room_with_doors(void **state)
-{
-    (void)state;
-    /* no light of its own: a sky through the doorways; its 16 spheres get LLGs */
-    expect e = {"room_with_doors/room.glb", "1,1,1", 1, 1, 1, 16};
-    bake_and_check(&e);
-}
-static void test_lamp(void **state)
-{
-    (void)state;
-    expect e = {"lights_punctual_lamp/LightsPunctualLamp.gltf", NULL, 1, 1, 1, 0};
-    bake_and_check(&e);
-}
+
+static expect cornell_box = {"cornell_box/CornellBox-Original.gltf", NULL, 1, 1, 0, 0};
+static expect cornell_box_bjs = {"cornell_box_bjs/cornellBox-2.80-Eevee-gltf.gltf", NULL, 1, 1, 1, 1};
+/* no light of its own: a sky through the doorways; its 16 spheres get LLGs */
+static expect room_with_doors = {"room_with_doors/room.glb", "1,1,1", 1, 1, 1, 16};
+static expect lamp = {"lights_punctual_lamp/LightsPunctualLamp.gltf", NULL, 1, 1, 1, 0};
+
 static void test_water_bottle_draco(void **state)
 {
     (void)state;
@@ -527,10 +514,10 @@ static void test_duplicate_names_made_unique(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_cornell_box),
-        cmocka_unit_test(test_cornell_box_bjs),
-        cmocka_unit_test(test_room_with_doors),
-        cmocka_unit_test(test_lamp),
+        {"test_cornell_box", test_shared_scene, NULL, NULL, &cornell_box},
+        {"test_cornell_box_bjs", test_shared_scene, NULL, NULL, &cornell_box_bjs},
+        {"test_room_with_doors", test_shared_scene, NULL, NULL, &room_with_doors},
+        {"test_lamp", test_shared_scene, NULL, NULL, &lamp},
         cmocka_unit_test(test_water_bottle_draco),
         cmocka_unit_test(test_deterministic_across_threads),
         cmocka_unit_test(test_no_light_is_refused),
