@@ -33,6 +33,7 @@
 #include "lbk/objects.h"
 #include "lbk/validate.h"
 #include "support/door_scenes.h"
+#include "support/room_compare.h"
 
 #define SAMPLES 96
 #define DENSITY 2.0f
@@ -156,40 +157,12 @@ static void apply_open(const baked *b, float omega, uint32_t **z, uint8_t **rgba
     free(w), free(bg), free(og), free(bl), free(ol);
 }
 
-static double texel_lum(uint32_t z, const uint8_t *rgba)
-{
-    lbk_ahd_texel t;
-    t.irradiance_z = z;
-    memcpy(t.rgba, rgba, 4);
-    const float n[3] = {0, 0, 1};
-    float e[3];
-    lbk_ahd_irradiance(&t, n, e);
-    return LBK_LUM_R * e[0] + LBK_LUM_G * e[1] + LBK_LUM_B * e[2];
-}
+typedef rc_result cmp;
 
-typedef struct cmp {
-    double l1, ratio;
-} cmp;
-
-/* Relative L1 Σ|a − b| / Σ b and energy ratio Σa / Σb over the room's texels. */
 static cmp compare_room(const baked *ba, const uint32_t *za, const uint8_t *ra, const baked *bb, const uint32_t *zb,
                         const uint8_t *rb)
 {
-    for (int k = 3; k < 5; k++) assert_int_equal(ba->room_rect[k], bb->room_rect[k]);
-    lbk_lmap_page pa, pb;
-    assert_int_equal(lbk_lmap_get_page(&ba->lmap, ba->room_rect[0], &pa), LBK_OK);
-    assert_int_equal(lbk_lmap_get_page(&bb->lmap, bb->room_rect[0], &pb), LBK_OK);
-    double diff = 0, sa = 0, sb = 0;
-    for (uint32_t y = 0; y < ba->room_rect[4]; y++)
-        for (uint32_t x = 0; x < ba->room_rect[3]; x++) {
-            uint64_t ia = pa.first_texel + (uint64_t)(ba->room_rect[2] + y) * pa.width + ba->room_rect[1] + x;
-            uint64_t ib = pb.first_texel + (uint64_t)(bb->room_rect[2] + y) * pb.width + bb->room_rect[1] + x;
-            /* physical: stored × each file's LMAP scale (spec §5.7) */
-            double a = texel_lum(za[ia], &ra[4 * ia]) * pa.scale, b = texel_lum(zb[ib], &rb[4 * ib]) * pb.scale;
-            diff += fabs(a - b), sa += a, sb += b;
-        }
-    cmp c = {sb > 0 ? diff / sb : 0, sb > 0 ? sa / sb : 0};
-    return c;
+    return rc_compare_room((rc_side){&ba->lmap, ba->room_rect, za, ra}, (rc_side){&bb->lmap, bb->room_rect, zb, rb});
 }
 
 static int setup(void **state)
