@@ -24,10 +24,11 @@ TOOL_INC := $(LIB_INC) -I. -I/usr/include/draco -I/usr/include/stb
 TOOL_LIBS:= -lembree3 -lOpenEXRCore -lqhull_r -lspng -lcjson -ldraco -lpthread -lm $(LIB_LIBS)
 
 LIB_SRC   := $(sort $(wildcard libformat/src/*.c))
-TOOL_CSRC := $(sort $(wildcard cli/*.c bake/*.c inspect/*.c convert/*.c))
-TOOL_CXXSRC := $(sort $(wildcard bake/*.cc))
+TOOL_CSRC := $(sort $(wildcard cli/*.c bake/*/*.c tools/*/*.c))
+TOOL_CXXSRC := $(sort $(wildcard bake/*/*.cc))
 TOOL_MAIN := cli/main.c
-TESTS     := $(patsubst tests/%.c,%,$(sort $(wildcard tests/test_*.c)))
+TEST_SRC  := $(sort $(wildcard tests/*/test_*.c))
+TESTS     := $(notdir $(TEST_SRC:.c=))
 TEST_SUPPORT := $(sort $(wildcard tests/support/*.c))
 BENCHES   := $(patsubst bench/%.c,%,$(sort $(wildcard bench/bench_*.c)))
 
@@ -106,7 +107,10 @@ $(BUILD)/lbk-asan: $(BUILD)/asan/$(TOOL_MAIN:.c=.o) $(TOOL_ASAN) $(LIB_ASAN)
 # ---- tests (ASan + UBSan) ------------------------------------------------------------------
 TEST_SUPPORT_OBJ := $(TEST_SUPPORT:%.c=$(BUILD)/asan/%.o)
 $(TEST_SUPPORT_OBJ): TOOL_INC += -Itests
-$(BUILD)/tests/%: tests/%.c $(TEST_SUPPORT_OBJ) $(TOOL_ASAN) $(LIB_ASAN)
+# A test binary is named after its source, wherever under tests/ it lives.
+test_src_of = $(foreach s,$(TEST_SRC),$(if $(filter $(1).c,$(notdir $(s))),$(s)))
+.SECONDEXPANSION:
+$(BUILD)/tests/%: $$(call test_src_of,$$*) $(TEST_SUPPORT_OBJ) $(TOOL_ASAN) $(LIB_ASAN)
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) -O1 -g $(SAN) $(WARN) $(TOOL_INC) -Itests -c $< -o $@.o
 	$(CXX) $(SAN) -o $@ $@.o $(TEST_SUPPORT_OBJ) $(TOOL_ASAN) $(LIB_ASAN) $(TOOL_LIBS) -lcmocka
@@ -162,7 +166,7 @@ install: all
 	install -m 644 libformat/include/lbk/*.h $(DESTDIR)$(PREFIX)/include/lbk/
 	sed 's|^prefix=.*|prefix=$(PREFIX)|' $(BUILD)/lbk.pc > $(DESTDIR)$(PREFIX)/lib/pkgconfig/lbk.pc
 	install -d $(DESTDIR)$(PREFIX)/share/lbk/profiles
-	install -m 644 convert/profiles/*.profile $(DESTDIR)$(PREFIX)/share/lbk/profiles/
+	install -m 644 tools/convert/profiles/*.profile $(DESTDIR)$(PREFIX)/share/lbk/profiles/
 
 clean:
 	rm -rf $(BUILD)

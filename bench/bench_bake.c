@@ -14,7 +14,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "bake/bake.h"
+#include "bake/pipeline/bake.h"
 #include "lbk/container.h"
 #include "lbk/lightmap.h"
 #include "lbk/pixel.h"

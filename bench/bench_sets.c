@@ -1,4 +1,4 @@
-/* Light sets and doors as baked by `lbk bake` (bake/bake_sets.c) on the room_with_doors test
+/* Light sets and doors as baked by `lbk bake` (bake/sets/bake_sets.c) on the room_with_doors test
  * levels (tests/support/door_scenes.h): per level the DLS section's payload against its
  * ancillary bytes (cluster records, set lists, runs, prefix data, names), the share of texels
  * the sparse storage kept, and the bake time of the sets against the base bake, measured in
@@ -10,7 +10,7 @@
 
 #include <math.h>
 
-#include "bake/bake.h"
+#include "bake/pipeline/bake.h"
 #include "lbk/ahd.h"
 #include "lbk/container.h"
 #include "lbk/dls.h"
@@ -185,7 +185,7 @@ static double rel_l1(const lit *a, const lit *ref, double *ratio)
 
 static int door_methods(const char *dir)
 {
-    /* the door level of tests/test_sets.c (door tagged, light outside, sky 0.5), lit only from
+    /* the door level of tests/bake/test_sets.c (door tagged, light outside, sky 0.5), lit only from
      * outside so S_O is most of the room's light; reference: a bake without the door panel at
      * 8× the budget */
     int bad = 0;

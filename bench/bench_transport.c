@@ -11,7 +11,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "bake/transport.h"
+#include "bake/transport/transport.h"
 #include "tests/support/scene_append.c"     /* what the scene builders below build on */
 #include "tests/support/transport_scenes.c" /* the C scene builders the tests use */
 

@@ -11,7 +11,7 @@
  *   - a uniform sky (scene extras lbk_sky) that enters through every open doorway;
  *   - a second, free-standing panel "outer" outside the north door, a sun through the north
  *     doorway, and the lbk_combinations key (see the fields below).
- * Written as a self-contained .gltf (buffer as a base64 data: URI). Used by tests/test_sets.c
+ * Written as a self-contained .gltf (buffer as a base64 data: URI). Used by tests/bake/test_sets.c
  * and bench/bench_sets.c. */
 #ifndef DS_DOOR_SCENES_H
 #define DS_DOOR_SCENES_H
@@ -33,7 +33,7 @@ typedef struct ds_options {
     int outside_light;     /* 1: the light outside the north doorway */
     float sky;             /* uniform sky radiance (nits); 0: none */
     float texel_density;   /* lbk_texel_density on room and door; 0: not written */
-    /* appended for the guided door estimator and combination states (tests/test_doors.c): */
+    /* appended for the guided door estimator and combination states (tests/bake/test_doors.c): */
     int outer_door;        /* enum ds_door: a second panel "outer", free-standing 1.5 m outside the
                               north door, between it and the outside light (it shadows the doorway) */
     int combinations;      /* 1: scene extras lbk_combinations [["north", "outer"]] */

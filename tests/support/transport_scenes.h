@@ -6,7 +6,7 @@
 
 #include <stdint.h>
 
-#include "bake/scene.h"
+#include "bake/scene/scene.h"
 
 void tsc_init(bk_scene *s);                /* empty scene, sky 0, one object "tsc" */
 void tsc_free(bk_scene *s);

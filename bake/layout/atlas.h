@@ -1,0 +1,116 @@
+/* Lightmap atlas: every lightmapped object's charts (uvgen.h) packed into pages.
+ *
+ * Layout rules (what the container's object table and the runtime rely on):
+ * - Texel (x, y) of a page covers [x, x+1]×[y, y+1] in texel coordinates; its centre is
+ *   (x+0.5, y+0.5). Normalised uv = texel coordinate / page size; u to the right, v down
+ *   (row 0 at the top, as bk_image and glTF TEXCOORD).
+ * - All charts of one object are on one page, inside the object's rectangle (x, y, w, h):
+ *   the charts are first packed into an object-local rectangle, then object rectangles are
+ *   packed into pages. So runtime uv = (rect.xy + local·rect.wh) / page size is possible.
+ * - Each chart owns a block of its content size (ceil of its extent, at least 1×1) plus a
+ *   margin of ceil(padding/2) texels on every side; blocks never overlap, so the content of
+ *   two charts is at least `padding` (default 2) texels apart and every chart has a ring of
+ *   margin texels of its own for dilation (bilinear filtering reads one texel around).
+ * - Page size: page_size (default 1024, rounded up to a multiple of 4; more if one object
+ *   needs it, up to max_page_size). The last page is shrunk to the area it uses (both sides
+ *   multiples of 4 for block compression), and repacked to be as small as it can be, so a
+ *   small scene gets one small page.
+ * - Packing: skyline bottom-left, rectangles sorted by height, then width, then index. The
+ *   chart packing inside an object tries a few widths and keeps the smallest area.
+ *   Deterministic: no floating-point decisions depend on anything but the input.
+ * - Density per object: density_override if > 0, else bk_object.texel_density if > 0, else
+ *   default_density. If the summed object rectangles exceed texel_budget, every density is
+ *   scaled by the same factor (density_scale < 1, reported) until they fit. An object too
+ *   large for one max_page_size page gets a lower density on its own (reported in its note).
+ * - Lightmap vertices: scene vertices are split where charts meet (and between objects), so
+ *   each lightmap vertex has one uv; scene_tri_vertices maps every triangle of an atlas
+ *   object to its three lightmap vertices (zero-area triangles too, with a uv of a vertex
+ *   they share, or of the object's first texel). */
+#ifndef BK_ATLAS_H
+#define BK_ATLAS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "lbk/lbk.h"
+#include "bake/scene/scene.h"
+#include "bake/layout/uvgen.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct bk_atlas_options {
+    float default_density;   /* texels per metre; 0: 8 (the `fast` preset; `high` uses 16) */
+    float density_override;  /* > 0: every object uses this (CLI --texel-density) */
+    int page_size;           /* 0: 1024 */
+    int max_page_size;       /* 0: 4096 */
+    int padding;             /* empty texels between charts; 0: 2 */
+    uint64_t texel_budget;   /* upper bound on Σ object rectangles, texels; 0: 16 Mi */
+    bk_uv_options uv;        /* max_chart_texels 0: page_size − 2·margin */
+} bk_atlas_options;
+
+typedef struct bk_atlas_page {
+    int width, height;       /* multiples of 4 */
+} bk_atlas_page;
+
+typedef struct bk_atlas_object {
+    uint32_t object;         /* scene object index */
+    int32_t page;            /* -1: nothing to lightmap (every triangle has zero area) */
+    int32_t x, y, w, h;      /* object rectangle in page texels (charts + margins) */
+    int uv_source;           /* enum bk_uv_source */
+    float requested_density; /* texels per metre asked for (override / object / default) */
+    float density;           /* texels per metre used */
+    uint32_t first_chart, chart_count;
+    uint32_t degenerate_tris;
+    char note[192];          /* uv1 rejection reason, density changes; "" */
+} bk_atlas_object;
+
+typedef struct bk_atlas_chart {
+    uint32_t slot;           /* index into bk_atlas.objects */
+    int32_t page;
+    int32_t x, y, w, h;      /* content rectangle in page texels; every covered texel is inside */
+    uint32_t first, count;   /* range in bk_atlas.tris */
+} bk_atlas_chart;
+
+typedef struct bk_atlas {
+    int padding;             /* the padding actually guaranteed (2 × margin) */
+    int margin;              /* texels of each chart's own ring */
+    float density_scale;     /* uniform factor applied for texel_budget (1: none) */
+    uint64_t texels;         /* Σ page width × height */
+    size_t page_count;
+    bk_atlas_page *pages;
+    size_t object_count;     /* lightmapped objects, in scene order */
+    bk_atlas_object *objects;
+    size_t scene_object_count;
+    int32_t *object_slot;    /* per scene object: index into objects, or -1 */
+    size_t chart_count;
+    bk_atlas_chart *charts;
+    size_t tri_count;        /* triangles with texels */
+    uint32_t *tris;          /* scene triangle per entry, grouped by chart */
+    uint32_t *tri_chart;     /* chart per entry */
+    float *tri_uv;           /* 6 per entry: the corners in page texel coordinates */
+    size_t scene_tri_count;
+    int32_t *scene_tri_entry;/* per scene triangle: entry index, or -1 */
+    size_t vertex_count;     /* lightmap vertices */
+    uint32_t *vertex_source; /* scene vertex */
+    uint32_t *vertex_slot;   /* atlas object */
+    float *vertex_uv;        /* 2 per vertex: normalised page uv */
+    uint32_t *scene_tri_vertices; /* 3 per scene triangle: lightmap vertex, UINT32_MAX if none */
+    char note[192];          /* budget scaling message; "" */
+} bk_atlas;
+
+/* The density an object asks for before budget scaling (override, object extras, default). */
+float bk_atlas_requested_density(const bk_scene *scene, uint32_t object, const bk_atlas_options *opt);
+
+/* Builds the atlas for the objects with lightmapped[i] != 0 (object_count entries; NULL:
+ * every object). opt may be NULL. On error *out is zeroed. Errors: LBK_ERR_INVALID_ARGUMENT,
+ * LBK_ERR_OUT_OF_MEMORY, LBK_ERR_LIMIT (more than 2^31 texels or entries). */
+lbk_result bk_atlas_build(const bk_scene *scene, const uint8_t *lightmapped, const bk_atlas_options *opt,
+                          bk_atlas *out);
+void bk_atlas_free(bk_atlas *atlas);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,120 @@
+/* Texel sample points ("receivers") of the lightmap atlas, their push-out from behind
+ * walls, the per-texel tangent frame, and dilation.
+ *
+ * Coverage (bk_texels_build): every chart triangle is rasterised into its page. A texel is
+ * covered when its centre lies inside a triangle (top-left fill rule, uv_raster.h) or, for
+ * the texels along chart borders, when the triangle's closest point to the centre lies
+ * inside the texel square (|dx|, |dy| < 0.5; conservative). A centre inside wins over a
+ * nearest point; among nearest points the closest wins; ties go to the lower triangle entry.
+ * The sample point is the world point at the centre (or at the closest point), its normal
+ * the interpolated shading normal (the geometric normal where that is zero).
+ *
+ * TANGENT FRAME CONVENTION (the AHD encoder and the runtime must use the same):
+ *   N = the unit interpolated shading normal of the receiver (+Z of the local frame);
+ *   T = dP/du of the triangle, P the world position and u the lightmap texel x coordinate
+ *       (to the right on the page; uv.x), made orthogonal to N and unit length (+X);
+ *   B = N × T (+Y), always right-handed: no handedness sign is stored, even for mirrored
+ *       authored uv1 (for generated charts B points along +v, down the page).
+ *   A world direction d has local coordinates (d·T, d·B, d·N). At runtime T is rebuilt
+ *   from the lightmap uv derivatives (or a per-vertex tangent computed the same way) and
+ *   B = cross(N, T). Where dP/du is undefined (zero uv area) T is the first vector of the
+ *   branchless orthonormal basis of N (Duff et al. 2017, see bk_tangent_frame).
+ *
+ * Push-out (bk_texels_push_out): from each sample, 8 rays along the geometric tangent plane
+ * (raised by ~3°) and 5 over the hemisphere search `reach` texels (default 1.5 texel sizes)
+ * for a BACK face (a ray arriving at the back of a triangle means the point is behind that
+ * surface: under a wall, inside a box). The sample is moved just in front of the closest such
+ * hit (bk_offset_ray_origin_scaled along that triangle's normal), up to 3 times (corners).
+ * Then 16 long hemisphere rays: when at least half of them end on back faces the point is
+ * inside closed geometry and cannot be lit: BK_TEXEL_VALID is cleared and BK_TEXEL_INSIDE
+ * set, and dilation fills the texel from valid neighbours instead. Orientation is the
+ * triangle winding (glTF front = counter-clockwise), also for double-sided materials: a
+ * closed mesh's interior is its back side either way.
+ *
+ * Dilation (bk_dilate): works on any per-texel payload (N floats per texel). */
+#ifndef BK_TEXELS_H
+#define BK_TEXELS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "lbk/lbk.h"
+#include "bake/layout/atlas.h"
+#include "bake/scene/scene.h"
+#include "bake/transport/tracer.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+enum bk_texel_flag {
+    BK_TEXEL_VALID = 1u,   /* light this sample */
+    BK_TEXEL_EDGE = 2u,    /* centre outside every triangle: sample at the nearest point */
+    BK_TEXEL_PUSHED = 4u,  /* moved out from behind a surface */
+    BK_TEXEL_INSIDE = 8u   /* inside closed geometry: not valid, filled by dilation */
+};
+
+typedef struct bk_texel {
+    float position[3];     /* world sample point */
+    float normal[3];       /* unit shading normal (+Z of the tangent frame) */
+    float tangent[3];      /* unit, ⟂ normal, along +u (see the convention above) */
+    float texel_size;      /* metres spanned by one texel here */
+    uint32_t object;       /* scene object */
+    uint32_t tri;          /* scene triangle */
+    uint32_t page;
+    uint16_t x, y;         /* texel in the page */
+    uint32_t flags;        /* enum bk_texel_flag */
+} bk_texel;
+
+typedef struct bk_texels {
+    size_t page_count;
+    bk_atlas_page *pages;  /* copy of the atlas page sizes */
+    size_t *page_offset;   /* page_count + 1: start of each page in index */
+    int32_t *index;        /* per texel of every page (row-major): receiver, or -1 */
+    size_t count;
+    bk_texel *receivers;/* page-major, then row-major: deterministic order */
+} bk_texels;
+
+/* Rasterises every chart of the atlas. Errors: LBK_ERR_INVALID_ARGUMENT,
+ * LBK_ERR_OUT_OF_MEMORY, LBK_ERR_LIMIT (page side > 65535). */
+lbk_result bk_texels_build(const bk_scene *scene, const bk_atlas *atlas, bk_texels *out);
+void bk_texels_free(bk_texels *tx);
+
+/* The receiver at texel (x, y) of a page, or NULL when the texel is empty. */
+const bk_texel *bk_texels_at(const bk_texels *tx, uint32_t page, int x, int y);
+
+typedef struct bk_pushout_options {
+    float reach;           /* search distance in texel sizes; 0: 1.5 */
+    int threads;           /* 0: all online cores (the result is the same for any count) */
+} bk_pushout_options;
+
+typedef struct bk_pushout_stats {
+    size_t tested, pushed, inside;
+} bk_pushout_stats;
+
+/* Moves sample points out from behind surfaces and marks those inside geometry (see
+ * above). The result does not depend on the thread count. stats may be NULL. */
+lbk_result bk_texels_push_out(bk_texels *tx, const bk_scene *scene, const bk_tracer *tracer,
+                              const bk_pushout_options *opt, bk_pushout_stats *stats);
+
+/* Fills mask (width × height of the page) with 1 for valid receivers, 0 elsewhere. */
+void bk_texels_valid_mask(const bk_texels *tx, uint32_t page, uint8_t *mask);
+
+/* T and B from unit N and dP/du per the convention above (t, b unit, b = n × t). */
+void bk_tangent_frame(const float n[3], const float dpdu[3], float t[3], float b[3]);
+
+/* Dilation of a page-sized payload: data has `channels` floats per texel, row-major; mask
+ * has one byte per texel, non-zero = holds a value. Each pass fills every empty texel that
+ * has a filled 4-neighbour with the mean of those 4-neighbours, or else, with a filled
+ * diagonal neighbour, the mean of those (neighbours filled before this pass only, so the
+ * result does not depend on the scan order). After `passes` passes every empty texel within
+ * Chebyshev distance `passes` of a filled one is filled (mask set to 2), none further.
+ * Returns the number of texels filled. Use passes >= the atlas margin (padding / 2) so
+ * bilinear filtering never reads an empty texel; more passes also fill the gaps between
+ * charts, which helps block compression. */
+size_t bk_dilate(float *data, int channels, uint8_t *mask, int width, int height, int passes);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

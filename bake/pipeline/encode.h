@@ -1,0 +1,45 @@
+/* Encoding baked radiance into container payloads: the AHD lightmap pages (tangent frame,
+ * dilation, AHD) — shared by the base bake and the dynamic-set bakes. */
+#ifndef BK_ENCODE_H
+#define BK_ENCODE_H
+
+#include <stdint.h>
+
+#include "bake/layout/texels.h"
+#include "lbk/ahd.h"
+#include "lbk/sh.h"
+
+/* Tangent-space band-1 irradiance (the AHD linear form) of a texel receiver from its
+ * world-space incident radiance SH (frame convention: bake/layout/texels.h). */
+void bk_texel_linear(const bk_texel *t, const lbk_sh9_rgb *radiance_world, lbk_ahd_linear *out);
+
+/* AHD pages from per-texel linear forms (physical): `lin` and `has` are indexed like
+ * tx->receivers; texels without a value are filled by dilation (margin + 2 passes) where a chart
+ * is near, else zero. Every value is multiplied by inv_scale (1/the LMAP scale, a power of two:
+ * exact) before dilation and encoding, so the texels are in stored units.
+ * pages_out[p] receives a malloc'ed width×height array per page (free each with free()). */
+lbk_result bk_encode_pages(const bk_texels *tx, int margin, const lbk_ahd_linear *lin, const uint8_t *has,
+                           float inv_scale, lbk_ahd_texel **pages_out);
+
+/* The radiometric scale of a lighting section (spec/container.md §5.7) whose largest value
+ * (texels: irradiance along the normal; probes: SH DC; any channel) is max_value: the power of
+ * two 2^k that puts it in [2^13, 2^14) stored — 2^2 below the R11G11B10F / RGB9E5 maximum
+ * (~2^16), headroom for dilation and for DLS sums at run time, 2^34 above the smallest
+ * R11G11B10F step. 1 when max_value is 0 or not finite; k is clamped to [-126, 127]. */
+float bk_scale_for(double max_value);
+
+/* Largest irradiance along the normal (any channel) over the texels with `has` set. */
+double bk_texel_max(const lbk_ahd_linear *lin, const uint8_t *has, size_t n);
+
+/* Largest SH DC coefficient (any channel) over n probes. */
+double bk_probe_max(const lbk_sh9_rgb *sh, size_t n);
+
+/* Texel colour channels whose stored irradiance along the normal (physical × inv_scale) lies
+ * outside what R11G11B10F holds: above its largest value 65024 (stored saturated) or positive
+ * but below half its smallest step 2^-20 (stored as 0). With the scale of bk_scale_for this
+ * happens only when the values within the section span more than the format's ~2^36.
+ * `lin`/`has` as for bk_encode_pages; n entries. */
+void bk_count_out_of_range(const lbk_ahd_linear *lin, const uint8_t *has, size_t n, float inv_scale,
+                           uint64_t *saturated, uint64_t *flushed);
+
+#endif

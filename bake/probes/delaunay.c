@@ -1,0 +1,507 @@
+/* Delaunay tetrahedralisation on top of libqhull_r.
+ *
+ * qhull is run WITHOUT triangulated output ('Qt'): where points are cospherical (every cube of
+ * a regular grid) it returns one merged, non-simplicial Delaunay cell, and we triangulate those
+ * cells ourselves with a "pulling" triangulation keyed on global point indices. Each 2-face of a
+ * cell is computed as the intersection of the vertex sets of the two cells that share it and is
+ * split by a fan from its lowest-index vertex, so both sides of a shared face always agree and
+ * no zero-volume "glue" tetrahedra are needed. 'Qt' by contrast triangulates each cell from its
+ * own first vertex and leaves flat tetrahedra where the two sides disagree, and 'QJ' joggles
+ * with a time-seeded generator (not deterministic). See bake/probes/PROBES.md. */
+#include "bake/probes/delaunay.h"
+#include "bake/probes/probe_math.h"
+
+#include <libqhull_r/qhull_ra.h>
+
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A tetrahedron whose volume is below this fraction of its longest edge cubed is flat. A regular
+ * tetrahedron scores 0.118; genuine Delaunay slivers of sane input stay far above 1e-9. */
+#define FLAT_VOLUME_RATIO 1e-9
+
+const char *bk_delaunay_status_name(int status)
+{
+    switch (status) {
+    case BK_DELAUNAY_OK: return "ok";
+    case BK_DELAUNAY_TOO_FEW: return "fewer than 4 distinct points";
+    case BK_DELAUNAY_FLAT: return "all points on one plane";
+    case BK_DELAUNAY_NO_MEMORY: return "out of memory";
+    case BK_DELAUNAY_FAILED: return "qhull failed";
+    default: return "unknown";
+    }
+}
+
+static double orient(const double *a, const double *b, const double *c, const double *d)
+{
+    double ux = b[0] - a[0], uy = b[1] - a[1], uz = b[2] - a[2];
+    double vx = c[0] - a[0], vy = c[1] - a[1], vz = c[2] - a[2];
+    double wx = d[0] - a[0], wy = d[1] - a[1], wz = d[2] - a[2];
+    return ux * (vy * wz - vz * wy) - uy * (vx * wz - vz * wx) + uz * (vx * wy - vy * wx);
+}
+
+double bk_tet_signed_volume(const float *p0, const float *p1, const float *p2, const float *p3)
+{
+    double a[3] = {p0[0], p0[1], p0[2]}, b[3] = {p1[0], p1[1], p1[2]};
+    double c[3] = {p2[0], p2[1], p2[2]}, d[3] = {p3[0], p3[1], p3[2]};
+    return orient(a, b, c, d) / 6.0;
+}
+
+void bk_tetmesh_free(bk_tetmesh *m)
+{
+    if (!m) return;
+    free(m->points);
+    free(m->point_source);
+    free(m->input_to_point);
+    free(m->tets);
+    free(m->neighbours);
+    memset(m, 0, sizeof *m);
+}
+
+/* ---- growable tetra list ------------------------------------------------------------------ */
+typedef struct tet_list { uint32_t *v; size_t n, cap; int oom; } tet_list;
+
+static void tet_push(tet_list *l, uint32_t a, uint32_t b, uint32_t c, uint32_t d)
+{
+    if (l->oom) return;
+    if (l->n == l->cap) {
+        size_t cap = l->cap ? l->cap * 2 : 256;
+        uint32_t *v = realloc(l->v, cap * 4 * sizeof *v);
+        if (!v) { l->oom = 1; return; }
+        l->v = v; l->cap = cap;
+    }
+    uint32_t *t = l->v + 4 * l->n++;
+    t[0] = a; t[1] = b; t[2] = c; t[3] = d;
+}
+
+/* ---- duplicate merging: sorted cell keys, first point (input order) wins ------------------ */
+typedef struct cell_key { int64_t x, y, z; uint32_t index; } cell_key;
+
+static int cmp_cell_key(const void *pa, const void *pb)
+{
+    const cell_key *a = pa, *b = pb;
+    if (a->x != b->x) return a->x < b->x ? -1 : 1;
+    if (a->y != b->y) return a->y < b->y ? -1 : 1;
+    if (a->z != b->z) return a->z < b->z ? -1 : 1;
+    return (a->index > b->index) - (a->index < b->index);
+}
+
+static size_t lower_bound_cell(const cell_key *keys, size_t n, int64_t x, int64_t y, int64_t z)
+{
+    size_t lo = 0, hi = n;
+    cell_key probe = {x, y, z, 0};
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (cmp_cell_key(&keys[mid], &probe) < 0) lo = mid + 1; else hi = mid;
+    }
+    return lo;
+}
+
+static int cmp_u32(const void *pa, const void *pb)
+{
+    uint32_t a = *(const uint32_t *)pa, b = *(const uint32_t *)pb;
+    return (a > b) - (a < b);
+}
+
+/* ---- face records for adjacency ----------------------------------------------------------- */
+typedef struct face_rec { uint32_t v[3]; uint32_t tet; uint32_t slot; } face_rec;
+
+static int cmp_face(const void *pa, const void *pb)
+{
+    const face_rec *a = pa, *b = pb;
+    for (int k = 0; k < 3; k++)
+        if (a->v[k] != b->v[k]) return a->v[k] < b->v[k] ? -1 : 1;
+    if (a->tet != b->tet) return a->tet < b->tet ? -1 : 1;
+    return (a->slot > b->slot) - (a->slot < b->slot);
+}
+
+static void sort3(uint32_t *v)
+{
+    uint32_t t;
+    if (v[0] > v[1]) { t = v[0]; v[0] = v[1]; v[1] = t; }
+    if (v[1] > v[2]) { t = v[1]; v[1] = v[2]; v[2] = t; }
+    if (v[0] > v[1]) { t = v[0]; v[0] = v[1]; v[1] = t; }
+}
+
+static int cmp_tet_sorted(const void *pa, const void *pb)
+{
+    const uint32_t *a = pa, *b = pb;  /* records of 8: sorted tuple then oriented tuple */
+    for (int k = 0; k < 4; k++)
+        if (a[k] != b[k]) return a[k] < b[k] ? -1 : 1;
+    return 0;
+}
+
+/* ---- triangulation of one merged (non-simplicial) Delaunay cell --------------------------- */
+typedef struct angle_item { double angle; uint32_t id; } angle_item;
+
+static int cmp_angle(const void *pa, const void *pb)
+{
+    const angle_item *a = pa, *b = pb;
+    if (a->angle != b->angle) return a->angle < b->angle ? -1 : 1;
+    return (a->id > b->id) - (a->id < b->id);
+}
+
+/* Fans the convex polygon with (ascending) vertex set face[0..n) from its lowest vertex and
+ * cones each triangle to apex. The result depends only on the vertex set, so the two cells
+ * that share the face split it the same way. */
+static void cone_over_face(tet_list *out, const double *pts, uint32_t apex, const uint32_t *face,
+                           size_t n, angle_item *scratch)
+{
+    if (n < 3) return;
+    if (n == 3) { tet_push(out, apex, face[0], face[1], face[2]); return; }
+    const double *p0 = pts + 3 * (size_t)face[0];
+    size_t far = 1; double best = -1.0;
+    for (size_t i = 1; i < n; i++) {
+        const double *p = pts + 3 * (size_t)face[i];
+        double d = (p[0]-p0[0])*(p[0]-p0[0]) + (p[1]-p0[1])*(p[1]-p0[1]) + (p[2]-p0[2])*(p[2]-p0[2]);
+        if (d > best) { best = d; far = i; }
+    }
+    const double *p1 = pts + 3 * (size_t)face[far];
+    double u[3] = {p1[0]-p0[0], p1[1]-p0[1], p1[2]-p0[2]}, nrm[3] = {0, 0, 0};
+    best = -1.0;
+    for (size_t i = 1; i < n; i++) {
+        const double *p = pts + 3 * (size_t)face[i];
+        double w[3] = {p[0]-p0[0], p[1]-p0[1], p[2]-p0[2]};
+        double c[3] = {u[1]*w[2]-u[2]*w[1], u[2]*w[0]-u[0]*w[2], u[0]*w[1]-u[1]*w[0]};
+        double l = c[0]*c[0] + c[1]*c[1] + c[2]*c[2];
+        if (l > best) { best = l; nrm[0] = c[0]; nrm[1] = c[1]; nrm[2] = c[2]; }
+    }
+    if (!(best > 0.0)) return;  /* collinear face: contributes no volume */
+    double ul = sqrt(u[0]*u[0] + u[1]*u[1] + u[2]*u[2]), nl = sqrt(best);
+    double e0[3] = {u[0]/ul, u[1]/ul, u[2]/ul}, nn[3] = {nrm[0]/nl, nrm[1]/nl, nrm[2]/nl};
+    double e1[3] = {nn[1]*e0[2]-nn[2]*e0[1], nn[2]*e0[0]-nn[0]*e0[2], nn[0]*e0[1]-nn[1]*e0[0]};
+    double cen[3] = {0, 0, 0};
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) cen[k] += pts[3 * (size_t)face[i] + k] / (double)n;
+    size_t start = 0;
+    for (size_t i = 0; i < n; i++) {
+        const double *p = pts + 3 * (size_t)face[i];
+        double d[3] = {p[0]-cen[0], p[1]-cen[1], p[2]-cen[2]};
+        scratch[i].angle = atan2(d[0]*e1[0] + d[1]*e1[1] + d[2]*e1[2], d[0]*e0[0] + d[1]*e0[1] + d[2]*e0[2]);
+        scratch[i].id = face[i];
+    }
+    qsort(scratch, n, sizeof *scratch, cmp_angle);
+    for (size_t i = 0; i < n; i++) if (scratch[i].id == face[0]) start = i;
+    /* fan from face[0] (the lowest index); triangles along an edge through it are flat */
+    double edge_scale = best;  /* |u × w|² of the widest triangle: a scale for flatness */
+    for (size_t k = 1; k + 1 < n; k++) {
+        uint32_t b = scratch[(start + k) % n].id, c = scratch[(start + k + 1) % n].id;
+        const double *pb = pts + 3 * (size_t)b, *pc = pts + 3 * (size_t)c;
+        double v1[3] = {pb[0]-p0[0], pb[1]-p0[1], pb[2]-p0[2]}, v2[3] = {pc[0]-p0[0], pc[1]-p0[1], pc[2]-p0[2]};
+        double cr[3] = {v1[1]*v2[2]-v1[2]*v2[1], v1[2]*v2[0]-v1[0]*v2[2], v1[0]*v2[1]-v1[1]*v2[0]};
+        if (cr[0]*cr[0] + cr[1]*cr[1] + cr[2]*cr[2] <= 1e-18 * edge_scale) continue;
+        tet_push(out, apex, face[0], b, c);
+    }
+}
+
+static size_t facet_point_ids(qhT *qh, facetT *facet, uint32_t *ids, size_t cap)
+{
+    vertexT *vertex, **vertexp;
+    size_t n = 0;
+    FOREACHvertex_(facet->vertices) {
+        if (n < cap) ids[n] = (uint32_t)qh_pointid(qh, vertex->point);
+        n++;
+    }
+    if (n <= cap) qsort(ids, n, sizeof *ids, cmp_u32);
+    return n;
+}
+
+/* Grows the four per-facet scratch buffers to cap entries together (a huge cospherical cell).
+ * 0 when out of memory; every pointer stays valid (grown or not) for the caller to free. */
+static int scratch_grow(size_t cap, uint32_t **ids, uint32_t **nids, uint32_t **common, angle_item **scratch)
+{
+    uint32_t *a = realloc(*ids, cap * sizeof *a); if (a) *ids = a;
+    uint32_t *b = realloc(*nids, cap * sizeof *b); if (b) *nids = b;
+    uint32_t *c = realloc(*common, cap * sizeof *c); if (c) *common = c;
+    angle_item *s = realloc(*scratch, cap * sizeof *s); if (s) *scratch = s;
+    return a && b && c && s;
+}
+
+static int run_qhull(const double *pts, size_t n, tet_list *out)
+{
+    int status = BK_DELAUNAY_OK;
+    qhT *qh = calloc(1, sizeof *qh);
+    coordT *coords = malloc(3 * n * sizeof *coords);
+    uint32_t *ids = NULL, *nids = NULL, *common = NULL;
+    angle_item *scratch = NULL;
+    FILE *sink = fopen("/dev/null", "w");
+    if (!qh || !coords || !sink) { status = BK_DELAUNAY_NO_MEMORY; goto done; }
+    memcpy(coords, pts, 3 * n * sizeof *coords);
+    qh_zero(qh, sink);
+    char flags[] = "qhull d Qbb Qc Qz Q12";
+    int code = qh_new_qhull(qh, 3, (int)n, coords, False, flags, NULL, sink);
+    if (code == qh_ERRsingular) { status = BK_DELAUNAY_FLAT; goto freeqh; }
+    if (code == qh_ERRmem) { status = BK_DELAUNAY_NO_MEMORY; goto freeqh; }
+    if (code) { status = BK_DELAUNAY_FAILED; goto freeqh; }
+
+    size_t cap = 64;
+    ids = malloc(cap * sizeof *ids); nids = malloc(cap * sizeof *nids);
+    common = malloc(cap * sizeof *common); scratch = malloc(cap * sizeof *scratch);
+    if (!ids || !nids || !common || !scratch) { status = BK_DELAUNAY_NO_MEMORY; goto freeqh; }
+
+    facetT *facet, *neighbor, **neighborp;
+    FORALLfacets {
+        if (facet->upperdelaunay) continue;
+        size_t k = facet_point_ids(qh, facet, ids, cap);
+        if (k > cap) {  /* a huge cospherical cell: grow the scratch buffers and retry */
+            cap = k;
+            if (!scratch_grow(cap, &ids, &nids, &common, &scratch)) { status = BK_DELAUNAY_NO_MEMORY; goto freeqh; }
+            k = facet_point_ids(qh, facet, ids, cap);
+        }
+        if (k < 4 || ids[k - 1] >= n) continue;  /* the point at infinity ('Qz') */
+        if (k == 4) { tet_push(out, ids[0], ids[1], ids[2], ids[3]); continue; }
+        uint32_t apex = ids[0];
+        FOREACHneighbor_(facet) {
+            size_t m = facet_point_ids(qh, neighbor, nids, cap);
+            if (m > cap) {
+                cap = m;
+                if (!scratch_grow(cap, &ids, &nids, &common, &scratch)) { status = BK_DELAUNAY_NO_MEMORY; goto freeqh; }
+                k = facet_point_ids(qh, facet, ids, cap);
+                m = facet_point_ids(qh, neighbor, nids, cap);
+            }
+            size_t c = 0, i = 0, j = 0;
+            while (i < k && j < m) {
+                if (ids[i] == nids[j]) { common[c++] = ids[i]; i++; j++; }
+                else if (ids[i] < nids[j]) i++;
+                else j++;
+            }
+            if (c < 3 || common[0] == apex) continue;  /* faces through the apex: no volume */
+            cone_over_face(out, pts, apex, common, c, scratch);
+        }
+    }
+    if (out->oom) status = BK_DELAUNAY_NO_MEMORY;
+freeqh:
+    {
+        int curlong, totlong;
+        qh_freeqhull(qh, !qh_ALL);
+        qh_memfreeshort(qh, &curlong, &totlong);
+    }
+done:
+    if (sink) fclose(sink);
+    free(ids); free(nids); free(common); free(scratch);
+    free(coords);
+    free(qh);
+    return status;
+}
+
+int bk_delaunay(const float *points, size_t count, const bk_delaunay_options *options,
+                bk_tetmesh *out)
+{
+    memset(out, 0, sizeof *out);
+    int status = BK_DELAUNAY_OK;
+    cell_key *keys = NULL;
+    uint32_t *rep = NULL, *distinct = NULL, *face_tmp = NULL;
+    double *pts = NULL;
+    tet_list tl = {0};
+    face_rec *faces = NULL;
+
+    out->input_count = count;
+    if (count > 0xFFFFFFF0u) return BK_DELAUNAY_FAILED;
+    out->input_to_point = malloc((count ? count : 1) * sizeof *out->input_to_point);
+    rep = malloc((count ? count : 1) * sizeof *rep);
+    keys = malloc((count ? count : 1) * sizeof *keys);
+    if (!out->input_to_point || !rep || !keys) { status = BK_DELAUNAY_NO_MEMORY; goto fail; }
+    for (size_t i = 0; i < count; i++) out->input_to_point[i] = BK_TET_NONE;
+
+    double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
+    size_t finite = 0;
+    for (size_t i = 0; i < count; i++) {
+        const float *p = points + 3 * i;
+        if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) continue;
+        finite++;
+        for (int k = 0; k < 3; k++) {
+            if (p[k] < lo[k]) lo[k] = p[k];
+            if (p[k] > hi[k]) hi[k] = p[k];
+        }
+    }
+    if (finite < 4) { status = BK_DELAUNAY_TOO_FEW; goto fail; }
+    double diag = sqrt((hi[0]-lo[0])*(hi[0]-lo[0]) + (hi[1]-lo[1])*(hi[1]-lo[1]) + (hi[2]-lo[2])*(hi[2]-lo[2]));
+    if (!(diag > 0.0)) { status = BK_DELAUNAY_TOO_FEW; goto fail; }
+    double eps = options && options->merge_distance > 0.0 ? options->merge_distance : 1e-6 * diag;
+    if (eps < diag * 1e-12) eps = diag * 1e-12;  /* keeps cell keys within int64 */
+
+    /* merge points within eps: bin into cells of size eps, look in the 27 around each */
+    size_t nk = 0;
+    for (size_t i = 0; i < count; i++) {
+        const float *p = points + 3 * i;
+        rep[i] = BK_TET_NONE;
+        if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) continue;
+        keys[nk].x = (int64_t)floor((p[0] - lo[0]) / eps);
+        keys[nk].y = (int64_t)floor((p[1] - lo[1]) / eps);
+        keys[nk].z = (int64_t)floor((p[2] - lo[2]) / eps);
+        keys[nk].index = (uint32_t)i;
+        nk++;
+    }
+    qsort(keys, nk, sizeof *keys, cmp_cell_key);
+    size_t nd = 0;
+    for (size_t i = 0; i < count; i++) {
+        const float *p = points + 3 * i;
+        if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) continue;
+        int64_t cx = (int64_t)floor((p[0] - lo[0]) / eps), cy = (int64_t)floor((p[1] - lo[1]) / eps);
+        int64_t cz = (int64_t)floor((p[2] - lo[2]) / eps);
+        uint32_t best = BK_TET_NONE;
+        for (int dx = -1; dx <= 1; dx++) for (int dy = -1; dy <= 1; dy++) for (int dz = -1; dz <= 1; dz++) {
+            size_t s = lower_bound_cell(keys, nk, cx + dx, cy + dy, cz + dz);
+            for (; s < nk && keys[s].x == cx + dx && keys[s].y == cy + dy && keys[s].z == cz + dz; s++) {
+                uint32_t j = keys[s].index;
+                if (j >= i) break;             /* sorted by index within a cell */
+                if (rep[j] != j || j >= best) continue;
+                const float *q = points + 3 * (size_t)j;
+                double ddx = (double)p[0] - q[0], ddy = (double)p[1] - q[1], ddz = (double)p[2] - q[2];
+                if (ddx*ddx + ddy*ddy + ddz*ddz <= eps * eps) best = j;
+            }
+        }
+        if (best == BK_TET_NONE) { rep[i] = (uint32_t)i; nd++; }
+        else { rep[i] = best; out->merged_count++; }
+    }
+    free(keys); keys = NULL;
+    if (nd < 4) { status = BK_DELAUNAY_TOO_FEW; goto fail; }
+
+    /* distinct points, centred on the bounding box so far-from-origin levels keep precision */
+    distinct = malloc(nd * sizeof *distinct);
+    pts = malloc(3 * nd * sizeof *pts);
+    if (!distinct || !pts) { status = BK_DELAUNAY_NO_MEMORY; goto fail; }
+    double centre[3] = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
+    nd = 0;
+    for (size_t i = 0; i < count; i++) {
+        if (rep[i] != i) continue;
+        distinct[nd] = (uint32_t)i;
+        for (int k = 0; k < 3; k++) pts[3 * nd + k] = (double)points[3 * i + k] - centre[k];
+        nd++;
+    }
+
+    /* Points within the merge distance of their least-squares plane span no volume. qhull would
+     * find float-rounding-thin tetrahedra there instead of refusing. */
+    {
+        double mean[3] = {0, 0, 0}, cov[9] = {0}, val[3], vec[3][3], dev = 0.0;
+        for (size_t d = 0; d < nd; d++) for (int k = 0; k < 3; k++) mean[k] += pts[3 * d + k] / (double)nd;
+        for (size_t d = 0; d < nd; d++)
+            for (int r = 0; r < 3; r++) for (int c = 0; c < 3; c++)
+                cov[3 * r + c] += (pts[3 * d + r] - mean[r]) * (pts[3 * d + c] - mean[c]);
+        bk_sym3_eigen(cov, val, vec);
+        for (size_t d = 0; d < nd; d++) {
+            double x = 0.0;
+            for (int k = 0; k < 3; k++) x += (pts[3 * d + k] - mean[k]) * vec[2][k];
+            if (fabs(x) > dev) dev = fabs(x);
+        }
+        if (dev <= eps) { status = BK_DELAUNAY_FLAT; goto fail; }
+    }
+
+    status = run_qhull(pts, nd, &tl);
+    if (status != BK_DELAUNAY_OK) goto fail;
+
+    /* orient positively, drop flat tetrahedra, canonical order */
+    size_t nt = 0;
+    uint32_t *recs = malloc((tl.n ? tl.n : 1) * 8 * sizeof *recs);
+    if (!recs) { status = BK_DELAUNAY_NO_MEMORY; goto fail; }
+    for (size_t t = 0; t < tl.n; t++) {
+        uint32_t *v = tl.v + 4 * t;
+        const double *a = pts + 3 * (size_t)v[0], *b = pts + 3 * (size_t)v[1];
+        const double *c = pts + 3 * (size_t)v[2], *d = pts + 3 * (size_t)v[3];
+        double o = orient(a, b, c, d);
+        double l = 0.0;
+        const double *q[4] = {a, b, c, d};
+        for (int x = 0; x < 4; x++) for (int y = x + 1; y < 4; y++) {
+            double e = (q[x][0]-q[y][0])*(q[x][0]-q[y][0]) + (q[x][1]-q[y][1])*(q[x][1]-q[y][1]) + (q[x][2]-q[y][2])*(q[x][2]-q[y][2]);
+            if (e > l) l = e;
+        }
+        if (!(fabs(o) / 6.0 > FLAT_VOLUME_RATIO * l * sqrt(l))) { out->dropped_flat++; continue; }
+        uint32_t *r = recs + 8 * nt++;
+        memcpy(r, v, 4 * sizeof *r);
+        /* insertion sort of the tuple */
+        for (int x = 1; x < 4; x++) for (int y = x; y > 0 && r[y-1] > r[y]; y--) { uint32_t s = r[y]; r[y] = r[y-1]; r[y-1] = s; }
+        r[4] = v[0]; r[5] = v[1];
+        if (o > 0) { r[6] = v[2]; r[7] = v[3]; } else { r[6] = v[3]; r[7] = v[2]; }
+    }
+    qsort(recs, nt, 8 * sizeof *recs, cmp_tet_sorted);
+    size_t unique = 0;
+    for (size_t t = 0; t < nt; t++) {
+        if (unique && memcmp(recs + 8 * (unique - 1), recs + 8 * t, 4 * sizeof *recs) == 0) continue;
+        memmove(recs + 8 * unique, recs + 8 * t, 8 * sizeof *recs);
+        unique++;
+    }
+    nt = unique;
+    if (nt == 0) { free(recs); status = BK_DELAUNAY_FLAT; goto fail; }
+
+    /* vertices actually used, in input order */
+    face_tmp = calloc(nd, sizeof *face_tmp);   /* distinct index -> vertex index + 1 */
+    if (!face_tmp) { free(recs); status = BK_DELAUNAY_NO_MEMORY; goto fail; }
+    for (size_t t = 0; t < nt; t++) for (int k = 0; k < 4; k++) face_tmp[recs[8 * t + k]] = 1;
+    size_t np = 0;
+    for (size_t d = 0; d < nd; d++) if (face_tmp[d]) face_tmp[d] = (uint32_t)++np;
+    out->unused_count = nd - np;
+    out->point_count = np;
+    out->points = malloc(3 * np * sizeof *out->points);
+    out->point_source = malloc(np * sizeof *out->point_source);
+    out->tets = malloc(4 * nt * sizeof *out->tets);
+    out->neighbours = malloc(4 * nt * sizeof *out->neighbours);
+    faces = malloc(4 * nt * sizeof *faces);
+    if (!out->points || !out->point_source || !out->tets || !out->neighbours || !faces) {
+        free(recs); status = BK_DELAUNAY_NO_MEMORY; goto fail;
+    }
+    for (size_t d = 0; d < nd; d++) {
+        if (!face_tmp[d]) continue;
+        uint32_t v = face_tmp[d] - 1, src = distinct[d];
+        out->point_source[v] = src;
+        memcpy(out->points + 3 * (size_t)v, points + 3 * (size_t)src, 3 * sizeof(float));
+    }
+    for (size_t i = 0; i < count; i++)
+        if (rep[i] != BK_TET_NONE) {
+            /* rep[i] is an input index; find its distinct slot by binary search */
+            size_t a = 0, b = nd;
+            while (a < b) { size_t mid = (a + b) / 2; if (distinct[mid] < rep[i]) a = mid + 1; else b = mid; }
+            out->input_to_point[i] = face_tmp[a] ? face_tmp[a] - 1 : BK_TET_NONE;
+        }
+    out->tet_count = nt;
+    for (size_t t = 0; t < nt; t++) {
+        for (int k = 0; k < 4; k++) out->tets[4 * t + k] = face_tmp[recs[8 * t + 4 + k]] - 1;
+        const float *P = out->points;
+        const uint32_t *v = out->tets + 4 * t;
+        out->volume += bk_tet_signed_volume(P + 3 * (size_t)v[0], P + 3 * (size_t)v[1],
+                                            P + 3 * (size_t)v[2], P + 3 * (size_t)v[3]);
+    }
+    free(recs);
+
+    /* adjacency by face hashing (sorting): faces shared by exactly two tetrahedra are linked */
+    for (size_t t = 0; t < nt; t++)
+        for (uint32_t i = 0; i < 4; i++) {
+            face_rec *f = faces + 4 * t + i;
+            int w = 0;
+            for (int k = 0; k < 4; k++) if ((uint32_t)k != i) f->v[w++] = out->tets[4 * t + k];
+            sort3(f->v);
+            f->tet = (uint32_t)t; f->slot = i;
+            out->neighbours[4 * t + i] = BK_TET_NONE;
+        }
+    qsort(faces, 4 * nt, sizeof *faces, cmp_face);
+    for (size_t s = 0; s < 4 * nt;) {
+        size_t e = s + 1;
+        while (e < 4 * nt && memcmp(faces[e].v, faces[s].v, sizeof faces[s].v) == 0) e++;
+        if (e - s == 2) {
+            out->neighbours[4 * (size_t)faces[s].tet + faces[s].slot] = faces[s + 1].tet;
+            out->neighbours[4 * (size_t)faces[s + 1].tet + faces[s + 1].slot] = faces[s].tet;
+        } else if (e - s > 2) {
+            out->nonmanifold_faces++;
+        }
+        s = e;
+    }
+
+    free(faces); free(face_tmp); free(tl.v); free(pts); free(distinct); free(rep);
+    return BK_DELAUNAY_OK;
+
+fail:
+    free(faces); free(face_tmp); free(tl.v); free(pts); free(distinct); free(rep); free(keys);
+    {
+        uint32_t *keep = out->input_to_point;
+        size_t merged = out->merged_count;
+        out->input_to_point = NULL;
+        bk_tetmesh_free(out);
+        out->input_to_point = keep;
+        out->input_count = count;
+        out->merged_count = merged;
+        if (keep) for (size_t i = 0; i < count; i++) keep[i] = BK_TET_NONE;
+    }
+    return status;
+}

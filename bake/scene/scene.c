@@ -1,0 +1,156 @@
+/* Small utilities over bk_scene: freeing, bounds, hashing, the "is anything lit" test, a check. */
+#include "bake/scene/scene.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define XXH_INLINE_ALL
+#include <xxhash.h>
+
+void bk_scene_free(bk_scene *scene)
+{
+    if (!scene) return;
+    free(scene->positions);
+    free(scene->normals);
+    free(scene->uv0);
+    free(scene->uv1);
+    free(scene->tris);
+    free(scene->tri_material);
+    free(scene->tri_object);
+    free(scene->materials);
+    free(scene->objects);
+    free(scene->lights);
+    for (size_t i = 0; i < scene->image_count; i++) free(scene->images[i].rgba);
+    free(scene->images);
+    free(scene->combinations);
+    memset(scene, 0, sizeof *scene);
+    scene->sky_image = -1;
+}
+
+void bk_scene_compute_bounds(bk_scene *scene)
+{
+    float mn[3] = {INFINITY, INFINITY, INFINITY}, mx[3] = {-INFINITY, -INFINITY, -INFINITY};
+    int any = 0;
+    for (size_t v = 0; v < scene->vertex_count; v++) {
+        for (int k = 0; k < 3; k++) {
+            float x = scene->positions[3 * v + k];
+            if (x < mn[k]) mn[k] = x;
+            if (x > mx[k]) mx[k] = x;
+        }
+        any = 1;
+    }
+    for (size_t i = 0; i < scene->light_count; i++) {
+        const bk_light *l = &scene->lights[i];
+        if (l->type == BK_LIGHT_DIRECTIONAL) continue;
+        for (int k = 0; k < 3; k++) {
+            if (l->position[k] < mn[k]) mn[k] = l->position[k];
+            if (l->position[k] > mx[k]) mx[k] = l->position[k];
+        }
+        any = 1;
+    }
+    for (int k = 0; k < 3; k++) {
+        scene->bounds_min[k] = any ? mn[k] : 0.0f;
+        scene->bounds_max[k] = any ? mx[k] : 0.0f;
+    }
+}
+
+uint64_t bk_geometry_hash(const float *positions, size_t vertex_count, const uint32_t *indices,
+                          size_t index_count)
+{
+    XXH3_state_t st;
+    XXH3_INITSTATE(&st);
+    XXH3_64bits_reset(&st);
+    if (vertex_count) XXH3_64bits_update(&st, positions, vertex_count * 3 * sizeof(float));
+    if (index_count) XXH3_64bits_update(&st, indices, index_count * sizeof(uint32_t));
+    return XXH3_64bits_digest(&st);
+}
+
+static int rgb_positive(const float c[3])
+{
+    return c[0] > 0.0f || c[1] > 0.0f || c[2] > 0.0f;
+}
+
+int bk_scene_has_light(const bk_scene *scene)
+{
+    if (scene->sky_image >= 0 || rgb_positive(scene->sky)) return 1;
+    for (size_t i = 0; i < scene->light_count; i++)
+        if (rgb_positive(scene->lights[i].color)) return 1;
+    for (size_t t = 0; t < scene->tri_count; t++) {
+        uint32_t m = scene->tri_material[t];
+        if (m < scene->material_count && rgb_positive(scene->materials[m].emission)) return 1;
+    }
+    return 0;
+}
+
+static int finite_n(const float *v, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (!isfinite(v[i])) return 0;
+    return 1;
+}
+
+int bk_scene_check(const bk_scene *s, char *err, size_t err_len)
+{
+#define FAIL(...) do { if (err && err_len) snprintf(err, err_len, __VA_ARGS__); return 1; } while (0)
+    if (s->vertex_count && (!s->positions || !s->normals || !s->uv0 || !s->uv1))
+        FAIL("scene has %zu vertices but a vertex array is missing", s->vertex_count);
+    if (s->tri_count && (!s->tris || !s->tri_material || !s->tri_object))
+        FAIL("scene has %zu triangles but a triangle array is missing", s->tri_count);
+    for (size_t v = 0; v < s->vertex_count; v++) {
+        if (!finite_n(s->positions + 3 * v, 3)) FAIL("vertex %zu: non-finite position", v);
+        if (!finite_n(s->normals + 3 * v, 3)) FAIL("vertex %zu: non-finite normal", v);
+        if (!finite_n(s->uv0 + 2 * v, 2) || !finite_n(s->uv1 + 2 * v, 2))
+            FAIL("vertex %zu: non-finite uv", v);
+        const float *n = s->normals + 3 * v;
+        float len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (fabsf(len - 1.0f) > 1e-3f) FAIL("vertex %zu: normal length %g, not unit", v, len);
+    }
+    for (size_t t = 0; t < s->tri_count; t++) {
+        for (int k = 0; k < 3; k++)
+            if (s->tris[3 * t + k] >= s->vertex_count)
+                FAIL("triangle %zu: vertex index %u out of range (%zu vertices)", t,
+                     s->tris[3 * t + k], s->vertex_count);
+        if (s->tri_material[t] >= s->material_count)
+            FAIL("triangle %zu: material %u out of range", t, s->tri_material[t]);
+        if (s->tri_object[t] >= s->object_count)
+            FAIL("triangle %zu: object %u out of range", t, s->tri_object[t]);
+    }
+    for (size_t i = 0; i < s->object_count; i++) {
+        const bk_object *o = &s->objects[i];
+        if ((size_t)o->first_tri + o->tri_count > s->tri_count)
+            FAIL("object %zu (%s): triangle range out of bounds", i, o->name);
+        for (uint32_t t = o->first_tri; t < o->first_tri + o->tri_count; t++)
+            if (s->tri_object[t] != i) FAIL("object %zu (%s): triangle %u belongs to object %u", i,
+                                             o->name, t, s->tri_object[t]);
+        if (!(o->texel_density >= 0.0f) || !isfinite(o->texel_density))
+            FAIL("object %zu (%s): bad texel density", i, o->name);
+    }
+    for (size_t i = 0; i < s->material_count; i++) {
+        const bk_material *m = &s->materials[i];
+        if (!finite_n(m->albedo, 3) || !finite_n(m->emission, 3))
+            FAIL("material %zu (%s): non-finite colour", i, m->name);
+        if ((m->albedo_tex >= 0 && (size_t)m->albedo_tex >= s->image_count) ||
+            (m->emission_tex >= 0 && (size_t)m->emission_tex >= s->image_count))
+            FAIL("material %zu (%s): texture index out of range", i, m->name);
+    }
+    for (size_t i = 0; i < s->light_count; i++) {
+        const bk_light *l = &s->lights[i];
+        if (!finite_n(l->color, 3) || !finite_n(l->position, 3) || !finite_n(l->direction, 3) ||
+            !isfinite(l->range) || !isfinite(l->inner_cone) || !isfinite(l->outer_cone))
+            FAIL("light %zu (%s): non-finite value", i, l->name);
+        if (l->type < BK_LIGHT_POINT || l->type > BK_LIGHT_DIRECTIONAL)
+            FAIL("light %zu (%s): unknown type %d", i, l->name, l->type);
+    }
+    for (size_t i = 0; i < s->image_count; i++) {
+        const bk_image *im = &s->images[i];
+        if (im->width <= 0 || im->height <= 0 || !im->rgba)
+            FAIL("image %zu: empty (%dx%d)", i, im->width, im->height);
+    }
+    if (s->sky_image >= 0 && (size_t)s->sky_image >= s->image_count)
+        FAIL("sky image %d out of range", s->sky_image);
+    if (!finite_n(s->sky, 3)) FAIL("non-finite sky radiance");
+    return 0;
+#undef FAIL
+}

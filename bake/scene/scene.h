@@ -1,0 +1,116 @@
+/* The baker's scene: what glTF import produces and every later phase consumes.
+ * Plain C, world space, metres, linear colour. Units: emission is radiance (emissiveFactor ×
+ * emissiveTexture × KHR_materials_emissive_strength, taken as cd/m²); point and spot
+ * intensity is in candela, directional in lux, as KHR_lights_punctual defines them; hence
+ * irradiance results are in lux-like units (lm/m²) and radiance in nits. */
+#ifndef BK_SCENE_H
+#define BK_SCENE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct bk_image {          /* linear RGBA float, row 0 at the top (v = 0) */
+    int width, height;
+    float *rgba;
+    float mean[4];                 /* average over all texels (import fills it; the albedo
+                                      average is what most of the baker needs) */
+} bk_image;
+
+typedef struct bk_material {
+    char name[64];
+    float albedo[3];               /* baseColorFactor (linear); multiplied by albedo_tex if any */
+    float emission[3];             /* radiance; multiplied by emission_tex if any */
+    int albedo_tex;                /* index into scene images, -1 none (sampled with uv0) */
+    int emission_tex;              /* index into scene images, -1 none (sampled with uv0) */
+    int double_sided;
+} bk_material;
+
+enum bk_lighting { BK_LIGHTING_AUTO = 0, BK_LIGHTING_LIGHTMAP, BK_LIGHTING_LLG, BK_LIGHTING_NONE };
+
+typedef struct bk_object {         /* one glTF node that instantiates a mesh */
+    char name[128];                /* node name, or "node<i>" */
+    uint64_t geometry_hash;        /* XXH3-64 of the object's local-space positions and indices */
+    uint32_t first_tri, tri_count; /* range in bk_scene.tris */
+    int lighting;                  /* enum bk_lighting, from extras lbk_lighting */
+    float texel_density;           /* texels per metre from extras lbk_texel_density; 0: default */
+    char light_set[64];            /* extras lbk_light_set ("" none): emissive triangles join that set */
+    char door[64];                 /* extras lbk_door ("" none): the object is a door, closed state */
+    int has_uv1;                   /* TEXCOORD_1 present on all its primitives */
+    float local_to_world[16];      /* column-major, as glTF */
+} bk_object;
+
+enum bk_light_type { BK_LIGHT_POINT = 0, BK_LIGHT_SPOT, BK_LIGHT_DIRECTIONAL };
+
+typedef struct bk_light {
+    char name[64];
+    int type;                      /* enum bk_light_type */
+    float color[3];                /* linear; intensity already multiplied in */
+    float position[3];             /* world; point/spot */
+    float direction[3];            /* world, unit, the direction light travels; spot/directional */
+    float range;                   /* 0: infinite */
+    float inner_cone, outer_cone;  /* radians; spot */
+    char light_set[64];            /* "" : static light, baked into the base */
+} bk_light;
+
+/* A combination state (scene extras lbk_combinations, spec/authoring.md; seed 001 §6.2): two
+ * doors, or a door and a light set, whose joint effect gets its own DLS set. */
+typedef struct bk_combination {
+    char members[2][64];           /* lbk_door or lbk_light_set names, as authored */
+} bk_combination;
+
+typedef struct bk_scene {
+    /* vertices, world space */
+    size_t vertex_count;
+    float *positions;              /* 3 per vertex */
+    float *normals;                /* 3 per vertex, unit (generated flat when the mesh has none) */
+    float *uv0;                    /* 2 per vertex (0,0 when absent) */
+    float *uv1;                    /* 2 per vertex; meaningful only where the object has_uv1 */
+    /* triangles */
+    size_t tri_count;
+    uint32_t *tris;                /* 3 vertex indices per triangle */
+    uint32_t *tri_material;        /* per triangle */
+    uint32_t *tri_object;          /* per triangle */
+    /* tables */
+    size_t material_count;  bk_material *materials;
+    size_t object_count;    bk_object *objects;
+    size_t light_count;     bk_light *lights;
+    size_t image_count;     bk_image *images;
+    /* sky: uniform radiance, or an equirectangular image when sky_image >= 0 (then sky holds the
+     * image's mean radiance, for information: it is not a multiplier). The image maps direction
+     * d (y up) to u = 0.5 + atan2(d.x, -d.z)/(2π), v = acos(d.y)/π (row 0 = straight up). */
+    float sky[3];
+    int sky_image;
+    /* provenance */
+    uint64_t source_hash;          /* XXH3-64 of the source file bytes (and its buffers) */
+    float bounds_min[3], bounds_max[3];
+    /* combination states to bake (scene extras lbk_combinations); names are checked by the set
+     * bakes (bake/sets/bake_sets.c), not by import */
+    size_t combination_count;
+    bk_combination *combinations;
+} bk_scene;
+
+/* Frees every array and image (all malloc'ed) and leaves an empty scene (all zero, sky_image
+ * -1). NULL is fine. */
+void bk_scene_free(bk_scene *scene);
+/* bounds_min/bounds_max over all vertices (and point/spot light positions); an empty scene gets
+ * min = max = 0. */
+void bk_scene_compute_bounds(bk_scene *scene);
+/* XXH3-64 over the raw bytes of `positions` (3 floats per vertex) followed by `indices`. */
+uint64_t bk_geometry_hash(const float *positions, size_t vertex_count, const uint32_t *indices,
+                          size_t index_count);
+/* 1 when something emits: a punctual light with non-zero colour, a material with non-zero emission
+ * used by at least one triangle, or a sky that is non-zero (uniform) or an image. The baker
+ * refuses a scene without light unless the CLI supplies --sky. */
+int bk_scene_has_light(const bk_scene *scene);
+/* Structural check of a scene made by hand or by import: indices in range, finite data, unit
+ * normals (±1e-3), image sizes. Returns 0 when valid, else writes the first problem to err. */
+int bk_scene_check(const bk_scene *scene, char *err, size_t err_len);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,82 @@
+/* Dynamic light sets and doors in the bake (seed 001 §3–§4): finding them in the scene,
+ * leaving them out of the base bake, baking each one's contribution at the same receivers,
+ * and writing the DLS and DOOR sections. With no sets and no doors every call is a no-op and
+ * no section is written. */
+#ifndef BK_BAKE_SETS_H
+#define BK_BAKE_SETS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "bake/probes/llg_place.h"
+#include "bake/util/progress.h"
+#include "bake/scene/scene.h"
+#include "bake/layout/texels.h"
+#include "bake/transport/tracer.h"
+#include "bake/transport/transport.h"
+#include "lbk/sh.h"
+
+/* How a door's open contribution S_O is computed (bake/sets/SETS.md). */
+enum bk_door_method {
+    BK_DOOR_DIFFERENCE = 0, /* L(door removed) − L(doors closed, black): two correlated full runs */
+    BK_DOOR_GUIDED = 1      /* the seed's guided estimator (bake/sets/door_guided.h), no full run */
+};
+
+typedef struct bk_set_bakes {
+    uint32_t set_count;   /* DLS sets written (light sets, door open/closed sets, combinations) */
+    uint32_t door_count;
+    void *impl;           /* owned by bake_sets.c */
+} bk_set_bakes;
+
+/* Everything the set bakes share with the base bake. */
+typedef struct bk_set_inputs {
+    const bk_scene *scene;
+    const bk_tracer *tracer;          /* over the whole scene, doors closed */
+    const bk_receiver *receivers;     /* valid texels, then GLG probes, then LLG probes */
+    size_t receiver_count;
+    size_t texel_receivers;           /* receivers [0, texel_receivers) are texels */
+    size_t glg_first, glg_count;      /* receivers [glg_first, glg_first+glg_count) are GLG probes */
+    size_t llg_first, llg_count;      /* then LLG probes, in LLG section order */
+    const bk_llg *llgs;               /* the LLGs those probes belong to (their objects) */
+    size_t llg_grids;
+    const uint32_t *texel_of_receiver;/* receiver → index in texels->receivers */
+    const bk_texels *texels;          /* page layout: DLS texel index = page_offset[page] + y·w + x */
+    int atlas_margin;                 /* dilation passes for set pages */
+    const lbk_sh9_rgb *base_radiance; /* the base bake, per receiver */
+    bk_transport_options transport;   /* the base bake's options (seed, threads, budgets) */
+    double base_samples_per_receiver; /* what the base bake reached: door bakes use this budget */
+    double threshold;                 /* sparse storage: fraction of the mean indirect light of the
+                                         texels a set lights directly (bake/sets/SETS.md); 0: 0.01;
+                                         < 0: store every receiver with a non-zero contribution */
+    bk_progress *progress;
+    int door_method;                  /* enum bk_door_method */
+    float origin[3];                  /* the bake frame's origin in world space: add it to every
+                                         position written (the scene is recentred, bake.c) */
+    float scale[3];                   /* sections only: the LMAP, GLG and LLG scales (spec §5.7);
+                                         DLS payloads are stored in them (0: 1) */
+} bk_set_inputs;
+
+/* Finds light sets (lights and emissive objects with lbk_light_set), doors (lbk_door) and the
+ * combination states the scene asks for (bk_scene.combinations; input errors for unknown names,
+ * two light sets, or a door paired with itself).
+ * Returns 0 or an LBK_EXIT_* code with a message in err. */
+int bk_set_bakes_prepare(bk_set_bakes *sets, const bk_scene *scene, bk_progress *progress, char *err,
+                         size_t err_len);
+/* Sets what the base bake must leave out: the sets' lights (transport's light_set filter does
+ * that already) and doors' reflection (albedo 0 in the base, seed §4.1). Returns 1 when the
+ * base run needs an albedo hook that calls bk_set_bakes_base_albedo (the caller owns the
+ * transport's user pointer, so it installs the hook), else 0. */
+int bk_set_bakes_base_hooks(bk_set_bakes *sets, const bk_scene *scene, bk_transport_options *base);
+/* The base bake's albedo rule: 0 on door triangles. */
+void bk_set_bakes_base_albedo(const bk_set_bakes *sets, const bk_scene *scene, uint32_t tri, float albedo[3]);
+/* Bakes every set's contribution at the receivers. 0 or an LBK_EXIT_* code. */
+int bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *err, size_t err_len);
+/* Largest value of any set's entries per DLS space (texels: irradiance along the normal; probes:
+ * SH DC), for choosing the base sections' scales. */
+void bk_set_bakes_max(const bk_set_bakes *sets, double max[3]);
+/* The DLS and DOOR section bytes (free with lbk_free); *door is NULL without doors. */
+lbk_result bk_set_bakes_sections(bk_set_bakes *sets, const bk_set_inputs *in, void **dls, size_t *dls_size,
+                                 void **door, size_t *door_size);
+void bk_set_bakes_free(bk_set_bakes *sets);
+
+#endif

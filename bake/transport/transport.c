@@ -1,0 +1,1150 @@
+/* Series-expansion light transport; see transport.h and TRANSPORT.md. */
+#include "bake/transport/transport.h"
+
+#include "bake/util/parallel.h"
+#include "bake/transport/shading.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#define TP_PI 3.14159265358979323846
+#define TP_Q_MAX 0.999      /* largest per-bounce ratio the tail formula trusts (factor ≤ 999) */
+#define TP_MAX_SUB 16       /* at most 16×16 cells per triangle side */
+#define TP_LIGHT_POINTS 16  /* points per cell that test punctual lights in bounce 1 */
+#define TP_BATCH 64         /* rays generated, then traced as one stream, then shaded */
+
+/* ---- counter-based random numbers --------------------------------------------------------- */
+
+static uint64_t mix64(uint64_t z)
+{
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+typedef struct { uint64_t s; } tp_rng;
+
+enum { DOM_CELL = 1, DOM_RECV = 2, DOM_CELL_NEE = 3, DOM_RECV_NEE = 4 };
+
+/* Keyed by everything that identifies one item's samples: never by thread or time. */
+static tp_rng rng_make(uint64_t seed, uint64_t domain, uint64_t half, uint64_t pass, uint64_t bounce, uint64_t item)
+{
+    uint64_t h = mix64(seed ^ 0x6C626B7472616E73ull);
+    h = mix64(h ^ (domain << 56) ^ (half << 48) ^ (pass << 32) ^ bounce);
+    h = mix64(h ^ item * 0x9E3779B97F4A7C15ull);
+    tp_rng r = {h};
+    return r;
+}
+
+static double rng_next(tp_rng *r)
+{
+    r->s += 0x9E3779B97F4A7C15ull;
+    return (double)(mix64(r->s) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* Randomly shifted rank-1 lattice {(j/S, j·g/S) + shift} mod 1, g ≈ 0.618·S coprime with S
+ * (Fibonacci-like): the first coordinate is an exactly stratified grid, which gives the
+ * provable furnace bound of TRANSPORT.md; the random shift keeps every estimate unbiased, so the
+ * two halves stay independent and the error estimate honest. */
+static uint32_t lattice_generator(uint32_t S)
+{
+    uint32_t g = (uint32_t)(0.6180339887498949 * S) | 1u;
+    for (;; g += 2) {
+        uint32_t a = g, b = S;
+        while (b) { uint32_t t = a % b; a = b; b = t; }
+        if (a == 1 || S <= 1) return g;
+    }
+}
+
+/* Sample j of the shifted lattice as u1 and the angle 2π·u2 given as (cos, sin): the angles of
+ * the unshifted lattice are S-th roots of unity (a table per sample count), and the shift is
+ * one rotation per item, so no trigonometry runs per ray. */
+typedef struct tp_lattice {
+    uint32_t S, g;
+    double *cos_k, *sin_k; /* cos/sin(2π k/S) */
+    uint32_t *k_of_j;      /* j·g mod S (a table: a 64-bit division per ray is not free) */
+} tp_lattice;
+
+static lbk_result lattice_init(tp_lattice *l, uint32_t S)
+{
+    if (l->S == S) return LBK_OK;
+    free(l->cos_k);
+    free(l->sin_k);
+    free(l->k_of_j);
+    l->cos_k = malloc(S * sizeof(double));
+    l->sin_k = malloc(S * sizeof(double));
+    l->k_of_j = malloc(S * sizeof(uint32_t));
+    l->S = 0;
+    if (!l->cos_k || !l->sin_k || !l->k_of_j) return LBK_ERR_OUT_OF_MEMORY;
+    for (uint32_t k = 0; k < S; k++) {
+        l->cos_k[k] = cos(2 * 3.14159265358979323846 * k / S);
+        l->sin_k[k] = sin(2 * 3.14159265358979323846 * k / S);
+    }
+    l->S = S;
+    l->g = lattice_generator(S);
+    for (uint32_t j = 0; j < S; j++) l->k_of_j[j] = (uint32_t)(((uint64_t)j * l->g) % S);
+    return LBK_OK;
+}
+
+static void lattice_free(tp_lattice *l) { free(l->cos_k); free(l->sin_k); free(l->k_of_j); }
+
+typedef struct tp_shift { double s1, cs, sn; } tp_shift;
+
+static tp_shift lattice_shift(double s1, double s2)
+{
+    tp_shift t = {s1, cos(2 * 3.14159265358979323846 * s2), sin(2 * 3.14159265358979323846 * s2)};
+    return t;
+}
+
+static void lattice(const tp_lattice *l, uint32_t j, const tp_shift *sh, double *u1, double *cphi, double *sphi)
+{
+    double a = (double)j / l->S + sh->s1;
+    *u1 = a - floor(a);
+    uint32_t k = l->k_of_j[j];
+    *cphi = l->cos_k[k] * sh->cs - l->sin_k[k] * sh->sn;
+    *sphi = l->sin_k[k] * sh->cs + l->cos_k[k] * sh->sn;
+}
+
+/* Sample j of the same lattice as a point of [0,1)² with its own shift (light samples). */
+static void lattice_uv(const tp_lattice *l, uint32_t j, double t1, double t2, double *a, double *b)
+{
+    double x = (double)j / l->S + t1;
+    uint32_t k = l->k_of_j[j];
+    double y = (double)k / l->S + t2;
+    *a = x - floor(x);
+    *b = y - floor(y);
+}
+
+/* ---- the run context ----------------------------------------------------------------------- */
+
+typedef struct tp_cell {
+    uint32_t tri;
+    uint16_t sub, m;
+    uint8_t side;
+    float n[3];        /* side normal, zero for degenerate triangles */
+    float area;
+    float albedo[3];
+    float le[3];       /* emitted radiance at the centroid (after the light-set filter) */
+    float nee_parea;   /* light-sampling density per unit area of points in this cell (both
+                          sides alike), 0 when next-event estimation never picks it */
+} tp_cell;
+
+/* A sub-triangle of an emissive triangle that light samples pick (one per (tri, sub), shared
+ * by both sides of a double-sided emitter). */
+typedef struct tp_emitter {
+    uint32_t tri;
+    uint32_t cell;      /* its side-0 cell */
+} tp_emitter;
+
+typedef struct tp_ctx {
+    const bk_scene *scene;
+    const bk_tracer *tracer;
+    const bk_transport_options *opt;
+    uint64_t seed;
+    int threads;
+    /* cache */
+    size_t cell_count;
+    tp_cell *cells;
+    uint32_t *tri_first;   /* first cell of each triangle */
+    uint8_t *tri_m;
+    uint8_t *tri_sides;
+    float *tri_edge_eps;   /* smallest barycentric a sample point may have: keeps points off edges */
+    float *tri_le;         /* 3 per triangle: emission factor after the light-set filter */
+    int32_t *tri_le_tex;   /* emission texture per triangle, -1 none */
+    /* next-event estimation: emitter sub-triangles picked by power through a CDF */
+    int nee;
+    size_t em_count;
+    tp_emitter *em;
+    double *em_cdf;        /* inclusive, em_cdf[em_count-1] = 1 */
+    /* light selection */
+    const bk_light **lights;
+    size_t light_count;
+    int use_sky;
+    float scene_scale;
+    /* per chain (half) state; [h] */
+    float *l_prev[2], *l_cur[2], *l_sum[2];
+    /* current job */
+    int half, pass, bounce, rays;
+    tp_lattice lat;        /* for `rays` samples */
+    /* receivers */
+    const bk_receiver *recv;
+    size_t recv_count;
+    float *punct_lum;      /* luminance of punctual E per receiver (for the error estimate) */
+    double *x_acc[2];      /* per receiver, per half: Σ_p w_p·bk_lum(E_p) */
+    const bk_transport_output *out;
+    double pass_weight;
+    /* counters: per thread, summed after each parallel step */
+    uint64_t *thread_rays, *thread_shadow, *thread_nonfinite;
+} tp_ctx;
+
+/* ---- parallel-for --------------------------------------------------------------------------- */
+
+typedef void (*tp_fn)(tp_ctx *c, size_t begin, size_t end, int thread);
+
+typedef struct tp_call { tp_ctx *c; tp_fn fn; } tp_call;
+
+static void tp_call_run(void *user, size_t begin, size_t end, int thread)
+{
+    const tp_call *k = (const tp_call *)user;
+    k->fn(k->c, begin, end, thread);
+}
+
+static void parallel_range(tp_ctx *c, size_t begin, size_t end, size_t chunk, tp_fn fn)
+{
+    tp_call k = {c, fn};
+    bk_parallel_chunks(begin, end, chunk, c->threads, tp_call_run, &k);
+}
+
+static void parallel_for(tp_ctx *c, size_t n, size_t chunk, tp_fn fn) { parallel_range(c, 0, n, chunk, fn); }
+
+/* ---- scene lookups -------------------------------------------------------------------------- */
+
+static void tri_vertices(const tp_ctx *c, uint32_t tri, double v[3][3])
+{
+    const uint32_t *ix = c->scene->tris + 3 * (size_t)tri;
+    for (int i = 0; i < 3; i++) {
+        uint32_t k = ix[i] < c->scene->vertex_count ? ix[i] : 0;
+        for (int a = 0; a < 3; a++) v[i][a] = c->scene->positions[3 * (size_t)k + a];
+    }
+}
+
+static void sky_radiance(const tp_ctx *c, const double d[3], double out[3])
+{
+    if (!c->use_sky) { out[0] = out[1] = out[2] = 0; return; }
+    bk_sky_radiance(c->scene, d, out);
+}
+
+static int in_light_set(const tp_ctx *c, const char *set)
+{
+    const char *want = c->opt->light_set ? c->opt->light_set : "";
+    return strncmp(set, want, 63) == 0;
+}
+
+/* Cell reached by a hit, or -1 when the hit side carries no radiance (back of a one-sided
+ * surface). */
+static long hit_cell(const tp_ctx *c, const bk_hit *h)
+{
+    if (h->tri >= c->scene->tri_count) return -1;
+    int side = h->front ? 0 : 1;
+    if (side >= c->tri_sides[h->tri]) return -1;
+    int m = c->tri_m[h->tri];
+    float a = h->u * (float)m, b = h->v * (float)m;
+    int i = (int)a, j = (int)b; /* truncation: u, v >= 0 up to rounding, and the clamps below */
+    if (j < 0) j = 0;
+    if (j > m - 1) j = m - 1;
+    if (i < 0) i = 0;
+    if (i > m - 1 - j) i = m - 1 - j;
+    int upper = (a - i) + (b - j) > 1 && i + j < m - 1;
+    long sub = (long)j * (2 * m - j) + 2 * i + upper;
+    return (long)c->tri_first[h->tri] + (long)side * m * m + sub;
+}
+
+/* A cell's sub-triangle in world space, and the edge band of its triangle, fetched once per
+ * cell and bounce rather than per ray. */
+typedef struct tp_cell_geom {
+    double b[3][2];     /* barycentric (u, v) corners of the sub-triangle */
+    double v[3][3];     /* the triangle's vertices */
+    double eps;
+} tp_cell_geom;
+
+static void cell_geom(const tp_ctx *c, const tp_cell *cell, tp_cell_geom *g)
+{
+    int m = cell->m, s = cell->sub, j = 0;
+    while (j < m - 1 && s >= 2 * (m - j) - 1) { s -= 2 * (m - j) - 1; j++; }
+    int i = s / 2, upper = s & 1;
+    double c0[2], c1[2], c2[2];
+    if (!upper) {
+        c0[0] = i; c0[1] = j; c1[0] = i + 1; c1[1] = j; c2[0] = i; c2[1] = j + 1;
+    } else {
+        c0[0] = i + 1; c0[1] = j; c1[0] = i + 1; c1[1] = j + 1; c2[0] = i; c2[1] = j + 1;
+    }
+    for (int k = 0; k < 2; k++) {
+        g->b[0][k] = c0[k] / m;
+        g->b[1][k] = c1[k] / m;
+        g->b[2][k] = c2[k] / m;
+    }
+    tri_vertices(c, cell->tri, g->v);
+    g->eps = c->tri_edge_eps[cell->tri];
+}
+
+/* The point of a cell for (r1, r2) in [0,1)², uniform over its area, kept off the triangle's
+ * edges; bu, bv (optional) get its barycentrics in the whole triangle. */
+static void cell_point_at(const tp_cell_geom *g, double r1, double r2, double p[3], double *bu, double *bv)
+{
+    double sq = sqrt(r1);
+    double w0 = 1 - sq, w1 = sq * (1 - r2), w2 = sq * r2;
+    double u = w0 * g->b[0][0] + w1 * g->b[1][0] + w2 * g->b[2][0];
+    double v = w0 * g->b[0][1] + w1 * g->b[1][1] + w2 * g->b[2][1];
+    /* clamp into the band-free interior: only points within the band move, and only onto the
+     * band's inner border, so the rest of the triangle is sampled exactly uniformly */
+    double eps = g->eps;
+    if (eps > 0) {
+        double w = 1 - u - v;
+        u = u < eps ? eps : u;
+        v = v < eps ? eps : v;
+        w = w < eps ? eps : w;
+        double sum = u + v + w;
+        u /= sum;
+        v /= sum;
+    }
+    for (int a = 0; a < 3; a++) p[a] = (1 - u - v) * g->v[0][a] + u * g->v[1][a] + v * g->v[2][a];
+    if (bu) *bu = u;
+    if (bv) *bv = v;
+}
+
+/* Random point in a cell, kept off the triangle's edges. */
+static void cell_point(const tp_cell_geom *g, tp_rng *r, double p[3])
+{
+    double r1 = rng_next(r), r2 = rng_next(r);
+    cell_point_at(g, r1, r2, p, NULL, NULL);
+}
+
+/* ---- emitters: next-event estimation and its MIS weights ------------------------------------ */
+
+/* Emitted radiance of triangle `tri` at barycentrics (u, v): the factor times the emission
+ * texture at the point's uv0, for both strategies alike (gather hits and light samples must
+ * see the same emitter or MIS would be biased). */
+static void emission_at(const tp_ctx *c, uint32_t tri, double u, double v, double out[3])
+{
+    const float *f = c->tri_le + 3 * (size_t)tri;
+    if (f[0] == 0 && f[1] == 0 && f[2] == 0) { out[0] = out[1] = out[2] = 0; return; }
+    int32_t tex = c->tri_le_tex[tri];
+    if (tex < 0) {
+        for (int k = 0; k < 3; k++) out[k] = f[k];
+        return;
+    }
+    double uv[2], te[3];
+    bk_tri_uv0(c->scene, tri, u, v, uv);
+    bk_sample_image(bk_scene_image(c->scene, tex), uv[0], uv[1], te);
+    for (int k = 0; k < 3; k++) {
+        double em = f[k] * te[k];
+        out[k] = isfinite(em) && em > 0 ? em : 0;
+    }
+}
+
+/* Which gather pdf a light sample is weighed against. */
+enum { PG_COSINE = 0, PG_HEMISPHERE = 1, PG_SPHERE = 2 };
+
+static double gather_pdf(int kind, double cos_p)
+{
+    return kind == PG_COSINE ? cos_p / TP_PI : kind == PG_HEMISPHERE ? 1 / (2 * TP_PI) : 1 / (4 * TP_PI);
+}
+
+/* Power heuristic (β = 2), one sample of each strategy per gather ray. */
+static double mis_power(double mine, double other)
+{
+    double a = mine * mine, b = other * other;
+    return a + b > 0 ? a / (a + b) : 0;
+}
+
+/* MIS weight of a gather ray (unit direction d, gather pdf pg) that hit cell hc at distance t:
+ * the light-sampling pdf of that point in solid angle is p_area·t²/|cos θ_light|. */
+static double mis_gather(const tp_ctx *c, const bk_hit *h, long hc, const double d[3], double pg)
+{
+    if (!c->nee) return 1;
+    double pa = c->cells[hc].nee_parea;
+    if (!(pa > 0)) return 1;
+    double cl = fabs(d[0] * h->ng[0] + d[1] * h->ng[1] + d[2] * h->ng[2]);
+    if (!(cl > 0)) return 1;
+    double t = h->t, pl = pa * t * t / cl;
+    return mis_power(pg, pl);
+}
+
+/* The emitter whose CDF interval holds u, and u's relative position inside it (which then
+ * places the point, so stratified u stay stratified over the emitter's area). */
+static size_t em_pick(const tp_ctx *c, double u, double *rem)
+{
+    size_t lo = 0, hi = c->em_count - 1;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (c->em_cdf[mid] > u) hi = mid;
+        else lo = mid + 1;
+    }
+    double a = lo ? c->em_cdf[lo - 1] : 0, b = c->em_cdf[lo];
+    double r = b > a ? (u - a) / (b - a) : 0.5;
+    *rem = r < 0 ? 0 : r > 0.9999999999999999 ? 0.9999999999999999 : r;
+    return lo;
+}
+
+/* One light sample for origin o (unit normal n; ignored for PG_SPHERE) from (u0, u1) in
+ * [0,1)²: picks an emitter sub-triangle by power, a uniform point on it, and traces a shadow
+ * ray. Returns 1 and fills the unit direction d, cos_p = d·n and val = Le·w_L/p_L (radiance
+ * over its solid-angle pdf, MIS-weighted) when the sample carries light. */
+static int nee_sample(const tp_ctx *c, const float o[3], const double n[3], int kind, double u0, double u1,
+                      double d[3], double *cos_p, double val[3], uint64_t *shadow)
+{
+    double rem;
+    const tp_emitter *em = &c->em[em_pick(c, u0, &rem)];
+    const tp_cell *cell = &c->cells[em->cell];
+    tp_cell_geom g;
+    cell_geom(c, cell, &g);
+    double x[3], bu, bv;
+    cell_point_at(&g, rem, u1, x, &bu, &bv);
+    double dv[3] = {x[0] - o[0], x[1] - o[1], x[2] - o[2]};
+    double dist2 = dv[0] * dv[0] + dv[1] * dv[1] + dv[2] * dv[2];
+    if (!(dist2 > 0) || !isfinite(dist2)) return 0;
+    double dist = sqrt(dist2);
+    for (int a = 0; a < 3; a++) d[a] = dv[a] / dist;
+    double cp = kind == PG_SPHERE ? 1 : d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
+    if (!(cp > 0)) return 0;
+    float ng[3];
+    bk_tracer_tri_normal(c->tracer, em->tri, ng);
+    double cl = -(d[0] * ng[0] + d[1] * ng[1] + d[2] * ng[2]);
+    int side = cl > 0 ? 0 : 1; /* the side facing the origin */
+    if (side >= c->tri_sides[em->tri]) return 0;
+    cl = fabs(cl);
+    if (!(cl > 1e-12)) return 0;
+    double le[3];
+    emission_at(c, em->tri, bu, bv, le);
+    if (le[0] <= 0 && le[1] <= 0 && le[2] <= 0) return 0;
+    double pl = cell->nee_parea * dist2 / cl;
+    if (!(pl > 0) || !isfinite(pl)) return 0;
+    double w = mis_power(pl, gather_pdf(kind, cp));
+    /* shadow ray to the point moved off the emitter toward the origin, stopped just short */
+    float xf[3] = {(float)x[0], (float)x[1], (float)x[2]}, xo[3];
+    float ns[3] = {side ? -ng[0] : ng[0], side ? -ng[1] : ng[1], side ? -ng[2] : ng[2]};
+    bk_offset_ray_origin_scaled(xf, ns, bk_tracer_tri_scale(c->tracer, em->tri), xo);
+    float sd[3] = {xo[0] - o[0], xo[1] - o[1], xo[2] - o[2]};
+    (*shadow)++;
+    if (bk_tracer_occluded(c->tracer, o, sd, 0.0f, 1.0f - 1e-5f)) return 0;
+    *cos_p = cp;
+    for (int a = 0; a < 3; a++) val[a] = le[a] * w / pl;
+    return 1;
+}
+
+/* ---- cache: one bounce for a range of cells ------------------------------------------------ */
+
+static void cache_bounce(tp_ctx *c, size_t begin, size_t end, int thread)
+{
+    const int h = c->half, k = c->bounce, R = c->rays;
+    const float *prev = c->l_prev[h];
+    float *cur = c->l_cur[h];
+    uint64_t rays = 0, shadow = 0, bad = 0;
+    for (size_t ci = begin; ci < end; ci++) {
+        const tp_cell *cell = &c->cells[ci];
+        double e[3] = {0, 0, 0};
+        if (cell->n[0] == 0 && cell->n[1] == 0 && cell->n[2] == 0) goto store;
+        if (cell->albedo[0] <= 0 && cell->albedo[1] <= 0 && cell->albedo[2] <= 0) goto store;
+        tp_rng rng = rng_make(c->seed, DOM_CELL, (uint64_t)h, (uint64_t)c->pass, (uint64_t)k, ci);
+        double n[3] = {cell->n[0], cell->n[1], cell->n[2]}, t[3], b[3];
+        bk_onb(n, t, b);
+        float nf[3] = {cell->n[0], cell->n[1], cell->n[2]};
+        float scale = bk_tracer_tri_scale(c->tracer, cell->tri);
+        double s1 = rng_next(&rng), s2 = rng_next(&rng);
+        tp_shift shift = lattice_shift(s1, s2);
+        tp_cell_geom geom;
+        cell_geom(c, cell, &geom);
+        int light_points = (k == 1 && c->light_count) ? (R < TP_LIGHT_POINTS ? R : TP_LIGHT_POINTS) : 0;
+        double ep[3] = {0, 0, 0}, en[3] = {0, 0, 0};
+        const int nee = k == 1 && c->nee;
+        double t1 = 0, t2 = 0;
+        if (nee) {
+            tp_rng nr = rng_make(c->seed, DOM_CELL_NEE, (uint64_t)h, (uint64_t)c->pass, 0, ci);
+            t1 = rng_next(&nr);
+            t2 = rng_next(&nr);
+        }
+        for (int j0 = 0; j0 < R; j0 += TP_BATCH) {
+            const int m = R - j0 < TP_BATCH ? R - j0 : TP_BATCH;
+            float org[3 * TP_BATCH], dir[3 * TP_BATCH];
+            double dd[TP_BATCH][3], pts[TP_BATCH][3];
+            bk_hit hits[TP_BATCH];
+            for (int jj = 0; jj < m; jj++) {
+                double *p = pts[jj];
+                cell_point(&geom, &rng, p);
+                float pf[3] = {(float)p[0], (float)p[1], (float)p[2]};
+                bk_offset_ray_origin_scaled(pf, nf, scale, org + 3 * jj);
+                /* cosine-distributed direction */
+                double u1, cp, sp;
+                lattice(&c->lat, (uint32_t)(j0 + jj), &shift, &u1, &cp, &sp);
+                double rr = sqrt(u1);
+                double lx = rr * cp, ly = rr * sp, lz = sqrt(fmax(0.0, 1 - u1));
+                for (int a = 0; a < 3; a++) {
+                    dd[jj][a] = lx * t[a] + ly * b[a] + lz * n[a];
+                    dir[3 * jj + a] = (float)dd[jj][a];
+                }
+            }
+            bk_tracer_intersect_n(c->tracer, (size_t)m, org, dir, 0.0f, NULL, hits);
+            rays += (uint64_t)m;
+            for (int jj = 0; jj < m; jj++) {
+                const int j = j0 + jj;
+                const double *d = dd[jj];
+                const float *o = org + 3 * jj;
+                const bk_hit *hit = &hits[jj];
+                double L[3] = {0, 0, 0};
+                if (hit->tri != UINT32_MAX) {
+                    long hc = hit_cell(c, hit);
+                    if (hc >= 0) {
+                        if (k == 1) {
+                            emission_at(c, hit->tri, hit->u, hit->v, L);
+                            if (L[0] > 0 || L[1] > 0 || L[2] > 0) {
+                                double lz = d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
+                                double w = mis_gather(c, hit, hc, d, lz / TP_PI);
+                                for (int a = 0; a < 3; a++) L[a] *= w;
+                            }
+                        } else {
+                            for (int a = 0; a < 3; a++) L[a] = prev[3 * hc + a];
+                        }
+                    }
+                } else if (k == 1) {
+                    sky_radiance(c, d, L);
+                }
+                if (!bk_finite3(L)) bad++;
+                else for (int a = 0; a < 3; a++) e[a] += L[a];
+                if (nee) {
+                    double u0, v0, ld[3], cq, val[3];
+                    lattice_uv(&c->lat, (uint32_t)j, t1, t2, &u0, &v0);
+                    if (nee_sample(c, o, n, PG_COSINE, u0, v0, ld, &cq, val, &shadow)) {
+                        if (bk_finite3(val))
+                            for (int a = 0; a < 3; a++) en[a] += val[a] * cq;
+                        else
+                            bad++;
+                    }
+                }
+                if (j < light_points) {
+                    for (size_t li = 0; li < c->light_count; li++) {
+                        double val[3], ld[3], dist;
+                        if (!bk_light_eval(c->lights[li], pts[jj], val, ld, &dist)) continue;
+                        double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
+                        if (cs <= 0) continue;
+                        shadow++;
+                        if (!bk_light_visible(c->tracer, o, ld, dist)) continue;
+                        for (int a = 0; a < 3; a++) ep[a] += val[a] * cs;
+                    }
+                }
+            }
+        }
+        for (int a = 0; a < 3; a++) {
+            e[a] = e[a] * (TP_PI / R) + en[a] / R;
+            if (light_points) e[a] += ep[a] / light_points;
+        }
+    store:
+        for (int a = 0; a < 3; a++) {
+            double v = cell->albedo[a] / TP_PI * e[a];
+            if (!isfinite(v) || v < 0) { bad++; v = 0; }
+            cur[3 * ci + a] = (float)v;
+        }
+    }
+    c->thread_rays[thread] += rays + shadow;
+    c->thread_shadow[thread] += shadow;
+    c->thread_nonfinite[thread] += bad;
+}
+
+static double cell_power(const tp_ctx *c, const float *l)
+{
+    double p = 0;
+    for (size_t i = 0; i < c->cell_count; i++) {
+        double v[3] = {l[3 * i], l[3 * i + 1], l[3 * i + 2]};
+        p += c->cells[i].area * bk_lum(v);
+    }
+    return p;
+}
+
+typedef struct tp_chain_result { int bounces; double q, tail_energy, total_energy; } tp_chain_result;
+
+/* Fills l_sum[h] with the reflected outgoing radiance per cell (all bounces + tail; emission is
+ * added where a gather ray hits it, with its MIS weight). */
+static tp_chain_result run_chain(tp_ctx *c, int h, int pass, int rays, double tol, int max_bounces)
+{
+    tp_chain_result res = {0, 0, 0, 0};
+    size_t n = c->cell_count;
+    float *sum = c->l_sum[h];
+    memset(sum, 0, 3 * (n ? n : 1) * sizeof *sum);
+    c->half = h;
+    c->pass = pass;
+    c->rays = rays;
+    if (lattice_init(&c->lat, (uint32_t)rays) != LBK_OK) { res.bounces = -1; return res; }
+    double pw[3] = {0, 0, 0}; /* energies of the last three bounces */
+    double indirect = 0, q = 0;
+    int k;
+    for (k = 1; k <= max_bounces; k++) {
+        c->bounce = k;
+        parallel_for(c, n, 64, cache_bounce);
+        double p = cell_power(c, c->l_cur[h]);
+        for (size_t i = 0; i < 3 * n; i++) sum[i] += c->l_cur[h][i];
+        indirect += p;
+        pw[0] = pw[1]; pw[1] = pw[2]; pw[2] = p;
+        float *tmp = c->l_prev[h]; c->l_prev[h] = c->l_cur[h]; c->l_cur[h] = tmp;
+        if (k >= 2) q = pw[1] > 0 ? pw[2] / pw[1] : 0;
+        if (!(p > 0) || p <= 1e-7 * indirect) break;
+        if (k >= 4) {
+            double q1 = pw[1] / pw[0], q2 = pw[2] / pw[1];
+            double qq = fmin(q2, TP_Q_MAX);
+            double sigma = fabs(q2 - q1);
+            double tail = p * qq / (1 - qq);
+            double frac = tail / (indirect + tail);
+            /* relative error of the total caused by an error sigma in q (d tail / dq) */
+            double unc = qq > 1e-3 ? frac * sigma / (qq * (1 - qq)) : frac;
+            if (unc <= tol) break;
+        }
+    }
+    if (k > max_bounces) k = max_bounces;
+    q = q < 0 ? 0 : q > TP_Q_MAX ? TP_Q_MAX : q;
+    if (!isfinite(q)) q = 0;
+    /* tail of the Neumann series: L_K·(q + q² + ...) = L_K·q/(1−q), shaped like the last bounce */
+    double f = q / (1 - q);
+    const float *last = c->l_prev[h];
+    for (size_t i = 0; i < 3 * n; i++) sum[i] += (float)(last[i] * f);
+    res.bounces = k;
+    res.q = q;
+    res.tail_energy = pw[2] * f;
+    res.total_energy = indirect + pw[2] * f;
+    return res;
+}
+
+/* ---- receivers ------------------------------------------------------------------------------- */
+
+static void recv_offset_origin(const tp_ctx *c, const bk_receiver *r, float o[3])
+{
+    if (r->normal[0] == 0 && r->normal[1] == 0 && r->normal[2] == 0) {
+        memcpy(o, r->position, 3 * sizeof(float));
+        return;
+    }
+    bk_offset_ray_origin_scaled(r->position, r->normal, c->scene_scale, o);
+}
+
+static void recv_normal(const bk_receiver *r, double n[3], int *sphere)
+{
+    double l = sqrt((double)r->normal[0] * r->normal[0] + (double)r->normal[1] * r->normal[1] +
+                    (double)r->normal[2] * r->normal[2]);
+    *sphere = !(l > 0);
+    for (int k = 0; k < 3; k++) n[k] = *sphere ? 0 : r->normal[k] / l;
+    if (*sphere) n[2] = 1;
+}
+
+static void recv_punctual(tp_ctx *c, size_t begin, size_t end, int thread)
+{
+    /* Punctual light is noise-free: computed once, then into the outputs / error scalars. */
+    uint64_t rays = 0;
+    for (size_t i = begin; i < end; i++) {
+        const bk_receiver *r = &c->recv[i];
+        double n[3];
+        int sphere;
+        recv_normal(r, n, &sphere);
+        float o[3];
+        recv_offset_origin(c, r, o);
+        double p[3] = {r->position[0], r->position[1], r->position[2]};
+        double e[3] = {0, 0, 0}, sh[3][9];
+        memset(sh, 0, sizeof sh);
+        for (size_t li = 0; li < c->light_count; li++) {
+            double val[3], ld[3], dist;
+            if (!bk_light_eval(c->lights[li], p, val, ld, &dist)) continue;
+            double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
+            if (!sphere && cs <= 0) continue;
+            rays++;
+            if (!bk_light_visible(c->tracer, o, ld, dist)) continue;
+            double y[9];
+            bk_sh9_basis_d(ld, y);
+            for (int a = 0; a < 3; a++) {
+                e[a] += sphere ? val[a] : val[a] * cs;
+                for (int kk = 0; kk < 9; kk++) sh[a][kk] += val[a] * y[kk];
+            }
+        }
+        if (c->punct_lum) {
+            c->punct_lum[i] = (float)bk_lum(e);
+            continue;
+        }
+        const bk_transport_output *out = c->out;
+        for (int a = 0; a < 3; a++) {
+            for (int kk = 0; kk < 9; kk++) {
+                out->radiance[i].c[a][kk] += (float)sh[a][kk];
+                if (out->direct) out->direct[i].c[a][kk] += (float)sh[a][kk];
+            }
+            if (out->irradiance) out->irradiance[3 * i + a] += (float)e[a];
+        }
+    }
+    c->thread_rays[thread] += rays;
+    c->thread_shadow[thread] += rays;
+}
+
+/* One sample of a receiver's estimate: radiance L (direct part Ld) from unit direction d with
+ * cosine factor cs (1 for probes) into the irradiance and the SH projections. */
+static void accumulate(const double d[3], double cs, const double L[3], const double Ld[3], double e[3],
+                       double sh_t[3][9], double sh_d[3][9])
+{
+    double y[9];
+    bk_sh9_basis_d(d, y);
+    int has_d = Ld[0] != 0 || Ld[1] != 0 || Ld[2] != 0;
+    for (int a = 0; a < 3; a++) {
+        e[a] += L[a] * cs;
+        for (int kk = 0; kk < 9; kk++) sh_t[a][kk] += L[a] * y[kk];
+        if (has_d)
+            for (int kk = 0; kk < 9; kk++) sh_d[a][kk] += Ld[a] * y[kk];
+    }
+}
+
+static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
+{
+    const int S = c->rays;
+    const double w = c->pass_weight;
+    const bk_transport_output *out = c->out;
+    uint64_t rays = 0, shadow = 0, bad = 0;
+    for (size_t i = begin; i < end; i++) {
+        const bk_receiver *r = &c->recv[i];
+        double n[3], t[3], b[3];
+        int sphere;
+        recv_normal(r, n, &sphere);
+        bk_onb(n, t, b);
+        float o[3];
+        recv_offset_origin(c, r, o);
+        double sh_t[3][9], sh_d[3][9], e_t[3];
+        memset(sh_t, 0, sizeof sh_t);
+        memset(sh_d, 0, sizeof sh_d);
+        memset(e_t, 0, sizeof e_t);
+        for (int h = 0; h < 2; h++) {
+            tp_rng rng = rng_make(c->seed, DOM_RECV, (uint64_t)h, (uint64_t)c->pass, 0, i);
+            double s1 = rng_next(&rng), s2 = rng_next(&rng);
+            tp_shift shift = lattice_shift(s1, s2);
+            const float *sum = c->l_sum[h];
+            double e[3] = {0, 0, 0};
+            /* uniform over the hemisphere (texels) or sphere (probes): the SH projection needs
+             * a pdf that does not vanish at the horizon */
+            const double solid = sphere ? 4 * TP_PI : 2 * TP_PI;
+            const int pg_kind = sphere ? PG_SPHERE : PG_HEMISPHERE;
+            double t1 = 0, t2 = 0;
+            if (c->nee) {
+                tp_rng nr = rng_make(c->seed, DOM_RECV_NEE, (uint64_t)h, (uint64_t)c->pass, 0, i);
+                t1 = rng_next(&nr);
+                t2 = rng_next(&nr);
+            }
+            for (int j0 = 0; j0 < S; j0 += TP_BATCH) {
+                const int m = S - j0 < TP_BATCH ? S - j0 : TP_BATCH;
+                float org[3 * TP_BATCH], dir[3 * TP_BATCH];
+                double dd[TP_BATCH][3], zz[TP_BATCH];
+                bk_hit hits[TP_BATCH];
+                for (int jj = 0; jj < m; jj++) {
+                    double u1, cp, sp;
+                    lattice(&c->lat, (uint32_t)(j0 + jj), &shift, &u1, &cp, &sp);
+                    double z = sphere ? 1 - 2 * u1 : u1;
+                    double rr = sqrt(fmax(0.0, 1 - z * z));
+                    double lx = rr * cp, ly = rr * sp;
+                    zz[jj] = z;
+                    for (int a = 0; a < 3; a++) {
+                        dd[jj][a] = lx * t[a] + ly * b[a] + z * n[a];
+                        dir[3 * jj + a] = (float)dd[jj][a];
+                        org[3 * jj + a] = o[a];
+                    }
+                }
+                bk_tracer_intersect_n(c->tracer, (size_t)m, org, dir, 0.0f, NULL, hits);
+                rays += (uint64_t)m;
+                for (int jj = 0; jj < m; jj++) {
+                    const double *d = dd[jj];
+                    const bk_hit *hit = &hits[jj];
+                    double L[3] = {0, 0, 0}, Ld[3] = {0, 0, 0};
+                    if (hit->tri != UINT32_MAX) {
+                        long hc = hit_cell(c, hit);
+                        if (hc >= 0) {
+                            emission_at(c, hit->tri, hit->u, hit->v, Ld);
+                            if (Ld[0] > 0 || Ld[1] > 0 || Ld[2] > 0) {
+                                double wg = mis_gather(c, hit, hc, d, 1 / solid);
+                                for (int a = 0; a < 3; a++) Ld[a] *= wg;
+                            }
+                            for (int a = 0; a < 3; a++) L[a] = sum[3 * hc + a] + Ld[a];
+                        }
+                    } else {
+                        sky_radiance(c, d, L);
+                        memcpy(Ld, L, sizeof L);
+                    }
+                    if (!bk_finite3(L) || !bk_finite3(Ld)) bad++;
+                    else accumulate(d, sphere ? 1 : zz[jj], L, Ld, e, sh_t, sh_d);
+                    if (c->nee) {
+                        /* one light sample per gather ray; its value Le·w/p is turned into the
+                         * gather's units (radiance, later × solid/S) by 1/solid */
+                        double u0, uu1, ld[3], cl, val[3];
+                        lattice_uv(&c->lat, (uint32_t)(j0 + jj), t1, t2, &u0, &uu1);
+                        if (nee_sample(c, o, n, pg_kind, u0, uu1, ld, &cl, val, &shadow)) {
+                            for (int a = 0; a < 3; a++) val[a] /= solid;
+                            if (!bk_finite3(val)) bad++;
+                            else accumulate(ld, cl, val, val, e, sh_t, sh_d);
+                        }
+                    }
+                }
+            }
+            for (int a = 0; a < 3; a++) e[a] *= solid / S;
+            /* error scalar: irradiance for texels, fluence/4 for probes (equal under uniform
+             * radiance, so texels and probes weigh alike in the relative RMSE) */
+            c->x_acc[h][i] += w * (bk_lum(e) + c->punct_lum[i]) * (sphere ? 0.25 : 1.0);
+            for (int a = 0; a < 3; a++) e_t[a] += e[a];
+        }
+        /* both halves: 2S samples of pdf 1/solid; weight w for this pass */
+        const double ws = w * (sphere ? 4 * TP_PI : 2 * TP_PI) / (2.0 * S);
+        for (int a = 0; a < 3; a++) {
+            for (int kk = 0; kk < 9; kk++) {
+                out->radiance[i].c[a][kk] += (float)(sh_t[a][kk] * ws);
+                if (out->direct) out->direct[i].c[a][kk] += (float)(sh_d[a][kk] * ws);
+            }
+            if (out->irradiance) out->irradiance[3 * i + a] += (float)(e_t[a] * w * 0.5);
+        }
+    }
+    c->thread_rays[thread] += rays + shadow;
+    c->thread_shadow[thread] += shadow;
+    c->thread_nonfinite[thread] += bad;
+}
+
+/* ---- setup ------------------------------------------------------------------------------------ */
+
+static int online_cores(void)
+{
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n < 1 ? 1 : n > 256 ? 256 : (int)n;
+}
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static void free_ctx(tp_ctx *c)
+{
+    free(c->cells); free(c->tri_first); free(c->tri_m); free(c->tri_sides); free(c->tri_edge_eps);
+    free(c->tri_le); free(c->tri_le_tex); free(c->em); free(c->em_cdf);
+    free(c->thread_shadow);
+    free(c->lights);
+    for (int h = 0; h < 2; h++) { free(c->l_prev[h]); free(c->l_cur[h]); free(c->l_sum[h]); free(c->x_acc[h]); }
+    free(c->punct_lum);
+    free(c->thread_rays); free(c->thread_nonfinite);
+    lattice_free(&c->lat);
+}
+
+static lbk_result build_cells(tp_ctx *c)
+{
+    const bk_scene *s = c->scene;
+    size_t nt = s->tri_count;
+    size_t max_cells = c->opt->max_cells > 0 ? (size_t)c->opt->max_cells : 32768;
+    c->tri_first = calloc(nt ? nt : 1, sizeof *c->tri_first);
+    c->tri_m = calloc(nt ? nt : 1, 1);
+    c->tri_sides = calloc(nt ? nt : 1, 1);
+    c->tri_edge_eps = calloc(nt ? nt : 1, sizeof(float));
+    c->tri_le = calloc(3 * (nt ? nt : 1), sizeof(float));
+    c->tri_le_tex = calloc(nt ? nt : 1, sizeof(int32_t));
+    if (!c->tri_first || !c->tri_m || !c->tri_sides || !c->tri_edge_eps || !c->tri_le || !c->tri_le_tex)
+        return LBK_ERR_OUT_OF_MEMORY;
+    double total = 0;
+    for (size_t i = 0; i < nt; i++) {
+        uint32_t mi = s->tri_material ? s->tri_material[i] : 0;
+        int ds = mi < s->material_count ? s->materials[mi].double_sided : 0;
+        c->tri_sides[i] = ds ? 2 : 1;
+        total += (double)bk_tracer_tri_area(c->tracer, (uint32_t)i) * c->tri_sides[i];
+    }
+    double cell_area = total > 0 ? total / (double)max_cells : 0;
+    size_t count = 0;
+    for (size_t i = 0; i < nt; i++) {
+        double a = bk_tracer_tri_area(c->tracer, (uint32_t)i);
+        int m = 1;
+        if (cell_area > 0 && a > 0) {
+            double per_side = a / cell_area;
+            double r = floor(sqrt(per_side));
+            m = r < 1 ? 1 : r > TP_MAX_SUB ? TP_MAX_SUB : (int)r;
+        }
+        c->tri_m[i] = (uint8_t)m;
+        if (count > UINT32_MAX - 2 * TP_MAX_SUB * TP_MAX_SUB) return LBK_ERR_LIMIT;
+        c->tri_first[i] = (uint32_t)count;
+        count += (size_t)c->tri_sides[i] * m * m;
+        /* keep sample points >= 8 ulps of the coordinates inside every edge (the tracer's edge
+         * limitation, tracer.h): a barycentric floor of 8 ulp / altitude */
+        double v[3][3];
+        tri_vertices(c, (uint32_t)i, v);
+        double longest = 0;
+        for (int e = 0; e < 3; e++) {
+            double l2 = 0;
+            for (int k = 0; k < 3; k++) l2 += (v[(e + 1) % 3][k] - v[e][k]) * (v[(e + 1) % 3][k] - v[e][k]);
+            longest = fmax(longest, sqrt(l2));
+        }
+        double alt = longest > 0 ? 2 * a / longest : 0;
+        double ulp = bk_tracer_tri_scale(c->tracer, (uint32_t)i) * 1.1920928955078125e-07;
+        double eps = alt > 0 && isfinite(alt) ? 8 * ulp / alt : 0;
+        c->tri_edge_eps[i] = (float)(eps > 0.3 ? 0.3 : eps);
+    }
+    c->cell_count = count;
+    c->cells = calloc(count ? count : 1, sizeof *c->cells);
+    if (!c->cells) return LBK_ERR_OUT_OF_MEMORY;
+    for (size_t i = 0; i < nt; i++) {
+        uint32_t mi = s->tri_material ? s->tri_material[i] : 0;
+        const bk_material *mat = mi < s->material_count ? &s->materials[mi] : NULL;
+        uint32_t oi = s->tri_object ? s->tri_object[i] : 0;
+        const char *set = (oi < s->object_count) ? s->objects[oi].light_set : "";
+        int emits = in_light_set(c, set);
+        float n[3];
+        bk_tracer_tri_normal(c->tracer, (uint32_t)i, n);
+        float area = bk_tracer_tri_area(c->tracer, (uint32_t)i);
+        int m = c->tri_m[i];
+        c->tri_le_tex[i] = -1;
+        if (mat && emits && area > 0) {
+            for (int k = 0; k < 3; k++) {
+                double em = mat->emission[k];
+                c->tri_le[3 * i + k] = (float)(isfinite(em) && em > 0 ? em : 0);
+            }
+            if (mat->emission_tex >= 0 && bk_scene_image(s, mat->emission_tex)) c->tri_le_tex[i] = mat->emission_tex;
+        }
+        for (int sub = 0; sub < m * m; sub++) {
+            /* material values at the cell's centroid (uv0) */
+            int j = 0, ss = sub;
+            while (j < m - 1 && ss >= 2 * (m - j) - 1) { ss -= 2 * (m - j) - 1; j++; }
+            int ii = ss / 2, up = ss & 1;
+            double cu = up ? (3.0 * ii + 2) / (3.0 * m) : (3.0 * ii + 1) / (3.0 * m);
+            double cv = up ? (3.0 * j + 2) / (3.0 * m) : (3.0 * j + 1) / (3.0 * m);
+            double uv[2];
+            bk_tri_uv0(s, (uint32_t)i, cu, cv, uv);
+            float albedo[3] = {0, 0, 0}, le[3] = {0, 0, 0};
+            if (mat) {
+                double al[3], em[3];
+                bk_material_albedo(s, mat, uv, al);
+                bk_material_emission(s, mat, uv, em);
+                for (int k = 0; k < 3; k++) {
+                    albedo[k] = (float)al[k];
+                    le[k] = emits ? (float)em[k] : 0;
+                }
+            }
+            if (c->opt->albedo_hook) {
+                c->opt->albedo_hook(c->opt->user, (uint32_t)i, albedo);
+                for (int k = 0; k < 3; k++)
+                    albedo[k] = isfinite(albedo[k]) ? (albedo[k] < 0 ? 0 : albedo[k] > 0.999f ? 0.999f : albedo[k]) : 0;
+            }
+            for (int side = 0; side < c->tri_sides[i]; side++) {
+                tp_cell *cell = &c->cells[c->tri_first[i] + (size_t)side * m * m + sub];
+                cell->tri = (uint32_t)i;
+                cell->sub = (uint16_t)sub;
+                cell->m = (uint16_t)m;
+                cell->side = (uint8_t)side;
+                for (int k = 0; k < 3; k++) cell->n[k] = side ? -n[k] : n[k];
+                cell->area = area / (float)(m * m);
+                memcpy(cell->albedo, albedo, sizeof albedo);
+                memcpy(cell->le, le, sizeof le);
+            }
+        }
+    }
+    return LBK_OK;
+}
+
+/* The light-sampling distribution: every emitting sub-triangle with probability proportional
+ * to its power area·bk_lum(Le) (Le at its centroid, as the cells carry it), a point uniform on it.
+ * A point's density per unit area is then bk_lum(Le_cell)/P_total, stored in both side cells so a
+ * gather hit can weigh itself against it. */
+static lbk_result build_emitters(tp_ctx *c)
+{
+    const bk_transport_options *opt = c->opt;
+    c->nee = 0;
+    if (opt->nee < 0) return LBK_OK;
+    size_t n = 0;
+    double power = 0, em_area = 0, total_area = 0;
+    for (size_t i = 0; i < c->scene->tri_count; i++) total_area += bk_tracer_tri_area(c->tracer, (uint32_t)i);
+    for (size_t ci = 0; ci < c->cell_count; ci++) {
+        const tp_cell *cell = &c->cells[ci];
+        if (cell->side != 0 || !(cell->area > 0)) continue;
+        double le[3] = {cell->le[0], cell->le[1], cell->le[2]};
+        double p = cell->area * bk_lum(le);
+        if (!(p > 0) || !isfinite(p)) continue;
+        n++;
+        power += p;
+        em_area += cell->area;
+    }
+    if (n == 0 || !(power > 0) || !isfinite(power)) return LBK_OK;
+    /* auto: emitters covering half the surface are hit by gather rays about as often as light
+     * samples would find them; gathering alone keeps the furnace exact (TRANSPORT.md) */
+    if (opt->nee == 0 && em_area >= 0.5 * total_area) return LBK_OK;
+    c->em = malloc(n * sizeof *c->em);
+    c->em_cdf = malloc(n * sizeof *c->em_cdf);
+    if (!c->em || !c->em_cdf) return LBK_ERR_OUT_OF_MEMORY;
+    double run = 0;
+    size_t k = 0;
+    for (size_t ci = 0; ci < c->cell_count; ci++) {
+        tp_cell *cell = &c->cells[ci];
+        if (cell->side != 0 || !(cell->area > 0)) continue;
+        double le[3] = {cell->le[0], cell->le[1], cell->le[2]};
+        double p = cell->area * bk_lum(le);
+        if (!(p > 0) || !isfinite(p)) continue;
+        run += p;
+        c->em[k].tri = cell->tri;
+        c->em[k].cell = (uint32_t)ci;
+        c->em_cdf[k] = run / power;
+        float pa = (float)(bk_lum(le) / power);
+        cell->nee_parea = pa;
+        if (c->tri_sides[cell->tri] > 1) c->cells[ci + (size_t)cell->m * cell->m].nee_parea = pa;
+        k++;
+    }
+    c->em_cdf[n - 1] = 1.0;
+    c->em_count = n;
+    c->nee = 1;
+    return LBK_OK;
+}
+
+/* ---- the run ---------------------------------------------------------------------------------- */
+
+lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, const bk_receiver *receivers,
+                            size_t count, const bk_transport_options *options,
+                            const bk_transport_output *output, bk_transport_stats *stats)
+{
+    double t0 = now_seconds();
+    bk_transport_options defaults;
+    memset(&defaults, 0, sizeof defaults);
+    const bk_transport_options *opt = options ? options : &defaults;
+    if (stats) memset(stats, 0, sizeof *stats);
+    if (!scene || !tracer || !output || (count > 0 && (!receivers || !output->radiance))) return LBK_ERR_INVALID_ARGUMENT;
+    if (bk_tracer_tri_count(tracer) != scene->tri_count) return LBK_ERR_INVALID_ARGUMENT;
+    if (scene->tri_count > 0 && !scene->tris) return LBK_ERR_INVALID_ARGUMENT;
+    for (size_t i = 0; i < count; i++) {
+        const bk_receiver *r = &receivers[i];
+        for (int k = 0; k < 3; k++)
+            if (!isfinite(r->position[k]) || !isfinite(r->normal[k])) return LBK_ERR_INVALID_ARGUMENT;
+    }
+
+    tp_ctx c;
+    memset(&c, 0, sizeof c);
+    c.scene = scene;
+    c.tracer = tracer;
+    c.opt = opt;
+    c.seed = opt->seed;
+    c.threads = opt->threads > 0 ? (opt->threads > 256 ? 256 : opt->threads) : online_cores();
+    c.recv = receivers;
+    c.recv_count = count;
+    c.out = output;
+    const int max_bounces = opt->max_bounces > 0 ? opt->max_bounces : 64;
+    const double max_samples = opt->max_samples > 0 ? opt->max_samples : 4096;
+    const double target = opt->target_error == 0 ? 0.01 : opt->target_error;
+    const int s0 = opt->first_pass_samples > 0 ? opt->first_pass_samples : 16;
+    const double tail_tol = fmax(0.1 * (target > 0 ? target : 0.001), 1e-5);
+
+    lbk_result res = LBK_OK;
+    c.thread_rays = calloc((size_t)c.threads, sizeof(uint64_t));
+    c.thread_nonfinite = calloc((size_t)c.threads, sizeof(uint64_t));
+    c.thread_shadow = calloc((size_t)c.threads, sizeof(uint64_t));
+    if (!c.thread_rays || !c.thread_nonfinite || !c.thread_shadow) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
+
+    /* scale of the coordinates: offsets for receivers, which carry no triangle */
+    for (size_t i = 0; i < scene->tri_count; i++) {
+        float sc = bk_tracer_tri_scale(tracer, (uint32_t)i);
+        if (sc > c.scene_scale) c.scene_scale = sc;
+    }
+    const int base_bake = !(opt->light_set && opt->light_set[0]);
+    c.use_sky = base_bake && !opt->no_sky;
+    if (!opt->no_punctual && scene->light_count) {
+        c.lights = calloc(scene->light_count, sizeof *c.lights);
+        if (!c.lights) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
+        for (size_t i = 0; i < scene->light_count; i++)
+            if (in_light_set(&c, scene->lights[i].light_set)) c.lights[c.light_count++] = &scene->lights[i];
+    }
+    res = build_cells(&c);
+    if (res != LBK_OK) goto done;
+    res = build_emitters(&c);
+    if (res != LBK_OK) goto done;
+    size_t nc = c.cell_count ? c.cell_count : 1;
+    for (int h = 0; h < 2; h++) {
+        c.l_prev[h] = calloc(3 * nc, sizeof(float));
+        c.l_cur[h] = calloc(3 * nc, sizeof(float));
+        c.l_sum[h] = calloc(3 * nc, sizeof(float));
+        c.x_acc[h] = calloc(count ? count : 1, sizeof(double));
+        if (!c.l_prev[h] || !c.l_cur[h] || !c.l_sum[h] || !c.x_acc[h]) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
+    }
+    c.punct_lum = calloc(count ? count : 1, sizeof(float));
+    if (!c.punct_lum) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
+
+    for (size_t i = 0; i < count; i++) {
+        memset(&output->radiance[i], 0, sizeof output->radiance[i]);
+        if (output->direct) memset(&output->direct[i], 0, sizeof output->direct[i]);
+        if (output->irradiance) output->irradiance[3 * i] = output->irradiance[3 * i + 1] = output->irradiance[3 * i + 2] = 0;
+    }
+    if (c.light_count) parallel_for(&c, count, 64, recv_punctual); /* luminance only, for the error */
+
+    double weight_sum = 0, spp = 0, err = 0, last_pass_time = 0;
+    int pass = 0, stop = BK_STOP_BUDGET;
+    tp_chain_result chain[2] = {{0, 0, 0, 0}, {0, 0, 0, 0}};
+    for (;; pass++) {
+        double pass_start = now_seconds();
+        /* both halves' caches */
+        /* cache rays: about as many as the receivers trace this pass (over ~4 bounces), within
+         * [min(4·2^(p/2), cap), cap], cap = cache_rays·2^p; both estimates shrink together */
+        int sp = pass < 20 ? pass : 20;
+        double cap = fmin((double)(opt->cache_rays > 0 ? opt->cache_rays : 16) * ldexp(1.0, sp), 65536.0);
+        double lo = fmin(cap, 4.0 * ldexp(1.0, sp / 2));
+        double want = ceil((double)s0 * ldexp(1.0, sp) * (double)count / (4.0 * (double)nc));
+        int cache_rays = (int)fmax(lo, fmin(cap, want));
+        for (int h = 0; h < 2; h++) {
+            chain[h] = run_chain(&c, h, pass, cache_rays, tail_tol, max_bounces);
+            if (chain[h].bounces < 0) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
+            if (opt->progress) {
+                double f = fmax(spp / max_samples, opt->time_limit > 0 ? (now_seconds() - t0) / opt->time_limit : 0);
+                opt->progress(opt->user, "cache", f > 1 ? 1 : f);
+            }
+        }
+        /* final gather at the receivers, in blocks so progress can be reported */
+        c.pass = pass;
+        c.rays = s0 << (pass < 20 ? pass : 20);
+        if (lattice_init(&c.lat, (uint32_t)c.rays) != LBK_OK) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
+        c.pass_weight = ldexp(1.0, pass);
+        size_t block = count / 8 + 1;
+        for (size_t b = 0; b < count; b += block) {
+            size_t e = b + block < count ? b + block : count;
+            parallel_range(&c, b, e, 16, recv_gather);
+            if (opt->progress) {
+                double f = fmax((spp + 2.0 * c.rays * (double)e / (double)(count ? count : 1)) / max_samples,
+                                opt->time_limit > 0 ? (now_seconds() - t0) / opt->time_limit : 0);
+                opt->progress(opt->user, "gather", f > 1 ? 1 : f);
+            }
+        }
+        weight_sum += c.pass_weight;
+        spp += 2.0 * c.rays;
+        /* error: two independent half estimates per receiver (TRANSPORT.md) */
+        double num = 0, den = 0;
+        for (size_t i = 0; i < count; i++) {
+            double a = c.x_acc[0][i] / weight_sum, b = c.x_acc[1][i] / weight_sum;
+            num += 0.25 * (a - b) * (a - b);
+            double m = 0.5 * (a + b);
+            den += m * m;
+        }
+        err = den > 0 ? sqrt(num / den) : 0;
+        last_pass_time = now_seconds() - pass_start;
+        if (opt->report) {
+            bk_transport_sample smp = {now_seconds() - t0, spp, err, chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces, pass};
+            opt->report(opt->user, &smp);
+        }
+        if (target > 0 && err <= target) { stop = BK_STOP_TARGET; break; }
+        double next_spp = spp + 2.0 * (s0 << (pass + 1 < 20 ? pass + 1 : 20));
+        if (next_spp > max_samples || pass >= 24) { stop = BK_STOP_BUDGET; break; }
+        /* the next pass costs about twice this one: start it only if it can finish in time */
+        if (opt->time_limit > 0 && now_seconds() - t0 + 2.1 * last_pass_time > opt->time_limit) { stop = BK_STOP_TIME; break; }
+    }
+
+    /* normalise the pass-weighted sums, then add the noise-free punctual light */
+    for (size_t i = 0; i < count; i++) {
+        float inv = (float)(1.0 / weight_sum);
+        for (int a = 0; a < 3; a++) {
+            for (int k = 0; k < 9; k++) {
+                output->radiance[i].c[a][k] *= inv;
+                if (output->direct) output->direct[i].c[a][k] *= inv;
+            }
+            if (output->irradiance) output->irradiance[3 * i + a] *= inv;
+        }
+    }
+    if (c.light_count) {
+        float *pl = c.punct_lum;
+        c.punct_lum = NULL; /* recv_punctual now writes into the outputs */
+        parallel_for(&c, count, 64, recv_punctual);
+        c.punct_lum = pl;
+    }
+
+    if (stats) {
+        stats->seconds = now_seconds() - t0;
+        stats->passes = pass + 1;
+        stats->samples_per_receiver = spp;
+        stats->est_rel_rmse = err;
+        stats->bounces = chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces;
+        stats->q = 0.5 * (chain[0].q + chain[1].q);
+        double tot = chain[0].total_energy + chain[1].total_energy;
+        stats->tail_fraction = tot > 0 ? (chain[0].tail_energy + chain[1].tail_energy) / tot : 0;
+        stats->cells = c.cell_count;
+        for (int t = 0; t < c.threads; t++) {
+            stats->rays += c.thread_rays[t];
+            stats->shadow_rays += c.thread_shadow[t];
+            stats->nonfinite += c.thread_nonfinite[t];
+        }
+        stats->stop = stop;
+        stats->nee = c.nee;
+    }
+done:
+    free_ctx(&c);
+    return res;
+}

@@ -1,0 +1,114 @@
+/* Light transport: incident radiance at receivers, as SH9, by the series expansion of the
+ * rendering equation (seed 001 §2.3), Lambertian surfaces. Method, error model and the
+ * guaranteed furnace bounds: bake/transport/TRANSPORT.md.
+ *
+ * Summary: a radiosity cache of surface cells (each triangle side split into m² sub-triangles
+ * by area, independent of lightmap UVs) is filled bounce by bounce: bounce 1 = punctual direct
+ * (shadow rays) + emission (gather rays and next-event estimation, combined by multiple
+ * importance sampling) + sky (gather rays); bounce k = albedo/π × irradiance gathered from
+ * bounce k−1 with fresh rays. Bounces stop when the per-bounce energy ratio q has settled; the
+ * rest of the Neumann series is added per cell as L_K·q/(1−q). Receivers then gather the cache's
+ * radiance (final gather, emitters again by MIS of gather hits and light samples) plus punctual
+ * direct light. Progressive passes double the samples; each pass runs two independent halves
+ * (own cache, own receiver rays), whose difference estimates the error.
+ *
+ * Determinism: every random number comes from a counter-based hash of (seed, half, pass,
+ * bounce, item, sample); each item (cell or receiver) is computed by one thread in a fixed
+ * order and all reductions run sequentially in item order, so the output is byte-identical for
+ * any thread count. */
+#ifndef BK_TRANSPORT_H
+#define BK_TRANSPORT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "lbk/lbk.h"
+#include "lbk/sh.h"
+#include "bake/scene/scene.h"
+#include "bake/transport/tracer.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct bk_receiver {
+    float position[3];
+    float normal[3];   /* unit: a surface texel gathering over the hemisphere around it;
+                          zero: a volumetric probe gathering over the full sphere */
+} bk_receiver;
+
+/* One point of the error-against-time record, written after every pass. */
+typedef struct bk_transport_sample {
+    double seconds;               /* since bk_transport_run started */
+    double samples_per_receiver;  /* gather rays per receiver so far (both halves, all passes) */
+    double est_rel_rmse;          /* estimated relative RMSE of the result so far (TRANSPORT.md) */
+    int bounces;                  /* bounces computed explicitly in the last pass (tail excluded) */
+    int pass;
+} bk_transport_sample;
+
+typedef struct bk_transport_options {
+    uint64_t seed;
+    int threads;             /* 0: all online cores */
+    int max_bounces;         /* explicit bounces per pass before the analytic tail; 0: 64 */
+    int max_samples;         /* budget of gather rays per receiver over the whole run; 0: 4096 */
+    double target_error;     /* stop when the estimated relative RMSE <= this; 0: 0.01; < 0: never */
+    double time_limit;       /* seconds; 0: none. At least one pass always completes. */
+    const char *light_set;   /* NULL or "": the base (lights / emissive objects whose light_set is
+                                "", plus the sky); else only that set's lights and emitters, no sky */
+    int no_punctual;         /* 1: leave punctual lights out (default 0: included) */
+    int no_sky;              /* 1: no sky even in the base */
+    int max_cells;           /* radiosity cache cells (both sides counted); 0: 32768. A triangle
+                                always gets at least one cell per side */
+    int cache_rays;          /* gather rays per cell per bounce in pass 0 (doubles per pass); 0: 16 */
+    int first_pass_samples;  /* gather rays per receiver per half in pass 0 (doubles); 0: 16 */
+    /* Next-event estimation of emissive triangles (one light sample per gather ray, combined
+     * with the gather hits by the power heuristic): 0 auto = on unless the emitters cover half
+     * the scene's surface or more (gather rays find them anyway; TRANSPORT.md), 1 on, -1 off. */
+    int nee;
+    /* Called once per cache cell with the triangle's textured albedo; may change it (e.g. 0 for
+     * doors in base bakes). Must be deterministic. NULL: none. */
+    void (*albedo_hook)(void *user, uint32_t tri, float albedo[3]);
+    /* phase is "cache" or "gather"; fraction is the estimated fraction of the whole run. */
+    void (*progress)(void *user, const char *phase, double fraction);
+    void (*report)(void *user, const bk_transport_sample *sample);
+    void *user;
+} bk_transport_options;
+
+/* Caller-owned output arrays, `count` entries each; NULL pointers are skipped. */
+typedef struct bk_transport_output {
+    lbk_sh9_rgb *radiance;   /* incident radiance projected on SH9 (zero below a texel's horizon) */
+    lbk_sh9_rgb *direct;     /* the part that arrives straight from lights, emitters and sky;
+                                radiance − direct is the indirect part */
+    float *irradiance;       /* 3 per receiver, estimated directly (not from the SH): texels the
+                                irradiance E(n) = ∫_H L cos; probes the fluence ∫_S² L dω */
+} bk_transport_output;
+
+enum bk_transport_stop { BK_STOP_TARGET = 0, BK_STOP_TIME, BK_STOP_BUDGET };
+
+typedef struct bk_transport_stats {
+    double seconds;
+    int passes;
+    double samples_per_receiver;
+    double est_rel_rmse;
+    int bounces;             /* explicit bounces of the last pass */
+    double q;                /* per-bounce energy ratio used for the tail (last pass, mean of halves) */
+    double tail_fraction;    /* share of the cache's indirect energy that came from the tail */
+    size_t cells;
+    uint64_t rays;           /* rays traced (gather + shadow) */
+    uint64_t shadow_rays;    /* of which shadow rays (punctual lights and light samples) */
+    int nee;                 /* 1 when emitters were light-sampled (next-event estimation) */
+    uint64_t nonfinite;      /* sample values that were NaN/Inf and were dropped (should be 0) */
+    int stop;                /* enum bk_transport_stop */
+} bk_transport_stats;
+
+/* Computes radiance at `count` receivers. The tracer must have been built from `scene`.
+ * Errors: LBK_ERR_INVALID_ARGUMENT (NULL scene/tracer/output->radiance with count > 0, tracer
+ * over another triangle count, non-finite receiver), LBK_ERR_OUT_OF_MEMORY. */
+lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, const bk_receiver *receivers,
+                            size_t count, const bk_transport_options *options,
+                            const bk_transport_output *output, bk_transport_stats *stats);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

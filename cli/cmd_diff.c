@@ -1,0 +1,128 @@
+/* lbk diff: compare the lighting of two bakes. */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli/cli.h"
+#include "tools/inspect/diff.h"
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: lbk diff A.lbk B.lbk [--abs-tol X] [--rel-tol Y] [--json] [--heatmap DIR] [-v]\n"
+            "\n"
+            "Compares decoded lighting, not bytes. Objects are matched by name and geometry hash (then by\n"
+            "name alone, then by hash alone = renamed), never by position in the file; pages by index;\n"
+            "GLG probes by index when both grids have the same probe positions, otherwise B is sampled at A's\n"
+            "probes; LLG probes through their object; light sets and doors by name.\n"
+            "A texel's (probe's) error is the largest |B - A| of the decoded irradiance over R, G, B and over\n"
+            "5 tangent-space normals (+Z and 45 degrees toward +-X, +-Y) (6 axis normals for probes). It is\n"
+            "over tolerance when error > abs-tol + rel-tol * max|A| over the same values.\n"
+            "Reported per object, page, grid and light set: max and mean absolute error, relative RMSE,\n"
+            "share of samples over tolerance and their bounding region; plus added/removed/changed\n"
+            "objects, sections and META bake parameters. Units: irradiance as baked (lux-like, lm/m^2).\n"
+            "\n"
+            "  --abs-tol X     absolute tolerance (default 0)\n"
+            "  --rel-tol Y     relative tolerance (default 0)\n"
+            "  --json          JSON on stdout (schema spec/diff-json.md, schema_version %d)\n"
+            "  --heatmap DIR   DIR/page_NNN.diff.png per page: black = within tolerance, blue..white = error\n"
+            "                  over tolerance relative to the page's largest, grey = not compared\n"
+            "  -v, --verbose   list unchanged items too\n"
+            "  -h, --help      this text\n"
+            "\n"
+            "exit codes: 0 equal within tolerance, 1 the bakes differ (lighting, objects, pages, probes,\n"
+            "            light sets, doors or lighting sections; META/REPT differences alone do not count),\n"
+            "            2 usage, 3 I/O error, 4 an input is not a valid container, 5 internal error\n",
+            TL_DIFF_SCHEMA_VERSION);
+}
+
+static int parse_tol(const char *flag, const char *v, double *out)
+{
+    char *end;
+    errno = 0;
+    double x = strtod(v, &end);
+    if (errno || end == v || *end || !isfinite(x) || x < 0) {
+        fprintf(stderr, "lbk diff: %s needs a finite number >= 0, got '%s'\n", flag, v);
+        return -1;
+    }
+    *out = x;
+    return 0;
+}
+
+int lbk_cmd_diff(int argc, char **argv)
+{
+    const char *path[2] = {NULL, NULL}, *heat = NULL;
+    int json = 0, verbose = 0, npath = 0;
+    tl_diff_options o = {0, 0, 0};
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            usage(stdout);
+            return LBK_EXIT_OK;
+        } else if (!strcmp(a, "--json")) {
+            json = 1;
+        } else if (!strcmp(a, "-v") || !strcmp(a, "--verbose")) {
+            verbose = 1;
+        } else if (!strcmp(a, "--abs-tol") || !strcmp(a, "--rel-tol") || !strcmp(a, "--heatmap")) {
+            if (i + 1 >= argc) {
+                fprintf(stderr, "lbk diff: %s needs a value\n", a);
+                return LBK_EXIT_USAGE;
+            }
+            const char *v = argv[++i];
+            if (!strcmp(a, "--heatmap")) heat = v;
+            else if (parse_tol(a, v, !strcmp(a, "--abs-tol") ? &o.abs_tol : &o.rel_tol)) return LBK_EXIT_USAGE;
+        } else if (a[0] == '-' && a[1]) {
+            fprintf(stderr, "lbk diff: unknown option '%s' (see lbk diff --help)\n", a);
+            return LBK_EXIT_USAGE;
+        } else if (npath < 2) {
+            path[npath++] = a;
+        } else {
+            fprintf(stderr, "lbk diff: more than two inputs\n");
+            return LBK_EXIT_USAGE;
+        }
+    }
+    if (npath != 2) {
+        fprintf(stderr, "lbk diff: need two containers A.lbk B.lbk (see lbk diff --help)\n");
+        return LBK_EXIT_USAGE;
+    }
+    o.keep_error_maps = heat != NULL;
+    char err[TL_ERR_LEN];
+    tl_bake bake[2];
+    for (int k = 0; k < 2; k++) {
+        tl_open_status st = tl_bake_open_file(path[k], &bake[k], err);
+        if (st != TL_OPEN_OK) {
+            fprintf(stderr, "lbk diff: %s\n", err);
+            if (k) tl_bake_close(&bake[0]);
+            return st == TL_OPEN_IO ? LBK_EXIT_IO : st == TL_OPEN_INVALID ? LBK_EXIT_INPUT : LBK_EXIT_INTERNAL;
+        }
+    }
+    tl_diff_result r;
+    int rc = tl_diff_run(&bake[0], &bake[1], &o, &r, err);
+    tl_bake_close(&bake[0]);
+    tl_bake_close(&bake[1]);
+    if (rc) {
+        fprintf(stderr, "lbk diff: %s\n", err);
+        return LBK_EXIT_INTERNAL;
+    }
+    int exit_code = r.differ ? LBK_EXIT_NEGATIVE : LBK_EXIT_OK;
+    if (json) {
+        char *text = tl_diff_json(&r, path[0], path[1]);
+        if (!text) {
+            fprintf(stderr, "lbk diff: out of memory\n");
+            exit_code = LBK_EXIT_INTERNAL;
+        } else {
+            printf("%s\n", text);
+            free(text);
+        }
+    } else {
+        tl_diff_print(stdout, &r, verbose);
+    }
+    if (heat && tl_diff_heatmaps(&r, heat, err)) {
+        fprintf(stderr, "lbk diff: %s\n", err);
+        exit_code = LBK_EXIT_IO;
+    }
+    tl_diff_free(&r);
+    return exit_code;
+}

@@ -1,0 +1,306 @@
+/* lbk inspect FILE [--json]: memory per level. Per section the bytes on disk, decoded and
+ * GPU-resident; header, table and padding bytes so that the disk column adds up exactly to the
+ * file size; then the level statistics laid out like Table 1 of seed 001. */
+#include <errno.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <string.h>
+
+#include <cjson/cJSON.h>
+
+#include "cli/cli.h"
+#include "tools/inspect/describe.h"
+#include "lbk/container.h"
+
+typedef struct section_row {
+    lbk_section_info info;
+    char type[5];
+    int known;       /* this build has a describer for the type */
+    int readable;    /* section_data succeeded */
+    lbk_result error;
+    inspect_stats st;
+} section_row;
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: lbk inspect FILE [--json]\n"
+            "\n"
+            "Memory per level: for each section the bytes on disk, decoded bytes and GPU-resident\n"
+            "bytes, plus header, table and padding bytes (the disk column adds up to the file size),\n"
+            "then the level statistics of seed 001 Table 1 (lightmap texels, LLG probes, GLG probes,\n"
+            "dynamic light sets, doors, memory without and with DLS).\n"
+            "\n"
+            "  --json    one JSON document (schema \"lbk-inspect/1\", spec/inspect-json.md)\n"
+            "  --help    this text\n"
+            "\n"
+            "exit codes: 0 ok, 2 usage, 3 I/O error, 4 not a readable container (run lbk validate), 5 internal\n");
+}
+
+/* 1234567 → "1,234,567" */
+static const char *grouped(uint64_t v, char buf[32])
+{
+    char tmp[32];
+    int n = snprintf(tmp, sizeof tmp, "%" PRIu64, v), o = 0;
+    for (int i = 0; i < n; i++) {
+        buf[o++] = tmp[i];
+        if ((n - i - 1) % 3 == 0 && i != n - 1) buf[o++] = ',';
+    }
+    buf[o] = '\0';
+    return buf;
+}
+
+/* Table 1 gives MB; small levels read better in kB or bytes. Decimal units. */
+static void human_bytes(uint64_t v, char *buf, size_t n)
+{
+    if (v < 10000) snprintf(buf, n, "%" PRIu64 " B", v);
+    else if (v < 10000000) snprintf(buf, n, "%.1f kB", (double)v / 1e3);
+    else snprintf(buf, n, "%.1f MB", (double)v / 1e6);
+}
+
+static void add_stats(inspect_stats *sum, const inspect_stats *s)
+{
+    sum->lm_texels += s->lm_texels;
+    sum->lm_pages += s->lm_pages;
+    sum->glg_probes += s->glg_probes;
+    sum->glg_tetrahedra += s->glg_tetrahedra;
+    sum->llg_grids += s->llg_grids;
+    sum->llg_probes += s->llg_probes;
+    sum->llg_vertices += s->llg_vertices;
+    sum->octp_probes += s->octp_probes;
+    sum->objects += s->objects;
+    sum->dls_light_sets += s->dls_light_sets;
+    sum->dls_sets += s->dls_sets;
+    sum->dls_clusters += s->dls_clusters;
+    sum->dls_payload_bytes += s->dls_payload_bytes;
+    sum->dls_ancillary_bytes += s->dls_ancillary_bytes;
+    sum->doors += s->doors;
+    sum->door_states += s->door_states;
+}
+
+static int is_dynamic(uint32_t type) { return type == LBK_SECTION_DLS || type == LBK_SECTION_DOOR; }
+
+typedef struct report {
+    const char *path;
+    const lbk_header_info *h;
+    uint32_t count;
+    section_row rows[LBK_MAX_SECTIONS];
+    uint64_t header_bytes, table_bytes, padding_bytes, disk_total, decoded_total, gpu_total;
+    uint64_t memory_without_dls, memory_with_dls;
+    inspect_stats level;
+    int any_unreadable;
+} report;
+
+static void print_text(const report *r)
+{
+    char a[32], b[32], c[32];
+    printf("%s: lbk container %u.%u, %u section%s, alignment %u, %s bytes\n\n", r->path, r->h->version_major,
+           r->h->version_minor, r->count, r->count == 1 ? "" : "s", r->h->section_alignment,
+           grouped(r->h->file_size, a));
+    printf("%-8s %-5s %14s %14s %14s  %s\n", "section", "comp", "on disk", "decoded", "GPU", "detail");
+    printf("%-8s %-5s %14s %14s %14s  %s\n", "header", "", grouped(r->header_bytes, a), "-", "-", "64-byte header");
+    printf("%-8s %-5s %14s %14s %14s  %s\n", "table", "", grouped(r->table_bytes, a), "-", "-", "48 bytes per section");
+    for (uint32_t i = 0; i < r->count; i++) {
+        const section_row *s = &r->rows[i];
+        char detail[260];
+        if (!s->readable) snprintf(detail, sizeof detail, "unreadable: %s", lbk_result_name(s->error));
+        else if (!s->known) snprintf(detail, sizeof detail, "unknown optional section (skipped)");
+        else if (!s->st.parsed) snprintf(detail, sizeof detail, "payload did not parse (run lbk validate); GPU unknown");
+        else snprintf(detail, sizeof detail, "%s", s->st.detail);
+        printf("%-8s %-5s %14s %14s %14s  %s%s\n", s->type, s->info.compression ? "zstd" : "none",
+               grouped(s->info.stored_size, a), s->readable ? grouped(s->info.decoded_size, b) : "?",
+               grouped(s->st.gpu_bytes, c), detail, (s->info.flags & LBK_SECTION_FLAG_REQUIRED) ? " [required]" : "");
+    }
+    printf("%-8s %-5s %14s %14s %14s  %s\n", "padding", "", grouped(r->padding_bytes, a), "-", "-",
+           "zero bytes for section alignment");
+    printf("%-8s %-5s %14s %14s %14s\n", "total", "", grouped(r->disk_total, a), grouped(r->decoded_total, b),
+           grouped(r->gpu_total, c));
+    printf("check: header + table + sections + padding = %s bytes %s file size %s bytes%s\n\n",
+           grouped(r->disk_total, a), r->disk_total == r->h->file_size ? "==" : "!=", grouped(r->h->file_size, b),
+           r->disk_total == r->h->file_size ? "" : "  MISMATCH");
+
+    const inspect_stats *l = &r->level;
+    printf("level statistics (as in seed 001, Table 1)\n");
+    printf("%14s %14s %14s %8s %8s %18s %18s\n", "# LM texels", "# LLG probes", "# GLG probes", "# DLS", "# doors",
+           "memory (no DLS)", "memory (DLS)");
+    char m1[40], m2[40], d[32], e[32];
+    human_bytes(r->memory_without_dls, m1, sizeof m1);
+    human_bytes(r->memory_with_dls, m2, sizeof m2);
+    snprintf(d, sizeof d, "%" PRIu64, l->dls_light_sets);
+    snprintf(e, sizeof e, "%" PRIu64, l->doors);
+    printf("%14s %14s %14s %8s %8s %18s %18s\n", grouped(l->lm_texels, a), grouped(l->llg_probes, b),
+           grouped(l->glg_probes, c), d, e, m1, m2);
+    printf("\n  lightmap pages %" PRIu64 ", LLG grids %" PRIu64 ", GLG tetrahedra %" PRIu64 ", octahedral probes %" PRIu64
+           ", objects %" PRIu64 "\n",
+           l->lm_pages, l->llg_grids, l->glg_tetrahedra, l->octp_probes, l->objects);
+    printf("  DLS: %" PRIu64 " sets in all, %" PRIu64 " clusters, payload %s B, ancillary %s B; door states %" PRIu64
+           "\n",
+           l->dls_sets, l->dls_clusters, grouped(l->dls_payload_bytes, a), grouped(l->dls_ancillary_bytes, b),
+           l->door_states);
+    printf("  memory = GPU-resident bytes; \"no DLS\" leaves out the DLS and DOOR sections\n");
+}
+
+static int print_json(const report *r)
+{
+    cJSON *doc = cJSON_CreateObject();
+    if (!doc) return 0;
+    cJSON_AddStringToObject(doc, "schema", "lbk-inspect/1");
+    cJSON_AddStringToObject(doc, "file", r->path);
+    cJSON_AddNumberToObject(doc, "file_size", (double)r->h->file_size);
+    cJSON *ver = cJSON_AddObjectToObject(doc, "version");
+    if (ver) {
+        cJSON_AddNumberToObject(ver, "major", r->h->version_major);
+        cJSON_AddNumberToObject(ver, "minor", r->h->version_minor);
+    }
+    cJSON_AddNumberToObject(doc, "section_alignment", r->h->section_alignment);
+    cJSON_AddNumberToObject(doc, "required_features", r->h->required_features);
+    cJSON_AddNumberToObject(doc, "header_bytes", (double)r->header_bytes);
+    cJSON_AddNumberToObject(doc, "table_bytes", (double)r->table_bytes);
+    cJSON_AddNumberToObject(doc, "padding_bytes", (double)r->padding_bytes);
+    cJSON *secs = cJSON_AddArrayToObject(doc, "sections");
+    for (uint32_t i = 0; secs && i < r->count; i++) {
+        const section_row *s = &r->rows[i];
+        cJSON *j = cJSON_CreateObject();
+        if (!j || !cJSON_AddItemToArray(secs, j)) {
+            cJSON_Delete(j);
+            break;
+        }
+        cJSON_AddStringToObject(j, "type", s->type);
+        cJSON_AddBoolToObject(j, "required", (s->info.flags & LBK_SECTION_FLAG_REQUIRED) != 0);
+        cJSON_AddStringToObject(j, "compression", s->info.compression ? "zstd" : "none");
+        cJSON_AddNumberToObject(j, "offset", (double)s->info.offset);
+        cJSON_AddNumberToObject(j, "disk_bytes", (double)s->info.stored_size);
+        cJSON_AddNumberToObject(j, "decoded_bytes", (double)s->info.decoded_size);
+        cJSON_AddNumberToObject(j, "gpu_bytes", (double)s->st.gpu_bytes);
+        cJSON_AddBoolToObject(j, "known", s->known);
+        cJSON_AddBoolToObject(j, "readable", s->readable);
+        cJSON_AddBoolToObject(j, "parsed", s->st.parsed);
+        if (!s->readable) cJSON_AddStringToObject(j, "error", lbk_result_name(s->error));
+        cJSON_AddStringToObject(j, "detail", s->st.detail);
+    }
+    cJSON *tot = cJSON_AddObjectToObject(doc, "totals");
+    if (tot) {
+        cJSON_AddNumberToObject(tot, "disk_bytes", (double)r->disk_total);
+        cJSON_AddNumberToObject(tot, "decoded_bytes", (double)r->decoded_total);
+        cJSON_AddNumberToObject(tot, "gpu_bytes", (double)r->gpu_total);
+        cJSON_AddBoolToObject(tot, "disk_matches_file_size", r->disk_total == r->h->file_size);
+    }
+    const inspect_stats *l = &r->level;
+    cJSON *lv = cJSON_AddObjectToObject(doc, "level");
+    if (lv) {
+        cJSON_AddNumberToObject(lv, "lm_texels", (double)l->lm_texels);
+        cJSON_AddNumberToObject(lv, "lm_pages", (double)l->lm_pages);
+        cJSON_AddNumberToObject(lv, "llg_probes", (double)l->llg_probes);
+        cJSON_AddNumberToObject(lv, "llg_grids", (double)l->llg_grids);
+        cJSON_AddNumberToObject(lv, "llg_vertices", (double)l->llg_vertices);
+        cJSON_AddNumberToObject(lv, "glg_probes", (double)l->glg_probes);
+        cJSON_AddNumberToObject(lv, "glg_tetrahedra", (double)l->glg_tetrahedra);
+        cJSON_AddNumberToObject(lv, "octp_probes", (double)l->octp_probes);
+        cJSON_AddNumberToObject(lv, "objects", (double)l->objects);
+        cJSON_AddNumberToObject(lv, "dls_light_sets", (double)l->dls_light_sets);
+        cJSON_AddNumberToObject(lv, "dls_sets", (double)l->dls_sets);
+        cJSON_AddNumberToObject(lv, "dls_clusters", (double)l->dls_clusters);
+        cJSON_AddNumberToObject(lv, "dls_payload_bytes", (double)l->dls_payload_bytes);
+        cJSON_AddNumberToObject(lv, "dls_ancillary_bytes", (double)l->dls_ancillary_bytes);
+        cJSON_AddNumberToObject(lv, "doors", (double)l->doors);
+        cJSON_AddNumberToObject(lv, "door_states", (double)l->door_states);
+        cJSON_AddNumberToObject(lv, "memory_without_dls_bytes", (double)r->memory_without_dls);
+        cJSON_AddNumberToObject(lv, "memory_with_dls_bytes", (double)r->memory_with_dls);
+    }
+    char *text = cJSON_Print(doc);
+    cJSON_Delete(doc);
+    if (!text) return 0;
+    puts(text);
+    cJSON_free(text);
+    return 1;
+}
+
+int lbk_cmd_inspect(int argc, char **argv)
+{
+    const char *path = NULL;
+    int json = 0;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--json")) json = 1;
+        else if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+            usage(stdout);
+            return LBK_EXIT_OK;
+        } else if (argv[i][0] == '-' && argv[i][1]) {
+            fprintf(stderr, "lbk inspect: unknown option '%s'\n", argv[i]);
+            usage(stderr);
+            return LBK_EXIT_USAGE;
+        } else if (path) {
+            fprintf(stderr, "lbk inspect: one FILE only ('%s' and '%s')\n", path, argv[i]);
+            return LBK_EXIT_USAGE;
+        } else {
+            path = argv[i];
+        }
+    }
+    if (!path) {
+        usage(stderr);
+        return LBK_EXIT_USAGE;
+    }
+    lbk_reader *reader;
+    errno = 0;
+    lbk_result res = lbk_reader_open_file(path, NULL, &reader);
+    if (res == LBK_ERR_IO) {
+        fprintf(stderr, "lbk inspect: %s: %s\n", path, errno ? strerror(errno) : lbk_result_message(res));
+        return LBK_EXIT_IO;
+    }
+    if (res == LBK_ERR_OUT_OF_MEMORY) {
+        fprintf(stderr, "lbk inspect: out of memory\n");
+        return LBK_EXIT_INTERNAL;
+    }
+    if (res != LBK_OK) {
+        fprintf(stderr, "lbk inspect: %s: not a readable container: %s (%s); run 'lbk validate %s'\n", path,
+                lbk_result_name(res), lbk_result_message(res), path);
+        return LBK_EXIT_INPUT;
+    }
+
+    static report r; /* large (64 rows); one per process */
+    memset(&r, 0, sizeof r);
+    r.path = path;
+    r.h = lbk_reader_header(reader);
+    r.count = lbk_reader_section_count(reader);
+    r.header_bytes = LBK_HEADER_SIZE;
+    r.table_bytes = (uint64_t)LBK_SECTION_ENTRY_SIZE * r.count;
+    uint64_t sections_disk = 0, prev_end = r.header_bytes + r.table_bytes;
+    for (uint32_t i = 0; i < r.count; i++) {
+        section_row *s = &r.rows[i];
+        lbk_reader_section_info(reader, i, &s->info);
+        lbk_fourcc_string(s->info.type, s->type);
+        inspect_describe_fn fn = inspect_describer(s->info.type);
+        s->known = fn != NULL;
+        const void *data;
+        size_t size;
+        s->error = lbk_reader_section_data(reader, i, &data, &size);
+        s->readable = s->error == LBK_OK;
+        if (s->readable && fn) fn(data, size, &s->st);
+        if (!s->readable) r.any_unreadable = 1;
+        sections_disk += s->info.stored_size;
+        /* the gaps the alignment rule left, measured (not derived from the file size) */
+        if (s->info.offset > prev_end) r.padding_bytes += s->info.offset - prev_end;
+        prev_end = s->info.offset + s->info.stored_size;
+        r.decoded_total += s->info.decoded_size;
+        r.gpu_total += s->st.gpu_bytes;
+        if (is_dynamic(s->info.type)) r.memory_with_dls += s->st.gpu_bytes;
+        else r.memory_without_dls += s->st.gpu_bytes;
+        add_stats(&r.level, &s->st);
+    }
+    r.memory_with_dls += r.memory_without_dls;
+    if (r.h->file_size > prev_end) r.padding_bytes += r.h->file_size - prev_end;
+    r.disk_total = r.header_bytes + r.table_bytes + sections_disk + r.padding_bytes;
+
+    int ok = 1;
+    if (json) ok = print_json(&r);
+    else print_text(&r);
+    lbk_reader_close(reader);
+    if (!ok) {
+        fprintf(stderr, "lbk inspect: out of memory\n");
+        return LBK_EXIT_INTERNAL;
+    }
+    if (r.any_unreadable) {
+        fprintf(stderr, "lbk inspect: %s: some sections could not be read; run 'lbk validate %s'\n", path, path);
+        return LBK_EXIT_INPUT;
+    }
+    return LBK_EXIT_OK;
+}

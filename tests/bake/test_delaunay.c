@@ -1,0 +1,351 @@
+/* Delaunay tetrahedralisation: validity on random, cospherical (regular grid), flat, duplicate
+ * and tiny inputs. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <libqhull_r/qhull_ra.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bake/probes/delaunay.h"
+
+static uint64_t rng_state;
+static double rnd(void)
+{
+    rng_state = rng_state * 6364136223846793005ull + 1442695040888963407ull;
+    return (double)(rng_state >> 11) * (1.0 / 9007199254740992.0);
+}
+
+static float *random_points(size_t n, uint64_t seed)
+{
+    float *p = malloc(3 * n * sizeof *p);
+    rng_state = seed;
+    for (size_t i = 0; i < 3 * n; i++) p[i] = (float)(rnd() * 4.0 - 2.0);
+    return p;
+}
+
+/* Convex hull volume straight from qhull (no Delaunay), as an independent reference. */
+static double hull_volume(const float *pts, size_t n)
+{
+    qhT qh_storage; qhT *qh = &qh_storage;
+    coordT *c = malloc(3 * n * sizeof *c);
+    for (size_t i = 0; i < 3 * n; i++) c[i] = pts[i];
+    FILE *sink = fopen("/dev/null", "w");
+    qh_zero(qh, sink);
+    char flags[] = "qhull FA";
+    int code = qh_new_qhull(qh, 3, (int)n, c, False, flags, NULL, sink);
+    assert_int_equal(code, 0);
+    qh_getarea(qh, qh->facet_list);
+    double v = qh->totvol;
+    int a, b;
+    qh_freeqhull(qh, !qh_ALL);
+    qh_memfreeshort(qh, &a, &b);
+    fclose(sink);
+    free(c);
+    return v;
+}
+
+static const float *P(const bk_tetmesh *m, uint32_t v) { return m->points + 3 * (size_t)v; }
+
+/* Structural checks every valid output must pass. */
+static void check_mesh(const bk_tetmesh *m)
+{
+    assert_int_equal(m->nonmanifold_faces, 0);
+    assert_int_equal(m->dropped_flat, 0);
+    double sum = 0.0;
+    for (size_t t = 0; t < m->tet_count; t++) {
+        const uint32_t *v = m->tets + 4 * t;
+        for (int k = 0; k < 4; k++) assert_true(v[k] < m->point_count);
+        double vol = bk_tet_signed_volume(P(m, v[0]), P(m, v[1]), P(m, v[2]), P(m, v[3]));
+        assert_true(vol > 0.0);
+        sum += vol;
+        for (uint32_t i = 0; i < 4; i++) {
+            uint32_t nb = m->neighbours[4 * t + i];
+            if (nb == BK_TET_NONE) continue;
+            assert_true(nb < m->tet_count);
+            assert_true(nb != t);
+            /* symmetric, and the neighbour holds exactly the three vertices of the face */
+            int back = 0;
+            for (int j = 0; j < 4; j++) if (m->neighbours[4 * (size_t)nb + j] == t) {
+                back++;
+                for (uint32_t k = 0; k < 4; k++) {
+                    if (k == i) continue;
+                    int found = 0;
+                    for (int q = 0; q < 4; q++) if (m->tets[4 * (size_t)nb + q] == v[k]) found = 1;
+                    assert_true(found);
+                }
+                /* the vertex opposite the face in the neighbour lies on the other side */
+                uint32_t w = m->tets[4 * (size_t)nb + j];
+                for (int q = 0; q < 4; q++) assert_true(v[q] != w);
+            }
+            assert_int_equal(back, 1);
+        }
+    }
+    assert_true(fabs(sum - m->volume) <= 1e-9 * fabs(sum) + 1e-12);
+}
+
+static void test_random_points(void **state)
+{
+    (void)state;
+    size_t n = 400;
+    float *pts = random_points(n, 12345);
+    bk_tetmesh m;
+    assert_int_equal(bk_delaunay(pts, n, NULL, &m), BK_DELAUNAY_OK);
+    check_mesh(&m);
+    /* every point of a random set is a Delaunay vertex */
+    assert_int_equal(m.point_count, n);
+    assert_int_equal(m.unused_count, 0);
+    for (size_t i = 0; i < n; i++) {
+        assert_true(m.input_to_point[i] < m.point_count);
+        assert_int_equal(m.point_source[m.input_to_point[i]], i);
+    }
+    double hv = hull_volume(pts, n);
+    assert_true(fabs(m.volume - hv) < 1e-9 * hv);
+    /* Euler-free tiling check: hull faces are convex hull faces (no point outside) */
+    size_t hull_faces = 0;
+    for (size_t t = 0; t < m.tet_count; t++)
+        for (int i = 0; i < 4; i++) {
+            if (m.neighbours[4 * t + i] != BK_TET_NONE) continue;
+            hull_faces++;
+            const uint32_t *v = m.tets + 4 * t;
+            /* replace vertex i by each point: none may lie beyond the face (negative volume) */
+            for (size_t q = 0; q < m.point_count; q += 7) {
+                const float *c[4];
+                for (int k = 0; k < 4; k++) c[k] = P(&m, v[k]);
+                c[i] = P(&m, (uint32_t)q);
+                assert_true(bk_tet_signed_volume(c[0], c[1], c[2], c[3]) > -1e-9);
+            }
+        }
+    assert_true(hull_faces >= 4);
+    /* empty circumsphere on a sample of tetrahedra */
+    for (size_t t = 0; t < m.tet_count; t += 17) {
+        const uint32_t *v = m.tets + 4 * t;
+        double a[3], r[3][3], rhs[3];
+        for (int k = 0; k < 3; k++) a[k] = P(&m, v[0])[k];
+        for (int j = 0; j < 3; j++) {
+            double s = 0;
+            for (int k = 0; k < 3; k++) { r[j][k] = P(&m, v[j + 1])[k] - a[k]; s += r[j][k] * r[j][k]; }
+            rhs[j] = 0.5 * s;
+        }
+        double det = r[0][0]*(r[1][1]*r[2][2]-r[1][2]*r[2][1]) - r[0][1]*(r[1][0]*r[2][2]-r[1][2]*r[2][0])
+                   + r[0][2]*(r[1][0]*r[2][1]-r[1][1]*r[2][0]);
+        double cx = (rhs[0]*(r[1][1]*r[2][2]-r[1][2]*r[2][1]) - r[0][1]*(rhs[1]*r[2][2]-r[1][2]*rhs[2])
+                   + r[0][2]*(rhs[1]*r[2][1]-r[1][1]*rhs[2])) / det;
+        double cy = (r[0][0]*(rhs[1]*r[2][2]-r[1][2]*rhs[2]) - rhs[0]*(r[1][0]*r[2][2]-r[1][2]*r[2][0])
+                   + r[0][2]*(r[1][0]*rhs[2]-rhs[1]*r[2][0])) / det;
+        double cz = (r[0][0]*(r[1][1]*rhs[2]-rhs[1]*r[2][1]) - r[0][1]*(r[1][0]*rhs[2]-rhs[1]*r[2][0])
+                   + rhs[0]*(r[1][0]*r[2][1]-r[1][1]*r[2][0])) / det;
+        double rad2 = cx * cx + cy * cy + cz * cz;
+        for (size_t q = 0; q < m.point_count; q++) {
+            double dx = P(&m, (uint32_t)q)[0] - a[0] - cx, dy = P(&m, (uint32_t)q)[1] - a[1] - cy;
+            double dz = P(&m, (uint32_t)q)[2] - a[2] - cz;
+            assert_true(dx * dx + dy * dy + dz * dz >= rad2 * (1.0 - 1e-6));
+        }
+    }
+    /* deterministic */
+    bk_tetmesh m2;
+    assert_int_equal(bk_delaunay(pts, n, NULL, &m2), BK_DELAUNAY_OK);
+    assert_int_equal(m2.tet_count, m.tet_count);
+    assert_memory_equal(m2.tets, m.tets, 4 * m.tet_count * sizeof *m.tets);
+    assert_memory_equal(m2.neighbours, m.neighbours, 4 * m.tet_count * sizeof *m.tets);
+    bk_tetmesh_free(&m2);
+    bk_tetmesh_free(&m);
+    free(pts);
+}
+
+static float *grid_points(int nx, int ny, int nz, float spacing, const float offset[3], size_t *n)
+{
+    *n = (size_t)nx * ny * nz;
+    float *p = malloc(3 * *n * sizeof *p);
+    size_t i = 0;
+    for (int z = 0; z < nz; z++) for (int y = 0; y < ny; y++) for (int x = 0; x < nx; x++, i++) {
+        p[3 * i + 0] = offset[0] + spacing * x;
+        p[3 * i + 1] = offset[1] + spacing * y;
+        p[3 * i + 2] = offset[2] + spacing * z;
+    }
+    return p;
+}
+
+static size_t count_hull_faces(const bk_tetmesh *m)
+{
+    size_t h = 0;
+    for (size_t k = 0; k < 4 * m->tet_count; k++) h += m->neighbours[k] == BK_TET_NONE;
+    return h;
+}
+
+/* A perfect 4x4x4 grid: every cube's 8 corners are cospherical. The cube must be filled
+ * exactly, with no flat tetrahedron and a conforming (2 triangles per boundary square) hull. */
+static void test_regular_grid(void **state)
+{
+    (void)state;
+    const float origin[3] = {0, 0, 0};
+    size_t n;
+    float *pts = grid_points(4, 4, 4, 1.0f, origin, &n);
+    bk_tetmesh m;
+    assert_int_equal(bk_delaunay(pts, n, NULL, &m), BK_DELAUNAY_OK);
+    check_mesh(&m);
+    assert_int_equal(m.point_count, 64);
+    assert_true(fabs(m.volume - 27.0) < 1e-9);
+    assert_int_equal(count_hull_faces(&m), 6 * 9 * 2);
+    /* every tetrahedron stays inside one unit cube of the grid (a Delaunay cell) */
+    for (size_t t = 0; t < m.tet_count; t++) {
+        float lo[3] = {1e9f, 1e9f, 1e9f}, hi[3] = {-1e9f, -1e9f, -1e9f};
+        for (int k = 0; k < 4; k++) for (int a = 0; a < 3; a++) {
+            float c = P(&m, m.tets[4 * t + k])[a];
+            if (c < lo[a]) lo[a] = c;
+            if (c > hi[a]) hi[a] = c;
+        }
+        for (int a = 0; a < 3; a++) assert_true(hi[a] - lo[a] <= 1.0f);
+    }
+    bk_tetmesh_free(&m);
+    free(pts);
+}
+
+/* Non-cubic spacing, far from the origin (a level 1e5 m away) and an uneven grid. */
+static void test_far_anisotropic_grid(void **state)
+{
+    (void)state;
+    const float origin[3] = {1e5f, -5e4f, 2e4f};
+    size_t n;
+    float *pts = grid_points(6, 5, 3, 0.5f, origin, &n);
+    /* stretch y so cells are boxes, not cubes (still cospherical) */
+    for (size_t i = 0; i < n; i++) pts[3 * i + 1] = origin[1] + (pts[3 * i + 1] - origin[1]) * 1.5f;
+    bk_tetmesh m;
+    assert_int_equal(bk_delaunay(pts, n, NULL, &m), BK_DELAUNAY_OK);
+    check_mesh(&m);
+    assert_int_equal(m.point_count, n);
+    double expect = (5 * 0.5) * (4 * 0.75) * (2 * 0.5);
+    assert_true(fabs(m.volume - expect) < 1e-6 * expect);
+    bk_tetmesh_free(&m);
+    free(pts);
+}
+
+static void test_coplanar_points(void **state)
+{
+    (void)state;
+    size_t n = 50;
+    float *pts = random_points(n, 7);
+    for (size_t i = 0; i < n; i++) pts[3 * i + 2] = 2.0f * pts[3 * i] + pts[3 * i + 1];
+    bk_tetmesh m;
+    assert_int_equal(bk_delaunay(pts, n, NULL, &m), BK_DELAUNAY_FLAT);
+    assert_int_equal(m.tet_count, 0);
+    assert_null(m.tets);
+    for (size_t i = 0; i < n; i++) assert_int_equal(m.input_to_point[i], BK_TET_NONE);
+    bk_tetmesh_free(&m);
+    /* a flat regular grid (cospherical and coplanar at once) */
+    const float origin[3] = {0, 0, 3};
+    float *g = grid_points(5, 5, 1, 1.0f, origin, &n);
+    assert_int_equal(bk_delaunay(g, n, NULL, &m), BK_DELAUNAY_FLAT);
+    bk_tetmesh_free(&m);
+    /* collinear */
+    for (size_t i = 0; i < n; i++) { g[3 * i] = (float)i; g[3 * i + 1] = 2.0f * i; g[3 * i + 2] = 1; }
+    assert_int_equal(bk_delaunay(g, n, NULL, &m), BK_DELAUNAY_FLAT);
+    bk_tetmesh_free(&m);
+    free(g);
+    free(pts);
+}
+
+static void test_duplicates(void **state)
+{
+    (void)state;
+    size_t n = 120, dup = 40;
+    float *pts = random_points(n + dup, 99);
+    for (size_t i = 0; i < dup; i++) {
+        size_t src = (i * 37) % n;
+        for (int k = 0; k < 3; k++) pts[3 * (n + i) + k] = pts[3 * src + k] + (k == 0 ? 1e-7f : 0.0f);
+    }
+    bk_tetmesh a, b;
+    assert_int_equal(bk_delaunay(pts, n, NULL, &a), BK_DELAUNAY_OK);
+    assert_int_equal(bk_delaunay(pts, n + dup, NULL, &b), BK_DELAUNAY_OK);
+    check_mesh(&b);
+    assert_int_equal(b.merged_count, dup);
+    assert_int_equal(b.point_count, a.point_count);
+    assert_int_equal(b.tet_count, a.tet_count);
+    assert_memory_equal(a.tets, b.tets, 4 * a.tet_count * sizeof *a.tets);
+    for (size_t i = 0; i < dup; i++)
+        assert_int_equal(b.input_to_point[n + i], b.input_to_point[(i * 37) % n]);
+    bk_tetmesh_free(&a);
+    bk_tetmesh_free(&b);
+    free(pts);
+}
+
+static void test_too_few(void **state)
+{
+    (void)state;
+    float pts[5 * 3] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    bk_tetmesh m;
+    assert_int_equal(bk_delaunay(pts, 0, NULL, &m), BK_DELAUNAY_TOO_FEW);
+    bk_tetmesh_free(&m);
+    assert_int_equal(bk_delaunay(pts, 3, NULL, &m), BK_DELAUNAY_TOO_FEW);
+    bk_tetmesh_free(&m);
+    /* 5 inputs but only 3 distinct */
+    float same[5 * 3] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 0, 0, 0, 0, 0};
+    assert_int_equal(bk_delaunay(same, 5, NULL, &m), BK_DELAUNAY_TOO_FEW);
+    bk_tetmesh_free(&m);
+    /* exactly 4: one tetrahedron of volume 1/6, hull on all sides */
+    assert_int_equal(bk_delaunay(pts, 4, NULL, &m), BK_DELAUNAY_OK);
+    check_mesh(&m);
+    assert_int_equal(m.tet_count, 1);
+    assert_true(fabs(m.volume - 1.0 / 6.0) < 1e-12);
+    assert_int_equal(count_hull_faces(&m), 4);
+    bk_tetmesh_free(&m);
+    /* 5 with the last a duplicate: still one tetrahedron */
+    assert_int_equal(bk_delaunay(pts, 5, NULL, &m), BK_DELAUNAY_OK);
+    assert_int_equal(m.tet_count, 1);
+    assert_int_equal(m.merged_count, 1);
+    assert_int_equal(m.input_to_point[4], m.input_to_point[0]);
+    bk_tetmesh_free(&m);
+    /* non-finite points are ignored */
+    float bad[6 * 3] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, NAN, 0, 0, 0, INFINITY, 0};
+    assert_int_equal(bk_delaunay(bad, 6, NULL, &m), BK_DELAUNAY_OK);
+    assert_int_equal(m.tet_count, 1);
+    assert_int_equal(m.input_to_point[4], BK_TET_NONE);
+    bk_tetmesh_free(&m);
+}
+
+/* A grid plus its cell centres (body-centred cubic) and points on a sphere: more cospherical
+ * configurations, mixed with general points. */
+static void test_mixed_degenerate(void **state)
+{
+    (void)state;
+    size_t n = 0, cap = 2000;
+    float *p = malloc(3 * cap * sizeof *p);
+    for (int z = 0; z < 5; z++) for (int y = 0; y < 5; y++) for (int x = 0; x < 5; x++) {
+        p[3 * n] = (float)x; p[3 * n + 1] = (float)y; p[3 * n + 2] = (float)z; n++;
+        if (x < 4 && y < 4 && z < 4 && ((x + y + z) % 2 == 0)) {
+            p[3 * n] = x + 0.5f; p[3 * n + 1] = y + 0.5f; p[3 * n + 2] = z + 0.5f; n++;
+        }
+    }
+    for (int i = 0; i < 64; i++) {  /* points on a sphere centred in the grid */
+        double th = 2.0 * M_PI * (i % 8) / 8.0, ph = M_PI * ((i / 8) + 0.5) / 8.0;
+        p[3 * n] = (float)(2.0 + 1.3 * sin(ph) * cos(th));
+        p[3 * n + 1] = (float)(2.0 + 1.3 * sin(ph) * sin(th));
+        p[3 * n + 2] = (float)(2.0 + 1.3 * cos(ph));
+        n++;
+    }
+    bk_tetmesh m;
+    assert_int_equal(bk_delaunay(p, n, NULL, &m), BK_DELAUNAY_OK);
+    check_mesh(&m);
+    assert_true(fabs(m.volume - 64.0) < 1e-6);
+    bk_tetmesh_free(&m);
+    free(p);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_random_points),
+        cmocka_unit_test(test_regular_grid),
+        cmocka_unit_test(test_far_anisotropic_grid),
+        cmocka_unit_test(test_coplanar_points),
+        cmocka_unit_test(test_duplicates),
+        cmocka_unit_test(test_too_few),
+        cmocka_unit_test(test_mixed_degenerate),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,516 @@
+/* Texel receivers (bake/layout/texels.h): coverage, normals and tangent frames, push-out at
+ * wall/floor junctions, inside-geometry detection, dilation. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bake/layout/atlas.h"
+#include "bake/layout/texels.h"
+#include "bake/transport/tracer.h"
+#include "support/uv_scenes.h"
+
+static uint32_t quad_object(bk_scene *s, const char *name, const float p0[3], const float p1[3], const float p2[3],
+                            const float p3[3], int n)
+{
+    uint32_t o = uvs_object(s, name);
+    uvs_quad(s, p0, p1, p2, p3, n, 0, NULL, 1.0f);
+    return o;
+}
+
+static void build(const bk_scene *s, float density, bk_atlas *a, bk_texels *tx)
+{
+    bk_atlas_options o = {0};
+    o.default_density = density;
+    assert_int_equal(bk_atlas_build(s, NULL, &o, a), LBK_OK);
+    assert_int_equal(bk_texels_build(s, a, tx), LBK_OK);
+}
+
+static double len3(const float v[3]) { return sqrt((double)v[0] * v[0] + (double)v[1] * v[1] + (double)v[2] * v[2]); }
+
+/* ---------------------------------------------------------------------------------------- */
+
+/* A flat 1 m quad at d texels/m covers exactly d × d texels, all centres inside. */
+static void test_quad_texel_count(void **state)
+{
+    (void)state;
+    const int dens[] = {4, 8, 13};
+    for (int i = 0; i < 3; i++) {
+        bk_scene s;
+        uvs_init(&s);
+        float p0[3] = {0, 0, 0}, p1[3] = {1, 0, 0}, p2[3] = {1, 0, -1}, p3[3] = {0, 0, -1};
+        quad_object(&s, "q", p0, p1, p2, p3, 3);
+        bk_atlas a;
+        bk_texels tx;
+        build(&s, (float)dens[i], &a, &tx);
+        assert_int_equal(tx.count, (size_t)(dens[i] * dens[i]));
+        for (size_t r = 0; r < tx.count; r++) {
+            assert_int_equal(tx.receivers[r].flags, BK_TEXEL_VALID);
+            assert_int_equal(tx.receivers[r].object, 0);
+            assert_float_equal(tx.receivers[r].texel_size, 1.0 / dens[i], 1e-5);
+            assert_float_equal(tx.receivers[r].position[1], 0.0, 1e-6);
+        }
+        bk_texels_free(&tx);
+        bk_atlas_free(&a);
+        uvs_free(&s);
+    }
+}
+
+/* Every texel whose centre lies (strictly) inside a chart triangle is a valid receiver on
+ * that triangle's plane; every receiver is unit-normal with a unit tangent ⟂ normal. */
+static void test_coverage_and_frames(void **state)
+{
+    (void)state;
+    bk_scene s;
+    uvs_init(&s);
+    uvs_object(&s, "sphere");
+    float c[3] = {0, 1, 0};
+    uvs_sphere(&s, c, 0.8f, 20, 10, 0);
+    uvs_object(&s, "box");
+    float mn[3] = {2, 0, 0}, mx[3] = {2.7f, 0.45f, 1.3f};
+    uvs_box(&s, mn, mx, 2, 0, 0);
+    float p0[3] = {-3, 0, 3}, p1[3] = {4, 0, 3}, p2[3] = {4, 0.3f, -3}, p3[3] = {-3, 0, -3}; /* not planar */
+    quad_object(&s, "floor", p0, p1, p2, p3, 5);
+    bk_atlas a;
+    bk_texels tx;
+    build(&s, 9.5f, &a, &tx);
+    size_t strictly_inside = 0;
+    for (size_t e = 0; e < a.tri_count; e++) {
+        const float *uv = a.tri_uv + 6 * e;
+        double x0 = uv[0], y0 = uv[1], x1 = uv[2], y1 = uv[3], x2 = uv[4], y2 = uv[5];
+        double area = (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0);
+        int page = a.charts[a.tri_chart[e]].page;
+        int xa = (int)floor(fmin(x0, fmin(x1, x2))), xb = (int)ceil(fmax(x0, fmax(x1, x2)));
+        int ya = (int)floor(fmin(y0, fmin(y1, y2))), yb = (int)ceil(fmax(y0, fmax(y1, y2)));
+        for (int y = ya; y <= yb; y++)
+            for (int x = xa; x <= xb; x++) {
+                double px = x + 0.5, py = y + 0.5;
+                double w0 = ((x1 - px) * (y2 - py) - (x2 - px) * (y1 - py)) / area;
+                double w1 = ((x2 - px) * (y0 - py) - (x0 - px) * (y2 - py)) / area;
+                double w2 = 1.0 - w0 - w1;
+                if (!(w0 > 1e-4 && w1 > 1e-4 && w2 > 1e-4)) continue;
+                strictly_inside++;
+                const bk_texel *r = bk_texels_at(&tx, (uint32_t)page, x, y);
+                assert_non_null(r);
+                assert_true(r->flags & BK_TEXEL_VALID);
+                assert_false(r->flags & BK_TEXEL_EDGE);
+                assert_int_equal(r->tri, a.tris[e]);
+                /* the sample is the barycentric point of that triangle */
+                for (int k = 0; k < 3; k++) {
+                    const float *P0 = s.positions + 3 * s.tris[3 * a.tris[e]], *P1 = s.positions + 3 * s.tris[3 * a.tris[e] + 1],
+                                *P2 = s.positions + 3 * s.tris[3 * a.tris[e] + 2];
+                    assert_float_equal(r->position[k], w0 * P0[k] + w1 * P1[k] + w2 * P2[k], 1e-4);
+                }
+            }
+    }
+    assert_true(strictly_inside > 1000);
+    for (size_t i = 0; i < tx.count; i++) {
+        const bk_texel *r = &tx.receivers[i];
+        assert_float_equal(len3(r->normal), 1.0, 1e-5);
+        assert_float_equal(len3(r->tangent), 1.0, 1e-5);
+        double d = (double)r->normal[0] * r->tangent[0] + (double)r->normal[1] * r->tangent[1] +
+                   (double)r->normal[2] * r->tangent[2];
+        assert_float_equal(d, 0.0, 1e-5);
+        assert_true(r->texel_size > 0.0f && isfinite(r->texel_size));
+        /* index and receiver agree */
+        assert_ptr_equal(bk_texels_at(&tx, r->page, r->x, r->y), r);
+    }
+    bk_texels_free(&tx);
+    bk_atlas_free(&a);
+    uvs_free(&s);
+}
+
+/* T is dP/du: the receiver one texel to the right lies one texel_size along T, and B = N×T
+ * points to the receiver one texel down (generated charts are never mirrored). */
+static void test_tangent_convention(void **state)
+{
+    (void)state;
+    bk_scene s;
+    uvs_init(&s);
+    float p0[3] = {0, 0, 0}, p1[3] = {0.6f, 0.8f, 0}, p2[3] = {0.6f, 0.8f, -2}, p3[3] = {0, 0, -2}; /* tilted */
+    quad_object(&s, "ramp", p0, p1, p2, p3, 2);
+    bk_atlas a;
+    bk_texels tx;
+    build(&s, 10.0f, &a, &tx);
+    size_t checked = 0;
+    for (size_t i = 0; i < tx.count; i++) {
+        const bk_texel *r = &tx.receivers[i], *right = bk_texels_at(&tx, r->page, r->x + 1, r->y),
+                          *down = bk_texels_at(&tx, r->page, r->x, r->y + 1);
+        if (!right || !down || (r->flags | right->flags | down->flags) & BK_TEXEL_EDGE) continue;
+        float b[3] = {r->normal[1] * r->tangent[2] - r->normal[2] * r->tangent[1],
+                      r->normal[2] * r->tangent[0] - r->normal[0] * r->tangent[2],
+                      r->normal[0] * r->tangent[1] - r->normal[1] * r->tangent[0]};
+        for (int k = 0; k < 3; k++) {
+            assert_float_equal(right->position[k] - r->position[k], r->tangent[k] * r->texel_size, 1e-4);
+            assert_float_equal(down->position[k] - r->position[k], b[k] * r->texel_size, 1e-4);
+        }
+        checked++;
+    }
+    assert_true(checked > 100);
+    /* the helper */
+    float n[3] = {0, 0, 1}, dpdu[3] = {2, 0, 1}, t[3], bb[3];
+    bk_tangent_frame(n, dpdu, t, bb);
+    assert_float_equal(t[0], 1, 1e-6);
+    assert_float_equal(t[1], 0, 1e-6);
+    assert_float_equal(t[2], 0, 1e-6);
+    assert_float_equal(bb[0], 0, 1e-6);
+    assert_float_equal(bb[1], 1, 1e-6);
+    assert_float_equal(bb[2], 0, 1e-6);
+    float zero[3] = {0, 0, 0}, n2[3] = {0.f, -0.6f, 0.8f};
+    bk_tangent_frame(n2, zero, t, bb);
+    assert_float_equal(len3(t), 1.0, 1e-6);
+    assert_float_equal(len3(bb), 1.0, 1e-6);
+    assert_float_equal(t[0] * n2[0] + t[1] * n2[1] + t[2] * n2[2], 0.0, 1e-6);
+    bk_texels_free(&tx);
+    bk_atlas_free(&a);
+    uvs_free(&s);
+}
+
+/* Degenerate triangles and uv-collapsed triangles never produce receivers or NaNs. */
+static void test_degenerate(void **state)
+{
+    (void)state;
+    bk_scene s;
+    uvs_init(&s);
+    float p0[3] = {0, 0, 0}, p1[3] = {1, 0, 0}, p2[3] = {1, 0, -1}, p3[3] = {0, 0, -1};
+    quad_object(&s, "q", p0, p1, p2, p3, 1);
+    float c0[3] = {0, 1, 0}, c1[3] = {1, 1, 0}, c2[3] = {2, 1, 0};
+    uvs_tri(&s, c0, c1, c2, 0);
+    uvs_tri(&s, c0, c0, c0, 0);
+    bk_atlas a;
+    bk_texels tx;
+    build(&s, 6.0f, &a, &tx);
+    assert_int_equal(tx.count, 36);
+    for (size_t i = 0; i < tx.count; i++) {
+        assert_int_not_equal(tx.receivers[i].tri, 2);
+        assert_int_not_equal(tx.receivers[i].tri, 3);
+        for (int k = 0; k < 3; k++) assert_true(isfinite(tx.receivers[i].position[k]));
+    }
+    bk_texels_free(&tx);
+    bk_atlas_free(&a);
+    uvs_free(&s);
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* Push-out                                                                                 */
+
+/* An L junction: a floor (y = 0, facing +y) that runs 0.12 m under a wall (x = 0, facing +x)
+ * which itself reaches 0.12 m below the floor. Texels are 0.1 m. */
+static void l_junction(bk_scene *s)
+{
+    uvs_init(s);
+    float f0[3] = {-0.12f, 0, 0}, f1[3] = {2, 0, 0}, f2[3] = {2, 0, -2}, f3[3] = {-0.12f, 0, -2};
+    quad_object(s, "floor", f0, f1, f2, f3, 4);
+    float w0[3] = {0, -0.12f, 0}, w1[3] = {0, -0.12f, -2}, w2[3] = {0, 2, -2}, w3[3] = {0, 2, 0};
+    quad_object(s, "wall", w0, w1, w2, w3, 4);
+    uvs_update_bounds(s);
+}
+
+static void test_pushout_l_junction(void **state)
+{
+    (void)state;
+    bk_scene s;
+    l_junction(&s);
+    bk_atlas a;
+    bk_texels tx;
+    build(&s, 10.0f, &a, &tx);
+    bk_tracer *tr = NULL;
+    assert_int_equal(bk_tracer_create(&s, 1, &tr), LBK_OK);
+    /* before: samples behind the wall (floor, x < 0) and under the floor (wall, y < 0) */
+    size_t behind = 0;
+    float *before = malloc(tx.count * 3 * sizeof(float));
+    assert_non_null(before);
+    for (size_t i = 0; i < tx.count; i++) {
+        const bk_texel *r = &tx.receivers[i];
+        memcpy(before + 3 * i, r->position, 3 * sizeof(float));
+        if ((r->object == 0 && r->position[0] < 0) || (r->object == 1 && r->position[1] < 0)) behind++;
+    }
+    assert_true(behind >= 2 * 20); /* one column of 20 texels on each side */
+    bk_pushout_stats st;
+    assert_int_equal(bk_texels_push_out(&tx, &s, tr, NULL, &st), LBK_OK);
+    assert_int_equal(st.tested, tx.count);
+    assert_true(st.pushed >= behind);
+    assert_int_equal(st.inside, 0);
+    for (size_t i = 0; i < tx.count; i++) {
+        const bk_texel *r = &tx.receivers[i];
+        assert_true(r->flags & BK_TEXEL_VALID);
+        /* nothing behind the wall or below the floor, and nothing moved far */
+        assert_true(r->position[0] >= 0.0f);
+        assert_true(r->position[1] >= 0.0f);
+        double mv = 0;
+        for (int k = 0; k < 3; k++) mv += (r->position[k] - before[3 * i + k]) * (r->position[k] - before[3 * i + k]);
+        assert_true(sqrt(mv) <= 0.15 + 1e-4);
+        /* samples well clear of the junction are untouched */
+        int far_from_junction = r->object == 0 ? before[3 * i] > 0.2f : before[3 * i + 1] > 0.2f;
+        if (far_from_junction) {
+            assert_false(r->flags & BK_TEXEL_PUSHED);
+            assert_memory_equal(r->position, before + 3 * i, 3 * sizeof(float));
+        }
+    }
+    free(before);
+    bk_tracer_destroy(tr);
+    bk_texels_free(&tx);
+    bk_atlas_free(&a);
+    uvs_free(&s);
+}
+
+/* A closed box standing on a floor that runs under it: floor texels deep under the box are
+ * inside (not valid), those near its walls are pushed out, the rest untouched. The result is
+ * the same for 1 and 3 threads. */
+static void test_pushout_inside_and_threads(void **state)
+{
+    (void)state;
+    bk_scene s;
+    uvs_init(&s);
+    float f0[3] = {-2, 0, 2}, f1[3] = {2, 0, 2}, f2[3] = {2, 0, -2}, f3[3] = {-2, 0, -2};
+    quad_object(&s, "floor", f0, f1, f2, f3, 4);
+    uvs_object(&s, "box");
+    float mn[3] = {-0.5f, 0, -0.5f}, mx[3] = {0.5f, 1, 0.5f};
+    uvs_box(&s, mn, mx, 1, 0, 0);
+    uvs_update_bounds(&s);
+    bk_atlas a;
+    bk_texels t1, t3;
+    build(&s, 10.0f, &a, &t1);
+    assert_int_equal(bk_texels_build(&s, &a, &t3), LBK_OK);
+    bk_tracer *tr = NULL;
+    assert_int_equal(bk_tracer_create(&s, 1, &tr), LBK_OK);
+    bk_pushout_options o1 = {0}, o3 = {0};
+    o1.threads = 1;
+    o3.threads = 3;
+    bk_pushout_stats st;
+    assert_int_equal(bk_texels_push_out(&t1, &s, tr, &o1, &st), LBK_OK);
+    assert_int_equal(bk_texels_push_out(&t3, &s, tr, &o3, NULL), LBK_OK);
+    assert_int_equal(t1.count, t3.count);
+    assert_memory_equal(t1.receivers, t3.receivers, t1.count * sizeof *t1.receivers);
+    size_t inside = 0;
+    for (size_t i = 0; i < t1.count; i++) {
+        const bk_texel *r = &t1.receivers[i];
+        if (r->object != 0) {
+            assert_true(r->flags & BK_TEXEL_VALID);
+            continue;
+        }
+        double ax = fabs(r->position[0]), az = fabs(r->position[2]);
+        int under = ax < 0.5 && az < 0.5;
+        if (r->flags & BK_TEXEL_VALID) {
+            /* a valid floor sample is never under the box */
+            assert_false(under);
+        } else {
+            assert_true(r->flags & BK_TEXEL_INSIDE);
+            inside++;
+        }
+        if (ax < 0.3 && az < 0.3) assert_true(r->flags & BK_TEXEL_INSIDE); /* deep under */
+        if (ax > 0.7 || az > 0.7) assert_int_equal(r->flags, BK_TEXEL_VALID); /* well clear */
+    }
+    assert_int_equal(inside, st.inside);
+    assert_true(inside >= 36);
+    bk_tracer_destroy(tr);
+    bk_texels_free(&t1);
+    bk_texels_free(&t3);
+    bk_atlas_free(&a);
+    uvs_free(&s);
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* Dilation                                                                                 */
+
+/* A filled rectangle: `passes` passes fill exactly the ring of Chebyshev distance ≤ passes
+ * and every filled texel copies the nearest valid texel (clamp to the rectangle). */
+static void test_dilate_ring_values(void **state)
+{
+    (void)state;
+    const int W = 24, H = 20, bx0 = 7, bx1 = 14, by0 = 5, by1 = 11;
+    float *data = calloc((size_t)W * H * 2, sizeof(float));
+    uint8_t *mask = calloc((size_t)W * H, 1);
+    assert_non_null(data);
+    assert_non_null(mask);
+    for (int y = by0; y <= by1; y++)
+        for (int x = bx0; x <= bx1; x++) {
+            mask[y * W + x] = 1;
+            data[2 * (y * W + x)] = (float)(x * 100 + y);
+            data[2 * (y * W + x) + 1] = (float)-x;
+        }
+    for (int passes = 1; passes <= 3; passes++) {
+        float *d = malloc((size_t)W * H * 2 * sizeof(float));
+        uint8_t *m = malloc((size_t)W * H);
+        memcpy(d, data, (size_t)W * H * 2 * sizeof(float));
+        memcpy(m, mask, (size_t)W * H);
+        size_t filled = bk_dilate(d, 2, m, W, H, passes);
+        size_t ring = (size_t)(bx1 - bx0 + 1 + 2 * passes) * (size_t)(by1 - by0 + 1 + 2 * passes) -
+                      (size_t)(bx1 - bx0 + 1) * (size_t)(by1 - by0 + 1);
+        assert_int_equal(filled, ring);
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                int dx = x < bx0 ? bx0 - x : x > bx1 ? x - bx1 : 0;
+                int dy = y < by0 ? by0 - y : y > by1 ? y - by1 : 0;
+                int cheb = dx > dy ? dx : dy;
+                if (cheb == 0) {
+                    assert_int_equal(m[y * W + x], 1);
+                } else if (cheb <= passes) {
+                    assert_int_equal(m[y * W + x], 2);
+                    int cx = x < bx0 ? bx0 : x > bx1 ? bx1 : x, cy = y < by0 ? by0 : y > by1 ? by1 : y;
+                    assert_float_equal(d[2 * (y * W + x)], (float)(cx * 100 + cy), 0);
+                    assert_float_equal(d[2 * (y * W + x) + 1], (float)-cx, 0);
+                } else {
+                    assert_int_equal(m[y * W + x], 0);
+                    assert_float_equal(d[2 * (y * W + x)], 0.0f, 0);
+                }
+            }
+        free(d);
+        free(m);
+    }
+    /* an L-shaped hole between two values gets their mean where both are 4-neighbours */
+    float v[9] = {1, 0, 0, 0, 0, 0, 0, 0, 0};
+    uint8_t mk[9] = {1, 0, 1, 0, 0, 0, 0, 0, 0};
+    v[2] = 3;
+    assert_int_equal(bk_dilate(v, 1, mk, 3, 3, 1), 4);
+    assert_float_equal(v[1], 2.0f, 0);       /* between 1 and 3 */
+    assert_float_equal(v[3], 1.0f, 0);       /* below 1 */
+    assert_float_equal(v[4], 2.0f, 0);       /* diagonal to both */
+    assert_int_equal(mk[6], 0);              /* distance 2 */
+    /* bad arguments fill nothing */
+    assert_int_equal(bk_dilate(NULL, 1, mk, 3, 3, 1), 0);
+    assert_int_equal(bk_dilate(v, 0, mk, 3, 3, 1), 0);
+    free(data);
+    free(mask);
+}
+
+/* On a real atlas page: dilating by the margin fills each chart's ring from that chart only
+ * (blocks never touch another chart's texels), so bilinear reads stay within the chart. */
+static void test_dilate_atlas_no_bleed(void **state)
+{
+    (void)state;
+    bk_scene s;
+    uvs_init(&s);
+    for (int i = 0; i < 6; i++) {
+        uvs_object(&s, "box");
+        float mn[3] = {(float)i * 2, 0, 0}, mx[3] = {(float)i * 2 + 0.3f + 0.17f * (float)i, 0.6f, 0.4f + 0.1f * (float)i};
+        uvs_box(&s, mn, mx, 1, 0, 0);
+    }
+    bk_atlas a;
+    bk_texels tx;
+    build(&s, 20.0f, &a, &tx);
+    for (uint32_t p = 0; p < a.page_count; p++) {
+        int W = a.pages[p].width, H = a.pages[p].height;
+        float *d = calloc((size_t)W * H, sizeof(float));
+        uint8_t *m = calloc((size_t)W * H, 1);
+        int32_t *owner = malloc((size_t)W * H * sizeof(int32_t));
+        for (int i = 0; i < W * H; i++) owner[i] = -1;
+        bk_texels_valid_mask(&tx, p, m);
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                const bk_texel *r = bk_texels_at(&tx, p, x, y);
+                if (r) d[y * W + x] = (float)a.scene_tri_entry[r->tri] >= 0 ? (float)a.tri_chart[a.scene_tri_entry[r->tri]] : -1;
+            }
+        for (size_t c = 0; c < a.chart_count; c++) {
+            const bk_atlas_chart *ch = &a.charts[c];
+            if (ch->page != (int32_t)p) continue;
+            for (int y = ch->y - a.margin; y < ch->y + ch->h + a.margin; y++)
+                for (int x = ch->x - a.margin; x < ch->x + ch->w + a.margin; x++) owner[y * W + x] = (int32_t)c;
+        }
+        bk_dilate(d, 1, m, W, H, a.margin);
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                if (!m[y * W + x]) continue;
+                /* every filled texel is inside a chart block and carries that chart's id */
+                assert_true(owner[y * W + x] >= 0);
+                assert_float_equal(d[y * W + x], (float)owner[y * W + x], 0);
+            }
+        /* bilinear footprint: each valid texel's 8 neighbours are filled after dilation */
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                const bk_texel *r = bk_texels_at(&tx, p, x, y);
+                if (!r) continue;
+                for (int dy = -1; dy <= 1; dy++)
+                    for (int dx = -1; dx <= 1; dx++) {
+                        int nx = x + dx, ny = y + dy;
+                        if (nx < 0 || ny < 0 || nx >= W || ny >= H) continue;
+                        assert_true(m[ny * W + nx] != 0);
+                    }
+            }
+        free(d);
+        free(m);
+        free(owner);
+    }
+    bk_texels_free(&tx);
+    bk_atlas_free(&a);
+    uvs_free(&s);
+}
+
+/* Extremes: the same furnished room at 1 mm, 10 km, and 1e5 m from the origin. The atlas
+ * keeps its rules and budget, and every receiver is finite with unit vectors after push-out;
+ * valid floor samples never end up under the box. */
+static void test_extreme_scales(void **state)
+{
+    (void)state;
+    const double scales[3] = {1e-3, 1e4, 1.0};
+    const double offsets[3] = {0.0, 0.0, 1e5};
+    for (int v = 0; v < 3; v++) {
+        bk_scene s;
+        uvs_init(&s);
+        uvs_object(&s, "room");
+        float rmn[3] = {-2, 0, -2}, rmx[3] = {2, 2.5f, 2};
+        uvs_box(&s, rmn, rmx, 2, 1, 0);
+        uvs_object(&s, "box");
+        float bmn[3] = {-0.5f, 0, -0.5f}, bmx[3] = {0.5f, 1, 0.5f};
+        uvs_box(&s, bmn, bmx, 1, 0, 0);
+        for (size_t i = 0; i < 3 * s.vertex_count; i++)
+            s.positions[i] = (float)(s.positions[i] * scales[v] + (i % 3 == 0 ? offsets[v] : 0.0));
+        uvs_update_bounds(&s);
+        bk_atlas_options o = {0};
+        o.default_density = 8.0f;
+        o.texel_budget = 1u << 16;
+        bk_atlas a;
+        assert_int_equal(bk_atlas_build(&s, NULL, &o, &a), LBK_OK);
+        assert_true(a.texels > 0);
+        uint64_t rects = 0;
+        for (size_t i = 0; i < a.object_count; i++) rects += (uint64_t)a.objects[i].w * (uint64_t)a.objects[i].h;
+        assert_true(rects <= o.texel_budget);
+        for (size_t i = 0; i < a.tri_count * 6; i++) assert_true(isfinite(a.tri_uv[i]));
+        for (size_t i = 0; i < a.vertex_count * 2; i++)
+            assert_true(a.vertex_uv[i] >= 0.0f && a.vertex_uv[i] <= 1.0f);
+        bk_texels tx;
+        assert_int_equal(bk_texels_build(&s, &a, &tx), LBK_OK);
+        bk_tracer *tr = NULL;
+        assert_int_equal(bk_tracer_create(&s, 1, &tr), LBK_OK);
+        assert_int_equal(bk_texels_push_out(&tx, &s, tr, NULL, NULL), LBK_OK);
+        double half = 0.5 * scales[v];
+        for (size_t i = 0; i < tx.count; i++) {
+            const bk_texel *r = &tx.receivers[i];
+            for (int k = 0; k < 3; k++) assert_true(isfinite(r->position[k]));
+            assert_float_equal(len3(r->normal), 1.0, 1e-5);
+            assert_float_equal(len3(r->tangent), 1.0, 1e-5);
+            assert_true(r->texel_size > 0.0f && isfinite(r->texel_size));
+            if (r->object == 0 && (r->flags & BK_TEXEL_VALID) && r->position[1] < 0.5 * scales[v]) {
+                double x = r->position[0] - offsets[v], z = r->position[2];
+                /* floor texels: never strictly under the box (its footprint minus rounding) */
+                assert_false(fabs(x) < half * 0.98 && fabs(z) < half * 0.98);
+            }
+        }
+        bk_tracer_destroy(tr);
+        bk_texels_free(&tx);
+        bk_atlas_free(&a);
+        uvs_free(&s);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_quad_texel_count),
+        cmocka_unit_test(test_coverage_and_frames),
+        cmocka_unit_test(test_tangent_convention),
+        cmocka_unit_test(test_degenerate),
+        cmocka_unit_test(test_pushout_l_junction),
+        cmocka_unit_test(test_pushout_inside_and_threads),
+        cmocka_unit_test(test_dilate_ring_values),
+        cmocka_unit_test(test_dilate_atlas_no_bleed),
+        cmocka_unit_test(test_extreme_scales),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,532 @@
+/* End to end: `lbk bake` on every shared scene and on the embedded Cornell box — output
+ * validates, has the sections the scene needs and no others, is byte-identical across thread
+ * counts, and the stop rules and reports behave as documented. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cjson/cJSON.h>
+
+#include "bake/pipeline/bake.h"
+#include "cli/cli.h"
+#include "lbk/container.h"
+#include "lbk/lightmap.h"
+#include "lbk/objects.h"
+#include "lbk/octa.h"
+#include "lbk/report.h"
+#include "lbk/validate.h"
+#include "support/door_scenes.h"
+#include "support/gltf_writer.h"
+
+static const char *scenes_dir(void)
+{
+    const char *d = getenv("LBK_SCENES");
+    return d && *d ? d : "../shared/scenes";
+}
+
+static char tmpdir[256];
+
+static int setup(void **state)
+{
+    (void)state;
+    snprintf(tmpdir, sizeof tmpdir, "/tmp/lbk-e2e-%d", (int)getpid());
+    char cmd[300];
+    snprintf(cmd, sizeof cmd, "mkdir -p %s", tmpdir);
+    return system(cmd);
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    char cmd[300];
+    snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
+    return system(cmd);
+}
+
+/* Test budgets: the fast preset with fewer samples, so the suite stays quick under ASan. */
+static void test_options(bk_bake_options *o, const char *in, const char *out)
+{
+    memset(o, 0, sizeof *o);
+    o->input = in;
+    o->output = out;
+    o->preset = "fast";
+    o->seed = 1;
+    o->target_error = -1;
+    o->max_samples = 64;
+    o->threads = 2;
+}
+
+static int bake_quiet(const bk_bake_options *o, bk_bake_summary *sum, char *err, size_t err_len)
+{
+    bk_progress p;
+    bk_progress_init(&p, 1);
+    return bk_bake(o, &p, sum, err, err_len);
+}
+
+static void *read_file(const char *path, size_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    void *buf = malloc((size_t)n + 1);
+    if (buf && fread(buf, 1, (size_t)n, f) != (size_t)n) {
+        free(buf);
+        buf = NULL;
+    }
+    fclose(f);
+    *size = (size_t)n;
+    return buf;
+}
+
+static int count_issue(void *user, const lbk_issue *issue)
+{
+    if (issue->severity != LBK_SEVERITY_WARNING) {
+        print_message("issue %u: %s\n", issue->id, issue->message);
+        (*(int *)user)++;
+    }
+    return 0;
+}
+
+static void assert_valid(const char *path)
+{
+    int bad = 0;
+    lbk_validate_summary s;
+    assert_int_equal(lbk_validate_file(path, NULL, count_issue, &bad, &s), LBK_OK);
+    assert_int_equal(s.fatal + s.errors, 0);
+    assert_int_equal(bad, 0);
+}
+
+static int has_section(lbk_reader *r, uint32_t type)
+{
+    uint32_t idx;
+    return lbk_reader_find_section(r, type, &idx) == LBK_OK;
+}
+
+typedef struct expect {
+    const char *path;
+    const char *sky;     /* NULL: the scene's own lights */
+    int lightmap, glg, llg, min_llgs;
+} expect;
+
+static void bake_and_check(const expect *e)
+{
+    char in[512], out[512], err[512] = "";
+    snprintf(in, sizeof in, "%s/%s", scenes_dir(), e->path);
+    if (access(in, R_OK) != 0) {
+        print_message("[  SKIP    ] %s missing (set LBK_SCENES)\n", in);
+        skip();
+    }
+    snprintf(out, sizeof out, "%s/scene.lbk", tmpdir);
+    bk_bake_options o;
+    test_options(&o, in, out);
+    if (e->sky) {
+        o.sky_set = 1;
+        sscanf(e->sky, "%f,%f,%f", &o.sky[0], &o.sky[1], &o.sky[2]);
+    }
+    bk_bake_summary sum;
+    int rc = bake_quiet(&o, &sum, err, sizeof err);
+    if (rc) print_message("bake %s: %s\n", e->path, err);
+    assert_int_equal(rc, 0);
+    assert_valid(out);
+    lbk_reader *r;
+    assert_int_equal(lbk_reader_open_file(out, NULL, &r), LBK_OK);
+    assert_int_equal(has_section(r, LBK_SECTION_LMAP), e->lightmap);
+    assert_int_equal(has_section(r, LBK_SECTION_GLG), e->glg);
+    assert_int_equal(has_section(r, LBK_SECTION_LLG), e->llg);
+    /* only what the scene needs: none of these scenes has sets, doors or asks for OCTP */
+    assert_false(has_section(r, LBK_SECTION_DLS));
+    assert_false(has_section(r, LBK_SECTION_DOOR));
+    assert_false(has_section(r, LBK_SECTION_OCTP));
+    assert_true(has_section(r, LBK_SECTION_OBJS));
+    assert_true(sum.llgs >= (uint64_t)e->min_llgs);
+    assert_true(isfinite(sum.final_error) && sum.final_error >= 0);
+    /* every lightmap texel decodes to finite, non-negative irradiance */
+    if (e->lightmap) {
+        const void *data;
+        size_t size;
+        assert_int_equal(lbk_reader_section_by_type(r, LBK_SECTION_LMAP, &data, &size), LBK_OK);
+        lbk_lmap_view v;
+        assert_int_equal(lbk_lmap_open(data, size, &v), LBK_OK);
+        uint64_t lit = 0;
+        for (uint64_t t = 0; t < sum.texels; t++) {
+            lbk_ahd_texel tx;
+            uint32_t page;
+            assert_int_equal(lbk_lmap_texel(&v, t, &tx, &page), LBK_OK);
+            float rgb[3], n[3] = {0, 0, 1};
+            lbk_ahd_irradiance(&tx, n, rgb);
+            for (int c = 0; c < 3; c++) assert_true(isfinite(rgb[c]) && rgb[c] >= 0);
+            lit += rgb[0] + rgb[1] + rgb[2] > 0;
+        }
+        assert_true(lit > 0);
+    }
+    lbk_reader_close(r);
+}
+
+/* One shared scene per case: the expectation is the case's initial state (see main). */
+static void test_shared_scene(void **state)
+{
+    bake_and_check(*state);
+}
+
+static expect cornell_box = {"cornell_box/CornellBox-Original.gltf", NULL, 1, 1, 0, 0};
+static expect cornell_box_bjs = {"cornell_box_bjs/cornellBox-2.80-Eevee-gltf.gltf", NULL, 1, 1, 1, 1};
+/* no light of its own: a sky through the doorways; its 16 spheres get LLGs */
+static expect room_with_doors = {"room_with_doors/room.glb", "1,1,1", 1, 1, 1, 16};
+static expect lamp = {"lights_punctual_lamp/LightsPunctualLamp.gltf", NULL, 1, 1, 1, 0};
+
+static void test_water_bottle_draco(void **state)
+{
+    (void)state;
+    /* one small object (0.11 × 0.26 m): the classifier picks its representation; it must bake */
+    char in[512], out[512], err[512] = "";
+    snprintf(in, sizeof in, "%s/water_bottle_draco/WaterBottle.gltf", scenes_dir());
+    if (access(in, R_OK) != 0) skip();
+    snprintf(out, sizeof out, "%s/bottle.lbk", tmpdir);
+    bk_bake_options o;
+    test_options(&o, in, out);
+    bk_bake_summary sum;
+    assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
+    assert_valid(out);
+    assert_int_equal(sum.objects, 1);
+}
+
+/* Same input and seed → the same bytes at 1 and 2 threads; another seed → other bytes. */
+static void test_deterministic_across_threads(void **state)
+{
+    (void)state;
+    char a[512], b[512], c[512], err[512];
+    snprintf(a, sizeof a, "%s/t1.lbk", tmpdir);
+    snprintf(b, sizeof b, "%s/t2.lbk", tmpdir);
+    snprintf(c, sizeof c, "%s/t3.lbk", tmpdir);
+    bk_bake_options o;
+    bk_bake_summary sum;
+    test_options(&o, "scenes/cornell_box/CornellBox-Original.gltf", a);
+    o.threads = 1;
+    assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
+    o.threads = 2;
+    o.output = b;
+    assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
+    o.seed = 2;
+    o.output = c;
+    assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
+    size_t na, nb, nc;
+    void *da = read_file(a, &na), *db = read_file(b, &nb), *dc = read_file(c, &nc);
+    assert_non_null(da);
+    assert_non_null(db);
+    assert_non_null(dc);
+    assert_int_equal(na, nb);
+    assert_memory_equal(da, db, na);
+    assert_true(na != nc || memcmp(da, dc, na) != 0);
+    free(da), free(db), free(dc);
+}
+
+/* A scene without light is refused with the input exit code, and nothing is written. */
+static void test_no_light_is_refused(void **state)
+{
+    (void)state;
+    char in[512], out[512], err[512] = "";
+    snprintf(in, sizeof in, "%s/room_with_doors/room.glb", scenes_dir());
+    if (access(in, R_OK) != 0) skip();
+    snprintf(out, sizeof out, "%s/nolight.lbk", tmpdir);
+    bk_bake_options o;
+    test_options(&o, in, out);
+    bk_bake_summary sum;
+    assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), LBK_EXIT_INPUT);
+    assert_non_null(strstr(err, "no light"));
+    assert_int_not_equal(access(out, F_OK), 0);
+}
+
+/* A missing input is an I/O error (exit 3), not an unusable scene; nothing is written. */
+static void test_missing_input_is_io_error(void **state)
+{
+    (void)state;
+    char out[512], err[512] = "";
+    snprintf(out, sizeof out, "%s/missing.lbk", tmpdir);
+    bk_bake_options o;
+    test_options(&o, "/nonexistent/level.glb", out);
+    bk_bake_summary sum;
+    assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), LBK_EXIT_IO);
+    assert_non_null(strstr(err, "/nonexistent/level.glb"));
+    assert_int_not_equal(access(out, F_OK), 0);
+}
+
+/* --target-error: a loose target stops after the first pass, and the stored report and the
+ * JSON report both carry the error-against-work samples. */
+static void test_target_error_and_reports(void **state)
+{
+    (void)state;
+    char out[512], json[512], err[512];
+    snprintf(out, sizeof out, "%s/target.lbk", tmpdir);
+    snprintf(json, sizeof json, "%s/target.json", tmpdir);
+    bk_bake_options o;
+    test_options(&o, "scenes/cornell_box/CornellBox-Original.gltf", out);
+    o.max_samples = 4096;
+    o.target_error = 0.9;
+    o.json_report = json;
+    bk_bake_summary sum;
+    assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
+    assert_true(sum.final_error <= 0.9);
+    lbk_reader *r;
+    assert_int_equal(lbk_reader_open_file(out, NULL, &r), LBK_OK);
+    const void *data;
+    size_t size;
+    assert_int_equal(lbk_reader_section_by_type(r, LBK_SECTION_REPT, &data, &size), LBK_OK);
+    lbk_report_view v;
+    assert_int_equal(lbk_report_parse(data, size, &v), LBK_OK);
+    assert_int_equal(v.header.status, LBK_BAKE_TARGET_REACHED);
+    assert_int_equal(v.header.record_count, 1);
+    lbk_report_record rec;
+    assert_int_equal(lbk_report_record_at(&v, 0, &rec), LBK_OK);
+    assert_true(rec.texel_rel_rmse <= 0.9f && rec.texel_rel_rmse > 0);
+    assert_true(rec.samples_per_texel > 0 && rec.samples_per_texel < 4096);
+    assert_true(rec.rays_traced > 0);
+    assert_float_equal(rec.elapsed_seconds, 0, 0); /* no wall time in the file by default */
+    lbk_reader_close(r);
+
+    size_t n;
+    char *text = read_file(json, &n);
+    assert_non_null(text);
+    text[n] = 0;
+    cJSON *root = cJSON_Parse(text);
+    assert_non_null(root);
+    assert_string_equal(cJSON_GetObjectItem(root, "schema")->valuestring, "lbk-bake-report/1");
+    cJSON *samples = cJSON_GetObjectItem(root, "samples");
+    assert_int_equal(cJSON_GetArraySize(samples), 1);
+    cJSON *s0 = cJSON_GetArrayItem(samples, 0);
+    assert_true(cJSON_GetObjectItem(s0, "seconds")->valuedouble > 0);
+    assert_float_equal(cJSON_GetObjectItem(s0, "est_rel_rmse")->valuedouble, rec.texel_rel_rmse, 1e-6);
+    assert_string_equal(cJSON_GetObjectItem(root, "status")->valuestring, "target reached");
+    /* the scales are the ones in the file: LMAP's as the lightmap view reports it */
+    double lmap_scale = cJSON_GetObjectItem(cJSON_GetObjectItem(root, "scales"), "lmap")->valuedouble;
+    assert_true(lmap_scale > 0 && frexp(lmap_scale, &(int){0}) == 0.5); /* a power of two */
+    assert_int_equal(lbk_reader_open_file(out, NULL, &r), LBK_OK);
+    assert_int_equal(lbk_reader_section_by_type(r, LBK_SECTION_LMAP, &data, &size), LBK_OK);
+    lbk_lmap_view lv;
+    assert_int_equal(lbk_lmap_open(data, size, &lv), LBK_OK);
+    assert_float_equal(lv.scale, lmap_scale, 0);
+    lbk_reader_close(r);
+    cJSON_Delete(root);
+    free(text);
+}
+
+/* --time-limit: a tiny budget still completes one pass and says it stopped on time. */
+static void test_time_limit(void **state)
+{
+    (void)state;
+    char out[512], err[512];
+    snprintf(out, sizeof out, "%s/time.lbk", tmpdir);
+    bk_bake_options o;
+    test_options(&o, "scenes/cornell_box/CornellBox-Original.gltf", out);
+    o.max_samples = 1 << 20;
+    o.target_error = 1e-6;
+    o.time_limit = 0.001;
+    bk_bake_summary sum;
+    assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
+    assert_valid(out);
+    lbk_reader *r;
+    assert_int_equal(lbk_reader_open_file(out, NULL, &r), LBK_OK);
+    const void *data;
+    size_t size;
+    assert_int_equal(lbk_reader_section_by_type(r, LBK_SECTION_REPT, &data, &size), LBK_OK);
+    lbk_report_view v;
+    assert_int_equal(lbk_report_parse(data, size, &v), LBK_OK);
+    assert_int_equal(v.header.status, LBK_BAKE_TIME_LIMIT);
+    assert_int_equal(v.header.record_count, 1);
+    lbk_reader_close(r);
+}
+
+/* --octahedral: OCTP probes at the GLG positions; depth moments are distances inside the box
+ * (the Cornell box is about 2 units across, so no probe sees further than its diagonal) and
+ * obey Jensen's inequality m2 >= m1^2. Without the flag there is no OCTP (checked above). */
+static void test_octahedral_probes(void **state)
+{
+    (void)state;
+    char out[512], err[512];
+    snprintf(out, sizeof out, "%s/octa.lbk", tmpdir);
+    bk_bake_options o;
+    test_options(&o, "scenes/cornell_box/CornellBox-Original.gltf", out);
+    o.octahedral_probes = 1;
+    bk_bake_summary sum;
+    assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
+    assert_valid(out);
+    lbk_reader *r;
+    assert_int_equal(lbk_reader_open_file(out, NULL, &r), LBK_OK);
+    const void *data;
+    size_t size;
+    assert_int_equal(lbk_reader_section_by_type(r, LBK_SECTION_OCTP, &data, &size), LBK_OK);
+    lbk_octp_view v;
+    assert_int_equal(lbk_octp_open(data, size, &v), LBK_OK);
+    assert_true(sum.glg_probes > 0);
+    for (uint32_t i = 0; i < (uint32_t)sum.glg_probes; i++) {
+        lbk_octp_probe_desc p;
+        assert_int_equal(lbk_octp_get(&v, i, &p), LBK_OK);
+        for (int k = 0; k < 144; k++) {
+            assert_true(p.depth[k][0] > 0 && p.depth[k][0] < 4.0f);
+            assert_true(p.depth[k][1] >= p.depth[k][0] * p.depth[k][0] * 0.99f);
+        }
+        float lit = 0;
+        for (int k = 0; k < 16; k++) lit += p.irradiance[k][0];
+        assert_true(lit > 0);
+    }
+    lbk_reader_close(r);
+}
+
+/* Issue 6 on real baker output: every shipped convert profile makes a pack that validates and
+ * diffs equal to its source; export → convert --from-exr gives back the same lighting. On a
+ * level with lightmaps, LLGs, GLG and OCTP, and on one with light sets and a door (DLS, DOOR). */
+static int run_cli(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static int run_cli(const char *fmt, ...)
+{
+    char cmd[2048], args[1800];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(args, sizeof args, fmt, ap);
+    va_end(ap);
+    snprintf(cmd, sizeof cmd, "%s %s >/dev/null 2>&1", getenv("LBK"), args);
+    int st = system(cmd);
+    return st == -1 ? -1 : WEXITSTATUS(st);
+}
+
+static void check_tools_on(const char *lbk)
+{
+    static const char *profiles[] = {"console-current", "console-previous", "pc", "archive"};
+    for (size_t i = 0; i < sizeof profiles / sizeof profiles[0]; i++) {
+        char pack[600];
+        snprintf(pack, sizeof pack, "%s.%s.lbk", lbk, profiles[i]);
+        assert_int_equal(run_cli("convert %s -o %s --profile %s", lbk, pack, profiles[i]), 0);
+        assert_int_equal(run_cli("validate %s", pack), 0);
+        assert_int_equal(run_cli("diff %s %s", lbk, pack), 0);
+    }
+    char dir[600], back[600];
+    snprintf(dir, sizeof dir, "%s.exr", lbk);
+    snprintf(back, sizeof back, "%s.back.lbk", lbk);
+    assert_int_equal(run_cli("export %s --exr %s --png %s", lbk, dir, dir), 0);
+    assert_int_equal(run_cli("convert --from-exr %s %s -o %s --profile archive", dir, lbk, back), 0);
+    assert_int_equal(run_cli("diff %s %s", lbk, back), 0);
+    assert_int_equal(run_cli("inspect %s --json", lbk), 0);
+}
+
+static void test_tools_on_baker_output(void **state)
+{
+    (void)state;
+    if (!getenv("LBK")) {
+        print_message("[  SKIP    ] LBK (path of the lbk binary) is not set; make test sets it\n");
+        skip();
+    }
+    char in[512], out[512], err[512];
+    bk_bake_options o;
+    bk_bake_summary sum;
+    snprintf(in, sizeof in, "%s/cornell_box_bjs/cornellBox-2.80-Eevee-gltf.gltf", scenes_dir());
+    if (access(in, R_OK) != 0) skip();
+    snprintf(out, sizeof out, "%s/tools_bjs.lbk", tmpdir);
+    test_options(&o, in, out);
+    o.max_samples = 32;
+    o.octahedral_probes = 1;
+    assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
+    check_tools_on(out);
+
+    ds_options d;
+    memset(&d, 0, sizeof d);
+    d.door = DS_DOOR_TAGGED;
+    d.inside = DS_INSIDE_SETS;
+    d.outside_light = 1;
+    d.texel_density = 2;
+    snprintf(in, sizeof in, "%s/sets.gltf", tmpdir);
+    assert_int_equal(ds_write_room_scene(DS_ROOM_GLB, in, &d, err, sizeof err), 0);
+    snprintf(out, sizeof out, "%s/tools_sets.lbk", tmpdir);
+    test_options(&o, in, out);
+    o.max_samples = 32;
+    assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
+    assert_true(sum.sets >= 4 && sum.doors == 1);
+    check_tools_on(out);
+}
+
+/* Two nodes named "crate" (and a third): OBJS gets "crate", "crate#2", "crate#3" in scene order
+ * (spec §8.2), so the validator has no duplicate-name warning and diff can match them. */
+static int no_warning(void *user, const lbk_issue *issue)
+{
+    (*(int *)user)++;
+    print_message("issue %u: %s\n", issue->id, issue->message);
+    return 0;
+}
+
+static void test_duplicate_names_made_unique(void **state)
+{
+    (void)state;
+    char in[512], out[512], err[512];
+    snprintf(in, sizeof in, "%s/crates.gltf", tmpdir);
+    snprintf(out, sizeof out, "%s/crates.lbk", tmpdir);
+    gw_scene *sc = gw_create();
+    const float grey[3] = {0.5f, 0.5f, 0.5f}, black[3] = {0, 0, 0}, sky[3] = {1, 1, 1};
+    int m = gw_material(sc, grey, black, 0, 0);
+    gw_geom floor_g = {0}, box = {0};
+    const float f0[3] = {-4, 0, 4}, f1[3] = {4, 0, 4}, f2[3] = {4, 0, -4}, f3[3] = {-4, 0, -4};
+    gw_geom_quad(&floor_g, f0, f1, f2, f3, 1);
+    const float mn[3] = {0, 0, 0}, mx[3] = {1, 1, 1};
+    gw_geom_box(&box, mn, mx, 1, 0);
+    gw_mesh(sc, "crate", &box, m, 1, (const double[3]){-2, 0, 0}, "lightmap");
+    gw_mesh(sc, "floor", &floor_g, m, 1, NULL, "lightmap");
+    gw_mesh(sc, "crate", &box, m, 1, (const double[3]){2, 0, 0}, "lightmap");
+    gw_mesh(sc, "crate", &box, m, 1, (const double[3]){0, 0, 2}, "lightmap");
+    gw_sky(sc, sky);
+    assert_int_equal(gw_write(sc, in), 0);
+    gw_geom_free(&floor_g);
+    gw_geom_free(&box);
+    gw_free(sc);
+    bk_bake_options o;
+    bk_bake_summary sum;
+    test_options(&o, in, out);
+    o.max_samples = 32;
+    assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
+    int issues = 0;
+    lbk_validate_summary vs;
+    assert_int_equal(lbk_validate_file(out, NULL, no_warning, &issues, &vs), LBK_OK);
+    assert_int_equal(issues, 0);
+    lbk_reader *r;
+    assert_int_equal(lbk_reader_open_file(out, NULL, &r), LBK_OK);
+    const void *data;
+    size_t size;
+    assert_int_equal(lbk_reader_section_by_type(r, LBK_SECTION_OBJS, &data, &size), LBK_OK);
+    lbk_objects_view v;
+    assert_int_equal(lbk_objects_parse(data, size, &v), LBK_OK);
+    assert_int_equal(v.count, 4);
+    static const char *want[] = {"crate", "floor", "crate#2", "crate#3"};
+    for (uint32_t i = 0; i < 4; i++) {
+        lbk_object ob;
+        assert_int_equal(lbk_objects_get(&v, i, &ob), LBK_OK);
+        assert_int_equal(ob.name.size, strlen(want[i]));
+        assert_memory_equal(ob.name.data, want[i], ob.name.size);
+    }
+    lbk_reader_close(r);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        {"test_cornell_box", test_shared_scene, NULL, NULL, &cornell_box},
+        {"test_cornell_box_bjs", test_shared_scene, NULL, NULL, &cornell_box_bjs},
+        {"test_room_with_doors", test_shared_scene, NULL, NULL, &room_with_doors},
+        {"test_lamp", test_shared_scene, NULL, NULL, &lamp},
+        cmocka_unit_test(test_water_bottle_draco),
+        cmocka_unit_test(test_deterministic_across_threads),
+        cmocka_unit_test(test_no_light_is_refused),
+        cmocka_unit_test(test_missing_input_is_io_error),
+        cmocka_unit_test(test_target_error_and_reports),
+        cmocka_unit_test(test_time_limit),
+        cmocka_unit_test(test_octahedral_probes),
+        cmocka_unit_test(test_tools_on_baker_output),
+        cmocka_unit_test(test_duplicate_names_made_unique),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}

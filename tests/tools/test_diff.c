@@ -1,0 +1,476 @@
+/* lbk diff: matching, decoded-lighting metrics, tolerance boundaries, JSON schema, exit codes. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <cjson/cJSON.h>
+
+#include "cli/cli.h"
+#include "tools/convert/convert.h"
+#include "tools/common/file_util.h"
+#include "tools/inspect/diff.h"
+#include "lbk/lightmap.h"
+#include "support/tools_fixtures.h"
+
+static char tmpdir[64];
+
+static int setup_dir(void **state)
+{
+    (void)state;
+    snprintf(tmpdir, sizeof tmpdir, "/tmp/lbk-diff-XXXXXX");
+    return mkdtemp(tmpdir) ? 0 : -1;
+}
+
+static int teardown_dir(void **state)
+{
+    (void)state;
+    char cmd[128];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+static void open_blob(const tf_blob *b, tl_bake *out)
+{
+    char err[TL_ERR_LEN];
+    if (tl_bake_open_memory(b->data, b->size, out, err) != TL_OPEN_OK) fail_msg("%s", err);
+}
+
+/* Runs a diff of two fixture scenes. */
+static void run_diff(const tf_options *oa, const tf_options *ob, double abs_tol, double rel_tol, int maps,
+                     tl_diff_result *r)
+{
+    tf_blob a = tf_build_scene(TF_SCENE_FULL, oa), b = tf_build_scene(TF_SCENE_FULL, ob);
+    tl_bake ba, bb;
+    open_blob(&a, &ba);
+    open_blob(&b, &bb);
+    tl_diff_options o = {abs_tol, rel_tol, maps};
+    char err[TL_ERR_LEN];
+    assert_int_equal(tl_diff_run(&ba, &bb, &o, r, err), 0);
+    tl_bake_close(&ba);
+    tl_bake_close(&bb);
+    tf_blob_free(&a);
+    tf_blob_free(&b);
+}
+
+static const tl_diff_object *find_object(const tl_diff_result *r, const char *name)
+{
+    for (size_t i = 0; i < r->object_count; i++)
+        if (!strcmp(r->objects[i].name, name)) return &r->objects[i];
+    fail_msg("object %s not in the diff", name);
+    return NULL;
+}
+
+static void test_self_is_equal(void **state)
+{
+    (void)state;
+    tl_diff_result r;
+    run_diff(NULL, NULL, 0, 0, 0, &r);
+    assert_int_equal(r.differ, 0);
+    assert_int_equal(r.object_count, 4);
+    for (size_t i = 0; i < r.object_count; i++) assert_int_equal(r.objects[i].status, TL_DIFF_SAME);
+    const tl_diff_object *floor_ = find_object(&r, "floor");
+    assert_int_equal(floor_->compared, 1);
+    assert_int_equal(floor_->lighting.count, 32 * 32);
+    assert_true(floor_->lighting.max_abs == 0.0);
+    assert_true(tl_err_rel_rmse(&floor_->lighting) == 0.0);
+    assert_int_equal(r.page_count, 2);
+    assert_int_equal(r.pages[0].lighting.count, 64 * 32);
+    assert_int_equal(r.glg.status, TL_DIFF_SAME);
+    assert_int_equal(r.glg.lighting.count, 8);
+    assert_int_equal(r.set_count, 1);
+    assert_int_equal(r.sets[0].status, TL_DIFF_SAME);
+    assert_int_equal(r.sets[0].lighting[LBK_DLS_SPACE_TEXEL].count, 256);
+    assert_int_equal(r.sets[0].lighting[LBK_DLS_SPACE_GLG].count, 2);
+    assert_int_equal(r.param_count, 0);
+    for (size_t i = 0; i < r.section_count; i++) assert_int_equal(r.sections[i].status, TL_DIFF_SAME);
+    tl_diff_free(&r);
+}
+
+/* The same physical lighting stored with other scales (LMAP and GLG 2^-6 and 2^5, DLS payloads in
+ * them): the diff compares physical values, so the bakes are equal, exactly — dividing by a power
+ * of two before encoding changes no rounding. The section bytes do differ. */
+static void test_other_scale_is_equal(void **state)
+{
+    (void)state;
+    static const int scales[2] = {-6, 5};
+    for (int i = 0; i < 2; i++) {
+        tf_options o;
+        memset(&o, 0, sizeof o);
+        o.scale_log2 = scales[i];
+        tl_diff_result r;
+        run_diff(NULL, &o, 0, 0, 0, &r);
+        assert_int_equal(r.differ, 0);
+        for (size_t k = 0; k < r.object_count; k++) assert_int_equal(r.objects[k].status, TL_DIFF_SAME);
+        const tl_diff_object *floor_ = find_object(&r, "floor");
+        assert_int_equal(floor_->lighting.count, 32 * 32);
+        assert_true(floor_->lighting.max_abs == 0.0);
+        assert_true(r.pages[0].lighting.max_abs == 0.0 && r.pages[1].lighting.max_abs == 0.0);
+        assert_int_equal(r.glg.status, TL_DIFF_SAME);
+        assert_true(r.glg.lighting.max_abs == 0.0);
+        assert_int_equal(r.sets[0].status, TL_DIFF_SAME);
+        assert_int_equal(r.sets[0].lighting[LBK_DLS_SPACE_TEXEL].count, 256);
+        assert_true(r.sets[0].lighting[LBK_DLS_SPACE_TEXEL].max_abs == 0.0);
+        assert_true(r.sets[0].lighting[LBK_DLS_SPACE_GLG].max_abs == 0.0);
+        int lmap_bytes_differ = 0;
+        for (size_t k = 0; k < r.section_count; k++)
+            if (r.sections[k].type == LBK_SECTION_LMAP) lmap_bytes_differ = r.sections[k].status == TL_DIFF_CHANGED;
+        assert_true(lmap_bytes_differ);
+        tl_diff_free(&r);
+        /* and a real change under the other scale is still seen */
+        o.texel_factor = 2.0f, o.texel_page = 1, o.texel_x = 3, o.texel_y = 4;
+        run_diff(NULL, &o, 0, 0, 0, &r);
+        assert_int_equal(r.differ, 1);
+        assert_int_equal(find_object(&r, "crate")->status, TL_DIFF_CHANGED);
+        tl_diff_free(&r);
+    }
+}
+
+/* One texel of the crate (page 1, rect at 0,0) doubled: exactly that object, that page, that
+ * texel region; nothing else. */
+static void test_one_texel_changed(void **state)
+{
+    (void)state;
+    tf_options ob = {0};
+    ob.texel_factor = 2.0f;
+    ob.texel_page = 1, ob.texel_x = 5, ob.texel_y = 7;
+    tl_diff_result r;
+    run_diff(NULL, &ob, 0, 0, 0, &r);
+    assert_int_equal(r.differ, 1);
+    assert_int_equal(r.objects_changed, 1);
+    assert_int_equal(r.objects_added + r.objects_removed, 0);
+    const tl_diff_object *crate = find_object(&r, "crate");
+    assert_int_equal(crate->status, TL_DIFF_CHANGED);
+    assert_int_equal(crate->lighting.over, 1);
+    assert_int_equal(crate->lighting.count, 256);
+    assert_true(crate->lighting.has_region);
+    assert_int_equal(crate->lighting.x0, 5);
+    assert_int_equal(crate->lighting.x1, 5);
+    assert_int_equal(crate->lighting.y0, 7);
+    assert_int_equal(crate->lighting.y1, 7);
+    assert_int_equal(crate->lighting.max_x, 5);
+    assert_int_equal(crate->lighting.max_y, 7);
+    assert_int_equal(find_object(&r, "floor")->status, TL_DIFF_SAME);
+    assert_int_equal(find_object(&r, "wall")->status, TL_DIFF_SAME);
+    assert_int_equal(r.pages[0].status, TL_DIFF_SAME);
+    assert_int_equal(r.pages[1].status, TL_DIFF_CHANGED);
+    assert_int_equal(r.pages[1].lighting.over, 1);
+    assert_int_equal(r.pages[1].lighting.x0, 5);
+    assert_int_equal(r.pages[1].lighting.y0, 7);
+    assert_int_equal(r.texels_over, 1);
+    assert_int_equal(r.probes_over, 0);
+    /* mean = max / count since a single texel differs */
+    assert_true(fabs(tl_err_mean(&crate->lighting) - crate->lighting.max_abs / 256.0) < 1e-12);
+    tl_diff_free(&r);
+}
+
+/* The largest decoded difference of the changed texel, computed the way spec/diff-json.md says. */
+static double expected_texel_error(const tf_options *ob, double *ref)
+{
+    tf_blob a = tf_build_scene(TF_SCENE_FULL, NULL), b = tf_build_scene(TF_SCENE_FULL, ob);
+    tl_bake ba, bb;
+    open_blob(&a, &ba);
+    open_blob(&b, &bb);
+    lbk_lmap_page pa, pb;
+    assert_int_equal(lbk_lmap_get_page(&ba.lmap, ob->texel_page, &pa), LBK_OK);
+    assert_int_equal(lbk_lmap_get_page(&bb.lmap, ob->texel_page, &pb), LBK_OK);
+    lbk_ahd_texel ta, tb;
+    lbk_lmap_page_texel(&pa, ob->texel_x, ob->texel_y, &ta);
+    lbk_lmap_page_texel(&pb, ob->texel_x, ob->texel_y, &tb);
+    float va[TL_TEXEL_NORMALS][3], vb[TL_TEXEL_NORMALS][3];
+    tl_texel_eval(&ta, pa.scale, va);
+    tl_texel_eval(&tb, pb.scale, vb);
+    double e = 0;
+    *ref = 0;
+    for (int n = 0; n < TL_TEXEL_NORMALS; n++)
+        for (int c = 0; c < 3; c++) {
+            e = fmax(e, fabs((double)vb[n][c] - (double)va[n][c]));
+            *ref = fmax(*ref, fabs((double)va[n][c]));
+        }
+    tl_bake_close(&ba);
+    tl_bake_close(&bb);
+    tf_blob_free(&a);
+    tf_blob_free(&b);
+    return e;
+}
+
+/* error == abs-tol is within tolerance; one ulp less is over. Same for rel-tol. */
+static void test_tolerance_boundaries(void **state)
+{
+    (void)state;
+    tf_options ob = {0};
+    ob.texel_delta = 0.25f;
+    ob.texel_page = 0, ob.texel_x = 10, ob.texel_y = 3;
+    double ref;
+    const double e = expected_texel_error(&ob, &ref);
+    assert_true(e > 0.1 && e < 1.0);
+    tl_diff_result r;
+    run_diff(NULL, &ob, e, 0, 0, &r);
+    assert_int_equal(r.texels_over, 0);
+    assert_int_equal(r.differ, 0);
+    assert_true(find_object(&r, "floor")->lighting.max_abs == e);
+    tl_diff_free(&r);
+    run_diff(NULL, &ob, nextafter(e, 0), 0, 0, &r);
+    assert_int_equal(r.texels_over, 1);
+    assert_int_equal(r.differ, 1);
+    assert_int_equal(find_object(&r, "floor")->lighting.over, 1);
+    tl_diff_free(&r);
+    /* relative: error ≤ rel × max|A| */
+    run_diff(NULL, &ob, 0, e / ref * (1 + 1e-12), 0, &r);
+    assert_int_equal(r.texels_over, 0);
+    tl_diff_free(&r);
+    run_diff(NULL, &ob, 0, e / ref * (1 - 1e-9), 0, &r);
+    assert_int_equal(r.texels_over, 1);
+    tl_diff_free(&r);
+}
+
+static void test_objects_matched_by_name_and_hash(void **state)
+{
+    (void)state;
+    tf_options ob = {0};
+    ob.drop_crate = 1;
+    ob.rename_wall = 1;
+    ob.samples = 128;
+    tl_diff_result r;
+    run_diff(NULL, &ob, 0, 0, 0, &r);
+    assert_int_equal(r.objects_removed, 1);
+    assert_int_equal(find_object(&r, "crate")->status, TL_DIFF_REMOVED);
+    const tl_diff_object *wall = find_object(&r, "wall");
+    assert_int_equal(wall->status, TL_DIFF_CHANGED);
+    assert_int_equal(wall->renamed, 1);
+    assert_string_equal(wall->name_b, "wall-renamed");
+    assert_int_equal(wall->lighting.over, 0); /* same texels: only the name changed */
+    assert_int_equal(r.param_count, 1);
+    assert_string_equal(r.params[0].key, "bake.samples");
+    assert_string_equal(r.params[0].a, "64");
+    assert_string_equal(r.params[0].b, "128");
+    assert_int_equal(r.params[0].status, TL_DIFF_CHANGED);
+    tl_diff_free(&r);
+
+    memset(&ob, 0, sizeof ob);
+    ob.move_crate_geometry = 1;
+    run_diff(NULL, &ob, 0, 0, 0, &r);
+    const tl_diff_object *crate = find_object(&r, "crate");
+    assert_int_equal(crate->status, TL_DIFF_CHANGED);
+    assert_int_equal(crate->geometry_changed, 1);
+    assert_int_equal(crate->renamed, 0);
+    tl_diff_free(&r);
+
+    /* only META differs: reported, but the lighting is equal → exit 0 */
+    memset(&ob, 0, sizeof ob);
+    ob.samples = 65;
+    run_diff(NULL, &ob, 0, 0, 0, &r);
+    assert_int_equal(r.params_changed, 1);
+    assert_int_equal(r.differ, 0);
+    tl_diff_free(&r);
+}
+
+static void test_probe_change(void **state)
+{
+    (void)state;
+    tf_options ob = {0};
+    ob.probe_scale = 1.5f;
+    tl_diff_result r;
+    run_diff(NULL, &ob, 0, 0, 0, &r);
+    assert_int_equal(r.glg.status, TL_DIFF_CHANGED);
+    assert_int_equal(r.glg.lighting.over, 1);
+    assert_int_equal(r.glg.lighting.x0, 3);
+    assert_int_equal(r.glg.lighting.x1, 3);
+    assert_int_equal(r.probes_over, 1);
+    assert_int_equal(r.objects_changed, 0);
+    assert_int_equal(r.differ, 1);
+    /* rel-RMSE of a 1.5× probe among 8: sqrt(Σ(0.5 A3)² / Σ A²) is strictly between 0 and 0.5 */
+    double rr = tl_err_rel_rmse(&r.glg.lighting);
+    assert_true(rr > 0.05 && rr < 0.5);
+    tl_diff_free(&r);
+}
+
+/* A console pack widens pages (row pitch) and drops META/REPT: the lighting is the same. */
+static void test_pack_equals_source(void **state)
+{
+    (void)state;
+    tf_blob a = tf_build_scene(TF_SCENE_FULL, NULL);
+    char err[TL_ERR_LEN];
+    tl_profile p;
+    assert_int_equal(tl_profile_resolve("console-current", "tools/convert/profiles", &p, err), 0);
+    tl_convert_options co = {&p, NULL};
+    void *pack;
+    size_t pack_size;
+    assert_int_equal(tl_convert_memory(a.data, a.size, &co, &pack, &pack_size, NULL, err), TL_CONVERT_OK);
+    tl_bake ba, bb;
+    open_blob(&a, &ba);
+    assert_int_equal(tl_bake_open_memory(pack, pack_size, &bb, err), TL_OPEN_OK);
+    tl_diff_options o = {0, 0, 0};
+    tl_diff_result r;
+    assert_int_equal(tl_diff_run(&ba, &bb, &o, &r, err), 0);
+    assert_int_equal(r.pages[1].resized, 1); /* 16 → 64 texels wide */
+    assert_int_equal(r.objects_changed, 0);
+    assert_int_equal(r.sets[0].status, TL_DIFF_SAME);
+    assert_int_equal(r.sets[0].lighting[LBK_DLS_SPACE_TEXEL].count, 256);
+    assert_int_equal(r.differ, 0);
+    tl_diff_free(&r);
+    tl_bake_close(&ba);
+    tl_bake_close(&bb);
+    free(pack);
+    tf_blob_free(&a);
+}
+
+static void require_key(const cJSON *o, const char *key)
+{
+    if (!cJSON_HasObjectItem(o, key)) fail_msg("JSON key '%s' missing", key);
+}
+
+static void test_json_schema(void **state)
+{
+    (void)state;
+    tf_options ob = {0};
+    ob.texel_factor = 3.0f;
+    ob.texel_page = 1, ob.texel_x = 2, ob.texel_y = 4;
+    tl_diff_result r;
+    run_diff(NULL, &ob, 0.001, 0, 0, &r);
+    char *text = tl_diff_json(&r, "a.lbk", "b.lbk");
+    tl_diff_free(&r);
+    cJSON *j = cJSON_Parse(text);
+    assert_non_null(j);
+    free(text);
+    assert_string_equal(cJSON_GetObjectItem(j, "schema")->valuestring, "lbk-diff");
+    assert_int_equal(cJSON_GetObjectItem(j, "schema_version")->valueint, 1);
+    const char *top[] = {"a", "b", "tolerance", "equal", "summary", "sections", "params", "objects", "pages", "glg",
+                         "light_sets", "doors"};
+    for (size_t i = 0; i < sizeof top / sizeof top[0]; i++) require_key(j, top[i]);
+    assert_true(cJSON_IsFalse(cJSON_GetObjectItem(j, "equal")));
+    const char *sum[] = {"objects_added", "objects_removed", "objects_changed", "pages_changed", "light_sets_changed",
+                         "doors_changed", "sections_changed", "params_changed", "texels_over_tolerance",
+                         "probes_over_tolerance"};
+    for (size_t i = 0; i < sizeof sum / sizeof sum[0]; i++) require_key(cJSON_GetObjectItem(j, "summary"), sum[i]);
+    const cJSON *objs = cJSON_GetObjectItem(j, "objects");
+    assert_int_equal(cJSON_GetArraySize(objs), 4);
+    const cJSON *o;
+    int found = 0;
+    cJSON_ArrayForEach(o, objs)
+    {
+        const char *keys[] = {"name", "b_name", "status", "changes", "a", "b", "resampled", "lighting"};
+        for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++) require_key(o, keys[i]);
+        if (strcmp(cJSON_GetObjectItem(o, "name")->valuestring, "crate")) continue;
+        found = 1;
+        assert_string_equal(cJSON_GetObjectItem(o, "status")->valuestring, "changed");
+        const cJSON *l = cJSON_GetObjectItem(o, "lighting");
+        const char *lk[] = {"count", "over_tolerance", "over_share", "max_abs", "mean_abs", "rel_rmse", "max_at",
+                            "over_region"};
+        for (size_t i = 0; i < sizeof lk / sizeof lk[0]; i++) require_key(l, lk[i]);
+        assert_int_equal(cJSON_GetObjectItem(l, "over_tolerance")->valueint, 1);
+        const cJSON *reg = cJSON_GetObjectItem(l, "over_region");
+        assert_int_equal(cJSON_GetObjectItem(reg, "x0")->valueint, 2);
+        assert_int_equal(cJSON_GetObjectItem(reg, "y1")->valueint, 4);
+        const cJSON *side = cJSON_GetObjectItem(o, "a");
+        assert_string_equal(cJSON_GetObjectItem(side, "geometry_hash")->valuestring, "0000000000003333");
+        assert_string_equal(cJSON_GetObjectItem(side, "representation")->valuestring, "lightmap");
+        assert_int_equal(cJSON_GetObjectItem(cJSON_GetObjectItem(side, "rect"), "page")->valueint, 1);
+    }
+    assert_true(found);
+    require_key(cJSON_GetObjectItem(j, "glg"), "lighting");
+    const cJSON *set = cJSON_GetArrayItem(cJSON_GetObjectItem(j, "light_sets"), 0);
+    assert_string_equal(cJSON_GetObjectItem(set, "name")->valuestring, "lamp");
+    require_key(set, "texels");
+    require_key(set, "glg");
+    require_key(set, "llg");
+    cJSON_Delete(j);
+}
+
+static void test_heatmap_png(void **state)
+{
+    (void)state;
+    tf_options ob = {0};
+    ob.texel_factor = 2.0f;
+    ob.texel_page = 0, ob.texel_x = 9, ob.texel_y = 11;
+    tl_diff_result r;
+    run_diff(NULL, &ob, 0, 0, 1, &r);
+    char err[TL_ERR_LEN], dir[128], path[192];
+    snprintf(dir, sizeof dir, "%s/heat", tmpdir);
+    assert_int_equal(tl_diff_heatmaps(&r, dir, err), 0);
+    tl_diff_free(&r);
+    snprintf(path, sizeof path, "%s/page_000.diff.png", dir);
+    int w, h;
+    uint8_t *rgb;
+    assert_int_equal(tl_png_read_rgb8(path, &w, &h, &rgb, err), 0);
+    assert_int_equal(w, 64);
+    assert_int_equal(h, 32);
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            const uint8_t *c = rgb + 3 * (y * w + x);
+            int black = c[0] == 0 && c[1] == 0 && c[2] == 0;
+            if (x == 9 && y == 11) assert_false(black);
+            else assert_true(black);
+        }
+    free(rgb);
+    snprintf(path, sizeof path, "%s/page_001.diff.png", dir);
+    assert_int_equal(access(path, R_OK), 0);
+}
+
+static int run_cli(int n, const char **args)
+{
+    char *argv[16];
+    for (int i = 0; i < n; i++) argv[i] = (char *)args[i];
+    fflush(stdout);
+    return lbk_cmd_diff(n, argv);
+}
+
+/* Documented exit codes: 0 equal, 1 differ, 2 usage, 3 I/O, 4 invalid input. */
+static void test_cli_exit_codes(void **state)
+{
+    (void)state;
+    char pa[128], pb[128], bad[128], missing[128], err[TL_ERR_LEN];
+    snprintf(pa, sizeof pa, "%s/a.lbk", tmpdir);
+    snprintf(pb, sizeof pb, "%s/b.lbk", tmpdir);
+    snprintf(bad, sizeof bad, "%s/bad.lbk", tmpdir);
+    snprintf(missing, sizeof missing, "%s/missing.lbk", tmpdir);
+    tf_options ob = {0};
+    ob.texel_factor = 2.0f;
+    tf_blob a = tf_build_scene(TF_SCENE_FULL, NULL), b = tf_build_scene(TF_SCENE_FULL, &ob);
+    assert_int_equal(tl_write_file_atomic(pa, a.data, a.size, err), 0);
+    assert_int_equal(tl_write_file_atomic(pb, b.data, b.size, err), 0);
+    ((uint8_t *)a.data)[a.size / 2] ^= 1;
+    assert_int_equal(tl_write_file_atomic(bad, a.data, a.size, err), 0);
+    tf_blob_free(&a);
+    tf_blob_free(&b);
+    const char *same[] = {"diff", pa, pa, "--json"};
+    assert_int_equal(run_cli(4, same), LBK_EXIT_OK);
+    const char *differ[] = {"diff", pa, pb};
+    assert_int_equal(run_cli(3, differ), LBK_EXIT_NEGATIVE);
+    const char *loose[] = {"diff", pa, pb, "--rel-tol", "1.5"}; /* 2× texel: error = 1 × A ≤ 1.5 × A */
+    assert_int_equal(run_cli(5, loose), LBK_EXIT_OK);
+    const char *usage1[] = {"diff", pa};
+    assert_int_equal(run_cli(2, usage1), LBK_EXIT_USAGE);
+    const char *usage2[] = {"diff", pa, pb, "--abs-tol", "-1"};
+    assert_int_equal(run_cli(5, usage2), LBK_EXIT_USAGE);
+    const char *usage3[] = {"diff", pa, pb, "--frobnicate"};
+    assert_int_equal(run_cli(4, usage3), LBK_EXIT_USAGE);
+    const char *io[] = {"diff", pa, missing};
+    assert_int_equal(run_cli(3, io), LBK_EXIT_IO);
+    const char *inv[] = {"diff", bad, pa};
+    assert_int_equal(run_cli(3, inv), LBK_EXIT_INPUT);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_self_is_equal),
+        cmocka_unit_test(test_other_scale_is_equal),
+        cmocka_unit_test(test_one_texel_changed),
+        cmocka_unit_test(test_tolerance_boundaries),
+        cmocka_unit_test(test_objects_matched_by_name_and_hash),
+        cmocka_unit_test(test_probe_change),
+        cmocka_unit_test(test_pack_equals_source),
+        cmocka_unit_test(test_json_schema),
+        cmocka_unit_test(test_heatmap_png),
+        cmocka_unit_test(test_cli_exit_codes),
+    };
+    return cmocka_run_group_tests(tests, setup_dir, teardown_dir);
+}

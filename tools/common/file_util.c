@@ -1,0 +1,102 @@
+/* Whole-file reading and atomic writing for the tools. */
+#include "tools/common/file_util.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+int tl_read_file(const char *path, void **data, size_t *size, char err[TL_ERR_LEN])
+{
+    *data = NULL;
+    *size = 0;
+    int fd = open(path, O_RDONLY);
+    if (fd < 0) {
+        snprintf(err, TL_ERR_LEN, "cannot open %s: %s", path, strerror(errno));
+        return -1;
+    }
+    struct stat sb;
+    if (fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode)) {
+        snprintf(err, TL_ERR_LEN, "%s is not a regular file", path);
+        close(fd);
+        return -1;
+    }
+    if ((uint64_t)sb.st_size > (uint64_t)SIZE_MAX - 1) {
+        snprintf(err, TL_ERR_LEN, "%s is too large", path);
+        close(fd);
+        return -1;
+    }
+    size_t n = (size_t)sb.st_size;
+    uint8_t *buf = malloc(n ? n : 1);
+    if (!buf) {
+        snprintf(err, TL_ERR_LEN, "out of memory reading %s (%zu bytes)", path, n);
+        close(fd);
+        return -1;
+    }
+    size_t got = 0;
+    while (got < n) {
+        ssize_t r = read(fd, buf + got, n - got);
+        if (r < 0 && errno == EINTR) continue;
+        if (r <= 0) {
+            snprintf(err, TL_ERR_LEN, "cannot read %s: %s", path, r < 0 ? strerror(errno) : "file shrank while reading");
+            free(buf);
+            close(fd);
+            return -1;
+        }
+        got += (size_t)r;
+    }
+    close(fd);
+    *data = buf;
+    *size = n;
+    return 0;
+}
+
+int tl_write_file_atomic(const char *path, const void *data, size_t size, char err[TL_ERR_LEN])
+{
+    size_t plen = strlen(path);
+    char *tmp = malloc(plen + 32);
+    if (!tmp) {
+        snprintf(err, TL_ERR_LEN, "out of memory");
+        return -1;
+    }
+    snprintf(tmp, plen + 32, "%s.tmp.%ld", path, (long)getpid());
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd < 0) {
+        snprintf(err, TL_ERR_LEN, "cannot create %s: %s", tmp, strerror(errno));
+        free(tmp);
+        return -1;
+    }
+    const uint8_t *p = data;
+    size_t done = 0;
+    int ok = 1;
+    while (done < size) {
+        ssize_t w = write(fd, p + done, size - done);
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) {
+            ok = 0;
+            break;
+        }
+        done += (size_t)w;
+    }
+    if (ok && fsync(fd) != 0) ok = 0;
+    int saved = errno;
+    if (close(fd) != 0 && ok) ok = 0, saved = errno;
+    if (ok && rename(tmp, path) != 0) ok = 0, saved = errno;
+    if (!ok) {
+        snprintf(err, TL_ERR_LEN, "cannot write %s: %s", path, strerror(saved));
+        unlink(tmp);
+        free(tmp);
+        return -1;
+    }
+    free(tmp);
+    return 0;
+}
+
+int tl_write_text(const char *path, const char *text, char err[TL_ERR_LEN])
+{
+    return tl_write_file_atomic(path, text, strlen(text), err);
+}

@@ -1,0 +1,16 @@
+/* Whole-file reading and atomic writing for the tools. Return 0, or -1 with err filled in. */
+#ifndef LBK_TOOLS_FILE_UTIL_H
+#define LBK_TOOLS_FILE_UTIL_H
+
+#include <stddef.h>
+
+#include "tools/common/image_io.h" /* TL_ERR_LEN */
+
+/* Reads a whole regular file into a malloc'ed buffer (at least 1 byte allocated). */
+int tl_read_file(const char *path, void **data, size_t *size, char err[TL_ERR_LEN]);
+/* Writes through a temp file beside path, fsync, rename: readers never see a partial file. */
+int tl_write_file_atomic(const char *path, const void *data, size_t size, char err[TL_ERR_LEN]);
+/* Writes a text file (for CSV/JSON listings); atomic like tl_write_file_atomic. */
+int tl_write_text(const char *path, const char *text, char err[TL_ERR_LEN]);
+
+#endif

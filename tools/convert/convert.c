@@ -1,0 +1,170 @@
+/* Repacking with a profile. The pack is a pure function of (input bytes, profile, imported pages):
+ * sections are decoded, optionally rewritten, and handed to the library writer, which lays them out
+ * in canonical order; zstd at a fixed level is deterministic, so converting twice gives the same
+ * bytes, and converting a pack again with the same profile reproduces it. */
+#include "tools/convert/convert.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tools/common/error_util.h"
+#include "tools/convert/lmap_layout.h"
+#include "lbk/validate.h"
+
+typedef struct first_issue {
+    int have;
+    lbk_issue issue;
+} first_issue;
+
+static int keep_first_error(void *user, const lbk_issue *issue)
+{
+    first_issue *f = user;
+    if (!f->have && issue->severity != LBK_SEVERITY_WARNING) {
+        f->issue = *issue;
+        f->have = 1;
+    }
+    return 0;
+}
+
+/* Validates bytes; on failure fills err with the first error. */
+static int validate_bytes(const void *data, size_t size, const char *what, char err[TL_ERR_LEN])
+{
+    first_issue f = {0};
+    lbk_validate_summary sum = {0};
+    lbk_result r = lbk_validate_memory(data, size, NULL, keep_first_error, &f, &sum);
+    if (r != LBK_OK) {
+        snprintf(err, TL_ERR_LEN, "%s: validation could not run (%s)", what, lbk_result_name(r));
+        return -1;
+    }
+    if (sum.fatal || sum.errors) {
+        char t[5];
+        lbk_fourcc_string(f.issue.section_type, t);
+        snprintf(err, TL_ERR_LEN, "%s is invalid: %u error(s); first: #%u in %s at byte %llu: %s", what,
+                 sum.fatal + sum.errors, f.issue.id, f.issue.section_type ? t : "header",
+                 (unsigned long long)f.issue.offset, f.issue.message);
+        return -1;
+    }
+    return 0;
+}
+
+tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_convert_options *opt, void **out,
+                                    size_t *out_size, tl_convert_report *report, char err[TL_ERR_LEN])
+{
+    *out = NULL;
+    *out_size = 0;
+    tl_convert_report local;
+    if (!report) report = &local;
+    memset(report, 0, sizeof *report);
+    report->in_size = in_size;
+    const tl_profile *p = opt->profile;
+
+    if (validate_bytes(in, in_size, "input", err)) return TL_CONVERT_BAD_INPUT;
+    lbk_reader *rd = NULL;
+    lbk_result r = lbk_reader_open_memory(in, in_size, NULL, &rd);
+    if (r != LBK_OK) return tl_fail(err, TL_CONVERT_BAD_INPUT, "input: %s", lbk_result_message(r));
+
+    lbk_write_options wo = {0};
+    wo.section_alignment = p->alignment;
+    lbk_writer *w = NULL;
+    r = lbk_writer_create(&wo, &w);
+    if (r != LBK_OK) {
+        lbk_reader_close(rd);
+        return tl_fail(err, TL_CONVERT_INTERNAL, "writer: %s", lbk_result_message(r));
+    }
+
+    tl_convert_status st = TL_CONVERT_OK;
+    tl_texel_remap remap;
+    memset(&remap, 0, sizeof remap);
+    int have_remap = 0;
+    uint32_t n = lbk_reader_section_count(rd);
+    for (uint32_t i = 0; i < n && st == TL_CONVERT_OK; i++) {
+        lbk_section_info si;
+        const void *data = NULL;
+        size_t size = 0;
+        if ((r = lbk_reader_section_info(rd, i, &si)) != LBK_OK || (r = lbk_reader_section_data(rd, i, &data, &size)) != LBK_OK) {
+            st = tl_fail(err, TL_CONVERT_BAD_INPUT, "input section %u: %s", i, lbk_result_message(r));
+            break;
+        }
+        tl_convert_section *cs = &report->sections[report->section_count++];
+        cs->type = si.type;
+        cs->in_stored = si.stored_size;
+        cs->in_decoded = si.decoded_size;
+        tl_section_rule rule = tl_profile_rule(p, si.type);
+        if (rule.ship == TL_SHIP_DROP) {
+            cs->dropped = 1;
+            continue;
+        }
+        void *rewritten = NULL;
+        size_t rewritten_size = 0;
+        int ls = TL_CONVERT_OK;
+        if (si.type == LBK_SECTION_LMAP) {
+            tl_lmap_layout_options lo = {p->lmap_row_pitch_alignment, p->lmap_page_alignment, opt->from_exr_dir};
+            uint32_t imported = 0;
+            tl_texel_remap_free(&remap);
+            ls = tl_lmap_rewrite(data, size, &lo, &rewritten, &rewritten_size, &imported, &remap, err);
+            report->pages_imported = imported;
+            have_remap = ls == TL_CONVERT_OK;
+        } else if (si.type == LBK_SECTION_DLS && have_remap && !remap.identity) {
+            ls = tl_dls_remap_texels(data, size, &remap, &rewritten, &rewritten_size, err);
+        }
+        if (ls != TL_CONVERT_OK) {
+            st = (tl_convert_status)ls;
+            break;
+        }
+        if (rewritten) {
+            cs->relaid = 1;
+            data = rewritten;
+            size = rewritten_size;
+        }
+        lbk_section_options so = {0};
+        so.flags = si.flags;
+        so.compression = rule.compression;
+        so.zstd_level = rule.zstd_level;
+        r = lbk_writer_add_section(w, si.type, data, size, &so);
+        free(rewritten);
+        if (r != LBK_OK) st = tl_fail(err, TL_CONVERT_INTERNAL, "writing section %u: %s", i, lbk_result_message(r));
+    }
+    if (st == TL_CONVERT_OK && opt->from_exr_dir && report->pages_imported == 0)
+        st = tl_fail(err, TL_CONVERT_BAD_EXR, "--from-exr %.160s: no page_NNN.exr for any lightmap page of the input",
+                  opt->from_exr_dir);
+
+    void *bytes = NULL;
+    size_t bytes_size = 0;
+    if (st == TL_CONVERT_OK) {
+        r = lbk_writer_to_memory(w, &bytes, &bytes_size);
+        if (r != LBK_OK) st = tl_fail(err, TL_CONVERT_INTERNAL, "serialising the pack: %s", lbk_result_message(r));
+    }
+    lbk_writer_destroy(w);
+    lbk_reader_close(rd);
+    tl_texel_remap_free(&remap);
+    if (st != TL_CONVERT_OK) {
+        lbk_free(NULL, bytes);
+        return st;
+    }
+    /* Re-read the output to fill in the stored sizes, and refuse to hand out an invalid pack. */
+    if (validate_bytes(bytes, bytes_size, "output", err)) {
+        lbk_free(NULL, bytes);
+        return TL_CONVERT_INTERNAL;
+    }
+    lbk_reader *ord = NULL;
+    if (lbk_reader_open_memory(bytes, bytes_size, NULL, &ord) == LBK_OK) {
+        for (uint32_t i = 0; i < report->section_count; i++) {
+            tl_convert_section *cs = &report->sections[i];
+            uint32_t idx;
+            lbk_section_info si;
+            if (cs->dropped || lbk_reader_find_section(ord, cs->type, &idx) != LBK_OK ||
+                lbk_reader_section_info(ord, idx, &si) != LBK_OK)
+                continue;
+            cs->out_stored = si.stored_size;
+            cs->out_decoded = si.decoded_size;
+            cs->compression = si.compression;
+        }
+        lbk_reader_close(ord);
+    }
+    /* lbk_free(NULL, …) is free(); hand the caller a malloc'ed buffer. */
+    *out = bytes;
+    *out_size = bytes_size;
+    report->out_size = bytes_size;
+    return TL_CONVERT_OK;
+}

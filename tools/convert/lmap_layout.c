@@ -1,0 +1,362 @@
+/* LMAP rewriting for convert: widening pages for a row pitch, EXR page import, DLS renumbering. */
+#include "tools/convert/lmap_layout.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "tools/convert/convert.h"
+#include "tools/common/error_util.h"
+#include "lbk/dls.h"
+#include "lbk/lightmap.h"
+#include "lbk/pixel.h"
+
+void tl_page_exr_path(char *out, size_t size, const char *dir, uint32_t page, const char *suffix)
+{
+    snprintf(out, size, "%s/page_%03u%s", dir, page, suffix);
+}
+
+void tl_texel_remap_free(tl_texel_remap *r)
+{
+    free(r->old_width);
+    free(r->new_width);
+    free(r->height);
+    free(r->old_first);
+    free(r->new_first);
+    memset(r, 0, sizeof *r);
+}
+
+int tl_texel_remap_apply(const tl_texel_remap *r, uint64_t old_index, uint64_t *new_index)
+{
+    if (old_index >= r->old_total) return -1;
+    if (r->identity) {
+        *new_index = old_index;
+        return 0;
+    }
+    uint32_t lo = 0, hi = r->page_count;
+    while (hi - lo > 1) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (r->old_first[mid] <= old_index) lo = mid;
+        else hi = mid;
+    }
+    uint64_t local = old_index - r->old_first[lo];
+    uint64_t y = local / r->old_width[lo], x = local % r->old_width[lo];
+    *new_index = r->new_first[lo] + y * r->new_width[lo] + x;
+    return 0;
+}
+
+/* Replaces plane 0 (and plane 1 when the .ahd.exr exists) of page p from DIR. Returns 1 when
+ * the page was imported, 0 when DIR has no file for it, or a negative tl_convert_status. */
+static int import_page(const char *dir, uint32_t p, uint32_t w, uint32_t h, float scale, lbk_ahd_texel *tex,
+                       char err[TL_ERR_LEN])
+{
+    char path[4096];
+    tl_page_exr_path(path, sizeof path, dir, p, ".exr");
+    if (access(path, F_OK) != 0) return 0;
+    static const char *const rgb_names[3] = {"R", "G", "B"};
+    int ew, eh;
+    float *px = NULL;
+    char e2[TL_ERR_LEN];
+    if (tl_exr_read(path, 3, rgb_names, &ew, &eh, &px, e2)) return -tl_fail(err, TL_CONVERT_BAD_EXR, "%s", e2);
+    if ((uint32_t)ew != w || (uint32_t)eh != h) {
+        free(px);
+        return -tl_fail(err, TL_CONVERT_BAD_EXR, "%s is %dx%d but page %u is %ux%u", path, ew, eh, p, w, h);
+    }
+    for (size_t i = 0; i < (size_t)w * h; i++) {
+        float v[3];
+        for (int c = 0; c < 3; c++) {
+            v[c] = px[3 * i + (size_t)c];
+            if (!isfinite(v[c])) {
+                free(px);
+                return -tl_fail(err, TL_CONVERT_BAD_EXR, "%s: pixel (%zu, %zu) %s is not finite", path, i % w, i / w,
+                             rgb_names[c]);
+            }
+            if (v[c] < 0) v[c] = 0; /* irradiance cannot be negative; painting tools overshoot */
+            v[c] /= scale;           /* the EXR is physical, the section stores value / scale (exact) */
+        }
+        tex[i].irradiance_z = lbk_pack_r11g11b10f(v);
+    }
+    free(px);
+    tl_page_exr_path(path, sizeof path, dir, p, ".ahd.exr");
+    if (access(path, F_OK) != 0) return 1;
+    static const char *const p1_names[4] = {"plane1.R", "plane1.G", "plane1.B", "plane1.A"};
+    if (tl_exr_read(path, 4, p1_names, &ew, &eh, &px, e2)) return -tl_fail(err, TL_CONVERT_BAD_EXR, "%s", e2);
+    if ((uint32_t)ew != w || (uint32_t)eh != h) {
+        free(px);
+        return -tl_fail(err, TL_CONVERT_BAD_EXR, "%s is %dx%d but page %u is %ux%u", path, ew, eh, p, w, h);
+    }
+    for (size_t i = 0; i < (size_t)w * h; i++)
+        for (int c = 0; c < 4; c++) {
+            float v = px[4 * i + (size_t)c];
+            if (!isfinite(v)) {
+                free(px);
+                return -tl_fail(err, TL_CONVERT_BAD_EXR, "%s: pixel (%zu, %zu) %s is not finite", path, i % w, i / w,
+                             p1_names[c]);
+            }
+            tex[i].rgba[c] = lbk_float_to_unorm8(v);
+        }
+    free(px);
+    return 1;
+}
+
+int tl_lmap_rewrite(const void *lmap, size_t size, const tl_lmap_layout_options *o, void **out, size_t *out_size,
+                    uint32_t *pages_imported, tl_texel_remap *remap, char err[TL_ERR_LEN])
+{
+    *out = NULL;
+    *out_size = 0;
+    *pages_imported = 0;
+    memset(remap, 0, sizeof *remap);
+    lbk_lmap_view v;
+    lbk_result r = lbk_lmap_open(lmap, size, &v);
+    if (r != LBK_OK) return tl_fail(err, TL_CONVERT_BAD_INPUT, "LMAP: %s", lbk_result_message(r));
+    const uint32_t n = v.page_count;
+    remap->page_count = n;
+    remap->old_width = calloc(n, sizeof(uint32_t));
+    remap->new_width = calloc(n, sizeof(uint32_t));
+    remap->height = calloc(n, sizeof(uint32_t));
+    remap->old_first = calloc(n, sizeof(uint64_t));
+    remap->new_first = calloc(n, sizeof(uint64_t));
+    if (!remap->old_width || !remap->new_width || !remap->height || !remap->old_first || !remap->new_first)
+        return tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
+    const uint32_t multiple = o->row_pitch_alignment > 4 ? o->row_pitch_alignment / 4 : 1;
+    int widen = 0;
+    uint64_t first = 0;
+    for (uint32_t p = 0; p < n; p++) {
+        lbk_lmap_page pg;
+        lbk_lmap_get_page(&v, p, &pg);
+        remap->old_width[p] = pg.width;
+        remap->height[p] = pg.height;
+        remap->old_first[p] = pg.first_texel;
+        remap->new_width[p] = (pg.width + multiple - 1) / multiple * multiple;
+        remap->new_first[p] = first;
+        first += (uint64_t)remap->new_width[p] * pg.height;
+        widen |= remap->new_width[p] != pg.width;
+    }
+    remap->old_total = v.texel_count;
+    remap->new_total = first;
+    remap->identity = !widen;
+    if (!widen && !o->from_exr_dir) {
+        /* nothing to rewrite; still honour the page alignment check */
+        for (uint32_t p = 0; p < n && o->page_alignment; p++) {
+            lbk_lmap_page pg;
+            lbk_lmap_get_page(&v, p, &pg);
+            if (pg.irradiance_offset % o->page_alignment || pg.rgba_offset % o->page_alignment)
+                return tl_fail(err, TL_CONVERT_UNSUPPORTED,
+                            "page %u planes start at LMAP bytes %llu and %llu, not multiples of page_alignment %u; "
+                            "format 1.0 places planes packed at 16-byte alignment",
+                            p, (unsigned long long)pg.irradiance_offset, (unsigned long long)pg.rgba_offset,
+                            o->page_alignment);
+        }
+        return TL_CONVERT_OK;
+    }
+    /* decode every page into texel arrays of the new width, import, rebuild */
+    lbk_lmap_page_desc *descs = calloc(n, sizeof *descs);
+    lbk_ahd_texel **tex = calloc(n, sizeof *tex);
+    int st = TL_CONVERT_OK;
+    if (!descs || !tex) st = tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
+    for (uint32_t p = 0; p < n && st == TL_CONVERT_OK; p++) {
+        lbk_lmap_page pg;
+        lbk_lmap_get_page(&v, p, &pg);
+        const uint32_t w = pg.width, h = pg.height, nw = remap->new_width[p];
+        lbk_ahd_texel *src = calloc((size_t)w * h, sizeof *src);
+        tex[p] = calloc((size_t)nw * h, sizeof(lbk_ahd_texel)); /* new columns: zero texels */
+        if (!src || !tex[p]) {
+            free(src);
+            st = tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
+            break;
+        }
+        for (uint32_t y = 0; y < h; y++)
+            for (uint32_t x = 0; x < w; x++) lbk_lmap_page_texel(&pg, x, y, &src[(size_t)y * w + x]);
+        if (o->from_exr_dir) {
+            int got = import_page(o->from_exr_dir, p, w, h, v.scale, src, err);
+            if (got < 0) st = -got;
+            else *pages_imported += (uint32_t)got;
+        }
+        for (uint32_t y = 0; y < h; y++) memcpy(&tex[p][(size_t)y * nw], &src[(size_t)y * w], (size_t)w * sizeof *src);
+        free(src);
+        descs[p] = (lbk_lmap_page_desc){nw, h, tex[p]};
+    }
+    if (st == TL_CONVERT_OK) {
+        void *built = NULL;
+        size_t built_size = 0;
+        r = lbk_lmap_build(descs, n, v.scale, NULL, &built, &built_size);
+        if (r != LBK_OK) st = tl_fail(err, TL_CONVERT_INTERNAL, "rebuilding LMAP: %s", lbk_result_message(r));
+        else {
+            lbk_lmap_view nv;
+            lbk_lmap_open(built, built_size, &nv);
+            for (uint32_t p = 0; p < n && o->page_alignment && st == TL_CONVERT_OK; p++) {
+                lbk_lmap_page pg;
+                lbk_lmap_get_page(&nv, p, &pg);
+                if (pg.irradiance_offset % o->page_alignment || pg.rgba_offset % o->page_alignment)
+                    st = tl_fail(err, TL_CONVERT_UNSUPPORTED,
+                              "page %u planes start at LMAP bytes %llu and %llu, not multiples of page_alignment %u; "
+                              "format 1.0 places planes packed at 16-byte alignment",
+                              p, (unsigned long long)pg.irradiance_offset, (unsigned long long)pg.rgba_offset,
+                              o->page_alignment);
+            }
+            /* hand out malloc'ed memory (lbk_free(NULL) is free, but keep ownership rules simple) */
+            if (st == TL_CONVERT_OK && !(*out = malloc(built_size ? built_size : 1)))
+                st = tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
+            if (st == TL_CONVERT_OK) {
+                memcpy(*out, built, built_size);
+                *out_size = built_size;
+            }
+            lbk_free(NULL, built);
+        }
+    }
+    for (uint32_t p = 0; tex && p < n; p++) free(tex[p]);
+    free(tex);
+    free(descs);
+    return st;
+}
+
+/* ---- DLS renumbering --------------------------------------------------------------------------- */
+
+typedef struct entry_list {
+    uint64_t count, cap;
+    uint32_t *targets;
+    uint8_t *payloads;
+} entry_list;
+
+typedef struct collect_ctx {
+    entry_list *lists; /* set_count × space count */
+    uint32_t space;
+    uint32_t payload_size;
+    const tl_texel_remap *remap;
+    int failed;
+} collect_ctx;
+
+static int collect(void *user, uint32_t target, uint32_t count, const uint32_t *sets, const uint8_t *payloads)
+{
+    collect_ctx *c = user;
+    uint64_t t = target;
+    if (c->space == LBK_DLS_SPACE_TEXEL && tl_texel_remap_apply(c->remap, target, &t) != 0) {
+        c->failed = 1;
+        return 1;
+    }
+    if (t > UINT32_MAX) {
+        c->failed = 1;
+        return 1;
+    }
+    for (uint32_t i = 0; i < count; i++) {
+        entry_list *l = &c->lists[(size_t)sets[i] * LBK_DLS_SPACE_COUNT_ + c->space];
+        if (l->count == l->cap) {
+            uint64_t nc = l->cap ? l->cap * 2 : 64;
+            uint32_t *nt = realloc(l->targets, (size_t)nc * sizeof *nt);
+            if (nt) l->targets = nt;
+            uint8_t *np = realloc(l->payloads, (size_t)nc * c->payload_size);
+            if (np) l->payloads = np;
+            if (!nt || !np) {
+                c->failed = 2;
+                return 1;
+            }
+            l->cap = nc;
+        }
+        l->targets[l->count] = (uint32_t)t;
+        memcpy(l->payloads + (size_t)l->count * c->payload_size, payloads + (size_t)i * c->payload_size, c->payload_size);
+        l->count++;
+    }
+    return 0;
+}
+
+int tl_dls_remap_texels(const void *dls, size_t size, const tl_texel_remap *remap, void **out, size_t *out_size,
+                        char err[TL_ERR_LEN])
+{
+    *out = NULL;
+    *out_size = 0;
+    lbk_dls_view *view = NULL;
+    lbk_result r = lbk_dls_view_open(dls, size, NULL, &view);
+    if (r != LBK_OK) return tl_fail(err, TL_CONVERT_BAD_INPUT, "DLS: %s", lbk_result_message(r));
+    const uint32_t ns = lbk_dls_set_count(view);
+    int st = TL_CONVERT_OK;
+    entry_list *lists = calloc((size_t)ns * LBK_DLS_SPACE_COUNT_ + 1, sizeof *lists);
+    lbk_dls_set_desc *sets = calloc((size_t)ns + 1, sizeof *sets);
+    char **names = calloc((size_t)ns + 1, sizeof *names);
+    char ***lights = calloc((size_t)ns + 1, sizeof *lights);
+    uint32_t **members = calloc((size_t)ns + 1, sizeof *members);
+    if (!lists || !sets || !names || !lights || !members) st = tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
+    for (uint32_t s = 0; s < ns && st == TL_CONVERT_OK; s++) {
+        lbk_dls_set_info si;
+        lbk_dls_set_get(view, s, &si);
+        names[s] = calloc(si.name_length + 1, 1);
+        lights[s] = calloc((size_t)si.light_count + 1, sizeof(char *));
+        members[s] = calloc((size_t)si.member_count + 1, sizeof(uint32_t));
+        if (!names[s] || !lights[s] || !members[s]) {
+            st = tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
+            break;
+        }
+        memcpy(names[s], si.name, si.name_length);
+        for (uint32_t i = 0; i < si.light_count; i++) {
+            const char *ln;
+            uint32_t ll;
+            lbk_dls_set_light(view, s, i, &ln, &ll);
+            lights[s][i] = calloc(ll + 1, 1);
+            if (!lights[s][i]) {
+                st = tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
+                break;
+            }
+            memcpy(lights[s][i], ln, ll);
+        }
+        for (uint32_t i = 0; i < si.member_count; i++) lbk_dls_set_member(view, s, i, &members[s][i]);
+        sets[s].name = names[s];
+        sets[s].kind = si.kind;
+        sets[s].light_count = si.light_count;
+        sets[s].light_names = (const char *const *)lights[s];
+        sets[s].member_count = si.member_count;
+        sets[s].members = members[s];
+    }
+    for (uint32_t c = 0; c < lbk_dls_cluster_count(view) && st == TL_CONVERT_OK; c++) {
+        lbk_dls_cluster_info ci;
+        lbk_dls_cluster_get(view, c, &ci);
+        collect_ctx cc = {lists, ci.space, ci.space == LBK_DLS_SPACE_TEXEL ? LBK_DLS_TEXEL_PAYLOAD : LBK_DLS_PROBE_PAYLOAD,
+                          remap, 0};
+        r = lbk_dls_cluster_decode(view, c, collect, &cc);
+        if (cc.failed == 1) st = tl_fail(err, TL_CONVERT_BAD_INPUT, "DLS cluster %u has a texel target outside LMAP", c);
+        else if (cc.failed) st = tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
+        else if (r != LBK_OK) st = tl_fail(err, TL_CONVERT_BAD_INPUT, "DLS cluster %u: %s", c, lbk_result_message(r));
+    }
+    if (st == TL_CONVERT_OK) {
+        lbk_dls_build_desc bd;
+        memset(&bd, 0, sizeof bd);
+        bd.set_count = ns;
+        bd.sets = sets;
+        for (uint32_t sp = 0; sp < LBK_DLS_SPACE_COUNT_; sp++) bd.target_count[sp] = lbk_dls_target_count(view, sp);
+        bd.target_count[LBK_DLS_SPACE_TEXEL] = remap->new_total;
+        for (uint32_t s = 0; s < ns; s++)
+            for (uint32_t sp = 0; sp < LBK_DLS_SPACE_COUNT_; sp++) {
+                entry_list *l = &lists[(size_t)s * LBK_DLS_SPACE_COUNT_ + sp];
+                sets[s].entries[sp] = (lbk_dls_sparse){l->count, l->targets, l->payloads};
+            }
+        void *built = NULL;
+        size_t built_size = 0;
+        r = lbk_dls_build(&bd, NULL, &built, &built_size, NULL);
+        if (r != LBK_OK) st = tl_fail(err, TL_CONVERT_INTERNAL, "rebuilding DLS: %s", lbk_result_message(r));
+        else if (!(*out = malloc(built_size ? built_size : 1))) st = tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
+        else {
+            memcpy(*out, built, built_size);
+            *out_size = built_size;
+        }
+        lbk_free(NULL, built);
+    }
+    for (uint32_t s = 0; s < ns; s++) {
+        if (lights && lights[s]) {
+            for (uint32_t i = 0; lights[s][i]; i++) free(lights[s][i]);
+            free(lights[s]);
+        }
+        if (names) free(names[s]);
+        if (members) free(members[s]);
+        for (uint32_t sp = 0; lists && sp < LBK_DLS_SPACE_COUNT_; sp++) {
+            free(lists[(size_t)s * LBK_DLS_SPACE_COUNT_ + sp].targets);
+            free(lists[(size_t)s * LBK_DLS_SPACE_COUNT_ + sp].payloads);
+        }
+    }
+    free(lists);
+    free(sets);
+    free(names);
+    free(lights);
+    free(members);
+    lbk_dls_view_close(view);
+    return st;
+}

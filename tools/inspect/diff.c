@@ -1,0 +1,786 @@
+/* lbk diff: matching and comparing decoded lighting (spec/diff-json.md). */
+#include "tools/inspect/diff.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "lbk/pixel.h"
+
+const char *tl_diff_status_name(int s)
+{
+    switch (s) {
+    case TL_DIFF_SAME: return "same";
+    case TL_DIFF_CHANGED: return "changed";
+    case TL_DIFF_ADDED: return "added";
+    case TL_DIFF_REMOVED: return "removed";
+    default: return "absent";
+    }
+}
+
+double tl_err_mean(const tl_err_stats *s) { return s->count ? s->sum_abs / (double)s->count : 0.0; }
+
+double tl_err_rel_rmse(const tl_err_stats *s)
+{
+    if (s->sum_sq_diff == 0.0) return 0.0;
+    if (s->sum_sq_ref == 0.0) return INFINITY;
+    return sqrt(s->sum_sq_diff / s->sum_sq_ref);
+}
+
+/* ---- one sample ---------------------------------------------------------------------------- */
+
+typedef struct tol {
+    double abs_tol, rel_tol;
+} tol;
+
+/* a and b: n normals × 3 channels. Returns 1 when over tolerance. NaN in B counts as over. */
+static int add_sample(tl_err_stats *s, const float *a, const float *b, int n, const tol *t, uint32_t x, uint32_t y,
+                      float *err_out)
+{
+    double err = 0, ref = 0, sqd = 0, sqr = 0;
+    int nan = 0;
+    for (int i = 0; i < 3 * n; i++) {
+        double d = (double)b[i] - (double)a[i];
+        if (isnan(d)) nan = 1;
+        double ad = fabs(d);
+        if (ad > err) err = ad;
+        if (fabs((double)a[i]) > ref) ref = fabs((double)a[i]);
+        sqd += d * d;
+        sqr += (double)a[i] * a[i];
+    }
+    if (nan) err = INFINITY;
+    s->count++;
+    s->sum_abs += err;
+    s->sum_sq_diff += sqd;
+    s->sum_sq_ref += sqr;
+    if (err > s->max_abs || s->count == 1) {
+        s->max_abs = err;
+        s->max_x = x;
+        s->max_y = y;
+    }
+    if (err_out) *err_out = (float)err;
+    if (!(err > t->abs_tol + t->rel_tol * ref)) return 0;
+    s->over++;
+    if (!s->has_region) {
+        s->has_region = 1;
+        s->x0 = s->x1 = x;
+        s->y0 = s->y1 = y;
+    } else {
+        if (x < s->x0) s->x0 = x;
+        if (x > s->x1) s->x1 = x;
+        if (y < s->y0) s->y0 = y;
+        if (y > s->y1) s->y1 = y;
+    }
+    return 1;
+}
+
+/* ---- texel access ------------------------------------------------------------------------- */
+
+static void texel_values(const lbk_lmap_page *pg, uint32_t x, uint32_t y, float out[TL_TEXEL_NORMALS][3])
+{
+    lbk_ahd_texel t;
+    lbk_lmap_page_texel(pg, x, y, &t);
+    tl_texel_eval(&t, pg->scale, out);
+}
+
+/* Bilinear sample of the evaluated values at rect-normalised (u, v) of a rect of page pg. */
+static void texel_bilinear(const lbk_lmap_page *pg, const uint32_t rect[4], double u, double v,
+                           float out[TL_TEXEL_NORMALS][3])
+{
+    double fx = u * rect[2] - 0.5, fy = v * rect[3] - 0.5;
+    if (fx < 0) fx = 0;
+    if (fy < 0) fy = 0;
+    if (fx > rect[2] - 1) fx = rect[2] - 1;
+    if (fy > rect[3] - 1) fy = rect[3] - 1;
+    uint32_t x0 = (uint32_t)fx, y0 = (uint32_t)fy;
+    uint32_t x1 = x0 + 1 < rect[2] ? x0 + 1 : x0, y1 = y0 + 1 < rect[3] ? y0 + 1 : y0;
+    double tx = fx - x0, ty = fy - y0;
+    float c[4][TL_TEXEL_NORMALS][3];
+    texel_values(pg, rect[0] + x0, rect[1] + y0, c[0]);
+    texel_values(pg, rect[0] + x1, rect[1] + y0, c[1]);
+    texel_values(pg, rect[0] + x0, rect[1] + y1, c[2]);
+    texel_values(pg, rect[0] + x1, rect[1] + y1, c[3]);
+    for (int n = 0; n < TL_TEXEL_NORMALS; n++)
+        for (int ch = 0; ch < 3; ch++)
+            out[n][ch] = (float)((c[0][n][ch] * (1 - tx) + c[1][n][ch] * tx) * (1 - ty) +
+                                 (c[2][n][ch] * (1 - tx) + c[3][n][ch] * tx) * ty);
+}
+
+/* ---- sections and META ---------------------------------------------------------------------- */
+
+static int diff_sections(const tl_bake *a, const tl_bake *b, tl_diff_result *r)
+{
+    r->sections = calloc(2 * LBK_MAX_SECTIONS, sizeof *r->sections);
+    if (!r->sections) return -1;
+    uint32_t types[2 * LBK_MAX_SECTIONS];
+    size_t nt = 0;
+    const tl_bake *both[2] = {a, b};
+    for (int side = 0; side < 2; side++)
+        for (uint32_t i = 0; i < lbk_reader_section_count(both[side]->reader); i++) {
+            lbk_section_info si;
+            lbk_reader_section_info(both[side]->reader, i, &si);
+            int seen = 0;
+            for (size_t k = 0; k < nt; k++) seen |= types[k] == si.type;
+            if (!seen) types[nt++] = si.type;
+        }
+    for (size_t k = 0; k < nt; k++) {
+        tl_diff_section *s = &r->sections[r->section_count++];
+        s->type = types[k];
+        const void *da = NULL, *db = NULL;
+        size_t na = 0, nb = 0;
+        int ina = lbk_reader_section_by_type(a->reader, types[k], &da, &na) == LBK_OK;
+        int inb = lbk_reader_section_by_type(b->reader, types[k], &db, &nb) == LBK_OK;
+        s->a_decoded = na;
+        s->b_decoded = nb;
+        s->status = !ina ? TL_DIFF_ADDED : !inb ? TL_DIFF_REMOVED
+                  : (na == nb && memcmp(da, db, na) == 0) ? TL_DIFF_SAME : TL_DIFF_CHANGED;
+        if (s->status != TL_DIFF_SAME) r->sections_changed++;
+    }
+    return 0;
+}
+
+static char *dup_string(lbk_string s)
+{
+    char *p = malloc(s.size + 1);
+    if (p) {
+        memcpy(p, s.data, s.size);
+        p[s.size] = '\0';
+    }
+    return p;
+}
+
+static int diff_params(const tl_bake *a, const tl_bake *b, tl_diff_result *r)
+{
+    size_t na = a->has_meta ? a->meta.entry_count : 0, nb = b->has_meta ? b->meta.entry_count : 0;
+    r->params = calloc(na + nb + 1, sizeof *r->params);
+    if (!r->params) return -1;
+    /* keys are sorted in both (lbk_meta_build sorts; the validator enforces it), so merge */
+    size_t i = 0, j = 0;
+    while (i < na || j < nb) {
+        lbk_string ka = {0}, va = {0}, kb = {0}, vb = {0};
+        if (i < na) lbk_meta_entry(&a->meta, (uint32_t)i, &ka, &va);
+        if (j < nb) lbk_meta_entry(&b->meta, (uint32_t)j, &kb, &vb);
+        int c;
+        if (i >= na) c = 1;
+        else if (j >= nb) c = -1;
+        else {
+            size_t m = ka.size < kb.size ? ka.size : kb.size;
+            c = memcmp(ka.data, kb.data, m);
+            if (!c) c = (ka.size > kb.size) - (ka.size < kb.size);
+        }
+        tl_diff_param p;
+        memset(&p, 0, sizeof p);
+        if (c < 0) {
+            tl_string_copy(p.key, sizeof p.key, ka);
+            p.a = dup_string(va);
+            p.status = TL_DIFF_REMOVED;
+            i++;
+        } else if (c > 0) {
+            tl_string_copy(p.key, sizeof p.key, kb);
+            p.b = dup_string(vb);
+            p.status = TL_DIFF_ADDED;
+            j++;
+        } else {
+            tl_string_copy(p.key, sizeof p.key, ka);
+            if (va.size == vb.size && !memcmp(va.data, vb.data, va.size)) {
+                i++, j++;
+                continue; /* only differences are listed */
+            }
+            p.a = dup_string(va);
+            p.b = dup_string(vb);
+            p.status = TL_DIFF_CHANGED;
+            i++, j++;
+        }
+        r->params[r->param_count++] = p;
+        r->params_changed++;
+    }
+    return 0;
+}
+
+/* ---- objects -------------------------------------------------------------------------------- */
+
+static uint32_t object_count(const tl_bake *b) { return b->has_objs ? b->objs.count : 0; }
+
+static int same_string(lbk_string x, lbk_string y) { return x.size == y.size && !memcmp(x.data, y.data, x.size); }
+
+/* Compares the lighting of a matched object pair. */
+static void compare_object(const tl_bake *a, const tl_bake *b, const lbk_object *oa, const lbk_object *ob,
+                           const tol *t, tl_diff_object *d)
+{
+    if (oa->representation == LBK_REPRESENTATION_LIGHTMAP && ob->representation == LBK_REPRESENTATION_LIGHTMAP &&
+        a->has_lmap && b->has_lmap) {
+        lbk_lmap_page pa, pb;
+        if (lbk_lmap_get_page(&a->lmap, oa->index, &pa) != LBK_OK || lbk_lmap_get_page(&b->lmap, ob->index, &pb) != LBK_OK)
+            return;
+        d->compared = 1;
+        const int same_size = oa->rect_w == ob->rect_w && oa->rect_h == ob->rect_h;
+        d->resampled = !same_size;
+        for (uint32_t y = 0; y < oa->rect_h; y++)
+            for (uint32_t x = 0; x < oa->rect_w; x++) {
+                float va[TL_TEXEL_NORMALS][3], vb[TL_TEXEL_NORMALS][3];
+                texel_values(&pa, oa->rect_x + x, oa->rect_y + y, va);
+                if (same_size) texel_values(&pb, ob->rect_x + x, ob->rect_y + y, vb);
+                else texel_bilinear(&pb, d->rect_b, (x + 0.5) / oa->rect_w, (y + 0.5) / oa->rect_h, vb);
+                add_sample(&d->lighting, &va[0][0], &vb[0][0], TL_TEXEL_NORMALS, t, x, y, NULL);
+            }
+        return;
+    }
+    if (oa->representation == LBK_REPRESENTATION_LLG && ob->representation == LBK_REPRESENTATION_LLG && a->has_llg &&
+        b->has_llg) {
+        lbk_llg_grid ga, gb;
+        if (lbk_llg_get_grid(&a->llg, oa->index, &ga) != LBK_OK || lbk_llg_get_grid(&b->llg, ob->index, &gb) != LBK_OK)
+            return;
+        d->compared = 1;
+        const int same = ga.dims[0] == gb.dims[0] && ga.dims[1] == gb.dims[1] && ga.dims[2] == gb.dims[2];
+        d->resampled = !same;
+        const uint64_t n = (uint64_t)ga.dims[0] * ga.dims[1] * ga.dims[2];
+        for (uint64_t i = 0; i < n; i++) {
+            lbk_sh9_rgb sa, sb;
+            tl_probe_unpack(a->llg.probes + (ga.probe_offset + i) * LBK_SH9_PACKED_SIZE, a->llg.scale, &sa);
+            if (same) {
+                tl_probe_unpack(b->llg.probes + (gb.probe_offset + i) * LBK_SH9_PACKED_SIZE, b->llg.scale, &sb);
+            } else {
+                float pos[3];
+                uint32_t ii = (uint32_t)(i % ga.dims[0]), jj = (uint32_t)(i / ga.dims[0] % ga.dims[1]),
+                         kk = (uint32_t)(i / ((uint64_t)ga.dims[0] * ga.dims[1]));
+                lbk_llg_probe_position(&ga, ii, jj, kk, pos);
+                if (lbk_llg_sample(&b->llg, ob->index, pos, &sb) != LBK_OK) memset(&sb, 0, sizeof sb);
+            }
+            float va[TL_PROBE_NORMALS][3], vb[TL_PROBE_NORMALS][3];
+            tl_probe_eval(&sa, va);
+            tl_probe_eval(&sb, vb);
+            add_sample(&d->lighting, &va[0][0], &vb[0][0], TL_PROBE_NORMALS, t, (uint32_t)i, 0, NULL);
+        }
+    }
+}
+
+static void fill_side(tl_diff_object *d, const lbk_object *o, int side)
+{
+    uint32_t *rect = side ? d->rect_b : d->rect_a;
+    rect[0] = o->rect_x, rect[1] = o->rect_y, rect[2] = o->rect_w, rect[3] = o->rect_h;
+    if (side) d->repr_b = o->representation, d->page_b = o->index, d->hash_b = o->geometry_hash;
+    else d->repr_a = o->representation, d->page_a = o->index, d->hash_a = o->geometry_hash;
+}
+
+static int diff_objects(const tl_bake *a, const tl_bake *b, const tol *t, tl_diff_result *r)
+{
+    const uint32_t na = object_count(a), nb = object_count(b);
+    r->objects = calloc((size_t)na + nb + 1, sizeof *r->objects);
+    int32_t *match_a = malloc(((size_t)na + 1) * sizeof *match_a);
+    uint8_t *used_b = calloc((size_t)nb + 1, 1);
+    if (!r->objects || !match_a || !used_b) {
+        free(match_a);
+        free(used_b);
+        return -1;
+    }
+    lbk_object *oa = calloc((size_t)na + 1, sizeof *oa), *ob = calloc((size_t)nb + 1, sizeof *ob);
+    if (!oa || !ob) {
+        free(oa), free(ob), free(match_a), free(used_b);
+        return -1;
+    }
+    for (uint32_t i = 0; i < na; i++) lbk_objects_get(&a->objs, i, &oa[i]), match_a[i] = -1;
+    for (uint32_t j = 0; j < nb; j++) lbk_objects_get(&b->objs, j, &ob[j]);
+    /* pass 1: same name and geometry; pass 2: same name; pass 3: same geometry (renamed) */
+    for (int pass = 0; pass < 3; pass++)
+        for (uint32_t i = 0; i < na; i++) {
+            if (match_a[i] >= 0) continue;
+            for (uint32_t j = 0; j < nb; j++) {
+                if (used_b[j]) continue;
+                const int name = same_string(oa[i].name, ob[j].name), geo = oa[i].geometry_hash == ob[j].geometry_hash;
+                if ((pass == 0 && name && geo) || (pass == 1 && name) || (pass == 2 && geo)) {
+                    match_a[i] = (int32_t)j;
+                    used_b[j] = 1;
+                    break;
+                }
+            }
+        }
+    for (uint32_t i = 0; i < na; i++) {
+        tl_diff_object *d = &r->objects[r->object_count++];
+        tl_string_copy(d->name, sizeof d->name, oa[i].name);
+        fill_side(d, &oa[i], 0);
+        d->repr_b = LBK_REPRESENTATION_COUNT_;
+        if (match_a[i] < 0) {
+            d->status = TL_DIFF_REMOVED;
+            r->objects_removed++;
+            continue;
+        }
+        const lbk_object *o2 = &ob[match_a[i]];
+        fill_side(d, o2, 1);
+        d->renamed = !same_string(oa[i].name, o2->name);
+        if (d->renamed) tl_string_copy(d->name_b, sizeof d->name_b, o2->name);
+        d->geometry_changed = d->hash_a != d->hash_b;
+        d->representation_changed = d->repr_a != d->repr_b;
+        d->rect_changed = memcmp(d->rect_a, d->rect_b, sizeof d->rect_a) != 0 || d->page_a != d->page_b;
+        compare_object(a, b, &oa[i], o2, t, d);
+        const int lighting_differs = d->lighting.over > 0;
+        d->status = (d->renamed || d->geometry_changed || d->representation_changed || lighting_differs ||
+                     (d->rect_changed && d->resampled))
+                        ? TL_DIFF_CHANGED
+                        : TL_DIFF_SAME;
+        if (d->status == TL_DIFF_CHANGED) r->objects_changed++;
+    }
+    for (uint32_t j = 0; j < nb; j++) {
+        if (used_b[j]) continue;
+        tl_diff_object *d = &r->objects[r->object_count++];
+        tl_string_copy(d->name, sizeof d->name, ob[j].name);
+        fill_side(d, &ob[j], 1);
+        d->repr_a = LBK_REPRESENTATION_COUNT_;
+        d->status = TL_DIFF_ADDED;
+        r->objects_added++;
+    }
+    free(oa), free(ob), free(match_a), free(used_b);
+    return 0;
+}
+
+/* ---- pages ---------------------------------------------------------------------------------- */
+
+static int diff_pages(const tl_bake *a, const tl_bake *b, const tol *t, int keep_maps, tl_diff_result *r)
+{
+    const uint32_t na = a->has_lmap ? a->lmap.page_count : 0, nb = b->has_lmap ? b->lmap.page_count : 0;
+    const uint32_t n = na > nb ? na : nb;
+    r->pages = calloc((size_t)n + 1, sizeof *r->pages);
+    if (!r->pages) return -1;
+    for (uint32_t p = 0; p < n; p++) {
+        tl_diff_page *d = &r->pages[r->page_count++];
+        d->index = p;
+        lbk_lmap_page pa, pb;
+        if (p < na) lbk_lmap_get_page(&a->lmap, p, &pa), d->wa = pa.width, d->ha = pa.height;
+        if (p < nb) lbk_lmap_get_page(&b->lmap, p, &pb), d->wb = pb.width, d->hb = pb.height;
+        if (p >= nb) {
+            d->status = TL_DIFF_REMOVED;
+            r->pages_changed++;
+            continue;
+        }
+        if (p >= na) {
+            d->status = TL_DIFF_ADDED;
+            r->pages_changed++;
+            continue;
+        }
+        d->resized = pa.width != pb.width || pa.height != pb.height;
+        const uint32_t w = pa.width < pb.width ? pa.width : pb.width, h = pa.height < pb.height ? pa.height : pb.height;
+        if (keep_maps) {
+            const size_t cnt = (size_t)pa.width * pa.height;
+            d->error_map = malloc(cnt * sizeof(float));
+            d->over_map = calloc(cnt, 1);
+            if (!d->error_map || !d->over_map) return -1;
+            for (size_t i = 0; i < cnt; i++) d->error_map[i] = NAN;
+        }
+        for (uint32_t y = 0; y < h; y++)
+            for (uint32_t x = 0; x < w; x++) {
+                float va[TL_TEXEL_NORMALS][3], vb[TL_TEXEL_NORMALS][3], e;
+                texel_values(&pa, x, y, va);
+                texel_values(&pb, x, y, vb);
+                int over = add_sample(&d->lighting, &va[0][0], &vb[0][0], TL_TEXEL_NORMALS, t, x, y, &e);
+                if (keep_maps) {
+                    d->error_map[(size_t)y * pa.width + x] = e;
+                    d->over_map[(size_t)y * pa.width + x] = (uint8_t)over;
+                }
+            }
+        r->texels_over += d->lighting.over;
+        /* a page only resized (e.g. widened by convert) with equal texels is the same lighting */
+        d->status = d->lighting.over ? TL_DIFF_CHANGED : TL_DIFF_SAME;
+        if (d->status != TL_DIFF_SAME) r->pages_changed++;
+    }
+    return 0;
+}
+
+/* ---- GLG ------------------------------------------------------------------------------------ */
+
+static int glg_same_layout(const tl_bake *a, const tl_bake *b)
+{
+    if (a->glg.probe_count != b->glg.probe_count) return 0;
+    for (uint32_t i = 0; i < a->glg.probe_count; i++) {
+        float pa[3], pb[3];
+        lbk_sh9_rgb s;
+        lbk_glg_probe(&a->glg, i, pa, &s);
+        lbk_glg_probe(&b->glg, i, pb, &s);
+        if (pa[0] != pb[0] || pa[1] != pb[1] || pa[2] != pb[2]) return 0;
+    }
+    return 1;
+}
+
+static void diff_glg(const tl_bake *a, const tl_bake *b, const tol *t, tl_diff_result *r)
+{
+    tl_diff_probes *d = &r->glg;
+    d->count_a = a->has_glg ? a->glg.probe_count : 0;
+    d->count_b = b->has_glg ? b->glg.probe_count : 0;
+    if (!a->has_glg && !b->has_glg) {
+        d->status = -1;
+        return;
+    }
+    if (!a->has_glg || !b->has_glg) {
+        d->status = a->has_glg ? TL_DIFF_REMOVED : TL_DIFF_ADDED;
+        return;
+    }
+    const int same = glg_same_layout(a, b);
+    d->resampled = !same;
+    uint32_t hint = 0;
+    for (uint32_t i = 0; i < a->glg.probe_count; i++) {
+        float pos[3], pb[3];
+        lbk_sh9_rgb sa, sb;
+        lbk_glg_probe(&a->glg, i, pos, &sa);
+        if (same) lbk_glg_probe(&b->glg, i, pb, &sb);
+        else if (lbk_glg_sample(&b->glg, pos, &hint, &sb, NULL) != LBK_OK) memset(&sb, 0, sizeof sb);
+        float va[TL_PROBE_NORMALS][3], vb[TL_PROBE_NORMALS][3];
+        tl_probe_eval(&sa, va);
+        tl_probe_eval(&sb, vb);
+        add_sample(&d->lighting, &va[0][0], &vb[0][0], TL_PROBE_NORMALS, t, i, 0, NULL);
+    }
+    r->probes_over += d->lighting.over;
+    d->status = (d->lighting.over || !same) ? TL_DIFF_CHANGED : TL_DIFF_SAME;
+}
+
+/* ---- light sets ------------------------------------------------------------------------------ */
+
+typedef struct set_entries {
+    uint32_t space, set, payload;
+    uint64_t count, cap;
+    uint32_t *targets;
+    uint8_t *payloads;
+    int failed;
+} set_entries;
+
+static int gather(void *user, uint32_t target, uint32_t count, const uint32_t *sets, const uint8_t *payloads)
+{
+    set_entries *e = user;
+    for (uint32_t i = 0; i < count; i++) {
+        if (sets[i] != e->set) continue;
+        if (e->count == e->cap) {
+            uint64_t nc = e->cap ? 2 * e->cap : 256;
+            uint32_t *nt = realloc(e->targets, (size_t)nc * sizeof *nt);
+            if (nt) e->targets = nt;
+            uint8_t *np = realloc(e->payloads, (size_t)nc * e->payload);
+            if (np) e->payloads = np;
+            if (!nt || !np) {
+                e->failed = 1;
+                return 1;
+            }
+            e->cap = nc;
+        }
+        e->targets[e->count] = target;
+        memcpy(e->payloads + (size_t)e->count * e->payload, payloads + (size_t)i * e->payload, e->payload);
+        e->count++;
+    }
+    return 0;
+}
+
+static int collect_set(const lbk_dls_view *v, uint32_t set, uint32_t space, set_entries *e)
+{
+    memset(e, 0, sizeof *e);
+    e->space = space;
+    e->set = set;
+    e->payload = space == LBK_DLS_SPACE_TEXEL ? LBK_DLS_TEXEL_PAYLOAD : LBK_DLS_PROBE_PAYLOAD;
+    for (uint32_t c = 0; c < lbk_dls_cluster_count(v); c++) {
+        lbk_dls_cluster_info ci;
+        lbk_dls_cluster_get(v, c, &ci);
+        if (ci.space != space) continue;
+        int member = 0;
+        for (uint32_t i = 0; i < ci.set_count; i++) {
+            uint32_t s;
+            lbk_dls_cluster_set(v, c, i, &s);
+            member |= s == set;
+        }
+        if (member && lbk_dls_cluster_decode(v, c, gather, e) != LBK_OK) return -1;
+        if (e->failed) return -1;
+    }
+    return 0;
+}
+
+typedef struct keyed {
+    uint64_t key;
+    uint64_t index;
+} keyed;
+
+static int cmp_keyed(const void *x, const void *y)
+{
+    const keyed *a = x, *b = y;
+    return (a->key > b->key) - (a->key < b->key);
+}
+
+/* Texel targets become (page, y, x) keys so bakes whose pages differ in size still line up;
+ * probe targets are their index. Sorted, because entry order depends on the clustering. */
+static keyed *sorted_keys(const tl_bake *bk, const set_entries *e)
+{
+    keyed *k = malloc(((size_t)e->count + 1) * sizeof *k);
+    if (!k) return NULL;
+    for (uint64_t i = 0; i < e->count; i++) {
+        uint64_t key = e->targets[i];
+        if (e->space == LBK_DLS_SPACE_TEXEL && bk->has_lmap) {
+            lbk_ahd_texel t;
+            uint32_t page;
+            if (lbk_lmap_texel(&bk->lmap, e->targets[i], &t, &page) == LBK_OK) {
+                lbk_lmap_page pg;
+                lbk_lmap_get_page(&bk->lmap, page, &pg);
+                uint64_t local = e->targets[i] - pg.first_texel;
+                key = ((uint64_t)page << 32) | ((local / pg.width) << 16) | (local % pg.width);
+            }
+        }
+        k[i] = (keyed){key, i};
+    }
+    qsort(k, (size_t)e->count, sizeof *k, cmp_keyed);
+    return k;
+}
+
+/* The scale DLS payloads of a space are stored in: their base section's (spec §12.2). */
+static float space_scale(const tl_bake *b, uint32_t space)
+{
+    if (space == LBK_DLS_SPACE_TEXEL) return b->has_lmap ? b->lmap.scale : 1.0f;
+    if (space == LBK_DLS_SPACE_GLG) return b->has_glg ? b->glg.scale : 1.0f;
+    return b->has_llg ? b->llg.scale : 1.0f;
+}
+
+static void eval_payload(uint32_t space, const uint8_t *p, float scale, float *out)
+{
+    if (space == LBK_DLS_SPACE_TEXEL) {
+        lbk_ahd_texel t;
+        if (p) lbk_ahd_texel_load(p, &t);
+        else memset(&t, 0, sizeof t);
+        tl_texel_eval(&t, scale, (float(*)[3])out);
+    } else {
+        lbk_sh9_rgb s;
+        if (p) tl_probe_unpack(p, scale, &s);
+        else memset(&s, 0, sizeof s);
+        tl_probe_eval(&s, (float(*)[3])out);
+    }
+}
+
+/* Can the targets of a space be lined up? Texels always can (by page and position); probes when
+ * both grids have the same layout. */
+static int space_comparable(const tl_bake *a, const tl_bake *b, uint32_t space)
+{
+    if (space == LBK_DLS_SPACE_TEXEL) return a->has_lmap && b->has_lmap;
+    if (lbk_dls_target_count(a->dls, space) != lbk_dls_target_count(b->dls, space)) return 0;
+    if (space == LBK_DLS_SPACE_GLG) return a->has_glg && b->has_glg && glg_same_layout(a, b);
+    if (!a->has_llg || !b->has_llg || a->llg.grid_count != b->llg.grid_count) return 0;
+    for (uint32_t g = 0; g < a->llg.grid_count; g++) {
+        lbk_llg_grid ga, gb;
+        lbk_llg_get_grid(&a->llg, g, &ga);
+        lbk_llg_get_grid(&b->llg, g, &gb);
+        if (memcmp(ga.dims, gb.dims, sizeof ga.dims)) return 0;
+    }
+    return 1;
+}
+
+static int compare_set_space(const tl_bake *a, uint32_t sa, const tl_bake *b, uint32_t sb, uint32_t space, const tol *t,
+                             tl_err_stats *st)
+{
+    set_entries ea, eb;
+    keyed *ka = NULL, *kb = NULL;
+    int rc = -1;
+    memset(&eb, 0, sizeof eb);
+    if (collect_set(a->dls, sa, space, &ea) || collect_set(b->dls, sb, space, &eb)) goto out;
+    if (!(ka = sorted_keys(a, &ea)) || !(kb = sorted_keys(b, &eb))) goto out;
+    uint64_t i = 0, j = 0;
+    const int n = space == LBK_DLS_SPACE_TEXEL ? TL_TEXEL_NORMALS : TL_PROBE_NORMALS;
+    while (i < ea.count || j < eb.count) {
+        const uint8_t *pa = NULL, *pb = NULL;
+        uint64_t key;
+        if (j >= eb.count || (i < ea.count && ka[i].key < kb[j].key)) {
+            key = ka[i].key;
+            pa = ea.payloads + (size_t)ka[i++].index * ea.payload;
+        } else if (i >= ea.count || kb[j].key < ka[i].key) {
+            key = kb[j].key;
+            pb = eb.payloads + (size_t)kb[j++].index * eb.payload;
+        } else {
+            key = ka[i].key;
+            pa = ea.payloads + (size_t)ka[i++].index * ea.payload;
+            pb = eb.payloads + (size_t)kb[j++].index * eb.payload;
+        }
+        float va[TL_PROBE_NORMALS * 3], vb[TL_PROBE_NORMALS * 3];
+        eval_payload(space, pa, space_scale(a, space), va);
+        eval_payload(space, pb, space_scale(b, space), vb);
+        /* texels: x = position in page, y = row; probes: x = index */
+        uint32_t x = space == LBK_DLS_SPACE_TEXEL ? (uint32_t)(key & 0xFFFF) : (uint32_t)key;
+        uint32_t y = space == LBK_DLS_SPACE_TEXEL ? (uint32_t)((key >> 16) & 0xFFFF) : 0;
+        add_sample(st, va, vb, n, t, x, y, NULL);
+    }
+    rc = 0;
+out:
+    free(ka), free(kb);
+    free(ea.targets), free(ea.payloads), free(eb.targets), free(eb.payloads);
+    return rc;
+}
+
+static void set_name(const lbk_dls_view *v, uint32_t s, char *out, size_t size)
+{
+    lbk_dls_set_info si;
+    lbk_dls_set_get(v, s, &si);
+    tl_string_copy(out, size, (lbk_string){si.name, si.name_length});
+}
+
+static int set_meta_equal(const tl_bake *a, uint32_t sa, const tl_bake *b, uint32_t sb)
+{
+    lbk_dls_set_info ia, ib;
+    lbk_dls_set_get(a->dls, sa, &ia);
+    lbk_dls_set_get(b->dls, sb, &ib);
+    if (ia.kind != ib.kind || ia.light_count != ib.light_count || ia.member_count != ib.member_count) return 0;
+    for (uint32_t i = 0; i < ia.light_count; i++) {
+        const char *na, *nb;
+        uint32_t la, lb;
+        lbk_dls_set_light(a->dls, sa, i, &na, &la);
+        lbk_dls_set_light(b->dls, sb, i, &nb, &lb);
+        if (la != lb || memcmp(na, nb, la)) return 0;
+    }
+    for (uint32_t i = 0; i < ia.member_count; i++) {
+        uint32_t ma, mb;
+        char xa[128], xb[128];
+        lbk_dls_set_member(a->dls, sa, i, &ma);
+        lbk_dls_set_member(b->dls, sb, i, &mb);
+        set_name(a->dls, ma, xa, sizeof xa);
+        set_name(b->dls, mb, xb, sizeof xb);
+        if (strcmp(xa, xb)) return 0;
+    }
+    return 1;
+}
+
+static int diff_sets(const tl_bake *a, const tl_bake *b, const tol *t, tl_diff_result *r)
+{
+    const uint32_t na = a->dls ? lbk_dls_set_count(a->dls) : 0, nb = b->dls ? lbk_dls_set_count(b->dls) : 0;
+    r->sets = calloc((size_t)na + nb + 1, sizeof *r->sets);
+    if (!r->sets) return -1;
+    int comparable[LBK_DLS_SPACE_COUNT_] = {0};
+    if (a->dls && b->dls)
+        for (uint32_t sp = 0; sp < LBK_DLS_SPACE_COUNT_; sp++) comparable[sp] = space_comparable(a, b, sp);
+    for (uint32_t s = 0; s < na; s++) {
+        tl_diff_set *d = &r->sets[r->set_count++];
+        set_name(a->dls, s, d->name, sizeof d->name);
+        uint32_t sb;
+        if (!b->dls || lbk_dls_find_set(b->dls, d->name, &sb) != LBK_OK) {
+            d->status = TL_DIFF_REMOVED;
+            r->sets_changed++;
+            continue;
+        }
+        d->meta_changed = !set_meta_equal(a, s, b, sb);
+        int over = 0;
+        for (uint32_t sp = 0; sp < LBK_DLS_SPACE_COUNT_; sp++) {
+            if (lbk_dls_target_count(a->dls, sp) == 0 && lbk_dls_target_count(b->dls, sp) == 0) continue;
+            if (!comparable[sp]) {
+                d->not_comparable[sp] = 1;
+                continue;
+            }
+            d->compared[sp] = 1;
+            if (compare_set_space(a, s, b, sb, sp, t, &d->lighting[sp])) return -1;
+            over |= d->lighting[sp].over > 0;
+            if (sp == LBK_DLS_SPACE_TEXEL) r->texels_over += d->lighting[sp].over;
+            else r->probes_over += d->lighting[sp].over;
+        }
+        int nc = 0;
+        for (uint32_t sp = 0; sp < LBK_DLS_SPACE_COUNT_; sp++) nc |= d->not_comparable[sp];
+        d->status = (over || d->meta_changed || nc) ? TL_DIFF_CHANGED : TL_DIFF_SAME;
+        if (d->status != TL_DIFF_SAME) r->sets_changed++;
+    }
+    for (uint32_t s = 0; s < nb; s++) {
+        char name[128];
+        set_name(b->dls, s, name, sizeof name);
+        uint32_t x;
+        if (a->dls && lbk_dls_find_set(a->dls, name, &x) == LBK_OK) continue;
+        tl_diff_set *d = &r->sets[r->set_count++];
+        memcpy(d->name, name, sizeof name);
+        d->status = TL_DIFF_ADDED;
+        r->sets_changed++;
+    }
+    return 0;
+}
+
+/* ---- doors ---------------------------------------------------------------------------------- */
+
+static int door_find(const tl_bake *b, const char *name, lbk_door_info *out)
+{
+    if (!b->door) return 0;
+    for (uint32_t i = 0; i < lbk_door_count(b->door); i++) {
+        lbk_door_get(b->door, i, out);
+        if (strlen(name) == out->name_length && !memcmp(name, out->name, out->name_length)) return 1;
+    }
+    return 0;
+}
+
+static int door_equal(const tl_bake *a, const lbk_door_info *da, const tl_bake *b, const lbk_door_info *db)
+{
+    if (memcmp(da->centre, db->centre, sizeof da->centre) || memcmp(da->axes, db->axes, sizeof da->axes) ||
+        memcmp(da->half_extents, db->half_extents, sizeof da->half_extents))
+        return 0;
+    char x[128], y[128];
+    set_name(a->dls, da->open_set, x, sizeof x);
+    set_name(b->dls, db->open_set, y, sizeof y);
+    if (strcmp(x, y)) return 0;
+    if ((da->closed_set == LBK_DLS_NO_SET) != (db->closed_set == LBK_DLS_NO_SET)) return 0;
+    if (da->closed_set != LBK_DLS_NO_SET) {
+        set_name(a->dls, da->closed_set, x, sizeof x);
+        set_name(b->dls, db->closed_set, y, sizeof y);
+        if (strcmp(x, y)) return 0;
+    }
+    return 1;
+}
+
+static int diff_doors(const tl_bake *a, const tl_bake *b, tl_diff_result *r)
+{
+    const uint32_t na = a->door ? lbk_door_count(a->door) : 0, nb = b->door ? lbk_door_count(b->door) : 0;
+    r->doors = calloc((size_t)na + nb + 1, sizeof *r->doors);
+    if (!r->doors) return -1;
+    for (uint32_t i = 0; i < na; i++) {
+        lbk_door_info da, db;
+        lbk_door_get(a->door, i, &da);
+        tl_diff_door *d = &r->doors[r->door_count++];
+        tl_string_copy(d->name, sizeof d->name, (lbk_string){da.name, da.name_length});
+        if (!door_find(b, d->name, &db)) d->status = TL_DIFF_REMOVED;
+        else d->status = door_equal(a, &da, b, &db) ? TL_DIFF_SAME : TL_DIFF_CHANGED;
+        if (d->status != TL_DIFF_SAME) r->doors_changed++;
+    }
+    for (uint32_t i = 0; i < nb; i++) {
+        lbk_door_info db, da;
+        lbk_door_get(b->door, i, &db);
+        char name[128];
+        tl_string_copy(name, sizeof name, (lbk_string){db.name, db.name_length});
+        if (door_find(a, name, &da)) continue;
+        tl_diff_door *d = &r->doors[r->door_count++];
+        memcpy(d->name, name, sizeof name);
+        d->status = TL_DIFF_ADDED;
+        r->doors_changed++;
+    }
+    return 0;
+}
+
+/* ---- driver -------------------------------------------------------------------------------- */
+
+int tl_diff_run(const tl_bake *a, const tl_bake *b, const tl_diff_options *o, tl_diff_result *r, char err[TL_ERR_LEN])
+{
+    memset(r, 0, sizeof *r);
+    r->abs_tol = o->abs_tol;
+    r->rel_tol = o->rel_tol;
+    tol t = {o->abs_tol, o->rel_tol};
+    if (diff_sections(a, b, r) || diff_params(a, b, r) || diff_objects(a, b, &t, r) ||
+        diff_pages(a, b, &t, o->keep_error_maps, r) || diff_sets(a, b, &t, r) || diff_doors(a, b, r)) {
+        snprintf(err, TL_ERR_LEN, "out of memory");
+        tl_diff_free(r);
+        return -1;
+    }
+    diff_glg(a, b, &t, r);
+    for (size_t i = 0; i < r->object_count; i++) {
+        const tl_diff_object *d = &r->objects[i];
+        if (d->repr_a == LBK_REPRESENTATION_LLG && d->compared) r->probes_over += d->lighting.over;
+    }
+    /* the exit decision: lighting and structure; META and REPT are provenance only */
+    int structural_sections = 0;
+    for (size_t i = 0; i < r->section_count; i++) {
+        const tl_diff_section *s = &r->sections[i];
+        if (s->type == LBK_SECTION_META || s->type == LBK_SECTION_REPT) continue;
+        if (s->status == TL_DIFF_ADDED || s->status == TL_DIFF_REMOVED) structural_sections = 1;
+    }
+    r->differ = structural_sections || r->objects_added || r->objects_removed || r->objects_changed ||
+                r->pages_changed || r->sets_changed || r->doors_changed || r->texels_over || r->probes_over ||
+                r->glg.status == TL_DIFF_CHANGED || r->glg.status == TL_DIFF_ADDED || r->glg.status == TL_DIFF_REMOVED;
+    return 0;
+}
+
+void tl_diff_free(tl_diff_result *r)
+{
+    for (size_t i = 0; i < r->param_count; i++) free(r->params[i].a), free(r->params[i].b);
+    for (size_t i = 0; i < r->page_count; i++) free(r->pages[i].error_map), free(r->pages[i].over_map);
+    free(r->sections);
+    free(r->params);
+    free(r->objects);
+    free(r->pages);
+    free(r->sets);
+    free(r->doors);
+    memset(r, 0, sizeof *r);
+}

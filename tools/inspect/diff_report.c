@@ -1,0 +1,318 @@
+/* lbk diff output: JSON (spec/diff-json.md), text, heatmap PNGs. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cjson/cJSON.h>
+
+#include "tools/inspect/diff.h"
+
+static void hex64(uint64_t v, char out[17]) { snprintf(out, 17, "%016llx", (unsigned long long)v); }
+
+static cJSON *num_or_null(double v) { return isfinite(v) ? cJSON_CreateNumber(v) : cJSON_CreateNull(); }
+
+static cJSON *stats_json(const tl_err_stats *s, int texels)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddNumberToObject(o, "count", (double)s->count);
+    cJSON_AddNumberToObject(o, "over_tolerance", (double)s->over);
+    cJSON_AddNumberToObject(o, "over_share", s->count ? (double)s->over / (double)s->count : 0.0);
+    cJSON_AddItemToObject(o, "max_abs", num_or_null(s->max_abs));
+    cJSON_AddItemToObject(o, "mean_abs", num_or_null(tl_err_mean(s)));
+    cJSON_AddItemToObject(o, "rel_rmse", num_or_null(tl_err_rel_rmse(s)));
+    if (texels) {
+        cJSON *at = cJSON_CreateArray();
+        cJSON_AddItemToArray(at, cJSON_CreateNumber(s->max_x));
+        cJSON_AddItemToArray(at, cJSON_CreateNumber(s->max_y));
+        cJSON_AddItemToObject(o, "max_at", s->count ? at : (cJSON_Delete(at), cJSON_CreateNull()));
+        if (s->has_region) {
+            cJSON *r = cJSON_CreateObject();
+            cJSON_AddNumberToObject(r, "x0", s->x0);
+            cJSON_AddNumberToObject(r, "y0", s->y0);
+            cJSON_AddNumberToObject(r, "x1", s->x1);
+            cJSON_AddNumberToObject(r, "y1", s->y1);
+            cJSON_AddItemToObject(o, "over_region", r);
+        } else {
+            cJSON_AddNullToObject(o, "over_region");
+        }
+    } else {
+        if (s->count) cJSON_AddNumberToObject(o, "max_at", s->max_x);
+        else cJSON_AddNullToObject(o, "max_at");
+        if (s->has_region) {
+            cJSON *r = cJSON_CreateObject();
+            cJSON_AddNumberToObject(r, "first", s->x0);
+            cJSON_AddNumberToObject(r, "last", s->x1);
+            cJSON_AddItemToObject(o, "over_region", r);
+        } else {
+            cJSON_AddNullToObject(o, "over_region");
+        }
+    }
+    return o;
+}
+
+static const char *repr_name(uint32_t r) { return r >= LBK_REPRESENTATION_COUNT_ ? NULL : lbk_representation_name(r); }
+
+static cJSON *rect_json(uint32_t page, const uint32_t rect[4])
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddNumberToObject(o, "page", page);
+    cJSON_AddNumberToObject(o, "x", rect[0]);
+    cJSON_AddNumberToObject(o, "y", rect[1]);
+    cJSON_AddNumberToObject(o, "w", rect[2]);
+    cJSON_AddNumberToObject(o, "h", rect[3]);
+    return o;
+}
+
+static cJSON *side_json(uint32_t repr, uint32_t index, const uint32_t rect[4], uint64_t hash)
+{
+    if (repr >= LBK_REPRESENTATION_COUNT_) return cJSON_CreateNull();
+    cJSON *o = cJSON_CreateObject();
+    char h[17];
+    hex64(hash, h);
+    cJSON_AddStringToObject(o, "geometry_hash", h);
+    cJSON_AddStringToObject(o, "representation", repr_name(repr));
+    if (repr == LBK_REPRESENTATION_LIGHTMAP) cJSON_AddItemToObject(o, "rect", rect_json(index, rect));
+    else if (repr == LBK_REPRESENTATION_LLG) cJSON_AddNumberToObject(o, "grid", index);
+    return o;
+}
+
+static const char *space_name(uint32_t sp) { return sp == LBK_DLS_SPACE_TEXEL ? "texels" : sp == LBK_DLS_SPACE_GLG ? "glg" : "llg"; }
+
+char *tl_diff_json(const tl_diff_result *r, const char *path_a, const char *path_b)
+{
+    cJSON *root = cJSON_CreateObject();
+    cJSON_AddStringToObject(root, "schema", "lbk-diff");
+    cJSON_AddNumberToObject(root, "schema_version", TL_DIFF_SCHEMA_VERSION);
+    cJSON_AddStringToObject(root, "a", path_a);
+    cJSON_AddStringToObject(root, "b", path_b);
+    cJSON *tol = cJSON_AddObjectToObject(root, "tolerance");
+    cJSON_AddNumberToObject(tol, "abs", r->abs_tol);
+    cJSON_AddNumberToObject(tol, "rel", r->rel_tol);
+    cJSON_AddBoolToObject(root, "equal", !r->differ);
+
+    cJSON *sum = cJSON_AddObjectToObject(root, "summary");
+    cJSON_AddNumberToObject(sum, "objects_added", r->objects_added);
+    cJSON_AddNumberToObject(sum, "objects_removed", r->objects_removed);
+    cJSON_AddNumberToObject(sum, "objects_changed", r->objects_changed);
+    cJSON_AddNumberToObject(sum, "pages_changed", r->pages_changed);
+    cJSON_AddNumberToObject(sum, "light_sets_changed", r->sets_changed);
+    cJSON_AddNumberToObject(sum, "doors_changed", r->doors_changed);
+    cJSON_AddNumberToObject(sum, "sections_changed", r->sections_changed);
+    cJSON_AddNumberToObject(sum, "params_changed", r->params_changed);
+    cJSON_AddNumberToObject(sum, "texels_over_tolerance", (double)r->texels_over);
+    cJSON_AddNumberToObject(sum, "probes_over_tolerance", (double)r->probes_over);
+
+    cJSON *secs = cJSON_AddArrayToObject(root, "sections");
+    for (size_t i = 0; i < r->section_count; i++) {
+        const tl_diff_section *s = &r->sections[i];
+        cJSON *o = cJSON_CreateObject();
+        char t[5];
+        lbk_fourcc_string(s->type, t);
+        cJSON_AddStringToObject(o, "type", t);
+        cJSON_AddStringToObject(o, "status", tl_diff_status_name(s->status));
+        cJSON_AddNumberToObject(o, "a_decoded_bytes", (double)s->a_decoded);
+        cJSON_AddNumberToObject(o, "b_decoded_bytes", (double)s->b_decoded);
+        cJSON_AddItemToArray(secs, o);
+    }
+    cJSON *params = cJSON_AddArrayToObject(root, "params");
+    for (size_t i = 0; i < r->param_count; i++) {
+        const tl_diff_param *p = &r->params[i];
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "key", p->key);
+        cJSON_AddStringToObject(o, "status", tl_diff_status_name(p->status));
+        if (p->a) cJSON_AddStringToObject(o, "a", p->a);
+        else cJSON_AddNullToObject(o, "a");
+        if (p->b) cJSON_AddStringToObject(o, "b", p->b);
+        else cJSON_AddNullToObject(o, "b");
+        cJSON_AddItemToArray(params, o);
+    }
+    cJSON *objs = cJSON_AddArrayToObject(root, "objects");
+    for (size_t i = 0; i < r->object_count; i++) {
+        const tl_diff_object *d = &r->objects[i];
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "name", d->name);
+        if (d->renamed) cJSON_AddStringToObject(o, "b_name", d->name_b);
+        else cJSON_AddNullToObject(o, "b_name");
+        cJSON_AddStringToObject(o, "status", tl_diff_status_name(d->status));
+        cJSON *flags = cJSON_AddArrayToObject(o, "changes");
+        if (d->renamed) cJSON_AddItemToArray(flags, cJSON_CreateString("renamed"));
+        if (d->geometry_changed) cJSON_AddItemToArray(flags, cJSON_CreateString("geometry"));
+        if (d->representation_changed) cJSON_AddItemToArray(flags, cJSON_CreateString("representation"));
+        if (d->rect_changed) cJSON_AddItemToArray(flags, cJSON_CreateString("placement"));
+        if (d->lighting.over) cJSON_AddItemToArray(flags, cJSON_CreateString("lighting"));
+        cJSON_AddItemToObject(o, "a", side_json(d->repr_a, d->page_a, d->rect_a, d->hash_a));
+        cJSON_AddItemToObject(o, "b", side_json(d->repr_b, d->page_b, d->rect_b, d->hash_b));
+        cJSON_AddBoolToObject(o, "resampled", d->resampled);
+        if (d->compared) cJSON_AddItemToObject(o, "lighting", stats_json(&d->lighting, d->repr_a == LBK_REPRESENTATION_LIGHTMAP));
+        else cJSON_AddNullToObject(o, "lighting");
+        cJSON_AddItemToArray(objs, o);
+    }
+    cJSON *pages = cJSON_AddArrayToObject(root, "pages");
+    for (size_t i = 0; i < r->page_count; i++) {
+        const tl_diff_page *p = &r->pages[i];
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddNumberToObject(o, "index", p->index);
+        cJSON_AddStringToObject(o, "status", tl_diff_status_name(p->status));
+        cJSON *sa = cJSON_CreateArray(), *sb = cJSON_CreateArray();
+        cJSON_AddItemToArray(sa, cJSON_CreateNumber(p->wa));
+        cJSON_AddItemToArray(sa, cJSON_CreateNumber(p->ha));
+        cJSON_AddItemToArray(sb, cJSON_CreateNumber(p->wb));
+        cJSON_AddItemToArray(sb, cJSON_CreateNumber(p->hb));
+        cJSON_AddItemToObject(o, "a_size", sa);
+        cJSON_AddItemToObject(o, "b_size", sb);
+        cJSON_AddBoolToObject(o, "resized", p->resized);
+        if (p->status == TL_DIFF_SAME || p->status == TL_DIFF_CHANGED) cJSON_AddItemToObject(o, "lighting", stats_json(&p->lighting, 1));
+        else cJSON_AddNullToObject(o, "lighting");
+        cJSON_AddItemToArray(pages, o);
+    }
+    cJSON *glg = cJSON_AddObjectToObject(root, "glg");
+    cJSON_AddStringToObject(glg, "status", tl_diff_status_name(r->glg.status));
+    cJSON_AddNumberToObject(glg, "a_probes", r->glg.count_a);
+    cJSON_AddNumberToObject(glg, "b_probes", r->glg.count_b);
+    cJSON_AddBoolToObject(glg, "resampled", r->glg.resampled);
+    if (r->glg.status == TL_DIFF_SAME || r->glg.status == TL_DIFF_CHANGED) cJSON_AddItemToObject(glg, "lighting", stats_json(&r->glg.lighting, 0));
+    else cJSON_AddNullToObject(glg, "lighting");
+    cJSON *sets = cJSON_AddArrayToObject(root, "light_sets");
+    for (size_t i = 0; i < r->set_count; i++) {
+        const tl_diff_set *d = &r->sets[i];
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "name", d->name);
+        cJSON_AddStringToObject(o, "status", tl_diff_status_name(d->status));
+        cJSON_AddBoolToObject(o, "definition_changed", d->meta_changed);
+        for (uint32_t sp = 0; sp < LBK_DLS_SPACE_COUNT_; sp++) {
+            if (d->compared[sp]) cJSON_AddItemToObject(o, space_name(sp), stats_json(&d->lighting[sp], sp == LBK_DLS_SPACE_TEXEL));
+            else if (d->not_comparable[sp]) cJSON_AddStringToObject(o, space_name(sp), "not comparable");
+            else cJSON_AddNullToObject(o, space_name(sp));
+        }
+        cJSON_AddItemToArray(sets, o);
+    }
+    cJSON *doors = cJSON_AddArrayToObject(root, "doors");
+    for (size_t i = 0; i < r->door_count; i++) {
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "name", r->doors[i].name);
+        cJSON_AddStringToObject(o, "status", tl_diff_status_name(r->doors[i].status));
+        cJSON_AddItemToArray(doors, o);
+    }
+    char *text = cJSON_Print(root);
+    cJSON_Delete(root);
+    return text;
+}
+
+static void print_stats(FILE *f, const tl_err_stats *s, int texels)
+{
+    fprintf(f, "max %.6g  mean %.6g  rel-rmse %.6g  over %llu/%llu (%.3g%%)", s->max_abs, tl_err_mean(s),
+            tl_err_rel_rmse(s), (unsigned long long)s->over, (unsigned long long)s->count,
+            s->count ? 100.0 * (double)s->over / (double)s->count : 0.0);
+    if (s->has_region) {
+        if (texels) fprintf(f, "  region x %u..%u y %u..%u", s->x0, s->x1, s->y0, s->y1);
+        else fprintf(f, "  probes %u..%u", s->x0, s->x1);
+    }
+}
+
+void tl_diff_print(FILE *f, const tl_diff_result *r, int verbose)
+{
+    fprintf(f, "%s (abs-tol %g, rel-tol %g)\n", r->differ ? "DIFFERENT" : "EQUAL within tolerance", r->abs_tol, r->rel_tol);
+    fprintf(f, "objects: %u added, %u removed, %u changed; pages changed %u; light sets changed %u; doors changed %u\n",
+            r->objects_added, r->objects_removed, r->objects_changed, r->pages_changed, r->sets_changed, r->doors_changed);
+    fprintf(f, "texels over tolerance %llu, probes over tolerance %llu\n", (unsigned long long)r->texels_over,
+            (unsigned long long)r->probes_over);
+    for (size_t i = 0; i < r->section_count; i++) {
+        const tl_diff_section *s = &r->sections[i];
+        if (s->status == TL_DIFF_SAME && !verbose) continue;
+        char t[5];
+        lbk_fourcc_string(s->type, t);
+        fprintf(f, "section %-4s %-8s %llu -> %llu decoded bytes\n", t, tl_diff_status_name(s->status),
+                (unsigned long long)s->a_decoded, (unsigned long long)s->b_decoded);
+    }
+    for (size_t i = 0; i < r->param_count; i++) {
+        const tl_diff_param *p = &r->params[i];
+        fprintf(f, "param %s %s: %s -> %s\n", p->key, tl_diff_status_name(p->status), p->a ? p->a : "(none)",
+                p->b ? p->b : "(none)");
+    }
+    for (size_t i = 0; i < r->object_count; i++) {
+        const tl_diff_object *d = &r->objects[i];
+        if (d->status == TL_DIFF_SAME && !verbose) continue;
+        fprintf(f, "object %s %s", d->name, tl_diff_status_name(d->status));
+        if (d->renamed) fprintf(f, " (renamed to %s)", d->name_b);
+        if (d->geometry_changed) fprintf(f, " (geometry changed)");
+        if (d->representation_changed) fprintf(f, " (%s -> %s)", repr_name(d->repr_a), repr_name(d->repr_b));
+        if (d->rect_changed) fprintf(f, " (placement changed%s)", d->resampled ? ", resampled" : "");
+        if (d->compared) {
+            fprintf(f, "\n    ");
+            print_stats(f, &d->lighting, d->repr_a == LBK_REPRESENTATION_LIGHTMAP);
+        }
+        fprintf(f, "\n");
+    }
+    for (size_t i = 0; i < r->page_count; i++) {
+        const tl_diff_page *p = &r->pages[i];
+        if (p->status == TL_DIFF_SAME && !verbose) continue;
+        fprintf(f, "page %u %s %ux%u -> %ux%u", p->index, tl_diff_status_name(p->status), p->wa, p->ha, p->wb, p->hb);
+        if (p->status == TL_DIFF_SAME || p->status == TL_DIFF_CHANGED) {
+            fprintf(f, "\n    ");
+            print_stats(f, &p->lighting, 1);
+        }
+        fprintf(f, "\n");
+    }
+    if (r->glg.status >= 0 && (r->glg.status != TL_DIFF_SAME || verbose)) {
+        fprintf(f, "glg %s %u -> %u probes%s", tl_diff_status_name(r->glg.status), r->glg.count_a, r->glg.count_b,
+                r->glg.resampled ? " (resampled at A's probes)" : "");
+        if (r->glg.status == TL_DIFF_SAME || r->glg.status == TL_DIFF_CHANGED) {
+            fprintf(f, "\n    ");
+            print_stats(f, &r->glg.lighting, 0);
+        }
+        fprintf(f, "\n");
+    }
+    for (size_t i = 0; i < r->set_count; i++) {
+        const tl_diff_set *d = &r->sets[i];
+        if (d->status == TL_DIFF_SAME && !verbose) continue;
+        fprintf(f, "light set %s %s%s\n", d->name, tl_diff_status_name(d->status), d->meta_changed ? " (definition changed)" : "");
+        for (uint32_t sp = 0; sp < LBK_DLS_SPACE_COUNT_; sp++) {
+            if (d->not_comparable[sp]) fprintf(f, "    %s: not comparable (layout changed)\n", space_name(sp));
+            if (!d->compared[sp]) continue;
+            fprintf(f, "    %s: ", space_name(sp));
+            print_stats(f, &d->lighting[sp], sp == LBK_DLS_SPACE_TEXEL);
+            fprintf(f, "\n");
+        }
+    }
+    for (size_t i = 0; i < r->door_count; i++)
+        if (r->doors[i].status != TL_DIFF_SAME || verbose)
+            fprintf(f, "door %s %s\n", r->doors[i].name, tl_diff_status_name(r->doors[i].status));
+}
+
+int tl_diff_heatmaps(const tl_diff_result *r, const char *dir, char err[TL_ERR_LEN])
+{
+    if (tl_mkdirs(dir, err)) return -1;
+    for (size_t i = 0; i < r->page_count; i++) {
+        const tl_diff_page *p = &r->pages[i];
+        if (!p->error_map) continue;
+        const size_t n = (size_t)p->wa * p->ha;
+        double max_over = 0;
+        for (size_t k = 0; k < n; k++)
+            if (p->over_map[k] && isfinite(p->error_map[k]) && p->error_map[k] > max_over) max_over = p->error_map[k];
+        uint8_t *rgb = malloc(n * 3);
+        if (!rgb) {
+            snprintf(err, TL_ERR_LEN, "out of memory");
+            return -1;
+        }
+        for (size_t k = 0; k < n; k++) {
+            uint8_t *c = rgb + 3 * k;
+            float e = p->error_map[k];
+            if (isnan(e)) { /* not compared (outside the common region of a resized page) */
+                c[0] = c[1] = c[2] = 64;
+            } else if (!p->over_map[k]) {
+                c[0] = c[1] = c[2] = 0;
+            } else if (!isfinite(e) || max_over <= 0) {
+                tl_heat_color(1.0f, c);
+            } else {
+                tl_heat_color((float)(0.15 + 0.85 * e / max_over), c);
+            }
+        }
+        char path[4096];
+        snprintf(path, sizeof path, "%s/page_%03u.diff.png", dir, p->index);
+        int rc = tl_png_write_rgb8(path, (int)p->wa, (int)p->ha, rgb, err);
+        free(rgb);
+        if (rc) return -1;
+    }
+    return 0;
+}
