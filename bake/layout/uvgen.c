@@ -736,6 +736,9 @@ static lbk_result try_authored(gen_ctx *g, double density, int cap, bk_uv_object
     if (r != LBK_OK) return r;
     o->density = (float)(sc * sqrt(auv / aw));
     o->source = BK_UV_AUTHORED;
+    o->uv1_scale = sc;
+    o->uv1_min[0] = mnu, o->uv1_min[1] = mnv;
+    o->uv1_max[0] = mxu, o->uv1_max[1] = mxv;
     *used = 1;
     return LBK_OK;
 }

@@ -14,6 +14,7 @@
 #include <cjson/cJSON.h>
 
 #include "bake/layout/atlas.h"
+#include "bake/pipeline/uv_section.h"
 #include "bake/sets/bake_sets.h"
 #include "bake/layout/classify.h"
 #include "bake/pipeline/encode.h"
@@ -776,6 +777,12 @@ static int do_encode_and_write(bake *b, bk_bake_summary *sum)
     lbk_result r = build_meta(b, &sl);
     if (!r && b->sample_count) r = build_report(b, &sl);
     if (!r) r = build_objects(b, &sl);
+    if (!r) { /* lightmap coordinates for engines (spec §16) */
+        void *uv = NULL;
+        size_t uv_size = 0;
+        r = bk_uv_section_build(&b->scene, &b->atlas, b->classes, &uv, &uv_size);
+        if (!r && uv) r = sections_add(&sl, LBK_SECTION_LMUV, r, uv, uv_size);
+    }
     if (!r && b->texels.page_count && b->texel_receivers) r = build_lmap(b, &sl);
     if (!r && b->have_glg) r = build_glg(b, &sl);
     if (!r && b->llg_count) r = build_llg(b, &sl);

@@ -23,7 +23,10 @@ extern "C" {
 #endif
 
 #define LBK_VERSION_MAJOR 1 /* container format major version written by this library */
-#define LBK_VERSION_MINOR 0 /* container format minor version written by this library */
+/* The newest container minor version this library reads and writes. A writer stamps each file
+ * with the lowest minor version that defines every known section in it (spec §1.3): 1 when it
+ * holds LMUV, else 0, so a file without 1.1 content keeps the bytes a 1.0 writer gave it. */
+#define LBK_VERSION_MINOR 1
 #define LBK_LIBRARY_VERSION_STRING "1.0.0"
 
 typedef enum lbk_result {
@@ -71,6 +74,7 @@ typedef struct lbk_allocator {
 #define LBK_SECTION_DLS  LBK_FOURCC('D', 'L', 'S', ' ') /* dynamic light sets + clusters */
 #define LBK_SECTION_DOOR LBK_FOURCC('D', 'O', 'O', 'R') /* interactive elements */
 #define LBK_SECTION_OCTP LBK_FOURCC('O', 'C', 'T', 'P') /* octahedral probes (GIBS style) */
+#define LBK_SECTION_LMUV LBK_FOURCC('L', 'M', 'U', 'V') /* lightmap coordinates per object (1.1) */
 
 /* Writes the 4 characters of a type code plus a NUL into out[5]; non-printable bytes become '?'. */
 LBK_API void lbk_fourcc_string(uint32_t type, char out[5]);
