@@ -30,6 +30,9 @@ typedef struct ex {
     uint32_t *page_w, *page_h;
     int *lm_material;    /* per (source material, page): glTF material, or -1 */
     int *plain_material; /* per source material */
+    int *llg_material;   /* per source material: the vertex-colour preview of LLG objects */
+    float *texels;       /* 3 per texel of every page: physical irradiance along the normal */
+    float exposure;      /* of every preview: the p99 rule of tools/convert/README.md "Previews" */
     int any_unlit;
     char dir[4096], stem[200];
     tl_gltf_stats *st;
@@ -42,12 +45,13 @@ typedef struct prim_data {
     uint32_t *sv;       /* per vertex: the scene vertex it copies */
     float *uv1;         /* 2 per vertex: TEXCOORD_1; NULL when not lightmapped */
     float *vis, *bent;  /* LLG per-vertex data; NULL when absent */
+    float *col;         /* LLG: 3 per vertex, the preview of V·E(bent normal) × exposure, clamped */
     uint32_t *idx;      /* world winding (the scene's) */
 } prim_data;
 
 static void prim_free(prim_data *p)
 {
-    free(p->sv), free(p->uv1), free(p->vis), free(p->bent), free(p->idx);
+    free(p->sv), free(p->uv1), free(p->vis), free(p->bent), free(p->col), free(p->idx);
     memset(p, 0, sizeof *p);
 }
 
@@ -184,43 +188,53 @@ static int gather_generated(ex *e, const bk_primitive *p, const lbk_lmuv_primiti
     return 0;
 }
 
-/* LLG data per exported vertex: visibility and the bent normal in world space. The grid's
- * vertices are the object's used scene vertices in ascending order (bake/probes/llg_place.h). */
+/* The LLG vertex index of every scene vertex of an object: the grid's vertices are the object's
+ * used scene vertices in ascending order (bake/probes/llg_place.h). rank: vertex_count entries,
+ * UINT32_MAX where unused. Returns the number of used vertices. */
+static uint32_t llg_ranks(const bk_scene *s, size_t object, uint32_t *rank)
+{
+    const bk_object *o = &s->objects[object];
+    for (size_t v = 0; v < s->vertex_count; v++) rank[v] = UINT32_MAX;
+    for (size_t k = 0; k < 3 * (size_t)o->tri_count; k++) rank[s->tris[3 * (size_t)o->first_tri + k]] = 0;
+    uint32_t n = 0;
+    for (size_t v = 0; v < s->vertex_count; v++)
+        if (rank[v] != UINT32_MAX) rank[v] = n++;
+    return n;
+}
+
+/* LLG data per exported vertex: visibility, the bent normal in world space and the preview colour. */
 static int gather_llg(ex *e, size_t object, uint32_t grid, prim_data *d)
 {
     const bk_scene *s = e->s;
-    const bk_object *o = &s->objects[object];
     lbk_llg_grid g;
     if (!e->b->has_llg || lbk_llg_get_grid(&e->b->llg, grid, &g) != LBK_OK) return 0;
-    uint8_t *used = calloc(s->vertex_count ? s->vertex_count : 1, 1);
+    uint32_t *rank = malloc((s->vertex_count ? s->vertex_count : 1) * sizeof *rank);
     d->vis = malloc((d->nv ? d->nv : 1) * sizeof *d->vis);
     d->bent = malloc((d->nv ? d->nv : 1) * 3 * sizeof *d->bent);
-    if (!used || !d->vis || !d->bent) {
-        free(used);
+    d->col = malloc((d->nv ? d->nv : 1) * 3 * sizeof *d->col);
+    if (!rank || !d->vis || !d->bent || !d->col) {
+        free(rank);
         return tl_fail(e->err, TL_GLTF_INTERNAL, "out of memory");
     }
-    for (size_t k = 0; k < 3 * (size_t)o->tri_count; k++) used[s->tris[3 * (size_t)o->first_tri + k]] = 1;
-    uint32_t *rank = malloc((s->vertex_count ? s->vertex_count : 1) * sizeof *rank);
-    if (!rank) {
-        free(used);
-        return tl_fail(e->err, TL_GLTF_INTERNAL, "out of memory");
-    }
-    uint32_t n = 0;
-    for (size_t v = 0; v < s->vertex_count; v++) rank[v] = used[v] ? n++ : UINT32_MAX;
-    const int match = n == g.vertex_count;
+    const int match = llg_ranks(s, object, rank) == g.vertex_count;
     for (size_t v = 0; v < d->nv; v++) {
         const uint32_t sv = d->sv[v];
-        const float *nrm = &s->normals[3 * (size_t)sv];
         lbk_llg_vertex lv = {1.0f, {0, 0, 1}};
+        float rgb[3] = {0, 0, 0};
         const int have = match && rank[sv] != UINT32_MAX;
-        if (have) lbk_llg_vertex_decode(e->b->llg.vertices + 4 * (g.vertex_offset + rank[sv]), &lv);
+        if (have) {
+            lbk_llg_vertex_decode(e->b->llg.vertices + 4 * (g.vertex_offset + rank[sv]), &lv);
+            lbk_llg_vertex_irradiance(&e->b->llg, grid, rank[sv], &s->positions[3 * (size_t)sv], rgb);
+        }
         d->vis[v] = lv.visibility;
-        for (int c = 0; c < 3; c++)
+        for (int c = 0; c < 3; c++) {
             d->bent[3 * v + (size_t)c] = have ? lv.bent_normal[0] * g.axes[0][c] + lv.bent_normal[1] * g.axes[1][c] +
                                                     lv.bent_normal[2] * g.axes[2][c]
-                                              : nrm[c];
+                                              : s->normals[3 * (size_t)sv + (size_t)c];
+            const float x = rgb[c] * e->exposure;
+            d->col[3 * v + (size_t)c] = x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f;
+        }
     }
-    free(used);
     free(rank);
     return 0;
 }
@@ -237,16 +251,22 @@ static cJSON *material_extras(const bk_material *m, int page)
     return x;
 }
 
-/* Lightmapped: unlit, base colour = albedo × the page preview (TEXCOORD_1), so viewers show
- * the bake; engines take the lightmap from the primitive's extras. Others: plain PBR factors. */
+#define MATERIAL_PLAIN (-1)
+#define MATERIAL_LLG (-2)
+
+/* Lightmapped: unlit, base colour = albedo × the page preview (TEXCOORD_1); LLG objects: unlit,
+ * albedo × COLOR_0 (their probe lighting per vertex, same exposure): so viewers show the bake.
+ * Engines take the lighting from the extras. Others (not lit by the bake): plain PBR factors. */
 static int material_for(ex *e, uint32_t mi, int page)
 {
-    int *slot = page >= 0 ? &e->lm_material[(size_t)mi * e->pages + (uint32_t)page] : &e->plain_material[mi];
+    int *slot = page >= 0 ? &e->lm_material[(size_t)mi * e->pages + (uint32_t)page]
+                          : page == MATERIAL_LLG ? &e->llg_material[mi] : &e->plain_material[mi];
     if (*slot >= 0) return *slot;
     const bk_material *m = &e->s->materials[mi];
     cJSON *mat = cJSON_CreateObject(), *pbr = cJSON_AddObjectToObject(mat, "pbrMetallicRoughness");
     char name[96];
-    snprintf(name, sizeof name, page >= 0 ? "%s@lightmap%u" : "%s", m->name, (unsigned)page);
+    if (page >= 0) snprintf(name, sizeof name, "%s@lightmap%u", m->name, (unsigned)page);
+    else snprintf(name, sizeof name, page == MATERIAL_LLG ? "%s@llg" : "%s", m->name);
     cJSON_AddStringToObject(mat, "name", name);
     const float base[4] = {clamp01(m->albedo[0]), clamp01(m->albedo[1]), clamp01(m->albedo[2]), 1.0f};
     cJSON_AddItemToObject(pbr, "baseColorFactor", cJSON_CreateFloatArray(base, 4));
@@ -256,6 +276,8 @@ static int material_for(ex *e, uint32_t mi, int page)
         cJSON *tex = cJSON_AddObjectToObject(pbr, "baseColorTexture");
         cJSON_AddNumberToObject(tex, "index", page);
         cJSON_AddNumberToObject(tex, "texCoord", 1);
+    }
+    if (page != MATERIAL_PLAIN) {
         cJSON_AddObjectToObject(cJSON_AddObjectToObject(mat, "extensions"), "KHR_materials_unlit");
         e->any_unlit = 1;
     } else {
@@ -290,6 +312,7 @@ static cJSON *emit_primitive(ex *e, const prim_data *d, int material)
     /* always: TEXCOORD sets must start at 0 (glTF 2.0 §3.7.2.1) */
     cJSON_AddNumberToObject(at, "TEXCOORD_0", tl_glb_accessor_f32(&e->g, uv0, d->nv, 2, TL_GLTF_ARRAY_BUFFER, 0));
     if (d->uv1) cJSON_AddNumberToObject(at, "TEXCOORD_1", tl_glb_accessor_f32(&e->g, d->uv1, d->nv, 2, TL_GLTF_ARRAY_BUFFER, 0));
+    if (d->col) cJSON_AddNumberToObject(at, "COLOR_0", tl_glb_accessor_f32(&e->g, d->col, d->nv, 3, TL_GLTF_ARRAY_BUFFER, 0));
     if (d->vis) {
         cJSON_AddNumberToObject(at, "_LBK_LLG_VISIBILITY", tl_glb_accessor_f32(&e->g, d->vis, d->nv, 1, TL_GLTF_ARRAY_BUFFER, 0));
         cJSON_AddNumberToObject(at, "_LBK_LLG_BENT_NORMAL", tl_glb_accessor_f32(&e->g, d->bent, d->nv, 3, TL_GLTF_ARRAY_BUFFER, 0));
@@ -367,7 +390,8 @@ static int emit_object_primitive(ex *e, size_t i, const lbk_object *ob, const lb
         return rc;
     }
     const uint32_t mi = d.ni ? s->tri_material[p->first_tri] : 0; /* the primitive's material */
-    cJSON *gp = emit_primitive(e, &d, material_for(e, mi, lm ? (int)ob->index : -1));
+    const int kind = lm ? (int)ob->index : d.col ? MATERIAL_LLG : MATERIAL_PLAIN;
+    cJSON *gp = emit_primitive(e, &d, material_for(e, mi, kind));
     prim_free(&d);
     if (!gp) return tl_fail(e->err, TL_GLTF_INTERNAL, "out of memory");
     if (lm) {
@@ -445,13 +469,12 @@ static int emit_object(ex *e, size_t i)
 
 /* ---- pages, probes, root ----------------------------------------------------------------------- */
 
-static int write_pages(ex *e)
+/* Every page's irradiance along the normal, physical (stored × scale: exact, a power of two). */
+static int decode_texels(ex *e)
 {
-    static const char *const RGB[3] = {"R", "G", "B"};
-    static const char *const AHD[7] = {"plane0.R", "plane0.G", "plane0.B", "plane1.R", "plane1.G", "plane1.B", "plane1.A"};
     const lbk_lmap_view *lm = &e->b->lmap;
-    float *all = malloc(((size_t)lm->texel_count + 1) * 3 * sizeof *all);
-    if (!all) return tl_fail(e->err, TL_GLTF_INTERNAL, "out of memory");
+    e->texels = malloc(((size_t)(e->pages ? lm->texel_count : 0) + 1) * 3 * sizeof *e->texels);
+    if (!e->texels) return tl_fail(e->err, TL_GLTF_INTERNAL, "out of memory");
     size_t k = 0;
     for (uint32_t p = 0; p < e->pages; p++) {
         lbk_lmap_page pg;
@@ -459,35 +482,77 @@ static int write_pages(ex *e)
         for (uint32_t t = 0; t < pg.width * pg.height; t++, k++) {
             lbk_unpack_r11g11b10f((uint32_t)pg.irradiance[4 * t] | (uint32_t)pg.irradiance[4 * t + 1] << 8 |
                                       (uint32_t)pg.irradiance[4 * t + 2] << 16 | (uint32_t)pg.irradiance[4 * t + 3] << 24,
-                                  all + 3 * k);
-            for (int c = 0; c < 3; c++) all[3 * k + (size_t)c] *= lm->scale; /* physical: exact (power of two) */
+                                  e->texels + 3 * k);
+            for (int c = 0; c < 3; c++) e->texels[3 * k + (size_t)c] *= lm->scale;
         }
     }
-    e->st->exposure = tl_exposure_p99(all, k, 3);
+    return 0;
+}
+
+/* The preview exposure: p99 over every texel (tools/convert/README.md "Previews"); a bake without
+ * lightmaps uses its LLG vertices' irradiance instead. */
+static int compute_exposure(ex *e)
+{
+    if (e->pages) {
+        e->exposure = tl_exposure_p99(e->texels, (size_t)e->b->lmap.texel_count, 3);
+        return 0;
+    }
+    e->exposure = 1.0f;
+    if (!e->b->has_llg || e->b->llg.vertex_count == 0) return 0;
+    const bk_scene *s = e->s;
+    float *rgb = malloc((size_t)e->b->llg.vertex_count * 3 * sizeof *rgb);
+    uint32_t *rank = malloc((s->vertex_count ? s->vertex_count : 1) * sizeof *rank);
+    if (!rgb || !rank) {
+        free(rgb), free(rank);
+        return tl_fail(e->err, TL_GLTF_INTERNAL, "out of memory");
+    }
+    size_t n = 0;
+    for (size_t i = 0; i < s->object_count; i++) {
+        lbk_object ob;
+        lbk_objects_get(&e->b->objs, (uint32_t)i, &ob);
+        lbk_llg_grid g;
+        if (ob.representation != LBK_REPRESENTATION_LLG || lbk_llg_get_grid(&e->b->llg, ob.index, &g) != LBK_OK ||
+            llg_ranks(s, i, rank) != g.vertex_count)
+            continue;
+        for (size_t v = 0; v < s->vertex_count && n < e->b->llg.vertex_count; v++)
+            if (rank[v] != UINT32_MAX &&
+                lbk_llg_vertex_irradiance(&e->b->llg, ob.index, rank[v], &s->positions[3 * v], rgb + 3 * n) == LBK_OK)
+                n++;
+    }
+    e->exposure = tl_exposure_p99(rgb, n, 3);
+    free(rgb), free(rank);
+    return 0;
+}
+
+static int write_pages(ex *e)
+{
+    static const char *const RGB[3] = {"R", "G", "B"};
+    static const char *const AHD[7] = {"plane0.R", "plane0.G", "plane0.B", "plane1.R", "plane1.G", "plane1.B", "plane1.A"};
     int rc = 0;
     size_t first = 0;
     for (uint32_t p = 0; p < e->pages && !rc; p++) {
         lbk_lmap_page pg;
-        lbk_lmap_get_page(lm, p, &pg);
+        lbk_lmap_get_page(&e->b->lmap, p, &pg);
         const size_t n = (size_t)pg.width * pg.height;
+        const float *ez = e->texels + 3 * first;
         float *ahd = malloc(n * 7 * sizeof *ahd);
         uint8_t *png = malloc(n * 3);
         char path[4400];
         if (!ahd || !png) rc = tl_fail(e->err, TL_GLTF_INTERNAL, "out of memory");
         for (size_t t = 0; !rc && t < n; t++) {
-            memcpy(ahd + 7 * t, all + 3 * (first + t), 3 * sizeof(float));
+            memcpy(ahd + 7 * t, ez + 3 * t, 3 * sizeof(float));
             for (int c = 0; c < 4; c++) ahd[7 * t + 3 + (size_t)c] = pg.rgba[4 * t + (size_t)c] / 255.0f;
         }
         if (!rc) {
             snprintf(path, sizeof path, "%s/%s.lightmap_%03u.exr", e->dir, e->stem, p);
-            rc = tl_exr_write(path, (int)pg.width, (int)pg.height, 3, RGB, all + 3 * first, e->err) ? TL_GLTF_IO : 0;
+            rc = tl_exr_write(path, (int)pg.width, (int)pg.height, 3, RGB, ez, e->err) ? TL_GLTF_IO : 0;
         }
         if (!rc) {
             snprintf(path, sizeof path, "%s/%s.lightmap_%03u.ahd.exr", e->dir, e->stem, p);
             rc = tl_exr_write(path, (int)pg.width, (int)pg.height, 7, AHD, ahd, e->err) ? TL_GLTF_IO : 0;
         }
         if (!rc) {
-            tl_tonemap(all + 3 * first, n, 3, e->st->exposure, png);
+            tl_tonemap(ez, n, 3, e->exposure, png);
             snprintf(path, sizeof path, "%s/%s.lightmap_%03u.png", e->dir, e->stem, p);
             rc = tl_png_write_rgb8(path, (int)pg.width, (int)pg.height, png, e->err) ? TL_GLTF_IO : 0;
         }
@@ -495,7 +560,6 @@ static int write_pages(ex *e)
         free(ahd), free(png);
         first += n;
     }
-    free(all);
     return rc;
 }
 
@@ -579,7 +643,7 @@ static void add_root_extras(ex *e, const char *container)
         cJSON_AddNumberToObject(pg, "preview_texture", p);
         cJSON_AddItemToArray(pages, pg);
     }
-    cJSON_AddNumberToObject(l, "preview_exposure", e->st->exposure);
+    cJSON_AddNumberToObject(l, "preview_exposure", e->exposure);
     cJSON_AddStringToObject(l, "sh9_layout",
                             "27 floats per probe: R0..R8, G0..G8, B0..B8, real SH basis of lbk/sh.h (spec 5.5)");
     if (e->b->has_glg) add_glg(e, l);
@@ -614,10 +678,12 @@ static int run(ex *e, const tl_gltf_options *o)
     e->page_h = calloc(e->pages + 1, sizeof *e->page_h);
     e->lm_material = malloc(((size_t)e->s->material_count * e->pages + 1) * sizeof *e->lm_material);
     e->plain_material = malloc((e->s->material_count + 1) * sizeof *e->plain_material);
-    if (!e->page_w || !e->page_h || !e->lm_material || !e->plain_material || tl_glb_init(&e->g, "lbk export " LBK_LIBRARY_VERSION_STRING))
+    e->llg_material = malloc((e->s->material_count + 1) * sizeof *e->llg_material);
+    if (!e->page_w || !e->page_h || !e->lm_material || !e->plain_material || !e->llg_material ||
+        tl_glb_init(&e->g, "lbk export " LBK_LIBRARY_VERSION_STRING))
         return tl_fail(e->err, TL_GLTF_INTERNAL, "out of memory");
     for (size_t i = 0; i < (size_t)e->s->material_count * e->pages; i++) e->lm_material[i] = -1;
-    for (size_t i = 0; i < e->s->material_count; i++) e->plain_material[i] = -1;
+    for (size_t i = 0; i < e->s->material_count; i++) e->plain_material[i] = e->llg_material[i] = -1;
     for (uint32_t p = 0; p < e->pages; p++) {
         lbk_lmap_page pg;
         lbk_lmap_get_page(&e->b->lmap, p, &pg);
@@ -625,6 +691,8 @@ static int run(ex *e, const tl_gltf_options *o)
         e->page_h[p] = pg.height;
     }
     e->st->pages = e->pages;
+    if ((rc = decode_texels(e)) || (rc = compute_exposure(e))) return rc;
+    e->st->exposure = e->exposure;
     e->nodes = cJSON_AddArrayToObject(e->g.root, "nodes");
     e->meshes = cJSON_AddArrayToObject(e->g.root, "meshes");
     e->materials = cJSON_AddArrayToObject(e->g.root, "materials");
@@ -663,7 +731,7 @@ int tl_gltf_export(const tl_bake *b, const tl_gltf_options *o, tl_gltf_stats *st
     split_output(o->output, e.dir, sizeof e.dir, e.stem, sizeof e.stem);
     int rc = scene.primitives ? run(&e, o) : tl_fail(err, TL_GLTF_INTERNAL, "the scene import gave no primitive table");
     tl_glb_free(&e.g);
-    free(e.page_w), free(e.page_h), free(e.lm_material), free(e.plain_material);
+    free(e.page_w), free(e.page_h), free(e.lm_material), free(e.plain_material), free(e.llg_material), free(e.texels);
     bk_scene_free(&scene);
     return rc;
 }
