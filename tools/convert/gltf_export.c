@@ -353,6 +353,9 @@ static cJSON *node_extras(uint32_t i, const lbk_object *ob, const lbk_lmuv_objec
     cJSON_AddNumberToObject(l, "object", i);
     cJSON_AddStringToObject(l, "representation", lbk_representation_name(ob->representation));
     cJSON_AddNumberToObject(l, "source_node", so->node);
+    /* what the baker read from the source node, so the export bakes the same way */
+    if (so->light_set[0]) cJSON_AddStringToObject(x, "lbk_light_set", so->light_set);
+    if (so->door[0]) cJSON_AddStringToObject(x, "lbk_door", so->door);
     if (ob->representation == LBK_REPRESENTATION_LIGHTMAP) {
         const int rect[4] = {(int)ob->rect_x, (int)ob->rect_y, (int)ob->rect_w, (int)ob->rect_h};
         cJSON_AddNumberToObject(l, "page", ob->index);
@@ -669,6 +672,61 @@ static void split_output(const char *out, char *dir, size_t dn, char *stem, size
     stem[k] = '\0';
 }
 
+/* The quaternion [x, y, z, w] turning −Z (a glTF light's direction) onto unit d. */
+static void rotation_to(const float d[3], float q[4])
+{
+    const double c = -d[2]; /* cos of the angle between −Z and d */
+    if (c < -0.999999) {    /* d = +Z: half a turn about X */
+        q[0] = 1, q[1] = q[2] = q[3] = 0;
+        return;
+    }
+    double v[4] = {d[1], -d[0], 0, 1 + c}; /* (−Z × d, 1 + cos) */
+    const double n = sqrt(v[0] * v[0] + v[1] * v[1] + v[3] * v[3]);
+    for (int k = 0; k < 4; k++) q[k] = (float)(v[k] / n);
+}
+
+/* The scene's punctual lights (KHR_lights_punctual, candela / lux as the source had them) and
+ * its uniform sky (scene extras lbk_sky), so the export is a level that bakes again. */
+static void add_lights(ex *e, cJSON *scene_nodes)
+{
+    const bk_scene *s = e->s;
+    if (!s->light_count) return;
+    cJSON *lights = cJSON_AddArrayToObject(cJSON_AddObjectToObject(cJSON_AddObjectToObject(e->g.root, "extensions"),
+                                                                   "KHR_lights_punctual"), "lights");
+    static const char *const types[3] = {"point", "spot", "directional"};
+    for (size_t i = 0; i < s->light_count; i++) {
+        const bk_light *l = &s->lights[i];
+        const float k = fmaxf(l->color[0], fmaxf(l->color[1], l->color[2]));
+        const float col[3] = {k > 0 ? l->color[0] / k : 1, k > 0 ? l->color[1] / k : 1, k > 0 ? l->color[2] / k : 1};
+        cJSON *li = cJSON_CreateObject();
+        cJSON_AddStringToObject(li, "name", l->name);
+        cJSON_AddStringToObject(li, "type", types[l->type >= 0 && l->type <= 2 ? l->type : 0]);
+        cJSON_AddItemToObject(li, "color", cJSON_CreateFloatArray(col, 3));
+        cJSON_AddNumberToObject(li, "intensity", k);
+        if (l->range > 0 && l->type != BK_LIGHT_DIRECTIONAL) cJSON_AddNumberToObject(li, "range", l->range);
+        if (l->type == BK_LIGHT_SPOT) {
+            cJSON *sp = cJSON_AddObjectToObject(li, "spot");
+            /* the extension wants inner < outer; an equal pair becomes a hair softer */
+            cJSON_AddNumberToObject(sp, "innerConeAngle", l->inner_cone < l->outer_cone ? l->inner_cone : 0.999f * l->outer_cone);
+            cJSON_AddNumberToObject(sp, "outerConeAngle", l->outer_cone);
+        }
+        cJSON_AddItemToArray(lights, li);
+        cJSON *n = cJSON_CreateObject();
+        cJSON_AddStringToObject(n, "name", l->name);
+        if (l->type != BK_LIGHT_DIRECTIONAL) cJSON_AddItemToObject(n, "translation", cJSON_CreateFloatArray(l->position, 3));
+        if (l->type != BK_LIGHT_POINT) {
+            float q[4];
+            rotation_to(l->direction, q);
+            cJSON_AddItemToObject(n, "rotation", cJSON_CreateFloatArray(q, 4));
+        }
+        cJSON_AddNumberToObject(cJSON_AddObjectToObject(cJSON_AddObjectToObject(n, "extensions"), "KHR_lights_punctual"),
+                                "light", (double)i);
+        if (l->light_set[0]) cJSON_AddStringToObject(cJSON_AddObjectToObject(n, "extras"), "lbk_light_set", l->light_set);
+        cJSON_AddItemToArray(e->nodes, n);
+        cJSON_AddItemToArray(scene_nodes, cJSON_CreateNumber(cJSON_GetArraySize(e->nodes) - 1));
+    }
+}
+
 static int run(ex *e, const tl_gltf_options *o)
 {
     int rc = check_objects(e);
@@ -701,12 +759,19 @@ static int run(ex *e, const tl_gltf_options *o)
     if (e->pages && (rc = write_pages(e))) return rc;
     if (e->pages) add_textures(e);
     add_root_extras(e, o->container);
-    if (e->any_unlit) cJSON_AddItemToArray(cJSON_AddArrayToObject(e->g.root, "extensionsUsed"), cJSON_CreateString("KHR_materials_unlit"));
     cJSON_AddNumberToObject(e->g.root, "scene", 0);
     cJSON *scenes = cJSON_AddArrayToObject(e->g.root, "scenes"), *sc = cJSON_CreateObject(), *nodes = cJSON_AddArrayToObject(sc, "nodes");
     cJSON_AddStringToObject(sc, "name", "lbk level");
     for (uint32_t i = 0; i < e->st->nodes; i++) cJSON_AddItemToArray(nodes, cJSON_CreateNumber(i));
+    add_lights(e, nodes);
+    if (e->s->sky_image < 0 && (e->s->sky[0] > 0 || e->s->sky[1] > 0 || e->s->sky[2] > 0))
+        cJSON_AddItemToObject(cJSON_AddObjectToObject(sc, "extras"), "lbk_sky", cJSON_CreateFloatArray(e->s->sky, 3));
     cJSON_AddItemToArray(scenes, sc);
+    if (e->any_unlit || e->s->light_count) {
+        cJSON *used = cJSON_AddArrayToObject(e->g.root, "extensionsUsed");
+        if (e->any_unlit) cJSON_AddItemToArray(used, cJSON_CreateString("KHR_materials_unlit"));
+        if (e->s->light_count) cJSON_AddItemToArray(used, cJSON_CreateString("KHR_lights_punctual"));
+    }
     return tl_glb_write(&e->g, o->output, e->err) ? (e->g.failed ? TL_GLTF_INTERNAL : TL_GLTF_IO) : 0;
 }
 
