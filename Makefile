@@ -40,7 +40,7 @@ TOOL_OBJ  := $(filter-out $(BUILD)/rel/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUIL
 LIB_ASAN  := $(LIB_SRC:%.c=$(BUILD)/asan/%.o)
 TOOL_ASAN := $(filter-out $(BUILD)/asan/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUILD)/asan/%.o)) $(TOOL_CXXSRC:%.cc=$(BUILD)/asan/%.o)
 
-.PHONY: all lib deps demo test check bench fuzz install install-check clean help
+.PHONY: all lib deps demo test check bench fuzz install install-check clean help gltf-validator
 all: $(BUILD)/lbk $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc
 
 help:
@@ -128,9 +128,29 @@ install-check: all
 	    $$(PKG_CONFIG_PATH=$(INST)/lib/pkgconfig pkg-config --cflags lbk) $(INST)/lib/liblbk.a \
 	    $$(PKG_CONFIG_PATH=$(INST)/lib/pkgconfig pkg-config --static --libs-only-other --libs-only-l lbk | sed 's/-llbk//') -lcmocka
 
+# The Khronos glTF-Validator (npm package, runs under node) for the `lbk export --gltf` check of
+# tests/tools/gltf_validator.sh, installed into the build folder at a pinned version. Without npm
+# (and not root to install it) the check is reported SKIPPED.
+GLTF_VALIDATOR_VERSION := 2.0.0-dev.3.10
+GLTF_VALIDATOR := $(BUILD)/npm/node_modules/gltf-validator
+$(GLTF_VALIDATOR)/package.json:
+	@mkdir -p $(BUILD)/npm
+	npm install --prefix $(BUILD)/npm --no-audit --no-fund --loglevel=error gltf-validator@$(GLTF_VALIDATOR_VERSION)
+gltf-validator:
+	@if ! command -v npm >/dev/null 2>&1 && [ "$$(id -u)" = 0 ]; then \
+	  echo "lbk: installing npm (for the glTF-Validator check)"; \
+	  (apt-get update -qq || true) && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq npm >/dev/null || true; \
+	fi
+	@if command -v npm >/dev/null 2>&1 && command -v node >/dev/null 2>&1; then \
+	  $(MAKE) --no-print-directory $(GLTF_VALIDATOR)/package.json; \
+	else echo "lbk: npm/node not found: the glTF-Validator check will be SKIPPED (apt-get install npm)"; fi
+
 test: deps
 	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BUILD)/lbk-asan $(TESTS:%=$(BUILD)/tests/%) $(BUILD)/fuzz_container install-check
-	@LBK=$(BUILD)/lbk-asan BUILD=$(BUILD) FUZZ=$(BUILD)/fuzz_container sh tests/run.sh $(TESTS) install_check_shared install_check_static
+	@$(MAKE) --no-print-directory gltf-validator
+	@LBK=$(BUILD)/lbk-asan BUILD=$(BUILD) FUZZ=$(BUILD)/fuzz_container \
+	  GLTF_VALIDATOR=$$(test -f $(GLTF_VALIDATOR)/package.json && echo $(GLTF_VALIDATOR)) \
+	  sh tests/run.sh $(TESTS) install_check_shared install_check_static
 check: test
 
 # ---- fuzzing (clang libFuzzer) --------------------------------------------------------------
@@ -150,6 +170,7 @@ $(BUILD)/bench/%: bench/%.c $(TOOL_OBJ) $(BUILD)/liblbk.a
 bench: deps
 	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BENCHES:%=$(BUILD)/bench/%)
 	@for b in $(BENCHES); do echo "== $$b"; $(BUILD)/bench/$$b || exit 1; done
+	@echo "== blender_import"; sh bench/blender_import.sh $(BUILD)/lbk $(BUILD)/bench-blender
 
 # ---- demo -----------------------------------------------------------------------------------
 demo: deps

@@ -11,6 +11,7 @@
 #include <xxhash.h>
 
 #include "lbk/container.h"
+#include "lbk/lightmap_uv.h"
 #include "lbk/meta.h"
 #include "lbk/objects.h"
 #include "lbk/report.h"
@@ -61,11 +62,38 @@ static void read_views(uint32_t type, const void *d, size_t n)
     }
 }
 
+/* LMUV: whatever lbk_lmuv_open accepts, every element it promises is readable and in range. */
+static void read_lmuv(const void *d, size_t n)
+{
+    lbk_lmuv_view v;
+    if (lbk_lmuv_open(d, n, &v) != LBK_OK) return;
+    for (uint32_t r = 0; r < v.record_count && r < 4096; r++) {
+        lbk_lmuv_object o;
+        uint32_t back;
+        if (lbk_lmuv_get_object(&v, r, &o) != LBK_OK) abort();
+        lbk_lmuv_find_object(&v, o.object, &back);
+    }
+    for (uint32_t p = 0; p < v.primitive_count && p < 4096; p++) {
+        lbk_lmuv_primitive q;
+        if (lbk_lmuv_get_primitive(&v, p, &q) != LBK_OK) abort();
+        for (uint32_t i = 0; i < q.index_count && i < 65536; i++) {
+            uint32_t x;
+            if (lbk_lmuv_index(&v, &q, i, &x) != LBK_OK || x >= q.vertex_count) abort();
+        }
+        for (uint32_t k = 0; k < q.vertex_count && k < 65536; k++) {
+            uint32_t src;
+            float xy[2];
+            if (lbk_lmuv_vertex(&v, &q, k, &src, xy) != LBK_OK || src >= q.source_vertex_count) abort();
+        }
+    }
+}
+
 static int known_type(uint32_t t)
 {
     static const uint32_t known[] = {LBK_SECTION_META, LBK_SECTION_REPT, LBK_SECTION_OBJS,
                                      LBK_SECTION_LMAP, LBK_SECTION_GLG,  LBK_SECTION_LLG,
-                                     LBK_SECTION_DLS,  LBK_SECTION_DOOR, LBK_SECTION_OCTP};
+                                     LBK_SECTION_DLS,  LBK_SECTION_DOOR, LBK_SECTION_OCTP,
+                                     LBK_SECTION_LMUV};
     for (size_t i = 0; i < sizeof known / sizeof known[0]; i++)
         if (known[i] == t) return 1;
     return 0;
@@ -97,6 +125,7 @@ static void exercise(const uint8_t *data, size_t size)
         if (lbk_reader_section_data(r, i, &d, &n) == LBK_OK) {
             if (n != si.decoded_size) abort();
             read_views(si.type, d, n);
+            if (si.type == LBK_SECTION_LMUV) read_lmuv(d, n);
         } else if (valid && known_type(si.type)) {
             abort();
         }

@@ -1,7 +1,7 @@
 /* Writes the seed corpus of fuzz_container into tests/fuzz/corpus (run once by hand; the files
  * are committed). Besides copies of the golden files it writes containers with an object table
  * that references a real LMAP and LLG, raw and zstd, so the fuzzer starts from inputs that reach
- * the cross-section checks:
+ * the cross-section checks (lmuv_raw.lbk: also a 1.1 LMUV section, authored and generated):
  *   cc -std=c11 -Ilibformat/include tests/fuzz/make_corpus.c build/liblbk.a -lzstd -lxxhash -lm \
  *      -o /tmp/make_corpus && /tmp/make_corpus */
 #include <stdio.h>
@@ -9,6 +9,7 @@
 
 #include "lbk/container.h"
 #include "lbk/lightmap.h"
+#include "lbk/lightmap_uv.h"
 #include "lbk/llg.h"
 #include "lbk/meta.h"
 #include "lbk/objects.h"
@@ -62,5 +63,28 @@ int main(void)
         lbk_free(NULL, bytes);
         lbk_writer_destroy(w);
     }
+    /* floor (object 0, rect 0,0 8x4): generated, two primitives; wall (object 1, rect 0,0 4x2
+     * on page 1): authored */
+    const uint32_t remap[4] = {0, 1, 2, 3}, idx[6] = {0, 1, 2, 0, 2, 3}, idx1[3] = {0, 1, 2};
+    const float xy[8] = {0.5f, 0.5f, 7.5f, 0.5f, 7.5f, 3.5f, 0.5f, 3.5f};
+    const lbk_lmuv_primitive_desc prims[2] = {{0, 4, 4, 6, remap, idx, xy}, {1, 3, 3, 3, remap, idx1, xy}};
+    lbk_lmuv_object_desc uv[2];
+    memset(uv, 0, sizeof uv);
+    uv[0].object = 0, uv[0].kind = LBK_LMUV_GENERATED, uv[0].source_node = 0, uv[0].primitive_count = 2;
+    uv[0].primitives = prims;
+    uv[1].object = 1, uv[1].kind = LBK_LMUV_AUTHORED, uv[1].source_node = 1;
+    uv[1].scale[0] = 3, uv[1].scale[1] = 1, uv[1].offset[0] = uv[1].offset[1] = 0.5f;
+    uv[1].uv_max[0] = uv[1].uv_max[1] = 1;
+    void *lmuv, *bytes;
+    size_t lmuvn, n;
+    lbk_writer *w;
+    lbk_section_options o = {LBK_SECTION_FLAG_REQUIRED, 0, 0};
+    if (lbk_lmuv_build(uv, 2, NULL, &lmuv, &lmuvn) || lbk_writer_create(NULL, &w) ||
+        lbk_writer_add_section(w, LBK_SECTION_OBJS, ob, obn, &o) || lbk_writer_add_section(w, LBK_SECTION_LMAP, lm, lmn, &o) ||
+        lbk_writer_add_section(w, LBK_SECTION_LLG, llg, llgn, &o) || lbk_writer_add_section(w, LBK_SECTION_LMUV, lmuv, lmuvn, NULL) ||
+        lbk_writer_to_memory(w, &bytes, &n) || write_file("tests/fuzz/corpus/lmuv_raw.lbk", bytes, n))
+        return 1;
+    lbk_free(NULL, bytes);
+    lbk_writer_destroy(w);
     return 0;
 }
