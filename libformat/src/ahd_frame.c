@@ -1,6 +1,7 @@
 /* The tangent frame an AHD direction is stored in (spec/container.md §5.6 "Tangent frame"). In
- * double, step for step as the baker computes it (bake/layout/texels.c), so the two agree bit
- * for bit on the frame a texel was encoded in (tests/bake/test_uv_section.c checks it). */
+ * double, step for step as the baker computes it (bake/layout/texels.c): equal bit for bit to
+ * bk_tangent_frame, and within 3e-8 of the baker's receivers when rebuilt from LMUV coordinates
+ * (tests/bake/test_uv_section.c checks both). */
 #include "lbk/ahd.h"
 
 #include <math.h>
