@@ -20,11 +20,11 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "bake/pipeline/bake.h"
+#include "lbk/bake.h"
+#include "support/bake_file.h"
 #include "bake/sets/door_sampling.h"
 #include "bake/scene/import.h"
 #include "bake/transport/tracer.h"
-#include "cli/cli.h"
 #include "lbk/ahd.h"
 #include "lbk/container.h"
 #include "lbk/dls.h"
@@ -61,20 +61,18 @@ static int bake_scene(const char *name, const ds_options *o, uint64_t seed, int 
     snprintf(gltf, sizeof gltf, "%s/%s.gltf", tmpdir, name);
     snprintf(out_path, 256, "%s/%s.lbk", tmpdir, name);
     assert_int_equal(ds_write_room_scene(DS_ROOM_GLB, gltf, o, err, err_len), 0);
-    bk_bake_options bo;
+    tb_job bo;
     memset(&bo, 0, sizeof bo);
-    bo.input = gltf;
-    bo.output = out_path;
-    bo.threads = 2;
-    bo.seed = seed;
-    bo.target_error = 1e-6; /* never reached: the full budget */
-    bo.max_samples = SAMPLES;
-    bo.glg_spacing = 2.5f;
-    bo.door_method = method;
-    bk_progress pr;
-    bk_progress_init(&pr, 1);
-    bk_bake_summary sum;
-    int rc = bk_bake(&bo, &pr, &sum, err, err_len);
+    bo.in = gltf;
+    bo.out = out_path;
+    bo.d.threads = 2;
+    bo.d.seed = seed;
+    bo.d.target_error = 1e-6; /* never reached: the full budget */
+    bo.d.max_samples = SAMPLES;
+    bo.d.glg_spacing = 2.5f;
+    bo.d.door_method = method;
+    lbk_bake_report sum;
+    lbk_result rc = tb_bake(&bo, &sum, err, err_len);
     unlink(gltf);
     return rc;
 }
@@ -445,7 +443,7 @@ static void test_combination_unknown_name(void **state)
     char err[512], path[256];
     int rc = bake_scene("badcombo", &o, 1, 0, err, sizeof err, path);
     print_message("%s\n", err);
-    assert_int_equal(rc, LBK_EXIT_INPUT);
+    assert_int_equal(rc, LBK_ERR_BAD_INPUT);
     assert_non_null(strstr(err, "'outer'"));
     unlink(path);
 }

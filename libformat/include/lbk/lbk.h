@@ -42,6 +42,9 @@ typedef enum lbk_result {
     LBK_ERR_LIMIT,              /* a size exceeds a cap (caller's or the file's) */
     LBK_ERR_RANGE,              /* a value is outside what the encoding can hold */
     LBK_ERR_OVERLAPS,           /* more dynamic-set overlaps than the DLS forms allow */
+    LBK_ERR_CANCELLED,          /* the caller's progress callback asked to stop (liblbkbake) */
+    LBK_ERR_BAD_INPUT,          /* an input scene is unusable: bad glTF, no light, nothing to bake */
+    LBK_ERR_INTERNAL,           /* a failure of the library itself or of a dependency (a bug) */
     LBK_RESULT_COUNT_
 } lbk_result;
 
