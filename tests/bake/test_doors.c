@@ -21,7 +21,7 @@
 #include <unistd.h>
 
 #include "lbk/bake.h"
-#include "support/bake_file.h"
+#include "tests/support/bake_file.h"
 #include "bake/sets/door_sampling.h"
 #include "bake/scene/import.h"
 #include "bake/transport/tracer.h"

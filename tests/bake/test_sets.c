@@ -23,7 +23,7 @@
 #include <unistd.h>
 
 #include "lbk/bake.h"
-#include "support/bake_file.h"
+#include "tests/support/bake_file.h"
 #include "lbk/ahd.h"
 #include "lbk/container.h"
 #include "lbk/dls.h"

@@ -17,7 +17,7 @@
 #include <cjson/cJSON.h>
 
 #include "lbk/bake.h"
-#include "support/bake_file.h"
+#include "tests/support/bake_file.h"
 #include "cli/cli.h"
 #include "lbk/container.h"
 #include "lbk/lightmap.h"

@@ -33,7 +33,7 @@
 #include <unistd.h>
 
 #include "lbk/bake.h"
-#include "support/bake_file.h"
+#include "tests/support/bake_file.h"
 #include "lbk/container.h"
 #include "lbk/glg.h"
 #include "lbk/lightmap.h"

@@ -1,5 +1,5 @@
 /* See bake_file.h. */
-#include "support/bake_file.h"
+#include "tests/support/bake_file.h"
 
 #include <stdio.h>
 #include <string.h>
