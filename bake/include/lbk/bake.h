@@ -19,8 +19,9 @@
  *   LBK_ERR_OUT_OF_MEMORY, LBK_ERR_INTERNAL
  *                             the bake failed on its own (exit code 5).
  * Every failure except LBK_ERR_CANCELLED sends one LBK_BAKE_SEVERITY_ERROR message that says
- * why (naming the file, node, object or extras key at fault). The library never writes a file
- * unless asked (lbk_bake_output_write_file, lbk_bake_report_write_json).
+ * why (naming the file, node, object or extras key at fault) — unless the desc itself cannot be
+ * read (NULL `out`, a size below sizeof(size_t)). The library never writes a file unless asked
+ * (lbk_bake_output_write_file, lbk_bake_report_write_json).
  *
  * Determinism: the same input, desc and seed give byte-identical containers for any thread
  * count (every random number is a counter-based hash of the seed and the work item, every
