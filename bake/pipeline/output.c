@@ -23,7 +23,7 @@ void bk_output_free_mem(const lbk_bake_output *out, void *p)
 void lbk_bake_output_free(lbk_bake_output *out)
 {
     if (!out) return;
-    lbk_writer_destroy(out->writer);
+    lbk_writer_close(out->writer);
     bk_output_free_mem(out, out->passes);
     bk_output_free_mem(out, out->input);
     lbk_allocator a = out->allocator;

@@ -93,7 +93,7 @@ static lbk_result build_lmap(bk_pipeline *b, section_list *sl)
     }
     void *data;
     size_t size;
-    r = lbk_lmap_build(desc, (uint32_t)tx->page_count, scale, NULL, &data, &size);
+    r = lbk_lmap_build(&(lbk_lmap_build_desc){.pages = desc, .page_count = (uint32_t)tx->page_count, .scale = scale}, NULL, &data, &size);
     r = sections_add(sl, LBK_SECTION_LMAP, r, data, size);
 done:
     if (pages)
@@ -112,7 +112,7 @@ static lbk_result build_glg(bk_pipeline *b, section_list *sl)
     }
     bk_glg_visibility_unorm8(&b->glg, vis);
     for (size_t i = 0; i < b->glg.probe_count; i++) bk_pipeline_to_world(b, &b->glg.positions[3 * i], world[i]);
-    lbk_glg_desc d;
+    lbk_glg_build_desc d;
     memset(&d, 0, sizeof d);
     d.probe_count = (uint32_t)b->glg.probe_count;
     d.tetra_count = (uint32_t)b->glg.tet_count;
@@ -155,7 +155,7 @@ static lbk_result build_octp(bk_pipeline *b, section_list *sl)
             for (int c = 0; c < 3; c++)
                 if (p[i].irradiance[t][c] > m && isfinite(p[i].irradiance[t][c])) m = p[i].irradiance[t][c];
     b->octp_scale = bk_scale_for(m);
-    lbk_result r = lbk_octp_build(p, (uint32_t)b->glg.probe_count, b->octp_scale, NULL, &data, &size);
+    lbk_result r = lbk_octp_build(&(lbk_octp_build_desc){.probes = p, .probe_count = (uint32_t)b->glg.probe_count, .scale = b->octp_scale}, NULL, &data, &size);
     free(p);
     return sections_add(sl, LBK_SECTION_OCTP, r, data, size);
 }
@@ -171,7 +171,7 @@ static lbk_result build_llg(bk_pipeline *b, section_list *sl)
         const bk_llg *l = &b->llgs[i];
         bk_pipeline_to_world(b, l->centre, g[i].centre);
         memcpy(g[i].axes, l->axes, sizeof g[i].axes);
-        memcpy(g[i].half_extent, l->half_extents, sizeof g[i].half_extent);
+        memcpy(g[i].half_extents, l->half_extents, sizeof g[i].half_extents);
         memcpy(g[i].dims, l->dims, sizeof g[i].dims);
         g[i].probes = &b->radiance[probe];
         probe += bk_llg_probe_count(l);
@@ -186,7 +186,7 @@ static lbk_result build_llg(bk_pipeline *b, section_list *sl)
     double set_max[3];
     bk_set_bakes_max(&b->sets, set_max);
     b->scale[2] = bk_scale_for(fmax(bk_probe_max(&b->radiance[b->llg_first], b->receiver_count - b->llg_first), set_max[2]));
-    r = lbk_llg_build(g, (uint32_t)b->llg_count, b->scale[2], NULL, &data, &size);
+    r = lbk_llg_build(&(lbk_llg_build_desc){.grids = g, .grid_count = (uint32_t)b->llg_count, .scale = b->scale[2]}, NULL, &data, &size);
     r = sections_add(sl, LBK_SECTION_LLG, r, data, size);
 done:
     if (verts)
@@ -390,7 +390,7 @@ lbk_result bk_pipeline_encode(bk_pipeline *b)
     lbk_write_options wo;
     memset(&wo, 0, sizeof wo);
     wo.allocator = &b->out->allocator;
-    if (!r) r = lbk_writer_create(&wo, &b->out->writer);
+    if (!r) r = lbk_writer_open(&wo, &b->out->writer);
     for (int i = 0; !r && i < sl.count; i++) {
         lbk_section_options so;
         memset(&so, 0, sizeof so);
@@ -398,7 +398,7 @@ lbk_result bk_pipeline_encode(bk_pipeline *b)
          * convert` makes compressed packs. The small CPU-side tables are required to read them. */
         if (sl.type[i] == LBK_SECTION_OBJS || sl.type[i] == LBK_SECTION_DLS || sl.type[i] == LBK_SECTION_DOOR)
             so.flags = LBK_SECTION_FLAG_REQUIRED;
-        r = lbk_writer_add_section(b->out->writer, sl.type[i], sl.data[i], sl.size[i], &so);
+        r = lbk_writer_section_add(b->out->writer, sl.type[i], sl.data[i], sl.size[i], &so);
     }
     sections_free(&sl);
     /* the size as baked, for the report: serialising is a copy, cheap next to the bake */

@@ -1041,7 +1041,7 @@ static lbk_result encode_payloads(const bs_impl *im, const bk_set_inputs *in, ui
                     lbk_ahd_linear_add_scaled(&l, (const lbk_ahd_linear *)st->values[s] + i, inv);
                     lbk_ahd_texel t;
                     lbk_ahd_from_linear(&l, &t);
-                    lbk_ahd_texel_store(&t, e + stride * i);
+                    lbk_ahd_texel_pack(&t, e + stride * i);
                 } else {
                     lbk_sh9_rgb sh;
                     memset(&sh, 0, sizeof sh);

@@ -328,7 +328,7 @@ static void test_normals_and_one_object(void **state)
     size_t n;
     assert_int_equal(lbk_reader_section_by_type(rd, LBK_SECTION_OBJS, &objs, &n), LBK_OK);
     lbk_objects_view v;
-    assert_int_equal(lbk_objects_parse(objs, n, &v), LBK_OK);
+    assert_int_equal(lbk_objects_open(objs, n, &v), LBK_OK);
     assert_int_equal(v.count, 1);
     lbk_object o;
     assert_int_equal(lbk_objects_get(&v, 0, &o), LBK_OK);

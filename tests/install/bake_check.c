@@ -430,8 +430,8 @@ static void test_same_bytes_as_lbk_bake(void **state)
     int compared = 0;
     for (uint32_t i = 0; i < n; i++) {
         lbk_section_info si, sm;
-        assert_int_equal(lbk_reader_section_info(cli, i, &si), LBK_OK);
-        assert_int_equal(lbk_reader_section_info(mem, i, &sm), LBK_OK);
+        assert_int_equal(lbk_reader_section_get(cli, i, &si), LBK_OK);
+        assert_int_equal(lbk_reader_section_get(mem, i, &sm), LBK_OK);
         assert_int_equal(si.type, sm.type);
         const void *pc, *pm;
         size_t sc, sz;

@@ -35,8 +35,7 @@ typedef struct lbk_lmap_page_desc {
  * stored units: the caller encodes physical irradiance / scale. scale: 0 means 1, otherwise a
  * positive normal power of two (LBK_ERR_INVALID_ARGUMENT if not). The buffer is allocated with
  * `allocator` (NULL: malloc); free it with lbk_free. */
-LBK_API lbk_result lbk_lmap_build(const lbk_lmap_page_desc *pages, uint32_t page_count, float scale,
-                                  const lbk_allocator *allocator, void **out, size_t *size);
+LBK_API lbk_result lbk_lmap_build(&(lbk_lmap_build_desc){.pages = const lbk_lmap_page_desc *pages, .page_count = uint32_t page_count, .scale = float scale}, const lbk_allocator *allocator, void **out, size_t *size);
 
 /* A read-only view into section bytes (nothing is copied). lbk_lmap_open checks the structure
  * (header, page table, plane layout, size); it does not scan texels — lbk_validate does. */
@@ -58,11 +57,11 @@ typedef struct lbk_lmap_page {
 } lbk_lmap_page;
 
 LBK_API lbk_result lbk_lmap_open(const void *data, size_t size, lbk_lmap_view *out);
-LBK_API lbk_result lbk_lmap_get_page(const lbk_lmap_view *view, uint32_t index, lbk_lmap_page *out);
+LBK_API lbk_result lbk_lmap_page_get(const lbk_lmap_view *view, uint32_t index, lbk_lmap_page *out);
 /* One texel of a page, encoded in stored units; x < width, y < height (LBK_ERR_RANGE otherwise). */
-LBK_API lbk_result lbk_lmap_page_texel(const lbk_lmap_page *page, uint32_t x, uint32_t y, lbk_ahd_texel *out);
+LBK_API lbk_result lbk_lmap_page_texel_get(const lbk_lmap_page *page, uint32_t x, uint32_t y, lbk_ahd_texel *out);
 /* A texel by its global index; also returns its page (optional). */
-LBK_API lbk_result lbk_lmap_texel(const lbk_lmap_view *view, uint64_t texel_index, lbk_ahd_texel *out,
+LBK_API lbk_result lbk_lmap_texel_get(const lbk_lmap_view *view, uint64_t texel_index, lbk_ahd_texel *out,
                                   uint32_t *page_out);
 /* Physical irradiance of texel (x, y) for the tangent-space unit normal n (lbk_ahd_irradiance
  * of the stored texel × the section's scale). */
