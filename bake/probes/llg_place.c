@@ -4,6 +4,7 @@
 
 #include "bake/probes/probe_math.h"
 #include "bake/transport/tracer.h"
+#include "bake/util/parallel.h"
 
 #include <float.h>
 #include <math.h>
@@ -127,9 +128,8 @@ typedef struct vis_ctx {
     float *vis, *bent;
 } vis_ctx;
 
-static void vertex_visibility(void *vctx, size_t v)
+static void vertex_visibility(const vis_ctx *c, size_t v)
 {
-    const vis_ctx *c = vctx;
     const float *n = c->nrm + 3 * v, *p = c->pos + 3 * v;
     /* orthonormal basis (Duff et al. 2017) */
     float sign = n[2] >= 0.0f ? 1.0f : -1.0f;
@@ -163,6 +163,11 @@ static void vertex_visibility(void *vctx, size_t v)
     c->vis[v] = (float)open / (float)c->rays;
     double l = sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
     for (int k = 0; k < 3; k++) c->bent[3 * v + k] = l > 0.0 ? (float)(sum[k] / l) : n[k];
+}
+
+static void vertex_visibility_chunk(void *vctx, size_t begin, size_t end, int thread)
+{
+    for (size_t v = begin; v < end; v++) vertex_visibility(vctx, v);
 }
 
 static int cmp_u32(const void *pa, const void *pb)
@@ -277,7 +282,7 @@ lbk_result bk_llg_place(const bk_scene *scene, uint32_t object, const bk_llg_opt
     int rays = o.visibility_rays > 0 ? o.visibility_rays : 64;
     if (rays > 4096) rays = 4096;
     vis_ctx vc = {tracer, sub.positions, nrm, toward, rays, out->visibility, out->bent_normals};
-    bk_probe_parallel_for(nv, threads, vertex_visibility, &vc);
+    bk_parallel_chunks(0, nv, 64, bk_thread_count(threads), vertex_visibility_chunk, &vc);
     bk_tracer_destroy(tracer);
 done:
     free(sub.positions); free(sub.tris); free(nrm); free(acc); free(toward);

@@ -1,14 +1,13 @@
 /* The guided door estimator; see door_guided.h and bake/sets/SETS.md. */
 #include "bake/sets/door_guided.h"
 
+#include "bake/util/clock.h"
 #include "bake/util/parallel.h"
 #include "bake/transport/shading.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
-#include <unistd.h>
 
 #define DG_PI 3.14159265358979323846
 
@@ -111,17 +110,10 @@ static void acc_store(const dg_ctx *c, size_t i, const dg_acc *a)
 
 /* ---- the cache: nearest texel receiver with a compatible normal ------------------------------- */
 
-static uint64_t mix64(uint64_t z)
-{
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
 static uint64_t cell_key(int64_t x, int64_t y, int64_t z)
 {
-    return mix64((uint64_t)x * 0x9E3779B97F4A7C15ull ^ mix64((uint64_t)y + 0x632BE59BD9B4E019ull) ^
-                 mix64(mix64((uint64_t)z) + 0x85157AF5ull));
+    return bk_mix64((uint64_t)x * BK_GOLDEN64 ^ bk_mix64((uint64_t)y + 0x632BE59BD9B4E019ull) ^
+                    bk_mix64(bk_mix64((uint64_t)z) + 0x85157AF5ull));
 }
 
 typedef struct key_idx { uint64_t key; uint32_t texel; } key_idx;
@@ -329,10 +321,10 @@ static void stage0(dg_ctx *c, size_t begin, size_t end, int thread)
             int want = (int)ceil(c->S * sqrt(om / (2 * DG_PI)));
             want = want < 8 ? 8 : want > c->S ? c->S : want;
             int side = (int)ceil(sqrt((double)want)), N = side * side;
-            bk_door_rng rng = bk_door_rng_make(c->in->seed, DOM_STAGE0, 0, i);
+            bk_rng rng = bk_door_rng_make(c->in->seed, DOM_STAGE0, 0, i);
             for (int j = 0; j < N; j++) {
-                double pa = ((j % side) + bk_door_rng_next(&rng)) / side;
-                double pb = ((j / side) + bk_door_rng_next(&rng)) / side;
+                double pa = ((j % side) + bk_rng_next(&rng)) / side;
+                double pb = ((j / side) + bk_rng_next(&rng)) / side;
                 double d[3], w, L[3], Ld[3];
                 if (!portal_sample(c, r.o, r.n, r.sphere, pa, pb, d, &w, L, Ld, &rays)) continue;
                 if (!bk_finite3(L)) continue;
@@ -350,7 +342,7 @@ static void stage0(dg_ctx *c, size_t begin, size_t end, int thread)
 
 /* Door-direct radiance leaving the surface a gather ray hit (seed §4.2): the punctual lights of
  * the box the point lies in (direct light culling) and one portal sample. */
-static void door_bounce(const dg_ctx *c, const dg_surf *s, bk_door_rng *rng, double L[3], uint64_t *rays)
+static void door_bounce(const dg_ctx *c, const dg_surf *s, bk_rng *rng, double L[3], uint64_t *rays)
 {
     L[0] = L[1] = L[2] = 0;
     if (s->albedo[0] <= 0 && s->albedo[1] <= 0 && s->albedo[2] <= 0) return;
@@ -366,7 +358,7 @@ static void door_bounce(const dg_ctx *c, const dg_surf *s, bk_door_rng *rng, dou
         }
     }
     double d[3], w, Lp[3], Ld[3];
-    double pa = bk_door_rng_next(rng), pb = bk_door_rng_next(rng);
+    double pa = bk_rng_next(rng), pb = bk_rng_next(rng);
     if (portal_sample(c, s->yo, s->n, 0, pa, pb, d, &w, Lp, Ld, rays) && bk_finite3(Lp)) {
         double cs = dot3(d, s->n);
         for (int a = 0; a < 3; a++) e[a] += Lp[a] * w * cs;
@@ -392,8 +384,8 @@ static void stage1(dg_ctx *c, size_t begin, size_t end, int thread)
         dg_acc a;
         memset(&a, 0, sizeof a);
         const double pu = r.sphere ? 1 / (4 * DG_PI) : 1 / (2 * DG_PI);
-        bk_door_rng rng = bk_door_rng_make(c->in->seed, DOM_STAGE1, 0, i);
-        double s1 = bk_door_rng_next(&rng), s2 = bk_door_rng_next(&rng);
+        bk_rng rng = bk_door_rng_make(c->in->seed, DOM_STAGE1, 0, i);
+        double s1 = bk_rng_next(&rng), s2 = bk_rng_next(&rng);
         for (int j = 0; j < Nu + Ng; j++) {
             double d[3];
             if (j < Nu) {
@@ -401,7 +393,7 @@ static void stage1(dg_ctx *c, size_t begin, size_t end, int thread)
                 double u1 = (double)j / Nu + s1, u2 = (double)j * 0.6180339887498949 + s2;
                 uniform_dir(&r, u1 - floor(u1), u2 - floor(u2), d);
             } else {
-                double g0 = bk_door_rng_next(&rng), g1 = bk_door_rng_next(&rng), g2 = bk_door_rng_next(&rng);
+                double g0 = bk_rng_next(&rng), g1 = bk_rng_next(&rng), g2 = bk_rng_next(&rng);
                 if (!bk_guide_sample(c->boxes, r.p, g0, g1, g2, d)) continue;
                 if (!r.sphere && !(dot3(d, r.n) > 0)) continue; /* below the horizon: contributes 0 */
             }
@@ -435,8 +427,8 @@ static void stage_bounce(dg_ctx *c, size_t begin, size_t end, int thread)
         dg_acc a;
         memset(&a, 0, sizeof a);
         const double w = (r.sphere ? 4 * DG_PI : 2 * DG_PI) / N;
-        bk_door_rng rng = bk_door_rng_make(c->in->seed, DOM_BOUNCE, (uint64_t)c->bounce, i);
-        double s1 = bk_door_rng_next(&rng), s2 = bk_door_rng_next(&rng);
+        bk_rng rng = bk_door_rng_make(c->in->seed, DOM_BOUNCE, (uint64_t)c->bounce, i);
+        double s1 = bk_rng_next(&rng), s2 = bk_rng_next(&rng);
         for (int j = 0; j < N; j++) {
             double d[3], u1 = (double)j / N + s1, u2 = (double)j * 0.6180339887498949 + s2;
             uniform_dir(&r, u1 - floor(u1), u2 - floor(u2), d);
@@ -474,12 +466,6 @@ static void parallel_for(dg_ctx *c, size_t n, dg_fn fn)
     bk_parallel_chunks(0, n, 16, c->threads, dg_call_run, &k);
 }
 
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-}
 
 /* ---- the run ------------------------------------------------------------------------------------ */
 
@@ -504,7 +490,7 @@ static double texel_energy(const dg_ctx *c)
 lbk_result bk_door_guided_run(const bk_door_guided_inputs *in, lbk_sh9_rgb *radiance, lbk_sh9_rgb *direct,
                               bk_door_guided_stats *stats, bk_guide_boxes *boxes_out)
 {
-    double t0 = now_seconds();
+    double t0 = bk_now();
     bk_door_guided_stats st;
     memset(&st, 0, sizeof st);
     if (boxes_out) memset(boxes_out, 0, sizeof *boxes_out);
@@ -518,8 +504,7 @@ lbk_result bk_door_guided_run(const bk_door_guided_inputs *in, lbk_sh9_rgb *radi
     memset(&c, 0, sizeof c);
     c.in = in;
     c.S = in->samples > 0 ? in->samples : 64;
-    long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    c.threads = in->threads > 0 ? in->threads : (int)(cores < 1 ? 1 : cores > 256 ? 256 : cores);
+    c.threads = bk_thread_count(in->threads);
     for (size_t i = 0; i < in->scene->tri_count; i++) {
         float sc = bk_tracer_tri_scale(in->tracer, (uint32_t)i);
         if (sc > c.scene_scale) c.scene_scale = sc;
@@ -635,7 +620,7 @@ done:
     free(c.lights), free(c.base_e), free(c.prev_e), free(c.cur_e), free(c.stage_sh), free(c.stage_direct);
     free(c.thread_rays), free(c.thread_portal), free(c.thread_portal_n);
     free(c.grid.keys), free(c.grid.texel);
-    st.seconds = now_seconds() - t0;
+    st.seconds = bk_now() - t0;
     if (stats) *stats = st;
     return res;
 }

@@ -12,26 +12,11 @@
 
 /* ---- random numbers ------------------------------------------------------------------------ */
 
-static uint64_t mix64(uint64_t z)
-{
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
+#define DS_RNG_SALT 0x646F6F7273616D70ull /* "doorsamp": door streams differ from the transport's */
 
-bk_door_rng bk_door_rng_make(uint64_t seed, uint64_t domain, uint64_t a, uint64_t b)
+bk_rng bk_door_rng_make(uint64_t seed, uint64_t domain, uint64_t a, uint64_t b)
 {
-    uint64_t h = mix64(seed ^ 0x646F6F7273616D70ull);
-    h = mix64(h ^ (domain << 48) ^ a);
-    h = mix64(h ^ b * 0x9E3779B97F4A7C15ull);
-    bk_door_rng r = {h};
-    return r;
-}
-
-double bk_door_rng_next(bk_door_rng *r)
-{
-    r->s += 0x9E3779B97F4A7C15ull;
-    return (double)(mix64(r->s) >> 11) * (1.0 / 9007199254740992.0);
+    return bk_rng_stream(seed, DS_RNG_SALT, (domain << 48) ^ a, b);
 }
 
 /* ---- small vector helpers ------------------------------------------------------------------ */
@@ -238,14 +223,14 @@ lbk_result bk_shoot_shadow_photons(const bk_scene *scene, const bk_tracer *trace
     size_t sources = nl + (size_t)sky + (em.count ? 1 : 0);
     size_t k = 0;
     for (size_t i = 0; i < count && sources; i++) {
-        bk_door_rng rng = bk_door_rng_make(opt->seed, 7, 0, i);
+        bk_rng rng = bk_door_rng_make(opt->seed, 7, 0, i);
         /* stratified over the portal: a jittered grid of about √count × √count cells */
         size_t side = (size_t)ceil(sqrt((double)count));
-        double a = ((double)(i % side) + bk_door_rng_next(&rng)) / (double)side;
-        double b = ((double)((i / side) % side) + bk_door_rng_next(&rng)) / (double)side;
+        double a = ((double)(i % side) + bk_rng_next(&rng)) / (double)side;
+        double b = ((double)((i / side) % side) + bk_rng_next(&rng)) / (double)side;
         double q[3];
         bk_portal_point(portal, a, b, q);
-        size_t pick = (size_t)(bk_door_rng_next(&rng) * (double)sources);
+        size_t pick = (size_t)(bk_rng_next(&rng) * (double)sources);
         if (pick >= sources) pick = sources - 1;
         float qf[3] = {(float)q[0], (float)q[1], (float)q[2]};
         double scale = (double)sources * portal->area / (double)count; /* 1 / (p_source · p_point · N) */
@@ -258,7 +243,7 @@ lbk_result bk_shoot_shadow_photons(const bk_scene *scene, const bk_tracer *trace
             if (land(scene, tracer, q, back, w, lights[pick], &ph[k])) k++;
         } else if (pick == nl && sky) {
             /* a uniform direction on the sphere, the sky seen along it */
-            double z = 1 - 2 * bk_door_rng_next(&rng), phi = 2 * DS_PI * bk_door_rng_next(&rng);
+            double z = 1 - 2 * bk_rng_next(&rng), phi = 2 * DS_PI * bk_rng_next(&rng);
             double rr = sqrt(fmax(0, 1 - z * z)), d[3] = {rr * cos(phi), rr * sin(phi), z};
             float df[3] = {(float)d[0], (float)d[1], (float)d[2]};
             if (bk_tracer_occluded(tracer, qf, df, 0.0f, INFINITY)) continue;
@@ -268,7 +253,7 @@ lbk_result bk_shoot_shadow_photons(const bk_scene *scene, const bk_tracer *trace
             float w = (float)(bk_lum(L) * fabs(dot3(d, portal->n)) * 4 * DS_PI * scale);
             if (land(scene, tracer, q, back, w, BK_SOURCE_SKY, &ph[k])) k++;
         } else {
-            double u = bk_door_rng_next(&rng);
+            double u = bk_rng_next(&rng);
             size_t lo = 0, hi = em.count - 1;
             while (lo < hi) {
                 size_t mid = lo + (hi - lo) / 2;
@@ -277,7 +262,7 @@ lbk_result bk_shoot_shadow_photons(const bk_scene *scene, const bk_tracer *trace
             }
             uint32_t tri = em.tri[lo];
             double x[3], bu, bv, alb[3], le[3];
-            tri_point(scene, tri, bk_door_rng_next(&rng), bk_door_rng_next(&rng), x, &bu, &bv);
+            tri_point(scene, tri, bk_rng_next(&rng), bk_rng_next(&rng), x, &bu, &bv);
             bk_door_surface(scene, tri, bu, bv, set, alb, le);
             double dv[3] = {x[0] - q[0], x[1] - q[1], x[2] - q[2]}, dist = len3(dv);
             if (!(dist > 0)) continue;
