@@ -125,6 +125,81 @@ static void make_receiver(const bk_scene *s, const bk_atlas *a, uint32_t e, cons
     r->flags = BK_TEXEL_VALID;
 }
 
+/* Claims for each triangle of the chart the texels whose centre it covers (distance -1) or
+ * whose square it touches (squared distance to its closest point); the nearest claim wins,
+ * the first on ties. idx / bst: the chart's page in index / best. */
+static void rasterise_chart(const bk_atlas *a, const bk_atlas_chart *ch, int32_t *idx, float *bst)
+{
+    int pw = a->pages[ch->page].width, ph = a->pages[ch->page].height;
+    for (uint32_t e = ch->first; e < ch->first + ch->count; e++) {
+        bk_rtri t;
+        if (!bk_rtri_setup(a->tri_uv + 6 * (size_t)e, &t)) continue;
+        double mnx = fmin(t.x[0], fmin(t.x[1], t.x[2])), mxx = fmax(t.x[0], fmax(t.x[1], t.x[2]));
+        double mny = fmin(t.y[0], fmin(t.y[1], t.y[2])), mxy = fmax(t.y[0], fmax(t.y[1], t.y[2]));
+        int x0 = (int)fmax(0.0, floor(mnx) - 1), x1 = (int)fmin((double)pw - 1, floor(mxx) + 1);
+        int y0 = (int)fmax(0.0, floor(mny) - 1), y1 = (int)fmin((double)ph - 1, floor(mxy) + 1);
+        for (int y = y0; y <= y1; y++)
+            for (int x = x0; x <= x1; x++) {
+                double cx = x + 0.5, cy = y + 0.5;
+                float d;
+                if (bk_rtri_inside(&t, cx, cy, NULL)) {
+                    d = -1.0f;
+                } else {
+                    double qx, qy;
+                    double d2 = bk_rtri_closest(&t, cx, cy, NULL, &qx, &qy);
+                    if (!(fabs(qx - cx) < 0.5 && fabs(qy - cy) < 0.5)) continue;
+                    d = (float)d2;
+                }
+                size_t i = (size_t)y * (size_t)pw + (size_t)x;
+                if (d < bst[i]) {
+                    bst[i] = d;
+                    idx[i] = (int32_t)e;
+                }
+            }
+    }
+}
+
+/* One receiver per claimed texel, pages in order and rows top to bottom; index switches from
+ * the owning triangle entry to the receiver. A texel whose centre lies outside its triangle
+ * samples the triangle's closest point and is marked BK_TEXEL_EDGE. */
+static lbk_result emit_receivers(const bk_scene *s, const bk_atlas *a, const float *best, bk_texels *out)
+{
+    size_t total = out->page_offset[out->page_count], count = 0;
+    for (size_t i = 0; i < total; i++) count += out->index[i] >= 0;
+    out->receivers = malloc((count ? count : 1) * sizeof *out->receivers);
+    if (!out->receivers) return LBK_ERR_OUT_OF_MEMORY;
+    size_t r = 0;
+    for (size_t p = 0; p < out->page_count; p++) {
+        int pw = a->pages[p].width, ph = a->pages[p].height;
+        int32_t *idx = out->index + out->page_offset[p];
+        const float *bst = best + out->page_offset[p];
+        for (int y = 0; y < ph; y++)
+            for (int x = 0; x < pw; x++) {
+                size_t i = (size_t)y * (size_t)pw + (size_t)x;
+                if (idx[i] < 0) continue;
+                uint32_t e = (uint32_t)idx[i];
+                bk_rtri t;
+                bk_rtri_setup(a->tri_uv + 6 * (size_t)e, &t);
+                double w[3];
+                int edge = 0;
+                if (!(bst[i] < 0.0f) || !bk_rtri_inside(&t, x + 0.5, y + 0.5, w)) {
+                    bk_rtri_closest(&t, x + 0.5, y + 0.5, w, NULL, NULL);
+                    edge = 1;
+                }
+                bk_texel *rc = &out->receivers[r];
+                make_receiver(s, a, e, w, rc);
+                if (edge) rc->flags |= BK_TEXEL_EDGE;
+                rc->page = (uint32_t)p;
+                rc->x = (uint16_t)x;
+                rc->y = (uint16_t)y;
+                idx[i] = (int32_t)r;
+                r++;
+            }
+    }
+    out->count = count;
+    return LBK_OK;
+}
+
 lbk_result bk_texels_build(const bk_scene *s, const bk_atlas *a, bk_texels *out)
 {
     if (!out) return LBK_ERR_INVALID_ARGUMENT;
@@ -164,75 +239,12 @@ lbk_result bk_texels_build(const bk_scene *s, const bk_atlas *a, bk_texels *out)
     for (size_t c = 0; c < a->chart_count; c++) {
         const bk_atlas_chart *ch = &a->charts[c];
         if (ch->page < 0 || (size_t)ch->page >= np) continue;
-        int pw = a->pages[ch->page].width, ph = a->pages[ch->page].height;
-        int32_t *idx = out->index + out->page_offset[ch->page];
-        float *bst = best + out->page_offset[ch->page];
-        for (uint32_t e = ch->first; e < ch->first + ch->count; e++) {
-            bk_rtri t;
-            if (!bk_rtri_setup(a->tri_uv + 6 * (size_t)e, &t)) continue;
-            double mnx = fmin(t.x[0], fmin(t.x[1], t.x[2])), mxx = fmax(t.x[0], fmax(t.x[1], t.x[2]));
-            double mny = fmin(t.y[0], fmin(t.y[1], t.y[2])), mxy = fmax(t.y[0], fmax(t.y[1], t.y[2]));
-            int x0 = (int)fmax(0.0, floor(mnx) - 1), x1 = (int)fmin((double)pw - 1, floor(mxx) + 1);
-            int y0 = (int)fmax(0.0, floor(mny) - 1), y1 = (int)fmin((double)ph - 1, floor(mxy) + 1);
-            for (int y = y0; y <= y1; y++)
-                for (int x = x0; x <= x1; x++) {
-                    double cx = x + 0.5, cy = y + 0.5;
-                    float d;
-                    if (bk_rtri_inside(&t, cx, cy, NULL)) {
-                        d = -1.0f;
-                    } else {
-                        double qx, qy;
-                        double d2 = bk_rtri_closest(&t, cx, cy, NULL, &qx, &qy);
-                        if (!(fabs(qx - cx) < 0.5 && fabs(qy - cy) < 0.5)) continue;
-                        d = (float)d2;
-                    }
-                    size_t i = (size_t)y * (size_t)pw + (size_t)x;
-                    if (d < bst[i]) {
-                        bst[i] = d;
-                        idx[i] = (int32_t)e;
-                    }
-                }
-        }
+        rasterise_chart(a, ch, out->index + out->page_offset[ch->page], best + out->page_offset[ch->page]);
     }
-    size_t count = 0;
-    for (size_t i = 0; i < total; i++) count += out->index[i] >= 0;
-    out->receivers = malloc((count ? count : 1) * sizeof *out->receivers);
-    if (!out->receivers) {
-        free(best);
-        bk_texels_free(out);
-        return LBK_ERR_OUT_OF_MEMORY;
-    }
-    size_t r = 0;
-    for (size_t p = 0; p < np; p++) {
-        int pw = a->pages[p].width, ph = a->pages[p].height;
-        int32_t *idx = out->index + out->page_offset[p];
-        const float *bst = best + out->page_offset[p];
-        for (int y = 0; y < ph; y++)
-            for (int x = 0; x < pw; x++) {
-                size_t i = (size_t)y * (size_t)pw + (size_t)x;
-                if (idx[i] < 0) continue;
-                uint32_t e = (uint32_t)idx[i];
-                bk_rtri t;
-                bk_rtri_setup(a->tri_uv + 6 * (size_t)e, &t);
-                double w[3];
-                int edge = 0;
-                if (!(bst[i] < 0.0f) || !bk_rtri_inside(&t, x + 0.5, y + 0.5, w)) {
-                    bk_rtri_closest(&t, x + 0.5, y + 0.5, w, NULL, NULL);
-                    edge = 1;
-                }
-                bk_texel *rc = &out->receivers[r];
-                make_receiver(s, a, e, w, rc);
-                if (edge) rc->flags |= BK_TEXEL_EDGE;
-                rc->page = (uint32_t)p;
-                rc->x = (uint16_t)x;
-                rc->y = (uint16_t)y;
-                idx[i] = (int32_t)r;
-                r++;
-            }
-    }
-    out->count = count;
+    lbk_result res = emit_receivers(s, a, best, out);
     free(best);
-    return LBK_OK;
+    if (res != LBK_OK) bk_texels_free(out);
+    return res;
 }
 
 /* ---------------------------------------------------------------------------------------- */
