@@ -6,7 +6,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "lbk/container.h"
 #include "lbk/lightmap.h"
@@ -16,12 +15,7 @@
 #include "lbk/report.h"
 #include "lbk/validate.h"
 
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
+#include "bake/util/clock.h"
 
 static uint32_t rng_state = 12345;
 static uint32_t rnd(void)
@@ -112,11 +106,11 @@ static int count_issues(void *user, const lbk_issue *issue)
 /* validate, then open + decode every section; returns total seconds, *validate_s the first part. */
 static double load_once(const void *file, size_t size, unsigned *issues, double *validate_s)
 {
-    double t0 = now();
+    double t0 = bk_now();
     lbk_validate_summary s;
     *issues = 0;
     CHECK(lbk_validate_memory(file, size, NULL, count_issues, issues, &s));
-    *validate_s = now() - t0;
+    *validate_s = bk_now() - t0;
     lbk_reader *r;
     CHECK(lbk_reader_open_memory(file, size, NULL, &r));
     volatile uint8_t sink = 0;
@@ -128,16 +122,16 @@ static double load_once(const void *file, size_t size, unsigned *issues, double 
     }
     lbk_reader_close(r);
     (void)sink;
-    return now() - t0;
+    return bk_now() - t0;
 }
 
 static double memcpy_once(void *dst, const void *src, size_t n)
 {
-    double t0 = now();
+    double t0 = bk_now();
     memcpy(dst, src, n);
     volatile uint8_t sink = ((uint8_t *)dst)[n / 2];
     (void)sink;
-    return now() - t0;
+    return bk_now() - t0;
 }
 
 static void throughput(void)

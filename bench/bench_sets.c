@@ -11,6 +11,7 @@
 #include <math.h>
 
 #include "bake/pipeline/bake.h"
+#include "bake/util/clock.h"
 #include "lbk/ahd.h"
 #include "lbk/container.h"
 #include "lbk/dls.h"

@@ -1,16 +1,10 @@
 #include "bake/util/progress.h"
 
+#include "bake/util/clock.h"
+
 #include <stdarg.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
-
-double bk_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 void bk_progress_init(bk_progress *p, int quiet)
 {

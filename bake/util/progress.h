@@ -3,6 +3,8 @@
 #ifndef BK_PROGRESS_H
 #define BK_PROGRESS_H
 
+#include "bake/util/clock.h" /* bk_now, for the callers that still reach it through here */
+
 #include <stdio.h>
 
 typedef struct bk_progress {
@@ -15,7 +17,6 @@ typedef struct bk_progress {
     double last_draw;
 } bk_progress;
 
-double bk_now(void); /* monotonic seconds */
 void bk_progress_init(bk_progress *p, int quiet);
 /* Starts a phase ("import", "uv", "probes", "bake", "encode", "write"). */
 void bk_progress_phase(bk_progress *p, const char *phase);
