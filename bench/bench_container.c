@@ -152,16 +152,16 @@ static void throughput(void)
            "ratio", "issues");
     for (int zstd = 0; zstd < 2; zstd++) {
         lbk_writer *w;
-        CHECK(lbk_writer_create(NULL, &w));
+        CHECK(lbk_writer_open(NULL, &w));
         lbk_section_options o = {LBK_SECTION_FLAG_REQUIRED, zstd ? LBK_COMPRESSION_ZSTD : 0, 3};
-        CHECK(lbk_writer_add_section(w, LBK_SECTION_META, meta, meta_n, NULL));
-        CHECK(lbk_writer_add_section(w, LBK_SECTION_REPT, rept, rept_n, NULL));
-        CHECK(lbk_writer_add_section(w, LBK_SECTION_OBJS, objs, objs_n, &o));
-        CHECK(lbk_writer_add_section(w, LBK_SECTION_LMAP, lmap, lmap_n, &o));
+        CHECK(lbk_writer_section_add(w, LBK_SECTION_META, meta, meta_n, NULL));
+        CHECK(lbk_writer_section_add(w, LBK_SECTION_REPT, rept, rept_n, NULL));
+        CHECK(lbk_writer_section_add(w, LBK_SECTION_OBJS, objs, objs_n, &o));
+        CHECK(lbk_writer_section_add(w, LBK_SECTION_LMAP, lmap, lmap_n, &o));
         void *file;
         size_t size;
         CHECK(lbk_writer_to_memory(w, &file, &size));
-        lbk_writer_destroy(w);
+        lbk_writer_close(w);
         size_t decoded = meta_n + rept_n + objs_n + lmap_n;
         void *dst = malloc(decoded);
         memset(dst, 1, decoded);
@@ -197,18 +197,18 @@ static void overhead_row(const char *label, void *lmap, size_t lmap_n, void *llg
     size_t meta_n = 0, rept_n = 0, objs_n = 0;
     if (objects) build_small_sections(objects, &meta, &meta_n, &rept, &rept_n, &objs, &objs_n, grids, chart, per_row);
     lbk_writer *w;
-    CHECK(lbk_writer_create(NULL, &w));
-    CHECK(lbk_writer_add_section(w, LBK_SECTION_LMAP, lmap, lmap_n, NULL));
-    CHECK(lbk_writer_add_section(w, LBK_SECTION_LLG, llg, llg_n, NULL));
+    CHECK(lbk_writer_open(NULL, &w));
+    CHECK(lbk_writer_section_add(w, LBK_SECTION_LMAP, lmap, lmap_n, NULL));
+    CHECK(lbk_writer_section_add(w, LBK_SECTION_LLG, llg, llg_n, NULL));
     if (objects) {
-        CHECK(lbk_writer_add_section(w, LBK_SECTION_META, meta, meta_n, NULL));
-        CHECK(lbk_writer_add_section(w, LBK_SECTION_REPT, rept, rept_n, NULL));
-        CHECK(lbk_writer_add_section(w, LBK_SECTION_OBJS, objs, objs_n, NULL));
+        CHECK(lbk_writer_section_add(w, LBK_SECTION_META, meta, meta_n, NULL));
+        CHECK(lbk_writer_section_add(w, LBK_SECTION_REPT, rept, rept_n, NULL));
+        CHECK(lbk_writer_section_add(w, LBK_SECTION_OBJS, objs, objs_n, NULL));
     }
     void *file;
     size_t size;
     CHECK(lbk_writer_to_memory(w, &file, &size));
-    lbk_writer_destroy(w);
+    lbk_writer_close(w);
     lbk_validate_summary s;
     CHECK(lbk_validate_memory(file, size, NULL, NULL, NULL, &s));
     const uint64_t payload = texels * 8 + probe_count * 28;

@@ -517,7 +517,7 @@ static lbk_result build_glg(bake *b, section_list *sl)
     }
     bk_glg_visibility_unorm8(&b->glg, vis);
     for (size_t i = 0; i < b->glg.probe_count; i++) to_world(b, &b->glg.positions[3 * i], world[i]);
-    lbk_glg_desc d;
+    lbk_glg_build_desc d;
     memset(&d, 0, sizeof d);
     d.probe_count = (uint32_t)b->glg.probe_count;
     d.tetra_count = (uint32_t)b->glg.tet_count;
@@ -576,7 +576,7 @@ static lbk_result build_llg(bake *b, section_list *sl)
         const bk_llg *l = &b->llgs[i];
         to_world(b, l->centre, g[i].centre);
         memcpy(g[i].axes, l->axes, sizeof g[i].axes);
-        memcpy(g[i].half_extent, l->half_extents, sizeof g[i].half_extent);
+        memcpy(g[i].half_extents, l->half_extents, sizeof g[i].half_extents);
         memcpy(g[i].dims, l->dims, sizeof g[i].dims);
         g[i].probes = &b->radiance[probe];
         probe += bk_llg_probe_count(l);
@@ -792,7 +792,7 @@ static int do_encode_and_write(bake *b, bk_bake_summary *sum)
     }
     bk_progress_update(b->progress, 0.5);
     lbk_writer *w = NULL;
-    if (!r) r = lbk_writer_create(NULL, &w);
+    if (!r) r = lbk_writer_open(NULL, &w);
     for (int i = 0; !r && i < sl.count; i++) {
         lbk_section_options so;
         memset(&so, 0, sizeof so);
@@ -800,15 +800,15 @@ static int do_encode_and_write(bake *b, bk_bake_summary *sum)
          * convert` makes compressed packs. The small CPU-side tables are required to read them. */
         if (sl.type[i] == LBK_SECTION_OBJS || sl.type[i] == LBK_SECTION_DLS || sl.type[i] == LBK_SECTION_DOOR)
             so.flags = LBK_SECTION_FLAG_REQUIRED;
-        r = lbk_writer_add_section(w, sl.type[i], sl.data[i], sl.size[i], &so);
+        r = lbk_writer_section_add(w, sl.type[i], sl.data[i], sl.size[i], &so);
     }
     sections_free(&sl);
     if (r) {
-        lbk_writer_destroy(w);
+        lbk_writer_close(w);
         return fail(b, LBK_EXIT_INTERNAL, "encoding the container: %s", lbk_result_message(r));
     }
     r = lbk_writer_to_file(w, b->opt->output);
-    lbk_writer_destroy(w);
+    lbk_writer_close(w);
     if (r) return fail(b, LBK_EXIT_IO, "writing %s: %s", b->opt->output, lbk_result_message(r));
     FILE *f = fopen(b->opt->output, "rb");
     if (f) {

@@ -950,7 +950,7 @@ lbk_result bk_set_bakes_sections(bk_set_bakes *sets, const bk_set_inputs *in, vo
                     lbk_ahd_linear_add_scaled(&l, (const lbk_ahd_linear *)st->values[s] + i, inv);
                     lbk_ahd_texel t;
                     lbk_ahd_from_linear(&l, &t);
-                    lbk_ahd_texel_store(&t, e + stride * i);
+                    lbk_ahd_texel_pack(&t, e + stride * i);
                 } else {
                     lbk_sh9_rgb sh;
                     memset(&sh, 0, sizeof sh);

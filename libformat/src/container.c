@@ -114,7 +114,7 @@ const void *lbk_reader_bytes(const lbk_reader *r, size_t *size)
 
 uint32_t lbk_reader_section_count(const lbk_reader *r) { return r ? r->fr.count : 0; }
 
-lbk_result lbk_reader_section_info(const lbk_reader *r, uint32_t index, lbk_section_info *out)
+lbk_result lbk_reader_section_get(const lbk_reader *r, uint32_t index, lbk_section_info *out)
 {
     if (!r || !out) return LBK_ERR_INVALID_ARGUMENT;
     if (index >= r->fr.count) return LBK_ERR_NOT_FOUND;
@@ -122,7 +122,7 @@ lbk_result lbk_reader_section_info(const lbk_reader *r, uint32_t index, lbk_sect
     return LBK_OK;
 }
 
-lbk_result lbk_reader_find_section(const lbk_reader *r, uint32_t type, uint32_t *index)
+lbk_result lbk_reader_section_find(const lbk_reader *r, uint32_t type, uint32_t *index)
 {
     if (!r || !index) return LBK_ERR_INVALID_ARGUMENT;
     for (uint32_t i = 0; i < r->fr.count; i++)
@@ -161,7 +161,7 @@ lbk_result lbk_reader_section_by_type(lbk_reader *r, uint32_t type, const void *
     uint32_t index;
     if (data) *data = NULL;
     if (size) *size = 0;
-    lbk_result res = lbk_reader_find_section(r, type, &index);
+    lbk_result res = lbk_reader_section_find(r, type, &index);
     if (res != LBK_OK) return res;
     return lbk_reader_section_data(r, index, data, size);
 }
@@ -181,7 +181,7 @@ struct lbk_writer {
     writer_section s[LBK_MAX_SECTIONS];
 };
 
-lbk_result lbk_writer_create(const lbk_write_options *options, lbk_writer **out)
+lbk_result lbk_writer_open(const lbk_write_options *options, lbk_writer **out)
 {
     if (!out) return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
@@ -196,7 +196,7 @@ lbk_result lbk_writer_create(const lbk_write_options *options, lbk_writer **out)
     return LBK_OK;
 }
 
-void lbk_writer_destroy(lbk_writer *w)
+void lbk_writer_close(lbk_writer *w)
 {
     if (!w) return;
     for (uint32_t i = 0; i < w->count; i++) lbk_dealloc(&w->alloc, w->s[i].stored);
@@ -242,7 +242,7 @@ static lbk_result compress(lbk_writer *w, const void *data, size_t size, int lev
     return LBK_OK;
 }
 
-lbk_result lbk_writer_add_section(lbk_writer *w, uint32_t type, const void *data, size_t size,
+lbk_result lbk_writer_section_add(lbk_writer *w, uint32_t type, const void *data, size_t size,
                                   const lbk_section_options *options)
 {
     if (!w || !data || size == 0 || !lbk_fourcc_printable(type)) return LBK_ERR_INVALID_ARGUMENT;
@@ -329,8 +329,8 @@ lbk_result lbk_writer_to_memory(lbk_writer *w, void **out, size_t *size)
         if (s->compression == LBK_COMPRESSION_ZSTD) required |= LBK_FEATURE_ZSTD;
     }
     memcpy(f, lbk_magic, 8);
-    lbk_wr16(f + LBK_HDR_VERSION_MAJOR, LBK_VERSION_MAJOR);
-    lbk_wr16(f + LBK_HDR_VERSION_MINOR, LBK_VERSION_MINOR);
+    lbk_wr16(f + LBK_HDR_VERSION_MAJOR, LBK_FORMAT_VERSION_MAJOR);
+    lbk_wr16(f + LBK_HDR_VERSION_MINOR, LBK_FORMAT_VERSION_MINOR);
     lbk_wr32(f + LBK_HDR_HEADER_SIZE, LBK_HEADER_SIZE);
     lbk_wr64(f + LBK_HDR_FILE_SIZE, file_size);
     lbk_wr32(f + LBK_HDR_REQUIRED_FEATURES, required);

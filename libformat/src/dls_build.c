@@ -844,13 +844,13 @@ lbk_result lbk_dls_build(const lbk_dls_build_desc *desc, const lbk_dls_build_opt
 
     /* Self-check: the output must pass the section's own rules (and gives the statistics). */
     lbk_dls_view *v;
-    r = lbk_dls_view_open(bytes, (size_t)L.size, a, &v);
+    r = lbk_dls_open(bytes, (size_t)L.size, a, &v);
     if (r != LBK_OK) {
         lbk_dealloc(a, bytes);
         return LBK_ERR_CORRUPT;
     }
-    if (stats) lbk_dls_compute_stats(v, stats);
-    lbk_dls_view_close(v);
+    if (stats) lbk_dls_stats_get(v, stats);
+    lbk_dls_close(v);
     *out = bytes;
     *out_size = (size_t)L.size;
     return LBK_OK;

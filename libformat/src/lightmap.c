@@ -105,7 +105,7 @@ lbk_result lbk_lmap_open(const void *data, size_t size, lbk_lmap_view *out)
     return LBK_OK;
 }
 
-lbk_result lbk_lmap_get_page(const lbk_lmap_view *view, uint32_t index, lbk_lmap_page *out)
+lbk_result lbk_lmap_page_get(const lbk_lmap_view *view, uint32_t index, lbk_lmap_page *out)
 {
     if (!view || !out || !view->data) return LBK_ERR_INVALID_ARGUMENT;
     if (index >= view->page_count) return LBK_ERR_NOT_FOUND;
@@ -121,7 +121,7 @@ lbk_result lbk_lmap_get_page(const lbk_lmap_view *view, uint32_t index, lbk_lmap
     return LBK_OK;
 }
 
-lbk_result lbk_lmap_page_texel(const lbk_lmap_page *page, uint32_t x, uint32_t y, lbk_ahd_texel *out)
+lbk_result lbk_lmap_page_texel_get(const lbk_lmap_page *page, uint32_t x, uint32_t y, lbk_ahd_texel *out)
 {
     if (!page || !out) return LBK_ERR_INVALID_ARGUMENT;
     if (x >= page->width || y >= page->height) return LBK_ERR_RANGE;
@@ -135,14 +135,14 @@ lbk_result lbk_lmap_page_irradiance(const lbk_lmap_page *page, uint32_t x, uint3
 {
     if (!n || !rgb) return LBK_ERR_INVALID_ARGUMENT;
     lbk_ahd_texel t;
-    lbk_result r = lbk_lmap_page_texel(page, x, y, &t);
+    lbk_result r = lbk_lmap_page_texel_get(page, x, y, &t);
     if (r != LBK_OK) return r;
     lbk_ahd_irradiance(&t, n, rgb);
     for (int c = 0; c < 3; c++) rgb[c] *= page->scale;
     return LBK_OK;
 }
 
-lbk_result lbk_lmap_texel(const lbk_lmap_view *view, uint64_t texel_index, lbk_ahd_texel *out, uint32_t *page_out)
+lbk_result lbk_lmap_texel_get(const lbk_lmap_view *view, uint64_t texel_index, lbk_ahd_texel *out, uint32_t *page_out)
 {
     if (!view || !out || !view->data) return LBK_ERR_INVALID_ARGUMENT;
     if (texel_index >= view->texel_count) return LBK_ERR_RANGE;
@@ -155,10 +155,10 @@ lbk_result lbk_lmap_texel(const lbk_lmap_view *view, uint64_t texel_index, lbk_a
         else hi = mid;
     }
     lbk_lmap_page pg;
-    lbk_lmap_get_page(view, lo, &pg);
+    lbk_lmap_page_get(view, lo, &pg);
     const uint64_t local = texel_index - pg.first_texel;
     if (page_out) *page_out = lo;
-    return lbk_lmap_page_texel(&pg, (uint32_t)(local % pg.width), (uint32_t)(local / pg.width), out);
+    return lbk_lmap_page_texel_get(&pg, (uint32_t)(local % pg.width), (uint32_t)(local / pg.width), out);
 }
 
 /* ---- validation ------------------------------------------------------------------------------ */

@@ -96,7 +96,7 @@ lbk_result lbk_octp_build(const lbk_octp_probe_desc *probes, uint32_t count, flo
                 lbk_oct_border_source(LBK_OCTP_IRR_N, x, y, &sx, &sy);
                 const float *c = pd->irradiance[(sy - 1) * LBK_OCTP_IRR_N + (sx - 1)];
                 const float st[3] = {c[0] * inv, c[1] * inv, c[2] * inv};
-                lbk_wr32(q + LBK_OCTP_IRR_OFFSET + 4 * (y * IRR_S + x), lbk_pack_r11g11b10f(st));
+                lbk_wr32(q + LBK_OCTP_IRR_OFFSET + 4 * (y * IRR_S + x), lbk_r11g11b10f_pack(st));
             }
         for (uint32_t y = 0; y < DEPTH_S; y++)
             for (uint32_t x = 0; x < DEPTH_S; x++) {
@@ -135,7 +135,7 @@ lbk_result lbk_octp_open(const void *data, size_t size, lbk_octp_view *out)
     return LBK_OK;
 }
 
-lbk_result lbk_octp_get(const lbk_octp_view *view, uint32_t index, lbk_octp_probe_desc *out)
+lbk_result lbk_octp_probe_get(const lbk_octp_view *view, uint32_t index, lbk_octp_probe_desc *out)
 {
     if (!view || !view->data || !out) return LBK_ERR_INVALID_ARGUMENT;
     if (index >= view->probe_count) return LBK_ERR_RANGE;
@@ -143,7 +143,7 @@ lbk_result lbk_octp_get(const lbk_octp_view *view, uint32_t index, lbk_octp_prob
     for (uint32_t j = 0; j < LBK_OCTP_IRR_N; j++)
         for (uint32_t i = 0; i < LBK_OCTP_IRR_N; i++) {
             float *c = out->irradiance[j * LBK_OCTP_IRR_N + i];
-            lbk_unpack_r11g11b10f(lbk_rd32(q + LBK_OCTP_IRR_OFFSET + 4 * ((j + 1) * IRR_S + i + 1)), c);
+            lbk_r11g11b10f_unpack(lbk_rd32(q + LBK_OCTP_IRR_OFFSET + 4 * ((j + 1) * IRR_S + i + 1)), c);
             for (int k = 0; k < 3; k++) c[k] *= view->scale;
         }
     for (uint32_t j = 0; j < LBK_OCTP_DEPTH_N; j++)
@@ -179,7 +179,7 @@ lbk_result lbk_octp_irradiance(const lbk_octp_view *view, uint32_t index, const 
         for (int dx = 0; dx < 2; dx++) {
             const float w = (dx ? f[0] : 1.0f - f[0]) * (dy ? f[1] : 1.0f - f[1]);
             float c[3];
-            lbk_unpack_r11g11b10f(lbk_rd32(q + 4 * ((size_t)(i0[1] + dy) * IRR_S + (size_t)(i0[0] + dx))), c);
+            lbk_r11g11b10f_unpack(lbk_rd32(q + 4 * ((size_t)(i0[1] + dy) * IRR_S + (size_t)(i0[0] + dx))), c);
             for (int k = 0; k < 3; k++) rgb[k] += w * c[k];
         }
     for (int k = 0; k < 3; k++) rgb[k] *= view->scale;

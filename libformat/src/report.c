@@ -85,7 +85,7 @@ lbk_result lbk_report_build(const lbk_report *rep, const lbk_allocator *allocato
     return LBK_OK;
 }
 
-lbk_result lbk_report_parse(const void *data, size_t size, lbk_report_view *out)
+lbk_result lbk_report_open(const void *data, size_t size, lbk_report_view *out)
 {
     if (!out || (!data && size)) return LBK_ERR_INVALID_ARGUMENT;
     memset(out, 0, sizeof *out);
@@ -105,7 +105,7 @@ lbk_result lbk_report_parse(const void *data, size_t size, lbk_report_view *out)
     return LBK_OK;
 }
 
-lbk_result lbk_report_record_at(const lbk_report_view *v, uint32_t index, lbk_report_record *out)
+lbk_result lbk_report_record_get(const lbk_report_view *v, uint32_t index, lbk_report_record *out)
 {
     if (!v || !out) return LBK_ERR_INVALID_ARGUMENT;
     if (index >= v->header.record_count) return LBK_ERR_NOT_FOUND;
@@ -123,7 +123,7 @@ void lbk_validate_rept(lbk_vctx *ctx, const uint8_t *d, size_t size)
     }
     lbk_report_view v;
     uint32_t n = lbk_rd32(d + 8);
-    if (lbk_report_parse(d, size, &v) != LBK_OK) {
+    if (lbk_report_open(d, size, &v) != LBK_OK) {
         lbk_vreport(ctx, 351, 8, "REPT of %u records needs %llu bytes, section has %zu", n,
                     (unsigned long long)(LBK_REPORT_HEADER_SIZE + (uint64_t)LBK_REPORT_RECORD_SIZE * n), size);
         return;

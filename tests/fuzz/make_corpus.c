@@ -48,11 +48,11 @@ int main(void)
         lbk_writer *w;
         lbk_write_options wo = {NULL, zstd ? 16 : 64};
         lbk_section_options o = {LBK_SECTION_FLAG_REQUIRED, zstd ? LBK_COMPRESSION_ZSTD : 0, 3};
-        if (lbk_writer_create(&wo, &w) || lbk_writer_add_section(w, LBK_SECTION_META, me, men, NULL) ||
-            lbk_writer_add_section(w, LBK_SECTION_REPT, re, ren, &o) ||
-            lbk_writer_add_section(w, LBK_SECTION_OBJS, ob, obn, &o) ||
-            lbk_writer_add_section(w, LBK_SECTION_LMAP, lm, lmn, &o) ||
-            lbk_writer_add_section(w, LBK_SECTION_LLG, llg, llgn, &o))
+        if (lbk_writer_open(&wo, &w) || lbk_writer_section_add(w, LBK_SECTION_META, me, men, NULL) ||
+            lbk_writer_section_add(w, LBK_SECTION_REPT, re, ren, &o) ||
+            lbk_writer_section_add(w, LBK_SECTION_OBJS, ob, obn, &o) ||
+            lbk_writer_section_add(w, LBK_SECTION_LMAP, lm, lmn, &o) ||
+            lbk_writer_section_add(w, LBK_SECTION_LLG, llg, llgn, &o))
             return 1;
         void *bytes;
         size_t n;
@@ -60,7 +60,7 @@ int main(void)
         if (write_file(zstd ? "tests/fuzz/corpus/objects_zstd.lbk" : "tests/fuzz/corpus/objects_raw.lbk", bytes, n))
             return 1;
         lbk_free(NULL, bytes);
-        lbk_writer_destroy(w);
+        lbk_writer_close(w);
     }
     return 0;
 }

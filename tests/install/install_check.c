@@ -21,12 +21,12 @@ static void test_golden_opens_and_validates(void **state)
     lbk_reader *r;
     assert_int_equal(lbk_reader_open_file("tests/golden/small.lbk", NULL, &r), LBK_OK);
     assert_true(lbk_reader_section_count(r) >= 1);
-    assert_int_equal(lbk_reader_header(r)->version_major, LBK_VERSION_MAJOR);
+    assert_int_equal(lbk_reader_header(r)->version_major, LBK_FORMAT_VERSION_MAJOR);
     const void *data;
     size_t size;
     assert_int_equal(lbk_reader_section_by_type(r, LBK_SECTION_META, &data, &size), LBK_OK);
     lbk_meta_view v;
-    assert_int_equal(lbk_meta_parse(data, size, &v), LBK_OK);
+    assert_int_equal(lbk_meta_open(data, size, &v), LBK_OK);
     assert_true(v.entry_count > 0);
     lbk_reader_close(r);
     assert_string_equal(lbk_result_name(LBK_ERR_CHECKSUM), "LBK_ERR_CHECKSUM");

@@ -125,7 +125,7 @@ static void expect(mutator m, uint32_t id, facts f)
     assert_non_null(lbk_issue_template(id, &sev));
     if (sev != LBK_SEVERITY_WARNING) assert_true(errors > 0);
     lbk_dls_view *v;
-    if (sev != LBK_SEVERITY_WARNING && id != 803) assert_int_not_equal(lbk_dls_view_open(b.d, b.n, NULL, &v), LBK_OK);
+    if (sev != LBK_SEVERITY_WARNING && id != 803) assert_int_not_equal(lbk_dls_open(b.d, b.n, NULL, &v), LBK_OK);
     free(b.d);
 }
 
@@ -438,8 +438,8 @@ static void test_door_validation(void **state)
     assert_true(has(&raw, 912));
     assert_true(has(&raw, 902));
     lbk_door_view *v;
-    assert_int_equal(lbk_door_view_open(d, n, NULL, &v), LBK_ERR_CORRUPT);
-    for (size_t t = 0; t < n; t++) assert_int_not_equal(lbk_door_view_open(d, t, NULL, &v), LBK_OK);
+    assert_int_equal(lbk_door_open(d, n, NULL, &v), LBK_ERR_CORRUPT);
+    for (size_t t = 0; t < n; t++) assert_int_not_equal(lbk_door_open(d, t, NULL, &v), LBK_OK);
     free(out);
 }
 

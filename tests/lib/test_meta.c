@@ -76,13 +76,13 @@ typedef struct section {
 static issues validate_sections(const section *s, size_t n, int zstd)
 {
     lbk_writer *w;
-    assert_int_equal(lbk_writer_create(NULL, &w), LBK_OK);
+    assert_int_equal(lbk_writer_open(NULL, &w), LBK_OK);
     lbk_section_options o = {0, zstd ? LBK_COMPRESSION_ZSTD : 0, 1};
-    for (size_t i = 0; i < n; i++) assert_int_equal(lbk_writer_add_section(w, s[i].type, s[i].data, s[i].size, &o), LBK_OK);
+    for (size_t i = 0; i < n; i++) assert_int_equal(lbk_writer_section_add(w, s[i].type, s[i].data, s[i].size, &o), LBK_OK);
     void *bytes;
     size_t size;
     assert_int_equal(lbk_writer_to_memory(w, &bytes, &size), LBK_OK);
-    lbk_writer_destroy(w);
+    lbk_writer_close(w);
     issues c = {{0}, 0};
     lbk_validate_summary sum;
     assert_int_equal(lbk_validate_memory(bytes, size, NULL, collect, &c, &sum), LBK_OK);
@@ -132,12 +132,12 @@ static void test_meta_round_trip(void **state)
     size_t n;
     assert_int_equal(lbk_meta_build(pairs, 6, NULL, &b, &n), LBK_OK);
     lbk_meta_view v;
-    assert_int_equal(lbk_meta_parse(b, n, &v), LBK_OK);
+    assert_int_equal(lbk_meta_open(b, n, &v), LBK_OK);
     assert_int_equal(v.entry_count, 6);
     const char *sorted[] = {"bake.seed", "revision", "scene.hash", "timestamp", "writer", "writer.version"};
     for (uint32_t i = 0; i < 6; i++) {
         lbk_string k, val;
-        assert_int_equal(lbk_meta_entry(&v, i, &k, &val), LBK_OK);
+        assert_int_equal(lbk_meta_entry_get(&v, i, &k, &val), LBK_OK);
         assert_int_equal(k.size, strlen(sorted[i]));
         assert_memory_equal(k.data, sorted[i], k.size);
     }
@@ -146,18 +146,18 @@ static void test_meta_round_trip(void **state)
     assert_int_equal(val.size, strlen(pairs[4].value));
     assert_memory_equal(val.data, pairs[4].value, val.size);
     assert_int_equal(lbk_meta_find(&v, "writer.versio", &val), LBK_ERR_NOT_FOUND);
-    assert_int_equal(lbk_meta_entry(&v, 6, NULL, NULL), LBK_ERR_NOT_FOUND);
+    assert_int_equal(lbk_meta_entry_get(&v, 6, NULL, NULL), LBK_ERR_NOT_FOUND);
     issues c = validate_one(LBK_SECTION_META, b, n);
     assert_int_equal(c.count, 0);
     /* parse rejects what would be unsafe to view */
-    assert_int_equal(lbk_meta_parse(b, n - 1, &v), LBK_ERR_TRUNCATED);
-    assert_int_equal(lbk_meta_parse(b, 15, &v), LBK_ERR_TRUNCATED);
+    assert_int_equal(lbk_meta_open(b, n - 1, &v), LBK_ERR_TRUNCATED);
+    assert_int_equal(lbk_meta_open(b, 15, &v), LBK_ERR_TRUNCATED);
     uint8_t *m = malloc(n + 1);
     memcpy(m, b, n);
     m[n] = 0;
-    assert_int_equal(lbk_meta_parse(m, n + 1, &v), LBK_ERR_CORRUPT);
+    assert_int_equal(lbk_meta_open(m, n + 1, &v), LBK_ERR_CORRUPT);
     wr32(m + 16 + 4, 0x7fffffff); /* key length past the blob */
-    assert_int_equal(lbk_meta_parse(m, n, &v), LBK_ERR_CORRUPT);
+    assert_int_equal(lbk_meta_open(m, n, &v), LBK_ERR_CORRUPT);
     free(m);
     lbk_free(NULL, b);
 }
@@ -262,24 +262,24 @@ static void test_report_round_trip(void **state)
     assert_int_equal(rd32(d + 12), 64);
     assert_int_equal(rd32(d + 28), 0);
     lbk_report_view v;
-    assert_int_equal(lbk_report_parse(b, n, &v), LBK_OK);
+    assert_int_equal(lbk_report_open(b, n, &v), LBK_OK);
     assert_int_equal(v.header.status, LBK_BAKE_TARGET_REACHED);
     assert_true(v.header.time_limit_seconds == 600.0);
     assert_true(v.header.target_rel_rmse == 0.1f);
     for (uint32_t i = 0; i < 3; i++) {
         lbk_report_record r;
-        assert_int_equal(lbk_report_record_at(&v, i, &r), LBK_OK);
+        assert_int_equal(lbk_report_record_get(&v, i, &r), LBK_OK);
         assert_memory_equal(&r, &records[i], sizeof r);
     }
     lbk_report_record r;
-    assert_int_equal(lbk_report_record_at(&v, 3, &r), LBK_ERR_NOT_FOUND);
+    assert_int_equal(lbk_report_record_get(&v, 3, &r), LBK_ERR_NOT_FOUND);
     assert_string_equal(lbk_bake_status_name(2), "time limit");
     assert_string_equal(lbk_bake_status_name(9), "unknown");
     issues c = validate_one(LBK_SECTION_REPT, b, n);
     assert_int_equal(c.count, 0);
     c = validate_sections(&(section){LBK_SECTION_REPT, b, n}, 1, 1); /* zstd */
     assert_int_equal(c.count, 0);
-    assert_int_equal(lbk_report_parse(b, n - 1, &v), LBK_ERR_TRUNCATED);
+    assert_int_equal(lbk_report_open(b, n - 1, &v), LBK_ERR_TRUNCATED);
     lbk_free(NULL, b);
 }
 
@@ -390,7 +390,7 @@ static void test_objects_round_trip(void **state)
     assert_int_equal(rd32(d + 16 + 40 + 0), 5); /* packed: second name after "crate" */
     assert_memory_equal(d + 16 + 120, "cratestatue \xe2\x98\x83sky", 18);
     lbk_objects_view v;
-    assert_int_equal(lbk_objects_parse(b, n, &v), LBK_OK);
+    assert_int_equal(lbk_objects_open(b, n, &v), LBK_OK);
     assert_int_equal(v.count, 3);
     for (uint32_t i = 0; i < 3; i++) {
         lbk_object o;
@@ -408,7 +408,7 @@ static void test_objects_round_trip(void **state)
     assert_int_equal(idx, 2);
     assert_int_equal(lbk_objects_find(&v, (lbk_string){"sk", 2}, &idx), LBK_ERR_NOT_FOUND);
     assert_string_equal(lbk_representation_name(1), "llg");
-    assert_int_equal(lbk_objects_parse(b, n - 1, &v), LBK_ERR_TRUNCATED);
+    assert_int_equal(lbk_objects_open(b, n - 1, &v), LBK_ERR_TRUNCATED);
     lbk_free(NULL, b);
 
     /* builder rejections */

@@ -133,7 +133,7 @@ static void lmap_round_trip_and_rules(void **state)
     assert_int_equal(v.page_count, 2);
     assert_int_equal(v.texel_count, 26);
     lbk_lmap_page pg;
-    assert_int_equal(lbk_lmap_get_page(&v, 1, &pg), LBK_OK);
+    assert_int_equal(lbk_lmap_page_get(&v, 1, &pg), LBK_OK);
     assert_int_equal(pg.width, 5);
     assert_int_equal(pg.first_texel, 6);
     assert_int_equal(pg.irradiance_offset, 144);
@@ -141,15 +141,15 @@ static void lmap_round_trip_and_rules(void **state)
     for (uint64_t i = 0; i < 26; i++) {
         lbk_ahd_texel t;
         uint32_t page;
-        assert_int_equal(lbk_lmap_texel(&v, i, &t, &page), LBK_OK);
+        assert_int_equal(lbk_lmap_texel_get(&v, i, &t, &page), LBK_OK);
         const lbk_ahd_texel *e = i < 6 ? &t0[i] : &t1[i - 6];
         assert_int_equal(page, i < 6 ? 0 : 1);
         assert_int_equal(t.irradiance_z, e->irradiance_z);
         assert_memory_equal(t.rgba, e->rgba, 4);
     }
     lbk_ahd_texel t;
-    assert_int_equal(lbk_lmap_texel(&v, 26, &t, NULL), LBK_ERR_RANGE);
-    assert_int_equal(lbk_lmap_page_texel(&pg, 5, 0, &t), LBK_ERR_RANGE);
+    assert_int_equal(lbk_lmap_texel_get(&v, 26, &t, NULL), LBK_ERR_RANGE);
+    assert_int_equal(lbk_lmap_page_texel_get(&pg, 5, 0, &t), LBK_ERR_RANGE);
     /* validator: clean, and the facts */
     issues is;
     lbk_vctx facts;
@@ -197,7 +197,7 @@ static void glg_fixture(uint32_t probes, void **out, size_t *size)
     memset(sh, 0, sizeof sh);
     for (int i = 0; i < 9; i++)
         for (int c = 0; c < 3; c++) sh[i].c[c][0] = 1.0f + (float)i;
-    lbk_glg_desc d = {probes, 6, cube_pos, sh, cube_tets, NULL, NULL, 0};
+    lbk_glg_build_desc d = {probes, 6, cube_pos, sh, cube_tets, NULL, NULL, 0};
     assert_int_equal(lbk_glg_build(&d, NULL, out, size), LBK_OK);
 }
 
@@ -219,9 +219,9 @@ static void glg_rules(void **state)
     assert_int_equal(lbk_glg_open(b, n, &v), LBK_OK);
     float p[3];
     lbk_sh9_rgb sh;
-    assert_int_equal(lbk_glg_probe(&v, 7, p, &sh), LBK_OK);
+    assert_int_equal(lbk_glg_probe_get(&v, 7, p, &sh), LBK_OK);
     assert_true(p[0] == 1.0f && p[1] == 1.0f && p[2] == 1.0f && sh.c[2][0] == 8.0f);
-    assert_int_equal(lbk_glg_probe(&v, 8, p, &sh), LBK_ERR_RANGE);
+    assert_int_equal(lbk_glg_probe_get(&v, 8, p, &sh), LBK_ERR_RANGE);
     uint8_t *c;
     expect_only(lbk_validate_glg, b, 31, 600);
     c = dup_bytes(b, n); c[20] = 1; expect_only(lbk_validate_glg, c, n, 601); free(c);
@@ -267,7 +267,7 @@ static void llg_fixture(void **out, size_t *size)
     memset(g, 0, sizeof g);
     for (int k = 0; k < 2; k++) {
         g[k].axes[0][0] = g[k].axes[1][1] = g[k].axes[2][2] = 1.0f;
-        g[k].half_extent[0] = g[k].half_extent[1] = g[k].half_extent[2] = 1.0f + (float)k;
+        g[k].half_extents[0] = g[k].half_extents[1] = g[k].half_extents[2] = 1.0f + (float)k;
         g[k].dims[0] = g[k].dims[1] = k ? 3 : 2;
         g[k].dims[2] = 3;
         g[k].probes = probes + (k ? 12 : 0);
@@ -295,11 +295,11 @@ static void llg_rules(void **state)
     lbk_llg_view v;
     assert_int_equal(lbk_llg_open(b, n, &v), LBK_OK);
     lbk_llg_grid g;
-    assert_int_equal(lbk_llg_get_grid(&v, 1, &g), LBK_OK);
+    assert_int_equal(lbk_llg_grid_get(&v, 1, &g), LBK_OK);
     assert_int_equal(g.probe_offset, 12);
     assert_int_equal(g.vertex_offset, 0);
     assert_int_equal(g.vertex_count, 3);
-    assert_true(g.half_extent[2] == 2.0f);
+    assert_true(g.half_extents[2] == 2.0f);
     const uint8_t *vx = v.vertices + 4;
     assert_int_equal(vx[0], 64); /* 0.25 · 255 = 63.75 → 64 */
     uint8_t *c;
@@ -383,7 +383,7 @@ static void octp_rules(void **state)
     assert_int_equal(n, 16 + 2048);
     lbk_octp_view v;
     assert_int_equal(lbk_octp_open(b, n, &v), LBK_OK);
-    assert_int_equal(lbk_octp_get(&v, 1, &back), LBK_OK);
+    assert_int_equal(lbk_octp_probe_get(&v, 1, &back), LBK_OK);
     assert_memory_equal(back.irradiance, pd[1].irradiance, sizeof back.irradiance);
     assert_memory_equal(back.position, pd[1].position, sizeof back.position);
     for (int i = 0; i < 144; i++) {
@@ -428,10 +428,10 @@ static void container_clean(void **state)
     octp_fixture(pd, &s[3], &n[3]);
     const uint32_t types[4] = {LBK_SECTION_LMAP, LBK_SECTION_GLG, LBK_SECTION_LLG, LBK_SECTION_OCTP};
     lbk_writer *w;
-    assert_int_equal(lbk_writer_create(NULL, &w), LBK_OK);
+    assert_int_equal(lbk_writer_open(NULL, &w), LBK_OK);
     for (int i = 0; i < 4; i++) {
         lbk_section_options o = {0, i == 1 ? LBK_COMPRESSION_ZSTD : LBK_COMPRESSION_NONE, 3};
-        assert_int_equal(lbk_writer_add_section(w, types[i], s[i], n[i], &o), LBK_OK);
+        assert_int_equal(lbk_writer_section_add(w, types[i], s[i], n[i], &o), LBK_OK);
     }
     void *file;
     size_t fsize;
@@ -447,7 +447,7 @@ static void container_clean(void **state)
     for (uint32_t id = 700; id <= 713; id++) assert_non_null(lbk_issue_template(id, NULL));
     for (uint32_t id = 1000; id <= 1009; id++) assert_non_null(lbk_issue_template(id, NULL));
     lbk_free(NULL, file);
-    lbk_writer_destroy(w);
+    lbk_writer_close(w);
     for (int i = 0; i < 4; i++) lbk_free(NULL, s[i]);
 }
 
@@ -471,7 +471,7 @@ static void scaled_sections(void **state)
     lbk_lmap_page pg;
     assert_int_equal(lbk_lmap_open(bs, ns, &lv), LBK_OK);
     assert_true(lv.scale == 0x1p-20f);
-    assert_int_equal(lbk_lmap_get_page(&lv, 0, &pg), LBK_OK);
+    assert_int_equal(lbk_lmap_page_get(&lv, 0, &pg), LBK_OK);
     assert_true(pg.scale == 0x1p-20f);
     const float nz[3] = {0, 0.6f, 0.8f};
     for (uint32_t i = 0; i < 6; i++) {
@@ -496,7 +496,7 @@ static void scaled_sections(void **state)
             sh[i].c[c][0] = 3e5f * (float)(i + 1) * (float)(c + 1);
             sh[i].c[c][3] = 1e5f * (float)(i + 1); /* within √3·DC */
         }
-    lbk_glg_desc d = {8, 6, cube_pos, sh, cube_tets, NULL, NULL, 0x1p8f};
+    lbk_glg_build_desc d = {8, 6, cube_pos, sh, cube_tets, NULL, NULL, 0x1p8f};
     void *gb;
     size_t gn;
     assert_int_equal(lbk_glg_build(&d, NULL, &gb, &gn), LBK_OK);
@@ -511,7 +511,7 @@ static void scaled_sections(void **state)
         lbk_sh9_pack(&want, packed);
         assert_memory_equal(gv.probes + LBK_SH9_PACKED_SIZE * i, packed, LBK_SH9_PACKED_SIZE);
         lbk_sh9_unpack(packed, &stored);
-        assert_int_equal(lbk_glg_probe(&gv, i, NULL, &got), LBK_OK);
+        assert_int_equal(lbk_glg_probe_get(&gv, i, NULL, &got), LBK_OK);
         for (int c = 0; c < 3; c++)
             for (int k = 0; k < 9; k++) assert_true(got.c[c][k] == stored.c[c][k] * 0x1p8f);
         /* RGB9E5 DC within 2^-9 of the largest channel (up to 7.2e6: far above 65408, the format maximum at scale 1) */
@@ -535,7 +535,7 @@ static void scaled_sections(void **state)
     lbk_llg_grid_desc g;
     memset(&g, 0, sizeof g);
     g.axes[0][0] = g.axes[1][1] = g.axes[2][2] = 1.0f;
-    g.half_extent[0] = g.half_extent[1] = g.half_extent[2] = 1.0f;
+    g.half_extents[0] = g.half_extents[1] = g.half_extents[2] = 1.0f;
     g.dims[0] = g.dims[1] = g.dims[2] = 2;
     g.probes = lp;
     g.vertices = &vert;
@@ -570,7 +570,7 @@ static void scaled_sections(void **state)
     lbk_octp_view ov;
     assert_int_equal(lbk_octp_open(ob, on, &ov), LBK_OK);
     assert_true(ov.scale == 0x1p20f);
-    assert_int_equal(lbk_octp_get(&ov, 1, &back), LBK_OK);
+    assert_int_equal(lbk_octp_probe_get(&ov, 1, &back), LBK_OK);
     assert_memory_equal(back.irradiance, pd[1].irradiance, sizeof back.irradiance);
     float dir[3], rgb[3];
     lbk_oct_texel_direction(4, 2, 1, dir);

@@ -55,12 +55,12 @@ int fixture_small_container(uint32_t alignment, void **out, size_t *size)
     lbk_write_options wo = {NULL, alignment};
     lbk_section_options zstd = {0, LBK_COMPRESSION_ZSTD, 3};
     if (fixture_meta(&meta, &meta_n) || fixture_report(&rept, &rept_n) || fixture_objects(&objs, &objs_n)) goto out;
-    if (lbk_writer_create(&wo, &w) != LBK_OK) goto out;
+    if (lbk_writer_open(&wo, &w) != LBK_OK) goto out;
     /* Added out of canonical order on purpose: the writer sorts. */
-    if (lbk_writer_add_section(w, LBK_FOURCC('X', 'T', 'R', 'A'), fixture_xtra, sizeof fixture_xtra, NULL) ||
-        lbk_writer_add_section(w, LBK_SECTION_OBJS, objs, objs_n, NULL) ||
-        lbk_writer_add_section(w, LBK_SECTION_REPT, rept, rept_n, &zstd) ||
-        lbk_writer_add_section(w, LBK_SECTION_META, meta, meta_n, NULL))
+    if (lbk_writer_section_add(w, LBK_FOURCC('X', 'T', 'R', 'A'), fixture_xtra, sizeof fixture_xtra, NULL) ||
+        lbk_writer_section_add(w, LBK_SECTION_OBJS, objs, objs_n, NULL) ||
+        lbk_writer_section_add(w, LBK_SECTION_REPT, rept, rept_n, &zstd) ||
+        lbk_writer_section_add(w, LBK_SECTION_META, meta, meta_n, NULL))
         goto out;
     void *bytes;
     if (lbk_writer_to_memory(w, &bytes, size) != LBK_OK) goto out;
@@ -69,7 +69,7 @@ int fixture_small_container(uint32_t alignment, void **out, size_t *size)
     lbk_free(NULL, bytes);
     rc = *out == NULL;
 out:
-    lbk_writer_destroy(w);
+    lbk_writer_close(w);
     lbk_free(NULL, meta);
     lbk_free(NULL, rept);
     lbk_free(NULL, objs);

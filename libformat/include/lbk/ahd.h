@@ -79,8 +79,8 @@ LBK_API void lbk_ahd_linear_add_light(lbk_ahd_linear *lin, const float dir[3], c
 LBK_API void lbk_ahd_linear_add_scaled(lbk_ahd_linear *dst, const lbk_ahd_linear *src, float w);
 
 /* The 8 bytes as the spec's texel view (u32 LE then RGBA) — for tools that keep texels packed. */
-LBK_API void lbk_ahd_texel_store(const lbk_ahd_texel *texel, uint8_t out[LBK_AHD_TEXEL_SIZE]);
-LBK_API void lbk_ahd_texel_load(const uint8_t in[LBK_AHD_TEXEL_SIZE], lbk_ahd_texel *texel);
+LBK_API void lbk_ahd_texel_pack(const lbk_ahd_texel *texel, uint8_t out[LBK_AHD_TEXEL_SIZE]);
+LBK_API void lbk_ahd_texel_unpack(const uint8_t in[LBK_AHD_TEXEL_SIZE], lbk_ahd_texel *texel);
 
 #ifdef __cplusplus
 }

@@ -75,9 +75,9 @@ LBK_API const lbk_header_info *lbk_reader_header(const lbk_reader *reader);
 /* The whole file as mapped / passed in. */
 LBK_API const void *lbk_reader_bytes(const lbk_reader *reader, size_t *size);
 LBK_API uint32_t lbk_reader_section_count(const lbk_reader *reader);
-LBK_API lbk_result lbk_reader_section_info(const lbk_reader *reader, uint32_t index, lbk_section_info *out);
+LBK_API lbk_result lbk_reader_section_get(const lbk_reader *reader, uint32_t index, lbk_section_info *out);
 /* Index of the section of a given type; LBK_ERR_NOT_FOUND if absent. */
-LBK_API lbk_result lbk_reader_find_section(const lbk_reader *reader, uint32_t type, uint32_t *index);
+LBK_API lbk_result lbk_reader_section_find(const lbk_reader *reader, uint32_t type, uint32_t *index);
 /* The decoded bytes of a section. Uncompressed sections are returned in place (zero copy, aligned
  * as the header says); zstd sections are decoded once and cached. Verifies the checksum of the
  * stored bytes on first access unless options->skip_checksums. The pointer lives as long as the
@@ -101,11 +101,11 @@ typedef struct lbk_section_options {
     int zstd_level;        /* 0: 19 */
 } lbk_section_options;
 
-LBK_API lbk_result lbk_writer_create(const lbk_write_options *options, lbk_writer **out);
-LBK_API void lbk_writer_destroy(lbk_writer *writer);
+LBK_API lbk_result lbk_writer_open(const lbk_write_options *options, lbk_writer **out);
+LBK_API void lbk_writer_close(lbk_writer *writer);
 /* Copies the bytes. Each type may be added once. Sections are written in the canonical order of
  * spec/container.md §3 regardless of the order they are added in, so output is deterministic. */
-LBK_API lbk_result lbk_writer_add_section(lbk_writer *writer, uint32_t type, const void *data, size_t size,
+LBK_API lbk_result lbk_writer_section_add(lbk_writer *writer, uint32_t type, const void *data, size_t size,
                                           const lbk_section_options *options);
 /* Serialises into one buffer allocated with the writer's allocator; free it with lbk_free. */
 LBK_API lbk_result lbk_writer_to_memory(lbk_writer *writer, void **out, size_t *size);

@@ -4,8 +4,8 @@
  *
  * Three parts:
  *   - the builder (lbk_dls_build): sets + sparse per-set entries → DLS section bytes;
- *   - the view (lbk_dls_view_open): a checked, read-only view of DLS section bytes;
- *   - the runtime (lbk_dls_runtime_create / lbk_dls_apply): final texels and probes for weights.
+ *   - the view (lbk_dls_open): a checked, read-only view of DLS section bytes;
+ *   - the runtime (lbk_dls_runtime_open / lbk_dls_apply): final texels and probes for weights.
  * Doors (lbk/door.h) are DLS sets of kinds 1–3 whose weights follow the door's opening. */
 #ifndef LBK_DLS_H
 #define LBK_DLS_H
@@ -29,7 +29,7 @@ typedef enum lbk_dls_set_kind {
  * page (as LMAP numbers them); GLG probes by GLG probe index; LLG probes by index into the
  * concatenated LLG probe array. */
 typedef enum lbk_dls_space {
-    LBK_DLS_SPACE_TEXEL = 0, /* payload: 8-byte AHD texel (lbk_ahd_texel_store layout) */
+    LBK_DLS_SPACE_TEXEL = 0, /* payload: 8-byte AHD texel (lbk_ahd_texel_pack layout) */
     LBK_DLS_SPACE_GLG = 1,   /* payload: 28-byte SH9 probe (lbk_sh9_pack layout) */
     LBK_DLS_SPACE_LLG = 2,   /* payload: 28-byte SH9 probe */
     LBK_DLS_SPACE_COUNT_
@@ -129,9 +129,9 @@ typedef struct lbk_dls_view lbk_dls_view;
 /* Checks every structural rule of spec/container.md §12 (the DLS rules of spec/validation.md
  * except the cross-section ones) and returns LBK_ERR_CORRUPT / LBK_ERR_TRUNCATED if any fails.
  * The bytes are not copied and must outlive the view. */
-LBK_API lbk_result lbk_dls_view_open(const void *data, size_t size, const lbk_allocator *allocator,
+LBK_API lbk_result lbk_dls_open(const void *data, size_t size, const lbk_allocator *allocator,
                                      lbk_dls_view **out);
-LBK_API void lbk_dls_view_close(lbk_dls_view *view);
+LBK_API void lbk_dls_close(lbk_dls_view *view);
 
 typedef struct lbk_dls_set_info {
     const char *name;       /* not NUL-terminated */
@@ -154,16 +154,16 @@ typedef struct lbk_dls_cluster_info {
 
 LBK_API uint32_t lbk_dls_set_count(const lbk_dls_view *view);
 LBK_API lbk_result lbk_dls_set_get(const lbk_dls_view *view, uint32_t set, lbk_dls_set_info *out);
-LBK_API lbk_result lbk_dls_set_light(const lbk_dls_view *view, uint32_t set, uint32_t i, const char **name,
+LBK_API lbk_result lbk_dls_set_light_get(const lbk_dls_view *view, uint32_t set, uint32_t i, const char **name,
                                      uint32_t *length);
-LBK_API lbk_result lbk_dls_set_member(const lbk_dls_view *view, uint32_t set, uint32_t i, uint32_t *member);
+LBK_API lbk_result lbk_dls_set_member_get(const lbk_dls_view *view, uint32_t set, uint32_t i, uint32_t *member);
 /* LBK_ERR_NOT_FOUND when no set has that name. */
-LBK_API lbk_result lbk_dls_find_set(const lbk_dls_view *view, const char *name, uint32_t *set);
+LBK_API lbk_result lbk_dls_set_find(const lbk_dls_view *view, const char *name, uint32_t *set);
 /* Target space sizes the section was built for. */
 LBK_API uint64_t lbk_dls_target_count(const lbk_dls_view *view, uint32_t space);
 LBK_API uint32_t lbk_dls_cluster_count(const lbk_dls_view *view);
 LBK_API lbk_result lbk_dls_cluster_get(const lbk_dls_view *view, uint32_t cluster, lbk_dls_cluster_info *out);
-LBK_API lbk_result lbk_dls_cluster_set(const lbk_dls_view *view, uint32_t cluster, uint32_t i, uint32_t *set);
+LBK_API lbk_result lbk_dls_cluster_set_get(const lbk_dls_view *view, uint32_t cluster, uint32_t i, uint32_t *set);
 
 /* Decodes a cluster target by target, in payload order: for each target its index, its entry
  * count, the set index of each entry and the entries' payloads (count × payload size, in set
@@ -173,7 +173,7 @@ typedef int (*lbk_dls_target_fn)(void *user, uint32_t target, uint32_t count, co
 LBK_API lbk_result lbk_dls_cluster_decode(const lbk_dls_view *view, uint32_t cluster, lbk_dls_target_fn fn,
                                           void *user);
 
-LBK_API lbk_result lbk_dls_compute_stats(const lbk_dls_view *view, lbk_dls_stats *out);
+LBK_API lbk_result lbk_dls_stats_get(const lbk_dls_view *view, lbk_dls_stats *out);
 
 /* ---- reference runtime ----------------------------------------------------------------- */
 
@@ -207,8 +207,8 @@ typedef struct lbk_dls_apply_stats {
 
 /* Checks that the views agree (door sets exist and have the right kinds) and that every needed
  * buffer is present. The views and buffers must outlive the runtime. */
-LBK_API lbk_result lbk_dls_runtime_create(const lbk_dls_runtime_desc *desc, lbk_dls_runtime **out);
-LBK_API void lbk_dls_runtime_destroy(lbk_dls_runtime *runtime);
+LBK_API lbk_result lbk_dls_runtime_open(const lbk_dls_runtime_desc *desc, lbk_dls_runtime **out);
+LBK_API void lbk_dls_runtime_close(lbk_dls_runtime *runtime);
 /* The next apply rewrites every target. */
 LBK_API void lbk_dls_runtime_invalidate(lbk_dls_runtime *runtime);
 

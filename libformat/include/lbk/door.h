@@ -44,9 +44,9 @@ typedef struct lbk_door_view lbk_door_view;
 
 /* Checks the structural rules of §13 (LBK_ERR_CORRUPT / LBK_ERR_TRUNCATED). The bytes must outlive
  * the view. */
-LBK_API lbk_result lbk_door_view_open(const void *data, size_t size, const lbk_allocator *allocator,
+LBK_API lbk_result lbk_door_open(const void *data, size_t size, const lbk_allocator *allocator,
                                       lbk_door_view **out);
-LBK_API void lbk_door_view_close(lbk_door_view *view);
+LBK_API void lbk_door_close(lbk_door_view *view);
 /* Cross-checks set indices and kinds against a DLS view (LBK_ERR_CORRUPT if they disagree). */
 LBK_API lbk_result lbk_door_check_dls(const lbk_door_view *doors, const lbk_dls_view *dls);
 
@@ -62,7 +62,7 @@ LBK_API lbk_result lbk_door_get(const lbk_door_view *view, uint32_t door, lbk_do
 LBK_API uint32_t lbk_door_state_count(const lbk_door_view *view);
 /* The state's doors (ascending) and its combination set. */
 LBK_API lbk_result lbk_door_state_get(const lbk_door_view *view, uint32_t state, uint32_t *door_count, uint32_t *set);
-LBK_API lbk_result lbk_door_state_door(const lbk_door_view *view, uint32_t state, uint32_t i, uint32_t *door);
+LBK_API lbk_result lbk_door_state_door_get(const lbk_door_view *view, uint32_t state, uint32_t i, uint32_t *door);
 
 #ifdef __cplusplus
 }

@@ -22,8 +22,8 @@ extern "C" {
 #define LBK_API
 #endif
 
-#define LBK_VERSION_MAJOR 1 /* container format major version written by this library */
-#define LBK_VERSION_MINOR 0 /* container format minor version written by this library */
+#define LBK_FORMAT_VERSION_MAJOR 1 /* container format major version written by this library */
+#define LBK_FORMAT_VERSION_MINOR 0 /* container format minor version written by this library */
 #define LBK_LIBRARY_VERSION_STRING "1.0.0"
 
 typedef enum lbk_result {

@@ -58,11 +58,11 @@ typedef struct lbk_lmap_page {
 } lbk_lmap_page;
 
 LBK_API lbk_result lbk_lmap_open(const void *data, size_t size, lbk_lmap_view *out);
-LBK_API lbk_result lbk_lmap_get_page(const lbk_lmap_view *view, uint32_t index, lbk_lmap_page *out);
+LBK_API lbk_result lbk_lmap_page_get(const lbk_lmap_view *view, uint32_t index, lbk_lmap_page *out);
 /* One texel of a page, encoded in stored units; x < width, y < height (LBK_ERR_RANGE otherwise). */
-LBK_API lbk_result lbk_lmap_page_texel(const lbk_lmap_page *page, uint32_t x, uint32_t y, lbk_ahd_texel *out);
+LBK_API lbk_result lbk_lmap_page_texel_get(const lbk_lmap_page *page, uint32_t x, uint32_t y, lbk_ahd_texel *out);
 /* A texel by its global index; also returns its page (optional). */
-LBK_API lbk_result lbk_lmap_texel(const lbk_lmap_view *view, uint64_t texel_index, lbk_ahd_texel *out,
+LBK_API lbk_result lbk_lmap_texel_get(const lbk_lmap_view *view, uint64_t texel_index, lbk_ahd_texel *out,
                                   uint32_t *page_out);
 /* Physical irradiance of texel (x, y) for the tangent-space unit normal n (lbk_ahd_irradiance
  * of the stored texel × the section's scale). */

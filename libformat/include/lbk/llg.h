@@ -44,7 +44,7 @@ typedef struct lbk_llg_vertex {
 typedef struct lbk_llg_grid_desc {
     float centre[3];
     float axes[3][3];       /* orthonormal rows: axis0, axis1, axis2 */
-    float half_extent[3];   /* > 0 */
+    float half_extents[3];   /* > 0 */
     uint32_t dims[3];       /* 2..64 each */
     const lbk_sh9_rgb *probes;        /* dims[0]·dims[1]·dims[2], i fastest */
     const lbk_llg_vertex *vertices;   /* vertex_count (may be 0) */
@@ -67,7 +67,7 @@ typedef struct lbk_llg_view {
 } lbk_llg_view;
 
 typedef struct lbk_llg_grid {
-    float centre[3], axes[3][3], half_extent[3];
+    float centre[3], axes[3][3], half_extents[3];
     uint32_t dims[3];
     uint64_t probe_offset, vertex_offset;
     uint32_t vertex_count;
@@ -75,12 +75,12 @@ typedef struct lbk_llg_grid {
 
 /* Structure only (sizes, offsets, reserved bytes); lbk_validate checks the frames. */
 LBK_API lbk_result lbk_llg_open(const void *data, size_t size, lbk_llg_view *out);
-LBK_API lbk_result lbk_llg_get_grid(const lbk_llg_view *view, uint32_t index, lbk_llg_grid *out);
+LBK_API lbk_result lbk_llg_grid_get(const lbk_llg_view *view, uint32_t index, lbk_llg_grid *out);
 LBK_API void lbk_llg_probe_position(const lbk_llg_grid *grid, uint32_t i, uint32_t j, uint32_t k, float out[3]);
 /* Trilinear physical radiance SH at world position p. */
 LBK_API lbk_result lbk_llg_sample(const lbk_llg_view *view, uint32_t grid, const float p[3], lbk_sh9_rgb *out);
-LBK_API void lbk_llg_vertex_encode(const lbk_llg_vertex *v, uint8_t out[4]);
-LBK_API void lbk_llg_vertex_decode(const uint8_t in[4], lbk_llg_vertex *v);
+LBK_API void lbk_llg_vertex_pack(const lbk_llg_vertex *v, uint8_t out[4]);
+LBK_API void lbk_llg_vertex_unpack(const uint8_t in[4], lbk_llg_vertex *v);
 /* E = V · E_sh(bent normal in world) at world position p for vertex `vertex` of grid `grid`. */
 LBK_API lbk_result lbk_llg_vertex_irradiance(const lbk_llg_view *view, uint32_t grid, uint32_t vertex, const float p[3],
                                              float rgb[3]);

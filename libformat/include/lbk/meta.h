@@ -40,8 +40,8 @@ typedef struct lbk_meta_view {
 
 /* Checks the sizes and that every string lies inside the blob (not the key rules: that is
  * lbk_validate's job), then fills the view. LBK_ERR_TRUNCATED / LBK_ERR_CORRUPT otherwise. */
-LBK_API lbk_result lbk_meta_parse(const void *data, size_t size, lbk_meta_view *out);
-LBK_API lbk_result lbk_meta_entry(const lbk_meta_view *view, uint32_t index, lbk_string *key, lbk_string *value);
+LBK_API lbk_result lbk_meta_open(const void *data, size_t size, lbk_meta_view *out);
+LBK_API lbk_result lbk_meta_entry_get(const lbk_meta_view *view, uint32_t index, lbk_string *key, lbk_string *value);
 /* The value of a key; LBK_ERR_NOT_FOUND if absent. */
 LBK_API lbk_result lbk_meta_find(const lbk_meta_view *view, const char *key, lbk_string *value);
 

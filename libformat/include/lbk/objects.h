@@ -42,7 +42,7 @@ typedef struct lbk_objects_view {
 } lbk_objects_view;
 
 /* Checks the sizes and that every name lies inside the blob, then fills the view. */
-LBK_API lbk_result lbk_objects_parse(const void *data, size_t size, lbk_objects_view *out);
+LBK_API lbk_result lbk_objects_open(const void *data, size_t size, lbk_objects_view *out);
 LBK_API lbk_result lbk_objects_get(const lbk_objects_view *view, uint32_t index, lbk_object *out);
 /* First object with this name; LBK_ERR_NOT_FOUND if none. */
 LBK_API lbk_result lbk_objects_find(const lbk_objects_view *view, lbk_string name, uint32_t *index);

@@ -20,7 +20,7 @@
  *
  * Scale (spec §5.7): the section header holds one f32 power of two; stored irradiance × scale =
  * physical irradiance. lbk_octp_build takes physical irradiance and divides before encoding;
- * lbk_octp_get and lbk_octp_irradiance return physical irradiance. Depth moments are unscaled. */
+ * lbk_octp_probe_get and lbk_octp_irradiance return physical irradiance. Depth moments are unscaled. */
 #ifndef LBK_OCTA_H
 #define LBK_OCTA_H
 
@@ -67,7 +67,7 @@ typedef struct lbk_octp_view {
 
 LBK_API lbk_result lbk_octp_open(const void *data, size_t size, lbk_octp_view *out);
 /* Decodes one probe's interior back into the builder form (physical irradiance). */
-LBK_API lbk_result lbk_octp_get(const lbk_octp_view *view, uint32_t index, lbk_octp_probe_desc *out);
+LBK_API lbk_result lbk_octp_probe_get(const lbk_octp_view *view, uint32_t index, lbk_octp_probe_desc *out);
 /* Bilinear physical irradiance lookup in direction dir (uses the border, never reads outside the probe). */
 LBK_API lbk_result lbk_octp_irradiance(const lbk_octp_view *view, uint32_t index, const float dir[3], float rgb[3]);
 

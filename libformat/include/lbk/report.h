@@ -52,13 +52,13 @@ LBK_API lbk_result lbk_report_build(const lbk_report *report, const lbk_allocato
 
 /* A read-only view: the header fields decoded, records read on demand. */
 typedef struct lbk_report_view {
-    lbk_report header;        /* records == NULL: use lbk_report_record_at */
+    lbk_report header;        /* records == NULL: use lbk_report_record_get */
     const uint8_t *record_bytes;
 } lbk_report_view;
 
 /* Checks the sizes (LBK_ERR_TRUNCATED / LBK_ERR_CORRUPT) and fills the view. */
-LBK_API lbk_result lbk_report_parse(const void *data, size_t size, lbk_report_view *out);
-LBK_API lbk_result lbk_report_record_at(const lbk_report_view *view, uint32_t index, lbk_report_record *out);
+LBK_API lbk_result lbk_report_open(const void *data, size_t size, lbk_report_view *out);
+LBK_API lbk_result lbk_report_record_get(const lbk_report_view *view, uint32_t index, lbk_report_record *out);
 
 /* "converged", "target reached", "time limit", "sample limit", or "unknown". */
 LBK_API const char *lbk_bake_status_name(uint32_t status);

@@ -46,7 +46,7 @@ LBK_API lbk_result lbk_validate_file(const char *path, const lbk_validate_option
 /* The registry: severity and message template of an ID; NULL if unknown. */
 LBK_API const char *lbk_issue_template(uint32_t id, lbk_severity *severity);
 /* Enumerates the registry: number of IDs, and the ID at a position (ascending; 0 past the end). */
-LBK_API uint32_t lbk_issue_registry_size(void);
+LBK_API uint32_t lbk_issue_registry_count(void);
 LBK_API uint32_t lbk_issue_registry_id(uint32_t index);
 /* Section type an ID belongs to (0: header and section table); 0 if unknown. */
 LBK_API uint32_t lbk_issue_section(uint32_t id);
