@@ -4,6 +4,7 @@
  * the clustered layout against its payload. Synthetic level at about the size of the seed's
  * ESTATE: 1M texels, 50k GLG and 20k LLG probes, 64 light sets with local footprints plus a
  * dense region where up to 16 sets overlap. */
+#define LBK_STATIC_LINKING_ONLY /* lbk_dls_stats: experimental (lbk/dls.h) */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -214,7 +215,7 @@ int main(void)
             payload_total += len;
         }
     }
-    lbk_dls_build_desc desc = {NSETS, sets, {T, G, L}};
+    lbk_dls_build_desc desc = {.set_count = NSETS, .sets = sets, .target_count = {T, G, L}};
     void *bytes;
     size_t size;
     lbk_dls_stats st;

@@ -73,7 +73,7 @@ static int known_type(uint32_t t)
 
 static void exercise(const uint8_t *data, size_t size)
 {
-    lbk_validate_options vo = {NULL, DECODE_CAP};
+    lbk_validate_options vo = {.max_decoded_bytes = DECODE_CAP};
     lbk_validate_summary s;
     size_t issues = 0;
     lbk_validate_memory(data, size, &vo, count_issue, &issues, &s);
@@ -82,7 +82,7 @@ static void exercise(const uint8_t *data, size_t size)
     /* The reader and the validator share the framing rules: a file the validator passes must
      * open and give every known section's bytes. */
     const int valid = s.fatal == 0 && s.errors == 0;
-    lbk_read_options ro = {NULL, DECODE_CAP, 0};
+    lbk_read_options ro = {.max_decoded_bytes = DECODE_CAP};
     lbk_reader *r;
     if (lbk_reader_open_memory(data, size, &ro, &r) != LBK_OK) {
         if (valid) abort();

@@ -56,11 +56,12 @@ static built build_three(uint32_t alignment, int reverse)
     fill(lmap, N_LMAP, 1);
     fill(glg, N_GLG, 2);
     fill(meta, N_META, 3);
-    lbk_write_options wo = {NULL, alignment};
+    lbk_write_options wo = {.section_alignment = alignment};
     lbk_writer *w;
     assert_int_equal(lbk_writer_open(&wo, &w), LBK_OK);
-    lbk_section_options z = {LBK_SECTION_FLAG_REQUIRED, LBK_COMPRESSION_ZSTD, 1};
-    lbk_section_options req = {LBK_SECTION_FLAG_REQUIRED, 0, 0};
+    lbk_section_options z = {.flags = LBK_SECTION_FLAG_REQUIRED, .compression = LBK_COMPRESSION_ZSTD,
+        .zstd_level = 1};
+    lbk_section_options req = {.flags = LBK_SECTION_FLAG_REQUIRED};
     if (reverse) {
         assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_GLG, glg, N_GLG, &z), LBK_OK);
         assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_LMAP, lmap, N_LMAP, &req), LBK_OK);
@@ -173,7 +174,7 @@ static void test_every_alignment(void **state)
         lbk_free(NULL, b.bytes);
     }
     lbk_writer *w;
-    lbk_write_options bad = {NULL, 8};
+    lbk_write_options bad = {.section_alignment = 8};
     assert_int_equal(lbk_writer_open(&bad, &w), LBK_ERR_INVALID_ARGUMENT);
     bad.section_alignment = 96;
     assert_int_equal(lbk_writer_open(&bad, &w), LBK_ERR_INVALID_ARGUMENT);
@@ -250,7 +251,7 @@ static void test_reader_rejections(void **state)
     uint64_t lmap_off = rd64(f + 64 + 48 + 16);
     f[lmap_off + 100] ^= 0x10; /* payload byte */
     assert_int_equal(open_copy(f, b.size), LBK_ERR_CHECKSUM);
-    lbk_read_options skip = {NULL, 0, 1};
+    lbk_read_options skip = {.skip_checksums = 1};
     lbk_reader *r;
     assert_int_equal(lbk_reader_open_memory(f, b.size, &skip, &r), LBK_OK);
     const void *d;
@@ -273,7 +274,7 @@ static void test_unknown_sections(void **state)
     for (int required = 0; required < 2; required++) {
         lbk_writer *w;
         assert_int_equal(lbk_writer_open(NULL, &w), LBK_OK);
-        lbk_section_options o = {required ? LBK_SECTION_FLAG_REQUIRED : 0, 0, 0};
+        lbk_section_options o = {.flags = required ? LBK_SECTION_FLAG_REQUIRED : 0};
         fill(lmap, N_LMAP, 9);
         assert_int_equal(lbk_writer_section_add(w, LBK_FOURCC('Z', 'Z', 'Z', 'Z'), x, sizeof x, &o), LBK_OK);
         assert_int_equal(lbk_writer_section_add(w, LBK_FOURCC('A', 'N', 'E', 'W'), x, 10, NULL), LBK_OK);
@@ -335,7 +336,7 @@ static built zeros_bomb(size_t decoded)
     assert_non_null(z);
     lbk_writer *w;
     assert_int_equal(lbk_writer_open(NULL, &w), LBK_OK);
-    lbk_section_options o = {0, LBK_COMPRESSION_ZSTD, 1};
+    lbk_section_options o = {.compression = LBK_COMPRESSION_ZSTD, .zstd_level = 1};
     assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_LMAP, z, decoded, &o), LBK_OK);
     free(z);
     built b;
@@ -352,7 +353,7 @@ static void test_decoded_cap_stops_bomb(void **state)
     assert_true(b.size < 4096);
     counting c = {0};
     lbk_allocator a = {c_alloc, c_free, &c};
-    lbk_read_options ro = {&a, (uint64_t)1 << 20, 0};
+    lbk_read_options ro = {.allocator = &a, .max_decoded_bytes = (uint64_t)1 << 20};
     lbk_reader *r;
     assert_int_equal(lbk_reader_open_memory(b.bytes, b.size, &ro, &r), LBK_OK);
     const void *d;
@@ -361,7 +362,7 @@ static void test_decoded_cap_stops_bomb(void **state)
     assert_true(c.peak_single < ((size_t)1 << 20)); /* refused before allocating */
     lbk_reader_close(r);
     assert_int_equal(c.live_bytes, 0);
-    lbk_validate_options vo = {NULL, (uint64_t)1 << 20};
+    lbk_validate_options vo = {.max_decoded_bytes = (uint64_t)1 << 20};
     lbk_validate_summary s;
     assert_int_equal(lbk_validate_memory(b.bytes, b.size, &vo, NULL, NULL, &s), LBK_OK);
     assert_int_equal(s.errors, 1); /* 217 */
@@ -391,11 +392,11 @@ static void test_allocator_hooks(void **state)
     (void)state;
     counting c = {0};
     lbk_allocator a = {c_alloc, c_free, &c};
-    lbk_write_options wo = {&a, 0};
+    lbk_write_options wo = {.allocator = &a};
     lbk_writer *w;
     fill(glg, N_GLG, 4);
     assert_int_equal(lbk_writer_open(&wo, &w), LBK_OK);
-    lbk_section_options z = {0, LBK_COMPRESSION_ZSTD, 3};
+    lbk_section_options z = {.compression = LBK_COMPRESSION_ZSTD, .zstd_level = 3};
     assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_GLG, glg, N_GLG, &z), LBK_OK);
     size_t after_add = c.allocs;
     assert_true(after_add >= 3); /* writer, zstd context (through the hook), stored bytes */
@@ -406,7 +407,7 @@ static void test_allocator_hooks(void **state)
     assert_true(c.allocs > after_add);
     assert_int_equal(c.live_bytes, size); /* only the returned buffer is still alive */
 
-    lbk_read_options ro = {&a, 0, 0};
+    lbk_read_options ro = {.allocator = &a};
     lbk_reader *r;
     size_t before_read = c.allocs;
     assert_int_equal(lbk_reader_open_memory(bytes, size, &ro, &r), LBK_OK);
@@ -416,7 +417,7 @@ static void test_allocator_hooks(void **state)
     assert_memory_equal(d, glg, N_GLG);
     assert_true(c.allocs >= before_read + 3); /* reader, decoded bytes, zstd context */
     lbk_reader_close(r);
-    lbk_validate_options vo = {&a, 0};
+    lbk_validate_options vo = {.allocator = &a};
     lbk_validate_summary s;
     size_t before_validate = c.allocs;
     assert_int_equal(lbk_validate_memory(bytes, size, &vo, NULL, NULL, &s), LBK_OK);
@@ -437,7 +438,7 @@ static void test_writer_arguments(void **state)
     assert_int_equal(lbk_writer_to_memory(w, &bytes, &size), LBK_ERR_INVALID_ARGUMENT); /* no sections */
     assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_META, x, 0, NULL), LBK_ERR_INVALID_ARGUMENT);
     assert_int_equal(lbk_writer_section_add(w, LBK_FOURCC('A', 'B', '\n', 'D'), x, 4, NULL), LBK_ERR_INVALID_ARGUMENT);
-    lbk_section_options bad_flags = {0x2, 0, 0}, bad_comp = {0, 2, 0};
+    lbk_section_options bad_flags = {.flags = 0x2}, bad_comp = {.compression = 2};
     assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_META, x, 4, &bad_flags), LBK_ERR_INVALID_ARGUMENT);
     assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_META, x, 4, &bad_comp), LBK_ERR_INVALID_ARGUMENT);
     assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_META, x, 4, NULL), LBK_OK);
@@ -465,8 +466,9 @@ static void test_atomic_file_write(void **state)
     built b = build_three(0, 0);
     lbk_writer *w;
     assert_int_equal(lbk_writer_open(NULL, &w), LBK_OK);
-    lbk_section_options z = {LBK_SECTION_FLAG_REQUIRED, LBK_COMPRESSION_ZSTD, 1};
-    lbk_section_options req = {LBK_SECTION_FLAG_REQUIRED, 0, 0};
+    lbk_section_options z = {.flags = LBK_SECTION_FLAG_REQUIRED, .compression = LBK_COMPRESSION_ZSTD,
+        .zstd_level = 1};
+    lbk_section_options req = {.flags = LBK_SECTION_FLAG_REQUIRED};
     assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_META, meta, N_META, NULL), LBK_OK);
     assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_LMAP, lmap, N_LMAP, &req), LBK_OK);
     assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_GLG, glg, N_GLG, &z), LBK_OK);

@@ -97,7 +97,7 @@ static size_t flip_payload(uint32_t type, const uint8_t *payload, size_t n, int 
             p[byte] ^= (uint8_t)(1u << bit);
             lbk_writer *w;
             assert_int_equal(lbk_writer_open(NULL, &w), LBK_OK);
-            lbk_section_options o = {0, zstd ? LBK_COMPRESSION_ZSTD : 0, 1};
+            lbk_section_options o = {.compression = zstd ? LBK_COMPRESSION_ZSTD : 0, .zstd_level = 1};
             assert_int_equal(lbk_writer_section_add(w, type, p, n, &o), LBK_OK);
             void *bytes;
             size_t size;

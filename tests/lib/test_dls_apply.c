@@ -2,6 +2,7 @@
  * encode) within the codecs' quantisation on random sets and random weights; incremental applies
  * that skip unchanged clusters give the bytes of a full apply; all-zero weights give exactly the
  * base; a set without entries adds no data; door weights drive kinds 1–3. */
+#define LBK_STATIC_LINKING_ONLY /* lbk_dls_stats: experimental (lbk/dls.h) */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -385,7 +386,7 @@ static void test_door_weights(void **state)
                           .closed_set = 2};
     uint32_t door0 = 0;
     lbk_door_state_desc state0 = {1, &door0, 3};
-    lbk_door_build_desc dd = {1, &door, 1, &state0};
+    lbk_door_build_desc dd = {.door_count = 1, .doors = &door, .state_count = 1, .states = &state0};
     void *db;
     size_t dsize;
     assert_int_equal(lbk_door_build(&dd, NULL, &db, &dsize), LBK_OK);

@@ -33,7 +33,7 @@ static int build_golden(const char *name, void **out, size_t *size)
     void *meta, *objs, *bytes;
     size_t mn, on;
     if (fixture_meta(&meta, &mn) || fixture_objects(&objs, &on)) return 1;
-    lbk_write_options wo = {NULL, 16};
+    lbk_write_options wo = {.section_alignment = 16};
     lbk_writer *w;
     int rc = lbk_writer_open(&wo, &w) != LBK_OK || lbk_writer_section_add(w, LBK_SECTION_OBJS, objs, on, NULL) ||
              lbk_writer_section_add(w, LBK_SECTION_META, meta, mn, NULL) ||

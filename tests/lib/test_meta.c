@@ -77,7 +77,7 @@ static issues validate_sections(const section *s, size_t n, int zstd)
 {
     lbk_writer *w;
     assert_int_equal(lbk_writer_open(NULL, &w), LBK_OK);
-    lbk_section_options o = {0, zstd ? LBK_COMPRESSION_ZSTD : 0, 1};
+    lbk_section_options o = {.compression = zstd ? LBK_COMPRESSION_ZSTD : 0, .zstd_level = 1};
     for (size_t i = 0; i < n; i++) assert_int_equal(lbk_writer_section_add(w, s[i].type, s[i].data, s[i].size, &o), LBK_OK);
     void *bytes;
     size_t size;
@@ -250,7 +250,8 @@ static const lbk_report_record records[3] = {
 static void test_report_round_trip(void **state)
 {
     (void)state;
-    lbk_report rep = {LBK_BAKE_TARGET_REACHED, LBK_REPORT_HAS_TIMES, 64, 600.0, 0.1f, records, 3};
+    lbk_report rep = {.status = LBK_BAKE_TARGET_REACHED, .flags = LBK_REPORT_HAS_TIMES, .max_samples_per_texel = 64,
+        .time_limit_seconds = 600.0, .target_rel_rmse = 0.1f, .records = records, .record_count = 3};
     void *b;
     size_t n;
     assert_int_equal(lbk_report_build(&rep, NULL, &b, &n), LBK_OK);
@@ -289,7 +290,7 @@ static void test_report_builder_rejects(void **state)
     void *b;
     size_t n;
     lbk_report_record rr[2] = {records[0], records[1]};
-    lbk_report rep = {LBK_BAKE_CONVERGED, LBK_REPORT_HAS_TIMES, 0, 0, 0, rr, 2};
+    lbk_report rep = {.status = LBK_BAKE_CONVERGED, .flags = LBK_REPORT_HAS_TIMES, .records = rr, .record_count = 2};
     assert_int_equal(lbk_report_build(&rep, NULL, &b, &n), LBK_OK);
     lbk_free(NULL, b);
     rep.flags = 0; /* times present but not declared */
@@ -313,7 +314,7 @@ static void test_report_builder_rejects(void **state)
     assert_int_equal(lbk_report_build(&rep, NULL, &b, &n), LBK_ERR_INVALID_ARGUMENT);
     /* -0 is written as +0: one encoding per value */
     lbk_report_record z = {-0.0, 0, 0, 0, -0.0f, 0};
-    lbk_report rz = {LBK_BAKE_CONVERGED, 0, 0, -0.0, 0, &z, 1};
+    lbk_report rz = {.status = LBK_BAKE_CONVERGED, .time_limit_seconds = -0.0, .records = &z, .record_count = 1};
     assert_int_equal(lbk_report_build(&rz, NULL, &b, &n), LBK_OK);
     for (size_t i = 0; i < n; i++)
         if (i != 8) assert_int_equal(((uint8_t *)b)[i], 0); /* byte 8: record_count = 1 */
@@ -323,7 +324,8 @@ static void test_report_builder_rejects(void **state)
 static void test_report_validator_rules(void **state)
 {
     (void)state;
-    lbk_report rep = {LBK_BAKE_TARGET_REACHED, LBK_REPORT_HAS_TIMES, 64, 600.0, 0.1f, records, 3};
+    lbk_report rep = {.status = LBK_BAKE_TARGET_REACHED, .flags = LBK_REPORT_HAS_TIMES, .max_samples_per_texel = 64,
+        .time_limit_seconds = 600.0, .target_rel_rmse = 0.1f, .records = records, .record_count = 3};
     void *b;
     size_t n;
     assert_int_equal(lbk_report_build(&rep, NULL, &b, &n), LBK_OK);
@@ -463,12 +465,13 @@ static void build_lmap_llg(void **lmap, size_t *lmap_n, void **llg, size_t *llg_
     static lbk_ahd_texel texels[16 * 8];
     for (int i = 0; i < 16 * 8; i++) texels[i] = (lbk_ahd_texel){0, {255, 128, 128, 255}};
     lbk_lmap_page_desc pages[2] = {{16, 8, texels}, {4, 4, texels}};
-    assert_int_equal(lbk_lmap_build(pages, 2, 0, NULL, lmap, lmap_n), LBK_OK);
+    assert_int_equal(lbk_lmap_build(&(lbk_lmap_build_desc){.pages = pages,
+        .page_count = 2}, NULL, lmap, lmap_n), LBK_OK);
     static lbk_sh9_rgb probes[8];
     memset(probes, 0, sizeof probes);
     lbk_llg_grid_desc g = {{0, 0, 0}, {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {1, 1, 1}, {2, 2, 2}, probes, NULL, 0};
     lbk_llg_grid_desc grids[2] = {g, g};
-    assert_int_equal(lbk_llg_build(grids, 2, 0, NULL, llg, llg_n), LBK_OK);
+    assert_int_equal(lbk_llg_build(&(lbk_llg_build_desc){.grids = grids, .grid_count = 2}, NULL, llg, llg_n), LBK_OK);
 }
 
 static void test_objects_validator_rules(void **state)
