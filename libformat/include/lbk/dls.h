@@ -65,7 +65,8 @@ typedef enum lbk_dls_form {
 /* ---- building -------------------------------------------------------------------------- */
 
 /* One set's entries in one target space. targets: distinct indices < the space's target count,
- * in any order; payloads: count × payload size (8 or 28 bytes), entry i for targets[i]. */
+ * in any order; payloads: count × payload size (8 or 28 bytes), entry i for targets[i].
+ * lbk_dls_sparse and lbk_dls_set_desc are array elements (frozen). */
 typedef struct lbk_dls_sparse {
     uint64_t count;
     const uint32_t *targets;

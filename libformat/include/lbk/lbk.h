@@ -44,8 +44,8 @@
  *   lbk_allocator are frozen within a major version: growth comes as new functions or structs.
  * Experimental. Declarations under `#ifdef LBK_STATIC_LINKING_ONLY` (the DLS builder's tuning
  *   and statistics) may change in any release; use them only when linking liblbk statically.
- * Versions. LBK_LIBRARY_VERSION_* describe this library's API (semantic versioning; the soname
- *   follows the major; lbk.pc takes its Version from here); lbk_version_number() and
+ * Versions. LBK_LIBRARY_VERSION_* describe this library's API (semantic versioning; the soname is
+ *   liblbk.so.<major>; lbk.pc takes its Version from here); lbk_version_number() and
  *   lbk_version_string() report the library linked at run time. LBK_FORMAT_VERSION_* are the
  *   container format version this library writes and the newest it reads: a separate number.
  * Thread safety. Every header says what holds for its functions. No function keeps hidden
