@@ -58,11 +58,11 @@ static int load_texels(const char *path, texels *t)
             for (uint64_t i = 0; i < v.texel_count; i++) {
                 lbk_ahd_texel tx;
                 float rgb[3];
-                if (lbk_lmap_texel(&v, i, &tx, NULL)) {
+                if (lbk_lmap_texel_get(&v, i, &tx, NULL)) {
                     rc = -1;
                     break;
                 }
-                lbk_unpack_r11g11b10f(tx.irradiance_z, rgb);
+                lbk_r11g11b10f_unpack(tx.irradiance_z, rgb);
                 t->lum[i] = lum(rgb);
             }
         }

@@ -3,6 +3,7 @@
  * ancillary bytes (cluster records, set lists, runs, prefix data, names), the share of texels
  * the sparse storage kept, and the bake time of the sets against the base bake, measured in
  * this run. The seed reports about 132 KB of ancillary data for its largest map. */
+#define LBK_STATIC_LINKING_ONLY /* lbk_dls_stats: experimental (lbk/dls.h) */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -62,9 +63,9 @@ static int run(const level *lv, const char *dir)
     memset(&st, 0, sizeof st);
     if (lbk_reader_section_by_type(rd, LBK_SECTION_DLS, &d, &n) == LBK_OK) {
         lbk_dls_view *v;
-        if (lbk_dls_view_open(d, n, NULL, &v) == LBK_OK) {
-            lbk_dls_compute_stats(v, &st);
-            lbk_dls_view_close(v);
+        if (lbk_dls_open(d, n, NULL, &v) == LBK_OK) {
+            lbk_dls_stats_get(v, &st);
+            lbk_dls_close(v);
         }
     }
     lbk_reader_close(rd);
@@ -136,7 +137,7 @@ static int bake_open(const char *dir, const char *name, const ds_options *o, int
     out->lum = malloc(out->n * sizeof *out->lum);
     for (uint64_t i = 0; i < out->n; i++) {
         lbk_ahd_texel t;
-        lbk_lmap_texel(&lm, i, &t, NULL);
+        lbk_lmap_texel_get(&lm, i, &t, NULL);
         z[i] = t.irradiance_z;
         memcpy(&rgba[4 * i], t.rgba, 4);
     }
@@ -146,7 +147,7 @@ static int bake_open(const char *dir, const char *name, const ds_options *o, int
     lbk_door_view *door = NULL;
     if (lbk_reader_section_by_type(rd, LBK_SECTION_DLS, &dd, &dn) == LBK_OK &&
         lbk_reader_section_by_type(rd, LBK_SECTION_DOOR, &doord, &doorn) == LBK_OK &&
-        lbk_dls_view_open(dd, dn, NULL, &dv) == LBK_OK && lbk_door_view_open(doord, doorn, NULL, &door) == LBK_OK) {
+        lbk_dls_open(dd, dn, NULL, &dv) == LBK_OK && lbk_door_open(doord, doorn, NULL, &door) == LBK_OK) {
         uint64_t ng = lbk_dls_target_count(dv, LBK_DLS_SPACE_GLG), nl = lbk_dls_target_count(dv, LBK_DLS_SPACE_LLG);
         uint8_t *bg = calloc(ng + 1, 28), *og = calloc(ng + 1, 28), *bl = calloc(nl + 1, 28), *ol = calloc(nl + 1, 28);
         lbk_dls_runtime_desc rd2;
@@ -156,17 +157,17 @@ static int bake_open(const char *dir, const char *name, const ds_options *o, int
         rd2.out_llg = ol;
         lbk_dls_runtime *rt;
         float w[64] = {0}, dw[8] = {1, 1, 1, 1, 1, 1, 1, 1};
-        if (lbk_dls_runtime_create(&rd2, &rt) == LBK_OK) {
+        if (lbk_dls_runtime_open(&rd2, &rt) == LBK_OK) {
             lbk_dls_apply(rt, w, dw, NULL);
-            lbk_dls_runtime_destroy(rt);
+            lbk_dls_runtime_close(rt);
             memcpy(z, oz, out->n * 4);
             memcpy(rgba, orgba, out->n * 4);
         }
         free(bg), free(og), free(bl), free(ol);
     }
     for (uint64_t i = 0; i < out->n; i++) out->lum[i] = texel_lum(z[i], &rgba[4 * i]);
-    if (door) lbk_door_view_close(door);
-    if (dv) lbk_dls_view_close(dv);
+    if (door) lbk_door_close(door);
+    if (dv) lbk_dls_close(dv);
     lbk_reader_close(rd);
     unlink(path);
     free(z), free(oz), free(rgba), free(orgba);

@@ -498,7 +498,9 @@ static lbk_result build_lmap(bake *b, section_list *sl)
     }
     void *data;
     size_t size;
-    r = lbk_lmap_build(desc, (uint32_t)tx->page_count, scale, NULL, &data, &size);
+    const lbk_lmap_build_desc bd = {
+        .size = sizeof bd, .pages = desc, .page_count = (uint32_t)tx->page_count, .scale = scale};
+    r = lbk_lmap_build(&bd, NULL, &data, &size);
     r = sections_add(sl, LBK_SECTION_LMAP, r, data, size);
 done:
     if (pages)
@@ -517,8 +519,7 @@ static lbk_result build_glg(bake *b, section_list *sl)
     }
     bk_glg_visibility_unorm8(&b->glg, vis);
     for (size_t i = 0; i < b->glg.probe_count; i++) to_world(b, &b->glg.positions[3 * i], world[i]);
-    lbk_glg_desc d;
-    memset(&d, 0, sizeof d);
+    lbk_glg_build_desc d = LBK_GLG_BUILD_DESC_INIT;
     d.probe_count = (uint32_t)b->glg.probe_count;
     d.tetra_count = (uint32_t)b->glg.tet_count;
     d.positions = (const float(*)[3])world;
@@ -560,7 +561,9 @@ static lbk_result build_octp(bake *b, section_list *sl)
             for (int c = 0; c < 3; c++)
                 if (p[i].irradiance[t][c] > m && isfinite(p[i].irradiance[t][c])) m = p[i].irradiance[t][c];
     b->octp_scale = bk_scale_for(m);
-    lbk_result r = lbk_octp_build(p, (uint32_t)b->glg.probe_count, b->octp_scale, NULL, &data, &size);
+    const lbk_octp_build_desc bd = {
+        .size = sizeof bd, .probes = p, .probe_count = (uint32_t)b->glg.probe_count, .scale = b->octp_scale};
+    lbk_result r = lbk_octp_build(&bd, NULL, &data, &size);
     free(p);
     return sections_add(sl, LBK_SECTION_OCTP, r, data, size);
 }
@@ -576,7 +579,7 @@ static lbk_result build_llg(bake *b, section_list *sl)
         const bk_llg *l = &b->llgs[i];
         to_world(b, l->centre, g[i].centre);
         memcpy(g[i].axes, l->axes, sizeof g[i].axes);
-        memcpy(g[i].half_extent, l->half_extents, sizeof g[i].half_extent);
+        memcpy(g[i].half_extents, l->half_extents, sizeof g[i].half_extents);
         memcpy(g[i].dims, l->dims, sizeof g[i].dims);
         g[i].probes = &b->radiance[probe];
         probe += bk_llg_probe_count(l);
@@ -591,7 +594,9 @@ static lbk_result build_llg(bake *b, section_list *sl)
     double set_max[3];
     bk_set_bakes_max(&b->sets, set_max);
     b->scale[2] = bk_scale_for(fmax(bk_probe_max(&b->radiance[b->llg_first], b->receiver_count - b->llg_first), set_max[2]));
-    r = lbk_llg_build(g, (uint32_t)b->llg_count, b->scale[2], NULL, &data, &size);
+    const lbk_llg_build_desc bd = {.size = sizeof bd, .grids = g, .grid_count = (uint32_t)b->llg_count,
+        .scale = b->scale[2]};
+    r = lbk_llg_build(&bd, NULL, &data, &size);
     r = sections_add(sl, LBK_SECTION_LLG, r, data, size);
 done:
     if (verts)
@@ -750,8 +755,7 @@ static lbk_result build_report(bake *b, section_list *sl)
         if (i > 0 && rec[i].rays_traced < rec[i - 1].rays_traced) rec[i].rays_traced = rec[i - 1].rays_traced;
     }
     if (b->sample_count) rec[b->sample_count - 1].rays_traced = b->stats.rays;
-    lbk_report rp;
-    memset(&rp, 0, sizeof rp);
+    lbk_report rp = LBK_REPORT_INIT;
     rp.status = bake_status(b);
     rp.max_samples_per_texel = (uint32_t)(b->opt->max_samples > 0 ? b->opt->max_samples : b->pre->max_samples);
     /* Passes double their samples, so the budget stops the bake at the last pass that fits in it:
@@ -792,23 +796,22 @@ static int do_encode_and_write(bake *b, bk_bake_summary *sum)
     }
     bk_progress_update(b->progress, 0.5);
     lbk_writer *w = NULL;
-    if (!r) r = lbk_writer_create(NULL, &w);
+    if (!r) r = lbk_writer_open(NULL, &w);
     for (int i = 0; !r && i < sl.count; i++) {
-        lbk_section_options so;
-        memset(&so, 0, sizeof so);
+        lbk_section_options so = LBK_SECTION_OPTIONS_INIT;
         /* Lighting payloads stay uncompressed so a runtime can upload them in place; `lbk
          * convert` makes compressed packs. The small CPU-side tables are required to read them. */
         if (sl.type[i] == LBK_SECTION_OBJS || sl.type[i] == LBK_SECTION_DLS || sl.type[i] == LBK_SECTION_DOOR)
             so.flags = LBK_SECTION_FLAG_REQUIRED;
-        r = lbk_writer_add_section(w, sl.type[i], sl.data[i], sl.size[i], &so);
+        r = lbk_writer_section_add(w, sl.type[i], sl.data[i], sl.size[i], &so);
     }
     sections_free(&sl);
     if (r) {
-        lbk_writer_destroy(w);
+        lbk_writer_close(w);
         return fail(b, LBK_EXIT_INTERNAL, "encoding the container: %s", lbk_result_message(r));
     }
     r = lbk_writer_to_file(w, b->opt->output);
-    lbk_writer_destroy(w);
+    lbk_writer_close(w);
     if (r) return fail(b, LBK_EXIT_IO, "writing %s: %s", b->opt->output, lbk_result_message(r));
     FILE *f = fopen(b->opt->output, "rb");
     if (f) {

@@ -950,7 +950,7 @@ lbk_result bk_set_bakes_sections(bk_set_bakes *sets, const bk_set_inputs *in, vo
                     lbk_ahd_linear_add_scaled(&l, (const lbk_ahd_linear *)st->values[s] + i, inv);
                     lbk_ahd_texel t;
                     lbk_ahd_from_linear(&l, &t);
-                    lbk_ahd_texel_store(&t, e + stride * i);
+                    lbk_ahd_texel_pack(&t, e + stride * i);
                 } else {
                     lbk_sh9_rgb sh;
                     memset(&sh, 0, sizeof sh);
@@ -973,8 +973,7 @@ lbk_result bk_set_bakes_sections(bk_set_bakes *sets, const bk_set_inputs *in, vo
             sd[j].entries[s].payloads = enc[j * LBK_DLS_SPACE_COUNT_ + (size_t)s];
         }
     }
-    lbk_dls_build_desc bd;
-    memset(&bd, 0, sizeof bd);
+    lbk_dls_build_desc bd = LBK_DLS_BUILD_DESC_INIT;
     bd.set_count = (uint32_t)im->set_count;
     bd.sets = sd;
     const bk_texels *tx = in->texels;
@@ -1017,8 +1016,7 @@ lbk_result bk_set_bakes_sections(bk_set_bakes *sets, const bk_set_inputs *in, vo
         states[c].doors = &state_doors[2 * c];
         states[c].set = co->set;
     }
-    lbk_door_build_desc db;
-    memset(&db, 0, sizeof db);
+    lbk_door_build_desc db = LBK_DOOR_BUILD_DESC_INIT;
     db.door_count = (uint32_t)im->door_count;
     db.doors = dd;
     db.state_count = (uint32_t)im->combo_count;

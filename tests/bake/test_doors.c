@@ -96,13 +96,13 @@ static void bake_one(baked *b, const char *name, const ds_options *o, uint64_t s
     b->base_rgba = malloc(b->texels * 4);
     for (uint64_t i = 0; i < b->texels; i++) {
         lbk_ahd_texel t;
-        assert_int_equal(lbk_lmap_texel(&b->lmap, i, &t, NULL), LBK_OK);
+        assert_int_equal(lbk_lmap_texel_get(&b->lmap, i, &t, NULL), LBK_OK);
         b->base_z[i] = t.irradiance_z;
         memcpy(&b->base_rgba[4 * i], t.rgba, 4);
     }
     lbk_objects_view ov;
     assert_int_equal(lbk_reader_section_by_type(b->rd, LBK_SECTION_OBJS, &d, &n), LBK_OK);
-    assert_int_equal(lbk_objects_parse(d, n, &ov), LBK_OK);
+    assert_int_equal(lbk_objects_open(d, n, &ov), LBK_OK);
     uint32_t idx;
     lbk_string room = {"Room", 4};
     assert_int_equal(lbk_objects_find(&ov, room, &idx), LBK_OK);
@@ -113,18 +113,18 @@ static void bake_one(baked *b, const char *name, const ds_options *o, uint64_t s
     const void *dd;
     size_t dn;
     if (lbk_reader_section_by_type(b->rd, LBK_SECTION_DLS, &dd, &dn) == LBK_OK) {
-        assert_int_equal(lbk_dls_view_open(dd, dn, NULL, &b->dls), LBK_OK);
+        assert_int_equal(lbk_dls_open(dd, dn, NULL, &b->dls), LBK_OK);
         b->glg_count = (uint32_t)lbk_dls_target_count(b->dls, LBK_DLS_SPACE_GLG);
         b->llg_count = (uint32_t)lbk_dls_target_count(b->dls, LBK_DLS_SPACE_LLG);
     }
     if (lbk_reader_section_by_type(b->rd, LBK_SECTION_DOOR, &dd, &dn) == LBK_OK)
-        assert_int_equal(lbk_door_view_open(dd, dn, NULL, &b->door), LBK_OK);
+        assert_int_equal(lbk_door_open(dd, dn, NULL, &b->door), LBK_OK);
 }
 
 static void baked_free(baked *b)
 {
-    if (b->door) lbk_door_view_close(b->door);
-    if (b->dls) lbk_dls_view_close(b->dls);
+    if (b->door) lbk_door_close(b->door);
+    if (b->dls) lbk_dls_close(b->dls);
     if (b->rd) lbk_reader_close(b->rd);
     free(b->base_z), free(b->base_rgba);
     if (b->path[0]) unlink(b->path);
@@ -149,11 +149,11 @@ static void apply_open(const baked *b, float omega, uint32_t **z, uint8_t **rgba
     d.base_irradiance_z = b->base_z, d.base_rgba = b->base_rgba, d.base_glg = bg, d.base_llg = bl;
     d.out_irradiance_z = *z, d.out_rgba = *rgba, d.out_glg = og, d.out_llg = ol;
     lbk_dls_runtime *rt;
-    assert_int_equal(lbk_dls_runtime_create(&d, &rt), LBK_OK);
+    assert_int_equal(lbk_dls_runtime_open(&d, &rt), LBK_OK);
     float *w = calloc(lbk_dls_set_count(b->dls), sizeof *w);
     float dw[4] = {omega, omega, omega, omega};
     assert_int_equal(lbk_dls_apply(rt, w, dw, NULL), LBK_OK);
-    lbk_dls_runtime_destroy(rt);
+    lbk_dls_runtime_close(rt);
     free(w), free(bg), free(og), free(bl), free(ol);
 }
 
@@ -381,17 +381,17 @@ static void test_combination_two_doors(void **state)
     /* sets: two doors × (open, closed), then the combination with both open sets as members */
     assert_int_equal(lbk_dls_set_count(C.dls), 5);
     uint32_t s;
-    assert_int_equal(lbk_dls_find_set(C.dls, "combo/north+outer", &s), LBK_OK);
+    assert_int_equal(lbk_dls_set_find(C.dls, "combo/north+outer", &s), LBK_OK);
     assert_int_equal(s, 4);
     lbk_dls_set_info si;
     assert_int_equal(lbk_dls_set_get(C.dls, s, &si), LBK_OK);
     assert_int_equal(si.kind, LBK_DLS_KIND_COMBINATION);
     assert_int_equal(si.member_count, 2);
     uint32_t m0, m1, open_n, open_o;
-    assert_int_equal(lbk_dls_set_member(C.dls, s, 0, &m0), LBK_OK);
-    assert_int_equal(lbk_dls_set_member(C.dls, s, 1, &m1), LBK_OK);
-    assert_int_equal(lbk_dls_find_set(C.dls, "door/north/open", &open_n), LBK_OK);
-    assert_int_equal(lbk_dls_find_set(C.dls, "door/outer/open", &open_o), LBK_OK);
+    assert_int_equal(lbk_dls_set_member_get(C.dls, s, 0, &m0), LBK_OK);
+    assert_int_equal(lbk_dls_set_member_get(C.dls, s, 1, &m1), LBK_OK);
+    assert_int_equal(lbk_dls_set_find(C.dls, "door/north/open", &open_n), LBK_OK);
+    assert_int_equal(lbk_dls_set_find(C.dls, "door/outer/open", &open_o), LBK_OK);
     assert_true((m0 == open_n && m1 == open_o) || (m0 == open_o && m1 == open_n));
     assert_int_equal(lbk_door_count(C.door), 2);
     assert_int_equal(lbk_door_state_count(C.door), 1);
@@ -399,8 +399,8 @@ static void test_combination_two_doors(void **state)
     assert_int_equal(lbk_door_state_get(C.door, 0, &dc, &set), LBK_OK);
     assert_int_equal(dc, 2);
     assert_int_equal(set, s);
-    assert_int_equal(lbk_door_state_door(C.door, 0, 0, &d0), LBK_OK);
-    assert_int_equal(lbk_door_state_door(C.door, 0, 1, &d1), LBK_OK);
+    assert_int_equal(lbk_door_state_door_get(C.door, 0, 0, &d0), LBK_OK);
+    assert_int_equal(lbk_door_state_door_get(C.door, 0, 1, &d1), LBK_OK);
     assert_int_equal(d0, 0);
     assert_int_equal(d1, 1);
     assert_int_equal(lbk_door_check_dls(C.door, C.dls), LBK_OK);

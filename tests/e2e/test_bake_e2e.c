@@ -110,7 +110,7 @@ static void assert_valid(const char *path)
 static int has_section(lbk_reader *r, uint32_t type)
 {
     uint32_t idx;
-    return lbk_reader_find_section(r, type, &idx) == LBK_OK;
+    return lbk_reader_section_find(r, type, &idx) == LBK_OK;
 }
 
 typedef struct expect {
@@ -162,7 +162,7 @@ static void bake_and_check(const expect *e)
         for (uint64_t t = 0; t < sum.texels; t++) {
             lbk_ahd_texel tx;
             uint32_t page;
-            assert_int_equal(lbk_lmap_texel(&v, t, &tx, &page), LBK_OK);
+            assert_int_equal(lbk_lmap_texel_get(&v, t, &tx, &page), LBK_OK);
             float rgb[3], n[3] = {0, 0, 1};
             lbk_ahd_irradiance(&tx, n, rgb);
             for (int c = 0; c < 3; c++) assert_true(isfinite(rgb[c]) && rgb[c] >= 0);
@@ -283,11 +283,11 @@ static void test_target_error_and_reports(void **state)
     size_t size;
     assert_int_equal(lbk_reader_section_by_type(r, LBK_SECTION_REPT, &data, &size), LBK_OK);
     lbk_report_view v;
-    assert_int_equal(lbk_report_parse(data, size, &v), LBK_OK);
+    assert_int_equal(lbk_report_open(data, size, &v), LBK_OK);
     assert_int_equal(v.header.status, LBK_BAKE_TARGET_REACHED);
     assert_int_equal(v.header.record_count, 1);
     lbk_report_record rec;
-    assert_int_equal(lbk_report_record_at(&v, 0, &rec), LBK_OK);
+    assert_int_equal(lbk_report_record_get(&v, 0, &rec), LBK_OK);
     assert_true(rec.texel_rel_rmse <= 0.9f && rec.texel_rel_rmse > 0);
     assert_true(rec.samples_per_texel > 0 && rec.samples_per_texel < 4096);
     assert_true(rec.rays_traced > 0);
@@ -340,7 +340,7 @@ static void test_time_limit(void **state)
     size_t size;
     assert_int_equal(lbk_reader_section_by_type(r, LBK_SECTION_REPT, &data, &size), LBK_OK);
     lbk_report_view v;
-    assert_int_equal(lbk_report_parse(data, size, &v), LBK_OK);
+    assert_int_equal(lbk_report_open(data, size, &v), LBK_OK);
     assert_int_equal(v.header.status, LBK_BAKE_TIME_LIMIT);
     assert_int_equal(v.header.record_count, 1);
     lbk_reader_close(r);
@@ -370,7 +370,7 @@ static void test_octahedral_probes(void **state)
     assert_true(sum.glg_probes > 0);
     for (uint32_t i = 0; i < (uint32_t)sum.glg_probes; i++) {
         lbk_octp_probe_desc p;
-        assert_int_equal(lbk_octp_get(&v, i, &p), LBK_OK);
+        assert_int_equal(lbk_octp_probe_get(&v, i, &p), LBK_OK);
         for (int k = 0; k < 144; k++) {
             assert_true(p.depth[k][0] > 0 && p.depth[k][0] < 4.0f);
             assert_true(p.depth[k][1] >= p.depth[k][0] * p.depth[k][0] * 0.99f);
@@ -499,7 +499,7 @@ static void test_duplicate_names_made_unique(void **state)
     size_t size;
     assert_int_equal(lbk_reader_section_by_type(r, LBK_SECTION_OBJS, &data, &size), LBK_OK);
     lbk_objects_view v;
-    assert_int_equal(lbk_objects_parse(data, size, &v), LBK_OK);
+    assert_int_equal(lbk_objects_open(data, size, &v), LBK_OK);
     assert_int_equal(v.count, 4);
     static const char *want[] = {"crate", "floor", "crate#2", "crate#3"};
     for (uint32_t i = 0; i < 4; i++) {

@@ -133,10 +133,10 @@ static void decode(const char *path, baked *b)
     size_t size;
     if (lbk_reader_section_by_type(r, LBK_SECTION_REPT, &data, &size) == LBK_OK) {
         lbk_report_view v;
-        assert_int_equal(lbk_report_parse(data, size, &v), LBK_OK);
+        assert_int_equal(lbk_report_open(data, size, &v), LBK_OK);
         b->passes = v.header.record_count;
         lbk_report_record rec;
-        assert_int_equal(lbk_report_record_at(&v, v.header.record_count - 1, &rec), LBK_OK);
+        assert_int_equal(lbk_report_record_get(&v, v.header.record_count - 1, &rec), LBK_OK);
         assert_true(isfinite(rec.texel_rel_rmse) && rec.texel_rel_rmse >= 0);
         assert_true(isfinite(rec.probe_rel_rmse) && rec.probe_rel_rmse >= 0);
     }
@@ -151,8 +151,8 @@ static void decode(const char *path, baked *b)
         static const float normals[5][3] = {{0, 0, 1}, {0.6f, 0, 0.8f}, {0, -0.6f, 0.8f}, {1, 0, 0}, {0, 0, -1}};
         for (uint64_t t = 0; t < v.texel_count; t++) {
             lbk_ahd_texel tx;
-            assert_int_equal(lbk_lmap_texel(&v, t, &tx, NULL), LBK_OK);
-            lbk_unpack_r11g11b10f(tx.irradiance_z, b->ez[t]);
+            assert_int_equal(lbk_lmap_texel_get(&v, t, &tx, NULL), LBK_OK);
+            lbk_r11g11b10f_unpack(tx.irradiance_z, b->ez[t]);
             for (int c = 0; c < 3; c++) b->ez[t][c] *= v.scale;
             for (int n = 0; n < 5; n++) {
                 float e[3];
@@ -175,7 +175,7 @@ static void decode(const char *path, baked *b)
         assert_non_null(b->glg_dc);
         for (uint32_t p = 0; p < v.probe_count; p++) {
             lbk_sh9_rgb sh;
-            assert_int_equal(lbk_glg_probe(&v, p, b->glg_pos[p], &sh), LBK_OK);
+            assert_int_equal(lbk_glg_probe_get(&v, p, b->glg_pos[p], &sh), LBK_OK);
             assert_sh_clean(&sh);
             for (int c = 0; c < 3; c++) b->glg_dc[p][c] = sh.c[c][0];
         }
