@@ -106,9 +106,11 @@ $(BUILD)/liblbk.a: $(LIB_OBJ)
 	ar rcs $@ $^
 $(BUILD)/liblbk.so: $(LIB_PIC)
 	$(CC) -shared -Wl,-soname,liblbk.so.1 -o $@ $^ $(LIB_LIBS)
-$(BUILD)/lbk.pc: Makefile
+# The library's version, from LBK_LIBRARY_VERSION_{MAJOR,MINOR,PATCH} in lbk.h (never the format's).
+LIB_VERSION := $(shell for k in MAJOR MINOR PATCH; do sed -n "s/^\#define LBK_LIBRARY_VERSION_$$k  *\([0-9][0-9]*\).*/\1/p" libformat/include/lbk/lbk.h; done | paste -sd. -)
+$(BUILD)/lbk.pc: Makefile libformat/include/lbk/lbk.h
 	@mkdir -p $(@D)
-	@printf 'prefix=%s\nincludedir=$${prefix}/include\nlibdir=$${prefix}/lib\n\nName: lbk\nDescription: light bake kit container library\nVersion: 1.0.0\nRequires.private: libzstd libxxhash\nCflags: -I$${includedir}\nLibs: -L$${libdir} -llbk\nLibs.private: -lm\n' '$(PREFIX)' > $@
+	@printf 'prefix=%s\nincludedir=$${prefix}/include\nlibdir=$${prefix}/lib\n\nName: lbk\nDescription: light bake kit container library\nVersion: %s\nRequires.private: libzstd libxxhash\nCflags: -I$${includedir}\nLibs: -L$${libdir} -llbk\nLibs.private: -lm\n' '$(PREFIX)' '$(LIB_VERSION)' > $@
 lib: $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc
 
 # ---- the baker library (lbk/bake.h): over liblbk, with the heavy dependencies ------------------

@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "lbk/bake.h"
+#include "bake/util/parallel.h"
 #include "lbk/container.h"
 #include "lbk/lightmap.h"
 #include "lbk/pixel.h"
@@ -188,14 +189,14 @@ int main(void)
     char cmd[300];
     snprintf(cmd, sizeof cmd, "mkdir -p %s", tmpdir);
     if (system(cmd)) return 1;
-    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    int cores = bk_online_cores();
     double load[1] = {0};
     FILE *f = fopen("/proc/loadavg", "r");
     if (f) {
         if (fscanf(f, "%lf", &load[0]) != 1) load[0] = 0;
         fclose(f);
     }
-    printf("bench_bake: %ld cores online, load average %.2f%s\n", cores, load[0], quick() ? " (quick)" : "");
+    printf("bench_bake: %d cores online, load average %.2f%s\n", cores, load[0], quick() ? " (quick)" : "");
 
     /* Pass p traces 32·2^p rays per receiver (both halves), so P passes cost 32·(2^P − 1): the
      * budgets below stop after exactly 1, 2, 3, … passes. */

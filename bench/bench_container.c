@@ -6,7 +6,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "lbk/container.h"
 #include "lbk/lightmap.h"
@@ -16,12 +15,7 @@
 #include "lbk/report.h"
 #include "lbk/validate.h"
 
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
+#include "bake/util/clock.h"
 
 static uint32_t rng_state = 12345;
 static uint32_t rnd(void)
@@ -78,7 +72,8 @@ static void build_small_sections(uint32_t objects, void **meta, size_t *meta_n, 
     for (int i = 0; i < 16; i++)
         rec[i] = (lbk_report_record){0, (uint64_t)(i + 1) << 24, (uint32_t)(i + 1) * 16, 3, 0.5f / (float)(i + 1),
                                      0.4f / (float)(i + 1)};
-    lbk_report rep = {.status = LBK_BAKE_TARGET_REACHED, .max_samples_per_texel = 1024, .target_rel_rmse = 0.04f, .records = rec, .record_count = 16};
+    lbk_report rep = {.status = LBK_BAKE_TARGET_REACHED, .max_samples_per_texel = 1024, .target_rel_rmse = 0.04f,
+        .records = rec, .record_count = 16};
     CHECK(lbk_report_build(&rep, NULL, rept, rept_n));
     lbk_object *o = calloc(objects, sizeof *o);
     char (*names)[32] = calloc(objects, 32);
@@ -112,11 +107,11 @@ static int count_issues(void *user, const lbk_issue *issue)
 /* validate, then open + decode every section; returns total seconds, *validate_s the first part. */
 static double load_once(const void *file, size_t size, unsigned *issues, double *validate_s)
 {
-    double t0 = now();
+    double t0 = bk_now();
     lbk_validate_summary s;
     *issues = 0;
     CHECK(lbk_validate_memory(file, size, NULL, count_issues, issues, &s));
-    *validate_s = now() - t0;
+    *validate_s = bk_now() - t0;
     lbk_reader *r;
     CHECK(lbk_reader_open_memory(file, size, NULL, &r));
     volatile uint8_t sink = 0;
@@ -128,16 +123,16 @@ static double load_once(const void *file, size_t size, unsigned *issues, double 
     }
     lbk_reader_close(r);
     (void)sink;
-    return now() - t0;
+    return bk_now() - t0;
 }
 
 static double memcpy_once(void *dst, const void *src, size_t n)
 {
-    double t0 = now();
+    double t0 = bk_now();
     memcpy(dst, src, n);
     volatile uint8_t sink = ((uint8_t *)dst)[n / 2];
     (void)sink;
-    return now() - t0;
+    return bk_now() - t0;
 }
 
 static void throughput(void)
@@ -153,7 +148,8 @@ static void throughput(void)
     for (int zstd = 0; zstd < 2; zstd++) {
         lbk_writer *w;
         CHECK(lbk_writer_open(NULL, &w));
-        lbk_section_options o = {.flags = LBK_SECTION_FLAG_REQUIRED, .compression = zstd ? LBK_COMPRESSION_ZSTD : 0, .zstd_level = 3};
+        lbk_section_options o = {.flags = LBK_SECTION_FLAG_REQUIRED, .compression = zstd ? LBK_COMPRESSION_ZSTD : 0,
+            .zstd_level = 3};
         CHECK(lbk_writer_section_add(w, LBK_SECTION_META, meta, meta_n, NULL));
         CHECK(lbk_writer_section_add(w, LBK_SECTION_REPT, rept, rept_n, NULL));
         CHECK(lbk_writer_section_add(w, LBK_SECTION_OBJS, objs, objs_n, &o));

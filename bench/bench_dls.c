@@ -4,25 +4,22 @@
  * the clustered layout against its payload. Synthetic level at about the size of the seed's
  * ESTATE: 1M texels, 50k GLG and 20k LLG probes, 64 light sets with local footprints plus a
  * dense region where up to 16 sets overlap. */
+#define LBK_STATIC_LINKING_ONLY /* lbk_dls_stats: experimental (lbk/dls.h) */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "lbk/ahd.h"
 #include "lbk/dls.h"
 #include "lbk/sh.h"
 
+#include "bake/util/clock.h"
+#include "bake/util/rng.h"
+
 #define NSETS 64
 
-static uint64_t rng_next(uint64_t *s)
-{
-    uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
+static uint64_t rng_next(uint64_t *s) { return bk_mix64(*s += BK_GOLDEN64); } /* splitmix64 */
 static float uni(uint64_t *s) { return (float)(rng_next(s) >> 40) / 16777216.0f; }
 
 static void random_texel(uint64_t *rng, float scale, uint8_t out[8])
@@ -49,13 +46,6 @@ static void random_probe(uint64_t *rng, float scale, uint8_t out[28])
         lbk_sh9_add_sample(&sh, d, rgb, 3.14159265f);
     }
     lbk_sh9_pack(&sh, out);
-}
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 /* ---- naive per-target gather ---------------------------------------------------------------- */
@@ -218,9 +208,9 @@ int main(void)
     void *bytes;
     size_t size;
     lbk_dls_stats st;
-    double t0 = now();
+    double t0 = bk_now();
     lbk_result r = lbk_dls_build(&desc, NULL, &bytes, &size, &st);
-    double t_build = now() - t0;
+    double t_build = bk_now() - t0;
     if (r != LBK_OK) {
         fprintf(stderr, "build failed: %s\n", lbk_result_name(r));
         return 1;
@@ -274,12 +264,12 @@ int main(void)
     /* memcpy of the output bytes */
     double best_copy = 1e9;
     for (int i = 0; i < reps; i++) {
-        t0 = now();
+        t0 = bk_now();
         memcpy(oz, bz, T * 4);
         memcpy(orgba, brgba, T * 4);
         memcpy(og, bg, G * 28);
         memcpy(ol, bl, L * 28);
-        double dt = now() - t0;
+        double dt = bk_now() - t0;
         if (dt < best_copy) best_copy = dt;
     }
 
@@ -304,15 +294,15 @@ int main(void)
             } else {
                 lbk_dls_apply(rt, NULL, NULL, NULL); /* previous frame: everything off */
             }
-            t0 = now();
+            t0 = bk_now();
             lbk_dls_apply(rt, w2, NULL, NULL);
-            double dt = now() - t0;
+            double dt = bk_now() - t0;
             if (dt < best_rt) best_rt = dt;
-            t0 = now();
+            t0 = bk_now();
             naive_texels(&nv[0], w2, bz, brgba, nz, nrgba);
             naive_probes(&nv[1], w2, bg, ng);
             naive_probes(&nv[2], w2, bl, nl);
-            dt = now() - t0;
+            dt = bk_now() - t0;
             if (dt < best_nv) best_nv = dt;
         }
         int same = !memcmp(oz, nz, T * 4) && !memcmp(orgba, nrgba, T * 4) && !memcmp(og, ng, G * 28) && !memcmp(ol, nl, L * 28);

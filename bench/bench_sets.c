@@ -3,6 +3,7 @@
  * ancillary bytes (cluster records, set lists, runs, prefix data, names), the share of texels
  * the sparse storage kept, and the bake time of the sets against the base bake, measured in
  * this run. The seed reports about 132 KB of ancillary data for its largest map. */
+#define LBK_STATIC_LINKING_ONLY /* lbk_dls_stats: experimental (lbk/dls.h) */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>

@@ -37,7 +37,7 @@ int main(int argc, char **argv)
         return LBK_EXIT_OK;
     }
     if (!strcmp(argv[1], "--version")) {
-        printf("lbk %s (container format %d.%d)\n", LBK_LIBRARY_VERSION_STRING, LBK_FORMAT_VERSION_MAJOR,
+        printf("lbk %s (container format %d.%d)\n", lbk_version_string(), LBK_FORMAT_VERSION_MAJOR,
                LBK_FORMAT_VERSION_MINOR);
         return LBK_EXIT_OK;
     }

@@ -1071,8 +1071,7 @@ static lbk_result build_dls(const bs_impl *im, const bk_set_inputs *in, uint8_t 
             sd[j].entries[s].payloads = enc[j * LBK_DLS_SPACE_COUNT_ + (size_t)s];
         }
     }
-    lbk_dls_build_desc bd;
-    memset(&bd, 0, sizeof bd);
+    lbk_dls_build_desc bd = LBK_DLS_BUILD_DESC_INIT;
     bd.set_count = (uint32_t)im->set_count;
     bd.sets = sd;
     const bk_texels *tx = in->texels;
@@ -1111,8 +1110,7 @@ static lbk_result build_door(const bs_impl *im, const bk_set_inputs *in, void **
             states[c].doors = &state_doors[2 * c];
             states[c].set = co->set;
         }
-        lbk_door_build_desc db;
-        memset(&db, 0, sizeof db);
+        lbk_door_build_desc db = LBK_DOOR_BUILD_DESC_INIT;
         db.door_count = (uint32_t)im->door_count;
         db.doors = dd;
         db.state_count = (uint32_t)im->combo_count;

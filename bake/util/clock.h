@@ -1,8 +1,7 @@
-/* The baker's clock: monotonic seconds, for phase times and time limits (never stored in a
- * container unless a timestamp is asked for). */
+/* Wall-clock time for progress, reports and benchmarks; never for anything that goes into a file. */
 #ifndef BK_CLOCK_H
 #define BK_CLOCK_H
 
-double bk_now(void);
+double bk_now(void); /* monotonic seconds since an arbitrary origin */
 
 #endif

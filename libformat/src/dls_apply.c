@@ -280,10 +280,15 @@ void lbk_dls_runtime_close(lbk_dls_runtime *r)
     lbk_dealloc(a, r);
 }
 
-lbk_result lbk_dls_runtime_open(const lbk_dls_runtime_desc *desc, lbk_dls_runtime **out)
+lbk_result lbk_dls_runtime_open(const lbk_dls_runtime_desc *caller_desc, lbk_dls_runtime **out)
 {
-    if (!desc || !out || !desc->dls) return LBK_ERR_INVALID_ARGUMENT;
+    if (!caller_desc || !out) return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
+    lbk_dls_runtime_desc in;
+    lbk_result rc = LBK_SIZED_IN(&in, caller_desc, lbk_dls_runtime_desc, allocator);
+    if (rc != LBK_OK) return rc;
+    const lbk_dls_runtime_desc *desc = &in;
+    if (!desc->dls) return LBK_ERR_INVALID_ARGUMENT;
     if (desc->doors) {
         lbk_result cr = lbk_door_check_dls(desc->doors, desc->dls);
         if (cr != LBK_OK) return cr;

@@ -411,10 +411,15 @@ static int cmp_u32(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-lbk_result lbk_door_build(const lbk_door_build_desc *desc, const lbk_allocator *a, void **out, size_t *out_size)
+lbk_result lbk_door_build(const lbk_door_build_desc *caller_desc, const lbk_allocator *a, void **out,
+                          size_t *out_size)
 {
-    if (!desc || !out || !out_size || !desc->door_count || !desc->doors || (desc->state_count && !desc->states))
-        return LBK_ERR_INVALID_ARGUMENT;
+    if (!caller_desc || !out || !out_size) return LBK_ERR_INVALID_ARGUMENT;
+    lbk_door_build_desc in;
+    lbk_result rc = LBK_SIZED_IN(&in, caller_desc, lbk_door_build_desc, states);
+    if (rc != LBK_OK) return rc;
+    const lbk_door_build_desc *desc = &in;
+    if (!desc->door_count || !desc->doors || (desc->state_count && !desc->states)) return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
     *out_size = 0;
     uint64_t strings = 0, members = 0;

@@ -27,7 +27,8 @@ static bool lmap_next_page(lmap_cursor *c, uint32_t w, uint32_t h, uint64_t *pla
     return true;
 }
 
-lbk_result lbk_lmap_build(&(lbk_lmap_build_desc){.pages = const lbk_lmap_page_desc *pages, .page_count = uint32_t page_count, .scale = float scale}, const lbk_allocator *allocator, void **out, size_t *size)
+static lbk_result build_pages(const lbk_lmap_page_desc *pages, uint32_t page_count, float scale,
+                              const lbk_allocator *allocator, void **out, size_t *size)
 {
     if (!out || !size || !pages || page_count == 0) return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
@@ -71,6 +72,18 @@ lbk_result lbk_lmap_build(&(lbk_lmap_build_desc){.pages = const lbk_lmap_page_de
     *out = d;
     *size = (size_t)c.pos;
     return LBK_OK;
+}
+
+lbk_result lbk_lmap_build(const lbk_lmap_build_desc *caller_desc, const lbk_allocator *allocator, void **out,
+                          size_t *size)
+{
+    if (out) *out = NULL;
+    if (size) *size = 0;
+    if (!caller_desc) return LBK_ERR_INVALID_ARGUMENT;
+    lbk_lmap_build_desc desc;
+    lbk_result rc = LBK_SIZED_IN(&desc, caller_desc, lbk_lmap_build_desc, scale);
+    if (rc != LBK_OK) return rc;
+    return build_pages(desc.pages, desc.page_count, desc.scale, allocator, out, size);
 }
 
 lbk_result lbk_lmap_open(const void *data, size_t size, lbk_lmap_view *out)
@@ -123,7 +136,7 @@ lbk_result lbk_lmap_page_get(const lbk_lmap_view *view, uint32_t index, lbk_lmap
 lbk_result lbk_lmap_page_texel_get(const lbk_lmap_page *page, uint32_t x, uint32_t y, lbk_ahd_texel *out)
 {
     if (!page || !out) return LBK_ERR_INVALID_ARGUMENT;
-    if (x >= page->width || y >= page->height) return LBK_ERR_RANGE;
+    if (x >= page->width || y >= page->height) return LBK_ERR_NOT_FOUND;
     const size_t i = (size_t)y * page->width + x;
     out->irradiance_z = lbk_rd32(page->irradiance + 4 * i);
     memcpy(out->rgba, page->rgba + 4 * i, 4);
@@ -144,7 +157,7 @@ lbk_result lbk_lmap_page_irradiance(const lbk_lmap_page *page, uint32_t x, uint3
 lbk_result lbk_lmap_texel_get(const lbk_lmap_view *view, uint64_t texel_index, lbk_ahd_texel *out, uint32_t *page_out)
 {
     if (!view || !out || !view->data) return LBK_ERR_INVALID_ARGUMENT;
-    if (texel_index >= view->texel_count) return LBK_ERR_RANGE;
+    if (texel_index >= view->texel_count) return LBK_ERR_NOT_FOUND;
     /* binary search on first_texel (ascending by construction) */
     uint32_t lo = 0, hi = view->page_count;
     while (hi - lo > 1) {

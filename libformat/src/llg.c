@@ -69,7 +69,8 @@ static bool grid_desc_ok(const lbk_llg_grid_desc *g)
     return g->probes && (g->vertex_count == 0 || g->vertices);
 }
 
-lbk_result lbk_llg_build(&(lbk_llg_build_desc){.grids = const lbk_llg_grid_desc *grids, .grid_count = uint32_t grid_count, .scale = float scale}, const lbk_allocator *allocator, void **out, size_t *size)
+static lbk_result build_grids(const lbk_llg_grid_desc *grids, uint32_t grid_count, float scale,
+                              const lbk_allocator *allocator, void **out, size_t *size)
 {
     if (!grids || !out || !size || grid_count == 0) return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
@@ -117,6 +118,18 @@ lbk_result lbk_llg_build(&(lbk_llg_build_desc){.grids = const lbk_llg_grid_desc 
     *out = d;
     *size = (size_t)L.end;
     return LBK_OK;
+}
+
+lbk_result lbk_llg_build(const lbk_llg_build_desc *caller_desc, const lbk_allocator *allocator, void **out,
+                         size_t *size)
+{
+    if (out) *out = NULL;
+    if (size) *size = 0;
+    if (!caller_desc) return LBK_ERR_INVALID_ARGUMENT;
+    lbk_llg_build_desc desc;
+    lbk_result rc = LBK_SIZED_IN(&desc, caller_desc, lbk_llg_build_desc, scale);
+    if (rc != LBK_OK) return rc;
+    return build_grids(desc.grids, desc.grid_count, desc.scale, allocator, out, size);
 }
 
 static void read_grid(const uint8_t *r, lbk_llg_grid *g)
@@ -230,7 +243,7 @@ lbk_result lbk_llg_vertex_irradiance(const lbk_llg_view *view, uint32_t grid, ui
     lbk_llg_grid g;
     lbk_result r = lbk_llg_grid_get(view, grid, &g);
     if (r != LBK_OK) return r;
-    if (vertex >= g.vertex_count) return LBK_ERR_RANGE;
+    if (vertex >= g.vertex_count) return LBK_ERR_NOT_FOUND;
     lbk_llg_vertex v;
     lbk_llg_vertex_unpack(view->vertices + (g.vertex_offset + vertex) * 4, &v);
     float n[3] = {0, 0, 0};

@@ -71,7 +71,8 @@ void lbk_oct_texel_direction(uint32_t n, uint32_t i, uint32_t j, float dir[3])
 #define IRR_S (LBK_OCTP_IRR_N + 2u)
 #define DEPTH_S (LBK_OCTP_DEPTH_N + 2u)
 
-lbk_result lbk_octp_build(&(lbk_octp_build_desc){.probes = const lbk_octp_probe_desc *probes, .probe_count = uint32_t count, .scale = float scale}, const lbk_allocator *allocator, void **out, size_t *size)
+static lbk_result build_probes(const lbk_octp_probe_desc *probes, uint32_t count, float scale,
+                               const lbk_allocator *allocator, void **out, size_t *size)
 {
     if (!probes || !out || !size || count == 0) return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
@@ -115,6 +116,18 @@ lbk_result lbk_octp_build(&(lbk_octp_build_desc){.probes = const lbk_octp_probe_
     return LBK_OK;
 }
 
+lbk_result lbk_octp_build(const lbk_octp_build_desc *caller_desc, const lbk_allocator *allocator, void **out,
+                          size_t *size)
+{
+    if (out) *out = NULL;
+    if (size) *size = 0;
+    if (!caller_desc) return LBK_ERR_INVALID_ARGUMENT;
+    lbk_octp_build_desc desc;
+    lbk_result rc = LBK_SIZED_IN(&desc, caller_desc, lbk_octp_build_desc, scale);
+    if (rc != LBK_OK) return rc;
+    return build_probes(desc.probes, desc.probe_count, desc.scale, allocator, out, size);
+}
+
 lbk_result lbk_octp_open(const void *data, size_t size, lbk_octp_view *out)
 {
     if (!out || (!data && size)) return LBK_ERR_INVALID_ARGUMENT;
@@ -137,7 +150,7 @@ lbk_result lbk_octp_open(const void *data, size_t size, lbk_octp_view *out)
 lbk_result lbk_octp_probe_get(const lbk_octp_view *view, uint32_t index, lbk_octp_probe_desc *out)
 {
     if (!view || !view->data || !out) return LBK_ERR_INVALID_ARGUMENT;
-    if (index >= view->probe_count) return LBK_ERR_RANGE;
+    if (index >= view->probe_count) return LBK_ERR_NOT_FOUND;
     const uint8_t *q = view->probes + (size_t)LBK_OCTP_PROBE_SIZE * index;
     for (uint32_t j = 0; j < LBK_OCTP_IRR_N; j++)
         for (uint32_t i = 0; i < LBK_OCTP_IRR_N; i++) {
@@ -158,7 +171,7 @@ lbk_result lbk_octp_probe_get(const lbk_octp_view *view, uint32_t index, lbk_oct
 lbk_result lbk_octp_irradiance(const lbk_octp_view *view, uint32_t index, const float dir[3], float rgb[3])
 {
     if (!view || !view->data || !dir || !rgb) return LBK_ERR_INVALID_ARGUMENT;
-    if (index >= view->probe_count) return LBK_ERR_RANGE;
+    if (index >= view->probe_count) return LBK_ERR_NOT_FOUND;
     const uint8_t *q = view->probes + (size_t)LBK_OCTP_PROBE_SIZE * index;
     float uv[2];
     lbk_oct_encode(dir, uv);

@@ -43,9 +43,14 @@ static void read_record(const uint8_t *r, lbk_report_record *out)
     out->probe_rel_rmse = lbk_rdf32(r + 28);
 }
 
-lbk_result lbk_report_build(const lbk_report *rep, const lbk_allocator *allocator, void **out, size_t *size)
+lbk_result lbk_report_build(const lbk_report *caller_report, const lbk_allocator *allocator, void **out, size_t *size)
 {
-    if (!rep || !out || !size || (!rep->records && rep->record_count)) return LBK_ERR_INVALID_ARGUMENT;
+    if (!caller_report || !out || !size) return LBK_ERR_INVALID_ARGUMENT;
+    lbk_report in;
+    lbk_result rc = LBK_SIZED_IN(&in, caller_report, lbk_report, record_count);
+    if (rc != LBK_OK) return rc;
+    const lbk_report *rep = &in;
+    if (!rep->records && rep->record_count) return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
     *size = 0;
     if (rep->record_count == 0 || rep->status >= LBK_BAKE_STATUS_COUNT_ || (rep->flags & ~LBK_REPORT_HAS_TIMES))
@@ -95,6 +100,7 @@ lbk_result lbk_report_open(const void *data, size_t size, lbk_report_view *out)
     uint64_t need = LBK_REPORT_HEADER_SIZE + (uint64_t)LBK_REPORT_RECORD_SIZE * n;
     if (need > size) return LBK_ERR_TRUNCATED;
     if (need != size) return LBK_ERR_CORRUPT;
+    out->header.size = sizeof out->header;
     out->header.status = lbk_rd32(d + 0);
     out->header.flags = lbk_rd32(d + 4);
     out->header.record_count = n;

@@ -15,7 +15,8 @@ static const struct {
     [LBK_ERR_TRUNCATED] = {"LBK_ERR_TRUNCATED", "the data ends before the structure it describes"},
     [LBK_ERR_UNSUPPORTED_VERSION] = {"LBK_ERR_UNSUPPORTED_VERSION", "unsupported container major version"},
     [LBK_ERR_UNSUPPORTED_FEATURE] = {"LBK_ERR_UNSUPPORTED_FEATURE",
-                                     "unknown required feature flag or required section type"},
+                                     "unknown required feature flag or required section type, or an "
+                                     "options/desc field this library does not know"},
     [LBK_ERR_CORRUPT] = {"LBK_ERR_CORRUPT", "the container breaks a structural rule of the format"},
     [LBK_ERR_CHECKSUM] = {"LBK_ERR_CHECKSUM", "checksum mismatch"},
     [LBK_ERR_DECOMPRESS] = {"LBK_ERR_DECOMPRESS", "decompression failed or gave the wrong length"},

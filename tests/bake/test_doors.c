@@ -326,13 +326,13 @@ static void test_mis_weights(void **state)
     const double x[3] = {0.3, 0.05, 1.0}; /* on the floor, 3 m from the patch */
     const double pu = 1 / (2 * 3.14159265358979323846);
     const double nu = 48, ng = 48;
-    bk_door_rng rng = bk_door_rng_make(11, 1, 0, 0);
+    bk_rng rng = bk_door_rng_make(11, 1, 0, 0);
     int both = 0;
     double inv_sum = 0;
     const int M = 400000;
     for (int i = 0; i < M; i++) {
         double d[3];
-        double u0 = bk_door_rng_next(&rng), u1 = bk_door_rng_next(&rng), u2 = bk_door_rng_next(&rng);
+        double u0 = bk_rng_next(&rng), u1 = bk_rng_next(&rng), u2 = bk_rng_next(&rng);
         assert_true(bk_guide_sample(&sun_boxes, x, u0, u1, u2, d));
         double pg = bk_guide_pdf(&sun_boxes, x, d);
         assert_true(pg > 0);
@@ -348,7 +348,7 @@ static void test_mis_weights(void **state)
     int hit = 0;
     const int U = 400000;
     for (int i = 0; i < U; i++) {
-        double z = 1 - 2 * bk_door_rng_next(&rng), phi = 2 * 3.14159265358979323846 * bk_door_rng_next(&rng);
+        double z = 1 - 2 * bk_rng_next(&rng), phi = 2 * 3.14159265358979323846 * bk_rng_next(&rng);
         double r = sqrt(fmax(0, 1 - z * z)), d[3] = {r * cos(phi), r * sin(phi), z};
         hit += bk_guide_pdf(&sun_boxes, x, d) > 0;
     }

@@ -152,7 +152,9 @@ static void test_glg_cap_and_build(void **state)
     for (size_t t = 0; t < g.tet_count; t++)
         for (int i = 0; i < 4; i++)
             assert_int_equal(vis8[t][i], (int)lrintf(g.face_visibility[4 * t + (size_t)i] * 255.0f));
-    lbk_glg_build_desc desc = {.probe_count = (uint32_t)g.probe_count, .tetra_count = (uint32_t)g.tet_count, .positions = (const float (*)[3])g.positions, .probes = sh, .tetras = (const uint32_t (*)[4])g.tets, .adjacency = (const uint32_t (*)[4])g.neighbours, .visibility = (const uint8_t (*)[4])vis8};
+    lbk_glg_build_desc desc = {.probe_count = (uint32_t)g.probe_count, .tetra_count = (uint32_t)g.tet_count,
+        .positions = (const float (*)[3])g.positions, .probes = sh, .tetras = (const uint32_t (*)[4])g.tets,
+        .adjacency = (const uint32_t (*)[4])g.neighbours, .visibility = (const uint8_t (*)[4])vis8};
     void *bytes = NULL;
     size_t size = 0;
     assert_int_equal(lbk_glg_build(&desc, NULL, &bytes, &size), LBK_OK);
@@ -359,7 +361,8 @@ static void test_llg_obb_rotated_box(void **state)
         gd.vertex_count = (uint32_t)l.vertex_count;
         void *bytes = NULL;
         size_t size = 0;
-        assert_int_equal(lbk_llg_build(&(lbk_llg_build_desc){.grids = &gd, .grid_count = 1}, NULL, &bytes, &size), LBK_OK);
+        assert_int_equal(lbk_llg_build(&(lbk_llg_build_desc){.grids = &gd,
+            .grid_count = 1}, NULL, &bytes, &size), LBK_OK);
         lbk_llg_view view;
         lbk_llg_grid grid;
         assert_int_equal(lbk_llg_open(bytes, size, &view), LBK_OK);

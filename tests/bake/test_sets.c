@@ -10,6 +10,7 @@
  *        (base + S_O) must equal it (light through the opening).
  * Tolerances come from the bakes' own noise: the same comparison between two independent full
  * bakes (R1 with seeds 1 and 2) measures it in the same run. */
+#define LBK_STATIC_LINKING_ONLY /* lbk_dls_stats: experimental (lbk/dls.h) */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>

@@ -59,7 +59,8 @@ static built build_three(uint32_t alignment, int reverse)
     lbk_write_options wo = {.section_alignment = alignment};
     lbk_writer *w;
     assert_int_equal(lbk_writer_open(&wo, &w), LBK_OK);
-    lbk_section_options z = {.flags = LBK_SECTION_FLAG_REQUIRED, .compression = LBK_COMPRESSION_ZSTD, .zstd_level = 1};
+    lbk_section_options z = {.flags = LBK_SECTION_FLAG_REQUIRED, .compression = LBK_COMPRESSION_ZSTD,
+        .zstd_level = 1};
     lbk_section_options req = {.flags = LBK_SECTION_FLAG_REQUIRED};
     if (reverse) {
         assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_GLG, glg, N_GLG, &z), LBK_OK);
@@ -465,7 +466,8 @@ static void test_atomic_file_write(void **state)
     built b = build_three(0, 0);
     lbk_writer *w;
     assert_int_equal(lbk_writer_open(NULL, &w), LBK_OK);
-    lbk_section_options z = {.flags = LBK_SECTION_FLAG_REQUIRED, .compression = LBK_COMPRESSION_ZSTD, .zstd_level = 1};
+    lbk_section_options z = {.flags = LBK_SECTION_FLAG_REQUIRED, .compression = LBK_COMPRESSION_ZSTD,
+        .zstd_level = 1};
     lbk_section_options req = {.flags = LBK_SECTION_FLAG_REQUIRED};
     assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_META, meta, N_META, NULL), LBK_OK);
     assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_LMAP, lmap, N_LMAP, &req), LBK_OK);

@@ -2,6 +2,7 @@
  * encode) within the codecs' quantisation on random sets and random weights; incremental applies
  * that skip unchanged clusters give the bytes of a full apply; all-zero weights give exactly the
  * base; a set without entries adds no data; door weights drive kinds 1–3. */
+#define LBK_STATIC_LINKING_ONLY /* lbk_dls_stats: experimental (lbk/dls.h) */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>

@@ -2,6 +2,7 @@
  * beyond), cluster sizes at and around the 16- and 8-target base boundaries, an independent
  * decoder of the prefix bits written from spec/container.md §12, determinism, the clustering
  * rule and the statistics numbers. */
+#define LBK_STATIC_LINKING_ONLY /* lbk_dls_tuning: experimental (lbk/dls.h) */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -470,7 +471,8 @@ static void test_clustering_keeps_set_lists_small(void **state)
     free(bytes);
 
     /* With a dispatch minimum of 1000 targets the two families share one cluster of 12 sets. */
-    lbk_dls_build_options opt = {.min_dispatch_targets = 1000};
+    const lbk_dls_tuning tune = {.min_dispatch_targets = 1000};
+    const lbk_dls_build_options opt = {.size = sizeof opt, .tuning = &tune};
     build_ok(&fx, &opt, &bytes, &size, &st, &v);
     assert_int_equal(lbk_dls_cluster_count(v), 1);
     lbk_dls_cluster_info info;
@@ -490,7 +492,8 @@ static void test_packed_cap(void **state)
     dlsfx fx;
     dlsfx_init(&fx, 10, 2000, 0, 0);
     for (uint32_t s = 0; s < 10; s++) dlsfx_add_range(&fx, &rng, s, 0, 150 * s, 100);
-    lbk_dls_build_options opt = {.min_dispatch_targets = 10000, .packed_max_targets = 300};
+    const lbk_dls_tuning tune = {.min_dispatch_targets = 10000, .packed_max_targets = 300};
+    const lbk_dls_build_options opt = {.size = sizeof opt, .tuning = &tune};
     void *bytes;
     size_t size;
     lbk_dls_stats st;

@@ -250,7 +250,8 @@ static const lbk_report_record records[3] = {
 static void test_report_round_trip(void **state)
 {
     (void)state;
-    lbk_report rep = {.status = LBK_BAKE_TARGET_REACHED, .flags = LBK_REPORT_HAS_TIMES, .max_samples_per_texel = 64, .time_limit_seconds = 600.0, .target_rel_rmse = 0.1f, .records = records, .record_count = 3};
+    lbk_report rep = {.status = LBK_BAKE_TARGET_REACHED, .flags = LBK_REPORT_HAS_TIMES, .max_samples_per_texel = 64,
+        .time_limit_seconds = 600.0, .target_rel_rmse = 0.1f, .records = records, .record_count = 3};
     void *b;
     size_t n;
     assert_int_equal(lbk_report_build(&rep, NULL, &b, &n), LBK_OK);
@@ -323,7 +324,8 @@ static void test_report_builder_rejects(void **state)
 static void test_report_validator_rules(void **state)
 {
     (void)state;
-    lbk_report rep = {.status = LBK_BAKE_TARGET_REACHED, .flags = LBK_REPORT_HAS_TIMES, .max_samples_per_texel = 64, .time_limit_seconds = 600.0, .target_rel_rmse = 0.1f, .records = records, .record_count = 3};
+    lbk_report rep = {.status = LBK_BAKE_TARGET_REACHED, .flags = LBK_REPORT_HAS_TIMES, .max_samples_per_texel = 64,
+        .time_limit_seconds = 600.0, .target_rel_rmse = 0.1f, .records = records, .record_count = 3};
     void *b;
     size_t n;
     assert_int_equal(lbk_report_build(&rep, NULL, &b, &n), LBK_OK);
@@ -463,7 +465,8 @@ static void build_lmap_llg(void **lmap, size_t *lmap_n, void **llg, size_t *llg_
     static lbk_ahd_texel texels[16 * 8];
     for (int i = 0; i < 16 * 8; i++) texels[i] = (lbk_ahd_texel){0, {255, 128, 128, 255}};
     lbk_lmap_page_desc pages[2] = {{16, 8, texels}, {4, 4, texels}};
-    assert_int_equal(lbk_lmap_build(&(lbk_lmap_build_desc){.pages = pages, .page_count = 2}, NULL, lmap, lmap_n), LBK_OK);
+    assert_int_equal(lbk_lmap_build(&(lbk_lmap_build_desc){.pages = pages,
+        .page_count = 2}, NULL, lmap, lmap_n), LBK_OK);
     static lbk_sh9_rgb probes[8];
     memset(probes, 0, sizeof probes);
     lbk_llg_grid_desc g = {{0, 0, 0}, {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {1, 1, 1}, {2, 2, 2}, probes, NULL, 0};

@@ -32,7 +32,8 @@ int fixture_report(void **out, size_t *size)
         {0.0, 4000000, 16, 2, 0.25f, 0.125f},
         {0.0, 8000000, 32, 2, 0.125f, 0.0625f},
     };
-    const lbk_report rep = {.status = LBK_BAKE_TARGET_REACHED, .max_samples_per_texel = 256, .time_limit_seconds = 0.0, .target_rel_rmse = 0.15f, .records = records, .record_count = 4};
+    const lbk_report rep = {.status = LBK_BAKE_TARGET_REACHED, .max_samples_per_texel = 256,
+        .time_limit_seconds = 0.0, .target_rel_rmse = 0.15f, .records = records, .record_count = 4};
     return lbk_report_build(&rep, NULL, out, size) != LBK_OK;
 }
 

@@ -154,7 +154,8 @@ tf_blob tf_build_scene(int kind, const tf_options *opt_in)
             }
         pages[p] = (lbk_lmap_page_desc){pw[p], ph[p], tex[p]};
     }
-    CHECK(lbk_lmap_build(&(lbk_lmap_build_desc){.pages = pages, .page_count = 2, .scale = ldexpf(1.0f, opt.scale_log2)}, NULL, &data, &size));
+    const lbk_lmap_build_desc lb = {.pages = pages, .page_count = 2, .scale = ldexpf(1.0f, opt.scale_log2)};
+    CHECK(lbk_lmap_build(&lb, NULL, &data, &size));
     add(w, LBK_SECTION_LMAP, data, size, LBK_SECTION_FLAG_REQUIRED);
     const uint64_t texel_count = (uint64_t)pw[0] * ph[0] + (uint64_t)pw[1] * ph[1];
 

@@ -64,7 +64,7 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
     lbk_result r = lbk_reader_open_memory(in, in_size, NULL, &rd);
     if (r != LBK_OK) return tl_fail(err, TL_CONVERT_BAD_INPUT, "input: %s", lbk_result_message(r));
 
-    lbk_write_options wo = {0};
+    lbk_write_options wo = LBK_WRITE_OPTIONS_INIT;
     wo.section_alignment = p->alignment;
     lbk_writer *w = NULL;
     r = lbk_writer_open(&wo, &w);
@@ -117,7 +117,7 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
             data = rewritten;
             size = rewritten_size;
         }
-        lbk_section_options so = {0};
+        lbk_section_options so = LBK_SECTION_OPTIONS_INIT;
         so.flags = si.flags;
         so.compression = rule.compression;
         so.zstd_level = rule.zstd_level;

@@ -181,7 +181,8 @@ int tl_lmap_rewrite(const void *lmap, size_t size, const tl_lmap_layout_options 
     if (st == TL_CONVERT_OK) {
         void *built = NULL;
         size_t built_size = 0;
-        r = lbk_lmap_build(&(lbk_lmap_build_desc){.pages = descs, .page_count = n, .scale = v.scale}, NULL, &built, &built_size);
+        const lbk_lmap_build_desc bd = {.size = sizeof bd, .pages = descs, .page_count = n, .scale = v.scale};
+        r = lbk_lmap_build(&bd, NULL, &built, &built_size);
         if (r != LBK_OK) st = tl_fail(err, TL_CONVERT_INTERNAL, "rebuilding LMAP: %s", lbk_result_message(r));
         else {
             lbk_lmap_view nv;
@@ -318,8 +319,7 @@ int tl_dls_remap_texels(const void *dls, size_t size, const tl_texel_remap *rema
         else if (r != LBK_OK) st = tl_fail(err, TL_CONVERT_BAD_INPUT, "DLS cluster %u: %s", c, lbk_result_message(r));
     }
     if (st == TL_CONVERT_OK) {
-        lbk_dls_build_desc bd;
-        memset(&bd, 0, sizeof bd);
+        lbk_dls_build_desc bd = LBK_DLS_BUILD_DESC_INIT;
         bd.set_count = ns;
         bd.sets = sets;
         for (uint32_t sp = 0; sp < LBK_DLS_SPACE_COUNT_; sp++) bd.target_count[sp] = lbk_dls_target_count(view, sp);

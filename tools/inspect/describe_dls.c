@@ -1,5 +1,6 @@
 /* DLS in `lbk inspect`: sets, clusters, payload and ancillary bytes. GPU: the entries' payloads
  * and the per-target index data the apply dispatches read; set names and tables stay on the CPU. */
+#define LBK_STATIC_LINKING_ONLY /* lbk_dls_stats: experimental (lbk/dls.h) */
 #include <stdio.h>
 
 #include "tools/inspect/describe.h"

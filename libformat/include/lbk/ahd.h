@@ -35,7 +35,9 @@
  *   4. I_c = 2·max(0, g_c·d), a_c = max(0, e0_c − I_c/4), Ez_c = a_c + I_c·k;
  *   5. plane 0 = R11G11B10F(Ez) (rules of lbk/pixel.h), r = lum(a)/lum(Ez) (1 when lum(Ez) ≤ 0).
  * Exact (up to quantisation) for any lighting whose channels share one gradient direction and
- * whose ambient and directional parts share a chroma; the measured error bounds are in the spec. */
+ * whose ambient and directional parts share a chroma; the measured error bounds are in the spec.
+ *
+ * Thread safety: every function is pure (no state): safe to call from any thread. */
 #ifndef LBK_AHD_H
 #define LBK_AHD_H
 

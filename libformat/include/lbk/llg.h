@@ -3,9 +3,9 @@
  * Layout: spec/container.md §11.
  *
  * Lattice: dims (nx, ny, nz), each 2..64. Probe (i, j, k) sits at
- *     centre + Σ_a axis_a · half_extent_a · (2·idx_a / (n_a − 1) − 1)
+ *     centre + Σ_a axis_a · half_extents_a · (2·idx_a / (n_a − 1) − 1)
  * and is stored at probe_offset + i + nx·(j + ny·k) of the section's shared probe array.
- * Sampling a world point p: local l_a = ((p − centre)·axis_a) / half_extent_a, clamped to
+ * Sampling a world point p: local l_a = ((p − centre)·axis_a) / half_extents_a, clamped to
  * [−1, 1] (points outside the box take the value at the nearest box point), lattice coordinate
  * g_a = (l_a + 1)/2 · (n_a − 1), trilinear blend of the 8 unpacked probes around g.
  *
@@ -18,10 +18,11 @@
  * (lbk_sh9_irradiance) of the trilinearly interpolated radiance at the vertex position. Because
  * the data are in the box frame, instances of a model share them.
  *
- * Scale (spec §5.7): one f32 power of two in the header; packed probe × scale = physical
- * radiance. The builder takes physical SH and divides before packing; lbk_llg_sample and
- * lbk_llg_vertex_irradiance return physical values; the raw bytes at view->probes (and DLS LLG
- * payloads) are in stored units. */
+ * Scale: packed probe × scale = radiance (lbk.h, "radiometric scale"): the grid descs' SH,
+ * lbk_llg_sample and lbk_llg_vertex_irradiance are physical; the bytes at view->probes and DLS
+ * LLG payloads are stored units.
+ *
+ * Thread safety: every function is safe to call from any thread; views are read-only. */
 #ifndef LBK_LLG_H
 #define LBK_LLG_H
 
@@ -41,6 +42,7 @@ typedef struct lbk_llg_vertex {
     float bent_normal[3]; /* unit, grid frame */
 } lbk_llg_vertex;
 
+/* One grid (an array element: frozen). */
 typedef struct lbk_llg_grid_desc {
     float centre[3];
     float axes[3][3];       /* orthonormal rows: axis0, axis1, axis2 */
@@ -51,9 +53,18 @@ typedef struct lbk_llg_grid_desc {
     uint32_t vertex_count;
 } lbk_llg_grid_desc;
 
-/* Serialises grids (deterministic). scale: 0 means 1, else a positive normal power of two (the
- * probes are divided by it before packing). Free the buffer with lbk_free. */
-LBK_API lbk_result lbk_llg_build(&(lbk_llg_build_desc){.grids = const lbk_llg_grid_desc *grids, .grid_count = uint32_t grid_count, .scale = float scale}, const lbk_allocator *allocator, void **out, size_t *size);
+/* Size-tagged (lbk.h): set size with LBK_LLG_BUILD_DESC_INIT. */
+typedef struct lbk_llg_build_desc {
+    size_t size;
+    const lbk_llg_grid_desc *grids;
+    uint32_t grid_count;
+    float scale; /* 0: 1; else a positive normal power of two (the probes are divided by it) */
+} lbk_llg_build_desc;
+#define LBK_LLG_BUILD_DESC_INIT LBK_SIZED_INIT(lbk_llg_build_desc)
+
+/* Serialises the grids (deterministic). Free the buffer with lbk_free. */
+LBK_API lbk_result lbk_llg_build(const lbk_llg_build_desc *desc, const lbk_allocator *allocator, void **out,
+                                 size_t *size);
 
 typedef struct lbk_llg_view {
     const uint8_t *data;

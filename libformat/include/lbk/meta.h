@@ -1,4 +1,6 @@
-/* META: provenance key/value pairs. Layout: spec/container.md §6. */
+/* META: provenance key/value pairs. Layout: spec/container.md §6.
+ *
+ * Thread safety: every function is safe to call from any thread; views are read-only. */
 #ifndef LBK_META_H
 #define LBK_META_H
 
@@ -19,6 +21,7 @@ extern "C" {
 #define LBK_META_REVISION "revision"             /* optional free text, e.g. a VCS revision */
 #define LBK_META_TIMESTAMP "timestamp"           /* only when asked for: "YYYY-MM-DDTHH:MM:SSZ" (UTC) */
 
+/* Builder input (an array element: frozen). */
 typedef struct lbk_meta_pair {
     const char *key;   /* NUL-terminated */
     const char *value; /* NUL-terminated UTF-8; may be empty */

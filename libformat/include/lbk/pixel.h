@@ -18,7 +18,9 @@
  *
  * unorm8: code = rne(clamp(x, 0, 1) · 255), NaN → 0; value = code / 255.
  * snorm8: code = rne(clamp(x, −1, 1) · 127) stored as two's complement int8, NaN → 0;
- *         value = max(code / 127, −1) (so −128 and −127 both mean −1, as on GPUs). */
+ *         value = max(code / 127, −1) (so −128 and −127 both mean −1, as on GPUs).
+ *
+ * Thread safety: every function is pure (no state): safe to call from any thread. */
 #ifndef LBK_PIXEL_H
 #define LBK_PIXEL_H
 
