@@ -39,6 +39,7 @@
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
+#include <cerrno>
 #include <cstdlib>
 #include <cstring>
 #include <map>
@@ -121,16 +122,56 @@ bool read_capped(const std::string &p, size_t cap, std::vector<unsigned char> *o
     return true;
 }
 
+// Where a scene may read from: its own folder (symlinks resolved), plus one folder the caller
+// allows. A scene from an untrusted source must not read /etc/passwd through "../../..".
+struct ResourcePolicy {
+    std::string root;   // realpath of the scene's folder, with a trailing '/'
+    std::string allow;  // realpath of the allowed outside folder with '/', or empty
+};
+
+bool under(const std::string &real, const std::string &dir)
+{
+    return !dir.empty() && real.compare(0, dir.size(), dir) == 0;
+}
+
+std::string real_dir(const std::string &d)
+{
+    char *r = realpath(d.c_str(), nullptr);
+    if (!r) return std::string();
+    std::string out(r);
+    free(r);
+    if (out.empty() || out.back() != '/') out += '/';
+    return out;
+}
+
+// True if `p` (after resolving every symlink) lies inside the policy's folders; else *why says so.
+bool resource_allowed(const ResourcePolicy &pol, const std::string &p, std::string *why)
+{
+    char *r = realpath(p.c_str(), nullptr);
+    if (!r) {
+        *why = std::string("cannot open: ") + strerror(errno);
+        return false;
+    }
+    std::string real(r);
+    free(r);
+    if (under(real, pol.root) || under(real, pol.allow)) return true;
+    *why = "resolves to " + real + ", outside the scene's folder " + pol.root +
+           " (resources must lie inside it; --allow-outside DIR permits one more folder)";
+    return false;
+}
+
 struct FsState {
     size_t cap;
+    const ResourcePolicy *policy;
 };
 
 bool fs_exists(const std::string &p, void *) { return is_regular_file(p, nullptr); }
 std::string fs_expand(const std::string &p, void *) { return p; }
 bool fs_read(std::vector<unsigned char> *out, std::string *err, const std::string &p, void *user)
 {
+    const FsState *st = static_cast<FsState *>(user);
     std::string why;
-    if (read_capped(p, static_cast<FsState *>(user)->cap, out, &why)) return true;
+    if (resource_allowed(*st->policy, p, &why) && read_capped(p, st->cap, out, &why)) return true;
     if (err) *err += p + ": " + why;
     return false;
 }
@@ -264,25 +305,66 @@ const nlohmann::json *jarr(const nlohmann::json &o, const char *key)
     return (it != o.end() && it->is_array()) ? &*it : nullptr;
 }
 
-struct DepthExceeded {};
+// Deepest nesting of arrays and objects in JSON text, in one linear scan (brackets inside
+// strings do not count). nlohmann's callback parser would check depth for us, but it re-scans
+// the open container each time an element closes, which made 80 k empty nodes take ~17 s and
+// 10^6 nodes effectively never finish; the plain parser after this scan is linear.
+static int json_max_depth(const char *p, size_t n)
+{
+    int depth = 0, deepest = 0;
+    bool in_string = false;
+    for (size_t i = 0; i < n; i++) {
+        const char c = p[i];
+        if (in_string) {
+            if (c == '\\') i++;
+            else if (c == '"') in_string = false;
+        } else if (c == '"') {
+            in_string = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > deepest) deepest = depth;
+        } else if (c == ']' || c == '}') {
+            depth--;
+        }
+    }
+    return deepest;
+}
+
+// Buffers and images name files relative to the scene (or embed data: URIs). An absolute path
+// or another URI scheme (file://, http://) would reach outside it: refuse them up front, with the
+// entry named; `..` escapes and symlinks are caught when the file is opened (resource_allowed).
+void check_uris(const nlohmann::json &doc, const std::string &file)
+{
+    for (const char *kind : {"buffers", "images"}) {
+        const nlohmann::json *arr = jarr(doc, kind);
+        if (!arr) continue;
+        for (size_t i = 0; i < arr->size(); i++) {
+            const nlohmann::json &e = (*arr)[i];
+            if (!e.is_object() || !e.contains("uri") || !e["uri"].is_string()) continue;
+            const std::string uri = e["uri"].get<std::string>();
+            if (uri.compare(0, 5, "data:") == 0) continue;
+            const size_t colon = uri.find(':'), slash = uri.find('/');
+            const bool scheme = colon != std::string::npos && (slash == std::string::npos || colon < slash);
+            if (uri.empty() || uri[0] == '/' || uri[0] == '\\' || scheme)
+                fail("%s: %.*s %zu: uri %s is not a path relative to the scene's folder (absolute paths and "
+                     "URI schemes other than data: are refused)",
+                     file.c_str(), (int)strlen(kind) - 1, kind, i, qstr(uri).c_str());
+        }
+    }
+}
 
 Prepass prepass(const char *json_begin, size_t json_len, const std::string &file)
 {
     Prepass pp;
-    nlohmann::json::parser_callback_t depth_guard = [](int depth, nlohmann::json::parse_event_t,
-                                                       nlohmann::json &) {
-        if (depth > kMaxJsonDepth) throw DepthExceeded{};
-        return true;
-    };
+    if (json_max_depth(json_begin, json_len) > kMaxJsonDepth)
+        fail("%s: JSON nested deeper than %d levels", file.c_str(), kMaxJsonDepth);
     nlohmann::json doc;
     try {
-        doc = nlohmann::json::parse(json_begin, json_begin + json_len, depth_guard, true);
-    } catch (const DepthExceeded &) {
-        fail("%s: JSON nested deeper than %d levels", file.c_str(), kMaxJsonDepth);
+        doc = nlohmann::json::parse(json_begin, json_begin + json_len, nullptr, true);
     } catch (const nlohmann::json::exception &e) {
         fail("%s: invalid JSON: %s", file.c_str(), e.what());
     }
     if (!doc.is_object()) fail("%s: the JSON root is not an object", file.c_str());
+    check_uris(doc, file);
 
     // Image bufferViews: tinygltf forms a pointer into the buffer before we see it.
     const nlohmann::json *buffers = jarr(doc, "buffers");
@@ -506,6 +588,7 @@ private:
     bk_scene *s_;
     tinygltf::Model m_;
     Prepass pp_;
+    ResourcePolicy policy_;
     XXH3_state_t hash_;
     std::vector<int> image_map_;      // glTF image -> scene image (-1: none)
     std::vector<bk_image> images_;
@@ -576,6 +659,12 @@ void Importer::load()
     if (!read_capped(path_, o_.max_file_bytes, &bytes, &why)) fail("%s: %s", file, why.c_str());
     if (bytes.empty()) fail("%s: empty file", file);
     XXH3_64bits_update(&hash_, bytes.data(), bytes.size());
+    policy_.root = real_dir(dir_of(path_));
+    if (policy_.root.empty()) fail("%s: cannot resolve its folder: %s", file, strerror(errno));
+    if (o_.allow_outside && *o_.allow_outside) {
+        policy_.allow = real_dir(o_.allow_outside);
+        if (policy_.allow.empty()) fail("%s: allowed folder %s: %s", file, o_.allow_outside, strerror(errno));
+    }
 
     bool glb = bytes.size() >= 4 && !memcmp(bytes.data(), "glTF", 4);
     GlbParts g;
@@ -586,7 +675,7 @@ void Importer::load()
     pp_ = prepass(glb ? g.json : reinterpret_cast<const char *>(bytes.data()), json_len, path_);
 
     tinygltf::TinyGLTF loader;
-    FsState fss{o_.max_file_bytes};
+    FsState fss{o_.max_file_bytes, &policy_};
     tinygltf::FsCallbacks fs{fs_exists, fs_expand, fs_read, fs_write, &fss};
     loader.SetFsCallbacks(fs);
     ImageLoaderCtx ictx{&pp_.needed_images, o_.skip_textures != 0};
@@ -1467,7 +1556,7 @@ void Importer::read_sky()
     std::string p = rel[0] == '/' ? rel : dir_of(path_) + "/" + rel;
     std::vector<unsigned char> bytes;
     std::string why;
-    if (!read_capped(p, o_.max_file_bytes, &bytes, &why))
+    if (!resource_allowed(policy_, p, &why) || !read_capped(p, o_.max_file_bytes, &bytes, &why))
         fail("%s: %s: lbk_sky %s: %s", file, where.c_str(), qstr(rel).c_str(), why.c_str());
     XXH3_64bits_update(&hash_, bytes.data(), bytes.size());
     bytes.clear();

@@ -8,6 +8,8 @@
 #include <stdint.h>
 #include <string.h>
 
+#define LBK_STATIC_LINKING_ONLY /* the library implements its experimental declarations too */
+#include "lbk/dls.h"
 #include "lbk/validate.h"
 
 /* ---- little-endian access (the file is LE whatever the host is) -------------------------- */
@@ -67,6 +69,17 @@ static inline uint64_t lbk_align_up(uint64_t v, uint64_t a) { return (v + a - 1)
 void *lbk_alloc(const lbk_allocator *a, size_t size);
 void *lbk_calloc(const lbk_allocator *a, size_t count, size_t size); /* overflow-checked, zeroed */
 void lbk_dealloc(const lbk_allocator *a, void *p);
+
+/* ---- size-tagged structs (lbk.h) ----------------------------------------------------------
+ * Reads the caller's struct *src (NULL: all defaults) into *dst, a zeroed struct of the current
+ * layout with dst->size = sizeof *dst: the caller's size (0: v1_size, its layout in liblbk 1.0)
+ * decides how many bytes are copied. LBK_ERR_INVALID_ARGUMENT for a size below v1_size,
+ * LBK_ERR_UNSUPPORTED_FEATURE for non-zero bytes past the fields this library knows. */
+lbk_result lbk_sized_in(void *dst, size_t dst_size, const void *src, size_t v1_size);
+/* The layout of liblbk 1.0 ends at field `last_v1`; fields appended later leave the calls as
+ * they are. */
+#define LBK_SIZED_IN(dst, src, type, last_v1) lbk_sized_in((dst), sizeof(type), (src), LBK_V1_SIZE(type, last_v1))
+#define LBK_V1_SIZE(type, last) (offsetof(type, last) + sizeof(((type *)0)->last))
 
 /* ---- validation context ---------------------------------------------------------------------
  * validate.c walks the sections in dependency order (META, REPT, LMAP, GLG, LLG, OCTP, OBJS, LMUV,

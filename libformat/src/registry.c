@@ -247,9 +247,9 @@ const char *lbk_issue_template(uint32_t id, lbk_severity *severity)
     return NULL;
 }
 
-uint32_t lbk_issue_registry_size(void) { return (uint32_t)(sizeof registry / sizeof registry[0]); }
+uint32_t lbk_issue_registry_count(void) { return (uint32_t)(sizeof registry / sizeof registry[0]); }
 
-uint32_t lbk_issue_registry_id(uint32_t index) { return index < lbk_issue_registry_size() ? registry[index].id : 0; }
+uint32_t lbk_issue_registry_id(uint32_t index) { return index < lbk_issue_registry_count() ? registry[index].id : 0; }
 
 uint32_t lbk_issue_section(uint32_t id)
 {

@@ -32,10 +32,10 @@ static void read_views(uint32_t type, const void *d, size_t n)
 {
     if (type == LBK_SECTION_META) {
         lbk_meta_view v;
-        if (lbk_meta_parse(d, n, &v) == LBK_OK) {
+        if (lbk_meta_open(d, n, &v) == LBK_OK) {
             for (uint32_t i = 0; i < v.entry_count && i < 4096; i++) {
                 lbk_string k, val;
-                lbk_meta_entry(&v, i, &k, &val);
+                lbk_meta_entry_get(&v, i, &k, &val);
                 if (k.size && ((const volatile char *)k.data)[k.size - 1] == 0x7f) abort(); /* touch the bytes */
             }
             lbk_string val;
@@ -43,14 +43,14 @@ static void read_views(uint32_t type, const void *d, size_t n)
         }
     } else if (type == LBK_SECTION_REPT) {
         lbk_report_view v;
-        if (lbk_report_parse(d, n, &v) == LBK_OK)
+        if (lbk_report_open(d, n, &v) == LBK_OK)
             for (uint32_t i = 0; i < v.header.record_count && i < 4096; i++) {
                 lbk_report_record r;
-                lbk_report_record_at(&v, i, &r);
+                lbk_report_record_get(&v, i, &r);
             }
     } else if (type == LBK_SECTION_OBJS) {
         lbk_objects_view v;
-        if (lbk_objects_parse(d, n, &v) == LBK_OK) {
+        if (lbk_objects_open(d, n, &v) == LBK_OK) {
             for (uint32_t i = 0; i < v.count && i < 4096; i++) {
                 lbk_object o;
                 lbk_objects_get(&v, i, &o);
@@ -101,7 +101,7 @@ static int known_type(uint32_t t)
 
 static void exercise(const uint8_t *data, size_t size)
 {
-    lbk_validate_options vo = {NULL, DECODE_CAP};
+    lbk_validate_options vo = {.max_decoded_bytes = DECODE_CAP};
     lbk_validate_summary s;
     size_t issues = 0;
     lbk_validate_memory(data, size, &vo, count_issue, &issues, &s);
@@ -110,7 +110,7 @@ static void exercise(const uint8_t *data, size_t size)
     /* The reader and the validator share the framing rules: a file the validator passes must
      * open and give every known section's bytes. */
     const int valid = s.fatal == 0 && s.errors == 0;
-    lbk_read_options ro = {NULL, DECODE_CAP, 0};
+    lbk_read_options ro = {.max_decoded_bytes = DECODE_CAP};
     lbk_reader *r;
     if (lbk_reader_open_memory(data, size, &ro, &r) != LBK_OK) {
         if (valid) abort();
@@ -119,7 +119,7 @@ static void exercise(const uint8_t *data, size_t size)
     if (s.fatal) abort(); /* the reader accepted what the validator found unreadable */
     for (uint32_t i = 0; i < lbk_reader_section_count(r); i++) {
         lbk_section_info si;
-        if (lbk_reader_section_info(r, i, &si) != LBK_OK) abort();
+        if (lbk_reader_section_get(r, i, &si) != LBK_OK) abort();
         const void *d;
         size_t n;
         if (lbk_reader_section_data(r, i, &d, &n) == LBK_OK) {

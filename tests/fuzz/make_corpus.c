@@ -38,22 +38,25 @@ int main(void)
     };
     const lbk_meta_pair meta[2] = {{"writer", "make_corpus"}, {"writer.version", "1"}};
     const lbk_report_record rec[2] = {{0, 10, 1, 1, 0.5f, 0.5f}, {0, 20, 2, 1, 0.25f, 0.3f}};
-    const lbk_report rep = {LBK_BAKE_SAMPLE_LIMIT, 0, 2, 0, 0, rec, 2};
+    const lbk_report rep = {.status = LBK_BAKE_SAMPLE_LIMIT, .max_samples_per_texel = 2, .records = rec,
+        .record_count = 2};
     void *lm, *llg, *ob, *me, *re;
     size_t lmn, llgn, obn, men, ren;
-    if (lbk_lmap_build(pages, 2, 0, NULL, &lm, &lmn) || lbk_llg_build(&grid, 1, 0, NULL, &llg, &llgn) ||
+    if (lbk_lmap_build(&(lbk_lmap_build_desc){.pages = pages, .page_count = 2}, NULL, &lm, &lmn) ||
+        lbk_llg_build(&(lbk_llg_build_desc){.grids = &grid, .grid_count = 1}, NULL, &llg, &llgn) ||
         lbk_objects_build(objs, 3, NULL, &ob, &obn) || lbk_meta_build(meta, 2, NULL, &me, &men) ||
         lbk_report_build(&rep, NULL, &re, &ren))
         return 1;
     for (int zstd = 0; zstd < 2; zstd++) {
         lbk_writer *w;
-        lbk_write_options wo = {NULL, zstd ? 16 : 64};
-        lbk_section_options o = {LBK_SECTION_FLAG_REQUIRED, zstd ? LBK_COMPRESSION_ZSTD : 0, 3};
-        if (lbk_writer_create(&wo, &w) || lbk_writer_add_section(w, LBK_SECTION_META, me, men, NULL) ||
-            lbk_writer_add_section(w, LBK_SECTION_REPT, re, ren, &o) ||
-            lbk_writer_add_section(w, LBK_SECTION_OBJS, ob, obn, &o) ||
-            lbk_writer_add_section(w, LBK_SECTION_LMAP, lm, lmn, &o) ||
-            lbk_writer_add_section(w, LBK_SECTION_LLG, llg, llgn, &o))
+        lbk_write_options wo = {.section_alignment = zstd ? 16 : 64};
+        lbk_section_options o = {.flags = LBK_SECTION_FLAG_REQUIRED, .compression = zstd ? LBK_COMPRESSION_ZSTD : 0,
+            .zstd_level = 3};
+        if (lbk_writer_open(&wo, &w) || lbk_writer_section_add(w, LBK_SECTION_META, me, men, NULL) ||
+            lbk_writer_section_add(w, LBK_SECTION_REPT, re, ren, &o) ||
+            lbk_writer_section_add(w, LBK_SECTION_OBJS, ob, obn, &o) ||
+            lbk_writer_section_add(w, LBK_SECTION_LMAP, lm, lmn, &o) ||
+            lbk_writer_section_add(w, LBK_SECTION_LLG, llg, llgn, &o))
             return 1;
         void *bytes;
         size_t n;
@@ -61,7 +64,7 @@ int main(void)
         if (write_file(zstd ? "tests/fuzz/corpus/objects_zstd.lbk" : "tests/fuzz/corpus/objects_raw.lbk", bytes, n))
             return 1;
         lbk_free(NULL, bytes);
-        lbk_writer_destroy(w);
+        lbk_writer_close(w);
     }
     /* floor (object 0, rect 0,0 8x4): generated, two primitives; wall (object 1, rect 0,0 4x2
      * on page 1): authored */
@@ -78,13 +81,13 @@ int main(void)
     void *lmuv, *bytes;
     size_t lmuvn, n;
     lbk_writer *w;
-    lbk_section_options o = {LBK_SECTION_FLAG_REQUIRED, 0, 0};
-    if (lbk_lmuv_build(uv, 2, NULL, &lmuv, &lmuvn) || lbk_writer_create(NULL, &w) ||
-        lbk_writer_add_section(w, LBK_SECTION_OBJS, ob, obn, &o) || lbk_writer_add_section(w, LBK_SECTION_LMAP, lm, lmn, &o) ||
-        lbk_writer_add_section(w, LBK_SECTION_LLG, llg, llgn, &o) || lbk_writer_add_section(w, LBK_SECTION_LMUV, lmuv, lmuvn, NULL) ||
+    lbk_section_options o = {.flags = LBK_SECTION_FLAG_REQUIRED};
+    if (lbk_lmuv_build(uv, 2, NULL, &lmuv, &lmuvn) || lbk_writer_open(NULL, &w) ||
+        lbk_writer_section_add(w, LBK_SECTION_OBJS, ob, obn, &o) || lbk_writer_section_add(w, LBK_SECTION_LMAP, lm, lmn, &o) ||
+        lbk_writer_section_add(w, LBK_SECTION_LLG, llg, llgn, &o) || lbk_writer_section_add(w, LBK_SECTION_LMUV, lmuv, lmuvn, NULL) ||
         lbk_writer_to_memory(w, &bytes, &n) || write_file("tests/fuzz/corpus/lmuv_raw.lbk", bytes, n))
         return 1;
     lbk_free(NULL, bytes);
-    lbk_writer_destroy(w);
+    lbk_writer_close(w);
     return 0;
 }

@@ -99,23 +99,23 @@ static void container(const uint8_t *lmuv, size_t lmuv_size, int with_objs, uint
     static lbk_ahd_texel texels[64 * 64];
     lbk_lmap_page_desc pg = {64, 64, texels};
     lbk_writer *w;
-    assert_int_equal(lbk_writer_create(NULL, &w), LBK_OK);
+    assert_int_equal(lbk_writer_open(NULL, &w), LBK_OK);
     void *d;
     size_t n;
     lbk_section_options so = {0};
     if (with_objs) {
         assert_int_equal(lbk_objects_build(o, 4, NULL, &d, &n), LBK_OK);
-        assert_int_equal(lbk_writer_add_section(w, LBK_SECTION_OBJS, d, n, &so), LBK_OK);
+        assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_OBJS, d, n, &so), LBK_OK);
         lbk_free(NULL, d);
     }
-    assert_int_equal(lbk_lmap_build(&pg, 1, 0, NULL, &d, &n), LBK_OK);
-    assert_int_equal(lbk_writer_add_section(w, LBK_SECTION_LMAP, d, n, &so), LBK_OK);
+    assert_int_equal(lbk_lmap_build(&(lbk_lmap_build_desc){.pages = &pg, .page_count = 1}, NULL, &d, &n), LBK_OK);
+    assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_LMAP, d, n, &so), LBK_OK);
     lbk_free(NULL, d);
-    if (lmuv) assert_int_equal(lbk_writer_add_section(w, LBK_SECTION_LMUV, lmuv, lmuv_size, &so), LBK_OK);
+    if (lmuv) assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_LMUV, lmuv, lmuv_size, &so), LBK_OK);
     static const uint8_t xtra[16] = {1};
-    if (extra) assert_int_equal(lbk_writer_add_section(w, extra, xtra, sizeof xtra, &so), LBK_OK);
+    if (extra) assert_int_equal(lbk_writer_section_add(w, extra, xtra, sizeof xtra, &so), LBK_OK);
     assert_int_equal(lbk_writer_to_memory(w, out, size), LBK_OK);
-    lbk_writer_destroy(w);
+    lbk_writer_close(w);
 }
 
 typedef struct issues {
@@ -492,8 +492,8 @@ static void version_and_order(void **state)
         lbk_reader *rd;
         assert_int_equal(lbk_reader_open_memory(f, fn, NULL, &rd), LBK_OK);
         uint32_t at_lmuv, at_other;
-        assert_int_equal(lbk_reader_find_section(rd, LBK_SECTION_LMUV, &at_lmuv), LBK_OK);
-        assert_int_equal(lbk_reader_find_section(rd, other, &at_other), LBK_OK);
+        assert_int_equal(lbk_reader_section_find(rd, LBK_SECTION_LMUV, &at_lmuv), LBK_OK);
+        assert_int_equal(lbk_reader_section_find(rd, other, &at_other), LBK_OK);
         assert_true(k ? at_lmuv < at_other : at_other < at_lmuv); /* ascending code among the non-1.0 types */
         lbk_reader_close(rd);
         issues is;

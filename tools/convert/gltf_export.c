@@ -207,7 +207,7 @@ static int gather_llg(ex *e, size_t object, uint32_t grid, prim_data *d)
 {
     const bk_scene *s = e->s;
     lbk_llg_grid g;
-    if (!e->b->has_llg || lbk_llg_get_grid(&e->b->llg, grid, &g) != LBK_OK) return 0;
+    if (!e->b->has_llg || lbk_llg_grid_get(&e->b->llg, grid, &g) != LBK_OK) return 0;
     uint32_t *rank = malloc((s->vertex_count ? s->vertex_count : 1) * sizeof *rank);
     d->vis = malloc((d->nv ? d->nv : 1) * sizeof *d->vis);
     d->bent = malloc((d->nv ? d->nv : 1) * 3 * sizeof *d->bent);
@@ -223,7 +223,7 @@ static int gather_llg(ex *e, size_t object, uint32_t grid, prim_data *d)
         float rgb[3] = {0, 0, 0};
         const int have = match && rank[sv] != UINT32_MAX;
         if (have) {
-            lbk_llg_vertex_decode(e->b->llg.vertices + 4 * (g.vertex_offset + rank[sv]), &lv);
+            lbk_llg_vertex_unpack(e->b->llg.vertices + 4 * (g.vertex_offset + rank[sv]), &lv);
             lbk_llg_vertex_irradiance(&e->b->llg, grid, rank[sv], &s->positions[3 * (size_t)sv], rgb);
         }
         d->vis[v] = lv.visibility;
@@ -445,12 +445,12 @@ static int emit_object(ex *e, size_t i)
     cJSON_AddItemToObject(node, "extras", node_extras((uint32_t)i, &ob, &rec, &e->s->objects[i]));
     if (ob.representation == LBK_REPRESENTATION_LLG && e->b->has_llg) {
         lbk_llg_grid g;
-        if (lbk_llg_get_grid(&e->b->llg, ob.index, &g) == LBK_OK) {
+        if (lbk_llg_grid_get(&e->b->llg, ob.index, &g) == LBK_OK) {
             cJSON *l = cJSON_GetObjectItem(cJSON_GetObjectItem(node, "extras"), "lbk"), *x = cJSON_AddObjectToObject(l, "llg");
             cJSON_AddItemToObject(x, "centre", cJSON_CreateFloatArray(g.centre, 3));
             cJSON *axes = cJSON_AddArrayToObject(x, "axes");
             for (int a = 0; a < 3; a++) cJSON_AddItemToArray(axes, cJSON_CreateFloatArray(g.axes[a], 3));
-            cJSON_AddItemToObject(x, "half_extent", cJSON_CreateFloatArray(g.half_extent, 3));
+            cJSON_AddItemToObject(x, "half_extents", cJSON_CreateFloatArray(g.half_extents, 3));
             const int dims[3] = {(int)g.dims[0], (int)g.dims[1], (int)g.dims[2]};
             cJSON_AddItemToObject(x, "dims", cJSON_CreateIntArray(dims, 3));
             size_t n = (size_t)g.dims[0] * g.dims[1] * g.dims[2];
@@ -481,9 +481,9 @@ static int decode_texels(ex *e)
     size_t k = 0;
     for (uint32_t p = 0; p < e->pages; p++) {
         lbk_lmap_page pg;
-        lbk_lmap_get_page(lm, p, &pg);
+        lbk_lmap_page_get(lm, p, &pg);
         for (uint32_t t = 0; t < pg.width * pg.height; t++, k++) {
-            lbk_unpack_r11g11b10f((uint32_t)pg.irradiance[4 * t] | (uint32_t)pg.irradiance[4 * t + 1] << 8 |
+            lbk_r11g11b10f_unpack((uint32_t)pg.irradiance[4 * t] | (uint32_t)pg.irradiance[4 * t + 1] << 8 |
                                       (uint32_t)pg.irradiance[4 * t + 2] << 16 | (uint32_t)pg.irradiance[4 * t + 3] << 24,
                                   e->texels + 3 * k);
             for (int c = 0; c < 3; c++) e->texels[3 * k + (size_t)c] *= lm->scale;
@@ -514,7 +514,7 @@ static int compute_exposure(ex *e)
         lbk_object ob;
         lbk_objects_get(&e->b->objs, (uint32_t)i, &ob);
         lbk_llg_grid g;
-        if (ob.representation != LBK_REPRESENTATION_LLG || lbk_llg_get_grid(&e->b->llg, ob.index, &g) != LBK_OK ||
+        if (ob.representation != LBK_REPRESENTATION_LLG || lbk_llg_grid_get(&e->b->llg, ob.index, &g) != LBK_OK ||
             llg_ranks(s, i, rank) != g.vertex_count)
             continue;
         for (size_t v = 0; v < s->vertex_count && n < e->b->llg.vertex_count; v++)
@@ -535,7 +535,7 @@ static int write_pages(ex *e)
     size_t first = 0;
     for (uint32_t p = 0; p < e->pages && !rc; p++) {
         lbk_lmap_page pg;
-        lbk_lmap_get_page(&e->b->lmap, p, &pg);
+        lbk_lmap_page_get(&e->b->lmap, p, &pg);
         const size_t n = (size_t)pg.width * pg.height;
         const float *ez = e->texels + 3 * first;
         float *ahd = malloc(n * 7 * sizeof *ahd);
@@ -601,7 +601,7 @@ static void add_glg(ex *e, cJSON *lbk)
     } else {
         for (size_t i = 0; i < np; i++) {
             lbk_sh9_rgb s;
-            lbk_glg_probe(v, (uint32_t)i, pos + 3 * i, &s);
+            lbk_glg_probe_get(v, (uint32_t)i, pos + 3 * i, &s);
             memcpy(sh + 27 * i, s.c, sizeof s.c);
         }
         for (size_t i = 0; i < 4 * nt; i++) {
@@ -744,7 +744,7 @@ static int run(ex *e, const tl_gltf_options *o)
     for (size_t i = 0; i < e->s->material_count; i++) e->plain_material[i] = e->llg_material[i] = -1;
     for (uint32_t p = 0; p < e->pages; p++) {
         lbk_lmap_page pg;
-        lbk_lmap_get_page(&e->b->lmap, p, &pg);
+        lbk_lmap_page_get(&e->b->lmap, p, &pg);
         e->page_w[p] = pg.width;
         e->page_h[p] = pg.height;
     }

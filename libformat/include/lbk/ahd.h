@@ -35,7 +35,9 @@
  *   4. I_c = 2·max(0, g_c·d), a_c = max(0, e0_c − I_c/4), Ez_c = a_c + I_c·k;
  *   5. plane 0 = R11G11B10F(Ez) (rules of lbk/pixel.h), r = lum(a)/lum(Ez) (1 when lum(Ez) ≤ 0).
  * Exact (up to quantisation) for any lighting whose channels share one gradient direction and
- * whose ambient and directional parts share a chroma; the measured error bounds are in the spec. */
+ * whose ambient and directional parts share a chroma; the measured error bounds are in the spec.
+ *
+ * Thread safety: every function is pure (no state): safe to call from any thread. */
 #ifndef LBK_AHD_H
 #define LBK_AHD_H
 
@@ -98,8 +100,8 @@ LBK_API void lbk_ahd_tangent_frame(const float n[3], const float dpdx[3], float 
 LBK_API void lbk_ahd_triangle_dpdx(const float p[3][3], const float coord[3][2], float dpdx[3]);
 
 /* The 8 bytes as the spec's texel view (u32 LE then RGBA) — for tools that keep texels packed. */
-LBK_API void lbk_ahd_texel_store(const lbk_ahd_texel *texel, uint8_t out[LBK_AHD_TEXEL_SIZE]);
-LBK_API void lbk_ahd_texel_load(const uint8_t in[LBK_AHD_TEXEL_SIZE], lbk_ahd_texel *texel);
+LBK_API void lbk_ahd_texel_pack(const lbk_ahd_texel *texel, uint8_t out[LBK_AHD_TEXEL_SIZE]);
+LBK_API void lbk_ahd_texel_unpack(const uint8_t in[LBK_AHD_TEXEL_SIZE], lbk_ahd_texel *texel);
 
 #ifdef __cplusplus
 }
