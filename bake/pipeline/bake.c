@@ -125,6 +125,7 @@ static lbk_result import_file(bk_pipeline *b, const char *path)
     memset(&io, 0, sizeof io);
     io.warn = import_warning;
     io.warn_user = b;
+    io.allow_outside = b->opt->allow_outside;
     FILE *probe = fopen(path, "rb");
     if (!probe) return bk_pipeline_fail(b, LBK_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
     fclose(probe);

@@ -129,6 +129,8 @@ typedef struct lbk_bake_desc {
     lbk_bake_door_method door_method; /* [difference] */
     const char *revision;       /* stored in META [NULL: none] */
     int timestamp;              /* 1: store the bake time in META (no longer byte-identical) */
+    const char *allow_outside;  /* files a glTF names (buffers, images, its lbk_sky EXR) must lie in
+                                   its folder (spec/authoring.md); this folder is allowed too [NULL] */
     lbk_bake_progress_fn progress; /* [NULL: none, no cancellation] */
     lbk_bake_message_fn message;   /* [NULL: messages are dropped] */
     void *user;                    /* passed to both callbacks */
