@@ -7,12 +7,22 @@ CC       ?= cc
 CXX      ?= c++
 CLANG    ?= clang
 
-# Debian packages the build needs; `make deps` installs the missing ones when run as root.
-DEB_PKGS := build-essential pkg-config libzstd-dev libxxhash-dev libembree-dev libopenexr-dev \
-            libdraco-dev libtinygltf-dev libstb-dev nlohmann-json3-dev libqhull-dev libspng-dev \
-            libcjson-dev libcmocka-dev clang libclang-rt-14-dev
+# Debian packages: liblbk alone (`make install-lib`), the baker and CLI, the tests on top.
+DEB_LIB_PKGS  := build-essential libzstd-dev libxxhash-dev
+DEB_TOOL_PKGS := $(DEB_LIB_PKGS) libembree-dev libopenexr-dev libdraco-dev libtinygltf-dev libstb-dev \
+                 nlohmann-json3-dev libqhull-dev libspng-dev libcjson-dev
+DEB_PKGS      := $(DEB_TOOL_PKGS) pkg-config libcmocka-dev clang libclang-rt-14-dev
 
 WARN     := -Wall -Wextra -Wshadow -Wstrict-prototypes -Wmissing-prototypes -Wno-unused-parameter
+# The glTF shim: its own code warns like the C code; tinygltf, Draco, stb and nlohmann come in
+# through -isystem, so warnings inside them (not ours to fix) do not count.
+CXXWARN  := -Wall -Wextra -Wshadow -Wno-unused-parameter
+# WERROR=1 (CI sets it) makes every warning of every compile an error: C and C++, release,
+# ASan, TSan, tests, benchmarks and the clang fuzz build.
+ifeq ($(WERROR),1)
+WARN     += -Werror
+CXXWARN  += -Werror
+endif
 CSTD     := -std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE
 OPT      ?= -O2 -g
 SAN      := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
@@ -21,6 +31,7 @@ LIB_INC  := -Ilibformat/include
 LIB_LIBS := -lzstd -lxxhash -lm
 # The tools: everything heavy lives here, never in liblbk.
 TOOL_INC := $(LIB_INC) -I. -I/usr/include/draco -I/usr/include/stb
+TOOL_CXXINC := $(LIB_INC) -I. -isystem /usr/include/draco -isystem /usr/include/stb
 TOOL_LIBS:= -lembree3 -lOpenEXRCore -lqhull_r -lspng -lcjson -ldraco -lpthread -lm $(LIB_LIBS)
 
 LIB_SRC   := $(sort $(wildcard libformat/src/*.c))
@@ -40,7 +51,7 @@ TOOL_OBJ  := $(filter-out $(BUILD)/rel/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUIL
 LIB_ASAN  := $(LIB_SRC:%.c=$(BUILD)/asan/%.o)
 TOOL_ASAN := $(filter-out $(BUILD)/asan/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUILD)/asan/%.o)) $(TOOL_CXXSRC:%.cc=$(BUILD)/asan/%.o)
 
-.PHONY: all lib deps demo test check bench fuzz install install-check clean help
+.PHONY: all lib deps demo test check bench fuzz install install-check clean help tsan install-lib install-lib-check
 all: $(BUILD)/lbk $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc
 
 help:
@@ -52,17 +63,33 @@ help:
 	@echo "make install PREFIX=/usr/local"
 
 # ---- dependencies -------------------------------------------------------------------------
+# `make deps` installs whatever of DEB_PKGS is missing: that is what it is asked for (through
+# sudo when not root). The targets that need packages (test, demo, bench, fuzz) only check: they
+# install the missing ones themselves when run as root with CI set (.ci/run) or when
+# LBK_INSTALL_DEPS=1, and say which and why; otherwise they print the one command to run and stop.
+# $(1): the packages; $(2): the reason to install without asking, empty to ask first.
+define deps_sh
+missing=$$(for p in $(1); do dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; done); \
+[ -z "$$missing" ] && exit 0; missing=$$(echo $$missing); \
+if [ "$$(id -u)" = 0 ]; then sudo=; else sudo="sudo "; fi; \
+why="$(2)"; \
+[ -z "$$why" ] && [ "$${LBK_INSTALL_DEPS:-}" = 1 ] && why="LBK_INSTALL_DEPS=1"; \
+[ -z "$$why" ] && [ -n "$${CI:-}" ] && [ -z "$$sudo" ] && why="CI=$$CI, running as root"; \
+if [ -z "$$why" ]; then \
+  echo "lbk: make $(MAKECMDGOALS) needs Debian packages that are not installed: $$missing"; \
+  echo "lbk: install them with"; echo "  $${sudo}apt-get install -y $$missing"; \
+  echo "lbk: (or run make deps, or LBK_INSTALL_DEPS=1 make $(MAKECMDGOALS))"; exit 1; \
+fi; \
+echo "lbk: installing missing Debian packages ($$why): $$missing"; \
+{ $${sudo}apt-get update -qq || true; } && $${sudo}env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >/dev/null
+endef
+.PHONY: deps-tools deps-test
 deps:
-	@missing=$$(for p in $(DEB_PKGS); do dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; done); \
-	if [ -n "$$missing" ]; then \
-	  if [ "$$(id -u)" = 0 ]; then \
-	    echo "lbk: installing missing Debian packages:" $$missing; \
-	    (apt-get update -qq || true) && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >/dev/null; \
-	  else \
-	    echo "lbk: missing Debian packages. Run as root:"; \
-	    echo "  sudo apt-get install -y" $$missing; exit 1; \
-	  fi; \
-	fi
+	@$(call deps_sh,$(DEB_PKGS),make deps)
+deps-tools:
+	@$(call deps_sh,$(DEB_TOOL_PKGS),)
+deps-test:
+	@$(call deps_sh,$(DEB_PKGS),)
 
 # ---- compile rules --------------------------------------------------------------------------
 $(BUILD)/rel/libformat/%.o: libformat/%.c
@@ -82,10 +109,10 @@ $(BUILD)/asan/%.o: %.c
 	$(CC) $(CSTD) -O1 -g $(SAN) $(WARN) $(TOOL_INC) -MMD -MP -c $< -o $@
 $(BUILD)/rel/%.o: %.cc
 	@mkdir -p $(@D)
-	$(CXX) -std=c++17 $(OPT) -w $(TOOL_INC) -MMD -MP -c $< -o $@
+	$(CXX) -std=c++17 $(OPT) $(CXXWARN) $(TOOL_CXXINC) -MMD -MP -c $< -o $@
 $(BUILD)/asan/%.o: %.cc
 	@mkdir -p $(@D)
-	$(CXX) -std=c++17 -O1 -g $(SAN) -w $(TOOL_INC) -MMD -MP -c $< -o $@
+	$(CXX) -std=c++17 -O1 -g $(SAN) $(CXXWARN) $(TOOL_CXXINC) -MMD -MP -c $< -o $@
 
 # ---- the library ----------------------------------------------------------------------------
 $(BUILD)/liblbk.a: $(LIB_OBJ)
@@ -128,17 +155,77 @@ install-check: all
 	    $$(PKG_CONFIG_PATH=$(INST)/lib/pkgconfig pkg-config --cflags lbk) $(INST)/lib/liblbk.a \
 	    $$(PKG_CONFIG_PATH=$(INST)/lib/pkgconfig pkg-config --static --libs-only-other --libs-only-l lbk | sed 's/-llbk//') -lcmocka
 
-test: deps
-	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BUILD)/lbk-asan $(TESTS:%=$(BUILD)/tests/%) $(BUILD)/fuzz_container install-check
-	@LBK=$(BUILD)/lbk-asan BUILD=$(BUILD) FUZZ=$(BUILD)/fuzz_container sh tests/run.sh $(TESTS) install_check_shared install_check_static
+test: deps-test
+	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BUILD)/lbk-asan $(TESTS:%=$(BUILD)/tests/%) $(BUILD)/fuzz_container \
+	    install-check install-lib-check $(TSAN_TESTS:%=$(BUILD)/tsan/bin/%)
+	@LBK=$(BUILD)/lbk-asan BUILD=$(BUILD) FUZZ=$(BUILD)/fuzz_container TSAN_BIN=$(BUILD)/tsan/bin \
+	    sh tests/run.sh $(TESTS) install_check_shared install_check_static install_lib_check
 check: test
+
+# ---- ThreadSanitizer: the determinism cases of tests/tsan/determinism.list -------------------
+# Their own objects under $(BUILD)/tsan (TSan cannot be mixed with ASan). Embree's internal
+# threads are not instrumented: tests/tsan/suppressions.txt silences reports inside Embree and
+# TBB only, never in lbk code.
+TSAN      := -fsanitize=thread -fno-omit-frame-pointer
+TSAN_TESTS := $(sort $(shell sed -n 's/^\(test_[a-z0-9_]*\).*/\1/p' tests/tsan/determinism.list))
+LIB_TSAN  := $(LIB_SRC:%.c=$(BUILD)/tsan/%.o)
+TOOL_TSAN := $(filter-out $(BUILD)/tsan/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUILD)/tsan/%.o)) $(TOOL_CXXSRC:%.cc=$(BUILD)/tsan/%.o)
+TEST_SUPPORT_TSAN := $(TEST_SUPPORT:%.c=$(BUILD)/tsan/%.o) $(BUILD)/tsan/tests/tsan/test_filter.o
+$(TEST_SUPPORT_TSAN): TOOL_INC += -Itests
+# only pattern rules name them: keep make from deleting them as intermediates
+.SECONDARY: $(LIB_TSAN) $(TOOL_TSAN)
+$(BUILD)/tsan/libformat/%.o: libformat/%.c
+	@mkdir -p $(@D)
+	$(CC) $(CSTD) -O1 -g $(TSAN) $(WARN) $(LIB_INC) -MMD -MP -c $< -o $@
+$(BUILD)/tsan/%.o: %.c
+	@mkdir -p $(@D)
+	$(CC) $(CSTD) -O1 -g $(TSAN) $(WARN) $(TOOL_INC) -MMD -MP -c $< -o $@
+$(BUILD)/tsan/%.o: %.cc
+	@mkdir -p $(@D)
+	$(CXX) -std=c++17 -O1 -g $(TSAN) $(CXXWARN) $(TOOL_CXXINC) -MMD -MP -c $< -o $@
+$(BUILD)/tsan/bin/%: $$(call test_src_of,$$*) $(TEST_SUPPORT_TSAN) $(TOOL_TSAN) $(LIB_TSAN)
+	@mkdir -p $(@D)
+	$(CC) $(CSTD) -O1 -g $(TSAN) $(WARN) $(TOOL_INC) -Itests -c $< -o $@.o
+	$(CXX) $(TSAN) -o $@ $@.o $(TEST_SUPPORT_TSAN) $(TOOL_TSAN) $(LIB_TSAN) $(TOOL_LIBS) -lcmocka \
+	    -Wl,--wrap=_cmocka_run_group_tests
+tsan: deps-test
+	@$(MAKE) --no-print-directory $(TSAN_TESTS:%=$(BUILD)/tsan/bin/%)
+	@BUILD=$(BUILD) TSAN_BIN=$(BUILD)/tsan/bin sh tests/run.sh
+
+# ---- liblbk alone: zstd, xxHash and a C compiler, nothing else -----------------------------
+# install-lib builds and installs only the container library (static, shared, headers, lbk.pc).
+# install-lib-check installs it into a throwaway DESTDIR from a build folder of its own, checks
+# that nothing but libformat was compiled and that liblbk.so needs only zstd, xxHash and libc/libm,
+# and builds tests/install/install_check.c against the staged copy (run by tests/run.sh).
+install-lib: $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc
+	install -d $(DESTDIR)$(PREFIX)/lib/pkgconfig $(DESTDIR)$(PREFIX)/include/lbk
+	install -m 644 $(BUILD)/liblbk.a $(DESTDIR)$(PREFIX)/lib/liblbk.a
+	install -m 755 $(BUILD)/liblbk.so $(DESTDIR)$(PREFIX)/lib/liblbk.so.1
+	ln -sf liblbk.so.1 $(DESTDIR)$(PREFIX)/lib/liblbk.so
+	install -m 644 libformat/include/lbk/*.h $(DESTDIR)$(PREFIX)/include/lbk/
+	sed 's|^prefix=.*|prefix=$(PREFIX)|' $(BUILD)/lbk.pc > $(DESTDIR)$(PREFIX)/lib/pkgconfig/lbk.pc
+LIBONLY := $(BUILD)/lib-only
+LIBSTAGE := $(abspath $(LIBONLY))/stage
+LIBPC = PKG_CONFIG_PATH=$(LIBSTAGE)/opt/lbk/lib/pkgconfig pkg-config --define-variable=prefix=$(LIBSTAGE)/opt/lbk
+install-lib-check:
+	@rm -rf $(LIBSTAGE) && mkdir -p $(BUILD)/tests
+	@$(MAKE) --no-print-directory install-lib BUILD=$(LIBONLY) PREFIX=/opt/lbk DESTDIR=$(LIBSTAGE) >/dev/null
+	@built=$$(cd $(LIBONLY) && find . -name '*.o' ! -path './*/libformat/*'); \
+	  if [ -n "$$built" ]; then echo "install-lib compiled more than libformat:" $$built; exit 1; fi
+	@needed=$$(readelf -d $(LIBSTAGE)/opt/lbk/lib/liblbk.so.1 | sed -n 's/.*Shared library: \[\(.*\)\]/\1/p' | sort | tr '\n' ' '); \
+	  case "$$needed" in "libc.so.6 libm.so.6 libxxhash.so.0 libzstd.so.1 ") ;; \
+	  *) echo "liblbk.so needs more than zstd, xxHash, libc and libm: $$needed"; exit 1;; esac
+	$(CC) $(CSTD) $(WARN) tests/install/install_check.c -o $(BUILD)/tests/install_lib_check \
+	    $$($(LIBPC) --cflags lbk) $(LIBSTAGE)/opt/lbk/lib/liblbk.a \
+	    $$($(LIBPC) --static --libs-only-other --libs-only-l lbk | sed 's/-llbk//') -lcmocka
 
 # ---- fuzzing (clang libFuzzer) --------------------------------------------------------------
 FUZZ_FLAGS := -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined -g -O1
 $(BUILD)/fuzz_container: tests/fuzz/fuzz_container.c $(LIB_SRC)
 	@mkdir -p $(@D)
-	$(CLANG) $(CSTD) $(FUZZ_FLAGS) $(LIB_INC) -o $@ $^ $(LIB_LIBS)
-fuzz: deps $(BUILD)/fuzz_container
+	$(CLANG) $(CSTD) $(FUZZ_FLAGS) $(WARN) $(LIB_INC) -o $@ $^ $(LIB_LIBS)
+fuzz: deps-test
+	@$(MAKE) --no-print-directory $(BUILD)/fuzz_container
 	@mkdir -p $(BUILD)/fuzz-corpus
 	$(BUILD)/fuzz_container -max_total_time=$${FUZZ_SECONDS:-60} $(BUILD)/fuzz-corpus tests/fuzz/corpus
 
@@ -147,12 +234,12 @@ $(BUILD)/bench/%: bench/%.c $(TOOL_OBJ) $(BUILD)/liblbk.a
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) -O2 -g $(WARN) $(TOOL_INC) -c $< -o $@.o
 	$(CXX) -o $@ $@.o $(TOOL_OBJ) $(BUILD)/liblbk.a $(TOOL_LIBS)
-bench: deps
+bench: deps-tools
 	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BENCHES:%=$(BUILD)/bench/%)
 	@for b in $(BENCHES); do echo "== $$b"; $(BUILD)/bench/$$b || exit 1; done
 
 # ---- demo -----------------------------------------------------------------------------------
-demo: deps
+demo: deps-tools
 	@$(MAKE) --no-print-directory $(BUILD)/lbk
 	@sh scenes/demo.sh $(BUILD)
 
