@@ -56,8 +56,14 @@ all: $(BUILD)/lbk $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc
 
 help:
 	@echo "make            build liblbk.a, liblbk.so, lbk.pc and the lbk CLI into $(BUILD)/"
-	@echo "make demo       install missing packages, bake the embedded scene, inspect it, write a PNG"
-	@echo "make test       install missing packages, build with ASan+UBSan, run the whole suite"
+	@echo "make deps       install the missing Debian packages"
+	@echo "make demo       bake the embedded scene, inspect it, write a PNG"
+	@echo "make test       build with ASan+UBSan, run the whole suite, then make tsan's cases"
+	@echo "                (demo, test, bench, fuzz install missing packages only as root with CI set"
+	@echo "                or with LBK_INSTALL_DEPS=1; else they print the apt-get line and stop)"
+	@echo "make tsan       the determinism cases of tests/tsan/determinism.list under ThreadSanitizer"
+	@echo "make install-lib PREFIX=/usr/local   liblbk only (needs a C compiler, zstd, xxHash)"
+	@echo "WERROR=1        every compiler warning is an error (CI)"
 	@echo "make bench      benchmarks, printed as ratios against baselines measured in the same run"
 	@echo "make fuzz       libFuzzer harness for the container reader (clang)"
 	@echo "make install PREFIX=/usr/local"
