@@ -51,7 +51,7 @@ TOOL_OBJ  := $(filter-out $(BUILD)/rel/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUIL
 LIB_ASAN  := $(LIB_SRC:%.c=$(BUILD)/asan/%.o)
 TOOL_ASAN := $(filter-out $(BUILD)/asan/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUILD)/asan/%.o)) $(TOOL_CXXSRC:%.cc=$(BUILD)/asan/%.o)
 
-.PHONY: all lib deps demo test check bench fuzz install install-check clean help tsan install-lib install-lib-check
+.PHONY: all lib deps demo test check bench fuzz install install-check clean help tsan install-lib install-lib-check fuzz-corpus
 all: $(BUILD)/lbk $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc
 
 help:
@@ -230,10 +230,20 @@ FUZZ_FLAGS := -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefine
 $(BUILD)/fuzz_container: tests/fuzz/fuzz_container.c $(LIB_SRC)
 	@mkdir -p $(@D)
 	$(CLANG) $(CSTD) $(FUZZ_FLAGS) $(WARN) $(LIB_INC) -o $@ $^ $(LIB_LIBS)
+# The seed corpus (tests/fuzz/README.md): the golden files, the containers make_corpus.c builds
+# (every section type) and two small real bakes. Regenerate by hand; the files are committed.
+fuzz-corpus: $(BUILD)/liblbk.a $(BUILD)/lbk
+	$(CC) $(CSTD) -O1 $(WARN) $(LIB_INC) tests/fuzz/make_corpus.c $(BUILD)/liblbk.a $(LIB_LIBS) -o $(BUILD)/make_corpus
+	cp tests/golden/*.lbk tests/fuzz/corpus/
+	$(BUILD)/make_corpus
+	$(BUILD)/lbk bake tests/fuzz/sets_scene.gltf -o tests/fuzz/corpus/bake_sets.lbk -q --threads 2 \
+	    --texel-density 2 --samples 8 --glg-spacing 3 --octahedral
+	$(BUILD)/lbk bake scenes/cornell_box/CornellBox-Original.gltf -o tests/fuzz/corpus/bake_cornell.lbk -q --threads 2 \
+	    --texel-density 2 --samples 8 --glg-spacing 2.5 --octahedral
 fuzz: deps-test
 	@$(MAKE) --no-print-directory $(BUILD)/fuzz_container
 	@mkdir -p $(BUILD)/fuzz-corpus
-	$(BUILD)/fuzz_container -max_total_time=$${FUZZ_SECONDS:-60} $(BUILD)/fuzz-corpus tests/fuzz/corpus
+	$(BUILD)/fuzz_container -max_total_time=$${FUZZ_SECONDS:-60} -max_len=65536 $(BUILD)/fuzz-corpus tests/fuzz/corpus
 
 # ---- benchmarks -----------------------------------------------------------------------------
 $(BUILD)/bench/%: bench/%.c $(TOOL_OBJ) $(BUILD)/liblbk.a
