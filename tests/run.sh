@@ -15,7 +15,10 @@ run_one() {
   t0=$(date +%s)
   if "$@" >"$log" 2>&1 </dev/null; then st=0; else st=$?; fi
   secs=$(( $(date +%s) - t0 ))
-  p=$(grep -c '^\[       OK \]' "$log"); f=$(grep -c '^\[  FAILED  \]' "$log"); s=$(grep -c '^\[  SKIPPED \]' "$log")
+  # one line per case until cmocka's "[==========] N test(s) run." (its summary lists them again)
+  set -- $(awk '/^\[==========\] .* run\./ { exit } /^\[       OK \]/ { p++ } /^\[  FAILED  \]/ { f++ }
+                /^\[  SKIPPED \]/ { s++ } END { print p + 0, f + 0, s + 0 }' "$log")
+  p=$1; f=$2; s=$3
   [ "$st" -ne 0 ] && [ "$f" -eq 0 ] && f=1
   # a run that passes no case at all tests nothing (a filter that matches no case, say)
   [ "$st" -eq 0 ] && [ "$p" -eq 0 ] && [ "$s" -eq 0 ] && { f=1; st=1; echo "no case ran" >>"$log"; }
