@@ -176,7 +176,7 @@ TSAN      := -fsanitize=thread -fno-omit-frame-pointer
 TSAN_TESTS := $(sort $(shell sed -n 's/^\(test_[a-z0-9_]*\).*/\1/p' tests/tsan/determinism.list))
 LIB_TSAN  := $(LIB_SRC:%.c=$(BUILD)/tsan/%.o)
 TOOL_TSAN := $(filter-out $(BUILD)/tsan/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUILD)/tsan/%.o)) $(TOOL_CXXSRC:%.cc=$(BUILD)/tsan/%.o)
-TEST_SUPPORT_TSAN := $(TEST_SUPPORT:%.c=$(BUILD)/tsan/%.o) $(BUILD)/tsan/tests/tsan/test_filter.o
+TEST_SUPPORT_TSAN := $(TEST_SUPPORT:%.c=$(BUILD)/tsan/%.o) $(BUILD)/tsan/tests/tsan/case_filter.o
 $(TEST_SUPPORT_TSAN): TOOL_INC += -Itests
 # only pattern rules name them: keep make from deleting them as intermediates
 .SECONDARY: $(LIB_TSAN) $(TOOL_TSAN)
