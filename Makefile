@@ -51,7 +51,7 @@ TOOL_OBJ  := $(filter-out $(BUILD)/rel/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUIL
 LIB_ASAN  := $(LIB_SRC:%.c=$(BUILD)/asan/%.o)
 TOOL_ASAN := $(filter-out $(BUILD)/asan/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUILD)/asan/%.o)) $(TOOL_CXXSRC:%.cc=$(BUILD)/asan/%.o)
 
-.PHONY: all lib deps demo test check bench fuzz install install-check clean help tsan install-lib install-lib-check fuzz-corpus
+.PHONY: all lib deps demo test check bench fuzz install install-check clean help
 all: $(BUILD)/lbk $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc
 
 help:
@@ -172,6 +172,7 @@ check: test
 # Their own objects under $(BUILD)/tsan (TSan cannot be mixed with ASan). Embree's internal
 # threads are not instrumented: tests/tsan/suppressions.txt silences reports inside Embree and
 # TBB only, never in lbk code.
+.PHONY: tsan
 TSAN      := -fsanitize=thread -fno-omit-frame-pointer
 TSAN_TESTS := $(sort $(shell sed -n 's/^\(test_[a-z0-9_]*\).*/\1/p' tests/tsan/determinism.list))
 LIB_TSAN  := $(LIB_SRC:%.c=$(BUILD)/tsan/%.o)
@@ -203,6 +204,7 @@ tsan: deps-test
 # install-lib-check installs it into a throwaway DESTDIR from a build folder of its own, checks
 # that nothing but libformat was compiled and that liblbk.so needs only zstd, xxHash and libc/libm,
 # and builds tests/install/install_check.c against the staged copy (run by tests/run.sh).
+.PHONY: install-lib install-lib-check
 install-lib: $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc
 	install -d $(DESTDIR)$(PREFIX)/lib/pkgconfig $(DESTDIR)$(PREFIX)/include/lbk
 	install -m 644 $(BUILD)/liblbk.a $(DESTDIR)$(PREFIX)/lib/liblbk.a
@@ -232,6 +234,7 @@ $(BUILD)/fuzz_container: tests/fuzz/fuzz_container.c $(LIB_SRC)
 	$(CLANG) $(CSTD) $(FUZZ_FLAGS) $(WARN) $(LIB_INC) -o $@ $^ $(LIB_LIBS)
 # The seed corpus (tests/fuzz/README.md): the golden files, the containers make_corpus.c builds
 # (every section type) and two small real bakes. Regenerate by hand; the files are committed.
+.PHONY: fuzz-corpus
 fuzz-corpus: $(BUILD)/liblbk.a $(BUILD)/lbk
 	$(CC) $(CSTD) -O1 $(WARN) $(LIB_INC) tests/fuzz/make_corpus.c $(BUILD)/liblbk.a $(LIB_LIBS) -o $(BUILD)/make_corpus
 	cp tests/golden/*.lbk tests/fuzz/corpus/
