@@ -59,5 +59,18 @@ if [ -n "${TSAN_BIN:-}" ]; then
   unset LBK_TEST_FILTER
 fi
 
+
+# The Khronos glTF-Validator over `lbk export --gltf` of the shared scenes (0 errors each).
+scenes="${LBK_SCENES:-../shared/scenes}"
+log="$BUILD/tests/gltf_validator.log"
+if [ -z "${GLTF_VALIDATOR:-}" ]; then
+  skip=$((skip + 1)); echo "SKIPPED gltf_validator (npm/node not found: apt-get install npm)"
+elif [ ! -d "$scenes" ]; then
+  skip=$((skip + 1)); echo "SKIPPED gltf_validator (no shared scenes at $scenes; set LBK_SCENES)"
+elif sh tests/tools/gltf_validator.sh "$BUILD/lbk" "${LBK:-$BUILD/lbk-asan}" "$GLTF_VALIDATOR" "$BUILD/gltf-validator" >"$log" 2>&1; then
+  pass=$((pass + 1)); echo "ok   gltf_validator ($(grep -c ' 0 errors' "$log") exports, 0 errors)"
+else
+  fail=$((fail + 1)); failed="$failed gltf_validator"; echo "FAIL gltf_validator"; tail -n 30 "$log"
+fi
 echo "tests: $pass passed, $fail failed, $skip skipped"
 [ -z "$failed" ]

@@ -442,16 +442,18 @@ static lbk_result build_vertices(const bk_scene *scene, bk_atlas *a)
 }
 
 /* ---------------------------------------------------------------------------------------- */
+/* The atlas: objects → rectangles within the budget → pages → charts in page coordinates    */
 
-lbk_result bk_atlas_build(const bk_scene *scene, const uint8_t *lightmapped, const bk_atlas_options *opt,
-                          bk_atlas *out)
+/* The options with their defaults and caps applied. */
+typedef struct atlas_limits {
+    int page, max_page;  /* default and largest page side, multiples of 4 */
+    int margin;          /* ceil(padding / 2) */
+    uint64_t budget;     /* texels */
+    bk_uv_options uv;
+} atlas_limits;
+
+static lbk_result resolve_limits(const bk_atlas_options *opt, atlas_limits *l)
 {
-    if (!out) return LBK_ERR_INVALID_ARGUMENT;
-    memset(out, 0, sizeof *out);
-    if (!scene || (scene->object_count && !scene->objects) || (scene->tri_count && !scene->tris))
-        return LBK_ERR_INVALID_ARGUMENT;
-    if (scene->tri_count > (size_t)INT32_MAX || scene->object_count > (size_t)INT32_MAX) return LBK_ERR_LIMIT;
-
     int page = opt && opt->page_size > 0 ? opt->page_size : DEFAULT_PAGE;
     int max_page = opt && opt->max_page_size > 0 ? opt->max_page_size : DEFAULT_MAX_PAGE;
     if (max_page > 16384) max_page = 16384;
@@ -461,81 +463,106 @@ lbk_result bk_atlas_build(const bk_scene *scene, const uint8_t *lightmapped, con
     if (page > max_page) page = max_page;
     int padding = opt && opt->padding > 0 ? opt->padding : DEFAULT_PADDING;
     if (padding > 64) padding = 64;
-    int margin = (padding + 1) / 2;
-    uint64_t budget = opt && opt->texel_budget > 0 ? opt->texel_budget : DEFAULT_BUDGET;
-    bk_uv_options uvo = {0};
-    if (opt) uvo = opt->uv;
-    if (uvo.max_chart_texels <= 0 || uvo.max_chart_texels > page - 2 * margin) uvo.max_chart_texels = page - 2 * margin;
-    if (uvo.max_chart_texels < 1) return LBK_ERR_INVALID_ARGUMENT;
+    l->page = page;
+    l->max_page = max_page;
+    l->margin = (padding + 1) / 2;
+    l->budget = opt && opt->texel_budget > 0 ? opt->texel_budget : DEFAULT_BUDGET;
+    memset(&l->uv, 0, sizeof l->uv);
+    if (opt) l->uv = opt->uv;
+    int room = page - 2 * l->margin;
+    if (l->uv.max_chart_texels <= 0 || l->uv.max_chart_texels > room) l->uv.max_chart_texels = room;
+    return l->uv.max_chart_texels < 1 ? LBK_ERR_INVALID_ARGUMENT : LBK_OK;
+}
 
-    out->padding = 2 * margin;
-    out->margin = margin;
-    out->density_scale = 1.0f;
-    out->scene_object_count = scene->object_count;
-    out->scene_tri_count = scene->tri_count;
-
+/* One slot per lightmapped object (out->objects, out->object_slot) with the density it asks
+ * for; *op_out gets the matching packing state, zeroed. */
+static lbk_result select_objects(const bk_scene *scene, const uint8_t *lightmapped, const bk_atlas_options *opt,
+                                 bk_atlas *out, obj_pack **op_out)
+{
     size_t nobj = 0;
     for (size_t i = 0; i < scene->object_count; i++)
         if (!lightmapped || lightmapped[i]) nobj++;
     obj_pack *op = calloc(nobj ? nobj : 1, sizeof *op);
+    *op_out = op;
     out->object_slot = malloc((scene->object_count ? scene->object_count : 1) * sizeof *out->object_slot);
     out->objects = calloc(nobj ? nobj : 1, sizeof *out->objects);
-    lbk_result r = (op && out->object_slot && out->objects) ? LBK_OK : LBK_ERR_OUT_OF_MEMORY;
+    if (!op || !out->object_slot || !out->objects) return LBK_ERR_OUT_OF_MEMORY;
+    out->object_count = nobj;
     size_t slot = 0;
-    for (size_t i = 0; r == LBK_OK && i < scene->object_count; i++) {
+    for (size_t i = 0; i < scene->object_count; i++) {
         out->object_slot[i] = -1;
         if (lightmapped && !lightmapped[i]) continue;
         const bk_object *ob = &scene->objects[i];
-        if ((uint64_t)ob->first_tri + ob->tri_count > scene->tri_count) r = LBK_ERR_INVALID_ARGUMENT;
+        if ((uint64_t)ob->first_tri + ob->tri_count > scene->tri_count) return LBK_ERR_INVALID_ARGUMENT;
         out->object_slot[i] = (int32_t)slot;
         out->objects[slot].object = (uint32_t)i;
         op[slot].requested = bk_atlas_requested_density(scene, (uint32_t)i, opt);
         op[slot].fit_scale = 1.0f;
         slot++;
     }
-    out->object_count = nobj;
+    return LBK_OK;
+}
 
-    /* charts and object rectangles, shrinking densities until within budget */
+/* Charts of one object at its density × scale, lowering the object's own fit_scale until its
+ * rectangle fits one max page. */
+static lbk_result pack_object_to_fit(const bk_scene *scene, uint32_t object, double scale, const atlas_limits *l,
+                                     obj_pack *p)
+{
+    for (int attempt = 0; attempt < 24; attempt++) {
+        int fits;
+        double d = p->requested * scale * p->fit_scale;
+        lbk_result r = pack_object(scene, object, d, &l->uv, l->margin, l->max_page, p, &fits);
+        if (r != LBK_OK || fits) return r;
+        p->fit_scale *= 0.8f;
+    }
+    return LBK_ERR_LIMIT;
+}
+
+/* Charts and object rectangles of every object; when their texels exceed the budget, every
+ * density is scaled by the same factor and all are packed again (noted in out->note). */
+static lbk_result pack_objects_within_budget(const bk_scene *scene, bk_atlas *out, obj_pack *op, const atlas_limits *l)
+{
     double scale = 1.0;
-    for (int round = 0; r == LBK_OK && round < 12; round++) {
+    for (int round = 0;; round++) {
         double total = 0.0;
-        for (size_t s = 0; r == LBK_OK && s < nobj; s++) {
-            for (int attempt = 0; attempt < 24; attempt++) {
-                int fits;
-                double d = op[s].requested * scale * op[s].fit_scale;
-                r = pack_object(scene, out->objects[s].object, d, &uvo, margin, max_page, &op[s], &fits);
-                if (r != LBK_OK || fits) break;
-                op[s].fit_scale *= 0.8f;
-                if (attempt == 23) r = LBK_ERR_LIMIT;
-            }
+        for (size_t s = 0; s < out->object_count; s++) {
+            lbk_result r = pack_object_to_fit(scene, out->objects[s].object, scale, l, &op[s]);
+            if (r != LBK_OK) return r;
             total += (double)op[s].w * op[s].h;
         }
-        if (r != LBK_OK || total <= (double)budget) break;
-        double f = sqrt((double)budget / total) * 0.98;
-        scale *= f;
-        if (round == 11) r = LBK_ERR_LIMIT;
+        if (total <= (double)l->budget) break;
+        if (round == 11) return LBK_ERR_LIMIT;
+        scale *= sqrt((double)l->budget / total) * 0.98;
     }
-    if (r == LBK_OK && scale < 1.0) {
+    if (scale < 1.0) {
         out->density_scale = (float)scale;
-        snprintf(out->note, sizeof out->note,
-                 "texel budget %llu exceeded: every density scaled by %.4f", (unsigned long long)budget, scale);
+        snprintf(out->note, sizeof out->note, "texel budget %llu exceeded: every density scaled by %.4f",
+                 (unsigned long long)l->budget, scale);
     }
+    return LBK_OK;
+}
 
-    /* page size: one object rectangle may need more than the default */
-    int psize = page;
-    for (size_t s = 0; r == LBK_OK && s < nobj; s++) {
+/* The page side: the default, or more when one object rectangle needs it (at most max_page). */
+static int page_side(const obj_pack *op, size_t nobj, const atlas_limits *l)
+{
+    int psize = l->page;
+    for (size_t s = 0; s < nobj; s++) {
         int m = op[s].w > op[s].h ? op[s].w : op[s].h;
-        if (m > psize) psize = round4(m) > max_page ? max_page : round4(m);
+        if (m > psize) psize = round4(m) > l->max_page ? l->max_page : round4(m);
     }
+    return psize;
+}
 
-    /* object rectangles → pages */
-    pk_rect *rc = NULL;
+/* Fills the object records from their packing (uv source, densities, notes) and returns the
+ * rectangles of the objects that have charts, sorted for the packer. */
+static lbk_result object_rects(bk_atlas *out, const obj_pack *op, int max_page, pk_rect **rc_out, int *nrect_out)
+{
+    size_t nobj = out->object_count;
+    pk_rect *rc = malloc((nobj ? nobj : 1) * sizeof *rc);
+    *rc_out = rc;
+    if (!rc) return LBK_ERR_OUT_OF_MEMORY;
     int nrect = 0;
-    if (r == LBK_OK) {
-        rc = malloc((nobj ? nobj : 1) * sizeof *rc);
-        if (!rc) r = LBK_ERR_OUT_OF_MEMORY;
-    }
-    for (size_t s = 0; r == LBK_OK && s < nobj; s++) {
+    for (size_t s = 0; s < nobj; s++) {
         bk_atlas_object *o = &out->objects[s];
         o->page = -1;
         o->uv_source = op[s].uv.source;
@@ -544,9 +571,9 @@ lbk_result bk_atlas_build(const bk_scene *scene, const uint8_t *lightmapped, con
         o->degenerate_tris = (uint32_t)op[s].uv.degenerate_count;
         snprintf(o->note, sizeof o->note, "%s", op[s].uv.note);
         if (op[s].fit_scale < 1.0f) {
-            size_t l = strlen(o->note);
-            snprintf(o->note + l, sizeof o->note - l, "%sdensity lowered to %g texels/m to fit a %d page",
-                     l ? "; " : "", o->density, max_page);
+            size_t len = strlen(o->note);
+            snprintf(o->note + len, sizeof o->note - len, "%sdensity lowered to %g texels/m to fit a %d page",
+                     len ? "; " : "", o->density, max_page);
         }
         if (op[s].uv.chart_count == 0) continue;
         rc[nrect].w = op[s].w;
@@ -555,27 +582,23 @@ lbk_result bk_atlas_build(const bk_scene *scene, const uint8_t *lightmapped, con
         rc[nrect].placed = 0;
         nrect++;
     }
-    if (r == LBK_OK) qsort(rc, (size_t)nrect, sizeof *rc, cmp_rect);
-    int *rect_page = NULL;
+    qsort(rc, (size_t)nrect, sizeof *rc, cmp_rect);
+    *nrect_out = nrect;
+    return LBK_OK;
+}
+
+/* Fills psize × psize pages one after the other with the sorted rectangles (out->pages);
+ * rect_page[i] gets the page of rc[i]. */
+static lbk_result fill_pages(bk_atlas *out, pk_rect *rc, int nrect, int psize, int *rect_page)
+{
+    out->pages = malloc((size_t)(nrect ? nrect : 1) * sizeof *out->pages);
+    if (!out->pages) return LBK_ERR_OUT_OF_MEMORY;
     size_t npages = 0;
-    if (r == LBK_OK) {
-        rect_page = malloc((size_t)(nrect ? nrect : 1) * sizeof *rect_page);
-        out->pages = malloc((size_t)(nrect ? nrect : 1) * sizeof *out->pages);
-        if (!rect_page || !out->pages) r = LBK_ERR_OUT_OF_MEMORY;
-    }
-    int remaining = nrect;
-    while (r == LBK_OK && remaining > 0) {
+    for (int remaining = nrect; remaining > 0;) {
         int uw, uh;
-        /* snapshot which were placed before this page */
         int placed = pack_into(rc, nrect, psize, psize, &uw, &uh);
-        if (placed < 0) {
-            r = LBK_ERR_OUT_OF_MEMORY;
-            break;
-        }
-        if (placed == 0) {
-            r = LBK_ERR_LIMIT; /* cannot happen: every rectangle fits an empty page */
-            break;
-        }
+        if (placed < 0) return LBK_ERR_OUT_OF_MEMORY;
+        if (placed == 0) return LBK_ERR_LIMIT; /* cannot happen: every rectangle fits an empty page */
         for (int i = 0; i < nrect; i++)
             if (rc[i].placed == 1) {
                 rect_page[i] = (int)npages;
@@ -583,111 +606,162 @@ lbk_result bk_atlas_build(const bk_scene *scene, const uint8_t *lightmapped, con
             }
         out->pages[npages].width = psize;
         out->pages[npages].height = psize;
-        npages++;
+        out->page_count = ++npages;
         remaining -= placed;
     }
-    /* shrink the last page: repack its rectangles as tightly as possible */
-    if (r == LBK_OK && npages > 0) {
-        int last = (int)npages - 1, cnt = 0;
-        pk_rect *lr = malloc((size_t)nrect * sizeof *lr);
-        int *idx = malloc((size_t)nrect * sizeof *idx);
-        if (!lr || !idx) r = LBK_ERR_OUT_OF_MEMORY;
-        for (int i = 0; r == LBK_OK && i < nrect; i++)
-            if (rect_page[i] == last) {
-                lr[cnt] = rc[i];
-                lr[cnt].id = (uint32_t)i;
-                lr[cnt].placed = 0;
-                cnt++;
-            }
-        int pw = 0, ph = 0;
-        int ok = r == LBK_OK ? pack_tight(lr, cnt, psize, psize, 4, &pw, &ph) : -1;
-        if (r == LBK_OK && ok < 0) r = LBK_ERR_OUT_OF_MEMORY;
-        if (r == LBK_OK && ok == 1) {
-            for (int i = 0; i < cnt; i++) {
-                rc[lr[i].id].x = lr[i].x;
-                rc[lr[i].id].y = lr[i].y;
-            }
-            out->pages[last].width = pw;
-            out->pages[last].height = ph;
-        } else if (r == LBK_OK) {
-            /* keep the first packing; shrink to its extent */
-            int uw = 0, uh = 0;
-            for (int i = 0; i < nrect; i++)
-                if (rect_page[i] == last) {
-                    if (rc[i].x + rc[i].w > uw) uw = rc[i].x + rc[i].w;
-                    if (rc[i].y + rc[i].h > uh) uh = rc[i].y + rc[i].h;
-                }
-            out->pages[last].width = round4(uw);
-            out->pages[last].height = round4(uh);
+    return LBK_OK;
+}
+
+/* The last page is usually part full: repack its rectangles as tightly as possible, or, when
+ * that finds nothing, keep the first packing and crop the page to its extent. */
+static lbk_result shrink_last_page(bk_atlas *out, pk_rect *rc, int nrect, const int *rect_page, int psize)
+{
+    if (out->page_count == 0) return LBK_OK;
+    int last = (int)out->page_count - 1, cnt = 0;
+    pk_rect *lr = malloc((size_t)nrect * sizeof *lr);
+    if (!lr) return LBK_ERR_OUT_OF_MEMORY;
+    for (int i = 0; i < nrect; i++)
+        if (rect_page[i] == last) {
+            lr[cnt] = rc[i];
+            lr[cnt].id = (uint32_t)i;
+            lr[cnt].placed = 0;
+            cnt++;
         }
-        free(lr);
-        free(idx);
+    int pw = 0, ph = 0;
+    int ok = pack_tight(lr, cnt, psize, psize, 4, &pw, &ph);
+    if (ok == 1) {
+        for (int i = 0; i < cnt; i++) {
+            rc[lr[i].id].x = lr[i].x;
+            rc[lr[i].id].y = lr[i].y;
+        }
+        out->pages[last].width = pw;
+        out->pages[last].height = ph;
+    } else if (ok == 0) {
+        int uw = 0, uh = 0;
+        for (int i = 0; i < nrect; i++)
+            if (rect_page[i] == last) {
+                if (rc[i].x + rc[i].w > uw) uw = rc[i].x + rc[i].w;
+                if (rc[i].y + rc[i].h > uh) uh = rc[i].y + rc[i].h;
+            }
+        out->pages[last].width = round4(uw);
+        out->pages[last].height = round4(uh);
     }
-    out->page_count = npages;
-    for (size_t p = 0; p < npages; p++)
-        out->texels += (uint64_t)out->pages[p].width * (uint64_t)out->pages[p].height;
-    for (int i = 0; r == LBK_OK && i < nrect; i++) {
-        bk_atlas_object *o = &out->objects[rc[i].id];
-        o->page = rect_page[i];
-        o->x = rc[i].x;
-        o->y = rc[i].y;
-        o->w = rc[i].w;
-        o->h = rc[i].h;
+    free(lr);
+    return ok < 0 ? LBK_ERR_OUT_OF_MEMORY : LBK_OK;
+}
+
+/* Object rectangles → pages: out->pages, out->texels and each object's page and rectangle. */
+static lbk_result pack_pages(bk_atlas *out, const obj_pack *op, const atlas_limits *l)
+{
+    int psize = page_side(op, out->object_count, l);
+    pk_rect *rc = NULL;
+    int nrect = 0;
+    lbk_result r = object_rects(out, op, l->max_page, &rc, &nrect);
+    int *rect_page = r == LBK_OK ? malloc((size_t)(nrect ? nrect : 1) * sizeof *rect_page) : NULL;
+    if (r == LBK_OK && !rect_page) r = LBK_ERR_OUT_OF_MEMORY;
+    if (r == LBK_OK) r = fill_pages(out, rc, nrect, psize, rect_page);
+    if (r == LBK_OK) r = shrink_last_page(out, rc, nrect, rect_page, psize);
+    if (r == LBK_OK) {
+        for (size_t p = 0; p < out->page_count; p++)
+            out->texels += (uint64_t)out->pages[p].width * (uint64_t)out->pages[p].height;
+        for (int i = 0; i < nrect; i++) {
+            bk_atlas_object *o = &out->objects[rc[i].id];
+            o->page = rect_page[i];
+            o->x = rc[i].x;
+            o->y = rc[i].y;
+            o->w = rc[i].w;
+            o->h = rc[i].h;
+        }
     }
     free(rc);
     free(rect_page);
+    return r;
+}
 
-    /* charts and triangles in page coordinates */
-    size_t nchart = 0, ntri = 0;
+/* Charts and triangles in page coordinates: every chart's block sits at its object's
+ * rectangle plus its offset inside it, its content one margin further in. */
+static lbk_result place_charts(const bk_scene *scene, bk_atlas *out, const obj_pack *op, int margin)
+{
+    size_t nobj = out->object_count, nchart = 0, ntri = 0;
     for (size_t s = 0; s < nobj; s++) {
         nchart += op[s].uv.chart_count;
         ntri += op[s].uv.tri_count;
     }
-    if (r == LBK_OK && (nchart > (size_t)INT32_MAX || ntri > (size_t)INT32_MAX)) r = LBK_ERR_LIMIT;
-    if (r == LBK_OK) {
-        out->charts = malloc((nchart ? nchart : 1) * sizeof *out->charts);
-        out->tris = malloc((ntri ? ntri : 1) * sizeof *out->tris);
-        out->tri_chart = malloc((ntri ? ntri : 1) * sizeof *out->tri_chart);
-        out->tri_uv = malloc((ntri ? ntri : 1) * 6 * sizeof *out->tri_uv);
-        out->scene_tri_entry = malloc((scene->tri_count ? scene->tri_count : 1) * sizeof *out->scene_tri_entry);
-        if (!out->charts || !out->tris || !out->tri_chart || !out->tri_uv || !out->scene_tri_entry)
-            r = LBK_ERR_OUT_OF_MEMORY;
-    }
-    if (r == LBK_OK) {
-        for (size_t i = 0; i < scene->tri_count; i++) out->scene_tri_entry[i] = -1;
-        size_t c = 0, t = 0;
-        for (size_t s = 0; s < nobj; s++) {
-            bk_atlas_object *o = &out->objects[s];
-            const bk_uv_object *u = &op[s].uv;
-            o->first_chart = (uint32_t)c;
-            o->chart_count = (uint32_t)u->chart_count;
-            for (size_t k = 0; k < u->chart_count; k++, c++) {
-                bk_atlas_chart *ch = &out->charts[c];
-                ch->slot = (uint32_t)s;
-                ch->page = o->page;
-                ch->x = o->x + op[s].chart_x[k] + margin;
-                ch->y = o->y + op[s].chart_y[k] + margin;
-                ch->w = content_size(u->charts[k].width);
-                ch->h = content_size(u->charts[k].height);
-                ch->first = (uint32_t)t;
-                ch->count = u->charts[k].count;
-                for (uint32_t j = 0; j < u->charts[k].count; j++, t++) {
-                    size_t src = (size_t)u->charts[k].first + j;
-                    out->tris[t] = u->tris[src];
-                    out->tri_chart[t] = (uint32_t)c;
-                    out->scene_tri_entry[u->tris[src]] = (int32_t)t;
-                    for (int q = 0; q < 3; q++) {
-                        out->tri_uv[6 * t + 2 * (size_t)q] = (float)ch->x + u->uv[6 * src + 2 * (size_t)q];
-                        out->tri_uv[6 * t + 2 * (size_t)q + 1] = (float)ch->y + u->uv[6 * src + 2 * (size_t)q + 1];
-                    }
+    if (nchart > (size_t)INT32_MAX || ntri > (size_t)INT32_MAX) return LBK_ERR_LIMIT;
+    out->charts = malloc((nchart ? nchart : 1) * sizeof *out->charts);
+    out->tris = malloc((ntri ? ntri : 1) * sizeof *out->tris);
+    out->tri_chart = malloc((ntri ? ntri : 1) * sizeof *out->tri_chart);
+    out->tri_uv = malloc((ntri ? ntri : 1) * 6 * sizeof *out->tri_uv);
+    out->scene_tri_entry = malloc((scene->tri_count ? scene->tri_count : 1) * sizeof *out->scene_tri_entry);
+    if (!out->charts || !out->tris || !out->tri_chart || !out->tri_uv || !out->scene_tri_entry)
+        return LBK_ERR_OUT_OF_MEMORY;
+    for (size_t i = 0; i < scene->tri_count; i++) out->scene_tri_entry[i] = -1;
+    size_t c = 0, t = 0;
+    for (size_t s = 0; s < nobj; s++) {
+        bk_atlas_object *o = &out->objects[s];
+        const bk_uv_object *u = &op[s].uv;
+        o->first_chart = (uint32_t)c;
+        o->chart_count = (uint32_t)u->chart_count;
+        for (size_t k = 0; k < u->chart_count; k++, c++) {
+            bk_atlas_chart *ch = &out->charts[c];
+            ch->slot = (uint32_t)s;
+            ch->page = o->page;
+            ch->x = o->x + op[s].chart_x[k] + margin;
+            ch->y = o->y + op[s].chart_y[k] + margin;
+            ch->w = content_size(u->charts[k].width);
+            ch->h = content_size(u->charts[k].height);
+            ch->first = (uint32_t)t;
+            ch->count = u->charts[k].count;
+            if (u->source == BK_UV_AUTHORED) { /* one chart: its origin is uv1_min */
+                o->uv1_scale = u->uv1_scale;
+                for (int q = 0; q < 2; q++) {
+                    o->uv1_offset[q] = (q ? ch->y : ch->x) - u->uv1_min[q] * u->uv1_scale;
+                    o->uv1_min[q] = u->uv1_min[q];
+                    o->uv1_max[q] = u->uv1_max[q];
+                }
+            }
+            for (uint32_t j = 0; j < u->charts[k].count; j++, t++) {
+                size_t src = (size_t)u->charts[k].first + j;
+                out->tris[t] = u->tris[src];
+                out->tri_chart[t] = (uint32_t)c;
+                out->scene_tri_entry[u->tris[src]] = (int32_t)t;
+                for (int q = 0; q < 3; q++) {
+                    out->tri_uv[6 * t + 2 * (size_t)q] = (float)ch->x + u->uv[6 * src + 2 * (size_t)q];
+                    out->tri_uv[6 * t + 2 * (size_t)q + 1] = (float)ch->y + u->uv[6 * src + 2 * (size_t)q + 1];
                 }
             }
         }
-        out->chart_count = nchart;
-        out->tri_count = ntri;
-        r = build_vertices(scene, out);
     }
-    for (size_t s = 0; s < nobj; s++) obj_pack_free(&op[s]);
+    out->chart_count = nchart;
+    out->tri_count = ntri;
+    return LBK_OK;
+}
+
+lbk_result bk_atlas_build(const bk_scene *scene, const uint8_t *lightmapped, const bk_atlas_options *opt,
+                          bk_atlas *out)
+{
+    if (!out) return LBK_ERR_INVALID_ARGUMENT;
+    memset(out, 0, sizeof *out);
+    if (!scene || (scene->object_count && !scene->objects) || (scene->tri_count && !scene->tris))
+        return LBK_ERR_INVALID_ARGUMENT;
+    if (scene->tri_count > (size_t)INT32_MAX || scene->object_count > (size_t)INT32_MAX) return LBK_ERR_LIMIT;
+    atlas_limits lim;
+    lbk_result r = resolve_limits(opt, &lim);
+    if (r != LBK_OK) return r;
+
+    out->padding = 2 * lim.margin;
+    out->margin = lim.margin;
+    out->density_scale = 1.0f;
+    out->scene_object_count = scene->object_count;
+    out->scene_tri_count = scene->tri_count;
+    obj_pack *op = NULL;
+    r = select_objects(scene, lightmapped, opt, out, &op);
+    if (r == LBK_OK) r = pack_objects_within_budget(scene, out, op, &lim);
+    if (r == LBK_OK) r = pack_pages(out, op, &lim);
+    if (r == LBK_OK) r = place_charts(scene, out, op, lim.margin);
+    if (r == LBK_OK) r = build_vertices(scene, out);
+    if (op)
+        for (size_t s = 0; s < out->object_count; s++) obj_pack_free(&op[s]);
     free(op);
     if (r != LBK_OK) bk_atlas_free(out);
     return r;

@@ -201,9 +201,9 @@ static void test_glg_cap_and_build(void **state)
     for (size_t t = 0; t < g.tet_count; t++)
         for (int i = 0; i < 4; i++)
             assert_int_equal(vis8[t][i], (int)lrintf(g.face_visibility[4 * t + (size_t)i] * 255.0f));
-    lbk_glg_desc desc = {(uint32_t)g.probe_count, (uint32_t)g.tet_count, (const float (*)[3])g.positions, sh,
-                         (const uint32_t (*)[4])g.tets, (const uint32_t (*)[4])g.neighbours,
-                         (const uint8_t (*)[4])vis8, 0};
+    lbk_glg_build_desc desc = {.probe_count = (uint32_t)g.probe_count, .tetra_count = (uint32_t)g.tet_count,
+        .positions = (const float (*)[3])g.positions, .probes = sh, .tetras = (const uint32_t (*)[4])g.tets,
+        .adjacency = (const uint32_t (*)[4])g.neighbours, .visibility = (const uint8_t (*)[4])vis8};
     void *bytes = NULL;
     size_t size = 0;
     assert_int_equal(lbk_glg_build(&desc, NULL, &bytes, &size), LBK_OK);
@@ -404,18 +404,19 @@ static void test_llg_obb_rotated_box(void **state)
         memset(&gd, 0, sizeof gd);
         memcpy(gd.centre, l.centre, sizeof gd.centre);
         memcpy(gd.axes, l.axes, sizeof gd.axes);
-        memcpy(gd.half_extent, l.half_extents, sizeof gd.half_extent);
+        memcpy(gd.half_extents, l.half_extents, sizeof gd.half_extents);
         memcpy(gd.dims, l.dims, sizeof gd.dims);
         gd.probes = sh;
         gd.vertices = recs;
         gd.vertex_count = (uint32_t)l.vertex_count;
         void *bytes = NULL;
         size_t size = 0;
-        assert_int_equal(lbk_llg_build(&gd, 1, 0, NULL, &bytes, &size), LBK_OK);
+        assert_int_equal(lbk_llg_build(&(lbk_llg_build_desc){.grids = &gd,
+            .grid_count = 1}, NULL, &bytes, &size), LBK_OK);
         lbk_llg_view view;
         lbk_llg_grid grid;
         assert_int_equal(lbk_llg_open(bytes, size, &view), LBK_OK);
-        assert_int_equal(lbk_llg_get_grid(&view, 0, &grid), LBK_OK);
+        assert_int_equal(lbk_llg_grid_get(&view, 0, &grid), LBK_OK);
         for (uint32_t k = 0; k < l.dims[2]; k++) for (uint32_t j = 0; j < l.dims[1]; j++)
             for (uint32_t i = 0; i < l.dims[0]; i++) {
                 float a[3], b[3];

@@ -23,6 +23,7 @@
 #include "lbk/door.h"
 #include "lbk/glg.h"
 #include "lbk/lightmap.h"
+#include "lbk/lightmap_uv.h"
 #include "lbk/llg.h"
 #include "lbk/meta.h"
 #include "lbk/objects.h"
@@ -65,23 +66,23 @@ static void read_meta_objs_rept(uint32_t type, const void *d, size_t n)
 {
     if (type == LBK_SECTION_META) {
         lbk_meta_view v;
-        if (lbk_meta_parse(d, n, &v) != LBK_OK) return;
+        if (lbk_meta_open(d, n, &v) != LBK_OK) return;
         for (uint32_t i = 0; i < v.entry_count && i < 4096; i++) {
             lbk_string k, val;
-            if (lbk_meta_entry(&v, i, &k, &val) == LBK_OK) touch(k.data, k.size), touch(val.data, val.size);
+            if (lbk_meta_entry_get(&v, i, &k, &val) == LBK_OK) touch(k.data, k.size), touch(val.data, val.size);
         }
         lbk_string val;
         lbk_meta_find(&v, "writer", &val);
     } else if (type == LBK_SECTION_REPT) {
         lbk_report_view v;
-        if (lbk_report_parse(d, n, &v) != LBK_OK) return;
+        if (lbk_report_open(d, n, &v) != LBK_OK) return;
         for (uint32_t i = 0; i < v.header.record_count && i < 4096; i++) {
             lbk_report_record r;
-            lbk_report_record_at(&v, i, &r);
+            lbk_report_record_get(&v, i, &r);
         }
     } else if (type == LBK_SECTION_OBJS) {
         lbk_objects_view v;
-        if (lbk_objects_parse(d, n, &v) != LBK_OK) return;
+        if (lbk_objects_open(d, n, &v) != LBK_OK) return;
         for (uint32_t i = 0; i < v.count && i < 4096; i++) {
             lbk_object o;
             if (lbk_objects_get(&v, i, &o) == LBK_OK) touch(o.name.data, o.name.size);
@@ -98,22 +99,22 @@ static int sample_lmap(const void *d, size_t n)
     if (r != LBK_OK) return r;
     for (uint32_t i = 0; i < v.page_count && i < ITEM_CAP; i++) {
         lbk_lmap_page pg;
-        if (lbk_lmap_get_page(&v, i, &pg) != LBK_OK) continue;
+        if (lbk_lmap_page_get(&v, i, &pg) != LBK_OK) continue;
         const uint32_t xs[3] = {0, pg.width / 2, pg.width ? pg.width - 1 : 0}, ys[3] = {0, pg.height / 2, pg.height ? pg.height - 1 : 0};
         for (int k = 0; k < 3; k++) {
             lbk_ahd_texel t;
             float rgb[3];
-            if (lbk_lmap_page_texel(&pg, xs[k], ys[k], &t) == LBK_OK) touch(&t, sizeof t);
+            if (lbk_lmap_page_texel_get(&pg, xs[k], ys[k], &t) == LBK_OK) touch(&t, sizeof t);
             if (lbk_lmap_page_irradiance(&pg, xs[k], ys[k], DIRS[k], rgb) == LBK_OK) touch_floats(rgb, 3);
         }
         lbk_ahd_texel t;
-        lbk_lmap_page_texel(&pg, pg.width, 0, &t); /* out of range: must be refused, not read */
+        lbk_lmap_page_texel_get(&pg, pg.width, 0, &t); /* out of range: must be refused, not read */
     }
     const uint64_t idx[4] = {0, v.texel_count / 2, v.texel_count ? v.texel_count - 1 : 0, v.texel_count};
     for (int k = 0; k < 4; k++) {
         lbk_ahd_texel t;
         uint32_t page;
-        if (lbk_lmap_texel(&v, idx[k], &t, &page) == LBK_OK) touch(&t, sizeof t);
+        if (lbk_lmap_texel_get(&v, idx[k], &t, &page) == LBK_OK) touch(&t, sizeof t);
     }
     return LBK_OK;
 }
@@ -129,7 +130,7 @@ static int sample_glg(const void *d, size_t n, int valid)
     for (uint32_t i = 0; i < v.probe_count && i < ITEM_CAP; i++) {
         float p[3];
         lbk_sh9_rgb sh;
-        if (lbk_glg_probe(&v, i, p, &sh) != LBK_OK) continue;
+        if (lbk_glg_probe_get(&v, i, p, &sh) != LBK_OK) continue;
         touch_floats(sh.c[0], 27);
         for (int k = 0; k < 3; k++) {
             if (!(p[k] > -1e30f && p[k] < 1e30f)) continue; /* NaN and huge: lo/hi stay finite */
@@ -143,7 +144,7 @@ static int sample_glg(const void *d, size_t n, int valid)
         if (i < 8) { /* the box corners pushed outwards */
             for (int k = 0; k < 3; k++) p[k] = (i >> k & 1) ? hi[k] + 1.0f : lo[k] - 1.0f;
         } else if (i < 16 && v.probe_count) {
-            lbk_glg_probe(&v, (i * 2654435761u) % v.probe_count, p, NULL);
+            lbk_glg_probe_get(&v, (i * 2654435761u) % v.probe_count, p, NULL);
         } else {
             for (int k = 0; k < 3; k++) p[k] = lo[k] + (hi[k] - lo[k]) * (float)((i * (k + 3)) % 7) / 6.0f;
         }
@@ -165,7 +166,7 @@ static int sample_llg(const void *d, size_t n, int valid)
     if (r != LBK_OK) return r;
     for (uint32_t g = 0; g < v.grid_count && g < ITEM_CAP; g++) {
         lbk_llg_grid grid;
-        if (lbk_llg_get_grid(&v, g, &grid) != LBK_OK) {
+        if (lbk_llg_grid_get(&v, g, &grid) != LBK_OK) {
             if (valid) abort();
             continue;
         }
@@ -200,7 +201,7 @@ static int sample_octp(const void *d, size_t n, int valid)
     if (r != LBK_OK) return r;
     for (uint32_t i = 0; i < v.probe_count && i < ITEM_CAP; i++) {
         lbk_octp_probe_desc p;
-        if (lbk_octp_get(&v, i, &p) == LBK_OK) touch_floats(p.irradiance[0], 48), touch_floats(p.depth[0], 288);
+        if (lbk_octp_probe_get(&v, i, &p) == LBK_OK) touch_floats(p.irradiance[0], 48), touch_floats(p.depth[0], 288);
         else if (valid) abort();
         for (int k = 0; k < 7; k++) {
             float rgb[3];
@@ -231,27 +232,27 @@ static void read_dls(const lbk_dls_view *dv)
         for (uint32_t i = 0; i < si.light_count && i < ITEM_CAP; i++) {
             const char *name;
             uint32_t len;
-            if (lbk_dls_set_light(dv, s, i, &name, &len) == LBK_OK) touch(name, len);
+            if (lbk_dls_set_light_get(dv, s, i, &name, &len) == LBK_OK) touch(name, len);
         }
         for (uint32_t i = 0; i < si.member_count && i < ITEM_CAP; i++) {
             uint32_t m;
-            lbk_dls_set_member(dv, s, i, &m);
+            lbk_dls_set_member_get(dv, s, i, &m);
         }
     }
     uint32_t found;
-    lbk_dls_find_set(dv, "A", &found);
+    lbk_dls_set_find(dv, "A", &found);
     for (uint32_t c = 0; c < lbk_dls_cluster_count(dv) && c < ITEM_CAP; c++) {
         lbk_dls_cluster_info ci;
         if (lbk_dls_cluster_get(dv, c, &ci) != LBK_OK) continue;
         for (uint32_t i = 0; i < ci.set_count && i < ITEM_CAP; i++) {
             uint32_t set;
-            lbk_dls_cluster_set(dv, c, i, &set);
+            lbk_dls_cluster_set_get(dv, c, i, &set);
         }
         size_t payload = ci.space == LBK_DLS_SPACE_TEXEL ? LBK_DLS_TEXEL_PAYLOAD : LBK_DLS_PROBE_PAYLOAD;
         lbk_dls_cluster_decode(dv, c, touch_target, &payload);
     }
     lbk_dls_stats st;
-    lbk_dls_compute_stats(dv, &st);
+    lbk_dls_stats_get(dv, &st);
 }
 
 /* The reference runtime over base buffers filled from the input, with doors when the DOOR
@@ -282,7 +283,7 @@ static void apply_dls(const lbk_dls_view *dv, const lbk_door_view *doors, const 
     rd.base_irradiance_z = (const uint32_t *)base_z, rd.base_rgba = base_rgba, rd.base_glg = base_glg, rd.base_llg = base_llg;
     rd.out_irradiance_z = (uint32_t *)out_z, rd.out_rgba = out_rgba, rd.out_glg = out_glg, rd.out_llg = out_llg;
     lbk_dls_runtime *rt;
-    if (lbk_dls_runtime_create(&rd, &rt) != LBK_OK) {
+    if (lbk_dls_runtime_open(&rd, &rt) != LBK_OK) {
         if (valid) abort();
         goto done;
     }
@@ -297,7 +298,7 @@ static void apply_dls(const lbk_dls_view *dv, const lbk_door_view *doors, const 
     lbk_dls_runtime_invalidate(rt);
     if (lbk_dls_apply(rt, NULL, NULL, &st) != LBK_OK && valid) abort();
     touch(out_z, 4 * tx), touch(out_rgba, 4 * tx), touch(out_glg, 28 * gp), touch(out_llg, 28 * lp);
-    lbk_dls_runtime_destroy(rt);
+    lbk_dls_runtime_close(rt);
 done:
     free(base_z), free(base_rgba), free(base_glg), free(base_llg);
     free(out_z), free(out_rgba), free(out_glg), free(out_llg);
@@ -315,7 +316,7 @@ static void read_doors(const lbk_door_view *dv)
         if (lbk_door_state_get(dv, s, &count, &set) != LBK_OK) continue;
         for (uint32_t i = 0; i < count && i < ITEM_CAP; i++) {
             uint32_t door;
-            lbk_door_state_door(dv, s, i, &door);
+            lbk_door_state_door_get(dv, s, i, &door);
         }
     }
 }
@@ -327,29 +328,56 @@ static void exercise_sets(lbk_reader *r, const uint8_t *file, size_t file_n, int
     size_t n;
     lbk_door_view *doors = NULL;
     if (lbk_reader_section_by_type(r, LBK_SECTION_DOOR, &d, &n) == LBK_OK) {
-        if (lbk_door_view_open(d, n, NULL, &doors) == LBK_OK) read_doors(doors);
+        if (lbk_door_open(d, n, NULL, &doors) == LBK_OK) read_doors(doors);
         else if (valid) abort();
     }
     if (lbk_reader_section_by_type(r, LBK_SECTION_DLS, &d, &n) == LBK_OK) {
         lbk_dls_view *dv;
-        if (lbk_dls_view_open(d, n, NULL, &dv) == LBK_OK) {
+        if (lbk_dls_open(d, n, NULL, &dv) == LBK_OK) {
             read_dls(dv);
             int agree = doors && lbk_door_check_dls(doors, dv) == LBK_OK;
             if (doors && !agree && valid) abort();
             apply_dls(dv, agree ? doors : NULL, file, file_n, valid);
-            lbk_dls_view_close(dv);
+            lbk_dls_close(dv);
         } else if (valid) {
             abort();
         }
     }
-    if (doors) lbk_door_view_close(doors);
+    if (doors) lbk_door_close(doors);
+}
+
+/* LMUV: whatever lbk_lmuv_open accepts, every element it promises is readable and in range. */
+static void read_lmuv(const void *d, size_t n)
+{
+    lbk_lmuv_view v;
+    if (lbk_lmuv_open(d, n, &v) != LBK_OK) return;
+    for (uint32_t r = 0; r < v.record_count && r < 4096; r++) {
+        lbk_lmuv_object o;
+        uint32_t back;
+        if (lbk_lmuv_get_object(&v, r, &o) != LBK_OK) abort();
+        lbk_lmuv_find_object(&v, o.object, &back);
+    }
+    for (uint32_t p = 0; p < v.primitive_count && p < 4096; p++) {
+        lbk_lmuv_primitive q;
+        if (lbk_lmuv_get_primitive(&v, p, &q) != LBK_OK) abort();
+        for (uint32_t i = 0; i < q.index_count && i < 65536; i++) {
+            uint32_t x;
+            if (lbk_lmuv_index(&v, &q, i, &x) != LBK_OK || x >= q.vertex_count) abort();
+        }
+        for (uint32_t k = 0; k < q.vertex_count && k < 65536; k++) {
+            uint32_t src;
+            float xy[2];
+            if (lbk_lmuv_vertex(&v, &q, k, &src, xy) != LBK_OK || src >= q.source_vertex_count) abort();
+        }
+    }
 }
 
 static int known_type(uint32_t t)
 {
     static const uint32_t known[] = {LBK_SECTION_META, LBK_SECTION_REPT, LBK_SECTION_OBJS,
                                      LBK_SECTION_LMAP, LBK_SECTION_GLG,  LBK_SECTION_LLG,
-                                     LBK_SECTION_DLS,  LBK_SECTION_DOOR, LBK_SECTION_OCTP};
+                                     LBK_SECTION_DLS,  LBK_SECTION_DOOR, LBK_SECTION_OCTP,
+                                     LBK_SECTION_LMUV};
     for (size_t i = 0; i < sizeof known / sizeof known[0]; i++)
         if (known[i] == t) return 1;
     return 0;
@@ -357,7 +385,7 @@ static int known_type(uint32_t t)
 
 static void exercise(const uint8_t *data, size_t size)
 {
-    lbk_validate_options vo = {NULL, DECODE_CAP};
+    lbk_validate_options vo = {.max_decoded_bytes = DECODE_CAP};
     lbk_validate_summary s;
     size_t issues = 0;
     lbk_validate_memory(data, size, &vo, count_issue, &issues, &s);
@@ -366,7 +394,7 @@ static void exercise(const uint8_t *data, size_t size)
     /* The reader and the validator share the framing rules: a file the validator passes must
      * open and give every known section's bytes and views. */
     const int valid = s.fatal == 0 && s.errors == 0;
-    lbk_read_options ro = {NULL, DECODE_CAP, 0};
+    lbk_read_options ro = {.max_decoded_bytes = DECODE_CAP};
     lbk_reader *r;
     if (lbk_reader_open_memory(data, size, &ro, &r) != LBK_OK) {
         if (valid) abort();
@@ -375,7 +403,7 @@ static void exercise(const uint8_t *data, size_t size)
     if (s.fatal) abort(); /* the reader accepted what the validator found unreadable */
     for (uint32_t i = 0; i < lbk_reader_section_count(r); i++) {
         lbk_section_info si;
-        if (lbk_reader_section_info(r, i, &si) != LBK_OK) abort();
+        if (lbk_reader_section_get(r, i, &si) != LBK_OK) abort();
         const void *d;
         size_t n;
         if (lbk_reader_section_data(r, i, &d, &n) != LBK_OK) {
@@ -389,6 +417,7 @@ static void exercise(const uint8_t *data, size_t size)
         case LBK_SECTION_GLG: opened = sample_glg(d, n, valid); break;
         case LBK_SECTION_LLG: opened = sample_llg(d, n, valid); break;
         case LBK_SECTION_OCTP: opened = sample_octp(d, n, valid); break;
+        case LBK_SECTION_LMUV: read_lmuv(d, n); break;
         default: read_meta_objs_rept(si.type, d, n); break;
         }
         if (opened != LBK_OK && valid) abort();

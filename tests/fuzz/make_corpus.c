@@ -46,16 +46,16 @@ static int print_issue(void *user, const lbk_issue *issue)
 static int write_container(const char *path, const section *s, int count, int zstd)
 {
     lbk_writer *w;
-    lbk_write_options wo = {NULL, zstd ? 16 : 64};
-    lbk_section_options o = {LBK_SECTION_FLAG_REQUIRED, zstd ? LBK_COMPRESSION_ZSTD : 0, 3};
-    if (lbk_writer_create(&wo, &w)) return 1;
+    lbk_write_options wo = {.section_alignment = zstd ? 16 : 64};
+    lbk_section_options o = {.flags = LBK_SECTION_FLAG_REQUIRED, .compression = zstd ? LBK_COMPRESSION_ZSTD : 0, .zstd_level = 3};
+    if (lbk_writer_open(&wo, &w)) return 1;
     for (int i = 0; i < count; i++)
-        if (lbk_writer_add_section(w, s[i].type, s[i].data, s[i].size, s[i].type == LBK_SECTION_META ? NULL : &o))
+        if (lbk_writer_section_add(w, s[i].type, s[i].data, s[i].size, s[i].type == LBK_SECTION_META ? NULL : &o))
             return 1;
     void *bytes;
     size_t n;
     if (lbk_writer_to_memory(w, &bytes, &n)) return 1;
-    lbk_writer_destroy(w);
+    lbk_writer_close(w);
     lbk_validate_summary vs;
     int rc = lbk_validate_memory(bytes, n, NULL, print_issue, (void *)path, &vs) != LBK_OK ||
              vs.fatal + vs.errors + vs.warnings != 0 || write_file(path, bytes, n);
@@ -90,7 +90,7 @@ static int build_glg(void **out, size_t *size)
     }
     const uint32_t tets[5][4] = {{1, 2, 4, 7}, {0, 1, 2, 4}, {3, 1, 2, 7}, {5, 1, 4, 7}, {6, 2, 4, 7}};
     const uint8_t vis[5][4] = {{255, 255, 255, 255}, {255, 128, 64, 0}, {10, 255, 255, 200}, {255, 0, 255, 0}, {1, 2, 3, 4}};
-    lbk_glg_desc d = {8, 5, (const float (*)[3])pos, sh, tets, NULL, vis, 0.25f};
+    lbk_glg_build_desc d = {.probe_count = 8, .tetra_count = 5, .positions = (const float (*)[3])pos, .probes = sh, .tetras = tets, .visibility = vis, .scale = 0.25f};
     return lbk_glg_build(&d, NULL, out, size) != LBK_OK;
 }
 
@@ -103,7 +103,7 @@ static int build_octp(void **out, size_t *size)
             for (int c = 0; c < 3; c++) p[k].irradiance[i][c] = 0.5f + 0.1f * (float)i + 0.2f * (float)c + (float)k;
         for (int i = 0; i < 144; i++) p[k].depth[i][0] = 1.0f + 0.01f * (float)i, p[k].depth[i][1] = p[k].depth[i][0] * p[k].depth[i][0] + 0.1f;
     }
-    return lbk_octp_build(p, 2, 0.5f, NULL, out, size) != LBK_OK;
+    return lbk_octp_build(&(lbk_octp_build_desc){.probes = p, .probe_count = 2, .scale = 0.5f}, NULL, out, size) != LBK_OK;
 }
 
 /* DLS over 48 texels (the LMAP), 8 GLG and 8 LLG probes: two light sets, a door's open and
@@ -131,7 +131,7 @@ static int build_dls_door(void **dls, size_t *dls_n, void **door, size_t *door_n
                 targets[s][sp][i] = first + i;
                 if (sp == LBK_DLS_SPACE_TEXEL) {
                     lbk_ahd_texel t = texel((int)(first + i) + 7 * s);
-                    lbk_ahd_texel_store(&t, &payloads[s][sp][8 * i]);
+                    lbk_ahd_texel_pack(&t, &payloads[s][sp][8 * i]);
                 } else {
                     lbk_sh9_rgb sh;
                     probe_sh((int)i + s, &sh);
@@ -144,7 +144,7 @@ static int build_dls_door(void **dls, size_t *dls_n, void **door, size_t *door_n
     sets[0].light_count = 1, sets[0].light_names = lights_a;
     sets[1].light_count = 2, sets[1].light_names = lights_b;
     sets[4].member_count = 2, sets[4].members = combo_members;
-    lbk_dls_build_desc dd = {5, sets, {TEXELS, GLG_PROBES, LLG_PROBES}};
+    lbk_dls_build_desc dd = {.set_count = 5, .sets = sets, .target_count = {TEXELS, GLG_PROBES, LLG_PROBES}};
     lbk_result r = lbk_dls_build(&dd, NULL, dls, dls_n, NULL);
     if (r != LBK_OK) {
         fprintf(stderr, "make_corpus: DLS: %s\n", lbk_result_message(r));
@@ -153,7 +153,7 @@ static int build_dls_door(void **dls, size_t *dls_n, void **door, size_t *door_n
     const lbk_door_desc d1 = {"d1", {1, 1, 0}, {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {0.5f, 1.0f, 0.05f}, 2, 3};
     const uint32_t door0 = 0;
     const lbk_door_state_desc state = {1, &door0, 4};
-    const lbk_door_build_desc doors = {1, &d1, 1, &state};
+    const lbk_door_build_desc doors = {.door_count = 1, .doors = &d1, .state_count = 1, .states = &state};
     r = lbk_door_build(&doors, NULL, door, door_n);
     if (r != LBK_OK) fprintf(stderr, "make_corpus: DOOR: %s\n", lbk_result_message(r));
     return r != LBK_OK;
@@ -175,14 +175,14 @@ int main(void)
     };
     const lbk_meta_pair meta[2] = {{"writer", "make_corpus"}, {"writer.version", "1"}};
     const lbk_report_record rec[2] = {{0, 10, 1, 1, 0.5f, 0.5f}, {0, 20, 2, 1, 0.25f, 0.3f}};
-    const lbk_report rep = {LBK_BAKE_SAMPLE_LIMIT, 0, 2, 0, 0, rec, 2};
+    const lbk_report rep = {.status = LBK_BAKE_SAMPLE_LIMIT, .max_samples_per_texel = 2, .records = rec, .record_count = 2};
     section s[9] = {{LBK_SECTION_META, 0, 0}, {LBK_SECTION_REPT, 0, 0}, {LBK_SECTION_OBJS, 0, 0},
                     {LBK_SECTION_LMAP, 0, 0}, {LBK_SECTION_LLG, 0, 0},  {LBK_SECTION_GLG, 0, 0},
                     {LBK_SECTION_OCTP, 0, 0}, {LBK_SECTION_DLS, 0, 0},  {LBK_SECTION_DOOR, 0, 0}};
     if (lbk_meta_build(meta, 2, NULL, &s[0].data, &s[0].size) || lbk_report_build(&rep, NULL, &s[1].data, &s[1].size) ||
         lbk_objects_build(objs, 3, NULL, &s[2].data, &s[2].size) ||
-        lbk_lmap_build(pages, 2, 0, NULL, &s[3].data, &s[3].size) ||
-        lbk_llg_build(&grid, 1, 0, NULL, &s[4].data, &s[4].size) || build_glg(&s[5].data, &s[5].size) ||
+        lbk_lmap_build(&(lbk_lmap_build_desc){.pages = pages, .page_count = 2}, NULL, &s[3].data, &s[3].size) ||
+        lbk_llg_build(&(lbk_llg_build_desc){.grids = &grid, .grid_count = 1}, NULL, &s[4].data, &s[4].size) || build_glg(&s[5].data, &s[5].size) ||
         build_octp(&s[6].data, &s[6].size) || build_dls_door(&s[7].data, &s[7].size, &s[8].data, &s[8].size)) {
         fprintf(stderr, "make_corpus: a section builder failed\n");
         return 1;
