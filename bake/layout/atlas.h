@@ -71,6 +71,7 @@ typedef struct bk_atlas_chart {
     int32_t page;
     int32_t x, y, w, h;      /* content rectangle in page texels; every covered texel is inside */
     uint32_t first, count;   /* range in bk_atlas.tris */
+    uint8_t quarter_turns;   /* 0-2: turned by the packer (inside its object, with its object) */
 } bk_atlas_chart;
 
 typedef struct bk_atlas {

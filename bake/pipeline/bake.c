@@ -14,6 +14,7 @@
 #include <cjson/cJSON.h>
 
 #include "bake/layout/atlas.h"
+#include "bake/layout/seams.h"
 #include "bake/sets/bake_sets.h"
 #include "bake/layout/classify.h"
 #include "bake/pipeline/encode.h"
@@ -62,6 +63,7 @@ typedef struct bake {
     bk_scene scene;
     bk_object_class *classes;
     bk_atlas atlas;
+    bk_seams seams;                 /* stitched after transport unless opt->no_seam_stitch */
     bk_texels texels;
     bk_tracer *tracer;
     bk_glg glg;
@@ -279,6 +281,10 @@ static int do_layout(bake *b)
                         lbk_result_message(r));
         }
         if (b->atlas.note[0]) bk_progress_note(b->progress, "lbk bake: note: %s", b->atlas.note);
+        if (!b->opt->no_seam_stitch && (r = bk_seams_find(s, &b->atlas, &b->seams)) != LBK_OK) {
+            free(lightmapped);
+            return fail(b, LBK_EXIT_INTERNAL, "lightmap seams: %s", lbk_result_message(r));
+        }
         for (size_t i = 0; i < b->atlas.object_count; i++)
             if (b->atlas.objects[i].note[0])
                 bk_progress_note(b->progress, "lbk bake: note: object '%s': %s",
@@ -404,6 +410,7 @@ static void set_inputs(const bake *b, bk_set_inputs *in)
     in->texel_of_receiver = b->texel_of_receiver;
     in->texels = &b->texels;
     in->atlas_margin = b->atlas.margin;
+    in->seams = b->opt->no_seam_stitch ? NULL : &b->seams;
     in->base_radiance = b->radiance;
     bk_bake_transport_options(b->opt, b->pre->max_samples, b->pre->target_error, &in->transport);
     in->base_samples_per_receiver = b->stats.samples_per_receiver;
@@ -489,7 +496,7 @@ static lbk_result build_lmap(bake *b, section_list *sl)
                          "and are stored as 0: the level's irradiance spans more than the format's range "
                          "(~7e10) within one lightmap",
                          (unsigned long long)b->flushed, (double)scale);
-    r = bk_encode_pages(tx, b->atlas.margin, lin, has, inv, pages);
+    r = bk_encode_pages(tx, b->atlas.margin, b->opt->no_seam_stitch ? NULL : &b->seams, lin, has, inv, pages);
     if (r) goto done;
     for (size_t p = 0; p < tx->page_count; p++) {
         desc[p].width = (uint32_t)tx->pages[p].width;
@@ -900,6 +907,7 @@ static void bake_free(bake *b)
     bk_glg_free(&b->glg);
     if (b->tracer) bk_tracer_destroy(b->tracer);
     bk_texels_free(&b->texels);
+    bk_seams_free(&b->seams);
     bk_atlas_free(&b->atlas);
     free(b->classes);
     bk_scene_free(&b->scene);

@@ -465,8 +465,8 @@ static lbk_result emit_set(const bk_set_inputs *in, bs_set *st, const lbk_sh9_rg
     lbk_result r = LBK_ERR_OUT_OF_MEMORY;
     bs_vec tv = {NULL, NULL, 0, 0, sizeof(lbk_ahd_linear)}, gv = {NULL, NULL, 0, 0, sizeof(lbk_sh9_rgb)},
            lv = {NULL, NULL, 0, 0, sizeof(lbk_sh9_rgb)};
-    /* texels, page by page, dilated like the base (bk_encode_pages) so bilinear filtering at
-     * chart borders sees the set's light in the gutter too */
+    /* texels, page by page, dilated and stitched like the base (bk_encode_pages) so bilinear
+     * filtering at chart borders sees the set's light in the gutter too */
     if (nt && tx->page_count) {
         int32_t *recv_of_texel = NULL;
         recv_of_texel = malloc((tx->count ? tx->count : 1) * sizeof *recv_of_texel);
@@ -488,7 +488,10 @@ static lbk_result emit_set(const bk_set_inputs *in, bs_set *st, const lbk_sh9_rg
                 memcpy(&data[12 * i], lin[recv_of_texel[ti]].c, 12 * sizeof(float));
                 mask[i] = 1;
             }
-            bk_dilate(data, 12, mask, w, h, in->atlas_margin + 2);
+            if (bk_finish_page(data, mask, w, h, in->atlas_margin, in->seams, (uint32_t)p) != LBK_OK) {
+                free(data), free(mask), free(recv_of_texel);
+                goto done;
+            }
             for (size_t i = 0; i < n && thr >= 0; i++) {
                 if (!mask[i]) continue;
                 lbk_ahd_linear l;
