@@ -2,7 +2,6 @@
 #include "bake/layout/seams.h"
 
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -13,6 +12,8 @@
 #define STITCH_LAMBDA (1.0 / 4096.0)
 #define STITCH_TOL 1e-4
 #define STITCH_MAX_ITER 1000
+#define STITCH_MU2 16.0          /* weight² of holding a colour's irradiance at zero */
+#define STITCH_ROUNDS 4
 
 void bk_seams_free(bk_seams *s)
 {
@@ -267,35 +268,52 @@ static void seam_point(const bk_seam *sm, int side, int i, int n, double *x, dou
     *y = u[1] + t * ((double)u[3] - u[1]);
 }
 
+/* The two sides' filtered luminance at point i of n of a seam. */
+static void point_lum(const bk_seam *sm, int i, int n, int w, int h, const float *lum, double v[2])
+{
+    for (int side = 0; side < 2; side++) {
+        double x, y, tw[4];
+        int32_t ti[4];
+        seam_point(sm, side, i, n, &x, &y);
+        bk_bilinear_taps(x, y, w, h, ti, tw);
+        v[side] = 0.0;
+        for (int t = 0; t < 4; t++) v[side] += tw[t] * lum[ti[t]];
+    }
+}
+
 void bk_seams_score(const bk_seams *s, const bk_atlas_page *pages, size_t page_count, const float *const *lum,
                     bk_seam_score *out)
 {
     memset(out, 0, sizeof *out);
     if (!s || !pages || !lum) return;
-    double wsum = 0.0, jsum = 0.0;
-    for (size_t k = 0; k < s->count; k++) {
-        const bk_seam *sm = &s->seams[k];
-        if (!sm->smooth || sm->page >= page_count || !lum[sm->page]) continue;
-        out->seams++;
-        out->length += sm->length;
-        int w = pages[sm->page].width, h = pages[sm->page].height, n = bk_seam_points(sm);
-        for (int i = 0; i < n; i++) {
-            double v[2];
-            for (int side = 0; side < 2; side++) {
-                double x, y, tw[4];
-                int32_t ti[4];
-                seam_point(sm, side, i, n, &x, &y);
-                bk_bilinear_taps(x, y, w, h, ti, tw);
-                v[side] = 0.0;
-                for (int t = 0; t < 4; t++) v[side] += tw[t] * lum[sm->page][ti[t]];
+    /* pass 0: the mean level along the seams (the floor of the denominator); pass 1: jumps */
+    double level = 0.0, level_w = 0.0, wsum = 0.0, jsum = 0.0;
+    for (int pass = 0; pass < 2; pass++) {
+        double floor_l = level_w > 0.0 ? level / level_w / 16.0 : 0.0;
+        for (size_t k = 0; k < s->count; k++) {
+            const bk_seam *sm = &s->seams[k];
+            if (!sm->smooth || sm->page >= page_count || !lum[sm->page]) continue;
+            if (pass) {
+                out->seams++;
+                out->length += sm->length;
             }
-            double mean = 0.5 * (v[0] + v[1]);
-            if (!(mean > 0.0)) continue;
-            double j = fabs(v[0] - v[1]) / mean;
-            jsum += j * sm->length / n;
-            wsum += sm->length / n;
-            if (j > out->max) out->max = j;
-            out->points++;
+            int w = pages[sm->page].width, h = pages[sm->page].height, n = bk_seam_points(sm);
+            for (int i = 0; i < n; i++) {
+                double v[2];
+                point_lum(sm, i, n, w, h, lum[sm->page], v);
+                double mean = 0.5 * (v[0] + v[1]);
+                if (!pass) {
+                    if (isfinite(mean)) level += mean * sm->length / n, level_w += sm->length / n;
+                    continue;
+                }
+                double den = fmax(mean, floor_l);
+                if (!(den > 0.0)) continue;
+                double j = fabs(v[0] - v[1]) / den;
+                jsum += j * sm->length / n;
+                wsum += sm->length / n;
+                if (j > out->max) out->max = j;
+                out->points++;
+            }
         }
     }
     out->mean = wsum > 0.0 ? jsum / wsum : 0.0;
@@ -317,6 +335,7 @@ typedef struct stitch_sys {
     size_t np;
     size_t nu;           /* unknown texels */
     int32_t *texel;      /* page index of each unknown */
+    uint8_t *held;       /* 3 per unknown: colour held at zero irradiance along the normal */
 } stitch_sys;
 
 /* R·v on the three (g.x, g.y) pairs of a 12-float AHD linear form, identity elsewhere. */
@@ -331,10 +350,19 @@ static void rotate12(const double v[CH], double c, double s, int transpose, doub
     }
 }
 
-/* out = λ·v + Σ_points Jᵀ J v, J v = R·f0(v) − f1(v). */
+/* out = λ·v + Σ_points Jᵀ J v + μ² Σ_held Hᵀ H v, with J v = R·f0(v) − f1(v) and H v =
+ * e0 + g.z of a held colour (its irradiance along the normal). */
 static void stitch_apply(const stitch_sys *sys, const double *v, double *out)
 {
     for (size_t i = 0; i < sys->nu * CH; i++) out[i] = STITCH_LAMBDA * v[i];
+    for (size_t u = 0; u < sys->nu; u++)
+        for (int col = 0; col < 3; col++) {
+            if (!sys->held[3 * u + (size_t)col]) continue;
+            size_t e0 = u * CH + 4 * (size_t)col, gz = e0 + 3;
+            double h = STITCH_MU2 * (v[e0] + v[gz]);
+            out[e0] += h;
+            out[gz] += h;
+        }
     for (size_t p = 0; p < sys->np; p++) {
         const stitch_point *q = &sys->pt[p];
         double f[2][CH], rf[CH], r[CH], back[CH];
@@ -361,14 +389,22 @@ static double dot_n(const double *a, const double *b, size_t n)
     return s;
 }
 
-/* Jacobi preconditioner: the diagonal of λI + JᵀJ per unknown texel (the same for its 12
- * channels: the rotations keep lengths). */
+/* Jacobi preconditioner: the diagonal of the operator (the seam part is the same for the 12
+ * channels of a texel: the rotations keep lengths). */
 static void stitch_diagonal(const stitch_sys *sys, double *diag)
 {
-    for (size_t u = 0; u < sys->nu; u++) diag[u] = STITCH_LAMBDA;
+    for (size_t i = 0; i < sys->nu * CH; i++) diag[i] = STITCH_LAMBDA;
     for (size_t p = 0; p < sys->np; p++)
         for (int side = 0; side < 2; side++)
-            for (int k = 0; k < 4; k++) diag[sys->pt[p].t[side][k]] += sys->pt[p].w[side][k] * sys->pt[p].w[side][k];
+            for (int k = 0; k < 4; k++)
+                for (int c = 0; c < CH; c++)
+                    diag[(size_t)sys->pt[p].t[side][k] * CH + (size_t)c] += sys->pt[p].w[side][k] * sys->pt[p].w[side][k];
+    for (size_t u = 0; u < sys->nu; u++)
+        for (int col = 0; col < 3; col++)
+            if (sys->held[3 * u + (size_t)col]) {
+                diag[u * CH + 4 * (size_t)col] += STITCH_MU2;
+                diag[u * CH + 4 * (size_t)col + 3] += STITCH_MU2;
+            }
 }
 
 /* Preconditioned conjugate gradients for (λI + JᵀJ) x = λ x0, starting at x0; returns the
@@ -377,7 +413,7 @@ static int stitch_solve(const stitch_sys *sys, const double *x0, double *x)
 {
     size_t n = sys->nu * CH;
     double *r = malloc(n * sizeof *r), *z = malloc(n * sizeof *z), *p = malloc(n * sizeof *p);
-    double *ap = malloc(n * sizeof *ap), *diag = malloc(sys->nu * sizeof *diag);
+    double *ap = malloc(n * sizeof *ap), *diag = malloc(n * sizeof *diag);
     int it = -1;
     if (r && z && p && ap && diag) {
         stitch_diagonal(sys, diag);
@@ -385,7 +421,7 @@ static int stitch_solve(const stitch_sys *sys, const double *x0, double *x)
         stitch_apply(sys, x, ap);
         for (size_t i = 0; i < n; i++) {
             r[i] = STITCH_LAMBDA * x0[i] - ap[i];
-            z[i] = r[i] / diag[i / CH];
+            z[i] = r[i] / diag[i];
             p[i] = z[i];
         }
         /* relative to the first residual: the seam mismatch of x0 */
@@ -398,7 +434,7 @@ static int stitch_solve(const stitch_sys *sys, const double *x0, double *x)
             for (size_t i = 0; i < n; i++) {
                 x[i] += alpha * p[i];
                 r[i] -= alpha * ap[i];
-                z[i] = r[i] / diag[i / CH];
+                z[i] = r[i] / diag[i];
             }
             double rz1 = dot_n(r, z, n), beta = rz1 / rz;
             rz = rz1;
@@ -475,28 +511,52 @@ static int stitch_setup(const bk_seams *s, uint32_t page, int width, int height,
     return 1;
 }
 
+/* Solves, then holds at zero every colour whose irradiance along the normal came out negative
+ * (the encoder would clamp it and break the match) and solves again, a few rounds. Returns 0
+ * when out of memory. */
+static int stitch_rounds(stitch_sys *sys, const double *x0, double *x)
+{
+    for (int round = 0; round < STITCH_ROUNDS; round++) {
+        if (stitch_solve(sys, x0, x) < 0) return 0;
+        int more = 0;
+        for (size_t u = 0; u < sys->nu; u++)
+            for (int col = 0; col < 3; col++) {
+                size_t e0 = u * CH + 4 * (size_t)col;
+                if (sys->held[3 * u + (size_t)col] || !(x[e0] + x[e0 + 3] < 0.0)) continue;
+                sys->held[3 * u + (size_t)col] = 1;
+                more = 1;
+            }
+        if (!more) break;
+    }
+    return 1;
+}
+
+static void stitch_free(stitch_sys *sys)
+{
+    free(sys->pt), free(sys->texel), free(sys->held);
+}
+
 size_t bk_seams_stitch(const bk_seams *s, uint32_t page, int width, int height, float *data, const uint8_t *mask)
 {
     if (!s || !data || !mask || width <= 0 || height <= 0 || s->smooth_count == 0) return 0;
     stitch_sys sys;
     if (!stitch_setup(s, page, width, height, mask, &sys)) {
-        free(sys.pt), free(sys.texel);
+        stitch_free(&sys);
         return (size_t)-1;
     }
     size_t changed = 0;
     if (sys.np > 0) {
         size_t n = sys.nu * CH;
         double *x0 = malloc(n * sizeof *x0), *x = malloc(n * sizeof *x);
-        if (!x0 || !x) {
-            free(x0), free(x), free(sys.pt), free(sys.texel);
+        sys.held = calloc(3 * sys.nu, 1);
+        if (!x0 || !x || !sys.held) {
+            free(x0), free(x), stitch_free(&sys);
             return (size_t)-1;
         }
         for (size_t u = 0; u < sys.nu; u++)
             for (int c = 0; c < CH; c++) x0[u * CH + (size_t)c] = data[(size_t)sys.texel[u] * CH + (size_t)c];
-        int it = stitch_solve(&sys, x0, x);
-        if (getenv("STITCH_DEBUG")) fprintf(stderr, "stitch: %zu points %zu texels %d iterations\n", sys.np, sys.nu, it);
-        if (it < 0) {
-            free(x0), free(x), free(sys.pt), free(sys.texel);
+        if (!stitch_rounds(&sys, x0, x)) {
+            free(x0), free(x), stitch_free(&sys);
             return (size_t)-1;
         }
         for (size_t u = 0; u < sys.nu; u++) {
@@ -513,6 +573,6 @@ size_t bk_seams_stitch(const bk_seams *s, uint32_t page, int width, int height, 
         }
         free(x0), free(x);
     }
-    free(sys.pt), free(sys.texel);
+    stitch_free(&sys);
     return changed;
 }

@@ -14,8 +14,11 @@
  *
  * Score (bk_seams_score): along every smooth seam, points at t = (i + 0.5)/n with n = max(2,
  * ceil(2 × the longer side's length in texels)); at each the relative jump
- * |L0 − L1| / ((L0 + L1)/2) of the two sides' bilinearly filtered luminance; the mean weighted
- * by world length (points where both sides are 0 are skipped).
+ * |L0 − L1| / max((L0 + L1)/2, L̄/16) of the two sides' bilinearly filtered luminance, L̄ the
+ * mean of (L0 + L1)/2 over all the points (so that near-black points, e.g. at a shadow
+ * terminator, count by their absolute jump against 1/16 of the seams' light level instead of
+ * blowing up); the mean weighted by world length (points where the denominator is 0 are
+ * skipped).
  *
  * Stitching (bk_seams_stitch): the least-squares seam stitching of Sloan / Castaño ("The
  * Witness" lightmaps; Unity's "Stitch Seams" does the same): the texels read by bilinear
@@ -23,9 +26,12 @@
  *     minimise Σ_points |R·f0(x) − f1(x)|² + λ Σ_texels |x − x0|²,   λ = 1/64,
  * where f_s is side s's bilinear filter and R turns side 0's tangent-plane components into
  * side 1's frame (texels.h convention: the two frames share N and differ by a rotation about
- * it). Solved by conjugate gradients on the normal equations, in double, in a fixed order:
- * deterministic. The result is linear in x0 (up to the solver's tolerance), so stitching the
- * base bake and each dynamic set separately agrees with stitching their sum. */
+ * it). Solved by Jacobi-preconditioned conjugate gradients on the normal equations, to 1e-4 of
+ * the first residual, in double, in a fixed order: deterministic, single-threaded. The
+ * encoder stores the irradiance along the normal clamped at 0, so a colour whose e0 + g.z
+ * comes out negative is then held at 0 by a penalty row (weight² 16) and the system solved
+ * again (up to 4 rounds). The mismatch is linear in the texels, so when the base bake and each
+ * dynamic set are stitched separately, any weighted sum of them agrees across seams too. */
 #ifndef BK_SEAMS_H
 #define BK_SEAMS_H
 
