@@ -20,9 +20,11 @@
  * blowing up); the mean weighted by world length (points where the denominator is 0 are
  * skipped).
  *
- * Stitching (bk_seams_stitch): the least-squares seam stitching of Sloan / Castaño ("The
- * Witness" lightmaps; Unity's "Stitch Seams" does the same): the texels read by bilinear
- * filtering at the score's points become unknowns x, and
+ * Stitching (bk_seams_stitch): least-squares seam optimisation after Iwanicki ("Lighting
+ * Technology of The Last of Us", SIGGRAPH 2013; also S. Sylvan, "Fixing Texture Seams With
+ * Linear Least-Squares", 2015, and ands/seamoptimizer, which likewise stitches only edges whose
+ * normals agree; Unity's "Stitch Seams" is the same feature, also per object only): the texels
+ * read by bilinear filtering at the score's points become unknowns x, and
  *     minimise Σ_points |R·f0(x) − f1(x)|² + λ Σ_texels |x − x0|²,   λ = 1/64,
  * where f_s is side s's bilinear filter and R turns side 0's tangent-plane components into
  * side 1's frame (texels.h convention: the two frames share N and differ by a rotation about
