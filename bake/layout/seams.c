@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "bake/layout/uv_math.h"
+#include "bake/util/parallel.h"
 
 #define SMOOTH_DOT 0.999
 #define UV_SAME_EPS 1e-3          /* texels: an edge mapped to the same place on both sides */
@@ -128,6 +129,7 @@ static int make_seam(const bk_scene *s, const bk_atlas *a, uint32_t first, const
     if (!(diff > UV_SAME_EPS)) return 0;
     out->entry[0] = e[0];
     out->entry[1] = e[1];
+    out->slot = a->charts[a->tri_chart[e[0]]].slot;
     out->page = (uint32_t)a->charts[a->tri_chart[e[0]]].page;
     double pa[3], pb[3], d[3];
     bkv_load(pa, s->positions + 3 * (size_t)s->tris[3 * (size_t)tri[0] + x[0].ka]);
@@ -407,9 +409,10 @@ static void stitch_diagonal(const stitch_sys *sys, double *diag)
             }
 }
 
-/* Preconditioned conjugate gradients for (λI + JᵀJ) x = λ x0, starting at x0; returns the
- * iterations, -1 when out of memory. */
-static int stitch_solve(const stitch_sys *sys, const double *x0, double *x)
+/* Preconditioned conjugate gradients for (λI + JᵀJ + μ²HᵀH) x = λ x0, starting at x (warm);
+ * stops when the residual is below STITCH_TOL × *ref (*ref ≤ 0: set to the first residual).
+ * Returns the iterations, -1 when out of memory. */
+static int stitch_solve(const stitch_sys *sys, const double *x0, double *x, double *ref)
 {
     size_t n = sys->nu * CH;
     double *r = malloc(n * sizeof *r), *z = malloc(n * sizeof *z), *p = malloc(n * sizeof *p);
@@ -417,16 +420,15 @@ static int stitch_solve(const stitch_sys *sys, const double *x0, double *x)
     int it = -1;
     if (r && z && p && ap && diag) {
         stitch_diagonal(sys, diag);
-        memcpy(x, x0, n * sizeof *x);
         stitch_apply(sys, x, ap);
         for (size_t i = 0; i < n; i++) {
             r[i] = STITCH_LAMBDA * x0[i] - ap[i];
             z[i] = r[i] / diag[i];
             p[i] = z[i];
         }
-        /* relative to the first residual: the seam mismatch of x0 */
-        double bb = dot_n(r, r, n), rz = dot_n(r, z, n);
-        for (it = 0; it < STITCH_MAX_ITER && dot_n(r, r, n) > STITCH_TOL * STITCH_TOL * bb && rz > 0.0; it++) {
+        double rr = dot_n(r, r, n), rz = dot_n(r, z, n);
+        if (!(*ref > 0.0)) *ref = rr;
+        for (it = 0; it < STITCH_MAX_ITER && rr > STITCH_TOL * STITCH_TOL * *ref && rz > 0.0; it++) {
             stitch_apply(sys, p, ap);
             double pap = dot_n(p, ap, n);
             if (!(pap > 0.0)) break;
@@ -438,6 +440,7 @@ static int stitch_solve(const stitch_sys *sys, const double *x0, double *x)
             }
             double rz1 = dot_n(r, z, n), beta = rz1 / rz;
             rz = rz1;
+            rr = dot_n(r, r, n);
             for (size_t i = 0; i < n; i++) p[i] = z[i] + beta * p[i];
         }
     }
@@ -462,15 +465,15 @@ static uint32_t unknown_of(const stitch_sys *sys, int32_t texel)
     return (uint32_t)lo;
 }
 
-/* The points of the page's smooth seams whose filters read only filled texels, and their
+/* The points of the smooth seams [k0, k1) whose filters read only filled texels, and their
  * taps as unknowns. Returns 0 when out of memory. */
-static int stitch_setup(const bk_seams *s, uint32_t page, int width, int height, const uint8_t *mask,
+static int stitch_setup(const bk_seams *s, size_t k0, size_t k1, int width, int height, const uint8_t *mask,
                         stitch_sys *sys)
 {
     memset(sys, 0, sizeof *sys);
     size_t cap = 0;
-    for (size_t k = 0; k < s->count; k++)
-        if (s->seams[k].smooth && s->seams[k].page == page) cap += (size_t)bk_seam_points(&s->seams[k]);
+    for (size_t k = k0; k < k1; k++)
+        if (s->seams[k].smooth) cap += (size_t)bk_seam_points(&s->seams[k]);
     if (cap == 0) return 1;
     sys->pt = malloc(cap * sizeof *sys->pt);
     sys->texel = malloc(cap * 8 * sizeof *sys->texel);
@@ -478,9 +481,9 @@ static int stitch_setup(const bk_seams *s, uint32_t page, int width, int height,
     int32_t (*taps)[2][4] = malloc(cap * sizeof *taps);
     if (!taps) return 0;
     size_t nt = 0;
-    for (size_t k = 0; k < s->count; k++) {
+    for (size_t k = k0; k < k1; k++) {
         const bk_seam *sm = &s->seams[k];
-        if (!sm->smooth || sm->page != page) continue;
+        if (!sm->smooth) continue;
         int n = bk_seam_points(sm);
         for (int i = 0; i < n; i++) {
             stitch_point *q = &sys->pt[sys->np];
@@ -512,12 +515,14 @@ static int stitch_setup(const bk_seams *s, uint32_t page, int width, int height,
 }
 
 /* Solves, then holds at zero every colour whose irradiance along the normal came out negative
- * (the encoder would clamp it and break the match) and solves again, a few rounds. Returns 0
- * when out of memory. */
+ * (the encoder would clamp it and break the match) and solves again from there, a few rounds.
+ * Returns 0 when out of memory. */
 static int stitch_rounds(stitch_sys *sys, const double *x0, double *x)
 {
+    double ref = 0.0;
+    memcpy(x, x0, sys->nu * CH * sizeof *x);
     for (int round = 0; round < STITCH_ROUNDS; round++) {
-        if (stitch_solve(sys, x0, x) < 0) return 0;
+        if (stitch_solve(sys, x0, x, &ref) < 0) return 0;
         int more = 0;
         for (size_t u = 0; u < sys->nu; u++)
             for (int col = 0; col < 3; col++) {
@@ -536,11 +541,13 @@ static void stitch_free(stitch_sys *sys)
     free(sys->pt), free(sys->texel), free(sys->held);
 }
 
-size_t bk_seams_stitch(const bk_seams *s, uint32_t page, int width, int height, float *data, const uint8_t *mask)
+/* Stitches seams [k0, k1) (one object: its texels are its own); returns the texels changed,
+ * (size_t)-1 when out of memory. */
+static size_t stitch_group(const bk_seams *s, size_t k0, size_t k1, int width, int height, float *data,
+                           const uint8_t *mask)
 {
-    if (!s || !data || !mask || width <= 0 || height <= 0 || s->smooth_count == 0) return 0;
     stitch_sys sys;
-    if (!stitch_setup(s, page, width, height, mask, &sys)) {
+    if (!stitch_setup(s, k0, k1, width, height, mask, &sys)) {
         stitch_free(&sys);
         return (size_t)-1;
     }
@@ -575,4 +582,58 @@ size_t bk_seams_stitch(const bk_seams *s, uint32_t page, int width, int height, 
     }
     stitch_free(&sys);
     return changed;
+}
+
+typedef struct stitch_job {
+    const bk_seams *s;
+    const size_t *range;  /* 2 per group: seams [range[2g], range[2g+1]) */
+    size_t *changed;      /* per group */
+    int width, height;
+    float *data;
+    const uint8_t *mask;
+} stitch_job;
+
+static void stitch_chunk(void *user, size_t begin, size_t end, int thread)
+{
+    const stitch_job *j = user;
+    (void)thread;
+    for (size_t g = begin; g < end; g++)
+        j->changed[g] = stitch_group(j->s, j->range[2 * g], j->range[2 * g + 1], j->width, j->height, j->data, j->mask);
+}
+
+size_t bk_seams_stitch(const bk_seams *s, uint32_t page, int width, int height, float *data, const uint8_t *mask,
+                       int threads)
+{
+    if (!s || !data || !mask || width <= 0 || height <= 0 || s->smooth_count == 0) return 0;
+    /* one group per object (seams come object by object): each object's texels are its own,
+     * so the groups are independent and any thread count gives the same result */
+    size_t groups = 0;
+    for (size_t k = 0; k < s->count; k++)
+        if (s->seams[k].page == page && (k == 0 || s->seams[k].slot != s->seams[k - 1].slot || s->seams[k - 1].page != page))
+            groups++;
+    if (groups == 0) return 0;
+    size_t *range = malloc(2 * groups * sizeof *range), *changed = calloc(groups, sizeof *changed);
+    if (!range || !changed) {
+        free(range), free(changed);
+        return (size_t)-1;
+    }
+    size_t g = 0;
+    for (size_t k = 0; k < s->count; k++) {
+        if (s->seams[k].page != page) continue;
+        if (g == 0 || s->seams[k].slot != s->seams[range[2 * (g - 1) + 1] - 1].slot || range[2 * (g - 1) + 1] != k) {
+            range[2 * g] = k;
+            g++;
+        }
+        range[2 * (g - 1) + 1] = k + 1;
+    }
+    stitch_job job = {s, range, changed, width, height, data, mask};
+    bk_parallel_chunks(0, g, 1, bk_thread_count(threads), stitch_chunk, &job);
+    size_t total = 0;
+    int oom = 0;
+    for (size_t i = 0; i < g; i++) {
+        if (changed[i] == (size_t)-1) oom = 1;
+        else total += changed[i];
+    }
+    free(range), free(changed);
+    return oom ? (size_t)-1 : total;
 }

@@ -28,8 +28,8 @@
  *     minimise Σ_points |R·f0(x) − f1(x)|² + λ Σ_texels |x − x0|²,   λ = 1/64,
  * where f_s is side s's bilinear filter and R turns side 0's tangent-plane components into
  * side 1's frame (texels.h convention: the two frames share N and differ by a rotation about
- * it). Solved by Jacobi-preconditioned conjugate gradients on the normal equations, to 1e-4 of
- * the first residual, in double, in a fixed order: deterministic, single-threaded. The
+ * it). Solved per object by Jacobi-preconditioned conjugate gradients on the normal
+ * equations, to 1e-4 of the first residual, in double, in a fixed order: deterministic. The
  * encoder stores the irradiance along the normal clamped at 0, so a colour whose e0 + g.z
  * comes out negative is then held at 0 by a penalty row (weight² 16) and the system solved
  * again (up to 4 rounds). The mismatch is linear in the texels, so when the base bake and each
@@ -50,6 +50,7 @@ extern "C" {
 
 typedef struct bk_seam {
     uint32_t entry[2];   /* atlas triangle entries (bk_atlas.tris) of side 0 and side 1 */
+    uint32_t slot;       /* atlas object (bk_atlas.objects) */
     uint32_t page;       /* both sides: one object is on one page */
     float uv[2][4];      /* side s: the edge's ends (x0, y0, x1, y1), page texel coordinates */
     float rot[2];        /* cos, sin: side 0's tangent-plane (x, y) → side 1's frame */
@@ -87,12 +88,14 @@ typedef struct bk_seam_score {
 void bk_seams_score(const bk_seams *seams, const bk_atlas_page *pages, size_t page_count, const float *const *lum,
                     bk_seam_score *out);
 
-/* Stitches the smooth seams of one page in place. data: 12 floats per texel in lbk_ahd_linear
- * order ({e0, g.x, g.y, g.z} per colour, tangent space), row-major; mask: non-zero where a
- * texel holds a value (a point whose filter reads an empty texel is left out). Returns the
- * number of texels changed, or (size_t)-1 when out of memory (data unchanged). */
+/* Stitches the smooth seams of one page in place, object by object (objects own disjoint
+ * texels: one system each, solved on up to `threads` threads, 0: all cores; the result does
+ * not depend on the count). data: 12 floats per texel in lbk_ahd_linear order ({e0, g.x,
+ * g.y, g.z} per colour, tangent space), row-major; mask: non-zero where a texel holds a value
+ * (a point whose filter reads an empty texel is left out). Returns the number of texels
+ * changed, or (size_t)-1 when out of memory (then objects may be partly stitched). */
 size_t bk_seams_stitch(const bk_seams *seams, uint32_t page, int width, int height, float *data,
-                       const uint8_t *mask);
+                       const uint8_t *mask, int threads);
 
 #ifdef __cplusplus
 }

@@ -488,7 +488,8 @@ static lbk_result emit_set(const bk_set_inputs *in, bs_set *st, const lbk_sh9_rg
                 memcpy(&data[12 * i], lin[recv_of_texel[ti]].c, 12 * sizeof(float));
                 mask[i] = 1;
             }
-            if (bk_finish_page(data, mask, w, h, in->atlas_margin, in->seams, (uint32_t)p) != LBK_OK) {
+            if (bk_finish_page(data, mask, w, h, in->atlas_margin, in->seams, (uint32_t)p, in->transport.threads) !=
+                LBK_OK) {
                 free(data), free(mask), free(recv_of_texel);
                 goto done;
             }

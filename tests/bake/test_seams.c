@@ -30,6 +30,18 @@ static void sphere_scene(bk_scene *s)
     uvs_update_bounds(s);
 }
 
+/* Three spheres, three objects on one page (three independent stitching systems). */
+static void spheres_scene(bk_scene *s)
+{
+    uvs_init(s);
+    for (int i = 0; i < 3; i++) {
+        uvs_object(s, "sphere");
+        float c[3] = {3.0f * (float)i, 0, 0};
+        uvs_sphere(s, c, 0.6f + 0.2f * (float)i, 24, 12, 0);
+    }
+    uvs_update_bounds(s);
+}
+
 static void build(const bk_scene *s, float density, bk_atlas *a, bk_texels *tx, bk_seams *sm)
 {
     bk_atlas_options o = {0};
@@ -181,7 +193,8 @@ static uint32_t lcg(uint32_t *st)
 
 /* Stitching random texels in [1, 2): the seam mismatch (all 12 channels, rotated) drops by
  * more than 100× (the solver stops at 1e-4 of its first residual; λ = 1/4096 leaves ~1/300),
- * texels no seam point reads are left bit for bit, and empty texels stay empty. */
+ * the same for 1 and 3 threads, texels no seam point reads are left bit for bit, and empty
+ * texels stay empty. */
 static void test_stitch_solver(void **state)
 {
     (void)state;
@@ -189,8 +202,9 @@ static void test_stitch_solver(void **state)
     bk_atlas a;
     bk_texels tx;
     bk_seams sm;
-    sphere_scene(&s);
+    spheres_scene(&s);
     build(&s, 8.0f, &a, &tx, &sm);
+    assert_int_equal(a.page_count, 1);
     int W = a.pages[0].width, H = a.pages[0].height;
     size_t n = (size_t)W * H;
     float *x = calloc(n * 12, sizeof(float)), *x0 = malloc(n * 12 * sizeof(float));
@@ -204,8 +218,15 @@ static void test_stitch_solver(void **state)
     }
     memcpy(x0, x, n * 12 * sizeof(float));
     double mx0, before = mismatch(&sm, x, W, H, 0xFu, &mx0);
-    size_t changed = bk_seams_stitch(&sm, 0, W, H, x, mask);
+    size_t changed = bk_seams_stitch(&sm, 0, W, H, x, mask, 1);
     assert_true(changed > 100 && changed != (size_t)-1);
+    /* any thread count, the same bits */
+    float *x3 = malloc(n * 12 * sizeof(float));
+    assert_non_null(x3);
+    memcpy(x3, x0, n * 12 * sizeof(float));
+    assert_int_equal(bk_seams_stitch(&sm, 0, W, H, x3, mask, 3), changed);
+    assert_memory_equal(x3, x, n * 12 * sizeof(float));
+    free(x3);
     double mx1, after = mismatch(&sm, x, W, H, 0xFu, &mx1);
     assert_true(before > 0.1);
     assert_true(after < before / 100.0);
@@ -313,7 +334,7 @@ static baked bake_and_score(const bk_scene *s, float density, int samples, int a
     res.est_error = st.est_rel_rmse;
     for (int stitch = 0; stitch < 2; stitch++) {
         lbk_ahd_texel *pages[1] = {NULL};
-        assert_int_equal(bk_encode_pages(&tx, a.margin, stitch ? &sm : NULL, lin, has, 1.0f, pages), LBK_OK);
+        assert_int_equal(bk_encode_pages(&tx, a.margin, stitch ? &sm : NULL, 2, lin, has, 1.0f, pages), LBK_OK);
         float *lum = page_lum(pages[0], (size_t)a.pages[0].width * a.pages[0].height);
         const float *lp[1] = {lum};
         bk_seams_score(&scored, a.pages, 1, lp, stitch ? &res.stitched : &res.raw);
