@@ -8,6 +8,8 @@
 #include "bake/layout/uv_math.h"
 
 #define SMALL_AREA 16
+#define TINY_AREA 4
+#define HARD_EDGE_COS 0.5   /* cos 60° */
 #define OVERLAP_EPS 1e-4
 #define NONE UINT32_MAX
 
@@ -41,6 +43,20 @@ static void world(const merge_ctx *m, uint32_t entry, int k, double p[3])
 {
     uint32_t tri = m->o->tris[entry];
     bkv_load(p, m->s->positions + 3 * (size_t)m->s->tris[3 * (size_t)tri + (size_t)k]);
+}
+
+static int is_tiny(const merge_ctx *m, uint32_t c) { return content(m->w[c]) * content(m->h[c]) <= TINY_AREA; }
+
+/* Cosine of the angle between the face normals of two entries (1: coplanar). */
+static double hinge_cos(const merge_ctx *m, uint32_t a, uint32_t b)
+{
+    double p[3][3], na[3], nb[3];
+    for (int k = 0; k < 3; k++) world(m, a, k, p[k]);
+    bk_tri_cross(p, na);
+    for (int k = 0; k < 3; k++) world(m, b, k, p[k]);
+    bk_tri_cross(p, nb);
+    if (bkv_normalize(na) == 0.0 || bkv_normalize(nb) == 0.0) return -1.0;
+    return bkv_dot(na, nb);
 }
 
 /* The corners (ka, kb of local triangle t; ja, jb of local u) of the edge t and u share;
@@ -163,6 +179,9 @@ static uint32_t unfold(merge_ctx *m, uint32_t c, uint32_t n)
         }
     }
     if (seed == NONE) return 0;
+    /* a fold steeper than 60° is a hard edge: filtering across it would mix two faces' light,
+     * so only a tiny chart (no texel of its own to lose) crosses one */
+    if (!is_tiny(m, c) && hinge_cos(m, seed, nb_seed) < HARD_EDGE_COS) return 0;
     double nuv[6];
     entry_uv(m, nb_seed, nuv);
     double ua[2] = {nuv[2 * ja], nuv[2 * ja + 1]}, ub[2] = {nuv[2 * jb], nuv[2 * jb + 1]};

@@ -7,7 +7,10 @@
  * onto the neighbour chart it shares the longest edge with (then the next ones): starting at
  * that edge, every triangle is laid down across an edge of an already placed one by the
  * similarity that maps the edge's world segment onto its chart segment (a hinge: lengths and
- * angles kept, the scale of the hinge edge). So the shared edges stop being seams. The merge
+ * angles kept, the scale of the hinge edge). So the shared edges stop being seams. A hinge
+ * folded by more than 60° (a hard edge: filtering across it would mix the light of two faces)
+ * is only crossed by a tiny chart (at most 4 texels of content: no texel of its own to lose);
+ * so a bevel merges, a 90° door jamb one texel wide does not. The merge
  * is kept only when every laid triangle keeps the chart's orientation, no two triangles of the
  * merged chart overlap (separating axis test, tolerance 1e-4 texel), the hinge scale is within
  * a factor 2 of the chart's density, the merged chart stays within max_chart_texels, and the

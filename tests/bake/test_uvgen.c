@@ -444,7 +444,8 @@ static void test_deterministic(void **state)
  * down 90° on one cell edge (3 × 1 texels) becomes one chart: each merge makes the chart's
  * block (content plus its ring) smaller than the two blocks were (7×7 + 7×3 → 8×7, then + 5×3
  * → 8×8). The hinge unfolding keeps every edge length (× density) and the merged chart has no
- * overlap. Two 1 m panels at 90° (10 × 10 texels each) stay two charts. */
+ * overlap. Two 1 m panels at 90° (10 × 10 texels each) stay two charts, and so does a 90° jamb
+ * one texel wide (a hard edge is crossed by tiny charts only). */
 static void test_merge_small_charts(void **state)
 {
     (void)state;
@@ -487,6 +488,19 @@ static void test_merge_small_charts(void **state)
     float w0[3] = {0, 0, 0}, w1[3] = {0, 0, -1}, w2[3] = {0, 1, -1}, w3[3] = {0, 1, 0};
     uvs_quad(&s, f0, f1, f2, f3, 1, 0, NULL, 1.0f);
     uvs_quad(&s, w0, w1, w2, w3, 1, 0, NULL, 1.0f);
+    assert_int_equal(bk_uvgen_object(&s, 0, 10.0f, NULL, &u), LBK_OK);
+    check_invariants(&s, &u);
+    assert_int_equal(u.chart_count, 2);
+    bk_uv_object_free(&u);
+    uvs_free(&s);
+
+    /* a 10 cm jamb at 90° along a 1 m panel: small (10 × 1 texels) but not tiny, and the fold is
+     * a hard edge, so it keeps its own chart */
+    uvs_init(&s);
+    uvs_object(&s, "jamb");
+    float j0[3] = {1, 0, 0}, j1[3] = {1, -0.1f, 0}, j2[3] = {1, -0.1f, -1}, j3[3] = {1, 0, -1};
+    uvs_quad(&s, f0, f1, f2, f3, 1, 0, NULL, 1.0f);
+    uvs_quad(&s, j0, j1, j2, j3, 1, 0, NULL, 1.0f);
     assert_int_equal(bk_uvgen_object(&s, 0, 10.0f, NULL, &u), LBK_OK);
     check_invariants(&s, &u);
     assert_int_equal(u.chart_count, 2);
