@@ -19,7 +19,7 @@
 #include "bake/layout/classify.h"
 #include "bake/layout/seams.h"
 #include "bake/layout/texels.h"
-#include "bake/pipeline/bake.h"
+#include "lbk/bake.h"
 #include "bake/scene/import.h"
 #include "lbk/container.h"
 #include "lbk/lightmap.h"
@@ -86,7 +86,7 @@ static int load_lum(const char *path, const bk_atlas *a, float ***lum_out)
         ok = 1;
         for (uint32_t p = 0; p < v.page_count && ok; p++) {
             lbk_lmap_page pg;
-            ok = lbk_lmap_get_page(&v, p, &pg) == LBK_OK && (int)pg.width == a->pages[p].width &&
+            ok = lbk_lmap_page_get(&v, p, &pg) == LBK_OK && (int)pg.width == a->pages[p].width &&
                  (int)pg.height == a->pages[p].height;
             if (!ok) break;
             lum[p] = malloc((size_t)pg.width * pg.height * sizeof **lum);
@@ -95,8 +95,8 @@ static int load_lum(const char *path, const bk_atlas *a, float ***lum_out)
                 for (uint32_t x = 0; x < pg.width; x++) {
                     lbk_ahd_texel t;
                     float rgb[3];
-                    lbk_lmap_page_texel(&pg, x, y, &t);
-                    lbk_unpack_r11g11b10f(t.irradiance_z, rgb);
+                    lbk_lmap_page_texel_get(&pg, x, y, &t);
+                    lbk_r11g11b10f_unpack(t.irradiance_z, rgb);
                     lum[p][(size_t)y * pg.width + x] = LBK_LUM_R * rgb[0] + LBK_LUM_G * rgb[1] + LBK_LUM_B * rgb[2];
                 }
         }
@@ -109,24 +109,17 @@ static int load_lum(const char *path, const bk_atlas *a, float ***lum_out)
 /* Bakes the scene (stitched or not) into out; 1 on success. */
 static int bake_scene(const scene_case *c, const char *in, const char *out, int no_stitch)
 {
-    bk_bake_options o;
-    memset(&o, 0, sizeof o);
-    o.input = in;
-    o.output = out;
-    o.preset = "fast";
-    o.seed = 1;
-    o.max_samples = 16;
-    o.no_seam_stitch = no_stitch;
+    lbk_bake_desc d = {.size = sizeof d, .seed = 1, .max_samples = 16, .no_seam_stitch = no_stitch};
     if (c->sky) {
-        o.sky_set = 1;
-        o.sky[0] = o.sky[1] = o.sky[2] = 1.0f;
+        d.sky_override = 1;
+        d.sky[0] = d.sky[1] = d.sky[2] = 1.0f;
     }
-    bk_progress pr;
-    bk_progress_init(&pr, 1);
-    bk_bake_summary sum;
-    char err[512] = "";
-    if (bk_bake(&o, &pr, &sum, err, sizeof err) == 0) return 1;
-    fprintf(stderr, "bench_atlas: %s: %s\n", in, err);
+    lbk_bake_output *res = NULL;
+    lbk_result r = lbk_bake_from_file(in, &d, &res);
+    if (!r) r = lbk_bake_output_write_file(res, out);
+    lbk_bake_output_free(res);
+    if (r == LBK_OK) return 1;
+    fprintf(stderr, "bench_atlas: %s: %s\n", in, lbk_result_message(r));
     return 0;
 }
 

@@ -514,6 +514,15 @@ static void place_chart(const bk_scene *scene, bk_atlas *out, const obj_pack *op
     ch->quarter_turns = (uint8_t)(tc + to);
     ch->first = (uint32_t)t;
     ch->count = u->charts[k].count;
+    if (u->source == BK_UV_AUTHORED) { /* one chart, never turned: its origin is uv1_min (LMUV) */
+        bk_atlas_object *ao = &out->objects[s];
+        ao->uv1_scale = u->uv1_scale;
+        for (int q = 0; q < 2; q++) {
+            ao->uv1_offset[q] = (q ? ch->y : ch->x) - u->uv1_min[q] * u->uv1_scale;
+            ao->uv1_min[q] = u->uv1_min[q];
+            ao->uv1_max[q] = u->uv1_max[q];
+        }
+    }
     for (uint32_t j = 0; j < u->charts[k].count; j++, t++) {
         size_t src = (size_t)u->charts[k].first + j;
         out->tris[t] = u->tris[src];

@@ -280,7 +280,7 @@ static float *page_lum(const lbk_ahd_texel *page, size_t n)
     assert_non_null(l);
     for (size_t i = 0; i < n; i++) {
         float rgb[3];
-        lbk_unpack_r11g11b10f(page[i].irradiance_z, rgb);
+        lbk_r11g11b10f_unpack(page[i].irradiance_z, rgb);
         l[i] = LBK_LUM_R * rgb[0] + LBK_LUM_G * rgb[1] + LBK_LUM_B * rgb[2];
     }
     return l;
