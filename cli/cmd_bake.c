@@ -34,6 +34,9 @@ static void help(FILE *f)
           "  --door-method difference|guided\n"
           "                          how the light through an open door is baked: differences of\n"
           "                          full runs (default) or the seed's guided estimator (bake/sets/SETS.md)\n"
+          "  --denoise auto|off      edge-aware denoising of lightmap texels and GLG probes, guided\n"
+          "                          by the transport's own noise estimate (default auto: on in both\n"
+          "                          presets; bake/transport/DENOISE.md)\n"
           "  --threads N             worker threads (default: all cores)\n"
           "  --seed N                random seed (default 1)\n"
           "  --json-report FILE      write the error-against-time report as JSON\n"
@@ -144,6 +147,14 @@ int lbk_cmd_bake(int argc, char **argv)
             else if (!strcmp(v, "guided")) o.door_method = 1;
             else {
                 fprintf(stderr, "lbk bake: unknown door method '%s' (difference, guided)\n", v);
+                return LBK_EXIT_USAGE;
+            }
+        } else if (!strcmp(a, "--denoise")) {
+            NEED_VALUE;
+            if (!strcmp(v, "auto")) o.denoise = 0;
+            else if (!strcmp(v, "off")) o.denoise = -1;
+            else {
+                fprintf(stderr, "lbk bake: unknown denoise mode '%s' (auto, off)\n", v);
                 return LBK_EXIT_USAGE;
             }
         } else if (!strcmp(a, "--threads")) {

@@ -24,6 +24,7 @@
 #include "bake/probes/octa_bake.h"
 #include "bake/scene/scene.h"
 #include "bake/layout/texels.h"
+#include "bake/transport/denoise.h"
 #include "bake/transport/tracer.h"
 #include "bake/transport/transport.h"
 #include "cli/cli.h"
@@ -74,6 +75,8 @@ typedef struct bake {
     size_t receiver_count, texel_receivers, glg_first, llg_first;
     uint32_t *texel_of_receiver;    /* receiver → index in texels.receivers */
     lbk_sh9_rgb *radiance;
+    float *variance;                /* per receiver, from the transport: the denoiser's input */
+    bk_denoiser *denoiser;          /* the base bake's weights, reused for every light set */
     bk_transport_stats stats;
     bk_transport_sample *samples;
     size_t sample_count, sample_cap;
@@ -410,6 +413,7 @@ static void set_inputs(const bake *b, bk_set_inputs *in)
     in->threshold = b->opt->dls_threshold;
     in->progress = b->progress;
     in->door_method = b->opt->door_method;
+    in->denoiser = b->denoiser;
     memcpy(in->origin, b->origin, sizeof in->origin);
 }
 
@@ -427,11 +431,45 @@ static int do_transport(bake *b)
     bk_transport_output out;
     memset(&out, 0, sizeof out);
     out.radiance = b->radiance;
+    if (b->opt->denoise >= 0) {
+        b->variance = calloc(b->receiver_count ? b->receiver_count : 1, sizeof *b->variance);
+        if (!b->variance) return fail(b, LBK_EXIT_INTERNAL, "out of memory");
+        out.variance = b->variance;
+    }
     lbk_result r = bk_transport_run(&b->scene, b->tracer, b->receivers, b->receiver_count, &to, &out, &b->stats);
     if (r) return fail(b, LBK_EXIT_INTERNAL, "light transport: %s", lbk_result_message(r));
     if (b->stats.nonfinite)
         bk_progress_note(b->progress, "lbk bake: warning: %llu non-finite samples were dropped",
                          (unsigned long long)b->stats.nonfinite);
+    return 0;
+}
+
+/* The base bake's denoising weights (texels and GLG probes), applied to the base here and to
+ * every light set and door state by bake_sets.c (bake/transport/DENOISE.md). */
+static int do_denoise(bake *b)
+{
+    if (b->opt->denoise < 0) return 0;
+    phase(b, "denoise");
+    bk_denoise_inputs in;
+    memset(&in, 0, sizeof in);
+    in.scene = &b->scene;
+    in.tracer = b->tracer;
+    in.atlas = &b->atlas;
+    in.texels = &b->texels;
+    in.texel_of_receiver = b->texel_of_receiver;
+    in.texel_count = b->texel_receivers;
+    in.glg = b->have_glg ? &b->glg : NULL;
+    in.glg_first = b->glg_first;
+    in.receiver_count = b->receiver_count;
+    in.radiance = b->radiance;
+    in.variance = b->variance;
+    bk_denoise_options o;
+    memset(&o, 0, sizeof o);
+    o.threads = b->opt->threads;
+    lbk_result r = bk_denoiser_create(&in, &o, &b->denoiser);
+    if (!r) r = bk_denoiser_apply(b->denoiser, b->radiance);
+    if (r) return fail(b, LBK_EXIT_INTERNAL, "denoising: %s", lbk_result_message(r));
+    bk_progress_update(b->progress, 1);
     return 0;
 }
 
@@ -706,6 +744,7 @@ static lbk_result build_meta(bake *b, section_list *sl)
     p[n++] = (lbk_meta_pair){"bake.target_error", target};
     p[n++] = (lbk_meta_pair){"bake.max_bounces", bounces};
     p[n++] = (lbk_meta_pair){"bake.time_limit", tlimit};
+    p[n++] = (lbk_meta_pair){"bake.denoise", b->opt->denoise < 0 ? "off" : "auto"};
     if (b->opt->revision) p[n++] = (lbk_meta_pair){LBK_META_REVISION, b->opt->revision};
     if (b->opt->timestamp) {
         time_t now = time(NULL);
@@ -890,6 +929,8 @@ static int write_json_report(bake *b, const bk_bake_summary *sum)
 static void bake_free(bake *b)
 {
     bk_set_bakes_free(&b->sets);
+    bk_denoiser_destroy(b->denoiser);
+    free(b->variance);
     free(b->samples);
     free(b->radiance);
     free(b->texel_of_receiver);
@@ -921,6 +962,7 @@ int bk_bake(const bk_bake_options *opt, bk_progress *progress, bk_bake_summary *
     if (!rc) rc = do_layout(&b);
     if (!rc) rc = bk_set_bakes_prepare(&b.sets, &b.scene, progress, err, err_len);
     if (!rc) rc = do_transport(&b);
+    if (!rc) rc = do_denoise(&b);
     if (!rc && b.sets.set_count) {
         phase(&b, "sets");
         bk_set_inputs in;

@@ -32,6 +32,8 @@ typedef struct bk_bake_options {
                                      directly; 0: 0.01 (seed 001 §3.2); < 0: every non-zero receiver */
     int door_method;              /* how doors' open light is baked: 0 difference of full runs (default),
                                      1 the seed's guided estimator (enum bk_door_method, bake/sets/SETS.md) */
+    int denoise;                  /* 0 auto: texels and GLG probes denoised (both presets), -1 off
+                                     (bake/transport/DENOISE.md) */
 } bk_bake_options;
 
 typedef struct bk_bake_summary {

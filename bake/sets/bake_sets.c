@@ -402,8 +402,32 @@ static int is_door_texel(const bk_set_inputs *in, size_t k)
  * direct part of it. Rule (bake/sets/SETS.md): threshold = fraction × mean indirect irradiance
  * (luminance) of the texels the set lights directly; an entry is stored where the contribution
  * exceeds it. Door receivers are left out of door sets (when the door is open it is not there). */
+static lbk_result emit_entries(const bk_set_inputs *in, bs_set *st, const lbk_sh9_rgb *contrib, const lbk_sh9_rgb *direct,
+                               double fraction, int skip_doors);
+
 static lbk_result emit_set(const bk_set_inputs *in, bs_set *st, const lbk_sh9_rgb *contrib, const lbk_sh9_rgb *direct,
                            double fraction, int skip_doors)
+{
+    /* the base bake's denoising weights, so base + set stays what a denoised sum would be */
+    lbk_sh9_rgb *denoised = NULL;
+    if (in->denoiser) {
+        denoised = malloc((in->receiver_count ? in->receiver_count : 1) * sizeof *denoised);
+        if (!denoised) return LBK_ERR_OUT_OF_MEMORY;
+        memcpy(denoised, contrib, in->receiver_count * sizeof *denoised);
+        lbk_result dr = bk_denoiser_apply(in->denoiser, denoised);
+        if (dr) {
+            free(denoised);
+            return dr;
+        }
+        contrib = denoised;
+    }
+    lbk_result r = emit_entries(in, st, contrib, direct, fraction, skip_doors);
+    free(denoised);
+    return r;
+}
+
+static lbk_result emit_entries(const bk_set_inputs *in, bs_set *st, const lbk_sh9_rgb *contrib, const lbk_sh9_rgb *direct,
+                               double fraction, int skip_doors)
 {
     const bk_texels *tx = in->texels;
     size_t nt = in->texel_receivers;

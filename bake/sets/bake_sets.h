@@ -12,6 +12,7 @@
 #include "bake/util/progress.h"
 #include "bake/scene/scene.h"
 #include "bake/layout/texels.h"
+#include "bake/transport/denoise.h"
 #include "bake/transport/tracer.h"
 #include "bake/transport/transport.h"
 #include "lbk/sh.h"
@@ -50,6 +51,9 @@ typedef struct bk_set_inputs {
                                          < 0: store every receiver with a non-zero contribution */
     bk_progress *progress;
     int door_method;                  /* enum bk_door_method */
+    const bk_denoiser *denoiser;      /* the base bake's denoising weights, applied to every set's
+                                         contribution (linear: sets add up as in a denoised sum);
+                                         NULL: not denoised */
     float origin[3];                  /* the bake frame's origin in world space: add it to every
                                          position written (the scene is recentred, bake.c) */
     float scale[3];                   /* sections only: the LMAP, GLG and LLG scales (spec §5.7);
