@@ -444,12 +444,32 @@ static int do_transport(bake *b)
     return 0;
 }
 
-/* The base bake's denoising weights (texels and GLG probes), applied to the base here and to
- * every light set and door state by bake_sets.c (bake/transport/DENOISE.md). */
+/* The denoising weights (texels and GLG probes) from the base + every light set and door (the
+ * guide), applied to the base here and to every set by bk_set_bakes_emit with the same weights
+ * (bake/transport/DENOISE.md). */
 static int do_denoise(bake *b)
 {
     if (b->opt->denoise < 0) return 0;
     phase(b, "denoise");
+    const lbk_sh9_rgb *set_sum;
+    const float *set_var;
+    bk_set_bakes_guide(&b->sets, &set_sum, &set_var);
+    lbk_sh9_rgb *guide = NULL;
+    float *guide_var = NULL;
+    if (set_sum) {
+        size_t n = b->receiver_count ? b->receiver_count : 1;
+        guide = malloc(n * sizeof *guide);
+        guide_var = malloc(n * sizeof *guide_var);
+        if (!guide || !guide_var) {
+            free(guide), free(guide_var);
+            return fail(b, LBK_EXIT_INTERNAL, "out of memory");
+        }
+        for (size_t i = 0; i < b->receiver_count; i++) {
+            for (int c = 0; c < 3; c++)
+                for (int k = 0; k < 9; k++) guide[i].c[c][k] = b->radiance[i].c[c][k] + set_sum[i].c[c][k];
+            guide_var[i] = b->variance[i] + set_var[i];
+        }
+    }
     bk_denoise_inputs in;
     memset(&in, 0, sizeof in);
     in.scene = &b->scene;
@@ -461,12 +481,13 @@ static int do_denoise(bake *b)
     in.glg = b->have_glg ? &b->glg : NULL;
     in.glg_first = b->glg_first;
     in.receiver_count = b->receiver_count;
-    in.radiance = b->radiance;
-    in.variance = b->variance;
+    in.radiance = guide ? guide : b->radiance;
+    in.variance = guide_var ? guide_var : b->variance;
     bk_denoise_options o;
     memset(&o, 0, sizeof o);
     o.threads = b->opt->threads;
     lbk_result r = bk_denoiser_create(&in, &o, &b->denoiser);
+    free(guide), free(guide_var);
     if (!r) r = bk_denoiser_apply(b->denoiser, b->radiance);
     if (r) return fail(b, LBK_EXIT_INTERNAL, "denoising: %s", lbk_result_message(r));
     bk_progress_update(b->progress, 1);
@@ -962,12 +983,17 @@ int bk_bake(const bk_bake_options *opt, bk_progress *progress, bk_bake_summary *
     if (!rc) rc = do_layout(&b);
     if (!rc) rc = bk_set_bakes_prepare(&b.sets, &b.scene, progress, err, err_len);
     if (!rc) rc = do_transport(&b);
-    if (!rc) rc = do_denoise(&b);
     if (!rc && b.sets.set_count) {
         phase(&b, "sets");
         bk_set_inputs in;
         set_inputs(&b, &in);
         rc = bk_set_bakes_run(&b.sets, &in, err, err_len);
+    }
+    if (!rc) rc = do_denoise(&b);
+    if (!rc && b.sets.set_count) {
+        bk_set_inputs in;
+        set_inputs(&b, &in);
+        rc = bk_set_bakes_emit(&b.sets, &in, err, err_len);
     }
     if (!rc) {
         summary->objects = b.scene.object_count;

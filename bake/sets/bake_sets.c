@@ -43,6 +43,12 @@ typedef struct bs_set {
     double threshold;              /* absolute luminance threshold used (lux) */
     uint32_t members[2];           /* kind 3: the member sets */
     uint32_t member_count;
+    /* the contribution kept from its run until bk_set_bakes_emit (the denoiser's weights need
+     * every set first): radiance per receiver, direct luminance per texel receiver */
+    lbk_sh9_rgb *stash;
+    double *stash_direct;
+    double stash_fraction;
+    int stash_skip_doors;
 } bs_set;
 
 typedef struct bs_door {
@@ -66,6 +72,10 @@ typedef struct bs_impl {
     size_t light_set_count;
     bs_combo *combos;
     size_t combo_count;
+    /* the denoiser's guide (bake/transport/DENOISE.md): Σ of the light sets' and doors'
+     * contributions, and Σ of the light-set runs' variances (independent runs); NULL before any */
+    lbk_sh9_rgb *guide;
+    float *guide_var;
 } bs_impl;
 
 /* ---- prepare --------------------------------------------------------------------------- */
@@ -399,34 +409,49 @@ static int is_door_texel(const bk_set_inputs *in, size_t k)
 }
 
 /* Chooses and encodes a set's entries from its per-receiver contribution (radiance SH) and the
- * direct part of it. Rule (bake/sets/SETS.md): threshold = fraction × mean indirect irradiance
- * (luminance) of the texels the set lights directly; an entry is stored where the contribution
- * exceeds it. Door receivers are left out of door sets (when the door is open it is not there). */
-static lbk_result emit_entries(const bk_set_inputs *in, bs_set *st, const lbk_sh9_rgb *contrib, const lbk_sh9_rgb *direct,
+ * luminance of its direct part per texel receiver. Rule (bake/sets/SETS.md): threshold =
+ * fraction × mean indirect irradiance (luminance) of the texels the set lights directly; an
+ * entry is stored where the contribution exceeds it. Door receivers are left out of door sets
+ * (when the door is open it is not there). */
+static lbk_result emit_entries(const bk_set_inputs *in, bs_set *st, const lbk_sh9_rgb *contrib, const double *dl,
                                double fraction, int skip_doors);
 
-static lbk_result emit_set(const bk_set_inputs *in, bs_set *st, const lbk_sh9_rgb *contrib, const lbk_sh9_rgb *direct,
-                           double fraction, int skip_doors)
+/* Keeps a set's contribution for bk_set_bakes_emit and adds it to the denoiser's guide
+ * (combination sets are corrections of their members: not in the guide). `variance` is the
+ * run's own (light sets) or NULL (differences of correlated runs: unknown). */
+static lbk_result stash_set(const bk_set_inputs *in, bs_impl *im, bs_set *st, const lbk_sh9_rgb *contrib,
+                            const lbk_sh9_rgb *direct, const float *variance, double fraction, int skip_doors)
 {
-    /* the base bake's denoising weights, so base + set stays what a denoised sum would be */
-    lbk_sh9_rgb *denoised = NULL;
-    if (in->denoiser) {
-        denoised = malloc((in->receiver_count ? in->receiver_count : 1) * sizeof *denoised);
-        if (!denoised) return LBK_ERR_OUT_OF_MEMORY;
-        memcpy(denoised, contrib, in->receiver_count * sizeof *denoised);
-        lbk_result dr = bk_denoiser_apply(in->denoiser, denoised);
-        if (dr) {
-            free(denoised);
-            return dr;
-        }
-        contrib = denoised;
+    size_t n = in->receiver_count, nt = in->texel_receivers;
+    free(st->stash), free(st->stash_direct);
+    st->stash = malloc((n ? n : 1) * sizeof *st->stash);
+    st->stash_direct = malloc((nt ? nt : 1) * sizeof *st->stash_direct);
+    if (!st->stash || !st->stash_direct) return LBK_ERR_OUT_OF_MEMORY;
+    memcpy(st->stash, contrib, n * sizeof *st->stash);
+    for (size_t k = 0; k < nt; k++) {
+        lbk_ahd_linear dlin;
+        float ez[3];
+        bk_texel_linear(&in->texels->receivers[in->texel_of_receiver[k]], &direct[k], &dlin);
+        lin_ez(&dlin, ez);
+        st->stash_direct[k] = lum3(ez);
     }
-    lbk_result r = emit_entries(in, st, contrib, direct, fraction, skip_doors);
-    free(denoised);
-    return r;
+    st->stash_fraction = fraction;
+    st->stash_skip_doors = skip_doors;
+    if (st->kind == LBK_DLS_KIND_COMBINATION) return LBK_OK;
+    if (!im->guide) {
+        im->guide = calloc(n ? n : 1, sizeof *im->guide);
+        im->guide_var = calloc(n ? n : 1, sizeof *im->guide_var);
+        if (!im->guide || !im->guide_var) return LBK_ERR_OUT_OF_MEMORY;
+    }
+    for (size_t i = 0; i < n; i++) {
+        for (int c = 0; c < 3; c++)
+            for (int k = 0; k < 9; k++) im->guide[i].c[c][k] += contrib[i].c[c][k];
+        if (variance && isfinite(variance[i])) im->guide_var[i] += variance[i];
+    }
+    return LBK_OK;
 }
 
-static lbk_result emit_entries(const bk_set_inputs *in, bs_set *st, const lbk_sh9_rgb *contrib, const lbk_sh9_rgb *direct,
+static lbk_result emit_entries(const bk_set_inputs *in, bs_set *st, const lbk_sh9_rgb *contrib, const double *dl,
                                double fraction, int skip_doors)
 {
     const bk_texels *tx = in->texels;
@@ -439,11 +464,6 @@ static lbk_result emit_entries(const bk_set_inputs *in, bs_set *st, const lbk_sh
     }
     /* threshold from the directly lit texels */
     double dmax = 0;
-    double *dl = calloc(nt ? nt : 1, sizeof *dl);
-    if (!dl) {
-        free(lin), free(lum);
-        return LBK_ERR_OUT_OF_MEMORY;
-    }
     for (size_t k = 0; k < nt; k++) {
         const bk_texel *t = &tx->receivers[in->texel_of_receiver[k]];
         bk_texel_linear(t, &contrib[k], &lin[k]);
@@ -452,10 +472,6 @@ static lbk_result emit_entries(const bk_set_inputs *in, bs_set *st, const lbk_sh
         float ez[3];
         lin_ez(&lin[k], ez);
         lum[k] = lum3(ez);
-        lbk_ahd_linear dlin;
-        bk_texel_linear(t, &direct[k], &dlin);
-        lin_ez(&dlin, ez);
-        dl[k] = lum3(ez);
         if (lum[k] > 0 && dl[k] > dmax) dmax = dl[k];
     }
     double sum = 0, all = 0;
@@ -484,7 +500,6 @@ static lbk_result emit_entries(const bk_set_inputs *in, bs_set *st, const lbk_sh
     }
     double thr = fraction * reference;
     st->threshold = thr;
-    free(dl);
 
     lbk_result r = LBK_ERR_OUT_OF_MEMORY;
     bs_vec tv = {NULL, NULL, 0, 0, sizeof(lbk_ahd_linear)}, gv = {NULL, NULL, 0, 0, sizeof(lbk_sh9_rgb)},
@@ -575,6 +590,7 @@ typedef struct run_ctx {
     const bk_set_inputs *in;
     int run, runs;
     const bk_scene *scene;   /* scene of the current run (the hook's triangle indices) */
+    float *variance;         /* NULL, or where run_one writes the run's per-receiver variance */
     int black_doors;         /* 1: door triangles get albedo 0 ... */
     const char *keep;        /* ... except this door's */
 } run_ctx;
@@ -648,6 +664,7 @@ static int run_one(run_ctx *rc, const bk_scene *scene, const bk_tracer *tracer, 
     memset(&out, 0, sizeof out);
     out.radiance = radiance;
     out.direct = direct;
+    out.variance = rc->variance;
     bk_transport_stats st;
     lbk_result r = bk_transport_run(scene, tracer, in->receivers, in->receiver_count, &opt, &out, &st);
     rc->run++;
@@ -775,7 +792,8 @@ int bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *err, siz
     int code = 0;
     char what[256];
     lbk_sh9_rgb *ls_closed = NULL, *ls_closed_dir = NULL;
-    if (!rad || !dir) goto oom;
+    float *var = malloc(n * sizeof *var);
+    if (!rad || !dir || !var) goto oom;
 
     /* Light sets: their lights alone (transport leaves out the sky and every other emitter);
      * doors stay closed with their albedo (seed §4.1: the other elements in their default
@@ -787,9 +805,11 @@ int bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *err, siz
         opt.light_set = st->name;
         rc.black_doors = 0;
         snprintf(what, sizeof what, "light set '%s'", st->name);
+        rc.variance = var;
         code = run_one(&rc, in->scene, in->tracer, &opt, rad, dir, what, err, err_len);
+        rc.variance = NULL;
         if (code) goto out;
-        if (emit_set(in, st, rad, dir, fraction, 0)) goto oom;
+        if (stash_set(in, im, st, rad, dir, var, fraction, 0)) goto oom;
     }
 
     if (im->door_count) {
@@ -843,7 +863,7 @@ int bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *err, siz
                 sh_sub(rad, ref, in->receiver_count);
                 sh_sub(dir, ref_dir, in->receiver_count);
             }
-            if (emit_set(in, &im->sets[d->open_set], rad, dir, fraction, 1)) goto oom;
+            if (stash_set(in, im, &im->sets[d->open_set], rad, dir, NULL, fraction, 1)) goto oom;
 
             /* S_C = L(door p closed with its albedo, others black) − reference */
             rc.keep = d->name;
@@ -852,7 +872,7 @@ int bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *err, siz
             if (code) goto out;
             sh_sub(rad, ref, in->receiver_count);
             sh_sub(dir, ref_dir, in->receiver_count);
-            if (emit_set(in, &im->sets[d->closed_set], rad, dir, fraction, 1)) goto oom;
+            if (stash_set(in, im, &im->sets[d->closed_set], rad, dir, NULL, fraction, 1)) goto oom;
         }
 
         /* Combination states (seed §6.2) by inclusion–exclusion of correlated runs:
@@ -860,7 +880,7 @@ int bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *err, siz
          *   door A, light set: S_AX = L_X(A open) − L_X(A closed) (the set's lights alone, other
          *                      doors closed with their albedo, as the set's own bake).
          * With both open the runtime then shows base + S_A + S_B + S_AB = L(A, B open). Clamped
-         * like every difference (emit_set). */
+         * like every difference (emit_entries). */
         for (size_t c = 0; c < im->combo_count; c++) {
             const bs_combo *co = &im->combos[c];
             bs_set *st = &im->sets[co->set];
@@ -905,7 +925,7 @@ int bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *err, siz
                 sh_sub(rad, ls_closed, in->receiver_count);
                 sh_sub(dir, ls_closed_dir, in->receiver_count);
             }
-            if (emit_set(in, st, rad, dir, fraction, 1)) goto oom;
+            if (stash_set(in, im, st, rad, dir, NULL, fraction, 1)) goto oom;
         }
     }
     goto out;
@@ -916,8 +936,39 @@ out:
     if (keep)
         for (size_t p = 0; p < im->door_count; p++) free(keep[p]), free(keep_dir[p]);
     free(keep), free(keep_dir), free(texel_size), free(door_texel), free(ls_closed), free(ls_closed_dir);
-    free(rad), free(dir), free(ref), free(ref_dir);
+    free(rad), free(dir), free(ref), free(ref_dir), free(var);
     return code;
+}
+
+void bk_set_bakes_guide(const bk_set_bakes *sets, const lbk_sh9_rgb **sum, const float **variance)
+{
+    const bs_impl *im = sets->impl;
+    *sum = im ? im->guide : NULL;
+    *variance = im ? im->guide_var : NULL;
+}
+
+int bk_set_bakes_emit(bk_set_bakes *sets, const bk_set_inputs *in, char *err, size_t err_len)
+{
+    bs_impl *im = sets->impl;
+    if (!im) return 0;
+    lbk_result r = LBK_OK;
+    for (size_t j = 0; j < im->set_count && !r; j++) {
+        bs_set *st = &im->sets[j];
+        if (!st->stash) continue;
+        /* every set with the same weights (the guide's), so sets toggled at run time add up to
+         * what a denoised bake of the sum would be */
+        if (in->denoiser) r = bk_denoiser_apply(in->denoiser, st->stash);
+        if (!r) r = emit_entries(in, st, st->stash, st->stash_direct, st->stash_fraction, st->stash_skip_doors);
+        free(st->stash), free(st->stash_direct);
+        st->stash = NULL, st->stash_direct = NULL;
+    }
+    free(im->guide), free(im->guide_var);
+    im->guide = NULL, im->guide_var = NULL;
+    if (r) {
+        snprintf(err, err_len, "light sets: %s", lbk_result_message(r));
+        return LBK_EXIT_INTERNAL;
+    }
+    return 0;
 }
 
 /* ---- sections -------------------------------------------------------------------------- */
@@ -1063,9 +1114,10 @@ void bk_set_bakes_free(bk_set_bakes *sets)
     if (im) {
         for (size_t j = 0; j < im->set_count; j++) {
             free(im->sets[j].light_names);
+            free(im->sets[j].stash), free(im->sets[j].stash_direct);
             for (int s = 0; s < LBK_DLS_SPACE_COUNT_; s++) free(im->sets[j].targets[s]), free(im->sets[j].values[s]);
         }
-        free(im->sets), free(im->doors), free(im->combos), free(im);
+        free(im->sets), free(im->doors), free(im->combos), free(im->guide), free(im->guide_var), free(im);
     }
     memset(sets, 0, sizeof *sets);
 }
