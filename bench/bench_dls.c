@@ -4,6 +4,7 @@
  * the clustered layout against its payload. Synthetic level at about the size of the seed's
  * ESTATE: 1M texels, 50k GLG and 20k LLG probes, 64 light sets with local footprints plus a
  * dense region where up to 16 sets overlap. */
+#define LBK_STATIC_LINKING_ONLY /* lbk_dls_stats: experimental (lbk/dls.h) */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -32,7 +33,7 @@ static void random_texel(uint64_t *rng, float scale, uint8_t out[8])
     lbk_ahd_linear_add_light(&lin, dir, rgb);
     lbk_ahd_texel t;
     lbk_ahd_from_linear(&lin, &t);
-    lbk_ahd_texel_store(&t, out);
+    lbk_ahd_texel_pack(&t, out);
 }
 
 static void random_probe(uint64_t *rng, float scale, uint8_t out[28])
@@ -127,7 +128,7 @@ static void naive_texels(const naive *nv, const float *w, const uint32_t *bz, co
             float wj = w[p[0]];
             if (wj == 0.0f) continue;
             lbk_ahd_texel e;
-            lbk_ahd_texel_load(p + 1, &e);
+            lbk_ahd_texel_unpack(p + 1, &e);
             lbk_ahd_to_linear(&e, &l);
             lbk_ahd_linear_add_scaled(&acc, &l, wj);
         }
@@ -203,7 +204,7 @@ int main(void)
             payload_total += len;
         }
     }
-    lbk_dls_build_desc desc = {NSETS, sets, {T, G, L}};
+    lbk_dls_build_desc desc = {.set_count = NSETS, .sets = sets, .target_count = {T, G, L}};
     void *bytes;
     size_t size;
     lbk_dls_stats st;
@@ -215,7 +216,7 @@ int main(void)
         return 1;
     }
     lbk_dls_view *v;
-    lbk_dls_view_open(bytes, size, NULL, &v);
+    lbk_dls_open(bytes, size, NULL, &v);
     printf("level: %llu texels, %llu GLG, %llu LLG probes, %d sets, %llu entries; build %.2f s\n",
            (unsigned long long)T, (unsigned long long)G, (unsigned long long)L, NSETS, (unsigned long long)payload_total, t_build);
     printf("clusters: %u (dedicated %u, packed %u with %u sub-groups, prefix-2 %u, prefix-3 %u, prefix-8 %u)\n", st.cluster_count,
@@ -238,7 +239,7 @@ int main(void)
         uint8_t b[8];
         random_texel(&rng, 1.0f, b);
         lbk_ahd_texel tx;
-        lbk_ahd_texel_load(b, &tx);
+        lbk_ahd_texel_unpack(b, &tx);
         bz[t] = tx.irradiance_z;
         memcpy(brgba + 4 * t, tx.rgba, 4);
     }
@@ -247,7 +248,7 @@ int main(void)
     lbk_dls_runtime_desc rd = {.dls = v, .base_irradiance_z = bz, .base_rgba = brgba, .base_glg = bg, .base_llg = bl,
                                .out_irradiance_z = oz, .out_rgba = orgba, .out_glg = og, .out_llg = ol};
     lbk_dls_runtime *rt;
-    if (lbk_dls_runtime_create(&rd, &rt) != LBK_OK) return 1;
+    if (lbk_dls_runtime_open(&rd, &rt) != LBK_OK) return 1;
     naive nv[3];
     for (uint32_t sp = 0; sp < 3; sp++) naive_build(&nv[sp], v, sp);
     uint64_t naive_index = 0;
@@ -308,8 +309,8 @@ int main(void)
         printf("%s:\n  clustered %.3f ms, naive gather %.3f ms: %.1fx faster; clustered at %.3f of memcpy speed%s\n", scen[sc].name,
                best_rt * 1e3, best_nv * 1e3, best_nv / best_rt, best_copy / best_rt, same ? "" : " (OUTPUTS DIFFER)");
     }
-    lbk_dls_runtime_destroy(rt);
-    lbk_dls_view_close(v);
+    lbk_dls_runtime_close(rt);
+    lbk_dls_close(v);
     free(bytes);
     for (uint32_t sp = 0; sp < 3; sp++) free(nv[sp].offset), free(nv[sp].stream);
     for (uint32_t s = 0; s < NSETS; s++)

@@ -712,6 +712,14 @@ static lbk_result place_charts(const bk_scene *scene, bk_atlas *out, const obj_p
             ch->h = content_size(u->charts[k].height);
             ch->first = (uint32_t)t;
             ch->count = u->charts[k].count;
+            if (u->source == BK_UV_AUTHORED) { /* one chart: its origin is uv1_min */
+                o->uv1_scale = u->uv1_scale;
+                for (int q = 0; q < 2; q++) {
+                    o->uv1_offset[q] = (q ? ch->y : ch->x) - u->uv1_min[q] * u->uv1_scale;
+                    o->uv1_min[q] = u->uv1_min[q];
+                    o->uv1_max[q] = u->uv1_max[q];
+                }
+            }
             for (uint32_t j = 0; j < u->charts[k].count; j++, t++) {
                 size_t src = (size_t)u->charts[k].first + j;
                 out->tris[t] = u->tris[src];

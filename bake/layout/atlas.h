@@ -64,6 +64,9 @@ typedef struct bk_atlas_object {
     uint32_t first_chart, chart_count;
     uint32_t degenerate_tris;
     char note[192];          /* uv1 rejection reason, density changes; "" */
+    /* BK_UV_AUTHORED: page texel coordinate X = uv1_offset[0] + uv1_scale · u1, Y likewise (the
+     * rule of spec/container.md §16.3 in real arithmetic); uv1_min/max: the uv1 bounding box */
+    double uv1_scale, uv1_offset[2], uv1_min[2], uv1_max[2];
 } bk_atlas_object;
 
 typedef struct bk_atlas_chart {

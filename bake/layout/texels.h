@@ -9,7 +9,8 @@
  * The sample point is the world point at the centre (or at the closest point), its normal
  * the interpolated shading normal (the geometric normal where that is zero).
  *
- * TANGENT FRAME CONVENTION (the AHD encoder and the runtime must use the same):
+ * TANGENT FRAME CONVENTION (the AHD encoder and the runtime must use the same; normative in
+ * spec/container.md §5.6, lbk_ahd_tangent_frame in lbk/ahd.h computes it for renderers):
  *   N = the unit interpolated shading normal of the receiver (+Z of the local frame);
  *   T = dP/du of the triangle, P the world position and u the lightmap texel x coordinate
  *       (to the right on the page; uv.x), made orthogonal to N and unit length (+X);

@@ -767,6 +767,9 @@ static lbk_result try_authored(gen_ctx *g, double density, int cap, bk_uv_object
     if (r != LBK_OK || !acceptable) return r;
     o->density = (float)(sc * sqrt(e.uv_area / e.world_area));
     o->source = BK_UV_AUTHORED;
+    o->uv1_scale = sc;
+    o->uv1_min[0] = e.mnu, o->uv1_min[1] = e.mnv;
+    o->uv1_max[0] = e.mxu, o->uv1_max[1] = e.mxv;
     *used = 1;
     return LBK_OK;
 }

@@ -65,6 +65,9 @@ typedef struct bk_uv_object {
     uint32_t *tris;          /* scene triangle indices, grouped by chart */
     float *uv;               /* 6 per entry of tris: the 3 corners' chart coordinates, texels */
     size_t degenerate_count; /* the object's triangles without a chart */
+    /* BK_UV_AUTHORED: the one chart's coordinates are (uv1 − uv1_min) · uv1_scale texels, per
+     * axis; uv1_min/uv1_max bound the uv1 of the triangles that have area (0 otherwise) */
+    double uv1_scale, uv1_min[2], uv1_max[2];
 } bk_uv_object;
 
 /* Charts for scene object `object` at `density` texels per metre (> 0, finite). opt may be
