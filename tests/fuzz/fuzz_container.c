@@ -18,6 +18,7 @@
 #include <string.h>
 #include <xxhash.h>
 
+#define LBK_STATIC_LINKING_ONLY /* the DLS statistics (experimental API) */
 #include "lbk/container.h"
 #include "lbk/dls.h"
 #include "lbk/door.h"

@@ -130,6 +130,7 @@ typedef struct lbk_bake_desc {
     const char *sky_exr;        /* with sky_override: an equirectangular EXR instead of `sky` */
     int no_glg;                 /* 1: leave out the global light grid */
     int octahedral_probes;      /* 1: also write OCTP probes at the GLG positions */
+    int no_seam_stitch;         /* 1: leave lightmap seams unstitched (for comparisons, bench_atlas) [0] */
     double dls_threshold;       /* light sets and doors store a receiver where their light exceeds
                                    this fraction of the mean indirect light of the texels they
                                    light directly [0: 0.01]; < 0: every non-zero receiver */
