@@ -32,7 +32,7 @@ typedef struct dn_texels {
     size_t *poff;
     int32_t *grid;
     int32_t *patch;            /* NLM: 9 per receiver, its 3×3 neighbours in its chart or -1 */
-    /* from the base: luminance and variance at the input of each level (levels × n), the
+    /* from the guide: luminance and variance at the input of each level (levels × n), the
      * noise std of the input (smoothed variance, n) and the clamp blend (n) */
     float *lum, *var;
     float *sigma;

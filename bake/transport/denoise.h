@@ -8,13 +8,14 @@
  * and runs on the transport's output (incident radiance SH9 per receiver) before anything
  * encodes it.
  *
- * Linearity (light sets and doors): the weights are computed once, from the base bake (its
- * luminance, its variance and the geometry), and stored in a bk_denoiser; bk_denoiser_apply
- * then filters any per-receiver SH with those same weights, so denoise(base + set) =
- * denoise(base) + denoise(set) up to float rounding and a light set toggled at run time adds
- * exactly what it would have added to a denoised sum. Every weight is >= 0 and each output is
- * a normalised combination (weights sum to 1), so an output never leaves the range of the
- * inputs it averages: the furnace (every input within its bound) stays within its bound.
+ * Linearity (light sets and doors): the weights are computed once, from a guide (its
+ * luminance, its variance and the geometry; the pipeline passes base + every light set and
+ * door contribution), and kept in a bk_denoiser; bk_denoiser_apply then filters any
+ * per-receiver SH with those same weights, so denoise(base + set) = denoise(base) +
+ * denoise(set) up to float rounding and a light set toggled at run time adds exactly what it
+ * would have added to a denoised sum. Every weight is >= 0 and each output is a normalised
+ * combination (weights sum to 1), so an output never leaves the range of the inputs it
+ * averages: the furnace (every input within its bound) stays within its bound.
  *
  * Texels are averaged only with texels of the same chart (never across a chart border) on the
  * same page; probes only with tetrahedral neighbours they can see (an unoccluded segment
@@ -53,8 +54,9 @@ typedef struct bk_denoise_options {   /* zero = defaults */
     int method;              /* enum bk_denoise_method */
     int threads;             /* 0: all online cores (results do not depend on it) */
     int iterations;          /* à-trous levels (steps 1, 2, 4, ...); 0: 4 */
-    int radius;              /* NLM search half-window; 0: 5 */
-    float sigma_lum;         /* luminance stop in noise standard deviations; 0: method default */
+    int radius;              /* NLM search half-window (BLUR: its window); 0: 5, at most 16 */
+    float sigma_lum;         /* NLM: k of the patch distance, 0: 1; à-trous and probes: the stop
+                                in noise standard deviations, 0: 4 */
     float sigma_normal;      /* normal stop exponent, max(0, n·n')^s; 0: 32 */
     float sigma_plane;       /* distance off the tangent plane, texel sizes; 0: 0.5 */
     float sigma_albedo;      /* albedo stop (Euclidean RGB distance); 0: no albedo stop (DENOISE.md) */
@@ -76,22 +78,20 @@ typedef struct bk_denoise_inputs {
     const bk_glg *glg;                /* NULL: no probe filtering */
     size_t glg_first;
     size_t receiver_count;            /* size of the radiance and variance arrays */
-    const lbk_sh9_rgb *radiance;      /* the base bake, per receiver */
-    const float *variance;            /* per receiver (bk_transport_output.variance) */
+    const lbk_sh9_rgb *radiance;      /* the guide, per receiver: the base bake (+ the sets) */
+    const float *variance;            /* per receiver (bk_transport_output.variance, summed) */
 } bk_denoise_inputs;
 
 typedef struct bk_denoise_stats {
-    double seconds;                   /* building the weights + filtering the base */
+    double seconds;                   /* building the weights (bk_denoiser_create) */
     size_t texels, probes;            /* receivers filtered */
     size_t probe_edges, probe_edges_visible;
-    double mean_texel_weight;         /* mean over texels of 1/Σw² (effective samples averaged) */
-    double mean_probe_weight;
     size_t clamped;                   /* texels and probes whose move was limited by the clamp */
 } bk_denoise_stats;
 
 typedef struct bk_denoiser bk_denoiser;
 
-/* Builds the weights from the base bake. *out must be destroyed with bk_denoiser_destroy.
+/* Builds the weights from the guide in `in`. *out must be destroyed with bk_denoiser_destroy.
  * Errors: LBK_ERR_INVALID_ARGUMENT (NULL in/out/radiance/variance, texels without atlas or
  * mapping, receiver ranges outside receiver_count), LBK_ERR_OUT_OF_MEMORY. */
 lbk_result bk_denoiser_create(const bk_denoise_inputs *in, const bk_denoise_options *opt, bk_denoiser **out);

@@ -102,7 +102,7 @@ static lbk_result build_adjacency(dn_probes *p, const uint64_t *edges, const uin
     return LBK_OK;
 }
 
-/* Weights and clamp from the base probes: σ_i from the transport's variance averaged over the
+/* Weights and clamp from the guide's probes: σ_i from the transport's variance averaged over the
  * probe and its visible neighbours (0 when the probe's own estimate is 0: noise-free). */
 static void probe_weights(dn_probes *p, const lbk_sh9_rgb *base, const float *variance, float sigma_lum, float clamp)
 {
