@@ -159,7 +159,8 @@ typedef struct lbk_bake_desc {
  * normals are flat-shaded (each gets its own three vertices and its face normal); given normals
  * are normalised; base colours above 1 are clamped (with a warning). META differs: its
  * scene.hash is the XXH3-64 of the description's arrays (not of a file) and its scene.name is
- * lbk_bake_scene.name. */
+ * lbk_bake_scene.name. A description also gets no LMUV section (spec §16): LMUV maps lightmap
+ * UVs onto a glTF file's own nodes, primitives and vertices, which a description does not have. */
 
 typedef enum lbk_bake_lighting {
     LBK_BAKE_LIGHTING_AUTO = 0, /* the baker's heuristic (bake/layout/classify.h) */
