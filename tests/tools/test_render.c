@@ -21,13 +21,15 @@
  * and every filter of zeros is 0. The codec's smallest step would hide a leak below it, never
  * create one: the bound is 0 for every pixel (walls, floor, the LLG prop, GLG-lit spheres).
  *
- * Light sets: room_with_doors with two lights in sets A and B (tests/support/door_scenes.h),
- * rendered with A = B = 1 through lbk_dls_apply, against full bakes with both lights static.
- * Both are unbiased estimates of the same image, so the difference of two with different seeds
- * has mean square σ_S² + σ_R², each σ measured from two seeds (rmse(X1 − X2)² = 2σ²). Asserted: rmse(S − R)² ≤
- * 2 (σ_S² + σ_R²) + (2^−6 · mean)² — the factor 2 covers the spread of a mean over the view's
- * few hundred independent texels (its standard deviation is ~5 %), the last term the one extra
- * R11G11B10F rounding of the applied texels. And the weights matter: A = B = 0 must be far off. */
+ * Light sets and doors: room_with_doors (tests/support/door_scenes.h) with two lights in sets A
+ * and B rendered with A = B = 1 through lbk_dls_apply, against full bakes with both lights
+ * static; and with the north door tagged and open, against the room without the panel. Both are
+ * unbiased estimates of the same image, so the difference of two with different seeds has mean
+ * square σ_S² + σ_R², each σ measured from two seeds (rmse(X1 − X2)² = 2σ²). Asserted:
+ * rmse(S − R)² ≤ 2 (σ_S² + σ_R²) + (2^−6 · mean)² — the factor 2 covers the spread of a mean
+ * over the view's few hundred independent texels (its standard deviation is ~5 %), the last
+ * term the one extra R11G11B10F rounding of the applied texels. And the weights matter: lights
+ * off, or the door closed, must be far off. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -62,6 +64,7 @@ static int setup(void **state)
 static int teardown(void **state)
 {
     (void)state;
+    if (getenv("LBK_TEST_KEEP")) return printf("kept %s\n", tmpdir), 0; /* for a look with lbk inspect */
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
     return system(cmd) == 0 ? 0 : -1;
@@ -204,38 +207,79 @@ static double rmse(const tl_image *a, const tl_image *b)
     return sqrt(s / (double)n);
 }
 
-static void light_sets(void **state)
+/* Writes a room level and bakes it with seeds 1 and 2 into lbk[0], lbk[1]. */
+static void room_pair(const char *name, const ds_options *ds, char gltf[160], char lbk[2][160])
 {
-    (void)state;
-    char gltf[2][128], lbk[4][128];
-    const char *names[4] = {"sets1", "sets2", "static1", "static2"};
+    snprintf(gltf, 160, "%s/%s.gltf", tmpdir, name);
+    char err[256];
+    assert_int_equal(ds_write_room_scene(DS_ROOM_GLB, gltf, ds, err, sizeof err), 0);
     for (int k = 0; k < 2; k++) {
-        ds_options d = {.inside = k == 0 ? DS_INSIDE_SETS : DS_INSIDE_STATIC, .sky = 0.5f};
-        snprintf(gltf[k], sizeof gltf[k], "%s/%s.gltf", tmpdir, names[2 * k]);
-        char err[256];
-        assert_int_equal(ds_write_room_scene(DS_ROOM_GLB, gltf[k], &d, err, sizeof err), 0);
+        snprintf(lbk[k], 160, "%s/%s%d.lbk", tmpdir, name, k + 1);
+        bake(gltf, lbk[k], (uint64_t)k + 1, 96, 2.0f, 2.5f);
     }
-    for (int k = 0; k < 4; k++) {
-        snprintf(lbk[k], sizeof lbk[k], "%s/%s.lbk", tmpdir, names[k]);
-        bake(gltf[k / 2], lbk[k], (uint64_t)(k % 2) + 1, 96, 2.0f, 2.5f);
-    }
-    const tl_weight on[2] = {{"A", 1.0f}, {"B", 1.0f}}, off[2] = {{"A", 0.0f}, {"B", 0.0f}};
-    tl_render_options o = {.width = 80, .height = 60, .threads = 2, .sets = on, .set_count = 2};
-    o.camera = look(0.0f, 2.0f, 4.5f, 0.0f, 1.5f, -3.0f, 75);
-    tl_image s1 = render(gltf[0], lbk[0], &o), s2 = render(gltf[0], lbk[1], &o);
-    o.set_count = 0;
-    tl_image r1 = render(gltf[1], lbk[2], &o), r2 = render(gltf[1], lbk[3], &o);
-    o.sets = off, o.set_count = 2;
-    tl_image base = render(gltf[0], lbk[0], &o);
+}
+
+/* S (two seeds, with weights `on`) against R (two seeds, plain): the bound of the header; S with
+ * weights `off` must be far from R. */
+static void agree(const char *what, const char *gs, char ls[2][160], const tl_render_options *on,
+                  const tl_render_options *off, const char *gr, char lr[2][160])
+{
+    tl_render_options plain = *on;
+    plain.set_count = plain.door_count = 0;
+    tl_image s1 = render(gs, ls[0], on), s2 = render(gs, ls[1], on), base = render(gs, ls[0], off);
+    tl_image r1 = render(gr, lr[0], &plain), r2 = render(gr, lr[1], &plain);
     const double mean = mean_luminance(&r1), sig_s = rmse(&s1, &s2) / sqrt(2.0), sig_r = rmse(&r1, &r2) / sqrt(2.0);
     /* seeds 1 against 2: independent estimates (the same seed correlates the two bakes' samples) */
     const double d = rmse(&s1, &r2), bound = sqrt(2 * (sig_s * sig_s + sig_r * sig_r) + pow(ldexp(mean, -6), 2));
-    printf("light sets: rmse(sets seed 1 - static seed 2) %.4f%% of the mean (same seed %.4f%%), noise %.4f%% (sets) "
-           "%.4f%% (static), bound %.4f%%; sets off: %.2f%%\n", 100 * d / mean, 100 * rmse(&s1, &r1) / mean,
-           100 * sig_s / mean, 100 * sig_r / mean, 100 * bound / mean, 100 * rmse(&base, &r1) / mean);
+    printf("%s: rmse(S seed 1 - R seed 2) %.4f%% of the mean (same seed %.4f%%), noise %.4f%% (S) %.4f%% (R), "
+           "bound %.4f%%; off %.2f%%\n", what, 100 * d / mean, 100 * rmse(&s1, &r1) / mean, 100 * sig_s / mean,
+           100 * sig_r / mean, 100 * bound / mean, 100 * rmse(&base, &r1) / mean);
     assert_true(d <= bound);
     assert_true(rmse(&base, &r1) > 5 * bound);
     tl_image_free(&s1), tl_image_free(&s2), tl_image_free(&r1), tl_image_free(&r2), tl_image_free(&base);
+}
+
+/* Lights A and B in sets, on (weight 1), against the same lights static. No door: see below. */
+static void light_sets(void **state)
+{
+    (void)state;
+    char gs[160], gr[160], ls[2][160], lr[2][160];
+    const ds_options ds = {.inside = DS_INSIDE_SETS, .sky = 0.5f}, dr = {.inside = DS_INSIDE_STATIC, .sky = 0.5f};
+    room_pair("sets", &ds, gs, ls);
+    room_pair("sets_static", &dr, gr, lr);
+    const tl_weight on[2] = {{"A", 1.0f}, {"B", 1.0f}}, off[2] = {{"A", 0.0f}, {"B", 0.0f}};
+    tl_render_options o = {.width = 80, .height = 60, .threads = 2, .sets = on, .set_count = 2};
+    o.camera = look(0.0f, 2.0f, 4.5f, 0.0f, 1.5f, -3.0f, 75);
+    tl_render_options o_off = o;
+    o_off.sets = off;
+    agree("light sets", gs, ls, &o, &o_off, gr, lr);
+}
+
+/* The north door open (ω = 1: its open set at full weight, the panel not drawn) against the room
+ * without the panel; a light outside reaches the room only through that doorway. Closed must be
+ * far off.
+ *
+ * Not tested, because the bake gets them wrong (found here; the renderer applies what is stored):
+ *  - lights in sets with the door open: a set's bake keeps its light's bounce off the closed door
+ *    (bake/sets/SETS.md), which opening the door must take away again; the combination state
+ *    meant for it (lbk_combinations north+A) is a difference clamped at 0, so it cannot: this
+ *    view was 3.5 % too bright against the lights static without the panel, with and without
+ *    the combination states;
+ *  - the closed door itself: tagged, it becomes an LLG object whose room side renders 20–37 %
+ *    brighter than the same panel as plain (lightmapped) geometry. */
+static void door(void **state)
+{
+    (void)state;
+    char gs[160], gr[160], ls[2][160], lr[2][160];
+    const ds_options ds = {.door = DS_DOOR_TAGGED, .outside_light = 1}, dr = {.outside_light = 1};
+    room_pair("door", &ds, gs, ls);
+    room_pair("door_removed", &dr, gr, lr);
+    const tl_weight open = {"north", 1.0f}, closed = {"north", 0.0f};
+    tl_render_options o = {.width = 80, .height = 60, .threads = 2, .doors = &open, .door_count = 1};
+    o.camera = look(0.0f, 2.0f, 4.5f, 0.0f, 1.5f, -3.0f, 75); /* the north doorway in the middle */
+    tl_render_options o_off = o;
+    o_off.doors = &closed;
+    agree("door", gs, ls, &o, &o_off, gr, lr);
 }
 
 /* Names the level does not have are usage errors; the renderer never guesses. */
@@ -262,6 +306,7 @@ int main(void)
         cmocka_unit_test(leak),
         cmocka_unit_test(refusals),
         cmocka_unit_test(light_sets),
+        cmocka_unit_test(door),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -41,14 +41,26 @@ static int make_view(const tl_camera *c, int w, int h, view *v)
 }
 
 /* The default camera: inside the level's bounds, near their +z side at mid height, looking at
- * the centre, 60° vertical field of view. */
-static void default_camera(const bk_scene *s, tl_camera *c)
+ * the centre (an interior); when that spot is inside a closed object (the first surface towards
+ * the centre shows its back), outside the bounds at +z instead, far enough to see them whole.
+ * 60° vertical field of view. */
+static void default_camera(const rl_level *L, tl_camera *c)
 {
-    for (int k = 0; k < 3; k++) c->at[k] = 0.5f * (s->bounds_min[k] + s->bounds_max[k]);
+    const bk_scene *s = &L->scene;
+    float ext[3], r = 0.0f;
+    for (int k = 0; k < 3; k++) {
+        c->at[k] = 0.5f * (s->bounds_min[k] + s->bounds_max[k]);
+        ext[k] = s->bounds_max[k] - s->bounds_min[k];
+        r += 0.25f * ext[k] * ext[k];
+    }
     memcpy(c->from, c->at, sizeof c->from);
-    c->from[2] += 0.45f * (s->bounds_max[2] - s->bounds_min[2]);
+    c->from[2] += 0.45f * ext[2];
     c->up[0] = 0, c->up[1] = 1, c->up[2] = 0;
     c->yfov = 60.0f * 3.14159265f / 180.0f;
+    const float d[3] = {0, 0, -1};
+    bk_hit h;
+    if (bk_tracer_intersect(L->tracer, c->from, d, 0.0f, INFINITY, &h) && !h.front)
+        c->from[2] = c->at[2] + 2.0f * sqrtf(r); /* the bounding sphere fills about 60° */
 }
 
 /* Closest test sphere along the ray before tmax; -1 if none. */
@@ -144,7 +156,7 @@ int tl_render(const char *scene_path, const char *lbk_path, const tl_render_opti
     rl_level L;
     int rc = rl_level_load(scene_path, lbk_path, &o, &L, err);
     if (rc) return rc;
-    if (!(o.camera.yfov > 0)) default_camera(&L.scene, &o.camera);
+    if (!(o.camera.yfov > 0)) default_camera(&L, &o.camera);
     job *j = calloc(1, sizeof *j);
     const size_t np = (size_t)o.width * (size_t)o.height;
     out->width = o.width, out->height = o.height;

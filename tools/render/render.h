@@ -61,7 +61,8 @@ typedef struct tl_image {
     int width, height;
     float *rgb;     /* width × height × 3 radiance (nits), row 0 at the top */
     unsigned char *seam; /* with options.seams: bit 0: a chart boundary lies between this pixel and
-                          * the one to its right, bit 1: ... and the one below; else NULL */
+                          * the one to its right, bit 1: it is flat (both sides on one plane);
+                          * bits 2 and 3: the same towards the pixel below (seams.h); else NULL */
     unsigned char *lightmapped; /* with options.seams: 1 where the centre ray hit a lightmapped surface */
 } tl_image;
 

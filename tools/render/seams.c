@@ -67,9 +67,10 @@ static int is_seam(const rl_level *L, const rl_hit *a, const rl_hit *b, float fa
     frame_of(L, a->tri, &ta);
     frame_of(L, b->tri, &tb);
     if (plane_distance(&ta, b->p) > 2.0f * fa || plane_distance(&tb, a->p) > 2.0f * fb) return 0; /* occlusion edge */
-    if (pa != pb) return 1;
+    const int flat = dot3(ta.n, tb.n) > 0.9998f ? 2 : 0; /* within about 1°: the true image is smooth here */
+    if (pa != pb) return 1 | flat;
     extrapolate(&ta, b->p, pred);
-    return fabsf(pred[0] - cb[0]) > 1.0f || fabsf(pred[1] - cb[1]) > 1.0f;
+    return fabsf(pred[0] - cb[0]) > 1.0f || fabsf(pred[1] - cb[1]) > 1.0f ? 1 | flat : 0;
 }
 
 int rl_seams(const rl_gbuffer *g, const rl_level *L, int w, int h, float footprint, const float from[3], tl_image *out)
@@ -91,11 +92,10 @@ int rl_seams(const rl_gbuffer *g, const rl_level *L, int w, int h, float footpri
         for (int x = 0; x < w; x++) {
             const size_t i = (size_t)y * (size_t)w + (size_t)x;
             if (!out->lightmapped[i]) continue;
-            if (x + 1 < w && out->lightmapped[i + 1] && is_seam(L, &g->hit[i], &g->hit[i + 1], fp[i], fp[i + 1]))
-                out->seam[i] |= 1;
-            if (y + 1 < h && out->lightmapped[i + (size_t)w] &&
-                is_seam(L, &g->hit[i], &g->hit[i + (size_t)w], fp[i], fp[i + (size_t)w]))
-                out->seam[i] |= 2;
+            if (x + 1 < w && out->lightmapped[i + 1])
+                out->seam[i] |= (unsigned char)(is_seam(L, &g->hit[i], &g->hit[i + 1], fp[i], fp[i + 1]) * 1);
+            if (y + 1 < h && out->lightmapped[i + (size_t)w])
+                out->seam[i] |= (unsigned char)(is_seam(L, &g->hit[i], &g->hit[i + (size_t)w], fp[i], fp[i + (size_t)w]) * 4);
         }
     free(fp);
     return 0;

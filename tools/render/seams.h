@@ -3,7 +3,9 @@
  * surfaces that are geometrically continuous (each hit within two pixel footprints of the
  * other's triangle plane: not an occlusion edge) while the lightmap parameterisation is not
  * (another page, or the first triangle's lightmap mapping, extrapolated to the second hit,
- * misses its coordinate by more than one texel). Internal to tools/render. */
+ * misses its coordinate by more than one texel). A seam is "flat" when the two triangles' planes
+ * agree within about 1°: there the true image is smooth and any jump is the lightmap's.
+ * Internal to tools/render. */
 #ifndef LBK_TOOLS_RENDER_SEAMS_H
 #define LBK_TOOLS_RENDER_SEAMS_H
 
@@ -18,7 +20,7 @@ typedef struct rl_gbuffer {
 
 rl_gbuffer *rl_gbuffer_create(size_t pixels);
 void rl_gbuffer_free(rl_gbuffer *g);
-/* Fills out->seam and out->lightmapped. footprint: a pixel's size per metre of distance; from: the
+/* Fills out->seam (tl_image.seam's bits) and out->lightmapped. footprint: a pixel's size per metre of distance; from: the
  * camera position. Returns -1 when out of memory. */
 int rl_seams(const rl_gbuffer *g, const rl_level *L, int width, int height, float footprint, const float from[3],
              tl_image *out);
