@@ -212,7 +212,7 @@ bench: deps
 # comes from LBK_CYCLES_HARNESS (bench/cycles of the cycles branch until it is merged).
 LBK_CYCLES_HARNESS ?= bench/cycles
 bench-render: $(BUILD)/lbk
-	@LBK_CYCLES_HARNESS=$(LBK_CYCLES_HARNESS) python3 bench/render/run.py --lbk $(BUILD)/lbk --out $(BUILD)/bench-render
+	@LBK_CYCLES_HARNESS=$(LBK_CYCLES_HARNESS) python3 bench/render/run.py --lbk $(BUILD)/lbk --out $(BUILD)/bench-render $(BENCH_RENDER_ARGS)
 
 # ---- demo -----------------------------------------------------------------------------------
 demo: deps

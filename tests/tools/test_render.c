@@ -42,6 +42,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "cli/cli.h"
 #include "support/bake_file.h"
 #include "support/door_scenes.h"
 #include "support/gltf_writer.h"
@@ -299,12 +300,57 @@ static void refusals(void **state)
     assert_int_equal(tl_render(LEAK_SCENE, "/nonexistent.lbk", &o, &im, err), TL_RENDER_IO);
 }
 
+/* The command line is thin: the EXR it writes holds what tl_render returns, the PNG exists, and
+ * every failure has its exit code. */
+static int cmd(int n, const char **argv)
+{
+    return lbk_cmd_render(n, (char **)argv);
+}
+
+static void command_line(void **state)
+{
+    (void)state;
+    char lbk[128], exr[128], png[128];
+    snprintf(lbk, sizeof lbk, "%s/leak.lbk", tmpdir);
+    snprintf(exr, sizeof exr, "%s/view.exr", tmpdir);
+    snprintf(png, sizeof png, "%s/view.png", tmpdir);
+    if (access(lbk, R_OK)) bake(LEAK_SCENE, lbk, 1, 0, 0, 0);
+    const char *ok[] = {"render", LEAK_SCENE, lbk, "-o", exr, "--png", png, "--camera", "0", "--size", "32x24",
+                        "--samples", "1", "--threads", "1", "-q", NULL};
+    assert_int_equal(cmd(16, ok), LBK_EXIT_OK);
+    static const char *const names[3] = {"R", "G", "B"};
+    int w, h;
+    float *px;
+    char err[TL_ERR_LEN];
+    assert_int_equal(tl_exr_read(exr, 3, names, &w, &h, &px, err), 0);
+    tl_render_options o = {.width = 32, .height = 24, .samples = 1, .threads = 1};
+    assert_int_equal(tl_gltf_camera(LEAK_SCENE, 0, &o.camera, err), TL_RENDER_OK);
+    tl_image im = render(LEAK_SCENE, lbk, &o);
+    assert_int_equal(w, 32), assert_int_equal(h, 24);
+    assert_memory_equal(px, im.rgb, sizeof(float) * 3 * 32 * 24);
+    free(px), tl_image_free(&im);
+    uint8_t *rgb8;
+    assert_int_equal(tl_png_read_rgb8(png, &w, &h, &rgb8, err), 0);
+    free(rgb8);
+    const char *unknown_set[] = {"render", LEAK_SCENE, lbk, "-o", exr, "--set", "lamp=0", NULL};
+    assert_int_equal(cmd(7, unknown_set), LBK_EXIT_USAGE); /* the level has no DLS */
+    const char *other[] = {"render", "scenes/leak_rooms/leak_rooms.gltf", lbk, "-o", exr, NULL};
+    assert_int_equal(cmd(5, other), LBK_EXIT_INPUT);
+    const char *missing[] = {"render", LEAK_SCENE, "/nonexistent.lbk", "-o", exr, NULL};
+    assert_int_equal(cmd(5, missing), LBK_EXIT_IO);
+    const char *bad_size[] = {"render", LEAK_SCENE, lbk, "-o", exr, "--size", "0x3", NULL};
+    assert_int_equal(cmd(7, bad_size), LBK_EXIT_USAGE);
+    const char *no_output[] = {"render", LEAK_SCENE, lbk, NULL};
+    assert_int_equal(cmd(3, no_output), LBK_EXIT_USAGE);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(furnace),
         cmocka_unit_test(leak),
         cmocka_unit_test(refusals),
+        cmocka_unit_test(command_line),
         cmocka_unit_test(light_sets),
         cmocka_unit_test(door),
     };
