@@ -125,6 +125,7 @@ static lbk_result import_file(bk_pipeline *b, const char *path)
     memset(&io, 0, sizeof io);
     io.warn = import_warning;
     io.warn_user = b;
+    io.allow_outside = b->opt->allow_outside;
     FILE *probe = fopen(path, "rb");
     if (!probe) return bk_pipeline_fail(b, LBK_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
     fclose(probe);
@@ -268,6 +269,8 @@ static lbk_result layout_atlas(bk_pipeline *b, const uint8_t *lightmapped)
     if (r == LBK_ERR_LIMIT) return bk_pipeline_fail(b, LBK_ERR_BAD_INPUT, "lightmap atlas: %s", lbk_result_message(r));
     if (r) return bk_pipeline_failed(b, r, "lightmap atlas");
     if (b->atlas.note[0]) bk_events_say(&b->events, LBK_BAKE_SEVERITY_NOTE, "%s", b->atlas.note);
+    if (!b->opt->no_seam_stitch && (r = bk_seams_find(s, &b->atlas, &b->seams)) != LBK_OK)
+        return bk_pipeline_failed(b, r, "lightmap seams");
     for (size_t i = 0; i < b->atlas.object_count; i++)
         if (b->atlas.objects[i].note[0])
             bk_events_say(&b->events, LBK_BAKE_SEVERITY_NOTE, "object '%s': %s", s->objects[b->atlas.objects[i].object].name,
@@ -421,6 +424,7 @@ void bk_pipeline_set_inputs(const bk_pipeline *b, bk_set_inputs *in)
     in->texel_of_receiver = b->texel_of_receiver;
     in->texels = &b->texels;
     in->atlas_margin = b->atlas.margin;
+    in->seams = b->opt->no_seam_stitch ? NULL : &b->seams;
     in->base_radiance = b->radiance;
     transport_options(b, &in->transport);
     in->base_samples_per_receiver = b->stats.samples_per_receiver;
@@ -547,6 +551,7 @@ static void pipeline_free(bk_pipeline *b)
     bk_glg_free(&b->glg);
     if (b->tracer) bk_tracer_destroy(b->tracer);
     bk_texels_free(&b->texels);
+    bk_seams_free(&b->seams);
     bk_atlas_free(&b->atlas);
     free(b->classes);
     bk_scene_free(&b->scene);

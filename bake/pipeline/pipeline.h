@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "bake/layout/atlas.h"
+#include "bake/layout/seams.h"
 #include "bake/layout/classify.h"
 #include "bake/layout/texels.h"
 #include "bake/probes/glg_place.h"
@@ -48,6 +49,7 @@ typedef struct bk_pipeline {
     bk_scene scene;
     bk_object_class *classes;
     bk_atlas atlas;
+    bk_seams seams;                 /* stitched after transport unless opt->no_seam_stitch */
     bk_texels texels;
     bk_tracer *tracer;
     bk_glg glg;

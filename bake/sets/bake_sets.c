@@ -510,7 +510,7 @@ static lbk_result emit_texels(const bk_set_inputs *in, const lbk_ahd_linear *lin
             memcpy(&data[12 * i], lin[recv_of_texel[ti]].c, 12 * sizeof(float));
             mask[i] = 1;
         }
-        if (!r) bk_dilate(data, 12, mask, w, h, in->atlas_margin + 2);
+        if (!r) r = bk_finish_page(data, mask, w, h, in->atlas_margin, in->seams, (uint32_t)p, in->transport.threads);
         for (size_t i = 0; !r && i < n && thr >= 0; i++) {
             if (!mask[i]) continue;
             lbk_ahd_linear l;

@@ -10,6 +10,7 @@
 
 #include "bake/probes/llg_place.h"
 #include "bake/scene/scene.h"
+#include "bake/layout/seams.h"
 #include "bake/layout/texels.h"
 #include "bake/util/events.h"
 #include "bake/transport/tracer.h"
@@ -42,6 +43,7 @@ typedef struct bk_set_inputs {
     const uint32_t *texel_of_receiver;/* receiver → index in texels->receivers */
     const bk_texels *texels;          /* page layout: DLS texel index = page_offset[page] + y·w + x */
     int atlas_margin;                 /* dilation passes for set pages */
+    const bk_seams *seams;            /* stitched like the base pages (bk_finish_page); NULL: not */
     const lbk_sh9_rgb *base_radiance; /* the base bake, per receiver */
     bk_transport_options transport;   /* the base bake's options (seed, threads, budgets) */
     double base_samples_per_receiver; /* what the base bake reached: door bakes use this budget */

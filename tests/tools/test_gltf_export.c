@@ -20,7 +20,7 @@
 
 #include <cjson/cJSON.h>
 
-#include "bake/pipeline/bake.h"
+#include "support/bake_file.h"
 #include "bake/scene/import.h"
 #include "tools/common/bake_data.h"
 #include "tools/common/file_util.h"
@@ -53,22 +53,17 @@ static const char *scenes_dir(void)
 
 static void bake(const char *in, const char *out, float density)
 {
-    bk_bake_options o;
+    tb_job o;
     memset(&o, 0, sizeof o);
-    o.input = in;
-    o.output = out;
-    o.preset = "fast";
-    o.seed = 1;
-    o.target_error = -1;
-    o.max_samples = 16;
-    o.threads = 2;
-    o.texel_density = density;
-    o.no_glg = 1;
-    bk_progress p;
-    bk_progress_init(&p, 1);
-    bk_bake_summary sum;
+    o.in = in;
+    o.out = out;
+    o.d.seed = 1;
+    o.d.max_samples = 16;
+    o.d.threads = 2;
+    o.d.texel_density = density;
+    o.d.no_glg = 1;
     char err[512];
-    if (bk_bake(&o, &p, &sum, err, sizeof err)) fail_msg("bake %s: %s", in, err);
+    if (tb_bake(&o, NULL, err, sizeof err)) fail_msg("bake %s: %s", in, err);
 }
 
 static void import(const char *path, bk_scene *s)
