@@ -72,6 +72,7 @@ help:
 	@echo "make install-lib PREFIX=/usr/local   liblbk only (needs a C compiler, zstd, xxHash)"
 	@echo "WERROR=1        every compiler warning is an error (CI)"
 	@echo "make bench      benchmarks, printed as ratios against baselines measured in the same run"
+	@echo "make bench-render  lbk render against Blender Cycles (LBK_CYCLES_HARNESS=bench/cycles of the cycles branch)"
 	@echo "make fuzz       libFuzzer harness for the container reader (clang)"
 	@echo "make install PREFIX=/usr/local"
 
