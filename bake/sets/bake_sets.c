@@ -835,8 +835,11 @@ static lbk_result guided_open(run_ctx *rc, const bs_door *d, const float *texel_
     double spp = in->base_samples_per_receiver > 0 ? in->base_samples_per_receiver : 64;
     gi.samples = (int)fmin(fmax(spp, 16), 4096);
     gi.use_sky = !in->transport.no_sky;
+    gi.irradiance = malloc((in->receiver_count ? in->receiver_count : 1) * 3 * sizeof *gi.irradiance);
     bk_door_guided_stats st;
-    r = bk_door_guided_run(&gi, rad, dir, &st, NULL);
+    r = gi.irradiance ? bk_door_guided_run(&gi, rad, dir, &st, NULL) : LBK_ERR_OUT_OF_MEMORY;
+    if (!r) bk_texels_match_irradiance(in->texels, in->texel_of_receiver, in->texel_receivers, rad, gi.irradiance);
+    free(gi.irradiance);
     bk_tracer_destroy(tr);
     filtered_free(&fs);
     rc->run++;
