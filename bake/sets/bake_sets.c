@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "bake/sets/door_guided.h"
+#include "bake/util/clock.h"
 #include "bake/pipeline/encode.h"
 #include "lbk/ahd.h"
 #include "lbk/container.h"
@@ -664,6 +665,8 @@ lbk_result bk_set_bakes_emit(bk_set_bakes *sets, const bk_set_inputs *in, char *
 typedef struct run_ctx {
     const bk_set_inputs *in;
     bs_impl *im;             /* where run_one logs each run's estimate */
+    double t_start;          /* bk_now() when the runs began, and the transport's share of the */
+    double transport_secs;   /* time since: the rest (scenes without doors, tracers) is overhead */
     int run, runs;
     const bk_scene *scene;   /* scene of the current run (the hook's triangle indices) */
     float *variance;         /* NULL, or where run_one writes the run's per-receiver variance */
@@ -765,6 +768,15 @@ static lbk_result run_one(run_ctx *rc, const bk_scene *scene, const bk_tracer *t
 {
     const bk_set_inputs *in = rc->in;
     bk_transport_options opt = *base;
+    if (in->deadline > 0) {
+        /* the bake's one budget: an equal share of what is left per remaining run (door runs
+         * too: their differences stay unbiased, only noisier, if their passes differ) */
+        const int left = rc->runs - rc->run > 0 ? rc->runs - rc->run : 1;
+        const double now = bk_now();
+        /* what each run costs besides its transport (a scene without a door, its tracer), so far */
+        const double overhead = rc->run > 0 ? fmax(0, (now - rc->t_start - rc->transport_secs) / rc->run) : 0;
+        opt.time_limit = fmax(1e-3, (in->deadline - now) / left - overhead);
+    }
     opt.progress = run_progress;
     opt.report = NULL;
     opt.albedo_hook = rc->black_doors ? run_albedo : NULL;
@@ -785,6 +797,7 @@ static lbk_result run_one(run_ctx *rc, const bk_scene *scene, const bk_tracer *t
     if (!r) bk_texels_match_irradiance(in->texels, in->texel_of_receiver, in->texel_receivers, radiance, irradiance);
     free(irradiance);
     rc->run++;
+    rc->transport_secs += st.seconds;
     if (r) return failure(rc, r, "light transport for %s: %s", what);
     if (st.nonfinite)
         bk_events_say(in->events, LBK_BAKE_SEVERITY_WARNING, "%s: %llu non-finite samples were dropped", what,
@@ -1083,6 +1096,17 @@ static void set_run_free(set_run *s)
     free(s->rad), free(s->dir), free(s->ref), free(s->ref_dir), free(s->var);
 }
 
+int bk_set_bakes_planned_runs(const bk_set_bakes *sets)
+{
+    const bs_impl *im = sets ? sets->impl : NULL;
+    if (!im) return 0;
+    int runs = 0;
+    for (size_t j = 0; j < im->light_set_count; j++) runs += !im->sets[j].zero;
+    runs += im->door_count ? 1 + 2 * (int)im->door_count : 0;
+    for (size_t c = 0; c < im->combo_count; c++) runs += im->combos[c].door[1] >= 0 ? 3 : 2;
+    return runs;
+}
+
 lbk_result bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *err, size_t err_len)
 {
     bs_impl *im = sets->impl;
@@ -1097,9 +1121,8 @@ lbk_result bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *e
     s.rc.im = im;
     s.rc.err = err;
     s.rc.err_len = err_len;
-    for (size_t j = 0; j < im->light_set_count; j++) s.rc.runs += !im->sets[j].zero;
-    s.rc.runs += im->door_count ? 1 + 2 * (int)im->door_count : 0;
-    for (size_t c = 0; c < im->combo_count; c++) s.rc.runs += im->combos[c].door[1] >= 0 ? 3 : 2;
+    s.rc.runs = bk_set_bakes_planned_runs(sets);
+    s.rc.t_start = bk_now();
     const int guided = in->door_method == BK_DOOR_GUIDED;
     s.rad = malloc(s.n * sizeof *s.rad), s.dir = malloc(s.n * sizeof *s.dir), s.var = malloc(s.n * sizeof *s.var);
     lbk_result r = s.rad && s.dir && s.var ? LBK_OK : out_of_memory(&s);

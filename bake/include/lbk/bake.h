@@ -119,7 +119,10 @@ typedef struct lbk_bake_desc {
     int threads;                /* worker threads [0: one per online core] */
     uint64_t seed;              /* used as given, 0 included (`lbk bake` passes 1 unless --seed) */
     double target_error;        /* stop when the estimated relative RMSE reaches this; <= 0: preset */
-    double time_limit;          /* seconds for the transport; at least one pass completes [0: none] */
+    double time_limit;          /* seconds for the whole bake from the call, base + every light-set
+                                   and door run: each run gets an equal share of what is left;
+                                   every run completes at least one pass, and the guided door
+                                   estimator and writing are not limited [0: none] */
     int max_samples;            /* gather samples per receiver, whole run [0: preset] */
     int max_bounces;            /* explicit bounces before the analytic tail [0: 64] */
     float texel_density;        /* texels per metre for every object [0: the object's own
