@@ -6,11 +6,13 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "cli/cli.h"
 #include "cli/progress.h"
 #include "lbk/bake.h"
+#include "tools/common/file_util.h"
 
 static void help(FILE *f)
 {
@@ -175,8 +177,23 @@ static int write_report_tmp(const lbk_bake_report *rep, const char *container, c
     return 0;
 }
 
+static void say_removed(void *user, const char *file)
+{
+    fprintf(stderr, "lbk %s: removed %s, a temporary file an interrupted write left behind\n", (const char *)user, file);
+}
+
+/* Temporary files of earlier writes to our outputs that were killed between writing and renaming.
+ * Only those older than a minute before this process started: a concurrent bake to the same
+ * path may be writing its own right now. */
+static void remove_stale(const bake_args *o, time_t started)
+{
+    tl_remove_stale_temps(o->output, started - 60, say_removed, "bake");
+    if (o->json_report) tl_remove_stale_temps(o->json_report, started - 60, say_removed, "bake");
+}
+
 static int bake(bake_args *o, int quiet)
 {
+    const time_t started = time(NULL);
     bake_ui ui;
     memset(&ui, 0, sizeof ui);
     ui.phase = -1;
@@ -198,6 +215,7 @@ static int bake(bake_args *o, int quiet)
         lbk_bake_output_free(out);
         return LBK_EXIT_IO;
     }
+    remove_stale(o, started);
     r = lbk_bake_output_write_file(out, o->output);
     if (r) {
         int saved = errno;
