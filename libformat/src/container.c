@@ -35,6 +35,7 @@ struct lbk_reader {
     lbk_framing fr;
     const uint8_t *data[LBK_MAX_SECTIONS]; /* decoded (or in-place) bytes once accessed */
     void *owned[LBK_MAX_SECTIONS];
+    uint8_t verified[LBK_MAX_SECTIONS];    /* stored checksum checked (or skip_checksums) */
 };
 
 typedef struct open_state {
@@ -135,27 +136,75 @@ lbk_result lbk_reader_section_find(const lbk_reader *r, uint32_t type, uint32_t 
     return LBK_ERR_NOT_FOUND;
 }
 
-lbk_result lbk_reader_section_data(lbk_reader *r, uint32_t index, const void **data, size_t *size)
+/* ---- loading: each section's checksum verified once, each zstd section decoded once -------- */
+
+const lbk_framing *lbk_reader_framing(const lbk_reader *r) { return &r->fr; }
+const lbk_allocator *lbk_reader_allocator(const lbk_reader *r) { return &r->alloc; }
+uint64_t lbk_reader_budget_left(const lbk_reader *r) { return r->budget_left; }
+
+lbk_result lbk_reader_verify(lbk_reader *r, uint32_t index, uint32_t *issue_id)
 {
-    if (!r || !data || !size) return LBK_ERR_INVALID_ARGUMENT;
-    *data = NULL;
-    *size = 0;
+    *issue_id = 0;
     if (index >= r->fr.count) return LBK_ERR_NOT_FOUND;
-    const lbk_section_info *s = &r->fr.sections[index];
     if (!r->fr.usable[index]) return LBK_ERR_CORRUPT;
+    if (r->verified[index] || r->skip_checksums) return LBK_OK;
+    const lbk_section_info *s = &r->fr.sections[index];
+    if (XXH3_64bits(r->bytes + s->offset, (size_t)s->stored_size) != s->checksum) {
+        *issue_id = 214;
+        return LBK_ERR_CHECKSUM;
+    }
+    r->verified[index] = 1;
+    return LBK_OK;
+}
+
+lbk_result lbk_reader_load(lbk_reader *r, uint32_t index, const uint8_t **data, uint32_t *issue_id)
+{
+    *data = NULL;
+    lbk_result res = lbk_reader_verify(r, index, issue_id);
+    if (res != LBK_OK) return res;
     if (!r->data[index]) {
-        uint32_t issue;
         const uint8_t *d;
         void *owned;
-        lbk_result res = lbk_section_load(r->bytes, s, &r->alloc, r->skip_checksums, &r->budget_left, &d, &owned,
-                                          &issue);
+        res = lbk_section_load(r->bytes, &r->fr.sections[index], &r->alloc, 1, &r->budget_left, &d, &owned, issue_id);
         if (res != LBK_OK) return res;
         r->data[index] = d;
         r->owned[index] = owned;
     }
     *data = r->data[index];
-    *size = (size_t)s->decoded_size;
     return LBK_OK;
+}
+
+lbk_result lbk_reader_section_data(lbk_reader *r, uint32_t index, const void **data, size_t *size)
+{
+    if (!r || !data || !size) return LBK_ERR_INVALID_ARGUMENT;
+    *data = NULL;
+    *size = 0;
+    uint32_t issue;
+    const uint8_t *d;
+    lbk_result res = lbk_reader_load(r, index, &d, &issue);
+    if (res != LBK_OK) return res;
+    *data = d;
+    *size = (size_t)r->fr.sections[index].decoded_size;
+    return LBK_OK;
+}
+
+lbk_result lbk_reader_section_unpack(lbk_reader *r, uint32_t index, void *dst, size_t dst_size)
+{
+    if (!r || (!dst && dst_size)) return LBK_ERR_INVALID_ARGUMENT;
+    if (index >= r->fr.count) return LBK_ERR_NOT_FOUND;
+    const lbk_section_info *s = &r->fr.sections[index];
+    if (dst_size < s->decoded_size) return LBK_ERR_INVALID_ARGUMENT;
+    uint32_t issue;
+    lbk_result res = lbk_reader_verify(r, index, &issue);
+    if (res != LBK_OK) return res;
+    if (r->data[index] || s->compression == LBK_COMPRESSION_NONE) {
+        memcpy(dst, r->data[index] ? r->data[index] : r->bytes + s->offset, (size_t)s->decoded_size);
+        return LBK_OK;
+    }
+    /* caller memory: nothing is allocated but zstd's context, so the decoded-bytes cap does not apply */
+    res = lbk_section_frame_check(r->bytes, s, &issue);
+    if (res == LBK_OK) res = lbk_section_decode_into(r->bytes, s, &r->alloc, dst, &issue);
+    return res;
 }
 
 lbk_result lbk_reader_section_by_type(lbk_reader *r, uint32_t type, const void **data, size_t *size)

@@ -387,6 +387,82 @@ static void test_decoded_cap_stops_bomb(void **state)
     lbk_free(NULL, b.bytes);
 }
 
+static int count_issue(void *user, const lbk_issue *issue)
+{
+    (void)issue;
+    ++*(int *)user;
+    return 0;
+}
+
+/* lbk_reader_validate: the same verdict as lbk_validate_memory, through the reader's cache — the
+ * zstd REPT of the fixture is decoded once (one allocation of its decoded size, kept until close),
+ * and section_data afterwards allocates nothing. lbk_reader_section_unpack decodes into caller
+ * memory with no allocation of the decoded size, and equals section_data byte for byte. */
+static void test_reader_validate_decodes_once(void **state)
+{
+    (void)state;
+    void *file;
+    size_t size;
+    assert_int_equal(fixture_small_container(0, &file, &size), 0);
+    int n_mem = 0, n_rd = 0;
+    lbk_validate_summary sm, sr;
+    assert_int_equal(lbk_validate_memory(file, size, NULL, count_issue, &n_mem, &sm), LBK_OK);
+    counting c = {0};
+    lbk_allocator a = {c_alloc, c_free, &c};
+    lbk_read_options ro = {.allocator = &a};
+    lbk_reader *r;
+    assert_int_equal(lbk_reader_open_memory(file, size, &ro, &r), LBK_OK);
+    uint32_t ri;
+    lbk_section_info si;
+    assert_int_equal(lbk_reader_section_find(r, LBK_SECTION_REPT, &ri), LBK_OK);
+    assert_int_equal(lbk_reader_section_get(r, ri, &si), LBK_OK);
+    assert_int_equal(si.compression, LBK_COMPRESSION_ZSTD);
+    /* unpack first: nothing of the decoded size is allocated, nothing is cached */
+    uint8_t *mine = malloc((size_t)si.decoded_size + 1);
+    size_t live = c.live_bytes;
+    assert_int_equal(lbk_reader_section_unpack(r, ri, mine, (size_t)si.decoded_size - 1), LBK_ERR_INVALID_ARGUMENT);
+    assert_int_equal(lbk_reader_section_unpack(r, ri, mine, (size_t)si.decoded_size + 1), LBK_OK);
+    assert_int_equal(c.live_bytes, live); /* zstd's context came and went; nothing was kept */
+    assert_int_equal(lbk_reader_validate(r, count_issue, &n_rd, &sr), LBK_OK);
+    assert_int_equal(n_rd, n_mem);
+    assert_int_equal(sr.fatal, sm.fatal);
+    assert_int_equal(sr.errors, sm.errors);
+    assert_int_equal(sr.warnings, sm.warnings);
+    assert_int_equal(sr.errors + sr.fatal, 0);
+    assert_int_equal(c.live_bytes - live, (size_t)si.decoded_size); /* REPT decoded once and kept */
+    size_t allocs = c.allocs;
+    const void *d;
+    size_t dn;
+    for (uint32_t i = 0; i < lbk_reader_section_count(r); i++) assert_int_equal(lbk_reader_section_data(r, i, &d, &dn), LBK_OK);
+    assert_int_equal(c.allocs, allocs); /* every section already there */
+    assert_int_equal(lbk_reader_section_data(r, ri, &d, &dn), LBK_OK);
+    assert_memory_equal(d, mine, dn);
+    /* a second validation through the same reader: same verdict, nothing decoded again */
+    n_rd = 0;
+    assert_int_equal(lbk_reader_validate(r, count_issue, &n_rd, &sr), LBK_OK);
+    assert_int_equal(n_rd, n_mem);
+    assert_int_equal(c.live_bytes - live, (size_t)si.decoded_size);
+    lbk_reader_close(r);
+    assert_int_equal(c.live_bytes, 0);
+
+    /* a flipped byte in the zstd section: both validations report 214 for it */
+    uint8_t *bad = malloc(size);
+    memcpy(bad, file, size);
+    bad[si.offset + si.stored_size / 2] ^= 0x10;
+    n_mem = n_rd = 0;
+    assert_int_equal(lbk_validate_memory(bad, size, NULL, count_issue, &n_mem, &sm), LBK_OK);
+    assert_int_equal(lbk_reader_open_memory(bad, size, NULL, &r), LBK_OK);
+    assert_int_equal(lbk_reader_validate(r, count_issue, &n_rd, &sr), LBK_OK);
+    assert_true(sm.errors >= 1);
+    assert_int_equal(sr.errors, sm.errors);
+    assert_int_equal(n_rd, n_mem);
+    assert_int_equal(lbk_reader_section_unpack(r, ri, mine, (size_t)si.decoded_size), LBK_ERR_CHECKSUM);
+    lbk_reader_close(r);
+    free(bad);
+    free(mine);
+    free(file);
+}
+
 static void test_allocator_hooks(void **state)
 {
     (void)state;
@@ -699,6 +775,7 @@ int main(void)
         cmocka_unit_test(test_reader_rejections),
         cmocka_unit_test(test_unknown_sections),
         cmocka_unit_test(test_decoded_cap_stops_bomb),
+        cmocka_unit_test(test_reader_validate_decodes_once),
         cmocka_unit_test(test_allocator_hooks),
         cmocka_unit_test(test_writer_arguments),
         cmocka_unit_test(test_atomic_file_write),

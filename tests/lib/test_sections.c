@@ -7,6 +7,7 @@
 #include <cmocka.h>
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -186,6 +187,76 @@ static void lmap_round_trip_and_rules(void **state)
     assert_int_equal(is.n, 9);
     free(c);
     lbk_free(NULL, b);
+}
+
+/* Counts issue `id` of a validation: listed ones plus the "... and N more" summary. */
+typedef struct id_count {
+    uint32_t id;
+    unsigned long long n;
+} id_count;
+
+static int count_id(void *user, const lbk_issue *issue)
+{
+    id_count *c = user;
+    if (issue->id != c->id) return 0;
+    unsigned long long more;
+    if (sscanf(issue->message, "... and %llu more", &more) == 1) c->n += more;
+    else c->n++;
+    return 0;
+}
+
+/* The validator's fast texel scan (blocks of 1024 texels, integer tests) flags exactly the texels
+ * the decoder's float rule calls short (510) — every (G, B) for every A that can be short
+ * (A ≤ 127; A ≥ 128 gives z² > 1/4) — and every exponent-31 channel (509) anywhere in a page,
+ * also in the last, partial block. */
+static void lmap_fast_scan_exact(void **state)
+{
+    (void)state;
+    lbk_ahd_texel *t = malloc(256 * 256 * sizeof *t);
+    for (int a = 0; a < 128; a += 1) {
+        unsigned long long want = 0;
+        for (int y = 0; y < 256; y++)
+            for (int x = 0; x < 256; x++) {
+                t[y * 256 + x] = (lbk_ahd_texel){0, {0, (uint8_t)x, (uint8_t)y, (uint8_t)a}};
+                const float dx = 2.0f * x / 255.0f - 1.0f, dy = 2.0f * y / 255.0f - 1.0f, dz = a / 255.0f;
+                want += dx * dx + dy * dy + dz * dz < 0.25f;
+            }
+        void *b;
+        size_t n;
+        lbk_lmap_page_desc pd = {256, 256, t};
+        assert_int_equal(lbk_lmap_build(&(lbk_lmap_build_desc){.pages = &pd, .page_count = 1}, NULL, &b, &n), LBK_OK);
+        id_count c = {510, 0};
+        lbk_validate_summary sum;
+        memset(&sum, 0, sizeof sum);
+        lbk_allocator alloc = {0};
+        lbk_vctx ctx;
+        memset(&ctx, 0, sizeof ctx);
+        ctx.callback = count_id;
+        ctx.user = &c;
+        ctx.summary = &sum;
+        ctx.allocator = &alloc;
+        lbk_validate_lmap(&ctx, b, n);
+        assert_int_equal(c.n, want);
+        if (a == 0) assert_true(want > 10000);
+        lbk_dealloc(NULL, (void *)ctx.lmap_page_width);
+        lbk_dealloc(NULL, (void *)ctx.lmap_page_height);
+        lbk_free(NULL, b);
+    }
+    /* 509: a 1000 x 3 page (two full blocks and a partial one), exponent 31 in R, G or B of texels
+     * spread over all three blocks */
+    for (int i = 0; i < 3000; i++) t[i] = (lbk_ahd_texel){0x3c0u | 0x3c0u << 11 | 0x1e0u << 22, {255, 128, 128, 255}};
+    const uint32_t bad[5] = {0, 1023, 1024, 2047, 2999};
+    for (int k = 0; k < 5; k++) t[bad[k]].irradiance_z |= k % 3 == 0 ? 0x7c0u : k % 3 == 1 ? 0x7c0u << 11 : 0x3e0u << 22;
+    void *b;
+    size_t n;
+    lbk_lmap_page_desc pd = {1000, 3, t};
+    assert_int_equal(lbk_lmap_build(&(lbk_lmap_build_desc){.pages = &pd, .page_count = 1}, NULL, &b, &n), LBK_OK);
+    issues is;
+    run(lbk_validate_lmap, b, n, &is, NULL);
+    assert_int_equal(is.n, 5);
+    for (int k = 0; k < 5; k++) assert_int_equal(is.id[k], 509);
+    lbk_free(NULL, b);
+    free(t);
 }
 
 /* One cube split in 6 tetras plus an unused ninth probe (optional). */
@@ -626,7 +697,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(lmap_round_trip_and_rules), cmocka_unit_test(glg_rules), cmocka_unit_test(llg_rules),
         cmocka_unit_test(octa_mapping),              cmocka_unit_test(octp_rules), cmocka_unit_test(container_clean),
-        cmocka_unit_test(scaled_sections),
+        cmocka_unit_test(scaled_sections),      cmocka_unit_test(lmap_fast_scan_exact),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -57,19 +57,18 @@ static tl_open_status open_views(tl_bake *b, char err[TL_ERR_LEN])
 {
     first_issue f = {0};
     lbk_validate_summary sum = {0};
-    lbk_result r = lbk_validate_memory(b->bytes, b->size, NULL, keep_first, &f, &sum);
+    /* open first, then validate through the reader: every section is checksummed and decoded
+     * once, and the views below use those bytes */
+    lbk_result r = lbk_reader_open_memory(b->bytes, b->size, NULL, &b->reader);
+    if (r == LBK_OK) r = lbk_reader_validate(b->reader, keep_first, &f, &sum);
+    else if (r != LBK_ERR_OUT_OF_MEMORY) r = lbk_validate_memory(b->bytes, b->size, NULL, keep_first, &f, &sum);
     if (r != LBK_OK) {
         snprintf(err, TL_ERR_LEN, "validation could not run: %s", lbk_result_message(r));
         return TL_OPEN_INTERNAL;
     }
-    if (sum.fatal || sum.errors) {
+    if (sum.fatal || sum.errors || !b->reader) {
         snprintf(err, TL_ERR_LEN, "not a valid container (%u errors; first #%u at byte %llu: %s); run lbk validate",
                  sum.fatal + sum.errors, f.issue.id, (unsigned long long)f.issue.offset, f.issue.message);
-        return TL_OPEN_INVALID;
-    }
-    r = lbk_reader_open_memory(b->bytes, b->size, NULL, &b->reader);
-    if (r != LBK_OK) {
-        snprintf(err, TL_ERR_LEN, "%s", lbk_result_message(r));
         return TL_OPEN_INVALID;
     }
     const void *d;

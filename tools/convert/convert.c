@@ -27,12 +27,14 @@ static int keep_first_error(void *user, const lbk_issue *issue)
     return 0;
 }
 
-/* Validates bytes; on failure fills err with the first error. */
-static int validate_bytes(const void *data, size_t size, const char *what, char err[TL_ERR_LEN])
+/* Validates bytes (through the reader when there is one, so each section is decoded once); on
+ * failure fills err with the first error. */
+static int validate_bytes(const void *data, size_t size, lbk_reader *reader, const char *what, char err[TL_ERR_LEN])
 {
     first_issue f = {0};
     lbk_validate_summary sum = {0};
-    lbk_result r = lbk_validate_memory(data, size, NULL, keep_first_error, &f, &sum);
+    lbk_result r = reader ? lbk_reader_validate(reader, keep_first_error, &f, &sum)
+                          : lbk_validate_memory(data, size, NULL, keep_first_error, &f, &sum);
     if (r != LBK_OK) {
         snprintf(err, TL_ERR_LEN, "%s: validation could not run (%s)", what, lbk_result_name(r));
         return -1;
@@ -59,10 +61,16 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
     report->in_size = in_size;
     const tl_profile *p = opt->profile;
 
-    if (validate_bytes(in, in_size, "input", err)) return TL_CONVERT_BAD_INPUT;
     lbk_reader *rd = NULL;
     lbk_result r = lbk_reader_open_memory(in, in_size, NULL, &rd);
-    if (r != LBK_OK) return tl_fail(err, TL_CONVERT_BAD_INPUT, "input: %s", lbk_result_message(r));
+    if (r != LBK_OK) {
+        if (validate_bytes(in, in_size, NULL, "input", err)) return TL_CONVERT_BAD_INPUT;
+        return tl_fail(err, TL_CONVERT_BAD_INPUT, "input: %s", lbk_result_message(r));
+    }
+    if (validate_bytes(in, in_size, rd, "input", err)) {
+        lbk_reader_close(rd);
+        return TL_CONVERT_BAD_INPUT;
+    }
 
     lbk_write_options wo = LBK_WRITE_OPTIONS_INIT;
     wo.section_alignment = p->alignment;
@@ -143,7 +151,7 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
         return st;
     }
     /* Re-read the output to fill in the stored sizes, and refuse to hand out an invalid pack. */
-    if (validate_bytes(bytes, bytes_size, "output", err)) {
+    if (validate_bytes(bytes, bytes_size, NULL, "output", err)) {
         lbk_free(NULL, bytes);
         return TL_CONVERT_INTERNAL;
     }
