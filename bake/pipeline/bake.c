@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "bake/pipeline/pipeline.h"
+#include "bake/pipeline/provenance.h"
 #include "bake/scene/exr_read.h"
 #include "bake/scene/import.h"
 #include "bake/scene/scene_desc.h"
@@ -147,6 +148,10 @@ static lbk_result apply_sky(bk_pipeline *b)
     memset(&im, 0, sizeof im);
     if (bk_exr_read(b->opt->sky_exr, (size_t)64 << 20, &im, msg, sizeof msg))
         return bk_pipeline_fail(b, LBK_ERR_BAD_INPUT, "sky: %s", msg);
+    if (bk_provenance_add_file(&b->scene, b->opt->sky_exr, "sky")) {
+        free(im.rgba);
+        return bk_pipeline_fail(b, LBK_ERR_IO, "sky: %s: cannot read it again to hash it", b->opt->sky_exr);
+    }
     bk_image *n = realloc(b->scene.images, (b->scene.image_count + 1) * sizeof *n);
     if (!n) {
         free(im.rgba);

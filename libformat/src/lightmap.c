@@ -344,3 +344,9 @@ void lbk_validate_lmap(lbk_vctx *ctx, const uint8_t *d, size_t size)
     ctx->lmap_ok = 1; /* the layout parsed; content errors above still make the file invalid */
     (void)ok;
 }
+
+uint64_t lbk_lmap_page_rect_bytes(const lbk_lmap_page *page, uint32_t x, uint32_t y, uint32_t w, uint32_t h)
+{
+    if (!page || (uint64_t)x + w > page->width || (uint64_t)y + h > page->height) return 0;
+    return (uint64_t)w * h * LBK_AHD_TEXEL_SIZE;
+}

@@ -93,6 +93,9 @@ static tl_open_status open_views(tl_bake *b, char err[TL_ERR_LEN])
     VIEW(LBK_SECTION_LLG, b->has_llg, lbk_llg_open(d, n, &b->llg));
     VIEW(LBK_SECTION_OCTP, b->has_octp, lbk_octp_open(d, n, &b->octp));
     VIEW(LBK_SECTION_LMUV, b->has_lmuv, lbk_lmuv_open(d, n, &b->lmuv));
+    VIEW(LBK_SECTION_REPT, b->has_rept, lbk_report_open(d, n, &b->rept));
+    if (b->has_rept && lbk_report_record_get(&b->rept, b->rept.header.record_count - 1, &b->rept_last) != LBK_OK)
+        b->has_rept = 0;
     VIEW(LBK_SECTION_DLS, dls, lbk_dls_open(d, n, NULL, &b->dls));
     VIEW(LBK_SECTION_DOOR, door, lbk_door_open(d, n, NULL, &b->door));
 #undef VIEW

@@ -18,6 +18,7 @@
 #include "lbk/meta.h"
 #include "lbk/objects.h"
 #include "lbk/octa.h"
+#include "lbk/report.h"
 
 typedef enum tl_open_status {
     TL_OPEN_OK = 0,
@@ -30,7 +31,7 @@ typedef struct tl_bake {
     void *bytes; /* owned file bytes */
     size_t size;
     lbk_reader *reader;
-    int has_meta, has_objs, has_lmap, has_glg, has_llg, has_octp, has_lmuv;
+    int has_meta, has_objs, has_lmap, has_glg, has_llg, has_octp, has_lmuv, has_rept;
     lbk_meta_view meta;
     lbk_objects_view objs;
     lbk_lmap_view lmap;
@@ -38,6 +39,8 @@ typedef struct tl_bake {
     lbk_llg_view llg;
     lbk_octp_view octp;
     lbk_lmuv_view lmuv;
+    lbk_report_view rept;
+    lbk_report_record rept_last; /* the final estimate, when has_rept */
     lbk_dls_view *dls;   /* NULL when absent */
     lbk_door_view *door; /* NULL when absent */
 } tl_bake;

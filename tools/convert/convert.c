@@ -10,6 +10,7 @@
 
 #include "tools/common/error_util.h"
 #include "tools/convert/lmap_layout.h"
+#include "lbk/meta.h"
 #include "lbk/validate.h"
 
 typedef struct first_issue {
@@ -48,6 +49,44 @@ static int validate_bytes(const void *data, size_t size, lbk_reader *reader, con
         return -1;
     }
     return 0;
+}
+
+/* META of a pack that keeps it: the input's keys plus convert.profile and convert.profile_hash
+ * (spec/container.md §6.2), replacing those of an earlier convert, so converting again with the
+ * same profile gives the same bytes. */
+static int meta_with_profile(const void *data, size_t size, const tl_profile *p, void **out, size_t *out_size,
+                             char err[TL_ERR_LEN])
+{
+    lbk_meta_view v;
+    if (lbk_meta_open(data, size, &v) != LBK_OK) return tl_fail(err, TL_CONVERT_BAD_INPUT, "input META unreadable");
+    lbk_meta_pair *pairs = calloc((size_t)v.entry_count + 2, sizeof *pairs);
+    char **owned = calloc(2 * (size_t)v.entry_count + 1, sizeof *owned);
+    char hash[17];
+    lbk_meta_hash_hex(p->text_hash, hash);
+    size_t n = 0, k = 0;
+    int st = TL_CONVERT_INTERNAL;
+    if (!pairs || !owned) goto done;
+    for (uint32_t i = 0; i < v.entry_count; i++) {
+        lbk_string key, val;
+        lbk_meta_entry_get(&v, i, &key, &val);
+        if ((key.size == 15 && !memcmp(key.data, "convert.profile", 15)) ||
+            (key.size == 20 && !memcmp(key.data, "convert.profile_hash", 20)))
+            continue;
+        char *ks = strndup(key.data, key.size), *vs = strndup(val.data, val.size);
+        owned[k++] = ks, owned[k++] = vs;
+        if (!ks || !vs) goto done;
+        pairs[n++] = (lbk_meta_pair){ks, vs};
+    }
+    pairs[n++] = (lbk_meta_pair){"convert.profile", p->name};
+    pairs[n++] = (lbk_meta_pair){"convert.profile_hash", hash};
+    st = lbk_meta_build(pairs, n, NULL, out, out_size) == LBK_OK ? TL_CONVERT_OK : TL_CONVERT_INTERNAL;
+    if (st != TL_CONVERT_OK) tl_fail(err, st, "META with the profile could not be built");
+done:
+    for (size_t i = 0; i < k; i++) free(owned[i]);
+    free(owned);
+    free(pairs);
+    if (st == TL_CONVERT_INTERNAL && !*out) snprintf(err, TL_ERR_LEN, "out of memory");
+    return st;
 }
 
 tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_convert_options *opt, void **out,
@@ -115,6 +154,8 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
             have_remap = ls == TL_CONVERT_OK;
         } else if (si.type == LBK_SECTION_DLS && have_remap && !remap.identity) {
             ls = tl_dls_remap_texels(data, size, &remap, &rewritten, &rewritten_size, err);
+        } else if (si.type == LBK_SECTION_META) {
+            ls = meta_with_profile(data, size, p, &rewritten, &rewritten_size, err);
         }
         if (ls != TL_CONVERT_OK) {
             st = (tl_convert_status)ls;

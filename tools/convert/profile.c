@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <xxhash.h>
 #include <unistd.h>
 
 #include "tools/common/error_util.h"
@@ -74,6 +75,7 @@ static int parse_rule(const char *v, tl_section_rule *r)
 int tl_profile_parse(const char *text, size_t size, const char *origin, tl_profile *out, char err[TL_ERR_LEN])
 {
     memset(out, 0, sizeof *out);
+    out->text_hash = XXH3_64bits(text, size);
     out->defaults.compression = LBK_COMPRESSION_NONE;
     enum { TOP, SECTIONS, LMAP } group = TOP;
     int have_name = 0, have_align = 0, have_default = 0, have_pitch = 0, have_page = 0, have_desc = 0;

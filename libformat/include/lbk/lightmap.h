@@ -77,6 +77,11 @@ LBK_API lbk_result lbk_lmap_texel_get(const lbk_lmap_view *view, uint64_t texel_
 LBK_API lbk_result lbk_lmap_page_irradiance(const lbk_lmap_page *page, uint32_t x, uint32_t y, const float n[3],
                                             float rgb[3]);
 
+/* GPU bytes of the texels [x, x + w) × [y, y + h) of a page in its planes' encodings: 8 per texel
+ * for R11G11B10F + RGBA8; for block-compressed planes every block the rectangle touches. 0 when the
+ * rectangle is not inside the page. */
+LBK_API uint64_t lbk_lmap_page_rect_bytes(const lbk_lmap_page *page, uint32_t x, uint32_t y, uint32_t w, uint32_t h);
+
 #ifdef __cplusplus
 }
 #endif
