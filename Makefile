@@ -10,7 +10,7 @@ CLANG    ?= clang
 # Debian packages the build needs; `make deps` installs the missing ones when run as root.
 DEB_PKGS := build-essential pkg-config libzstd-dev libxxhash-dev libembree-dev libopenexr-dev \
             libdraco-dev libtinygltf-dev libstb-dev nlohmann-json3-dev libqhull-dev libspng-dev \
-            libcjson-dev libcmocka-dev clang libclang-rt-14-dev
+            libcjson-dev libcmocka-dev clang libclang-rt-14-dev libastcenc-dev
 
 WARN     := -Wall -Wextra -Wshadow -Wstrict-prototypes -Wmissing-prototypes -Wno-unused-parameter
 CSTD     := -std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE
@@ -22,13 +22,14 @@ LIB_LIBS := -lzstd -lxxhash -lm
 # The baker (liblbkbake) and the tools: everything heavy lives here, never in liblbk.
 TOOL_INC := $(LIB_INC) -Ibake/include -I. -I/usr/include/draco -I/usr/include/stb
 BAKE_LIBS:= -lembree3 -lOpenEXRCore -lqhull_r -lspng -lcjson -ldraco -lpthread -lm
-TOOL_LIBS:= $(BAKE_LIBS) $(LIB_LIBS)
+# astcenc: the ASTC plane encodings of lbk convert / export / diff (tools/common/astc_codec.cc)
+TOOL_LIBS:= $(BAKE_LIBS) -lastcenc $(LIB_LIBS)
 
 LIB_SRC   := $(sort $(wildcard libformat/src/*.c))
 BAKE_CSRC := $(sort $(wildcard bake/*/*.c))
 BAKE_CXXSRC := $(sort $(wildcard bake/*/*.cc))
 TOOL_CSRC := $(sort $(wildcard cli/*.c bake/*/*.c tools/*/*.c))
-TOOL_CXXSRC := $(BAKE_CXXSRC)
+TOOL_CXXSRC := $(BAKE_CXXSRC) $(sort $(wildcard tools/*/*.cc))
 TOOL_MAIN := cli/main.c
 TEST_SRC  := $(sort $(wildcard tests/*/test_*.c))
 TESTS     := $(notdir $(TEST_SRC:.c=))
@@ -41,7 +42,8 @@ LIB_PIC   := $(LIB_SRC:%.c=$(BUILD)/pic/%.o)
 BAKE_OBJ  := $(BAKE_CSRC:%.c=$(BUILD)/rel/%.o) $(BAKE_CXXSRC:%.cc=$(BUILD)/rel/%.o)
 BAKE_PIC  := $(BAKE_CSRC:%.c=$(BUILD)/pic/%.o) $(BAKE_CXXSRC:%.cc=$(BUILD)/pic/%.o)
 # cli/ and tools/ (the baker comes from liblbkbake.a)
-TOOL_OBJ  := $(filter-out $(BUILD)/rel/$(TOOL_MAIN:.c=.o) $(BAKE_OBJ),$(TOOL_CSRC:%.c=$(BUILD)/rel/%.o))
+TOOL_OBJ  := $(filter-out $(BUILD)/rel/$(TOOL_MAIN:.c=.o) $(BAKE_OBJ),$(TOOL_CSRC:%.c=$(BUILD)/rel/%.o)) \
+             $(patsubst %.cc,$(BUILD)/rel/%.o,$(sort $(wildcard tools/*/*.cc)))
 # Sanitizer objects for the test build
 LIB_ASAN  := $(LIB_SRC:%.c=$(BUILD)/asan/%.o)
 TOOL_ASAN := $(filter-out $(BUILD)/asan/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUILD)/asan/%.o)) $(TOOL_CXXSRC:%.cc=$(BUILD)/asan/%.o)

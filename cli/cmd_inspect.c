@@ -216,6 +216,10 @@ static int print_json(const report *r)
     if (lv) {
         cJSON_AddNumberToObject(lv, "lm_texels", (double)l->lm_texels);
         cJSON_AddNumberToObject(lv, "lm_pages", (double)l->lm_pages);
+        uint64_t lm_gpu = 0;
+        for (uint32_t i = 0; i < r->count; i++)
+            if (r->rows[i].info.type == LBK_SECTION_LMAP) lm_gpu = r->rows[i].st.gpu_bytes;
+        cJSON_AddNumberToObject(lv, "lm_gpu_bytes_per_texel", l->lm_texels ? (double)lm_gpu / (double)l->lm_texels : 0.0);
         cJSON_AddNumberToObject(lv, "llg_probes", (double)l->llg_probes);
         cJSON_AddNumberToObject(lv, "llg_grids", (double)l->llg_grids);
         cJSON_AddNumberToObject(lv, "llg_vertices", (double)l->llg_vertices);

@@ -5,6 +5,7 @@
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,7 +24,7 @@ const bk_preset bk_presets[LBK_BAKE_PRESET_COUNT_] = {
 
 /* The size of version 1 of lbk_bake_desc, what size 0 means. When fields are added, this stays
  * the offset of the first new one. */
-#define BK_DESC_SIZE_V1 sizeof(lbk_bake_desc)
+#define BK_DESC_SIZE_V1 offsetof(lbk_bake_desc, block_align)
 
 /* ---- talking to the caller ------------------------------------------------------------- */
 
@@ -269,6 +270,7 @@ static lbk_result layout_atlas(bk_pipeline *b, const uint8_t *lightmapped)
     memset(&ao, 0, sizeof ao);
     ao.default_density = b->pre->texel_density;
     ao.density_override = b->opt->texel_density > 0 ? b->opt->texel_density : 0;
+    ao.block_align = b->opt->block_align;
     lbk_result r = bk_atlas_build(s, lightmapped, &ao, &b->atlas);
     if (r == LBK_ERR_LIMIT) return bk_pipeline_fail(b, LBK_ERR_BAD_INPUT, "lightmap atlas: %s", lbk_result_message(r));
     if (r) return bk_pipeline_failed(b, r, "lightmap atlas");

@@ -304,6 +304,7 @@ lbk_result bk_provenance_meta(const bk_pipeline *b, void **data, size_t *size)
     p[n++] = (lbk_meta_pair){"bake.sky", skyv.p};
     p[n++] = (lbk_meta_pair){"bake.no_glg", o->no_glg ? "1" : "0"};
     p[n++] = (lbk_meta_pair){"bake.octahedral", o->octahedral_probes ? "1" : "0"};
+    if (o->block_align) p[n++] = (lbk_meta_pair){"bake.block_align", "1"}; /* absent: 0 (older bakes) */
     p[n++] = (lbk_meta_pair){"bake.dls_threshold", threshold};
     p[n++] = (lbk_meta_pair){"bake.door_method", o->door_method == LBK_BAKE_DOOR_GUIDED ? "guided" : "difference"};
     if (o->revision) p[n++] = (lbk_meta_pair){LBK_META_REVISION, o->revision};

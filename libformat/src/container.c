@@ -13,6 +13,7 @@
 #include <zstd_errors.h>
 
 #include "framing.h"
+#include "lbk/lightmap.h"
 
 #define LBK_DEFAULT_ZSTD_LEVEL 19
 
@@ -221,6 +222,7 @@ lbk_result lbk_reader_section_by_type(lbk_reader *r, uint32_t type, const void *
 
 typedef struct writer_section {
     uint32_t type, flags, compression;
+    uint32_t features; /* required features the payload needs (LMAP: block pages) */
     uint8_t *stored;
     uint64_t stored_size, decoded_size, checksum;
 } writer_section;
@@ -327,6 +329,7 @@ lbk_result lbk_writer_section_add(lbk_writer *w, uint32_t type, const void *data
     s->type = type;
     s->flags = flags;
     s->compression = compression;
+    s->features = type == LBK_SECTION_LMAP ? lbk_lmap_required_features(data, size) : 0;
     s->stored = stored;
     s->stored_size = stored_size;
     s->decoded_size = size;
@@ -372,10 +375,12 @@ lbk_result lbk_writer_to_memory(lbk_writer *w, void **out, size_t *size)
     if (!f) return LBK_ERR_OUT_OF_MEMORY;
 
     uint32_t required = 0;
-    uint16_t minor = 0; /* §1.3: the lowest minor version that defines every known section here */
+    uint16_t minor = 0; /* §1.3: the lowest minor version that defines everything in the file */
     for (uint32_t i = 0; i < w->count; i++) {
-        if (w->s[order[i]].type == LBK_SECTION_LMUV) minor = 1;
         const writer_section *s = &w->s[order[i]];
+        if (s->type == LBK_SECTION_LMUV && minor < 1) minor = 1;
+        if (s->features & LBK_FEATURE_LMAP_BLOCK) minor = 2;
+        required |= s->features;
         uint8_t *e = f + LBK_HEADER_SIZE + (size_t)LBK_SECTION_ENTRY_SIZE * i;
         lbk_wr32(e + LBK_ENT_TYPE, s->type);
         lbk_wr32(e + LBK_ENT_FLAGS, s->flags);

@@ -97,6 +97,7 @@ typedef struct lbk_vctx {
     int section_compressed;        /* offsets inside compressed sections report the section start */
     uint32_t present_types[64];    /* every type listed in the section table, usable or not */
     uint32_t present_count;
+    uint32_t required_features;    /* the header's (LMAP checks LBK_FEATURE_LMAP_BLOCK against its pages) */
 
     /* facts from earlier sections */
     int lmap_ok;

@@ -129,6 +129,9 @@ static lbk_result validate_core(const uint8_t *d, size_t size, const lbk_validat
     if (!fr->header_ok || ctx.stop) goto done;
 
     for (uint32_t i = 0; i < fr->count; i++) ctx.present_types[ctx.present_count++] = fr->sections[i].type;
+    ctx.required_features = fr->header.required_features;
+    if ((ctx.required_features & LBK_FEATURE_LMAP_BLOCK) && !lbk_vctx_has_section(&ctx, LBK_SECTION_LMAP))
+        vreport_at(&ctx, 117, 0, LBK_HDR_REQUIRED_FEATURES, "required feature LMAP_BLOCK is set but there is no LMAP");
 
     /* Pass 1, file order: checksums of every usable section, known or not. */
     uint8_t checksum_ok[LBK_MAX_SECTIONS] = {0};

@@ -13,4 +13,7 @@ int tl_write_file_atomic(const char *path, const void *data, size_t size, char e
 /* Writes a text file (for CSV/JSON listings); atomic like tl_write_file_atomic. */
 int tl_write_text(const char *path, const char *text, char err[TL_ERR_LEN]);
 
+/* Monotonic seconds (for the timings tools print; never stored in a file). */
+double tl_seconds(void);
+
 #endif

@@ -125,6 +125,8 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
     memset(&remap, 0, sizeof remap);
     int have_remap = 0;
     uint32_t n = lbk_reader_section_count(rd);
+    const void *objs = NULL; /* OBJS precedes LMAP (canonical order): which texels objects use */
+    size_t objs_size = 0;
     for (uint32_t i = 0; i < n && st == TL_CONVERT_OK; i++) {
         lbk_section_info si;
         const void *data = NULL;
@@ -133,6 +135,7 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
             st = tl_fail(err, TL_CONVERT_BAD_INPUT, "input section %u: %s", i, lbk_result_message(r));
             break;
         }
+        if (si.type == LBK_SECTION_OBJS) objs = data, objs_size = size;
         tl_convert_section *cs = &report->sections[report->section_count++];
         cs->type = si.type;
         cs->in_stored = si.stored_size;
@@ -146,7 +149,9 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
         size_t rewritten_size = 0;
         int ls = TL_CONVERT_OK;
         if (si.type == LBK_SECTION_LMAP) {
-            tl_lmap_layout_options lo = {p->lmap_row_pitch_alignment, p->lmap_page_alignment, opt->from_exr_dir};
+            tl_lmap_layout_options lo = {p->lmap_row_pitch_alignment, p->lmap_page_alignment, opt->from_exr_dir,
+                                         {p->lmap_format[0], p->lmap_format[1]}, objs, objs_size,
+                                         &report->encode_seconds};
             uint32_t imported = 0;
             tl_texel_remap_free(&remap);
             ls = tl_lmap_rewrite(data, size, &lo, &rewritten, &rewritten_size, &imported, &remap, err);

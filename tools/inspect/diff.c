@@ -79,15 +79,27 @@ static int add_sample(tl_err_stats *s, const float *a, const float *b, int n, co
 
 /* ---- texel access ------------------------------------------------------------------------- */
 
-static void texel_values(const lbk_lmap_page *pg, uint32_t x, uint32_t y, float out[TL_TEXEL_NORMALS][3])
+/* A page of one side: its bake and index, and its planes (any encoding). */
+typedef struct pageref {
+    const tl_bake *b;
+    uint32_t page;
+    lbk_lmap_planes pl;
+} pageref;
+
+static int pageref_get(const tl_bake *b, uint32_t page, pageref *out)
 {
-    lbk_ahd_texel t;
-    lbk_lmap_page_texel_get(pg, x, y, &t);
-    tl_texel_eval(&t, pg->scale, out);
+    out->b = b;
+    out->page = page;
+    return tl_bake_planes(b, page, &out->pl);
+}
+
+static void texel_values(const pageref *pg, uint32_t x, uint32_t y, float out[TL_TEXEL_NORMALS][3])
+{
+    if (tl_bake_texel_eval(pg->b, pg->page, x, y, out)) memset(out, 0, sizeof(float) * 3 * TL_TEXEL_NORMALS);
 }
 
 /* Bilinear sample of the evaluated values at rect-normalised (u, v) of a rect of page pg. */
-static void texel_bilinear(const lbk_lmap_page *pg, const uint32_t rect[4], double u, double v,
+static void texel_bilinear(const pageref *pg, const uint32_t rect[4], double u, double v,
                            float out[TL_TEXEL_NORMALS][3])
 {
     double fx = u * rect[2] - 0.5, fy = v * rect[3] - 0.5;
@@ -113,7 +125,7 @@ static void texel_bilinear(const lbk_lmap_page *pg, const uint32_t rect[4], doub
  * of the five normals against the texel's level (its mean over them), the largest of the five, for
  * the mean test (REPT's estimate when the rectangle is too small to tell); and when `local` is not
  * NULL, per texel the high-pass of its 4×4 tile at +Z, for the texel test (malloc'ed, w × h). */
-static double rect_noise(const lbk_lmap_page *pg, const uint32_t rect[4], double fallback, float **local)
+static double rect_noise(const pageref *pg, const uint32_t rect[4], double fallback, float **local)
 {
     const size_t n = (size_t)rect[2] * rect[3];
     if (local) *local = NULL;
@@ -242,9 +254,8 @@ static void compare_object(const tl_bake *a, const tl_bake *b, const lbk_object 
 {
     if (oa->representation == LBK_REPRESENTATION_LIGHTMAP && ob->representation == LBK_REPRESENTATION_LIGHTMAP &&
         a->has_lmap && b->has_lmap) {
-        lbk_lmap_page pa, pb;
-        if (lbk_lmap_page_get(&a->lmap, oa->index, &pa) != LBK_OK || lbk_lmap_page_get(&b->lmap, ob->index, &pb) != LBK_OK)
-            return;
+        pageref pa, pb;
+        if (pageref_get(a, oa->index, &pa) || pageref_get(b, ob->index, &pb)) return;
         d->compared = 1;
         const int same_size = oa->rect_w == ob->rect_w && oa->rect_h == ob->rect_h;
         d->resampled = !same_size;
@@ -396,9 +407,10 @@ static int diff_pages(const tl_bake *a, const tl_bake *b, const tol *t, int keep
     for (uint32_t p = 0; p < n; p++) {
         tl_diff_page *d = &r->pages[r->page_count++];
         d->index = p;
-        lbk_lmap_page pa, pb;
-        if (p < na) lbk_lmap_page_get(&a->lmap, p, &pa), d->wa = pa.width, d->ha = pa.height;
-        if (p < nb) lbk_lmap_page_get(&b->lmap, p, &pb), d->wb = pb.width, d->hb = pb.height;
+        pageref ra, rb;
+        lbk_lmap_planes pa = {0}, pb = {0};
+        if (p < na) pageref_get(a, p, &ra), pa = ra.pl, d->wa = pa.width, d->ha = pa.height;
+        if (p < nb) pageref_get(b, p, &rb), pb = rb.pl, d->wb = pb.width, d->hb = pb.height;
         if (p >= nb) {
             d->status = TL_DIFF_REMOVED;
             r->pages_changed++;
@@ -416,9 +428,9 @@ static int diff_pages(const tl_bake *a, const tl_bake *b, const tol *t, int keep
         float *local_a = NULL, *local_b = NULL;
         int objects_changed = 0;
         if (t->noise) {
-            const uint32_t ra[4] = {0, 0, pa.width, pa.height}, rb[4] = {0, 0, pb.width, pb.height};
-            rect_noise(&pa, ra, t->noise->rept[0][0], &local_a);
-            rect_noise(&pb, rb, t->noise->rept[1][0], &local_b);
+            const uint32_t rect_a[4] = {0, 0, pa.width, pa.height}, rect_b[4] = {0, 0, pb.width, pb.height};
+            rect_noise(&ra, rect_a, t->noise->rept[0][0], &local_a);
+            rect_noise(&rb, rect_b, t->noise->rept[1][0], &local_b);
             owner = malloc(sizeof *owner * ((size_t)pa.width * pa.height + 1));
             if (!owner || !local_a || !local_b) {
                 free(owner), free(local_a), free(local_b);
@@ -444,8 +456,8 @@ static int diff_pages(const tl_bake *a, const tl_bake *b, const tol *t, int keep
         for (uint32_t y = 0; y < h; y++)
             for (uint32_t x = 0; x < w; x++) {
                 float va[TL_TEXEL_NORMALS][3], vb[TL_TEXEL_NORMALS][3], e;
-                texel_values(&pa, x, y, va);
-                texel_values(&pb, x, y, vb);
+                texel_values(&ra, x, y, va);
+                texel_values(&rb, x, y, vb);
                 int over = add_sample(&d->lighting, &va[0][0], &vb[0][0], TL_TEXEL_NORMALS, t, x, y, &e);
                 if (owner)
                     over = tl_noise_sample_significant(t->noise, 0, local_a[(size_t)y * pa.width + x],
@@ -597,13 +609,13 @@ static keyed *sorted_keys(const tl_bake *bk, const set_entries *e)
     for (uint64_t i = 0; i < e->count; i++) {
         uint64_t key = e->targets[i];
         if (e->space == LBK_DLS_SPACE_TEXEL && bk->has_lmap) {
-            lbk_ahd_texel t;
-            uint32_t page;
-            if (lbk_lmap_texel_get(&bk->lmap, e->targets[i], &t, &page) == LBK_OK) {
-                lbk_lmap_page pg;
-                lbk_lmap_page_get(&bk->lmap, page, &pg);
-                uint64_t local = e->targets[i] - pg.first_texel;
+            for (uint32_t page = bk->lmap.page_count; page-- > 0;) { /* pages ascend by first_texel */
+                lbk_lmap_planes pg;
+                lbk_lmap_planes_get(&bk->lmap, page, &pg);
+                if (pg.first_texel > e->targets[i]) continue;
+                const uint64_t local = e->targets[i] - pg.first_texel;
                 key = ((uint64_t)page << 32) | ((local / pg.width) << 16) | (local % pg.width);
+                break;
             }
         }
         k[i] = (keyed){key, i};

@@ -9,9 +9,9 @@
  * planes, every block the rectangle touches). */
 static uint64_t rect_bytes(const lbk_lmap_view *v, uint32_t page, const lbk_object *o)
 {
-    lbk_lmap_page pg;
-    if (lbk_lmap_page_get(v, page, &pg) != LBK_OK) return 0;
-    return lbk_lmap_page_rect_bytes(&pg, o->rect_x, o->rect_y, o->rect_w, o->rect_h);
+    lbk_lmap_planes pl;
+    if (lbk_lmap_planes_get(v, page, &pl) != LBK_OK) return 0;
+    return lbk_lmap_planes_rect_bytes(&pl, o->rect_x, o->rect_y, o->rect_w, o->rect_h);
 }
 
 typedef struct owner_maps {
@@ -35,12 +35,14 @@ static int charge(void *user, uint32_t target, uint32_t count, const uint32_t *s
         }
     int32_t owner = -1;
     if (om->space == LBK_DLS_SPACE_TEXEL && om->b->has_lmap) {
-        lbk_ahd_texel t;
-        uint32_t page;
-        lbk_lmap_page pg;
-        if (lbk_lmap_texel_get(&om->b->lmap, target, &t, &page) == LBK_OK &&
-            lbk_lmap_page_get(&om->b->lmap, page, &pg) == LBK_OK && om->texel_owner[page])
-            owner = om->texel_owner[page][target - pg.first_texel];
+        for (uint32_t page = om->b->lmap.page_count; page-- > 0;) {
+            lbk_lmap_planes pg;
+            lbk_lmap_planes_get(&om->b->lmap, page, &pg);
+            if (pg.first_texel > target) continue;
+            if (om->texel_owner[page] && target - pg.first_texel < (uint64_t)pg.width * pg.height)
+                owner = om->texel_owner[page][target - pg.first_texel];
+            break;
+        }
     } else if (om->space == LBK_DLS_SPACE_LLG && om->b->has_llg) {
         for (uint32_t g = 0; g < om->b->llg.grid_count; g++) {
             lbk_llg_grid grid;
@@ -72,8 +74,8 @@ static int owner_maps_build(const tl_bake *b, tl_level_memory *m, owner_maps *om
     if (!om->texel_owner || !om->llg_owner) return -1;
     for (uint32_t g = 0; g < grids; g++) om->llg_owner[g] = -1;
     for (uint32_t p = 0; p < pages; p++) {
-        lbk_lmap_page pg;
-        lbk_lmap_page_get(&b->lmap, p, &pg);
+        lbk_lmap_planes pg;
+        lbk_lmap_planes_get(&b->lmap, p, &pg);
         om->texel_owner[p] = malloc(((size_t)pg.width * pg.height + 1) * sizeof **om->texel_owner);
         if (!om->texel_owner[p]) return -1;
         for (size_t i = 0; i < (size_t)pg.width * pg.height; i++) om->texel_owner[p][i] = -1;
@@ -82,8 +84,8 @@ static int owner_maps_build(const tl_bake *b, tl_level_memory *m, owner_maps *om
         lbk_object o;
         lbk_objects_get(&b->objs, i, &o);
         if (o.representation == LBK_REPRESENTATION_LIGHTMAP && o.index < pages) {
-            lbk_lmap_page pg;
-            lbk_lmap_page_get(&b->lmap, o.index, &pg);
+            lbk_lmap_planes pg;
+            lbk_lmap_planes_get(&b->lmap, o.index, &pg);
             for (uint32_t y = o.rect_y; y < o.rect_y + o.rect_h && y < pg.height; y++)
                 for (uint32_t x = o.rect_x; x < o.rect_x + o.rect_w && x < pg.width; x++)
                     om->texel_owner[o.index][(size_t)y * pg.width + x] = (int32_t)i;

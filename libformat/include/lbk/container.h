@@ -24,8 +24,9 @@ extern "C" {
 #define LBK_MAX_SECTIONS 64u
 
 /* Header required_features bits. A reader rejects any bit it does not know. */
-#define LBK_FEATURE_ZSTD 0x1u /* at least one section is zstd-compressed */
-#define LBK_KNOWN_REQUIRED_FEATURES LBK_FEATURE_ZSTD
+#define LBK_FEATURE_ZSTD 0x1u       /* at least one section is zstd-compressed */
+#define LBK_FEATURE_LMAP_BLOCK 0x2u /* 1.2: some LMAP page stores a plane block-compressed (spec §9.2) */
+#define LBK_KNOWN_REQUIRED_FEATURES (LBK_FEATURE_ZSTD | LBK_FEATURE_LMAP_BLOCK)
 
 /* Section entry flags. */
 #define LBK_SECTION_FLAG_REQUIRED 0x1u /* a reader that does not know the type must reject the file */
