@@ -17,7 +17,10 @@ CSTD     := -std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE
 OPT      ?= -O2 -g
 SAN      := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
 
-LIB_INC  := -Ilibformat/include
+# xxHash's x86 runtime dispatch (AVX2/AVX-512 checksums) when the installed libxxhash has it
+XXH_DISPATCH := $(shell printf '\043include <xxh_x86dispatch.h>\nint main(void){return (int)XXH3_64bits_dispatch("", 0);}\n' | \
+                  $(CC) -x c - -o /dev/null -lxxhash 2>/dev/null && echo -DLBK_HAVE_XXH_DISPATCH)
+LIB_INC  := -Ilibformat/include $(XXH_DISPATCH)
 LIB_LIBS := -lzstd -lxxhash -lm
 # The baker (liblbkbake) and the tools: everything heavy lives here, never in liblbk.
 TOOL_INC := $(LIB_INC) -Ibake/include -I. -I/usr/include/draco -I/usr/include/stb
@@ -48,7 +51,7 @@ TOOL_OBJ  := $(filter-out $(BUILD)/rel/$(TOOL_MAIN:.c=.o) $(BAKE_OBJ),$(TOOL_CSR
 LIB_ASAN  := $(LIB_SRC:%.c=$(BUILD)/asan/%.o)
 TOOL_ASAN := $(filter-out $(BUILD)/asan/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUILD)/asan/%.o)) $(TOOL_CXXSRC:%.cc=$(BUILD)/asan/%.o)
 
-.PHONY: all lib bake-lib deps demo test check bench fuzz install install-check clean help gltf-validator
+.PHONY: all lib bake-lib deps demo test check bench mesa-bc-check fuzz install install-check clean help gltf-validator
 all: $(BUILD)/lbk $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc \
      $(BUILD)/liblbkbake.a $(BUILD)/liblbkbake.so $(BUILD)/lbk-bake.pc
 
@@ -57,6 +60,7 @@ help:
 	@echo "make demo       install missing packages, bake the embedded scene, inspect it, write a PNG"
 	@echo "make test       install missing packages, build with ASan+UBSan, run the whole suite"
 	@echo "make bench      benchmarks, printed as ratios against baselines measured in the same run"
+	@echo "make mesa-bc-check  BC6H/BC4 codecs against Mesa's (optional: libegl-dev libgl-dev)"
 	@echo "make fuzz       libFuzzer harness for the container reader (clang)"
 	@echo "make install PREFIX=/usr/local"
 
@@ -204,6 +208,13 @@ $(BUILD)/bench/%: bench/%.c $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) -O2 -g $(WARN) $(TOOL_INC) -c $< -o $@.o
 	$(CXX) -o $@ $@.o $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a $(TOOL_LIBS)
+# The BC codecs against Mesa's (llvmpipe, surfaceless EGL): optional, needs libegl-dev libgl-dev.
+mesa-bc-check: $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a
+	@mkdir -p $(BUILD)/bench
+	$(CC) $(CSTD) -O2 -g $(WARN) $(TOOL_INC) -c bench/mesa_bc_check.c -o $(BUILD)/bench/mesa_bc_check.o
+	$(CXX) -o $(BUILD)/bench/mesa_bc_check $(BUILD)/bench/mesa_bc_check.o $(TOOL_OBJ) $(BUILD)/liblbkbake.a \
+	    $(BUILD)/liblbk.a $(TOOL_LIBS) -lEGL -lGL
+	$(BUILD)/bench/mesa_bc_check
 bench: deps
 	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BENCHES:%=$(BUILD)/bench/%)
 	@for b in $(BENCHES); do echo "== $$b"; $(BUILD)/bench/$$b || exit 1; done

@@ -1,7 +1,9 @@
 /* Container benchmarks (printed, never asserted):
  *  1. load throughput of a ~50 MB container (a real LMAP of 6.25 M texels plus META/OBJS):
  *     uncompressed, open + checksum + validation next to memcpy of the same bytes (goal: within
- *     20 %); zstd levels 3 and 19, the section's decode next to libzstd decoding the same frame in
+ *     20 %; an uncompressed LMAP is checksummed and its texels block-tested in one pass over
+ *     memory, libformat/src/lightmap.c lbk_lmap_hash_prescan, with xxHash's AVX2 dispatch and AVX2
+ *     block tests where the CPU has them); zstd levels 3 and 19, the section's decode next to libzstd decoding the same frame in
  *     the same run (goal: at least 80 % of its speed);
  *  2. non-payload overhead of a container with 1 M lightmap texels (8 MB of planes) and 100 k
  *     SH9 probes (2.8 MB, as LLG grids), with META, REPT and OBJS: goal < 0.5 % of the file. */

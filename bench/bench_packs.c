@@ -145,10 +145,10 @@ static void compare(const tl_bake *a, const tl_bake *p, errors *e)
 static void run_profiles(const char *scene, const void *bytes, size_t size, uint64_t base_texels,
                          const char *const *names, size_t count, const char *suffix)
 {
-    char err[TL_ERR_LEN];
+    char err[TL_ERR_LEN] = "";
     tl_bake a;
     if (tl_bake_open_memory(bytes, size, &a, err) != TL_OPEN_OK || !a.has_lmap) {
-        printf("%-22s no lightmap (%s)\n", scene, err);
+        printf("%-22s no lightmap%s%s%s\n", scene, *err ? " (" : "", err, *err ? ")" : "");
         if (a.bytes) tl_bake_close(&a);
         return;
     }
@@ -224,7 +224,9 @@ static const char *scenes_dir(void)
     return d && *d ? d : "../shared/scenes";
 }
 
-int main(void)
+/* bench_packs [PROFILE...]: the shipped profiles, or the named ones / profile files (then without
+ * the --block-align bakes), e.g. to compare a variant of a profile. */
+int main(int argc, char **argv)
 {
     printf("lightmap packs per profile (preset fast, to its 3 %% target): GPU bytes per texel of the pack's LMAP over\n"
            "the bake's texels (the pack's own texels, padding included, in brackets), block-encoding seconds,\n"
@@ -254,6 +256,11 @@ int main(void)
             if (lbk_reader_section_by_type(r, LBK_SECTION_LMAP, &d, &n) == LBK_OK && lbk_lmap_open(d, n, &v) == LBK_OK)
                 texels = v.texel_count;
             lbk_reader_close(r);
+        }
+        if (argc > 1) {
+            run_profiles(scenes[s][0], bytes, size, texels ? texels : 1, (const char *const *)argv + 1, (size_t)argc - 1, "");
+            lbk_free(NULL, bytes);
+            continue;
         }
         run_profiles(scenes[s][0], bytes, size, texels ? texels : 1, profiles, sizeof profiles / sizeof profiles[0], "");
         /* the same level baked with --block-align: no block holds two charts */

@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#define XXH_STATIC_LINKING_ONLY /* XXH3_state_t on the stack */
+#define XXH_INLINE_ALL /* as the rest of the baker: liblbkbake links no xxhash of its own */
 #include <xxhash.h>
 
 #include "lbk/meta.h"

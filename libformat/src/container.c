@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <sys/stat.h>
 #include <unistd.h>
-#include <xxhash.h>
+#include "xxh.h"
 #include <zstd.h>
 #include <zstd_errors.h>
 
@@ -156,6 +156,16 @@ lbk_result lbk_reader_verify(lbk_reader *r, uint32_t index, uint32_t *issue_id)
     }
     r->verified[index] = 1;
     return LBK_OK;
+}
+
+int lbk_reader_checksum_pending(const lbk_reader *r, uint32_t index)
+{
+    return index < r->fr.count && r->fr.usable[index] && !r->verified[index] && !r->skip_checksums;
+}
+
+void lbk_reader_set_verified(lbk_reader *r, uint32_t index)
+{
+    if (index < r->fr.count) r->verified[index] = 1;
 }
 
 lbk_result lbk_reader_load(lbk_reader *r, uint32_t index, const uint8_t **data, uint32_t *issue_id)

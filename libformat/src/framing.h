@@ -87,6 +87,10 @@ typedef struct lbk_reader lbk_reader;
 const lbk_framing *lbk_reader_framing(const lbk_reader *r);
 const lbk_allocator *lbk_reader_allocator(const lbk_reader *r);
 lbk_result lbk_reader_verify(lbk_reader *r, uint32_t index, uint32_t *issue_id);
+/* 1 when section index's checksum has yet to be verified (not verified, checksums not skipped);
+ * lbk_reader_set_verified records a checksum the caller verified itself. */
+int lbk_reader_checksum_pending(const lbk_reader *r, uint32_t index);
+void lbk_reader_set_verified(lbk_reader *r, uint32_t index);
 lbk_result lbk_reader_load(lbk_reader *r, uint32_t index, const uint8_t **data, uint32_t *issue_id);
 uint64_t lbk_reader_budget_left(const lbk_reader *r);
 

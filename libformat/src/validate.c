@@ -144,6 +144,21 @@ static lbk_result validate_core(const uint8_t *d, size_t size, const lbk_validat
         uint32_t issue;
         lbk_section_info only_checksum = *s;
         only_checksum.compression = LBK_COMPRESSION_NONE; /* verify, do not decode yet */
+        if (s->type == LBK_SECTION_LMAP && s->compression == LBK_COMPRESSION_NONE && !ctx.lmap_hits &&
+            (!rd || lbk_reader_checksum_pending(rd, i))) {
+            /* one pass over the lightmap: its checksum and the block tests of its texels */
+            uint8_t *hits;
+            uint64_t bits;
+            if (lbk_lmap_hash_prescan(d + s->offset, (size_t)s->stored_size, &alloc, &hits, &bits) == s->checksum) {
+                checksum_ok[i] = 1;
+                if (rd) lbk_reader_set_verified(rd, i);
+                ctx.lmap_hits = hits, ctx.lmap_hit_bits = bits;
+            } else {
+                lbk_dealloc(&alloc, hits);
+                vreport_at(&ctx, 214, s->type, s->offset, "%s", load_message(214));
+            }
+            continue;
+        }
         lbk_result r = rd ? lbk_reader_verify(rd, i, &issue)
                           : lbk_section_load(d, &only_checksum, &alloc, 0, &unlimited, &sd, &owned, &issue);
         if (r == LBK_OK) checksum_ok[i] = 1;
@@ -188,6 +203,7 @@ static lbk_result validate_core(const uint8_t *d, size_t size, const lbk_validat
     }
 
 done:
+    lbk_dealloc(&alloc, ctx.lmap_hits);
     lbk_dealloc(&alloc, (void *)ctx.lmap_page_width);
     lbk_dealloc(&alloc, (void *)ctx.lmap_page_height);
     lbk_dealloc(&alloc, ctx.objs_facts);

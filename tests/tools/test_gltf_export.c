@@ -20,12 +20,12 @@
 
 #include <cjson/cJSON.h>
 
-#include "bake/pipeline/bake.h"
 #include "bake/scene/import.h"
 #include "tools/common/bake_data.h"
 #include "tools/common/file_util.h"
 #include "tools/convert/gltf_export.h"
 #include "lbk/container.h"
+#include "support/bake_file.h"
 #include "support/lmuv_scene.h"
 
 static char tmpdir[64];
@@ -53,22 +53,18 @@ static const char *scenes_dir(void)
 
 static void bake(const char *in, const char *out, float density)
 {
-    bk_bake_options o;
-    memset(&o, 0, sizeof o);
-    o.input = in;
-    o.output = out;
-    o.preset = "fast";
-    o.seed = 1;
-    o.target_error = -1;
-    o.max_samples = 16;
-    o.threads = 2;
-    o.texel_density = density;
-    o.no_glg = 1;
-    bk_progress p;
-    bk_progress_init(&p, 1);
-    bk_bake_summary sum;
+    tb_job j;
+    memset(&j, 0, sizeof j);
+    j.in = in;
+    j.out = out;
+    j.d.preset = LBK_BAKE_PRESET_FAST;
+    j.d.seed = 1;
+    j.d.max_samples = 16;
+    j.d.threads = 2;
+    j.d.texel_density = density;
+    j.d.no_glg = 1;
     char err[512];
-    if (bk_bake(&o, &p, &sum, err, sizeof err)) fail_msg("bake %s: %s", in, err);
+    if (tb_bake(&j, NULL, err, sizeof err) != LBK_OK) fail_msg("bake %s: %s", in, err);
 }
 
 static void import(const char *path, bk_scene *s)

@@ -22,13 +22,26 @@ bool make(int hdr, bool decode_only, astcenc_context **ctx, char *err, size_t er
     return true;
 }
 
+bool shape_ok(uint32_t width, uint32_t height, size_t size, char *err, size_t err_len)
+{
+    if (width == 0 || height == 0 || width % 4 || height % 4) {
+        std::snprintf(err, err_len, "astc: %ux%u is not whole 4x4 blocks", width, height);
+        return false;
+    }
+    if (size / 16 < (size_t)(width / 4) * (height / 4)) {
+        std::snprintf(err, err_len, "astc: %zu bytes for %ux%u texels", size, width, height);
+        return false;
+    }
+    return true;
+}
+
 }  // namespace
 
 extern "C" int tl_astc_encode(const float *rgba, uint32_t width, uint32_t height, int hdr, uint8_t *out,
                               size_t out_size, char *err, size_t err_len)
 {
     astcenc_context *ctx = nullptr;
-    if (!make(hdr, false, &ctx, err, err_len)) return -1;
+    if (!shape_ok(width, height, out_size, err, err_len) || !make(hdr, false, &ctx, err, err_len)) return -1;
     void *slice = const_cast<float *>(rgba);
     astcenc_image img{width, height, 1, ASTCENC_TYPE_F32, &slice};
     const astcenc_swizzle swz{ASTCENC_SWZ_R, ASTCENC_SWZ_G, ASTCENC_SWZ_B, ASTCENC_SWZ_A};
@@ -45,7 +58,7 @@ extern "C" int tl_astc_decode(const uint8_t *blocks, size_t size, uint32_t width
                               float *rgba, char *err, size_t err_len)
 {
     astcenc_context *ctx = nullptr;
-    if (!make(hdr, true, &ctx, err, err_len)) return -1;
+    if (!shape_ok(width, height, size, err, err_len) || !make(hdr, true, &ctx, err, err_len)) return -1;
     void *slice = rgba;
     astcenc_image img{width, height, 1, ASTCENC_TYPE_F32, &slice};
     const astcenc_swizzle swz{ASTCENC_SWZ_R, ASTCENC_SWZ_G, ASTCENC_SWZ_B, ASTCENC_SWZ_A};

@@ -12,19 +12,6 @@
 #include "lbk/lightmap.h"
 #include "lbk/pixel.h"
 
-/* ---- bit writer ------------------------------------------------------------------------------ */
-
-typedef struct bitwriter {
-    uint8_t *p;
-    unsigned pos;
-} bitwriter;
-
-static void put_bits(bitwriter *w, unsigned v, unsigned n)
-{
-    for (unsigned i = 0; i < n; i++, w->pos++)
-        if ((v >> i) & 1u) w->p[w->pos >> 3] |= (uint8_t)(1u << (w->pos & 7));
-}
-
 /* ---- BC6H, one-region modes ----------------------------------------------------------------- */
 
 typedef struct mode1 {
@@ -126,26 +113,11 @@ static void pack_mode1(const mode1 *m, int qa[3], int qb[3], int idx[16], uint8_
         }
         for (int t = 0; t < 16; t++) idx[t] = 15 - idx[t];
     }
-    memset(out, 0, 16);
-    bitwriter w = {out, 0};
-    put_bits(&w, m->code, 5);
-    unsigned second[3];
-    for (int c = 0; c < 3; c++)
-        second[c] = m->transformed ? (unsigned)(qb[c] - qa[c]) & ((1u << m->d) - 1) : (unsigned)qb[c];
-    for (int c = 0; c < 3; c++) put_bits(&w, (unsigned)qa[c] & 0x3ffu, 10); /* w[9:0] for R, G, B */
-    for (int c = 0; c < 3; c++) {
-        put_bits(&w, second[c], m->d);
-        if (m->w > 10) {
-            const unsigned hi = (unsigned)qa[c] >> 10, n = (unsigned)m->w - 10;
-            unsigned v = hi;
-            if (m->hi_reversed) { /* bit 10 first in the stream's last position */
-                v = 0;
-                for (unsigned i = 0; i < n; i++) v |= ((hi >> i) & 1u) << (n - 1 - i);
-            }
-            put_bits(&w, v, n);
-        }
-    }
-    for (int t = 0; t < 16; t++) put_bits(&w, (unsigned)idx[t], t == 0 ? 3 : 4);
+    const int ep[4][3] = {{qa[0], qa[1], qa[2]}, {qb[0], qb[1], qb[2]}, {0, 0, 0}, {0, 0, 0}};
+    uint8_t ix[16];
+    for (int t = 0; t < 16; t++) ix[t] = (uint8_t)idx[t];
+    const int mode = 11 + (int)(m - modes1); /* modes 11..14 of the specification */
+    if (lbk_bc6h_pack(mode, 0, ep, ix, out) != LBK_OK) memset(out, 0, 16); /* checked by the caller */
 }
 
 /* Principal axis of the weighted points (power iteration on the covariance). */
@@ -194,9 +166,93 @@ static void refit(const double u[16][3], const float wt[16], const int idx[16], 
     }
 }
 
-/* ---- BC6H, two-region modes ------------------------------------------------------------------- */
+/* ---- BC6H, any mode: evaluation and endpoint refinement ------------------------------------- */
 
 static const int w3[8] = {0, 9, 18, 27, 37, 46, 55, 64};
+
+/* The weighted error (half-bit space) of quantised endpoints ep of `mode` / `shape`, with the best
+ * index per texel; the block in out. Endpoints whose anchor index would need its top bit are
+ * swapped (on a copy) as the format requires; +Inf when the deltas cannot be stored. */
+static double eval_ep(int mode, int shape, const int ep[4][3], const int h[16][3], const float wt[16],
+                      uint8_t out[16])
+{
+    int regions, bits, db[3], transformed;
+    lbk_bc6h_mode_info(mode, &regions, &bits, db, &transformed);
+    const uint16_t sh = regions == 2 ? lbk_bc6h_shape(shape) : 0;
+    const int anchors[2] = {0, regions == 2 ? lbk_bc6h_anchor(shape) : 0};
+    const int n = regions == 2 ? 8 : 16;
+    const int *wgt = regions == 2 ? w3 : w4;
+    int e[4][3];
+    memcpy(e, ep, sizeof e);
+    uint8_t idx[16] = {0};
+    double total = 0;
+    for (int r = 0; r < regions; r++) {
+        uint16_t pal[16][3];
+        for (int c = 0; c < 3; c++) {
+            const int ua = unq(e[2 * r][c], bits), ub = unq(e[2 * r + 1][c], bits);
+            for (int i = 0; i < n; i++) pal[i][c] = (uint16_t)((((ua * (64 - wgt[i]) + ub * wgt[i] + 32) >> 6) * 31) >> 6);
+        }
+        for (int t = 0; t < 16; t++) {
+            if ((int)((sh >> t) & 1u) != r) continue;
+            double be = INFINITY;
+            int bi = 0;
+            for (int i = 0; i < n; i++) {
+                const double d = sq(pal[i][0] - h[t][0]) + sq(pal[i][1] - h[t][1]) + sq(pal[i][2] - h[t][2]);
+                if (d < be) be = d, bi = i;
+            }
+            idx[t] = (uint8_t)bi;
+            total += wt[t] * be;
+        }
+        if (idx[anchors[r]] >= n / 2) { /* the anchor's index has no top bit */
+            for (int c = 0; c < 3; c++) {
+                const int tmp = e[2 * r][c];
+                e[2 * r][c] = e[2 * r + 1][c], e[2 * r + 1][c] = tmp;
+            }
+            for (int t = 0; t < 16; t++)
+                if ((int)((sh >> t) & 1u) == r) idx[t] = (uint8_t)(n - 1 - idx[t]);
+        }
+    }
+    if (lbk_bc6h_pack(mode, shape, (const int(*)[3])e, idx, out) != LBK_OK) return INFINITY;
+    return total;
+}
+
+/* Coordinate descent on the quantised endpoints: each endpoint channel one step up or down while
+ * that lowers the error. Quantising each endpoint to its nearest value is not the best block:
+ * moving one endpoint a step outward often lets the interpolated entries land on the texels (and
+ * keeps a chart's colour where 6-bit endpoints would round all channels alike). */
+static void refine_ep(int mode, int shape, int ep[4][3], const int h[16][3], const float wt[16], double *err,
+                      uint8_t out[16])
+{
+    int regions, bits, db[3], transformed;
+    lbk_bc6h_mode_info(mode, &regions, &bits, db, &transformed);
+    const int max = (1 << bits) - 1;
+    uint8_t tmp[16];
+    for (int pass = 0; pass < 4; pass++) {
+        int improved = 0;
+        /* moves: one channel of one endpoint (c < 3), or all three together (c = 3: brightness,
+         * which single-channel steps cannot reach when each alone would tint the texels) */
+        for (int k = 0; k < 2 * regions; k++)
+            for (int c = 0; c < 4; c++)
+                for (int d = -1; d <= 1; d += 2) {
+                    const int c0 = c < 3 ? c : 0, c1 = c < 3 ? c : 2;
+                    int ok = 1;
+                    for (int cc = c0; cc <= c1; cc++) ok &= ep[k][cc] + d >= 0 && ep[k][cc] + d <= max;
+                    if (!ok) continue;
+                    for (int cc = c0; cc <= c1; cc++) ep[k][cc] += d;
+                    const double e = eval_ep(mode, shape, (const int(*)[3])ep, h, wt, tmp);
+                    if (e < *err) {
+                        *err = e;
+                        memcpy(out, tmp, 16);
+                        improved = 1;
+                    } else {
+                        for (int cc = c0; cc <= c1; cc++) ep[k][cc] -= d;
+                    }
+                }
+        if (!improved) break;
+    }
+}
+
+/* ---- BC6H, two-region modes ------------------------------------------------------------------- */
 
 /* Indices (3 bits) and weighted error of region r's texels for endpoints qa, qb. */
 static double assign3(const int h[16][3], const float wt[16], uint16_t sh, int r, const int qa[3], const int qb[3],
@@ -241,9 +297,39 @@ static double shape_scatter(const double u[16][3], const float wt[16], uint16_t 
     return total;
 }
 
-/* The best encoding of mode (1..10) and shape, if it beats *best. */
+/* The best few (mode, shape, endpoints) of the search, refined at the end. */
+#define TWO_REGION_KEEP 3
+typedef struct candidate {
+    int mode, shape;
+    int ep[4][3];
+    double err;
+} candidate;
+typedef struct candidates {
+    candidate c[TWO_REGION_KEEP];
+    int n;
+} candidates;
+
+static double cand_bar(const candidates *cl, double best)
+{
+    const double worst = cl->n < TWO_REGION_KEEP ? INFINITY : cl->c[cl->n - 1].err;
+    return worst < best ? worst : best;
+}
+
+static void cand_push(candidates *cl, int mode, int shape, const int ep[4][3], double err)
+{
+    int i;
+    if (cl->n < TWO_REGION_KEEP) i = cl->n++;
+    else if (err >= cl->c[TWO_REGION_KEEP - 1].err) return;
+    else i = TWO_REGION_KEEP - 1;
+    for (; i > 0 && cl->c[i - 1].err > err; i--) cl->c[i] = cl->c[i - 1];
+    cl->c[i].mode = mode, cl->c[i].shape = shape, cl->c[i].err = err;
+    memcpy(cl->c[i].ep, ep, sizeof cl->c[i].ep);
+}
+
+/* Endpoints for mode (1..10) and shape from each region's principal axis; a candidate when it
+ * beats the list's worst (and *best). */
 static void try_two_region(const int h[16][3], const double u[16][3], const float wt[16], int mode, int shape,
-                           double *best, uint8_t out[16])
+                           double best, candidates *cl)
 {
     int regions, bits, db[3], transformed;
     lbk_bc6h_mode_info(mode, &regions, &bits, db, &transformed);
@@ -295,18 +381,18 @@ static void try_two_region(const int h[16][3], const double u[16][3], const floa
                     if (ep[k][c] < lo) ep[k][c] = lo < 0 ? 0 : lo;
                     if (ep[k][c] > hi) ep[k][c] = hi > (1 << bits) - 1 ? (1 << bits) - 1 : hi;
                 }
-        if (pass == 1 || err >= *best) {
-            err = 0;
-            for (int r = 0; r < 2; r++) err += assign3(h, wt, sh, r, ep[2 * r], ep[2 * r + 1], bits, idx);
+        if (pass == 1 || err >= cand_bar(cl, best)) {
             uint8_t tmp[16];
-            if (err < *best && lbk_bc6h_pack(mode, shape, ep, idx, tmp) == LBK_OK) {
-                *best = err;
-                memcpy(out, tmp, 16);
-            }
+            err = eval_ep(mode, shape, (const int(*)[3])ep, h, wt, tmp);
+            if (err < cand_bar(cl, best)) cand_push(cl, mode, shape, (const int(*)[3])ep, err);
             return;
         }
     }
 }
+
+#ifndef TWO_REGION_SHAPES
+#define TWO_REGION_SHAPES 4
+#endif
 
 /* Blocks a single line fits badly (an edge, a chart next to another, a dark corner): the four
  * shapes that split the block best, with every two-region mode. */
@@ -339,8 +425,19 @@ static void two_region_search(const int h[16][3], const double u[16][3], const f
             const int t = order[j];
             order[j] = order[j - 1], order[j - 1] = t;
         }
-    for (int k = 0; k < 4; k++)
-        for (int mode = 1; mode <= 10; mode++) try_two_region(h, u, wt, mode, order[k], best, out);
+    candidates cl;
+    cl.n = 0;
+    for (int k = 0; k < TWO_REGION_SHAPES; k++)
+        for (int mode = 1; mode <= 10; mode++) try_two_region(h, u, wt, mode, order[k], *best, &cl);
+    for (int i = 0; i < cl.n; i++) {
+        uint8_t tmp[16];
+        double e = eval_ep(cl.c[i].mode, cl.c[i].shape, (const int(*)[3])cl.c[i].ep, h, wt, tmp);
+        refine_ep(cl.c[i].mode, cl.c[i].shape, cl.c[i].ep, h, wt, &e, tmp);
+        if (e < *best) {
+            *best = e;
+            memcpy(out, tmp, 16);
+        }
+    }
 }
 
 void tl_bc6h_encode_block(const float rgb[16][3], const float weight[16], const int owner[16], uint8_t out[16])
@@ -373,6 +470,7 @@ void tl_bc6h_encode_block(const float rgb[16][3], const float weight[16], const 
         if (s > tmax) tmax = s;
     }
     double best = INFINITY;
+    int best_mode = 0, best_ep[4][3] = {{0}};
     for (int mi = 0; mi < 4; mi++) {
         const mode1 *m = &modes1[mi];
         double A[3], B[3];
@@ -388,12 +486,17 @@ void tl_bc6h_encode_block(const float rgb[16][3], const float weight[16], const 
             const double e = assign(h, wt, pal, idx);
             if (idx[0] >= 8 && !fits_swapped(m, qa, qb)) break;
             if (e < best) {
-                best = e;
+                best = e, best_mode = 11 + mi;
+                memcpy(best_ep[0], qa, sizeof qa), memcpy(best_ep[1], qb, sizeof qb);
                 pack_mode1(m, qa, qb, idx, out);
             }
             refit(u, wt, idx, A, B);
         }
     }
+    /* endpoints a step off their nearest quantisation, where the fit is not already exact */
+    double wsum1 = 0;
+    for (int t = 0; t < 16; t++) wsum1 += wt[t];
+    if (best_mode && best > 1.0 * wsum1) refine_ep(best_mode, 0, best_ep, h, wt, &best, out);
     /* a line in half-float space fits badly (more than ~1 % average error): try two regions */
     double wsum2 = 0;
     for (int t = 0; t < 16; t++) wsum2 += wt[t];

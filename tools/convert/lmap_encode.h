@@ -16,9 +16,10 @@
 /* BC6H_UF16 of one 4×4 block: rgb[16][3] ≥ 0 (stored units, clamped to 65504), weights[16] ≥ 0,
  * owner[16] the texels' objects (-1 none) or NULL.
  * One-region modes 11–14 (the best of the four by weighted squared error in half-float bit
- * space, ~relative error), endpoints by principal axis, refined by least squares; where that fits
- * badly (an edge, two charts, a dark corner), the two-region modes 1–10 on the four shapes that
- * split the block best. */
+ * space, ~relative error), endpoints by principal axis, refined by least squares, then a
+ * coordinate descent on the quantised endpoints (one channel, or all three, a step at a time);
+ * where that fits badly (an edge, two charts, a dark corner), the two-region modes 1–10 on the four
+ * shapes that split the block best, the three best candidates refined the same way. */
 void tl_bc6h_encode_block(const float rgb[16][3], const float weight[16], const int owner[16], uint8_t out[16]);
 /* BC4_UNORM of one block: v[16] in [0, 1]. The 8-value mode, endpoints searched around the
  * weighted range. */

@@ -236,6 +236,12 @@ out:
 int tl_diff_provenance(const tl_bake *a, const tl_bake *b, tl_diff_result *r)
 {
     changes c = {r, 0, 0};
+    if (a->has_meta != b->has_meta) { /* a pack whose profile drops META: nothing to compare */
+        add_change(&c, TL_CHANGE_OPTION, a->has_meta ? TL_DIFF_REMOVED : TL_DIFF_ADDED, "META", NULL, NULL,
+                   "%s has no META (provenance dropped, e.g. by a pack profile): inputs and options not compared",
+                   a->has_meta ? "B" : "A");
+        return c.failed ? -1 : 0;
+    }
     diff_options(&c, r);
     diff_lines(&c, a, b, "input.files", TL_CHANGE_FILE, 1);
     diff_lines(&c, a, b, "scene.lights", TL_CHANGE_LIGHT, 0);
