@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bake/layout/chart_merge.h"
 #include "bake/layout/uv_math.h"
 #include "bake/layout/uv_raster.h"
 
@@ -892,6 +893,11 @@ lbk_result bk_uvgen_object(const bk_scene *scene, uint32_t object, float density
             snprintf(msg, sizeof msg, "density lowered from %g to %g texels/m: a triangle exceeds %d texels", d, nd, cap);
             note_append(out, msg);
             d = nd;
+        }
+        if (r == LBK_OK) {
+            bk_chart_graph cg = {g.first, g.n, g.wid, g.adj_start, g.adj};
+            size_t merged;
+            r = bk_merge_small_charts(scene, &cg, d, cap, out, &merged);
         }
         out->density = (float)d;
         out->source = BK_UV_GENERATED;

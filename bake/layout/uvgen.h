@@ -19,7 +19,10 @@
  * moved to the origin. A chart whose projection overlaps itself at texel resolution, or
  * whose longer side exceeds max_chart_texels, is split at the median of its triangles along
  * its longer side (then into connected pieces) until it fits. A single triangle that is
- * still too large makes the whole object use a lower density (reported in note).
+ * still too large makes the whole object use a lower density (reported in note). Finally small
+ * charts (at most 16 texels of content, or one texel thin) are unfolded onto a neighbour
+ * across their longest shared edge when that makes the pair's blocks smaller (chart_merge.h):
+ * small objects no longer shatter into 1–3-texel charts, each with its own margin ring.
  *
  * Degenerate triangles (zero or non-finite area, indices out of range) get no chart: they
  * are counted in degenerate_count and receive no texels.

@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "bake/layout/atlas.h"
+#include "bake/layout/seams.h"
 #include "bake/layout/classify.h"
 #include "bake/layout/texels.h"
 #include "bake/probes/glg_place.h"
@@ -48,6 +49,7 @@ typedef struct bk_pipeline {
     bk_scene scene;
     bk_object_class *classes;
     bk_atlas atlas;
+    bk_seams seams;                 /* stitched after transport unless opt->no_seam_stitch */
     bk_texels texels;
     bk_tracer *tracer;
     bk_glg glg;
@@ -60,6 +62,8 @@ typedef struct bk_pipeline {
     size_t receiver_count, texel_receivers, glg_first, llg_first;
     uint32_t *texel_of_receiver;    /* receiver → index in texels.receivers */
     lbk_sh9_rgb *radiance;
+    float *variance;                /* per receiver, from the transport: the denoiser's input */
+    struct bk_denoiser *denoiser;   /* weights of the base + every set (do_denoise), for all of them */
     bk_transport_stats stats;
     bk_transport_sample *samples;
     size_t sample_count, sample_cap;

@@ -86,7 +86,8 @@ static lbk_result build_lmap(bk_pipeline *b, section_list *sl)
                       "and are stored as 0: the level's irradiance spans more than the format's range "
                       "(~7e10) within one lightmap",
                       (unsigned long long)b->flushed, (double)scale);
-    r = bk_encode_pages(tx, b->atlas.margin, lin, has, inv, pages);
+    r = bk_encode_pages(tx, b->atlas.margin, b->opt->no_seam_stitch ? NULL : &b->seams, b->opt->threads, lin, has, inv,
+                        pages);
     if (r) goto done;
     for (size_t p = 0; p < tx->page_count; p++) {
         desc[p].width = (uint32_t)tx->pages[p].width;

@@ -502,10 +502,10 @@ GlbParts split_glb(const std::vector<unsigned char> &f, const std::string &file)
     return g;
 }
 
-std::vector<unsigned char> make_glb(const std::string &json, const GlbParts &g)
+std::vector<unsigned char> make_glb(const std::string &json_text, const GlbParts &g)
 {
     std::vector<unsigned char> out;
-    size_t jpad = (json.size() + 3) & ~(size_t)3;
+    size_t jpad = (json_text.size() + 3) & ~(size_t)3;
     size_t bpad = (g.bin_len + 3) & ~(size_t)3;
     size_t total = 12 + 8 + jpad + (g.bin ? 8 + bpad : 0);
     out.reserve(total);
@@ -514,8 +514,8 @@ std::vector<unsigned char> make_glb(const std::string &json, const GlbParts &g)
     put32(out, (uint32_t)total);
     put32(out, (uint32_t)jpad);
     put32(out, 0x4E4F534Au);
-    out.insert(out.end(), json.begin(), json.end());
-    out.insert(out.end(), jpad - json.size(), ' ');
+    out.insert(out.end(), json_text.begin(), json_text.end());
+    out.insert(out.end(), jpad - json_text.size(), ' ');
     if (g.bin) {
         put32(out, (uint32_t)bpad);
         put32(out, 0x004E4942u);

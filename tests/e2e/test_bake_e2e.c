@@ -12,8 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
-
-#include <cjson/cJSON.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cjson/cJSON.h>
@@ -512,6 +511,45 @@ static void test_cli_exit_codes(void **state)
     assert_int_equal(system(cmd), 0);
 }
 
+/* Careless use: an output naming an input (or a hard link to it) is refused and the input is
+ * untouched; integer options are strict; an unwritable --json-report fails before anything is
+ * written, so neither the container nor the report appears, and the message names the OS cause. */
+static long file_size(const char *p)
+{
+    struct stat st;
+    return stat(p, &st) == 0 ? (long)st.st_size : -1;
+}
+
+static void test_cli_careless_use(void **state)
+{
+    (void)state;
+    if (!getenv("LBK")) skip();
+    char in[512], link[512], out[512], cmd[2048];
+    snprintf(in, sizeof in, "%s/careless.gltf", tmpdir);
+    snprintf(link, sizeof link, "%s/careless_link.lbk", tmpdir);
+    snprintf(out, sizeof out, "%s/careless.lbk", tmpdir);
+    snprintf(cmd, sizeof cmd, "cp scenes/cornell_box/CornellBox-Original.gltf %s && ln -f %s %s", in, in, link);
+    assert_int_equal(system(cmd), 0);
+    const long before = file_size(in);
+    assert_true(before > 0);
+    assert_int_equal(run_cli("bake %s -o %s -q --samples 32", in, in), LBK_EXIT_USAGE);
+    assert_int_equal(run_cli("bake %s -o %s -q --samples 32", in, link), LBK_EXIT_USAGE);
+    assert_int_equal(run_cli("bake %s -o %s -q --samples 32 --json-report %s", in, out, in), LBK_EXIT_USAGE);
+    assert_int_equal(file_size(in), before);
+    const char *bad[] = {"--threads 1.5", "--threads -2", "--seed -1", "--seed 1e3", "--samples 0x20",
+                         "--samples ' 32'", "--max-bounces 2.0"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)
+        assert_int_equal(run_cli("bake %s -o %s -q %s", in, out, bad[i]), LBK_EXIT_USAGE);
+    assert_int_equal(run_cli("bake %s -o %s -q --samples 32 --json-report %s/no/such/dir/r.json", in, out, tmpdir),
+                     LBK_EXIT_IO);
+    assert_int_equal(file_size(out), -1);
+    snprintf(cmd, sizeof cmd,
+             "%s bake %s -o %s -q --samples 32 --json-report %s/no/r.json 2>&1 | grep -q 'No such file or directory'",
+             getenv("LBK"), in, out, tmpdir);
+    assert_int_equal(system(cmd), 0);
+    assert_int_equal(file_size(out), -1);
+}
+
 /* Two nodes named "crate" (and a third): OBJS gets "crate", "crate#2", "crate#3" in scene order
  * (spec §8.2), so the validator has no duplicate-name warning and diff can match them. */
 static int no_warning(void *user, const lbk_issue *issue)
@@ -588,6 +626,7 @@ int main(void)
         cmocka_unit_test(test_tools_on_baker_output),
         cmocka_unit_test(test_duplicate_names_made_unique),
         cmocka_unit_test(test_cli_exit_codes),
+        cmocka_unit_test(test_cli_careless_use),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -20,6 +20,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "support/bake_file.h"
 #include "bake/scene/import.h"
 #include "tools/common/bake_data.h"
 #include "tools/common/file_util.h"
@@ -53,18 +54,18 @@ static const char *scenes_dir(void)
 
 static void bake(const char *in, const char *out, float density)
 {
-    tb_job j;
-    memset(&j, 0, sizeof j);
-    j.in = in;
-    j.out = out;
-    j.d.preset = LBK_BAKE_PRESET_FAST;
-    j.d.seed = 1;
-    j.d.max_samples = 16;
-    j.d.threads = 2;
-    j.d.texel_density = density;
-    j.d.no_glg = 1;
+    tb_job o;
+    memset(&o, 0, sizeof o);
+    o.in = in;
+    o.out = out;
+    o.d.preset = LBK_BAKE_PRESET_FAST;
+    o.d.seed = 1;
+    o.d.max_samples = 16;
+    o.d.threads = 2;
+    o.d.texel_density = density;
+    o.d.no_glg = 1;
     char err[512];
-    if (tb_bake(&j, NULL, err, sizeof err) != LBK_OK) fail_msg("bake %s: %s", in, err);
+    if (tb_bake(&o, NULL, err, sizeof err)) fail_msg("bake %s: %s", in, err);
 }
 
 static void import(const char *path, bk_scene *s)
