@@ -173,7 +173,7 @@ static void test_every_input_and_option(void **state)
 /* Copies the level into the temp folder with checkerBJS.png repainted (another valid PNG). */
 static void copy_with_new_texture(const char *to)
 {
-    char cmd[3000];
+    char cmd[4600]; /* four 1023-byte paths */
     snprintf(cmd, sizeof cmd, "mkdir -p '%s' && cp '%s'/*.gltf '%s'/*.bin '%s'/*.png '%s'/", to, scene_dir, scene_dir,
              scene_dir, to);
     assert_int_equal(system(cmd), 0);
@@ -193,7 +193,7 @@ static void test_diff_names_the_changed_texture(void **state)
     snprintf(b_dir, sizeof b_dir, "%s/level_b", dir);
     snprintf(sky, sizeof sky, "%s/sky.exr", dir);
     write_sky(sky);
-    char cmd[600];
+    char cmd[4600];
     snprintf(cmd, sizeof cmd, "mkdir -p '%s' && cp '%s'/*.gltf '%s'/*.bin '%s'/*.png '%s'/", a_dir, scene_dir, scene_dir,
              scene_dir, a_dir);
     assert_int_equal(system(cmd), 0);
