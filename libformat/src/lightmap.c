@@ -391,7 +391,8 @@ static inline uint32_t maybe_short(uint32_t v)
 /* With AVX2 where the CPU has it (GCC's function multiversioning picks at load time): twice the
  * texels per instruction of the SSE2 default, which is what keeps the fused checksum + texel pass
  * at memory speed. Not under the sanitizers (ifunc resolvers run before their runtime). */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__) && defined(__ELF__)
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__) && \
+    !defined(__SANITIZE_THREAD__) && defined(__ELF__)
 #define LBK_BLOCK_CLONES __attribute__((target_clones("avx2", "default")))
 #else
 #define LBK_BLOCK_CLONES

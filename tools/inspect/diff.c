@@ -133,11 +133,21 @@ static void texel_bilinear(const pageref *pg, const uint32_t rect[4], double u, 
                                  (c[2][n][ch] * (1 - tx) + c[3][n][ch] * tx) * ty);
 }
 
+static int bake_denoised(const tl_bake *b)
+{
+    lbk_string v;
+    return b->has_meta && lbk_meta_find(&b->meta, "bake.denoise", &v) == LBK_OK && v.size == 4 &&
+           memcmp(v.data, "auto", 4) == 0;
+}
+
+/* A denoised bake's texels are at least REPT's noise (tl_noise_model.denoised). */
+static double texel_floor(const tl_noise_model *m, int side) { return m->denoised[side] ? m->rept[side][0] : 0; }
+
 /* Relative noise of an object's lightmap (diff_noise.h): the high-pass of its own texels at each
  * of the five normals against the texel's level (its mean over them), the largest of the five, for
  * the mean test (REPT's estimate when the rectangle is too small to tell); and when `local` is not
  * NULL, per texel the high-pass of its 4×4 tile at +Z, for the texel test (malloc'ed, w × h). */
-static double rect_noise(const pageref *pg, const uint32_t rect[4], double fallback, float **local)
+static double rect_noise(const pageref *pg, const uint32_t rect[4], double fallback, double floor_noise, float **local)
 {
     const size_t n = (size_t)rect[2] * rect[3];
     if (local) *local = NULL;
@@ -158,7 +168,11 @@ static double rect_noise(const pageref *pg, const uint32_t rect[4], double fallb
     double s = -1;
     for (int k = 0; k < TL_TEXEL_NORMALS; k++) s = fmax(s, tl_noise_highpass(lum + k * (n + 1), ref, rect[2], rect[3]));
     if (s < 0) s = fallback;
-    if (local && (*local = malloc(sizeof **local * (n + 1)))) tl_noise_highpass_tiles(lum, rect[2], rect[3], s, *local);
+    s = fmax(s, floor_noise);
+    if (local && (*local = malloc(sizeof **local * (n + 1)))) {
+        tl_noise_highpass_tiles(lum, rect[2], rect[3], s, *local);
+        for (size_t i = 0; i < n; i++) (*local)[i] = fmaxf((*local)[i], (float)floor_noise);
+    }
     free(lum);
     return s;
 }
@@ -273,8 +287,8 @@ static void compare_object(const tl_bake *a, const tl_bake *b, const lbk_object 
         d->resampled = !same_size;
         float *local_a = NULL, *local_b = NULL;
         if (t->noise)
-            tl_noise_begin(&d->noise, t->noise, 0, rect_noise(&pa, d->rect_a, t->noise->rept[0][0], &local_a),
-                           rect_noise(&pb, d->rect_b, t->noise->rept[1][0], same_size ? &local_b : NULL));
+            tl_noise_begin(&d->noise, t->noise, 0, rect_noise(&pa, d->rect_a, t->noise->rept[0][0], texel_floor(t->noise, 0), &local_a),
+                           rect_noise(&pb, d->rect_b, t->noise->rept[1][0], texel_floor(t->noise, 1), same_size ? &local_b : NULL));
         for (uint32_t y = 0; y < oa->rect_h; y++)
             for (uint32_t x = 0; x < oa->rect_w; x++) {
                 float va[TL_TEXEL_NORMALS][3], vb[TL_TEXEL_NORMALS][3];
@@ -445,8 +459,8 @@ static int diff_pages(const tl_bake *a, const tl_bake *b, const tol *t, int keep
         int objects_changed = 0;
         if (t->noise) {
             const uint32_t rect_a[4] = {0, 0, pa.width, pa.height}, rect_b[4] = {0, 0, pb.width, pb.height};
-            rect_noise(&ra, rect_a, t->noise->rept[0][0], &local_a);
-            rect_noise(&rb, rect_b, t->noise->rept[1][0], &local_b);
+            rect_noise(&ra, rect_a, t->noise->rept[0][0], texel_floor(t->noise, 0), &local_a);
+            rect_noise(&rb, rect_b, t->noise->rept[1][0], texel_floor(t->noise, 1), &local_b);
             owner = malloc(sizeof *owner * ((size_t)pa.width * pa.height + 1));
             if (!owner || !local_a || !local_b) {
                 free(owner), free(local_a), free(local_b);
@@ -890,6 +904,8 @@ static void choose_mode(const tl_bake *a, const tl_bake *b, const tl_diff_option
     const double ra[2] = {a->has_rept ? a->rept_last.texel_rel_rmse : 0, a->has_rept ? a->rept_last.probe_rel_rmse : 0};
     const double rb[2] = {b->has_rept ? b->rept_last.texel_rel_rmse : 0, b->has_rept ? b->rept_last.probe_rel_rmse : 0};
     tl_noise_model_init(model, o->false_alarm > 0 ? o->false_alarm : TL_NOISE_DEFAULT_FALSE_ALARM, ra, rb);
+    model->denoised[0] = bake_denoised(a);
+    model->denoised[1] = bake_denoised(b);
 }
 
 int tl_diff_run(const tl_bake *a, const tl_bake *b, const tl_diff_options *o, tl_diff_result *r, char err[TL_ERR_LEN])

@@ -43,6 +43,10 @@ typedef struct tl_noise_model {
     double common;          /* c */
     /* REPT's final estimates: [side][0 texels, 1 probes]; 0 when REPT is absent */
     double rept[2][2];
+    /* per side: the bake was denoised (META bake.denoise = auto). The denoiser removes the high
+     * frequencies a texel's own high-pass measures, and what noise remains is smooth, so for a
+     * denoised bake the texel noise is at least REPT's (the undenoised estimate, an upper side) */
+    int denoised[2];
 } tl_noise_model;
 
 /* α → the model's thresholds; rept from the two bakes. */
