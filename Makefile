@@ -10,7 +10,8 @@ CLANG    ?= clang
 # Debian packages: liblbk alone (`make install-lib`), the baker and CLI, the tests on top.
 DEB_LIB_PKGS  := build-essential libzstd-dev libxxhash-dev
 DEB_TOOL_PKGS := $(DEB_LIB_PKGS) libembree-dev libopenexr-dev libdraco-dev libtinygltf-dev libstb-dev \
-                 nlohmann-json3-dev libqhull-dev libspng-dev libcjson-dev
+                 nlohmann-json3-dev libqhull-dev libspng-dev libcjson-dev \
+                 libastcenc-dev
 DEB_PKGS      := $(DEB_TOOL_PKGS) pkg-config libcmocka-dev clang libclang-rt-14-dev
 
 WARN     := -Wall -Wextra -Wshadow -Wstrict-prototypes -Wmissing-prototypes -Wno-unused-parameter
@@ -27,19 +28,23 @@ CSTD     := -std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE
 OPT      ?= -O2 -g
 SAN      := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
 
-LIB_INC  := -Ilibformat/include
+# xxHash's x86 runtime dispatch (AVX2/AVX-512 checksums) when the installed libxxhash has it
+XXH_DISPATCH := $(shell printf '\043include <xxh_x86dispatch.h>\nint main(void){return (int)XXH3_64bits_dispatch("", 0);}\n' | \
+                  $(CC) -x c - -o /dev/null -lxxhash 2>/dev/null && echo -DLBK_HAVE_XXH_DISPATCH)
+LIB_INC  := -Ilibformat/include $(XXH_DISPATCH)
 LIB_LIBS := -lzstd -lxxhash -lm
 # The baker (liblbkbake) and the tools: everything heavy lives here, never in liblbk.
 TOOL_INC := $(LIB_INC) -Ibake/include -I. -I/usr/include/draco -I/usr/include/stb
 BAKE_LIBS:= -lembree3 -lOpenEXRCore -lqhull_r -lspng -lcjson -ldraco -lpthread -lm
-TOOL_LIBS:= $(BAKE_LIBS) $(LIB_LIBS)
+# astcenc: the ASTC plane encodings of lbk convert / export / diff (tools/common/astc_codec.cc)
+TOOL_LIBS:= $(BAKE_LIBS) -lastcenc $(LIB_LIBS)
 TOOL_CXXINC := $(LIB_INC) -Ibake/include -I. -isystem /usr/include/draco -isystem /usr/include/stb
 
 LIB_SRC   := $(sort $(wildcard libformat/src/*.c))
 BAKE_CSRC := $(sort $(wildcard bake/*/*.c))
 BAKE_CXXSRC := $(sort $(wildcard bake/*/*.cc))
 TOOL_CSRC := $(sort $(wildcard cli/*.c bake/*/*.c tools/*/*.c))
-TOOL_CXXSRC := $(BAKE_CXXSRC)
+TOOL_CXXSRC := $(BAKE_CXXSRC) $(sort $(wildcard tools/*/*.cc))
 TOOL_MAIN := cli/main.c
 TEST_SRC  := $(sort $(wildcard tests/*/test_*.c))
 TESTS     := $(notdir $(TEST_SRC:.c=))
@@ -52,12 +57,13 @@ LIB_PIC   := $(LIB_SRC:%.c=$(BUILD)/pic/%.o)
 BAKE_OBJ  := $(BAKE_CSRC:%.c=$(BUILD)/rel/%.o) $(BAKE_CXXSRC:%.cc=$(BUILD)/rel/%.o)
 BAKE_PIC  := $(BAKE_CSRC:%.c=$(BUILD)/pic/%.o) $(BAKE_CXXSRC:%.cc=$(BUILD)/pic/%.o)
 # cli/ and tools/ (the baker comes from liblbkbake.a)
-TOOL_OBJ  := $(filter-out $(BUILD)/rel/$(TOOL_MAIN:.c=.o) $(BAKE_OBJ),$(TOOL_CSRC:%.c=$(BUILD)/rel/%.o))
+TOOL_OBJ  := $(filter-out $(BUILD)/rel/$(TOOL_MAIN:.c=.o) $(BAKE_OBJ),$(TOOL_CSRC:%.c=$(BUILD)/rel/%.o)) \
+             $(patsubst %.cc,$(BUILD)/rel/%.o,$(sort $(wildcard tools/*/*.cc)))
 # Sanitizer objects for the test build
 LIB_ASAN  := $(LIB_SRC:%.c=$(BUILD)/asan/%.o)
 TOOL_ASAN := $(filter-out $(BUILD)/asan/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUILD)/asan/%.o)) $(TOOL_CXXSRC:%.cc=$(BUILD)/asan/%.o)
 
-.PHONY: all lib bake-lib deps demo test check bench bench-render fuzz install install-check clean help gltf-validator
+.PHONY: all lib bake-lib deps demo test check bench bench-render mesa-bc-check fuzz install install-check clean help gltf-validator
 all: $(BUILD)/lbk $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc \
      $(BUILD)/liblbkbake.a $(BUILD)/liblbkbake.so $(BUILD)/lbk-bake.pc
 
@@ -73,6 +79,7 @@ help:
 	@echo "WERROR=1        every compiler warning is an error (CI)"
 	@echo "make bench      benchmarks, printed as ratios against baselines measured in the same run"
 	@echo "make bench-render  lbk render against Blender Cycles (LBK_CYCLES_HARNESS=bench/cycles of the cycles branch)"
+	@echo "make mesa-bc-check  BC6H/BC4 codecs against Mesa's (optional: libegl-dev libgl-dev)"
 	@echo "make fuzz       libFuzzer harness for the container reader (clang)"
 	@echo "make install PREFIX=/usr/local"
 
@@ -308,6 +315,13 @@ $(BUILD)/bench/%: bench/%.c $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) -O2 -g $(WARN) $(TOOL_INC) -c $< -o $@.o
 	$(CXX) -o $@ $@.o $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a $(TOOL_LIBS)
+# The BC codecs against Mesa's (llvmpipe, surfaceless EGL): optional, needs libegl-dev libgl-dev.
+mesa-bc-check: $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a
+	@mkdir -p $(BUILD)/bench
+	$(CC) $(CSTD) -O2 -g $(WARN) $(TOOL_INC) -c bench/mesa_bc_check.c -o $(BUILD)/bench/mesa_bc_check.o
+	$(CXX) -o $(BUILD)/bench/mesa_bc_check $(BUILD)/bench/mesa_bc_check.o $(TOOL_OBJ) $(BUILD)/liblbkbake.a \
+	    $(BUILD)/liblbk.a $(TOOL_LIBS) -lEGL -lGL
+	$(BUILD)/bench/mesa_bc_check
 bench: deps-tools
 	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BENCHES:%=$(BUILD)/bench/%)
 	@for b in $(BENCHES); do echo "== $$b"; $(BUILD)/bench/$$b || exit 1; done

@@ -5,7 +5,7 @@
 /* Exit codes, the same for every subcommand (README "Exit codes"). */
 enum {
     LBK_EXIT_OK = 0,        /* success; validate: valid; diff: equal within tolerance */
-    LBK_EXIT_NEGATIVE = 1,  /* validate: the file is invalid; diff: the bakes differ */
+    LBK_EXIT_NEGATIVE = 1,  /* validate: the file is invalid; diff: the bakes differ; inspect --budget: over budget */
     LBK_EXIT_USAGE = 2,     /* bad command line */
     LBK_EXIT_IO = 3,        /* a file could not be read or written */
     LBK_EXIT_INPUT = 4,     /* an input is unusable (bad glTF, invalid container for a reader) */

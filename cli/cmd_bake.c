@@ -36,6 +36,8 @@ static void help(FILE *f)
           "  --sky R,G,B | FILE.exr  sky radiance (overrides the scene's lbk_sky)\n"
           "  --no-glg                leave out the global light grid\n"
           "  --octahedral            also write GIBS-style octahedral probes (OCTP)\n"
+          "  --block-align           charts on 4-texel boundaries, so no 4x4 block of a block-compressed pack\n"
+          "                          (lbk convert --profile console-current, handheld) holds two charts\n"
           "  --dls-threshold X       light sets and doors store a texel/probe only where their light\n"
           "                          exceeds X times the mean indirect light of the texels they light\n"
           "                          directly (default 0.01; 0 keeps every lit receiver)\n"
@@ -251,6 +253,7 @@ int lbk_cmd_bake(int argc, char **argv)
 {
     bake_args o;
     memset(&o, 0, sizeof o);
+    o.d.size = sizeof o.d; /* this build's fields, block_align included */
     o.d.seed = 1;
     int quiet = 0;
     for (int i = 1; i < argc; i++) {
@@ -334,6 +337,8 @@ int lbk_cmd_bake(int argc, char **argv)
             o.d.no_glg = 1;
         } else if (!strcmp(a, "--octahedral")) {
             o.d.octahedral_probes = 1;
+        } else if (!strcmp(a, "--block-align")) {
+            o.d.block_align = 1;
         } else if (!strcmp(a, "--dls-threshold")) {
             NEED_NUMBER(0, 1);
             o.d.dls_threshold = d > 0 ? d : -1;

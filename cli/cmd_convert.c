@@ -6,6 +6,7 @@
 #include <time.h>
 
 #include "cli/cli.h"
+#include "tools/common/lmap_decode.h"
 #include "tools/convert/convert.h"
 #include "tools/common/file_util.h"
 
@@ -132,6 +133,9 @@ int lbk_cmd_convert(int argc, char **argv)
         }
         printf("  file  %-12s %12llu  %12llu\n", "", (unsigned long long)rep.in_size, (unsigned long long)rep.out_size);
         if (exr_dir) printf("  imported %u page(s) from %s\n", rep.pages_imported, exr_dir);
+        if (profile.lmap_format[0] || profile.lmap_format[1])
+            printf("  lightmap planes %s + %s: block-encoded in %.2f s\n", tl_lmap_format_name(0, profile.lmap_format[0]),
+                   tl_lmap_format_name(1, profile.lmap_format[1]), rep.encode_seconds);
     }
     return LBK_EXIT_OK;
 }

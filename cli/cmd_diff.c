@@ -11,28 +11,39 @@
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: lbk diff A.lbk B.lbk [--abs-tol X] [--rel-tol Y] [--json] [--heatmap DIR] [-v]\n"
+            "usage: lbk diff A.lbk B.lbk [--mode noise|tolerance] [--false-alarm P] [--abs-tol X] [--rel-tol Y]\n"
+            "                [--json] [--heatmap DIR] [-v]\n"
             "\n"
             "Compares decoded lighting, not bytes. Objects are matched by name and geometry hash (then by\n"
             "name alone, then by hash alone = renamed), never by position in the file; pages by index;\n"
             "GLG probes by index when both grids have the same probe positions, otherwise B is sampled at A's\n"
             "probes; LLG probes through their object; light sets and doors by name.\n"
-            "A texel's (probe's) error is the largest |B - A| of the decoded irradiance over R, G, B and over\n"
-            "5 tangent-space normals (+Z and 45 degrees toward +-X, +-Y) (6 axis normals for probes). It is\n"
-            "over tolerance when error > abs-tol + rel-tol * max|A| over the same values.\n"
+            "Two verdicts (spec/diff-json.md):\n"
+            "  noise mode (the default when both bakes carry REPT): an object, the GLG or a light set differs\n"
+            "    when its change exceeds the Monte Carlo noise of the two bakes: its mean shift beyond\n"
+            "    k x the noise of the mean (REPT's estimate and the object's own texel noise), or more\n"
+            "    texels changing beyond their noise than the false-alarm rate allows. A reseed is equal.\n"
+            "  tolerance mode (--abs-tol/--rel-tol, or --mode tolerance; exact with 0): a texel's (probe's)\n"
+            "    error is the largest |B - A| of the decoded irradiance over R, G, B and over 5 tangent-space\n"
+            "    normals (+Z and 45 degrees toward +-X, +-Y) (6 axis normals for probes); it is over\n"
+            "    tolerance when error > abs-tol + rel-tol * max|A| over the same values.\n"
+            "What changed in the inputs and options (META provenance: options, files, lights, materials,\n"
+            "per-object geometry/material/options) is listed first.\n"
             "Reported per object, page, grid and light set: max and mean absolute error, relative RMSE,\n"
             "share of samples over tolerance and their bounding region; plus added/removed/changed\n"
             "objects, sections and META bake parameters. Units: irradiance as baked (lux-like, lm/m^2).\n"
             "\n"
-            "  --abs-tol X     absolute tolerance (default 0)\n"
-            "  --rel-tol Y     relative tolerance (default 0)\n"
+            "  --mode M        noise or tolerance (default: noise when both bakes carry REPT)\n"
+            "  --false-alarm P noise mode: false-alarm rate per item, 0 < P < 0.5 (default 0.001)\n"
+            "  --abs-tol X     absolute tolerance (default 0); implies tolerance mode unless --mode noise\n"
+            "  --rel-tol Y     relative tolerance (default 0); implies tolerance mode unless --mode noise\n"
             "  --json          JSON on stdout (schema spec/diff-json.md, schema_version %d)\n"
             "  --heatmap DIR   DIR/page_NNN.diff.png per page: black = within tolerance, blue..white = error\n"
             "                  over tolerance relative to the page's largest, grey = not compared\n"
             "  -v, --verbose   list unchanged items too\n"
             "  -h, --help      this text\n"
             "\n"
-            "exit codes: 0 equal within tolerance, 1 the bakes differ (lighting, objects, pages, probes,\n"
+            "exit codes: 0 equal (within noise / tolerance), 1 the bakes differ (lighting, objects, pages, probes,\n"
             "            light sets, doors or lighting sections; META/REPT differences alone do not count),\n"
             "            2 usage, 3 I/O error, 4 an input is not a valid container, 5 internal error\n",
             TL_DIFF_SCHEMA_VERSION);
@@ -55,7 +66,9 @@ int lbk_cmd_diff(int argc, char **argv)
 {
     const char *path[2] = {NULL, NULL}, *heat = NULL;
     int json = 0, verbose = 0, npath = 0;
-    tl_diff_options o = {0, 0, 0};
+    tl_diff_options o = {0};
+    o.mode = TL_DIFF_MODE_AUTO;
+    int mode_given = 0, tol_given = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
@@ -65,14 +78,33 @@ int lbk_cmd_diff(int argc, char **argv)
             json = 1;
         } else if (!strcmp(a, "-v") || !strcmp(a, "--verbose")) {
             verbose = 1;
-        } else if (!strcmp(a, "--abs-tol") || !strcmp(a, "--rel-tol") || !strcmp(a, "--heatmap")) {
+        } else if (!strcmp(a, "--abs-tol") || !strcmp(a, "--rel-tol") || !strcmp(a, "--heatmap") ||
+                   !strcmp(a, "--mode") || !strcmp(a, "--false-alarm")) {
             if (i + 1 >= argc) {
                 fprintf(stderr, "lbk diff: %s needs a value\n", a);
                 return LBK_EXIT_USAGE;
             }
             const char *v = argv[++i];
-            if (!strcmp(a, "--heatmap")) heat = v;
-            else if (parse_tol(a, v, !strcmp(a, "--abs-tol") ? &o.abs_tol : &o.rel_tol)) return LBK_EXIT_USAGE;
+            if (!strcmp(a, "--heatmap")) {
+                heat = v;
+            } else if (!strcmp(a, "--mode")) {
+                if (!strcmp(v, "noise")) o.mode = TL_DIFF_MODE_NOISE;
+                else if (!strcmp(v, "tolerance")) o.mode = TL_DIFF_MODE_TOLERANCE;
+                else {
+                    fprintf(stderr, "lbk diff: --mode is noise or tolerance, got '%s'\n", v);
+                    return LBK_EXIT_USAGE;
+                }
+                mode_given = 1;
+            } else if (!strcmp(a, "--false-alarm")) {
+                if (parse_tol(a, v, &o.false_alarm)) return LBK_EXIT_USAGE;
+                if (!(o.false_alarm > 0 && o.false_alarm < 0.5)) {
+                    fprintf(stderr, "lbk diff: --false-alarm needs 0 < P < 0.5, got '%s'\n", v);
+                    return LBK_EXIT_USAGE;
+                }
+            } else {
+                if (parse_tol(a, v, !strcmp(a, "--abs-tol") ? &o.abs_tol : &o.rel_tol)) return LBK_EXIT_USAGE;
+                tol_given = 1;
+            }
         } else if (a[0] == '-' && a[1]) {
             fprintf(stderr, "lbk diff: unknown option '%s' (see lbk diff --help)\n", a);
             return LBK_EXIT_USAGE;
@@ -87,6 +119,7 @@ int lbk_cmd_diff(int argc, char **argv)
         fprintf(stderr, "lbk diff: need two containers A.lbk B.lbk (see lbk diff --help)\n");
         return LBK_EXIT_USAGE;
     }
+    if (tol_given && !mode_given) o.mode = TL_DIFF_MODE_TOLERANCE;
     o.keep_error_maps = heat != NULL;
     char err[TL_ERR_LEN];
     tl_bake bake[2];

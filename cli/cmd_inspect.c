@@ -9,7 +9,10 @@
 #include <cjson/cJSON.h>
 
 #include "cli/cli.h"
+#include "tools/common/bake_data.h"
+#include "tools/inspect/budget.h"
 #include "tools/inspect/describe.h"
+#include "tools/inspect/memory.h"
 #include "lbk/container.h"
 
 typedef struct section_row {
@@ -24,17 +27,26 @@ typedef struct section_row {
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: lbk inspect FILE [--json]\n"
+            "usage: lbk inspect FILE [--json] [--budget SIZE|FILE]\n"
             "\n"
             "Memory per level: for each section the bytes on disk, decoded bytes and GPU-resident\n"
             "bytes, plus header, table and padding bytes (the disk column adds up to the file size),\n"
             "then the level statistics of seed 001 Table 1 (lightmap texels, LLG probes, GLG probes,\n"
             "dynamic light sets, doors, memory without and with DLS).\n"
             "\n"
-            "  --json    one JSON document (schema \"lbk-inspect/1\", spec/inspect-json.md)\n"
-            "  --help    this text\n"
+            "With --json also the GPU memory of every object (lightmap texels, LLG probes, the light-set\n"
+            "entries that touch it) and of every light set, for a pipeline to chart per revision.\n"
             "\n"
-            "exit codes: 0 ok, 2 usage, 3 I/O error, 4 not a readable container (run lbk validate), 5 internal\n");
+            "  --json           one JSON document (schema \"lbk-inspect/1\", spec/inspect-json.md)\n"
+            "  --budget SIZE    a build gate: fail when the level's GPU memory exceeds SIZE (e.g. 48MiB)\n"
+            "  --budget FILE    ... or the limits of a budget file: total, per section type, per object,\n"
+            "                   per light set (spec/inspect-json.md \"Budget files\"); every item over its\n"
+            "                   limit is named\n"
+            "  --help           this text\n"
+            "\n"
+            "exit codes: 0 ok (within budget), 1 over budget, 2 usage, 3 I/O error, 4 not a readable\n"
+            "            container (run lbk validate; --budget and per-object numbers need a valid one),\n"
+            "            5 internal\n");
 }
 
 /* 1234567 → "1,234,567" */
@@ -89,6 +101,10 @@ typedef struct report {
     uint64_t memory_without_dls, memory_with_dls;
     inspect_stats level;
     int any_unreadable;
+    const tl_level_memory *memory; /* per object / light set (a valid file), else NULL */
+    const char *memory_error;
+    const tl_budget *budget;       /* --budget, else NULL */
+    const tl_budget_result *budget_result;
 } report;
 
 static void print_text(const report *r)
@@ -138,6 +154,16 @@ static void print_text(const report *r)
            l->dls_sets, l->dls_clusters, grouped(l->dls_payload_bytes, a), grouped(l->dls_ancillary_bytes, b),
            l->door_states);
     printf("  memory = GPU-resident bytes; \"no DLS\" leaves out the DLS and DOOR sections\n");
+    if (r->budget) {
+        const tl_budget_result *br = r->budget_result;
+        printf("\nbudget %s: %zu limits checked, %s\n", r->budget->name, br->checked,
+               br->violation_count ? "OVER BUDGET" : "within budget");
+        for (size_t i = 0; i < br->violation_count; i++) {
+            const tl_budget_violation *v = &br->violations[i];
+            printf("  over budget: %s%s%s %s B > %s B (by %s B)\n", tl_budget_kind_name(v->kind), v->name[0] ? " " : "",
+                   v->name, grouped(v->bytes, a), grouped(v->limit, b), grouped(v->bytes - v->limit, c));
+        }
+    }
 }
 
 static int print_json(const report *r)
@@ -190,6 +216,10 @@ static int print_json(const report *r)
     if (lv) {
         cJSON_AddNumberToObject(lv, "lm_texels", (double)l->lm_texels);
         cJSON_AddNumberToObject(lv, "lm_pages", (double)l->lm_pages);
+        uint64_t lm_gpu = 0;
+        for (uint32_t i = 0; i < r->count; i++)
+            if (r->rows[i].info.type == LBK_SECTION_LMAP) lm_gpu = r->rows[i].st.gpu_bytes;
+        cJSON_AddNumberToObject(lv, "lm_gpu_bytes_per_texel", l->lm_texels ? (double)lm_gpu / (double)l->lm_texels : 0.0);
         cJSON_AddNumberToObject(lv, "llg_probes", (double)l->llg_probes);
         cJSON_AddNumberToObject(lv, "llg_grids", (double)l->llg_grids);
         cJSON_AddNumberToObject(lv, "llg_vertices", (double)l->llg_vertices);
@@ -207,6 +237,69 @@ static int print_json(const report *r)
         cJSON_AddNumberToObject(lv, "memory_without_dls_bytes", (double)r->memory_without_dls);
         cJSON_AddNumberToObject(lv, "memory_with_dls_bytes", (double)r->memory_with_dls);
     }
+    if (r->memory) {
+        cJSON *objs = cJSON_AddArrayToObject(doc, "objects");
+        for (size_t i = 0; objs && i < r->memory->object_count; i++) {
+            const tl_object_memory *o = &r->memory->objects[i];
+            cJSON *j = cJSON_CreateObject();
+            if (!j || !cJSON_AddItemToArray(objs, j)) {
+                cJSON_Delete(j);
+                break;
+            }
+            cJSON_AddStringToObject(j, "name", o->name);
+            cJSON_AddStringToObject(j, "representation", lbk_representation_name(o->representation));
+            cJSON_AddNumberToObject(j, "texels", (double)o->texels);
+            cJSON_AddNumberToObject(j, "lightmap_bytes", (double)o->lightmap_bytes);
+            cJSON_AddNumberToObject(j, "llg_probes", (double)o->llg_probes);
+            cJSON_AddNumberToObject(j, "llg_vertices", (double)o->llg_vertices);
+            cJSON_AddNumberToObject(j, "llg_bytes", (double)o->llg_bytes);
+            cJSON_AddNumberToObject(j, "dls_entries", (double)o->dls_entries);
+            cJSON_AddNumberToObject(j, "dls_bytes", (double)o->dls_bytes);
+            cJSON_AddNumberToObject(j, "total_bytes", (double)o->total_bytes);
+        }
+        cJSON *sets = cJSON_AddArrayToObject(doc, "light_sets");
+        for (size_t i = 0; sets && i < r->memory->set_count; i++) {
+            const tl_set_memory *m = &r->memory->sets[i];
+            cJSON *j = cJSON_CreateObject();
+            if (!j || !cJSON_AddItemToArray(sets, j)) {
+                cJSON_Delete(j);
+                break;
+            }
+            static const char *const kinds[] = {"lights", "door_open", "door_closed", "combination"};
+            cJSON_AddStringToObject(j, "name", m->name);
+            cJSON_AddStringToObject(j, "kind", m->kind < 4 ? kinds[m->kind] : "unknown");
+            cJSON_AddNumberToObject(j, "texel_entries", (double)m->entries[0]);
+            cJSON_AddNumberToObject(j, "glg_entries", (double)m->entries[1]);
+            cJSON_AddNumberToObject(j, "llg_entries", (double)m->entries[2]);
+            cJSON_AddNumberToObject(j, "payload_bytes", (double)m->payload_bytes);
+        }
+        cJSON_AddNumberToObject(doc, "dls_unowned_bytes", (double)r->memory->dls_unowned_bytes);
+    } else {
+        cJSON_AddNullToObject(doc, "objects");
+        cJSON_AddNullToObject(doc, "light_sets");
+        cJSON_AddStringToObject(doc, "objects_error", r->memory_error ? r->memory_error : "");
+    }
+    if (r->budget) {
+        cJSON *bj = cJSON_AddObjectToObject(doc, "budget");
+        cJSON_AddStringToObject(bj, "name", r->budget->name);
+        cJSON_AddNumberToObject(bj, "checked", (double)r->budget_result->checked);
+        cJSON_AddBoolToObject(bj, "within", r->budget_result->violation_count == 0);
+        cJSON *vs = cJSON_AddArrayToObject(bj, "violations");
+        for (size_t i = 0; vs && i < r->budget_result->violation_count; i++) {
+            const tl_budget_violation *v = &r->budget_result->violations[i];
+            cJSON *j = cJSON_CreateObject();
+            if (!j || !cJSON_AddItemToArray(vs, j)) {
+                cJSON_Delete(j);
+                break;
+            }
+            cJSON_AddStringToObject(j, "kind", tl_budget_kind_name(v->kind));
+            cJSON_AddStringToObject(j, "name", v->name);
+            cJSON_AddNumberToObject(j, "bytes", (double)v->bytes);
+            cJSON_AddNumberToObject(j, "limit", (double)v->limit);
+        }
+    } else {
+        cJSON_AddNullToObject(doc, "budget");
+    }
     char *text = cJSON_Print(doc);
     cJSON_Delete(doc);
     if (!text) return 0;
@@ -217,10 +310,17 @@ static int print_json(const report *r)
 
 int lbk_cmd_inspect(int argc, char **argv)
 {
-    const char *path = NULL;
+    const char *path = NULL, *budget_arg = NULL;
     int json = 0;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--json")) json = 1;
+        else if (!strcmp(argv[i], "--budget")) {
+            if (i + 1 >= argc) {
+                fprintf(stderr, "lbk inspect: --budget needs a SIZE or a FILE\n");
+                return LBK_EXIT_USAGE;
+            }
+            budget_arg = argv[++i];
+        }
         else if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             usage(stdout);
             return LBK_EXIT_OK;
@@ -237,6 +337,12 @@ int lbk_cmd_inspect(int argc, char **argv)
     }
     if (!path) {
         usage(stderr);
+        return LBK_EXIT_USAGE;
+    }
+    static tl_budget budget;
+    char err[TL_ERR_LEN];
+    if (budget_arg && tl_budget_load(budget_arg, &budget, err)) {
+        fprintf(stderr, "lbk inspect: %s\n", err);
         return LBK_EXIT_USAGE;
     }
     lbk_reader *reader;
@@ -290,10 +396,48 @@ int lbk_cmd_inspect(int argc, char **argv)
     if (r.h->file_size > prev_end) r.padding_bytes += r.h->file_size - prev_end;
     r.disk_total = r.header_bytes + r.table_bytes + sections_disk + r.padding_bytes;
 
+    /* per object and light set: needs the views, so a file that validates */
+    tl_bake bake;
+    tl_level_memory mem;
+    int have_mem = 0;
+    if (json || budget_arg) {
+        tl_open_status st = tl_bake_open_file(path, &bake, err);
+        if (st == TL_OPEN_OK) {
+            if (tl_level_memory_get(&bake, &mem) == 0) have_mem = 1, r.memory = &mem;
+            else r.memory_error = "out of memory";
+            tl_bake_close(&bake);
+        } else {
+            r.memory_error = "the file does not validate (run lbk validate)";
+        }
+    }
+    tl_budget_result br = {0};
+    uint32_t types[LBK_MAX_SECTIONS];
+    uint64_t gpu[LBK_MAX_SECTIONS];
+    if (budget_arg) {
+        for (uint32_t i = 0; i < r.count; i++) types[i] = r.rows[i].info.type, gpu[i] = r.rows[i].st.gpu_bytes;
+        tl_budget_level lv = {r.memory_with_dls, types, gpu, r.count, r.memory};
+        if (!r.memory) {
+            fprintf(stderr, "lbk inspect: %s: %s; a budget needs a valid container\n", path, r.memory_error);
+            lbk_reader_close(reader);
+            return LBK_EXIT_INPUT;
+        }
+        if (tl_budget_check(&budget, &lv, &br)) {
+            fprintf(stderr, "lbk inspect: out of memory\n");
+            lbk_reader_close(reader);
+            if (have_mem) tl_level_memory_free(&mem);
+            return LBK_EXIT_INTERNAL;
+        }
+        r.budget = &budget;
+        r.budget_result = &br;
+    }
+
     int ok = 1;
     if (json) ok = print_json(&r);
     else print_text(&r);
     lbk_reader_close(reader);
+    if (have_mem) tl_level_memory_free(&mem);
+    const int over = br.violation_count > 0;
+    tl_budget_result_free(&br);
     if (!ok) {
         fprintf(stderr, "lbk inspect: out of memory\n");
         return LBK_EXIT_INTERNAL;
@@ -301,6 +445,10 @@ int lbk_cmd_inspect(int argc, char **argv)
     if (r.any_unreadable) {
         fprintf(stderr, "lbk inspect: %s: some sections could not be read; run 'lbk validate %s'\n", path, path);
         return LBK_EXIT_INPUT;
+    }
+    if (over) {
+        if (json) fprintf(stderr, "lbk inspect: %s: over budget %s\n", path, budget.name);
+        return LBK_EXIT_NEGATIVE;
     }
     return LBK_EXIT_OK;
 }

@@ -51,7 +51,7 @@ static int may_turn(const bk_uv_object *uv) { return uv->source == BK_UV_GENERAT
 /* Generates charts at `density` and packs them; returns LBK_OK with *fits = 0 when the
  * result exceeds max_page (the caller lowers the density). */
 static lbk_result pack_object(const bk_scene *scene, uint32_t object, double density, const bk_uv_options *uvo,
-                              int margin, int max_page, int score_align, obj_pack *p, int *fits)
+                              int margin, int align, int max_page, int score_align, obj_pack *p, int *fits)
 {
     *fits = 1;
     obj_pack_free(p);
@@ -78,8 +78,13 @@ static lbk_result pack_object(const bk_scene *scene, uint32_t object, double den
             return LBK_OK;
         }
         memset(&rc[i], 0, sizeof rc[i]);
-        rc[i].w = (int)bw;
-        rc[i].h = (int)bh;
+        rc[i].w = ((int)bw + align - 1) / align * align; /* block_align: whole 4×4 blocks per chart */
+        rc[i].h = ((int)bh + align - 1) / align * align;
+        if (rc[i].w > max_page || rc[i].h > max_page) {
+            free(rc);
+            *fits = 0;
+            return LBK_OK;
+        }
         rc[i].id = (uint32_t)i;
         rc[i].turnable = (uint8_t)may_turn(&p->uv);
     }
@@ -248,6 +253,7 @@ static lbk_result build_vertices(const bk_scene *scene, bk_atlas *a)
 typedef struct atlas_limits {
     int page, max_page;  /* default and largest page side, multiples of 4 */
     int margin;          /* ceil(padding / 2) */
+    int align;           /* 1, or 4 with block_align */
     int lone;            /* one object only: its rectangle becomes the page (sides multiples of 4) */
     uint64_t budget;     /* texels */
     bk_uv_options uv;
@@ -267,6 +273,7 @@ static lbk_result resolve_limits(const bk_atlas_options *opt, atlas_limits *l)
     l->page = page;
     l->max_page = max_page;
     l->margin = (padding + 1) / 2;
+    l->align = opt && opt->block_align ? 4 : 1;
     l->budget = opt && opt->texel_budget > 0 ? opt->texel_budget : DEFAULT_BUDGET;
     memset(&l->uv, 0, sizeof l->uv);
     if (opt) l->uv = opt->uv;
@@ -312,7 +319,7 @@ static lbk_result pack_object_to_fit(const bk_scene *scene, uint32_t object, dou
     for (int attempt = 0; attempt < 24; attempt++) {
         int fits;
         double d = p->requested * scale * p->fit_scale;
-        lbk_result r = pack_object(scene, object, d, &l->uv, l->margin, l->max_page, l->lone ? 4 : 1, p, &fits);
+        lbk_result r = pack_object(scene, object, d, &l->uv, l->margin, l->align, l->max_page, l->lone ? 4 : 1, p, &fits);
         if (r != LBK_OK || fits) return r;
         p->fit_scale *= 0.8f;
     }

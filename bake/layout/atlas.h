@@ -57,6 +57,8 @@ typedef struct bk_atlas_options {
     int padding;             /* empty texels between charts; 0: 2 */
     uint64_t texel_budget;   /* upper bound on Σ object rectangles, texels; 0: 16 Mi */
     bk_uv_options uv;        /* max_chart_texels 0: page_size − 2·margin */
+    int block_align;         /* 1: chart blocks (chart + margins) sized to multiples of 4, so every
+                                chart and object rectangle starts on a 4-texel boundary */
 } bk_atlas_options;
 
 typedef struct bk_atlas_page {

@@ -5,12 +5,14 @@
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "bake/pipeline/encode.h"
 #include "bake/pipeline/pipeline.h"
+#include "bake/pipeline/provenance.h"
 #include "bake/scene/exr_read.h"
 #include "bake/scene/import.h"
 #include "bake/scene/scene_desc.h"
@@ -24,7 +26,7 @@ const bk_preset bk_presets[LBK_BAKE_PRESET_COUNT_] = {
 
 /* The size of version 1 of lbk_bake_desc, what size 0 means. When fields are added, this stays
  * the offset of the first new one. */
-#define BK_DESC_SIZE_V1 sizeof(lbk_bake_desc)
+#define BK_DESC_SIZE_V1 offsetof(lbk_bake_desc, block_align)
 
 /* ---- talking to the caller ------------------------------------------------------------- */
 
@@ -150,6 +152,10 @@ static lbk_result apply_sky(bk_pipeline *b)
     memset(&im, 0, sizeof im);
     if (bk_exr_read(b->opt->sky_exr, (size_t)64 << 20, &im, msg, sizeof msg))
         return bk_pipeline_fail(b, LBK_ERR_BAD_INPUT, "sky: %s", msg);
+    if (bk_provenance_add_file(&b->scene, b->opt->sky_exr, "sky")) {
+        free(im.rgba);
+        return bk_pipeline_fail(b, LBK_ERR_IO, "sky: %s: cannot read it again to hash it", b->opt->sky_exr);
+    }
     bk_image *n = realloc(b->scene.images, (b->scene.image_count + 1) * sizeof *n);
     if (!n) {
         free(im.rgba);
@@ -267,6 +273,7 @@ static lbk_result layout_atlas(bk_pipeline *b, const uint8_t *lightmapped)
     memset(&ao, 0, sizeof ao);
     ao.default_density = b->pre->texel_density;
     ao.density_override = b->opt->texel_density > 0 ? b->opt->texel_density : 0;
+    ao.block_align = b->opt->block_align;
     lbk_result r = bk_atlas_build(s, lightmapped, &ao, &b->atlas);
     if (r == LBK_ERR_LIMIT) return bk_pipeline_fail(b, LBK_ERR_BAD_INPUT, "lightmap atlas: %s", lbk_result_message(r));
     if (r) return bk_pipeline_failed(b, r, "lightmap atlas");

@@ -10,6 +10,7 @@
 
 #include "bake/pipeline/encode.h"
 #include "bake/pipeline/pipeline.h"
+#include "bake/pipeline/provenance.h"
 #include "bake/pipeline/uv_section.h"
 #include "bake/probes/octa_bake.h"
 #include "lbk/ahd.h"
@@ -278,42 +279,9 @@ done:
 
 static lbk_result build_meta(bk_pipeline *b, section_list *sl)
 {
-    char hash[17], seed[32], density[32], spacing[32], samples[32], target[32], bounces[32], tlimit[32], ts[32];
-    lbk_meta_hash_hex(b->scene.source_hash, hash);
-    snprintf(seed, sizeof seed, "%llu", (unsigned long long)b->opt->seed);
-    snprintf(density, sizeof density, "%g", b->opt->texel_density > 0 ? b->opt->texel_density : b->pre->texel_density);
-    snprintf(spacing, sizeof spacing, "%g", b->opt->glg_spacing > 0 ? b->opt->glg_spacing : b->pre->glg_spacing);
-    snprintf(samples, sizeof samples, "%d", b->opt->max_samples > 0 ? b->opt->max_samples : b->pre->max_samples);
-    snprintf(target, sizeof target, "%g", b->opt->target_error > 0 ? b->opt->target_error : b->pre->target_error);
-    snprintf(bounces, sizeof bounces, "%d", b->opt->max_bounces);
-    snprintf(tlimit, sizeof tlimit, "%g", b->opt->time_limit);
-    const char *base = b->scene_name;
-    lbk_meta_pair p[16];
-    size_t n = 0;
-    p[n++] = (lbk_meta_pair){LBK_META_WRITER, "lbk bake"};
-    p[n++] = (lbk_meta_pair){LBK_META_WRITER_VERSION, LBK_LIBRARY_VERSION_STRING};
-    p[n++] = (lbk_meta_pair){LBK_META_SCENE_HASH, hash};
-    p[n++] = (lbk_meta_pair){"scene.name", base};
-    p[n++] = (lbk_meta_pair){"bake.preset", b->pre->name};
-    p[n++] = (lbk_meta_pair){"bake.seed", seed};
-    p[n++] = (lbk_meta_pair){"bake.texel_density", density};
-    p[n++] = (lbk_meta_pair){"bake.glg_spacing", spacing};
-    p[n++] = (lbk_meta_pair){"bake.max_samples", samples};
-    p[n++] = (lbk_meta_pair){"bake.target_error", target};
-    p[n++] = (lbk_meta_pair){"bake.max_bounces", bounces};
-    p[n++] = (lbk_meta_pair){"bake.time_limit", tlimit};
-    p[n++] = (lbk_meta_pair){"bake.denoise", b->opt->denoise == LBK_BAKE_DENOISE_OFF ? "off" : "auto"};
-    if (b->opt->revision) p[n++] = (lbk_meta_pair){LBK_META_REVISION, b->opt->revision};
-    if (b->opt->timestamp) {
-        time_t now = time(NULL);
-        struct tm tmv;
-        gmtime_r(&now, &tmv);
-        strftime(ts, sizeof ts, "%Y-%m-%dT%H:%M:%SZ", &tmv);
-        p[n++] = (lbk_meta_pair){LBK_META_TIMESTAMP, ts};
-    }
     void *data;
     size_t size;
-    lbk_result r = lbk_meta_build(p, n, NULL, &data, &size);
+    lbk_result r = bk_provenance_meta(b, &data, &size);
     return sections_add(sl, LBK_SECTION_META, r, data, size);
 }
 

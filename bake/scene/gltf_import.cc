@@ -160,9 +160,17 @@ bool resource_allowed(const ResourcePolicy &pol, const std::string &p, std::stri
     return false;
 }
 
+// A file the import read, for provenance (META input.files, spec/container.md §6.2).
+struct InputRecord {
+    std::string path;  // as opened
+    const char *role;  // "scene", "buffer", "image", "sky"
+    uint64_t bytes, hash;
+};
+
 struct FsState {
     size_t cap;
     const ResourcePolicy *policy;
+    std::vector<InputRecord> *reads;  // every file tinygltf read through us (buffers, images)
 };
 
 bool fs_exists(const std::string &p, void *) { return is_regular_file(p, nullptr); }
@@ -171,7 +179,10 @@ bool fs_read(std::vector<unsigned char> *out, std::string *err, const std::strin
 {
     const FsState *st = static_cast<FsState *>(user);
     std::string why;
-    if (resource_allowed(*st->policy, p, &why) && read_capped(p, st->cap, out, &why)) return true;
+    if (resource_allowed(*st->policy, p, &why) && read_capped(p, st->cap, out, &why)) {
+        st->reads->push_back(InputRecord{p, "image", out->size(), XXH3_64bits(out->data(), out->size())});
+        return true;
+    }
     if (err) *err += p + ": " + why;
     return false;
 }
@@ -590,6 +601,7 @@ private:
     Prepass pp_;
     ResourcePolicy policy_;
     XXH3_state_t hash_;
+    std::vector<InputRecord> reads_;  // every file read, in the order read
     std::vector<int> image_map_;      // glTF image -> scene image (-1: none)
     std::vector<bk_image> images_;
     size_t image_bytes_ = 0;
@@ -626,6 +638,7 @@ private:
     void emit_lights();
     void read_sky();
     void read_combinations();
+    void record_inputs();
     std::vector<float> downsample(const float *rgba, int w, int h, int max_side, int *ow, int *oh);
 };
 
@@ -659,6 +672,7 @@ void Importer::load()
     if (!read_capped(path_, o_.max_file_bytes, &bytes, &why)) fail("%s: %s", file, why.c_str());
     if (bytes.empty()) fail("%s: empty file", file);
     XXH3_64bits_update(&hash_, bytes.data(), bytes.size());
+    reads_.push_back(InputRecord{path_, "scene", bytes.size(), XXH3_64bits(bytes.data(), bytes.size())});
     policy_.root = real_dir(dir_of(path_));
     if (policy_.root.empty()) fail("%s: cannot resolve its folder: %s", file, strerror(errno));
     if (o_.allow_outside && *o_.allow_outside) {
@@ -675,7 +689,7 @@ void Importer::load()
     pp_ = prepass(glb ? g.json : reinterpret_cast<const char *>(bytes.data()), json_len, path_);
 
     tinygltf::TinyGLTF loader;
-    FsState fss{o_.max_file_bytes, &policy_};
+    FsState fss{o_.max_file_bytes, &policy_, &reads_};
     tinygltf::FsCallbacks fs{fs_exists, fs_expand, fs_read, fs_write, &fss};
     loader.SetFsCallbacks(fs);
     ImageLoaderCtx ictx{&pp_.needed_images, o_.skip_textures != 0};
@@ -707,6 +721,12 @@ void Importer::load()
     }
     for (const auto &b : m_.buffers)
         if (!b.data.empty()) XXH3_64bits_update(&hash_, b.data.data(), b.data.size());
+    // tinygltf reads the buffers' files, then the images': a file named by a buffer's uri is a buffer
+    for (InputRecord &r : reads_)
+        for (const auto &b : m_.buffers)
+            if (r.role != std::string("scene") && !b.uri.empty() && b.uri.rfind("data:", 0) != 0 &&
+                r.path.size() >= b.uri.size() && r.path.compare(r.path.size() - b.uri.size(), b.uri.size(), b.uri) == 0)
+                r.role = "buffer";
 }
 
 void Importer::check_extensions()
@@ -1559,6 +1579,7 @@ void Importer::read_sky()
     if (!resource_allowed(policy_, p, &why) || !read_capped(p, o_.max_file_bytes, &bytes, &why))
         fail("%s: %s: lbk_sky %s: %s", file, where.c_str(), qstr(rel).c_str(), why.c_str());
     XXH3_64bits_update(&hash_, bytes.data(), bytes.size());
+    reads_.push_back(InputRecord{p, "sky", bytes.size(), XXH3_64bits(bytes.data(), bytes.size())});
     bytes.clear();
     bytes.shrink_to_fit();
     bk_image im{};
@@ -1633,6 +1654,31 @@ void Importer::read_combinations()
     s_->combination_count = n;
 }
 
+// The files read, into the scene: paths relative to the scene's folder (the scene file by its
+// name), so the record does not depend on where the level is checked out.
+void Importer::record_inputs()
+{
+    const std::string dir = dir_of(path_) + "/";
+    s_->inputs = alloc_array<bk_input_file>(reads_.empty() ? 1 : reads_.size(), 1);
+    memset(s_->inputs, 0, (reads_.empty() ? 1 : reads_.size()) * sizeof *s_->inputs);
+    for (size_t i = 0; i < reads_.size(); i++) {
+        const InputRecord &r = reads_[i];
+        std::string rel = r.path;
+        if (r.role == std::string("scene")) {
+            size_t sl = rel.find_last_of('/');
+            if (sl != std::string::npos) rel = rel.substr(sl + 1);
+        } else if (rel.compare(0, dir.size(), dir) == 0) {
+            rel = rel.substr(dir.size());
+        }
+        bk_input_file &f = s_->inputs[i];
+        snprintf(f.path, sizeof f.path, "%s", rel.c_str());
+        snprintf(f.role, sizeof f.role, "%s", r.role);
+        f.bytes = r.bytes;
+        f.hash = r.hash;
+    }
+    s_->input_count = reads_.size();
+}
+
 void Importer::run()
 {
     load();
@@ -1653,6 +1699,7 @@ void Importer::run()
     if (!images_.empty()) memcpy(s_->images, images_.data(), images_.size() * sizeof(bk_image));
     s_->image_count = images_.size();
     images_.clear();
+    record_inputs();
     s_->source_hash = XXH3_64bits_digest(&hash_);
     bk_scene_compute_bounds(s_);
 }

@@ -78,6 +78,14 @@ typedef struct bk_combination {
     char members[2][64];           /* lbk_door or lbk_light_set names, as authored */
 } bk_combination;
 
+/* A file the scene was read from (provenance: META input.files, spec/container.md §6.2). */
+typedef struct bk_input_file {
+    char path[256];                /* relative to the scene file's folder; the scene file by name */
+    char role[8];                  /* "scene", "buffer", "image", "sky" */
+    uint64_t bytes;
+    uint64_t hash;                 /* XXH3-64 of the file's bytes */
+} bk_input_file;
+
 typedef struct bk_scene {
     /* vertices, world space */
     size_t vertex_count;
@@ -106,6 +114,8 @@ typedef struct bk_scene {
     int sky_image;
     /* provenance */
     uint64_t source_hash;          /* XXH3-64 of the source file bytes (and its buffers) */
+    size_t input_count;            /* every file import read, in the order read (0 for scenes */
+    bk_input_file *inputs;         /* not made by import) */
     float bounds_min[3], bounds_max[3];
     /* combination states to bake (scene extras lbk_combinations); names are checked by the set
      * bakes (bake/sets/bake_sets.c), not by import */

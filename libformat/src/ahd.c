@@ -97,6 +97,41 @@ void lbk_ahd_to_linear(const lbk_ahd_texel *texel, lbk_ahd_linear *out)
     }
 }
 
+void lbk_ahd_texel_f_from_texel(const lbk_ahd_texel *texel, lbk_ahd_texel_f *out)
+{
+    lbk_r11g11b10f_unpack(texel->irradiance_z, out->ez);
+    for (int c = 0; c < 3; c++) {
+        if (out->ez[c] != out->ez[c]) out->ez[c] = 0.0f;
+        if (out->ez[c] > LBK_UF11_MAX) out->ez[c] = LBK_UF11_MAX;
+    }
+    for (int k = 0; k < 4; k++) out->rgba[k] = lbk_unorm8_to_float(texel->rgba[k]);
+}
+
+void lbk_ahd_texel_f_to_linear(const lbk_ahd_texel_f *t, lbk_ahd_linear *out)
+{
+    float d[3];
+    const float x = 2.0f * t->rgba[1] - 1.0f, y = 2.0f * t->rgba[2] - 1.0f, z = t->rgba[3];
+    const float len = sqrtf(x * x + y * y + z * z);
+    if (!(len >= 0.5f)) {
+        d[0] = d[1] = 0.0f;
+        d[2] = 1.0f;
+    } else {
+        d[0] = x / len, d[1] = y / len, d[2] = z / len;
+    }
+    float r = t->rgba[0];
+    if (!(r >= 0.0f)) r = 0.0f;
+    if (r > 1.0f) r = 1.0f;
+    const float k = 0.25f + 0.5f * d[2];
+    for (int c = 0; c < 3; c++) {
+        float e = t->ez[c];
+        if (!(e >= 0.0f)) e = 0.0f;
+        if (e > 65504.0f) e = 65504.0f;
+        const float amb = r * e, inten = (1.0f - r) * e / k;
+        out->c[c][0] = amb + 0.25f * inten;
+        for (int i = 0; i < 3; i++) out->c[c][1 + i] = 0.5f * inten * d[i];
+    }
+}
+
 void lbk_ahd_linear_eval(const lbk_ahd_linear *lin, const float n[3], float rgb[3])
 {
     for (int c = 0; c < 3; c++) {

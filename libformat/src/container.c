@@ -8,11 +8,12 @@
 #include <stdlib.h>
 #include <sys/stat.h>
 #include <unistd.h>
-#include <xxhash.h>
+#include "xxh.h"
 #include <zstd.h>
 #include <zstd_errors.h>
 
 #include "framing.h"
+#include "lbk/lightmap.h"
 
 #define LBK_DEFAULT_ZSTD_LEVEL 19
 
@@ -35,6 +36,7 @@ struct lbk_reader {
     lbk_framing fr;
     const uint8_t *data[LBK_MAX_SECTIONS]; /* decoded (or in-place) bytes once accessed */
     void *owned[LBK_MAX_SECTIONS];
+    uint8_t verified[LBK_MAX_SECTIONS];    /* stored checksum checked (or skip_checksums) */
 };
 
 typedef struct open_state {
@@ -135,27 +137,85 @@ lbk_result lbk_reader_section_find(const lbk_reader *r, uint32_t type, uint32_t 
     return LBK_ERR_NOT_FOUND;
 }
 
-lbk_result lbk_reader_section_data(lbk_reader *r, uint32_t index, const void **data, size_t *size)
+/* ---- loading: each section's checksum verified once, each zstd section decoded once -------- */
+
+const lbk_framing *lbk_reader_framing(const lbk_reader *r) { return &r->fr; }
+const lbk_allocator *lbk_reader_allocator(const lbk_reader *r) { return &r->alloc; }
+uint64_t lbk_reader_budget_left(const lbk_reader *r) { return r->budget_left; }
+
+lbk_result lbk_reader_verify(lbk_reader *r, uint32_t index, uint32_t *issue_id)
 {
-    if (!r || !data || !size) return LBK_ERR_INVALID_ARGUMENT;
-    *data = NULL;
-    *size = 0;
+    *issue_id = 0;
     if (index >= r->fr.count) return LBK_ERR_NOT_FOUND;
-    const lbk_section_info *s = &r->fr.sections[index];
     if (!r->fr.usable[index]) return LBK_ERR_CORRUPT;
+    if (r->verified[index] || r->skip_checksums) return LBK_OK;
+    const lbk_section_info *s = &r->fr.sections[index];
+    if (XXH3_64bits(r->bytes + s->offset, (size_t)s->stored_size) != s->checksum) {
+        *issue_id = 214;
+        return LBK_ERR_CHECKSUM;
+    }
+    r->verified[index] = 1;
+    return LBK_OK;
+}
+
+int lbk_reader_checksum_pending(const lbk_reader *r, uint32_t index)
+{
+    return index < r->fr.count && r->fr.usable[index] && !r->verified[index] && !r->skip_checksums;
+}
+
+void lbk_reader_set_verified(lbk_reader *r, uint32_t index)
+{
+    if (index < r->fr.count) r->verified[index] = 1;
+}
+
+lbk_result lbk_reader_load(lbk_reader *r, uint32_t index, const uint8_t **data, uint32_t *issue_id)
+{
+    *data = NULL;
+    lbk_result res = lbk_reader_verify(r, index, issue_id);
+    if (res != LBK_OK) return res;
     if (!r->data[index]) {
-        uint32_t issue;
         const uint8_t *d;
         void *owned;
-        lbk_result res = lbk_section_load(r->bytes, s, &r->alloc, r->skip_checksums, &r->budget_left, &d, &owned,
-                                          &issue);
+        res = lbk_section_load(r->bytes, &r->fr.sections[index], &r->alloc, 1, &r->budget_left, &d, &owned, issue_id);
         if (res != LBK_OK) return res;
         r->data[index] = d;
         r->owned[index] = owned;
     }
     *data = r->data[index];
-    *size = (size_t)s->decoded_size;
     return LBK_OK;
+}
+
+lbk_result lbk_reader_section_data(lbk_reader *r, uint32_t index, const void **data, size_t *size)
+{
+    if (!r || !data || !size) return LBK_ERR_INVALID_ARGUMENT;
+    *data = NULL;
+    *size = 0;
+    uint32_t issue;
+    const uint8_t *d;
+    lbk_result res = lbk_reader_load(r, index, &d, &issue);
+    if (res != LBK_OK) return res;
+    *data = d;
+    *size = (size_t)r->fr.sections[index].decoded_size;
+    return LBK_OK;
+}
+
+lbk_result lbk_reader_section_unpack(lbk_reader *r, uint32_t index, void *dst, size_t dst_size)
+{
+    if (!r || (!dst && dst_size)) return LBK_ERR_INVALID_ARGUMENT;
+    if (index >= r->fr.count) return LBK_ERR_NOT_FOUND;
+    const lbk_section_info *s = &r->fr.sections[index];
+    if (dst_size < s->decoded_size) return LBK_ERR_INVALID_ARGUMENT;
+    uint32_t issue;
+    lbk_result res = lbk_reader_verify(r, index, &issue);
+    if (res != LBK_OK) return res;
+    if (r->data[index] || s->compression == LBK_COMPRESSION_NONE) {
+        memcpy(dst, r->data[index] ? r->data[index] : r->bytes + s->offset, (size_t)s->decoded_size);
+        return LBK_OK;
+    }
+    /* caller memory: nothing is allocated but zstd's context, so the decoded-bytes cap does not apply */
+    res = lbk_section_frame_check(r->bytes, s, &issue);
+    if (res == LBK_OK) res = lbk_section_decode_into(r->bytes, s, &r->alloc, dst, &issue);
+    return res;
 }
 
 lbk_result lbk_reader_section_by_type(lbk_reader *r, uint32_t type, const void **data, size_t *size)
@@ -172,6 +232,7 @@ lbk_result lbk_reader_section_by_type(lbk_reader *r, uint32_t type, const void *
 
 typedef struct writer_section {
     uint32_t type, flags, compression;
+    uint32_t features; /* required features the payload needs (LMAP: block pages) */
     uint8_t *stored;
     uint64_t stored_size, decoded_size, checksum;
 } writer_section;
@@ -278,6 +339,7 @@ lbk_result lbk_writer_section_add(lbk_writer *w, uint32_t type, const void *data
     s->type = type;
     s->flags = flags;
     s->compression = compression;
+    s->features = type == LBK_SECTION_LMAP ? lbk_lmap_required_features(data, size) : 0;
     s->stored = stored;
     s->stored_size = stored_size;
     s->decoded_size = size;
@@ -323,10 +385,12 @@ lbk_result lbk_writer_to_memory(lbk_writer *w, void **out, size_t *size)
     if (!f) return LBK_ERR_OUT_OF_MEMORY;
 
     uint32_t required = 0;
-    uint16_t minor = 0; /* §1.3: the lowest minor version that defines every known section here */
+    uint16_t minor = 0; /* §1.3: the lowest minor version that defines everything in the file */
     for (uint32_t i = 0; i < w->count; i++) {
-        if (w->s[order[i]].type == LBK_SECTION_LMUV) minor = 1;
         const writer_section *s = &w->s[order[i]];
+        if (s->type == LBK_SECTION_LMUV && minor < 1) minor = 1;
+        if (s->features & LBK_FEATURE_LMAP_BLOCK) minor = 2;
+        required |= s->features;
         uint8_t *e = f + LBK_HEADER_SIZE + (size_t)LBK_SECTION_ENTRY_SIZE * i;
         lbk_wr32(e + LBK_ENT_TYPE, s->type);
         lbk_wr32(e + LBK_ENT_FLAGS, s->flags);

@@ -6,7 +6,7 @@
 #include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
-#include <xxhash.h>
+#include "xxh.h"
 #include <zstd.h>
 #include <zstd_errors.h>
 
@@ -310,6 +310,46 @@ int lbk_framing_parse(const uint8_t *d, size_t size, lbk_framing *out, lbk_frami
 static void *zstd_alloc(void *user, size_t size) { return lbk_alloc((const lbk_allocator *)user, size); }
 static void zstd_free(void *user, void *p) { lbk_dealloc((const lbk_allocator *)user, p); }
 
+lbk_result lbk_section_frame_check(const uint8_t *file, const lbk_section_info *s, uint32_t *issue_id)
+{
+    const uint8_t *stored = file + s->offset;
+    unsigned long long content = ZSTD_getFrameContentSize(stored, (size_t)s->stored_size);
+    if (content == ZSTD_CONTENTSIZE_ERROR || content == ZSTD_CONTENTSIZE_UNKNOWN) {
+        *issue_id = 215;
+        return LBK_ERR_DECOMPRESS;
+    }
+    if (content != s->decoded_size) {
+        *issue_id = 216;
+        return LBK_ERR_DECOMPRESS;
+    }
+    size_t frame = ZSTD_findFrameCompressedSize(stored, (size_t)s->stored_size);
+    if (ZSTD_isError(frame) || frame != s->stored_size) {
+        *issue_id = ZSTD_isError(frame) ? 218 : 219;
+        return LBK_ERR_DECOMPRESS;
+    }
+    if (s->decoded_size > SIZE_MAX) {
+        *issue_id = 217;
+        return LBK_ERR_LIMIT;
+    }
+    return LBK_OK;
+}
+
+lbk_result lbk_section_decode_into(const uint8_t *file, const lbk_section_info *s, const lbk_allocator *allocator,
+                                   void *dst, uint32_t *issue_id)
+{
+    ZSTD_customMem mem = {zstd_alloc, zstd_free, (void *)allocator};
+    ZSTD_DCtx *dctx = ZSTD_createDCtx_advanced(mem);
+    if (!dctx) return LBK_ERR_OUT_OF_MEMORY;
+    size_t got = ZSTD_decompressDCtx(dctx, dst, (size_t)s->decoded_size, file + s->offset, (size_t)s->stored_size);
+    ZSTD_freeDCtx(dctx);
+    if (ZSTD_isError(got) || got != s->decoded_size) {
+        if (ZSTD_isError(got) && ZSTD_getErrorCode(got) == ZSTD_error_memory_allocation) return LBK_ERR_OUT_OF_MEMORY;
+        *issue_id = 218;
+        return LBK_ERR_DECOMPRESS;
+    }
+    return LBK_OK;
+}
+
 lbk_result lbk_section_load(const uint8_t *file, const lbk_section_info *s, const lbk_allocator *allocator,
                             int skip_checksum, uint64_t *budget_left, const uint8_t **data, void **owned,
                             uint32_t *issue_id)
@@ -326,39 +366,18 @@ lbk_result lbk_section_load(const uint8_t *file, const lbk_section_info *s, cons
         *data = stored;
         return LBK_OK;
     }
-    unsigned long long content = ZSTD_getFrameContentSize(stored, (size_t)s->stored_size);
-    if (content == ZSTD_CONTENTSIZE_ERROR || content == ZSTD_CONTENTSIZE_UNKNOWN) {
-        *issue_id = 215;
-        return LBK_ERR_DECOMPRESS;
-    }
-    if (content != s->decoded_size) {
-        *issue_id = 216;
-        return LBK_ERR_DECOMPRESS;
-    }
-    size_t frame = ZSTD_findFrameCompressedSize(stored, (size_t)s->stored_size);
-    if (ZSTD_isError(frame) || frame != s->stored_size) {
-        *issue_id = ZSTD_isError(frame) ? 218 : 219;
-        return LBK_ERR_DECOMPRESS;
-    }
-    if (s->decoded_size > *budget_left || s->decoded_size > SIZE_MAX) {
+    lbk_result r = lbk_section_frame_check(file, s, issue_id);
+    if (r != LBK_OK) return r;
+    if (s->decoded_size > *budget_left) {
         *issue_id = 217;
         return LBK_ERR_LIMIT;
     }
     void *buf = lbk_alloc(allocator, (size_t)s->decoded_size);
     if (!buf) return LBK_ERR_OUT_OF_MEMORY;
-    ZSTD_customMem mem = {zstd_alloc, zstd_free, (void *)allocator};
-    ZSTD_DCtx *dctx = ZSTD_createDCtx_advanced(mem);
-    if (!dctx) {
+    r = lbk_section_decode_into(file, s, allocator, buf, issue_id);
+    if (r != LBK_OK) {
         lbk_dealloc(allocator, buf);
-        return LBK_ERR_OUT_OF_MEMORY;
-    }
-    size_t got = ZSTD_decompressDCtx(dctx, buf, (size_t)s->decoded_size, stored, (size_t)s->stored_size);
-    ZSTD_freeDCtx(dctx);
-    if (ZSTD_isError(got) || got != s->decoded_size) {
-        lbk_dealloc(allocator, buf);
-        if (ZSTD_isError(got) && ZSTD_getErrorCode(got) == ZSTD_error_memory_allocation) return LBK_ERR_OUT_OF_MEMORY;
-        *issue_id = 218;
-        return LBK_ERR_DECOMPRESS;
+        return r;
     }
     *budget_left -= s->decoded_size;
     *data = buf;

@@ -73,6 +73,27 @@ lbk_result lbk_section_load(const uint8_t *file, const lbk_section_info *s, cons
                             int skip_checksum, uint64_t *budget_left, const uint8_t **data, void **owned,
                             uint32_t *issue_id);
 
+/* The zstd frame rules of §4.1 for a compressed section (215, 216, 219; 217 when it cannot be
+ * addressed), without decoding it. */
+lbk_result lbk_section_frame_check(const uint8_t *file, const lbk_section_info *s, uint32_t *issue_id);
+/* Decodes a compressed section whose frame passed lbk_section_frame_check into dst
+ * (decoded_size bytes); zstd's working memory comes from the allocator. */
+lbk_result lbk_section_decode_into(const uint8_t *file, const lbk_section_info *s, const lbk_allocator *allocator,
+                                   void *dst, uint32_t *issue_id);
+
+/* What validate.c needs from a reader to validate through it (lbk_reader_validate): its bytes
+ * and framing, the checksum of a section verified once, and a section decoded once and kept. */
+typedef struct lbk_reader lbk_reader;
+const lbk_framing *lbk_reader_framing(const lbk_reader *r);
+const lbk_allocator *lbk_reader_allocator(const lbk_reader *r);
+lbk_result lbk_reader_verify(lbk_reader *r, uint32_t index, uint32_t *issue_id);
+/* 1 when section index's checksum has yet to be verified (not verified, checksums not skipped);
+ * lbk_reader_set_verified records a checksum the caller verified itself. */
+int lbk_reader_checksum_pending(const lbk_reader *r, uint32_t index);
+void lbk_reader_set_verified(lbk_reader *r, uint32_t index);
+lbk_result lbk_reader_load(lbk_reader *r, uint32_t index, const uint8_t **data, uint32_t *issue_id);
+uint64_t lbk_reader_budget_left(const lbk_reader *r);
+
 /* Default cap on decoded bytes (§4.3). */
 uint64_t lbk_default_decode_cap(uint64_t file_size);
 

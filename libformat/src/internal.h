@@ -97,6 +97,12 @@ typedef struct lbk_vctx {
     int section_compressed;        /* offsets inside compressed sections report the section start */
     uint32_t present_types[64];    /* every type listed in the section table, usable or not */
     uint32_t present_count;
+    uint32_t required_features;    /* the header's (LMAP checks LBK_FEATURE_LMAP_BLOCK against its pages) */
+    /* the LMAP block tests already run while its checksum was computed (lbk_lmap_hash_prescan):
+     * one bit per full 1024-texel block of each 1.0 plane, in page and plane order, set where the
+     * block needs the texel-by-texel scan; NULL: not available. Freed by validate.c. */
+    uint8_t *lmap_hits;
+    uint64_t lmap_hit_bits;
 
     /* facts from earlier sections */
     int lmap_ok;
@@ -152,6 +158,11 @@ void lbk_vreport_capped(lbk_vctx *ctx, uint32_t *errors, uint16_t reported[100],
 void lbk_validate_meta(lbk_vctx *ctx, const uint8_t *data, size_t size);
 void lbk_validate_rept(lbk_vctx *ctx, const uint8_t *data, size_t size);
 void lbk_validate_lmap(lbk_vctx *ctx, const uint8_t *data, size_t size);
+/* XXH3-64 of an uncompressed LMAP section's bytes, and, while each texel block is in cache, the
+ * validator's block test (lbk_vctx.lmap_hits; *hits allocated with `allocator`, NULL when the
+ * section does not parse): checksum and texel validation in one pass over memory. */
+uint64_t lbk_lmap_hash_prescan(const uint8_t *d, size_t size, const lbk_allocator *allocator, uint8_t **hits,
+                               uint64_t *bits);
 void lbk_validate_glg(lbk_vctx *ctx, const uint8_t *data, size_t size);
 void lbk_validate_llg(lbk_vctx *ctx, const uint8_t *data, size_t size);
 void lbk_validate_octp(lbk_vctx *ctx, const uint8_t *data, size_t size);

@@ -1,6 +1,6 @@
 /* OBJS: build, view and validate (spec/container.md §8, spec/validation.md 400–499). */
 #define XXH_STATIC_LINKING_ONLY /* XXH3_state_t on the stack */
-#include <xxhash.h>
+#include "xxh.h"
 
 #include "lbk/objects.h"
 

@@ -39,6 +39,7 @@ static const issue_row registry[] = {
     {114, FATAL, 0, "section table checksum mismatch"},
     {115, WARNING, 0, "minor version newer than this reader (newer optional content skipped)"},
     {116, ERROR, 0, "required feature ZSTD disagrees with the sections' compression"},
+    {117, ERROR, 0, "required feature LMAP_BLOCK is set but there is no LMAP section"},
 
     /* ---- 200–299 section table and framing (container helper) ---------------------------- */
     {200, ERROR, 0, "section type is not four printable ASCII characters"},
@@ -106,7 +107,7 @@ static const issue_row registry[] = {
 
     /* ---- 500–599 LMAP (codec helper) ----------------------------------------------------- */
     {500, ERROR, LBK_SECTION_LMAP, "LMAP shorter than its 16-byte header"},
-    {501, ERROR, LBK_SECTION_LMAP, "LMAP reserved field is not zero"},
+    {501, ERROR, LBK_SECTION_LMAP, "LMAP reserved field (or reserved encoding bits) is not zero"},
     {502, ERROR, LBK_SECTION_LMAP, "LMAP page_count is zero or the page table runs past the section"},
     {503, ERROR, LBK_SECTION_LMAP, "LMAP page width or height outside 1..16384"},
     {504, ERROR, LBK_SECTION_LMAP, "LMAP texel_count differs from the sum of page areas"},
@@ -117,6 +118,10 @@ static const issue_row registry[] = {
     {509, ERROR, LBK_SECTION_LMAP, "LMAP irradiance texel has an Inf/NaN channel (exponent 31)"},
     {510, WARNING, LBK_SECTION_LMAP, "LMAP highlight direction shorter than 1/2 (decodes as +Z)"},
     {511, ERROR, LBK_SECTION_LMAP, "LMAP scale is not a positive finite power of two"},
+    {512, ERROR, LBK_SECTION_LMAP, "LMAP page plane format is not defined"},
+    {513, ERROR, LBK_SECTION_LMAP, "LMAP block-encoded page width or height is not a multiple of 4"},
+    {514, ERROR, LBK_SECTION_LMAP, "LMAP BC6H block uses a reserved mode"},
+    {515, ERROR, LBK_SECTION_LMAP, "LMAP block-encoded pages disagree with the required feature LMAP_BLOCK"},
 
     /* ---- 600–699 GLG (codec helper) ------------------------------------------------------ */
     {600, ERROR, LBK_SECTION_GLG, "GLG shorter than its 32-byte header"},

@@ -1,5 +1,5 @@
 /* Names and descriptions of lbk_result codes, and printable four-character codes. */
-#include <xxhash.h>
+#include "xxh.h"
 
 #include "internal.h"
 

@@ -106,19 +106,14 @@ static void check_dependencies(lbk_vctx *ctx)
         vreport_at(ctx, 221, 0, LBK_HEADER_SIZE, "'DOOR' is present but there is no 'DLS ' section");
 }
 
-lbk_result lbk_validate_memory(const void *data, size_t size, const lbk_validate_options *caller_options,
-                               lbk_issue_callback callback, void *user, lbk_validate_summary *summary)
+/* Every check, over the bytes d; with a reader r (whose bytes d are), each section's checksum and
+ * decode go through the reader, which keeps what it decoded, so nothing is decoded twice. */
+static lbk_result validate_core(const uint8_t *d, size_t size, const lbk_validate_options *options,
+                                lbk_issue_callback callback, void *user, lbk_validate_summary *summary, lbk_reader *rd)
 {
-    lbk_validate_summary local;
-    if (!summary) summary = &local;
-    memset(summary, 0, sizeof *summary);
-    if (!data && size) return LBK_ERR_INVALID_ARGUMENT;
-    lbk_validate_options options;
-    lbk_result rc = LBK_SIZED_IN(&options, caller_options, lbk_validate_options, max_decoded_bytes);
-    if (rc != LBK_OK) return rc;
-    const uint8_t *d = data;
     lbk_allocator alloc = {0};
-    if (options.allocator && options.allocator->alloc && options.allocator->free) alloc = *options.allocator;
+    if (rd) alloc = *lbk_reader_allocator(rd);
+    else if (options->allocator && options->allocator->alloc && options->allocator->free) alloc = *options->allocator;
 
     lbk_framing *fr = lbk_alloc(&alloc, sizeof *fr);
     if (!fr) return LBK_ERR_OUT_OF_MEMORY;
@@ -134,6 +129,9 @@ lbk_result lbk_validate_memory(const void *data, size_t size, const lbk_validate
     if (!fr->header_ok || ctx.stop) goto done;
 
     for (uint32_t i = 0; i < fr->count; i++) ctx.present_types[ctx.present_count++] = fr->sections[i].type;
+    ctx.required_features = fr->header.required_features;
+    if ((ctx.required_features & LBK_FEATURE_LMAP_BLOCK) && !lbk_vctx_has_section(&ctx, LBK_SECTION_LMAP))
+        vreport_at(&ctx, 117, 0, LBK_HDR_REQUIRED_FEATURES, "required feature LMAP_BLOCK is set but there is no LMAP");
 
     /* Pass 1, file order: checksums of every usable section, known or not. */
     uint8_t checksum_ok[LBK_MAX_SECTIONS] = {0};
@@ -146,15 +144,30 @@ lbk_result lbk_validate_memory(const void *data, size_t size, const lbk_validate
         uint32_t issue;
         lbk_section_info only_checksum = *s;
         only_checksum.compression = LBK_COMPRESSION_NONE; /* verify, do not decode yet */
-        if (lbk_section_load(d, &only_checksum, &alloc, 0, &unlimited, &sd, &owned, &issue) == LBK_OK)
-            checksum_ok[i] = 1;
-        else
-            vreport_at(&ctx, issue, s->type, s->offset, "%s", load_message(issue));
+        if (s->type == LBK_SECTION_LMAP && s->compression == LBK_COMPRESSION_NONE && !ctx.lmap_hits &&
+            (!rd || lbk_reader_checksum_pending(rd, i))) {
+            /* one pass over the lightmap: its checksum and the block tests of its texels */
+            uint8_t *hits;
+            uint64_t bits;
+            if (lbk_lmap_hash_prescan(d + s->offset, (size_t)s->stored_size, &alloc, &hits, &bits) == s->checksum) {
+                checksum_ok[i] = 1;
+                if (rd) lbk_reader_set_verified(rd, i);
+                ctx.lmap_hits = hits, ctx.lmap_hit_bits = bits;
+            } else {
+                lbk_dealloc(&alloc, hits);
+                vreport_at(&ctx, 214, s->type, s->offset, "%s", load_message(214));
+            }
+            continue;
+        }
+        lbk_result r = rd ? lbk_reader_verify(rd, i, &issue)
+                          : lbk_section_load(d, &only_checksum, &alloc, 0, &unlimited, &sd, &owned, &issue);
+        if (r == LBK_OK) checksum_ok[i] = 1;
+        else vreport_at(&ctx, issue, s->type, s->offset, "%s", load_message(issue));
     }
     check_dependencies(&ctx);
 
     /* Pass 2, dependency order: decode and run each section's validator. */
-    uint64_t budget = options.max_decoded_bytes ? options.max_decoded_bytes : lbk_default_decode_cap(size);
+    uint64_t budget = options->max_decoded_bytes ? options->max_decoded_bytes : lbk_default_decode_cap(size);
     for (size_t k = 0; k < sizeof dependency_order / sizeof dependency_order[0] && !ctx.stop; k++) {
         uint32_t i;
         for (i = 0; i < fr->count; i++)
@@ -162,9 +175,11 @@ lbk_result lbk_validate_memory(const void *data, size_t size, const lbk_validate
         if (i == fr->count || !checksum_ok[i]) continue;
         const lbk_section_info *s = &fr->sections[i];
         const uint8_t *sd;
-        void *owned;
+        void *owned = NULL;
         uint32_t issue;
-        lbk_result r = lbk_section_load(d, s, &alloc, 1, &budget, &sd, &owned, &issue);
+        if (rd) budget = lbk_reader_budget_left(rd);
+        lbk_result r = rd ? lbk_reader_load(rd, i, &sd, &issue)
+                          : lbk_section_load(d, s, &alloc, 1, &budget, &sd, &owned, &issue);
         if (r == LBK_ERR_OUT_OF_MEMORY) {
             result = r;
             goto done;
@@ -188,12 +203,40 @@ lbk_result lbk_validate_memory(const void *data, size_t size, const lbk_validate
     }
 
 done:
+    lbk_dealloc(&alloc, ctx.lmap_hits);
     lbk_dealloc(&alloc, (void *)ctx.lmap_page_width);
     lbk_dealloc(&alloc, (void *)ctx.lmap_page_height);
     lbk_dealloc(&alloc, ctx.objs_facts);
     lbk_dealloc(&alloc, ctx.dls_facts);
     lbk_dealloc(&alloc, fr);
     return result;
+}
+
+lbk_result lbk_validate_memory(const void *data, size_t size, const lbk_validate_options *caller_options,
+                               lbk_issue_callback callback, void *user, lbk_validate_summary *summary)
+{
+    lbk_validate_summary local;
+    if (!summary) summary = &local;
+    memset(summary, 0, sizeof *summary);
+    if (!data && size) return LBK_ERR_INVALID_ARGUMENT;
+    lbk_validate_options options;
+    lbk_result rc = LBK_SIZED_IN(&options, caller_options, lbk_validate_options, max_decoded_bytes);
+    if (rc != LBK_OK) return rc;
+    return validate_core(data, size, &options, callback, user, summary, NULL);
+}
+
+lbk_result lbk_reader_validate(lbk_reader *reader, lbk_issue_callback callback, void *user,
+                               lbk_validate_summary *summary)
+{
+    lbk_validate_summary local;
+    if (!summary) summary = &local;
+    memset(summary, 0, sizeof *summary);
+    if (!reader) return LBK_ERR_INVALID_ARGUMENT;
+    size_t size;
+    const uint8_t *d = lbk_reader_bytes(reader, &size);
+    lbk_validate_options options;
+    memset(&options, 0, sizeof options);
+    return validate_core(d, size, &options, callback, user, summary, reader);
 }
 
 lbk_result lbk_validate_file(const char *path, const lbk_validate_options *options, lbk_issue_callback callback,

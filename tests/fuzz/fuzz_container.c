@@ -373,6 +373,35 @@ static void read_lmuv(const void *d, size_t n)
     }
 }
 
+/* LMAP, any page encoding (1.0 planes, BC6H, BC5/BC4, ASTC): whatever lbk_lmap_open accepts, every
+ * page's planes lie inside the section and a few texels of each decode (or are refused cleanly). */
+static void read_lmap(const void *d, size_t n)
+{
+    lbk_lmap_view v;
+    lbk_lmap_required_features(d, n);
+    if (lbk_lmap_open(d, n, &v) != LBK_OK) return;
+    for (uint32_t p = 0; p < v.page_count && p < 64; p++) {
+        lbk_lmap_planes pl;
+        if (lbk_lmap_planes_get(&v, p, &pl) != LBK_OK) abort();
+        for (int k = 0; k < 2; k++)
+            if (pl.offset[k] > n || pl.bytes[k] > n - pl.offset[k]) abort();
+        const uint32_t xs[3] = {0, pl.width / 2, pl.width - 1}, ys[3] = {0, pl.height / 2, pl.height - 1};
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++) {
+                lbk_ahd_texel_f t;
+                const lbk_result r = lbk_lmap_planes_texel_unpack(&pl, xs[i], ys[j], &t);
+                if (r != LBK_OK && r != LBK_ERR_UNSUPPORTED_FEATURE) abort();
+                float rgb[3];
+                const float nz[3] = {0, 0, 1};
+                lbk_lmap_planes_irradiance(&pl, xs[i], ys[j], nz, rgb);
+            }
+        lbk_lmap_planes_rect_bytes(&pl, 0, 0, pl.width, pl.height);
+        lbk_lmap_page pg;
+        const lbk_result r = lbk_lmap_page_get(&v, p, &pg);
+        if (r != LBK_OK && !(r == LBK_ERR_UNSUPPORTED_FEATURE && pl.blocks_x)) abort();
+    }
+}
+
 static int known_type(uint32_t t)
 {
     static const uint32_t known[] = {LBK_SECTION_META, LBK_SECTION_REPT, LBK_SECTION_OBJS,
@@ -414,7 +443,10 @@ static void exercise(const uint8_t *data, size_t size)
         if (n != si.decoded_size) abort();
         int opened = LBK_OK;
         switch (si.type) {
-        case LBK_SECTION_LMAP: opened = sample_lmap(d, n); break;
+        case LBK_SECTION_LMAP:
+            read_lmap(d, n);
+            opened = sample_lmap(d, n);
+            break;
         case LBK_SECTION_GLG: opened = sample_glg(d, n, valid); break;
         case LBK_SECTION_LLG: opened = sample_llg(d, n, valid); break;
         case LBK_SECTION_OCTP: opened = sample_octp(d, n, valid); break;

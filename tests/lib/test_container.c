@@ -16,6 +16,7 @@
 #include <xxhash.h>
 
 #include "lbk/container.h"
+#include "lbk/lightmap.h"
 #include "lbk/validate.h"
 #include "support/container_fixture.h"
 
@@ -387,6 +388,82 @@ static void test_decoded_cap_stops_bomb(void **state)
     lbk_free(NULL, b.bytes);
 }
 
+static int count_issue(void *user, const lbk_issue *issue)
+{
+    (void)issue;
+    ++*(int *)user;
+    return 0;
+}
+
+/* lbk_reader_validate: the same verdict as lbk_validate_memory, through the reader's cache — the
+ * zstd REPT of the fixture is decoded once (one allocation of its decoded size, kept until close),
+ * and section_data afterwards allocates nothing. lbk_reader_section_unpack decodes into caller
+ * memory with no allocation of the decoded size, and equals section_data byte for byte. */
+static void test_reader_validate_decodes_once(void **state)
+{
+    (void)state;
+    void *file;
+    size_t size;
+    assert_int_equal(fixture_small_container(0, &file, &size), 0);
+    int n_mem = 0, n_rd = 0;
+    lbk_validate_summary sm, sr;
+    assert_int_equal(lbk_validate_memory(file, size, NULL, count_issue, &n_mem, &sm), LBK_OK);
+    counting c = {0};
+    lbk_allocator a = {c_alloc, c_free, &c};
+    lbk_read_options ro = {.allocator = &a};
+    lbk_reader *r;
+    assert_int_equal(lbk_reader_open_memory(file, size, &ro, &r), LBK_OK);
+    uint32_t ri;
+    lbk_section_info si;
+    assert_int_equal(lbk_reader_section_find(r, LBK_SECTION_REPT, &ri), LBK_OK);
+    assert_int_equal(lbk_reader_section_get(r, ri, &si), LBK_OK);
+    assert_int_equal(si.compression, LBK_COMPRESSION_ZSTD);
+    /* unpack first: nothing of the decoded size is allocated, nothing is cached */
+    uint8_t *mine = malloc((size_t)si.decoded_size + 1);
+    size_t live = c.live_bytes;
+    assert_int_equal(lbk_reader_section_unpack(r, ri, mine, (size_t)si.decoded_size - 1), LBK_ERR_INVALID_ARGUMENT);
+    assert_int_equal(lbk_reader_section_unpack(r, ri, mine, (size_t)si.decoded_size + 1), LBK_OK);
+    assert_int_equal(c.live_bytes, live); /* zstd's context came and went; nothing was kept */
+    assert_int_equal(lbk_reader_validate(r, count_issue, &n_rd, &sr), LBK_OK);
+    assert_int_equal(n_rd, n_mem);
+    assert_int_equal(sr.fatal, sm.fatal);
+    assert_int_equal(sr.errors, sm.errors);
+    assert_int_equal(sr.warnings, sm.warnings);
+    assert_int_equal(sr.errors + sr.fatal, 0);
+    assert_int_equal(c.live_bytes - live, (size_t)si.decoded_size); /* REPT decoded once and kept */
+    size_t allocs = c.allocs;
+    const void *d;
+    size_t dn;
+    for (uint32_t i = 0; i < lbk_reader_section_count(r); i++) assert_int_equal(lbk_reader_section_data(r, i, &d, &dn), LBK_OK);
+    assert_int_equal(c.allocs, allocs); /* every section already there */
+    assert_int_equal(lbk_reader_section_data(r, ri, &d, &dn), LBK_OK);
+    assert_memory_equal(d, mine, dn);
+    /* a second validation through the same reader: same verdict, nothing decoded again */
+    n_rd = 0;
+    assert_int_equal(lbk_reader_validate(r, count_issue, &n_rd, &sr), LBK_OK);
+    assert_int_equal(n_rd, n_mem);
+    assert_int_equal(c.live_bytes - live, (size_t)si.decoded_size);
+    lbk_reader_close(r);
+    assert_int_equal(c.live_bytes, 0);
+
+    /* a flipped byte in the zstd section: both validations report 214 for it */
+    uint8_t *bad = malloc(size);
+    memcpy(bad, file, size);
+    bad[si.offset + si.stored_size / 2] ^= 0x10;
+    n_mem = n_rd = 0;
+    assert_int_equal(lbk_validate_memory(bad, size, NULL, count_issue, &n_mem, &sm), LBK_OK);
+    assert_int_equal(lbk_reader_open_memory(bad, size, NULL, &r), LBK_OK);
+    assert_int_equal(lbk_reader_validate(r, count_issue, &n_rd, &sr), LBK_OK);
+    assert_true(sm.errors >= 1);
+    assert_int_equal(sr.errors, sm.errors);
+    assert_int_equal(n_rd, n_mem);
+    assert_int_equal(lbk_reader_section_unpack(r, ri, mine, (size_t)si.decoded_size), LBK_ERR_CHECKSUM);
+    lbk_reader_close(r);
+    free(bad);
+    free(mine);
+    free(file);
+}
+
 static void test_allocator_hooks(void **state)
 {
     (void)state;
@@ -574,7 +651,7 @@ static void test_validator_framing_ids(void **state)
     } cases[] = {
         {0, 0xff, 0, 101}, {4, 0x07, 0, 102}, {8, 0x03, 0, 103}, {60, 0x01, 0, 104},
         {12, 0x01, 1, 105}, {24, 0x04, 1, 108}, {32, 0xff, 1, 110}, {36, 0x01, 1, 111},
-        {40, 0x08, 1, 112}, {64 + 30, 0x01, 2, 114}, {28, 0x01, 1, 109}, {10, 0x02, 1, 115}, /* minor 2 > 1 */
+        {40, 0x08, 1, 112}, {64 + 30, 0x01, 2, 114}, {28, 0x01, 1, 109}, {10, 0x04, 1, 115}, /* minor 4 > 2 */
         {64 + 12, 0x01, 1, 205}, {64 + 4, 0x02, 1, 203}, {64 + 8, 0x02, 1, 204},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
@@ -634,8 +711,131 @@ static void test_validator_framing_ids(void **state)
     c = validate(f, n, &s);
     assert_true(has_id(&c, 116));
     assert_int_equal(s.errors, 1);
+    /* the LMAP_BLOCK feature bit set without an LMAP */
+    memcpy(f, good, n);
+    f[24] |= 2u;
+    fixture_fix_checksums(f);
+    c = validate(f, n, &s);
+    assert_true(has_id(&c, 117));
+    assert_int_equal(s.errors, 1);
     free(f);
     free(good);
+}
+
+/* The texel checks of an uncompressed LMAP run in the checksum's pass over memory (the block tests
+ * while the bytes are in cache, lbk_lmap_hash_prescan): the same issues at the same offsets as the
+ * zstd-compressed copy of the section, which takes the ordinary path; and a corrupted lightmap
+ * still reports its checksum (214) and nothing else. */
+static void test_lmap_fused_scan(void **state)
+{
+    (void)state;
+    enum { W = 64, H = 40 }; /* 2560 texels: two full 1024-texel blocks and a partial one per plane */
+    static lbk_ahd_texel tx[W * H];
+    for (int i = 0; i < W * H; i++) {
+        tx[i].irradiance_z = 0x3c003c00u;
+        tx[i].rgba[0] = 255, tx[i].rgba[1] = 128, tx[i].rgba[2] = 128, tx[i].rgba[3] = 255;
+    }
+    tx[1500].irradiance_z = 0x7c0u;                         /* Inf in R: 509, block 1 */
+    tx[2400].irradiance_z = 0xf8000000u;                    /* B: 509, the partial block */
+    tx[10].rgba[1] = 128, tx[10].rgba[2] = 128, tx[10].rgba[3] = 20; /* short direction: 510, block 0 */
+    const lbk_lmap_page_desc pg = {W, H, tx};
+    lbk_lmap_build_desc bd = LBK_LMAP_BUILD_DESC_INIT;
+    bd.pages = &pg;
+    bd.page_count = 1;
+    void *lm;
+    size_t lm_n;
+    assert_int_equal(lbk_lmap_build(&bd, NULL, &lm, &lm_n), LBK_OK);
+    collected got[2];
+    lbk_validate_summary sm[2];
+    uint64_t lmap_offset[2];
+    for (int z = 0; z < 2; z++) {
+        lbk_writer *w;
+        void *file;
+        size_t n;
+        const lbk_section_options zo = {.compression = LBK_COMPRESSION_ZSTD, .zstd_level = 3};
+        assert_int_equal(lbk_writer_open(NULL, &w), LBK_OK);
+        assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_LMAP, lm, lm_n, z ? &zo : NULL), LBK_OK);
+        assert_int_equal(lbk_writer_to_memory(w, &file, &n), LBK_OK);
+        lbk_writer_close(w);
+        lmap_offset[z] = rd64((const uint8_t *)file + 64 + 16);
+        got[z] = validate(file, n, &sm[z]);
+        /* through a reader too: the same */
+        lbk_reader *r;
+        collected c = {0};
+        lbk_validate_summary sr;
+        assert_int_equal(lbk_reader_open_memory(file, n, NULL, &r), LBK_OK);
+        assert_int_equal(lbk_reader_validate(r, collect, &c, &sr), LBK_OK);
+        lbk_reader_close(r);
+        assert_int_equal(c.count, got[z].count);
+        assert_memory_equal(c.ids, got[z].ids, sizeof c.ids[0] * c.count);
+        if (!z) { /* a flipped texel byte: the checksum, nothing from the texels */
+            uint8_t *bad = malloc(n);
+            memcpy(bad, file, n);
+            bad[lmap_offset[0] + 200] ^= 0x01;
+            lbk_validate_summary sb;
+            collected cb = validate(bad, n, &sb);
+            assert_true(has_id(&cb, 214));
+            assert_false(has_id(&cb, 509) || has_id(&cb, 510));
+            free(bad);
+        }
+        lbk_free(NULL, file);
+    }
+    lbk_free(NULL, lm);
+    /* the 221 warning (no OBJS), 509 twice, 510 once; uncompressed offsets are file offsets */
+    for (int z = 0; z < 2; z++) {
+        assert_true(has_id(&got[z], 509) && has_id(&got[z], 510));
+        assert_int_equal(sm[z].errors, got[0].count - sm[0].warnings);
+    }
+    assert_int_equal(got[0].count, got[1].count);
+    assert_memory_equal(got[0].ids, got[1].ids, sizeof got[0].ids[0] * got[0].count);
+    int n509 = 0;
+    for (uint32_t i = 0; i < got[0].count; i++) {
+        if (got[0].ids[i] == 509) {
+            const uint64_t at = got[0].offsets[i] - lmap_offset[0];
+            assert_true(at == 48 + 4 * 1500 || at == 48 + 4 * 2400);
+            n509++;
+        }
+        if (got[0].ids[i] == 510) assert_int_equal(got[0].offsets[i] - lmap_offset[0], 48 + 4 * W * H + 4 * 10 + 0);
+    }
+    assert_int_equal(n509, 2);
+}
+
+/* Format 1.2: a file with a block-encoded LMAP page says so (minor 2, required feature
+ * LMAP_BLOCK) and validates clean; a 1.0 LMAP keeps minor 0 and no feature bit. */
+static void test_lmap_block_version(void **state)
+{
+    (void)state;
+    uint8_t p0[16] = {0x03}, p1[24] = {0};
+    lbk_ahd_texel tx[16];
+    memset(tx, 0, sizeof tx);
+    const lbk_lmap_encoded_page enc = {4, 4, {LBK_LMAP_BC6H, LBK_LMAP_BC5_BC4}, {p0, p1}};
+    const lbk_lmap_page_desc plain = {4, 4, tx};
+    for (int block = 0; block < 2; block++) {
+        lbk_lmap_build_desc bd = LBK_LMAP_BUILD_DESC_INIT;
+        bd.page_count = 1;
+        if (block) bd.encoded = &enc;
+        else bd.pages = &plain;
+        void *lm, *file;
+        size_t lm_n, n;
+        assert_int_equal(lbk_lmap_build(&bd, NULL, &lm, &lm_n), LBK_OK);
+        lbk_writer *w;
+        assert_int_equal(lbk_writer_open(NULL, &w), LBK_OK);
+        assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_LMAP, lm, lm_n, NULL), LBK_OK);
+        assert_int_equal(lbk_writer_to_memory(w, &file, &n), LBK_OK);
+        lbk_writer_close(w);
+        lbk_free(NULL, lm);
+        lbk_reader *r;
+        assert_int_equal(lbk_reader_open_memory(file, n, NULL, &r), LBK_OK);
+        const lbk_header_info *h = lbk_reader_header(r);
+        assert_int_equal(h->version_minor, block ? 2 : 0);
+        assert_int_equal(h->required_features & LBK_FEATURE_LMAP_BLOCK, block ? LBK_FEATURE_LMAP_BLOCK : 0);
+        int issues = 0;
+        lbk_validate_summary sm;
+        assert_int_equal(lbk_reader_validate(r, count_issue, &issues, &sm), LBK_OK);
+        assert_int_equal(sm.errors + sm.fatal, 0);
+        lbk_reader_close(r);
+        lbk_free(NULL, file);
+    }
 }
 
 static void test_registry_sorted(void **state)
@@ -699,10 +899,13 @@ int main(void)
         cmocka_unit_test(test_reader_rejections),
         cmocka_unit_test(test_unknown_sections),
         cmocka_unit_test(test_decoded_cap_stops_bomb),
+        cmocka_unit_test(test_reader_validate_decodes_once),
         cmocka_unit_test(test_allocator_hooks),
         cmocka_unit_test(test_writer_arguments),
         cmocka_unit_test(test_atomic_file_write),
         cmocka_unit_test(test_validator_framing_ids),
+        cmocka_unit_test(test_lmap_block_version),
+        cmocka_unit_test(test_lmap_fused_scan),
         cmocka_unit_test(test_registry_sorted),
         cmocka_unit_test(test_registry_matches_spec),
     };

@@ -7,9 +7,11 @@
 #include <cmocka.h>
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "lbk/bc.h"
 #include "lbk/container.h"
 #include "lbk/glg.h"
 #include "lbk/lightmap.h"
@@ -46,6 +48,8 @@ static bool has(const issues *is, uint32_t id)
 typedef void (*validator)(lbk_vctx *, const uint8_t *, size_t);
 
 /* Runs one section validator on a copy (so ASan sees reads past the end). */
+static uint32_t run_features; /* the header's required features the validator sees */
+
 static void run(validator fn, const uint8_t *bytes, size_t size, issues *is, lbk_vctx *facts)
 {
     memset(is, 0, sizeof *is);
@@ -59,6 +63,7 @@ static void run(validator fn, const uint8_t *bytes, size_t size, issues *is, lbk
     ctx.summary = &sum;
     ctx.allocator = &alloc;
     ctx.section_type = LBK_SECTION_LMAP;
+    ctx.required_features = run_features;
     uint8_t *copy = malloc(size ? size : 1);
     memcpy(copy, bytes, size);
     fn(&ctx, copy, size);
@@ -167,7 +172,7 @@ static void lmap_round_trip_and_rules(void **state)
     uint8_t *c;
     expect_only(lbk_validate_lmap, b, 10, 500);
     c = dup_bytes(b, n); c[5] = 1; expect_only(lbk_validate_lmap, c, n, 511); free(c); /* scale 1 + 2^-15 */
-    c = dup_bytes(b, n); c[16 + 32 + 5] = 1; expect_only(lbk_validate_lmap, c, n, 501); free(c);
+    c = dup_bytes(b, n); c[16 + 32 + 6] = 1; expect_only(lbk_validate_lmap, c, n, 501); free(c); /* encoding bit 16 */
     c = dup_bytes(b, n); lbk_wr32(c, 0); expect_only(lbk_validate_lmap, c, n, 502); free(c);
     c = dup_bytes(b, n); lbk_wr32(c, 100); expect_only(lbk_validate_lmap, c, n, 502); free(c);
     c = dup_bytes(b, n); lbk_wr16(c + 16, 0); expect_only(lbk_validate_lmap, c, n, 503); free(c);
@@ -186,6 +191,203 @@ static void lmap_round_trip_and_rules(void **state)
     assert_int_equal(is.n, 9);
     free(c);
     lbk_free(NULL, b);
+}
+
+/* Counts issue `id` of a validation: listed ones plus the "... and N more" summary. */
+typedef struct id_count {
+    uint32_t id;
+    unsigned long long n;
+} id_count;
+
+/* Format 1.2 block pages (spec §9.2): an 8×4 BC6H + BC5/BC4 page next to a 1.0 page, built,
+ * opened, decoded by the planes API, and every new rule (512–515). */
+static void lmap_block_pages(void **state)
+{
+    (void)state;
+    /* plane 0: two BC6H mode-11 blocks; plane 1: BC5 (2 × 16 B), then BC4 at 16·2 (2 × 8 B) */
+    uint8_t p0[32], p1[48];
+    for (int b = 0; b < 2; b++) {
+        const int ep[4][3] = {{100 + 50 * b, 200, 300}, {600, 500 - 100 * b, 400}, {0, 0, 0}, {0, 0, 0}};
+        uint8_t idx[16];
+        for (int t = 0; t < 16; t++) idx[t] = (uint8_t)(t == 0 ? 3 : (t * 5 + b) % 16);
+        assert_int_equal(lbk_bc6h_pack(11, 0, ep, idx, p0 + 16 * b), LBK_OK);
+    }
+    for (int i = 0; i < 48; i++) p1[i] = (uint8_t)(i * 37 + 11);
+    assert_int_equal(lbk_lmap_plane_size(0, LBK_LMAP_BC6H, 8, 4), 32);
+    assert_int_equal(lbk_lmap_plane_size(1, LBK_LMAP_BC5_BC4, 8, 4), 48);
+    assert_int_equal(lbk_lmap_plane_size(1, LBK_LMAP_BC5_BC4, 4, 4), 24); /* BC4 at 16 */
+    assert_int_equal(lbk_lmap_plane_size(0, LBK_LMAP_BC6H, 6, 4), 0);
+    assert_int_equal(lbk_lmap_plane_size(0, 7, 8, 4), 0);
+    uint8_t r0[24], r1[24]; /* a 3×2 page as 1.0 planes */
+    for (int i = 0; i < 6; i++) {
+        lbk_wr32(r0 + 4 * i, lbk_r11g11b10f_pack((const float[3]){0.25f * (float)(i + 1), 0.5f, 1.0f}));
+        memcpy(r1 + 4 * i, (const uint8_t[4]){128, 128, 128, 255}, 4);
+    }
+    const lbk_lmap_encoded_page enc[2] = {{8, 4, {LBK_LMAP_BC6H, LBK_LMAP_BC5_BC4}, {p0, p1}},
+                                          {3, 2, {LBK_LMAP_R11G11B10F, LBK_LMAP_RGBA8}, {r0, r1}}};
+    void *b;
+    size_t n;
+    assert_int_equal(lbk_lmap_build(&(lbk_lmap_build_desc){.size = sizeof(lbk_lmap_build_desc), .page_count = 2,
+                                                          .encoded = enc}, NULL, &b, &n), LBK_OK);
+    /* header 80; page 0 plane 0 at 80 (32 B), plane 1 at 112 (48 B) → 160; page 1 at 160 and 192 */
+    assert_int_equal(n, 216);
+    assert_int_equal(lbk_lmap_required_features(b, n), LBK_FEATURE_LMAP_BLOCK);
+    lbk_lmap_view v;
+    assert_int_equal(lbk_lmap_open(b, n, &v), LBK_OK);
+    assert_int_equal(v.texel_count, 38);
+    lbk_lmap_page pg;
+    assert_int_equal(lbk_lmap_page_get(&v, 0, &pg), LBK_ERR_UNSUPPORTED_FEATURE);
+    assert_int_equal(lbk_lmap_page_get(&v, 1, &pg), LBK_OK);
+    lbk_lmap_planes pl;
+    assert_int_equal(lbk_lmap_planes_get(&v, 0, &pl), LBK_OK);
+    assert_int_equal(pl.format[0], LBK_LMAP_BC6H);
+    assert_int_equal(pl.format[1], LBK_LMAP_BC5_BC4);
+    assert_int_equal(pl.blocks_x, 2);
+    assert_int_equal(pl.blocks_y, 1);
+    assert_int_equal(pl.offset[0], 80);
+    assert_int_equal(pl.offset[1], 112);
+    assert_int_equal(pl.bytes[1], 48);
+    for (uint32_t y = 0; y < 4; y++)
+        for (uint32_t x = 0; x < 8; x++) {
+            lbk_ahd_texel_f t;
+            assert_int_equal(lbk_lmap_planes_texel_unpack(&pl, x, y, &t), LBK_OK);
+            uint16_t h[16][3];
+            float dir[16][2], ratio[16];
+            const int blk = (int)(x / 4), k = (int)(y * 4 + x % 4);
+            lbk_bc6h_unpack(p0 + 16 * blk, h);
+            lbk_bc5_unpack(p1 + 16 * blk, dir);
+            lbk_bc4_unpack(p1 + 32 + 8 * blk, ratio);
+            for (int c = 0; c < 3; c++) assert_true(t.ez[c] == lbk_half_to_float(h[k][c]));
+            assert_true(t.rgba[0] == ratio[k] && t.rgba[1] == dir[k][0] && t.rgba[2] == dir[k][1]);
+            const float dx = 2 * dir[k][0] - 1, dy = 2 * dir[k][1] - 1, zz = 1 - dx * dx - dy * dy;
+            assert_true(t.rgba[3] == (zz > 0 ? sqrtf(zz) : 0.0f));
+            float rgb[3];
+            assert_int_equal(lbk_lmap_planes_irradiance(&pl, x, y, (const float[3]){0, 0, 1}, rgb), LBK_OK);
+        }
+    lbk_ahd_texel_f tf;
+    assert_int_equal(lbk_lmap_planes_texel_unpack(&pl, 8, 0, &tf), LBK_ERR_NOT_FOUND);
+    /* GPU bytes: whole blocks (16 + 16 + 8 per block touched), 8 per texel on a 1.0 page */
+    assert_int_equal(lbk_lmap_planes_rect_bytes(&pl, 1, 1, 1, 1), 40);
+    assert_int_equal(lbk_lmap_planes_rect_bytes(&pl, 3, 0, 2, 4), 80);
+    assert_int_equal(lbk_lmap_planes_rect_bytes(&pl, 0, 0, 8, 4), 80);
+    assert_int_equal(lbk_lmap_planes_rect_bytes(&pl, 7, 0, 2, 1), 0);
+    lbk_lmap_planes pl1;
+    assert_int_equal(lbk_lmap_planes_get(&v, 1, &pl1), LBK_OK);
+    assert_int_equal(pl1.blocks_x, 0);
+    assert_int_equal(lbk_lmap_planes_rect_bytes(&pl1, 0, 0, 2, 2), 32);
+    for (uint32_t i = 0; i < 6; i++) { /* 1.0 planes decode bit for bit as the 1.0 API */
+        float a[3], c[3];
+        const float nn[3] = {0.0f, 0.6f, 0.8f};
+        assert_int_equal(lbk_lmap_planes_irradiance(&pl1, i % 3, i / 3, nn, a), LBK_OK);
+        assert_int_equal(lbk_lmap_page_irradiance(&pg, i % 3, i / 3, nn, c), LBK_OK);
+        assert_memory_equal(a, c, sizeof a);
+    }
+    /* validator: clean with the feature bit, 515 without; 514, 512, 513 */
+    issues is;
+    run_features = LBK_FEATURE_LMAP_BLOCK;
+    run(lbk_validate_lmap, b, n, &is, NULL);
+    assert_int_equal(is.n, 0);
+    uint8_t *c;
+    c = dup_bytes(b, n); c[80] = 0x13; expect_only(lbk_validate_lmap, c, n, 514); free(c); /* reserved mode 10011 */
+    c = dup_bytes(b, n); lbk_wr32(c + 16 + 4, 0x0303); expect_only(lbk_validate_lmap, c, n, 512); free(c);
+    c = dup_bytes(b, n); lbk_wr32(c + 16 + 4, 0x0103); expect_only(lbk_validate_lmap, c, n, 512); free(c);
+    c = dup_bytes(b, n); lbk_wr32(c + 16 + 4, 0x10101); expect_has(lbk_validate_lmap, c, n, 501); free(c);
+    c = dup_bytes(b, n); lbk_wr16(c + 16, 6); expect_only(lbk_validate_lmap, c, n, 513); free(c);
+    run_features = 0;
+    expect_only(lbk_validate_lmap, b, n, 515);
+    lbk_lmap_view cv;
+    c = dup_bytes(b, n); lbk_wr16(c + 16, 6); assert_int_equal(lbk_lmap_open(c, n, &cv), LBK_ERR_CORRUPT); free(c);
+    /* a 1.0 page with the feature bit set: 515 */
+    void *b0;
+    size_t n0;
+    lbk_ahd_texel t0[6], t1[20];
+    lmap_fixture(&b0, &n0, t0, t1);
+    assert_int_equal(lbk_lmap_required_features(b0, n0), 0);
+    run_features = LBK_FEATURE_LMAP_BLOCK;
+    expect_only(lbk_validate_lmap, b0, n0, 515);
+    run_features = 0;
+    lbk_free(NULL, b0);
+    /* ASTC planes: described, not decoded by liblbk */
+    uint8_t a0[32] = {0}, a1[32] = {0};
+    const lbk_lmap_encoded_page ea = {8, 4, {LBK_LMAP_ASTC4X4_HDR, LBK_LMAP_ASTC4X4_LDR}, {a0, a1}};
+    void *ba;
+    size_t na;
+    assert_int_equal(lbk_lmap_build(&(lbk_lmap_build_desc){.size = sizeof(lbk_lmap_build_desc), .page_count = 1,
+                                                          .encoded = &ea}, NULL, &ba, &na), LBK_OK);
+    assert_int_equal(lbk_lmap_open(ba, na, &v), LBK_OK);
+    assert_int_equal(lbk_lmap_planes_get(&v, 0, &pl), LBK_OK);
+    assert_int_equal(lbk_lmap_planes_texel_unpack(&pl, 0, 0, &tf), LBK_ERR_UNSUPPORTED_FEATURE);
+    assert_int_equal(lbk_lmap_planes_rect_bytes(&pl, 0, 0, 1, 1), 32);
+    lbk_free(NULL, ba);
+    /* a block page whose side is not a multiple of 4 cannot be built */
+    const lbk_lmap_encoded_page eb = {6, 4, {LBK_LMAP_BC6H, LBK_LMAP_RGBA8}, {p0, p1}};
+    assert_int_not_equal(lbk_lmap_build(&(lbk_lmap_build_desc){.size = sizeof(lbk_lmap_build_desc), .page_count = 1,
+                                                              .encoded = &eb}, NULL, &ba, &na), LBK_OK);
+    lbk_free(NULL, b);
+}
+
+static int count_id(void *user, const lbk_issue *issue)
+{
+    id_count *c = user;
+    if (issue->id != c->id) return 0;
+    unsigned long long more;
+    if (sscanf(issue->message, "... and %llu more", &more) == 1) c->n += more;
+    else c->n++;
+    return 0;
+}
+
+/* The validator's fast texel scan (blocks of 1024 texels, integer tests) flags exactly the texels
+ * the decoder's float rule calls short (510) — every (G, B) for every A that can be short
+ * (A ≤ 127; A ≥ 128 gives z² > 1/4) — and every exponent-31 channel (509) anywhere in a page,
+ * also in the last, partial block. */
+static void lmap_fast_scan_exact(void **state)
+{
+    (void)state;
+    lbk_ahd_texel *t = malloc(256 * 256 * sizeof *t);
+    for (int a = 0; a < 128; a += 1) {
+        unsigned long long want = 0;
+        for (int y = 0; y < 256; y++)
+            for (int x = 0; x < 256; x++) {
+                t[y * 256 + x] = (lbk_ahd_texel){0, {0, (uint8_t)x, (uint8_t)y, (uint8_t)a}};
+                const float dx = 2.0f * x / 255.0f - 1.0f, dy = 2.0f * y / 255.0f - 1.0f, dz = a / 255.0f;
+                want += dx * dx + dy * dy + dz * dz < 0.25f;
+            }
+        void *b;
+        size_t n;
+        lbk_lmap_page_desc pd = {256, 256, t};
+        assert_int_equal(lbk_lmap_build(&(lbk_lmap_build_desc){.pages = &pd, .page_count = 1}, NULL, &b, &n), LBK_OK);
+        id_count c = {510, 0};
+        lbk_validate_summary sum;
+        memset(&sum, 0, sizeof sum);
+        lbk_allocator alloc = {0};
+        lbk_vctx ctx;
+        memset(&ctx, 0, sizeof ctx);
+        ctx.callback = count_id;
+        ctx.user = &c;
+        ctx.summary = &sum;
+        ctx.allocator = &alloc;
+        lbk_validate_lmap(&ctx, b, n);
+        assert_int_equal(c.n, want);
+        if (a == 0) assert_true(want > 10000);
+        lbk_dealloc(NULL, (void *)ctx.lmap_page_width);
+        lbk_dealloc(NULL, (void *)ctx.lmap_page_height);
+        lbk_free(NULL, b);
+    }
+    /* 509: a 1000 x 3 page (two full blocks and a partial one), exponent 31 in R, G or B of texels
+     * spread over all three blocks */
+    for (int i = 0; i < 3000; i++) t[i] = (lbk_ahd_texel){0x3c0u | 0x3c0u << 11 | 0x1e0u << 22, {255, 128, 128, 255}};
+    const uint32_t bad[5] = {0, 1023, 1024, 2047, 2999};
+    for (int k = 0; k < 5; k++) t[bad[k]].irradiance_z |= k % 3 == 0 ? 0x7c0u : k % 3 == 1 ? 0x7c0u << 11 : 0x3e0u << 22;
+    void *b;
+    size_t n;
+    lbk_lmap_page_desc pd = {1000, 3, t};
+    assert_int_equal(lbk_lmap_build(&(lbk_lmap_build_desc){.pages = &pd, .page_count = 1}, NULL, &b, &n), LBK_OK);
+    issues is;
+    run(lbk_validate_lmap, b, n, &is, NULL);
+    assert_int_equal(is.n, 5);
+    for (int k = 0; k < 5; k++) assert_int_equal(is.id[k], 509);
+    lbk_free(NULL, b);
+    free(t);
 }
 
 /* One cube split in 6 tetras plus an unused ninth probe (optional). */
@@ -626,7 +828,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(lmap_round_trip_and_rules), cmocka_unit_test(glg_rules), cmocka_unit_test(llg_rules),
         cmocka_unit_test(octa_mapping),              cmocka_unit_test(octp_rules), cmocka_unit_test(container_clean),
-        cmocka_unit_test(scaled_sections),
+        cmocka_unit_test(scaled_sections),      cmocka_unit_test(lmap_fast_scan_exact), cmocka_unit_test(lmap_block_pages),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -114,7 +114,16 @@ static void test_shipped_profiles(void **state)
     assert_int_equal(tl_profile_rule(&p, LBK_SECTION_REPT).ship, TL_SHIP_DROP);
     assert_int_equal(tl_profile_rule(&p, LBK_SECTION_LMAP).compression, LBK_COMPRESSION_NONE);
     assert_int_equal(tl_profile_rule(&p, LBK_SECTION_OBJS).compression, LBK_COMPRESSION_ZSTD);
+    assert_int_equal(p.lmap_row_pitch_alignment, 0);
+    assert_int_equal(p.lmap_format[0], LBK_LMAP_BC6H);
+    assert_int_equal(p.lmap_format[1], LBK_LMAP_BC5_BC4);
+
+    assert_int_equal(tl_profile_resolve("handheld", "tools/convert/profiles", &p, err), 0);
+    assert_int_equal(p.alignment, 4096);
     assert_int_equal(p.lmap_row_pitch_alignment, 256);
+    assert_int_equal(p.lmap_format[0], LBK_LMAP_ASTC4X4_HDR);
+    assert_int_equal(p.lmap_format[1], LBK_LMAP_ASTC4X4_LDR);
+    assert_int_equal(tl_profile_rule(&p, LBK_SECTION_LMAP).compression, LBK_COMPRESSION_ZSTD);
 
     assert_int_equal(tl_profile_resolve("console-previous", "tools/convert/profiles", &p, err), 0);
     assert_int_equal(p.alignment, 2048);

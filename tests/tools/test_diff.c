@@ -51,7 +51,7 @@ static void run_diff(const tf_options *oa, const tf_options *ob, double abs_tol,
     tl_bake ba, bb;
     open_blob(&a, &ba);
     open_blob(&b, &bb);
-    tl_diff_options o = {abs_tol, rel_tol, maps};
+    tl_diff_options o = {.abs_tol = abs_tol, .rel_tol = rel_tol, .keep_error_maps = maps};
     char err[TL_ERR_LEN];
     assert_int_equal(tl_diff_run(&ba, &bb, &o, r, err), 0);
     tl_bake_close(&ba);
@@ -292,33 +292,51 @@ static void test_probe_change(void **state)
     tl_diff_free(&r);
 }
 
-/* A console pack widens pages (row pitch) and drops META/REPT: the lighting is the same. */
+/* A pc pack widens pages (row pitch) and drops META/REPT: the lighting is the same. A
+ * console-current pack block-compresses the lightmaps (BC6H + BC5/BC4): diff reads it, matches
+ * every object and finds only the encoding's small error. */
 static void test_pack_equals_source(void **state)
 {
     (void)state;
     tf_blob a = tf_build_scene(TF_SCENE_FULL, NULL);
     char err[TL_ERR_LEN];
-    tl_profile p;
-    assert_int_equal(tl_profile_resolve("console-current", "tools/convert/profiles", &p, err), 0);
-    tl_convert_options co = {&p, NULL};
-    void *pack;
-    size_t pack_size;
-    assert_int_equal(tl_convert_memory(a.data, a.size, &co, &pack, &pack_size, NULL, err), TL_CONVERT_OK);
     tl_bake ba, bb;
     open_blob(&a, &ba);
-    assert_int_equal(tl_bake_open_memory(pack, pack_size, &bb, err), TL_OPEN_OK);
-    tl_diff_options o = {0, 0, 0};
-    tl_diff_result r;
-    assert_int_equal(tl_diff_run(&ba, &bb, &o, &r, err), 0);
-    assert_int_equal(r.pages[1].resized, 1); /* 16 → 64 texels wide */
-    assert_int_equal(r.objects_changed, 0);
-    assert_int_equal(r.sets[0].status, TL_DIFF_SAME);
-    assert_int_equal(r.sets[0].lighting[LBK_DLS_SPACE_TEXEL].count, 256);
-    assert_int_equal(r.differ, 0);
-    tl_diff_free(&r);
+    for (int k = 0; k < 2; k++) {
+        tl_profile p;
+        assert_int_equal(tl_profile_resolve(k ? "console-current" : "pc", "tools/convert/profiles", &p, err), 0);
+        tl_convert_options co = {&p, NULL};
+        void *pack;
+        size_t pack_size;
+        assert_int_equal(tl_convert_memory(a.data, a.size, &co, &pack, &pack_size, NULL, err), TL_CONVERT_OK);
+        assert_int_equal(tl_bake_open_memory(pack, pack_size, &bb, err), TL_OPEN_OK);
+        tl_diff_options o = {0};
+        tl_diff_result r;
+        assert_int_equal(tl_diff_run(&ba, &bb, &o, &r, err), 0);
+        if (!k) {
+            assert_int_equal(r.pages[1].resized, 1); /* 16 → 64 texels wide */
+            assert_int_equal(r.objects_changed, 0);
+            assert_int_equal(r.sets[0].status, TL_DIFF_SAME);
+            assert_int_equal(r.sets[0].lighting[LBK_DLS_SPACE_TEXEL].count, 256);
+            assert_int_equal(r.differ, 0);
+        } else {
+            /* block pages: padded to whole blocks only; every lightmapped object compared */
+            size_t compared = 0;
+            for (size_t i = 0; i < r.object_count; i++) {
+                const tl_diff_object *ob = &r.objects[i];
+                assert_int_equal(ob->geometry_changed, 0);
+                if (!ob->compared || ob->repr_a != LBK_REPRESENTATION_LIGHTMAP) continue;
+                compared++;
+                const double rr = tl_err_rel_rmse(&ob->lighting);
+                if (!(rr < 0.1)) fail_msg("object %s: relative RMSE %g after BC6H + BC5/BC4", ob->name, rr);
+            }
+            assert_true(compared > 0);
+        }
+        tl_diff_free(&r);
+        tl_bake_close(&bb);
+        free(pack);
+    }
     tl_bake_close(&ba);
-    tl_bake_close(&bb);
-    free(pack);
     tf_blob_free(&a);
 }
 
@@ -341,14 +359,16 @@ static void test_json_schema(void **state)
     assert_non_null(j);
     free(text);
     assert_string_equal(cJSON_GetObjectItem(j, "schema")->valuestring, "lbk-diff");
-    assert_int_equal(cJSON_GetObjectItem(j, "schema_version")->valueint, 1);
-    const char *top[] = {"a", "b", "tolerance", "equal", "summary", "sections", "params", "objects", "pages", "glg",
-                         "light_sets", "doors"};
+    assert_int_equal(cJSON_GetObjectItem(j, "schema_version")->valueint, 2);
+    const char *top[] = {"a", "b", "tolerance", "equal", "mode", "mode_reason", "noise_model", "inputs", "summary",
+                         "sections", "params", "objects", "pages", "glg", "light_sets", "doors"};
     for (size_t i = 0; i < sizeof top / sizeof top[0]; i++) require_key(j, top[i]);
     assert_true(cJSON_IsFalse(cJSON_GetObjectItem(j, "equal")));
+    assert_string_equal(cJSON_GetObjectItem(j, "mode")->valuestring, "tolerance");
+    assert_true(cJSON_IsNull(cJSON_GetObjectItem(j, "noise_model")));
     const char *sum[] = {"objects_added", "objects_removed", "objects_changed", "pages_changed", "light_sets_changed",
                          "doors_changed", "sections_changed", "params_changed", "texels_over_tolerance",
-                         "probes_over_tolerance"};
+                         "probes_over_tolerance", "beyond_noise", "inputs_changed"};
     for (size_t i = 0; i < sizeof sum / sizeof sum[0]; i++) require_key(cJSON_GetObjectItem(j, "summary"), sum[i]);
     const cJSON *objs = cJSON_GetObjectItem(j, "objects");
     assert_int_equal(cJSON_GetArraySize(objs), 4);
@@ -356,7 +376,8 @@ static void test_json_schema(void **state)
     int found = 0;
     cJSON_ArrayForEach(o, objs)
     {
-        const char *keys[] = {"name", "b_name", "status", "changes", "a", "b", "resampled", "lighting"};
+        const char *keys[] = {"name", "b_name", "status", "changes", "inputs_changed", "a", "b", "resampled", "lighting",
+                              "noise"};
         for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++) require_key(o, keys[i]);
         if (strcmp(cJSON_GetObjectItem(o, "name")->valuestring, "crate")) continue;
         found = 1;
@@ -442,8 +463,13 @@ static void test_cli_exit_codes(void **state)
     tf_blob_free(&b);
     const char *same[] = {"diff", pa, pa, "--json"};
     assert_int_equal(run_cli(4, same), LBK_EXIT_OK);
-    const char *differ[] = {"diff", pa, pb};
-    assert_int_equal(run_cli(3, differ), LBK_EXIT_NEGATIVE);
+    /* exact: the one texel doubled differs (the default for these files is noise mode: both carry REPT) */
+    const char *differ[] = {"diff", pa, pb, "--mode", "tolerance"};
+    assert_int_equal(run_cli(5, differ), LBK_EXIT_NEGATIVE);
+    const char *bad_mode[] = {"diff", pa, pb, "--mode", "fuzzy"};
+    assert_int_equal(run_cli(5, bad_mode), LBK_EXIT_USAGE);
+    const char *bad_alpha[] = {"diff", pa, pb, "--false-alarm", "0.7"};
+    assert_int_equal(run_cli(5, bad_alpha), LBK_EXIT_USAGE);
     const char *loose[] = {"diff", pa, pb, "--rel-tol", "1.5"}; /* 2× texel: error = 1 × A ≤ 1.5 × A */
     assert_int_equal(run_cli(5, loose), LBK_EXIT_OK);
     const char *usage1[] = {"diff", pa};

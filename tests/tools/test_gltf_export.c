@@ -26,6 +26,7 @@
 #include "tools/common/file_util.h"
 #include "tools/convert/gltf_export.h"
 #include "lbk/container.h"
+#include "support/bake_file.h"
 #include "support/lmuv_scene.h"
 
 static char tmpdir[64];
@@ -57,6 +58,7 @@ static void bake(const char *in, const char *out, float density)
     memset(&o, 0, sizeof o);
     o.in = in;
     o.out = out;
+    o.d.preset = LBK_BAKE_PRESET_FAST;
     o.d.seed = 1;
     o.d.max_samples = 16;
     o.d.threads = 2;

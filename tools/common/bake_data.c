@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "tools/common/file_util.h"
+#include "tools/common/lmap_decode.h"
 #include "lbk/validate.h"
 
 #define S45 0.70710678118654752f
@@ -53,23 +54,100 @@ static int keep_first(void *user, const lbk_issue *issue)
     return 0;
 }
 
+/* Block-encoded pages are decoded once at open, so texel access stays cheap and const. */
+static tl_open_status decode_block_pages(tl_bake *b, char err[TL_ERR_LEN])
+{
+    if (!b->has_lmap) return TL_OPEN_OK;
+    b->block_pages = calloc(b->lmap.page_count + 1, sizeof *b->block_pages);
+    if (!b->block_pages) {
+        snprintf(err, TL_ERR_LEN, "out of memory");
+        return TL_OPEN_INTERNAL;
+    }
+    for (uint32_t p = 0; p < b->lmap.page_count; p++) {
+        lbk_lmap_planes pl;
+        lbk_lmap_planes_get(&b->lmap, p, &pl);
+        if (!pl.blocks_x) continue;
+        b->block_pages[p] = malloc(sizeof **b->block_pages * (size_t)pl.width * pl.height);
+        char e2[TL_ERR_LEN];
+        if (!b->block_pages[p] || tl_lmap_page_decode(&pl, b->block_pages[p], e2, sizeof e2)) {
+            snprintf(err, TL_ERR_LEN, "LMAP page %u: %.200s", p, b->block_pages[p] ? e2 : "out of memory");
+            return TL_OPEN_INTERNAL;
+        }
+    }
+    return TL_OPEN_OK;
+}
+
+int tl_bake_planes(const tl_bake *b, uint32_t page, lbk_lmap_planes *out)
+{
+    return b->has_lmap && lbk_lmap_planes_get(&b->lmap, page, out) == LBK_OK ? 0 : -1;
+}
+
+static void unit_direction(const float x, const float y, const float z, float d[3])
+{
+    const float len = sqrtf(x * x + y * y + z * z);
+    if (!(len >= 0.5f)) d[0] = 0, d[1] = 0, d[2] = 1;
+    else d[0] = x / len, d[1] = y / len, d[2] = z / len;
+}
+
+int tl_bake_texel_get(const tl_bake *b, uint32_t page, uint32_t x, uint32_t y, lbk_ahd_texel_f *texel,
+                      lbk_ahd_linear *linear, float dir[3])
+{
+    lbk_lmap_planes pl;
+    if (tl_bake_planes(b, page, &pl) || x >= pl.width || y >= pl.height) return -1;
+    const size_t i = (size_t)y * pl.width + x;
+    if (!b->block_pages[page]) {
+        const uint8_t *z = pl.plane[0] + 4 * i;
+        lbk_ahd_texel t = {(uint32_t)z[0] | (uint32_t)z[1] << 8 | (uint32_t)z[2] << 16 | (uint32_t)z[3] << 24, {0}};
+        memcpy(t.rgba, pl.plane[1] + 4 * i, 4);
+        if (texel) lbk_ahd_texel_f_from_texel(&t, texel);
+        if (linear) lbk_ahd_to_linear(&t, linear);
+        if (dir) unit_direction(2.0f * t.rgba[1] / 255.0f - 1.0f, 2.0f * t.rgba[2] / 255.0f - 1.0f, t.rgba[3] / 255.0f, dir);
+        return 0;
+    }
+    const lbk_ahd_texel_f *tf = &b->block_pages[page][i];
+    if (texel) *texel = *tf;
+    if (linear) lbk_ahd_texel_f_to_linear(tf, linear);
+    if (dir) unit_direction(2.0f * tf->rgba[1] - 1.0f, 2.0f * tf->rgba[2] - 1.0f, tf->rgba[3], dir);
+    return 0;
+}
+
+int tl_bake_texel_eval(const tl_bake *b, uint32_t page, uint32_t x, uint32_t y, float out[TL_TEXEL_NORMALS][3])
+{
+    lbk_lmap_planes pl;
+    if (tl_bake_planes(b, page, &pl) || x >= pl.width || y >= pl.height) return -1;
+    if (!b->block_pages[page]) {
+        const size_t i = (size_t)y * pl.width + x;
+        const uint8_t *z = pl.plane[0] + 4 * i;
+        lbk_ahd_texel t = {(uint32_t)z[0] | (uint32_t)z[1] << 8 | (uint32_t)z[2] << 16 | (uint32_t)z[3] << 24, {0}};
+        memcpy(t.rgba, pl.plane[1] + 4 * i, 4);
+        tl_texel_eval(&t, pl.scale, out);
+        return 0;
+    }
+    lbk_ahd_linear lin;
+    lbk_ahd_texel_f_to_linear(&b->block_pages[page][(size_t)y * pl.width + x], &lin);
+    for (int n = 0; n < TL_TEXEL_NORMALS; n++) {
+        lbk_ahd_linear_eval(&lin, tl_texel_normals[n], out[n]);
+        for (int c = 0; c < 3; c++) out[n][c] *= pl.scale;
+    }
+    return 0;
+}
+
 static tl_open_status open_views(tl_bake *b, char err[TL_ERR_LEN])
 {
     first_issue f = {0};
     lbk_validate_summary sum = {0};
-    lbk_result r = lbk_validate_memory(b->bytes, b->size, NULL, keep_first, &f, &sum);
+    /* open first, then validate through the reader: every section is checksummed and decoded
+     * once, and the views below use those bytes */
+    lbk_result r = lbk_reader_open_memory(b->bytes, b->size, NULL, &b->reader);
+    if (r == LBK_OK) r = lbk_reader_validate(b->reader, keep_first, &f, &sum);
+    else if (r != LBK_ERR_OUT_OF_MEMORY) r = lbk_validate_memory(b->bytes, b->size, NULL, keep_first, &f, &sum);
     if (r != LBK_OK) {
         snprintf(err, TL_ERR_LEN, "validation could not run: %s", lbk_result_message(r));
         return TL_OPEN_INTERNAL;
     }
-    if (sum.fatal || sum.errors) {
+    if (sum.fatal || sum.errors || !b->reader) {
         snprintf(err, TL_ERR_LEN, "not a valid container (%u errors; first #%u at byte %llu: %s); run lbk validate",
                  sum.fatal + sum.errors, f.issue.id, (unsigned long long)f.issue.offset, f.issue.message);
-        return TL_OPEN_INVALID;
-    }
-    r = lbk_reader_open_memory(b->bytes, b->size, NULL, &b->reader);
-    if (r != LBK_OK) {
-        snprintf(err, TL_ERR_LEN, "%s", lbk_result_message(r));
         return TL_OPEN_INVALID;
     }
     const void *d;
@@ -94,10 +172,13 @@ static tl_open_status open_views(tl_bake *b, char err[TL_ERR_LEN])
     VIEW(LBK_SECTION_LLG, b->has_llg, lbk_llg_open(d, n, &b->llg));
     VIEW(LBK_SECTION_OCTP, b->has_octp, lbk_octp_open(d, n, &b->octp));
     VIEW(LBK_SECTION_LMUV, b->has_lmuv, lbk_lmuv_open(d, n, &b->lmuv));
+    VIEW(LBK_SECTION_REPT, b->has_rept, lbk_report_open(d, n, &b->rept));
+    if (b->has_rept && lbk_report_record_get(&b->rept, b->rept.header.record_count - 1, &b->rept_last) != LBK_OK)
+        b->has_rept = 0;
     VIEW(LBK_SECTION_DLS, dls, lbk_dls_open(d, n, NULL, &b->dls));
     VIEW(LBK_SECTION_DOOR, door, lbk_door_open(d, n, NULL, &b->door));
 #undef VIEW
-    return TL_OPEN_OK;
+    return decode_block_pages(b, err);
 }
 
 tl_open_status tl_bake_open_memory(const void *data, size_t size, tl_bake *b, char err[TL_ERR_LEN])
@@ -133,6 +214,8 @@ tl_open_status tl_bake_open_file(const char *path, tl_bake *b, char err[TL_ERR_L
 
 void tl_bake_close(tl_bake *b)
 {
+    for (uint32_t p = 0; b->block_pages && p < b->lmap.page_count; p++) free(b->block_pages[p]);
+    free(b->block_pages);
     if (b->door) lbk_door_close(b->door);
     if (b->dls) lbk_dls_close(b->dls);
     if (b->reader) lbk_reader_close(b->reader);

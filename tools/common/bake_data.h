@@ -18,6 +18,7 @@
 #include "lbk/meta.h"
 #include "lbk/objects.h"
 #include "lbk/octa.h"
+#include "lbk/report.h"
 
 typedef enum tl_open_status {
     TL_OPEN_OK = 0,
@@ -30,7 +31,7 @@ typedef struct tl_bake {
     void *bytes; /* owned file bytes */
     size_t size;
     lbk_reader *reader;
-    int has_meta, has_objs, has_lmap, has_glg, has_llg, has_octp, has_lmuv;
+    int has_meta, has_objs, has_lmap, has_glg, has_llg, has_octp, has_lmuv, has_rept;
     lbk_meta_view meta;
     lbk_objects_view objs;
     lbk_lmap_view lmap;
@@ -38,8 +39,12 @@ typedef struct tl_bake {
     lbk_llg_view llg;
     lbk_octp_view octp;
     lbk_lmuv_view lmuv;
+    lbk_report_view rept;
+    lbk_report_record rept_last; /* the final estimate, when has_rept */
     lbk_dls_view *dls;   /* NULL when absent */
     lbk_door_view *door; /* NULL when absent */
+    /* per LMAP page: its texels decoded when the page is block-encoded (spec §9.2), else NULL */
+    lbk_ahd_texel_f **block_pages;
 } tl_bake;
 
 /* Reads and validates a file and opens every section view. */
@@ -53,6 +58,18 @@ void tl_bake_close(tl_bake *bake);
 #define TL_PROBE_NORMALS 6 /* ±X, ±Y, ±Z (world space) */
 extern const float tl_texel_normals[TL_TEXEL_NORMALS][3];
 extern const float tl_probe_normals[TL_PROBE_NORMALS][3];
+/* Physical irradiance of texel (x, y) of LMAP page `page` at the five normals, for any encoding:
+ * the stored texel's (tl_texel_eval) on a 1.0 page, the decoded one's on a block page. 0, or -1
+ * outside the page. */
+int tl_bake_texel_eval(const tl_bake *b, uint32_t page, uint32_t x, uint32_t y, float out[TL_TEXEL_NORMALS][3]);
+/* Texel (x, y) of page `page` as floats (stored units) with its linear form and its unit highlight
+ * direction, any encoding: on a 1.0 page exactly the 1.0 decoder's (lbk_ahd_to_linear on the stored
+ * bytes). Any output may be NULL. 0, or -1 outside the page. */
+int tl_bake_texel_get(const tl_bake *b, uint32_t page, uint32_t x, uint32_t y, lbk_ahd_texel_f *texel,
+                      lbk_ahd_linear *linear, float dir[3]);
+/* Page p's planes (lbk_lmap_planes_get); 0 or -1. */
+int tl_bake_planes(const tl_bake *b, uint32_t page, lbk_lmap_planes *out);
+
 /* Physical irradiance of a stored texel at the five normals (decoded × the LMAP scale, or the
  * scale of the base section a DLS payload belongs to): out[n][channel]. */
 void tl_texel_eval(const lbk_ahd_texel *texel, float scale, float out[TL_TEXEL_NORMALS][3]);

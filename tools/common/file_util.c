@@ -7,6 +7,7 @@
 #include <fcntl.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <time.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -101,6 +102,13 @@ int tl_write_file_atomic(const char *path, const void *data, size_t size, char e
 int tl_write_text(const char *path, const char *text, char err[TL_ERR_LEN])
 {
     return tl_write_file_atomic(path, text, strlen(text), err);
+}
+
+double tl_seconds(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
 /* "XXXXXX" of mkstemp: exactly six letters or digits. */

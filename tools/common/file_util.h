@@ -20,4 +20,7 @@ int tl_remove_stale_temps(const char *path, time_t before, void (*removed)(void 
 /* Writes a text file (for CSV/JSON listings); atomic like tl_write_file_atomic. */
 int tl_write_text(const char *path, const char *text, char err[TL_ERR_LEN]);
 
+/* Monotonic seconds (for the timings tools print; never stored in a file). */
+double tl_seconds(void);
+
 #endif

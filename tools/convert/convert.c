@@ -10,6 +10,7 @@
 
 #include "tools/common/error_util.h"
 #include "tools/convert/lmap_layout.h"
+#include "lbk/meta.h"
 #include "lbk/validate.h"
 
 typedef struct first_issue {
@@ -27,12 +28,14 @@ static int keep_first_error(void *user, const lbk_issue *issue)
     return 0;
 }
 
-/* Validates bytes; on failure fills err with the first error. */
-static int validate_bytes(const void *data, size_t size, const char *what, char err[TL_ERR_LEN])
+/* Validates bytes (through the reader when there is one, so each section is decoded once); on
+ * failure fills err with the first error. */
+static int validate_bytes(const void *data, size_t size, lbk_reader *reader, const char *what, char err[TL_ERR_LEN])
 {
     first_issue f = {0};
     lbk_validate_summary sum = {0};
-    lbk_result r = lbk_validate_memory(data, size, NULL, keep_first_error, &f, &sum);
+    lbk_result r = reader ? lbk_reader_validate(reader, keep_first_error, &f, &sum)
+                          : lbk_validate_memory(data, size, NULL, keep_first_error, &f, &sum);
     if (r != LBK_OK) {
         snprintf(err, TL_ERR_LEN, "%s: validation could not run (%s)", what, lbk_result_name(r));
         return -1;
@@ -48,6 +51,44 @@ static int validate_bytes(const void *data, size_t size, const char *what, char 
     return 0;
 }
 
+/* META of a pack that keeps it: the input's keys plus convert.profile and convert.profile_hash
+ * (spec/container.md §6.2), replacing those of an earlier convert, so converting again with the
+ * same profile gives the same bytes. */
+static int meta_with_profile(const void *data, size_t size, const tl_profile *p, void **out, size_t *out_size,
+                             char err[TL_ERR_LEN])
+{
+    lbk_meta_view v;
+    if (lbk_meta_open(data, size, &v) != LBK_OK) return tl_fail(err, TL_CONVERT_BAD_INPUT, "input META unreadable");
+    lbk_meta_pair *pairs = calloc((size_t)v.entry_count + 2, sizeof *pairs);
+    char **owned = calloc(2 * (size_t)v.entry_count + 1, sizeof *owned);
+    char hash[17];
+    lbk_meta_hash_hex(p->text_hash, hash);
+    size_t n = 0, k = 0;
+    int st = TL_CONVERT_INTERNAL;
+    if (!pairs || !owned) goto done;
+    for (uint32_t i = 0; i < v.entry_count; i++) {
+        lbk_string key, val;
+        lbk_meta_entry_get(&v, i, &key, &val);
+        if ((key.size == 15 && !memcmp(key.data, "convert.profile", 15)) ||
+            (key.size == 20 && !memcmp(key.data, "convert.profile_hash", 20)))
+            continue;
+        char *ks = strndup(key.data, key.size), *vs = strndup(val.data, val.size);
+        owned[k++] = ks, owned[k++] = vs;
+        if (!ks || !vs) goto done;
+        pairs[n++] = (lbk_meta_pair){ks, vs};
+    }
+    pairs[n++] = (lbk_meta_pair){"convert.profile", p->name};
+    pairs[n++] = (lbk_meta_pair){"convert.profile_hash", hash};
+    st = lbk_meta_build(pairs, n, NULL, out, out_size) == LBK_OK ? TL_CONVERT_OK : TL_CONVERT_INTERNAL;
+    if (st != TL_CONVERT_OK) tl_fail(err, st, "META with the profile could not be built");
+done:
+    for (size_t i = 0; i < k; i++) free(owned[i]);
+    free(owned);
+    free(pairs);
+    if (st == TL_CONVERT_INTERNAL && !*out) snprintf(err, TL_ERR_LEN, "out of memory");
+    return st;
+}
+
 tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_convert_options *opt, void **out,
                                     size_t *out_size, tl_convert_report *report, char err[TL_ERR_LEN])
 {
@@ -59,10 +100,16 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
     report->in_size = in_size;
     const tl_profile *p = opt->profile;
 
-    if (validate_bytes(in, in_size, "input", err)) return TL_CONVERT_BAD_INPUT;
     lbk_reader *rd = NULL;
     lbk_result r = lbk_reader_open_memory(in, in_size, NULL, &rd);
-    if (r != LBK_OK) return tl_fail(err, TL_CONVERT_BAD_INPUT, "input: %s", lbk_result_message(r));
+    if (r != LBK_OK) {
+        if (validate_bytes(in, in_size, NULL, "input", err)) return TL_CONVERT_BAD_INPUT;
+        return tl_fail(err, TL_CONVERT_BAD_INPUT, "input: %s", lbk_result_message(r));
+    }
+    if (validate_bytes(in, in_size, rd, "input", err)) {
+        lbk_reader_close(rd);
+        return TL_CONVERT_BAD_INPUT;
+    }
 
     lbk_write_options wo = LBK_WRITE_OPTIONS_INIT;
     wo.section_alignment = p->alignment;
@@ -78,6 +125,8 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
     memset(&remap, 0, sizeof remap);
     int have_remap = 0;
     uint32_t n = lbk_reader_section_count(rd);
+    const void *objs = NULL; /* OBJS precedes LMAP (canonical order): which texels objects use */
+    size_t objs_size = 0;
     for (uint32_t i = 0; i < n && st == TL_CONVERT_OK; i++) {
         lbk_section_info si;
         const void *data = NULL;
@@ -86,6 +135,7 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
             st = tl_fail(err, TL_CONVERT_BAD_INPUT, "input section %u: %s", i, lbk_result_message(r));
             break;
         }
+        if (si.type == LBK_SECTION_OBJS) objs = data, objs_size = size;
         tl_convert_section *cs = &report->sections[report->section_count++];
         cs->type = si.type;
         cs->in_stored = si.stored_size;
@@ -99,7 +149,9 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
         size_t rewritten_size = 0;
         int ls = TL_CONVERT_OK;
         if (si.type == LBK_SECTION_LMAP) {
-            tl_lmap_layout_options lo = {p->lmap_row_pitch_alignment, p->lmap_page_alignment, opt->from_exr_dir};
+            tl_lmap_layout_options lo = {p->lmap_row_pitch_alignment, p->lmap_page_alignment, opt->from_exr_dir,
+                                         {p->lmap_format[0], p->lmap_format[1]}, objs, objs_size,
+                                         &report->encode_seconds};
             uint32_t imported = 0;
             tl_texel_remap_free(&remap);
             ls = tl_lmap_rewrite(data, size, &lo, &rewritten, &rewritten_size, &imported, &remap, err);
@@ -107,6 +159,8 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
             have_remap = ls == TL_CONVERT_OK;
         } else if (si.type == LBK_SECTION_DLS && have_remap && !remap.identity) {
             ls = tl_dls_remap_texels(data, size, &remap, &rewritten, &rewritten_size, err);
+        } else if (si.type == LBK_SECTION_META) {
+            ls = meta_with_profile(data, size, p, &rewritten, &rewritten_size, err);
         }
         if (ls != TL_CONVERT_OK) {
             st = (tl_convert_status)ls;
@@ -143,7 +197,7 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
         return st;
     }
     /* Re-read the output to fill in the stored sizes, and refuse to hand out an invalid pack. */
-    if (validate_bytes(bytes, bytes_size, "output", err)) {
+    if (validate_bytes(bytes, bytes_size, NULL, "output", err)) {
         lbk_free(NULL, bytes);
         return TL_CONVERT_INTERNAL;
     }

@@ -32,6 +32,7 @@ typedef struct tl_convert_report {
     uint32_t section_count;
     uint64_t in_size, out_size;
     uint32_t pages_imported; /* --from-exr */
+    double encode_seconds;   /* block-encoding the lightmap pages (wall clock) */
 } tl_convert_report;
 
 typedef struct tl_convert_options {

@@ -33,30 +33,30 @@ typedef struct page_images {
     float *ez, *dom, *p1;
 } page_images;
 
-static int decode_page(const lbk_lmap_page *pg, page_images *im)
+static int decode_page(const tl_bake *b, uint32_t p, page_images *im)
 {
-    const size_t n = (size_t)pg->width * pg->height;
-    im->w = pg->width;
-    im->h = pg->height;
+    lbk_lmap_planes pg;
+    if (tl_bake_planes(b, p, &pg)) return -1;
+    const size_t n = (size_t)pg.width * pg.height;
+    im->w = pg.width;
+    im->h = pg.height;
     im->ez = malloc(n * 3 * sizeof(float));
     im->dom = malloc(n * 3 * sizeof(float));
     im->p1 = malloc(n * 4 * sizeof(float));
     if (!im->ez || !im->dom || !im->p1) return -1;
-    for (uint32_t y = 0; y < pg->height; y++)
-        for (uint32_t x = 0; x < pg->width; x++) {
-            const size_t i = (size_t)y * pg->width + x;
-            lbk_ahd_texel t;
-            lbk_lmap_page_texel_get(pg, x, y, &t);
-            lbk_r11g11b10f_unpack(t.irradiance_z, im->ez + 3 * i);
-            /* the stored highlight direction, decoded as lbk/ahd.h does */
-            float d[3] = {2.0f * t.rgba[1] / 255.0f - 1.0f, 2.0f * t.rgba[2] / 255.0f - 1.0f, t.rgba[3] / 255.0f};
-            float len = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-            if (len < 0.5f) d[0] = 0, d[1] = 0, d[2] = 1;
-            else d[0] /= len, d[1] /= len, d[2] /= len;
-            lbk_ahd_irradiance(&t, d, im->dom + 3 * i);
+    for (uint32_t y = 0; y < pg.height; y++)
+        for (uint32_t x = 0; x < pg.width; x++) {
+            const size_t i = (size_t)y * pg.width + x;
+            lbk_ahd_texel_f t;
+            lbk_ahd_linear lin;
+            float d[3];
+            tl_bake_texel_get(b, p, x, y, &t, &lin, d); /* any encoding (spec §9.2) */
+            memcpy(im->ez + 3 * i, t.ez, sizeof t.ez);
+            /* the irradiance at the stored highlight direction, decoded as lbk/ahd.h does */
+            lbk_ahd_linear_eval(&lin, d, im->dom + 3 * i);
             /* physical values: stored × the section's scale (a power of two: exact) */
-            for (int c = 0; c < 3; c++) im->ez[3 * i + (size_t)c] *= pg->scale, im->dom[3 * i + (size_t)c] *= pg->scale;
-            for (int c = 0; c < 4; c++) im->p1[4 * i + (size_t)c] = t.rgba[c] / 255.0f;
+            for (int c = 0; c < 3; c++) im->ez[3 * i + (size_t)c] *= pg.scale, im->dom[3 * i + (size_t)c] *= pg.scale;
+            memcpy(im->p1 + 4 * i, t.rgba, sizeof t.rgba);
         }
     return 0;
 }
@@ -320,12 +320,14 @@ int tl_export(const tl_bake *b, const tl_export_options *o, tl_export_stats *st,
         if (!all) return tl_fail(err, -1, "out of memory");
         uint64_t k = 0;
         for (uint32_t p = 0; p < np; p++) {
-            lbk_lmap_page pg;
-            lbk_lmap_page_get(&b->lmap, p, &pg);
-            for (uint32_t i = 0; i < pg.width * pg.height; i++, k++)
-                lbk_r11g11b10f_unpack(pg.irradiance[4 * i] | (uint32_t)pg.irradiance[4 * i + 1] << 8 |
-                                          (uint32_t)pg.irradiance[4 * i + 2] << 16 | (uint32_t)pg.irradiance[4 * i + 3] << 24,
-                                      all + 3 * k);
+            lbk_lmap_planes pg;
+            tl_bake_planes(b, p, &pg);
+            for (uint32_t y = 0; y < pg.height; y++)
+                for (uint32_t x = 0; x < pg.width; x++, k++) {
+                    lbk_ahd_texel_f t;
+                    tl_bake_texel_get(b, p, x, y, &t, NULL, NULL);
+                    memcpy(all + 3 * k, t.ez, sizeof t.ez);
+                }
         }
         for (uint64_t i = 0; i < 3 * total; i++) all[i] *= b->lmap.scale;
         st->exposure = tl_exposure_p99(all, (size_t)total, 3);
@@ -340,11 +342,9 @@ int tl_export(const tl_bake *b, const tl_export_options *o, tl_export_stats *st,
     }
     int rc = 0;
     for (uint32_t p = 0; p < np && !rc; p++) {
-        lbk_lmap_page pg;
-        lbk_lmap_page_get(&b->lmap, p, &pg);
         page_images im;
         memset(&im, 0, sizeof im);
-        if (decode_page(&pg, &im)) {
+        if (decode_page(b, p, &im)) {
             free_page(&im);
             rc = tl_fail(err, -1, "out of memory");
             break;

@@ -480,14 +480,14 @@ static int decode_texels(ex *e)
     if (!e->texels) return tl_fail(e->err, TL_GLTF_INTERNAL, "out of memory");
     size_t k = 0;
     for (uint32_t p = 0; p < e->pages; p++) {
-        lbk_lmap_page pg;
-        lbk_lmap_page_get(lm, p, &pg);
-        for (uint32_t t = 0; t < pg.width * pg.height; t++, k++) {
-            lbk_r11g11b10f_unpack((uint32_t)pg.irradiance[4 * t] | (uint32_t)pg.irradiance[4 * t + 1] << 8 |
-                                      (uint32_t)pg.irradiance[4 * t + 2] << 16 | (uint32_t)pg.irradiance[4 * t + 3] << 24,
-                                  e->texels + 3 * k);
-            for (int c = 0; c < 3; c++) e->texels[3 * k + (size_t)c] *= lm->scale;
-        }
+        lbk_lmap_planes pg;
+        tl_bake_planes(e->b, p, &pg);
+        for (uint32_t y = 0; y < pg.height; y++)
+            for (uint32_t x = 0; x < pg.width; x++, k++) {
+                lbk_ahd_texel_f t; /* any encoding (spec §9.2) */
+                tl_bake_texel_get(e->b, p, x, y, &t, NULL, NULL);
+                for (int c = 0; c < 3; c++) e->texels[3 * k + (size_t)c] = t.ez[c] * lm->scale;
+            }
     }
     return 0;
 }
@@ -534,8 +534,8 @@ static int write_pages(ex *e)
     int rc = 0;
     size_t first = 0;
     for (uint32_t p = 0; p < e->pages && !rc; p++) {
-        lbk_lmap_page pg;
-        lbk_lmap_page_get(&e->b->lmap, p, &pg);
+        lbk_lmap_planes pg;
+        tl_bake_planes(e->b, p, &pg);
         const size_t n = (size_t)pg.width * pg.height;
         const float *ez = e->texels + 3 * first;
         float *ahd = malloc(n * 7 * sizeof *ahd);
@@ -544,7 +544,9 @@ static int write_pages(ex *e)
         if (!ahd || !png) rc = tl_fail(e->err, TL_GLTF_INTERNAL, "out of memory");
         for (size_t t = 0; !rc && t < n; t++) {
             memcpy(ahd + 7 * t, ez + 3 * t, 3 * sizeof(float));
-            for (int c = 0; c < 4; c++) ahd[7 * t + 3 + (size_t)c] = pg.rgba[4 * t + (size_t)c] / 255.0f;
+            lbk_ahd_texel_f tf;
+            tl_bake_texel_get(e->b, p, (uint32_t)(t % pg.width), (uint32_t)(t / pg.width), &tf, NULL, NULL);
+            memcpy(ahd + 7 * t + 3, tf.rgba, sizeof tf.rgba);
         }
         if (!rc) {
             snprintf(path, sizeof path, "%s/%s.lightmap_%03u.exr", e->dir, e->stem, p);
@@ -743,8 +745,8 @@ static int run(ex *e, const tl_gltf_options *o)
     for (size_t i = 0; i < (size_t)e->s->material_count * e->pages; i++) e->lm_material[i] = -1;
     for (size_t i = 0; i < e->s->material_count; i++) e->plain_material[i] = e->llg_material[i] = -1;
     for (uint32_t p = 0; p < e->pages; p++) {
-        lbk_lmap_page pg;
-        lbk_lmap_page_get(&e->b->lmap, p, &pg);
+        lbk_lmap_planes pg;
+        tl_bake_planes(e->b, p, &pg);
         e->page_w[p] = pg.width;
         e->page_h[p] = pg.height;
     }

@@ -9,6 +9,9 @@
 
 #include "tools/convert/convert.h"
 #include "tools/common/error_util.h"
+#include "tools/common/file_util.h"
+#include "tools/convert/lmap_encode.h"
+#include "lbk/objects.h"
 #include "lbk/dls.h"
 #include "lbk/lightmap.h"
 #include "lbk/pixel.h"
@@ -101,6 +104,117 @@ static int import_page(const char *dir, uint32_t p, uint32_t w, uint32_t h, floa
     return 1;
 }
 
+/* The smallest width ≥ w that suits the planes: a multiple of 4 for block encodings, and every
+ * plane texture's row (4 bytes per texel-column, 2 for the BC4 ratio of BC5_BC4) a multiple of the
+ * row pitch alignment. */
+static uint32_t padded_width(uint32_t w, const uint32_t f[2], uint32_t pitch)
+{
+    const int block = f[0] != LBK_LMAP_R11G11B10F || f[1] != LBK_LMAP_RGBA8;
+    const uint32_t step = block ? 4 : 1;
+    uint32_t nw = (w + step - 1) / step * step;
+    for (; nw <= LBK_LMAP_MAX_DIM; nw += step) {
+        int ok = !pitch || (4 * nw) % pitch == 0;
+        if (ok && pitch && f[1] == LBK_LMAP_BC5_BC4) ok = (2 * nw) % pitch == 0;
+        if (ok) return nw;
+    }
+    return 0;
+}
+
+static int check_page_alignment(const lbk_lmap_view *v, uint32_t alignment, char err[TL_ERR_LEN])
+{
+    for (uint32_t p = 0; p < v->page_count && alignment; p++) {
+        lbk_lmap_planes pg;
+        lbk_lmap_planes_get(v, p, &pg);
+        if (pg.offset[0] % alignment || pg.offset[1] % alignment)
+            return tl_fail(err, TL_CONVERT_UNSUPPORTED,
+                           "page %u planes start at LMAP bytes %llu and %llu, not multiples of page_alignment %u; "
+                           "the format places planes packed at 16-byte alignment",
+                           p, (unsigned long long)pg.offset[0], (unsigned long long)pg.offset[1], alignment);
+    }
+    return TL_CONVERT_OK;
+}
+
+/* Per texel of page p: 1 inside some object's lightmap rectangle, 0 elsewhere (atlas gaps, the
+ * padding): what the block encoders may ignore; and which object it belongs to (-1 none). */
+static float *used_texels(const lbk_objects_view *objs, uint32_t p, uint32_t w, uint32_t h, int32_t **owners)
+{
+    float *wt = calloc((size_t)w * h + 1, sizeof *wt);
+    *owners = malloc(((size_t)w * h + 1) * sizeof **owners);
+    if (!wt || !*owners) {
+        free(wt), free(*owners), *owners = NULL;
+        return NULL;
+    }
+    for (size_t i = 0; i < (size_t)w * h; i++) (*owners)[i] = -1, wt[i] = objs ? 0.0f : 1.0f;
+    for (uint32_t i = 0; objs && i < objs->count; i++) {
+        lbk_object o;
+        lbk_objects_get(objs, i, &o);
+        if (o.representation != LBK_REPRESENTATION_LIGHTMAP || o.index != p) continue;
+        for (uint32_t y = o.rect_y; y < o.rect_y + o.rect_h && y < h; y++)
+            for (uint32_t x = o.rect_x; x < o.rect_x + o.rect_w && x < w; x++)
+                wt[(size_t)y * w + x] = 1, (*owners)[(size_t)y * w + x] = (int32_t)i;
+    }
+    return wt;
+}
+
+static int remap_alloc(tl_texel_remap *remap, uint32_t n, char err[TL_ERR_LEN])
+{
+    remap->page_count = n;
+    remap->old_width = calloc(n + 1, sizeof(uint32_t));
+    remap->new_width = calloc(n + 1, sizeof(uint32_t));
+    remap->height = calloc(n + 1, sizeof(uint32_t));
+    remap->old_first = calloc(n + 1, sizeof(uint64_t));
+    remap->new_first = calloc(n + 1, sizeof(uint64_t));
+    if (!remap->old_width || !remap->new_width || !remap->height || !remap->old_first || !remap->new_first)
+        return tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
+    return TL_CONVERT_OK;
+}
+
+/* Encodes the padded texel pages in the asked formats and builds the section. */
+static int build_encoded(const lbk_lmap_view *v, lbk_ahd_texel **tex, const tl_texel_remap *remap, const uint32_t *new_h,
+                         const tl_lmap_layout_options *o, void **built, size_t *built_size, char err[TL_ERR_LEN])
+{
+    const uint32_t n = v->page_count;
+    lbk_lmap_encoded_page *ep = calloc(n + 1, sizeof *ep);
+    void **planes = calloc(2 * (size_t)n + 1, sizeof *planes);
+    int st = ep && planes ? TL_CONVERT_OK : tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
+    lbk_objects_view objs;
+    const int have_objs = o->objs && lbk_objects_open(o->objs, o->objs_size, &objs) == LBK_OK;
+    const double t0 = tl_seconds();
+    for (uint32_t p = 0; p < n && st == TL_CONVERT_OK; p++) {
+        const uint32_t w = remap->new_width[p], h = new_h[p];
+        lbk_ahd_texel_f *tf = malloc(sizeof *tf * (size_t)w * h + 1);
+        int32_t *owners = NULL;
+        float *wt = used_texels(have_objs ? &objs : NULL, p, w, h, &owners);
+        if (!tf || !wt) st = tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
+        for (size_t i = 0; st == TL_CONVERT_OK && i < (size_t)w * h; i++) {
+            lbk_ahd_texel_f_from_texel(&tex[p][i], &tf[i]);
+            /* a texel the baker never wrote (all 8 bytes zero; an unlit texel it did write has
+             * plane 1 FF 80 80 FF, spec §5.6) is not drawn: it costs nothing */
+            const lbk_ahd_texel *t = &tex[p][i];
+            if (!t->irradiance_z && !t->rgba[0] && !t->rgba[1] && !t->rgba[2] && !t->rgba[3]) wt[i] = 0, owners[i] = -1;
+        }
+        char e2[TL_ERR_LEN];
+        if (st == TL_CONVERT_OK &&
+            tl_lmap_encode_page(tf, wt, have_objs ? owners : NULL, w, h, o->format[0], o->format[1], &planes[2 * p],
+                                &planes[2 * p + 1], e2, sizeof e2))
+            st = tl_fail(err, TL_CONVERT_INTERNAL, "encoding page %u: %s", p, e2);
+        ep[p] = (lbk_lmap_encoded_page){w, h, {o->format[0], o->format[1]}, {planes[2 * p], planes[2 * p + 1]}};
+        free(tf);
+        free(wt);
+        free(owners);
+    }
+    if (o->encode_seconds) *o->encode_seconds += tl_seconds() - t0;
+    if (st == TL_CONVERT_OK) {
+        const lbk_lmap_build_desc bd = {.size = sizeof bd, .page_count = n, .scale = v->scale, .encoded = ep};
+        lbk_result r = lbk_lmap_build(&bd, NULL, built, built_size);
+        if (r != LBK_OK) st = tl_fail(err, TL_CONVERT_INTERNAL, "rebuilding LMAP: %s", lbk_result_message(r));
+    }
+    for (size_t i = 0; planes && i < 2 * (size_t)n; i++) free(planes[i]);
+    free(planes);
+    free(ep);
+    return st;
+}
+
 int tl_lmap_rewrite(const void *lmap, size_t size, const tl_lmap_layout_options *o, void **out, size_t *out_size,
                     uint32_t *pages_imported, tl_texel_remap *remap, char err[TL_ERR_LEN])
 {
@@ -112,56 +226,56 @@ int tl_lmap_rewrite(const void *lmap, size_t size, const tl_lmap_layout_options 
     lbk_result r = lbk_lmap_open(lmap, size, &v);
     if (r != LBK_OK) return tl_fail(err, TL_CONVERT_BAD_INPUT, "LMAP: %s", lbk_result_message(r));
     const uint32_t n = v.page_count;
-    remap->page_count = n;
-    remap->old_width = calloc(n, sizeof(uint32_t));
-    remap->new_width = calloc(n, sizeof(uint32_t));
-    remap->height = calloc(n, sizeof(uint32_t));
-    remap->old_first = calloc(n, sizeof(uint64_t));
-    remap->new_first = calloc(n, sizeof(uint64_t));
-    if (!remap->old_width || !remap->new_width || !remap->height || !remap->old_first || !remap->new_first)
-        return tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
-    const uint32_t multiple = o->row_pitch_alignment > 4 ? o->row_pitch_alignment / 4 : 1;
-    int widen = 0;
+    int st = remap_alloc(remap, n, err);
+    if (st != TL_CONVERT_OK) return st;
+    const int block = o->format[0] != LBK_LMAP_R11G11B10F || o->format[1] != LBK_LMAP_RGBA8;
+    uint32_t *new_h = calloc(n + 1, sizeof *new_h);
+    if (!new_h) return tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
+    int resize = 0, input_block = 0, same_formats = 1;
     uint64_t first = 0;
     for (uint32_t p = 0; p < n; p++) {
-        lbk_lmap_page pg;
-        lbk_lmap_page_get(&v, p, &pg);
+        lbk_lmap_planes pg;
+        lbk_lmap_planes_get(&v, p, &pg);
+        input_block |= pg.blocks_x != 0;
+        same_formats &= pg.format[0] == o->format[0] && pg.format[1] == o->format[1];
         remap->old_width[p] = pg.width;
         remap->height[p] = pg.height;
         remap->old_first[p] = pg.first_texel;
-        remap->new_width[p] = (pg.width + multiple - 1) / multiple * multiple;
+        remap->new_width[p] = padded_width(pg.width, o->format, o->row_pitch_alignment);
+        new_h[p] = block ? (pg.height + 3) / 4 * 4 : pg.height;
+        if (!remap->new_width[p] || new_h[p] > LBK_LMAP_MAX_DIM) {
+            free(new_h);
+            return tl_fail(err, TL_CONVERT_UNSUPPORTED, "page %u (%ux%u) cannot be padded for the profile's layout", p,
+                           pg.width, pg.height);
+        }
         remap->new_first[p] = first;
-        first += (uint64_t)remap->new_width[p] * pg.height;
-        widen |= remap->new_width[p] != pg.width;
+        first += (uint64_t)remap->new_width[p] * new_h[p];
+        resize |= remap->new_width[p] != pg.width || new_h[p] != pg.height;
     }
     remap->old_total = v.texel_count;
     remap->new_total = first;
-    remap->identity = !widen;
-    if (!widen && !o->from_exr_dir) {
-        /* nothing to rewrite; still honour the page alignment check */
-        for (uint32_t p = 0; p < n && o->page_alignment; p++) {
-            lbk_lmap_page pg;
-            lbk_lmap_page_get(&v, p, &pg);
-            if (pg.irradiance_offset % o->page_alignment || pg.rgba_offset % o->page_alignment)
-                return tl_fail(err, TL_CONVERT_UNSUPPORTED,
-                            "page %u planes start at LMAP bytes %llu and %llu, not multiples of page_alignment %u; "
-                            "format 1.0 places planes packed at 16-byte alignment",
-                            p, (unsigned long long)pg.irradiance_offset, (unsigned long long)pg.rgba_offset,
-                            o->page_alignment);
-        }
-        return TL_CONVERT_OK;
+    remap->identity = !resize;
+    if (input_block) { /* block planes cannot be re-encoded without loss: ship them as they are or refuse */
+        free(new_h);
+        if (!same_formats || resize || o->from_exr_dir)
+            return tl_fail(err, TL_CONVERT_UNSUPPORTED,
+                           "the input's lightmap pages are already block-encoded; convert the original bake instead");
+        return check_page_alignment(&v, o->page_alignment, err);
     }
-    /* decode every page into texel arrays of the new width, import, rebuild */
-    lbk_lmap_page_desc *descs = calloc(n, sizeof *descs);
-    lbk_ahd_texel **tex = calloc(n, sizeof *tex);
-    int st = TL_CONVERT_OK;
+    if (!resize && !o->from_exr_dir && !block) {
+        free(new_h);
+        return check_page_alignment(&v, o->page_alignment, err); /* nothing to rewrite */
+    }
+    /* decode every page into texel arrays of the new size (new texels: zero), import, rebuild */
+    lbk_lmap_page_desc *descs = calloc(n + 1, sizeof *descs);
+    lbk_ahd_texel **tex = calloc(n + 1, sizeof *tex);
     if (!descs || !tex) st = tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
     for (uint32_t p = 0; p < n && st == TL_CONVERT_OK; p++) {
         lbk_lmap_page pg;
         lbk_lmap_page_get(&v, p, &pg);
         const uint32_t w = pg.width, h = pg.height, nw = remap->new_width[p];
         lbk_ahd_texel *src = calloc((size_t)w * h, sizeof *src);
-        tex[p] = calloc((size_t)nw * h, sizeof(lbk_ahd_texel)); /* new columns: zero texels */
+        tex[p] = calloc((size_t)nw * new_h[p], sizeof(lbk_ahd_texel));
         if (!src || !tex[p]) {
             free(src);
             st = tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
@@ -176,40 +290,34 @@ int tl_lmap_rewrite(const void *lmap, size_t size, const tl_lmap_layout_options 
         }
         for (uint32_t y = 0; y < h; y++) memcpy(&tex[p][(size_t)y * nw], &src[(size_t)y * w], (size_t)w * sizeof *src);
         free(src);
-        descs[p] = (lbk_lmap_page_desc){nw, h, tex[p]};
+        descs[p] = (lbk_lmap_page_desc){nw, new_h[p], tex[p]};
     }
-    if (st == TL_CONVERT_OK) {
-        void *built = NULL;
-        size_t built_size = 0;
+    void *built = NULL;
+    size_t built_size = 0;
+    if (st == TL_CONVERT_OK && block) {
+        st = build_encoded(&v, tex, remap, new_h, o, &built, &built_size, err);
+    } else if (st == TL_CONVERT_OK) {
         const lbk_lmap_build_desc bd = {.size = sizeof bd, .pages = descs, .page_count = n, .scale = v.scale};
         r = lbk_lmap_build(&bd, NULL, &built, &built_size);
         if (r != LBK_OK) st = tl_fail(err, TL_CONVERT_INTERNAL, "rebuilding LMAP: %s", lbk_result_message(r));
-        else {
-            lbk_lmap_view nv;
-            lbk_lmap_open(built, built_size, &nv);
-            for (uint32_t p = 0; p < n && o->page_alignment && st == TL_CONVERT_OK; p++) {
-                lbk_lmap_page pg;
-                lbk_lmap_page_get(&nv, p, &pg);
-                if (pg.irradiance_offset % o->page_alignment || pg.rgba_offset % o->page_alignment)
-                    st = tl_fail(err, TL_CONVERT_UNSUPPORTED,
-                              "page %u planes start at LMAP bytes %llu and %llu, not multiples of page_alignment %u; "
-                              "format 1.0 places planes packed at 16-byte alignment",
-                              p, (unsigned long long)pg.irradiance_offset, (unsigned long long)pg.rgba_offset,
-                              o->page_alignment);
-            }
-            /* hand out malloc'ed memory (lbk_free(NULL) is free, but keep ownership rules simple) */
-            if (st == TL_CONVERT_OK && !(*out = malloc(built_size ? built_size : 1)))
-                st = tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
-            if (st == TL_CONVERT_OK) {
-                memcpy(*out, built, built_size);
-                *out_size = built_size;
-            }
-            lbk_free(NULL, built);
-        }
     }
+    if (st == TL_CONVERT_OK) {
+        lbk_lmap_view nv;
+        lbk_lmap_open(built, built_size, &nv);
+        st = check_page_alignment(&nv, o->page_alignment, err);
+    }
+    /* hand out malloc'ed memory (lbk_free(NULL) is free, but keep ownership rules simple) */
+    if (st == TL_CONVERT_OK && !(*out = malloc(built_size ? built_size : 1)))
+        st = tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
+    if (st == TL_CONVERT_OK) {
+        memcpy(*out, built, built_size);
+        *out_size = built_size;
+    }
+    lbk_free(NULL, built);
     for (uint32_t p = 0; tex && p < n; p++) free(tex[p]);
     free(tex);
     free(descs);
+    free(new_h);
     return st;
 }
 

@@ -11,8 +11,12 @@
 
 typedef struct tl_lmap_layout_options {
     uint32_t row_pitch_alignment; /* 0: no requirement */
-    uint32_t page_alignment;      /* 0: no requirement (checked only; format 1.0 fixes placement) */
+    uint32_t page_alignment;      /* 0: no requirement (checked only; the format fixes placement) */
     const char *from_exr_dir;     /* NULL: no import */
+    uint32_t format[2];           /* plane encodings of the output (lbk_lmap_format0/1); 0, 0: 1.0 planes */
+    const void *objs;             /* the OBJS payload (which texels objects use, for the block encoders), or NULL */
+    size_t objs_size;
+    double *encode_seconds;       /* when non-NULL, += the time spent block-encoding */
 } tl_lmap_layout_options;
 
 /* How texel indices move when pages are widened (identity when no page changed width). */

@@ -10,6 +10,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <xxhash.h>
+
+#include "tools/common/lmap_decode.h"
 #include <unistd.h>
 
 #include "tools/common/error_util.h"
@@ -74,9 +77,10 @@ static int parse_rule(const char *v, tl_section_rule *r)
 int tl_profile_parse(const char *text, size_t size, const char *origin, tl_profile *out, char err[TL_ERR_LEN])
 {
     memset(out, 0, sizeof *out);
+    out->text_hash = XXH3_64bits(text, size);
     out->defaults.compression = LBK_COMPRESSION_NONE;
     enum { TOP, SECTIONS, LMAP } group = TOP;
-    int have_name = 0, have_align = 0, have_default = 0, have_pitch = 0, have_page = 0, have_desc = 0;
+    int have_name = 0, have_align = 0, have_default = 0, have_pitch = 0, have_page = 0, have_desc = 0, have_plane[2] = {0, 0};
     size_t pos = 0;
     int line_no = 0;
     while (pos < size) {
@@ -145,13 +149,21 @@ int tl_profile_parse(const char *text, size_t size, const char *origin, tl_profi
             if (out->rule_count == TL_PROFILE_MAX_RULES) return tl_fail(err, -1, "%s:%d: more than %d section rules", origin, line_no, TL_PROFILE_MAX_RULES);
             r.type = type;
             out->rules[out->rule_count++] = r;
+        } else if (!strcmp(key, "plane0") || !strcmp(key, "plane1")) {
+            const int k = key[5] - '0';
+            if (have_plane[k]++) return tl_fail(err, -1, "%s:%d: duplicate key '%s'", origin, line_no, key);
+            const int f = tl_lmap_format_parse(k, val);
+            if (f < 0)
+                return tl_fail(err, -1, "%s:%d: %s '%s' is not an encoding (%s)", origin, line_no, key, val,
+                               k == 0 ? "r11g11b10f, bc6h, astc4x4_hdr" : "rgba8, bc5_bc4, astc4x4");
+            out->lmap_format[k] = (uint32_t)f;
         } else {
             uint32_t v;
             int *seen;
             uint32_t *dst;
             if (!strcmp(key, "row_pitch_alignment")) seen = &have_pitch, dst = &out->lmap_row_pitch_alignment;
             else if (!strcmp(key, "page_alignment")) seen = &have_page, dst = &out->lmap_page_alignment;
-            else return tl_fail(err, -1, "%s:%d: unknown key '%s' in [lmap] (known: row_pitch_alignment, page_alignment)", origin, line_no, key);
+            else return tl_fail(err, -1, "%s:%d: unknown key '%s' in [lmap] (known: row_pitch_alignment, page_alignment, plane0, plane1)", origin, line_no, key);
             if ((*seen)++) return tl_fail(err, -1, "%s:%d: duplicate key '%s'", origin, line_no, key);
             if (parse_u32(val, &v) || (v != 0 && (!is_pow2(v) || v > LBK_MAX_ALIGNMENT)))
                 return tl_fail(err, -1, "%s:%d: %s '%s' must be 0 or a power of two up to %u", origin, line_no, key, val, LBK_MAX_ALIGNMENT);

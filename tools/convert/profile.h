@@ -34,6 +34,8 @@ typedef struct tl_profile {
     /* [lmap] texture layout the runtime needs */
     uint32_t lmap_row_pitch_alignment; /* bytes per page row padded to a multiple of this; 0: as baked */
     uint32_t lmap_page_alignment;      /* each page plane starts at a multiple of this; 0: as baked */
+    uint32_t lmap_format[2];           /* plane encodings (lbk_lmap_format0/1; spec §9.2); 0, 0: as baked */
+    uint64_t text_hash;                /* XXH3-64 of the profile's text (META convert.profile_hash) */
 } tl_profile;
 
 /* Parses profile text. `origin` names the text in error messages ("console-current.profile").

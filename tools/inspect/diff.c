@@ -18,6 +18,8 @@ const char *tl_diff_status_name(int s)
     }
 }
 
+const char *tl_diff_mode_name(int mode) { return mode == TL_DIFF_MODE_NOISE ? "noise" : "tolerance"; }
+
 double tl_err_mean(const tl_err_stats *s) { return s->count ? s->sum_abs / (double)s->count : 0.0; }
 
 double tl_err_rel_rmse(const tl_err_stats *s)
@@ -31,6 +33,7 @@ double tl_err_rel_rmse(const tl_err_stats *s)
 
 typedef struct tol {
     double abs_tol, rel_tol;
+    const tl_noise_model *noise; /* NULL: tolerance mode */
 } tol;
 
 /* a and b: n normals × 3 channels. Returns 1 when over tolerance. NaN in B counts as over. */
@@ -76,15 +79,39 @@ static int add_sample(tl_err_stats *s, const float *a, const float *b, int n, co
 
 /* ---- texel access ------------------------------------------------------------------------- */
 
-static void texel_values(const lbk_lmap_page *pg, uint32_t x, uint32_t y, float out[TL_TEXEL_NORMALS][3])
+/* A page of one side: its bake and index, and its planes (any encoding). */
+typedef struct pageref {
+    const tl_bake *b;
+    uint32_t page;
+    lbk_lmap_planes pl;
+} pageref;
+
+static int pageref_get(const tl_bake *b, uint32_t page, pageref *out)
 {
-    lbk_ahd_texel t;
-    lbk_lmap_page_texel_get(pg, x, y, &t);
-    tl_texel_eval(&t, pg->scale, out);
+    out->b = b;
+    out->page = page;
+    return tl_bake_planes(b, page, &out->pl);
+}
+
+static void texel_values(const pageref *pg, uint32_t x, uint32_t y, float out[TL_TEXEL_NORMALS][3])
+{
+    if (tl_bake_texel_eval(pg->b, pg->page, x, y, out)) memset(out, 0, sizeof(float) * 3 * TL_TEXEL_NORMALS);
+}
+
+/* A texel the baker never wrote (a rectangle's unused corner): on a 1.0 page all 8 bytes are zero
+ * (a written black texel has plane 1 = FF 80 80 FF, spec §5.6). Block pages cannot tell: their
+ * encoder was free to put anything there (§9.2), which is why such texels are not compared. */
+static int texel_unwritten(const pageref *pg, uint32_t x, uint32_t y)
+{
+    const lbk_lmap_planes *pl = &pg->pl;
+    if (pl->blocks_x || x >= pl->width || y >= pl->height) return 0;
+    const size_t i = (size_t)y * pl->width + x;
+    static const uint8_t zero[4] = {0, 0, 0, 0};
+    return !memcmp(pl->plane[0] + 4 * i, zero, 4) && !memcmp(pl->plane[1] + 4 * i, zero, 4);
 }
 
 /* Bilinear sample of the evaluated values at rect-normalised (u, v) of a rect of page pg. */
-static void texel_bilinear(const lbk_lmap_page *pg, const uint32_t rect[4], double u, double v,
+static void texel_bilinear(const pageref *pg, const uint32_t rect[4], double u, double v,
                            float out[TL_TEXEL_NORMALS][3])
 {
     double fx = u * rect[2] - 0.5, fy = v * rect[3] - 0.5;
@@ -104,6 +131,50 @@ static void texel_bilinear(const lbk_lmap_page *pg, const uint32_t rect[4], doub
         for (int ch = 0; ch < 3; ch++)
             out[n][ch] = (float)((c[0][n][ch] * (1 - tx) + c[1][n][ch] * tx) * (1 - ty) +
                                  (c[2][n][ch] * (1 - tx) + c[3][n][ch] * tx) * ty);
+}
+
+static int bake_denoised(const tl_bake *b)
+{
+    lbk_string v;
+    return b->has_meta && lbk_meta_find(&b->meta, "bake.denoise", &v) == LBK_OK && v.size == 4 &&
+           memcmp(v.data, "auto", 4) == 0;
+}
+
+/* A denoised bake's texels are at least REPT's noise (tl_noise_model.denoised). */
+static double texel_floor(const tl_noise_model *m, int side) { return m->denoised[side] ? m->rept[side][0] : 0; }
+
+/* Relative noise of an object's lightmap (diff_noise.h): the high-pass of its own texels at each
+ * of the five normals against the texel's level (its mean over them), the largest of the five, for
+ * the mean test (REPT's estimate when the rectangle is too small to tell); and when `local` is not
+ * NULL, per texel the high-pass of its 4×4 tile at +Z, for the texel test (malloc'ed, w × h). */
+static double rect_noise(const pageref *pg, const uint32_t rect[4], double fallback, double floor_noise, float **local)
+{
+    const size_t n = (size_t)rect[2] * rect[3];
+    if (local) *local = NULL;
+    float *lum = malloc(sizeof *lum * (TL_TEXEL_NORMALS + 1) * (n + 1));
+    if (!lum) return fallback;
+    float *ref = lum + TL_TEXEL_NORMALS * (n + 1);
+    for (uint32_t y = 0; y < rect[3]; y++)
+        for (uint32_t x = 0; x < rect[2]; x++) {
+            float v[TL_TEXEL_NORMALS][3];
+            texel_values(pg, rect[0] + x, rect[1] + y, v);
+            const size_t i = (size_t)y * rect[2] + x;
+            ref[i] = 0;
+            for (int k = 0; k < TL_TEXEL_NORMALS; k++) {
+                lum[k * (n + 1) + i] = LBK_LUM_R * v[k][0] + LBK_LUM_G * v[k][1] + LBK_LUM_B * v[k][2];
+                ref[i] += lum[k * (n + 1) + i] / TL_TEXEL_NORMALS;
+            }
+        }
+    double s = -1;
+    for (int k = 0; k < TL_TEXEL_NORMALS; k++) s = fmax(s, tl_noise_highpass(lum + k * (n + 1), ref, rect[2], rect[3]));
+    if (s < 0) s = fallback;
+    s = fmax(s, floor_noise);
+    if (local && (*local = malloc(sizeof **local * (n + 1)))) {
+        tl_noise_highpass_tiles(lum, rect[2], rect[3], s, *local);
+        for (size_t i = 0; i < n; i++) (*local)[i] = fmaxf((*local)[i], (float)floor_noise);
+    }
+    free(lum);
+    return s;
 }
 
 /* ---- sections and META ---------------------------------------------------------------------- */
@@ -209,20 +280,35 @@ static void compare_object(const tl_bake *a, const tl_bake *b, const lbk_object 
 {
     if (oa->representation == LBK_REPRESENTATION_LIGHTMAP && ob->representation == LBK_REPRESENTATION_LIGHTMAP &&
         a->has_lmap && b->has_lmap) {
-        lbk_lmap_page pa, pb;
-        if (lbk_lmap_page_get(&a->lmap, oa->index, &pa) != LBK_OK || lbk_lmap_page_get(&b->lmap, ob->index, &pb) != LBK_OK)
-            return;
+        pageref pa, pb;
+        if (pageref_get(a, oa->index, &pa) || pageref_get(b, ob->index, &pb)) return;
         d->compared = 1;
         const int same_size = oa->rect_w == ob->rect_w && oa->rect_h == ob->rect_h;
         d->resampled = !same_size;
+        float *local_a = NULL, *local_b = NULL;
+        if (t->noise)
+            tl_noise_begin(&d->noise, t->noise, 0, rect_noise(&pa, d->rect_a, t->noise->rept[0][0], texel_floor(t->noise, 0), &local_a),
+                           rect_noise(&pb, d->rect_b, t->noise->rept[1][0], texel_floor(t->noise, 1), same_size ? &local_b : NULL));
         for (uint32_t y = 0; y < oa->rect_h; y++)
             for (uint32_t x = 0; x < oa->rect_w; x++) {
                 float va[TL_TEXEL_NORMALS][3], vb[TL_TEXEL_NORMALS][3];
+                /* unwritten on one side while the other is a block page: nothing to compare */
+                const int ua = texel_unwritten(&pa, oa->rect_x + x, oa->rect_y + y);
+                const int ub = same_size && texel_unwritten(&pb, ob->rect_x + x, ob->rect_y + y);
+                if ((ua && pb.pl.blocks_x) || (ub && pa.pl.blocks_x)) continue;
                 texel_values(&pa, oa->rect_x + x, oa->rect_y + y, va);
                 if (same_size) texel_values(&pb, ob->rect_x + x, ob->rect_y + y, vb);
                 else texel_bilinear(&pb, d->rect_b, (x + 0.5) / oa->rect_w, (y + 0.5) / oa->rect_h, vb);
                 add_sample(&d->lighting, &va[0][0], &vb[0][0], TL_TEXEL_NORMALS, t, x, y, NULL);
+                if (t->noise) {
+                    const size_t i = (size_t)y * oa->rect_w + x;
+                    tl_noise_add(&d->noise, t->noise, 0, &va[0][0], &vb[0][0], TL_TEXEL_NORMALS,
+                                 local_a ? local_a[i] : d->noise.noise_a, local_b ? local_b[i] : d->noise.noise_b);
+                }
             }
+        if (t->noise) tl_noise_end(&d->noise, t->noise);
+        free(local_a);
+        free(local_b);
         return;
     }
     if (oa->representation == LBK_REPRESENTATION_LLG && ob->representation == LBK_REPRESENTATION_LLG && a->has_llg &&
@@ -233,6 +319,7 @@ static void compare_object(const tl_bake *a, const tl_bake *b, const lbk_object 
         d->compared = 1;
         const int same = ga.dims[0] == gb.dims[0] && ga.dims[1] == gb.dims[1] && ga.dims[2] == gb.dims[2];
         d->resampled = !same;
+        if (t->noise) tl_noise_begin(&d->noise, t->noise, 1, t->noise->rept[0][1], t->noise->rept[1][1]);
         const uint64_t n = (uint64_t)ga.dims[0] * ga.dims[1] * ga.dims[2];
         for (uint64_t i = 0; i < n; i++) {
             lbk_sh9_rgb sa, sb;
@@ -250,7 +337,11 @@ static void compare_object(const tl_bake *a, const tl_bake *b, const lbk_object 
             tl_probe_eval(&sa, va);
             tl_probe_eval(&sb, vb);
             add_sample(&d->lighting, &va[0][0], &vb[0][0], TL_PROBE_NORMALS, t, (uint32_t)i, 0, NULL);
+            if (t->noise)
+                tl_noise_add(&d->noise, t->noise, 1, &va[0][0], &vb[0][0], TL_PROBE_NORMALS,
+                             TL_NOISE_PROBE_SPREAD * d->noise.noise_a, TL_NOISE_PROBE_SPREAD * d->noise.noise_b);
         }
+        if (t->noise) tl_noise_end(&d->noise, t->noise);
     }
 }
 
@@ -298,6 +389,7 @@ static int diff_objects(const tl_bake *a, const tl_bake *b, const tol *t, tl_dif
         tl_diff_object *d = &r->objects[r->object_count++];
         tl_string_copy(d->name, sizeof d->name, oa[i].name);
         fill_side(d, &oa[i], 0);
+        d->index_a = i;
         d->repr_b = LBK_REPRESENTATION_COUNT_;
         if (match_a[i] < 0) {
             d->status = TL_DIFF_REMOVED;
@@ -306,13 +398,14 @@ static int diff_objects(const tl_bake *a, const tl_bake *b, const tol *t, tl_dif
         }
         const lbk_object *o2 = &ob[match_a[i]];
         fill_side(d, o2, 1);
+        d->index_b = (uint32_t)match_a[i];
         d->renamed = !same_string(oa[i].name, o2->name);
         if (d->renamed) tl_string_copy(d->name_b, sizeof d->name_b, o2->name);
         d->geometry_changed = d->hash_a != d->hash_b;
         d->representation_changed = d->repr_a != d->repr_b;
         d->rect_changed = memcmp(d->rect_a, d->rect_b, sizeof d->rect_a) != 0 || d->page_a != d->page_b;
         compare_object(a, b, &oa[i], o2, t, d);
-        const int lighting_differs = d->lighting.over > 0;
+        const int lighting_differs = t->noise ? (d->compared && !d->noise.within_noise) : d->lighting.over > 0;
         d->status = (d->renamed || d->geometry_changed || d->representation_changed || lighting_differs ||
                      (d->rect_changed && d->resampled))
                         ? TL_DIFF_CHANGED
@@ -324,6 +417,7 @@ static int diff_objects(const tl_bake *a, const tl_bake *b, const tol *t, tl_dif
         tl_diff_object *d = &r->objects[r->object_count++];
         tl_string_copy(d->name, sizeof d->name, ob[j].name);
         fill_side(d, &ob[j], 1);
+        d->index_b = j;
         d->repr_a = LBK_REPRESENTATION_COUNT_;
         d->status = TL_DIFF_ADDED;
         r->objects_added++;
@@ -343,9 +437,10 @@ static int diff_pages(const tl_bake *a, const tl_bake *b, const tol *t, int keep
     for (uint32_t p = 0; p < n; p++) {
         tl_diff_page *d = &r->pages[r->page_count++];
         d->index = p;
-        lbk_lmap_page pa, pb;
-        if (p < na) lbk_lmap_page_get(&a->lmap, p, &pa), d->wa = pa.width, d->ha = pa.height;
-        if (p < nb) lbk_lmap_page_get(&b->lmap, p, &pb), d->wb = pb.width, d->hb = pb.height;
+        pageref ra, rb;
+        lbk_lmap_planes pa = {0}, pb = {0};
+        if (p < na) pageref_get(a, p, &ra), pa = ra.pl, d->wa = pa.width, d->ha = pa.height;
+        if (p < nb) pageref_get(b, p, &rb), pb = rb.pl, d->wb = pb.width, d->hb = pb.height;
         if (p >= nb) {
             d->status = TL_DIFF_REMOVED;
             r->pages_changed++;
@@ -358,6 +453,29 @@ static int diff_pages(const tl_bake *a, const tl_bake *b, const tol *t, int keep
         }
         d->resized = pa.width != pb.width || pa.height != pb.height;
         const uint32_t w = pa.width < pb.width ? pa.width : pb.width, h = pa.height < pb.height ? pa.height : pb.height;
+        /* noise mode: which object (of A) each texel belongs to, for its noise and its verdict */
+        int32_t *owner = NULL;
+        float *local_a = NULL, *local_b = NULL;
+        int objects_changed = 0;
+        if (t->noise) {
+            const uint32_t rect_a[4] = {0, 0, pa.width, pa.height}, rect_b[4] = {0, 0, pb.width, pb.height};
+            rect_noise(&ra, rect_a, t->noise->rept[0][0], texel_floor(t->noise, 0), &local_a);
+            rect_noise(&rb, rect_b, t->noise->rept[1][0], texel_floor(t->noise, 1), &local_b);
+            owner = malloc(sizeof *owner * ((size_t)pa.width * pa.height + 1));
+            if (!owner || !local_a || !local_b) {
+                free(owner), free(local_a), free(local_b);
+                return -1;
+            }
+            for (size_t i = 0; i < (size_t)pa.width * pa.height; i++) owner[i] = -1;
+            for (size_t k = 0; k < r->object_count; k++) {
+                const tl_diff_object *o = &r->objects[k];
+                if (o->repr_a != LBK_REPRESENTATION_LIGHTMAP || o->page_a != p) continue;
+                objects_changed |= o->status == TL_DIFF_CHANGED;
+                for (uint32_t y = o->rect_a[1]; y < o->rect_a[1] + o->rect_a[3] && y < pa.height; y++)
+                    for (uint32_t x = o->rect_a[0]; x < o->rect_a[0] + o->rect_a[2] && x < pa.width; x++)
+                        owner[(size_t)y * pa.width + x] = (int32_t)k;
+            }
+        }
         if (keep_maps) {
             const size_t cnt = (size_t)pa.width * pa.height;
             d->error_map = malloc(cnt * sizeof(float));
@@ -368,17 +486,23 @@ static int diff_pages(const tl_bake *a, const tl_bake *b, const tol *t, int keep
         for (uint32_t y = 0; y < h; y++)
             for (uint32_t x = 0; x < w; x++) {
                 float va[TL_TEXEL_NORMALS][3], vb[TL_TEXEL_NORMALS][3], e;
-                texel_values(&pa, x, y, va);
-                texel_values(&pb, x, y, vb);
+                texel_values(&ra, x, y, va);
+                texel_values(&rb, x, y, vb);
                 int over = add_sample(&d->lighting, &va[0][0], &vb[0][0], TL_TEXEL_NORMALS, t, x, y, &e);
+                if (owner)
+                    over = tl_noise_sample_significant(t->noise, 0, local_a[(size_t)y * pa.width + x],
+                                                       local_b[(size_t)y * pb.width + x], &va[0][0], &vb[0][0],
+                                                       TL_TEXEL_NORMALS);
                 if (keep_maps) {
                     d->error_map[(size_t)y * pa.width + x] = e;
                     d->over_map[(size_t)y * pa.width + x] = (uint8_t)over;
                 }
             }
+        free(owner), free(local_a), free(local_b);
         r->texels_over += d->lighting.over;
-        /* a page only resized (e.g. widened by convert) with equal texels is the same lighting */
-        d->status = d->lighting.over ? TL_DIFF_CHANGED : TL_DIFF_SAME;
+        /* a page only resized (e.g. widened by convert) with equal texels is the same lighting; in
+         * noise mode a page changed when one of its objects did */
+        d->status = (t->noise ? objects_changed : d->lighting.over > 0) ? TL_DIFF_CHANGED : TL_DIFF_SAME;
         if (d->status != TL_DIFF_SAME) r->pages_changed++;
     }
     return 0;
@@ -414,6 +538,7 @@ static void diff_glg(const tl_bake *a, const tl_bake *b, const tol *t, tl_diff_r
     }
     const int same = glg_same_layout(a, b);
     d->resampled = !same;
+    if (t->noise) tl_noise_begin(&d->noise, t->noise, 1, t->noise->rept[0][1], t->noise->rept[1][1]);
     uint32_t hint = 0;
     for (uint32_t i = 0; i < a->glg.probe_count; i++) {
         float pos[3], pb[3];
@@ -425,9 +550,17 @@ static void diff_glg(const tl_bake *a, const tl_bake *b, const tol *t, tl_diff_r
         tl_probe_eval(&sa, va);
         tl_probe_eval(&sb, vb);
         add_sample(&d->lighting, &va[0][0], &vb[0][0], TL_PROBE_NORMALS, t, i, 0, NULL);
+        if (t->noise)
+            tl_noise_add(&d->noise, t->noise, 1, &va[0][0], &vb[0][0], TL_PROBE_NORMALS,
+                         TL_NOISE_PROBE_SPREAD * d->noise.noise_a, TL_NOISE_PROBE_SPREAD * d->noise.noise_b);
     }
     r->probes_over += d->lighting.over;
-    d->status = (d->lighting.over || !same) ? TL_DIFF_CHANGED : TL_DIFF_SAME;
+    if (t->noise) {
+        tl_noise_end(&d->noise, t->noise);
+        if (!d->noise.within_noise) r->items_beyond_noise++;
+    }
+    const int differs = t->noise ? !d->noise.within_noise : d->lighting.over > 0;
+    d->status = (differs || !same) ? TL_DIFF_CHANGED : TL_DIFF_SAME;
 }
 
 /* ---- light sets ------------------------------------------------------------------------------ */
@@ -506,13 +639,13 @@ static keyed *sorted_keys(const tl_bake *bk, const set_entries *e)
     for (uint64_t i = 0; i < e->count; i++) {
         uint64_t key = e->targets[i];
         if (e->space == LBK_DLS_SPACE_TEXEL && bk->has_lmap) {
-            lbk_ahd_texel t;
-            uint32_t page;
-            if (lbk_lmap_texel_get(&bk->lmap, e->targets[i], &t, &page) == LBK_OK) {
-                lbk_lmap_page pg;
-                lbk_lmap_page_get(&bk->lmap, page, &pg);
-                uint64_t local = e->targets[i] - pg.first_texel;
+            for (uint32_t page = bk->lmap.page_count; page-- > 0;) { /* pages ascend by first_texel */
+                lbk_lmap_planes pg;
+                lbk_lmap_planes_get(&bk->lmap, page, &pg);
+                if (pg.first_texel > e->targets[i]) continue;
+                const uint64_t local = e->targets[i] - pg.first_texel;
                 key = ((uint64_t)page << 32) | ((local / pg.width) << 16) | (local % pg.width);
+                break;
             }
         }
         k[i] = (keyed){key, i};
@@ -562,8 +695,10 @@ static int space_comparable(const tl_bake *a, const tl_bake *b, uint32_t space)
 }
 
 static int compare_set_space(const tl_bake *a, uint32_t sa, const tl_bake *b, uint32_t sb, uint32_t space, const tol *t,
-                             tl_err_stats *st)
+                             tl_err_stats *st, tl_noise_stats *ns)
 {
+    const int kind = space == LBK_DLS_SPACE_TEXEL ? 0 : 1;
+    if (t->noise) tl_noise_begin(ns, t->noise, kind, t->noise->rept[0][kind], t->noise->rept[1][kind]);
     set_entries ea, eb;
     keyed *ka = NULL, *kb = NULL;
     int rc = -1;
@@ -593,7 +728,12 @@ static int compare_set_space(const tl_bake *a, uint32_t sa, const tl_bake *b, ui
         uint32_t x = space == LBK_DLS_SPACE_TEXEL ? (uint32_t)(key & 0xFFFF) : (uint32_t)key;
         uint32_t y = space == LBK_DLS_SPACE_TEXEL ? (uint32_t)((key >> 16) & 0xFFFF) : 0;
         add_sample(st, va, vb, n, t, x, y, NULL);
+        if (t->noise) {
+            const double spread = kind ? TL_NOISE_PROBE_SPREAD : 1.0;
+            tl_noise_add(ns, t->noise, kind, va, vb, n, spread * ns->noise_a, spread * ns->noise_b);
+        }
     }
+    if (t->noise) tl_noise_end(ns, t->noise);
     rc = 0;
 out:
     free(ka), free(kb);
@@ -659,8 +799,13 @@ static int diff_sets(const tl_bake *a, const tl_bake *b, const tol *t, tl_diff_r
                 continue;
             }
             d->compared[sp] = 1;
-            if (compare_set_space(a, s, b, sb, sp, t, &d->lighting[sp])) return -1;
-            over |= d->lighting[sp].over > 0;
+            if (compare_set_space(a, s, b, sb, sp, t, &d->lighting[sp], &d->noise[sp])) return -1;
+            if (t->noise) {
+                over |= !d->noise[sp].within_noise;
+                r->items_beyond_noise += !d->noise[sp].within_noise;
+            } else {
+                over |= d->lighting[sp].over > 0;
+            }
             if (sp == LBK_DLS_SPACE_TEXEL) r->texels_over += d->lighting[sp].over;
             else r->probes_over += d->lighting[sp].over;
         }
@@ -742,14 +887,37 @@ static int diff_doors(const tl_bake *a, const tl_bake *b, tl_diff_result *r)
 
 /* ---- driver -------------------------------------------------------------------------------- */
 
+static void choose_mode(const tl_bake *a, const tl_bake *b, const tl_diff_options *o, tl_diff_result *r,
+                        tl_noise_model *model)
+{
+    const int have_rept = a->has_rept && b->has_rept;
+    r->mode = TL_DIFF_MODE_TOLERANCE;
+    if (o->mode == TL_DIFF_MODE_TOLERANCE) {
+        r->mode_reason = "asked for";
+    } else if (!have_rept) {
+        r->mode_reason = o->mode == TL_DIFF_MODE_NOISE ? "noise mode asked for, but a bake has no REPT (no noise estimate)"
+                                                       : "a bake has no REPT (no noise estimate)";
+    } else {
+        r->mode = TL_DIFF_MODE_NOISE;
+        r->mode_reason = o->mode == TL_DIFF_MODE_NOISE ? "asked for" : "both bakes carry REPT";
+    }
+    const double ra[2] = {a->has_rept ? a->rept_last.texel_rel_rmse : 0, a->has_rept ? a->rept_last.probe_rel_rmse : 0};
+    const double rb[2] = {b->has_rept ? b->rept_last.texel_rel_rmse : 0, b->has_rept ? b->rept_last.probe_rel_rmse : 0};
+    tl_noise_model_init(model, o->false_alarm > 0 ? o->false_alarm : TL_NOISE_DEFAULT_FALSE_ALARM, ra, rb);
+    model->denoised[0] = bake_denoised(a);
+    model->denoised[1] = bake_denoised(b);
+}
+
 int tl_diff_run(const tl_bake *a, const tl_bake *b, const tl_diff_options *o, tl_diff_result *r, char err[TL_ERR_LEN])
 {
     memset(r, 0, sizeof *r);
     r->abs_tol = o->abs_tol;
     r->rel_tol = o->rel_tol;
-    tol t = {o->abs_tol, o->rel_tol};
+    choose_mode(a, b, o, r, &r->noise);
+    tol t = {o->abs_tol, o->rel_tol, r->mode == TL_DIFF_MODE_NOISE ? &r->noise : NULL};
     if (diff_sections(a, b, r) || diff_params(a, b, r) || diff_objects(a, b, &t, r) ||
-        diff_pages(a, b, &t, o->keep_error_maps, r) || diff_sets(a, b, &t, r) || diff_doors(a, b, r)) {
+        diff_pages(a, b, &t, o->keep_error_maps, r) || diff_sets(a, b, &t, r) || diff_doors(a, b, r) ||
+        tl_diff_provenance(a, b, r)) {
         snprintf(err, TL_ERR_LEN, "out of memory");
         tl_diff_free(r);
         return -1;
@@ -758,6 +926,7 @@ int tl_diff_run(const tl_bake *a, const tl_bake *b, const tl_diff_options *o, tl
     for (size_t i = 0; i < r->object_count; i++) {
         const tl_diff_object *d = &r->objects[i];
         if (d->repr_a == LBK_REPRESENTATION_LLG && d->compared) r->probes_over += d->lighting.over;
+        if (d->compared && d->noise.evaluated && !d->noise.within_noise) r->items_beyond_noise++;
     }
     /* the exit decision: lighting and structure; META and REPT are provenance only */
     int structural_sections = 0;
@@ -766,8 +935,10 @@ int tl_diff_run(const tl_bake *a, const tl_bake *b, const tl_diff_options *o, tl
         if (s->type == LBK_SECTION_META || s->type == LBK_SECTION_REPT) continue;
         if (s->status == TL_DIFF_ADDED || s->status == TL_DIFF_REMOVED) structural_sections = 1;
     }
+    /* noise mode: samples over the (zero) tolerance are expected; the items' verdicts decide */
+    const int samples_over = r->mode == TL_DIFF_MODE_NOISE ? 0 : r->texels_over || r->probes_over;
     r->differ = structural_sections || r->objects_added || r->objects_removed || r->objects_changed ||
-                r->pages_changed || r->sets_changed || r->doors_changed || r->texels_over || r->probes_over ||
+                r->pages_changed || r->sets_changed || r->doors_changed || samples_over ||
                 r->glg.status == TL_DIFF_CHANGED || r->glg.status == TL_DIFF_ADDED || r->glg.status == TL_DIFF_REMOVED;
     return 0;
 }
@@ -775,6 +946,8 @@ int tl_diff_run(const tl_bake *a, const tl_bake *b, const tl_diff_options *o, tl
 void tl_diff_free(tl_diff_result *r)
 {
     for (size_t i = 0; i < r->param_count; i++) free(r->params[i].a), free(r->params[i].b);
+    for (size_t i = 0; i < r->change_count; i++) free(r->changes[i].a), free(r->changes[i].b), free(r->changes[i].what);
+    free(r->changes);
     for (size_t i = 0; i < r->page_count; i++) free(r->pages[i].error_map), free(r->pages[i].over_map);
     free(r->sections);
     free(r->params);

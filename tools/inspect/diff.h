@@ -8,8 +8,9 @@
 #include <stdio.h>
 
 #include "tools/common/bake_data.h"
+#include "tools/inspect/diff_noise.h"
 
-#define TL_DIFF_SCHEMA_VERSION 1
+#define TL_DIFF_SCHEMA_VERSION 2
 
 typedef enum tl_diff_status {
     TL_DIFF_SAME = 0,    /* present in both, equal within tolerance */
@@ -39,10 +40,22 @@ double tl_err_mean(const tl_err_stats *s);
 /* sqrt(sum_sq_diff / sum_sq_ref); 0 when both are 0; +Inf when only A is all zero. */
 double tl_err_rel_rmse(const tl_err_stats *s);
 
+/* How lighting differences become a verdict. */
+typedef enum tl_diff_mode {
+    TL_DIFF_MODE_TOLERANCE = 0, /* a sample differs when its error exceeds abs_tol + rel_tol × ref
+                                   (exact with both 0) */
+    TL_DIFF_MODE_NOISE = 1,     /* an item differs when its change exceeds the noise of the two bakes
+                                   (diff_noise.h); needs REPT in both, else tolerance */
+    TL_DIFF_MODE_AUTO = 2       /* noise when both bakes carry REPT, else tolerance (lbk diff's default) */
+} tl_diff_mode;
+const char *tl_diff_mode_name(int mode); /* "tolerance", "noise" */
+
 typedef struct tl_diff_options {
     double abs_tol; /* ≥ 0; default 0 */
     double rel_tol; /* ≥ 0; default 0 */
     int keep_error_maps; /* keep per-page error images for heatmaps */
+    int mode;            /* tl_diff_mode */
+    double false_alarm;  /* noise mode: α per item; 0: TL_NOISE_DEFAULT_FALSE_ALARM */
 } tl_diff_options;
 
 typedef struct tl_diff_section {
@@ -69,7 +82,31 @@ typedef struct tl_diff_object {
     int compared;            /* lighting was compared */
     int resampled;           /* B sampled at A's texel centres / probe positions (sizes differ) */
     tl_err_stats lighting;   /* texels (rect-local x, y) or LLG probes (index) */
+    tl_noise_stats noise;    /* noise mode */
+    int inputs_changed;      /* TL_INPUT_* bits from META scene.objects (provenance) */
+    uint32_t index_a, index_b; /* OBJS record indices (of the sides present) */
 } tl_diff_object;
+
+/* What META says changed in an object's inputs. */
+enum { TL_INPUT_GEOMETRY = 1, TL_INPUT_MATERIAL = 2, TL_INPUT_OPTIONS = 4 };
+
+/* One difference of the inputs or options (META provenance, spec/container.md §6.2). */
+typedef enum tl_change_kind {
+    TL_CHANGE_OPTION = 0,   /* a bake.* option, or the writer */
+    TL_CHANGE_FILE,         /* a file of input.files (by path) */
+    TL_CHANGE_LIGHT,        /* a line of scene.lights (by name) */
+    TL_CHANGE_MATERIAL,     /* a line of scene.materials (by name) */
+    TL_CHANGE_OBJECT        /* an object's line of scene.objects */
+} tl_change_kind;
+const char *tl_change_kind_name(int kind); /* "option", "file", "light", "material", "object" */
+
+typedef struct tl_diff_change {
+    int kind;               /* tl_change_kind */
+    int status;             /* changed, added, removed */
+    char name[160];         /* option key, file path, light/material/object name */
+    char *a, *b;            /* the values (a field list for lights/materials, a hash for files); NULL if absent */
+    char *what;             /* one line: "sky 1,1,1 -> 1.2,1.2,1.2", "object Wall_03 material changed" */
+} tl_diff_change;
 
 typedef struct tl_diff_page {
     uint32_t index;
@@ -86,6 +123,7 @@ typedef struct tl_diff_probes {
     uint32_t count_a, count_b;
     int resampled;            /* B sampled at A's probe positions (layouts differ) */
     tl_err_stats lighting;
+    tl_noise_stats noise;
 } tl_diff_probes;
 
 typedef struct tl_diff_set {
@@ -95,6 +133,7 @@ typedef struct tl_diff_set {
     int compared[LBK_DLS_SPACE_COUNT_];        /* 0: space absent on both sides or not comparable */
     int not_comparable[LBK_DLS_SPACE_COUNT_];  /* target spaces differ between A and B (layout changed) */
     tl_err_stats lighting[LBK_DLS_SPACE_COUNT_];
+    tl_noise_stats noise[LBK_DLS_SPACE_COUNT_];
 } tl_diff_set;
 
 typedef struct tl_diff_door {
@@ -104,6 +143,10 @@ typedef struct tl_diff_door {
 
 typedef struct tl_diff_result {
     double abs_tol, rel_tol;
+    int mode;                 /* the mode used: tolerance or noise */
+    const char *mode_reason;  /* why (auto mode): "both bakes carry REPT", "… has no REPT" */
+    tl_noise_model noise;     /* noise mode */
+    tl_diff_change *changes; size_t change_count; /* inputs and options that changed */
     tl_diff_section *sections; size_t section_count;
     tl_diff_param *params; size_t param_count;
     tl_diff_object *objects; size_t object_count;
@@ -115,8 +158,13 @@ typedef struct tl_diff_result {
     uint32_t objects_added, objects_removed, objects_changed;
     uint32_t pages_changed, sets_changed, doors_changed, sections_changed, params_changed;
     uint64_t texels_over, probes_over;
+    uint32_t items_beyond_noise; /* noise mode: objects, the GLG and light-set spaces whose change exceeds the noise */
     int differ; /* the exit-code decision: lighting or structure differs (not META/REPT alone) */
 } tl_diff_result;
+
+/* The inputs and options that differ (META provenance) into result->changes, and each matched
+ * object's inputs_changed (diff_provenance.c). Returns 0, or -1 when out of memory. */
+int tl_diff_provenance(const tl_bake *a, const tl_bake *b, tl_diff_result *result);
 
 /* Compares two opened bakes. Returns 0, or -1 (out of memory; err says so). */
 int tl_diff_run(const tl_bake *a, const tl_bake *b, const tl_diff_options *options, tl_diff_result *out,

@@ -51,6 +51,28 @@ static cJSON *stats_json(const tl_err_stats *s, int texels)
     return o;
 }
 
+static cJSON *noise_json(const tl_noise_stats *n)
+{
+    if (!n->evaluated) return cJSON_CreateNull();
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddNumberToObject(o, "count", (double)n->count);
+    cJSON_AddItemToObject(o, "mean_shift", num_or_null(n->mean_shift));
+    cJSON_AddItemToObject(o, "z", num_or_null(n->z));
+    cJSON_AddItemToObject(o, "rmse", num_or_null(n->rmse));
+    cJSON *nz = cJSON_AddObjectToObject(o, "noise");
+    cJSON_AddNumberToObject(nz, "a", n->noise_a);
+    cJSON_AddNumberToObject(nz, "b", n->noise_b);
+    cJSON_AddNumberToObject(nz, "common", n->noise_common);
+    cJSON_AddNumberToObject(nz, "mean", n->noise_mean);
+    cJSON_AddNumberToObject(o, "significant", (double)n->significant);
+    cJSON_AddNumberToObject(o, "significant_share", n->significant_share);
+    cJSON_AddNumberToObject(o, "share_limit", n->share_limit);
+    cJSON_AddBoolToObject(o, "shift_significant", n->shift_significant);
+    cJSON_AddBoolToObject(o, "share_significant", n->share_significant);
+    cJSON_AddBoolToObject(o, "within_noise", n->within_noise);
+    return o;
+}
+
 static const char *repr_name(uint32_t r) { return r >= LBK_REPRESENTATION_COUNT_ ? NULL : lbk_representation_name(r); }
 
 static cJSON *rect_json(uint32_t page, const uint32_t rect[4])
@@ -90,6 +112,24 @@ char *tl_diff_json(const tl_diff_result *r, const char *path_a, const char *path
     cJSON_AddNumberToObject(tol, "abs", r->abs_tol);
     cJSON_AddNumberToObject(tol, "rel", r->rel_tol);
     cJSON_AddBoolToObject(root, "equal", !r->differ);
+    cJSON_AddStringToObject(root, "mode", tl_diff_mode_name(r->mode));
+    cJSON_AddStringToObject(root, "mode_reason", r->mode_reason ? r->mode_reason : "");
+    if (r->mode == TL_DIFF_MODE_NOISE) {
+        cJSON *nm = cJSON_AddObjectToObject(root, "noise_model");
+        cJSON_AddNumberToObject(nm, "false_alarm", r->noise.false_alarm);
+        cJSON_AddNumberToObject(nm, "k_mean", r->noise.k_mean);
+        cJSON_AddNumberToObject(nm, "k_sample", r->noise.k_sample);
+        cJSON_AddNumberToObject(nm, "probe_spread", TL_NOISE_PROBE_SPREAD);
+        cJSON_AddNumberToObject(nm, "common", r->noise.common);
+        cJSON_AddNumberToObject(nm, "share_factor", TL_NOISE_SHARE_FACTOR);
+        cJSON *ra = cJSON_AddObjectToObject(nm, "rept_a"), *rb = cJSON_AddObjectToObject(nm, "rept_b");
+        cJSON_AddNumberToObject(ra, "texel_rel_rmse", r->noise.rept[0][0]);
+        cJSON_AddNumberToObject(ra, "probe_rel_rmse", r->noise.rept[0][1]);
+        cJSON_AddNumberToObject(rb, "texel_rel_rmse", r->noise.rept[1][0]);
+        cJSON_AddNumberToObject(rb, "probe_rel_rmse", r->noise.rept[1][1]);
+    } else {
+        cJSON_AddNullToObject(root, "noise_model");
+    }
 
     cJSON *sum = cJSON_AddObjectToObject(root, "summary");
     cJSON_AddNumberToObject(sum, "objects_added", r->objects_added);
@@ -102,6 +142,23 @@ char *tl_diff_json(const tl_diff_result *r, const char *path_a, const char *path
     cJSON_AddNumberToObject(sum, "params_changed", r->params_changed);
     cJSON_AddNumberToObject(sum, "texels_over_tolerance", (double)r->texels_over);
     cJSON_AddNumberToObject(sum, "probes_over_tolerance", (double)r->probes_over);
+    cJSON_AddNumberToObject(sum, "beyond_noise", r->items_beyond_noise);
+    cJSON_AddNumberToObject(sum, "inputs_changed", (double)r->change_count);
+
+    cJSON *inputs = cJSON_AddArrayToObject(root, "inputs");
+    for (size_t i = 0; i < r->change_count; i++) {
+        const tl_diff_change *c = &r->changes[i];
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "kind", tl_change_kind_name(c->kind));
+        cJSON_AddStringToObject(o, "status", tl_diff_status_name(c->status));
+        cJSON_AddStringToObject(o, "name", c->name);
+        if (c->a) cJSON_AddStringToObject(o, "a", c->a);
+        else cJSON_AddNullToObject(o, "a");
+        if (c->b) cJSON_AddStringToObject(o, "b", c->b);
+        else cJSON_AddNullToObject(o, "b");
+        cJSON_AddStringToObject(o, "what", c->what);
+        cJSON_AddItemToArray(inputs, o);
+    }
 
     cJSON *secs = cJSON_AddArrayToObject(root, "sections");
     for (size_t i = 0; i < r->section_count; i++) {
@@ -140,12 +197,18 @@ char *tl_diff_json(const tl_diff_result *r, const char *path_a, const char *path
         if (d->geometry_changed) cJSON_AddItemToArray(flags, cJSON_CreateString("geometry"));
         if (d->representation_changed) cJSON_AddItemToArray(flags, cJSON_CreateString("representation"));
         if (d->rect_changed) cJSON_AddItemToArray(flags, cJSON_CreateString("placement"));
-        if (d->lighting.over) cJSON_AddItemToArray(flags, cJSON_CreateString("lighting"));
+        if (r->mode == TL_DIFF_MODE_NOISE ? (d->noise.evaluated && !d->noise.within_noise) : d->lighting.over > 0)
+            cJSON_AddItemToArray(flags, cJSON_CreateString("lighting"));
+        cJSON *in = cJSON_AddArrayToObject(o, "inputs_changed");
+        if (d->inputs_changed & TL_INPUT_GEOMETRY) cJSON_AddItemToArray(in, cJSON_CreateString("geometry"));
+        if (d->inputs_changed & TL_INPUT_MATERIAL) cJSON_AddItemToArray(in, cJSON_CreateString("material"));
+        if (d->inputs_changed & TL_INPUT_OPTIONS) cJSON_AddItemToArray(in, cJSON_CreateString("options"));
         cJSON_AddItemToObject(o, "a", side_json(d->repr_a, d->page_a, d->rect_a, d->hash_a));
         cJSON_AddItemToObject(o, "b", side_json(d->repr_b, d->page_b, d->rect_b, d->hash_b));
         cJSON_AddBoolToObject(o, "resampled", d->resampled);
         if (d->compared) cJSON_AddItemToObject(o, "lighting", stats_json(&d->lighting, d->repr_a == LBK_REPRESENTATION_LIGHTMAP));
         else cJSON_AddNullToObject(o, "lighting");
+        cJSON_AddItemToObject(o, "noise", noise_json(&d->noise));
         cJSON_AddItemToArray(objs, o);
     }
     cJSON *pages = cJSON_AddArrayToObject(root, "pages");
@@ -173,6 +236,7 @@ char *tl_diff_json(const tl_diff_result *r, const char *path_a, const char *path
     cJSON_AddBoolToObject(glg, "resampled", r->glg.resampled);
     if (r->glg.status == TL_DIFF_SAME || r->glg.status == TL_DIFF_CHANGED) cJSON_AddItemToObject(glg, "lighting", stats_json(&r->glg.lighting, 0));
     else cJSON_AddNullToObject(glg, "lighting");
+    cJSON_AddItemToObject(glg, "noise", noise_json(&r->glg.noise));
     cJSON *sets = cJSON_AddArrayToObject(root, "light_sets");
     for (size_t i = 0; i < r->set_count; i++) {
         const tl_diff_set *d = &r->sets[i];
@@ -185,6 +249,9 @@ char *tl_diff_json(const tl_diff_result *r, const char *path_a, const char *path
             else if (d->not_comparable[sp]) cJSON_AddStringToObject(o, space_name(sp), "not comparable");
             else cJSON_AddNullToObject(o, space_name(sp));
         }
+        cJSON *nz = cJSON_AddObjectToObject(o, "noise");
+        for (uint32_t sp = 0; sp < LBK_DLS_SPACE_COUNT_; sp++)
+            cJSON_AddItemToObject(nz, space_name(sp), noise_json(&d->noise[sp]));
         cJSON_AddItemToArray(sets, o);
     }
     cJSON *doors = cJSON_AddArrayToObject(root, "doors");
@@ -197,6 +264,15 @@ char *tl_diff_json(const tl_diff_result *r, const char *path_a, const char *path
     char *text = cJSON_Print(root);
     cJSON_Delete(root);
     return text;
+}
+
+static void print_noise(FILE *f, const tl_noise_stats *n)
+{
+    if (!n->evaluated) return;
+    fprintf(f, "\n    %s: shift %+.4f (z %+.2f, noise of the mean %.4f), rmse %.6g, significant %llu/%llu (%.3g%%, limit %.3g%%)",
+            n->within_noise ? "within noise" : "BEYOND NOISE", n->mean_shift, n->z, n->noise_mean, n->rmse,
+            (unsigned long long)n->significant, (unsigned long long)n->count, 100 * n->significant_share,
+            100 * n->share_limit);
 }
 
 static void print_stats(FILE *f, const tl_err_stats *s, int texels)
@@ -212,11 +288,24 @@ static void print_stats(FILE *f, const tl_err_stats *s, int texels)
 
 void tl_diff_print(FILE *f, const tl_diff_result *r, int verbose)
 {
-    fprintf(f, "%s (abs-tol %g, rel-tol %g)\n", r->differ ? "DIFFERENT" : "EQUAL within tolerance", r->abs_tol, r->rel_tol);
+    if (r->mode == TL_DIFF_MODE_NOISE)
+        fprintf(f, "%s (noise mode, false-alarm rate %g per item: %s)\n", r->differ ? "DIFFERENT" : "EQUAL within noise",
+                r->noise.false_alarm, r->mode_reason);
+    else
+        fprintf(f, "%s (abs-tol %g, rel-tol %g; tolerance mode: %s)\n", r->differ ? "DIFFERENT" : "EQUAL within tolerance",
+                r->abs_tol, r->rel_tol, r->mode_reason ? r->mode_reason : "");
+    if (r->change_count) {
+        fprintf(f, "inputs and options:");
+        for (size_t i = 0; i < r->change_count; i++) fprintf(f, "%s%s", i ? "; " : " ", r->changes[i].what);
+        fprintf(f, "\n");
+    }
     fprintf(f, "objects: %u added, %u removed, %u changed; pages changed %u; light sets changed %u; doors changed %u\n",
             r->objects_added, r->objects_removed, r->objects_changed, r->pages_changed, r->sets_changed, r->doors_changed);
-    fprintf(f, "texels over tolerance %llu, probes over tolerance %llu\n", (unsigned long long)r->texels_over,
-            (unsigned long long)r->probes_over);
+    if (r->mode == TL_DIFF_MODE_NOISE)
+        fprintf(f, "items beyond noise %u (objects, the GLG, light-set spaces)\n", r->items_beyond_noise);
+    else
+        fprintf(f, "texels over tolerance %llu, probes over tolerance %llu\n", (unsigned long long)r->texels_over,
+                (unsigned long long)r->probes_over);
     for (size_t i = 0; i < r->section_count; i++) {
         const tl_diff_section *s = &r->sections[i];
         if (s->status == TL_DIFF_SAME && !verbose) continue;
@@ -227,6 +316,10 @@ void tl_diff_print(FILE *f, const tl_diff_result *r, int verbose)
     }
     for (size_t i = 0; i < r->param_count; i++) {
         const tl_diff_param *p = &r->params[i];
+        if ((p->a && strchr(p->a, '\n')) || (p->b && strchr(p->b, '\n'))) { /* lists: the inputs line says what */
+            if (verbose) fprintf(f, "param %s %s\n", p->key, tl_diff_status_name(p->status));
+            continue;
+        }
         fprintf(f, "param %s %s: %s -> %s\n", p->key, tl_diff_status_name(p->status), p->a ? p->a : "(none)",
                 p->b ? p->b : "(none)");
     }
@@ -238,9 +331,13 @@ void tl_diff_print(FILE *f, const tl_diff_result *r, int verbose)
         if (d->geometry_changed) fprintf(f, " (geometry changed)");
         if (d->representation_changed) fprintf(f, " (%s -> %s)", repr_name(d->repr_a), repr_name(d->repr_b));
         if (d->rect_changed) fprintf(f, " (placement changed%s)", d->resampled ? ", resampled" : "");
+        if (d->inputs_changed)
+            fprintf(f, " (inputs changed:%s%s%s)", d->inputs_changed & TL_INPUT_GEOMETRY ? " geometry" : "",
+                    d->inputs_changed & TL_INPUT_MATERIAL ? " material" : "", d->inputs_changed & TL_INPUT_OPTIONS ? " options" : "");
         if (d->compared) {
             fprintf(f, "\n    ");
             print_stats(f, &d->lighting, d->repr_a == LBK_REPRESENTATION_LIGHTMAP);
+            print_noise(f, &d->noise);
         }
         fprintf(f, "\n");
     }
@@ -260,6 +357,7 @@ void tl_diff_print(FILE *f, const tl_diff_result *r, int verbose)
         if (r->glg.status == TL_DIFF_SAME || r->glg.status == TL_DIFF_CHANGED) {
             fprintf(f, "\n    ");
             print_stats(f, &r->glg.lighting, 0);
+            print_noise(f, &r->glg.noise);
         }
         fprintf(f, "\n");
     }
@@ -272,6 +370,7 @@ void tl_diff_print(FILE *f, const tl_diff_result *r, int verbose)
             if (!d->compared[sp]) continue;
             fprintf(f, "    %s: ", space_name(sp));
             print_stats(f, &d->lighting[sp], sp == LBK_DLS_SPACE_TEXEL);
+            print_noise(f, &d->noise[sp]);
             fprintf(f, "\n");
         }
     }

@@ -207,12 +207,17 @@ static int gather_texels(rl_level *L, char err[TL_ERR_LEN])
     L->texel_rgba = malloc((nt + 1) * 4);
     if (!L->pages || !L->texel_ez || !L->texel_rgba) return tl_fail(err, TL_RENDER_INTERNAL, "out of memory");
     for (uint32_t p = 0; p < np; p++) {
-        lbk_lmap_page_get(m, p, &L->pages[p]);
+        /* DLS apply works on the stored 1.0 texels, so block-compressed packs (lbk convert with a
+         * block profile, spec §9.2) are refused rather than drawn black */
+        lbk_result r = lbk_lmap_page_get(m, p, &L->pages[p]);
+        if (r != LBK_OK)
+            return tl_fail(err, TL_RENDER_INPUT, "lightmap page %u: %s (lbk render draws bakes with 1.0 lightmap planes, not block-compressed packs)", p, lbk_result_message(r));
         for (uint32_t y = 0; y < L->pages[p].height; y++)
             for (uint32_t x = 0; x < L->pages[p].width; x++) {
                 const uint64_t i = L->pages[p].first_texel + (uint64_t)y * L->pages[p].width + x;
                 lbk_ahd_texel t;
-                lbk_lmap_page_texel_get(&L->pages[p], x, y, &t);
+                r = lbk_lmap_page_texel_get(&L->pages[p], x, y, &t);
+                if (r != LBK_OK) return tl_fail(err, TL_RENDER_INPUT, "lightmap page %u texel (%u, %u): %s", p, x, y, lbk_result_message(r));
                 L->texel_ez[i] = t.irradiance_z;
                 memcpy(&L->texel_rgba[4 * i], t.rgba, 4);
             }

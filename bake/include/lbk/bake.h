@@ -149,6 +149,10 @@ typedef struct lbk_bake_desc {
     void *user;                    /* passed to both callbacks */
     const lbk_allocator *allocator;/* the output, its report and the container bytes [malloc];
                                       the bake's working memory is the C heap */
+    /* added in 1.1 of this library (fields past `size` read as 0) */
+    int block_align;            /* 1: every chart starts and ends on a 4-texel boundary, so a 4×4
+                                   block of a block-compressed pack (lbk convert, BC6H/ASTC) never
+                                   holds two charts [0: packed tight] */
 } lbk_bake_desc;
 
 /* ---- in-memory scenes ----------------------------------------------------------------------

@@ -57,6 +57,14 @@ typedef struct lbk_ahd_texel {
     uint8_t rgba[4];       /* plane 1: ratio, direction x, y, z */
 } lbk_ahd_texel;
 
+/* A texel as floats, the way a GPU samples the planes (1.2; any LMAP encoding): ez = plane 0
+ * (stored units), rgba = plane 1 as unorm in [0, 1] with the RGBA8 meaning (ratio, (d.x+1)/2,
+ * (d.y+1)/2, d.z). */
+typedef struct lbk_ahd_texel_f {
+    float ez[3];
+    float rgba[4];
+} lbk_ahd_texel_f;
+
 /* Band-1 irradiance in tangent space: E_ch(n) = c[ch][0] + c[ch][1]·n.x + c[ch][2]·n.y + c[ch][3]·n.z. */
 typedef struct lbk_ahd_linear {
     float c[3][4];
@@ -64,6 +72,12 @@ typedef struct lbk_ahd_linear {
 
 LBK_API void lbk_ahd_from_linear(const lbk_ahd_linear *lin, lbk_ahd_texel *out);
 LBK_API void lbk_ahd_to_linear(const lbk_ahd_texel *texel, lbk_ahd_linear *out);
+/* The float texel of a stored one: ez decoded (NaN as 0, Inf as 65024), rgba = byte / 255. */
+LBK_API void lbk_ahd_texel_f_from_texel(const lbk_ahd_texel *texel, lbk_ahd_texel_f *out);
+/* The decode rule of spec §5.6 on float planes (a direction shorter than 1/2 decodes as +Z). For a
+ * texel made by lbk_ahd_texel_f_from_texel the result may differ from lbk_ahd_to_linear in the last
+ * bit (byte / 255 is rounded once more); readers of 1.0 pages use lbk_ahd_to_linear. */
+LBK_API void lbk_ahd_texel_f_to_linear(const lbk_ahd_texel_f *texel, lbk_ahd_linear *out);
 /* Irradiance for a unit tangent-space normal (max(0, ·) per channel). */
 LBK_API void lbk_ahd_irradiance(const lbk_ahd_texel *texel, const float n[3], float rgb[3]);
 LBK_API void lbk_ahd_linear_eval(const lbk_ahd_linear *lin, const float n[3], float rgb[3]);

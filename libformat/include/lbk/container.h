@@ -2,9 +2,10 @@
  * Layout: spec/container.md §2–§4. Payload layouts live in the per-concept headers.
  *
  * Thread safety: a reader's const functions (header, bytes, section count/get/find) may run
- * concurrently; lbk_reader_section_data and lbk_reader_section_by_type decode and cache on first
- * access, so they need the reader to themselves until every section they return was accessed
- * once (or a lock around them). A writer is used by one thread at a time. Distinct readers and
+ * concurrently; lbk_reader_section_data, lbk_reader_section_by_type, lbk_reader_section_unpack and
+ * lbk_reader_validate (lbk/validate.h) verify, decode and cache on first access, so they need
+ * the reader to themselves until every section they return was accessed once (or a lock around
+ * them). A writer is used by one thread at a time. Distinct readers and
  * writers are independent. */
 #ifndef LBK_CONTAINER_H
 #define LBK_CONTAINER_H
@@ -23,8 +24,9 @@ extern "C" {
 #define LBK_MAX_SECTIONS 64u
 
 /* Header required_features bits. A reader rejects any bit it does not know. */
-#define LBK_FEATURE_ZSTD 0x1u /* at least one section is zstd-compressed */
-#define LBK_KNOWN_REQUIRED_FEATURES LBK_FEATURE_ZSTD
+#define LBK_FEATURE_ZSTD 0x1u       /* at least one section is zstd-compressed */
+#define LBK_FEATURE_LMAP_BLOCK 0x2u /* 1.2: some LMAP page stores a plane block-compressed (spec §9.2) */
+#define LBK_KNOWN_REQUIRED_FEATURES (LBK_FEATURE_ZSTD | LBK_FEATURE_LMAP_BLOCK)
 
 /* Section entry flags. */
 #define LBK_SECTION_FLAG_REQUIRED 0x1u /* a reader that does not know the type must reject the file */
@@ -90,6 +92,11 @@ LBK_API lbk_result lbk_reader_section_find(const lbk_reader *reader, uint32_t ty
  * stored bytes on first access unless options->skip_checksums. The pointer lives as long as the
  * reader. */
 LBK_API lbk_result lbk_reader_section_data(lbk_reader *reader, uint32_t index, const void **data, size_t *size);
+/* The decoded bytes of a section copied or decoded straight into caller memory (dst_size ≥ the
+ * section's decoded_size, else LBK_ERR_INVALID_ARGUMENT): a loader decodes into its upload or
+ * staging buffer without a second copy. Verifies the checksum once, like section_data; nothing is
+ * cached and the decoded-bytes cap does not apply (the memory is the caller's). */
+LBK_API lbk_result lbk_reader_section_unpack(lbk_reader *reader, uint32_t index, void *dst, size_t dst_size);
 /* Convenience: find + data. */
 LBK_API lbk_result lbk_reader_section_by_type(lbk_reader *reader, uint32_t type, const void **data, size_t *size);
 

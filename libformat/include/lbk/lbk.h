@@ -74,9 +74,10 @@ extern "C" {
  * version of this major up to LBK_FORMAT_VERSION_MINOR. Not the library's version. */
 #define LBK_FORMAT_VERSION_MAJOR 1
 /* The newest container minor version this library reads and writes. A writer stamps each file
- * with the lowest minor version that defines every known section in it (spec §1.3): 1 when it
- * holds LMUV, else 0, so a file without 1.1 content keeps the bytes a 1.0 writer gave it. */
-#define LBK_FORMAT_VERSION_MINOR 1
+ * with the lowest minor version that defines everything in it (spec §1.3): 2 when an LMAP page is
+ * block-encoded, 1 when it holds LMUV, else 0, so a file without newer content keeps the bytes an
+ * older writer gave it. */
+#define LBK_FORMAT_VERSION_MINOR 2
 
 /* This library's version (semantic versioning of the API and ABI). */
 #define LBK_LIBRARY_VERSION_MAJOR 1

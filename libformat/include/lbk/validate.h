@@ -50,6 +50,14 @@ LBK_API lbk_result lbk_validate_memory(const void *data, size_t size, const lbk_
 LBK_API lbk_result lbk_validate_file(const char *path, const lbk_validate_options *options,
                                      lbk_issue_callback callback, void *user, lbk_validate_summary *summary);
 
+/* Runs every check on the file an open reader holds, through the reader: each section's checksum
+ * is verified once and each zstd section decoded once, and the reader keeps them, so a loader
+ * that validates and then reads pays for one checksum and one decode per section, not two. The
+ * reader's allocator and decoded-bytes cap apply (and its skip_checksums: then checksums are not
+ * checked). The reader opened, so the header and table
+ * passed; their warnings are reported again. Same results as lbk_validate_memory on its bytes. */
+LBK_API lbk_result lbk_reader_validate(lbk_reader *reader, lbk_issue_callback callback, void *user,
+                                       lbk_validate_summary *summary);
 /* The registry: severity and message template of an ID; NULL if unknown. */
 LBK_API const char *lbk_issue_template(uint32_t id, lbk_severity *severity);
 /* Enumerates the registry: number of IDs, and the ID at a position (ascending; 0 past the end). */
