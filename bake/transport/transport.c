@@ -3,6 +3,7 @@
 
 #include "bake/util/parallel.h"
 #include "bake/transport/shading.h"
+#include "bake/transport/solid.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -12,7 +13,8 @@
 
 #define TP_PI 3.14159265358979323846
 #define TP_Q_MAX 0.999      /* largest per-bounce ratio the tail formula trusts (factor ≤ 999) */
-#define TP_MAX_SUB 16       /* at most 16×16 cells per triangle side */
+#define TP_MAX_SUB 1024     /* at most 1024² cells per triangle side (the cell budget binds first) */
+#define TP_CELL_CAP ((size_t)1 << 22) /* cells in all (~0.5 GB with both halves' radiance) */
 #define TP_LIGHT_POINTS 16  /* points per cell that test punctual lights in bounce 1 */
 #define TP_BATCH 64         /* rays generated, then traced as one stream, then shaded */
 
@@ -27,7 +29,7 @@ static uint64_t mix64(uint64_t z)
 
 typedef struct { uint64_t s; } tp_rng;
 
-enum { DOM_CELL = 1, DOM_RECV = 2, DOM_CELL_NEE = 3, DOM_RECV_NEE = 4 };
+enum { DOM_CELL = 1, DOM_RECV = 2, DOM_CELL_NEE = 3, DOM_RECV_NEE = 4, DOM_RECV_NEAR = 5, DOM_CELL_NEAR = 6 };
 
 /* Keyed by everything that identifies one item's samples: never by thread or time. */
 static tp_rng rng_make(uint64_t seed, uint64_t domain, uint64_t half, uint64_t pass, uint64_t bounce, uint64_t item)
@@ -122,7 +124,8 @@ static void lattice_uv(const tp_lattice *l, uint32_t j, double t1, double t2, do
 
 typedef struct tp_cell {
     uint32_t tri;
-    uint16_t sub, m;
+    uint32_t sub;
+    uint16_t m;
     uint8_t side;
     float n[3];        /* side normal, zero for degenerate triangles */
     float area;
@@ -149,9 +152,11 @@ typedef struct tp_ctx {
     size_t cell_count;
     tp_cell *cells;
     uint32_t *tri_first;   /* first cell of each triangle */
-    uint8_t *tri_m;
+    uint16_t *tri_m;
     uint8_t *tri_sides;
+    uint8_t *tri_closed;   /* bounds a closed solid (solid.h): its back side is the inside */
     float *tri_edge_eps;   /* smallest barycentric a sample point may have: keeps points off edges */
+    float *tri_cell_h;     /* size of the triangle's cells (metres): what "near" is measured in */
     float *tri_le;         /* 3 per triangle: emission factor after the light-set filter */
     int32_t *tri_le_tex;   /* emission texture per triangle, -1 none */
     /* next-event estimation: emitter sub-triangles picked by power through a CDF */
@@ -223,13 +228,16 @@ static int in_light_set(const tp_ctx *c, const char *set)
     return strncmp(set, want, 63) == 0;
 }
 
-/* Cell reached by a hit, or -1 when the hit side carries no radiance (back of a one-sided
- * surface). */
+/* What a hit reaches: its cell (>= 0), HIT_BLACK for the back of a one-sided open surface, or
+ * HIT_INSIDE for the back of a closed solid: the ray started inside that solid (solid.h). */
+enum { HIT_BLACK = -1, HIT_INSIDE = -2 };
+
 static long hit_cell(const tp_ctx *c, const bk_hit *h)
 {
-    if (h->tri >= c->scene->tri_count) return -1;
+    if (h->tri >= c->scene->tri_count) return HIT_BLACK;
+    if (!h->front && c->tri_closed[h->tri]) return HIT_INSIDE;
     int side = h->front ? 0 : 1;
-    if (side >= c->tri_sides[h->tri]) return -1;
+    if (side >= c->tri_sides[h->tri]) return HIT_BLACK;
     int m = c->tri_m[h->tri];
     float a = h->u * (float)m, b = h->v * (float)m;
     int i = (int)a, j = (int)b; /* truncation: u, v >= 0 up to rounding, and the clamps below */
@@ -242,6 +250,19 @@ static long hit_cell(const tp_ctx *c, const bk_hit *h)
     return (long)c->tri_first[h->tri] + (long)side * m * m + sub;
 }
 
+/* Row j of sub-triangle s in an m×m split: row r holds 2(m − r) − 1 cells, so rows before j
+ * hold j(2m − j); the largest j with j(2m − j) <= s, from the quadratic and one correction. */
+static int sub_row(int m, long s)
+{
+    double disc = (double)m * m - (double)s;
+    int j = (int)(m - sqrt(disc > 0 ? disc : 0));
+    if (j < 0) j = 0;
+    if (j > m - 1) j = m - 1;
+    while (j > 0 && (long)j * (2 * m - j) > s) j--;
+    while (j < m - 1 && (long)(j + 1) * (2 * m - j - 1) <= s) j++;
+    return j;
+}
+
 /* A cell's sub-triangle in world space, and the edge band of its triangle, fetched once per
  * cell and bounce rather than per ray. */
 typedef struct tp_cell_geom {
@@ -252,9 +273,11 @@ typedef struct tp_cell_geom {
 
 static void cell_geom(const tp_ctx *c, const tp_cell *cell, tp_cell_geom *g)
 {
-    int m = cell->m, s = cell->sub, j = 0;
-    while (j < m - 1 && s >= 2 * (m - j) - 1) { s -= 2 * (m - j) - 1; j++; }
-    int i = s / 2, upper = s & 1;
+    int m = cell->m;
+    long s = (long)cell->sub;
+    int j = sub_row(m, s);
+    s -= (long)j * (2 * m - j);
+    int i = (int)(s / 2), upper = (int)(s & 1);
     double c0[2], c1[2], c2[2];
     if (!upper) {
         c0[0] = i; c0[1] = j; c1[0] = i + 1; c1[1] = j; c2[0] = i; c2[1] = j + 1;
@@ -417,119 +440,146 @@ static int nee_sample(const tp_ctx *c, const float o[3], const double n[3], int 
 
 /* ---- cache: one bounce for a range of cells ------------------------------------------------ */
 
-static void cache_bounce(tp_ctx *c, size_t begin, size_t end, int thread)
+/* Per-thread counters of one parallel step. */
+typedef struct tp_count { uint64_t rays, shadow, bad; } tp_count;
+
+/* One cell's sample sums for one bounce: gathered radiance, light samples and punctual light,
+ * over the samples whose point can be seen (a sample whose gather ray reaches the inside of a
+ * closed solid started inside it: it belongs to no visible part of the cell and is dropped, so
+ * a cell that a wall cuts stands for its visible part only). */
+typedef struct tp_cell_sums {
+    double e[3], en[3], ep[3];
+    int valid, lit_points;
+} tp_cell_sums;
+
+/* Shades sample j of a cell (point p, offset origin o, cosine direction d, hit) into the sums. */
+static void cell_sample(tp_ctx *c, const double n[3], int j, const double p[3],
+                        const float o[3], const double d[3], const bk_hit *hit, const double nee_t[2],
+                        tp_cell_sums *cs, tp_count *cnt)
 {
-    const int h = c->half, k = c->bounce, R = c->rays;
+    const int k = c->bounce, h = c->half;
     const float *prev = c->l_prev[h];
-    float *cur = c->l_cur[h];
-    uint64_t rays = 0, shadow = 0, bad = 0;
-    for (size_t ci = begin; ci < end; ci++) {
-        const tp_cell *cell = &c->cells[ci];
-        double e[3] = {0, 0, 0};
-        if (cell->n[0] == 0 && cell->n[1] == 0 && cell->n[2] == 0) goto store;
-        if (cell->albedo[0] <= 0 && cell->albedo[1] <= 0 && cell->albedo[2] <= 0) goto store;
-        tp_rng rng = rng_make(c->seed, DOM_CELL, (uint64_t)h, (uint64_t)c->pass, (uint64_t)k, ci);
-        double n[3] = {cell->n[0], cell->n[1], cell->n[2]}, t[3], b[3];
-        bk_onb(n, t, b);
-        float nf[3] = {cell->n[0], cell->n[1], cell->n[2]};
-        float scale = bk_tracer_tri_scale(c->tracer, cell->tri);
-        double s1 = rng_next(&rng), s2 = rng_next(&rng);
-        tp_shift shift = lattice_shift(s1, s2);
-        tp_cell_geom geom;
-        cell_geom(c, cell, &geom);
-        int light_points = (k == 1 && c->light_count) ? (R < TP_LIGHT_POINTS ? R : TP_LIGHT_POINTS) : 0;
-        double ep[3] = {0, 0, 0}, en[3] = {0, 0, 0};
-        const int nee = k == 1 && c->nee;
-        double t1 = 0, t2 = 0;
-        if (nee) {
-            tp_rng nr = rng_make(c->seed, DOM_CELL_NEE, (uint64_t)h, (uint64_t)c->pass, 0, ci);
-            t1 = rng_next(&nr);
-            t2 = rng_next(&nr);
-        }
-        for (int j0 = 0; j0 < R; j0 += TP_BATCH) {
-            const int m = R - j0 < TP_BATCH ? R - j0 : TP_BATCH;
-            float org[3 * TP_BATCH], dir[3 * TP_BATCH];
-            double dd[TP_BATCH][3], pts[TP_BATCH][3];
-            bk_hit hits[TP_BATCH];
-            for (int jj = 0; jj < m; jj++) {
-                double *p = pts[jj];
-                cell_point(&geom, &rng, p);
-                float pf[3] = {(float)p[0], (float)p[1], (float)p[2]};
-                bk_offset_ray_origin_scaled(pf, nf, scale, org + 3 * jj);
-                /* cosine-distributed direction */
-                double u1, cp, sp;
-                lattice(&c->lat, (uint32_t)(j0 + jj), &shift, &u1, &cp, &sp);
-                double rr = sqrt(u1);
-                double lx = rr * cp, ly = rr * sp, lz = sqrt(fmax(0.0, 1 - u1));
-                for (int a = 0; a < 3; a++) {
-                    dd[jj][a] = lx * t[a] + ly * b[a] + lz * n[a];
-                    dir[3 * jj + a] = (float)dd[jj][a];
+    double L[3] = {0, 0, 0};
+    if (hit->tri != UINT32_MAX) {
+        long hc = hit_cell(c, hit);
+        if (hc == HIT_INSIDE) return;
+        if (hc >= 0) {
+            if (k == 1) {
+                emission_at(c, hit->tri, hit->u, hit->v, L);
+                if (L[0] > 0 || L[1] > 0 || L[2] > 0) {
+                    double lz = d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
+                    double w = mis_gather(c, hit, hc, d, lz / TP_PI);
+                    for (int a = 0; a < 3; a++) L[a] *= w;
                 }
-            }
-            bk_tracer_intersect_n(c->tracer, (size_t)m, org, dir, 0.0f, NULL, hits);
-            rays += (uint64_t)m;
-            for (int jj = 0; jj < m; jj++) {
-                const int j = j0 + jj;
-                const double *d = dd[jj];
-                const float *o = org + 3 * jj;
-                const bk_hit *hit = &hits[jj];
-                double L[3] = {0, 0, 0};
-                if (hit->tri != UINT32_MAX) {
-                    long hc = hit_cell(c, hit);
-                    if (hc >= 0) {
-                        if (k == 1) {
-                            emission_at(c, hit->tri, hit->u, hit->v, L);
-                            if (L[0] > 0 || L[1] > 0 || L[2] > 0) {
-                                double lz = d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
-                                double w = mis_gather(c, hit, hc, d, lz / TP_PI);
-                                for (int a = 0; a < 3; a++) L[a] *= w;
-                            }
-                        } else {
-                            for (int a = 0; a < 3; a++) L[a] = prev[3 * hc + a];
-                        }
-                    }
-                } else if (k == 1) {
-                    sky_radiance(c, d, L);
-                }
-                if (!bk_finite3(L)) bad++;
-                else for (int a = 0; a < 3; a++) e[a] += L[a];
-                if (nee) {
-                    double u0, v0, ld[3], cq, val[3];
-                    lattice_uv(&c->lat, (uint32_t)j, t1, t2, &u0, &v0);
-                    if (nee_sample(c, o, n, PG_COSINE, u0, v0, ld, &cq, val, &shadow)) {
-                        if (bk_finite3(val))
-                            for (int a = 0; a < 3; a++) en[a] += val[a] * cq;
-                        else
-                            bad++;
-                    }
-                }
-                if (j < light_points) {
-                    for (size_t li = 0; li < c->light_count; li++) {
-                        double val[3], ld[3], dist;
-                        if (!bk_light_eval(c->lights[li], pts[jj], val, ld, &dist)) continue;
-                        double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
-                        if (cs <= 0) continue;
-                        shadow++;
-                        if (!bk_light_visible(c->tracer, o, ld, dist)) continue;
-                        for (int a = 0; a < 3; a++) ep[a] += val[a] * cs;
-                    }
-                }
+            } else {
+                for (int a = 0; a < 3; a++) L[a] = prev[3 * hc + a];
             }
         }
-        for (int a = 0; a < 3; a++) {
-            e[a] = e[a] * (TP_PI / R) + en[a] / R;
-            if (light_points) e[a] += ep[a] / light_points;
-        }
-    store:
-        for (int a = 0; a < 3; a++) {
-            double v = cell->albedo[a] / TP_PI * e[a];
-            if (!isfinite(v) || v < 0) { bad++; v = 0; }
-            cur[3 * ci + a] = (float)v;
+    } else if (k == 1) {
+        sky_radiance(c, d, L);
+    }
+    cs->valid++;
+    if (!bk_finite3(L)) cnt->bad++;
+    else for (int a = 0; a < 3; a++) cs->e[a] += L[a];
+    if (k != 1) return;
+    if (c->nee) {
+        double u0, v0, ld[3], cq, val[3];
+        lattice_uv(&c->lat, (uint32_t)j, nee_t[0], nee_t[1], &u0, &v0);
+        if (nee_sample(c, o, n, PG_COSINE, u0, v0, ld, &cq, val, &cnt->shadow)) {
+            if (bk_finite3(val))
+                for (int a = 0; a < 3; a++) cs->en[a] += val[a] * cq;
+            else
+                cnt->bad++;
         }
     }
-    c->thread_rays[thread] += rays + shadow;
-    c->thread_shadow[thread] += shadow;
-    c->thread_nonfinite[thread] += bad;
+    /* punctual lights at the first TP_LIGHT_POINTS visible points */
+    if (c->light_count && cs->lit_points < TP_LIGHT_POINTS) {
+        cs->lit_points++;
+        for (size_t li = 0; li < c->light_count; li++) {
+            double val[3], ld[3], dist;
+            if (!bk_light_eval(c->lights[li], p, val, ld, &dist)) continue;
+            double cq = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
+            if (cq <= 0) continue;
+            cnt->shadow++;
+            if (!bk_light_visible(c->tracer, o, ld, dist)) continue;
+            for (int a = 0; a < 3; a++) cs->ep[a] += val[a] * cq;
+        }
+    }
+}
+
+/* Bounce k at one cell: R points uniform over the cell, cosine directions from the shifted
+ * lattice, traced 64 at a time; returns the reflected radiance albedo/π × irradiance. */
+static void cell_bounce(tp_ctx *c, size_t ci, tp_count *cnt, double out[3])
+{
+    const int h = c->half, k = c->bounce, R = c->rays;
+    const tp_cell *cell = &c->cells[ci];
+    tp_cell_sums cs;
+    memset(&cs, 0, sizeof cs);
+    out[0] = out[1] = out[2] = 0;
+    if (cell->n[0] == 0 && cell->n[1] == 0 && cell->n[2] == 0) return;
+    if (cell->albedo[0] <= 0 && cell->albedo[1] <= 0 && cell->albedo[2] <= 0) return;
+    tp_rng rng = rng_make(c->seed, DOM_CELL, (uint64_t)h, (uint64_t)c->pass, (uint64_t)k, ci);
+    double n[3] = {cell->n[0], cell->n[1], cell->n[2]}, t[3], b[3];
+    bk_onb(n, t, b);
+    float nf[3] = {cell->n[0], cell->n[1], cell->n[2]};
+    float scale = bk_tracer_tri_scale(c->tracer, cell->tri);
+    double s1 = rng_next(&rng), s2 = rng_next(&rng);
+    tp_shift shift = lattice_shift(s1, s2);
+    tp_cell_geom geom;
+    cell_geom(c, cell, &geom);
+    double nee_t[2] = {0, 0}; /* the light samples' own lattice shift */
+    if (k == 1 && c->nee) {
+        tp_rng nr = rng_make(c->seed, DOM_CELL_NEE, (uint64_t)h, (uint64_t)c->pass, 0, ci);
+        nee_t[0] = rng_next(&nr);
+        nee_t[1] = rng_next(&nr);
+    }
+    for (int j0 = 0; j0 < R; j0 += TP_BATCH) {
+        const int m = R - j0 < TP_BATCH ? R - j0 : TP_BATCH;
+        float org[3 * TP_BATCH], dir[3 * TP_BATCH];
+        double dd[TP_BATCH][3], pts[TP_BATCH][3];
+        bk_hit hits[TP_BATCH];
+        for (int jj = 0; jj < m; jj++) {
+            double *p = pts[jj];
+            cell_point(&geom, &rng, p);
+            float pf[3] = {(float)p[0], (float)p[1], (float)p[2]};
+            bk_offset_ray_origin_scaled(pf, nf, scale, org + 3 * jj);
+            double u1, cp, sp;
+            lattice(&c->lat, (uint32_t)(j0 + jj), &shift, &u1, &cp, &sp);
+            double rr = sqrt(u1);
+            double lx = rr * cp, ly = rr * sp, lz = sqrt(fmax(0.0, 1 - u1));
+            for (int a = 0; a < 3; a++) {
+                dd[jj][a] = lx * t[a] + ly * b[a] + lz * n[a];
+                dir[3 * jj + a] = (float)dd[jj][a];
+            }
+        }
+        bk_tracer_intersect_n(c->tracer, (size_t)m, org, dir, 0.0f, NULL, hits);
+        cnt->rays += (uint64_t)m;
+        for (int jj = 0; jj < m; jj++)
+            cell_sample(c, n, j0 + jj, pts[jj], org + 3 * jj, dd[jj], &hits[jj], nee_t, &cs, cnt);
+    }
+    if (!cs.valid) return; /* the whole cell is inside solids: never seen */
+    for (int a = 0; a < 3; a++) {
+        double e = (cs.e[a] * TP_PI + cs.en[a]) / cs.valid;
+        if (cs.lit_points) e += cs.ep[a] / cs.lit_points;
+        out[a] = cell->albedo[a] / TP_PI * e;
+    }
+}
+
+static void cache_bounce(tp_ctx *c, size_t begin, size_t end, int thread)
+{
+    float *cur = c->l_cur[c->half];
+    tp_count cnt = {0, 0, 0};
+    for (size_t ci = begin; ci < end; ci++) {
+        double v[3];
+        cell_bounce(c, ci, &cnt, v);
+        for (int a = 0; a < 3; a++) {
+            if (!isfinite(v[a]) || v[a] < 0) { cnt.bad++; v[a] = 0; }
+            cur[3 * ci + a] = (float)v[a];
+        }
+    }
+    c->thread_rays[thread] += cnt.rays + cnt.shadow;
+    c->thread_shadow[thread] += cnt.shadow;
+    c->thread_nonfinite[thread] += cnt.bad;
 }
 
 static double cell_power(const tp_ctx *c, const float *l)
@@ -675,112 +725,214 @@ static void accumulate(const double d[3], double cs, const double L[3], const do
     }
 }
 
+/* ---- near-field continuation -------------------------------------------------------------- */
+
+/* A cell holds one radiance for its whole area; read from closer than a few cell sizes (a
+ * corner, a leg under a table top) that constant is biased, and more samples never remove it.
+ * Such hits are evaluated at the exact hit point instead: one cosine-distributed gather from
+ * there (sky, emission, and the cache one bounce further, or another continuation when that
+ * hit is near too) plus one punctual light picked uniformly. An unbiased estimate of the
+ * reflected radiance at the point given the cache beyond it (TRANSPORT.md §Bias). */
+#define TP_NEAR_CELLS 2.0   /* continue when the hit is closer than this many cell sizes */
+#define TP_NEAR_DEPTH 3     /* continuations in a row before the cache is read anyway */
+
+static int near_hit(const tp_ctx *c, const bk_hit *h, long hc)
+{
+    return hc >= 0 && h->t < TP_NEAR_CELLS * c->tri_cell_h[h->tri];
+}
+
+/* Reflected radiance (all bounces, emission excluded) at the point of `hit` (cell hc, reached
+ * along unit d) from one continuation sample. */
+static void near_radiance(tp_ctx *c, const float *sum, const bk_hit *hit, long hc, int depth, tp_rng *rng,
+                          tp_count *cnt, double out[3])
+{
+    const tp_cell *cell = &c->cells[hc];
+    double v[3][3], x[3];
+    tri_vertices(c, hit->tri, v);
+    for (int a = 0; a < 3; a++) x[a] = (1.0 - hit->u - hit->v) * v[0][a] + hit->u * v[1][a] + hit->v * v[2][a];
+    double n[3] = {cell->n[0], cell->n[1], cell->n[2]}, t[3], b[3];
+    bk_onb(n, t, b);
+    float xf[3] = {(float)x[0], (float)x[1], (float)x[2]}, nf[3] = {cell->n[0], cell->n[1], cell->n[2]}, o[3];
+    bk_offset_ray_origin_scaled(xf, nf, bk_tracer_tri_scale(c->tracer, hit->tri), o);
+    double u1 = rng_next(rng), ph = 2 * TP_PI * rng_next(rng), rr = sqrt(u1), lz = sqrt(fmax(0.0, 1 - u1));
+    double d[3];
+    for (int a = 0; a < 3; a++) d[a] = rr * cos(ph) * t[a] + rr * sin(ph) * b[a] + lz * n[a];
+    float df[3] = {(float)d[0], (float)d[1], (float)d[2]};
+    double L[3] = {0, 0, 0};
+    bk_hit h2;
+    cnt->rays++;
+    if (!bk_tracer_intersect(c->tracer, o, df, 0.0f, INFINITY, &h2)) {
+        sky_radiance(c, d, L);
+    } else {
+        long h2c = hit_cell(c, &h2);
+        if (h2c >= 0) {
+            emission_at(c, h2.tri, h2.u, h2.v, L);
+            double r2[3];
+            if (depth + 1 < TP_NEAR_DEPTH && near_hit(c, &h2, h2c)) {
+                near_radiance(c, sum, &h2, h2c, depth + 1, rng, cnt, r2);
+            } else {
+                for (int a = 0; a < 3; a++) r2[a] = sum[3 * h2c + a];
+            }
+            for (int a = 0; a < 3; a++) L[a] += r2[a];
+        }
+    }
+    double e[3] = {TP_PI * L[0], TP_PI * L[1], TP_PI * L[2]};
+    if (c->light_count) {
+        size_t li = (size_t)(rng_next(rng) * (double)c->light_count);
+        if (li >= c->light_count) li = c->light_count - 1;
+        double val[3], ld[3], dist;
+        if (bk_light_eval(c->lights[li], x, val, ld, &dist)) {
+            double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
+            if (cs > 0) {
+                cnt->shadow++;
+                if (bk_light_visible(c->tracer, o, ld, dist))
+                    for (int a = 0; a < 3; a++) e[a] += (double)c->light_count * val[a] * cs;
+            }
+        }
+    }
+    for (int a = 0; a < 3; a++) out[a] = cell->albedo[a] / TP_PI * e[a];
+}
+
+/* ---- final gather ---------------------------------------------------------------------------- */
+
+/* A receiver's sums over one half of one pass. */
+typedef struct tp_recv_sums {
+    double e[3];          /* Σ L·cos (irradiance, before × solid/S) */
+    double sh_t[3][9], sh_d[3][9];
+} tp_recv_sums;
+
+/* Radiance L (direct part Ld) that gather ray d (pdf 1/solid) brings back from `hit`. */
+static void gather_hit(tp_ctx *c, const float *sum, const bk_hit *hit, const double d[3], double solid,
+                       tp_rng *cont, tp_count *cnt, double L[3], double Ld[3])
+{
+    for (int a = 0; a < 3; a++) L[a] = Ld[a] = 0;
+    if (hit->tri == UINT32_MAX) {
+        sky_radiance(c, d, L);
+        memcpy(Ld, L, 3 * sizeof(double));
+        return;
+    }
+    long hc = hit_cell(c, hit);
+    if (hc < 0) return; /* black, or the inside of a solid: a receiver there is dark */
+    emission_at(c, hit->tri, hit->u, hit->v, Ld);
+    if (Ld[0] > 0 || Ld[1] > 0 || Ld[2] > 0) {
+        double wg = mis_gather(c, hit, hc, d, 1 / solid);
+        for (int a = 0; a < 3; a++) Ld[a] *= wg;
+    }
+    double r[3];
+    if (near_hit(c, hit, hc)) {
+        near_radiance(c, sum, hit, hc, 0, cont, cnt, r);
+    } else {
+        for (int a = 0; a < 3; a++) r[a] = sum[3 * hc + a];
+    }
+    for (int a = 0; a < 3; a++) L[a] = r[a] + Ld[a];
+}
+
+/* One half of receiver i in this pass: S directions from the shifted lattice, uniform over the
+ * hemisphere (texels) or the sphere (probes) — the SH projection needs a pdf that does not
+ * vanish at the horizon — each with one light sample when NEE is on. */
+static void recv_half(tp_ctx *c, size_t i, int h, const double n[3], int sphere, const float o[3],
+                      tp_recv_sums *rs, tp_count *cnt)
+{
+    const int S = c->rays;
+    const float *sum = c->l_sum[h];
+    double t[3], b[3];
+    bk_onb(n, t, b);
+    tp_rng rng = rng_make(c->seed, DOM_RECV, (uint64_t)h, (uint64_t)c->pass, 0, i);
+    tp_rng cont = rng_make(c->seed, DOM_RECV_NEAR, (uint64_t)h, (uint64_t)c->pass, 0, i);
+    double s1 = rng_next(&rng), s2 = rng_next(&rng);
+    tp_shift shift = lattice_shift(s1, s2);
+    const double solid = sphere ? 4 * TP_PI : 2 * TP_PI;
+    const int pg_kind = sphere ? PG_SPHERE : PG_HEMISPHERE;
+    double t1 = 0, t2 = 0;
+    if (c->nee) {
+        tp_rng nr = rng_make(c->seed, DOM_RECV_NEE, (uint64_t)h, (uint64_t)c->pass, 0, i);
+        t1 = rng_next(&nr);
+        t2 = rng_next(&nr);
+    }
+    for (int j0 = 0; j0 < S; j0 += TP_BATCH) {
+        const int m = S - j0 < TP_BATCH ? S - j0 : TP_BATCH;
+        float org[3 * TP_BATCH], dir[3 * TP_BATCH];
+        double dd[TP_BATCH][3], zz[TP_BATCH];
+        bk_hit hits[TP_BATCH];
+        for (int jj = 0; jj < m; jj++) {
+            double u1, cp, sp;
+            lattice(&c->lat, (uint32_t)(j0 + jj), &shift, &u1, &cp, &sp);
+            double z = sphere ? 1 - 2 * u1 : u1;
+            double rr = sqrt(fmax(0.0, 1 - z * z));
+            zz[jj] = z;
+            for (int a = 0; a < 3; a++) {
+                dd[jj][a] = rr * cp * t[a] + rr * sp * b[a] + z * n[a];
+                dir[3 * jj + a] = (float)dd[jj][a];
+                org[3 * jj + a] = o[a];
+            }
+        }
+        bk_tracer_intersect_n(c->tracer, (size_t)m, org, dir, 0.0f, NULL, hits);
+        cnt->rays += (uint64_t)m;
+        for (int jj = 0; jj < m; jj++) {
+            double L[3], Ld[3];
+            gather_hit(c, sum, &hits[jj], dd[jj], solid, &cont, cnt, L, Ld);
+            if (!bk_finite3(L) || !bk_finite3(Ld)) cnt->bad++;
+            else accumulate(dd[jj], sphere ? 1 : zz[jj], L, Ld, rs->e, rs->sh_t, rs->sh_d);
+            if (!c->nee) continue;
+            /* one light sample per gather ray; its value Le·w/p is turned into the gather's
+             * units (radiance, later × solid/S) by 1/solid */
+            double u0, uu1, ld[3], cl, val[3];
+            lattice_uv(&c->lat, (uint32_t)(j0 + jj), t1, t2, &u0, &uu1);
+            if (nee_sample(c, o, n, pg_kind, u0, uu1, ld, &cl, val, &cnt->shadow)) {
+                for (int a = 0; a < 3; a++) val[a] /= solid;
+                if (!bk_finite3(val)) cnt->bad++;
+                else accumulate(ld, cl, val, val, rs->e, rs->sh_t, rs->sh_d);
+            }
+        }
+    }
+}
+
 static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
 {
     const int S = c->rays;
     const double w = c->pass_weight;
     const bk_transport_output *out = c->out;
-    uint64_t rays = 0, shadow = 0, bad = 0;
+    tp_count cnt = {0, 0, 0};
     for (size_t i = begin; i < end; i++) {
         const bk_receiver *r = &c->recv[i];
-        double n[3], t[3], b[3];
+        double n[3];
         int sphere;
         recv_normal(r, n, &sphere);
-        bk_onb(n, t, b);
         float o[3];
         recv_offset_origin(c, r, o);
-        double sh_t[3][9], sh_d[3][9], e_t[3];
-        memset(sh_t, 0, sizeof sh_t);
-        memset(sh_d, 0, sizeof sh_d);
-        memset(e_t, 0, sizeof e_t);
+        const double solid = sphere ? 4 * TP_PI : 2 * TP_PI;
+        tp_recv_sums tot;
+        memset(&tot, 0, sizeof tot);
         for (int h = 0; h < 2; h++) {
-            tp_rng rng = rng_make(c->seed, DOM_RECV, (uint64_t)h, (uint64_t)c->pass, 0, i);
-            double s1 = rng_next(&rng), s2 = rng_next(&rng);
-            tp_shift shift = lattice_shift(s1, s2);
-            const float *sum = c->l_sum[h];
-            double e[3] = {0, 0, 0};
-            /* uniform over the hemisphere (texels) or sphere (probes): the SH projection needs
-             * a pdf that does not vanish at the horizon */
-            const double solid = sphere ? 4 * TP_PI : 2 * TP_PI;
-            const int pg_kind = sphere ? PG_SPHERE : PG_HEMISPHERE;
-            double t1 = 0, t2 = 0;
-            if (c->nee) {
-                tp_rng nr = rng_make(c->seed, DOM_RECV_NEE, (uint64_t)h, (uint64_t)c->pass, 0, i);
-                t1 = rng_next(&nr);
-                t2 = rng_next(&nr);
-            }
-            for (int j0 = 0; j0 < S; j0 += TP_BATCH) {
-                const int m = S - j0 < TP_BATCH ? S - j0 : TP_BATCH;
-                float org[3 * TP_BATCH], dir[3 * TP_BATCH];
-                double dd[TP_BATCH][3], zz[TP_BATCH];
-                bk_hit hits[TP_BATCH];
-                for (int jj = 0; jj < m; jj++) {
-                    double u1, cp, sp;
-                    lattice(&c->lat, (uint32_t)(j0 + jj), &shift, &u1, &cp, &sp);
-                    double z = sphere ? 1 - 2 * u1 : u1;
-                    double rr = sqrt(fmax(0.0, 1 - z * z));
-                    double lx = rr * cp, ly = rr * sp;
-                    zz[jj] = z;
-                    for (int a = 0; a < 3; a++) {
-                        dd[jj][a] = lx * t[a] + ly * b[a] + z * n[a];
-                        dir[3 * jj + a] = (float)dd[jj][a];
-                        org[3 * jj + a] = o[a];
-                    }
-                }
-                bk_tracer_intersect_n(c->tracer, (size_t)m, org, dir, 0.0f, NULL, hits);
-                rays += (uint64_t)m;
-                for (int jj = 0; jj < m; jj++) {
-                    const double *d = dd[jj];
-                    const bk_hit *hit = &hits[jj];
-                    double L[3] = {0, 0, 0}, Ld[3] = {0, 0, 0};
-                    if (hit->tri != UINT32_MAX) {
-                        long hc = hit_cell(c, hit);
-                        if (hc >= 0) {
-                            emission_at(c, hit->tri, hit->u, hit->v, Ld);
-                            if (Ld[0] > 0 || Ld[1] > 0 || Ld[2] > 0) {
-                                double wg = mis_gather(c, hit, hc, d, 1 / solid);
-                                for (int a = 0; a < 3; a++) Ld[a] *= wg;
-                            }
-                            for (int a = 0; a < 3; a++) L[a] = sum[3 * hc + a] + Ld[a];
-                        }
-                    } else {
-                        sky_radiance(c, d, L);
-                        memcpy(Ld, L, sizeof L);
-                    }
-                    if (!bk_finite3(L) || !bk_finite3(Ld)) bad++;
-                    else accumulate(d, sphere ? 1 : zz[jj], L, Ld, e, sh_t, sh_d);
-                    if (c->nee) {
-                        /* one light sample per gather ray; its value Le·w/p is turned into the
-                         * gather's units (radiance, later × solid/S) by 1/solid */
-                        double u0, uu1, ld[3], cl, val[3];
-                        lattice_uv(&c->lat, (uint32_t)(j0 + jj), t1, t2, &u0, &uu1);
-                        if (nee_sample(c, o, n, pg_kind, u0, uu1, ld, &cl, val, &shadow)) {
-                            for (int a = 0; a < 3; a++) val[a] /= solid;
-                            if (!bk_finite3(val)) bad++;
-                            else accumulate(ld, cl, val, val, e, sh_t, sh_d);
-                        }
-                    }
-                }
-            }
-            for (int a = 0; a < 3; a++) e[a] *= solid / S;
+            tp_recv_sums rs;
+            memset(&rs, 0, sizeof rs);
+            recv_half(c, i, h, n, sphere, o, &rs, &cnt);
+            double e[3];
+            for (int a = 0; a < 3; a++) e[a] = rs.e[a] * solid / S;
             /* error scalar: irradiance for texels, fluence/4 for probes (equal under uniform
              * radiance, so texels and probes weigh alike in the relative RMSE) */
             c->x_acc[h][i] += w * (bk_lum(e) + c->punct_lum[i]) * (sphere ? 0.25 : 1.0);
-            for (int a = 0; a < 3; a++) e_t[a] += e[a];
+            for (int a = 0; a < 3; a++) {
+                tot.e[a] += e[a];
+                for (int kk = 0; kk < 9; kk++) {
+                    tot.sh_t[a][kk] += rs.sh_t[a][kk];
+                    tot.sh_d[a][kk] += rs.sh_d[a][kk];
+                }
+            }
         }
         /* both halves: 2S samples of pdf 1/solid; weight w for this pass */
-        const double ws = w * (sphere ? 4 * TP_PI : 2 * TP_PI) / (2.0 * S);
+        const double ws = w * solid / (2.0 * S);
         for (int a = 0; a < 3; a++) {
             for (int kk = 0; kk < 9; kk++) {
-                out->radiance[i].c[a][kk] += (float)(sh_t[a][kk] * ws);
-                if (out->direct) out->direct[i].c[a][kk] += (float)(sh_d[a][kk] * ws);
+                out->radiance[i].c[a][kk] += (float)(tot.sh_t[a][kk] * ws);
+                if (out->direct) out->direct[i].c[a][kk] += (float)(tot.sh_d[a][kk] * ws);
             }
-            if (out->irradiance) out->irradiance[3 * i + a] += (float)(e_t[a] * w * 0.5);
+            if (out->irradiance) out->irradiance[3 * i + a] += (float)(tot.e[a] * w * 0.5);
         }
     }
-    c->thread_rays[thread] += rays + shadow;
-    c->thread_shadow[thread] += shadow;
-    c->thread_nonfinite[thread] += bad;
+    c->thread_rays[thread] += cnt.rays + cnt.shadow;
+    c->thread_shadow[thread] += cnt.shadow;
+    c->thread_nonfinite[thread] += cnt.bad;
 }
 
 /* ---- setup ------------------------------------------------------------------------------------ */
@@ -800,7 +952,7 @@ static double now_seconds(void)
 
 static void free_ctx(tp_ctx *c)
 {
-    free(c->cells); free(c->tri_first); free(c->tri_m); free(c->tri_sides); free(c->tri_edge_eps);
+    free(c->cells); free(c->tri_first); free(c->tri_m); free(c->tri_sides); free(c->tri_closed); free(c->tri_cell_h); free(c->tri_edge_eps);
     free(c->tri_le); free(c->tri_le_tex); free(c->em); free(c->em_cdf);
     free(c->thread_shadow);
     free(c->lights);
@@ -810,54 +962,98 @@ static void free_ctx(tp_ctx *c)
     lattice_free(&c->lat);
 }
 
+/* Longest edge of triangle i. */
+static double tri_longest(const tp_ctx *c, uint32_t i)
+{
+    double v[3][3], longest = 0;
+    tri_vertices(c, i, v);
+    for (int e = 0; e < 3; e++) {
+        double l2 = 0;
+        for (int k = 0; k < 3; k++) l2 += (v[(e + 1) % 3][k] - v[e][k]) * (v[(e + 1) % 3][k] - v[e][k]);
+        longest = fmax(longest, sqrt(l2));
+    }
+    return longest;
+}
+
+/* Subdivision m of triangle i for cells of about `size` metres (sized), or of area cell_area
+ * (automatic budget); m² sub-triangles per side. */
+static int tri_subdivision(const tp_ctx *c, uint32_t i, double size, double cell_area)
+{
+    double a = bk_tracer_tri_area(c->tracer, i), m = 1;
+    if (!(a > 0) || !isfinite(a)) return 1;
+    if (size > 0) {
+        /* square-ish cells of the wanted size; slivers split along their length too */
+        m = fmax(ceil(sqrt(a) / size), ceil(tri_longest(c, i) / (2 * size)));
+    } else if (cell_area > 0) {
+        m = floor(sqrt(a / cell_area));
+    }
+    return m < 1 ? 1 : m > TP_MAX_SUB ? TP_MAX_SUB : (int)m;
+}
+
+/* Cells per triangle: sized triangles (options.cell_size, e.g. the lightmap's texel size: the
+ * cache then resolves light as finely as the lightmap stores it) and the rest sharing max_cells
+ * by area; if everything exceeds TP_CELL_CAP the sizes grow uniformly until it fits. */
+static lbk_result size_cells(tp_ctx *c, size_t *count_out)
+{
+    const bk_scene *s = c->scene;
+    const float *want = c->opt->cell_size;
+    size_t nt = s->tri_count;
+    size_t max_cells = c->opt->max_cells > 0 ? (size_t)c->opt->max_cells : 32768;
+    double auto_area = 0;
+    for (size_t i = 0; i < nt; i++) {
+        uint32_t mi = s->tri_material ? s->tri_material[i] : 0;
+        int ds = mi < s->material_count ? s->materials[mi].double_sided : 0;
+        /* a closed solid's back side is its inside: never seen, no cells */
+        c->tri_sides[i] = ds && !c->tri_closed[i] ? 2 : 1;
+        if (!(want && want[i] > 0 && isfinite(want[i])))
+            auto_area += (double)bk_tracer_tri_area(c->tracer, (uint32_t)i) * c->tri_sides[i];
+    }
+    double cell_area = auto_area > 0 ? auto_area / (double)max_cells : 0;
+    for (double grow = 1;; grow *= 1.25) {
+        size_t count = 0;
+        for (size_t i = 0; i < nt; i++) {
+            double size = want && want[i] > 0 && isfinite(want[i]) ? want[i] * grow : 0;
+            int m = tri_subdivision(c, (uint32_t)i, size, cell_area * grow * grow);
+            c->tri_m[i] = (uint16_t)m;
+            c->tri_first[i] = (uint32_t)(count < UINT32_MAX ? count : UINT32_MAX);
+            count += (size_t)c->tri_sides[i] * (size_t)m * (size_t)m;
+        }
+        if (count <= TP_CELL_CAP) { *count_out = count; return LBK_OK; }
+        if (grow > 1e6) return LBK_ERR_LIMIT;
+    }
+}
+
 static lbk_result build_cells(tp_ctx *c)
 {
     const bk_scene *s = c->scene;
     size_t nt = s->tri_count;
-    size_t max_cells = c->opt->max_cells > 0 ? (size_t)c->opt->max_cells : 32768;
     c->tri_first = calloc(nt ? nt : 1, sizeof *c->tri_first);
-    c->tri_m = calloc(nt ? nt : 1, 1);
+    c->tri_m = calloc(nt ? nt : 1, sizeof *c->tri_m);
     c->tri_sides = calloc(nt ? nt : 1, 1);
+    c->tri_closed = calloc(nt ? nt : 1, 1);
     c->tri_edge_eps = calloc(nt ? nt : 1, sizeof(float));
+    c->tri_cell_h = calloc(nt ? nt : 1, sizeof(float));
     c->tri_le = calloc(3 * (nt ? nt : 1), sizeof(float));
     c->tri_le_tex = calloc(nt ? nt : 1, sizeof(int32_t));
-    if (!c->tri_first || !c->tri_m || !c->tri_sides || !c->tri_edge_eps || !c->tri_le || !c->tri_le_tex)
+    if (!c->tri_first || !c->tri_m || !c->tri_sides || !c->tri_closed || !c->tri_edge_eps || !c->tri_cell_h ||
+        !c->tri_le || !c->tri_le_tex)
         return LBK_ERR_OUT_OF_MEMORY;
-    double total = 0;
-    for (size_t i = 0; i < nt; i++) {
-        uint32_t mi = s->tri_material ? s->tri_material[i] : 0;
-        int ds = mi < s->material_count ? s->materials[mi].double_sided : 0;
-        c->tri_sides[i] = ds ? 2 : 1;
-        total += (double)bk_tracer_tri_area(c->tracer, (uint32_t)i) * c->tri_sides[i];
-    }
-    double cell_area = total > 0 ? total / (double)max_cells : 0;
+    lbk_result r = bk_closed_triangles(s, c->tri_closed);
+    if (r != LBK_OK) return r;
     size_t count = 0;
+    r = size_cells(c, &count);
+    if (r != LBK_OK) return r;
     for (size_t i = 0; i < nt; i++) {
-        double a = bk_tracer_tri_area(c->tracer, (uint32_t)i);
-        int m = 1;
-        if (cell_area > 0 && a > 0) {
-            double per_side = a / cell_area;
-            double r = floor(sqrt(per_side));
-            m = r < 1 ? 1 : r > TP_MAX_SUB ? TP_MAX_SUB : (int)r;
-        }
-        c->tri_m[i] = (uint8_t)m;
-        if (count > UINT32_MAX - 2 * TP_MAX_SUB * TP_MAX_SUB) return LBK_ERR_LIMIT;
-        c->tri_first[i] = (uint32_t)count;
-        count += (size_t)c->tri_sides[i] * m * m;
         /* keep sample points >= 8 ulps of the coordinates inside every edge (the tracer's edge
          * limitation, tracer.h): a barycentric floor of 8 ulp / altitude */
-        double v[3][3];
-        tri_vertices(c, (uint32_t)i, v);
-        double longest = 0;
-        for (int e = 0; e < 3; e++) {
-            double l2 = 0;
-            for (int k = 0; k < 3; k++) l2 += (v[(e + 1) % 3][k] - v[e][k]) * (v[(e + 1) % 3][k] - v[e][k]);
-            longest = fmax(longest, sqrt(l2));
-        }
+        double a = bk_tracer_tri_area(c->tracer, (uint32_t)i), longest = tri_longest(c, (uint32_t)i);
         double alt = longest > 0 ? 2 * a / longest : 0;
         double ulp = bk_tracer_tri_scale(c->tracer, (uint32_t)i) * 1.1920928955078125e-07;
         double eps = alt > 0 && isfinite(alt) ? 8 * ulp / alt : 0;
         c->tri_edge_eps[i] = (float)(eps > 0.3 ? 0.3 : eps);
+        int m = c->tri_m[i];
+        double h = fmax(longest / m, sqrt(2 * a) / m);
+        c->tri_cell_h[i] = (float)(isfinite(h) ? h : 0);
     }
     c->cell_count = count;
     c->cells = calloc(count ? count : 1, sizeof *c->cells);
@@ -880,11 +1076,11 @@ static lbk_result build_cells(tp_ctx *c)
             }
             if (mat->emission_tex >= 0 && bk_scene_image(s, mat->emission_tex)) c->tri_le_tex[i] = mat->emission_tex;
         }
-        for (int sub = 0; sub < m * m; sub++) {
+        for (long sub = 0; sub < (long)m * m; sub++) {
             /* material values at the cell's centroid (uv0) */
-            int j = 0, ss = sub;
-            while (j < m - 1 && ss >= 2 * (m - j) - 1) { ss -= 2 * (m - j) - 1; j++; }
-            int ii = ss / 2, up = ss & 1;
+            int j = sub_row(m, sub);
+            long ss = sub - (long)j * (2 * m - j);
+            int ii = (int)(ss / 2), up = (int)(ss & 1);
             double cu = up ? (3.0 * ii + 2) / (3.0 * m) : (3.0 * ii + 1) / (3.0 * m);
             double cv = up ? (3.0 * j + 2) / (3.0 * m) : (3.0 * j + 1) / (3.0 * m);
             double uv[2];
@@ -907,7 +1103,7 @@ static lbk_result build_cells(tp_ctx *c)
             for (int side = 0; side < c->tri_sides[i]; side++) {
                 tp_cell *cell = &c->cells[c->tri_first[i] + (size_t)side * m * m + sub];
                 cell->tri = (uint32_t)i;
-                cell->sub = (uint16_t)sub;
+                cell->sub = (uint32_t)sub;
                 cell->m = (uint16_t)m;
                 cell->side = (uint8_t)side;
                 for (int k = 0; k < 3; k++) cell->n[k] = side ? -n[k] : n[k];

@@ -57,8 +57,14 @@ typedef struct bk_transport_options {
                                 "", plus the sky); else only that set's lights and emitters, no sky */
     int no_punctual;         /* 1: leave punctual lights out (default 0: included) */
     int no_sky;              /* 1: no sky even in the base */
-    int max_cells;           /* radiosity cache cells (both sides counted); 0: 32768. A triangle
-                                always gets at least one cell per side */
+    int max_cells;           /* radiosity cache cells (both sides counted) shared by area among
+                                the triangles without a cell_size; 0: 32768. A triangle always
+                                gets at least one cell per side */
+    /* Per scene triangle (tri_count entries) or NULL: the wanted cell size in metres, <= 0 for
+     * "share max_cells". The baker passes the lightmap's texel size, so the cache is as fine
+     * as the lightmap (TRANSPORT.md §Bias). All cells together stay below 4 Mi (sizes grow
+     * uniformly if needed). */
+    const float *cell_size;
     int cache_rays;          /* gather rays per cell per bounce in pass 0 (doubles per pass); 0: 16 */
     int first_pass_samples;  /* gather rays per receiver per half in pass 0 (doubles); 0: 16 */
     /* Next-event estimation of emissive triangles (one light sample per gather ray, combined
