@@ -310,6 +310,16 @@ int main(int argc, char **argv)
                  "lbk %d passes: %.0f samples/receiver, %.2f s, %zu cells, %d bounces, est. error %.2f %%",
                  a.passes[k], st.samples_per_receiver, st.seconds, st.cells, st.bounces, 100 * st.est_rel_rmse);
         report(&e, irr, irr2, label);
+        if (getenv("BIAS_DEBUG"))
+            for (size_t q = 0; q < e.n; q++)
+                if (e.group[q] == BSC_BURIED) {
+                    size_t ti = texel_of[e.recv[q]];
+                    const bk_texel *x = &tx.receivers[ti];
+                    printf("   buried %s: orig (%.3f %.3f %.3f) now (%.3f %.3f %.3f) n (%.2f %.2f %.2f) flags %u E %.4f\n",
+                           s.objects[s.tri_object[x->tri]].name, orig[3 * ti], orig[3 * ti + 1], orig[3 * ti + 2],
+                           x->position[0], x->position[1], x->position[2], x->normal[0], x->normal[1], x->normal[2],
+                           x->flags, lum3f(irr + 3 * e.recv[q]));
+                }
         if (a.worst && irr2) print_worst(&e, irr, irr2, a.worst);
     }
     free(irr2);

@@ -74,6 +74,7 @@ typedef struct bake {
     size_t receiver_count, texel_receivers, glg_first, llg_first;
     uint32_t *texel_of_receiver;    /* receiver → index in texels.receivers */
     lbk_sh9_rgb *radiance;
+    float *cell_size;               /* per scene triangle: the radiosity cache's cell size (texel size) */
     bk_transport_stats stats;
     bk_transport_sample *samples;
     size_t sample_count, sample_cap;
@@ -406,6 +407,7 @@ static void set_inputs(const bake *b, bk_set_inputs *in)
     in->atlas_margin = b->atlas.margin;
     in->base_radiance = b->radiance;
     bk_bake_transport_options(b->opt, b->pre->max_samples, b->pre->target_error, &in->transport);
+    in->transport.cell_size = b->cell_size;
     in->base_samples_per_receiver = b->stats.samples_per_receiver;
     in->threshold = b->opt->dls_threshold;
     in->progress = b->progress;
@@ -413,13 +415,32 @@ static void set_inputs(const bake *b, bk_set_inputs *in)
     memcpy(in->origin, b->origin, sizeof in->origin);
 }
 
+/* The radiosity cache as fine as the lightmap: cells of a lightmapped triangle are its object's
+ * texel size (bake/transport/TRANSPORT.md §Bias); other triangles share the default budget. */
+static int build_cell_sizes(bake *b)
+{
+    const bk_scene *s = &b->scene;
+    b->cell_size = calloc(s->tri_count ? s->tri_count : 1, sizeof *b->cell_size);
+    if (!b->cell_size) return fail(b, LBK_EXIT_INTERNAL, "out of memory");
+    for (size_t t = 0; t < s->tri_count; t++) {
+        uint32_t o = s->tri_object ? s->tri_object[t] : UINT32_MAX;
+        int32_t slot = o < b->atlas.scene_object_count && b->atlas.object_slot ? b->atlas.object_slot[o] : -1;
+        if (slot < 0) continue;
+        float density = b->atlas.objects[slot].density;
+        if (density > 0 && isfinite(density)) b->cell_size[t] = 1.0f / density;
+    }
+    return 0;
+}
+
 static int do_transport(bake *b)
 {
     phase(b, "light");
     int rc = build_receivers(b);
+    if (!rc) rc = build_cell_sizes(b);
     if (rc) return rc;
     bk_transport_options to;
     bk_bake_transport_options(b->opt, b->pre->max_samples, b->pre->target_error, &to);
+    to.cell_size = b->cell_size;
     to.progress = transport_progress;
     to.report = transport_report;
     to.user = b;
@@ -894,6 +915,7 @@ static void bake_free(bake *b)
     free(b->radiance);
     free(b->texel_of_receiver);
     free(b->receivers);
+    free(b->cell_size);
     for (size_t i = 0; i < b->llg_count; i++) bk_llg_free(&b->llgs[i]);
     free(b->llgs);
     free(b->object_llg);

@@ -573,9 +573,11 @@ static void run_albedo(void *user, uint32_t tri, float albedo[3])
 typedef struct filtered_scene {
     bk_scene scene;
     uint32_t *tris, *tri_material, *tri_object;
+    float *cell_size;  /* the transport's per-triangle cell sizes, filtered alike (NULL: none) */
 } filtered_scene;
 
-static lbk_result scene_without_doors(const bk_scene *s, const char *door, const char *door2, filtered_scene *out)
+static lbk_result scene_without_doors(const bk_scene *s, const char *door, const char *door2, const float *cell_size,
+                                      filtered_scene *out)
 {
     memset(out, 0, sizeof *out);
     out->scene = *s;
@@ -583,8 +585,9 @@ static lbk_result scene_without_doors(const bk_scene *s, const char *door, const
     out->tris = malloc(3 * n * sizeof *out->tris);
     out->tri_material = malloc(n * sizeof *out->tri_material);
     out->tri_object = malloc(n * sizeof *out->tri_object);
-    if (!out->tris || !out->tri_material || !out->tri_object) {
-        free(out->tris), free(out->tri_material), free(out->tri_object);
+    out->cell_size = cell_size ? malloc(n * sizeof *out->cell_size) : NULL;
+    if (!out->tris || !out->tri_material || !out->tri_object || (cell_size && !out->cell_size)) {
+        free(out->tris), free(out->tri_material), free(out->tri_object), free(out->cell_size);
         return LBK_ERR_OUT_OF_MEMORY;
     }
     size_t k = 0;
@@ -595,6 +598,7 @@ static lbk_result scene_without_doors(const bk_scene *s, const char *door, const
         memcpy(&out->tris[3 * k], &s->tris[3 * i], 3 * sizeof *out->tris);
         out->tri_material[k] = s->tri_material ? s->tri_material[i] : 0;
         out->tri_object[k] = o;
+        if (cell_size) out->cell_size[k] = cell_size[i];
         k++;
     }
     out->scene.tri_count = k;
@@ -606,7 +610,7 @@ static lbk_result scene_without_doors(const bk_scene *s, const char *door, const
 
 static void filtered_free(filtered_scene *f)
 {
-    free(f->tris), free(f->tri_material), free(f->tri_object);
+    free(f->tris), free(f->tri_material), free(f->tri_object), free(f->cell_size);
 }
 
 /* One transport run at the base receivers. */
@@ -659,7 +663,7 @@ static void sh_add(lbk_sh9_rgb *dst, const lbk_sh9_rgb *b, size_t n)
 static int open_without(const bk_set_inputs *in, const char *door, const char *door2, filtered_scene *fs,
                         bk_tracer **tr, char *err, size_t err_len)
 {
-    if (scene_without_doors(in->scene, door, door2, fs)) {
+    if (scene_without_doors(in->scene, door, door2, in->transport.cell_size, fs)) {
         snprintf(err, err_len, "out of memory");
         return LBK_EXIT_INTERNAL;
     }
@@ -680,7 +684,9 @@ static int run_without(run_ctx *rc, const char *door, const char *door2, const b
     bk_tracer *tr = NULL;
     int code = open_without(rc->in, door, door2, &fs, &tr, err, err_len);
     if (code) return code;
-    code = run_one(rc, &fs.scene, tr, opt, rad, dir, what, err, err_len);
+    bk_transport_options o = *opt;
+    o.cell_size = fs.cell_size;
+    code = run_one(rc, &fs.scene, tr, &o, rad, dir, what, err, err_len);
     bk_tracer_destroy(tr);
     filtered_free(&fs);
     return code;
