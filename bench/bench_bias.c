@@ -29,7 +29,8 @@
 typedef struct args {
     int passes[8], npasses;
     double density;
-    int ref_paths, per, ground, detail, threads, cells, sweep, noise, worst;
+    int ref_paths, per, ground, detail, threads, cells, sweep, noise, worst, footprint;
+    const char *ref_file;
     double cell_texels;
     uint64_t seed;
 } args;
@@ -41,8 +42,22 @@ static double now_s(void)
     return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
+static double cpu_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
 static double lum3d(const double *c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
 static double lum3f(const float *c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
+
+/* lbk's value of eval point i: its receiver's irradiance; a texel that is not baked (not valid)
+ * counts as 0 */
+static double lbk_at(const float *irr, size_t recv)
+{
+    return recv == SIZE_MAX ? 0.0 : lum3f(irr + 3 * recv);
+}
 
 static uint64_t fnv(uint64_t h, const void *p, size_t n)
 {
@@ -56,17 +71,27 @@ typedef struct eval_set {
     size_t *recv;      /* receiver index */
     int *group;
     float *p, *nrm;
+    uint32_t *fp_first, *fp_count; /* footprints (when the reference averages over them) */
     double *ref, *se;  /* reference irradiance (3 per point), stderr of its luminance */
 } eval_set;
 
-static void load_or_make_ref(const bk_scene *s, const bk_tracer *t, eval_set *e, int paths, int threads)
+static void load_or_make_ref(const bk_scene *s, const bk_tracer *t, eval_set *e, int paths, int threads,
+                             const bk_texels *tx, const char *file)
 {
     uint64_t h = fnv(0xCBF29CE484222325ull, e->p, 3 * e->n * sizeof(float));
+#ifndef BENCH_BIAS_ORIG
+    if (tx) {
+        for (size_t i = 0; i < e->n; i++)
+            h = fnv(h, tx->footprint + e->fp_first[i], e->fp_count[i] * sizeof *tx->footprint);
+        h = fnv(h, "footprint", 9);
+    }
+#endif
     h = fnv(h, e->nrm, 3 * e->n * sizeof(float));
     h = fnv(h, &paths, sizeof paths);
     h = fnv(h, s->positions, 3 * s->vertex_count * sizeof(float));
     char path[256];
     snprintf(path, sizeof path, "/tmp/lbk_bias_ref_%016llx.bin", (unsigned long long)h);
+    if (file) snprintf(path, sizeof path, "%s", file);
     FILE *f = fopen(path, "rb");
     if (f) {
         size_t a = fread(e->ref, sizeof(double), 3 * e->n, f), b = fread(e->se, sizeof(double), e->n, f);
@@ -74,7 +99,13 @@ static void load_or_make_ref(const bk_scene *s, const bk_tracer *t, eval_set *e,
         if (a == 3 * e->n && b == e->n) { printf("reference: %s (cached)\n", path); return; }
     }
     double t0 = now_s();
-    rp_irradiance(s, t, e->p, e->nrm, e->n, paths, 77, threads, e->ref, e->se);
+#ifndef BENCH_BIAS_ORIG
+    if (tx)
+        rp_footprint_irradiance(s, t, tx->footprint, e->fp_first, e->fp_count, e->p, e->nrm, e->n, paths, 77, threads,
+                                e->ref, e->se);
+    else
+#endif
+        rp_irradiance(s, t, e->p, e->nrm, e->n, paths, 77, threads, e->ref, e->se);
     printf("reference: %d paths at %zu points, %.1f s -> %s\n", paths, e->n, now_s() - t0, path);
     f = fopen(path, "wb");
     if (f) {
@@ -93,14 +124,14 @@ static void report(const eval_set *e, const float *irr, const float *irr2, const
     size_t cnt[BSC_GROUPS] = {0};
     for (size_t i = 0; i < e->n; i++) {
         int g = e->group[i];
-        double a = lum3f(irr + 3 * e->recv[i]), b = lum3d(e->ref + 3 * i);
+        double a = lbk_at(irr, e->recv[i]), b = lum3d(e->ref + 3 * i);
         num[g] += (a - b) * (a - b);
         den[g] += b * b;
         sgn[g] += a - b;
         sum[g] += b;
         noise[g] += e->se[i] * e->se[i];
         if (irr2) {
-            double a2 = lum3f(irr2 + 3 * e->recv[i]);
+            double a2 = lbk_at(irr2, e->recv[i]);
             own[g] += 0.5 * (a - a2) * (a - a2);
         }
         cnt[g]++;
@@ -115,7 +146,7 @@ static void report(const eval_set *e, const float *irr, const float *irr2, const
             size_t lit = 0;
             for (size_t i = 0; i < e->n; i++)
                 if (e->group[i] == g) {
-                    double a = lum3f(irr + 3 * e->recv[i]);
+                    double a = lbk_at(irr, e->recv[i]);
                     lit += a > 0;
                     mx = fmax(mx, a);
                 }
@@ -141,7 +172,7 @@ static void print_worst(const eval_set *e, const float *irr, const float *irr2, 
     double *z = calloc(e->n, sizeof *z);
     for (size_t i = 0; i < e->n; i++) {
         if (e->group[i] == BSC_SEALED || e->group[i] == BSC_BURIED) continue;
-        double a = lum3f(irr + 3 * e->recv[i]), a2 = lum3f(irr2 + 3 * e->recv[i]), b = lum3d(e->ref + 3 * i);
+        double a = lbk_at(irr, e->recv[i]), a2 = lbk_at(irr2, e->recv[i]), b = lum3d(e->ref + 3 * i);
         double sd = sqrt(e->se[i] * e->se[i] + 0.5 * (a - a2) * (a - a2) + 1e-12);
         z[i] = (0.5 * (a + a2) - b) / sd;
     }
@@ -152,7 +183,7 @@ static void print_worst(const eval_set *e, const float *irr, const float *irr2, 
             if (fabs(z[i]) > fabs(z[bi])) bi = i;
         if (z[bi] == 0) break;
         size_t i = bi;
-        double a = lum3f(irr + 3 * e->recv[i]), a2 = lum3f(irr2 + 3 * e->recv[i]), b = lum3d(e->ref + 3 * i);
+        double a = lbk_at(irr, e->recv[i]), a2 = lbk_at(irr2, e->recv[i]), b = lum3d(e->ref + 3 * i);
         printf("   %-12s p (%.3f %.3f %.3f) n (%.2f %.2f %.2f): lbk %.4f ref %.4f (%+.1f %%, z %.1f)\n",
                bsc_group_name[e->group[i]], e->p[3 * i], e->p[3 * i + 1], e->p[3 * i + 2], e->nrm[3 * i],
                e->nrm[3 * i + 1], e->nrm[3 * i + 2], 0.5 * (a + a2), b, 100 * (0.5 * (a + a2) / b - 1), z[i]);
@@ -184,6 +215,8 @@ static int parse(int argc, char **argv, args *a)
         else if (!strcmp(k, "--ground")) a->ground = 1;
         else if (!strcmp(k, "--sweep")) a->sweep = 1;
         else if (!strcmp(k, "--noise")) a->noise = 1;
+        else if (!strcmp(k, "--footprint")) a->footprint = 1;
+        else if (!strcmp(k, "--ref-file")) a->ref_file = v, i++;
         else if (!strcmp(k, "--worst")) a->worst = atoi(v), i++;
         else { fprintf(stderr, "unknown argument %s\n", k); return 1; }
     }
@@ -218,55 +251,66 @@ int main(int argc, char **argv)
     bk_texels_push_out(&tx, &s, t, &po, &ps);
     /* receivers: every valid texel, as the pipeline builds them */
     bk_receiver *r = calloc(tx.count, sizeof *r);
-    size_t *texel_of = calloc(tx.count, sizeof *texel_of);
+    size_t *texel_of = calloc(tx.count, sizeof *texel_of), *recv_of = calloc(tx.count, sizeof *recv_of);
     size_t nr = 0, inside_sealed = 0, sealed_total = 0, buried_total = 0, buried_inside = 0;
     int *tgroup = calloc(tx.count ? tx.count : 1, sizeof *tgroup);
     for (size_t i = 0; i < tx.count; i++) {
         const bk_texel *x = &tx.receivers[i];
-        int g = bsc_group(&s, x->tri, x->position, x->normal);
+        /* grouped by the texel's own centre (before push-out): the same texels in every version */
+        int g = bsc_group(&s, x->tri, orig + 3 * i, x->normal);
         if (bsc_solid_depth(orig + 3 * i) > 0.75 * x->texel_size) g = BSC_BURIED;
         tgroup[i] = g;
-        if (g == BSC_SEALED) { sealed_total++; inside_sealed += !(x->flags & BK_TEXEL_VALID); }
-        if (g == BSC_BURIED) { buried_total++; buried_inside += !(x->flags & BK_TEXEL_VALID); }
+        if (g == BSC_SEALED) { sealed_total++; inside_sealed += !!(x->flags & BK_TEXEL_INSIDE); }
+        if (g == BSC_BURIED) { buried_total++; buried_inside += !!(x->flags & BK_TEXEL_INSIDE); }
+        recv_of[i] = SIZE_MAX;
         if (!(x->flags & BK_TEXEL_VALID)) continue;
         memcpy(r[nr].position, x->position, 12);
         memcpy(r[nr].normal, x->normal, 12);
+#ifndef BENCH_BIAS_ORIG
+        if (a.footprint) {
+            r[nr].footprint_first = x->footprint_first;
+            r[nr].footprint_count = x->footprint_count;
+        }
+#endif
+        recv_of[i] = nr;
         texel_of[nr++] = i;
     }
     printf("scene: %zu triangles; %zu texels (density %.3g/m), %zu valid receivers; push-out: %zu pushed, %zu "
-           "inside; cavity texels %zu (%zu marked inside), buried texels %zu (%zu marked inside); marked inside: not "
-           "baked, dilated from neighbours by the pipeline\n",
+           "inside; cavity texels %zu (%zu inside), buried texels %zu (%zu inside)\n",
            s.tri_count, tx.count, a.density, nr, ps.pushed, ps.inside, sealed_total, inside_sealed, buried_total,
            buried_inside);
-    /* evaluation subset: up to `per` receivers of each group, evenly spread over the group */
+    /* evaluation subset: up to `per` texels of each group, evenly spread over the group */
     size_t gcount[BSC_GROUPS] = {0};
-    int *grp = calloc(nr, sizeof *grp);
-    for (size_t i = 0; i < nr; i++) {
-        grp[i] = tgroup[texel_of[i]];
-        gcount[grp[i]]++;
-    }
+    for (size_t i = 0; i < tx.count; i++) gcount[tgroup[i]]++;
     eval_set e;
     memset(&e, 0, sizeof e);
-    e.recv = calloc(nr, sizeof *e.recv);
-    e.group = calloc(nr, sizeof *e.group);
-    e.p = calloc(3 * nr, sizeof *e.p);
-    e.nrm = calloc(3 * nr, sizeof *e.nrm);
+    e.recv = calloc(tx.count, sizeof *e.recv);
+    e.group = calloc(tx.count, sizeof *e.group);
+    e.p = calloc(3 * tx.count, sizeof *e.p);
+    e.fp_first = calloc(tx.count, sizeof *e.fp_first);
+    e.fp_count = calloc(tx.count, sizeof *e.fp_count);
+    e.nrm = calloc(3 * tx.count, sizeof *e.nrm);
     /* the groups with a reference first, then the ones that must be 0 (no reference needed) */
     size_t seen[BSC_GROUPS] = {0}, took[BSC_GROUPS] = {0};
     for (int phase = 0; phase < 2; phase++)
-        for (size_t i = 0; i < nr; i++) {
-            int g = grp[i], zero = g == BSC_SEALED || g == BSC_BURIED;
+        for (size_t i = 0; i < tx.count; i++) {
+            int g = tgroup[i], zero = g == BSC_SEALED || g == BSC_BURIED;
             if (g == BSC_OUTSIDE || zero != phase) continue;
             size_t want = zero ? gcount[g] : (size_t)a.per;
-            /* take receiver i when the running quota crosses an integer */
+            /* take texel i when the running quota crosses an integer */
             size_t q = (seen[g] + 1) * want / gcount[g];
             seen[g]++;
             if (q <= took[g]) continue;
             took[g]++;
-            e.recv[e.n] = i;
+            const bk_texel *x = &tx.receivers[i];
+            e.recv[e.n] = recv_of[i];
             e.group[e.n] = g;
-            memcpy(e.p + 3 * e.n, r[i].position, 12);
-            memcpy(e.nrm + 3 * e.n, r[i].normal, 12);
+            memcpy(e.p + 3 * e.n, x->position, 12);
+            memcpy(e.nrm + 3 * e.n, x->normal, 12);
+#ifndef BENCH_BIAS_ORIG
+            e.fp_first[e.n] = x->footprint_first;
+            e.fp_count[e.n] = x->footprint_count;
+#endif
             e.n++;
         }
     e.ref = calloc(3 * e.n, sizeof *e.ref);
@@ -276,7 +320,7 @@ int main(int argc, char **argv)
     e.n = 0;
     for (size_t i = 0; i < ne; i++)
         if (e.group[i] != BSC_SEALED && e.group[i] != BSC_BURIED) e.n++;
-    load_or_make_ref(&s, t, &e, a.ref_paths, a.threads);
+    load_or_make_ref(&s, t, &e, a.ref_paths, a.threads, a.footprint ? &tx : NULL, a.ref_file);
     e.n = ne;
 
     float *cell_size = NULL;
@@ -289,6 +333,7 @@ int main(int argc, char **argv)
     float *irr2 = a.noise ? calloc(3 * nr, sizeof *irr2) : NULL;
     for (int k = 0; k < a.npasses; k++) {
         bk_transport_stats st;
+        double cpu = 0;
         for (int rep = 0; rep < (a.noise ? 2 : 1); rep++) {
             bk_transport_options o;
             memset(&o, 0, sizeof o);
@@ -300,30 +345,45 @@ int main(int argc, char **argv)
             o.max_cells = a.cells;
 #ifndef BENCH_BIAS_ORIG
             if (cell_size) o.cell_size = cell_size;
+            if (a.footprint) {
+                o.footprint = tx.footprint;
+                o.footprint_count = tx.footprint_count;
+            }
 #endif
             bk_transport_output out = {rad, NULL, rep ? irr2 : irr};
             bk_transport_stats st1;
+            double c0 = cpu_s();
             bk_transport_run(&s, t, r, nr, &o, &out, rep ? &st1 : &st);
+            if (!rep) cpu = cpu_s() - c0;
         }
         char label[256];
+#ifndef BENCH_BIAS_ORIG
+        double est_bias = st.est_cache_bias;
+#else
+        double est_bias = NAN;
+#endif
         snprintf(label, sizeof label,
-                 "lbk %d passes: %.0f samples/receiver, %.2f s, %zu cells, %d bounces, est. error %.2f %%",
-                 a.passes[k], st.samples_per_receiver, st.seconds, st.cells, st.bounces, 100 * st.est_rel_rmse);
+                 "lbk %d passes: %.0f samples/receiver, %.2f s (%.1f CPU s), %zu cells, %d bounces, %.3g rays, est. error %.2f %%, "
+                 "est. cache bias %.2f %%",
+                 a.passes[k], st.samples_per_receiver, st.seconds, cpu, st.cells, st.bounces, (double)st.rays,
+                 100 * st.est_rel_rmse, 100 * est_bias);
         report(&e, irr, irr2, label);
         if (getenv("BIAS_DEBUG"))
             for (size_t q = 0; q < e.n; q++)
                 if (e.group[q] == BSC_BURIED) {
+                    if (e.recv[q] == SIZE_MAX) continue;
                     size_t ti = texel_of[e.recv[q]];
                     const bk_texel *x = &tx.receivers[ti];
                     printf("   buried %s: orig (%.3f %.3f %.3f) now (%.3f %.3f %.3f) n (%.2f %.2f %.2f) flags %u E %.4f\n",
                            s.objects[s.tri_object[x->tri]].name, orig[3 * ti], orig[3 * ti + 1], orig[3 * ti + 2],
                            x->position[0], x->position[1], x->position[2], x->normal[0], x->normal[1], x->normal[2],
-                           x->flags, lum3f(irr + 3 * e.recv[q]));
+                           x->flags, lbk_at(irr, e.recv[q]));
                 }
         if (a.worst && irr2) print_worst(&e, irr, irr2, a.worst);
     }
     free(irr2);
-    free(rad); free(irr); free(r); free(texel_of); free(grp); free(tgroup); free(orig); free(cell_size);
+    free(rad); free(irr); free(r); free(texel_of); free(recv_of); free(tgroup); free(orig); free(cell_size);
+    free(e.fp_first); free(e.fp_count);
     free(e.recv); free(e.group); free(e.p); free(e.nrm); free(e.ref); free(e.se);
     bk_texels_free(&tx);
     bk_tracer_destroy(t);

@@ -52,6 +52,7 @@ void bk_tangent_frame(const float n[3], const float dpdu[3], float t[3], float b
 void bk_texels_free(bk_texels *tx)
 {
     if (!tx) return;
+    free(tx->footprint);
     free(tx->pages);
     free(tx->page_offset);
     free(tx->index);
@@ -126,6 +127,110 @@ static void make_receiver(const bk_scene *s, const bk_atlas *a, uint32_t e, cons
     r->flags = BK_TEXEL_VALID;
 }
 
+/* ---------------------------------------------------------------------------------------- */
+/* Footprint                                                                                */
+
+/* 1 unless a separating axis (the square's two, the triangle's three edge normals) splits the
+ * triangle from the square [x, x+1] × [y, y+1]; touching counts as overlapping. */
+static int tri_overlaps_square(const bk_rtri *t, double x, double y)
+{
+    double mnx = fmin(t->x[0], fmin(t->x[1], t->x[2])), mxx = fmax(t->x[0], fmax(t->x[1], t->x[2]));
+    double mny = fmin(t->y[0], fmin(t->y[1], t->y[2])), mxy = fmax(t->y[0], fmax(t->y[1], t->y[2]));
+    if (mxx < x || mnx > x + 1 || mxy < y || mny > y + 1) return 0;
+    const double cx[4] = {x, x + 1, x + 1, x}, cy[4] = {y, y, y + 1, y + 1};
+    for (int k = 0; k < 3; k++) {
+        int a = (k + 1) % 3, b = (k + 2) % 3; /* edge a→b; corner k is inside (orientation > 0) */
+        int outside = 0;
+        for (int q = 0; q < 4; q++)
+            outside += bk_orient_raw(t->x[a], t->y[a], t->x[b], t->y[b], cx[q], cy[q]) < 0.0;
+        if (outside == 4) return 0;
+    }
+    return 1;
+}
+
+/* Barycentric weights (original corner order) of any point, inside or not. */
+static void rtri_weights(const bk_rtri *t, double px, double py, double w[3])
+{
+    double e[3];
+    for (int k = 0; k < 3; k++) {
+        int a = (k + 1) % 3, b = (k + 2) % 3;
+        e[k] = bk_orient_raw(t->x[a], t->y[a], t->x[b], t->y[b], px, py) / t->area2;
+    }
+    w[0] = e[0];
+    w[1] = t->flipped ? e[2] : e[1];
+    w[2] = t->flipped ? e[1] : e[2];
+}
+
+typedef struct fp_pair { size_t texel; uint32_t entry; } fp_pair;
+
+static int cmp_pair(const void *a, const void *b)
+{
+    const fp_pair *p = a, *q = b;
+    if (p->texel != q->texel) return p->texel < q->texel ? -1 : 1;
+    return (p->entry > q->entry) - (p->entry < q->entry);
+}
+
+/* (texel, entry) for every chart triangle over a texel its chart owns; idx holds the owning
+ * entry per texel (or -1). Sorted by texel, then entry: receiver order. */
+static lbk_result footprint_pairs(const bk_atlas *a, const bk_texels *out, const int32_t *idx_all, fp_pair **pairs,
+                                  size_t *count)
+{
+    size_t n = 0, cap = 0;
+    fp_pair *v = NULL;
+    for (size_t c = 0; c < a->chart_count; c++) {
+        const bk_atlas_chart *ch = &a->charts[c];
+        if (ch->page < 0 || (size_t)ch->page >= out->page_count) continue;
+        int pw = out->pages[ch->page].width, ph = out->pages[ch->page].height;
+        size_t base = out->page_offset[ch->page];
+        const int32_t *idx = idx_all + base;
+        for (uint32_t e = ch->first; e < ch->first + ch->count; e++) {
+            bk_rtri t;
+            if (!bk_rtri_setup(a->tri_uv + 6 * (size_t)e, &t)) continue;
+            double mnx = fmin(t.x[0], fmin(t.x[1], t.x[2])), mxx = fmax(t.x[0], fmax(t.x[1], t.x[2]));
+            double mny = fmin(t.y[0], fmin(t.y[1], t.y[2])), mxy = fmax(t.y[0], fmax(t.y[1], t.y[2]));
+            int x0 = (int)fmax(0.0, floor(mnx) - 1), x1 = (int)fmin((double)pw - 1, floor(mxx) + 1);
+            int y0 = (int)fmax(0.0, floor(mny) - 1), y1 = (int)fmin((double)ph - 1, floor(mxy) + 1);
+            for (int y = y0; y <= y1; y++)
+                for (int x = x0; x <= x1; x++) {
+                    size_t i = (size_t)y * (size_t)pw + (size_t)x;
+                    if (idx[i] < 0 || a->tri_chart[idx[i]] != (uint32_t)c) continue;
+                    if (!tri_overlaps_square(&t, x, y)) continue;
+                    if (n == cap) {
+                        size_t nc = cap ? 2 * cap : 1024;
+                        fp_pair *nv = realloc(v, nc * sizeof *nv);
+                        if (!nv) { free(v); return LBK_ERR_OUT_OF_MEMORY; }
+                        v = nv;
+                        cap = nc;
+                    }
+                    v[n].texel = base + i;
+                    v[n].entry = e;
+                    n++;
+                }
+        }
+    }
+    if (n) qsort(v, n, sizeof *v, cmp_pair);
+    *pairs = v;
+    *count = n;
+    return LBK_OK;
+}
+
+/* The footprint triangle of `entry` over texel (x, y): barycentrics as affine maps of (s, t). */
+static void footprint_tri(const bk_atlas *a, uint32_t entry, int x, int y, bk_footprint_tri *f)
+{
+    bk_rtri t;
+    bk_rtri_setup(a->tri_uv + 6 * (size_t)entry, &t);
+    double w00[3], w10[3], w01[3];
+    rtri_weights(&t, x, y, w00);
+    rtri_weights(&t, x + 1, y, w10);
+    rtri_weights(&t, x, y + 1, w01);
+    f->tri = a->tris[entry];
+    for (int k = 0; k < 2; k++) {
+        f->uv[k][0] = (float)w00[k + 1];
+        f->uv[k][1] = (float)(w10[k + 1] - w00[k + 1]);
+        f->uv[k][2] = (float)(w01[k + 1] - w00[k + 1]);
+    }
+}
+
 lbk_result bk_texels_build(const bk_scene *s, const bk_atlas *a, bk_texels *out)
 {
     if (!out) return LBK_ERR_INVALID_ARGUMENT;
@@ -197,13 +302,24 @@ lbk_result bk_texels_build(const bk_scene *s, const bk_atlas *a, bk_texels *out)
     }
     size_t count = 0;
     for (size_t i = 0; i < total; i++) count += out->index[i] >= 0;
+    fp_pair *pairs = NULL;
+    size_t npairs = 0;
     out->receivers = malloc((count ? count : 1) * sizeof *out->receivers);
-    if (!out->receivers) {
+    if (!out->receivers || footprint_pairs(a, out, out->index, &pairs, &npairs) != LBK_OK ||
+        !(out->footprint = malloc((npairs ? npairs : 1) * sizeof *out->footprint))) {
         free(best);
+        free(pairs);
         bk_texels_free(out);
         return LBK_ERR_OUT_OF_MEMORY;
     }
-    size_t r = 0;
+    out->footprint_count = npairs;
+    if (npairs > UINT32_MAX) {
+        free(best);
+        free(pairs);
+        bk_texels_free(out);
+        return LBK_ERR_LIMIT;
+    }
+    size_t r = 0, fp = 0;
     for (size_t p = 0; p < np; p++) {
         int pw = a->pages[p].width, ph = a->pages[p].height;
         int32_t *idx = out->index + out->page_offset[p];
@@ -227,12 +343,22 @@ lbk_result bk_texels_build(const bk_scene *s, const bk_atlas *a, bk_texels *out)
                 rc->page = (uint32_t)p;
                 rc->x = (uint16_t)x;
                 rc->y = (uint16_t)y;
+                /* its footprint: the pairs of this texel (sorted alike) */
+                size_t g = out->page_offset[p] + i;
+                while (fp < npairs && pairs[fp].texel < g) fp++;
+                rc->footprint_first = (uint32_t)fp;
+                while (fp < npairs && pairs[fp].texel == g) {
+                    footprint_tri(a, pairs[fp].entry, x, y, &out->footprint[fp]);
+                    fp++;
+                }
+                rc->footprint_count = (uint32_t)(fp - rc->footprint_first);
                 idx[i] = (int32_t)r;
                 r++;
             }
     }
     out->count = count;
     free(best);
+    free(pairs);
     return LBK_OK;
 }
 
@@ -306,6 +432,9 @@ static void push_one(push_job *j, bk_texel *r)
     float reach = j->reach * r->texel_size;
     uint32_t cur_tri = r->tri;
     float cur_n[3] = {ngf[0], ngf[1], ngf[2]};
+    /* a move must stay on the texel: to a hit this close to the texel's own plane */
+    const float p0[3] = {r->position[0], r->position[1], r->position[2]};
+    const double band = 0.1 * r->texel_size;
     /* short rays: 8 along the tangent plane (raised ~3°), 5 over the hemisphere */
     double local[13][3];
     for (int i = 0; i < 8; i++) {
@@ -333,6 +462,10 @@ static void push_one(push_job *j, bk_texel *r)
             bk_hit h;
             if (!bk_tracer_intersect(j->tracer, org, d, 0.0f, reach, &h)) continue;
             if (h.front) continue;
+            float q[3] = {p0[0], p0[1], p0[2]};
+            hit_point(s, &h, q);
+            double height = (q[0] - p0[0]) * ng[0] + (q[1] - p0[1]) * ng[1] + (q[2] - p0[2]) * ng[2];
+            if (fabs(height) > band) continue;
             if (!found || h.t < best.t) {
                 best = h;
                 found = 1;
@@ -363,8 +496,7 @@ static void push_one(push_job *j, bk_texel *r)
         if (2 * back >= LONG_RAYS || 2 * (back + LONG_RAYS - 1 - i) < LONG_RAYS) break;
     }
     if (2 * back >= LONG_RAYS) {
-        r->flags &= ~(uint32_t)BK_TEXEL_VALID;
-        r->flags |= BK_TEXEL_INSIDE;
+        r->flags |= BK_TEXEL_INSIDE; /* still baked: black inside closed solids (texels.h) */
         j->stats.inside++;
     }
     j->stats.tested++;

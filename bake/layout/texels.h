@@ -20,16 +20,29 @@
  *   B = cross(N, T). Where dP/du is undefined (zero uv area) T is the first vector of the
  *   branchless orthonormal basis of N (Duff et al. 2017, see bk_tangent_frame).
  *
- * Push-out (bk_texels_push_out): from each sample, 8 rays along the geometric tangent plane
- * (raised by ~3°) and 5 over the hemisphere search `reach` texels (default 1.5 texel sizes)
- * for a BACK face (a ray arriving at the back of a triangle means the point is behind that
- * surface: under a wall, inside a box). The sample is moved just in front of the closest such
- * hit (bk_offset_ray_origin_scaled along that triangle's normal), up to 3 times (corners).
- * Then 16 long hemisphere rays: when at least half of them end on back faces the point is
- * inside closed geometry and cannot be lit: BK_TEXEL_VALID is cleared and BK_TEXEL_INSIDE
- * set, and dilation fills the texel from valid neighbours instead. Orientation is the
- * triangle winding (glTF front = counter-clockwise), also for double-sided materials: a
- * closed mesh's interior is its back side either way.
+ * Footprint: every triangle of the texel's own chart that overlaps its square (exact
+ * triangle/square overlap), as the affine map from texel-local (s, t) to the triangle's
+ * barycentrics (bk_footprint_tri). The light transport starts each gather ray from a random
+ * point of the square that one of them covers, so a texel's value is the irradiance averaged
+ * over the part of its square its chart covers, as a renderer's bake of the texel is (a chart
+ * of many small triangles is not sampled at one point each; TRANSPORT.md §Footprint).
+ *
+ * Push-out (bk_texels_push_out): the single sample point (which the transport still uses for
+ * punctual lights where no footprint triangle covers a quarter centre, and for parts of the
+ * square no triangle covers) is moved out from behind surfaces: from it, 8 rays along the
+ * geometric tangent plane (raised by ~3°) and 5 over the hemisphere search `reach` texels
+ * (default 1.5 texel sizes) for a BACK face (a ray arriving at the back of a triangle means
+ * the point is behind that surface: under a wall, inside a box). The sample is moved just in
+ * front of the closest such hit (bk_offset_ray_origin_scaled along that triangle's normal),
+ * up to 3 times (corners) — but only to a hit within a tenth of a texel of its own plane: the
+ * point must stay on its texel, never be carried through a wall to its far side (a shelf's end
+ * let into a wall is not moved out of the wall's outer face into the sky). Then 16 long
+ * hemisphere rays: when at least half of them end on back faces the point is inside closed
+ * geometry: BK_TEXEL_INSIDE is set (information only: the texel is still baked, and the
+ * transport makes the inside of closed solids black, so a face sealed inside a wall bakes to
+ * 0 as it does in a path tracer, instead of being dilated from lit neighbours). Orientation
+ * is the triangle winding (glTF front = counter-clockwise), also for double-sided materials:
+ * a closed mesh's interior is its back side either way.
  *
  * Dilation (bk_dilate): works on any per-texel payload (N floats per texel). */
 #ifndef BK_TEXELS_H
@@ -42,6 +55,7 @@
 #include "bake/layout/atlas.h"
 #include "bake/scene/scene.h"
 #include "bake/transport/tracer.h"
+#include "bake/transport/transport.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -51,7 +65,7 @@ enum bk_texel_flag {
     BK_TEXEL_VALID = 1u,   /* light this sample */
     BK_TEXEL_EDGE = 2u,    /* centre outside every triangle: sample at the nearest point */
     BK_TEXEL_PUSHED = 4u,  /* moved out from behind a surface */
-    BK_TEXEL_INSIDE = 8u   /* inside closed geometry: not valid, filled by dilation */
+    BK_TEXEL_INSIDE = 8u   /* its point is inside closed geometry (information; still valid) */
 };
 
 typedef struct bk_texel {
@@ -64,6 +78,8 @@ typedef struct bk_texel {
     uint32_t page;
     uint16_t x, y;         /* texel in the page */
     uint32_t flags;        /* enum bk_texel_flag */
+    uint32_t footprint_first, footprint_count; /* its chart's triangles over its square, in
+                                                  bk_texels.footprint (see Footprint above) */
 } bk_texel;
 
 typedef struct bk_texels {
@@ -73,6 +89,8 @@ typedef struct bk_texels {
     int32_t *index;        /* per texel of every page (row-major): receiver, or -1 */
     size_t count;
     bk_texel *receivers;/* page-major, then row-major: deterministic order */
+    size_t footprint_count;
+    bk_footprint_tri *footprint; /* grouped by texel, in receiver order */
 } bk_texels;
 
 /* Rasterises every chart of the atlas. Errors: LBK_ERR_INVALID_ARGUMENT,

@@ -29,7 +29,8 @@ static uint64_t mix64(uint64_t z)
 
 typedef struct { uint64_t s; } tp_rng;
 
-enum { DOM_CELL = 1, DOM_RECV = 2, DOM_CELL_NEE = 3, DOM_RECV_NEE = 4, DOM_RECV_NEAR = 5, DOM_CELL_NEAR = 6 };
+enum { DOM_CELL = 1, DOM_RECV = 2, DOM_CELL_NEE = 3, DOM_RECV_NEE = 4, DOM_RECV_NEAR = 5, DOM_RECV_POS = 6,
+       DOM_RECV_PROBE = 7 };
 
 /* Keyed by everything that identifies one item's samples: never by thread or time. */
 static tp_rng rng_make(uint64_t seed, uint64_t domain, uint64_t half, uint64_t pass, uint64_t bounce, uint64_t item)
@@ -175,12 +176,17 @@ typedef struct tp_ctx {
     int half, pass, bounce, rays;
     tp_lattice lat;        /* for `rays` samples */
     /* receivers */
+    const bk_scene *fscene;  /* the scene footprints index (options.footprint_scene or scene) */
     const bk_receiver *recv;
     size_t recv_count;
     float *punct_lum;      /* luminance of punctual E per receiver (for the error estimate) */
     double *x_acc[2];      /* per receiver, per half: Σ_p w_p·bk_lum(E_p) */
+    double *b_acc[2];      /* per receiver, per half: Σ_p w_p·bk_lum(cache bias probe of pass p) */
     const bk_transport_output *out;
     double pass_weight;
+    /* the run's settings and progress */
+    double t0, max_samples, target, tail_tol, weight_sum, spp;
+    int max_bounces, s0;
     /* counters: per thread, summed after each parallel step */
     uint64_t *thread_rays, *thread_shadow, *thread_nonfinite;
 } tp_ctx;
@@ -646,51 +652,127 @@ static tp_chain_result run_chain(tp_ctx *c, int h, int pass, int rays, double to
 
 /* ---- receivers ------------------------------------------------------------------------------- */
 
-static void recv_offset_origin(const tp_ctx *c, const bk_receiver *r, float o[3])
+/* Where a receiver's ray leaves from: the point, its unit normal (zero vector: a probe, which
+ * gathers over the sphere; n then holds +z for the frame), and the offset ray origin. */
+typedef struct tp_origin {
+    double p[3], n[3];
+    float o[3];
+    int sphere;
+} tp_origin;
+
+static void origin_from(const tp_ctx *c, const float p[3], const float nf[3], tp_origin *g)
 {
-    if (r->normal[0] == 0 && r->normal[1] == 0 && r->normal[2] == 0) {
-        memcpy(o, r->position, 3 * sizeof(float));
+    double l = sqrt((double)nf[0] * nf[0] + (double)nf[1] * nf[1] + (double)nf[2] * nf[2]);
+    g->sphere = !(l > 0) || !isfinite(l);
+    for (int k = 0; k < 3; k++) {
+        g->p[k] = p[k];
+        g->n[k] = g->sphere ? 0 : nf[k] / l;
+    }
+    if (g->sphere) {
+        g->n[2] = 1;
+        memcpy(g->o, p, 3 * sizeof(float));
         return;
     }
-    bk_offset_ray_origin_scaled(r->position, r->normal, c->scene_scale, o);
+    bk_offset_ray_origin_scaled(p, nf, c->scene_scale, g->o);
 }
 
-static void recv_normal(const bk_receiver *r, double n[3], int *sphere)
+/* The receiver's own point (the whole texel where it has no footprint). */
+static void recv_origin(const tp_ctx *c, const bk_receiver *r, tp_origin *g)
 {
-    double l = sqrt((double)r->normal[0] * r->normal[0] + (double)r->normal[1] * r->normal[1] +
-                    (double)r->normal[2] * r->normal[2]);
-    *sphere = !(l > 0);
-    for (int k = 0; k < 3; k++) n[k] = *sphere ? 0 : r->normal[k] / l;
-    if (*sphere) n[2] = 1;
+    origin_from(c, r->position, r->normal, g);
+}
+
+/* The point of receiver r's footprint at texel-local (s, t): on the footprint triangle that
+ * covers it (position and interpolated shading normal from the footprint scene; returns 1),
+ * else the receiver's own point (returns 0). */
+static int footprint_origin(const tp_ctx *c, const bk_receiver *r, double s, double t, tp_origin *g)
+{
+    const bk_scene *fs = c->fscene;
+    for (uint32_t k = 0; k < r->footprint_count; k++) {
+        const bk_footprint_tri *f = &c->opt->footprint[r->footprint_first + k];
+        double u = f->uv[0][0] + f->uv[0][1] * s + f->uv[0][2] * t;
+        double v = f->uv[1][0] + f->uv[1][1] * s + f->uv[1][2] * t;
+        if (!(u >= 0 && v >= 0 && u + v <= 1)) continue;
+        const uint32_t *ix = fs->tris + 3 * (size_t)f->tri;
+        double w[3] = {1 - u - v, u, v}, p[3] = {0, 0, 0}, n[3] = {0, 0, 0}, q[3][3];
+        for (int i = 0; i < 3; i++)
+            for (int a = 0; a < 3; a++) {
+                q[i][a] = fs->positions[3 * (size_t)ix[i] + a];
+                p[a] += w[i] * q[i][a];
+                if (fs->normals) n[a] += w[i] * fs->normals[3 * (size_t)ix[i] + a];
+            }
+        double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (!(l > 0) || !isfinite(l)) { /* no shading normal: the geometric one */
+            double e1[3], e2[3];
+            for (int a = 0; a < 3; a++) { e1[a] = q[1][a] - q[0][a]; e2[a] = q[2][a] - q[0][a]; }
+            n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+            n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+            n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+            l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+            if (!(l > 0) || !isfinite(l)) break;
+        }
+        float pf[3] = {(float)p[0], (float)p[1], (float)p[2]}, nf[3];
+        for (int a = 0; a < 3; a++) nf[a] = (float)(n[a] / l);
+        origin_from(c, pf, nf, g);
+        return 1;
+    }
+    recv_origin(c, r, g);
+    return 0;
+}
+
+/* A uniform point of the part of the texel's square that its footprint covers: rejection, at
+ * most TP_FOOTPRINT_TRIES draws (a sliver covering 10 % of the square falls back to the
+ * receiver's own point 18 % of the time, one covering 30 % 0.3 %). */
+#define TP_FOOTPRINT_TRIES 16
+static void footprint_sample(const tp_ctx *c, const bk_receiver *r, tp_rng *pos, tp_origin *g)
+{
+    for (int k = 0; k < TP_FOOTPRINT_TRIES; k++) {
+        double ps = rng_next(pos), pt = rng_next(pos);
+        if (footprint_origin(c, r, ps, pt, g)) return;
+    }
+}
+
+/* Punctual light at one point: irradiance (sphere: fluence) and the SH of its incident radiance. */
+static uint64_t punctual_at(const tp_ctx *c, const tp_origin *g, double e[3], double sh[3][9])
+{
+    uint64_t rays = 0;
+    for (size_t li = 0; li < c->light_count; li++) {
+        double val[3], ld[3], dist;
+        if (!bk_light_eval(c->lights[li], g->p, val, ld, &dist)) continue;
+        double cs = ld[0] * g->n[0] + ld[1] * g->n[1] + ld[2] * g->n[2];
+        if (!g->sphere && cs <= 0) continue;
+        rays++;
+        if (!bk_light_visible(c->tracer, g->o, ld, dist)) continue;
+        double y[9];
+        bk_sh9_basis_d(ld, y);
+        for (int a = 0; a < 3; a++) {
+            e[a] += g->sphere ? val[a] : val[a] * cs;
+            for (int kk = 0; kk < 9; kk++) sh[a][kk] += val[a] * y[kk];
+        }
+    }
+    return rays;
 }
 
 static void recv_punctual(tp_ctx *c, size_t begin, size_t end, int thread)
 {
-    /* Punctual light is noise-free: computed once, then into the outputs / error scalars. */
+    /* Punctual light is noise-free: computed once, then into the outputs / error scalars. A
+     * texel with a footprint averages its four quarter centres (hard shadow edges resolve to
+     * a quarter of a texel). */
     uint64_t rays = 0;
     for (size_t i = begin; i < end; i++) {
         const bk_receiver *r = &c->recv[i];
-        double n[3];
-        int sphere;
-        recv_normal(r, n, &sphere);
-        float o[3];
-        recv_offset_origin(c, r, o);
-        double p[3] = {r->position[0], r->position[1], r->position[2]};
         double e[3] = {0, 0, 0}, sh[3][9];
         memset(sh, 0, sizeof sh);
-        for (size_t li = 0; li < c->light_count; li++) {
-            double val[3], ld[3], dist;
-            if (!bk_light_eval(c->lights[li], p, val, ld, &dist)) continue;
-            double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
-            if (!sphere && cs <= 0) continue;
-            rays++;
-            if (!bk_light_visible(c->tracer, o, ld, dist)) continue;
-            double y[9];
-            bk_sh9_basis_d(ld, y);
-            for (int a = 0; a < 3; a++) {
-                e[a] += sphere ? val[a] : val[a] * cs;
-                for (int kk = 0; kk < 9; kk++) sh[a][kk] += val[a] * y[kk];
-            }
+        const int points = r->footprint_count ? 4 : 1;
+        for (int q = 0; q < points; q++) {
+            tp_origin g;
+            if (r->footprint_count) footprint_origin(c, r, 0.25 + 0.5 * (q & 1), 0.25 + 0.5 * (q >> 1), &g);
+            else recv_origin(c, r, &g);
+            rays += punctual_at(c, &g, e, sh);
+        }
+        for (int a = 0; a < 3; a++) {
+            e[a] /= points;
+            for (int kk = 0; kk < 9; kk++) sh[a][kk] /= points;
         }
         if (c->punct_lum) {
             c->punct_lum[i] = (float)bk_lum(e);
@@ -798,49 +880,63 @@ static void near_radiance(tp_ctx *c, const float *sum, const bk_hit *hit, long h
 /* A receiver's sums over one half of one pass. */
 typedef struct tp_recv_sums {
     double e[3];          /* Σ L·cos (irradiance, before × solid/S) */
+    double eb[3];         /* Σ (continuation − cell)·cos over the probed rays, × TP_PROBE_EVERY */
     double sh_t[3][9], sh_d[3][9];
 } tp_recv_sums;
 
-/* Radiance L (direct part Ld) that gather ray d (pdf 1/solid) brings back from `hit`. */
-static void gather_hit(tp_ctx *c, const float *sum, const bk_hit *hit, const double d[3], double solid,
+/* The cache's bias probe: every TP_PROBE_EVERY-th gather ray that reads a cell (a far hit) is
+ * also continued at its exact hit point; the mean difference (continuation − cell), scaled
+ * back up, estimates what the cells' constancy adds to the receiver: the first-hit cache bias,
+ * which the two halves cannot see (both read equally coarse cells). Costs 1/16 more rays. */
+#define TP_PROBE_EVERY 16
+
+/* Radiance L (direct part Ld) that gather ray d (pdf 1/solid) brings back from `hit`. Returns
+ * the cell it read (a far hit), else -1. */
+static long gather_hit(tp_ctx *c, const float *sum, const bk_hit *hit, const double d[3], double solid,
                        tp_rng *cont, tp_count *cnt, double L[3], double Ld[3])
 {
     for (int a = 0; a < 3; a++) L[a] = Ld[a] = 0;
     if (hit->tri == UINT32_MAX) {
         sky_radiance(c, d, L);
         memcpy(Ld, L, 3 * sizeof(double));
-        return;
+        return -1;
     }
     long hc = hit_cell(c, hit);
-    if (hc < 0) return; /* black, or the inside of a solid: a receiver there is dark */
+    if (hc < 0) return -1; /* black, or the inside of a solid: a receiver there is dark */
     emission_at(c, hit->tri, hit->u, hit->v, Ld);
     if (Ld[0] > 0 || Ld[1] > 0 || Ld[2] > 0) {
         double wg = mis_gather(c, hit, hc, d, 1 / solid);
         for (int a = 0; a < 3; a++) Ld[a] *= wg;
     }
     double r[3];
-    if (near_hit(c, hit, hc)) {
+    int near = near_hit(c, hit, hc);
+    if (near) {
         near_radiance(c, sum, hit, hc, 0, cont, cnt, r);
     } else {
         for (int a = 0; a < 3; a++) r[a] = sum[3 * hc + a];
     }
     for (int a = 0; a < 3; a++) L[a] = r[a] + Ld[a];
+    return near ? -1 : hc;
 }
 
 /* One half of receiver i in this pass: S directions from the shifted lattice, uniform over the
  * hemisphere (texels) or the sphere (probes) — the SH projection needs a pdf that does not
- * vanish at the horizon — each with one light sample when NEE is on. */
-static void recv_half(tp_ctx *c, size_t i, int h, const double n[3], int sphere, const float o[3],
-                      tp_recv_sums *rs, tp_count *cnt)
+ * vanish at the horizon — each with one light sample when NEE is on. A texel with a footprint
+ * starts each ray from its own random point of the footprint. */
+static void recv_half(tp_ctx *c, size_t i, int h, tp_recv_sums *rs, tp_count *cnt)
 {
     const int S = c->rays;
     const float *sum = c->l_sum[h];
-    double t[3], b[3];
-    bk_onb(n, t, b);
+    const bk_receiver *r = &c->recv[i];
     tp_rng rng = rng_make(c->seed, DOM_RECV, (uint64_t)h, (uint64_t)c->pass, 0, i);
     tp_rng cont = rng_make(c->seed, DOM_RECV_NEAR, (uint64_t)h, (uint64_t)c->pass, 0, i);
+    tp_rng pos = rng_make(c->seed, DOM_RECV_POS, (uint64_t)h, (uint64_t)c->pass, 0, i);
+    tp_rng probe = rng_make(c->seed, DOM_RECV_PROBE, (uint64_t)h, (uint64_t)c->pass, 0, i);
     double s1 = rng_next(&rng), s2 = rng_next(&rng);
     tp_shift shift = lattice_shift(s1, s2);
+    tp_origin g0;
+    recv_origin(c, r, &g0);
+    const int sphere = g0.sphere;
     const double solid = sphere ? 4 * TP_PI : 2 * TP_PI;
     const int pg_kind = sphere ? PG_SPHERE : PG_HEMISPHERE;
     double t1 = 0, t2 = 0;
@@ -849,36 +945,52 @@ static void recv_half(tp_ctx *c, size_t i, int h, const double n[3], int sphere,
         t1 = rng_next(&nr);
         t2 = rng_next(&nr);
     }
+    double t0[3], b0[3];
+    bk_onb(g0.n, t0, b0);
     for (int j0 = 0; j0 < S; j0 += TP_BATCH) {
         const int m = S - j0 < TP_BATCH ? S - j0 : TP_BATCH;
         float org[3 * TP_BATCH], dir[3 * TP_BATCH];
-        double dd[TP_BATCH][3], zz[TP_BATCH];
+        double dd[TP_BATCH][3], zz[TP_BATCH], nn[TP_BATCH][3];
         bk_hit hits[TP_BATCH];
         for (int jj = 0; jj < m; jj++) {
+            tp_origin g = g0;
+            double t[3] = {t0[0], t0[1], t0[2]}, b[3] = {b0[0], b0[1], b0[2]};
+            if (r->footprint_count) {
+                footprint_sample(c, r, &pos, &g);
+                bk_onb(g.n, t, b);
+            }
             double u1, cp, sp;
             lattice(&c->lat, (uint32_t)(j0 + jj), &shift, &u1, &cp, &sp);
             double z = sphere ? 1 - 2 * u1 : u1;
             double rr = sqrt(fmax(0.0, 1 - z * z));
             zz[jj] = z;
             for (int a = 0; a < 3; a++) {
-                dd[jj][a] = rr * cp * t[a] + rr * sp * b[a] + z * n[a];
+                dd[jj][a] = rr * cp * t[a] + rr * sp * b[a] + z * g.n[a];
                 dir[3 * jj + a] = (float)dd[jj][a];
-                org[3 * jj + a] = o[a];
+                org[3 * jj + a] = g.o[a];
+                nn[jj][a] = g.n[a];
             }
         }
         bk_tracer_intersect_n(c->tracer, (size_t)m, org, dir, 0.0f, NULL, hits);
         cnt->rays += (uint64_t)m;
         for (int jj = 0; jj < m; jj++) {
             double L[3], Ld[3];
-            gather_hit(c, sum, &hits[jj], dd[jj], solid, &cont, cnt, L, Ld);
+            long hc = gather_hit(c, sum, &hits[jj], dd[jj], solid, &cont, cnt, L, Ld);
             if (!bk_finite3(L) || !bk_finite3(Ld)) cnt->bad++;
             else accumulate(dd[jj], sphere ? 1 : zz[jj], L, Ld, rs->e, rs->sh_t, rs->sh_d);
+            if (hc >= 0 && (j0 + jj) % TP_PROBE_EVERY == 0) {
+                double q[3];
+                near_radiance(c, sum, &hits[jj], hc, 0, &probe, cnt, q);
+                double cs = (sphere ? 1 : zz[jj]) * TP_PROBE_EVERY;
+                if (bk_finite3(q))
+                    for (int a = 0; a < 3; a++) rs->eb[a] += (q[a] - sum[3 * hc + a]) * cs;
+            }
             if (!c->nee) continue;
             /* one light sample per gather ray; its value Le·w/p is turned into the gather's
              * units (radiance, later × solid/S) by 1/solid */
             double u0, uu1, ld[3], cl, val[3];
             lattice_uv(&c->lat, (uint32_t)(j0 + jj), t1, t2, &u0, &uu1);
-            if (nee_sample(c, o, n, pg_kind, u0, uu1, ld, &cl, val, &cnt->shadow)) {
+            if (nee_sample(c, org + 3 * jj, nn[jj], pg_kind, u0, uu1, ld, &cl, val, &cnt->shadow)) {
                 for (int a = 0; a < 3; a++) val[a] /= solid;
                 if (!bk_finite3(val)) cnt->bad++;
                 else accumulate(ld, cl, val, val, rs->e, rs->sh_t, rs->sh_d);
@@ -895,23 +1007,23 @@ static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
     tp_count cnt = {0, 0, 0};
     for (size_t i = begin; i < end; i++) {
         const bk_receiver *r = &c->recv[i];
-        double n[3];
-        int sphere;
-        recv_normal(r, n, &sphere);
-        float o[3];
-        recv_offset_origin(c, r, o);
+        const int sphere = !(r->normal[0] != 0 || r->normal[1] != 0 || r->normal[2] != 0);
         const double solid = sphere ? 4 * TP_PI : 2 * TP_PI;
         tp_recv_sums tot;
         memset(&tot, 0, sizeof tot);
         for (int h = 0; h < 2; h++) {
             tp_recv_sums rs;
             memset(&rs, 0, sizeof rs);
-            recv_half(c, i, h, n, sphere, o, &rs, &cnt);
-            double e[3];
-            for (int a = 0; a < 3; a++) e[a] = rs.e[a] * solid / S;
+            recv_half(c, i, h, &rs, &cnt);
+            double e[3], eb[3];
+            for (int a = 0; a < 3; a++) {
+                e[a] = rs.e[a] * solid / S;
+                eb[a] = rs.eb[a] * solid / S;
+            }
             /* error scalar: irradiance for texels, fluence/4 for probes (equal under uniform
              * radiance, so texels and probes weigh alike in the relative RMSE) */
             c->x_acc[h][i] += w * (bk_lum(e) + c->punct_lum[i]) * (sphere ? 0.25 : 1.0);
+            c->b_acc[h][i] += w * bk_lum(eb) * (sphere ? 0.25 : 1.0);
             for (int a = 0; a < 3; a++) {
                 tot.e[a] += e[a];
                 for (int kk = 0; kk < 9; kk++) {
@@ -956,7 +1068,9 @@ static void free_ctx(tp_ctx *c)
     free(c->tri_le); free(c->tri_le_tex); free(c->em); free(c->em_cdf);
     free(c->thread_shadow);
     free(c->lights);
-    for (int h = 0; h < 2; h++) { free(c->l_prev[h]); free(c->l_cur[h]); free(c->l_sum[h]); free(c->x_acc[h]); }
+    for (int h = 0; h < 2; h++) {
+        free(c->l_prev[h]); free(c->l_cur[h]); free(c->l_sum[h]); free(c->x_acc[h]); free(c->b_acc[h]);
+    }
     free(c->punct_lum);
     free(c->thread_rays); free(c->thread_nonfinite);
     lattice_free(&c->lat);
@@ -1170,6 +1284,203 @@ static lbk_result build_emitters(tp_ctx *c)
 
 /* ---- the run ---------------------------------------------------------------------------------- */
 
+/* Footprint ranges inside options.footprint, triangles and their vertices inside the footprint
+ * scene, finite maps. */
+static int footprints_valid(const bk_scene *scene, const bk_transport_options *opt, const bk_receiver *r, size_t n)
+{
+    const bk_scene *fs = opt->footprint_scene ? opt->footprint_scene : scene;
+    for (size_t i = 0; i < n; i++) {
+        if (!r[i].footprint_count) continue;
+        if (!opt->footprint || r[i].footprint_first > opt->footprint_count ||
+            r[i].footprint_count > opt->footprint_count - r[i].footprint_first)
+            return 0;
+    }
+    for (size_t k = 0; k < (opt->footprint ? opt->footprint_count : 0); k++) {
+        const bk_footprint_tri *f = &opt->footprint[k];
+        if (f->tri >= fs->tri_count || !fs->tris || !fs->positions) return 0;
+        for (int v = 0; v < 3; v++)
+            if (fs->tris[3 * (size_t)f->tri + v] >= fs->vertex_count) return 0;
+        for (int a = 0; a < 2; a++)
+            for (int b = 0; b < 3; b++)
+                if (!isfinite(f->uv[a][b])) return 0;
+    }
+    return 1;
+}
+
+static lbk_result check_inputs(const bk_scene *scene, const bk_tracer *tracer, const bk_receiver *receivers,
+                               size_t count, const bk_transport_options *opt, const bk_transport_output *output)
+{
+    if (!scene || !tracer || !output || (count > 0 && (!receivers || !output->radiance))) return LBK_ERR_INVALID_ARGUMENT;
+    if (bk_tracer_tri_count(tracer) != scene->tri_count) return LBK_ERR_INVALID_ARGUMENT;
+    if (scene->tri_count > 0 && !scene->tris) return LBK_ERR_INVALID_ARGUMENT;
+    for (size_t i = 0; i < count; i++) {
+        const bk_receiver *r = &receivers[i];
+        for (int k = 0; k < 3; k++)
+            if (!isfinite(r->position[k]) || !isfinite(r->normal[k])) return LBK_ERR_INVALID_ARGUMENT;
+    }
+    return footprints_valid(scene, opt, receivers, count) ? LBK_OK : LBK_ERR_INVALID_ARGUMENT;
+}
+
+/* Everything a run needs before its first pass: counters, the light selection, cells,
+ * emitters, the per-half radiance arrays and the receivers' accumulators. */
+static lbk_result ctx_init(tp_ctx *c)
+{
+    const bk_scene *scene = c->scene;
+    const bk_transport_options *opt = c->opt;
+    c->thread_rays = calloc((size_t)c->threads, sizeof(uint64_t));
+    c->thread_nonfinite = calloc((size_t)c->threads, sizeof(uint64_t));
+    c->thread_shadow = calloc((size_t)c->threads, sizeof(uint64_t));
+    if (!c->thread_rays || !c->thread_nonfinite || !c->thread_shadow) return LBK_ERR_OUT_OF_MEMORY;
+    /* scale of the coordinates: offsets for receivers, which carry no triangle */
+    for (size_t i = 0; i < scene->tri_count; i++) {
+        float sc = bk_tracer_tri_scale(c->tracer, (uint32_t)i);
+        if (sc > c->scene_scale) c->scene_scale = sc;
+    }
+    const int base_bake = !(opt->light_set && opt->light_set[0]);
+    c->use_sky = base_bake && !opt->no_sky;
+    if (!opt->no_punctual && scene->light_count) {
+        c->lights = calloc(scene->light_count, sizeof *c->lights);
+        if (!c->lights) return LBK_ERR_OUT_OF_MEMORY;
+        for (size_t i = 0; i < scene->light_count; i++)
+            if (in_light_set(c, scene->lights[i].light_set)) c->lights[c->light_count++] = &scene->lights[i];
+    }
+    lbk_result res = build_cells(c);
+    if (res == LBK_OK) res = build_emitters(c);
+    if (res != LBK_OK) return res;
+    size_t nc = c->cell_count ? c->cell_count : 1, n = c->recv_count ? c->recv_count : 1;
+    for (int h = 0; h < 2; h++) {
+        c->l_prev[h] = calloc(3 * nc, sizeof(float));
+        c->l_cur[h] = calloc(3 * nc, sizeof(float));
+        c->l_sum[h] = calloc(3 * nc, sizeof(float));
+        c->x_acc[h] = calloc(n, sizeof(double));
+        c->b_acc[h] = calloc(n, sizeof(double));
+        if (!c->l_prev[h] || !c->l_cur[h] || !c->l_sum[h] || !c->x_acc[h] || !c->b_acc[h]) return LBK_ERR_OUT_OF_MEMORY;
+    }
+    c->punct_lum = calloc(n, sizeof(float));
+    return c->punct_lum ? LBK_OK : LBK_ERR_OUT_OF_MEMORY;
+}
+
+static void report_progress(const tp_ctx *c, const char *phase, double done_spp)
+{
+    const bk_transport_options *opt = c->opt;
+    if (!opt->progress) return;
+    double f = fmax(done_spp / c->max_samples, opt->time_limit > 0 ? (now_seconds() - c->t0) / opt->time_limit : 0);
+    opt->progress(opt->user, phase, f > 1 ? 1 : f);
+}
+
+/* Cache rays per cell and bounce in pass p: about as many as the receivers trace this pass
+ * (over ~4 bounces), within [min(4·2^(p/2), cap), cap], cap = cache_rays·2^p; both estimates
+ * shrink together. */
+static int pass_cache_rays(const tp_ctx *c, int pass)
+{
+    int sp = pass < 20 ? pass : 20;
+    double nc = c->cell_count ? (double)c->cell_count : 1;
+    double cap = fmin((double)(c->opt->cache_rays > 0 ? c->opt->cache_rays : 16) * ldexp(1.0, sp), 65536.0);
+    double lo = fmin(cap, 4.0 * ldexp(1.0, sp / 2));
+    double want = ceil((double)c->s0 * ldexp(1.0, sp) * (double)c->recv_count / (4.0 * nc));
+    return (int)fmax(lo, fmin(cap, want));
+}
+
+/* One pass: both halves' caches, then the final gather at the receivers (in blocks, so
+ * progress can be reported). */
+static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
+{
+    int cache_rays = pass_cache_rays(c, pass);
+    for (int h = 0; h < 2; h++) {
+        chain[h] = run_chain(c, h, pass, cache_rays, c->tail_tol, c->max_bounces);
+        if (chain[h].bounces < 0) return LBK_ERR_OUT_OF_MEMORY;
+        report_progress(c, "cache", c->spp);
+    }
+    c->pass = pass;
+    c->rays = c->s0 << (pass < 20 ? pass : 20);
+    if (lattice_init(&c->lat, (uint32_t)c->rays) != LBK_OK) return LBK_ERR_OUT_OF_MEMORY;
+    c->pass_weight = ldexp(1.0, pass);
+    size_t count = c->recv_count, block = count / 8 + 1;
+    for (size_t b = 0; b < count; b += block) {
+        size_t e = b + block < count ? b + block : count;
+        parallel_range(c, b, e, 16, recv_gather);
+        report_progress(c, "gather", c->spp + 2.0 * c->rays * (double)e / (double)(count ? count : 1));
+    }
+    c->weight_sum += c->pass_weight;
+    c->spp += 2.0 * c->rays;
+    return LBK_OK;
+}
+
+/* The error estimates after a pass (TRANSPORT.md): the noise from the two independent halves,
+ * and the cache's bias from the probes, whose two halves' product is an unbiased estimate of
+ * each receiver's squared bias. Both relative to the RMS of the receivers' values. */
+static void estimate_error(const tp_ctx *c, double *noise, double *bias)
+{
+    double num = 0, den = 0, bb = 0;
+    for (size_t i = 0; i < c->recv_count; i++) {
+        double a = c->x_acc[0][i] / c->weight_sum, b = c->x_acc[1][i] / c->weight_sum;
+        num += 0.25 * (a - b) * (a - b);
+        double m = 0.5 * (a + b);
+        den += m * m;
+        bb += (c->b_acc[0][i] / c->weight_sum) * (c->b_acc[1][i] / c->weight_sum);
+    }
+    *noise = den > 0 ? sqrt(num / den) : 0;
+    *bias = den > 0 && bb > 0 ? sqrt(bb / den) : 0;
+}
+
+/* Stop after this pass? (target reached, the next pass over budget, or past the time limit:
+ * the next pass costs about twice this one, so it starts only if it can finish in time.) */
+static int stop_after(const tp_ctx *c, int pass, double err, double pass_seconds, int *stop)
+{
+    const bk_transport_options *opt = c->opt;
+    if (c->target > 0 && err <= c->target) { *stop = BK_STOP_TARGET; return 1; }
+    double next_spp = c->spp + 2.0 * (c->s0 << (pass + 1 < 20 ? pass + 1 : 20));
+    if (next_spp > c->max_samples || pass >= 24) { *stop = BK_STOP_BUDGET; return 1; }
+    if (opt->time_limit > 0 && now_seconds() - c->t0 + 2.1 * pass_seconds > opt->time_limit) {
+        *stop = BK_STOP_TIME;
+        return 1;
+    }
+    return 0;
+}
+
+/* Normalises the pass-weighted sums, then adds the noise-free punctual light. */
+static void finish_outputs(tp_ctx *c)
+{
+    const bk_transport_output *output = c->out;
+    float inv = (float)(1.0 / c->weight_sum);
+    for (size_t i = 0; i < c->recv_count; i++)
+        for (int a = 0; a < 3; a++) {
+            for (int k = 0; k < 9; k++) {
+                output->radiance[i].c[a][k] *= inv;
+                if (output->direct) output->direct[i].c[a][k] *= inv;
+            }
+            if (output->irradiance) output->irradiance[3 * i + a] *= inv;
+        }
+    if (c->light_count) {
+        float *pl = c->punct_lum;
+        c->punct_lum = NULL; /* recv_punctual now writes into the outputs */
+        parallel_for(c, c->recv_count, 64, recv_punctual);
+        c->punct_lum = pl;
+    }
+}
+
+static void fill_stats(const tp_ctx *c, int passes, double err, double bias, const tp_chain_result chain[2], int stop,
+                       bk_transport_stats *stats)
+{
+    stats->seconds = now_seconds() - c->t0;
+    stats->passes = passes;
+    stats->samples_per_receiver = c->spp;
+    stats->est_rel_rmse = err;
+    stats->est_cache_bias = bias;
+    stats->bounces = chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces;
+    stats->q = 0.5 * (chain[0].q + chain[1].q);
+    double tot = chain[0].total_energy + chain[1].total_energy;
+    stats->tail_fraction = tot > 0 ? (chain[0].tail_energy + chain[1].tail_energy) / tot : 0;
+    stats->cells = c->cell_count;
+    for (int t = 0; t < c->threads; t++) {
+        stats->rays += c->thread_rays[t];
+        stats->shadow_rays += c->thread_shadow[t];
+        stats->nonfinite += c->thread_nonfinite[t];
+    }
+    stats->stop = stop;
+    stats->nee = c->nee;
+}
+
 lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, const bk_receiver *receivers,
                             size_t count, const bk_transport_options *options,
                             const bk_transport_output *output, bk_transport_stats *stats)
@@ -1179,14 +1490,8 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
     memset(&defaults, 0, sizeof defaults);
     const bk_transport_options *opt = options ? options : &defaults;
     if (stats) memset(stats, 0, sizeof *stats);
-    if (!scene || !tracer || !output || (count > 0 && (!receivers || !output->radiance))) return LBK_ERR_INVALID_ARGUMENT;
-    if (bk_tracer_tri_count(tracer) != scene->tri_count) return LBK_ERR_INVALID_ARGUMENT;
-    if (scene->tri_count > 0 && !scene->tris) return LBK_ERR_INVALID_ARGUMENT;
-    for (size_t i = 0; i < count; i++) {
-        const bk_receiver *r = &receivers[i];
-        for (int k = 0; k < 3; k++)
-            if (!isfinite(r->position[k]) || !isfinite(r->normal[k])) return LBK_ERR_INVALID_ARGUMENT;
-    }
+    lbk_result res = check_inputs(scene, tracer, receivers, count, opt, output);
+    if (res != LBK_OK) return res;
 
     tp_ctx c;
     memset(&c, 0, sizeof c);
@@ -1197,46 +1502,16 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
     c.threads = opt->threads > 0 ? (opt->threads > 256 ? 256 : opt->threads) : online_cores();
     c.recv = receivers;
     c.recv_count = count;
+    c.fscene = opt->footprint_scene ? opt->footprint_scene : scene;
     c.out = output;
-    const int max_bounces = opt->max_bounces > 0 ? opt->max_bounces : 64;
-    const double max_samples = opt->max_samples > 0 ? opt->max_samples : 4096;
-    const double target = opt->target_error == 0 ? 0.01 : opt->target_error;
-    const int s0 = opt->first_pass_samples > 0 ? opt->first_pass_samples : 16;
-    const double tail_tol = fmax(0.1 * (target > 0 ? target : 0.001), 1e-5);
-
-    lbk_result res = LBK_OK;
-    c.thread_rays = calloc((size_t)c.threads, sizeof(uint64_t));
-    c.thread_nonfinite = calloc((size_t)c.threads, sizeof(uint64_t));
-    c.thread_shadow = calloc((size_t)c.threads, sizeof(uint64_t));
-    if (!c.thread_rays || !c.thread_nonfinite || !c.thread_shadow) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
-
-    /* scale of the coordinates: offsets for receivers, which carry no triangle */
-    for (size_t i = 0; i < scene->tri_count; i++) {
-        float sc = bk_tracer_tri_scale(tracer, (uint32_t)i);
-        if (sc > c.scene_scale) c.scene_scale = sc;
-    }
-    const int base_bake = !(opt->light_set && opt->light_set[0]);
-    c.use_sky = base_bake && !opt->no_sky;
-    if (!opt->no_punctual && scene->light_count) {
-        c.lights = calloc(scene->light_count, sizeof *c.lights);
-        if (!c.lights) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
-        for (size_t i = 0; i < scene->light_count; i++)
-            if (in_light_set(&c, scene->lights[i].light_set)) c.lights[c.light_count++] = &scene->lights[i];
-    }
-    res = build_cells(&c);
+    c.t0 = t0;
+    c.max_bounces = opt->max_bounces > 0 ? opt->max_bounces : 64;
+    c.max_samples = opt->max_samples > 0 ? opt->max_samples : 4096;
+    c.target = opt->target_error == 0 ? 0.01 : opt->target_error;
+    c.s0 = opt->first_pass_samples > 0 ? opt->first_pass_samples : 16;
+    c.tail_tol = fmax(0.1 * (c.target > 0 ? c.target : 0.001), 1e-5);
+    res = ctx_init(&c);
     if (res != LBK_OK) goto done;
-    res = build_emitters(&c);
-    if (res != LBK_OK) goto done;
-    size_t nc = c.cell_count ? c.cell_count : 1;
-    for (int h = 0; h < 2; h++) {
-        c.l_prev[h] = calloc(3 * nc, sizeof(float));
-        c.l_cur[h] = calloc(3 * nc, sizeof(float));
-        c.l_sum[h] = calloc(3 * nc, sizeof(float));
-        c.x_acc[h] = calloc(count ? count : 1, sizeof(double));
-        if (!c.l_prev[h] || !c.l_cur[h] || !c.l_sum[h] || !c.x_acc[h]) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
-    }
-    c.punct_lum = calloc(count ? count : 1, sizeof(float));
-    if (!c.punct_lum) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
 
     for (size_t i = 0; i < count; i++) {
         memset(&output->radiance[i], 0, sizeof output->radiance[i]);
@@ -1245,101 +1520,23 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
     }
     if (c.light_count) parallel_for(&c, count, 64, recv_punctual); /* luminance only, for the error */
 
-    double weight_sum = 0, spp = 0, err = 0, last_pass_time = 0;
+    double err = 0, bias = 0;
     int pass = 0, stop = BK_STOP_BUDGET;
     tp_chain_result chain[2] = {{0, 0, 0, 0}, {0, 0, 0, 0}};
     for (;; pass++) {
         double pass_start = now_seconds();
-        /* both halves' caches */
-        /* cache rays: about as many as the receivers trace this pass (over ~4 bounces), within
-         * [min(4·2^(p/2), cap), cap], cap = cache_rays·2^p; both estimates shrink together */
-        int sp = pass < 20 ? pass : 20;
-        double cap = fmin((double)(opt->cache_rays > 0 ? opt->cache_rays : 16) * ldexp(1.0, sp), 65536.0);
-        double lo = fmin(cap, 4.0 * ldexp(1.0, sp / 2));
-        double want = ceil((double)s0 * ldexp(1.0, sp) * (double)count / (4.0 * (double)nc));
-        int cache_rays = (int)fmax(lo, fmin(cap, want));
-        for (int h = 0; h < 2; h++) {
-            chain[h] = run_chain(&c, h, pass, cache_rays, tail_tol, max_bounces);
-            if (chain[h].bounces < 0) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
-            if (opt->progress) {
-                double f = fmax(spp / max_samples, opt->time_limit > 0 ? (now_seconds() - t0) / opt->time_limit : 0);
-                opt->progress(opt->user, "cache", f > 1 ? 1 : f);
-            }
-        }
-        /* final gather at the receivers, in blocks so progress can be reported */
-        c.pass = pass;
-        c.rays = s0 << (pass < 20 ? pass : 20);
-        if (lattice_init(&c.lat, (uint32_t)c.rays) != LBK_OK) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
-        c.pass_weight = ldexp(1.0, pass);
-        size_t block = count / 8 + 1;
-        for (size_t b = 0; b < count; b += block) {
-            size_t e = b + block < count ? b + block : count;
-            parallel_range(&c, b, e, 16, recv_gather);
-            if (opt->progress) {
-                double f = fmax((spp + 2.0 * c.rays * (double)e / (double)(count ? count : 1)) / max_samples,
-                                opt->time_limit > 0 ? (now_seconds() - t0) / opt->time_limit : 0);
-                opt->progress(opt->user, "gather", f > 1 ? 1 : f);
-            }
-        }
-        weight_sum += c.pass_weight;
-        spp += 2.0 * c.rays;
-        /* error: two independent half estimates per receiver (TRANSPORT.md) */
-        double num = 0, den = 0;
-        for (size_t i = 0; i < count; i++) {
-            double a = c.x_acc[0][i] / weight_sum, b = c.x_acc[1][i] / weight_sum;
-            num += 0.25 * (a - b) * (a - b);
-            double m = 0.5 * (a + b);
-            den += m * m;
-        }
-        err = den > 0 ? sqrt(num / den) : 0;
-        last_pass_time = now_seconds() - pass_start;
+        res = run_pass(&c, pass, chain);
+        if (res != LBK_OK) goto done;
+        estimate_error(&c, &err, &bias);
         if (opt->report) {
-            bk_transport_sample smp = {now_seconds() - t0, spp, err, chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces, pass};
+            bk_transport_sample smp = {now_seconds() - t0, c.spp, err,
+                                       chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces, pass};
             opt->report(opt->user, &smp);
         }
-        if (target > 0 && err <= target) { stop = BK_STOP_TARGET; break; }
-        double next_spp = spp + 2.0 * (s0 << (pass + 1 < 20 ? pass + 1 : 20));
-        if (next_spp > max_samples || pass >= 24) { stop = BK_STOP_BUDGET; break; }
-        /* the next pass costs about twice this one: start it only if it can finish in time */
-        if (opt->time_limit > 0 && now_seconds() - t0 + 2.1 * last_pass_time > opt->time_limit) { stop = BK_STOP_TIME; break; }
+        if (stop_after(&c, pass, err, now_seconds() - pass_start, &stop)) break;
     }
-
-    /* normalise the pass-weighted sums, then add the noise-free punctual light */
-    for (size_t i = 0; i < count; i++) {
-        float inv = (float)(1.0 / weight_sum);
-        for (int a = 0; a < 3; a++) {
-            for (int k = 0; k < 9; k++) {
-                output->radiance[i].c[a][k] *= inv;
-                if (output->direct) output->direct[i].c[a][k] *= inv;
-            }
-            if (output->irradiance) output->irradiance[3 * i + a] *= inv;
-        }
-    }
-    if (c.light_count) {
-        float *pl = c.punct_lum;
-        c.punct_lum = NULL; /* recv_punctual now writes into the outputs */
-        parallel_for(&c, count, 64, recv_punctual);
-        c.punct_lum = pl;
-    }
-
-    if (stats) {
-        stats->seconds = now_seconds() - t0;
-        stats->passes = pass + 1;
-        stats->samples_per_receiver = spp;
-        stats->est_rel_rmse = err;
-        stats->bounces = chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces;
-        stats->q = 0.5 * (chain[0].q + chain[1].q);
-        double tot = chain[0].total_energy + chain[1].total_energy;
-        stats->tail_fraction = tot > 0 ? (chain[0].tail_energy + chain[1].tail_energy) / tot : 0;
-        stats->cells = c.cell_count;
-        for (int t = 0; t < c.threads; t++) {
-            stats->rays += c.thread_rays[t];
-            stats->shadow_rays += c.thread_shadow[t];
-            stats->nonfinite += c.thread_nonfinite[t];
-        }
-        stats->stop = stop;
-        stats->nee = c.nee;
-    }
+    finish_outputs(&c);
+    if (stats) fill_stats(&c, pass + 1, err, bias, chain, stop, stats);
 done:
     free_ctx(&c);
     return res;

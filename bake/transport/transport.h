@@ -35,7 +35,22 @@ typedef struct bk_receiver {
     float position[3];
     float normal[3];   /* unit: a surface texel gathering over the hemisphere around it;
                           zero: a volumetric probe gathering over the full sphere */
+    /* Optional footprint (texels): footprint_count entries of options.footprint from
+     * footprint_first. Each gather ray then leaves from a random point of the texel's square:
+     * on the footprint triangle that covers it (its own position and interpolated normal), or
+     * from position/normal where no footprint triangle covers it. The texel's value is so the
+     * average over its square, as a renderer's bake of the same texel is (TRANSPORT.md). */
+    uint32_t footprint_first, footprint_count;
 } bk_receiver;
+
+/* One triangle of a texel's footprint: the barycentrics (u, v) of scene triangle `tri` (the
+ * p = (1-u-v)·v0 + u·v1 + v·v2 convention of bk_hit) as affine functions of the texel-local
+ * coordinates (s, t) in [0,1]²: u = uv[0][0] + uv[0][1]·s + uv[0][2]·t, v likewise. A point
+ * belongs to it when u, v >= 0 and u + v <= 1. */
+typedef struct bk_footprint_tri {
+    uint32_t tri;
+    float uv[2][3];
+} bk_footprint_tri;
 
 /* One point of the error-against-time record, written after every pass. */
 typedef struct bk_transport_sample {
@@ -65,6 +80,12 @@ typedef struct bk_transport_options {
      * as the lightmap (TRANSPORT.md §Bias). All cells together stay below 4 Mi (sizes grow
      * uniformly if needed). */
     const float *cell_size;
+    /* Texel footprints (bk_receiver.footprint_*): the triangles, and the scene whose triangles
+     * they index and whose vertex positions and normals place the points (NULL: `scene`; a
+     * bake over a scene with some triangles removed passes the full one). */
+    const bk_footprint_tri *footprint;
+    size_t footprint_count;
+    const bk_scene *footprint_scene;
     int cache_rays;          /* gather rays per cell per bounce in pass 0 (doubles per pass); 0: 16 */
     int first_pass_samples;  /* gather rays per receiver per half in pass 0 (doubles); 0: 16 */
     /* Next-event estimation of emissive triangles (one light sample per gather ray, combined
@@ -96,6 +117,9 @@ typedef struct bk_transport_stats {
     int passes;
     double samples_per_receiver;
     double est_rel_rmse;
+    double est_cache_bias;   /* estimated relative RMS bias of reading the cache's cells at the
+                                receivers' far hits (the probes, TRANSPORT.md §Bias); not in
+                                est_rel_rmse, which the two halves measure */
     int bounces;             /* explicit bounces of the last pass */
     double q;                /* per-bounce energy ratio used for the tail (last pass, mean of halves) */
     double tail_fraction;    /* share of the cache's indirect energy that came from the tail */

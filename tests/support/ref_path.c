@@ -114,7 +114,37 @@ typedef struct rp_job {
     int paths;
     uint64_t seed;
     double *out, *se;
+    const bk_footprint_tri *fp;   /* footprints (NULL: points) */
+    const uint32_t *first, *count;
 } rp_job;
+
+/* A point of texel i's footprint (the reference's own reading of bk_footprint_tri). */
+static int rp_footprint_point(const rp_job *j, size_t i, uint64_t *st, double p[3], double n[3])
+{
+    const bk_scene *s = j->s;
+    for (int tries = 0; tries < 1024; tries++) {
+        double a = rp_uniform(st), b = rp_uniform(st);
+        for (uint32_t k = 0; k < j->count[i]; k++) {
+            const bk_footprint_tri *f = &j->fp[j->first[i] + k];
+            double u = f->uv[0][0] + f->uv[0][1] * a + f->uv[0][2] * b;
+            double v = f->uv[1][0] + f->uv[1][1] * a + f->uv[1][2] * b;
+            if (u < 0 || v < 0 || u + v > 1) continue;
+            const uint32_t *ix = s->tris + 3 * (size_t)f->tri;
+            double w[3] = {1 - u - v, u, v};
+            for (int c = 0; c < 3; c++) {
+                p[c] = n[c] = 0;
+                for (int q = 0; q < 3; q++) {
+                    p[c] += w[q] * s->positions[3 * (size_t)ix[q] + c];
+                    n[c] += w[q] * s->normals[3 * (size_t)ix[q] + c];
+                }
+            }
+            double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+            for (int c = 0; c < 3; c++) n[c] /= l;
+            return 1;
+        }
+    }
+    return 0;
+}
 
 static void rp_chunk(void *user, size_t begin, size_t end, int thread)
 {
@@ -128,8 +158,16 @@ static void rp_chunk(void *user, size_t begin, size_t end, int thread)
         double p[3] = {j->p[3 * i], j->p[3 * i + 1], j->p[3 * i + 2]}, o[3];
         rp_offset(p, n, o);
         double sum[3] = {0, 0, 0}, s1 = 0, s2 = 0;
+        const double p0[3] = {p[0], p[1], p[2]}, n0[3] = {n[0], n[1], n[2]};
         for (int k = 0; k < j->paths; k++) {
             double d[3], L[3];
+            if (j->fp && j->count[i]) {
+                if (!rp_footprint_point(j, i, &st, p, n)) {
+                    memcpy(p, p0, sizeof p);
+                    memcpy(n, n0, sizeof n);
+                }
+                rp_offset(p, n, o);
+            }
             rp_cosine_dir(n, &st, d);
             rp_radiance(j->s, j->t, o, d, &st, L);
             for (int c = 0; c < 3; c++) sum[c] += L[c];
@@ -148,6 +186,14 @@ static void rp_chunk(void *user, size_t begin, size_t end, int thread)
 void rp_irradiance(const bk_scene *s, const bk_tracer *t, const float *p, const float *n, size_t count, int paths,
                    uint64_t seed, int threads, double *out_rgb, double *stderr_lum)
 {
-    rp_job j = {s, t, p, n, paths, seed, out_rgb, stderr_lum};
+    rp_job j = {s, t, p, n, paths, seed, out_rgb, stderr_lum, NULL, NULL, NULL};
     bk_parallel_chunks(0, count, 4, threads > 0 ? threads : 1, rp_chunk, &j);
+}
+
+void rp_footprint_irradiance(const bk_scene *s, const bk_tracer *t, const bk_footprint_tri *fp,
+                             const uint32_t *first, const uint32_t *count, const float *p, const float *n, size_t texels,
+                             int paths, uint64_t seed, int threads, double *out_rgb, double *stderr_lum)
+{
+    rp_job j = {s, t, p, n, paths, seed, out_rgb, stderr_lum, fp, first, count};
+    bk_parallel_chunks(0, texels, 4, threads > 0 ? threads : 1, rp_chunk, &j);
 }

@@ -21,6 +21,7 @@
 
 #include "bake/scene/scene.h"
 #include "bake/transport/tracer.h"
+#include "bake/transport/transport.h"
 
 /* 0 when the scene is within the model above, else 1 with a reason in err. */
 int rp_check(const bk_scene *s, char *err, size_t err_len);
@@ -31,6 +32,15 @@ int rp_check(const bk_scene *s, char *err, size_t err_len);
  * p + offset·n. */
 void rp_irradiance(const bk_scene *s, const bk_tracer *t, const float *p, const float *n, size_t count, int paths,
                    uint64_t seed, int threads, double *out_rgb, double *stderr_lum);
+
+/* Irradiance averaged over texel footprints: point k of texel i is uniform over the part of
+ * texel-local [0,1]² that one of its footprint triangles covers (fp[first[i] .. first[i] +
+ * count[i]), the bk_footprint_tri convention; scene `s` gives positions and shading normals),
+ * by rejection; `paths` points (one path each) per texel. A texel whose footprint covers
+ * nothing in 1024 draws uses p/n. Same outputs as rp_irradiance. */
+void rp_footprint_irradiance(const bk_scene *s, const bk_tracer *t, const bk_footprint_tri *fp,
+                             const uint32_t *first, const uint32_t *count, const float *p, const float *n, size_t texels,
+                             int paths, uint64_t seed, int threads, double *out_rgb, double *stderr_lum);
 
 /* One path's incident radiance along the unit direction d from origin o (already offset). Exposed
  * so the footprint reference (texel averages) can reuse the same estimator. state: the stream. */
