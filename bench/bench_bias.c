@@ -270,6 +270,7 @@ int main(int argc, char **argv)
         if (a.footprint) {
             r[nr].footprint_first = x->footprint_first;
             r[nr].footprint_count = x->footprint_count;
+            memcpy(r[nr].footprint_box, x->footprint_box, sizeof x->footprint_box);
         }
 #endif
         recv_of[i] = nr;

@@ -214,6 +214,43 @@ static lbk_result footprint_pairs(const bk_atlas *a, const bk_texels *out, const
     return LBK_OK;
 }
 
+/* Grows box (s0, t0, s1, t1) by the part of triangle `entry` inside texel (x, y)'s square
+ * (Sutherland–Hodgman against the square's four sides, in texel-local coordinates). */
+static void clip_box(const bk_atlas *a, uint32_t entry, int x, int y, double box[4])
+{
+    const float *uv = a->tri_uv + 6 * (size_t)entry;
+    double poly[2][16][2];
+    int n = 3, cur = 0;
+    for (int k = 0; k < 3; k++) {
+        poly[0][k][0] = uv[2 * k] - x;
+        poly[0][k][1] = uv[2 * k + 1] - y;
+    }
+    for (int side = 0; side < 4 && n > 0; side++) {
+        const int axis = side & 1;
+        const double lim = side < 2 ? 0.0 : 1.0, sg = side < 2 ? 1.0 : -1.0; /* keep sg·(c − lim) >= 0 */
+        int m = 0;
+        for (int k = 0; k < n; k++) {
+            const double *p = poly[cur][k], *q = poly[cur][(k + 1) % n];
+            double dp = sg * (p[axis] - lim), dq = sg * (q[axis] - lim);
+            if (dp >= 0 && m < 16) { poly[!cur][m][0] = p[0]; poly[!cur][m][1] = p[1]; m++; }
+            if ((dp >= 0) != (dq >= 0) && m < 16) {
+                double f = dp / (dp - dq);
+                poly[!cur][m][0] = p[0] + f * (q[0] - p[0]);
+                poly[!cur][m][1] = p[1] + f * (q[1] - p[1]);
+                m++;
+            }
+        }
+        n = m;
+        cur = !cur;
+    }
+    for (int k = 0; k < n; k++) {
+        box[0] = fmin(box[0], poly[cur][k][0]);
+        box[1] = fmin(box[1], poly[cur][k][1]);
+        box[2] = fmax(box[2], poly[cur][k][0]);
+        box[3] = fmax(box[3], poly[cur][k][1]);
+    }
+}
+
 /* The footprint triangle of `entry` over texel (x, y): barycentrics as affine maps of (s, t). */
 static void footprint_tri(const bk_atlas *a, uint32_t entry, int x, int y, bk_footprint_tri *f)
 {
@@ -347,11 +384,19 @@ lbk_result bk_texels_build(const bk_scene *s, const bk_atlas *a, bk_texels *out)
                 size_t g = out->page_offset[p] + i;
                 while (fp < npairs && pairs[fp].texel < g) fp++;
                 rc->footprint_first = (uint32_t)fp;
+                double box[4] = {1, 1, 0, 0};
                 while (fp < npairs && pairs[fp].texel == g) {
                     footprint_tri(a, pairs[fp].entry, x, y, &out->footprint[fp]);
+                    clip_box(a, pairs[fp].entry, x, y, box);
                     fp++;
                 }
                 rc->footprint_count = (uint32_t)(fp - rc->footprint_first);
+                /* the covered part's bounding box, a little larger against rounding */
+                for (int k = 0; k < 2; k++) {
+                    double lo = fmax(0.0, box[k] - 1e-4), hi = fmin(1.0, box[k + 2] + 1e-4);
+                    rc->footprint_box[k] = (float)lo;
+                    rc->footprint_box[k + 2] = (float)fmax(0.0, hi - lo);
+                }
                 idx[i] = (int32_t)r;
                 r++;
             }
@@ -422,6 +467,28 @@ static void hit_point(const bk_scene *s, const bk_hit *h, float out[3])
     for (int c = 0; c < 3; c++) out[c] = (float)(w0 * p[0][c] + h->u * p[1][c] + h->v * p[2][c]);
 }
 
+/* Whether q, projected onto triangle tri's plane, lies on the triangle (barycentrics >= -1e-4):
+ * a pushed point must stay on its own face, not move past its edge onto another surface. */
+static int on_own_triangle(const bk_scene *s, uint32_t tri, const float q[3])
+{
+    double p[3][3], e1[3], e2[3], d[3], n[3];
+    if (!bk_tri_positions(s, tri, p)) return 0;
+    double qd[3];
+    bkv_load(qd, q);
+    bkv_sub(e1, p[1], p[0]);
+    bkv_sub(e2, p[2], p[0]);
+    bkv_sub(d, qd, p[0]);
+    bkv_cross(n, e1, e2);
+    double nn = bkv_dot(n, n);
+    if (!(nn > 0)) return 0;
+    double c1[3], c2[3];
+    bkv_cross(c1, d, e2);
+    bkv_cross(c2, e1, d);
+    double u = bkv_dot(c1, n) / nn, v = bkv_dot(c2, n) / nn;
+    const double tol = 1e-4;
+    return u >= -tol && v >= -tol && u + v <= 1 + tol;
+}
+
 static void push_one(push_job *j, bk_texel *r)
 {
     const bk_scene *s = j->scene;
@@ -465,7 +532,7 @@ static void push_one(push_job *j, bk_texel *r)
             float q[3] = {p0[0], p0[1], p0[2]};
             hit_point(s, &h, q);
             double height = (q[0] - p0[0]) * ng[0] + (q[1] - p0[1]) * ng[1] + (q[2] - p0[2]) * ng[2];
-            if (fabs(height) > band) continue;
+            if (fabs(height) > band || !on_own_triangle(s, r->tri, q)) continue;
             if (!found || h.t < best.t) {
                 best = h;
                 found = 1;

@@ -80,6 +80,8 @@ typedef struct bk_texel {
     uint32_t flags;        /* enum bk_texel_flag */
     uint32_t footprint_first, footprint_count; /* its chart's triangles over its square, in
                                                   bk_texels.footprint (see Footprint above) */
+    float footprint_box[4];  /* s0, t0, width, height: the part of its square they cover lies in
+                                it (bk_receiver.footprint_box) */
 } bk_texel;
 
 typedef struct bk_texels {

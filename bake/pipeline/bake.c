@@ -363,6 +363,10 @@ static int build_receivers(bake *b)
         if (!(t->flags & BK_TEXEL_VALID)) continue;
         memcpy(b->receivers[k].position, t->position, sizeof t->position);
         memcpy(b->receivers[k].normal, t->normal, sizeof t->normal);
+        /* the texel's value is the average over its square (texels.h, Footprint) */
+        b->receivers[k].footprint_first = t->footprint_first;
+        b->receivers[k].footprint_count = t->footprint_count;
+        memcpy(b->receivers[k].footprint_box, t->footprint_box, sizeof t->footprint_box);
         b->texel_of_receiver[k++] = (uint32_t)i;
     }
     if (b->have_glg)
@@ -408,6 +412,9 @@ static void set_inputs(const bake *b, bk_set_inputs *in)
     in->base_radiance = b->radiance;
     bk_bake_transport_options(b->opt, b->pre->max_samples, b->pre->target_error, &in->transport);
     in->transport.cell_size = b->cell_size;
+    in->transport.footprint = b->texels.footprint;
+    in->transport.footprint_count = b->texels.footprint_count;
+    in->transport.footprint_scene = &b->scene; /* door runs trace a scene without the door */
     in->base_samples_per_receiver = b->stats.samples_per_receiver;
     in->threshold = b->opt->dls_threshold;
     in->progress = b->progress;
@@ -441,6 +448,8 @@ static int do_transport(bake *b)
     bk_transport_options to;
     bk_bake_transport_options(b->opt, b->pre->max_samples, b->pre->target_error, &to);
     to.cell_size = b->cell_size;
+    to.footprint = b->texels.footprint;
+    to.footprint_count = b->texels.footprint_count;
     to.progress = transport_progress;
     to.report = transport_report;
     to.user = b;

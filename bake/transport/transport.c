@@ -30,7 +30,7 @@ static uint64_t mix64(uint64_t z)
 typedef struct { uint64_t s; } tp_rng;
 
 enum { DOM_CELL = 1, DOM_RECV = 2, DOM_CELL_NEE = 3, DOM_RECV_NEE = 4, DOM_RECV_NEAR = 5, DOM_RECV_POS = 6,
-       DOM_RECV_PROBE = 7 };
+       DOM_RECV_PROBE = 7, DOM_CELL_NEAR = 8 };
 
 /* Keyed by everything that identifies one item's samples: never by thread or time. */
 static tp_rng rng_make(uint64_t seed, uint64_t domain, uint64_t half, uint64_t pass, uint64_t bounce, uint64_t item)
@@ -172,6 +172,7 @@ typedef struct tp_ctx {
     float scene_scale;
     /* per chain (half) state; [h] */
     float *l_prev[2], *l_cur[2], *l_sum[2];
+    float *l_prev2[2];     /* bounce k−2 (what a near hit in bounce k continues into) */
     /* current job */
     int half, pass, bounce, rays;
     tp_lattice lat;        /* for `rays` samples */
@@ -444,10 +445,84 @@ static int nee_sample(const tp_ctx *c, const float o[3], const double n[3], int 
     return 1;
 }
 
-/* ---- cache: one bounce for a range of cells ------------------------------------------------ */
-
 /* Per-thread counters of one parallel step. */
 typedef struct tp_count { uint64_t rays, shadow, bad; } tp_count;
+
+/* ---- near-field continuation -------------------------------------------------------------- */
+
+/* A cell holds one radiance for its whole area; read from closer than a few cell sizes (a
+ * corner, a leg under a table top) that constant is biased, and more samples never remove it.
+ * Such hits are evaluated at the exact hit point instead: one cosine-distributed gather from
+ * there (sky, emission, and the cache one bounce further, or another continuation when that
+ * hit is near too) plus one punctual light picked uniformly. An unbiased estimate of the
+ * reflected radiance at the point given the cache beyond it (TRANSPORT.md §Bias). */
+#define TP_NEAR_CELLS 2.0   /* continue when the hit is closer than this many cell sizes */
+#define TP_NEAR_DEPTH 3     /* continuations in a row before the cache is read anyway */
+
+static int near_hit(const tp_ctx *c, const bk_hit *h, long hc)
+{
+    return hc >= 0 && h->t < TP_NEAR_CELLS * c->tri_cell_h[h->tri];
+}
+
+/* Reflected radiance (all bounces, emission excluded) at the point of `hit` (cell hc, reached
+ * along unit d) from one continuation sample. */
+/* What a continuation sample gathers: the cells it reads at its hit (NULL: none) and whether
+ * the light sources count (sky, emission, one punctual light). The final gather continues with
+ * everything (read = the cache's sum); bounce k of the cache continues with the exact bounce
+ * k−1 at its near hit: the sources for k = 2, bounce k−2's cells beyond. */
+typedef struct tp_near_mode { const float *read; int sources, max_depth; } tp_near_mode;
+
+static void near_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, long hc, int depth, tp_rng *rng,
+                          tp_count *cnt, double out[3])
+{
+    const tp_cell *cell = &c->cells[hc];
+    double v[3][3], x[3];
+    tri_vertices(c, hit->tri, v);
+    for (int a = 0; a < 3; a++) x[a] = (1.0 - hit->u - hit->v) * v[0][a] + hit->u * v[1][a] + hit->v * v[2][a];
+    double n[3] = {cell->n[0], cell->n[1], cell->n[2]}, t[3], b[3];
+    bk_onb(n, t, b);
+    float xf[3] = {(float)x[0], (float)x[1], (float)x[2]}, nf[3] = {cell->n[0], cell->n[1], cell->n[2]}, o[3];
+    bk_offset_ray_origin_scaled(xf, nf, bk_tracer_tri_scale(c->tracer, hit->tri), o);
+    double u1 = rng_next(rng), ph = 2 * TP_PI * rng_next(rng), rr = sqrt(u1), lz = sqrt(fmax(0.0, 1 - u1));
+    double d[3];
+    for (int a = 0; a < 3; a++) d[a] = rr * cos(ph) * t[a] + rr * sin(ph) * b[a] + lz * n[a];
+    float df[3] = {(float)d[0], (float)d[1], (float)d[2]};
+    double L[3] = {0, 0, 0};
+    bk_hit h2;
+    cnt->rays++;
+    if (!bk_tracer_intersect(c->tracer, o, df, 0.0f, INFINITY, &h2)) {
+        if (md->sources) sky_radiance(c, d, L);
+    } else {
+        long h2c = hit_cell(c, &h2);
+        if (h2c >= 0) {
+            if (md->sources) emission_at(c, h2.tri, h2.u, h2.v, L);
+            double r2[3] = {0, 0, 0};
+            if (md->read && depth + 1 < md->max_depth && near_hit(c, &h2, h2c)) {
+                near_radiance(c, md, &h2, h2c, depth + 1, rng, cnt, r2);
+            } else if (md->read) {
+                for (int a = 0; a < 3; a++) r2[a] = md->read[3 * h2c + a];
+            }
+            for (int a = 0; a < 3; a++) L[a] += r2[a];
+        }
+    }
+    double e[3] = {TP_PI * L[0], TP_PI * L[1], TP_PI * L[2]};
+    if (md->sources && c->light_count) {
+        size_t li = (size_t)(rng_next(rng) * (double)c->light_count);
+        if (li >= c->light_count) li = c->light_count - 1;
+        double val[3], ld[3], dist;
+        if (bk_light_eval(c->lights[li], x, val, ld, &dist)) {
+            double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
+            if (cs > 0) {
+                cnt->shadow++;
+                if (bk_light_visible(c->tracer, o, ld, dist))
+                    for (int a = 0; a < 3; a++) e[a] += (double)c->light_count * val[a] * cs;
+            }
+        }
+    }
+    for (int a = 0; a < 3; a++) out[a] = cell->albedo[a] / TP_PI * e[a];
+}
+
+/* ---- cache: one bounce for a range of cells ------------------------------------------------ */
 
 /* One cell's sample sums for one bounce: gathered radiance, light samples and punctual light,
  * over the samples whose point can be seen (a sample whose gather ray reaches the inside of a
@@ -461,7 +536,7 @@ typedef struct tp_cell_sums {
 /* Shades sample j of a cell (point p, offset origin o, cosine direction d, hit) into the sums. */
 static void cell_sample(tp_ctx *c, const double n[3], int j, const double p[3],
                         const float o[3], const double d[3], const bk_hit *hit, const double nee_t[2],
-                        tp_cell_sums *cs, tp_count *cnt)
+                        tp_rng *near_rng, tp_cell_sums *cs, tp_count *cnt)
 {
     const int k = c->bounce, h = c->half;
     const float *prev = c->l_prev[h];
@@ -477,6 +552,10 @@ static void cell_sample(tp_ctx *c, const double n[3], int j, const double p[3],
                     double w = mis_gather(c, hit, hc, d, lz / TP_PI);
                     for (int a = 0; a < 3; a++) L[a] *= w;
                 }
+            } else if (near_hit(c, hit, hc)) {
+                /* bounce k−1 at the exact point (see near_radiance) */
+                const tp_near_mode md = {k == 2 ? NULL : c->l_prev2[h], k == 2, 1};
+                near_radiance(c, &md, hit, hc, 0, near_rng, cnt, L);
             } else {
                 for (int a = 0; a < 3; a++) L[a] = prev[3 * hc + a];
             }
@@ -525,6 +604,7 @@ static void cell_bounce(tp_ctx *c, size_t ci, tp_count *cnt, double out[3])
     if (cell->n[0] == 0 && cell->n[1] == 0 && cell->n[2] == 0) return;
     if (cell->albedo[0] <= 0 && cell->albedo[1] <= 0 && cell->albedo[2] <= 0) return;
     tp_rng rng = rng_make(c->seed, DOM_CELL, (uint64_t)h, (uint64_t)c->pass, (uint64_t)k, ci);
+    tp_rng near_rng = rng_make(c->seed, DOM_CELL_NEAR, (uint64_t)h, (uint64_t)c->pass, (uint64_t)k, ci);
     double n[3] = {cell->n[0], cell->n[1], cell->n[2]}, t[3], b[3];
     bk_onb(n, t, b);
     float nf[3] = {cell->n[0], cell->n[1], cell->n[2]};
@@ -561,7 +641,7 @@ static void cell_bounce(tp_ctx *c, size_t ci, tp_count *cnt, double out[3])
         bk_tracer_intersect_n(c->tracer, (size_t)m, org, dir, 0.0f, NULL, hits);
         cnt->rays += (uint64_t)m;
         for (int jj = 0; jj < m; jj++)
-            cell_sample(c, n, j0 + jj, pts[jj], org + 3 * jj, dd[jj], &hits[jj], nee_t, &cs, cnt);
+            cell_sample(c, n, j0 + jj, pts[jj], org + 3 * jj, dd[jj], &hits[jj], nee_t, &near_rng, &cs, cnt);
     }
     if (!cs.valid) return; /* the whole cell is inside solids: never seen */
     for (int a = 0; a < 3; a++) {
@@ -622,7 +702,11 @@ static tp_chain_result run_chain(tp_ctx *c, int h, int pass, int rays, double to
         for (size_t i = 0; i < 3 * n; i++) sum[i] += c->l_cur[h][i];
         indirect += p;
         pw[0] = pw[1]; pw[1] = pw[2]; pw[2] = p;
-        float *tmp = c->l_prev[h]; c->l_prev[h] = c->l_cur[h]; c->l_cur[h] = tmp;
+        /* rotate: k−2 <- k−1 <- k, the oldest buffer is overwritten next */
+        float *tmp = c->l_prev2[h];
+        c->l_prev2[h] = c->l_prev[h];
+        c->l_prev[h] = c->l_cur[h];
+        c->l_cur[h] = tmp;
         if (k >= 2) q = pw[1] > 0 ? pw[2] / pw[1] : 0;
         if (!(p > 0) || p <= 1e-7 * indirect) break;
         if (k >= 4) {
@@ -720,14 +804,21 @@ static int footprint_origin(const tp_ctx *c, const bk_receiver *r, double s, dou
     return 0;
 }
 
-/* A uniform point of the part of the texel's square that its footprint covers: rejection, at
- * most TP_FOOTPRINT_TRIES draws (a sliver covering 10 % of the square falls back to the
- * receiver's own point 18 % of the time, one covering 30 % 0.3 %). */
+/* A uniform point of the part of the texel's square that its footprint covers: rejection in the
+ * footprint box, at most TP_FOOTPRINT_TRIES draws (a footprint covering 10 % of its box falls
+ * back to the receiver's own point 18 % of the time, one covering 30 % 0.3 %; charts of
+ * axis-aligned slivers fill their boxes). */
 #define TP_FOOTPRINT_TRIES 16
 static void footprint_sample(const tp_ctx *c, const bk_receiver *r, tp_rng *pos, tp_origin *g)
 {
+    const float *bx = r->footprint_box;
+    int box = bx[2] > 0 && bx[3] > 0;
     for (int k = 0; k < TP_FOOTPRINT_TRIES; k++) {
         double ps = rng_next(pos), pt = rng_next(pos);
+        if (box) {
+            ps = bx[0] + ps * bx[2];
+            pt = bx[1] + pt * bx[3];
+        }
         if (footprint_origin(c, r, ps, pt, g)) return;
     }
 }
@@ -807,74 +898,6 @@ static void accumulate(const double d[3], double cs, const double L[3], const do
     }
 }
 
-/* ---- near-field continuation -------------------------------------------------------------- */
-
-/* A cell holds one radiance for its whole area; read from closer than a few cell sizes (a
- * corner, a leg under a table top) that constant is biased, and more samples never remove it.
- * Such hits are evaluated at the exact hit point instead: one cosine-distributed gather from
- * there (sky, emission, and the cache one bounce further, or another continuation when that
- * hit is near too) plus one punctual light picked uniformly. An unbiased estimate of the
- * reflected radiance at the point given the cache beyond it (TRANSPORT.md §Bias). */
-#define TP_NEAR_CELLS 2.0   /* continue when the hit is closer than this many cell sizes */
-#define TP_NEAR_DEPTH 3     /* continuations in a row before the cache is read anyway */
-
-static int near_hit(const tp_ctx *c, const bk_hit *h, long hc)
-{
-    return hc >= 0 && h->t < TP_NEAR_CELLS * c->tri_cell_h[h->tri];
-}
-
-/* Reflected radiance (all bounces, emission excluded) at the point of `hit` (cell hc, reached
- * along unit d) from one continuation sample. */
-static void near_radiance(tp_ctx *c, const float *sum, const bk_hit *hit, long hc, int depth, tp_rng *rng,
-                          tp_count *cnt, double out[3])
-{
-    const tp_cell *cell = &c->cells[hc];
-    double v[3][3], x[3];
-    tri_vertices(c, hit->tri, v);
-    for (int a = 0; a < 3; a++) x[a] = (1.0 - hit->u - hit->v) * v[0][a] + hit->u * v[1][a] + hit->v * v[2][a];
-    double n[3] = {cell->n[0], cell->n[1], cell->n[2]}, t[3], b[3];
-    bk_onb(n, t, b);
-    float xf[3] = {(float)x[0], (float)x[1], (float)x[2]}, nf[3] = {cell->n[0], cell->n[1], cell->n[2]}, o[3];
-    bk_offset_ray_origin_scaled(xf, nf, bk_tracer_tri_scale(c->tracer, hit->tri), o);
-    double u1 = rng_next(rng), ph = 2 * TP_PI * rng_next(rng), rr = sqrt(u1), lz = sqrt(fmax(0.0, 1 - u1));
-    double d[3];
-    for (int a = 0; a < 3; a++) d[a] = rr * cos(ph) * t[a] + rr * sin(ph) * b[a] + lz * n[a];
-    float df[3] = {(float)d[0], (float)d[1], (float)d[2]};
-    double L[3] = {0, 0, 0};
-    bk_hit h2;
-    cnt->rays++;
-    if (!bk_tracer_intersect(c->tracer, o, df, 0.0f, INFINITY, &h2)) {
-        sky_radiance(c, d, L);
-    } else {
-        long h2c = hit_cell(c, &h2);
-        if (h2c >= 0) {
-            emission_at(c, h2.tri, h2.u, h2.v, L);
-            double r2[3];
-            if (depth + 1 < TP_NEAR_DEPTH && near_hit(c, &h2, h2c)) {
-                near_radiance(c, sum, &h2, h2c, depth + 1, rng, cnt, r2);
-            } else {
-                for (int a = 0; a < 3; a++) r2[a] = sum[3 * h2c + a];
-            }
-            for (int a = 0; a < 3; a++) L[a] += r2[a];
-        }
-    }
-    double e[3] = {TP_PI * L[0], TP_PI * L[1], TP_PI * L[2]};
-    if (c->light_count) {
-        size_t li = (size_t)(rng_next(rng) * (double)c->light_count);
-        if (li >= c->light_count) li = c->light_count - 1;
-        double val[3], ld[3], dist;
-        if (bk_light_eval(c->lights[li], x, val, ld, &dist)) {
-            double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
-            if (cs > 0) {
-                cnt->shadow++;
-                if (bk_light_visible(c->tracer, o, ld, dist))
-                    for (int a = 0; a < 3; a++) e[a] += (double)c->light_count * val[a] * cs;
-            }
-        }
-    }
-    for (int a = 0; a < 3; a++) out[a] = cell->albedo[a] / TP_PI * e[a];
-}
-
 /* ---- final gather ---------------------------------------------------------------------------- */
 
 /* A receiver's sums over one half of one pass. */
@@ -911,7 +934,8 @@ static long gather_hit(tp_ctx *c, const float *sum, const bk_hit *hit, const dou
     double r[3];
     int near = near_hit(c, hit, hc);
     if (near) {
-        near_radiance(c, sum, hit, hc, 0, cont, cnt, r);
+        const tp_near_mode md = {sum, 1, TP_NEAR_DEPTH};
+        near_radiance(c, &md, hit, hc, 0, cont, cnt, r);
     } else {
         for (int a = 0; a < 3; a++) r[a] = sum[3 * hc + a];
     }
@@ -980,7 +1004,8 @@ static void recv_half(tp_ctx *c, size_t i, int h, tp_recv_sums *rs, tp_count *cn
             else accumulate(dd[jj], sphere ? 1 : zz[jj], L, Ld, rs->e, rs->sh_t, rs->sh_d);
             if (hc >= 0 && (j0 + jj) % TP_PROBE_EVERY == 0) {
                 double q[3];
-                near_radiance(c, sum, &hits[jj], hc, 0, &probe, cnt, q);
+                const tp_near_mode md = {sum, 1, TP_NEAR_DEPTH};
+                near_radiance(c, &md, &hits[jj], hc, 0, &probe, cnt, q);
                 double cs = (sphere ? 1 : zz[jj]) * TP_PROBE_EVERY;
                 if (bk_finite3(q))
                     for (int a = 0; a < 3; a++) rs->eb[a] += (q[a] - sum[3 * hc + a]) * cs;
@@ -1069,7 +1094,8 @@ static void free_ctx(tp_ctx *c)
     free(c->thread_shadow);
     free(c->lights);
     for (int h = 0; h < 2; h++) {
-        free(c->l_prev[h]); free(c->l_cur[h]); free(c->l_sum[h]); free(c->x_acc[h]); free(c->b_acc[h]);
+        free(c->l_prev[h]); free(c->l_prev2[h]); free(c->l_cur[h]); free(c->l_sum[h]); free(c->x_acc[h]);
+        free(c->b_acc[h]);
     }
     free(c->punct_lum);
     free(c->thread_rays); free(c->thread_nonfinite);
@@ -1350,11 +1376,13 @@ static lbk_result ctx_init(tp_ctx *c)
     size_t nc = c->cell_count ? c->cell_count : 1, n = c->recv_count ? c->recv_count : 1;
     for (int h = 0; h < 2; h++) {
         c->l_prev[h] = calloc(3 * nc, sizeof(float));
+        c->l_prev2[h] = calloc(3 * nc, sizeof(float));
         c->l_cur[h] = calloc(3 * nc, sizeof(float));
         c->l_sum[h] = calloc(3 * nc, sizeof(float));
         c->x_acc[h] = calloc(n, sizeof(double));
         c->b_acc[h] = calloc(n, sizeof(double));
-        if (!c->l_prev[h] || !c->l_cur[h] || !c->l_sum[h] || !c->x_acc[h] || !c->b_acc[h]) return LBK_ERR_OUT_OF_MEMORY;
+        if (!c->l_prev[h] || !c->l_prev2[h] || !c->l_cur[h] || !c->l_sum[h] || !c->x_acc[h] || !c->b_acc[h])
+            return LBK_ERR_OUT_OF_MEMORY;
     }
     c->punct_lum = calloc(n, sizeof(float));
     return c->punct_lum ? LBK_OK : LBK_ERR_OUT_OF_MEMORY;

@@ -41,6 +41,10 @@ typedef struct bk_receiver {
      * from position/normal where no footprint triangle covers it. The texel's value is so the
      * average over its square, as a renderer's bake of the same texel is (TRANSPORT.md). */
     uint32_t footprint_first, footprint_count;
+    /* s0, t0, width, height: a box of the square that holds every point a footprint triangle
+     * covers (points are drawn in it, so a sliver of a chart is sampled as well as a whole
+     * square); width or height <= 0: the whole square */
+    float footprint_box[4];
 } bk_receiver;
 
 /* One triangle of a texel's footprint: the barycentrics (u, v) of scene triangle `tri` (the

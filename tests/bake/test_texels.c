@@ -1,5 +1,5 @@
-/* Texel receivers (bake/layout/texels.h): coverage, normals and tangent frames, push-out at
- * wall/floor junctions, inside-geometry detection, dilation. */
+/* Texel receivers (bake/layout/texels.h): coverage, footprints, normals and tangent frames,
+ * push-out at wall/floor junctions, inside-geometry detection, dilation. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -261,8 +261,8 @@ static void test_pushout_l_junction(void **state)
 }
 
 /* A closed box standing on a floor that runs under it: floor texels deep under the box are
- * inside (not valid), those near its walls are pushed out, the rest untouched. The result is
- * the same for 1 and 3 threads. */
+ * marked inside (and still baked: the transport makes them black), those near its walls are
+ * pushed out, the rest untouched. The result is the same for 1 and 3 threads. */
 static void test_pushout_inside_and_threads(void **state)
 {
     (void)state;
@@ -297,11 +297,11 @@ static void test_pushout_inside_and_threads(void **state)
         }
         double ax = fabs(r->position[0]), az = fabs(r->position[2]);
         int under = ax < 0.5 && az < 0.5;
-        if (r->flags & BK_TEXEL_VALID) {
-            /* a valid floor sample is never under the box */
-            assert_false(under);
-        } else {
-            assert_true(r->flags & BK_TEXEL_INSIDE);
+        assert_true(r->flags & BK_TEXEL_VALID);
+        /* a floor sample under the box is marked inside; one marked inside is under it */
+        if (under) assert_true(r->flags & BK_TEXEL_INSIDE);
+        if (r->flags & BK_TEXEL_INSIDE) {
+            assert_true(under);
             inside++;
         }
         if (ax < 0.3 && az < 0.3) assert_true(r->flags & BK_TEXEL_INSIDE); /* deep under */
@@ -486,13 +486,101 @@ static void test_extreme_scales(void **state)
             assert_float_equal(len3(r->normal), 1.0, 1e-5);
             assert_float_equal(len3(r->tangent), 1.0, 1e-5);
             assert_true(r->texel_size > 0.0f && isfinite(r->texel_size));
-            if (r->object == 0 && (r->flags & BK_TEXEL_VALID) && r->position[1] < 0.5 * scales[v]) {
+            if (r->object == 0 && !(r->flags & BK_TEXEL_INSIDE) && r->position[1] < 0.5 * scales[v]) {
                 double x = r->position[0] - offsets[v], z = r->position[2];
-                /* floor texels: never strictly under the box (its footprint minus rounding) */
+                /* floor texels not marked inside: never strictly under the box (its footprint
+                 * minus rounding) */
                 assert_false(fabs(x) < half * 0.98 && fabs(z) < half * 0.98);
             }
         }
         bk_tracer_destroy(tr);
+        bk_texels_free(&tx);
+        bk_atlas_free(&a);
+        uvs_free(&s);
+    }
+}
+
+/* Footprints against brute force: for random points of every texel's square, "some footprint
+ * triangle covers it" equals "some triangle of the texel's chart covers it" (the whole chart
+ * searched), and both give the same world point. A sphere of many small triangles (charts of
+ * many triangles per texel) and a box (chart borders, padding) at two densities. */
+static void test_footprint_equals_chart_cover(void **state)
+{
+    (void)state;
+    const float dens[2] = {6.0f, 23.0f};
+    for (int dv = 0; dv < 2; dv++) {
+        bk_scene s;
+        uvs_init(&s);
+        uvs_object(&s, "sphere");
+        float c[3] = {0, 1, 0};
+        uvs_sphere(&s, c, 0.6f, 32, 16, 0);
+        uvs_object(&s, "box");
+        float mn[3] = {1, 0, -0.3f}, mx[3] = {1.7f, 0.4f, 0.3f};
+        uvs_box(&s, mn, mx, 2, 0, 0);
+        uvs_update_bounds(&s);
+        bk_atlas a;
+        bk_texels tx;
+        build(&s, dens[dv], &a, &tx);
+        assert_true(tx.footprint_count >= tx.count);
+        uint64_t rng = 0x1234567ull + (uint64_t)dv;
+        size_t points = 0, covered = 0, multi = 0;
+        for (size_t i = 0; i < tx.count; i++) {
+            const bk_texel *r = &tx.receivers[i];
+            assert_true(r->footprint_count >= 1);
+            assert_true((size_t)r->footprint_first + r->footprint_count <= tx.footprint_count);
+            multi += r->footprint_count > 1;
+            int32_t own = a.scene_tri_entry[r->tri];
+            assert_true(own >= 0);
+            const bk_atlas_chart *ch = &a.charts[a.tri_chart[own]];
+            for (int k = 0; k < 24; k++) {
+                rng = rng * 6364136223846793005ull + 1442695040888963407ull;
+                double ps = (double)(rng >> 11) / 9007199254740992.0;
+                rng = rng * 6364136223846793005ull + 1442695040888963407ull;
+                double pt = (double)(rng >> 11) / 9007199254740992.0;
+                /* brute force over the chart, in page coordinates; skip points within 1e-6 of an edge */
+                double px = r->x + ps, py = r->y + pt, bf[3] = {0, 0, 0};
+                int bf_hit = 0, near_edge = 0;
+                for (uint32_t e = ch->first; e < ch->first + ch->count && !bf_hit; e++) {
+                    const float *uv = a.tri_uv + 6 * (size_t)e;
+                    double d = (uv[2] - uv[0]) * (uv[5] - uv[1]) - (uv[4] - uv[0]) * (uv[3] - uv[1]);
+                    if (d == 0) continue;
+                    double w1 = ((px - uv[0]) * (uv[5] - uv[1]) - (uv[4] - uv[0]) * (py - uv[1])) / d;
+                    double w2 = ((uv[2] - uv[0]) * (py - uv[1]) - (px - uv[0]) * (uv[3] - uv[1])) / d;
+                    double w0 = 1 - w1 - w2;
+                    if (fabs(w0) < 1e-6 || fabs(w1) < 1e-6 || fabs(w2) < 1e-6) near_edge = 1;
+                    if (w0 < 0 || w1 < 0 || w2 < 0) continue;
+                    bf_hit = 1;
+                    const uint32_t *ix = s.tris + 3 * (size_t)a.tris[e];
+                    for (int q = 0; q < 3; q++)
+                        bf[q] = w0 * s.positions[3 * ix[0] + q] + w1 * s.positions[3 * ix[1] + q] +
+                                w2 * s.positions[3 * ix[2] + q];
+                }
+                if (near_edge) continue;
+                int fp_hit = 0;
+                double fp[3] = {0, 0, 0};
+                for (uint32_t k2 = 0; k2 < r->footprint_count && !fp_hit; k2++) {
+                    const bk_footprint_tri *f = &tx.footprint[r->footprint_first + k2];
+                    double u = f->uv[0][0] + f->uv[0][1] * ps + f->uv[0][2] * pt;
+                    double v = f->uv[1][0] + f->uv[1][1] * ps + f->uv[1][2] * pt;
+                    if (u < 0 || v < 0 || u + v > 1) continue;
+                    fp_hit = 1;
+                    const uint32_t *ix = s.tris + 3 * (size_t)f->tri;
+                    for (int q = 0; q < 3; q++)
+                        fp[q] = (1 - u - v) * s.positions[3 * ix[0] + q] + u * s.positions[3 * ix[1] + q] +
+                                v * s.positions[3 * ix[2] + q];
+                }
+                points++;
+                assert_int_equal(fp_hit, bf_hit);
+                if (!bf_hit) continue;
+                covered++;
+                for (int q = 0; q < 3; q++) assert_true(fabs(fp[q] - bf[q]) < 1e-4);
+            }
+        }
+        print_message("density %g: %zu texels, %zu footprint triangles (%zu texels with several), %zu of %zu points "
+                      "covered\n",
+                      dens[dv], tx.count, tx.footprint_count, multi, covered, points);
+        assert_true(multi > tx.count / 20);  /* many small triangles: texels do span several */
+        assert_true(covered < points);       /* chart borders: parts of squares are uncovered */
         bk_texels_free(&tx);
         bk_atlas_free(&a);
         uvs_free(&s);
@@ -504,6 +592,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_quad_texel_count),
         cmocka_unit_test(test_coverage_and_frames),
+        cmocka_unit_test(test_footprint_equals_chart_cover),
         cmocka_unit_test(test_tangent_convention),
         cmocka_unit_test(test_degenerate),
         cmocka_unit_test(test_pushout_l_junction),
