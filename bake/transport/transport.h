@@ -2,15 +2,20 @@
  * rendering equation (seed 001 §2.3), Lambertian surfaces. Method, error model and the
  * guaranteed furnace bounds: bake/transport/TRANSPORT.md.
  *
- * Summary: a radiosity cache of surface cells (each triangle side split into m² sub-triangles
- * by area, independent of lightmap UVs) is filled bounce by bounce: bounce 1 = punctual direct
+ * Summary: a radiosity cache of surface cells (each triangle side split into m² sub-triangles,
+ * as fine as options.cell_size asks — the baker passes the texel size — or by area from a
+ * budget; independent of lightmap UVs) is filled bounce by bounce: bounce 1 = punctual direct
  * (shadow rays) + emission (gather rays and next-event estimation, combined by multiple
  * importance sampling) + sky (gather rays); bounce k = albedo/π × irradiance gathered from
  * bounce k−1 with fresh rays. Bounces stop when the per-bounce energy ratio q has settled; the
  * rest of the Neumann series is added per cell as L_K·q/(1−q). Receivers then gather the cache's
  * radiance (final gather, emitters again by MIS of gather hits and light samples) plus punctual
- * direct light. Progressive passes double the samples; each pass runs two independent halves
- * (own cache, own receiver rays), whose difference estimates the error.
+ * direct light. Hits closer than two cell sizes are evaluated at the exact point (one more
+ * gather from there) instead of reading the cell; the inside of closed solids is black
+ * (bake/transport/solid.h); a texel with a footprint starts each ray from a random point of the
+ * part of its square its chart covers. Progressive passes double the samples; each pass runs two
+ * independent halves (own cache, own receiver rays), whose difference estimates the error; a
+ * probe of continued far hits estimates the cache's bias (TRANSPORT.md §Bias).
  *
  * Determinism: every random number comes from a counter-based hash of (seed, half, pass,
  * bounce, item, sample); each item (cell or receiver) is computed by one thread in a fixed

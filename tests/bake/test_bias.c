@@ -301,7 +301,7 @@ static void test_room_converges_unbiased(void **state)
         double mean = sqrt(ref2 / rm.ne), worst = 0;
         for (size_t k = 0; k < rm.nb; k++) worst = fmax(worst, lum(irr + 3 * rm.buried[k]));
         if (j == 3) print_message("faces let into slabs: %zu texels, brightest %.2g of the mean\n", rm.nb, worst / mean);
-        assert_true(worst < 2e-3 * mean);
+        assert_true(worst < 5e-3 * mean);
         free(irr);
     }
     /* unbiased: own MSE ∝ 1/N. Allowed: half the rate (factor 2 of slack on the ratio for the
