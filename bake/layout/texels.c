@@ -161,6 +161,89 @@ static void rtri_weights(const bk_rtri *t, double px, double py, double w[3])
     w[2] = t->flipped ? e[1] : e[2];
 }
 
+/* UV islands: entries of one chart joined by edges they share both in uv and in the world
+ * (exact corner coordinates). An authored layout is one chart holding many islands, often
+ * closer than a texel or even touching; a texel's footprint stays on its own island, as a
+ * renderer's bake stays on the texel's triangle. */
+typedef struct fp_edge { uint32_t chart; float k[10]; uint32_t entry; } fp_edge; /* uv a, uv b, world a, b */
+
+static int cmp_edge(const void *p, const void *q)
+{
+    const fp_edge *a = p, *b = q;
+    if (a->chart != b->chart) return a->chart < b->chart ? -1 : 1;
+    for (int k = 0; k < 10; k++)
+        if (a->k[k] != b->k[k]) return a->k[k] < b->k[k] ? -1 : 1;
+    return (a->entry > b->entry) - (a->entry < b->entry);
+}
+
+static int same_edge(const fp_edge *a, const fp_edge *b)
+{
+    if (a->chart != b->chart) return 0;
+    for (int k = 0; k < 10; k++)
+        if (a->k[k] != b->k[k]) return 0;
+    return 1;
+}
+
+static uint32_t uf_find(uint32_t *p, uint32_t x)
+{
+    while (p[x] != x) {
+        p[x] = p[p[x]];
+        x = p[x];
+    }
+    return x;
+}
+
+static uint32_t *uv_islands(const bk_scene *s, const bk_atlas *a)
+{
+    size_t n = a->tri_count;
+    uint32_t *parent = malloc((n ? n : 1) * sizeof *parent);
+    fp_edge *e = malloc((n ? 3 * n : 1) * sizeof *e);
+    if (!parent || !e) {
+        free(parent);
+        free(e);
+        return NULL;
+    }
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++) {
+        parent[i] = (uint32_t)i;
+        const float *uv = a->tri_uv + 6 * i;
+        const uint32_t *ix = s->tris + 3 * (size_t)a->tris[i];
+        for (int k = 0; k < 3; k++) {
+            int k2 = (k + 1) % 3;
+            float ka[5] = {uv[2 * k], uv[2 * k + 1], 0, 0, 0}, kb[5] = {uv[2 * k2], uv[2 * k2 + 1], 0, 0, 0};
+            int ok = ix[k] < s->vertex_count && ix[k2] < s->vertex_count;
+            for (int c = 0; ok && c < 3; c++) {
+                ka[2 + c] = s->positions[3 * (size_t)ix[k] + c];
+                kb[2 + c] = s->positions[3 * (size_t)ix[k2] + c];
+            }
+            for (int c = 0; c < 5; c++) ok = ok && isfinite(ka[c]) && isfinite(kb[c]);
+            if (!ok) continue;
+            int swap = 0; /* the lexicographically smaller corner first, so both sides agree */
+            for (int c = 0; c < 5 && !swap; c++) {
+                if (kb[c] < ka[c]) swap = 1;
+                if (kb[c] != ka[c]) break;
+            }
+            fp_edge *x = &e[m++];
+            x->chart = a->tri_chart[i];
+            for (int c = 0; c < 5; c++) {
+                x->k[c] = swap ? kb[c] : ka[c];
+                x->k[5 + c] = swap ? ka[c] : kb[c];
+            }
+            x->entry = (uint32_t)i;
+        }
+    }
+    qsort(e, m, sizeof *e, cmp_edge);
+    for (size_t i = 1; i < m; i++) {
+        const fp_edge *p = &e[i - 1], *q = &e[i];
+        if (!same_edge(p, q)) continue;
+        uint32_t r1 = uf_find(parent, p->entry), r2 = uf_find(parent, q->entry);
+        if (r1 != r2) parent[r1 > r2 ? r1 : r2] = r1 > r2 ? r2 : r1;
+    }
+    for (size_t i = 0; i < n; i++) parent[i] = uf_find(parent, (uint32_t)i);
+    free(e);
+    return parent;
+}
+
 typedef struct fp_pair { size_t texel; uint32_t entry; } fp_pair;
 
 static int cmp_pair(const void *a, const void *b)
@@ -172,11 +255,13 @@ static int cmp_pair(const void *a, const void *b)
 
 /* (texel, entry) for every chart triangle over a texel its chart owns; idx holds the owning
  * entry per texel (or -1). Sorted by texel, then entry: receiver order. */
-static lbk_result footprint_pairs(const bk_atlas *a, const bk_texels *out, const int32_t *idx_all, fp_pair **pairs,
-                                  size_t *count)
+static lbk_result footprint_pairs(const bk_scene *s, const bk_atlas *a, const bk_texels *out, const int32_t *idx_all,
+                                  fp_pair **pairs, size_t *count)
 {
     size_t n = 0, cap = 0;
     fp_pair *v = NULL;
+    uint32_t *island = uv_islands(s, a);
+    if (!island) return LBK_ERR_OUT_OF_MEMORY;
     for (size_t c = 0; c < a->chart_count; c++) {
         const bk_atlas_chart *ch = &a->charts[c];
         if (ch->page < 0 || (size_t)ch->page >= out->page_count) continue;
@@ -193,12 +278,12 @@ static lbk_result footprint_pairs(const bk_atlas *a, const bk_texels *out, const
             for (int y = y0; y <= y1; y++)
                 for (int x = x0; x <= x1; x++) {
                     size_t i = (size_t)y * (size_t)pw + (size_t)x;
-                    if (idx[i] < 0 || a->tri_chart[idx[i]] != (uint32_t)c) continue;
+                    if (idx[i] < 0 || island[idx[i]] != island[e]) continue;
                     if (!tri_overlaps_square(&t, x, y)) continue;
                     if (n == cap) {
                         size_t nc = cap ? 2 * cap : 1024;
                         fp_pair *nv = realloc(v, nc * sizeof *nv);
-                        if (!nv) { free(v); return LBK_ERR_OUT_OF_MEMORY; }
+                        if (!nv) { free(v); free(island); return LBK_ERR_OUT_OF_MEMORY; }
                         v = nv;
                         cap = nc;
                     }
@@ -208,6 +293,7 @@ static lbk_result footprint_pairs(const bk_atlas *a, const bk_texels *out, const
                 }
         }
     }
+    free(island);
     if (n) qsort(v, n, sizeof *v, cmp_pair);
     *pairs = v;
     *count = n;
@@ -342,7 +428,7 @@ lbk_result bk_texels_build(const bk_scene *s, const bk_atlas *a, bk_texels *out)
     fp_pair *pairs = NULL;
     size_t npairs = 0;
     out->receivers = malloc((count ? count : 1) * sizeof *out->receivers);
-    if (!out->receivers || footprint_pairs(a, out, out->index, &pairs, &npairs) != LBK_OK ||
+    if (!out->receivers || footprint_pairs(s, a, out, out->index, &pairs, &npairs) != LBK_OK ||
         !(out->footprint = malloc((npairs ? npairs : 1) * sizeof *out->footprint))) {
         free(best);
         free(pairs);

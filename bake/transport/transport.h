@@ -10,7 +10,7 @@
  * bounce k−1 with fresh rays. Bounces stop when the per-bounce energy ratio q has settled; the
  * rest of the Neumann series is added per cell as L_K·q/(1−q). Receivers then gather the cache's
  * radiance (final gather, emitters again by MIS of gather hits and light samples) plus punctual
- * direct light. Hits closer than two cell sizes are evaluated at the exact point (one more
+ * direct light. Hits closer than 1.5 cell sizes are evaluated at the exact point (one more
  * gather from there) instead of reading the cell; the inside of closed solids is black
  * (bake/transport/solid.h); a texel with a footprint starts each ray from a random point of the
  * part of its square its chart covers. Progressive passes double the samples; each pass runs two

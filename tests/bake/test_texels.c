@@ -587,12 +587,54 @@ static void test_footprint_equals_chart_cover(void **state)
     }
 }
 
+/* An authored layout is one chart of many islands: two faces of a slab (top up, bottom down)
+ * whose islands touch in uv1. A texel on the seam overlaps both, but its footprint keeps only
+ * its own island (else a floor texel would average in the floor's underside). */
+static void test_footprint_stays_on_island(void **state)
+{
+    (void)state;
+    bk_scene s;
+    uvs_init(&s);
+    uint32_t o = uvs_object(&s, "slab");
+    float t0[3] = {0, 0.1f, 0}, t1[3] = {2, 0.1f, 0}, t2[3] = {2, 0.1f, -2}, t3[3] = {0, 0.1f, -2};
+    float b0[3] = {0, 0, -2}, b1[3] = {2, 0, -2}, b2[3] = {2, 0, 0}, b3[3] = {0, 0, 0};
+    const float top_uv[2] = {0.0f, 0.0f}, bottom_uv[2] = {0.5f, 0.0f};
+    uvs_quad(&s, t0, t1, t2, t3, 2, 0, top_uv, 0.5f);
+    uvs_quad(&s, b0, b1, b2, b3, 2, 0, bottom_uv, 0.5f);
+    s.objects[o].has_uv1 = 1;
+    uvs_update_bounds(&s);
+    bk_atlas a;
+    bk_texels tx;
+    build(&s, 8.0f, &a, &tx);
+    assert_int_equal(a.objects[0].uv_source, BK_UV_AUTHORED);
+    size_t seam = 0;
+    for (size_t i = 0; i < tx.count; i++) {
+        const bk_texel *r = &tx.receivers[i];
+        int own_up = r->normal[1] > 0;
+        for (uint32_t k = 0; k < r->footprint_count; k++) {
+            uint32_t t = tx.footprint[r->footprint_first + k].tri;
+            const float *n = s.normals + 3 * (size_t)s.tris[3 * (size_t)t];
+            assert_int_equal(n[1] > 0, own_up);
+        }
+        /* texels whose square crosses the seam between the islands */
+        int32_t e = a.scene_tri_entry[r->tri];
+        double mx = 0;
+        for (int c = 0; c < 3; c++) mx = fmax(mx, a.tri_uv[6 * (size_t)e + 2 * c]);
+        seam += own_up && r->x + 1 > mx - 1e-3 && r->x < mx;
+    }
+    assert_true(seam >= 4);
+    bk_texels_free(&tx);
+    bk_atlas_free(&a);
+    uvs_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_quad_texel_count),
         cmocka_unit_test(test_coverage_and_frames),
         cmocka_unit_test(test_footprint_equals_chart_cover),
+        cmocka_unit_test(test_footprint_stays_on_island),
         cmocka_unit_test(test_tangent_convention),
         cmocka_unit_test(test_degenerate),
         cmocka_unit_test(test_pushout_l_junction),
