@@ -354,6 +354,67 @@ static void footprint_tri(const bk_atlas *a, uint32_t entry, int x, int y, bk_fo
     }
 }
 
+/* The owning triangle entry of every covered texel into out->index (coverage rule in texels.h);
+ * best[i]: its squared distance to the centre, -1 when the centre is inside. */
+static void rasterise_owners(const bk_atlas *a, bk_texels *out, float *best)
+{
+    for (size_t c = 0; c < a->chart_count; c++) {
+        const bk_atlas_chart *ch = &a->charts[c];
+        if (ch->page < 0 || (size_t)ch->page >= out->page_count) continue;
+        int pw = a->pages[ch->page].width, ph = a->pages[ch->page].height;
+        int32_t *idx = out->index + out->page_offset[ch->page];
+        float *bst = best + out->page_offset[ch->page];
+        for (uint32_t e = ch->first; e < ch->first + ch->count; e++) {
+            bk_rtri t;
+            if (!bk_rtri_setup(a->tri_uv + 6 * (size_t)e, &t)) continue;
+            double mnx = fmin(t.x[0], fmin(t.x[1], t.x[2])), mxx = fmax(t.x[0], fmax(t.x[1], t.x[2]));
+            double mny = fmin(t.y[0], fmin(t.y[1], t.y[2])), mxy = fmax(t.y[0], fmax(t.y[1], t.y[2]));
+            int x0 = (int)fmax(0.0, floor(mnx) - 1), x1 = (int)fmin((double)pw - 1, floor(mxx) + 1);
+            int y0 = (int)fmax(0.0, floor(mny) - 1), y1 = (int)fmin((double)ph - 1, floor(mxy) + 1);
+            for (int y = y0; y <= y1; y++)
+                for (int x = x0; x <= x1; x++) {
+                    double cx = x + 0.5, cy = y + 0.5;
+                    float d;
+                    if (bk_rtri_inside(&t, cx, cy, NULL)) {
+                        d = -1.0f;
+                    } else {
+                        double qx, qy;
+                        double d2 = bk_rtri_closest(&t, cx, cy, NULL, &qx, &qy);
+                        if (!(fabs(qx - cx) < 0.5 && fabs(qy - cy) < 0.5)) continue;
+                        d = (float)d2;
+                    }
+                    size_t i = (size_t)y * (size_t)pw + (size_t)x;
+                    if (d < bst[i]) {
+                        bst[i] = d;
+                        idx[i] = (int32_t)e;
+                    }
+                }
+        }
+    }
+}
+
+/* Texel (x, y) (global index g) gets its footprint: the pairs of g, from *fp on (sorted alike),
+ * as maps and as the bounding box of the part of its square they cover. */
+static void texel_footprint(const bk_atlas *a, const fp_pair *pairs, size_t npairs, size_t *fp, size_t g, int x,
+                            int y, bk_footprint_tri *fps, bk_texel *rc)
+{
+    while (*fp < npairs && pairs[*fp].texel < g) (*fp)++;
+    rc->footprint_first = (uint32_t)*fp;
+    double box[4] = {1, 1, 0, 0};
+    while (*fp < npairs && pairs[*fp].texel == g) {
+        footprint_tri(a, pairs[*fp].entry, x, y, &fps[*fp]);
+        clip_box(a, pairs[*fp].entry, x, y, box);
+        (*fp)++;
+    }
+    rc->footprint_count = (uint32_t)(*fp - rc->footprint_first);
+    /* a little larger against rounding */
+    for (int k = 0; k < 2; k++) {
+        double lo = fmax(0.0, box[k] - 1e-4), hi = fmin(1.0, box[k + 2] + 1e-4);
+        rc->footprint_box[k] = (float)lo;
+        rc->footprint_box[k + 2] = (float)fmax(0.0, hi - lo);
+    }
+}
+
 lbk_result bk_texels_build(const bk_scene *s, const bk_atlas *a, bk_texels *out)
 {
     if (!out) return LBK_ERR_INVALID_ARGUMENT;
@@ -390,39 +451,7 @@ lbk_result bk_texels_build(const bk_scene *s, const bk_atlas *a, bk_texels *out)
         out->index[i] = -1;
         best[i] = INFINITY;
     }
-    for (size_t c = 0; c < a->chart_count; c++) {
-        const bk_atlas_chart *ch = &a->charts[c];
-        if (ch->page < 0 || (size_t)ch->page >= np) continue;
-        int pw = a->pages[ch->page].width, ph = a->pages[ch->page].height;
-        int32_t *idx = out->index + out->page_offset[ch->page];
-        float *bst = best + out->page_offset[ch->page];
-        for (uint32_t e = ch->first; e < ch->first + ch->count; e++) {
-            bk_rtri t;
-            if (!bk_rtri_setup(a->tri_uv + 6 * (size_t)e, &t)) continue;
-            double mnx = fmin(t.x[0], fmin(t.x[1], t.x[2])), mxx = fmax(t.x[0], fmax(t.x[1], t.x[2]));
-            double mny = fmin(t.y[0], fmin(t.y[1], t.y[2])), mxy = fmax(t.y[0], fmax(t.y[1], t.y[2]));
-            int x0 = (int)fmax(0.0, floor(mnx) - 1), x1 = (int)fmin((double)pw - 1, floor(mxx) + 1);
-            int y0 = (int)fmax(0.0, floor(mny) - 1), y1 = (int)fmin((double)ph - 1, floor(mxy) + 1);
-            for (int y = y0; y <= y1; y++)
-                for (int x = x0; x <= x1; x++) {
-                    double cx = x + 0.5, cy = y + 0.5;
-                    float d;
-                    if (bk_rtri_inside(&t, cx, cy, NULL)) {
-                        d = -1.0f;
-                    } else {
-                        double qx, qy;
-                        double d2 = bk_rtri_closest(&t, cx, cy, NULL, &qx, &qy);
-                        if (!(fabs(qx - cx) < 0.5 && fabs(qy - cy) < 0.5)) continue;
-                        d = (float)d2;
-                    }
-                    size_t i = (size_t)y * (size_t)pw + (size_t)x;
-                    if (d < bst[i]) {
-                        bst[i] = d;
-                        idx[i] = (int32_t)e;
-                    }
-                }
-        }
-    }
+    rasterise_owners(a, out, best);
     size_t count = 0;
     for (size_t i = 0; i < total; i++) count += out->index[i] >= 0;
     fp_pair *pairs = NULL;
@@ -436,7 +465,7 @@ lbk_result bk_texels_build(const bk_scene *s, const bk_atlas *a, bk_texels *out)
         return LBK_ERR_OUT_OF_MEMORY;
     }
     out->footprint_count = npairs;
-    if (npairs > UINT32_MAX) {
+    if (npairs > UINT32_MAX) { /* footprint_first is 32-bit */
         free(best);
         free(pairs);
         bk_texels_free(out);
@@ -466,23 +495,7 @@ lbk_result bk_texels_build(const bk_scene *s, const bk_atlas *a, bk_texels *out)
                 rc->page = (uint32_t)p;
                 rc->x = (uint16_t)x;
                 rc->y = (uint16_t)y;
-                /* its footprint: the pairs of this texel (sorted alike) */
-                size_t g = out->page_offset[p] + i;
-                while (fp < npairs && pairs[fp].texel < g) fp++;
-                rc->footprint_first = (uint32_t)fp;
-                double box[4] = {1, 1, 0, 0};
-                while (fp < npairs && pairs[fp].texel == g) {
-                    footprint_tri(a, pairs[fp].entry, x, y, &out->footprint[fp]);
-                    clip_box(a, pairs[fp].entry, x, y, box);
-                    fp++;
-                }
-                rc->footprint_count = (uint32_t)(fp - rc->footprint_first);
-                /* the covered part's bounding box, a little larger against rounding */
-                for (int k = 0; k < 2; k++) {
-                    double lo = fmax(0.0, box[k] - 1e-4), hi = fmin(1.0, box[k + 2] + 1e-4);
-                    rc->footprint_box[k] = (float)lo;
-                    rc->footprint_box[k + 2] = (float)fmax(0.0, hi - lo);
-                }
+                texel_footprint(a, pairs, npairs, &fp, out->page_offset[p] + i, x, y, out->footprint, rc);
                 idx[i] = (int32_t)r;
                 r++;
             }
