@@ -3,13 +3,12 @@
 
 #include <float.h>
 #include <math.h>
-#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "bake/layout/uv_math.h"
 #include "bake/layout/uv_raster.h"
+#include "bake/util/parallel.h"
 
 /* ---------------------------------------------------------------------------------------- */
 /* Tangent frame                                                                            */
@@ -378,10 +377,9 @@ static void rasterise_owners(const bk_atlas *a, bk_texels *out, float *best)
                     if (bk_rtri_inside(&t, cx, cy, NULL)) {
                         d = -1.0f;
                     } else {
-                        double qx, qy;
-                        double d2 = bk_rtri_closest(&t, cx, cy, NULL, &qx, &qy);
-                        if (!(fabs(qx - cx) < 0.5 && fabs(qy - cy) < 0.5)) continue;
-                        d = (float)d2;
+                        /* the bilinear footprint: filtering at some point of the triangle reads it */
+                        if (!bk_rtri_meets_square(&t, cx, cy, 1.0)) continue;
+                        d = (float)bk_rtri_closest(&t, cx, cy, NULL, NULL, NULL);
                     }
                     size_t i = (size_t)y * (size_t)pw + (size_t)x;
                     if (d < bst[i]) {
@@ -515,8 +513,7 @@ typedef struct push_job {
     const bk_tracer *tracer;
     float reach;
     float far_dist;
-    size_t begin, end;
-    bk_pushout_stats stats;
+    bk_pushout_stats *thread_stats; /* one per thread, summed at the end */
 } push_job;
 
 /* Fixed hemisphere directions (local frame, z up): a Fibonacci spiral, deterministic. */
@@ -588,7 +585,7 @@ static int on_own_triangle(const bk_scene *s, uint32_t tri, const float q[3])
     return u >= -tol && v >= -tol && u + v <= 1 + tol;
 }
 
-static void push_one(push_job *j, bk_texel *r)
+static void push_one(const push_job *j, bk_texel *r, bk_pushout_stats *st)
 {
     const bk_scene *s = j->scene;
     double ng[3], t[3], b[3];
@@ -646,7 +643,7 @@ static void push_one(push_job *j, bk_texel *r)
         memcpy(cur_n, best.ng, sizeof cur_n);
         r->flags |= BK_TEXEL_PUSHED;
     }
-    if (r->flags & BK_TEXEL_PUSHED) j->stats.pushed++;
+    if (r->flags & BK_TEXEL_PUSHED) st->pushed++;
     /* inside closed geometry? */
     float org[3];
     bk_offset_ray_origin_scaled(r->position, cur_n, bk_tracer_tri_scale(j->tracer, cur_tri), org);
@@ -663,16 +660,15 @@ static void push_one(push_job *j, bk_texel *r)
     }
     if (2 * back >= LONG_RAYS) {
         r->flags |= BK_TEXEL_INSIDE; /* still baked: black inside closed solids (texels.h) */
-        j->stats.inside++;
+        st->inside++;
     }
-    j->stats.tested++;
+    st->tested++;
 }
 
-static void *push_worker(void *arg)
+static void push_chunk(void *user, size_t begin, size_t end, int thread)
 {
-    push_job *j = arg;
-    for (size_t i = j->begin; i < j->end; i++) push_one(j, &j->tx->receivers[i]);
-    return NULL;
+    const push_job *j = user;
+    for (size_t i = begin; i < end; i++) push_one(j, &j->tx->receivers[i], &j->thread_stats[thread]);
 }
 
 lbk_result bk_texels_push_out(bk_texels *tx, const bk_scene *scene, const bk_tracer *tracer,
@@ -681,10 +677,7 @@ lbk_result bk_texels_push_out(bk_texels *tx, const bk_scene *scene, const bk_tra
     if (stats) memset(stats, 0, sizeof *stats);
     if (!tx || !scene || !tracer) return LBK_ERR_INVALID_ARGUMENT;
     float reach = opt && opt->reach > 0.0f && isfinite(opt->reach) ? opt->reach : 1.5f;
-    long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    int threads = opt && opt->threads > 0 ? opt->threads : (cores > 0 && cores < 1024 ? (int)cores : 1);
-    if (threads > 256) threads = 256;
-    if ((size_t)threads > tx->count) threads = tx->count ? (int)tx->count : 1;
+    int threads = bk_thread_count(opt ? opt->threads : 0);
     /* long rays: beyond the scene's extent */
     double diag = 0.0;
     for (int c = 0; c < 3; c++) {
@@ -693,40 +686,18 @@ lbk_result bk_texels_push_out(bk_texels *tx, const bk_scene *scene, const bk_tra
     }
     float far_dist = diag > 0.0 ? (float)(2.0 * sqrt(diag)) : FLT_MAX;
     if (!isfinite(far_dist) || far_dist <= 0.0f) far_dist = FLT_MAX;
-    push_job *jobs = calloc((size_t)threads, sizeof *jobs);
-    pthread_t *tid = calloc((size_t)threads, sizeof *tid);
-    if (!jobs || !tid) {
-        free(jobs);
-        free(tid);
-        return LBK_ERR_OUT_OF_MEMORY;
-    }
-    size_t per = (tx->count + (size_t)threads - 1) / (size_t)threads;
-    int started = 0;
-    for (int k = 0; k < threads; k++) {
-        jobs[k].tx = tx;
-        jobs[k].scene = scene;
-        jobs[k].tracer = tracer;
-        jobs[k].reach = reach;
-        jobs[k].far_dist = far_dist;
-        jobs[k].begin = (size_t)k * per < tx->count ? (size_t)k * per : tx->count;
-        jobs[k].end = jobs[k].begin + per < tx->count ? jobs[k].begin + per : tx->count;
-    }
-    for (int k = 1; k < threads; k++) {
-        if (pthread_create(&tid[k], NULL, push_worker, &jobs[k]) != 0) break;
-        started = k;
-    }
-    push_worker(&jobs[0]);
-    for (int k = 1; k <= started; k++) pthread_join(tid[k], NULL);
-    /* jobs whose thread could not start run here */
-    for (int k = started + 1; k < threads; k++) push_worker(&jobs[k]);
+    push_job job = {tx, scene, tracer, reach, far_dist, calloc((size_t)threads, sizeof(bk_pushout_stats))};
+    if (!job.thread_stats) return LBK_ERR_OUT_OF_MEMORY;
+    /* 64 receivers a chunk (up to 3·13 short and 16 long rays each): coarse enough to hide the
+     * shared counter, fine enough to balance walls against cluttered corners */
+    bk_parallel_chunks(0, tx->count, 64, threads, push_chunk, &job);
     if (stats)
         for (int k = 0; k < threads; k++) {
-            stats->tested += jobs[k].stats.tested;
-            stats->pushed += jobs[k].stats.pushed;
-            stats->inside += jobs[k].stats.inside;
+            stats->tested += job.thread_stats[k].tested;
+            stats->pushed += job.thread_stats[k].pushed;
+            stats->inside += job.thread_stats[k].inside;
         }
-    free(jobs);
-    free(tid);
+    free(job.thread_stats);
     return LBK_OK;
 }
 

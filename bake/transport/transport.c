@@ -1388,12 +1388,13 @@ static lbk_result ctx_init(tp_ctx *c)
     return c->punct_lum ? LBK_OK : LBK_ERR_OUT_OF_MEMORY;
 }
 
-static void report_progress(const tp_ctx *c, const char *phase, double done_spp)
+/* Non-zero when the caller's progress callback asks to stop (LBK_ERR_CANCELLED). */
+static int report_progress(const tp_ctx *c, const char *phase, double done_spp)
 {
     const bk_transport_options *opt = c->opt;
-    if (!opt->progress) return;
+    if (!opt->progress) return 0;
     double f = fmax(done_spp / c->max_samples, opt->time_limit > 0 ? (now_seconds() - c->t0) / opt->time_limit : 0);
-    opt->progress(opt->user, phase, f > 1 ? 1 : f);
+    return opt->progress(opt->user, phase, f > 1 ? 1 : f);
 }
 
 /* Cache rays per cell and bounce in pass p: about as many as the receivers trace this pass
@@ -1417,7 +1418,7 @@ static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
     for (int h = 0; h < 2; h++) {
         chain[h] = run_chain(c, h, pass, cache_rays, c->tail_tol, c->max_bounces);
         if (chain[h].bounces < 0) return LBK_ERR_OUT_OF_MEMORY;
-        report_progress(c, "cache", c->spp);
+        if (report_progress(c, "cache", c->spp)) return LBK_ERR_CANCELLED;
     }
     c->pass = pass;
     c->rays = c->s0 << (pass < 20 ? pass : 20);
@@ -1427,7 +1428,8 @@ static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
     for (size_t b = 0; b < count; b += block) {
         size_t e = b + block < count ? b + block : count;
         parallel_range(c, b, e, 16, recv_gather);
-        report_progress(c, "gather", c->spp + 2.0 * c->rays * (double)e / (double)(count ? count : 1));
+        if (report_progress(c, "gather", c->spp + 2.0 * c->rays * (double)e / (double)(count ? count : 1)))
+            return LBK_ERR_CANCELLED;
     }
     c->weight_sum += c->pass_weight;
     c->spp += 2.0 * c->rays;
