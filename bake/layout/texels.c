@@ -300,8 +300,9 @@ static lbk_result footprint_pairs(const bk_scene *s, const bk_atlas *a, const bk
 }
 
 /* Grows box (s0, t0, s1, t1) by the part of triangle `entry` inside texel (x, y)'s square
- * (Sutherland–Hodgman against the square's four sides, in texel-local coordinates). */
-static void clip_box(const bk_atlas *a, uint32_t entry, int x, int y, double box[4])
+ * (Sutherland–Hodgman against the square's four sides, in texel-local coordinates); returns
+ * that part's area (in texels). */
+static double clip_box(const bk_atlas *a, uint32_t entry, int x, int y, double box[4])
 {
     const float *uv = a->tri_uv + 6 * (size_t)entry;
     double poly[2][16][2];
@@ -328,12 +329,16 @@ static void clip_box(const bk_atlas *a, uint32_t entry, int x, int y, double box
         n = m;
         cur = !cur;
     }
+    double area2 = 0.0;
     for (int k = 0; k < n; k++) {
-        box[0] = fmin(box[0], poly[cur][k][0]);
-        box[1] = fmin(box[1], poly[cur][k][1]);
-        box[2] = fmax(box[2], poly[cur][k][0]);
-        box[3] = fmax(box[3], poly[cur][k][1]);
+        const double *p = poly[cur][k], *q = poly[cur][(k + 1) % n];
+        area2 += p[0] * q[1] - q[0] * p[1];
+        box[0] = fmin(box[0], p[0]);
+        box[1] = fmin(box[1], p[1]);
+        box[2] = fmax(box[2], p[0]);
+        box[3] = fmax(box[3], p[1]);
     }
+    return 0.5 * fabs(area2);
 }
 
 /* The footprint triangle of `entry` over texel (x, y): barycentrics as affine maps of (s, t). */
@@ -391,20 +396,31 @@ static void rasterise_owners(const bk_atlas *a, bk_texels *out, float *best)
     }
 }
 
+/* Below this area (texels) the chart does not cover a texel's square: triangles that only touch
+ * it (an edge along the square's side) or a sliver of rounding. */
+#define RING_AREA 1e-6
+
 /* Texel (x, y) (global index g) gets its footprint: the pairs of g, from *fp on (sorted alike),
- * as maps and as the bounding box of the part of its square they cover. */
+ * as maps and as the bounding box of the part of its square they cover; a texel whose square
+ * the chart does not cover is a ring texel (texels.h). */
 static void texel_footprint(const bk_atlas *a, const fp_pair *pairs, size_t npairs, size_t *fp, size_t g, int x,
                             int y, bk_footprint_tri *fps, bk_texel *rc)
 {
     while (*fp < npairs && pairs[*fp].texel < g) (*fp)++;
     rc->footprint_first = (uint32_t)*fp;
-    double box[4] = {1, 1, 0, 0};
+    double box[4] = {1, 1, 0, 0}, area = 0.0;
     while (*fp < npairs && pairs[*fp].texel == g) {
         footprint_tri(a, pairs[*fp].entry, x, y, &fps[*fp]);
-        clip_box(a, pairs[*fp].entry, x, y, box);
+        area += clip_box(a, pairs[*fp].entry, x, y, box);
         (*fp)++;
     }
     rc->footprint_count = (uint32_t)(*fp - rc->footprint_first);
+    if (!(area > RING_AREA)) { /* only bilinear filtering reads it (texels.h, Ring) */
+        rc->footprint_count = 0;
+        rc->flags |= BK_TEXEL_RING;
+        memset(rc->footprint_box, 0, sizeof rc->footprint_box);
+        return;
+    }
     /* a little larger against rounding */
     for (int k = 0; k < 2; k++) {
         double lo = fmax(0.0, box[k] - 1e-4), hi = fmin(1.0, box[k + 2] + 1e-4);
@@ -585,6 +601,31 @@ static int on_own_triangle(const bk_scene *s, uint32_t tri, const float q[3])
     return u >= -tol && v >= -tol && u + v <= 1 + tol;
 }
 
+/* Whether a pushed point q stays on the texel's own face: on its own triangle, on one of its
+ * footprint triangles (its chart's triangles over its square), or — for a texel whose point lies
+ * on a triangle's border or corner (the bilinear ring, texels.h, has no footprint) — on a
+ * triangle of the same object in the same plane, found by a short probe ray down onto q. So the
+ * point moves onto the next triangle of its face, never off the face onto another surface. */
+static int on_own_face(const push_job *j, const bk_texel *r, const double ng[3], double band, const float q[3])
+{
+    const bk_scene *s = j->scene;
+    if (on_own_triangle(s, r->tri, q)) return 1;
+    for (uint32_t k = 0; k < r->footprint_count; k++)
+        if (on_own_triangle(s, j->tx->footprint[r->footprint_first + k].tri, q)) return 1;
+    float org[3], dir[3];
+    for (int c = 0; c < 3; c++) {
+        org[c] = (float)(q[c] + band * ng[c]);
+        dir[c] = (float)-ng[c];
+    }
+    bk_hit h;
+    /* q is within `band` of the texel's plane (push_one): the face lies within 2·band below org */
+    if (!bk_tracer_intersect(j->tracer, org, dir, 0.0f, (float)(2.5 * band), &h)) return 0;
+    if (!s->tri_object || s->tri_object[h.tri] != r->object) return 0;
+    double hn[3];
+    oriented_geo_normal(s, h.tri, r->normal, hn);
+    return bkv_dot(hn, ng) > 0.999;
+}
+
 static void push_one(const push_job *j, bk_texel *r, bk_pushout_stats *st)
 {
     const bk_scene *s = j->scene;
@@ -628,7 +669,10 @@ static void push_one(const push_job *j, bk_texel *r, bk_pushout_stats *st)
             float q[3] = {p0[0], p0[1], p0[2]};
             hit_point(s, &h, q);
             double height = (q[0] - p0[0]) * ng[0] + (q[1] - p0[1]) * ng[1] + (q[2] - p0[2]) * ng[2];
-            if (fabs(height) > band || !on_own_triangle(s, r->tri, q)) continue;
+            if (fabs(height) > band) continue;
+            float qo[3]; /* where the point would go: just in front of the surface hit */
+            bk_offset_ray_origin_scaled(q, h.ng, bk_tracer_tri_scale(j->tracer, h.tri), qo);
+            if (!on_own_face(j, r, ng, band, qo)) continue;
             if (!found || h.t < best.t) {
                 best = h;
                 found = 1;

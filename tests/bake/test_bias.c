@@ -296,12 +296,19 @@ static void test_room_converges_unbiased(void **state)
         for (size_t k = 0; k < rm.ns; k++)
             for (int c = 0; c < 3; c++) assert_true(irr[3 * rm.sealed[k] + c] == 0.0f); /* sealed: exactly 0 */
         /* faces let into a slab are dark: never pushed out through the slab into the light
-         * (the shelf's end came out of the wall's outer face and saw the sky, ~π), nor lit by
-         * their neighbours; what reaches them is what faces crossing inside the slab carry */
+         * (the shelf's end came out of the wall's outer face and saw the sky, ~π: several times
+         * the mean), nor lit by their neighbours (~the mean); what reaches them is what faces
+         * crossing inside the slab carry: grazing rays that run inside the east wall to the
+         * south wall's face where it passes through it, whose cache cell also covers the lit
+         * part in the room (the reference's 20000 paths at these points give 0). Since the
+         * atlas merges the tiny shelf end onto the shelf's top, the texels of the end face are
+         * its bilinear ring: point samples on its border, where those few rays are not averaged
+         * over a footprint: 0.015 of the mean at 112 samples, 0.003 at 1008. So below 5 % of the
+         * mean at every count (20× under either failure), and below 0.5 % once converged. */
         double mean = sqrt(ref2 / rm.ne), worst = 0;
         for (size_t k = 0; k < rm.nb; k++) worst = fmax(worst, lum(irr + 3 * rm.buried[k]));
-        if (j == 3) print_message("faces let into slabs: %zu texels, brightest %.2g of the mean\n", rm.nb, worst / mean);
-        assert_true(worst < 5e-3 * mean);
+        print_message("faces let into slabs: %zu texels, brightest %.2g of the mean\n", rm.nb, worst / mean);
+        assert_true(worst < (j == 3 ? 5e-3 : 5e-2) * mean);
         free(irr);
     }
     /* unbiased: own MSE ∝ 1/N. Allowed: half the rate (factor 2 of slack on the ratio for the
