@@ -1481,6 +1481,12 @@ static void finish_outputs(tp_ctx *c)
             }
             if (output->irradiance) output->irradiance[3 * i + a] *= inv;
         }
+    /* per-receiver variance of X from the two halves (the denoiser's input) */
+    if (output->variance)
+        for (size_t i = 0; i < c->recv_count; i++) {
+            double a = c->x_acc[0][i] / c->weight_sum, b = c->x_acc[1][i] / c->weight_sum;
+            output->variance[i] = (float)(0.25 * (a - b) * (a - b));
+        }
     if (c->light_count) {
         float *pl = c->punct_lum;
         c->punct_lum = NULL; /* recv_punctual now writes into the outputs */

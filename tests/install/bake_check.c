@@ -422,21 +422,24 @@ static void test_same_bytes_as_lbk_bake(void **state)
     assert_memory_equal(a, b, na);
     free(a), free(b);
 
-    /* the in-memory description: every section but META */
+    /* the in-memory description: every section but META and LMUV, which describe the source:
+     * META names the file, LMUV maps lightmap UVs onto the glTF's own nodes, primitives and
+     * vertices (spec §16), which a description does not have, so only the file's bake has it */
     lbk_reader *cli = open_reader(cli_path), *mem = open_reader(mem_path);
-    uint32_t n = lbk_reader_section_count(cli);
-    assert_int_equal(lbk_reader_section_count(mem), n);
-    assert_true(n >= 8); /* META REPT OBJS LMAP GLG LLG DLS DOOR */
+    uint32_t n = lbk_reader_section_count(cli), nm = lbk_reader_section_count(mem);
+    assert_true(nm >= 8); /* META REPT OBJS LMAP GLG LLG DLS DOOR */
     int compared = 0;
-    for (uint32_t i = 0; i < n; i++) {
+    for (uint32_t i = 0, j = 0; i < n; i++) {
         lbk_section_info si, sm;
         assert_int_equal(lbk_reader_section_get(cli, i, &si), LBK_OK);
-        assert_int_equal(lbk_reader_section_get(mem, i, &sm), LBK_OK);
+        if (si.type == LBK_SECTION_LMUV) continue;
+        assert_true(j < nm);
+        assert_int_equal(lbk_reader_section_get(mem, j, &sm), LBK_OK);
         assert_int_equal(si.type, sm.type);
         const void *pc, *pm;
         size_t sc, sz;
         assert_int_equal(lbk_reader_section_data(cli, i, &pc, &sc), LBK_OK);
-        assert_int_equal(lbk_reader_section_data(mem, i, &pm, &sz), LBK_OK);
+        assert_int_equal(lbk_reader_section_data(mem, j++, &pm, &sz), LBK_OK);
         if (si.type == LBK_SECTION_META) {
             assert_true(contains(pc, sc, "room.gltf")); /* the file's name ... */
             assert_false(contains(pm, sz, "room.gltf")); /* ... the description's: "room" */
@@ -446,7 +449,7 @@ static void test_same_bytes_as_lbk_bake(void **state)
         assert_memory_equal(pc, pm, sc);
         compared++;
     }
-    assert_int_equal(compared, (int)n - 1);
+    assert_int_equal(compared, (int)nm - 1);
     lbk_reader_close(cli);
     lbk_reader_close(mem);
 }
