@@ -339,6 +339,55 @@ static void test_pushout_inside_and_threads(void **state)
     uvs_free(&s);
 }
 
+/* A panel hung 5 mm over a floor at 10 texels/m (the band: a tenth of a texel), its back to the
+ * floor, like the Cornell box's light under its ceiling: floor texels whose square the panel
+ * hides in part lose their footprint (they keep their point: averaged over the hidden part,
+ * bilinear filtering would spread it over the floor beside the panel), the others keep it. */
+static void test_pushout_hidden_footprint(void **state)
+{
+    (void)state;
+    bk_scene s;
+    uvs_init(&s);
+    float f0[3] = {0, 0, 0}, f1[3] = {2, 0, 0}, f2[3] = {2, 0, -2}, f3[3] = {0, 0, -2};
+    quad_object(&s, "floor", f0, f1, f2, f3, 4);
+    const float h = 0.005f;
+    float q0[3] = {0.5f, h, -0.5f}, q1[3] = {0.9f, h, -0.5f}, q2[3] = {0.9f, h, -0.9f}, q3[3] = {0.5f, h, -0.9f};
+    quad_object(&s, "panel", q0, q1, q2, q3, 1);
+    uvs_update_bounds(&s);
+    bk_atlas a;
+    bk_texels tx;
+    build(&s, 10.0f, &a, &tx);
+    float *centre = malloc(3 * tx.count * sizeof *centre);
+    assert_non_null(centre);
+    for (size_t i = 0; i < tx.count; i++) memcpy(centre + 3 * i, tx.receivers[i].position, 12);
+    bk_tracer *tr = NULL;
+    assert_int_equal(bk_tracer_create(&s, 1, &tr), LBK_OK);
+    assert_int_equal(bk_texels_push_out(&tx, &s, tr, NULL, NULL), LBK_OK);
+    size_t hidden = 0, kept = 0;
+    for (size_t i = 0; i < tx.count; i++) {
+        const bk_texel *r = &tx.receivers[i];
+        if (r->object != 0 || (r->flags & BK_TEXEL_RING)) continue;
+        /* the square's overlap with the panel's shadow, per axis (texels: 0.1 m, half 0.05) */
+        double ox = 0.25 - fabs(centre[3 * i] - 0.7), oz = 0.25 - fabs(centre[3 * i + 2] + 0.7);
+        /* more than a probe cell (1/8 texel) of overlap on both axes: the 4 × 4 probes see it */
+        if (ox > 0.0125 && oz > 0.0125) {
+            assert_int_equal(r->footprint_count, 0);
+            hidden++;
+        }
+        if (ox < 0 || oz < 0) {
+            assert_true(r->footprint_count >= 1);
+            kept++;
+        }
+    }
+    assert_true(hidden >= 16); /* the 4 × 4 texels under the panel, at least */
+    assert_true(kept > 300);
+    free(centre);
+    bk_tracer_destroy(tr);
+    bk_texels_free(&tx);
+    bk_atlas_free(&a);
+    uvs_free(&s);
+}
+
 /* ---------------------------------------------------------------------------------------- */
 /* Dilation                                                                                 */
 
@@ -694,6 +743,7 @@ int main(void)
         cmocka_unit_test(test_degenerate),
         cmocka_unit_test(test_pushout_l_junction),
         cmocka_unit_test(test_pushout_inside_and_threads),
+        cmocka_unit_test(test_pushout_hidden_footprint),
         cmocka_unit_test(test_dilate_ring_values),
         cmocka_unit_test(test_conservative_coverage),
         cmocka_unit_test(test_extreme_scales),
