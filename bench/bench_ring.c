@@ -6,7 +6,7 @@
  * border, but no chart triangle covers its square. Two candidates:
  *   point:  bake it at its own sample point (the chart's closest point, pushed out of walls),
  *           with no footprint;
- *   dilate: do not bake it; bk_dilate fills it from its chart's baked neighbours (the pipeline).
+ *   dilate: leave it empty; bk_dilate fills it from its chart's baked neighbours.
  * Scene: the bias room (tests/support/bias_scene.h); every texel baked once by the transport
  * (the ring texels as point receivers), the two lightmaps built from the same run. Evaluation
  * points: uniform points of the chart triangles whose bilinear taps include a ring texel, not
@@ -120,7 +120,7 @@ int main(int argc, char **argv)
             float v = (float)lum3f(irr + 3 * (size_t)ri);
             pl_point[p][i] = v;
             mask2[i] = 1;
-            if (tx.receivers[ri].flags & BK_TEXEL_VALID) {
+            if (!(tx.receivers[ri].flags & BK_TEXEL_RING)) { /* dilate: the ring left empty */
                 pl_dil[p][i] = v;
                 mask[i] = 1;
             }

@@ -40,7 +40,7 @@
  * sample point, the chart's closest point to its centre (pushed out like any other), not left
  * to dilation: filtered at the chart points that read ring texels, the bias room
  * (bench/bench_ring.c) is 7.6 % from the reference with ring texels baked this way and 10.0 %
- * with them dilated from their chart's texels (15.9 / 18.5 % at 6 texels/m, 24.9 / 28.5 % at
+ * with them dilated from their chart's texels (14.9 / 18.5 % at 6 texels/m, 24.9 / 28.5 % at
  * 4): the border point extrapolates the chart's light to the ring's centre better than the
  * texels inside the chart do.
  *
