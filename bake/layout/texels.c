@@ -627,8 +627,8 @@ static int on_own_face(const push_job *j, const bk_texel *r, const double ng[3],
 }
 
 /* A texel whose square is partly hidden behind a surface in front of it (a back face within
- * `band` along the normal: a light panel hung a centimetre under a ceiling, a wall standing on
- * a floor that runs under it) loses its footprint and keeps its (pushed) point. A renderer never
+ * `band` along the normal: a light panel hung a centimetre under a ceiling, its back to it)
+ * loses its footprint and keeps its (pushed) point. A renderer never
  * shows the hidden part, but bilinear filtering spreads the texel's value over the visible
  * surface beside it: averaged over the panel's back-lit ceiling, the ceiling next to the Cornell
  * box's light baked 4–8× too bright (a halo one texel wide). Probed on a 4 × 4 grid of the

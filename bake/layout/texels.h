@@ -55,7 +55,11 @@
  * onto its own face (its triangle, a footprint triangle, or for a point on a triangle's border
  * a coplanar triangle of its object under the new point): the point must stay on its texel,
  * never be carried through a wall to its far side (a shelf's end let into a wall is not moved
- * out of the wall's outer face into the sky). Then 16 long
+ * out of the wall's outer face into the sky). A texel whose square is partly hidden behind a
+ * surface in front of it (a back face within the tenth of a texel along its normal, probed at
+ * 4 × 4 points: a light panel hung just under a ceiling) loses its footprint and keeps its
+ * pushed point: filtering would spread the hidden part's light over the visible surface beside
+ * it (TRANSPORT.md, After the atlas merge). Then 16 long
  * hemisphere rays: when at least half of them end on back faces the point is inside closed
  * geometry: BK_TEXEL_INSIDE is set (information only: the texel is still baked, and the
  * transport makes the inside of closed solids black, so a face sealed inside a wall bakes to
