@@ -1436,21 +1436,36 @@ static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
     return LBK_OK;
 }
 
-/* The error estimates after a pass (TRANSPORT.md): the noise from the two independent halves,
- * and the cache's bias from the probes, whose two halves' product is an unbiased estimate of
- * each receiver's squared bias. Both relative to the RMS of the receivers' values. */
-static void estimate_error(const tp_ctx *c, double *noise, double *bias)
+/* The noise estimate per receiver class (options.class_end) and for the probes together. */
+typedef struct tp_errors {
+    double cls[BK_RECEIVER_CLASSES];
+    double probe;
+} tp_errors;
+
+/* The error estimates after a pass (TRANSPORT.md): the noise from the two independent halves
+ * (all receivers, and per class), and the cache's bias from the probes, whose two halves'
+ * product is an unbiased estimate of each receiver's squared bias. Relative to the RMS of the
+ * receivers' values. */
+
+static void estimate_error(const tp_ctx *c, double *noise, double *bias, tp_errors *ce)
 {
-    double num = 0, den = 0, bb = 0;
+    const bk_transport_options *opt = c->opt;
+    double num = 0, den = 0, bb = 0, cnum[BK_RECEIVER_CLASSES] = {0}, cden[BK_RECEIVER_CLASSES] = {0};
+    int cls = 0;
     for (size_t i = 0; i < c->recv_count; i++) {
+        while (cls < BK_RECEIVER_CLASSES - 1 && i >= opt->class_end[cls] && opt->class_end[BK_RECEIVER_CLASSES - 1]) cls++;
         double a = c->x_acc[0][i] / c->weight_sum, b = c->x_acc[1][i] / c->weight_sum;
-        num += 0.25 * (a - b) * (a - b);
-        double m = 0.5 * (a + b);
+        double m = 0.5 * (a + b), v = 0.25 * (a - b) * (a - b);
+        num += v;
         den += m * m;
+        cnum[cls] += v;
+        cden[cls] += m * m;
         bb += (c->b_acc[0][i] / c->weight_sum) * (c->b_acc[1][i] / c->weight_sum);
     }
     *noise = den > 0 ? sqrt(num / den) : 0;
     *bias = den > 0 && bb > 0 ? sqrt(bb / den) : 0;
+    for (int k = 0; k < BK_RECEIVER_CLASSES; k++) ce->cls[k] = cden[k] > 0 ? sqrt(cnum[k] / cden[k]) : 0;
+    ce->probe = cden[1] + cden[2] > 0 ? sqrt((cnum[1] + cnum[2]) / (cden[1] + cden[2])) : 0;
 }
 
 /* Stop after this pass? (target reached, the next pass over budget, or past the time limit:
@@ -1495,9 +1510,11 @@ static void finish_outputs(tp_ctx *c)
     }
 }
 
-static void fill_stats(const tp_ctx *c, int passes, double err, double bias, const tp_chain_result chain[2], int stop,
-                       bk_transport_stats *stats)
+static void fill_stats(const tp_ctx *c, int passes, double err, double bias, const tp_errors *ce,
+                       const tp_chain_result chain[2], int stop, bk_transport_stats *stats)
 {
+    for (int k = 0; k < BK_RECEIVER_CLASSES; k++) stats->class_rel_rmse[k] = ce->cls[k];
+    stats->probe_rel_rmse = ce->probe;
     stats->seconds = now_seconds() - c->t0;
     stats->passes = passes;
     stats->samples_per_receiver = c->spp;
@@ -1557,22 +1574,27 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
     if (c.light_count) parallel_for(&c, count, 64, recv_punctual); /* luminance only, for the error */
 
     double err = 0, bias = 0;
+    tp_errors ce = {{0}, 0};
     int pass = 0, stop = BK_STOP_BUDGET;
     tp_chain_result chain[2] = {{0, 0, 0, 0}, {0, 0, 0, 0}};
     for (;; pass++) {
         double pass_start = now_seconds();
         res = run_pass(&c, pass, chain);
         if (res != LBK_OK) goto done;
-        estimate_error(&c, &err, &bias);
+        estimate_error(&c, &err, &bias, &ce);
         if (opt->report) {
             bk_transport_sample smp = {now_seconds() - t0, c.spp, err,
-                                       chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces, pass};
+                                       chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces, pass,
+                                       {ce.cls[0], ce.cls[1], ce.cls[2]}, ce.probe};
             opt->report(opt->user, &smp);
         }
-        if (stop_after(&c, pass, err, now_seconds() - pass_start, &stop)) break;
+        /* the target is about lightmap texels (REPT's texel_rel_rmse, spec §7.2) when there are
+         * any; probes' own estimates are reported beside it */
+        const double stop_err = opt->class_end[BK_RECEIVER_CLASSES - 1] && opt->class_end[BK_CLASS_TEXEL] ? ce.cls[BK_CLASS_TEXEL] : err;
+        if (stop_after(&c, pass, stop_err, now_seconds() - pass_start, &stop)) break;
     }
     finish_outputs(&c);
-    if (stats) fill_stats(&c, pass + 1, err, bias, chain, stop, stats);
+    if (stats) fill_stats(&c, pass + 1, err, bias, &ce, chain, stop, stats);
 done:
     free_ctx(&c);
     return res;
