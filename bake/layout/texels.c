@@ -51,6 +51,7 @@ void bk_tangent_frame(const float n[3], const float dpdu[3], float t[3], float b
 void bk_texels_free(bk_texels *tx)
 {
     if (!tx) return;
+    free(tx->footprint);
     free(tx->pages);
     free(tx->page_offset);
     free(tx->index);
@@ -125,78 +126,307 @@ static void make_receiver(const bk_scene *s, const bk_atlas *a, uint32_t e, cons
     r->flags = BK_TEXEL_VALID;
 }
 
-/* Claims for each triangle of the chart the texels whose centre it covers (distance -1) or
- * that bilinear filtering reads somewhere on it (squared distance to its closest point); the
- * nearest claim wins, the first on ties. idx / bst: the chart's page in index / best. */
-static void rasterise_chart(const bk_atlas *a, const bk_atlas_chart *ch, int32_t *idx, float *bst)
+/* ---------------------------------------------------------------------------------------- */
+/* Footprint                                                                                */
+
+/* 1 unless a separating axis (the square's two, the triangle's three edge normals) splits the
+ * triangle from the square [x, x+1] × [y, y+1]; touching counts as overlapping. */
+static int tri_overlaps_square(const bk_rtri *t, double x, double y)
 {
-    int pw = a->pages[ch->page].width, ph = a->pages[ch->page].height;
-    for (uint32_t e = ch->first; e < ch->first + ch->count; e++) {
-        bk_rtri t;
-        if (!bk_rtri_setup(a->tri_uv + 6 * (size_t)e, &t)) continue;
-        double mnx = fmin(t.x[0], fmin(t.x[1], t.x[2])), mxx = fmax(t.x[0], fmax(t.x[1], t.x[2]));
-        double mny = fmin(t.y[0], fmin(t.y[1], t.y[2])), mxy = fmax(t.y[0], fmax(t.y[1], t.y[2]));
-        int x0 = (int)fmax(0.0, floor(mnx) - 1), x1 = (int)fmin((double)pw - 1, floor(mxx) + 1);
-        int y0 = (int)fmax(0.0, floor(mny) - 1), y1 = (int)fmin((double)ph - 1, floor(mxy) + 1);
-        for (int y = y0; y <= y1; y++)
-            for (int x = x0; x <= x1; x++) {
-                double cx = x + 0.5, cy = y + 0.5;
-                float d;
-                if (bk_rtri_inside(&t, cx, cy, NULL)) {
-                    d = -1.0f;
-                } else {
-                    /* the bilinear footprint: filtering at some point of the triangle reads it */
-                    if (!bk_rtri_meets_square(&t, cx, cy, 1.0)) continue;
-                    d = (float)bk_rtri_closest(&t, cx, cy, NULL, NULL, NULL);
-                }
-                size_t i = (size_t)y * (size_t)pw + (size_t)x;
-                if (d < bst[i]) {
-                    bst[i] = d;
-                    idx[i] = (int32_t)e;
-                }
+    double mnx = fmin(t->x[0], fmin(t->x[1], t->x[2])), mxx = fmax(t->x[0], fmax(t->x[1], t->x[2]));
+    double mny = fmin(t->y[0], fmin(t->y[1], t->y[2])), mxy = fmax(t->y[0], fmax(t->y[1], t->y[2]));
+    if (mxx < x || mnx > x + 1 || mxy < y || mny > y + 1) return 0;
+    const double cx[4] = {x, x + 1, x + 1, x}, cy[4] = {y, y, y + 1, y + 1};
+    for (int k = 0; k < 3; k++) {
+        int a = (k + 1) % 3, b = (k + 2) % 3; /* edge a→b; corner k is inside (orientation > 0) */
+        int outside = 0;
+        for (int q = 0; q < 4; q++)
+            outside += bk_orient_raw(t->x[a], t->y[a], t->x[b], t->y[b], cx[q], cy[q]) < 0.0;
+        if (outside == 4) return 0;
+    }
+    return 1;
+}
+
+/* Barycentric weights (original corner order) of any point, inside or not. */
+static void rtri_weights(const bk_rtri *t, double px, double py, double w[3])
+{
+    double e[3];
+    for (int k = 0; k < 3; k++) {
+        int a = (k + 1) % 3, b = (k + 2) % 3;
+        e[k] = bk_orient_raw(t->x[a], t->y[a], t->x[b], t->y[b], px, py) / t->area2;
+    }
+    w[0] = e[0];
+    w[1] = t->flipped ? e[2] : e[1];
+    w[2] = t->flipped ? e[1] : e[2];
+}
+
+/* UV islands: entries of one chart joined by edges they share both in uv and in the world
+ * (exact corner coordinates). An authored layout is one chart holding many islands, often
+ * closer than a texel or even touching; a texel's footprint stays on its own island, as a
+ * renderer's bake stays on the texel's triangle. */
+typedef struct fp_edge { uint32_t chart; float k[10]; uint32_t entry; } fp_edge; /* uv a, uv b, world a, b */
+
+static int cmp_edge(const void *p, const void *q)
+{
+    const fp_edge *a = p, *b = q;
+    if (a->chart != b->chart) return a->chart < b->chart ? -1 : 1;
+    for (int k = 0; k < 10; k++)
+        if (a->k[k] != b->k[k]) return a->k[k] < b->k[k] ? -1 : 1;
+    return (a->entry > b->entry) - (a->entry < b->entry);
+}
+
+static int same_edge(const fp_edge *a, const fp_edge *b)
+{
+    if (a->chart != b->chart) return 0;
+    for (int k = 0; k < 10; k++)
+        if (a->k[k] != b->k[k]) return 0;
+    return 1;
+}
+
+static uint32_t uf_find(uint32_t *p, uint32_t x)
+{
+    while (p[x] != x) {
+        p[x] = p[p[x]];
+        x = p[x];
+    }
+    return x;
+}
+
+static uint32_t *uv_islands(const bk_scene *s, const bk_atlas *a)
+{
+    size_t n = a->tri_count;
+    uint32_t *parent = malloc((n ? n : 1) * sizeof *parent);
+    fp_edge *e = malloc((n ? 3 * n : 1) * sizeof *e);
+    if (!parent || !e) {
+        free(parent);
+        free(e);
+        return NULL;
+    }
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++) {
+        parent[i] = (uint32_t)i;
+        const float *uv = a->tri_uv + 6 * i;
+        const uint32_t *ix = s->tris + 3 * (size_t)a->tris[i];
+        for (int k = 0; k < 3; k++) {
+            int k2 = (k + 1) % 3;
+            float ka[5] = {uv[2 * k], uv[2 * k + 1], 0, 0, 0}, kb[5] = {uv[2 * k2], uv[2 * k2 + 1], 0, 0, 0};
+            int ok = ix[k] < s->vertex_count && ix[k2] < s->vertex_count;
+            for (int c = 0; ok && c < 3; c++) {
+                ka[2 + c] = s->positions[3 * (size_t)ix[k] + c];
+                kb[2 + c] = s->positions[3 * (size_t)ix[k2] + c];
             }
+            for (int c = 0; c < 5; c++) ok = ok && isfinite(ka[c]) && isfinite(kb[c]);
+            if (!ok) continue;
+            int swap = 0; /* the lexicographically smaller corner first, so both sides agree */
+            for (int c = 0; c < 5 && !swap; c++) {
+                if (kb[c] < ka[c]) swap = 1;
+                if (kb[c] != ka[c]) break;
+            }
+            fp_edge *x = &e[m++];
+            x->chart = a->tri_chart[i];
+            for (int c = 0; c < 5; c++) {
+                x->k[c] = swap ? kb[c] : ka[c];
+                x->k[5 + c] = swap ? ka[c] : kb[c];
+            }
+            x->entry = (uint32_t)i;
+        }
+    }
+    qsort(e, m, sizeof *e, cmp_edge);
+    for (size_t i = 1; i < m; i++) {
+        const fp_edge *p = &e[i - 1], *q = &e[i];
+        if (!same_edge(p, q)) continue;
+        uint32_t r1 = uf_find(parent, p->entry), r2 = uf_find(parent, q->entry);
+        if (r1 != r2) parent[r1 > r2 ? r1 : r2] = r1 > r2 ? r2 : r1;
+    }
+    for (size_t i = 0; i < n; i++) parent[i] = uf_find(parent, (uint32_t)i);
+    free(e);
+    return parent;
+}
+
+typedef struct fp_pair { size_t texel; uint32_t entry; } fp_pair;
+
+static int cmp_pair(const void *a, const void *b)
+{
+    const fp_pair *p = a, *q = b;
+    if (p->texel != q->texel) return p->texel < q->texel ? -1 : 1;
+    return (p->entry > q->entry) - (p->entry < q->entry);
+}
+
+/* (texel, entry) for every chart triangle over a texel its chart owns; idx holds the owning
+ * entry per texel (or -1). Sorted by texel, then entry: receiver order. */
+static lbk_result footprint_pairs(const bk_scene *s, const bk_atlas *a, const bk_texels *out, const int32_t *idx_all,
+                                  fp_pair **pairs, size_t *count)
+{
+    size_t n = 0, cap = 0;
+    fp_pair *v = NULL;
+    uint32_t *island = uv_islands(s, a);
+    if (!island) return LBK_ERR_OUT_OF_MEMORY;
+    for (size_t c = 0; c < a->chart_count; c++) {
+        const bk_atlas_chart *ch = &a->charts[c];
+        if (ch->page < 0 || (size_t)ch->page >= out->page_count) continue;
+        int pw = out->pages[ch->page].width, ph = out->pages[ch->page].height;
+        size_t base = out->page_offset[ch->page];
+        const int32_t *idx = idx_all + base;
+        for (uint32_t e = ch->first; e < ch->first + ch->count; e++) {
+            bk_rtri t;
+            if (!bk_rtri_setup(a->tri_uv + 6 * (size_t)e, &t)) continue;
+            double mnx = fmin(t.x[0], fmin(t.x[1], t.x[2])), mxx = fmax(t.x[0], fmax(t.x[1], t.x[2]));
+            double mny = fmin(t.y[0], fmin(t.y[1], t.y[2])), mxy = fmax(t.y[0], fmax(t.y[1], t.y[2]));
+            int x0 = (int)fmax(0.0, floor(mnx) - 1), x1 = (int)fmin((double)pw - 1, floor(mxx) + 1);
+            int y0 = (int)fmax(0.0, floor(mny) - 1), y1 = (int)fmin((double)ph - 1, floor(mxy) + 1);
+            for (int y = y0; y <= y1; y++)
+                for (int x = x0; x <= x1; x++) {
+                    size_t i = (size_t)y * (size_t)pw + (size_t)x;
+                    if (idx[i] < 0 || island[idx[i]] != island[e]) continue;
+                    if (!tri_overlaps_square(&t, x, y)) continue;
+                    if (n == cap) {
+                        size_t nc = cap ? 2 * cap : 1024;
+                        fp_pair *nv = realloc(v, nc * sizeof *nv);
+                        if (!nv) { free(v); free(island); return LBK_ERR_OUT_OF_MEMORY; }
+                        v = nv;
+                        cap = nc;
+                    }
+                    v[n].texel = base + i;
+                    v[n].entry = e;
+                    n++;
+                }
+        }
+    }
+    free(island);
+    if (n) qsort(v, n, sizeof *v, cmp_pair);
+    *pairs = v;
+    *count = n;
+    return LBK_OK;
+}
+
+/* Grows box (s0, t0, s1, t1) by the part of triangle `entry` inside texel (x, y)'s square
+ * (Sutherland–Hodgman against the square's four sides, in texel-local coordinates); returns
+ * that part's area (in texels). */
+static double clip_box(const bk_atlas *a, uint32_t entry, int x, int y, double box[4])
+{
+    const float *uv = a->tri_uv + 6 * (size_t)entry;
+    double poly[2][16][2];
+    int n = 3, cur = 0;
+    for (int k = 0; k < 3; k++) {
+        poly[0][k][0] = uv[2 * k] - x;
+        poly[0][k][1] = uv[2 * k + 1] - y;
+    }
+    for (int side = 0; side < 4 && n > 0; side++) {
+        const int axis = side & 1;
+        const double lim = side < 2 ? 0.0 : 1.0, sg = side < 2 ? 1.0 : -1.0; /* keep sg·(c − lim) >= 0 */
+        int m = 0;
+        for (int k = 0; k < n; k++) {
+            const double *p = poly[cur][k], *q = poly[cur][(k + 1) % n];
+            double dp = sg * (p[axis] - lim), dq = sg * (q[axis] - lim);
+            if (dp >= 0 && m < 16) { poly[!cur][m][0] = p[0]; poly[!cur][m][1] = p[1]; m++; }
+            if ((dp >= 0) != (dq >= 0) && m < 16) {
+                double f = dp / (dp - dq);
+                poly[!cur][m][0] = p[0] + f * (q[0] - p[0]);
+                poly[!cur][m][1] = p[1] + f * (q[1] - p[1]);
+                m++;
+            }
+        }
+        n = m;
+        cur = !cur;
+    }
+    double area2 = 0.0;
+    for (int k = 0; k < n; k++) {
+        const double *p = poly[cur][k], *q = poly[cur][(k + 1) % n];
+        area2 += p[0] * q[1] - q[0] * p[1];
+        box[0] = fmin(box[0], p[0]);
+        box[1] = fmin(box[1], p[1]);
+        box[2] = fmax(box[2], p[0]);
+        box[3] = fmax(box[3], p[1]);
+    }
+    return 0.5 * fabs(area2);
+}
+
+/* The footprint triangle of `entry` over texel (x, y): barycentrics as affine maps of (s, t). */
+static void footprint_tri(const bk_atlas *a, uint32_t entry, int x, int y, bk_footprint_tri *f)
+{
+    bk_rtri t;
+    bk_rtri_setup(a->tri_uv + 6 * (size_t)entry, &t);
+    double w00[3], w10[3], w01[3];
+    rtri_weights(&t, x, y, w00);
+    rtri_weights(&t, x + 1, y, w10);
+    rtri_weights(&t, x, y + 1, w01);
+    f->tri = a->tris[entry];
+    for (int k = 0; k < 2; k++) {
+        f->uv[k][0] = (float)w00[k + 1];
+        f->uv[k][1] = (float)(w10[k + 1] - w00[k + 1]);
+        f->uv[k][2] = (float)(w01[k + 1] - w00[k + 1]);
     }
 }
 
-/* One receiver per claimed texel, pages in order and rows top to bottom; index switches from
- * the owning triangle entry to the receiver. A texel whose centre lies outside its triangle
- * samples the triangle's closest point and is marked BK_TEXEL_EDGE. */
-static lbk_result emit_receivers(const bk_scene *s, const bk_atlas *a, const float *best, bk_texels *out)
+/* The owning triangle entry of every covered texel into out->index (coverage rule in texels.h);
+ * best[i]: its squared distance to the centre, -1 when the centre is inside. */
+static void rasterise_owners(const bk_atlas *a, bk_texels *out, float *best)
 {
-    size_t total = out->page_offset[out->page_count], count = 0;
-    for (size_t i = 0; i < total; i++) count += out->index[i] >= 0;
-    out->receivers = malloc((count ? count : 1) * sizeof *out->receivers);
-    if (!out->receivers) return LBK_ERR_OUT_OF_MEMORY;
-    size_t r = 0;
-    for (size_t p = 0; p < out->page_count; p++) {
-        int pw = a->pages[p].width, ph = a->pages[p].height;
-        int32_t *idx = out->index + out->page_offset[p];
-        const float *bst = best + out->page_offset[p];
-        for (int y = 0; y < ph; y++)
-            for (int x = 0; x < pw; x++) {
-                size_t i = (size_t)y * (size_t)pw + (size_t)x;
-                if (idx[i] < 0) continue;
-                uint32_t e = (uint32_t)idx[i];
-                bk_rtri t;
-                bk_rtri_setup(a->tri_uv + 6 * (size_t)e, &t);
-                double w[3];
-                int edge = 0;
-                if (!(bst[i] < 0.0f) || !bk_rtri_inside(&t, x + 0.5, y + 0.5, w)) {
-                    bk_rtri_closest(&t, x + 0.5, y + 0.5, w, NULL, NULL);
-                    edge = 1;
+    for (size_t c = 0; c < a->chart_count; c++) {
+        const bk_atlas_chart *ch = &a->charts[c];
+        if (ch->page < 0 || (size_t)ch->page >= out->page_count) continue;
+        int pw = a->pages[ch->page].width, ph = a->pages[ch->page].height;
+        int32_t *idx = out->index + out->page_offset[ch->page];
+        float *bst = best + out->page_offset[ch->page];
+        for (uint32_t e = ch->first; e < ch->first + ch->count; e++) {
+            bk_rtri t;
+            if (!bk_rtri_setup(a->tri_uv + 6 * (size_t)e, &t)) continue;
+            double mnx = fmin(t.x[0], fmin(t.x[1], t.x[2])), mxx = fmax(t.x[0], fmax(t.x[1], t.x[2]));
+            double mny = fmin(t.y[0], fmin(t.y[1], t.y[2])), mxy = fmax(t.y[0], fmax(t.y[1], t.y[2]));
+            int x0 = (int)fmax(0.0, floor(mnx) - 1), x1 = (int)fmin((double)pw - 1, floor(mxx) + 1);
+            int y0 = (int)fmax(0.0, floor(mny) - 1), y1 = (int)fmin((double)ph - 1, floor(mxy) + 1);
+            for (int y = y0; y <= y1; y++)
+                for (int x = x0; x <= x1; x++) {
+                    double cx = x + 0.5, cy = y + 0.5;
+                    float d;
+                    if (bk_rtri_inside(&t, cx, cy, NULL)) {
+                        d = -1.0f;
+                    } else {
+                        /* the bilinear footprint: filtering at some point of the triangle reads it */
+                        if (!bk_rtri_meets_square(&t, cx, cy, 1.0)) continue;
+                        d = (float)bk_rtri_closest(&t, cx, cy, NULL, NULL, NULL);
+                    }
+                    size_t i = (size_t)y * (size_t)pw + (size_t)x;
+                    if (d < bst[i]) {
+                        bst[i] = d;
+                        idx[i] = (int32_t)e;
+                    }
                 }
-                bk_texel *rc = &out->receivers[r];
-                make_receiver(s, a, e, w, rc);
-                if (edge) rc->flags |= BK_TEXEL_EDGE;
-                rc->page = (uint32_t)p;
-                rc->x = (uint16_t)x;
-                rc->y = (uint16_t)y;
-                idx[i] = (int32_t)r;
-                r++;
-            }
+        }
     }
-    out->count = count;
-    return LBK_OK;
+}
+
+/* Below this area (texels) the chart does not cover a texel's square: triangles that only touch
+ * it (an edge along the square's side) or a sliver of rounding. */
+#define RING_AREA 1e-6
+
+/* Texel (x, y) (global index g) gets its footprint: the pairs of g, from *fp on (sorted alike),
+ * as maps and as the bounding box of the part of its square they cover; a texel whose square
+ * the chart does not cover is a ring texel (texels.h). */
+static void texel_footprint(const bk_atlas *a, const fp_pair *pairs, size_t npairs, size_t *fp, size_t g, int x,
+                            int y, bk_footprint_tri *fps, bk_texel *rc)
+{
+    while (*fp < npairs && pairs[*fp].texel < g) (*fp)++;
+    rc->footprint_first = (uint32_t)*fp;
+    double box[4] = {1, 1, 0, 0}, area = 0.0;
+    while (*fp < npairs && pairs[*fp].texel == g) {
+        footprint_tri(a, pairs[*fp].entry, x, y, &fps[*fp]);
+        area += clip_box(a, pairs[*fp].entry, x, y, box);
+        (*fp)++;
+    }
+    rc->footprint_count = (uint32_t)(*fp - rc->footprint_first);
+    if (!(area > RING_AREA)) { /* only bilinear filtering reads it (texels.h, Ring) */
+        rc->footprint_count = 0;
+        rc->flags |= BK_TEXEL_RING;
+        memset(rc->footprint_box, 0, sizeof rc->footprint_box);
+        return;
+    }
+    /* a little larger against rounding */
+    for (int k = 0; k < 2; k++) {
+        double lo = fmax(0.0, box[k] - 1e-4), hi = fmin(1.0, box[k + 2] + 1e-4);
+        rc->footprint_box[k] = (float)lo;
+        rc->footprint_box[k + 2] = (float)fmax(0.0, hi - lo);
+    }
 }
 
 lbk_result bk_texels_build(const bk_scene *s, const bk_atlas *a, bk_texels *out)
@@ -235,15 +465,59 @@ lbk_result bk_texels_build(const bk_scene *s, const bk_atlas *a, bk_texels *out)
         out->index[i] = -1;
         best[i] = INFINITY;
     }
-    for (size_t c = 0; c < a->chart_count; c++) {
-        const bk_atlas_chart *ch = &a->charts[c];
-        if (ch->page < 0 || (size_t)ch->page >= np) continue;
-        rasterise_chart(a, ch, out->index + out->page_offset[ch->page], best + out->page_offset[ch->page]);
+    rasterise_owners(a, out, best);
+    size_t count = 0;
+    for (size_t i = 0; i < total; i++) count += out->index[i] >= 0;
+    fp_pair *pairs = NULL;
+    size_t npairs = 0;
+    out->receivers = malloc((count ? count : 1) * sizeof *out->receivers);
+    if (!out->receivers || footprint_pairs(s, a, out, out->index, &pairs, &npairs) != LBK_OK ||
+        !(out->footprint = malloc((npairs ? npairs : 1) * sizeof *out->footprint))) {
+        free(best);
+        free(pairs);
+        bk_texels_free(out);
+        return LBK_ERR_OUT_OF_MEMORY;
     }
-    lbk_result res = emit_receivers(s, a, best, out);
+    out->footprint_count = npairs;
+    if (npairs > UINT32_MAX) { /* footprint_first is 32-bit */
+        free(best);
+        free(pairs);
+        bk_texels_free(out);
+        return LBK_ERR_LIMIT;
+    }
+    size_t r = 0, fp = 0;
+    for (size_t p = 0; p < np; p++) {
+        int pw = a->pages[p].width, ph = a->pages[p].height;
+        int32_t *idx = out->index + out->page_offset[p];
+        const float *bst = best + out->page_offset[p];
+        for (int y = 0; y < ph; y++)
+            for (int x = 0; x < pw; x++) {
+                size_t i = (size_t)y * (size_t)pw + (size_t)x;
+                if (idx[i] < 0) continue;
+                uint32_t e = (uint32_t)idx[i];
+                bk_rtri t;
+                bk_rtri_setup(a->tri_uv + 6 * (size_t)e, &t);
+                double w[3];
+                int edge = 0;
+                if (!(bst[i] < 0.0f) || !bk_rtri_inside(&t, x + 0.5, y + 0.5, w)) {
+                    bk_rtri_closest(&t, x + 0.5, y + 0.5, w, NULL, NULL);
+                    edge = 1;
+                }
+                bk_texel *rc = &out->receivers[r];
+                make_receiver(s, a, e, w, rc);
+                if (edge) rc->flags |= BK_TEXEL_EDGE;
+                rc->page = (uint32_t)p;
+                rc->x = (uint16_t)x;
+                rc->y = (uint16_t)y;
+                texel_footprint(a, pairs, npairs, &fp, out->page_offset[p] + i, x, y, out->footprint, rc);
+                idx[i] = (int32_t)r;
+                r++;
+            }
+    }
+    out->count = count;
     free(best);
-    if (res != LBK_OK) bk_texels_free(out);
-    return res;
+    free(pairs);
+    return LBK_OK;
 }
 
 /* ---------------------------------------------------------------------------------------- */
@@ -305,6 +579,90 @@ static void hit_point(const bk_scene *s, const bk_hit *h, float out[3])
     for (int c = 0; c < 3; c++) out[c] = (float)(w0 * p[0][c] + h->u * p[1][c] + h->v * p[2][c]);
 }
 
+/* Whether q, projected onto triangle tri's plane, lies on the triangle (barycentrics >= -1e-4):
+ * a pushed point must stay on its own face, not move past its edge onto another surface. */
+static int on_own_triangle(const bk_scene *s, uint32_t tri, const float q[3])
+{
+    double p[3][3], e1[3], e2[3], d[3], n[3];
+    if (!bk_tri_positions(s, tri, p)) return 0;
+    double qd[3];
+    bkv_load(qd, q);
+    bkv_sub(e1, p[1], p[0]);
+    bkv_sub(e2, p[2], p[0]);
+    bkv_sub(d, qd, p[0]);
+    bkv_cross(n, e1, e2);
+    double nn = bkv_dot(n, n);
+    if (!(nn > 0)) return 0;
+    double c1[3], c2[3];
+    bkv_cross(c1, d, e2);
+    bkv_cross(c2, e1, d);
+    double u = bkv_dot(c1, n) / nn, v = bkv_dot(c2, n) / nn;
+    const double tol = 1e-4;
+    return u >= -tol && v >= -tol && u + v <= 1 + tol;
+}
+
+/* Whether a pushed point q stays on the texel's own face: on its own triangle, on one of its
+ * footprint triangles (its chart's triangles over its square), or — for a texel whose point lies
+ * on a triangle's border or corner (the bilinear ring, texels.h, has no footprint) — on a
+ * triangle of the same object in the same plane, found by a short probe ray down onto q. So the
+ * point moves onto the next triangle of its face, never off the face onto another surface. */
+static int on_own_face(const push_job *j, const bk_texel *r, const double ng[3], double band, const float q[3])
+{
+    const bk_scene *s = j->scene;
+    if (on_own_triangle(s, r->tri, q)) return 1;
+    for (uint32_t k = 0; k < r->footprint_count; k++)
+        if (on_own_triangle(s, j->tx->footprint[r->footprint_first + k].tri, q)) return 1;
+    float org[3], dir[3];
+    for (int c = 0; c < 3; c++) {
+        org[c] = (float)(q[c] + band * ng[c]);
+        dir[c] = (float)-ng[c];
+    }
+    bk_hit h;
+    /* q is within `band` of the texel's plane (push_one): the face lies within 2·band below org */
+    if (!bk_tracer_intersect(j->tracer, org, dir, 0.0f, (float)(2.5 * band), &h)) return 0;
+    if (!s->tri_object || s->tri_object[h.tri] != r->object) return 0;
+    double hn[3];
+    oriented_geo_normal(s, h.tri, r->normal, hn);
+    return bkv_dot(hn, ng) > 0.999;
+}
+
+/* A texel whose square is partly hidden behind a surface in front of it (a back face within
+ * `band` along the normal: a light panel hung a centimetre under a ceiling, its back to it)
+ * loses its footprint and keeps its (pushed) point. A renderer never
+ * shows the hidden part, but bilinear filtering spreads the texel's value over the visible
+ * surface beside it: averaged over the panel's back-lit ceiling, the ceiling next to the Cornell
+ * box's light baked 4–8× too bright (a halo one texel wide). Probed on a 4 × 4 grid of the
+ * square's points, one short ray each. */
+#define VIS_GRID 4
+static void drop_hidden_footprint(const push_job *j, bk_texel *r, double band)
+{
+    if (!r->footprint_count) return;
+    const bk_scene *s = j->scene;
+    for (int cy = 0; cy < VIS_GRID; cy++)
+        for (int cx = 0; cx < VIS_GRID; cx++) {
+            double ps = (cx + 0.5) / VIS_GRID, pt = (cy + 0.5) / VIS_GRID;
+            for (uint32_t k = 0; k < r->footprint_count; k++) {
+                const bk_footprint_tri *f = &j->tx->footprint[r->footprint_first + k];
+                double u = f->uv[0][0] + f->uv[0][1] * ps + f->uv[0][2] * pt;
+                double v = f->uv[1][0] + f->uv[1][1] * ps + f->uv[1][2] * pt;
+                if (!(u >= 0 && v >= 0 && u + v <= 1)) continue;
+                double q[3][3], n[3];
+                if (!bk_tri_positions(s, f->tri, q)) break;
+                oriented_geo_normal(s, f->tri, r->normal, n);
+                float pf[3], nf[3] = {(float)n[0], (float)n[1], (float)n[2]}, org[3];
+                for (int c = 0; c < 3; c++) pf[c] = (float)((1 - u - v) * q[0][c] + u * q[1][c] + v * q[2][c]);
+                bk_offset_ray_origin_scaled(pf, nf, bk_tracer_tri_scale(j->tracer, f->tri), org);
+                bk_hit h;
+                if (bk_tracer_intersect(j->tracer, org, nf, 0.0f, (float)band, &h) && !h.front) {
+                    r->footprint_count = 0;
+                    memset(r->footprint_box, 0, sizeof r->footprint_box);
+                    return;
+                }
+                break;
+            }
+        }
+}
+
 static void push_one(const push_job *j, bk_texel *r, bk_pushout_stats *st)
 {
     const bk_scene *s = j->scene;
@@ -315,6 +673,9 @@ static void push_one(const push_job *j, bk_texel *r, bk_pushout_stats *st)
     float reach = j->reach * r->texel_size;
     uint32_t cur_tri = r->tri;
     float cur_n[3] = {ngf[0], ngf[1], ngf[2]};
+    /* a move must stay on the texel: to a hit this close to the texel's own plane */
+    const float p0[3] = {r->position[0], r->position[1], r->position[2]};
+    const double band = 0.1 * r->texel_size;
     /* short rays: 8 along the tangent plane (raised ~3°), 5 over the hemisphere */
     double local[13][3];
     for (int i = 0; i < 8; i++) {
@@ -342,6 +703,13 @@ static void push_one(const push_job *j, bk_texel *r, bk_pushout_stats *st)
             bk_hit h;
             if (!bk_tracer_intersect(j->tracer, org, d, 0.0f, reach, &h)) continue;
             if (h.front) continue;
+            float q[3] = {p0[0], p0[1], p0[2]};
+            hit_point(s, &h, q);
+            double height = (q[0] - p0[0]) * ng[0] + (q[1] - p0[1]) * ng[1] + (q[2] - p0[2]) * ng[2];
+            if (fabs(height) > band) continue;
+            float qo[3]; /* where the point would go: just in front of the surface hit */
+            bk_offset_ray_origin_scaled(q, h.ng, bk_tracer_tri_scale(j->tracer, h.tri), qo);
+            if (!on_own_face(j, r, ng, band, qo)) continue;
             if (!found || h.t < best.t) {
                 best = h;
                 found = 1;
@@ -357,6 +725,7 @@ static void push_one(const push_job *j, bk_texel *r, bk_pushout_stats *st)
         r->flags |= BK_TEXEL_PUSHED;
     }
     if (r->flags & BK_TEXEL_PUSHED) st->pushed++;
+    drop_hidden_footprint(j, r, band);
     /* inside closed geometry? */
     float org[3];
     bk_offset_ray_origin_scaled(r->position, cur_n, bk_tracer_tri_scale(j->tracer, cur_tri), org);
@@ -372,8 +741,7 @@ static void push_one(const push_job *j, bk_texel *r, bk_pushout_stats *st)
         if (2 * back >= LONG_RAYS || 2 * (back + LONG_RAYS - 1 - i) < LONG_RAYS) break;
     }
     if (2 * back >= LONG_RAYS) {
-        r->flags &= ~(uint32_t)BK_TEXEL_VALID;
-        r->flags |= BK_TEXEL_INSIDE;
+        r->flags |= BK_TEXEL_INSIDE; /* still baked: black inside closed solids (texels.h) */
         st->inside++;
     }
     st->tested++;

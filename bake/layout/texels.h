@@ -25,16 +25,47 @@
  *   B = cross(N, T). Where dP/du is undefined (zero uv area) T is the first vector of the
  *   branchless orthonormal basis of N (Duff et al. 2017, see bk_tangent_frame).
  *
- * Push-out (bk_texels_push_out): from each sample, 8 rays along the geometric tangent plane
- * (raised by ~3°) and 5 over the hemisphere search `reach` texels (default 1.5 texel sizes)
- * for a BACK face (a ray arriving at the back of a triangle means the point is behind that
- * surface: under a wall, inside a box). The sample is moved just in front of the closest such
- * hit (bk_offset_ray_origin_scaled along that triangle's normal), up to 3 times (corners).
- * Then 16 long hemisphere rays: when at least half of them end on back faces the point is
- * inside closed geometry and cannot be lit: BK_TEXEL_VALID is cleared and BK_TEXEL_INSIDE
- * set, and dilation fills the texel from valid neighbours instead. Orientation is the
- * triangle winding (glTF front = counter-clockwise), also for double-sided materials: a
- * closed mesh's interior is its back side either way.
+ * Footprint: every triangle of the texel's own UV island that overlaps its square (exact
+ * triangle/square overlap; an island: the chart's triangles joined to the texel's own by shared
+ * UV edges — an authored layout is one chart of many islands, often less than a texel apart, and
+ * a floor texel must not average in the island next to it, perhaps the floor's underside), as the affine map from texel-local (s, t) to the triangle's
+ * barycentrics (bk_footprint_tri). The light transport starts each gather ray from a random
+ * point of the square that one of them covers, so a texel's value is the irradiance averaged
+ * over the part of its square its chart covers, as a renderer's bake of the texel is (a chart
+ * of many small triangles is not sampled at one point each; TRANSPORT.md §Footprint).
+ *
+ * Ring: a texel that bilinear filtering reads for points of its chart within a texel of the
+ * chart's border, but whose own square the chart does not cover (no area; triangles that only
+ * touch it do not count) has no footprint and is flagged BK_TEXEL_RING. It is baked at its
+ * sample point, the chart's closest point to its centre (pushed out like any other), not left
+ * to dilation: filtered at the chart points that read ring texels, the bias room
+ * (bench/bench_ring.c) is 7.6 % from the reference with ring texels baked this way and 10.0 %
+ * with them dilated from their chart's texels (14.9 / 18.5 % at 6 texels/m, 24.9 / 28.5 % at
+ * 4): the border point extrapolates the chart's light to the ring's centre better than the
+ * texels inside the chart do.
+ *
+ * Push-out (bk_texels_push_out): the single sample point (which the transport still uses for
+ * punctual lights where no footprint triangle covers a quarter centre, and for parts of the
+ * square no triangle covers) is moved out from behind surfaces: from it, 8 rays along the
+ * geometric tangent plane (raised by ~3°) and 5 over the hemisphere search `reach` texels
+ * (default 1.5 texel sizes) for a BACK face (a ray arriving at the back of a triangle means
+ * the point is behind that surface: under a wall, inside a box). The sample is moved just in
+ * front of the closest such hit (bk_offset_ray_origin_scaled along that triangle's normal),
+ * up to 3 times (corners) — but only to a hit within a tenth of a texel of its own plane and
+ * onto its own face (its triangle, a footprint triangle, or for a point on a triangle's border
+ * a coplanar triangle of its object under the new point): the point must stay on its texel,
+ * never be carried through a wall to its far side (a shelf's end let into a wall is not moved
+ * out of the wall's outer face into the sky). A texel whose square is partly hidden behind a
+ * surface in front of it (a back face within the tenth of a texel along its normal, probed at
+ * 4 × 4 points: a light panel hung just under a ceiling) loses its footprint and keeps its
+ * pushed point: filtering would spread the hidden part's light over the visible surface beside
+ * it (TRANSPORT.md, After the atlas merge). Then 16 long
+ * hemisphere rays: when at least half of them end on back faces the point is inside closed
+ * geometry: BK_TEXEL_INSIDE is set (information only: the texel is still baked, and the
+ * transport makes the inside of closed solids black, so a face sealed inside a wall bakes to
+ * 0 as it does in a path tracer, instead of being dilated from lit neighbours). Orientation
+ * is the triangle winding (glTF front = counter-clockwise), also for double-sided materials:
+ * a closed mesh's interior is its back side either way.
  *
  * Dilation (bk_dilate): works on any per-texel payload (N floats per texel). */
 #ifndef BK_TEXELS_H
@@ -47,6 +78,7 @@
 #include "bake/layout/atlas.h"
 #include "bake/scene/scene.h"
 #include "bake/transport/tracer.h"
+#include "bake/transport/transport.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -56,7 +88,9 @@ enum bk_texel_flag {
     BK_TEXEL_VALID = 1u,   /* light this sample */
     BK_TEXEL_EDGE = 2u,    /* centre outside every triangle: sample at the nearest point */
     BK_TEXEL_PUSHED = 4u,  /* moved out from behind a surface */
-    BK_TEXEL_INSIDE = 8u   /* inside closed geometry: not valid, filled by dilation */
+    BK_TEXEL_INSIDE = 8u,  /* its point is inside closed geometry (information; still valid) */
+    BK_TEXEL_RING = 16u    /* read only by bilinear filtering (its chart does not cover its square):
+                              baked at its point, no footprint (see Ring above; still valid) */
 };
 
 typedef struct bk_texel {
@@ -69,6 +103,10 @@ typedef struct bk_texel {
     uint32_t page;
     uint16_t x, y;         /* texel in the page */
     uint32_t flags;        /* enum bk_texel_flag */
+    uint32_t footprint_first, footprint_count; /* its chart's triangles over its square, in
+                                                  bk_texels.footprint (see Footprint above) */
+    float footprint_box[4];  /* s0, t0, width, height: the part of its square they cover lies in
+                                it (bk_receiver.footprint_box) */
 } bk_texel;
 
 typedef struct bk_texels {
@@ -78,6 +116,8 @@ typedef struct bk_texels {
     int32_t *index;        /* per texel of every page (row-major): receiver, or -1 */
     size_t count;
     bk_texel *receivers;/* page-major, then row-major: deterministic order */
+    size_t footprint_count;
+    bk_footprint_tri *footprint; /* grouped by texel, in receiver order */
 } bk_texels;
 
 /* Rasterises every chart of the atlas. Errors: LBK_ERR_INVALID_ARGUMENT,

@@ -391,6 +391,10 @@ static lbk_result build_receivers(bk_pipeline *b)
         if (!(t->flags & BK_TEXEL_VALID)) continue;
         memcpy(b->receivers[k].position, t->position, sizeof t->position);
         memcpy(b->receivers[k].normal, t->normal, sizeof t->normal);
+        /* the texel's value is the average over its square (texels.h, Footprint) */
+        b->receivers[k].footprint_first = t->footprint_first;
+        b->receivers[k].footprint_count = t->footprint_count;
+        memcpy(b->receivers[k].footprint_box, t->footprint_box, sizeof t->footprint_box);
         b->texel_of_receiver[k++] = (uint32_t)i;
     }
     if (b->have_glg)
@@ -414,6 +418,9 @@ static void transport_options(const bk_pipeline *b, bk_transport_options *to)
     to->max_samples = opt->max_samples > 0 ? opt->max_samples : b->pre->max_samples;
     to->target_error = opt->target_error > 0 ? opt->target_error : b->pre->target_error;
     to->time_limit = opt->time_limit;
+    to->cell_size = b->cell_size;
+    to->footprint = b->texels.footprint;
+    to->footprint_count = b->texels.footprint_count;
     to->class_end[BK_CLASS_TEXEL] = b->texel_receivers;
     to->class_end[BK_CLASS_GLG] = b->llg_first;
     to->class_end[BK_CLASS_LLG] = b->receiver_count;
@@ -439,6 +446,7 @@ void bk_pipeline_set_inputs(const bk_pipeline *b, bk_set_inputs *in)
     in->seams = b->opt->no_seam_stitch ? NULL : &b->seams;
     in->base_radiance = b->radiance;
     transport_options(b, &in->transport);
+    in->transport.footprint_scene = &b->scene; /* door runs trace a scene without the door */
     in->base_samples_per_receiver = b->stats.samples_per_receiver;
     in->threshold = b->opt->dls_threshold;
     in->events = &b->events;
@@ -448,10 +456,28 @@ void bk_pipeline_set_inputs(const bk_pipeline *b, bk_set_inputs *in)
     memcpy(in->origin, b->origin, sizeof in->origin);
 }
 
+/* The radiosity cache as fine as the lightmap: cells of a lightmapped triangle are its object's
+ * texel size (bake/transport/TRANSPORT.md §Bias); other triangles share the default budget. */
+static lbk_result build_cell_sizes(bk_pipeline *b)
+{
+    const bk_scene *s = &b->scene;
+    b->cell_size = calloc(s->tri_count ? s->tri_count : 1, sizeof *b->cell_size);
+    if (!b->cell_size) return LBK_ERR_OUT_OF_MEMORY;
+    for (size_t t = 0; t < s->tri_count; t++) {
+        uint32_t o = s->tri_object ? s->tri_object[t] : UINT32_MAX;
+        int32_t slot = o < b->atlas.scene_object_count && b->atlas.object_slot ? b->atlas.object_slot[o] : -1;
+        if (slot < 0) continue;
+        float density = b->atlas.objects[slot].density;
+        if (density > 0 && isfinite(density)) b->cell_size[t] = 1.0f / density;
+    }
+    return LBK_OK;
+}
+
 static lbk_result do_transport(bk_pipeline *b)
 {
     lbk_result r = phase(b, LBK_BAKE_PHASE_LIGHT);
     if (!r) r = build_receivers(b);
+    if (!r) r = build_cell_sizes(b);
     if (r) return r;
     bk_transport_options to;
     transport_options(b, &to);
@@ -636,6 +662,7 @@ static void pipeline_free(bk_pipeline *b)
     free(b->radiance);
     free(b->texel_of_receiver);
     free(b->receivers);
+    free(b->cell_size);
     for (size_t i = 0; i < b->llg_count; i++) bk_llg_free(&b->llgs[i]);
     free(b->llgs);
     free(b->object_llg);

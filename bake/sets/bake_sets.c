@@ -702,9 +702,11 @@ static lbk_result failure(run_ctx *rc, lbk_result r, const char *fmt, const char
 typedef struct filtered_scene {
     bk_scene scene;
     uint32_t *tris, *tri_material, *tri_object;
+    float *cell_size;  /* the transport's per-triangle cell sizes, filtered alike (NULL: none) */
 } filtered_scene;
 
-static lbk_result scene_without_doors(const bk_scene *s, const char *door, const char *door2, filtered_scene *out)
+static lbk_result scene_without_doors(const bk_scene *s, const char *door, const char *door2, const float *cell_size,
+                                      filtered_scene *out)
 {
     memset(out, 0, sizeof *out);
     out->scene = *s;
@@ -712,8 +714,9 @@ static lbk_result scene_without_doors(const bk_scene *s, const char *door, const
     out->tris = malloc(3 * n * sizeof *out->tris);
     out->tri_material = malloc(n * sizeof *out->tri_material);
     out->tri_object = malloc(n * sizeof *out->tri_object);
-    if (!out->tris || !out->tri_material || !out->tri_object) {
-        free(out->tris), free(out->tri_material), free(out->tri_object);
+    out->cell_size = cell_size ? malloc(n * sizeof *out->cell_size) : NULL;
+    if (!out->tris || !out->tri_material || !out->tri_object || (cell_size && !out->cell_size)) {
+        free(out->tris), free(out->tri_material), free(out->tri_object), free(out->cell_size);
         return LBK_ERR_OUT_OF_MEMORY;
     }
     size_t k = 0;
@@ -724,6 +727,7 @@ static lbk_result scene_without_doors(const bk_scene *s, const char *door, const
         memcpy(&out->tris[3 * k], &s->tris[3 * i], 3 * sizeof *out->tris);
         out->tri_material[k] = s->tri_material ? s->tri_material[i] : 0;
         out->tri_object[k] = o;
+        if (cell_size) out->cell_size[k] = cell_size[i];
         k++;
     }
     out->scene.tri_count = k;
@@ -735,7 +739,7 @@ static lbk_result scene_without_doors(const bk_scene *s, const char *door, const
 
 static void filtered_free(filtered_scene *f)
 {
-    free(f->tris), free(f->tri_material), free(f->tri_object);
+    free(f->tris), free(f->tri_material), free(f->tri_object), free(f->cell_size);
 }
 
 static lbk_result log_run(run_ctx *rc, const char *what, const bk_transport_stats *st)
@@ -825,7 +829,7 @@ static void sh_add(lbk_sh9_rgb *dst, const lbk_sh9_rgb *b, size_t n)
  * caller destroys *tr and frees *fs. */
 static lbk_result open_without(run_ctx *rc, const char *door, const char *door2, filtered_scene *fs, bk_tracer **tr)
 {
-    lbk_result r = scene_without_doors(rc->in->scene, door, door2, fs);
+    lbk_result r = scene_without_doors(rc->in->scene, door, door2, rc->in->transport.cell_size, fs);
     if (r) return failure(rc, r, "scene without door '%s': %s", door);
     r = bk_tracer_create(&fs->scene, rc->in->transport.threads, tr);
     if (r) {
@@ -843,7 +847,9 @@ static lbk_result run_without(run_ctx *rc, const char *door, const char *door2, 
     bk_tracer *tr = NULL;
     lbk_result r = open_without(rc, door, door2, &fs, &tr);
     if (r) return r;
-    r = run_one(rc, &fs.scene, tr, opt, rad, dir, what);
+    bk_transport_options o = *opt;
+    o.cell_size = fs.cell_size;
+    r = run_one(rc, &fs.scene, tr, &o, rad, dir, what);
     bk_tracer_destroy(tr);
     filtered_free(&fs);
     return r;

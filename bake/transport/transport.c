@@ -3,6 +3,7 @@
 
 #include "bake/util/parallel.h"
 #include "bake/transport/shading.h"
+#include "bake/transport/solid.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -12,7 +13,8 @@
 
 #define TP_PI 3.14159265358979323846
 #define TP_Q_MAX 0.999      /* largest per-bounce ratio the tail formula trusts (factor ≤ 999) */
-#define TP_MAX_SUB 16       /* at most 16×16 cells per triangle side */
+#define TP_MAX_SUB 1024     /* at most 1024² cells per triangle side (the cell budget binds first) */
+#define TP_CELL_CAP ((size_t)1 << 22) /* cells in all (~0.5 GB with both halves' radiance) */
 #define TP_LIGHT_POINTS 16  /* points per cell that test punctual lights in bounce 1 */
 #define TP_BATCH 64         /* rays generated, then traced as one stream, then shaded */
 
@@ -27,7 +29,8 @@ static uint64_t mix64(uint64_t z)
 
 typedef struct { uint64_t s; } tp_rng;
 
-enum { DOM_CELL = 1, DOM_RECV = 2, DOM_CELL_NEE = 3, DOM_RECV_NEE = 4 };
+enum { DOM_CELL = 1, DOM_RECV = 2, DOM_CELL_NEE = 3, DOM_RECV_NEE = 4, DOM_RECV_NEAR = 5, DOM_RECV_POS = 6,
+       DOM_RECV_PROBE = 7, DOM_CELL_NEAR = 8 };
 
 /* Keyed by everything that identifies one item's samples: never by thread or time. */
 static tp_rng rng_make(uint64_t seed, uint64_t domain, uint64_t half, uint64_t pass, uint64_t bounce, uint64_t item)
@@ -122,7 +125,8 @@ static void lattice_uv(const tp_lattice *l, uint32_t j, double t1, double t2, do
 
 typedef struct tp_cell {
     uint32_t tri;
-    uint16_t sub, m;
+    uint32_t sub;
+    uint16_t m;
     uint8_t side;
     float n[3];        /* side normal, zero for degenerate triangles */
     float area;
@@ -149,9 +153,11 @@ typedef struct tp_ctx {
     size_t cell_count;
     tp_cell *cells;
     uint32_t *tri_first;   /* first cell of each triangle */
-    uint8_t *tri_m;
+    uint16_t *tri_m;
     uint8_t *tri_sides;
+    uint8_t *tri_closed;   /* bounds a closed solid (solid.h): its back side is the inside */
     float *tri_edge_eps;   /* smallest barycentric a sample point may have: keeps points off edges */
+    float *tri_cell_h;     /* size of the triangle's cells (metres): what "near" is measured in */
     float *tri_le;         /* 3 per triangle: emission factor after the light-set filter */
     int32_t *tri_le_tex;   /* emission texture per triangle, -1 none */
     /* next-event estimation: emitter sub-triangles picked by power through a CDF */
@@ -166,16 +172,22 @@ typedef struct tp_ctx {
     float scene_scale;
     /* per chain (half) state; [h] */
     float *l_prev[2], *l_cur[2], *l_sum[2];
+    float *l_prev2[2];     /* bounce k−2 (what a near hit in bounce k continues into) */
     /* current job */
     int half, pass, bounce, rays;
     tp_lattice lat;        /* for `rays` samples */
     /* receivers */
+    const bk_scene *fscene;  /* the scene footprints index (options.footprint_scene or scene) */
     const bk_receiver *recv;
     size_t recv_count;
     float *punct_lum;      /* luminance of punctual E per receiver (for the error estimate) */
     double *x_acc[2];      /* per receiver, per half: Σ_p w_p·bk_lum(E_p) */
+    double *b_acc[2];      /* per receiver, per half: Σ_p w_p·bk_lum(cache bias probe of pass p) */
     const bk_transport_output *out;
     double pass_weight;
+    /* the run's settings and progress */
+    double t0, max_samples, target, tail_tol, weight_sum, spp;
+    int max_bounces, s0;
     /* counters: per thread, summed after each parallel step */
     uint64_t *thread_rays, *thread_shadow, *thread_nonfinite;
 } tp_ctx;
@@ -223,13 +235,16 @@ static int in_light_set(const tp_ctx *c, const char *set)
     return strncmp(set, want, 63) == 0;
 }
 
-/* Cell reached by a hit, or -1 when the hit side carries no radiance (back of a one-sided
- * surface). */
+/* What a hit reaches: its cell (>= 0), HIT_BLACK for the back of a one-sided open surface, or
+ * HIT_INSIDE for the back of a closed solid: the ray started inside that solid (solid.h). */
+enum { HIT_BLACK = -1, HIT_INSIDE = -2 };
+
 static long hit_cell(const tp_ctx *c, const bk_hit *h)
 {
-    if (h->tri >= c->scene->tri_count) return -1;
+    if (h->tri >= c->scene->tri_count) return HIT_BLACK;
+    if (!h->front && c->tri_closed[h->tri]) return HIT_INSIDE;
     int side = h->front ? 0 : 1;
-    if (side >= c->tri_sides[h->tri]) return -1;
+    if (side >= c->tri_sides[h->tri]) return HIT_BLACK;
     int m = c->tri_m[h->tri];
     float a = h->u * (float)m, b = h->v * (float)m;
     int i = (int)a, j = (int)b; /* truncation: u, v >= 0 up to rounding, and the clamps below */
@@ -242,6 +257,19 @@ static long hit_cell(const tp_ctx *c, const bk_hit *h)
     return (long)c->tri_first[h->tri] + (long)side * m * m + sub;
 }
 
+/* Row j of sub-triangle s in an m×m split: row r holds 2(m − r) − 1 cells, so rows before j
+ * hold j(2m − j); the largest j with j(2m − j) <= s, from the quadratic and one correction. */
+static int sub_row(int m, long s)
+{
+    double disc = (double)m * m - (double)s;
+    int j = (int)(m - sqrt(disc > 0 ? disc : 0));
+    if (j < 0) j = 0;
+    if (j > m - 1) j = m - 1;
+    while (j > 0 && (long)j * (2 * m - j) > s) j--;
+    while (j < m - 1 && (long)(j + 1) * (2 * m - j - 1) <= s) j++;
+    return j;
+}
+
 /* A cell's sub-triangle in world space, and the edge band of its triangle, fetched once per
  * cell and bounce rather than per ray. */
 typedef struct tp_cell_geom {
@@ -252,9 +280,11 @@ typedef struct tp_cell_geom {
 
 static void cell_geom(const tp_ctx *c, const tp_cell *cell, tp_cell_geom *g)
 {
-    int m = cell->m, s = cell->sub, j = 0;
-    while (j < m - 1 && s >= 2 * (m - j) - 1) { s -= 2 * (m - j) - 1; j++; }
-    int i = s / 2, upper = s & 1;
+    int m = cell->m;
+    long s = (long)cell->sub;
+    int j = sub_row(m, s);
+    s -= (long)j * (2 * m - j);
+    int i = (int)(s / 2), upper = (int)(s & 1);
     double c0[2], c1[2], c2[2];
     if (!upper) {
         c0[0] = i; c0[1] = j; c1[0] = i + 1; c1[1] = j; c2[0] = i; c2[1] = j + 1;
@@ -415,121 +445,227 @@ static int nee_sample(const tp_ctx *c, const float o[3], const double n[3], int 
     return 1;
 }
 
+/* Per-thread counters of one parallel step. */
+typedef struct tp_count { uint64_t rays, shadow, bad; } tp_count;
+
+/* ---- near-field continuation -------------------------------------------------------------- */
+
+/* A cell holds one radiance for its whole area; read from closer than a few cell sizes (a
+ * corner, a leg under a table top) that constant is biased, and more samples never remove it.
+ * Such hits are evaluated at the exact hit point instead: one cosine-distributed gather from
+ * there (sky, emission, and the cache one bounce further, or another continuation when that
+ * hit is near too) plus one punctual light picked uniformly. An unbiased estimate of the
+ * reflected radiance at the point given the cache beyond it (TRANSPORT.md §Bias). */
+#define TP_NEAR_CELLS 1.5   /* continue when the hit is closer than this many cell sizes */
+#define TP_NEAR_DEPTH 3     /* continuations in a row before the cache is read anyway */
+
+static int near_hit(const tp_ctx *c, const bk_hit *h, long hc)
+{
+    return hc >= 0 && h->t < TP_NEAR_CELLS * c->tri_cell_h[h->tri];
+}
+
+/* Reflected radiance (all bounces, emission excluded) at the point of `hit` (cell hc, reached
+ * along unit d) from one continuation sample. */
+/* What a continuation sample gathers: the cells it reads at its hit (NULL: none) and whether
+ * the light sources count (sky, emission, one punctual light). The final gather continues with
+ * everything (read = the cache's sum); bounce k of the cache continues with the exact bounce
+ * k−1 at its near hit: the sources for k = 2, bounce k−2's cells beyond. */
+typedef struct tp_near_mode { const float *read; int sources, max_depth; } tp_near_mode;
+
+static void near_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, long hc, int depth, tp_rng *rng,
+                          tp_count *cnt, double out[3])
+{
+    const tp_cell *cell = &c->cells[hc];
+    double v[3][3], x[3];
+    tri_vertices(c, hit->tri, v);
+    for (int a = 0; a < 3; a++) x[a] = (1.0 - hit->u - hit->v) * v[0][a] + hit->u * v[1][a] + hit->v * v[2][a];
+    double n[3] = {cell->n[0], cell->n[1], cell->n[2]}, t[3], b[3];
+    bk_onb(n, t, b);
+    float xf[3] = {(float)x[0], (float)x[1], (float)x[2]}, nf[3] = {cell->n[0], cell->n[1], cell->n[2]}, o[3];
+    bk_offset_ray_origin_scaled(xf, nf, bk_tracer_tri_scale(c->tracer, hit->tri), o);
+    double u1 = rng_next(rng), ph = 2 * TP_PI * rng_next(rng), rr = sqrt(u1), lz = sqrt(fmax(0.0, 1 - u1));
+    double d[3];
+    for (int a = 0; a < 3; a++) d[a] = rr * cos(ph) * t[a] + rr * sin(ph) * b[a] + lz * n[a];
+    float df[3] = {(float)d[0], (float)d[1], (float)d[2]};
+    double L[3] = {0, 0, 0};
+    bk_hit h2;
+    cnt->rays++;
+    if (!bk_tracer_intersect(c->tracer, o, df, 0.0f, INFINITY, &h2)) {
+        if (md->sources) sky_radiance(c, d, L);
+    } else {
+        long h2c = hit_cell(c, &h2);
+        if (h2c >= 0) {
+            if (md->sources) emission_at(c, h2.tri, h2.u, h2.v, L);
+            double r2[3] = {0, 0, 0};
+            if (md->read && depth + 1 < md->max_depth && near_hit(c, &h2, h2c)) {
+                near_radiance(c, md, &h2, h2c, depth + 1, rng, cnt, r2);
+            } else if (md->read) {
+                for (int a = 0; a < 3; a++) r2[a] = md->read[3 * h2c + a];
+            }
+            for (int a = 0; a < 3; a++) L[a] += r2[a];
+        }
+    }
+    double e[3] = {TP_PI * L[0], TP_PI * L[1], TP_PI * L[2]};
+    if (md->sources && c->light_count) {
+        size_t li = (size_t)(rng_next(rng) * (double)c->light_count);
+        if (li >= c->light_count) li = c->light_count - 1;
+        double val[3], ld[3], dist;
+        if (bk_light_eval(c->lights[li], x, val, ld, &dist)) {
+            double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
+            if (cs > 0) {
+                cnt->shadow++;
+                if (bk_light_visible(c->tracer, o, ld, dist))
+                    for (int a = 0; a < 3; a++) e[a] += (double)c->light_count * val[a] * cs;
+            }
+        }
+    }
+    for (int a = 0; a < 3; a++) out[a] = cell->albedo[a] / TP_PI * e[a];
+}
+
 /* ---- cache: one bounce for a range of cells ------------------------------------------------ */
+
+/* One cell's sample sums for one bounce: gathered radiance, light samples and punctual light,
+ * over the samples whose point can be seen (a sample whose gather ray reaches the inside of a
+ * closed solid started inside it: it belongs to no visible part of the cell and is dropped, so
+ * a cell that a wall cuts stands for its visible part only). */
+typedef struct tp_cell_sums {
+    double e[3], en[3], ep[3];
+    int valid, lit_points;
+} tp_cell_sums;
+
+/* Shades sample j of a cell (point p, offset origin o, cosine direction d, hit) into the sums. */
+static void cell_sample(tp_ctx *c, const double n[3], int j, const double p[3],
+                        const float o[3], const double d[3], const bk_hit *hit, const double nee_t[2],
+                        tp_rng *near_rng, tp_cell_sums *cs, tp_count *cnt)
+{
+    const int k = c->bounce, h = c->half;
+    const float *prev = c->l_prev[h];
+    double L[3] = {0, 0, 0};
+    if (hit->tri != UINT32_MAX) {
+        long hc = hit_cell(c, hit);
+        if (hc == HIT_INSIDE) return;
+        if (hc >= 0) {
+            if (k == 1) {
+                emission_at(c, hit->tri, hit->u, hit->v, L);
+                if (L[0] > 0 || L[1] > 0 || L[2] > 0) {
+                    double lz = d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
+                    double w = mis_gather(c, hit, hc, d, lz / TP_PI);
+                    for (int a = 0; a < 3; a++) L[a] *= w;
+                }
+            } else if (near_hit(c, hit, hc)) {
+                /* bounce k−1 at the exact point (see near_radiance) */
+                const tp_near_mode md = {k == 2 ? NULL : c->l_prev2[h], k == 2, 1};
+                near_radiance(c, &md, hit, hc, 0, near_rng, cnt, L);
+            } else {
+                for (int a = 0; a < 3; a++) L[a] = prev[3 * hc + a];
+            }
+        }
+    } else if (k == 1) {
+        sky_radiance(c, d, L);
+    }
+    cs->valid++;
+    if (!bk_finite3(L)) cnt->bad++;
+    else for (int a = 0; a < 3; a++) cs->e[a] += L[a];
+    if (k != 1) return;
+    if (c->nee) {
+        double u0, v0, ld[3], cq, val[3];
+        lattice_uv(&c->lat, (uint32_t)j, nee_t[0], nee_t[1], &u0, &v0);
+        if (nee_sample(c, o, n, PG_COSINE, u0, v0, ld, &cq, val, &cnt->shadow)) {
+            if (bk_finite3(val))
+                for (int a = 0; a < 3; a++) cs->en[a] += val[a] * cq;
+            else
+                cnt->bad++;
+        }
+    }
+    /* punctual lights at the first TP_LIGHT_POINTS visible points */
+    if (c->light_count && cs->lit_points < TP_LIGHT_POINTS) {
+        cs->lit_points++;
+        for (size_t li = 0; li < c->light_count; li++) {
+            double val[3], ld[3], dist;
+            if (!bk_light_eval(c->lights[li], p, val, ld, &dist)) continue;
+            double cq = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
+            if (cq <= 0) continue;
+            cnt->shadow++;
+            if (!bk_light_visible(c->tracer, o, ld, dist)) continue;
+            for (int a = 0; a < 3; a++) cs->ep[a] += val[a] * cq;
+        }
+    }
+}
+
+/* Bounce k at one cell: R points uniform over the cell, cosine directions from the shifted
+ * lattice, traced 64 at a time; returns the reflected radiance albedo/π × irradiance. */
+static void cell_bounce(tp_ctx *c, size_t ci, tp_count *cnt, double out[3])
+{
+    const int h = c->half, k = c->bounce, R = c->rays;
+    const tp_cell *cell = &c->cells[ci];
+    tp_cell_sums cs;
+    memset(&cs, 0, sizeof cs);
+    out[0] = out[1] = out[2] = 0;
+    if (cell->n[0] == 0 && cell->n[1] == 0 && cell->n[2] == 0) return;
+    if (cell->albedo[0] <= 0 && cell->albedo[1] <= 0 && cell->albedo[2] <= 0) return;
+    tp_rng rng = rng_make(c->seed, DOM_CELL, (uint64_t)h, (uint64_t)c->pass, (uint64_t)k, ci);
+    tp_rng near_rng = rng_make(c->seed, DOM_CELL_NEAR, (uint64_t)h, (uint64_t)c->pass, (uint64_t)k, ci);
+    double n[3] = {cell->n[0], cell->n[1], cell->n[2]}, t[3], b[3];
+    bk_onb(n, t, b);
+    float nf[3] = {cell->n[0], cell->n[1], cell->n[2]};
+    float scale = bk_tracer_tri_scale(c->tracer, cell->tri);
+    double s1 = rng_next(&rng), s2 = rng_next(&rng);
+    tp_shift shift = lattice_shift(s1, s2);
+    tp_cell_geom geom;
+    cell_geom(c, cell, &geom);
+    double nee_t[2] = {0, 0}; /* the light samples' own lattice shift */
+    if (k == 1 && c->nee) {
+        tp_rng nr = rng_make(c->seed, DOM_CELL_NEE, (uint64_t)h, (uint64_t)c->pass, 0, ci);
+        nee_t[0] = rng_next(&nr);
+        nee_t[1] = rng_next(&nr);
+    }
+    for (int j0 = 0; j0 < R; j0 += TP_BATCH) {
+        const int m = R - j0 < TP_BATCH ? R - j0 : TP_BATCH;
+        float org[3 * TP_BATCH], dir[3 * TP_BATCH];
+        double dd[TP_BATCH][3], pts[TP_BATCH][3];
+        bk_hit hits[TP_BATCH];
+        for (int jj = 0; jj < m; jj++) {
+            double *p = pts[jj];
+            cell_point(&geom, &rng, p);
+            float pf[3] = {(float)p[0], (float)p[1], (float)p[2]};
+            bk_offset_ray_origin_scaled(pf, nf, scale, org + 3 * jj);
+            double u1, cp, sp;
+            lattice(&c->lat, (uint32_t)(j0 + jj), &shift, &u1, &cp, &sp);
+            double rr = sqrt(u1);
+            double lx = rr * cp, ly = rr * sp, lz = sqrt(fmax(0.0, 1 - u1));
+            for (int a = 0; a < 3; a++) {
+                dd[jj][a] = lx * t[a] + ly * b[a] + lz * n[a];
+                dir[3 * jj + a] = (float)dd[jj][a];
+            }
+        }
+        bk_tracer_intersect_n(c->tracer, (size_t)m, org, dir, 0.0f, NULL, hits);
+        cnt->rays += (uint64_t)m;
+        for (int jj = 0; jj < m; jj++)
+            cell_sample(c, n, j0 + jj, pts[jj], org + 3 * jj, dd[jj], &hits[jj], nee_t, &near_rng, &cs, cnt);
+    }
+    if (!cs.valid) return; /* the whole cell is inside solids: never seen */
+    for (int a = 0; a < 3; a++) {
+        double e = (cs.e[a] * TP_PI + cs.en[a]) / cs.valid;
+        if (cs.lit_points) e += cs.ep[a] / cs.lit_points;
+        out[a] = cell->albedo[a] / TP_PI * e;
+    }
+}
 
 static void cache_bounce(tp_ctx *c, size_t begin, size_t end, int thread)
 {
-    const int h = c->half, k = c->bounce, R = c->rays;
-    const float *prev = c->l_prev[h];
-    float *cur = c->l_cur[h];
-    uint64_t rays = 0, shadow = 0, bad = 0;
+    float *cur = c->l_cur[c->half];
+    tp_count cnt = {0, 0, 0};
     for (size_t ci = begin; ci < end; ci++) {
-        const tp_cell *cell = &c->cells[ci];
-        double e[3] = {0, 0, 0};
-        if (cell->n[0] == 0 && cell->n[1] == 0 && cell->n[2] == 0) goto store;
-        if (cell->albedo[0] <= 0 && cell->albedo[1] <= 0 && cell->albedo[2] <= 0) goto store;
-        tp_rng rng = rng_make(c->seed, DOM_CELL, (uint64_t)h, (uint64_t)c->pass, (uint64_t)k, ci);
-        double n[3] = {cell->n[0], cell->n[1], cell->n[2]}, t[3], b[3];
-        bk_onb(n, t, b);
-        float nf[3] = {cell->n[0], cell->n[1], cell->n[2]};
-        float scale = bk_tracer_tri_scale(c->tracer, cell->tri);
-        double s1 = rng_next(&rng), s2 = rng_next(&rng);
-        tp_shift shift = lattice_shift(s1, s2);
-        tp_cell_geom geom;
-        cell_geom(c, cell, &geom);
-        int light_points = (k == 1 && c->light_count) ? (R < TP_LIGHT_POINTS ? R : TP_LIGHT_POINTS) : 0;
-        double ep[3] = {0, 0, 0}, en[3] = {0, 0, 0};
-        const int nee = k == 1 && c->nee;
-        double t1 = 0, t2 = 0;
-        if (nee) {
-            tp_rng nr = rng_make(c->seed, DOM_CELL_NEE, (uint64_t)h, (uint64_t)c->pass, 0, ci);
-            t1 = rng_next(&nr);
-            t2 = rng_next(&nr);
-        }
-        for (int j0 = 0; j0 < R; j0 += TP_BATCH) {
-            const int m = R - j0 < TP_BATCH ? R - j0 : TP_BATCH;
-            float org[3 * TP_BATCH], dir[3 * TP_BATCH];
-            double dd[TP_BATCH][3], pts[TP_BATCH][3];
-            bk_hit hits[TP_BATCH];
-            for (int jj = 0; jj < m; jj++) {
-                double *p = pts[jj];
-                cell_point(&geom, &rng, p);
-                float pf[3] = {(float)p[0], (float)p[1], (float)p[2]};
-                bk_offset_ray_origin_scaled(pf, nf, scale, org + 3 * jj);
-                /* cosine-distributed direction */
-                double u1, cp, sp;
-                lattice(&c->lat, (uint32_t)(j0 + jj), &shift, &u1, &cp, &sp);
-                double rr = sqrt(u1);
-                double lx = rr * cp, ly = rr * sp, lz = sqrt(fmax(0.0, 1 - u1));
-                for (int a = 0; a < 3; a++) {
-                    dd[jj][a] = lx * t[a] + ly * b[a] + lz * n[a];
-                    dir[3 * jj + a] = (float)dd[jj][a];
-                }
-            }
-            bk_tracer_intersect_n(c->tracer, (size_t)m, org, dir, 0.0f, NULL, hits);
-            rays += (uint64_t)m;
-            for (int jj = 0; jj < m; jj++) {
-                const int j = j0 + jj;
-                const double *d = dd[jj];
-                const float *o = org + 3 * jj;
-                const bk_hit *hit = &hits[jj];
-                double L[3] = {0, 0, 0};
-                if (hit->tri != UINT32_MAX) {
-                    long hc = hit_cell(c, hit);
-                    if (hc >= 0) {
-                        if (k == 1) {
-                            emission_at(c, hit->tri, hit->u, hit->v, L);
-                            if (L[0] > 0 || L[1] > 0 || L[2] > 0) {
-                                double lz = d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
-                                double w = mis_gather(c, hit, hc, d, lz / TP_PI);
-                                for (int a = 0; a < 3; a++) L[a] *= w;
-                            }
-                        } else {
-                            for (int a = 0; a < 3; a++) L[a] = prev[3 * hc + a];
-                        }
-                    }
-                } else if (k == 1) {
-                    sky_radiance(c, d, L);
-                }
-                if (!bk_finite3(L)) bad++;
-                else for (int a = 0; a < 3; a++) e[a] += L[a];
-                if (nee) {
-                    double u0, v0, ld[3], cq, val[3];
-                    lattice_uv(&c->lat, (uint32_t)j, t1, t2, &u0, &v0);
-                    if (nee_sample(c, o, n, PG_COSINE, u0, v0, ld, &cq, val, &shadow)) {
-                        if (bk_finite3(val))
-                            for (int a = 0; a < 3; a++) en[a] += val[a] * cq;
-                        else
-                            bad++;
-                    }
-                }
-                if (j < light_points) {
-                    for (size_t li = 0; li < c->light_count; li++) {
-                        double val[3], ld[3], dist;
-                        if (!bk_light_eval(c->lights[li], pts[jj], val, ld, &dist)) continue;
-                        double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
-                        if (cs <= 0) continue;
-                        shadow++;
-                        if (!bk_light_visible(c->tracer, o, ld, dist)) continue;
-                        for (int a = 0; a < 3; a++) ep[a] += val[a] * cs;
-                    }
-                }
-            }
-        }
+        double v[3];
+        cell_bounce(c, ci, &cnt, v);
         for (int a = 0; a < 3; a++) {
-            e[a] = e[a] * (TP_PI / R) + en[a] / R;
-            if (light_points) e[a] += ep[a] / light_points;
-        }
-    store:
-        for (int a = 0; a < 3; a++) {
-            double v = cell->albedo[a] / TP_PI * e[a];
-            if (!isfinite(v) || v < 0) { bad++; v = 0; }
-            cur[3 * ci + a] = (float)v;
+            if (!isfinite(v[a]) || v[a] < 0) { cnt.bad++; v[a] = 0; }
+            cur[3 * ci + a] = (float)v[a];
         }
     }
-    c->thread_rays[thread] += rays + shadow;
-    c->thread_shadow[thread] += shadow;
-    c->thread_nonfinite[thread] += bad;
+    c->thread_rays[thread] += cnt.rays + cnt.shadow;
+    c->thread_shadow[thread] += cnt.shadow;
+    c->thread_nonfinite[thread] += cnt.bad;
 }
 
 static double cell_power(const tp_ctx *c, const float *l)
@@ -566,7 +702,11 @@ static tp_chain_result run_chain(tp_ctx *c, int h, int pass, int rays, double to
         for (size_t i = 0; i < 3 * n; i++) sum[i] += c->l_cur[h][i];
         indirect += p;
         pw[0] = pw[1]; pw[1] = pw[2]; pw[2] = p;
-        float *tmp = c->l_prev[h]; c->l_prev[h] = c->l_cur[h]; c->l_cur[h] = tmp;
+        /* rotate: k−2 <- k−1 <- k, the oldest buffer is overwritten next */
+        float *tmp = c->l_prev2[h];
+        c->l_prev2[h] = c->l_prev[h];
+        c->l_prev[h] = c->l_cur[h];
+        c->l_cur[h] = tmp;
         if (k >= 2) q = pw[1] > 0 ? pw[2] / pw[1] : 0;
         if (!(p > 0) || p <= 1e-7 * indirect) break;
         if (k >= 4) {
@@ -596,51 +736,134 @@ static tp_chain_result run_chain(tp_ctx *c, int h, int pass, int rays, double to
 
 /* ---- receivers ------------------------------------------------------------------------------- */
 
-static void recv_offset_origin(const tp_ctx *c, const bk_receiver *r, float o[3])
+/* Where a receiver's ray leaves from: the point, its unit normal (zero vector: a probe, which
+ * gathers over the sphere; n then holds +z for the frame), and the offset ray origin. */
+typedef struct tp_origin {
+    double p[3], n[3];
+    float o[3];
+    int sphere;
+} tp_origin;
+
+static void origin_from(const tp_ctx *c, const float p[3], const float nf[3], tp_origin *g)
 {
-    if (r->normal[0] == 0 && r->normal[1] == 0 && r->normal[2] == 0) {
-        memcpy(o, r->position, 3 * sizeof(float));
+    double l = sqrt((double)nf[0] * nf[0] + (double)nf[1] * nf[1] + (double)nf[2] * nf[2]);
+    g->sphere = !(l > 0) || !isfinite(l);
+    for (int k = 0; k < 3; k++) {
+        g->p[k] = p[k];
+        g->n[k] = g->sphere ? 0 : nf[k] / l;
+    }
+    if (g->sphere) {
+        g->n[2] = 1;
+        memcpy(g->o, p, 3 * sizeof(float));
         return;
     }
-    bk_offset_ray_origin_scaled(r->position, r->normal, c->scene_scale, o);
+    bk_offset_ray_origin_scaled(p, nf, c->scene_scale, g->o);
 }
 
-static void recv_normal(const bk_receiver *r, double n[3], int *sphere)
+/* The receiver's own point (the whole texel where it has no footprint). */
+static void recv_origin(const tp_ctx *c, const bk_receiver *r, tp_origin *g)
 {
-    double l = sqrt((double)r->normal[0] * r->normal[0] + (double)r->normal[1] * r->normal[1] +
-                    (double)r->normal[2] * r->normal[2]);
-    *sphere = !(l > 0);
-    for (int k = 0; k < 3; k++) n[k] = *sphere ? 0 : r->normal[k] / l;
-    if (*sphere) n[2] = 1;
+    origin_from(c, r->position, r->normal, g);
+}
+
+/* The point of receiver r's footprint at texel-local (s, t): on the footprint triangle that
+ * covers it (position and interpolated shading normal from the footprint scene; returns 1),
+ * else the receiver's own point (returns 0). */
+static int footprint_origin(const tp_ctx *c, const bk_receiver *r, double s, double t, tp_origin *g)
+{
+    const bk_scene *fs = c->fscene;
+    for (uint32_t k = 0; k < r->footprint_count; k++) {
+        const bk_footprint_tri *f = &c->opt->footprint[r->footprint_first + k];
+        double u = f->uv[0][0] + f->uv[0][1] * s + f->uv[0][2] * t;
+        double v = f->uv[1][0] + f->uv[1][1] * s + f->uv[1][2] * t;
+        if (!(u >= 0 && v >= 0 && u + v <= 1)) continue;
+        const uint32_t *ix = fs->tris + 3 * (size_t)f->tri;
+        double w[3] = {1 - u - v, u, v}, p[3] = {0, 0, 0}, n[3] = {0, 0, 0}, q[3][3];
+        for (int i = 0; i < 3; i++)
+            for (int a = 0; a < 3; a++) {
+                q[i][a] = fs->positions[3 * (size_t)ix[i] + a];
+                p[a] += w[i] * q[i][a];
+                if (fs->normals) n[a] += w[i] * fs->normals[3 * (size_t)ix[i] + a];
+            }
+        double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (!(l > 0) || !isfinite(l)) { /* no shading normal: the geometric one */
+            double e1[3], e2[3];
+            for (int a = 0; a < 3; a++) { e1[a] = q[1][a] - q[0][a]; e2[a] = q[2][a] - q[0][a]; }
+            n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+            n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+            n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+            l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+            if (!(l > 0) || !isfinite(l)) break;
+        }
+        float pf[3] = {(float)p[0], (float)p[1], (float)p[2]}, nf[3];
+        for (int a = 0; a < 3; a++) nf[a] = (float)(n[a] / l);
+        origin_from(c, pf, nf, g);
+        return 1;
+    }
+    recv_origin(c, r, g);
+    return 0;
+}
+
+/* A uniform point of the part of the texel's square that its footprint covers: rejection in the
+ * footprint box, at most TP_FOOTPRINT_TRIES draws (a footprint covering 10 % of its box falls
+ * back to the receiver's own point 18 % of the time, one covering 30 % 0.3 %; charts of
+ * axis-aligned slivers fill their boxes). */
+#define TP_FOOTPRINT_TRIES 16
+static void footprint_sample(const tp_ctx *c, const bk_receiver *r, tp_rng *pos, tp_origin *g)
+{
+    const float *bx = r->footprint_box;
+    int box = bx[2] > 0 && bx[3] > 0;
+    for (int k = 0; k < TP_FOOTPRINT_TRIES; k++) {
+        double ps = rng_next(pos), pt = rng_next(pos);
+        if (box) {
+            ps = bx[0] + ps * bx[2];
+            pt = bx[1] + pt * bx[3];
+        }
+        if (footprint_origin(c, r, ps, pt, g)) return;
+    }
+}
+
+/* Punctual light at one point: irradiance (sphere: fluence) and the SH of its incident radiance. */
+static uint64_t punctual_at(const tp_ctx *c, const tp_origin *g, double e[3], double sh[3][9])
+{
+    uint64_t rays = 0;
+    for (size_t li = 0; li < c->light_count; li++) {
+        double val[3], ld[3], dist;
+        if (!bk_light_eval(c->lights[li], g->p, val, ld, &dist)) continue;
+        double cs = ld[0] * g->n[0] + ld[1] * g->n[1] + ld[2] * g->n[2];
+        if (!g->sphere && cs <= 0) continue;
+        rays++;
+        if (!bk_light_visible(c->tracer, g->o, ld, dist)) continue;
+        double y[9];
+        bk_sh9_basis_d(ld, y);
+        for (int a = 0; a < 3; a++) {
+            e[a] += g->sphere ? val[a] : val[a] * cs;
+            for (int kk = 0; kk < 9; kk++) sh[a][kk] += val[a] * y[kk];
+        }
+    }
+    return rays;
 }
 
 static void recv_punctual(tp_ctx *c, size_t begin, size_t end, int thread)
 {
-    /* Punctual light is noise-free: computed once, then into the outputs / error scalars. */
+    /* Punctual light is noise-free: computed once, then into the outputs / error scalars. A
+     * texel with a footprint averages its four quarter centres (hard shadow edges resolve to
+     * a quarter of a texel). */
     uint64_t rays = 0;
     for (size_t i = begin; i < end; i++) {
         const bk_receiver *r = &c->recv[i];
-        double n[3];
-        int sphere;
-        recv_normal(r, n, &sphere);
-        float o[3];
-        recv_offset_origin(c, r, o);
-        double p[3] = {r->position[0], r->position[1], r->position[2]};
         double e[3] = {0, 0, 0}, sh[3][9];
         memset(sh, 0, sizeof sh);
-        for (size_t li = 0; li < c->light_count; li++) {
-            double val[3], ld[3], dist;
-            if (!bk_light_eval(c->lights[li], p, val, ld, &dist)) continue;
-            double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
-            if (!sphere && cs <= 0) continue;
-            rays++;
-            if (!bk_light_visible(c->tracer, o, ld, dist)) continue;
-            double y[9];
-            bk_sh9_basis_d(ld, y);
-            for (int a = 0; a < 3; a++) {
-                e[a] += sphere ? val[a] : val[a] * cs;
-                for (int kk = 0; kk < 9; kk++) sh[a][kk] += val[a] * y[kk];
-            }
+        const int points = r->footprint_count ? 4 : 1;
+        for (int q = 0; q < points; q++) {
+            tp_origin g;
+            if (r->footprint_count) footprint_origin(c, r, 0.25 + 0.5 * (q & 1), 0.25 + 0.5 * (q >> 1), &g);
+            else recv_origin(c, r, &g);
+            rays += punctual_at(c, &g, e, sh);
+        }
+        for (int a = 0; a < 3; a++) {
+            e[a] /= points;
+            for (int kk = 0; kk < 9; kk++) sh[a][kk] /= points;
         }
         if (c->punct_lum) {
             c->punct_lum[i] = (float)bk_lum(e);
@@ -675,112 +898,178 @@ static void accumulate(const double d[3], double cs, const double L[3], const do
     }
 }
 
+/* ---- final gather ---------------------------------------------------------------------------- */
+
+/* A receiver's sums over one half of one pass. */
+typedef struct tp_recv_sums {
+    double e[3];          /* Σ L·cos (irradiance, before × solid/S) */
+    double eb[3];         /* Σ (continuation − cell)·cos over the probed rays, × TP_PROBE_EVERY */
+    double sh_t[3][9], sh_d[3][9];
+} tp_recv_sums;
+
+/* The cache's bias probe: every TP_PROBE_EVERY-th gather ray that reads a cell (a far hit) is
+ * also continued at its exact hit point; the mean difference (continuation − cell), scaled
+ * back up, estimates what the cells' constancy adds to the receiver: the first-hit cache bias,
+ * which the two halves cannot see (both read equally coarse cells). Costs 1/16 more rays. */
+#define TP_PROBE_EVERY 16
+
+/* Radiance L (direct part Ld) that gather ray d (pdf 1/solid) brings back from `hit`. Returns
+ * the cell it read (a far hit), else -1. */
+static long gather_hit(tp_ctx *c, const float *sum, const bk_hit *hit, const double d[3], double solid,
+                       tp_rng *cont, tp_count *cnt, double L[3], double Ld[3])
+{
+    for (int a = 0; a < 3; a++) L[a] = Ld[a] = 0;
+    if (hit->tri == UINT32_MAX) {
+        sky_radiance(c, d, L);
+        memcpy(Ld, L, 3 * sizeof(double));
+        return -1;
+    }
+    long hc = hit_cell(c, hit);
+    if (hc < 0) return -1; /* black, or the inside of a solid: a receiver there is dark */
+    emission_at(c, hit->tri, hit->u, hit->v, Ld);
+    if (Ld[0] > 0 || Ld[1] > 0 || Ld[2] > 0) {
+        double wg = mis_gather(c, hit, hc, d, 1 / solid);
+        for (int a = 0; a < 3; a++) Ld[a] *= wg;
+    }
+    double r[3];
+    int near = near_hit(c, hit, hc);
+    if (near) {
+        const tp_near_mode md = {sum, 1, TP_NEAR_DEPTH};
+        near_radiance(c, &md, hit, hc, 0, cont, cnt, r);
+    } else {
+        for (int a = 0; a < 3; a++) r[a] = sum[3 * hc + a];
+    }
+    for (int a = 0; a < 3; a++) L[a] = r[a] + Ld[a];
+    return near ? -1 : hc;
+}
+
+/* One half of receiver i in this pass: S directions from the shifted lattice, uniform over the
+ * hemisphere (texels) or the sphere (probes) — the SH projection needs a pdf that does not
+ * vanish at the horizon — each with one light sample when NEE is on. A texel with a footprint
+ * starts each ray from its own random point of the footprint. */
+static void recv_half(tp_ctx *c, size_t i, int h, tp_recv_sums *rs, tp_count *cnt)
+{
+    const int S = c->rays;
+    const float *sum = c->l_sum[h];
+    const bk_receiver *r = &c->recv[i];
+    tp_rng rng = rng_make(c->seed, DOM_RECV, (uint64_t)h, (uint64_t)c->pass, 0, i);
+    tp_rng cont = rng_make(c->seed, DOM_RECV_NEAR, (uint64_t)h, (uint64_t)c->pass, 0, i);
+    tp_rng pos = rng_make(c->seed, DOM_RECV_POS, (uint64_t)h, (uint64_t)c->pass, 0, i);
+    tp_rng probe = rng_make(c->seed, DOM_RECV_PROBE, (uint64_t)h, (uint64_t)c->pass, 0, i);
+    double s1 = rng_next(&rng), s2 = rng_next(&rng);
+    tp_shift shift = lattice_shift(s1, s2);
+    tp_origin g0;
+    recv_origin(c, r, &g0);
+    const int sphere = g0.sphere;
+    const double solid = sphere ? 4 * TP_PI : 2 * TP_PI;
+    const int pg_kind = sphere ? PG_SPHERE : PG_HEMISPHERE;
+    double t1 = 0, t2 = 0;
+    if (c->nee) {
+        tp_rng nr = rng_make(c->seed, DOM_RECV_NEE, (uint64_t)h, (uint64_t)c->pass, 0, i);
+        t1 = rng_next(&nr);
+        t2 = rng_next(&nr);
+    }
+    double t0[3], b0[3];
+    bk_onb(g0.n, t0, b0);
+    for (int j0 = 0; j0 < S; j0 += TP_BATCH) {
+        const int m = S - j0 < TP_BATCH ? S - j0 : TP_BATCH;
+        float org[3 * TP_BATCH], dir[3 * TP_BATCH];
+        double dd[TP_BATCH][3], zz[TP_BATCH], nn[TP_BATCH][3];
+        bk_hit hits[TP_BATCH];
+        for (int jj = 0; jj < m; jj++) {
+            tp_origin g = g0;
+            double t[3] = {t0[0], t0[1], t0[2]}, b[3] = {b0[0], b0[1], b0[2]};
+            if (r->footprint_count) {
+                footprint_sample(c, r, &pos, &g);
+                bk_onb(g.n, t, b);
+            }
+            double u1, cp, sp;
+            lattice(&c->lat, (uint32_t)(j0 + jj), &shift, &u1, &cp, &sp);
+            double z = sphere ? 1 - 2 * u1 : u1;
+            double rr = sqrt(fmax(0.0, 1 - z * z));
+            zz[jj] = z;
+            for (int a = 0; a < 3; a++) {
+                dd[jj][a] = rr * cp * t[a] + rr * sp * b[a] + z * g.n[a];
+                dir[3 * jj + a] = (float)dd[jj][a];
+                org[3 * jj + a] = g.o[a];
+                nn[jj][a] = g.n[a];
+            }
+        }
+        bk_tracer_intersect_n(c->tracer, (size_t)m, org, dir, 0.0f, NULL, hits);
+        cnt->rays += (uint64_t)m;
+        for (int jj = 0; jj < m; jj++) {
+            double L[3], Ld[3];
+            long hc = gather_hit(c, sum, &hits[jj], dd[jj], solid, &cont, cnt, L, Ld);
+            if (!bk_finite3(L) || !bk_finite3(Ld)) cnt->bad++;
+            else accumulate(dd[jj], sphere ? 1 : zz[jj], L, Ld, rs->e, rs->sh_t, rs->sh_d);
+            if (hc >= 0 && (j0 + jj) % TP_PROBE_EVERY == 0) {
+                double q[3];
+                const tp_near_mode md = {sum, 1, TP_NEAR_DEPTH};
+                near_radiance(c, &md, &hits[jj], hc, 0, &probe, cnt, q);
+                double cs = (sphere ? 1 : zz[jj]) * TP_PROBE_EVERY;
+                if (bk_finite3(q))
+                    for (int a = 0; a < 3; a++) rs->eb[a] += (q[a] - sum[3 * hc + a]) * cs;
+            }
+            if (!c->nee) continue;
+            /* one light sample per gather ray; its value Le·w/p is turned into the gather's
+             * units (radiance, later × solid/S) by 1/solid */
+            double u0, uu1, ld[3], cl, val[3];
+            lattice_uv(&c->lat, (uint32_t)(j0 + jj), t1, t2, &u0, &uu1);
+            if (nee_sample(c, org + 3 * jj, nn[jj], pg_kind, u0, uu1, ld, &cl, val, &cnt->shadow)) {
+                for (int a = 0; a < 3; a++) val[a] /= solid;
+                if (!bk_finite3(val)) cnt->bad++;
+                else accumulate(ld, cl, val, val, rs->e, rs->sh_t, rs->sh_d);
+            }
+        }
+    }
+}
+
 static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
 {
     const int S = c->rays;
     const double w = c->pass_weight;
     const bk_transport_output *out = c->out;
-    uint64_t rays = 0, shadow = 0, bad = 0;
+    tp_count cnt = {0, 0, 0};
     for (size_t i = begin; i < end; i++) {
         const bk_receiver *r = &c->recv[i];
-        double n[3], t[3], b[3];
-        int sphere;
-        recv_normal(r, n, &sphere);
-        bk_onb(n, t, b);
-        float o[3];
-        recv_offset_origin(c, r, o);
-        double sh_t[3][9], sh_d[3][9], e_t[3];
-        memset(sh_t, 0, sizeof sh_t);
-        memset(sh_d, 0, sizeof sh_d);
-        memset(e_t, 0, sizeof e_t);
+        const int sphere = !(r->normal[0] != 0 || r->normal[1] != 0 || r->normal[2] != 0);
+        const double solid = sphere ? 4 * TP_PI : 2 * TP_PI;
+        tp_recv_sums tot;
+        memset(&tot, 0, sizeof tot);
         for (int h = 0; h < 2; h++) {
-            tp_rng rng = rng_make(c->seed, DOM_RECV, (uint64_t)h, (uint64_t)c->pass, 0, i);
-            double s1 = rng_next(&rng), s2 = rng_next(&rng);
-            tp_shift shift = lattice_shift(s1, s2);
-            const float *sum = c->l_sum[h];
-            double e[3] = {0, 0, 0};
-            /* uniform over the hemisphere (texels) or sphere (probes): the SH projection needs
-             * a pdf that does not vanish at the horizon */
-            const double solid = sphere ? 4 * TP_PI : 2 * TP_PI;
-            const int pg_kind = sphere ? PG_SPHERE : PG_HEMISPHERE;
-            double t1 = 0, t2 = 0;
-            if (c->nee) {
-                tp_rng nr = rng_make(c->seed, DOM_RECV_NEE, (uint64_t)h, (uint64_t)c->pass, 0, i);
-                t1 = rng_next(&nr);
-                t2 = rng_next(&nr);
+            tp_recv_sums rs;
+            memset(&rs, 0, sizeof rs);
+            recv_half(c, i, h, &rs, &cnt);
+            double e[3], eb[3];
+            for (int a = 0; a < 3; a++) {
+                e[a] = rs.e[a] * solid / S;
+                eb[a] = rs.eb[a] * solid / S;
             }
-            for (int j0 = 0; j0 < S; j0 += TP_BATCH) {
-                const int m = S - j0 < TP_BATCH ? S - j0 : TP_BATCH;
-                float org[3 * TP_BATCH], dir[3 * TP_BATCH];
-                double dd[TP_BATCH][3], zz[TP_BATCH];
-                bk_hit hits[TP_BATCH];
-                for (int jj = 0; jj < m; jj++) {
-                    double u1, cp, sp;
-                    lattice(&c->lat, (uint32_t)(j0 + jj), &shift, &u1, &cp, &sp);
-                    double z = sphere ? 1 - 2 * u1 : u1;
-                    double rr = sqrt(fmax(0.0, 1 - z * z));
-                    double lx = rr * cp, ly = rr * sp;
-                    zz[jj] = z;
-                    for (int a = 0; a < 3; a++) {
-                        dd[jj][a] = lx * t[a] + ly * b[a] + z * n[a];
-                        dir[3 * jj + a] = (float)dd[jj][a];
-                        org[3 * jj + a] = o[a];
-                    }
-                }
-                bk_tracer_intersect_n(c->tracer, (size_t)m, org, dir, 0.0f, NULL, hits);
-                rays += (uint64_t)m;
-                for (int jj = 0; jj < m; jj++) {
-                    const double *d = dd[jj];
-                    const bk_hit *hit = &hits[jj];
-                    double L[3] = {0, 0, 0}, Ld[3] = {0, 0, 0};
-                    if (hit->tri != UINT32_MAX) {
-                        long hc = hit_cell(c, hit);
-                        if (hc >= 0) {
-                            emission_at(c, hit->tri, hit->u, hit->v, Ld);
-                            if (Ld[0] > 0 || Ld[1] > 0 || Ld[2] > 0) {
-                                double wg = mis_gather(c, hit, hc, d, 1 / solid);
-                                for (int a = 0; a < 3; a++) Ld[a] *= wg;
-                            }
-                            for (int a = 0; a < 3; a++) L[a] = sum[3 * hc + a] + Ld[a];
-                        }
-                    } else {
-                        sky_radiance(c, d, L);
-                        memcpy(Ld, L, sizeof L);
-                    }
-                    if (!bk_finite3(L) || !bk_finite3(Ld)) bad++;
-                    else accumulate(d, sphere ? 1 : zz[jj], L, Ld, e, sh_t, sh_d);
-                    if (c->nee) {
-                        /* one light sample per gather ray; its value Le·w/p is turned into the
-                         * gather's units (radiance, later × solid/S) by 1/solid */
-                        double u0, uu1, ld[3], cl, val[3];
-                        lattice_uv(&c->lat, (uint32_t)(j0 + jj), t1, t2, &u0, &uu1);
-                        if (nee_sample(c, o, n, pg_kind, u0, uu1, ld, &cl, val, &shadow)) {
-                            for (int a = 0; a < 3; a++) val[a] /= solid;
-                            if (!bk_finite3(val)) bad++;
-                            else accumulate(ld, cl, val, val, e, sh_t, sh_d);
-                        }
-                    }
-                }
-            }
-            for (int a = 0; a < 3; a++) e[a] *= solid / S;
             /* error scalar: irradiance for texels, fluence/4 for probes (equal under uniform
              * radiance, so texels and probes weigh alike in the relative RMSE) */
             c->x_acc[h][i] += w * (bk_lum(e) + c->punct_lum[i]) * (sphere ? 0.25 : 1.0);
-            for (int a = 0; a < 3; a++) e_t[a] += e[a];
+            c->b_acc[h][i] += w * bk_lum(eb) * (sphere ? 0.25 : 1.0);
+            for (int a = 0; a < 3; a++) {
+                tot.e[a] += e[a];
+                for (int kk = 0; kk < 9; kk++) {
+                    tot.sh_t[a][kk] += rs.sh_t[a][kk];
+                    tot.sh_d[a][kk] += rs.sh_d[a][kk];
+                }
+            }
         }
         /* both halves: 2S samples of pdf 1/solid; weight w for this pass */
-        const double ws = w * (sphere ? 4 * TP_PI : 2 * TP_PI) / (2.0 * S);
+        const double ws = w * solid / (2.0 * S);
         for (int a = 0; a < 3; a++) {
             for (int kk = 0; kk < 9; kk++) {
-                out->radiance[i].c[a][kk] += (float)(sh_t[a][kk] * ws);
-                if (out->direct) out->direct[i].c[a][kk] += (float)(sh_d[a][kk] * ws);
+                out->radiance[i].c[a][kk] += (float)(tot.sh_t[a][kk] * ws);
+                if (out->direct) out->direct[i].c[a][kk] += (float)(tot.sh_d[a][kk] * ws);
             }
-            if (out->irradiance) out->irradiance[3 * i + a] += (float)(e_t[a] * w * 0.5);
+            if (out->irradiance) out->irradiance[3 * i + a] += (float)(tot.e[a] * w * 0.5);
         }
     }
-    c->thread_rays[thread] += rays + shadow;
-    c->thread_shadow[thread] += shadow;
-    c->thread_nonfinite[thread] += bad;
+    c->thread_rays[thread] += cnt.rays + cnt.shadow;
+    c->thread_shadow[thread] += cnt.shadow;
+    c->thread_nonfinite[thread] += cnt.bad;
 }
 
 /* ---- setup ------------------------------------------------------------------------------------ */
@@ -800,64 +1089,111 @@ static double now_seconds(void)
 
 static void free_ctx(tp_ctx *c)
 {
-    free(c->cells); free(c->tri_first); free(c->tri_m); free(c->tri_sides); free(c->tri_edge_eps);
+    free(c->cells); free(c->tri_first); free(c->tri_m); free(c->tri_sides); free(c->tri_closed); free(c->tri_cell_h); free(c->tri_edge_eps);
     free(c->tri_le); free(c->tri_le_tex); free(c->em); free(c->em_cdf);
     free(c->thread_shadow);
     free(c->lights);
-    for (int h = 0; h < 2; h++) { free(c->l_prev[h]); free(c->l_cur[h]); free(c->l_sum[h]); free(c->x_acc[h]); }
+    for (int h = 0; h < 2; h++) {
+        free(c->l_prev[h]); free(c->l_prev2[h]); free(c->l_cur[h]); free(c->l_sum[h]); free(c->x_acc[h]);
+        free(c->b_acc[h]);
+    }
     free(c->punct_lum);
     free(c->thread_rays); free(c->thread_nonfinite);
     lattice_free(&c->lat);
+}
+
+/* Longest edge of triangle i. */
+static double tri_longest(const tp_ctx *c, uint32_t i)
+{
+    double v[3][3], longest = 0;
+    tri_vertices(c, i, v);
+    for (int e = 0; e < 3; e++) {
+        double l2 = 0;
+        for (int k = 0; k < 3; k++) l2 += (v[(e + 1) % 3][k] - v[e][k]) * (v[(e + 1) % 3][k] - v[e][k]);
+        longest = fmax(longest, sqrt(l2));
+    }
+    return longest;
+}
+
+/* Subdivision m of triangle i for cells of about `size` metres (sized), or of area cell_area
+ * (automatic budget); m² sub-triangles per side. */
+static int tri_subdivision(const tp_ctx *c, uint32_t i, double size, double cell_area)
+{
+    double a = bk_tracer_tri_area(c->tracer, i), m = 1;
+    if (!(a > 0) || !isfinite(a)) return 1;
+    if (size > 0) {
+        /* square-ish cells of the wanted size; slivers split along their length too */
+        m = fmax(ceil(sqrt(a) / size), ceil(tri_longest(c, i) / (2 * size)));
+    } else if (cell_area > 0) {
+        m = floor(sqrt(a / cell_area));
+    }
+    return m < 1 ? 1 : m > TP_MAX_SUB ? TP_MAX_SUB : (int)m;
+}
+
+/* Cells per triangle: sized triangles (options.cell_size, e.g. the lightmap's texel size: the
+ * cache then resolves light as finely as the lightmap stores it) and the rest sharing max_cells
+ * by area; if everything exceeds TP_CELL_CAP the sizes grow uniformly until it fits. */
+static lbk_result size_cells(tp_ctx *c, size_t *count_out)
+{
+    const bk_scene *s = c->scene;
+    const float *want = c->opt->cell_size;
+    size_t nt = s->tri_count;
+    size_t max_cells = c->opt->max_cells > 0 ? (size_t)c->opt->max_cells : 32768;
+    double auto_area = 0;
+    for (size_t i = 0; i < nt; i++) {
+        uint32_t mi = s->tri_material ? s->tri_material[i] : 0;
+        int ds = mi < s->material_count ? s->materials[mi].double_sided : 0;
+        /* a closed solid's back side is its inside: never seen, no cells */
+        c->tri_sides[i] = ds && !c->tri_closed[i] ? 2 : 1;
+        if (!(want && want[i] > 0 && isfinite(want[i])))
+            auto_area += (double)bk_tracer_tri_area(c->tracer, (uint32_t)i) * c->tri_sides[i];
+    }
+    double cell_area = auto_area > 0 ? auto_area / (double)max_cells : 0;
+    for (double grow = 1;; grow *= 1.25) {
+        size_t count = 0;
+        for (size_t i = 0; i < nt; i++) {
+            double size = want && want[i] > 0 && isfinite(want[i]) ? want[i] * grow : 0;
+            int m = tri_subdivision(c, (uint32_t)i, size, cell_area * grow * grow);
+            c->tri_m[i] = (uint16_t)m;
+            c->tri_first[i] = (uint32_t)(count < UINT32_MAX ? count : UINT32_MAX);
+            count += (size_t)c->tri_sides[i] * (size_t)m * (size_t)m;
+        }
+        if (count <= TP_CELL_CAP) { *count_out = count; return LBK_OK; }
+        if (grow > 1e6) return LBK_ERR_LIMIT;
+    }
 }
 
 static lbk_result build_cells(tp_ctx *c)
 {
     const bk_scene *s = c->scene;
     size_t nt = s->tri_count;
-    size_t max_cells = c->opt->max_cells > 0 ? (size_t)c->opt->max_cells : 32768;
     c->tri_first = calloc(nt ? nt : 1, sizeof *c->tri_first);
-    c->tri_m = calloc(nt ? nt : 1, 1);
+    c->tri_m = calloc(nt ? nt : 1, sizeof *c->tri_m);
     c->tri_sides = calloc(nt ? nt : 1, 1);
+    c->tri_closed = calloc(nt ? nt : 1, 1);
     c->tri_edge_eps = calloc(nt ? nt : 1, sizeof(float));
+    c->tri_cell_h = calloc(nt ? nt : 1, sizeof(float));
     c->tri_le = calloc(3 * (nt ? nt : 1), sizeof(float));
     c->tri_le_tex = calloc(nt ? nt : 1, sizeof(int32_t));
-    if (!c->tri_first || !c->tri_m || !c->tri_sides || !c->tri_edge_eps || !c->tri_le || !c->tri_le_tex)
+    if (!c->tri_first || !c->tri_m || !c->tri_sides || !c->tri_closed || !c->tri_edge_eps || !c->tri_cell_h ||
+        !c->tri_le || !c->tri_le_tex)
         return LBK_ERR_OUT_OF_MEMORY;
-    double total = 0;
-    for (size_t i = 0; i < nt; i++) {
-        uint32_t mi = s->tri_material ? s->tri_material[i] : 0;
-        int ds = mi < s->material_count ? s->materials[mi].double_sided : 0;
-        c->tri_sides[i] = ds ? 2 : 1;
-        total += (double)bk_tracer_tri_area(c->tracer, (uint32_t)i) * c->tri_sides[i];
-    }
-    double cell_area = total > 0 ? total / (double)max_cells : 0;
+    lbk_result r = bk_closed_triangles(s, c->tri_closed);
+    if (r != LBK_OK) return r;
     size_t count = 0;
+    r = size_cells(c, &count);
+    if (r != LBK_OK) return r;
     for (size_t i = 0; i < nt; i++) {
-        double a = bk_tracer_tri_area(c->tracer, (uint32_t)i);
-        int m = 1;
-        if (cell_area > 0 && a > 0) {
-            double per_side = a / cell_area;
-            double r = floor(sqrt(per_side));
-            m = r < 1 ? 1 : r > TP_MAX_SUB ? TP_MAX_SUB : (int)r;
-        }
-        c->tri_m[i] = (uint8_t)m;
-        if (count > UINT32_MAX - 2 * TP_MAX_SUB * TP_MAX_SUB) return LBK_ERR_LIMIT;
-        c->tri_first[i] = (uint32_t)count;
-        count += (size_t)c->tri_sides[i] * m * m;
         /* keep sample points >= 8 ulps of the coordinates inside every edge (the tracer's edge
          * limitation, tracer.h): a barycentric floor of 8 ulp / altitude */
-        double v[3][3];
-        tri_vertices(c, (uint32_t)i, v);
-        double longest = 0;
-        for (int e = 0; e < 3; e++) {
-            double l2 = 0;
-            for (int k = 0; k < 3; k++) l2 += (v[(e + 1) % 3][k] - v[e][k]) * (v[(e + 1) % 3][k] - v[e][k]);
-            longest = fmax(longest, sqrt(l2));
-        }
+        double a = bk_tracer_tri_area(c->tracer, (uint32_t)i), longest = tri_longest(c, (uint32_t)i);
         double alt = longest > 0 ? 2 * a / longest : 0;
         double ulp = bk_tracer_tri_scale(c->tracer, (uint32_t)i) * 1.1920928955078125e-07;
         double eps = alt > 0 && isfinite(alt) ? 8 * ulp / alt : 0;
         c->tri_edge_eps[i] = (float)(eps > 0.3 ? 0.3 : eps);
+        int m = c->tri_m[i];
+        double h = fmax(longest / m, sqrt(2 * a) / m);
+        c->tri_cell_h[i] = (float)(isfinite(h) ? h : 0);
     }
     c->cell_count = count;
     c->cells = calloc(count ? count : 1, sizeof *c->cells);
@@ -880,11 +1216,11 @@ static lbk_result build_cells(tp_ctx *c)
             }
             if (mat->emission_tex >= 0 && bk_scene_image(s, mat->emission_tex)) c->tri_le_tex[i] = mat->emission_tex;
         }
-        for (int sub = 0; sub < m * m; sub++) {
+        for (long sub = 0; sub < (long)m * m; sub++) {
             /* material values at the cell's centroid (uv0) */
-            int j = 0, ss = sub;
-            while (j < m - 1 && ss >= 2 * (m - j) - 1) { ss -= 2 * (m - j) - 1; j++; }
-            int ii = ss / 2, up = ss & 1;
+            int j = sub_row(m, sub);
+            long ss = sub - (long)j * (2 * m - j);
+            int ii = (int)(ss / 2), up = (int)(ss & 1);
             double cu = up ? (3.0 * ii + 2) / (3.0 * m) : (3.0 * ii + 1) / (3.0 * m);
             double cv = up ? (3.0 * j + 2) / (3.0 * m) : (3.0 * j + 1) / (3.0 * m);
             double uv[2];
@@ -907,7 +1243,7 @@ static lbk_result build_cells(tp_ctx *c)
             for (int side = 0; side < c->tri_sides[i]; side++) {
                 tp_cell *cell = &c->cells[c->tri_first[i] + (size_t)side * m * m + sub];
                 cell->tri = (uint32_t)i;
-                cell->sub = (uint16_t)sub;
+                cell->sub = (uint32_t)sub;
                 cell->m = (uint16_t)m;
                 cell->side = (uint8_t)side;
                 for (int k = 0; k < 3; k++) cell->n[k] = side ? -n[k] : n[k];
@@ -974,6 +1310,230 @@ static lbk_result build_emitters(tp_ctx *c)
 
 /* ---- the run ---------------------------------------------------------------------------------- */
 
+/* Footprint ranges inside options.footprint, triangles and their vertices inside the footprint
+ * scene, finite maps. */
+static int footprints_valid(const bk_scene *scene, const bk_transport_options *opt, const bk_receiver *r, size_t n)
+{
+    const bk_scene *fs = opt->footprint_scene ? opt->footprint_scene : scene;
+    for (size_t i = 0; i < n; i++) {
+        if (!r[i].footprint_count) continue;
+        if (!opt->footprint || r[i].footprint_first > opt->footprint_count ||
+            r[i].footprint_count > opt->footprint_count - r[i].footprint_first)
+            return 0;
+    }
+    for (size_t k = 0; k < (opt->footprint ? opt->footprint_count : 0); k++) {
+        const bk_footprint_tri *f = &opt->footprint[k];
+        if (f->tri >= fs->tri_count || !fs->tris || !fs->positions) return 0;
+        for (int v = 0; v < 3; v++)
+            if (fs->tris[3 * (size_t)f->tri + v] >= fs->vertex_count) return 0;
+        for (int a = 0; a < 2; a++)
+            for (int b = 0; b < 3; b++)
+                if (!isfinite(f->uv[a][b])) return 0;
+    }
+    return 1;
+}
+
+static lbk_result check_inputs(const bk_scene *scene, const bk_tracer *tracer, const bk_receiver *receivers,
+                               size_t count, const bk_transport_options *opt, const bk_transport_output *output)
+{
+    if (!scene || !tracer || !output || (count > 0 && (!receivers || !output->radiance))) return LBK_ERR_INVALID_ARGUMENT;
+    if (bk_tracer_tri_count(tracer) != scene->tri_count) return LBK_ERR_INVALID_ARGUMENT;
+    if (scene->tri_count > 0 && !scene->tris) return LBK_ERR_INVALID_ARGUMENT;
+    for (size_t i = 0; i < count; i++) {
+        const bk_receiver *r = &receivers[i];
+        for (int k = 0; k < 3; k++)
+            if (!isfinite(r->position[k]) || !isfinite(r->normal[k])) return LBK_ERR_INVALID_ARGUMENT;
+    }
+    return footprints_valid(scene, opt, receivers, count) ? LBK_OK : LBK_ERR_INVALID_ARGUMENT;
+}
+
+/* Everything a run needs before its first pass: counters, the light selection, cells,
+ * emitters, the per-half radiance arrays and the receivers' accumulators. */
+static lbk_result ctx_init(tp_ctx *c)
+{
+    const bk_scene *scene = c->scene;
+    const bk_transport_options *opt = c->opt;
+    c->thread_rays = calloc((size_t)c->threads, sizeof(uint64_t));
+    c->thread_nonfinite = calloc((size_t)c->threads, sizeof(uint64_t));
+    c->thread_shadow = calloc((size_t)c->threads, sizeof(uint64_t));
+    if (!c->thread_rays || !c->thread_nonfinite || !c->thread_shadow) return LBK_ERR_OUT_OF_MEMORY;
+    /* scale of the coordinates: offsets for receivers, which carry no triangle */
+    for (size_t i = 0; i < scene->tri_count; i++) {
+        float sc = bk_tracer_tri_scale(c->tracer, (uint32_t)i);
+        if (sc > c->scene_scale) c->scene_scale = sc;
+    }
+    const int base_bake = !(opt->light_set && opt->light_set[0]);
+    c->use_sky = base_bake && !opt->no_sky;
+    if (!opt->no_punctual && scene->light_count) {
+        c->lights = calloc(scene->light_count, sizeof *c->lights);
+        if (!c->lights) return LBK_ERR_OUT_OF_MEMORY;
+        for (size_t i = 0; i < scene->light_count; i++)
+            if (in_light_set(c, scene->lights[i].light_set)) c->lights[c->light_count++] = &scene->lights[i];
+    }
+    lbk_result res = build_cells(c);
+    if (res == LBK_OK) res = build_emitters(c);
+    if (res != LBK_OK) return res;
+    size_t nc = c->cell_count ? c->cell_count : 1, n = c->recv_count ? c->recv_count : 1;
+    for (int h = 0; h < 2; h++) {
+        c->l_prev[h] = calloc(3 * nc, sizeof(float));
+        c->l_prev2[h] = calloc(3 * nc, sizeof(float));
+        c->l_cur[h] = calloc(3 * nc, sizeof(float));
+        c->l_sum[h] = calloc(3 * nc, sizeof(float));
+        c->x_acc[h] = calloc(n, sizeof(double));
+        c->b_acc[h] = calloc(n, sizeof(double));
+        if (!c->l_prev[h] || !c->l_prev2[h] || !c->l_cur[h] || !c->l_sum[h] || !c->x_acc[h] || !c->b_acc[h])
+            return LBK_ERR_OUT_OF_MEMORY;
+    }
+    c->punct_lum = calloc(n, sizeof(float));
+    return c->punct_lum ? LBK_OK : LBK_ERR_OUT_OF_MEMORY;
+}
+
+/* Non-zero when the caller's progress callback asks to stop (LBK_ERR_CANCELLED). */
+static int report_progress(const tp_ctx *c, const char *phase, double done_spp)
+{
+    const bk_transport_options *opt = c->opt;
+    if (!opt->progress) return 0;
+    double f = fmax(done_spp / c->max_samples, opt->time_limit > 0 ? (now_seconds() - c->t0) / opt->time_limit : 0);
+    return opt->progress(opt->user, phase, f > 1 ? 1 : f);
+}
+
+/* Cache rays per cell and bounce in pass p: about as many as the receivers trace this pass
+ * (over ~4 bounces), within [min(4·2^(p/2), cap), cap], cap = cache_rays·2^p; both estimates
+ * shrink together. */
+static int pass_cache_rays(const tp_ctx *c, int pass)
+{
+    int sp = pass < 20 ? pass : 20;
+    double nc = c->cell_count ? (double)c->cell_count : 1;
+    double cap = fmin((double)(c->opt->cache_rays > 0 ? c->opt->cache_rays : 16) * ldexp(1.0, sp), 65536.0);
+    double lo = fmin(cap, 4.0 * ldexp(1.0, sp / 2));
+    double want = ceil((double)c->s0 * ldexp(1.0, sp) * (double)c->recv_count / (4.0 * nc));
+    return (int)fmax(lo, fmin(cap, want));
+}
+
+/* One pass: both halves' caches, then the final gather at the receivers (in blocks, so
+ * progress can be reported). */
+static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
+{
+    int cache_rays = pass_cache_rays(c, pass);
+    for (int h = 0; h < 2; h++) {
+        chain[h] = run_chain(c, h, pass, cache_rays, c->tail_tol, c->max_bounces);
+        if (chain[h].bounces < 0) return LBK_ERR_OUT_OF_MEMORY;
+        if (report_progress(c, "cache", c->spp)) return LBK_ERR_CANCELLED;
+    }
+    c->pass = pass;
+    c->rays = c->s0 << (pass < 20 ? pass : 20);
+    if (lattice_init(&c->lat, (uint32_t)c->rays) != LBK_OK) return LBK_ERR_OUT_OF_MEMORY;
+    c->pass_weight = ldexp(1.0, pass);
+    size_t count = c->recv_count, block = count / 8 + 1;
+    for (size_t b = 0; b < count; b += block) {
+        size_t e = b + block < count ? b + block : count;
+        parallel_range(c, b, e, 16, recv_gather);
+        if (report_progress(c, "gather", c->spp + 2.0 * c->rays * (double)e / (double)(count ? count : 1)))
+            return LBK_ERR_CANCELLED;
+    }
+    c->weight_sum += c->pass_weight;
+    c->spp += 2.0 * c->rays;
+    return LBK_OK;
+}
+
+/* The noise estimate per receiver class (options.class_end) and for the probes together. */
+typedef struct tp_errors {
+    double cls[BK_RECEIVER_CLASSES];
+    double probe;
+} tp_errors;
+
+/* The error estimates after a pass (TRANSPORT.md): the noise from the two independent halves
+ * (all receivers, and per class), and the cache's bias from the probes, whose two halves'
+ * product is an unbiased estimate of each receiver's squared bias. Relative to the RMS of the
+ * receivers' values. */
+
+static void estimate_error(const tp_ctx *c, double *noise, double *bias, tp_errors *ce)
+{
+    const bk_transport_options *opt = c->opt;
+    double num = 0, den = 0, bb = 0, cnum[BK_RECEIVER_CLASSES] = {0}, cden[BK_RECEIVER_CLASSES] = {0};
+    int cls = 0;
+    for (size_t i = 0; i < c->recv_count; i++) {
+        while (cls < BK_RECEIVER_CLASSES - 1 && i >= opt->class_end[cls] && opt->class_end[BK_RECEIVER_CLASSES - 1]) cls++;
+        double a = c->x_acc[0][i] / c->weight_sum, b = c->x_acc[1][i] / c->weight_sum;
+        double m = 0.5 * (a + b), v = 0.25 * (a - b) * (a - b);
+        num += v;
+        den += m * m;
+        cnum[cls] += v;
+        cden[cls] += m * m;
+        bb += (c->b_acc[0][i] / c->weight_sum) * (c->b_acc[1][i] / c->weight_sum);
+    }
+    *noise = den > 0 ? sqrt(num / den) : 0;
+    *bias = den > 0 && bb > 0 ? sqrt(bb / den) : 0;
+    for (int k = 0; k < BK_RECEIVER_CLASSES; k++) ce->cls[k] = cden[k] > 0 ? sqrt(cnum[k] / cden[k]) : 0;
+    ce->probe = cden[1] + cden[2] > 0 ? sqrt((cnum[1] + cnum[2]) / (cden[1] + cden[2])) : 0;
+}
+
+/* Stop after this pass? (target reached, the next pass over budget, or past the time limit:
+ * the next pass costs about twice this one, so it starts only if it can finish in time.) */
+static int stop_after(const tp_ctx *c, int pass, double err, double pass_seconds, int *stop)
+{
+    const bk_transport_options *opt = c->opt;
+    if (c->target > 0 && err <= c->target) { *stop = BK_STOP_TARGET; return 1; }
+    double next_spp = c->spp + 2.0 * (c->s0 << (pass + 1 < 20 ? pass + 1 : 20));
+    if (next_spp > c->max_samples || pass >= 24) { *stop = BK_STOP_BUDGET; return 1; }
+    if (opt->time_limit > 0 && now_seconds() - c->t0 + 2.1 * pass_seconds > opt->time_limit) {
+        *stop = BK_STOP_TIME;
+        return 1;
+    }
+    return 0;
+}
+
+/* Normalises the pass-weighted sums, then adds the noise-free punctual light. */
+static void finish_outputs(tp_ctx *c)
+{
+    const bk_transport_output *output = c->out;
+    float inv = (float)(1.0 / c->weight_sum);
+    for (size_t i = 0; i < c->recv_count; i++)
+        for (int a = 0; a < 3; a++) {
+            for (int k = 0; k < 9; k++) {
+                output->radiance[i].c[a][k] *= inv;
+                if (output->direct) output->direct[i].c[a][k] *= inv;
+            }
+            if (output->irradiance) output->irradiance[3 * i + a] *= inv;
+        }
+    /* per-receiver variance of X from the two halves (the denoiser's input) */
+    if (output->variance)
+        for (size_t i = 0; i < c->recv_count; i++) {
+            double a = c->x_acc[0][i] / c->weight_sum, b = c->x_acc[1][i] / c->weight_sum;
+            output->variance[i] = (float)(0.25 * (a - b) * (a - b));
+        }
+    if (c->light_count) {
+        float *pl = c->punct_lum;
+        c->punct_lum = NULL; /* recv_punctual now writes into the outputs */
+        parallel_for(c, c->recv_count, 64, recv_punctual);
+        c->punct_lum = pl;
+    }
+}
+
+static void fill_stats(const tp_ctx *c, int passes, double err, double bias, const tp_errors *ce,
+                       const tp_chain_result chain[2], int stop, bk_transport_stats *stats)
+{
+    for (int k = 0; k < BK_RECEIVER_CLASSES; k++) stats->class_rel_rmse[k] = ce->cls[k];
+    stats->probe_rel_rmse = ce->probe;
+    stats->seconds = now_seconds() - c->t0;
+    stats->passes = passes;
+    stats->samples_per_receiver = c->spp;
+    stats->est_rel_rmse = err;
+    stats->est_cache_bias = bias;
+    stats->bounces = chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces;
+    stats->q = 0.5 * (chain[0].q + chain[1].q);
+    double tot = chain[0].total_energy + chain[1].total_energy;
+    stats->tail_fraction = tot > 0 ? (chain[0].tail_energy + chain[1].tail_energy) / tot : 0;
+    stats->cells = c->cell_count;
+    for (int t = 0; t < c->threads; t++) {
+        stats->rays += c->thread_rays[t];
+        stats->shadow_rays += c->thread_shadow[t];
+        stats->nonfinite += c->thread_nonfinite[t];
+    }
+    stats->stop = stop;
+    stats->nee = c->nee;
+}
+
 lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, const bk_receiver *receivers,
                             size_t count, const bk_transport_options *options,
                             const bk_transport_output *output, bk_transport_stats *stats)
@@ -983,14 +1543,8 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
     memset(&defaults, 0, sizeof defaults);
     const bk_transport_options *opt = options ? options : &defaults;
     if (stats) memset(stats, 0, sizeof *stats);
-    if (!scene || !tracer || !output || (count > 0 && (!receivers || !output->radiance))) return LBK_ERR_INVALID_ARGUMENT;
-    if (bk_tracer_tri_count(tracer) != scene->tri_count) return LBK_ERR_INVALID_ARGUMENT;
-    if (scene->tri_count > 0 && !scene->tris) return LBK_ERR_INVALID_ARGUMENT;
-    for (size_t i = 0; i < count; i++) {
-        const bk_receiver *r = &receivers[i];
-        for (int k = 0; k < 3; k++)
-            if (!isfinite(r->position[k]) || !isfinite(r->normal[k])) return LBK_ERR_INVALID_ARGUMENT;
-    }
+    lbk_result res = check_inputs(scene, tracer, receivers, count, opt, output);
+    if (res != LBK_OK) return res;
 
     tp_ctx c;
     memset(&c, 0, sizeof c);
@@ -1001,46 +1555,16 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
     c.threads = opt->threads > 0 ? (opt->threads > 256 ? 256 : opt->threads) : online_cores();
     c.recv = receivers;
     c.recv_count = count;
+    c.fscene = opt->footprint_scene ? opt->footprint_scene : scene;
     c.out = output;
-    const int max_bounces = opt->max_bounces > 0 ? opt->max_bounces : 64;
-    const double max_samples = opt->max_samples > 0 ? opt->max_samples : 4096;
-    const double target = opt->target_error == 0 ? 0.01 : opt->target_error;
-    const int s0 = opt->first_pass_samples > 0 ? opt->first_pass_samples : 16;
-    const double tail_tol = fmax(0.1 * (target > 0 ? target : 0.001), 1e-5);
-
-    lbk_result res = LBK_OK;
-    c.thread_rays = calloc((size_t)c.threads, sizeof(uint64_t));
-    c.thread_nonfinite = calloc((size_t)c.threads, sizeof(uint64_t));
-    c.thread_shadow = calloc((size_t)c.threads, sizeof(uint64_t));
-    if (!c.thread_rays || !c.thread_nonfinite || !c.thread_shadow) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
-
-    /* scale of the coordinates: offsets for receivers, which carry no triangle */
-    for (size_t i = 0; i < scene->tri_count; i++) {
-        float sc = bk_tracer_tri_scale(tracer, (uint32_t)i);
-        if (sc > c.scene_scale) c.scene_scale = sc;
-    }
-    const int base_bake = !(opt->light_set && opt->light_set[0]);
-    c.use_sky = base_bake && !opt->no_sky;
-    if (!opt->no_punctual && scene->light_count) {
-        c.lights = calloc(scene->light_count, sizeof *c.lights);
-        if (!c.lights) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
-        for (size_t i = 0; i < scene->light_count; i++)
-            if (in_light_set(&c, scene->lights[i].light_set)) c.lights[c.light_count++] = &scene->lights[i];
-    }
-    res = build_cells(&c);
+    c.t0 = t0;
+    c.max_bounces = opt->max_bounces > 0 ? opt->max_bounces : 64;
+    c.max_samples = opt->max_samples > 0 ? opt->max_samples : 4096;
+    c.target = opt->target_error == 0 ? 0.01 : opt->target_error;
+    c.s0 = opt->first_pass_samples > 0 ? opt->first_pass_samples : 16;
+    c.tail_tol = fmax(0.1 * (c.target > 0 ? c.target : 0.001), 1e-5);
+    res = ctx_init(&c);
     if (res != LBK_OK) goto done;
-    res = build_emitters(&c);
-    if (res != LBK_OK) goto done;
-    size_t nc = c.cell_count ? c.cell_count : 1;
-    for (int h = 0; h < 2; h++) {
-        c.l_prev[h] = calloc(3 * nc, sizeof(float));
-        c.l_cur[h] = calloc(3 * nc, sizeof(float));
-        c.l_sum[h] = calloc(3 * nc, sizeof(float));
-        c.x_acc[h] = calloc(count ? count : 1, sizeof(double));
-        if (!c.l_prev[h] || !c.l_cur[h] || !c.l_sum[h] || !c.x_acc[h]) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
-    }
-    c.punct_lum = calloc(count ? count : 1, sizeof(float));
-    if (!c.punct_lum) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
 
     for (size_t i = 0; i < count; i++) {
         memset(&output->radiance[i], 0, sizeof output->radiance[i]);
@@ -1049,117 +1573,28 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
     }
     if (c.light_count) parallel_for(&c, count, 64, recv_punctual); /* luminance only, for the error */
 
-    double weight_sum = 0, spp = 0, err = 0, last_pass_time = 0, class_err[BK_RECEIVER_CLASSES] = {0}, probe_err = 0;
+    double err = 0, bias = 0;
+    tp_errors ce = {{0}, 0};
     int pass = 0, stop = BK_STOP_BUDGET;
     tp_chain_result chain[2] = {{0, 0, 0, 0}, {0, 0, 0, 0}};
     for (;; pass++) {
         double pass_start = now_seconds();
-        /* both halves' caches */
-        /* cache rays: about as many as the receivers trace this pass (over ~4 bounces), within
-         * [min(4·2^(p/2), cap), cap], cap = cache_rays·2^p; both estimates shrink together */
-        int sp = pass < 20 ? pass : 20;
-        double cap = fmin((double)(opt->cache_rays > 0 ? opt->cache_rays : 16) * ldexp(1.0, sp), 65536.0);
-        double lo = fmin(cap, 4.0 * ldexp(1.0, sp / 2));
-        double want = ceil((double)s0 * ldexp(1.0, sp) * (double)count / (4.0 * (double)nc));
-        int cache_rays = (int)fmax(lo, fmin(cap, want));
-        for (int h = 0; h < 2; h++) {
-            chain[h] = run_chain(&c, h, pass, cache_rays, tail_tol, max_bounces);
-            if (chain[h].bounces < 0) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
-            if (opt->progress) {
-                double f = fmax(spp / max_samples, opt->time_limit > 0 ? (now_seconds() - t0) / opt->time_limit : 0);
-                if (opt->progress(opt->user, "cache", f > 1 ? 1 : f)) { res = LBK_ERR_CANCELLED; goto done; }
-            }
-        }
-        /* final gather at the receivers, in blocks so progress can be reported */
-        c.pass = pass;
-        c.rays = s0 << (pass < 20 ? pass : 20);
-        if (lattice_init(&c.lat, (uint32_t)c.rays) != LBK_OK) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
-        c.pass_weight = ldexp(1.0, pass);
-        size_t block = count / 8 + 1;
-        for (size_t b = 0; b < count; b += block) {
-            size_t e = b + block < count ? b + block : count;
-            parallel_range(&c, b, e, 16, recv_gather);
-            if (opt->progress) {
-                double f = fmax((spp + 2.0 * c.rays * (double)e / (double)(count ? count : 1)) / max_samples,
-                                opt->time_limit > 0 ? (now_seconds() - t0) / opt->time_limit : 0);
-                if (opt->progress(opt->user, "gather", f > 1 ? 1 : f)) { res = LBK_ERR_CANCELLED; goto done; }
-            }
-        }
-        weight_sum += c.pass_weight;
-        spp += 2.0 * c.rays;
-        /* error: two independent half estimates per receiver (TRANSPORT.md) */
-        double num = 0, den = 0, cnum[BK_RECEIVER_CLASSES] = {0}, cden[BK_RECEIVER_CLASSES] = {0};
-        int cls = 0;
-        for (size_t i = 0; i < count; i++) {
-            while (cls < BK_RECEIVER_CLASSES - 1 && i >= opt->class_end[cls] && opt->class_end[BK_RECEIVER_CLASSES - 1]) cls++;
-            double a = c.x_acc[0][i] / weight_sum, b = c.x_acc[1][i] / weight_sum;
-            double m = 0.5 * (a + b), v = 0.25 * (a - b) * (a - b);
-            num += v, den += m * m;
-            cnum[cls] += v, cden[cls] += m * m;
-        }
-        err = den > 0 ? sqrt(num / den) : 0;
-        for (int k = 0; k < BK_RECEIVER_CLASSES; k++) class_err[k] = cden[k] > 0 ? sqrt(cnum[k] / cden[k]) : 0;
-        probe_err = cden[1] + cden[2] > 0 ? sqrt((cnum[1] + cnum[2]) / (cden[1] + cden[2])) : 0;
-        last_pass_time = now_seconds() - pass_start;
+        res = run_pass(&c, pass, chain);
+        if (res != LBK_OK) goto done;
+        estimate_error(&c, &err, &bias, &ce);
         if (opt->report) {
-            bk_transport_sample smp = {now_seconds() - t0, spp, err, chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces, pass,
-                                       {class_err[0], class_err[1], class_err[2]}, probe_err};
+            bk_transport_sample smp = {now_seconds() - t0, c.spp, err,
+                                       chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces, pass,
+                                       {ce.cls[0], ce.cls[1], ce.cls[2]}, ce.probe};
             opt->report(opt->user, &smp);
         }
         /* the target is about lightmap texels (REPT's texel_rel_rmse, spec §7.2) when there are
          * any; probes' own estimates are reported beside it */
-        const double stop_err = opt->class_end[BK_RECEIVER_CLASSES - 1] && opt->class_end[BK_CLASS_TEXEL] ? class_err[BK_CLASS_TEXEL] : err;
-        if (target > 0 && stop_err <= target) { stop = BK_STOP_TARGET; break; }
-        double next_spp = spp + 2.0 * (s0 << (pass + 1 < 20 ? pass + 1 : 20));
-        if (next_spp > max_samples || pass >= 24) { stop = BK_STOP_BUDGET; break; }
-        /* the next pass costs about twice this one: start it only if it can finish in time */
-        if (opt->time_limit > 0 && now_seconds() - t0 + 2.1 * last_pass_time > opt->time_limit) { stop = BK_STOP_TIME; break; }
+        const double stop_err = opt->class_end[BK_RECEIVER_CLASSES - 1] && opt->class_end[BK_CLASS_TEXEL] ? ce.cls[BK_CLASS_TEXEL] : err;
+        if (stop_after(&c, pass, stop_err, now_seconds() - pass_start, &stop)) break;
     }
-
-    /* normalise the pass-weighted sums, then add the noise-free punctual light */
-    for (size_t i = 0; i < count; i++) {
-        float inv = (float)(1.0 / weight_sum);
-        for (int a = 0; a < 3; a++) {
-            for (int k = 0; k < 9; k++) {
-                output->radiance[i].c[a][k] *= inv;
-                if (output->direct) output->direct[i].c[a][k] *= inv;
-            }
-            if (output->irradiance) output->irradiance[3 * i + a] *= inv;
-        }
-    }
-    /* per-receiver variance of X from the two halves (the denoiser's input) */
-    if (output->variance)
-        for (size_t i = 0; i < count; i++) {
-            double a = c.x_acc[0][i] / weight_sum, bh = c.x_acc[1][i] / weight_sum;
-            output->variance[i] = (float)(0.25 * (a - bh) * (a - bh));
-        }
-    if (c.light_count) {
-        float *pl = c.punct_lum;
-        c.punct_lum = NULL; /* recv_punctual now writes into the outputs */
-        parallel_for(&c, count, 64, recv_punctual);
-        c.punct_lum = pl;
-    }
-
-    if (stats) {
-        stats->seconds = now_seconds() - t0;
-        stats->passes = pass + 1;
-        stats->samples_per_receiver = spp;
-        stats->est_rel_rmse = err;
-        for (int k = 0; k < BK_RECEIVER_CLASSES; k++) stats->class_rel_rmse[k] = class_err[k];
-        stats->probe_rel_rmse = probe_err;
-        stats->bounces = chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces;
-        stats->q = 0.5 * (chain[0].q + chain[1].q);
-        double tot = chain[0].total_energy + chain[1].total_energy;
-        stats->tail_fraction = tot > 0 ? (chain[0].tail_energy + chain[1].tail_energy) / tot : 0;
-        stats->cells = c.cell_count;
-        for (int t = 0; t < c.threads; t++) {
-            stats->rays += c.thread_rays[t];
-            stats->shadow_rays += c.thread_shadow[t];
-            stats->nonfinite += c.thread_nonfinite[t];
-        }
-        stats->stop = stop;
-        stats->nee = c.nee;
-    }
+    finish_outputs(&c);
+    if (stats) fill_stats(&c, pass + 1, err, bias, &ce, chain, stop, stats);
 done:
     free_ctx(&c);
     return res;

@@ -2,15 +2,20 @@
  * rendering equation (seed 001 §2.3), Lambertian surfaces. Method, error model and the
  * guaranteed furnace bounds: bake/transport/TRANSPORT.md.
  *
- * Summary: a radiosity cache of surface cells (each triangle side split into m² sub-triangles
- * by area, independent of lightmap UVs) is filled bounce by bounce: bounce 1 = punctual direct
+ * Summary: a radiosity cache of surface cells (each triangle side split into m² sub-triangles,
+ * as fine as options.cell_size asks — the baker passes the texel size — or by area from a
+ * budget; independent of lightmap UVs) is filled bounce by bounce: bounce 1 = punctual direct
  * (shadow rays) + emission (gather rays and next-event estimation, combined by multiple
  * importance sampling) + sky (gather rays); bounce k = albedo/π × irradiance gathered from
  * bounce k−1 with fresh rays. Bounces stop when the per-bounce energy ratio q has settled; the
  * rest of the Neumann series is added per cell as L_K·q/(1−q). Receivers then gather the cache's
  * radiance (final gather, emitters again by MIS of gather hits and light samples) plus punctual
- * direct light. Progressive passes double the samples; each pass runs two independent halves
- * (own cache, own receiver rays), whose difference estimates the error.
+ * direct light. Hits closer than 1.5 cell sizes are evaluated at the exact point (one more
+ * gather from there) instead of reading the cell; the inside of closed solids is black
+ * (bake/transport/solid.h); a texel with a footprint starts each ray from a random point of the
+ * part of its square its chart covers. Progressive passes double the samples; each pass runs two
+ * independent halves (own cache, own receiver rays), whose difference estimates the error; a
+ * probe of continued far hits estimates the cache's bias (TRANSPORT.md §Bias).
  *
  * Determinism: every random number comes from a counter-based hash of (seed, half, pass,
  * bounce, item, sample); each item (cell or receiver) is computed by one thread in a fixed
@@ -35,7 +40,26 @@ typedef struct bk_receiver {
     float position[3];
     float normal[3];   /* unit: a surface texel gathering over the hemisphere around it;
                           zero: a volumetric probe gathering over the full sphere */
+    /* Optional footprint (texels): footprint_count entries of options.footprint from
+     * footprint_first. Each gather ray then leaves from a random point of the texel's square:
+     * on the footprint triangle that covers it (its own position and interpolated normal), or
+     * from position/normal where no footprint triangle covers it. The texel's value is so the
+     * average over its square, as a renderer's bake of the same texel is (TRANSPORT.md). */
+    uint32_t footprint_first, footprint_count;
+    /* s0, t0, width, height: a box of the square that holds every point a footprint triangle
+     * covers (points are drawn in it, so a sliver of a chart is sampled as well as a whole
+     * square); width or height <= 0: the whole square */
+    float footprint_box[4];
 } bk_receiver;
+
+/* One triangle of a texel's footprint: the barycentrics (u, v) of scene triangle `tri` (the
+ * p = (1-u-v)·v0 + u·v1 + v·v2 convention of bk_hit) as affine functions of the texel-local
+ * coordinates (s, t) in [0,1]²: u = uv[0][0] + uv[0][1]·s + uv[0][2]·t, v likewise. A point
+ * belongs to it when u, v >= 0 and u + v <= 1. */
+typedef struct bk_footprint_tri {
+    uint32_t tri;
+    float uv[2][3];
+} bk_footprint_tri;
 
 /* One point of the error-against-time record, written after every pass. */
 /* Receiver classes, in the order the pipeline lists receivers (bk_transport_options.class_end). */
@@ -64,8 +88,20 @@ typedef struct bk_transport_options {
                                 "", plus the sky); else only that set's lights and emitters, no sky */
     int no_punctual;         /* 1: leave punctual lights out (default 0: included) */
     int no_sky;              /* 1: no sky even in the base */
-    int max_cells;           /* radiosity cache cells (both sides counted); 0: 32768. A triangle
-                                always gets at least one cell per side */
+    int max_cells;           /* radiosity cache cells (both sides counted) shared by area among
+                                the triangles without a cell_size; 0: 32768. A triangle always
+                                gets at least one cell per side */
+    /* Per scene triangle (tri_count entries) or NULL: the wanted cell size in metres, <= 0 for
+     * "share max_cells". The baker passes the lightmap's texel size, so the cache is as fine
+     * as the lightmap (TRANSPORT.md §Bias). All cells together stay below 4 Mi (sizes grow
+     * uniformly if needed). */
+    const float *cell_size;
+    /* Texel footprints (bk_receiver.footprint_*): the triangles, and the scene whose triangles
+     * they index and whose vertex positions and normals place the points (NULL: `scene`; a
+     * bake over a scene with some triangles removed passes the full one). */
+    const bk_footprint_tri *footprint;
+    size_t footprint_count;
+    const bk_scene *footprint_scene;
     int cache_rays;          /* gather rays per cell per bounce in pass 0 (doubles per pass); 0: 16 */
     int first_pass_samples;  /* gather rays per receiver per half in pass 0 (doubles); 0: 16 */
     /* Next-event estimation of emissive triangles (one light sample per gather ray, combined
@@ -109,6 +145,9 @@ typedef struct bk_transport_stats {
     int passes;
     double samples_per_receiver;
     double est_rel_rmse;
+    double est_cache_bias;   /* estimated relative RMS bias of reading the cache's cells at the
+                                receivers' far hits (the probes, TRANSPORT.md §Bias); not in
+                                est_rel_rmse, which the two halves measure */
     double class_rel_rmse[BK_RECEIVER_CLASSES]; /* per class, as in bk_transport_sample */
     double probe_rel_rmse;
     int bounces;             /* explicit bounces of the last pass */

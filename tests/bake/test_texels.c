@@ -1,5 +1,5 @@
-/* Texel receivers (bake/layout/texels.h): coverage, normals and tangent frames, push-out at
- * wall/floor junctions, inside-geometry detection, dilation. */
+/* Texel receivers (bake/layout/texels.h): coverage, footprints, normals and tangent frames,
+ * push-out at wall/floor junctions, inside-geometry detection, dilation. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -39,7 +39,9 @@ static double len3(const float v[3]) { return sqrt((double)v[0] * v[0] + (double
 
 /* A flat 1 m quad at d texels/m covers exactly d × d texels with their centres inside, plus
  * the ring of 4d + 4 texels that bilinear filtering reads along its border: those sample the
- * quad's closest point (on its border) and are marked EDGE. */
+ * quad's closest point (on its border) and are marked EDGE, and RING because the quad lies on
+ * the texel grid, so their squares only share a side or a corner with it (zero area: no
+ * footprint). */
 static void test_quad_texel_count(void **state)
 {
     (void)state;
@@ -59,7 +61,8 @@ static void test_quad_texel_count(void **state)
             int border = p[0] == 0.0f || p[0] == 1.0f || p[2] == 0.0f || p[2] == -1.0f;
             inside += tx.receivers[r].flags == BK_TEXEL_VALID;
             if (tx.receivers[r].flags != BK_TEXEL_VALID) {
-                assert_int_equal(tx.receivers[r].flags, BK_TEXEL_VALID | BK_TEXEL_EDGE);
+                assert_int_equal(tx.receivers[r].flags, BK_TEXEL_VALID | BK_TEXEL_EDGE | BK_TEXEL_RING);
+                assert_int_equal(tx.receivers[r].footprint_count, 0);
                 assert_true(border);
             }
             assert_true(p[0] >= 0.0f && p[0] <= 1.0f && p[2] <= 0.0f && p[2] >= -1.0f);
@@ -278,8 +281,8 @@ static void test_pushout_l_junction(void **state)
 }
 
 /* A closed box standing on a floor that runs under it: floor texels deep under the box are
- * inside (not valid), those near its walls are pushed out, the rest untouched. The result is
- * the same for 1 and 3 threads. */
+ * marked inside (and still baked: the transport makes them black), those near its walls are
+ * pushed out, the rest untouched. The result is the same for 1 and 3 threads. */
 static void test_pushout_inside_and_threads(void **state)
 {
     (void)state;
@@ -314,21 +317,73 @@ static void test_pushout_inside_and_threads(void **state)
         }
         double ax = fabs(r->position[0]), az = fabs(r->position[2]);
         int under = ax < 0.5 && az < 0.5;
-        if (r->flags & BK_TEXEL_VALID) {
-            /* a valid floor sample is never under the box */
-            assert_false(under);
-        } else {
-            assert_true(r->flags & BK_TEXEL_INSIDE);
+        assert_true(r->flags & BK_TEXEL_VALID);
+        /* a floor sample under the box is marked inside; one marked inside is under it */
+        if (under) assert_true(r->flags & BK_TEXEL_INSIDE);
+        if (r->flags & BK_TEXEL_INSIDE) {
+            assert_true(under);
             inside++;
         }
         if (ax < 0.3 && az < 0.3) assert_true(r->flags & BK_TEXEL_INSIDE); /* deep under */
-        if (ax > 0.7 || az > 0.7) assert_int_equal(r->flags & ~(uint32_t)BK_TEXEL_EDGE, BK_TEXEL_VALID); /* well clear */
+        /* well clear: untouched (the floor's border ring is EDGE and RING: the 4 m floor lies on
+         * the texel grid at 10 texels/m, so the ring's squares only touch it) */
+        if (ax > 0.7 || az > 0.7)
+            assert_int_equal(r->flags & ~(uint32_t)(BK_TEXEL_EDGE | BK_TEXEL_RING), BK_TEXEL_VALID);
     }
     assert_int_equal(inside, st.inside);
     assert_true(inside >= 36);
     bk_tracer_destroy(tr);
     bk_texels_free(&t1);
     bk_texels_free(&t3);
+    bk_atlas_free(&a);
+    uvs_free(&s);
+}
+
+/* A panel hung 5 mm over a floor at 10 texels/m (the band: a tenth of a texel), its back to the
+ * floor, like the Cornell box's light under its ceiling: floor texels whose square the panel
+ * hides in part lose their footprint (they keep their point: averaged over the hidden part,
+ * bilinear filtering would spread it over the floor beside the panel), the others keep it. */
+static void test_pushout_hidden_footprint(void **state)
+{
+    (void)state;
+    bk_scene s;
+    uvs_init(&s);
+    float f0[3] = {0, 0, 0}, f1[3] = {2, 0, 0}, f2[3] = {2, 0, -2}, f3[3] = {0, 0, -2};
+    quad_object(&s, "floor", f0, f1, f2, f3, 4);
+    const float h = 0.005f;
+    float q0[3] = {0.5f, h, -0.5f}, q1[3] = {0.9f, h, -0.5f}, q2[3] = {0.9f, h, -0.9f}, q3[3] = {0.5f, h, -0.9f};
+    quad_object(&s, "panel", q0, q1, q2, q3, 1);
+    uvs_update_bounds(&s);
+    bk_atlas a;
+    bk_texels tx;
+    build(&s, 10.0f, &a, &tx);
+    float *centre = malloc(3 * tx.count * sizeof *centre);
+    assert_non_null(centre);
+    for (size_t i = 0; i < tx.count; i++) memcpy(centre + 3 * i, tx.receivers[i].position, 12);
+    bk_tracer *tr = NULL;
+    assert_int_equal(bk_tracer_create(&s, 1, &tr), LBK_OK);
+    assert_int_equal(bk_texels_push_out(&tx, &s, tr, NULL, NULL), LBK_OK);
+    size_t hidden = 0, kept = 0;
+    for (size_t i = 0; i < tx.count; i++) {
+        const bk_texel *r = &tx.receivers[i];
+        if (r->object != 0 || (r->flags & BK_TEXEL_RING)) continue;
+        /* the square's overlap with the panel's shadow, per axis (texels: 0.1 m, half 0.05) */
+        double ox = 0.25 - fabs(centre[3 * i] - 0.7), oz = 0.25 - fabs(centre[3 * i + 2] + 0.7);
+        /* more than a probe cell (1/8 texel) of overlap on both axes: the 4 × 4 probes see it */
+        if (ox > 0.0125 && oz > 0.0125) {
+            assert_int_equal(r->footprint_count, 0);
+            hidden++;
+        }
+        if (ox < 0 || oz < 0) {
+            assert_true(r->footprint_count >= 1);
+            kept++;
+        }
+    }
+    assert_true(hidden >= 16); /* the 4 × 4 texels under the panel, at least */
+    assert_true(kept > 300);
+    free(centre);
+    bk_tracer_destroy(tr);
+    bk_texels_free(&tx);
     bk_atlas_free(&a);
     uvs_free(&s);
 }
@@ -524,9 +579,10 @@ static void test_extreme_scales(void **state)
             assert_float_equal(len3(r->normal), 1.0, 1e-5);
             assert_float_equal(len3(r->tangent), 1.0, 1e-5);
             assert_true(r->texel_size > 0.0f && isfinite(r->texel_size));
-            if (r->object == 0 && (r->flags & BK_TEXEL_VALID) && r->position[1] < 0.5 * scales[v]) {
+            if (r->object == 0 && !(r->flags & BK_TEXEL_INSIDE) && r->position[1] < 0.5 * scales[v]) {
                 double x = r->position[0] - offsets[v], z = r->position[2];
-                /* floor texels: never strictly under the box (its footprint minus rounding) */
+                /* floor texels not marked inside: never strictly under the box (its footprint
+                 * minus rounding) */
                 assert_false(fabs(x) < half * 0.98 && fabs(z) < half * 0.98);
             }
         }
@@ -537,15 +593,157 @@ static void test_extreme_scales(void **state)
     }
 }
 
+/* Footprints against brute force: for random points of every texel's square, "some footprint
+ * triangle covers it" equals "some triangle of the texel's chart covers it" (the whole chart
+ * searched), and both give the same world point. A ring texel (read only by bilinear filtering:
+ * its chart meets the square of half-size 1 around its centre but not its own square) has no
+ * footprint, and the brute force finds no chart point in its square either. A sphere of many
+ * small triangles (charts of many triangles per texel) and a box (chart borders, padding) at
+ * two densities. */
+static void test_footprint_equals_chart_cover(void **state)
+{
+    (void)state;
+    const float dens[2] = {6.0f, 23.0f};
+    for (int dv = 0; dv < 2; dv++) {
+        bk_scene s;
+        uvs_init(&s);
+        uvs_object(&s, "sphere");
+        float c[3] = {0, 1, 0};
+        uvs_sphere(&s, c, 0.6f, 32, 16, 0);
+        uvs_object(&s, "box");
+        float mn[3] = {1, 0, -0.3f}, mx[3] = {1.7f, 0.4f, 0.3f};
+        uvs_box(&s, mn, mx, 2, 0, 0);
+        uvs_update_bounds(&s);
+        bk_atlas a;
+        bk_texels tx;
+        build(&s, dens[dv], &a, &tx);
+        uint64_t rng = 0x1234567ull + (uint64_t)dv;
+        size_t points = 0, covered = 0, multi = 0, rings = 0;
+        for (size_t i = 0; i < tx.count; i++) {
+            const bk_texel *r = &tx.receivers[i];
+            assert_true(r->flags & BK_TEXEL_VALID);
+            if (r->flags & BK_TEXEL_RING) {
+                assert_int_equal(r->footprint_count, 0);
+                assert_true(r->flags & BK_TEXEL_EDGE); /* its centre is off the chart, too */
+                rings++;
+            } else {
+                assert_true(r->footprint_count >= 1);
+            }
+            assert_true((size_t)r->footprint_first + r->footprint_count <= tx.footprint_count);
+            multi += r->footprint_count > 1;
+            int32_t own = a.scene_tri_entry[r->tri];
+            assert_true(own >= 0);
+            const bk_atlas_chart *ch = &a.charts[a.tri_chart[own]];
+            for (int k = 0; k < 24; k++) {
+                rng = rng * 6364136223846793005ull + 1442695040888963407ull;
+                double ps = (double)(rng >> 11) / 9007199254740992.0;
+                rng = rng * 6364136223846793005ull + 1442695040888963407ull;
+                double pt = (double)(rng >> 11) / 9007199254740992.0;
+                /* brute force over the chart, in page coordinates; skip points within 1e-6 of an edge */
+                double px = r->x + ps, py = r->y + pt, bf[3] = {0, 0, 0};
+                int bf_hit = 0, near_edge = 0;
+                for (uint32_t e = ch->first; e < ch->first + ch->count && !bf_hit; e++) {
+                    const float *uv = a.tri_uv + 6 * (size_t)e;
+                    double d = (uv[2] - uv[0]) * (uv[5] - uv[1]) - (uv[4] - uv[0]) * (uv[3] - uv[1]);
+                    if (d == 0) continue;
+                    double w1 = ((px - uv[0]) * (uv[5] - uv[1]) - (uv[4] - uv[0]) * (py - uv[1])) / d;
+                    double w2 = ((uv[2] - uv[0]) * (py - uv[1]) - (px - uv[0]) * (uv[3] - uv[1])) / d;
+                    double w0 = 1 - w1 - w2;
+                    if (fabs(w0) < 1e-6 || fabs(w1) < 1e-6 || fabs(w2) < 1e-6) near_edge = 1;
+                    if (w0 < 0 || w1 < 0 || w2 < 0) continue;
+                    bf_hit = 1;
+                    const uint32_t *ix = s.tris + 3 * (size_t)a.tris[e];
+                    for (int q = 0; q < 3; q++)
+                        bf[q] = w0 * s.positions[3 * ix[0] + q] + w1 * s.positions[3 * ix[1] + q] +
+                                w2 * s.positions[3 * ix[2] + q];
+                }
+                if (near_edge) continue;
+                int fp_hit = 0;
+                double fp[3] = {0, 0, 0};
+                for (uint32_t k2 = 0; k2 < r->footprint_count && !fp_hit; k2++) {
+                    const bk_footprint_tri *f = &tx.footprint[r->footprint_first + k2];
+                    double u = f->uv[0][0] + f->uv[0][1] * ps + f->uv[0][2] * pt;
+                    double v = f->uv[1][0] + f->uv[1][1] * ps + f->uv[1][2] * pt;
+                    if (u < 0 || v < 0 || u + v > 1) continue;
+                    fp_hit = 1;
+                    const uint32_t *ix = s.tris + 3 * (size_t)f->tri;
+                    for (int q = 0; q < 3; q++)
+                        fp[q] = (1 - u - v) * s.positions[3 * ix[0] + q] + u * s.positions[3 * ix[1] + q] +
+                                v * s.positions[3 * ix[2] + q];
+                }
+                points++;
+                assert_int_equal(fp_hit, bf_hit);
+                if (!bf_hit) continue;
+                covered++;
+                for (int q = 0; q < 3; q++) assert_true(fabs(fp[q] - bf[q]) < 1e-4);
+            }
+        }
+        print_message("density %g: %zu texels (%zu ring), %zu footprint triangles (%zu texels with several), %zu of "
+                      "%zu points covered\n",
+                      dens[dv], tx.count, rings, tx.footprint_count, multi, covered, points);
+        assert_true(rings > 0 && rings < tx.count / 2); /* the conservative ring exists, around charts */
+        assert_true(tx.footprint_count >= tx.count - rings);
+        assert_true(multi > tx.count / 20);  /* many small triangles: texels do span several */
+        assert_true(covered < points);       /* chart borders: parts of squares are uncovered */
+        bk_texels_free(&tx);
+        bk_atlas_free(&a);
+        uvs_free(&s);
+    }
+}
+
+/* An authored layout is one chart of many islands: two faces of a slab (top up, bottom down)
+ * whose islands touch in uv1. A texel on the seam overlaps both, but its footprint keeps only
+ * its own island (else a floor texel would average in the floor's underside). */
+static void test_footprint_stays_on_island(void **state)
+{
+    (void)state;
+    bk_scene s;
+    uvs_init(&s);
+    uint32_t o = uvs_object(&s, "slab");
+    float t0[3] = {0, 0.1f, 0}, t1[3] = {2, 0.1f, 0}, t2[3] = {2, 0.1f, -2}, t3[3] = {0, 0.1f, -2};
+    float b0[3] = {0, 0, -2}, b1[3] = {2, 0, -2}, b2[3] = {2, 0, 0}, b3[3] = {0, 0, 0};
+    const float top_uv[2] = {0.0f, 0.0f}, bottom_uv[2] = {0.5f, 0.0f};
+    uvs_quad(&s, t0, t1, t2, t3, 2, 0, top_uv, 0.5f);
+    uvs_quad(&s, b0, b1, b2, b3, 2, 0, bottom_uv, 0.5f);
+    s.objects[o].has_uv1 = 1;
+    uvs_update_bounds(&s);
+    bk_atlas a;
+    bk_texels tx;
+    build(&s, 8.0f, &a, &tx);
+    assert_int_equal(a.objects[0].uv_source, BK_UV_AUTHORED);
+    size_t seam = 0;
+    for (size_t i = 0; i < tx.count; i++) {
+        const bk_texel *r = &tx.receivers[i];
+        int own_up = r->normal[1] > 0;
+        for (uint32_t k = 0; k < r->footprint_count; k++) {
+            uint32_t t = tx.footprint[r->footprint_first + k].tri;
+            const float *n = s.normals + 3 * (size_t)s.tris[3 * (size_t)t];
+            assert_int_equal(n[1] > 0, own_up);
+        }
+        /* texels whose square crosses the seam between the islands */
+        int32_t e = a.scene_tri_entry[r->tri];
+        double mx = 0;
+        for (int c = 0; c < 3; c++) mx = fmax(mx, a.tri_uv[6 * (size_t)e + 2 * c]);
+        seam += own_up && r->x + 1 > mx - 1e-3 && r->x < mx;
+    }
+    assert_true(seam >= 4);
+    bk_texels_free(&tx);
+    bk_atlas_free(&a);
+    uvs_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_quad_texel_count),
         cmocka_unit_test(test_coverage_and_frames),
+        cmocka_unit_test(test_footprint_equals_chart_cover),
+        cmocka_unit_test(test_footprint_stays_on_island),
         cmocka_unit_test(test_tangent_convention),
         cmocka_unit_test(test_degenerate),
         cmocka_unit_test(test_pushout_l_junction),
         cmocka_unit_test(test_pushout_inside_and_threads),
+        cmocka_unit_test(test_pushout_hidden_footprint),
         cmocka_unit_test(test_dilate_ring_values),
         cmocka_unit_test(test_conservative_coverage),
         cmocka_unit_test(test_extreme_scales),
