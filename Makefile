@@ -16,6 +16,9 @@ WARN     := -Wall -Wextra -Wshadow -Wstrict-prototypes -Wmissing-prototypes -Wno
 CSTD     := -std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE
 OPT      ?= -O2 -g
 SAN      := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
+# liblbk's arithmetic is defined operation by operation (the DLS apply paths must give the same
+# bytes): never contract a multiply and an add into a fused one.
+LIB_FP   := -ffp-contract=off
 
 LIB_INC  := -Ilibformat/include
 LIB_LIBS := -lzstd -lxxhash -lm
@@ -67,13 +70,13 @@ deps:
 # ---- compile rules --------------------------------------------------------------------------
 $(BUILD)/rel/libformat/%.o: libformat/%.c
 	@mkdir -p $(@D)
-	$(CC) $(CSTD) $(OPT) $(WARN) $(LIB_INC) -MMD -MP -c $< -o $@
+	$(CC) $(CSTD) $(OPT) $(LIB_FP) $(WARN) $(LIB_INC) -MMD -MP -c $< -o $@
 $(BUILD)/pic/libformat/%.o: libformat/%.c
 	@mkdir -p $(@D)
-	$(CC) $(CSTD) $(OPT) $(WARN) -fPIC -fvisibility=hidden -DLBK_BUILDING_SHARED $(LIB_INC) -MMD -MP -c $< -o $@
+	$(CC) $(CSTD) $(OPT) $(LIB_FP) $(WARN) -fPIC -fvisibility=hidden -DLBK_BUILDING_SHARED $(LIB_INC) -MMD -MP -c $< -o $@
 $(BUILD)/asan/libformat/%.o: libformat/%.c
 	@mkdir -p $(@D)
-	$(CC) $(CSTD) -O1 -g $(SAN) $(WARN) $(LIB_INC) -MMD -MP -c $< -o $@
+	$(CC) $(CSTD) -O1 -g $(LIB_FP) $(SAN) $(WARN) $(LIB_INC) -MMD -MP -c $< -o $@
 $(BUILD)/rel/%.o: %.c
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) $(OPT) $(WARN) $(TOOL_INC) -MMD -MP -c $< -o $@
@@ -139,7 +142,7 @@ check: test
 FUZZ_FLAGS := -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined -g -O1
 $(BUILD)/fuzz_container: tests/fuzz/fuzz_container.c $(LIB_SRC)
 	@mkdir -p $(@D)
-	$(CLANG) $(CSTD) $(FUZZ_FLAGS) $(LIB_INC) -o $@ $^ $(LIB_LIBS)
+	$(CLANG) $(CSTD) $(FUZZ_FLAGS) $(LIB_FP) $(LIB_INC) -o $@ $^ $(LIB_LIBS)
 fuzz: deps $(BUILD)/fuzz_container
 	@mkdir -p $(BUILD)/fuzz-corpus
 	$(BUILD)/fuzz_container -max_total_time=$${FUZZ_SECONDS:-60} $(BUILD)/fuzz-corpus tests/fuzz/corpus
