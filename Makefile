@@ -10,7 +10,10 @@ CLANG    ?= clang
 # Debian packages the build needs; `make deps` installs the missing ones when run as root.
 DEB_PKGS := build-essential pkg-config libzstd-dev libxxhash-dev libembree-dev libopenexr-dev \
             libdraco-dev libtinygltf-dev libstb-dev nlohmann-json3-dev libqhull-dev libspng-dev \
-            libcjson-dev libcmocka-dev clang libclang-rt-14-dev
+            libcjson-dev libcmocka-dev clang libclang-rt-14-dev $(GPU_PKGS)
+# The GPU path (gpu/): Vulkan headers and loader, glslang, and Mesa's lavapipe (a CPU Vulkan
+# device) so that its tests run on a machine without a GPU.
+GPU_PKGS := libvulkan-dev mesa-vulkan-drivers glslang-tools
 
 WARN     := -Wall -Wextra -Wshadow -Wstrict-prototypes -Wmissing-prototypes -Wno-unused-parameter
 CSTD     := -std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE
@@ -43,7 +46,7 @@ TOOL_OBJ  := $(filter-out $(BUILD)/rel/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUIL
 LIB_ASAN  := $(LIB_SRC:%.c=$(BUILD)/asan/%.o)
 TOOL_ASAN := $(filter-out $(BUILD)/asan/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUILD)/asan/%.o)) $(TOOL_CXXSRC:%.cc=$(BUILD)/asan/%.o)
 
-.PHONY: all lib deps demo test check bench fuzz install install-check clean help
+.PHONY: all lib deps demo test check bench fuzz install install-check clean help gpu
 all: $(BUILD)/lbk $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc
 
 help:
@@ -52,6 +55,7 @@ help:
 	@echo "make test       install missing packages, build with ASan+UBSan, run the whole suite"
 	@echo "make bench      benchmarks, printed as ratios against baselines measured in the same run"
 	@echo "make fuzz       libFuzzer harness for the container reader (clang)"
+	@echo "make gpu        the Vulkan DLS apply tool build/lbk-gpu-apply (make test runs the GPU tests on lavapipe)"
 	@echo "make install PREFIX=/usr/local"
 
 # ---- dependencies -------------------------------------------------------------------------
@@ -109,6 +113,32 @@ $(BUILD)/lbk: $(BUILD)/rel/$(TOOL_MAIN:.c=.o) $(TOOL_OBJ) $(BUILD)/liblbk.a
 $(BUILD)/lbk-asan: $(BUILD)/asan/$(TOOL_MAIN:.c=.o) $(TOOL_ASAN) $(LIB_ASAN)
 	$(CXX) $(SAN) -o $@ $^ $(TOOL_LIBS)
 
+# ---- the GPU path (gpu/) --------------------------------------------------------------------
+# Built when the Vulkan headers and glslang are there (make deps installs them); without them
+# tests/gpu/test_gpu.c compiles to SKIPPED tests. Shaders become C arrays (glslang --vn).
+GLSLANG    ?= glslangValidator
+HAVE_VULKAN := $(shell test -f /usr/include/vulkan/vulkan.h && command -v $(GLSLANG) >/dev/null 2>&1 && echo 1)
+GPU_SHADERS := $(sort $(wildcard gpu/shaders/*.comp))
+GPU_SPV_H   := $(GPU_SHADERS:gpu/shaders/%.comp=$(BUILD)/gpu/%.spv.h)
+GPU_HOST    := $(sort $(wildcard gpu/host/*.c))
+$(BUILD)/gpu/%.spv.h: gpu/shaders/%.comp $(wildcard gpu/shaders/*.glsl)
+	@mkdir -p $(@D)
+	$(GLSLANG) -V --target-env vulkan1.1 --vn $*_spv -o $@ $< >/dev/null
+ifeq ($(HAVE_VULKAN),1)
+GPU_REL  := $(GPU_HOST:%.c=$(BUILD)/rel/%.o)
+GPU_ASAN := $(GPU_HOST:%.c=$(BUILD)/asan/%.o)
+$(GPU_REL) $(GPU_ASAN): $(GPU_SPV_H)
+$(GPU_REL) $(GPU_ASAN) $(BUILD)/tests/test_gpu: TOOL_INC += -I$(BUILD)/gpu -DLBK_HAVE_VULKAN=1
+$(BUILD)/tests/test_gpu: $(GPU_ASAN)
+$(BUILD)/tests/test_gpu: TEST_EXTRA = $(GPU_ASAN) -lvulkan
+$(BUILD)/lbk-gpu-apply: gpu/lbk_gpu_apply.c $(GPU_REL) $(BUILD)/liblbk.a
+	$(CC) $(CSTD) $(OPT) $(WARN) $(TOOL_INC) -I$(BUILD)/gpu -DLBK_HAVE_VULKAN=1 -o $@ $< $(GPU_REL) $(BUILD)/liblbk.a -lvulkan $(LIB_LIBS)
+gpu: $(BUILD)/lbk-gpu-apply
+else
+gpu:
+	@echo "lbk: the GPU path needs $(GPU_PKGS) (make deps installs them)"; exit 1
+endif
+
 # ---- tests (ASan + UBSan) ------------------------------------------------------------------
 TEST_SUPPORT_OBJ := $(TEST_SUPPORT:%.c=$(BUILD)/asan/%.o)
 $(TEST_SUPPORT_OBJ): TOOL_INC += -Itests
@@ -118,7 +148,7 @@ test_src_of = $(foreach s,$(TEST_SRC),$(if $(filter $(1).c,$(notdir $(s))),$(s))
 $(BUILD)/tests/%: $$(call test_src_of,$$*) $(TEST_SUPPORT_OBJ) $(TOOL_ASAN) $(LIB_ASAN)
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) -O1 -g $(SAN) $(WARN) $(TOOL_INC) -Itests -c $< -o $@.o
-	$(CXX) $(SAN) -o $@ $@.o $(TEST_SUPPORT_OBJ) $(TOOL_ASAN) $(LIB_ASAN) $(TOOL_LIBS) -lcmocka
+	$(CXX) $(SAN) -o $@ $@.o $(TEST_SUPPORT_OBJ) $(TOOL_ASAN) $(LIB_ASAN) $(TEST_EXTRA) $(TOOL_LIBS) -lcmocka
 
 # The install check: the library installed into $(BUILD)/inst, a program built against it with
 # pkg-config only, linked once with liblbk.so and once with liblbk.a.
