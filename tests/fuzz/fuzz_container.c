@@ -4,13 +4,16 @@
  *
  * Random bytes rarely get past the checksums, so every input is tried twice: as it is, and with
  * its file_size, section checksums, table and header checksums recomputed, which lets the
- * fuzzer mutate section contents and reach every section validator. */
+ * fuzzer mutate section contents and reach every section validator. A DLS section that opens
+ * also goes through the runtime (the job planner and the kernels walk its runs, sub-groups and
+ * prefix data): two applies and the dirty regions. */
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <xxhash.h>
 
 #include "lbk/container.h"
+#include "lbk/dls.h"
 #include "lbk/meta.h"
 #include "lbk/objects.h"
 #include "lbk/report.h"
@@ -27,9 +30,45 @@ static int count_issue(void *user, const lbk_issue *issue)
     return 0;
 }
 
+/* A DLS view that opened: apply it over zero bases (small target spaces only, to stay fast). */
+static void run_dls(const void *d, size_t n)
+{
+    lbk_dls_view *v;
+    if (lbk_dls_open(d, n, NULL, &v) != LBK_OK) return;
+    const uint64_t t = lbk_dls_target_count(v, 0), g = lbk_dls_target_count(v, 1), l = lbk_dls_target_count(v, 2);
+    const uint32_t sets = lbk_dls_set_count(v);
+    if (t <= (1u << 16) && g <= (1u << 14) && l <= (1u << 14) && sets <= 4096) {
+        uint8_t *b = calloc(8 * t + 56 * (g + l) + 16, 1), *o = calloc(8 * t + 56 * (g + l) + 16, 1);
+        float *w = calloc(sets + 1, sizeof *w);
+        if (b && o && w) {
+            lbk_dls_runtime_desc rd = {.dls = v};
+            if (t) rd.base_irradiance_z = (const uint32_t *)(void *)b, rd.base_rgba = b + 4 * t,
+            rd.out_irradiance_z = (uint32_t *)(void *)o, rd.out_rgba = o + 4 * t;
+            if (g) rd.base_glg = b + 8 * t, rd.out_glg = o + 8 * t;
+            if (l) rd.base_llg = b + 8 * t + 28 * g, rd.out_llg = o + 8 * t + 28 * g;
+            lbk_dls_runtime *r;
+            if (lbk_dls_runtime_open(&rd, &r) == LBK_OK) {
+                for (uint32_t i = 0; i < sets; i++) w[i] = i % 3 ? 0.5f : 0.0f;
+                lbk_dls_apply(r, w, NULL, NULL);
+                w[0] = 2.0f;
+                lbk_dls_apply(r, w, NULL, NULL);
+                for (uint32_t s = 0; s < 3; s++) {
+                    lbk_dls_range rg;
+                    for (uint32_t i = 0; i < lbk_dls_dirty_range_count(r, s); i++) lbk_dls_dirty_range_get(r, s, i, &rg);
+                }
+                lbk_dls_runtime_close(r);
+            }
+        }
+        free(b), free(o), free(w);
+    }
+    lbk_dls_close(v);
+}
+
 static void read_views(uint32_t type, const void *d, size_t n)
 {
-    if (type == LBK_SECTION_META) {
+    if (type == LBK_SECTION_DLS) {
+        run_dls(d, n);
+    } else if (type == LBK_SECTION_META) {
         lbk_meta_view v;
         if (lbk_meta_open(d, n, &v) == LBK_OK) {
             for (uint32_t i = 0; i < v.entry_count && i < 4096; i++) {
