@@ -131,6 +131,9 @@ $(GPU_REL) $(GPU_ASAN): $(GPU_SPV_H)
 $(GPU_REL) $(GPU_ASAN) $(BUILD)/tests/test_gpu: TOOL_INC += -I$(BUILD)/gpu -DLBK_HAVE_VULKAN=1
 $(BUILD)/tests/test_gpu: $(GPU_ASAN)
 $(BUILD)/tests/test_gpu: TEST_EXTRA = $(GPU_ASAN) -lvulkan
+$(BUILD)/bench/bench_gpu: $(GPU_REL)
+$(BUILD)/bench/bench_gpu: TOOL_INC += -I$(BUILD)/gpu -DLBK_HAVE_VULKAN=1
+$(BUILD)/bench/bench_gpu: BENCH_EXTRA = $(GPU_REL) -lvulkan
 $(BUILD)/lbk-gpu-apply: gpu/lbk_gpu_apply.c $(GPU_REL) $(BUILD)/liblbk.a
 	$(CC) $(CSTD) $(OPT) $(WARN) $(TOOL_INC) -I$(BUILD)/gpu -DLBK_HAVE_VULKAN=1 -o $@ $< $(GPU_REL) $(BUILD)/liblbk.a -lvulkan $(LIB_LIBS)
 gpu: $(BUILD)/lbk-gpu-apply
@@ -164,7 +167,8 @@ install-check: all
 	    $$(PKG_CONFIG_PATH=$(INST)/lib/pkgconfig pkg-config --static --libs-only-other --libs-only-l lbk | sed 's/-llbk//') -lcmocka
 
 test: deps
-	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BUILD)/lbk-asan $(TESTS:%=$(BUILD)/tests/%) $(BUILD)/fuzz_container install-check
+	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BUILD)/lbk-asan $(TESTS:%=$(BUILD)/tests/%) $(BUILD)/fuzz_container install-check \
+	    $(if $(HAVE_VULKAN),$(BUILD)/lbk-gpu-apply)
 	@LBK=$(BUILD)/lbk-asan BUILD=$(BUILD) FUZZ=$(BUILD)/fuzz_container sh tests/run.sh $(TESTS) install_check_shared install_check_static
 check: test
 
@@ -181,7 +185,7 @@ fuzz: deps $(BUILD)/fuzz_container
 $(BUILD)/bench/%: bench/%.c $(TOOL_OBJ) $(BUILD)/liblbk.a
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) -O2 -g $(WARN) $(TOOL_INC) -c $< -o $@.o
-	$(CXX) -o $@ $@.o $(TOOL_OBJ) $(BUILD)/liblbk.a $(TOOL_LIBS)
+	$(CXX) -o $@ $@.o $(TOOL_OBJ) $(BUILD)/liblbk.a $(BENCH_EXTRA) $(TOOL_LIBS)
 bench: deps
 	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BENCHES:%=$(BUILD)/bench/%)
 	@for b in $(BENCHES); do echo "== $$b"; $(BUILD)/bench/$$b || exit 1; done

@@ -1,13 +1,7 @@
 /* DLS apply (lbk_dls_apply) against memcpy, measured in the same run.
  *
- * Level: synthetic, the size of seed 001's ESTATE (Table 1: 2,637,824 lightmap texels, 229,725
- * GLG and 50,805 LLG probes, 132 light sets, 28 MB without and 77 MB with the sets): texels in
- * three pages (2 × 1024², 1024 × 528); 116 "room" sets, each a cluster of 10–16 charts
- * (rectangles of 12–96 texels a side) around a centre, plus 16 "hall" sets overlapping one
- * region 12–16 deep (the seed's stealth level, Fig. 5: most receivers see few sets, a few see
- * many); probes in intervals of the probe order around the room's place. The overlaps are
- * Poisson-like with a mean of about 1.7 sets per target, which puts the DLS payload near the
- * seed's 49 MB.
+ * Level: the synthetic ESTATE-sized level of tests/support/estate_level.h (seed 001 Table 1:
+ * 2.64 M texels, 280 k probes, 132 sets).
  *
  * Measured: apply when every set's weight changes (the seed's synchronous debug mode, its
  * 1.47 ms on a PS4 GPU) and when one set changes, on 1 and 2 threads (the job API), as the
@@ -38,128 +32,13 @@
 /* The generators live with the tests; benches link the tools only, so take their source. */
 #include "tests/support/dls_fixture.c"
 #include "tests/support/door_scenes.c"
+#include "tests/support/estate_level.c"
 
-#define NSETS 132
-#define ROOMS 116
-#define PAGES 3
-
-static const uint32_t page_w[PAGES] = {1024, 1024, 1024}, page_h[PAGES] = {1024, 1024, 528};
-static const uint64_t T = 2637824, G = 229725, L = 50805;
-
-/* ---- the synthetic level ------------------------------------------------------------------- */
-
-typedef struct level {
-    dlsfx fx;
-    void *bytes;
-    size_t size;
-    lbk_dls_view *view;
-    lbk_dls_stats st;
-} level;
-
-static uint64_t page_first(uint32_t p)
-{
-    uint64_t f = 0;
-    for (uint32_t q = 0; q < p; q++) f += (uint64_t)page_w[q] * page_h[q];
-    return f;
-}
-
-/* Marks a rectangle of page p in mark[] (one byte per texel). */
-static void mark_rect(uint8_t *mark, uint32_t p, int x0, int y0, int w, int h)
-{
-    const int W = (int)page_w[p], H = (int)page_h[p];
-    for (int y = y0 < 0 ? 0 : y0; y < y0 + h && y < H; y++)
-        for (int x = x0 < 0 ? 0 : x0; x < x0 + w && x < W; x++) mark[page_first(p) + (uint64_t)y * W + x] = 1;
-}
-
-static void add_marked(dlsfx *fx, uint64_t *rng, uint32_t s, uint8_t *mark)
-{
-    for (uint64_t t = 0; t < T; t++)
-        if (mark[t]) dlsfx_add(fx, rng, s, LBK_DLS_SPACE_TEXEL, (uint32_t)t), mark[t] = 0;
-}
-
-static void add_interval(dlsfx *fx, uint64_t *rng, uint32_t s, uint32_t sp, uint64_t n, int64_t centre, int64_t len,
-                         uint8_t *mark)
-{
-    int64_t a = centre - len / 2, b = centre + len / 2;
-    if (a < 0) a = 0;
-    if (b > (int64_t)n) b = (int64_t)n;
-    for (int64_t t = a; t < b; t++) mark[t] = 1;
-    (void)rng, (void)fx, (void)s, (void)sp;
-}
-
-static void add_marked_probes(dlsfx *fx, uint64_t *rng, uint32_t s, uint32_t sp, uint64_t n, uint8_t *mark)
-{
-    for (uint64_t t = 0; t < n; t++)
-        if (mark[t]) dlsfx_add(fx, rng, s, sp, (uint32_t)t), mark[t] = 0;
-}
-
-static int level_build(level *lv)
-{
-    uint64_t rng = 2024;
-    dlsfx_init(&lv->fx, NSETS, T, G, L);
-    uint8_t *mark = calloc(T, 1);
-    for (uint32_t s = 0; s < NSETS; s++) {
-        uint32_t p;
-        int cx, cy, glg_len, llg_len, spread;
-        if (s < ROOMS) {
-            p = (uint32_t)(dlsfx_rand(&rng) % 5) / 2; /* pages 0, 0, 1, 1, 2: by area */
-            cx = (int)(dlsfx_rand(&rng) % page_w[p]), cy = (int)(dlsfx_rand(&rng) % page_h[p]);
-            const int charts = 10 + (int)(dlsfx_rand(&rng) % 7);
-            for (int c = 0; c < charts; c++) {
-                int w = 12 + (int)(dlsfx_rand(&rng) % 85), h = 12 + (int)(dlsfx_rand(&rng) % 85);
-                int dx = (int)(dlsfx_rand(&rng) % 321) - 160, dy = (int)(dlsfx_rand(&rng) % 321) - 160;
-                mark_rect(mark, p, cx + dx - w / 2, cy + dy - h / 2, w, h);
-            }
-            glg_len = 700 + (int)(dlsfx_rand(&rng) % 1500), llg_len = 100 + (int)(dlsfx_rand(&rng) % 300), spread = 2;
-        } else { /* the hall: 256 × 200 texels of page 0, each set leaving out a corner */
-            p = 0, cx = 728, cy = 200;
-            int cut_w = (int)(dlsfx_rand(&rng) % 96), cut_h = (int)(dlsfx_rand(&rng) % 80);
-            mark_rect(mark, 0, 600, 100, 256, 200);
-            for (int y = 100; y < 100 + cut_h; y++)
-                for (int x = 600; x < 600 + cut_w; x++) mark[(uint64_t)y * 1024 + x] = 0;
-            glg_len = 3000, llg_len = 500, spread = 0;
-        }
-        add_marked(&lv->fx, &rng, s, mark);
-        /* probes: the room's place in the level, as a position in probe order */
-        const double at = (double)(page_first(p) + (uint64_t)cy * page_w[p] + (uint64_t)cx) / (double)T;
-        for (int i = 0; i <= spread / 2; i++) {
-            const int64_t off = spread ? (int64_t)(dlsfx_rand(&rng) % 4000) - 2000 : 0;
-            add_interval(&lv->fx, &rng, s, 1, G, (int64_t)(at * (double)G) + off, glg_len, mark);
-        }
-        add_marked_probes(&lv->fx, &rng, s, LBK_DLS_SPACE_GLG, G, mark);
-        for (int i = 0; i <= spread / 2; i++) {
-            const int64_t off = spread ? (int64_t)(dlsfx_rand(&rng) % 600) - 300 : 0;
-            add_interval(&lv->fx, &rng, s, 2, L, (int64_t)(at * (double)L) + off, llg_len, mark);
-        }
-        add_marked_probes(&lv->fx, &rng, s, LBK_DLS_SPACE_LLG, L, mark);
-    }
-    free(mark);
-    const double t0 = bk_now();
-    lbk_result r = lbk_dls_build(&lv->fx.desc, NULL, &lv->bytes, &lv->size, &lv->st);
-    const double t_build = bk_now() - t0;
-    if (r != LBK_OK || lbk_dls_open(lv->bytes, lv->size, NULL, &lv->view) != LBK_OK) {
-        fprintf(stderr, "build failed: %s\n", lbk_result_name(r));
-        return 1;
-    }
-    const lbk_dls_stats *st = &lv->st;
-    uint64_t entries = st->entries[0] + st->entries[1] + st->entries[2];
-    printf("level (ESTATE-sized): %llu texels in %d pages, %llu GLG, %llu LLG probes, %d sets, %llu entries (%.2f per "
-           "target); DLS %.1f MB (payload %.1f MB, ancillary %.0f KB; seed: ~49 MB, ~132 KB); build %.2f s\n",
-           (unsigned long long)T, PAGES, (unsigned long long)G, (unsigned long long)L, NSETS, (unsigned long long)entries,
-           (double)entries / (double)(T + G + L), st->section_bytes / 1e6, st->payload_bytes / 1e6, st->ancillary_bytes / 1e3,
-           t_build);
-    printf("  clusters %u: dedicated %u, packed %u (%u sub-groups), prefix-2 %u, prefix-3 %u, prefix-8 %u\n", st->cluster_count,
-           st->clusters_by_form[0], st->clusters_by_form[1], st->packed_subgroups, st->clusters_by_form[2],
-           st->clusters_by_form[3], st->clusters_by_form[4]);
-    printf("  texels by overlap (0, 1, 2, …, 16, more):");
-    for (int b = 0; b < LBK_DLS_HISTOGRAM_BINS; b++) printf(" %llu", (unsigned long long)st->histogram[0][b]);
-    printf("\n  texels by form: dedicated %.1f%%, packed %.2f%%, prefix %.2f%% of the touched\n",
-           100.0 * (double)st->targets_by_form[0] / (double)(st->touched[0] + st->touched[1] + st->touched[2]),
-           100.0 * (double)st->targets_by_form[1] / (double)(st->touched[0] + st->touched[1] + st->touched[2]),
-           100.0 * (double)(st->targets_by_form[2] + st->targets_by_form[3] + st->targets_by_form[4]) /
-               (double)(st->touched[0] + st->touched[1] + st->touched[2]));
-    return 0;
-}
+#define NSETS ESTATE_SETS
+#define PAGES ESTATE_PAGES
+#define T ESTATE_TEXELS
+#define G ESTATE_GLG
+#define L ESTATE_LLG
 
 /* ---- timing -------------------------------------------------------------------------------- */
 
@@ -295,9 +174,9 @@ static void report(const char *what, int threads, const scenario_result *r)
 
 static int estate(void)
 {
-    level lv;
-    memset(&lv, 0, sizeof lv);
-    if (level_build(&lv)) return 1;
+    estate_level lv;
+    if (estate_build(&lv)) return 1;
+    estate_describe(&lv);
     uint64_t rng = 99;
     uint8_t *base0 = malloc(T * 4), *base1 = malloc(T * 4), *out0 = malloc(T * 4), *out1 = malloc(T * 4);
     uint8_t *bg = malloc(G * 28), *og = malloc(G * 28), *bl = malloc(L * 28), *ol = malloc(L * 28);
@@ -310,8 +189,8 @@ static int estate(void)
     for (uint64_t t = 0; t < L; t++) dlsfx_random_probe(&rng, 2.0f, bl + 28 * t);
     lbk_dls_page pages[PAGES];
     for (uint32_t p = 0; p < PAGES; p++) {
-        const uint64_t f = page_first(p);
-        pages[p] = (lbk_dls_page){.width = page_w[p], .height = page_h[p], .base_irradiance = base0 + 4 * f,
+        const uint64_t f = estate_page_first(p);
+        pages[p] = (lbk_dls_page){.width = estate_page_w[p], .height = estate_page_h[p], .base_irradiance = base0 + 4 * f,
                                   .base_rgba = base1 + 4 * f, .out_irradiance = out0 + 4 * f, .out_rgba = out1 + 4 * f};
     }
     int bad = 0;
@@ -336,9 +215,7 @@ static int estate(void)
         lbk_dls_runtime_close(rt);
     }
     free(base0), free(base1), free(out0), free(out1), free(bg), free(og), free(bl), free(ol);
-    lbk_dls_close(lv.view);
-    free(lv.bytes);
-    dlsfx_free(&lv.fx);
+    estate_free(&lv);
     return bad;
 }
 

@@ -15,7 +15,7 @@
 #include "dls_apply.spv.h"
 #include "dls_naive.spv.h"
 
-enum { B_DLS, B_RUN_ORD, B_WEIGHTS, B_LMAP, B_LMAP_OUT, B_GLG, B_GLG_OUT, B_LLG, B_LLG_OUT, B_REC, B_OFFS, B_COUNT };
+enum { B_DLS, B_RUN_ORD, B_WEIGHTS, B_LMAP, B_LMAP_OUT, B_GLG, B_GLG_OUT, B_LLG, B_LLG_OUT, B_TABLE, B_REC, B_OFFS, B_COUNT };
 
 typedef struct apply_push {
     uint32_t cluster, mode;
@@ -29,6 +29,7 @@ typedef struct naive_push {
 typedef struct cluster {
     lbk_dls_cluster_info info;
     uint32_t set_first;    /* into sets[] / set_entries[] */
+    uint32_t run_first;    /* its first run in the section's run array */
 } cluster;
 
 struct gpu_dls {
@@ -43,13 +44,14 @@ struct gpu_dls {
     uint32_t *sets;           /* every cluster's set list, concatenated */
     uint64_t *set_entries;    /* entries per (cluster, set) */
     float *w, *last;
-    int valid;
+    int valid, per_cluster;
     gpu_buffer buf[B_COUNT];
     gpu_pipeline apply, naive;
     apply_push push;
     uint64_t naive_words[3], naive_first[3]; /* per space: record words, first record word / offset */
     double div_clustered, div_naive;
     uint8_t *count[3];        /* entries per target (every set on) */
+    uint32_t *run_ord;        /* per run: the cluster-order position of its first target */
 };
 
 /* ---- the level's index data on the host ----------------------------------------------------- */
@@ -167,6 +169,7 @@ static int run_ordinals(gpu_dls *g, uint32_t **out, uint64_t *n_out)
         const uint8_t *cr = (const uint8_t *)g->buf[B_DLS].map + coff + 64ull * i;
         uint32_t first, count, at = 0;
         memcpy(&first, cr + 20, 4), memcpy(&count, cr + 24, 4);
+        g->cl[i].run_first = first;
         for (uint32_t r = 0; r < count; r++) {
             uint32_t len;
             memcpy(&len, runs + 8ull * (first + r) + 4, 4);
@@ -283,6 +286,7 @@ int gpu_dls_open(gpu_ctx *c, const gpu_dls_level *lv, gpu_dls **out, char *err, 
     uint64_t nruns = 0, rec_words = 0, noffs = 0;
     bad = bad || run_ordinals(g, &ord, &nruns);
     bad = bad || gpu_buffer_create(c, 4 * nruns, ord, &g->buf[B_RUN_ORD]);
+    g->run_ord = ord, ord = NULL; /* kept for the batched dispatch's table */
     bad = bad || gpu_buffer_create(c, 4 * (uint64_t)g->nsets, NULL, &g->buf[B_WEIGHTS]);
     bad = bad || gpu_buffer_create(c, lv->lmap ? lv->lmap_size : 16, lv->lmap, &g->buf[B_LMAP]);
     bad = bad || gpu_buffer_create(c, lv->lmap ? lv->lmap_size : 16, lv->lmap, &g->buf[B_LMAP_OUT]);
@@ -290,16 +294,19 @@ int gpu_dls_open(gpu_ctx *c, const gpu_dls_level *lv, gpu_dls **out, char *err, 
     bad = bad || gpu_buffer_create(c, 28 * g->targets[1], NULL, &g->buf[B_GLG_OUT]);
     bad = bad || gpu_buffer_create(c, 28 * g->targets[2], lv->llg, &g->buf[B_LLG]);
     bad = bad || gpu_buffer_create(c, 28 * g->targets[2], NULL, &g->buf[B_LLG_OUT]);
+    uint64_t groups = 0; /* the batched dispatch's table: a workgroup of 64 per stretch of a cluster */
+    for (uint32_t i = 0; i < g->ncl; i++) groups += (g->cl[i].info.target_count + 63) / 64;
+    bad = bad || gpu_buffer_create(c, 12 * groups, NULL, &g->buf[B_TABLE]);
     if (!bad && lv->naive) bad = naive_records(g, &rec, &offs, &rec_words, &noffs);
     bad = bad || gpu_buffer_create(c, 4 * rec_words, rec, &g->buf[B_REC]);
     bad = bad || gpu_buffer_create(c, 4 * noffs, offs, &g->buf[B_OFFS]);
     free(ord), free(rec), free(offs);
     if (bad) FAIL("out of device memory");
-    if (gpu_pipeline_create(c, dls_apply_spv, sizeof dls_apply_spv, 9, sizeof(apply_push), &g->apply) ||
+    if (gpu_pipeline_create(c, dls_apply_spv, sizeof dls_apply_spv, 10, sizeof(apply_push), &g->apply) ||
         gpu_pipeline_create(c, dls_naive_spv, sizeof dls_naive_spv, 9, sizeof(naive_push), &g->naive))
         FAIL("pipeline creation failed");
-    const gpu_buffer *ab[9] = {&g->buf[B_DLS], &g->buf[B_RUN_ORD], &g->buf[B_WEIGHTS], &g->buf[B_LMAP], &g->buf[B_LMAP_OUT],
-                               &g->buf[B_GLG], &g->buf[B_GLG_OUT], &g->buf[B_LLG], &g->buf[B_LLG_OUT]};
+    const gpu_buffer *ab[10] = {&g->buf[B_DLS], &g->buf[B_RUN_ORD], &g->buf[B_WEIGHTS], &g->buf[B_LMAP], &g->buf[B_LMAP_OUT],
+                                &g->buf[B_GLG], &g->buf[B_GLG_OUT], &g->buf[B_LLG], &g->buf[B_LLG_OUT], &g->buf[B_TABLE]};
     gpu_pipeline_bind(c, &g->apply, ab);
     const gpu_buffer *nb[9] = {&g->buf[B_REC], &g->buf[B_OFFS], &g->buf[B_WEIGHTS], &g->buf[B_LMAP], &g->buf[B_LMAP_OUT],
                                &g->buf[B_GLG], &g->buf[B_GLG_OUT], &g->buf[B_LLG], &g->buf[B_LLG_OUT]};
@@ -329,12 +336,13 @@ void gpu_dls_close(gpu_dls *g)
     if (g->doors) lbk_door_close(g->doors);
     lbk_dls_close(g->view);
     free(g->kinds), free(g->member_first), free(g->members), free(g->door_of_set), free(g->w), free(g->last);
-    free(g->cl), free(g->sets), free(g->set_entries);
+    free(g->cl), free(g->sets), free(g->set_entries), free(g->run_ord);
     for (int s = 0; s < 3; s++) free(g->count[s]);
     free(g);
 }
 
 void gpu_dls_invalidate(gpu_dls *g) { g->valid = 0; }
+void gpu_dls_per_cluster(gpu_dls *g, int on) { g->per_cluster = on; }
 uint32_t gpu_dls_cluster_count(const gpu_dls *g) { return g->ncl; }
 const uint8_t *gpu_dls_lmap(const gpu_dls *g) { return g->buf[B_LMAP_OUT].map; }
 const uint8_t *gpu_dls_probes(const gpu_dls *g, uint32_t space) { return g->buf[space == 1 ? B_GLG_OUT : B_LLG_OUT].map; }
@@ -402,6 +410,7 @@ int gpu_dls_apply(gpu_dls *g, const float *set_weights, const float *door_weight
         s.bytes_moved += 2 * (g->buf[B_LMAP].size + g->buf[B_GLG].size + g->buf[B_LLG].size);
         gpu_barrier(c);
     }
+    uint32_t *table = g->buf[B_TABLE].map, groups = 0;
     for (uint32_t i = 0; i < g->ncl; i++) {
         const cluster *cl = &g->cl[i];
         bool changed = full, nonzero = false;
@@ -418,16 +427,32 @@ int gpu_dls_apply(gpu_dls *g, const float *set_weights, const float *door_weight
             s.clusters_skipped++;
             continue;
         }
-        apply_push p = g->push;
-        p.cluster = i;
-        p.mode = nonzero ? 0 : 1;
-        gpu_dispatch(c, &g->apply, &p, cl->info.target_count);
-        s.dispatches++;
+        if (g->per_cluster) {
+            apply_push p = g->push;
+            p.cluster = i;
+            p.mode = nonzero ? 0 : 1;
+            gpu_dispatch(c, &g->apply, &p, cl->info.target_count);
+            s.dispatches++;
+        } else { /* a workgroup per 64 targets: its cluster, first target and the run that holds it */
+            const uint32_t *ord = g->run_ord + cl->run_first;
+            for (uint32_t first = 0, run = 0; first < cl->info.target_count; first += 64, groups++) {
+                while (run + 1 < cl->info.run_count && ord[run + 1] <= first) run++;
+                table[3 * groups] = i | (nonzero ? 0u : 0x80000000u);
+                table[3 * groups + 1] = first;
+                table[3 * groups + 2] = cl->run_first + run;
+            }
+        }
         s.invocations += cl->info.target_count;
         const uint64_t psize = cl->info.space == 0 ? 8 : 28;
         s.bytes_moved += psize * (2 * (uint64_t)cl->info.target_count + active);
         if (nonzero) s.clusters_applied++;
         else s.clusters_copied++;
+    }
+    if (groups) {
+        apply_push p = g->push;
+        p.mode = 2;
+        gpu_dispatch(c, &g->apply, &p, 64 * (uint64_t)groups);
+        s.dispatches++;
     }
     gpu_timestamp(c, 1);
     gpu_barrier(c);

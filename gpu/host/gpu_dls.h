@@ -1,7 +1,9 @@
 /* lbk_dls_apply on a Vulkan device (gpu/shaders/dls_apply.comp): upload a level once — the DLS
  * section bytes as they are, the LMAP section as the base texels, the base probe arrays — then
- * apply weights as often as wanted, one compute dispatch per cluster whose sets changed (the
- * seed's design), and read the results back from mapped memory. The output has the layouts of the
+ * apply weights as often as wanted and read the results back from mapped memory. The clusters
+ * whose sets changed run as one dispatch (a table gives each workgroup of 64 its cluster and
+ * first target, so a workgroup never mixes clusters), or, gpu_dls_per_cluster, one dispatch per
+ * cluster as in the seed (whose per-dispatch overhead the batch avoids). The output has the layouts of the
  * inputs: an LMAP section's bytes (page planes at the page table's offsets, ready for
  * vkCmdCopyBufferToImage) and 28-byte probe arrays. The bytes equal lbk_dls_apply's.
  *
@@ -40,6 +42,8 @@ int gpu_dls_open(gpu_ctx *c, const gpu_dls_level *level, gpu_dls **out, char *er
 void gpu_dls_close(gpu_dls *g);
 /* The next apply rewrites every target. */
 void gpu_dls_invalidate(gpu_dls *g);
+/* 1: one dispatch per cluster (the seed's); 0 (the default): one batched dispatch. */
+void gpu_dls_per_cluster(gpu_dls *g, int on);
 /* set_weights / door_weights as lbk_dls_apply (NULL: all 0 / all doors closed). 0 on success. */
 int gpu_dls_apply(gpu_dls *g, const float *set_weights, const float *door_weights, gpu_dls_stats *stats);
 /* Every target, gathered per target (needs level.naive). */

@@ -1,11 +1,12 @@
 /* The GPU path (gpu/) against liblbk, on whatever Vulkan device the loader finds — lavapipe on a
  * machine without a GPU (mesa-vulkan-drivers; VK_ICD_FILENAMES or LBK_GPU_DEVICE choose one):
- *   - dls_apply.comp over a sequence of weights (first apply, incremental, all off, doors,
- *     weights of ±3e38 whose sums overflow):
+ *   - dls_apply.comp, batched and one dispatch per cluster, over a sequence of weights (first
+ *     apply, incremental, all off, doors, weights of ±3e38 whose sums overflow):
  *     the LMAP planes and probe arrays are byte-identical to lbk_dls_apply's, on every form;
  *     the naive gather gives the same bytes; dispatches and bytes moved are reported;
  *   - the reference shaders — AHD decode, SH9 irradiance, the GLG walk, LLG sampling — give
- *     liblbk's floats bit for bit.
+ *     liblbk's floats bit for bit;
+ *   - build/lbk-gpu-apply --check on a whole container agrees with lbk_dls_apply.
  * Without Vulkan (headers, glslang or a device) every test is SKIPPED, with the reason. */
 #define LBK_STATIC_LINKING_ONLY /* lbk_dls_stats: experimental (lbk/dls.h) */
 #include <stdarg.h>
@@ -18,8 +19,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "lbk/ahd.h"
+#include "lbk/container.h"
 #include "lbk/dls.h"
 #include "lbk/door.h"
 #include "lbk/glg.h"
@@ -199,6 +202,7 @@ static void test_gpu_apply_matches_cpu(void **state)
             w[3] = 3e38f, w[5] = -3e38f, w[6] = 3e38f, w[8] = 1e-30f, w[10] = -2.5f;
         lbk_dls_apply_stats cs;
         gpu_dls_stats gs;
+        gpu_dls_per_cluster(g, step % 2); /* the seed's dispatch per cluster, and the batched one */
         assert_int_equal(lbk_dls_apply(r, w, &omega, &cs), LBK_OK);
         assert_int_equal(gpu_dls_apply(g, w, &omega, &gs), 0);
         check_outputs(&lv, g);
@@ -209,8 +213,9 @@ static void test_gpu_apply_matches_cpu(void **state)
             assert_int_equal(gs.clusters_skipped, cs.clusters_skipped);
             assert_int_equal(gs.clusters_copied, cs.clusters_copied);
         }
-        print_message("apply %d: %u dispatches (+%u base copies) of %u clusters, %llu invocations, %.2f MB moved, "
-                      "%.3f ms device, %.3f ms wall\n", step, gs.dispatches, gs.copies, gpu_dls_cluster_count(g),
+        print_message("apply %d (%s): %u dispatches (+%u base copies) for %u clusters, %llu invocations, %.2f MB moved, "
+                      "%.3f ms device, %.3f ms wall\n", step, step % 2 ? "per cluster" : "batched", gs.dispatches, gs.copies,
+                      gpu_dls_cluster_count(g) - gs.clusters_skipped,
                       (unsigned long long)gs.invocations, gs.bytes_moved / 1e6, gs.gpu_ms, gs.wall_ms);
     }
     /* the naive gather, every target every time: the same bytes in 3 dispatches */
@@ -297,53 +302,59 @@ static void test_gpu_sh9_irradiance(void **state)
     free(pr), free(nrm), free(got);
 }
 
-/* A jittered 5×5×5 lattice, each cell split into 6 tetras along its diagonal (Kuhn). */
-#define GN 5
-static uint32_t lattice(int x, int y, int z) { return (uint32_t)(x + GN * (y + GN * z)); }
+/* A GLG on a jittered nx × ny × nz lattice, each cell split into 6 tetras along its diagonal
+ * (Kuhn), random probes and visibility, scale 1/4. */
+static void glg_lattice(uint64_t *rng, int nx, int ny, int nz, void **bytes, size_t *size)
+{
+    const uint32_t np = (uint32_t)(nx * ny * nz), nt = (uint32_t)((nx - 1) * (ny - 1) * (nz - 1) * 6);
+    float(*pos)[3] = calloc(np, sizeof *pos);
+    uint32_t(*tets)[4] = calloc(nt, sizeof *tets);
+    uint8_t(*vis)[4] = calloc(nt, sizeof *vis);
+    lbk_sh9_rgb *probes = calloc(np, sizeof *probes);
+#define V(x, y, z) ((uint32_t)((x) + nx * ((y) + ny * (z))))
+    for (int z = 0; z < nz; z++)
+        for (int y = 0; y < ny; y++)
+            for (int x = 0; x < nx; x++) {
+                const uint32_t v = V(x, y, z);
+                pos[v][0] = (float)x + 0.2f * (dlsfx_uniform(rng) - 0.5f);
+                pos[v][1] = (float)y + 0.2f * (dlsfx_uniform(rng) - 0.5f);
+                pos[v][2] = (float)z + 0.2f * (dlsfx_uniform(rng) - 0.5f);
+                for (int i = 0; i < 3; i++) {
+                    float d[3], rgb[3] = {dlsfx_uniform(rng), dlsfx_uniform(rng), dlsfx_uniform(rng)};
+                    unit(rng, d, 0);
+                    lbk_sh9_add_sample(&probes[v], d, rgb, 3.0f);
+                }
+            }
+    static const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+    uint32_t t = 0;
+    for (int cz = 0; cz < nz - 1; cz++)
+        for (int cy = 0; cy < ny - 1; cy++)
+            for (int cx = 0; cx < nx - 1; cx++)
+                for (int p = 0; p < 6; p++, t++) {
+                    int q[3] = {cx, cy, cz};
+                    tets[t][0] = V(q[0], q[1], q[2]);
+                    for (int k = 0; k < 3; k++) {
+                        q[perms[p][k]]++;
+                        tets[t][k + 1] = V(q[0], q[1], q[2]);
+                    }
+                    for (int k = 0; k < 4; k++) vis[t][k] = (uint8_t)(dlsfx_rand(rng) % 5 ? 128 + dlsfx_rand(rng) % 128 : 0);
+                }
+#undef V
+    lbk_glg_build_desc d = {.probe_count = np, .tetra_count = nt, .positions = (const float(*)[3])pos, .probes = probes,
+                            .tetras = (const uint32_t(*)[4])tets, .visibility = (const uint8_t(*)[4])vis, .scale = 0.25f};
+    assert_int_equal(lbk_glg_build(&d, NULL, bytes, size), LBK_OK);
+    free(pos), free(tets), free(vis), free(probes);
+}
 
 static void test_gpu_glg_walk(void **state)
 {
     (void)state;
     gpu_ctx *c = device();
-    enum { NP = GN * GN * GN, NT = (GN - 1) * (GN - 1) * (GN - 1) * 6, N = 4000 };
-    static float pos[NP][3];
-    static uint32_t tets[NT][4];
-    static uint8_t vis[NT][4];
-    static lbk_sh9_rgb probes[NP];
+    enum { GN = 5, NT = (GN - 1) * (GN - 1) * (GN - 1) * 6, N = 4000 };
     uint64_t rng = 6;
-    for (int z = 0; z < GN; z++)
-        for (int y = 0; y < GN; y++)
-            for (int x = 0; x < GN; x++) {
-                const uint32_t v = lattice(x, y, z);
-                pos[v][0] = (float)x + 0.2f * (dlsfx_uniform(&rng) - 0.5f);
-                pos[v][1] = (float)y + 0.2f * (dlsfx_uniform(&rng) - 0.5f);
-                pos[v][2] = (float)z + 0.2f * (dlsfx_uniform(&rng) - 0.5f);
-                memset(&probes[v], 0, sizeof probes[v]);
-                for (int i = 0; i < 3; i++) {
-                    float d[3], rgb[3] = {dlsfx_uniform(&rng), dlsfx_uniform(&rng), dlsfx_uniform(&rng)};
-                    unit(&rng, d, 0);
-                    lbk_sh9_add_sample(&probes[v], d, rgb, 3.0f);
-                }
-            }
-    static const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-    int t = 0;
-    for (int cz = 0; cz < GN - 1; cz++)
-        for (int cy = 0; cy < GN - 1; cy++)
-            for (int cx = 0; cx < GN - 1; cx++)
-                for (int p = 0; p < 6; p++, t++) {
-                    int q[3] = {cx, cy, cz};
-                    tets[t][0] = lattice(q[0], q[1], q[2]);
-                    for (int k = 0; k < 3; k++) {
-                        q[perms[p][k]]++;
-                        tets[t][k + 1] = lattice(q[0], q[1], q[2]);
-                    }
-                    for (int k = 0; k < 4; k++) vis[t][k] = (uint8_t)(dlsfx_rand(&rng) % 5 ? 128 + dlsfx_rand(&rng) % 128 : 0);
-                }
-    lbk_glg_build_desc d = {.probe_count = NP, .tetra_count = NT, .positions = (const float(*)[3])pos, .probes = probes,
-                            .tetras = (const uint32_t(*)[4])tets, .visibility = (const uint8_t(*)[4])vis, .scale = 0.25f};
     void *bytes;
     size_t size;
-    assert_int_equal(lbk_glg_build(&d, NULL, &bytes, &size), LBK_OK);
+    glg_lattice(&rng, GN, GN, GN, &bytes, &size);
     lbk_glg_view v;
     assert_int_equal(lbk_glg_open(bytes, size, &v), LBK_OK);
     float *pts = malloc(12 * N), *sh = malloc(4 * 27 * N), *wts = malloc(16 * N);
@@ -427,6 +438,64 @@ static void test_gpu_llg_sampling(void **state)
     free(pts), free(sh), free(rgb), free(gi), free(vi), free(bytes), free(probes[0]), free(probes[1]);
 }
 
+
+/* build/lbk-gpu-apply on a whole container (DLS, DOOR, LMAP, GLG, LLG as lbk bake writes them):
+ * uploads, applies its default sequence and --check compares every apply with lbk_dls_apply. */
+static void test_gpu_apply_tool(void **state)
+{
+    (void)state;
+    (void)device();
+    char tool[512];
+    const char *build = getenv("BUILD");
+    snprintf(tool, sizeof tool, "%s/lbk-gpu-apply", build && *build ? build : "build");
+    FILE *probe = fopen(tool, "rb");
+    if (!probe) fail_msg("%s is missing: make test builds it with Vulkan", tool);
+    fclose(probe);
+    level lv;
+    memset(&lv, 0, sizeof lv);
+    level_build(&lv, 9);
+    uint64_t rng = 10;
+    void *glg, *llg;
+    size_t glg_size, llg_size;
+    glg_lattice(&rng, 10, 10, 5, &glg, &glg_size); /* the level's 500 GLG probes */
+    lbk_sh9_rgb *probes = calloc(400, sizeof *probes);
+    for (int i = 0; i < 400; i++) probes[i].c[0][0] = probes[i].c[1][0] = probes[i].c[2][0] = 1.0f + 0.01f * (float)i;
+    lbk_llg_grid_desc grid = {.centre = {0, 0, 0}, .axes = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, .half_extents = {1, 1, 1},
+                              .dims = {10, 10, 4}, .probes = probes}; /* the level's 400 LLG probes */
+    lbk_llg_build_desc ld = {.grids = &grid, .grid_count = 1};
+    assert_int_equal(lbk_llg_build(&ld, NULL, &llg, &llg_size), LBK_OK);
+    lbk_writer *w;
+    assert_int_equal(lbk_writer_open(NULL, &w), LBK_OK);
+    assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_LMAP, lv.lmap, lv.lmap_size, NULL), LBK_OK);
+    assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_GLG, glg, glg_size, NULL), LBK_OK);
+    assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_LLG, llg, llg_size, NULL), LBK_OK);
+    assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_DLS, lv.dls, lv.dls_size, NULL), LBK_OK);
+    assert_int_equal(lbk_writer_section_add(w, LBK_SECTION_DOOR, lv.door, lv.door_size, NULL), LBK_OK);
+    char path[] = "/tmp/lbk_test_gpu_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    assert_int_equal(lbk_writer_to_file(w, path), LBK_OK);
+    lbk_writer_close(w);
+    char cmd[1200];
+    snprintf(cmd, sizeof cmd, "%s %s --check --naive --doors 0.5 > %s.log 2>&1", tool, path, path);
+    const int rc = system(cmd);
+    char log[600];
+    snprintf(log, sizeof log, "%s.log", path);
+    FILE *f = fopen(log, "r");
+    int identical = 0;
+    for (char line[512]; f && fgets(line, sizeof line, f);) {
+        identical += strstr(line, "identical to lbk_dls_apply") != NULL;
+        print_message("  %s", line);
+    }
+    if (f) fclose(f);
+    unlink(log), unlink(path);
+    assert_int_equal(rc, 0);
+    assert_int_equal(identical, 4); /* the default sequence: 4 applies */
+    free(glg), free(llg), free(probes);
+    level_free(&lv);
+}
+
 #else /* no Vulkan at build time */
 
 static void skipped(void)
@@ -439,6 +508,7 @@ static void test_gpu_ahd_irradiance(void **state) { (void)state, skipped(); }
 static void test_gpu_sh9_irradiance(void **state) { (void)state, skipped(); }
 static void test_gpu_glg_walk(void **state) { (void)state, skipped(); }
 static void test_gpu_llg_sampling(void **state) { (void)state, skipped(); }
+static void test_gpu_apply_tool(void **state) { (void)state, skipped(); }
 static int teardown(void **state) { (void)state; return 0; }
 #endif
 
@@ -447,7 +517,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_gpu_apply_matches_cpu), cmocka_unit_test(test_gpu_ahd_irradiance),
         cmocka_unit_test(test_gpu_sh9_irradiance), cmocka_unit_test(test_gpu_glg_walk),
-        cmocka_unit_test(test_gpu_llg_sampling),
+        cmocka_unit_test(test_gpu_llg_sampling), cmocka_unit_test(test_gpu_apply_tool),
     };
     return cmocka_run_group_tests(tests, NULL, teardown);
 }
