@@ -136,7 +136,6 @@ lbk_result lbk_dls_runtime_open(const lbk_dls_runtime_desc *caller_desc, lbk_dls
     r->ncl = lbk_dls_cluster_count(in.dls);
     r->kern = (in.flags & LBK_DLS_RUNTIME_SCALAR) ? NULL : dls_kernels_avx2();
     if (!r->kern) r->kern = dls_kernels_scalar();
-    dls_luts_fill(&r->lut);
     const lbk_allocator *a = r->alloc;
     const size_t ns = r->nsets ? r->nsets : 1;
     r->cl = lbk_calloc(a, r->ncl ? r->ncl : 1, sizeof *r->cl);

@@ -17,15 +17,6 @@
 #pragma STDC FP_CONTRACT OFF /* GCC: -std=c11 (or -ffp-contract=off) keeps contraction off */
 #endif
 
-/* Exact decode tables, filled once per runtime from the scalar codecs. */
-typedef struct dls_luts {
-    float dir_xy[256]; /* 2·c/255 − 1: a direction byte G or B */
-    float unorm[256];  /* c/255: the ratio R and the direction byte A */
-    float snorm[256];  /* lbk_snorm8_to_float */
-} dls_luts;
-
-void dls_luts_fill(dls_luts *lut);
-
 /* `count` targets that are consecutive in cluster order and contiguous in memory: bases at
  * base0/base1 (texels: the Ez and RGBA planes) or base0 (28-byte probes), outputs likewise. Target t's entries
  * start at entries + t·stride·payload; the m active ones are entry idx[j] of the target with
@@ -37,7 +28,6 @@ typedef struct dls_batch {
     const uint8_t *entries;
     const uint8_t *base0, *base1; /* texels: plane 0 (Ez) and plane 1 (RGBA); probes: base0 */
     uint8_t *out0, *out1;
-    const dls_luts *lut;
 } dls_batch;
 
 /* Variable entries per target (prefix forms): target t has n[t] entries starting at
@@ -50,7 +40,6 @@ typedef struct dls_var_batch {
     const uint8_t *entries;
     const uint8_t *base0, *base1;
     uint8_t *out0, *out1;
-    const dls_luts *lut;
 } dls_var_batch;
 
 typedef struct dls_kernels {

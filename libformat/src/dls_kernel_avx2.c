@@ -43,7 +43,34 @@ INL vf mul(vf a, vf b) { return _mm256_mul_ps(a, b); }
 INL vf dvd(vf a, vf b) { return _mm256_div_ps(a, b); }
 INL vf sel(vf mask, vf yes, vf no) { return _mm256_blendv_ps(no, yes, mask); }
 INL vf gt(vf a, vf b) { return _mm256_cmp_ps(a, b, _CMP_GT_OQ); }
-INL vf u8f(const float *lut, vi byte) { return _mm256_i32gather_ps(lut, byte, 4); }
+
+/* fl32(n / d) for small integers n and an odd d, without a division or a gather: n · fl64(1/d)
+ * is within 2^-52 (relative) of n/d, and n/d is either a float (only when d divides n: the callers
+ * blend those cases in, so the rounding mode cannot matter) or at least 2^-32 (relative) away from
+ * every float and from every point halfway between two (d odd divides n·2^k only if it divides n),
+ * so the one rounding to float gives the correctly rounded quotient, as the scalar division does. */
+INL vf ratio(vi n, double recip)
+{
+    const vd r = _mm256_set1_pd(recip);
+    const vd lo = _mm256_mul_pd(_mm256_cvtepi32_pd(_mm256_castsi256_si128(n)), r);
+    const vd hi = _mm256_mul_pd(_mm256_cvtepi32_pd(_mm256_extracti128_si256(n, 1)), r);
+    return _mm256_set_m128(_mm256_cvtpd_ps(hi), _mm256_cvtpd_ps(lo));
+}
+INL vf when(vi n, int v, float x, vf q) { return sel(_mm256_castsi256_ps(_mm256_cmpeq_epi32(n, iset(v))), fset(x), q); }
+/* lbk_unorm8_to_float: c/255 */
+INL vf unorm_f(vi c) { return when(c, 255, 1.0f, ratio(c, 1.0 / 255.0)); }
+/* decode_direction's x and y: 2c/255 − 1 */
+INL vf dir_f(vi c)
+{
+    const vi c2 = _mm256_add_epi32(c, c);
+    return sub(when(c2, 510, 2.0f, ratio(c2, 1.0 / 255.0)), fset(1.0f));
+}
+/* lbk_snorm8_to_float: max(q/127, −1) for the signed byte q */
+INL vf snorm_f(vi q)
+{
+    const vf v = when(q, 127, 1.0f, when(q, -127, -1.0f, ratio(q, 1.0 / 127.0)));
+    return _mm256_max_ps(v, fset(-1.0f));
+}
 INL vi byte_at(vi w, int i) { return _mm256_and_si256(_mm256_srli_epi32(w, 8 * i), iset(0xff)); }
 
 /* The two halves of 8 floats as doubles, and 8 doubles back to floats (rounded as (float)x). */
@@ -109,10 +136,10 @@ typedef struct lin8 {
 } lin8;
 
 /* decode_direction of the G, B, A bytes of rgba; k = 1/4 + d.z/2. */
-INL void direction(const dls_luts *lut, vi rgba, vf d[3], vf *k)
+INL void direction(vi rgba, vf d[3], vf *k)
 {
-    const vf x = u8f(lut->dir_xy, byte_at(rgba, 1)), y = u8f(lut->dir_xy, byte_at(rgba, 2));
-    const vf z = u8f(lut->unorm, _mm256_srli_epi32(rgba, 24));
+    const vf x = dir_f(byte_at(rgba, 1)), y = dir_f(byte_at(rgba, 2));
+    const vf z = unorm_f(_mm256_srli_epi32(rgba, 24));
     const vf len = _mm256_sqrt_ps(add(add(mul(x, x), mul(y, y)), mul(z, z)));
     const vf shortv = _mm256_cmp_ps(len, fset(0.5f), _CMP_LT_OQ);
     d[0] = sel(shortv, _mm256_setzero_ps(), dvd(x, len));
@@ -122,11 +149,11 @@ INL void direction(const dls_luts *lut, vi rgba, vf d[3], vf *k)
 }
 
 /* lbk_ahd_to_linear. */
-INL void texel_decode(const dls_luts *lut, vi z, vi rgba, lin8 *out)
+INL void texel_decode(vi z, vi rgba, lin8 *out)
 {
     vf d[3], k;
-    direction(lut, rgba, d, &k);
-    const vf r = u8f(lut->unorm, _mm256_and_si256(rgba, iset(0xff)));
+    direction(rgba, d, &k);
+    const vf r = unorm_f(_mm256_and_si256(rgba, iset(0xff)));
     const vf one_r = sub(fset(1.0f), r);
     const vf e[3] = {uf_decode(_mm256_and_si256(z, iset(0x7ff)), 6),
                      uf_decode(_mm256_and_si256(_mm256_srli_epi32(z, 11), iset(0x7ff)), 6),
@@ -185,12 +212,17 @@ INL vd lum_half(vd v0, vd v1, vd v2)
 }
 
 /* lbk_ahd_from_linear. */
-INL void texel_encode(const dls_luts *lut, const lin8 *lin, vi *z_out, vi *rgba_out)
+INL void texel_encode(const lin8 *lin, vi *z_out, vi *rgba_out)
 {
     vf e0[3], g[3][3];
+    /* sanitize changes nothing unless a component is NaN or beyond ±1e30: test that first */
+    vi big = _mm256_setzero_si256();
+    for (int c = 0; c < 3; c++)
+        for (int i = 0; i < 4; i++) big = _mm256_max_epu32(big, _mm256_and_si256(_mm256_castps_si256(lin->c[c][i]), iset(0x7fffffff)));
+    const int clean = _mm256_testz_si256(_mm256_cmpgt_epi32(big, iset(0x7149F2CA)), iset(-1)); /* bits of 1e30f */
     for (int c = 0; c < 3; c++) {
-        e0[c] = sanitize(lin->c[c][0]);
-        for (int i = 0; i < 3; i++) g[c][i] = sanitize(lin->c[c][1 + i]);
+        e0[c] = clean ? lin->c[c][0] : sanitize(lin->c[c][0]);
+        for (int i = 0; i < 3; i++) g[c][i] = clean ? lin->c[c][1 + i] : sanitize(lin->c[c][1 + i]);
     }
     vd gl[3][3], gh[3][3], dl[3], dh[3];
     for (int c = 0; c < 3; c++)
@@ -204,7 +236,7 @@ INL void texel_encode(const dls_luts *lut, const lin8 *lin, vi *z_out, vi *rgba_
     q[2] = unorm8(to_f(dl[2], dh[2]));
     vi rgba = _mm256_or_si256(_mm256_slli_epi32(q[0], 8), _mm256_or_si256(_mm256_slli_epi32(q[1], 16), _mm256_slli_epi32(q[2], 24)));
     vf d[3], k;
-    direction(lut, rgba, d, &k);
+    direction(rgba, d, &k);
     vf a[3], ez[3];
     for (int c = 0; c < 3; c++) {
         const vf gd = add(add(mul(g[c][0], d[0]), mul(g[c][1], d[1])), mul(g[c][2], d[2]));
@@ -238,19 +270,19 @@ INL void texel_entries(const uint8_t *first, vi index, vi *z, vi *rgba)
 }
 
 /* Eight targets from SoA buffers; n ≤ 8 valid lanes (the others compute on copies). */
-INL void texel8(const dls_luts *lut, const uint8_t *bz, const uint8_t *brgba, uint8_t *oz, uint8_t *orgba,
+INL void texel8(const uint8_t *bz, const uint8_t *brgba, uint8_t *oz, uint8_t *orgba,
                 const uint8_t *entries, vi index, uint32_t stride, uint32_t m, const uint32_t *idx, const float *w)
 {
     lin8 acc, l;
-    texel_decode(lut, load8(bz), load8(brgba), &acc);
+    texel_decode(load8(bz), load8(brgba), &acc);
     for (uint32_t j = 0; j < m; j++) {
         vi ez, erg;
         texel_entries(entries + (size_t)idx[j] * LBK_DLS_TEXEL_PAYLOAD, index, &ez, &erg);
-        texel_decode(lut, ez, erg, &l);
+        texel_decode(ez, erg, &l);
         texel_accumulate(&acc, &l, fset(w[j]));
     }
     vi z, rgba;
-    texel_encode(lut, &acc, &z, &rgba);
+    texel_encode(&acc, &z, &rgba);
     store8(oz, z);
     store8(orgba, rgba);
     (void)stride;
@@ -263,7 +295,7 @@ static void texels(const dls_batch *b)
     const size_t step = (size_t)8 * b->stride * LBK_DLS_TEXEL_PAYLOAD;
     uint32_t t = 0;
     for (; t + 8 <= b->count; t += 8)
-        texel8(b->lut, b->base0 + 4 * (size_t)t, b->base1 + 4 * (size_t)t, b->out0 + 4 * (size_t)t,
+        texel8(b->base0 + 4 * (size_t)t, b->base1 + 4 * (size_t)t, b->out0 + 4 * (size_t)t,
                b->out1 + 4 * (size_t)t, b->entries + (t / 8) * step, index, b->stride, b->m, b->idx, b->w);
     if (t == b->count) return;
     /* the tail: lanes past the end repeat the last target, and only the valid lanes are stored */
@@ -276,7 +308,7 @@ static void texels(const dls_batch *b)
     }
     const vi tail_index = _mm256_mullo_epi32(_mm256_min_epi32(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), iset((int)n - 1)),
                                              iset((int)words));
-    texel8(b->lut, bz, brgba, oz, orgba, b->entries + (t / 8) * step, tail_index, b->stride, b->m, b->idx, b->w);
+    texel8(bz, brgba, oz, orgba, b->entries + (t / 8) * step, tail_index, b->stride, b->m, b->idx, b->w);
     memcpy(b->out0 + 4 * (size_t)t, oz, 4 * (size_t)n);
     memcpy(b->out1 + 4 * (size_t)t, orgba, 4 * (size_t)n);
 }
@@ -290,8 +322,8 @@ typedef struct sh8 {
     vf c[3][9];
 } sh8;
 
-/* Byte `b` of 8 probes whose 7 words are in w[0..6]. */
-INL vi probe_byte(const vi w[7], int b) { return byte_at(w[b / 4], b % 4); }
+/* Byte `b` of 8 probes whose 7 words are in w[0..6], sign-extended. */
+INL vi probe_sbyte(const vi w[7], int b) { return _mm256_srai_epi32(_mm256_slli_epi32(w[b / 4], 24 - 8 * (b % 4)), 24); }
 
 /* lbk_rgb9e5_unpack. */
 INL void rgb9e5_unpack(vi w, vf dq[3])
@@ -302,14 +334,14 @@ INL void rgb9e5_unpack(vi w, vf dq[3])
 }
 
 /* lbk_sh9_unpack. */
-INL void probe_decode(const dls_luts *lut, const vi w[7], sh8 *out)
+INL void probe_decode(const vi w[7], sh8 *out)
 {
     vf dq[3];
     rgb9e5_unpack(w[0], dq);
     for (int c = 0; c < 3; c++) {
         out->c[c][0] = dq[c];
         for (int k = 1; k < 9; k++)
-            out->c[c][k] = mul(mul(u8f(lut->snorm, probe_byte(w, 4 + 3 * (k - 1) + c)), fset(k < 4 ? BS1 : BS2)), dq[c]);
+            out->c[c][k] = mul(mul(snorm_f(probe_sbyte(w, 4 + 3 * (k - 1) + c)), fset(k < 4 ? BS1 : BS2)), dq[c]);
     }
 }
 
@@ -386,11 +418,11 @@ static void probes(const dls_batch *b)
         vi w[7];
         sh8 acc, l;
         probe_gather(b->base0 + LBK_DLS_PROBE_PAYLOAD * (size_t)t, bi, w);
-        probe_decode(b->lut, w, &acc);
+        probe_decode(w, &acc);
         const uint8_t *e = b->entries + (size_t)t * b->stride * LBK_DLS_PROBE_PAYLOAD;
         for (uint32_t j = 0; j < b->m; j++) {
             probe_gather(e + (size_t)b->idx[j] * LBK_DLS_PROBE_PAYLOAD, ei, w);
-            probe_decode(b->lut, w, &l);
+            probe_decode(w, &l);
             probe_accumulate(&acc, &l, fset(b->w[j]));
         }
         probe_encode(&acc, w);
@@ -425,7 +457,7 @@ static void texels_var(const dls_var_batch *b)
             memcpy(brgba + 4 * i, b->base1 + 4 * (size_t)s, 4);
         }
         lin8 acc, l;
-        texel_decode(b->lut, load8(bz), load8(brgba), &acc);
+        texel_decode(load8(bz), load8(brgba), &acc);
         const vi base_index = _mm256_loadu_si256((const __m256i *)(const void *)off);
         for (uint32_t j = 0; j < most; j++) {
             float wl[8];
@@ -439,11 +471,11 @@ static void texels_var(const dls_var_batch *b)
             const vi index = _mm256_add_epi32(base_index, _mm256_loadu_si256((const __m256i *)(const void *)at));
             vi ez, erg;
             texel_entries(b->entries, index, &ez, &erg);
-            texel_decode(b->lut, ez, erg, &l);
+            texel_decode(ez, erg, &l);
             texel_accumulate(&acc, &l, _mm256_loadu_ps(wl));
         }
         vi z, rgba;
-        texel_encode(b->lut, &acc, &z, &rgba);
+        texel_encode(&acc, &z, &rgba);
         store8(oz, z);
         store8(orgba, rgba);
         for (uint32_t i = 0; i < n; i++) {
@@ -472,7 +504,7 @@ static void probes_var(const dls_var_batch *b)
         vi w[7];
         sh8 acc, l;
         probe_gather(b->base0 + LBK_DLS_PROBE_PAYLOAD * (size_t)t, bi, w);
-        probe_decode(b->lut, w, &acc);
+        probe_decode(w, &acc);
         const vi base_index = _mm256_loadu_si256((const __m256i *)(const void *)off);
         for (uint32_t j = 0; j < most; j++) {
             float wl[8];
@@ -484,7 +516,7 @@ static void probes_var(const dls_var_batch *b)
                 at[i] = has ? (int32_t)(7 * j) : 0;
             }
             probe_gather(b->entries, _mm256_add_epi32(base_index, _mm256_loadu_si256((const __m256i *)(const void *)at)), w);
-            probe_decode(b->lut, w, &l);
+            probe_decode(w, &l);
             probe_accumulate(&acc, &l, _mm256_loadu_ps(wl));
         }
         probe_encode(&acc, w);

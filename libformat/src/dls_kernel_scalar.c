@@ -8,15 +8,6 @@
 #include "lbk/pixel.h"
 #include "lbk/sh.h"
 
-void dls_luts_fill(dls_luts *lut)
-{
-    for (int c = 0; c < 256; c++) {
-        lut->dir_xy[c] = 2.0f * (float)c / 255.0f - 1.0f; /* as decode_direction in ahd.c */
-        lut->unorm[c] = lbk_unorm8_to_float((uint8_t)c);
-        lut->snorm[c] = lbk_snorm8_to_float((uint8_t)c);
-    }
-}
-
 static void texel_linear(const uint8_t *z, const uint8_t *rgba, lbk_ahd_linear *out)
 {
     lbk_ahd_texel t;

@@ -465,7 +465,7 @@ static void var_span(void *vv, uint64_t t, uint32_t len)
             for (uint32_t e = 0; e < n[i]; e++) we[off[i] + e] = v->wl[c->slots[v->w.entry + e]];
             v->w.entry += n[i];
         }
-        dls_var_batch b = {.count = cnt, .n = n, .off = off, .we = we, .entries = c->payload + first * psize, .lut = &r->lut};
+        dls_var_batch b = {.count = cnt, .n = n, .off = off, .we = we, .entries = c->payload + first * psize};
         if (c->space == LBK_DLS_SPACE_TEXEL) {
             b.base0 = s.b0, b.base1 = s.b1, b.out0 = s.o0, b.out1 = s.o1;
             r->kern->texels_var(&b);
@@ -489,7 +489,7 @@ void rt_chunk_run(const lbk_dls_runtime *r, const rt_chunk *ch)
     const float *wl = r->cw + c->set_first;
     uint32_t idx[LBK_DLS_MAX_CLUSTER_SETS];
     float wa[LBK_DLS_MAX_CLUSTER_SETS];
-    w.b = (dls_batch){.stride = c->k, .idx = idx, .w = wa, .lut = &r->lut};
+    w.b = (dls_batch){.stride = c->k, .idx = idx, .w = wa};
     if (r->action[ch->cluster] == RT_COPY) {
         w.copy = true;
         chunk_spans(r, ch, copy_span, &w);

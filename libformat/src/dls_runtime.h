@@ -49,7 +49,6 @@ struct lbk_dls_runtime {
     lbk_dls_runtime_desc desc;
     lbk_dls_raw raw;
     const dls_kernels *kern;
-    dls_luts lut;
     uint32_t nsets, ndoors;
     uint8_t *kinds;
     uint32_t *member_offset, *members;

@@ -57,8 +57,6 @@ static float random_weight(uint64_t *rng)
 static void fixed_case(const dls_kernels *v, uint64_t *rng, uint32_t space, uint32_t count, uint32_t stride)
 {
     const uint32_t psize = space == 0 ? 8 : 28, bsize = space == 0 ? 4 : 28;
-    dls_luts lut;
-    dls_luts_fill(&lut);
     uint8_t *entries = malloc((size_t)count * stride * psize);
     uint8_t *b0 = malloc((size_t)count * bsize), *b1 = malloc((size_t)count * 4);
     uint8_t *o0[2] = {malloc((size_t)count * bsize), malloc((size_t)count * bsize)};
@@ -79,7 +77,7 @@ static void fixed_case(const dls_kernels *v, uint64_t *rng, uint32_t space, uint
     if (m == 0) idx[m] = 0, w[m++] = 1.0f;
     for (int p = 0; p < 2; p++) {
         dls_batch b = {.count = count, .stride = stride, .m = m, .idx = idx, .w = w, .entries = entries,
-                       .base0 = b0, .base1 = b1, .out0 = o0[p], .out1 = o1[p], .lut = &lut};
+                       .base0 = b0, .base1 = b1, .out0 = o0[p], .out1 = o1[p]};
         const dls_kernels *k = p ? v : dls_kernels_scalar();
         (space == 0 ? k->texels : k->probes)(&b);
     }
@@ -103,8 +101,6 @@ static void test_fixed_batches(void **state)
 static void var_case(const dls_kernels *v, uint64_t *rng, uint32_t space, uint32_t count)
 {
     const uint32_t psize = space == 0 ? 8 : 28, bsize = space == 0 ? 4 : 28;
-    dls_luts lut;
-    dls_luts_fill(&lut);
     uint32_t *n = malloc(count * 4), *off = malloc(count * 4), total = 0;
     for (uint32_t t = 0; t < count; t++) {
         n[t] = 5 + (uint32_t)(dlsfx_rand(rng) % 13);
@@ -123,7 +119,7 @@ static void var_case(const dls_kernels *v, uint64_t *rng, uint32_t space, uint32
     random_bytes(rng, b1, (size_t)count * 4);
     for (int p = 0; p < 2; p++) {
         dls_var_batch b = {.count = count, .n = n, .off = off, .we = we, .entries = entries, .base0 = b0, .base1 = b1,
-                           .out0 = o0[p], .out1 = o1[p], .lut = &lut};
+                           .out0 = o0[p], .out1 = o1[p]};
         const dls_kernels *k = p ? v : dls_kernels_scalar();
         (space == 0 ? k->texels_var : k->probes_var)(&b);
     }
@@ -150,8 +146,6 @@ static void test_every_direction_byte(void **state)
 {
     (void)state;
     const dls_kernels *v = simd();
-    dls_luts lut;
-    dls_luts_fill(&lut);
     const uint32_t chunk = 1u << 16;
     uint8_t *b0 = malloc(chunk * 4), *b1 = malloc(chunk * 4), *entries = malloc(chunk * 8);
     uint8_t *o0[2] = {malloc(chunk * 4), malloc(chunk * 4)}, *o1[2] = {malloc(chunk * 4), malloc(chunk * 4)};
@@ -170,7 +164,7 @@ static void test_every_direction_byte(void **state)
         }
         for (int p = 0; p < 2; p++) {
             dls_batch b = {.count = chunk, .stride = 1, .m = 1, .idx = &idx, .w = &w, .entries = entries,
-                           .base0 = b0, .base1 = b1, .out0 = o0[p], .out1 = o1[p], .lut = &lut};
+                           .base0 = b0, .base1 = b1, .out0 = o0[p], .out1 = o1[p]};
             (p ? v : dls_kernels_scalar())->texels(&b);
         }
         if (memcmp(o0[0], o0[1], chunk * 4) || memcmp(o1[0], o1[1], chunk * 4)) {
