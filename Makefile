@@ -169,7 +169,10 @@ install-check: all
 test: deps
 	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BUILD)/lbk-asan $(TESTS:%=$(BUILD)/tests/%) $(BUILD)/fuzz_container install-check \
 	    $(if $(HAVE_VULKAN),$(BUILD)/lbk-gpu-apply)
-	@LBK=$(BUILD)/lbk-asan BUILD=$(BUILD) FUZZ=$(BUILD)/fuzz_container sh tests/run.sh $(TESTS) install_check_shared install_check_static
+	@LBK=$(BUILD)/lbk-asan BUILD=$(BUILD) FUZZ=$(BUILD)/fuzz_container sh tests/run.sh $(TESTS) install_check_shared install_check_static; \
+	st=$$?; n=$$(sed -n 's/^\[  SKIPPED \] \([0-9]*\) test(s).*/\1/p' $(BUILD)/tests/test_gpu.log 2>/dev/null); \
+	if [ "$${n:-0}" -gt 0 ]; then echo "tests: $$n GPU tests SKIPPED, not run: $$(grep -m1 -o 'SKIPPED: .*' $(BUILD)/tests/test_gpu.log)"; fi; \
+	exit $$st
 check: test
 
 # ---- fuzzing (clang libFuzzer) --------------------------------------------------------------
