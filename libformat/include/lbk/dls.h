@@ -232,7 +232,7 @@ typedef struct lbk_dls_runtime_desc {
     uint8_t *out_glg;
     uint8_t *out_llg;
     const lbk_allocator *allocator;
-    /* since liblbk 1.1 */
+    /* appended after the 1.0 layout (size 0 or the 1.0 size: these read as zero) */
     uint32_t page_count;          /* ≥ 1: texels in `pages` instead of the four arrays */
     const lbk_dls_page *pages;
     uint32_t flags;               /* LBK_DLS_RUNTIME_* */
