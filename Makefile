@@ -46,7 +46,7 @@ TOOL_OBJ  := $(filter-out $(BUILD)/rel/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUIL
 LIB_ASAN  := $(LIB_SRC:%.c=$(BUILD)/asan/%.o)
 TOOL_ASAN := $(filter-out $(BUILD)/asan/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUILD)/asan/%.o)) $(TOOL_CXXSRC:%.cc=$(BUILD)/asan/%.o)
 
-.PHONY: all lib deps demo test check bench fuzz install install-check clean help gpu
+.PHONY: all lib deps demo test test-build check bench fuzz install install-check clean help gpu
 all: $(BUILD)/lbk $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc
 
 help:
@@ -124,6 +124,11 @@ GPU_HOST    := $(sort $(wildcard gpu/host/*.c))
 $(BUILD)/gpu/%.spv.h: gpu/shaders/%.comp $(wildcard gpu/shaders/*.glsl)
 	@mkdir -p $(@D)
 	$(GLSLANG) -V --target-env vulkan1.1 --vn $*_spv -o $@ $< >/dev/null
+# test_gpu and bench_gpu compile differently with and without Vulkan: rebuild them when that changes.
+GPU_STAMP := $(BUILD)/gpu/vulkan-$(if $(HAVE_VULKAN),on,off)
+$(GPU_STAMP):
+	@mkdir -p $(@D) && rm -f $(BUILD)/gpu/vulkan-* && touch $@
+$(BUILD)/tests/test_gpu $(BUILD)/bench/bench_gpu: $(GPU_STAMP)
 ifeq ($(HAVE_VULKAN),1)
 GPU_REL  := $(GPU_HOST:%.c=$(BUILD)/rel/%.o)
 GPU_ASAN := $(GPU_HOST:%.c=$(BUILD)/asan/%.o)
@@ -166,9 +171,11 @@ install-check: all
 	    $$(PKG_CONFIG_PATH=$(INST)/lib/pkgconfig pkg-config --cflags lbk) $(INST)/lib/liblbk.a \
 	    $$(PKG_CONFIG_PATH=$(INST)/lib/pkgconfig pkg-config --static --libs-only-other --libs-only-l lbk | sed 's/-llbk//') -lcmocka
 
+# What `make test` builds; a sub-make builds it, so that HAVE_VULKAN sees what `deps` installed.
+test-build: $(BUILD)/lbk $(BUILD)/lbk-asan $(TESTS:%=$(BUILD)/tests/%) $(BUILD)/fuzz_container install-check \
+            $(if $(HAVE_VULKAN),$(BUILD)/lbk-gpu-apply)
 test: deps
-	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BUILD)/lbk-asan $(TESTS:%=$(BUILD)/tests/%) $(BUILD)/fuzz_container install-check \
-	    $(if $(HAVE_VULKAN),$(BUILD)/lbk-gpu-apply)
+	@$(MAKE) --no-print-directory test-build
 	@LBK=$(BUILD)/lbk-asan BUILD=$(BUILD) FUZZ=$(BUILD)/fuzz_container sh tests/run.sh $(TESTS) install_check_shared install_check_static; \
 	st=$$?; n=$$(sed -n 's/^\[  SKIPPED \] \([0-9]*\) test(s).*/\1/p' $(BUILD)/tests/test_gpu.log 2>/dev/null); \
 	if [ "$${n:-0}" -gt 0 ]; then echo "tests: $$n GPU tests SKIPPED, not run: $$(grep -m1 -o 'SKIPPED: .*' $(BUILD)/tests/test_gpu.log)"; fi; \
