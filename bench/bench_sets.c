@@ -11,13 +11,14 @@
 
 #include <math.h>
 
-#include "bake/pipeline/bake.h"
 #include "bake/util/clock.h"
+#include "lbk/bake.h"
 #include "lbk/ahd.h"
 #include "lbk/container.h"
 #include "lbk/dls.h"
 #include "lbk/door.h"
 #include "lbk/lightmap.h"
+#include "tests/support/bake_file.c"
 /* The generator lives with the tests; benches link the tools only, so take its source. */
 #include "tests/support/door_scenes.c"
 
@@ -36,18 +37,16 @@ static int run(const level *lv, const char *dir)
         fprintf(stderr, "%s: %s\n", lv->name, err);
         return 1;
     }
-    bk_bake_options bo;
+    tb_job bo;
     memset(&bo, 0, sizeof bo);
-    bo.input = gltf;
-    bo.output = out;
-    bo.seed = 1;
-    bo.target_error = -1;
-    bo.dls_threshold = lv->threshold;
-    bk_progress pr;
-    bk_progress_init(&pr, 1);
-    bk_bake_summary sum;
+    bo.in = gltf;
+    bo.out = out;
+    bo.d.seed = 1;
+    bo.d.target_error = -1;
+    bo.d.dls_threshold = lv->threshold;
+    lbk_bake_report sum;
     double t0 = bk_now();
-    int rc = bk_bake(&bo, &pr, &sum, err, sizeof err);
+    int rc = tb_bake(&bo, &sum, err, sizeof err);
     double secs = bk_now() - t0;
     unlink(gltf);
     if (rc) {
@@ -73,7 +72,7 @@ static int run(const level *lv, const char *dir)
     uint64_t tex = st.target_count[LBK_DLS_SPACE_TEXEL];
     printf("%-22s %6llu texels  %2u sets %u doors  LMAP %8zu B  DLS payload %8llu B  ancillary %6llu B (%5.2f%% of "
            "payload, %.2f index bits/touched texel)  touched %5.1f%% of texels  clusters %u  bake %.1f s\n",
-           lv->name, (unsigned long long)sum.texels, sum.sets, sum.doors, lmap, (unsigned long long)st.payload_bytes,
+           lv->name, (unsigned long long)sum.counts.texels, sum.counts.light_sets, sum.counts.doors, lmap, (unsigned long long)st.payload_bytes,
            (unsigned long long)st.ancillary_bytes,
            st.payload_bytes ? 100.0 * (double)st.ancillary_bytes / (double)st.payload_bytes : 0.0,
            st.index_bits_per_target[LBK_DLS_SPACE_TEXEL], tex ? 100.0 * (double)st.touched[0] / (double)tex : 0.0,
@@ -109,15 +108,13 @@ static int bake_open(const char *dir, const char *name, const ds_options *o, int
     snprintf(gltf, sizeof gltf, "%s/%s.gltf", dir, name);
     snprintf(path, sizeof path, "%s/%s.lbk", dir, name);
     if (ds_write_room_scene(DS_ROOM_GLB, gltf, o, err, sizeof err)) return 1;
-    bk_bake_options bo;
+    tb_job bo;
     memset(&bo, 0, sizeof bo);
-    bo.input = gltf, bo.output = path, bo.seed = seed, bo.target_error = 1e-9, bo.max_samples = samples;
-    bo.door_method = method;
-    bk_progress pr;
-    bk_progress_init(&pr, 1);
-    bk_bake_summary sum;
+    bo.in = gltf, bo.out = path, bo.d.seed = seed, bo.d.target_error = 1e-9, bo.d.max_samples = samples;
+    bo.d.door_method = method;
+    lbk_bake_report sum;
     double t0 = bk_now();
-    int rc = bk_bake(&bo, &pr, &sum, err, sizeof err);
+    int rc = tb_bake(&bo, &sum, err, sizeof err);
     out->seconds = bk_now() - t0;
     unlink(gltf);
     if (rc) {

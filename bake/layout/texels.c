@@ -126,8 +126,8 @@ static void make_receiver(const bk_scene *s, const bk_atlas *a, uint32_t e, cons
 }
 
 /* Claims for each triangle of the chart the texels whose centre it covers (distance -1) or
- * whose square it touches (squared distance to its closest point); the nearest claim wins,
- * the first on ties. idx / bst: the chart's page in index / best. */
+ * that bilinear filtering reads somewhere on it (squared distance to its closest point); the
+ * nearest claim wins, the first on ties. idx / bst: the chart's page in index / best. */
 static void rasterise_chart(const bk_atlas *a, const bk_atlas_chart *ch, int32_t *idx, float *bst)
 {
     int pw = a->pages[ch->page].width, ph = a->pages[ch->page].height;
@@ -145,10 +145,9 @@ static void rasterise_chart(const bk_atlas *a, const bk_atlas_chart *ch, int32_t
                 if (bk_rtri_inside(&t, cx, cy, NULL)) {
                     d = -1.0f;
                 } else {
-                    double qx, qy;
-                    double d2 = bk_rtri_closest(&t, cx, cy, NULL, &qx, &qy);
-                    if (!(fabs(qx - cx) < 0.5 && fabs(qy - cy) < 0.5)) continue;
-                    d = (float)d2;
+                    /* the bilinear footprint: filtering at some point of the triangle reads it */
+                    if (!bk_rtri_meets_square(&t, cx, cy, 1.0)) continue;
+                    d = (float)bk_rtri_closest(&t, cx, cy, NULL, NULL, NULL);
                 }
                 size_t i = (size_t)y * (size_t)pw + (size_t)x;
                 if (d < bst[i]) {

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bake/layout/chart_merge.h"
 #include "bake/layout/uv_math.h"
 #include "bake/layout/uv_raster.h"
 
@@ -767,6 +768,9 @@ static lbk_result try_authored(gen_ctx *g, double density, int cap, bk_uv_object
     if (r != LBK_OK || !acceptable) return r;
     o->density = (float)(sc * sqrt(e.uv_area / e.world_area));
     o->source = BK_UV_AUTHORED;
+    o->uv1_scale = sc;
+    o->uv1_min[0] = e.mnu, o->uv1_min[1] = e.mnv;
+    o->uv1_max[0] = e.mxu, o->uv1_max[1] = e.mxv;
     *used = 1;
     return LBK_OK;
 }
@@ -889,6 +893,11 @@ lbk_result bk_uvgen_object(const bk_scene *scene, uint32_t object, float density
             snprintf(msg, sizeof msg, "density lowered from %g to %g texels/m: a triangle exceeds %d texels", d, nd, cap);
             note_append(out, msg);
             d = nd;
+        }
+        if (r == LBK_OK) {
+            bk_chart_graph cg = {g.first, g.n, g.wid, g.adj_start, g.adj};
+            size_t merged;
+            r = bk_merge_small_charts(scene, &cg, d, cap, out, &merged);
         }
         out->density = (float)d;
         out->source = BK_UV_GENERATED;

@@ -491,10 +491,10 @@ GlbParts split_glb(const std::vector<unsigned char> &f, const std::string &file)
     return g;
 }
 
-std::vector<unsigned char> make_glb(const std::string &json, const GlbParts &g)
+std::vector<unsigned char> make_glb(const std::string &json_text, const GlbParts &g)
 {
     std::vector<unsigned char> out;
-    size_t jpad = (json.size() + 3) & ~(size_t)3;
+    size_t jpad = (json_text.size() + 3) & ~(size_t)3;
     size_t bpad = (g.bin_len + 3) & ~(size_t)3;
     size_t total = 12 + 8 + jpad + (g.bin ? 8 + bpad : 0);
     out.reserve(total);
@@ -503,8 +503,8 @@ std::vector<unsigned char> make_glb(const std::string &json, const GlbParts &g)
     put32(out, (uint32_t)total);
     put32(out, (uint32_t)jpad);
     put32(out, 0x4E4F534Au);
-    out.insert(out.end(), json.begin(), json.end());
-    out.insert(out.end(), jpad - json.size(), ' ');
+    out.insert(out.end(), json_text.begin(), json_text.end());
+    out.insert(out.end(), jpad - json_text.size(), ' ');
     if (g.bin) {
         put32(out, (uint32_t)bpad);
         put32(out, 0x004E4942u);
@@ -537,8 +537,11 @@ bool keep_encoded_image(tinygltf::Image *image, const int idx, std::string *, st
 struct Prim {  // one triangle primitive, in mesh-local space, ready to instance
     std::vector<float> pos, nrm, uv0, uv1;
     std::vector<uint32_t> tris;
+    std::vector<uint32_t> src;     // per vertex: its index in the glTF primitive (flat shading splits them)
     bool has_nrm = false, has_uv1 = false;
     uint32_t material = 0;
+    uint32_t gltf_index = 0;       // index in the glTF mesh's primitives
+    uint32_t source_vertices = 0;  // vertices of the glTF primitive (POSITION count or Draco points)
 };
 
 struct MeshData {
@@ -1260,19 +1263,23 @@ void Importer::prepare_prim(int mi, int pi, Prim &p, bool *is_triangles)
     }
     if (p.uv0.empty()) p.uv0.assign(nv * 2, 0.0f);
     if (p.uv1.empty()) p.uv1.assign(nv * 2, 0.0f);
+    p.source_vertices = (uint32_t)nv;
+    p.src.resize(nv);
+    for (size_t i = 0; i < nv; i++) p.src[i] = (uint32_t)i;
     if (!p.has_nrm) {
         // Flat shading: give every triangle its own three vertices; normals come at instancing.
         size_t nt = p.tris.size() / 3;
         std::vector<float> pos(nt * 9), uv0(nt * 6), uv1(nt * 6);
-        std::vector<uint32_t> tris(nt * 3);
+        std::vector<uint32_t> tris(nt * 3), src(nt * 3);
         for (size_t t = 0; t < nt * 3; t++) {
             uint32_t v = p.tris[t];
             memcpy(&pos[t * 3], &p.pos[(size_t)v * 3], 12);
             memcpy(&uv0[t * 2], &p.uv0[(size_t)v * 2], 8);
             memcpy(&uv1[t * 2], &p.uv1[(size_t)v * 2], 8);
             tris[t] = (uint32_t)t;
+            src[t] = v;
         }
-        p.pos.swap(pos); p.uv0.swap(uv0); p.uv1.swap(uv1); p.tris.swap(tris);
+        p.pos.swap(pos); p.uv0.swap(uv0); p.uv1.swap(uv1); p.tris.swap(tris); p.src.swap(src);
     }
 }
 
@@ -1294,6 +1301,7 @@ void Importer::prepare_mesh(int mi)
             continue;
         }
         md.all_uv1 = md.all_uv1 && p.has_uv1;
+        p.gltf_index = (uint32_t)pi;
         uint32_t base = (uint32_t)(hash_pos.size() / 3);
         hash_pos.insert(hash_pos.end(), p.pos.begin(), p.pos.end());
         for (uint32_t v : p.tris) hash_idx.push_back(base + v);
@@ -1353,7 +1361,12 @@ void Importer::emit_geometry()
     s_->tri_material = alloc_array<uint32_t>(total_t, 1);
     s_->tri_object = alloc_array<uint32_t>(total_t, 1);
     s_->objects = alloc_array<bk_object>(kept.size(), 1);
-    size_t v0 = 0, t0 = 0;
+    s_->vertex_source = alloc_array<uint32_t>(total_v, 1);
+    size_t total_p = 0;
+    for (const Instance &in : kept)
+        for (const Prim &p : meshes_[(size_t)m_.nodes[(size_t)in.node].mesh].prims) total_p += !p.tris.empty();
+    s_->primitives = alloc_array<bk_primitive>(total_p, 1);
+    size_t v0 = 0, t0 = 0, p0 = 0;
     for (size_t oi = 0; oi < kept.size(); oi++) {
         const Instance &in = kept[oi];
         const tinygltf::Node &nd = m_.nodes[(size_t)in.node];
@@ -1376,8 +1389,21 @@ void Importer::emit_geometry()
         double det = dets[oi];
         inverse_transpose3(A, det, N);
         bool flip = det < 0;
+        ob.node = in.node;
+        ob.mirrored = flip ? 1 : 0;
         for (const Prim &p : md.prims) {
             size_t nv = p.pos.size() / 3, nt = p.tris.size() / 3;
+            if (nt) {
+                bk_primitive &sp = s_->primitives[p0++];
+                sp.object = (uint32_t)oi;
+                sp.gltf_primitive = p.gltf_index;
+                sp.source_vertex_count = p.source_vertices;
+                sp.first_tri = (uint32_t)t0;
+                sp.tri_count = (uint32_t)nt;
+                sp.first_vertex = (uint32_t)v0;
+                sp.vertex_count = (uint32_t)nv;
+            }
+            if (nv) memcpy(&s_->vertex_source[v0], p.src.data(), nv * sizeof(uint32_t));
             for (size_t v = 0; v < nv; v++) {
                 double lp[3] = {p.pos[v * 3], p.pos[v * 3 + 1], p.pos[v * 3 + 2]}, wp[3];
                 xform_point(in.world, lp, wp);
@@ -1436,6 +1462,7 @@ void Importer::emit_geometry()
     s_->vertex_count = total_v;
     s_->tri_count = total_t;
     s_->object_count = kept.size();
+    s_->primitive_count = total_p;
 }
 
 void Importer::emit_lights()

@@ -323,7 +323,9 @@ lbk_result lbk_writer_to_memory(lbk_writer *w, void **out, size_t *size)
     if (!f) return LBK_ERR_OUT_OF_MEMORY;
 
     uint32_t required = 0;
+    uint16_t minor = 0; /* §1.3: the lowest minor version that defines every known section here */
     for (uint32_t i = 0; i < w->count; i++) {
+        if (w->s[order[i]].type == LBK_SECTION_LMUV) minor = 1;
         const writer_section *s = &w->s[order[i]];
         uint8_t *e = f + LBK_HEADER_SIZE + (size_t)LBK_SECTION_ENTRY_SIZE * i;
         lbk_wr32(e + LBK_ENT_TYPE, s->type);
@@ -338,7 +340,7 @@ lbk_result lbk_writer_to_memory(lbk_writer *w, void **out, size_t *size)
     }
     memcpy(f, lbk_magic, 8);
     lbk_wr16(f + LBK_HDR_VERSION_MAJOR, LBK_FORMAT_VERSION_MAJOR);
-    lbk_wr16(f + LBK_HDR_VERSION_MINOR, LBK_FORMAT_VERSION_MINOR);
+    lbk_wr16(f + LBK_HDR_VERSION_MINOR, minor);
     lbk_wr32(f + LBK_HDR_HEADER_SIZE, LBK_HEADER_SIZE);
     lbk_wr64(f + LBK_HDR_FILE_SIZE, file_size);
     lbk_wr32(f + LBK_HDR_REQUIRED_FEATURES, required);

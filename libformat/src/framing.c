@@ -26,6 +26,10 @@ int lbk_section_rank(uint32_t type)
     return 0;
 }
 
+/* Types added by a minor version have no rank: they sort after the 1.0 types by ascending code,
+ * exactly where a 1.0 reader expects a type it does not know (§3.2), so it accepts the order. */
+int lbk_section_known(uint32_t type) { return lbk_section_rank(type) != 0 || type == LBK_SECTION_LMUV; }
+
 uint64_t lbk_default_decode_cap(uint64_t file_size)
 {
     const uint64_t four_gib = (uint64_t)4 << 30;
@@ -278,7 +282,7 @@ int lbk_framing_parse(const uint8_t *d, size_t size, lbk_framing *out, lbk_frami
                 placement_broken = 1;
             }
         }
-        if (usable && lbk_section_rank(s->type) == 0) {
+        if (usable && !lbk_section_known(s->type)) {
             if (s->flags & LBK_SECTION_FLAG_REQUIRED) {
                 REPORT(212, LBK_ERR_UNSUPPORTED_FEATURE, s->type, eo + LBK_ENT_TYPE,
                        "section %u: unknown section type '%s' is marked required", i, cc);

@@ -82,8 +82,8 @@ lbk_result lbk_sized_in(void *dst, size_t dst_size, const void *src, size_t v1_s
 #define LBK_V1_SIZE(type, last) (offsetof(type, last) + sizeof(((type *)0)->last))
 
 /* ---- validation context ---------------------------------------------------------------------
- * validate.c walks the sections in dependency order (META, REPT, LMAP, GLG, LLG, OCTP, OBJS, DLS,
- * DOOR) and hands each section validator this context. A validator reports through lbk_vreport,
+ * validate.c walks the sections in dependency order (META, REPT, LMAP, GLG, LLG, OCTP, OBJS, LMUV,
+ * DLS, DOOR) and hands each section validator this context. A validator reports through lbk_vreport,
  * and fills in the facts later sections cross-check against. A fact stays zero when its section is
  * absent or unusable; *_ok flags say whether the section parsed. */
 typedef struct lbk_vctx {
@@ -113,6 +113,9 @@ typedef struct lbk_vctx {
     uint64_t llg_probe_count;
     int objs_ok;
     uint32_t object_count;
+    /* per OBJS object, 6 u32: representation, index, rect x, y, w, h; set by lbk_validate_objs when
+     * objs_ok (allocated with ctx->allocator, freed by validate.c); NULL if the allocation failed */
+    uint32_t *objs_facts;
     int dls_ok;
     uint32_t dls_set_count;
     /* DLS facts for DOOR, set by lbk_validate_dls when dls_ok: one allocation (dls_facts, freed by
@@ -153,6 +156,7 @@ void lbk_validate_glg(lbk_vctx *ctx, const uint8_t *data, size_t size);
 void lbk_validate_llg(lbk_vctx *ctx, const uint8_t *data, size_t size);
 void lbk_validate_octp(lbk_vctx *ctx, const uint8_t *data, size_t size);
 void lbk_validate_objs(lbk_vctx *ctx, const uint8_t *data, size_t size);
+void lbk_validate_lmuv(lbk_vctx *ctx, const uint8_t *data, size_t size);
 void lbk_validate_dls(lbk_vctx *ctx, const uint8_t *data, size_t size);
 void lbk_validate_door(lbk_vctx *ctx, const uint8_t *data, size_t size);
 

@@ -24,6 +24,9 @@ static const struct {
     [LBK_ERR_LIMIT] = {"LBK_ERR_LIMIT", "a size exceeds a limit"},
     [LBK_ERR_RANGE] = {"LBK_ERR_RANGE", "a value is outside the range the encoding can hold"},
     [LBK_ERR_OVERLAPS] = {"LBK_ERR_OVERLAPS", "more dynamic light set overlaps than the format allows"},
+    [LBK_ERR_CANCELLED] = {"LBK_ERR_CANCELLED", "cancelled by the caller"},
+    [LBK_ERR_BAD_INPUT] = {"LBK_ERR_BAD_INPUT", "the input is unusable"},
+    [LBK_ERR_INTERNAL] = {"LBK_ERR_INTERNAL", "internal error"},
 };
 
 const char *lbk_result_name(lbk_result r)

@@ -74,7 +74,8 @@ static const struct {
 } dependency_order[] = {
     {LBK_SECTION_META, lbk_validate_meta}, {LBK_SECTION_REPT, lbk_validate_rept}, {LBK_SECTION_LMAP, lbk_validate_lmap},
     {LBK_SECTION_GLG, lbk_validate_glg},   {LBK_SECTION_LLG, lbk_validate_llg},   {LBK_SECTION_OCTP, lbk_validate_octp},
-    {LBK_SECTION_OBJS, lbk_validate_objs}, {LBK_SECTION_DLS, lbk_validate_dls},   {LBK_SECTION_DOOR, lbk_validate_door},
+    {LBK_SECTION_OBJS, lbk_validate_objs}, {LBK_SECTION_LMUV, lbk_validate_lmuv}, {LBK_SECTION_DLS, lbk_validate_dls},
+    {LBK_SECTION_DOOR, lbk_validate_door},
 };
 
 static const char *load_message(uint32_t id)
@@ -189,6 +190,7 @@ lbk_result lbk_validate_memory(const void *data, size_t size, const lbk_validate
 done:
     lbk_dealloc(&alloc, (void *)ctx.lmap_page_width);
     lbk_dealloc(&alloc, (void *)ctx.lmap_page_height);
+    lbk_dealloc(&alloc, ctx.objs_facts);
     lbk_dealloc(&alloc, ctx.dls_facts);
     lbk_dealloc(&alloc, fr);
     return result;

@@ -20,11 +20,11 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "bake/pipeline/bake.h"
+#include "lbk/bake.h"
+#include "tests/support/bake_file.h"
 #include "bake/sets/door_sampling.h"
 #include "bake/scene/import.h"
 #include "bake/transport/tracer.h"
-#include "cli/cli.h"
 #include "lbk/ahd.h"
 #include "lbk/container.h"
 #include "lbk/dls.h"
@@ -54,27 +54,25 @@ typedef struct baked {
 static char tmpdir[128];
 static baked G, D, N, C, C0;
 
-static int bake_scene(const char *name, const ds_options *o, uint64_t seed, int method, char *err, size_t err_len,
-                      char *out_path)
+static int bake_scene(const char *name, const ds_options *o, uint64_t seed, int method, int threads, int samples,
+                      char *err, size_t err_len, char *out_path)
 {
     char gltf[256];
     snprintf(gltf, sizeof gltf, "%s/%s.gltf", tmpdir, name);
     snprintf(out_path, 256, "%s/%s.lbk", tmpdir, name);
     assert_int_equal(ds_write_room_scene(DS_ROOM_GLB, gltf, o, err, err_len), 0);
-    bk_bake_options bo;
+    tb_job bo;
     memset(&bo, 0, sizeof bo);
-    bo.input = gltf;
-    bo.output = out_path;
-    bo.threads = 2;
-    bo.seed = seed;
-    bo.target_error = 1e-6; /* never reached: the full budget */
-    bo.max_samples = SAMPLES;
-    bo.glg_spacing = 2.5f;
-    bo.door_method = method;
-    bk_progress pr;
-    bk_progress_init(&pr, 1);
-    bk_bake_summary sum;
-    int rc = bk_bake(&bo, &pr, &sum, err, err_len);
+    bo.in = gltf;
+    bo.out = out_path;
+    bo.d.threads = threads;
+    bo.d.seed = seed;
+    bo.d.target_error = 1e-6; /* never reached: the full budget */
+    bo.d.max_samples = samples;
+    bo.d.glg_spacing = 2.5f;
+    bo.d.door_method = method;
+    lbk_bake_report sum;
+    lbk_result rc = tb_bake(&bo, &sum, err, err_len);
     unlink(gltf);
     return rc;
 }
@@ -83,7 +81,7 @@ static void bake_one(baked *b, const char *name, const ds_options *o, uint64_t s
 {
     memset(b, 0, sizeof *b);
     char err[512];
-    int rc = bake_scene(name, o, seed, method, err, sizeof err, b->path);
+    int rc = bake_scene(name, o, seed, method, 2, SAMPLES, err, sizeof err, b->path);
     if (rc) fprintf(stderr, "bake %s: %s\n", name, err);
     assert_int_equal(rc, 0);
     assert_int_equal(lbk_reader_open_file(b->path, NULL, &b->rd), LBK_OK);
@@ -443,11 +441,61 @@ static void test_combination_unknown_name(void **state)
     (void)state;
     ds_options o = {DS_DOOR_TAGGED, DS_INSIDE_NONE, 0, 1, 0.5f, DENSITY, DS_NO_DOOR, 1, 0};
     char err[512], path[256];
-    int rc = bake_scene("badcombo", &o, 1, 0, err, sizeof err, path);
+    int rc = bake_scene("badcombo", &o, 1, 0, 2, SAMPLES, err, sizeof err, path);
     print_message("%s\n", err);
-    assert_int_equal(rc, LBK_EXIT_INPUT);
+    assert_int_equal(rc, LBK_ERR_BAD_INPUT);
     assert_non_null(strstr(err, "'outer'"));
     unlink(path);
+}
+
+/* ---- determinism ------------------------------------------------------------------------------ */
+
+static void *read_all(const char *path, size_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    assert_int_equal(fseek(f, 0, SEEK_END), 0);
+    long n = ftell(f);
+    assert_true(n > 0);
+    rewind(f);
+    void *d = malloc((size_t)n);
+    assert_int_equal(fread(d, 1, (size_t)n, f), (size_t)n);
+    fclose(f);
+    *size = (size_t)n;
+    return d;
+}
+
+/* Light sets and a guided door: the same bytes at 1 and 3 threads (the guided estimator and
+ * every set's transport run in parallel; `make tsan` runs this case, hence the small budget). */
+static void test_same_bytes_at_any_thread_count(void **state)
+{
+    (void)state;
+    ds_options o = {DS_DOOR_TAGGED, DS_INSIDE_SETS, 0, 1, 0.5f, 1.0f, 0, 0, 0};
+    char err[512], path[256];
+    void *bytes[2];
+    size_t size[2];
+    for (int t = 0; t < 2; t++) { /* one input name: META records it */
+        int rc = bake_scene("threads", &o, 5, 1, 1 + 2 * t, 16, err, sizeof err, path);
+        if (rc) fprintf(stderr, "bake at %d threads: %s\n", 1 + 2 * t, err);
+        assert_int_equal(rc, 0);
+        bytes[t] = read_all(path, &size[t]);
+        unlink(path);
+    }
+    assert_int_equal(size[1], size[0]);
+    assert_memory_equal(bytes[1], bytes[0], size[0]);
+    /* it is a bake with every part the threads touch */
+    lbk_reader *r;
+    assert_int_equal(lbk_reader_open_memory(bytes[0], size[0], NULL, &r), LBK_OK);
+    const void *d;
+    size_t n;
+    assert_int_equal(lbk_reader_section_by_type(r, LBK_SECTION_DLS, &d, &n), LBK_OK);
+    lbk_dls_view *dv;
+    assert_int_equal(lbk_dls_open(d, n, NULL, &dv), LBK_OK);
+    assert_int_equal(lbk_dls_set_count(dv), 4); /* A, B, the door's open and closed sets */
+    lbk_dls_close(dv);
+    assert_int_equal(lbk_reader_section_by_type(r, LBK_SECTION_DOOR, &d, &n), LBK_OK);
+    lbk_reader_close(r);
+    free(bytes[0]), free(bytes[1]);
 }
 
 static int teardown_sun(void **state)
@@ -467,6 +515,7 @@ int main(void)
         cmocka_unit_test_teardown(test_mis_weights, teardown_sun),
         cmocka_unit_test(test_combination_two_doors),
         cmocka_unit_test(test_combination_unknown_name),
+        cmocka_unit_test(test_same_bytes_at_any_thread_count),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -23,7 +23,8 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "bake/pipeline/bake.h"
+#include "lbk/bake.h"
+#include "tests/support/bake_file.h"
 #include "lbk/ahd.h"
 #include "lbk/container.h"
 #include "lbk/dls.h"
@@ -55,7 +56,7 @@ typedef struct baked {
     lbk_dls_view *dls;
     lbk_door_view *door;
     uint32_t room_rect[5]; /* page, x, y, w, h of object "Room" */
-    bk_bake_summary sum;
+    lbk_bake_report sum;
 } baked;
 
 static char tmpdir[128];
@@ -68,19 +69,17 @@ static void bake_one(baked *b, const char *name, const ds_options *o, uint64_t s
     snprintf(gltf, sizeof gltf, "%s/%s.gltf", tmpdir, name);
     snprintf(b->path, sizeof b->path, "%s/%s.lbk", tmpdir, name);
     assert_int_equal(ds_write_room_scene(DS_ROOM_GLB, gltf, o, err, sizeof err), 0);
-    bk_bake_options bo;
+    tb_job bo;
     memset(&bo, 0, sizeof bo);
-    bo.input = gltf;
-    bo.output = b->path;
-    bo.threads = 2;
-    bo.seed = seed;
-    bo.target_error = 1e-6; /* never reached: every bake runs its full sample budget */
-    bo.max_samples = SAMPLES;
-    bo.no_glg = 0;
-    bo.glg_spacing = 2.5f;
-    bk_progress pr;
-    bk_progress_init(&pr, 1);
-    int rc = bk_bake(&bo, &pr, &b->sum, err, sizeof err);
+    bo.in = gltf;
+    bo.out = b->path;
+    bo.d.threads = 2;
+    bo.d.seed = seed;
+    bo.d.target_error = 1e-6; /* never reached: every bake runs its full sample budget */
+    bo.d.max_samples = SAMPLES;
+    bo.d.no_glg = 0;
+    bo.d.glg_spacing = 2.5f;
+    lbk_result rc = tb_bake(&bo, &b->sum, err, sizeof err);
     if (rc) fprintf(stderr, "bake %s: %s\n", name, err);
     assert_int_equal(rc, 0);
     unlink(gltf);
@@ -226,9 +225,9 @@ static void test_bakes(void **state)
     bake_one(&R1b, "static_seed2", &o1, 2);
     ds_options o3 = {DS_NO_DOOR, DS_INSIDE_NONE, 0, 1, 0.5f, DENSITY, 0, 0, 0};
     bake_one(&R3, "nodoor", &o3, 2); /* another seed: independent noise */
-    assert_int_equal(S.sum.sets, 5); /* A, B, C, door/north/open, door/north/closed */
-    assert_int_equal(S.sum.doors, 1);
-    assert_int_equal(R1.sum.sets, 0);
+    assert_int_equal(S.sum.counts.light_sets, 5); /* A, B, C, door/north/open, door/north/closed */
+    assert_int_equal(S.sum.counts.doors, 1);
+    assert_int_equal(R1.sum.counts.light_sets, 0);
     assert_null(R1.dls);
     assert_non_null(S.dls);
     assert_non_null(S.door);

@@ -93,6 +93,7 @@ static tl_open_status open_views(tl_bake *b, char err[TL_ERR_LEN])
     VIEW(LBK_SECTION_GLG, b->has_glg, lbk_glg_open(d, n, &b->glg));
     VIEW(LBK_SECTION_LLG, b->has_llg, lbk_llg_open(d, n, &b->llg));
     VIEW(LBK_SECTION_OCTP, b->has_octp, lbk_octp_open(d, n, &b->octp));
+    VIEW(LBK_SECTION_LMUV, b->has_lmuv, lbk_lmuv_open(d, n, &b->lmuv));
     VIEW(LBK_SECTION_DLS, dls, lbk_dls_open(d, n, NULL, &b->dls));
     VIEW(LBK_SECTION_DOOR, door, lbk_door_open(d, n, NULL, &b->door));
 #undef VIEW

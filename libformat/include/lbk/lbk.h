@@ -73,7 +73,10 @@ extern "C" {
 /* The container format written by this library (spec/container.md §2); it reads every minor
  * version of this major up to LBK_FORMAT_VERSION_MINOR. Not the library's version. */
 #define LBK_FORMAT_VERSION_MAJOR 1
-#define LBK_FORMAT_VERSION_MINOR 0
+/* The newest container minor version this library reads and writes. A writer stamps each file
+ * with the lowest minor version that defines every known section in it (spec §1.3): 1 when it
+ * holds LMUV, else 0, so a file without 1.1 content keeps the bytes a 1.0 writer gave it. */
+#define LBK_FORMAT_VERSION_MINOR 1
 
 /* This library's version (semantic versioning of the API and ABI). */
 #define LBK_LIBRARY_VERSION_MAJOR 1
@@ -111,6 +114,9 @@ typedef enum lbk_result {
     LBK_ERR_LIMIT,              /* a size exceeds a cap (caller's or the file's) */
     LBK_ERR_RANGE,              /* a value is outside what the encoding can hold */
     LBK_ERR_OVERLAPS,           /* more dynamic-set overlaps than the DLS forms allow */
+    LBK_ERR_CANCELLED,          /* the caller's progress callback asked to stop (liblbkbake) */
+    LBK_ERR_BAD_INPUT,          /* an input scene is unusable: bad glTF, no light, nothing to bake */
+    LBK_ERR_INTERNAL,           /* a failure of the library itself or of a dependency (a bug) */
     /* new codes are appended here */
     LBK_RESULT_COUNT_           /* not part of the ABI: grows when codes are added */
 } lbk_result;
@@ -171,6 +177,7 @@ LBK_API void lbk_free(const lbk_allocator *allocator, void *ptr);
 #define LBK_SECTION_DLS  LBK_FOURCC('D', 'L', 'S', ' ') /* dynamic light sets + clusters */
 #define LBK_SECTION_DOOR LBK_FOURCC('D', 'O', 'O', 'R') /* interactive elements */
 #define LBK_SECTION_OCTP LBK_FOURCC('O', 'C', 'T', 'P') /* octahedral probes (GIBS style) */
+#define LBK_SECTION_LMUV LBK_FOURCC('L', 'M', 'U', 'V') /* lightmap coordinates per object (1.1) */
 
 /* Writes the 4 characters of a type code plus a NUL into out[5]; non-printable bytes become '?'. */
 LBK_API void lbk_fourcc_string(uint32_t type, char out[5]);
