@@ -19,17 +19,18 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "bake/pipeline/bake.h"
 #include "bake/util/clock.h"
 #include "bake/util/parallel.h"
 #include "bake/util/rng.h"
 #include "lbk/ahd.h"
+#include "lbk/bake.h"
 #include "lbk/container.h"
 #include "lbk/dls.h"
 #include "lbk/door.h"
 #include "lbk/lightmap.h"
 #include "lbk/sh.h"
 /* The generators live with the tests; benches link the tools only, so take their source. */
+#include "tests/support/bake_file.c"
 #include "tests/support/dls_fixture.c"
 #include "tests/support/door_scenes.c"
 #include "tests/support/estate_level.c"
@@ -230,13 +231,12 @@ static int baked(const char *dir, const char *name, const ds_options *o)
         fprintf(stderr, "%s: %s\n", name, err);
         return 1;
     }
-    bk_bake_options bo;
+    tb_job bo;
     memset(&bo, 0, sizeof bo);
-    bo.input = gltf, bo.output = path, bo.seed = 1, bo.target_error = 1e-9, bo.max_samples = 64;
-    bk_progress pr;
-    bk_progress_init(&pr, 1);
-    bk_bake_summary sum;
-    int rc = bk_bake(&bo, &pr, &sum, err, sizeof err);
+    bo.in = gltf, bo.out = path;
+    bo.d.seed = 1, bo.d.target_error = 1e-9, bo.d.max_samples = 64;
+    lbk_bake_report sum;
+    int rc = tb_bake(&bo, &sum, err, sizeof err);
     unlink(gltf);
     if (rc) {
         fprintf(stderr, "%s: bake failed: %s\n", name, err);
