@@ -117,6 +117,38 @@ static uint32_t subgroup_targets(const lbk_dls_runtime *r, const uint8_t *gr)
 /* Calls fn for each stretch of consecutive target indices of the chunk, in cluster order. */
 typedef void (*span_fn)(void *ctx, uint64_t start, uint32_t len);
 
+/* Runs are short (a chart row: tens of texels) and lie rows apart, beyond what a hardware
+ * prefetcher follows, so the first lines of every run's bases and outputs would each be a miss:
+ * ask for the next run's while this one computes. A hint only; nothing depends on it. */
+#define PREFETCH_LINES 4
+static void prefetch_lines(const void *p, size_t bytes, int write)
+{
+    const char *c = p;
+    const size_t n = bytes < PREFETCH_LINES * 64 ? bytes : PREFETCH_LINES * 64;
+#if defined(__GNUC__) || defined(__clang__)
+    for (size_t o = 0; o < n; o += 64) {
+        if (write) __builtin_prefetch(c + o, 1);
+        else __builtin_prefetch(c + o, 0);
+    }
+#else
+    (void)c, (void)n, (void)write;
+#endif
+}
+static void prefetch_run(const lbk_dls_runtime *r, uint32_t space, uint64_t t, uint32_t len, uint32_t *hint)
+{
+    if (space != LBK_DLS_SPACE_TEXEL) {
+        if (!r->probe_base[space] || !r->probe_out[space]) return;
+        prefetch_lines(r->probe_base[space] + LBK_DLS_PROBE_PAYLOAD * t, (size_t)LBK_DLS_PROBE_PAYLOAD * len, 0);
+        prefetch_lines(r->probe_out[space] + LBK_DLS_PROBE_PAYLOAD * t, (size_t)LBK_DLS_PROBE_PAYLOAD * len, 1);
+        return;
+    }
+    if (!r->nplanes) return;
+    texel_seg s;
+    texel_span(r, t, len, hint, &s);
+    prefetch_lines(s.b0, 4 * (size_t)s.len, 0), prefetch_lines(s.b1, 4 * (size_t)s.len, 0);
+    prefetch_lines(s.o0, 4 * (size_t)s.len, 1), prefetch_lines(s.o1, 4 * (size_t)s.len, 1);
+}
+
 static void chunk_spans(const lbk_dls_runtime *r, const rt_chunk *ch, span_fn fn, void *ctx)
 {
     if (ch->cluster == RT_GAP) {
@@ -135,9 +167,11 @@ static void chunk_spans(const lbk_dls_runtime *r, const rt_chunk *ch, span_fn fn
         }
         return;
     }
+    uint32_t hint = 0;
     for (uint32_t i = ch->run, skip = ch->skip; left > 0; i++, skip = 0) {
         uint32_t len = run_len(c->runs, i) - skip;
         if (len > left) len = left;
+        if (len < left) prefetch_run(r, c->space, run_start(c->runs, i + 1), run_len(c->runs, i + 1), &hint);
         fn(ctx, (uint64_t)run_start(c->runs, i) + skip, len);
         left -= len;
     }
