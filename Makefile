@@ -63,7 +63,7 @@ TOOL_OBJ  := $(filter-out $(BUILD)/rel/$(TOOL_MAIN:.c=.o) $(BAKE_OBJ),$(TOOL_CSR
 LIB_ASAN  := $(LIB_SRC:%.c=$(BUILD)/asan/%.o)
 TOOL_ASAN := $(filter-out $(BUILD)/asan/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUILD)/asan/%.o)) $(TOOL_CXXSRC:%.cc=$(BUILD)/asan/%.o)
 
-.PHONY: all lib bake-lib deps demo test check bench fuzz install install-check clean help gltf-validator gpu test-build
+.PHONY: all lib bake-lib deps demo test check bench bench-render fuzz install install-check clean help gltf-validator gpu test-build
 all: $(BUILD)/lbk $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc \
      $(BUILD)/liblbkbake.a $(BUILD)/liblbkbake.so $(BUILD)/lbk-bake.pc
 
@@ -78,6 +78,7 @@ help:
 	@echo "make install-lib PREFIX=/usr/local   liblbk only (needs a C compiler, zstd, xxHash)"
 	@echo "WERROR=1        every compiler warning is an error (CI)"
 	@echo "make bench      benchmarks, printed as ratios against baselines measured in the same run"
+	@echo "make bench-render  lbk render against Blender Cycles (LBK_CYCLES_HARNESS=bench/cycles of the cycles branch)"
 	@echo "make fuzz       libFuzzer harness for the container reader (clang)"
 	@echo "make gpu        the Vulkan DLS apply tool build/lbk-gpu-apply (make test runs the GPU tests on lavapipe)"
 	@echo "make install PREFIX=/usr/local"
@@ -360,6 +361,13 @@ bench: deps-tools
 	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BENCHES:%=$(BUILD)/bench/%)
 	@for b in $(BENCHES); do echo "== $$b"; $(BUILD)/bench/$$b || exit 1; done
 	@echo "== blender_import"; sh bench/blender_import.sh $(BUILD)/lbk $(BUILD)/bench-blender
+	@echo "== render (lbk render vs Blender Cycles)"; $(MAKE) --no-print-directory bench-render
+
+# lbk render against converged Cycles renders (bench/render/README.md); the Cycles scene converter
+# comes from LBK_CYCLES_HARNESS (bench/cycles of the cycles branch until it is merged).
+LBK_CYCLES_HARNESS ?= bench/cycles
+bench-render: $(BUILD)/lbk
+	@LBK_CYCLES_HARNESS=$(LBK_CYCLES_HARNESS) python3 bench/render/run.py --lbk $(BUILD)/lbk --out $(BUILD)/bench-render $(BENCH_RENDER_ARGS)
 
 # ---- demo -----------------------------------------------------------------------------------
 demo: deps-tools
