@@ -14,7 +14,8 @@ DEB_LIB_PKGS  := build-essential libzstd-dev libxxhash-dev
 GPU_PKGS      := libvulkan-dev mesa-vulkan-drivers glslang-tools
 DEB_TOOL_PKGS := $(DEB_LIB_PKGS) libembree-dev libopenexr-dev libdraco-dev libtinygltf-dev libstb-dev \
                  nlohmann-json3-dev libqhull-dev libspng-dev libcjson-dev
-DEB_PKGS      := $(DEB_TOOL_PKGS) pkg-config libcmocka-dev clang libclang-rt-14-dev $(GPU_PKGS)
+DEB_TEST_PKGS := $(DEB_TOOL_PKGS) pkg-config libcmocka-dev clang libclang-rt-14-dev
+DEB_PKGS      := $(DEB_TEST_PKGS) $(GPU_PKGS)
 
 WARN     := -Wall -Wextra -Wshadow -Wstrict-prototypes -Wmissing-prototypes -Wno-unused-parameter
 # The glTF shim: its own code warns like the C code; tinygltf, Draco, stb and nlohmann come in
@@ -88,7 +89,8 @@ help:
 # sudo when not root). The targets that need packages (test, demo, bench, fuzz) only check: they
 # install the missing ones themselves when run as root with CI set (.ci/run) or when
 # LBK_INSTALL_DEPS=1, and say which and why; otherwise they print the one command to run and stop.
-# $(1): the packages; $(2): the reason to install without asking, empty to ask first.
+# $(1): the packages; $(2): the reason to install without asking, empty to ask first; $(3): what
+# happens without them, for packages that are optional (then a note instead of a stop).
 define deps_sh
 missing=$$(for p in $(1); do dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; done); \
 [ -z "$$missing" ] && exit 0; missing=$$(echo $$missing); \
@@ -96,6 +98,10 @@ if [ "$$(id -u)" = 0 ]; then sudo=; else sudo="sudo "; fi; \
 why="$(2)"; \
 [ -z "$$why" ] && [ "$${LBK_INSTALL_DEPS:-}" = 1 ] && why="LBK_INSTALL_DEPS=1"; \
 [ -z "$$why" ] && [ -n "$${CI:-}" ] && [ -z "$$sudo" ] && why="CI=$$CI, running as root"; \
+if [ -z "$$why" ] && [ -n "$(3)" ]; then \
+  echo "lbk: not installed: $$missing; $(3)"; \
+  echo "lbk: (make deps, or LBK_INSTALL_DEPS=1 make $(MAKECMDGOALS), installs them)"; exit 0; \
+fi; \
 if [ -z "$$why" ]; then \
   echo "lbk: make $(MAKECMDGOALS) needs Debian packages that are not installed: $$missing"; \
   echo "lbk: install them with"; echo "  $${sudo}apt-get install -y $$missing"; \
@@ -109,8 +115,11 @@ deps:
 	@$(call deps_sh,$(DEB_PKGS),make deps)
 deps-tools:
 	@$(call deps_sh,$(DEB_TOOL_PKGS),)
+# The GPU packages are optional for make test: without them (and not allowed to install them)
+# tests/gpu/test_gpu.c is built without Vulkan and its cases count as skipped.
 deps-test:
-	@$(call deps_sh,$(DEB_PKGS),)
+	@$(call deps_sh,$(DEB_TEST_PKGS),)
+	@$(call deps_sh,$(GPU_PKGS),,the GPU tests will be SKIPPED (counted so))
 
 # ---- compile rules --------------------------------------------------------------------------
 $(BUILD)/rel/libformat/%.o: libformat/%.c
