@@ -407,6 +407,9 @@ static void transport_options(const bk_pipeline *b, bk_transport_options *to)
     to->max_samples = opt->max_samples > 0 ? opt->max_samples : b->pre->max_samples;
     to->target_error = opt->target_error > 0 ? opt->target_error : b->pre->target_error;
     to->time_limit = opt->time_limit;
+    to->class_end[BK_CLASS_TEXEL] = b->texel_receivers;
+    to->class_end[BK_CLASS_GLG] = b->llg_first;
+    to->class_end[BK_CLASS_LLG] = b->receiver_count;
 }
 
 void bk_pipeline_set_inputs(const bk_pipeline *b, bk_set_inputs *in)

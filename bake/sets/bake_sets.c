@@ -75,6 +75,8 @@ typedef struct bs_impl {
      * contributions, and Σ of the light-set runs' variances (independent runs); NULL before any */
     lbk_sh9_rgb *guide;
     float *guide_var;
+    bk_set_run_error *run_errors; /* every transport run's estimate, in order */
+    size_t run_error_count;
 } bs_impl;
 
 /* ---- prepare --------------------------------------------------------------------------- */
@@ -661,6 +663,7 @@ lbk_result bk_set_bakes_emit(bk_set_bakes *sets, const bk_set_inputs *in, char *
  * error's text goes. */
 typedef struct run_ctx {
     const bk_set_inputs *in;
+    bs_impl *im;             /* where run_one logs each run's estimate */
     int run, runs;
     const bk_scene *scene;   /* scene of the current run (the hook's triangle indices) */
     float *variance;         /* NULL, or where run_one writes the run's per-receiver variance */
@@ -732,6 +735,30 @@ static void filtered_free(filtered_scene *f)
     free(f->tris), free(f->tri_material), free(f->tri_object);
 }
 
+static lbk_result log_run(run_ctx *rc, const char *what, const bk_transport_stats *st)
+{
+    bs_impl *im = rc->im;
+    if (!im) return LBK_OK;
+    bk_set_run_error *n = realloc(im->run_errors, (im->run_error_count + 1) * sizeof *n);
+    if (!n) return LBK_ERR_OUT_OF_MEMORY;
+    im->run_errors = n;
+    bk_set_run_error *e = &n[im->run_error_count++];
+    memset(e, 0, sizeof *e);
+    snprintf(e->label, sizeof e->label, "%s", what);
+    e->est_rel_rmse = st->est_rel_rmse;
+    memcpy(e->class_rel_rmse, st->class_rel_rmse, sizeof e->class_rel_rmse);
+    e->probe_rel_rmse = st->probe_rel_rmse;
+    e->seconds = st->seconds;
+    return LBK_OK;
+}
+
+const bk_set_run_error *bk_set_bakes_run_errors(const bk_set_bakes *sets, size_t *count)
+{
+    const bs_impl *im = sets ? sets->impl : NULL;
+    *count = im ? im->run_error_count : 0;
+    return im ? im->run_errors : NULL;
+}
+
 /* One transport run at the base receivers. */
 static lbk_result run_one(run_ctx *rc, const bk_scene *scene, const bk_tracer *tracer, const bk_transport_options *base,
                           lbk_sh9_rgb *radiance, lbk_sh9_rgb *direct, const char *what)
@@ -764,7 +791,7 @@ static lbk_result run_one(run_ctx *rc, const bk_scene *scene, const bk_tracer *t
                       (unsigned long long)st.nonfinite);
     bk_events_say(in->events, LBK_BAKE_SEVERITY_INFO, "%-30s %2d passes %7.0f samples/receiver  est. error %6.2f%%  %6.1f s",
                   what, st.passes, st.samples_per_receiver, 100 * st.est_rel_rmse, st.seconds);
-    return LBK_OK;
+    return log_run(rc, what, &st);
 }
 
 static void sh_sub(lbk_sh9_rgb *dst, const lbk_sh9_rgb *b, size_t n)
@@ -1067,6 +1094,7 @@ lbk_result bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *e
     s.n = in->receiver_count ? in->receiver_count : 1;
     s.fraction = in->threshold == 0 ? BS_DEFAULT_THRESHOLD : in->threshold < 0 ? 0 : in->threshold;
     s.rc.in = in;
+    s.rc.im = im;
     s.rc.err = err;
     s.rc.err_len = err_len;
     for (size_t j = 0; j < im->light_set_count; j++) s.rc.runs += !im->sets[j].zero;
@@ -1236,7 +1264,7 @@ void bk_set_bakes_free(bk_set_bakes *sets)
             free(im->sets[j].stash), free(im->sets[j].stash_direct);
             for (int s = 0; s < LBK_DLS_SPACE_COUNT_; s++) free(im->sets[j].targets[s]), free(im->sets[j].values[s]);
         }
-        free(im->sets), free(im->doors), free(im->combos), free(im->guide), free(im->guide_var), free(im);
+        free(im->sets), free(im->doors), free(im->combos), free(im->guide), free(im->guide_var), free(im->run_errors), free(im);
     }
     memset(sets, 0, sizeof *sets);
 }
