@@ -40,7 +40,7 @@ TOOL_OBJ  := $(filter-out $(BUILD)/rel/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUIL
 LIB_ASAN  := $(LIB_SRC:%.c=$(BUILD)/asan/%.o)
 TOOL_ASAN := $(filter-out $(BUILD)/asan/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUILD)/asan/%.o)) $(TOOL_CXXSRC:%.cc=$(BUILD)/asan/%.o)
 
-.PHONY: all lib deps demo test check bench fuzz install install-check clean help
+.PHONY: all lib deps deps-bench demo test check bench bench-cycles fuzz install install-check clean help
 all: $(BUILD)/lbk $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc
 
 help:
@@ -48,12 +48,27 @@ help:
 	@echo "make demo       install missing packages, bake the embedded scene, inspect it, write a PNG"
 	@echo "make test       install missing packages, build with ASan+UBSan, run the whole suite"
 	@echo "make bench      benchmarks, printed as ratios against baselines measured in the same run"
+	@echo "make bench-cycles  lbk against Blender Cycles at equal time (part of make bench; bench/cycles/README.md)"
 	@echo "make fuzz       libFuzzer harness for the container reader (clang)"
 	@echo "make install PREFIX=/usr/local"
 
 # ---- dependencies -------------------------------------------------------------------------
 deps:
 	@missing=$$(for p in $(DEB_PKGS); do dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; done); \
+	if [ -n "$$missing" ]; then \
+	  if [ "$$(id -u)" = 0 ]; then \
+	    echo "lbk: installing missing Debian packages:" $$missing; \
+	    (apt-get update -qq || true) && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >/dev/null; \
+	  else \
+	    echo "lbk: missing Debian packages. Run as root:"; \
+	    echo "  sudo apt-get install -y" $$missing; exit 1; \
+	  fi; \
+	fi
+
+# What `make bench-cycles` needs besides the build: Blender (Cycles) and Python 3.
+BENCH_DEB_PKGS := blender python3
+deps-bench:
+	@missing=$$(for p in $(BENCH_DEB_PKGS); do dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; done); \
 	if [ -n "$$missing" ]; then \
 	  if [ "$$(id -u)" = 0 ]; then \
 	    echo "lbk: installing missing Debian packages:" $$missing; \
@@ -147,9 +162,31 @@ $(BUILD)/bench/%: bench/%.c $(TOOL_OBJ) $(BUILD)/liblbk.a
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) -O2 -g $(WARN) $(TOOL_INC) -c $< -o $@.o
 	$(CXX) -o $@ $@.o $(TOOL_OBJ) $(BUILD)/liblbk.a $(TOOL_LIBS)
-bench: deps
+bench: deps deps-bench
 	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BENCHES:%=$(BUILD)/bench/%)
 	@for b in $(BENCHES); do echo "== $$b"; $(BUILD)/bench/$$b || exit 1; done
+	@echo "== bench-cycles"; $(MAKE) --no-print-directory bench-cycles
+
+# lbk against Cycles (bench/cycles/README.md). LBK_TREE=/path/to/other/checkout compares that
+# tree's baker instead: its build/lbk (built there first) and texel_dump linked against its
+# baker objects, so the rebuilt layout is the one its lbk bakes.
+ifdef LBK_TREE
+CYC_LBK  := $(LBK_TREE)/$(BUILD)/lbk
+CYC_DUMP := $(BUILD)/bench/cycles/texel_dump-tree
+$(CYC_DUMP): bench/cycles/texel_dump.c FORCE
+	@$(MAKE) --no-print-directory -C $(LBK_TREE) $(BUILD)/lbk
+	@mkdir -p $(@D)
+	$(CC) $(CSTD) -O2 -g $(WARN) -I$(LBK_TREE)/libformat/include -I$(LBK_TREE) -I/usr/include/draco -I/usr/include/stb \
+	    -c $< -o $@.o
+	$(CXX) -o $@ $@.o $(sort $(wildcard $(LBK_TREE)/$(BUILD)/rel/bake/*/*.o)) $(LBK_TREE)/$(BUILD)/liblbk.a $(TOOL_LIBS)
+FORCE:
+else
+CYC_LBK  ?= $(BUILD)/lbk
+CYC_DUMP ?= $(BUILD)/bench/cycles/texel_dump
+endif
+bench-cycles: deps deps-bench
+	@$(MAKE) --no-print-directory $(BUILD)/lbk $(CYC_DUMP)
+	@LBK=$${LBK:-$(CYC_LBK)} LBK_TEXEL_DUMP=$${LBK_TEXEL_DUMP:-$(CYC_DUMP)} python3 bench/cycles/run.py
 
 # ---- demo -----------------------------------------------------------------------------------
 demo: deps
