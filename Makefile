@@ -185,7 +185,7 @@ CYC_LBK  ?= $(BUILD)/lbk
 CYC_DUMP ?= $(BUILD)/bench/cycles/texel_dump
 endif
 bench-cycles: deps deps-bench
-	@$(MAKE) --no-print-directory $(BUILD)/lbk $(CYC_DUMP)
+	@$(MAKE) --no-print-directory $(if $(LBK_TREE),,$(BUILD)/lbk) $(CYC_DUMP)
 	@LBK=$${LBK:-$(CYC_LBK)} LBK_TEXEL_DUMP=$${LBK_TEXEL_DUMP:-$(CYC_DUMP)} python3 bench/cycles/run.py
 
 # ---- demo -----------------------------------------------------------------------------------

@@ -32,8 +32,8 @@ import mathutils
 # analytic.py (see README.md). The Diffuse bake pass ("no colour") is irradiance / pi.
 #   point:  Cycles point light of power P [W], radius 0: radiant intensity P / (4 pi) W/sr
 #           -> P = 4 pi * I[cd]
-#   spot:   the same as a point light inside the cone (Cycles spot of power P has intensity
-#           P / (4 pi) on its axis)  -> P = 4 pi * I[cd]
+#   spot:   a point light of P = 4 pi * I[cd] whose emission strength is the glTF cone (see
+#           add_light: a Cycles spot light has another falloff)
 #   sun:    Cycles sun strength = irradiance at normal incidence -> strength = E[lux]
 LIGHT_UNITS = {"point": 4.0 * math.pi, "spot": 4.0 * math.pi, "directional": 1.0}
 
