@@ -10,6 +10,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 LUM = (0.2126, 0.7152, 0.0722)  # Rec. 709, as lbk (lbk/ahd.h)
 HIDDEN = 0x100  # texel_dump: the sensor point is enclosed by geometry (no reference value)
+OFFPLANE = 0x200  # texel_dump: push-out moved the point off its own (covered) surface
 
 
 def lum(rgb):

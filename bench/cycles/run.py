@@ -137,7 +137,7 @@ def run_scene(sc, work, opt, out):
             pct(g.cyc), ratio, "n/r" if g.unresolved else "yes" if ratio <= 0.5 else "no", pct(g.ref_noise)))
         return g, ratio
 
-    visible = [i for i in range(len(rec)) if not rec.flags[i] & common.HIDDEN]
+    visible = [i for i in range(len(rec)) if not rec.flags[i] & (common.HIDDEN | common.OFFPLANE)]
     for o in sorted(set(rec.obj)):
         idx = [i for i in visible if rec.obj[i] == o]
         if not idx:
@@ -174,8 +174,10 @@ def run_scene(sc, work, opt, out):
         cw = g.cyc * math.sqrt(eq["spp"] / spp_w)
         out("  at equal wall time instead (%.1f s; modelled from the calibration runs): Cycles %.0f spp, all-texel "
             "error %.1f %%, lbk/Cycles %.2f" % (lbk_wall, spp_w, 100 * cw, g.lbk / cw))
-    out("  left out: %d of %d receivers whose sensor point is enclosed by geometry (texel_dump HIDDEN)" % (
-        len(rec) - len(visible), len(rec)))
+    out("  left out (invisible, no reference value): %d of %d receivers whose sensor point is enclosed by "
+        "geometry, %d texels moved off their own surface by the push-out (texel_dump HIDDEN, OFFPLANE)" % (
+            sum(1 for f in rec.flags if f & common.HIDDEN), len(rec),
+            sum(1 for f in rec.flags if f & common.OFFPLANE and not f & common.HIDDEN)))
     cal_txt = ", ".join("%d spp %.1f %%" % (r["spp"], 100 * Group(tex, lum, lum2, r1, r2, v).cyc) for r, v in calib)
     out("  Cycles calibration runs (all texels): %s; scene done in %.0f s" % (cal_txt, time.perf_counter() - t_scene))
     return rows, {"scene": sc["name"], "lbk_wall_s": lbk_wall, "lbk_cpu_s": lbk_cpu, "lbk_est": est,

@@ -36,6 +36,11 @@
  * of lbk's own inside test — gets flag 0x100 (HIDDEN): e.g. the strip of wall behind a window
  * sill that sits flush against it. It is invisible, has no reference value (a sensor there sees
  * the inside of the sill), and run.py leaves it out of every statistic (counted).
+ * A texel whose sample point the push-out moved off its own surface — more than 1 % of a texel
+ * from its triangle's plane, e.g. the ceiling above the Cornell box's light, moved under the
+ * light — gets flag 0x200 (OFFPLANE): its own surface there is covered by another one, so it is
+ * invisible too, and its value is a convention (the baker may light the moved point or, with
+ * footprint sampling, its own covered surface); run.py leaves it out as well (counted).
  *
  * It links the baker's internals (like bench_transport.c) but writes nothing the baker reads;
  * the layout it rebuilds must come from the same source tree as the lbk that baked the file
@@ -58,6 +63,7 @@
 #include "lbk/report.h"
 
 #define DUMP_HIDDEN 0x100u
+#define DUMP_OFFPLANE 0x200u
 
 /* The presets' texel densities (bake/pipeline/bake.c `presets`). */
 static float preset_density(const char *preset) { return preset && !strcmp(preset, "high") ? 16.0f : 8.0f; }
@@ -220,6 +226,21 @@ static void inside_triangle(const bk_scene *s, const bk_texel *t, double p[3])
     for (int a = 0; a < 3; a++) p[a] += step * v[a] / len;
 }
 
+/* See OFFPLANE above. */
+static int off_plane(const bk_scene *s, const bk_texel *t)
+{
+    const float *v[3];
+    for (int k = 0; k < 3; k++) v[k] = s->positions + 3 * (size_t)s->tris[3 * (size_t)t->tri + k];
+    double e1[3], e2[3], n[3];
+    for (int a = 0; a < 3; a++) e1[a] = (double)v[1][a] - v[0][a], e2[a] = (double)v[2][a] - v[0][a];
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1], n[1] = e1[2] * e2[0] - e1[0] * e2[2], n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(len > 0)) return 0;
+    double dist = 0;
+    for (int a = 0; a < 3; a++) dist += ((double)t->position[a] - v[0][a]) * n[a] / len;
+    return fabs(dist) > 0.01 * t->texel_size;
+}
+
 /* See HIDDEN above: 16 directions over the hemisphere around n (equal solid angle bands). */
 static int enclosed(const bk_tracer *tr, const double p[3], const float n[3], double offset)
 {
@@ -252,7 +273,8 @@ static int write_texels(const dump *d, FILE *f)
         uint32_t mat = d->scene.tri_material ? d->scene.tri_material[t->tri] : 0;
         double p[3] = {t->position[0], t->position[1], t->position[2]};
         if (t->flags & BK_TEXEL_EDGE) inside_triangle(&d->scene, t, p);
-        uint32_t flags = t->flags | (enclosed(d->tracer, p, t->normal, sensor_offset(&d->scene)) ? DUMP_HIDDEN : 0);
+        uint32_t flags = t->flags | (enclosed(d->tracer, p, t->normal, sensor_offset(&d->scene)) ? DUMP_HIDDEN : 0) |
+                         (off_plane(&d->scene, t) ? DUMP_OFFPLANE : 0);
         fprintf(f, "T\t%u\t%u\t%u\t%u\t%u\t%.9g\t%.9g\t%.9g\t%.7g\t%.7g\t%.7g\t%.6g\t%.7g\t%.7g\t%.7g\t%u\n", t->object,
                 mat, t->page, t->x, t->y, p[0], p[1], p[2], t->normal[0], t->normal[1], t->normal[2], t->texel_size,
                 rgb[0], rgb[1], rgb[2], flags);
