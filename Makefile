@@ -178,7 +178,7 @@ $(CYC_DUMP): bench/cycles/texel_dump.c FORCE
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) -O2 -g $(WARN) -I$(LBK_TREE)/libformat/include -I$(LBK_TREE) -I/usr/include/draco -I/usr/include/stb \
 	    -c $< -o $@.o
-	$(CXX) -o $@ $@.o $(sort $(wildcard $(LBK_TREE)/$(BUILD)/rel/bake/*/*.o)) $(LBK_TREE)/$(BUILD)/liblbk.a $(TOOL_LIBS)
+	$(CXX) -o $@ $@.o $$(ls $(LBK_TREE)/$(BUILD)/rel/bake/*/*.o | sort) $(LBK_TREE)/$(BUILD)/liblbk.a $(TOOL_LIBS)
 FORCE:
 else
 CYC_LBK  ?= $(BUILD)/lbk
