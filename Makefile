@@ -7,25 +7,39 @@ CC       ?= cc
 CXX      ?= c++
 CLANG    ?= clang
 
-# Debian packages the build needs; `make deps` installs the missing ones when run as root.
-DEB_PKGS := build-essential pkg-config libzstd-dev libxxhash-dev libembree-dev libopenexr-dev \
-            libdraco-dev libtinygltf-dev libstb-dev nlohmann-json3-dev libqhull-dev libspng-dev \
-            libcjson-dev libcmocka-dev clang libclang-rt-14-dev
+# Debian packages: liblbk alone (`make install-lib`), the baker and CLI, the tests on top.
+DEB_LIB_PKGS  := build-essential libzstd-dev libxxhash-dev
+DEB_TOOL_PKGS := $(DEB_LIB_PKGS) libembree-dev libopenexr-dev libdraco-dev libtinygltf-dev libstb-dev \
+                 nlohmann-json3-dev libqhull-dev libspng-dev libcjson-dev
+DEB_PKGS      := $(DEB_TOOL_PKGS) pkg-config libcmocka-dev clang libclang-rt-14-dev
 
 WARN     := -Wall -Wextra -Wshadow -Wstrict-prototypes -Wmissing-prototypes -Wno-unused-parameter
+# The glTF shim: its own code warns like the C code; tinygltf, Draco, stb and nlohmann come in
+# through -isystem, so warnings inside them (not ours to fix) do not count.
+CXXWARN  := -Wall -Wextra -Wshadow -Wno-unused-parameter
+# WERROR=1 (CI sets it) makes every warning of every compile an error: C and C++, release,
+# ASan, TSan, tests, benchmarks and the clang fuzz build.
+ifeq ($(WERROR),1)
+WARN     += -Werror
+CXXWARN  += -Werror
+endif
 CSTD     := -std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE
 OPT      ?= -O2 -g
 SAN      := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
 
 LIB_INC  := -Ilibformat/include
 LIB_LIBS := -lzstd -lxxhash -lm
-# The tools: everything heavy lives here, never in liblbk.
-TOOL_INC := $(LIB_INC) -I. -I/usr/include/draco -I/usr/include/stb
-TOOL_LIBS:= -lembree3 -lOpenEXRCore -lqhull_r -lspng -lcjson -ldraco -lpthread -lm $(LIB_LIBS)
+# The baker (liblbkbake) and the tools: everything heavy lives here, never in liblbk.
+TOOL_INC := $(LIB_INC) -Ibake/include -I. -I/usr/include/draco -I/usr/include/stb
+BAKE_LIBS:= -lembree3 -lOpenEXRCore -lqhull_r -lspng -lcjson -ldraco -lpthread -lm
+TOOL_LIBS:= $(BAKE_LIBS) $(LIB_LIBS)
+TOOL_CXXINC := $(LIB_INC) -Ibake/include -I. -isystem /usr/include/draco -isystem /usr/include/stb
 
 LIB_SRC   := $(sort $(wildcard libformat/src/*.c))
+BAKE_CSRC := $(sort $(wildcard bake/*/*.c))
+BAKE_CXXSRC := $(sort $(wildcard bake/*/*.cc))
 TOOL_CSRC := $(sort $(wildcard cli/*.c bake/*/*.c tools/*/*.c))
-TOOL_CXXSRC := $(sort $(wildcard bake/*/*.cc))
+TOOL_CXXSRC := $(BAKE_CXXSRC)
 TOOL_MAIN := cli/main.c
 TEST_SRC  := $(sort $(wildcard tests/*/test_*.c))
 TESTS     := $(notdir $(TEST_SRC:.c=))
@@ -35,49 +49,66 @@ BENCHES   := $(patsubst bench/%.c,%,$(sort $(wildcard bench/bench_*.c)))
 # Release objects
 LIB_OBJ   := $(LIB_SRC:%.c=$(BUILD)/rel/%.o)
 LIB_PIC   := $(LIB_SRC:%.c=$(BUILD)/pic/%.o)
-TOOL_OBJ  := $(filter-out $(BUILD)/rel/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUILD)/rel/%.o)) $(TOOL_CXXSRC:%.cc=$(BUILD)/rel/%.o)
+BAKE_OBJ  := $(BAKE_CSRC:%.c=$(BUILD)/rel/%.o) $(BAKE_CXXSRC:%.cc=$(BUILD)/rel/%.o)
+BAKE_PIC  := $(BAKE_CSRC:%.c=$(BUILD)/pic/%.o) $(BAKE_CXXSRC:%.cc=$(BUILD)/pic/%.o)
+# cli/ and tools/ (the baker comes from liblbkbake.a)
+TOOL_OBJ  := $(filter-out $(BUILD)/rel/$(TOOL_MAIN:.c=.o) $(BAKE_OBJ),$(TOOL_CSRC:%.c=$(BUILD)/rel/%.o))
 # Sanitizer objects for the test build
 LIB_ASAN  := $(LIB_SRC:%.c=$(BUILD)/asan/%.o)
 TOOL_ASAN := $(filter-out $(BUILD)/asan/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUILD)/asan/%.o)) $(TOOL_CXXSRC:%.cc=$(BUILD)/asan/%.o)
 
-.PHONY: all lib deps deps-bench demo test check bench bench-cycles fuzz install install-check clean help
-all: $(BUILD)/lbk $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc
+.PHONY: all lib bake-lib deps deps-bench demo test check bench bench-cycles fuzz install install-check clean help gltf-validator
+all: $(BUILD)/lbk $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc \
+     $(BUILD)/liblbkbake.a $(BUILD)/liblbkbake.so $(BUILD)/lbk-bake.pc
 
 help:
-	@echo "make            build liblbk.a, liblbk.so, lbk.pc and the lbk CLI into $(BUILD)/"
-	@echo "make demo       install missing packages, bake the embedded scene, inspect it, write a PNG"
-	@echo "make test       install missing packages, build with ASan+UBSan, run the whole suite"
+	@echo "make            build liblbk.a/.so + lbk.pc, liblbkbake.a/.so + lbk-bake.pc and the lbk CLI into $(BUILD)/"
+	@echo "make deps       install the missing Debian packages"
+	@echo "make demo       bake the embedded scene, inspect it, write a PNG"
+	@echo "make test       build with ASan+UBSan, run the whole suite, then make tsan's cases"
+	@echo "                (demo, test, bench, fuzz install missing packages only as root with CI set"
+	@echo "                or with LBK_INSTALL_DEPS=1; else they print the apt-get line and stop)"
+	@echo "make tsan       the determinism cases of tests/tsan/determinism.list under ThreadSanitizer"
+	@echo "make install-lib PREFIX=/usr/local   liblbk only (needs a C compiler, zstd, xxHash)"
+	@echo "WERROR=1        every compiler warning is an error (CI)"
 	@echo "make bench      benchmarks, printed as ratios against baselines measured in the same run"
 	@echo "make bench-cycles  lbk against Blender Cycles at equal time (part of make bench; bench/cycles/README.md)"
 	@echo "make fuzz       libFuzzer harness for the container reader (clang)"
 	@echo "make install PREFIX=/usr/local"
 
 # ---- dependencies -------------------------------------------------------------------------
+# `make deps` installs whatever of DEB_PKGS is missing: that is what it is asked for (through
+# sudo when not root). The targets that need packages (test, demo, bench, fuzz) only check: they
+# install the missing ones themselves when run as root with CI set (.ci/run) or when
+# LBK_INSTALL_DEPS=1, and say which and why; otherwise they print the one command to run and stop.
+# $(1): the packages; $(2): the reason to install without asking, empty to ask first.
+define deps_sh
+missing=$$(for p in $(1); do dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; done); \
+[ -z "$$missing" ] && exit 0; missing=$$(echo $$missing); \
+if [ "$$(id -u)" = 0 ]; then sudo=; else sudo="sudo "; fi; \
+why="$(2)"; \
+[ -z "$$why" ] && [ "$${LBK_INSTALL_DEPS:-}" = 1 ] && why="LBK_INSTALL_DEPS=1"; \
+[ -z "$$why" ] && [ -n "$${CI:-}" ] && [ -z "$$sudo" ] && why="CI=$$CI, running as root"; \
+if [ -z "$$why" ]; then \
+  echo "lbk: make $(MAKECMDGOALS) needs Debian packages that are not installed: $$missing"; \
+  echo "lbk: install them with"; echo "  $${sudo}apt-get install -y $$missing"; \
+  echo "lbk: (or run make deps, or LBK_INSTALL_DEPS=1 make $(MAKECMDGOALS))"; exit 1; \
+fi; \
+echo "lbk: installing missing Debian packages ($$why): $$missing"; \
+{ $${sudo}apt-get update -qq || true; } && $${sudo}env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >/dev/null
+endef
+.PHONY: deps-tools deps-test
 deps:
-	@missing=$$(for p in $(DEB_PKGS); do dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; done); \
-	if [ -n "$$missing" ]; then \
-	  if [ "$$(id -u)" = 0 ]; then \
-	    echo "lbk: installing missing Debian packages:" $$missing; \
-	    (apt-get update -qq || true) && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >/dev/null; \
-	  else \
-	    echo "lbk: missing Debian packages. Run as root:"; \
-	    echo "  sudo apt-get install -y" $$missing; exit 1; \
-	  fi; \
-	fi
+	@$(call deps_sh,$(DEB_PKGS),make deps)
+deps-tools:
+	@$(call deps_sh,$(DEB_TOOL_PKGS),)
+deps-test:
+	@$(call deps_sh,$(DEB_PKGS),)
 
 # What `make bench-cycles` needs besides the build: Blender (Cycles) and Python 3.
 BENCH_DEB_PKGS := blender python3
 deps-bench:
-	@missing=$$(for p in $(BENCH_DEB_PKGS); do dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; done); \
-	if [ -n "$$missing" ]; then \
-	  if [ "$$(id -u)" = 0 ]; then \
-	    echo "lbk: installing missing Debian packages:" $$missing; \
-	    (apt-get update -qq || true) && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >/dev/null; \
-	  else \
-	    echo "lbk: missing Debian packages. Run as root:"; \
-	    echo "  sudo apt-get install -y" $$missing; exit 1; \
-	  fi; \
-	fi
+	@$(call deps_sh,$(BENCH_DEB_PKGS),)
 
 # ---- compile rules --------------------------------------------------------------------------
 $(BUILD)/rel/libformat/%.o: libformat/%.c
@@ -89,6 +120,12 @@ $(BUILD)/pic/libformat/%.o: libformat/%.c
 $(BUILD)/asan/libformat/%.o: libformat/%.c
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) -O1 -g $(SAN) $(WARN) $(LIB_INC) -MMD -MP -c $< -o $@
+$(BUILD)/pic/bake/%.o: bake/%.c
+	@mkdir -p $(@D)
+	$(CC) $(CSTD) $(OPT) $(WARN) -fPIC -fvisibility=hidden -DLBK_BAKE_BUILDING_SHARED $(TOOL_INC) -MMD -MP -c $< -o $@
+$(BUILD)/pic/bake/%.o: bake/%.cc
+	@mkdir -p $(@D)
+	$(CXX) -std=c++17 $(OPT) -w -fPIC -fvisibility=hidden -DLBK_BAKE_BUILDING_SHARED $(TOOL_INC) -MMD -MP -c $< -o $@
 $(BUILD)/rel/%.o: %.c
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) $(OPT) $(WARN) $(TOOL_INC) -MMD -MP -c $< -o $@
@@ -97,10 +134,10 @@ $(BUILD)/asan/%.o: %.c
 	$(CC) $(CSTD) -O1 -g $(SAN) $(WARN) $(TOOL_INC) -MMD -MP -c $< -o $@
 $(BUILD)/rel/%.o: %.cc
 	@mkdir -p $(@D)
-	$(CXX) -std=c++17 $(OPT) -w $(TOOL_INC) -MMD -MP -c $< -o $@
+	$(CXX) -std=c++17 $(OPT) $(CXXWARN) $(TOOL_CXXINC) -MMD -MP -c $< -o $@
 $(BUILD)/asan/%.o: %.cc
 	@mkdir -p $(@D)
-	$(CXX) -std=c++17 -O1 -g $(SAN) -w $(TOOL_INC) -MMD -MP -c $< -o $@
+	$(CXX) -std=c++17 -O1 -g $(SAN) $(CXXWARN) $(TOOL_CXXINC) -MMD -MP -c $< -o $@
 
 # ---- the library ----------------------------------------------------------------------------
 $(BUILD)/liblbk.a: $(LIB_OBJ)
@@ -108,14 +145,28 @@ $(BUILD)/liblbk.a: $(LIB_OBJ)
 	ar rcs $@ $^
 $(BUILD)/liblbk.so: $(LIB_PIC)
 	$(CC) -shared -Wl,-soname,liblbk.so.1 -o $@ $^ $(LIB_LIBS)
-$(BUILD)/lbk.pc: Makefile
+# The library's version, from LBK_LIBRARY_VERSION_{MAJOR,MINOR,PATCH} in lbk.h (never the format's).
+LIB_VERSION := $(shell for k in MAJOR MINOR PATCH; do sed -n "s/^\#define LBK_LIBRARY_VERSION_$$k  *\([0-9][0-9]*\).*/\1/p" libformat/include/lbk/lbk.h; done | paste -sd. -)
+$(BUILD)/lbk.pc: Makefile libformat/include/lbk/lbk.h
 	@mkdir -p $(@D)
-	@printf 'prefix=%s\nincludedir=$${prefix}/include\nlibdir=$${prefix}/lib\n\nName: lbk\nDescription: light bake kit container library\nVersion: 1.0.0\nRequires.private: libzstd libxxhash\nCflags: -I$${includedir}\nLibs: -L$${libdir} -llbk\nLibs.private: -lm\n' '$(PREFIX)' > $@
+	@printf 'prefix=%s\nincludedir=$${prefix}/include\nlibdir=$${prefix}/lib\n\nName: lbk\nDescription: light bake kit container library\nVersion: %s\nRequires.private: libzstd libxxhash\nCflags: -I$${includedir}\nLibs: -L$${libdir} -llbk\nLibs.private: -lm\n' '$(PREFIX)' '$(LIB_VERSION)' > $@
 lib: $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc
 
+# ---- the baker library (lbk/bake.h): over liblbk, with the heavy dependencies ------------------
+$(BUILD)/liblbkbake.a: $(BAKE_OBJ)
+	@rm -f $@
+	ar rcs $@ $^
+$(BUILD)/liblbkbake.so: $(BAKE_PIC) $(BUILD)/liblbk.so
+	$(CXX) -shared -Wl,-soname,liblbkbake.so.1 -Wl,--no-undefined -Wl,-rpath,'$$ORIGIN' -o $@ $(BAKE_PIC) \
+	    -L$(BUILD) -llbk $(BAKE_LIBS)
+$(BUILD)/lbk-bake.pc: Makefile
+	@mkdir -p $(@D)
+	@printf 'prefix=%s\nincludedir=$${prefix}/include\nlibdir=$${prefix}/lib\n\nName: lbk-bake\nDescription: light bake kit baker library\nVersion: 1.0.0\nRequires: lbk\nCflags: -I$${includedir}\nLibs: -L$${libdir} -llbkbake\nLibs.private: %s -lstdc++\n' '$(PREFIX)' '$(BAKE_LIBS)' > $@
+bake-lib: $(BUILD)/liblbkbake.a $(BUILD)/liblbkbake.so $(BUILD)/lbk-bake.pc
+
 # ---- the CLI --------------------------------------------------------------------------------
-$(BUILD)/lbk: $(BUILD)/rel/$(TOOL_MAIN:.c=.o) $(TOOL_OBJ) $(BUILD)/liblbk.a
-	$(CXX) -o $@ $(BUILD)/rel/$(TOOL_MAIN:.c=.o) $(TOOL_OBJ) $(BUILD)/liblbk.a $(TOOL_LIBS)
+$(BUILD)/lbk: $(BUILD)/rel/$(TOOL_MAIN:.c=.o) $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a
+	$(CXX) -o $@ $(BUILD)/rel/$(TOOL_MAIN:.c=.o) $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a $(TOOL_LIBS)
 $(BUILD)/lbk-asan: $(BUILD)/asan/$(TOOL_MAIN:.c=.o) $(TOOL_ASAN) $(LIB_ASAN)
 	$(CXX) $(SAN) -o $@ $^ $(TOOL_LIBS)
 
@@ -130,41 +181,142 @@ $(BUILD)/tests/%: $$(call test_src_of,$$*) $(TEST_SUPPORT_OBJ) $(TOOL_ASAN) $(LI
 	$(CC) $(CSTD) -O1 -g $(SAN) $(WARN) $(TOOL_INC) -Itests -c $< -o $@.o
 	$(CXX) $(SAN) -o $@ $@.o $(TEST_SUPPORT_OBJ) $(TOOL_ASAN) $(LIB_ASAN) $(TOOL_LIBS) -lcmocka
 
-# The install check: the library installed into $(BUILD)/inst, a program built against it with
-# pkg-config only, linked once with liblbk.so and once with liblbk.a.
+# The install check: the libraries installed into $(BUILD)/inst, programs built against them with
+# pkg-config only, linked once with the .so and once with the .a: install_check (liblbk) and
+# bake_check (liblbkbake: includes only lbk/bake.h, compares with the installed lbk bake).
 INST := $(abspath $(BUILD))/inst
+INST_PC := PKG_CONFIG_PATH=$(INST)/lib/pkgconfig pkg-config
 install-check: all
 	@rm -rf $(INST)
 	@$(MAKE) --no-print-directory install PREFIX=$(INST) >/dev/null
 	@mkdir -p $(BUILD)/tests
 	$(CC) $(CSTD) $(WARN) tests/install/install_check.c -o $(BUILD)/tests/install_check_shared \
-	    $$(PKG_CONFIG_PATH=$(INST)/lib/pkgconfig pkg-config --cflags --libs lbk) -Wl,-rpath,$(INST)/lib -lcmocka
+	    $$($(INST_PC) --cflags --libs lbk) -Wl,-rpath,$(INST)/lib -lcmocka
 	$(CC) $(CSTD) $(WARN) tests/install/install_check.c -o $(BUILD)/tests/install_check_static \
-	    $$(PKG_CONFIG_PATH=$(INST)/lib/pkgconfig pkg-config --cflags lbk) $(INST)/lib/liblbk.a \
-	    $$(PKG_CONFIG_PATH=$(INST)/lib/pkgconfig pkg-config --static --libs-only-other --libs-only-l lbk | sed 's/-llbk//') -lcmocka
+	    $$($(INST_PC) --cflags lbk) $(INST)/lib/liblbk.a \
+	    $$($(INST_PC) --static --libs-only-other --libs-only-l lbk | sed 's/-llbk//') -lcmocka
+	$(CC) $(CSTD) $(WARN) -DLBK_CLI='"$(INST)/bin/lbk"' tests/install/bake_check.c -o $(BUILD)/tests/bake_check_shared \
+	    $$($(INST_PC) --cflags --libs lbk-bake) -Wl,-rpath,$(INST)/lib -lcmocka
+	$(CC) $(CSTD) $(WARN) -DLBK_CLI='"$(INST)/bin/lbk"' tests/install/bake_check.c -o $(BUILD)/tests/bake_check_static \
+	    $$($(INST_PC) --cflags lbk-bake) $(INST)/lib/liblbkbake.a $(INST)/lib/liblbk.a \
+	    $$($(INST_PC) --static --libs-only-other --libs-only-l lbk-bake | sed 's/-llbkbake//; s/-llbk\b//') -lcmocka
 
-test: deps
-	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BUILD)/lbk-asan $(TESTS:%=$(BUILD)/tests/%) $(BUILD)/fuzz_container install-check
-	@LBK=$(BUILD)/lbk-asan BUILD=$(BUILD) FUZZ=$(BUILD)/fuzz_container sh tests/run.sh $(TESTS) install_check_shared install_check_static
+# The Khronos glTF-Validator (npm package, runs under node) for the `lbk export --gltf` check of
+# tests/tools/gltf_validator.sh, installed into the build folder at a pinned version. Without npm
+# (and not root to install it) the check is reported SKIPPED.
+GLTF_VALIDATOR_VERSION := 2.0.0-dev.3.10
+GLTF_VALIDATOR := $(BUILD)/npm/node_modules/gltf-validator
+$(GLTF_VALIDATOR)/package.json:
+	@mkdir -p $(BUILD)/npm
+	npm install --prefix $(BUILD)/npm --no-audit --no-fund --loglevel=error gltf-validator@$(GLTF_VALIDATOR_VERSION)
+gltf-validator:
+	@if ! command -v npm >/dev/null 2>&1 && [ "$$(id -u)" = 0 ]; then \
+	  echo "lbk: installing npm (for the glTF-Validator check)"; \
+	  (apt-get update -qq || true) && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq npm >/dev/null || true; \
+	fi
+	@if command -v npm >/dev/null 2>&1 && command -v node >/dev/null 2>&1; then \
+	  $(MAKE) --no-print-directory $(GLTF_VALIDATOR)/package.json; \
+	else echo "lbk: npm/node not found: the glTF-Validator check will be SKIPPED (apt-get install npm)"; fi
+
+test: deps-test
+	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BUILD)/lbk-asan $(TESTS:%=$(BUILD)/tests/%) $(BUILD)/fuzz_container \
+	    install-check install-lib-check $(TSAN_TESTS:%=$(BUILD)/tsan/bin/%)
+	@$(MAKE) --no-print-directory gltf-validator
+	@LBK=$(BUILD)/lbk-asan BUILD=$(BUILD) FUZZ=$(BUILD)/fuzz_container TSAN_BIN=$(BUILD)/tsan/bin \
+	  GLTF_VALIDATOR=$$(test -f $(GLTF_VALIDATOR)/package.json && echo $(GLTF_VALIDATOR)) \
+	  sh tests/run.sh $(TESTS) install_check_shared install_check_static install_lib_check \
+	    bake_check_shared bake_check_static
 check: test
+
+# ---- ThreadSanitizer: the determinism cases of tests/tsan/determinism.list -------------------
+# Their own objects under $(BUILD)/tsan (TSan cannot be mixed with ASan). Embree's internal
+# threads are not instrumented: tests/tsan/suppressions.txt silences reports inside Embree and
+# TBB only, never in lbk code.
+.PHONY: tsan
+TSAN      := -fsanitize=thread -fno-omit-frame-pointer
+TSAN_TESTS := $(sort $(shell sed -n 's/^\(test_[a-z0-9_]*\).*/\1/p' tests/tsan/determinism.list))
+LIB_TSAN  := $(LIB_SRC:%.c=$(BUILD)/tsan/%.o)
+TOOL_TSAN := $(filter-out $(BUILD)/tsan/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUILD)/tsan/%.o)) $(TOOL_CXXSRC:%.cc=$(BUILD)/tsan/%.o)
+TEST_SUPPORT_TSAN := $(TEST_SUPPORT:%.c=$(BUILD)/tsan/%.o) $(BUILD)/tsan/tests/tsan/case_filter.o
+$(TEST_SUPPORT_TSAN): TOOL_INC += -Itests
+# only pattern rules name them: keep make from deleting them as intermediates
+.SECONDARY: $(LIB_TSAN) $(TOOL_TSAN)
+$(BUILD)/tsan/libformat/%.o: libformat/%.c
+	@mkdir -p $(@D)
+	$(CC) $(CSTD) -O1 -g $(TSAN) $(WARN) $(LIB_INC) -MMD -MP -c $< -o $@
+$(BUILD)/tsan/%.o: %.c
+	@mkdir -p $(@D)
+	$(CC) $(CSTD) -O1 -g $(TSAN) $(WARN) $(TOOL_INC) -MMD -MP -c $< -o $@
+$(BUILD)/tsan/%.o: %.cc
+	@mkdir -p $(@D)
+	$(CXX) -std=c++17 -O1 -g $(TSAN) $(CXXWARN) $(TOOL_CXXINC) -MMD -MP -c $< -o $@
+$(BUILD)/tsan/bin/%: $$(call test_src_of,$$*) $(TEST_SUPPORT_TSAN) $(TOOL_TSAN) $(LIB_TSAN)
+	@mkdir -p $(@D)
+	$(CC) $(CSTD) -O1 -g $(TSAN) $(WARN) $(TOOL_INC) -Itests -c $< -o $@.o
+	$(CXX) $(TSAN) -o $@ $@.o $(TEST_SUPPORT_TSAN) $(TOOL_TSAN) $(LIB_TSAN) $(TOOL_LIBS) -lcmocka \
+	    -Wl,--wrap=_cmocka_run_group_tests
+tsan: deps-test
+	@$(MAKE) --no-print-directory $(TSAN_TESTS:%=$(BUILD)/tsan/bin/%)
+	@BUILD=$(BUILD) TSAN_BIN=$(BUILD)/tsan/bin sh tests/run.sh
+
+# ---- liblbk alone: zstd, xxHash and a C compiler, nothing else -----------------------------
+# install-lib builds and installs only the container library (static, shared, headers, lbk.pc).
+# install-lib-check installs it into a throwaway DESTDIR from a build folder of its own, checks
+# that nothing but libformat was compiled and that liblbk.so needs only zstd, xxHash and libc/libm,
+# and builds tests/install/install_check.c against the staged copy (run by tests/run.sh).
+.PHONY: install-lib install-lib-check
+install-lib: $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc
+	install -d $(DESTDIR)$(PREFIX)/lib/pkgconfig $(DESTDIR)$(PREFIX)/include/lbk
+	install -m 644 $(BUILD)/liblbk.a $(DESTDIR)$(PREFIX)/lib/liblbk.a
+	install -m 755 $(BUILD)/liblbk.so $(DESTDIR)$(PREFIX)/lib/liblbk.so.1
+	ln -sf liblbk.so.1 $(DESTDIR)$(PREFIX)/lib/liblbk.so
+	install -m 644 libformat/include/lbk/*.h $(DESTDIR)$(PREFIX)/include/lbk/
+	sed 's|^prefix=.*|prefix=$(PREFIX)|' $(BUILD)/lbk.pc > $(DESTDIR)$(PREFIX)/lib/pkgconfig/lbk.pc
+LIBONLY := $(BUILD)/lib-only
+LIBSTAGE := $(abspath $(LIBONLY))/stage
+LIBPC = PKG_CONFIG_PATH=$(LIBSTAGE)/opt/lbk/lib/pkgconfig pkg-config --define-variable=prefix=$(LIBSTAGE)/opt/lbk
+install-lib-check:
+	@rm -rf $(LIBSTAGE) && mkdir -p $(BUILD)/tests
+	@$(MAKE) --no-print-directory install-lib BUILD=$(LIBONLY) PREFIX=/opt/lbk DESTDIR=$(LIBSTAGE) >/dev/null
+	@built=$$(cd $(LIBONLY) && find . -name '*.o' ! -path './*/libformat/*'); \
+	  if [ -n "$$built" ]; then echo "install-lib compiled more than libformat:" $$built; exit 1; fi
+	@needed=$$(readelf -d $(LIBSTAGE)/opt/lbk/lib/liblbk.so.1 | sed -n 's/.*Shared library: \[\(.*\)\]/\1/p' | sort | tr '\n' ' '); \
+	  case "$$needed" in "libc.so.6 libm.so.6 libxxhash.so.0 libzstd.so.1 ") ;; \
+	  *) echo "liblbk.so needs more than zstd, xxHash, libc and libm: $$needed"; exit 1;; esac
+	$(CC) $(CSTD) $(WARN) tests/install/install_check.c -o $(BUILD)/tests/install_lib_check \
+	    $$($(LIBPC) --cflags lbk) $(LIBSTAGE)/opt/lbk/lib/liblbk.a \
+	    $$($(LIBPC) --static --libs-only-other --libs-only-l lbk | sed 's/-llbk//') -lcmocka
 
 # ---- fuzzing (clang libFuzzer) --------------------------------------------------------------
 FUZZ_FLAGS := -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined -g -O1
 $(BUILD)/fuzz_container: tests/fuzz/fuzz_container.c $(LIB_SRC)
 	@mkdir -p $(@D)
-	$(CLANG) $(CSTD) $(FUZZ_FLAGS) $(LIB_INC) -o $@ $^ $(LIB_LIBS)
-fuzz: deps $(BUILD)/fuzz_container
+	$(CLANG) $(CSTD) $(FUZZ_FLAGS) $(WARN) $(LIB_INC) -o $@ $^ $(LIB_LIBS)
+# The seed corpus (tests/fuzz/README.md): the golden files, the containers make_corpus.c builds
+# (every section type) and two small real bakes. Regenerate by hand; the files are committed.
+.PHONY: fuzz-corpus
+fuzz-corpus: $(BUILD)/liblbk.a $(BUILD)/lbk
+	$(CC) $(CSTD) -O1 $(WARN) $(LIB_INC) tests/fuzz/make_corpus.c $(BUILD)/liblbk.a $(LIB_LIBS) -o $(BUILD)/make_corpus
+	cp tests/golden/*.lbk tests/fuzz/corpus/
+	$(BUILD)/make_corpus
+	$(BUILD)/lbk bake tests/fuzz/sets_scene.gltf -o tests/fuzz/corpus/bake_sets.lbk -q --threads 2 \
+	    --texel-density 2 --samples 8 --glg-spacing 3 --octahedral
+	$(BUILD)/lbk bake scenes/cornell_box/CornellBox-Original.gltf -o tests/fuzz/corpus/bake_cornell.lbk -q --threads 2 \
+	    --texel-density 2 --samples 8 --glg-spacing 2.5 --octahedral
+fuzz: deps-test
+	@$(MAKE) --no-print-directory $(BUILD)/fuzz_container
 	@mkdir -p $(BUILD)/fuzz-corpus
-	$(BUILD)/fuzz_container -max_total_time=$${FUZZ_SECONDS:-60} $(BUILD)/fuzz-corpus tests/fuzz/corpus
+	$(BUILD)/fuzz_container -max_total_time=$${FUZZ_SECONDS:-60} -max_len=65536 $(BUILD)/fuzz-corpus tests/fuzz/corpus
 
 # ---- benchmarks -----------------------------------------------------------------------------
-$(BUILD)/bench/%: bench/%.c $(TOOL_OBJ) $(BUILD)/liblbk.a
+$(BUILD)/bench/%: bench/%.c $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) -O2 -g $(WARN) $(TOOL_INC) -c $< -o $@.o
-	$(CXX) -o $@ $@.o $(TOOL_OBJ) $(BUILD)/liblbk.a $(TOOL_LIBS)
-bench: deps deps-bench
+	$(CXX) -o $@ $@.o $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a $(TOOL_LIBS)
+bench: deps-tools deps-bench
 	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BENCHES:%=$(BUILD)/bench/%)
 	@for b in $(BENCHES); do echo "== $$b"; $(BUILD)/bench/$$b || exit 1; done
+	@echo "== blender_import"; sh bench/blender_import.sh $(BUILD)/lbk $(BUILD)/bench-blender
 	@echo "== bench-cycles"; $(MAKE) --no-print-directory bench-cycles
 
 # lbk against Cycles (bench/cycles/README.md). LBK_TREE=/path/to/other/checkout compares that
@@ -176,20 +328,20 @@ CYC_DUMP := $(BUILD)/bench/cycles/texel_dump-tree
 $(CYC_DUMP): bench/cycles/texel_dump.c FORCE
 	@$(MAKE) --no-print-directory -C $(LBK_TREE) $(BUILD)/lbk
 	@mkdir -p $(@D)
-	$(CC) $(CSTD) -O2 -g $(WARN) -I$(LBK_TREE)/libformat/include -I$(LBK_TREE) -I/usr/include/draco -I/usr/include/stb \
-	    -c $< -o $@.o
+	$(CC) $(CSTD) -O2 -g $(WARN) -I$(LBK_TREE)/libformat/include -I$(LBK_TREE)/bake/include -I$(LBK_TREE) \
+	    -I/usr/include/draco -I/usr/include/stb -c $< -o $@.o
 	$(CXX) -o $@ $@.o $$(ls $(LBK_TREE)/$(BUILD)/rel/bake/*/*.o | sort) $(LBK_TREE)/$(BUILD)/liblbk.a $(TOOL_LIBS)
 FORCE:
 else
 CYC_LBK  ?= $(BUILD)/lbk
 CYC_DUMP ?= $(BUILD)/bench/cycles/texel_dump
 endif
-bench-cycles: deps deps-bench
+bench-cycles: deps-tools deps-bench
 	@$(MAKE) --no-print-directory $(if $(LBK_TREE),,$(BUILD)/lbk) $(CYC_DUMP)
 	@LBK=$${LBK:-$(CYC_LBK)} LBK_TEXEL_DUMP=$${LBK_TEXEL_DUMP:-$(CYC_DUMP)} python3 bench/cycles/run.py
 
 # ---- demo -----------------------------------------------------------------------------------
-demo: deps
+demo: deps-tools
 	@$(MAKE) --no-print-directory $(BUILD)/lbk
 	@sh scenes/demo.sh $(BUILD)
 
@@ -202,6 +354,11 @@ install: all
 	ln -sf liblbk.so.1 $(DESTDIR)$(PREFIX)/lib/liblbk.so
 	install -m 644 libformat/include/lbk/*.h $(DESTDIR)$(PREFIX)/include/lbk/
 	sed 's|^prefix=.*|prefix=$(PREFIX)|' $(BUILD)/lbk.pc > $(DESTDIR)$(PREFIX)/lib/pkgconfig/lbk.pc
+	install -m 644 $(BUILD)/liblbkbake.a $(DESTDIR)$(PREFIX)/lib/liblbkbake.a
+	install -m 755 $(BUILD)/liblbkbake.so $(DESTDIR)$(PREFIX)/lib/liblbkbake.so.1
+	ln -sf liblbkbake.so.1 $(DESTDIR)$(PREFIX)/lib/liblbkbake.so
+	install -m 644 bake/include/lbk/*.h $(DESTDIR)$(PREFIX)/include/lbk/
+	sed 's|^prefix=.*|prefix=$(PREFIX)|' $(BUILD)/lbk-bake.pc > $(DESTDIR)$(PREFIX)/lib/pkgconfig/lbk-bake.pc
 	install -d $(DESTDIR)$(PREFIX)/share/lbk/profiles
 	install -m 644 tools/convert/profiles/*.profile $(DESTDIR)$(PREFIX)/share/lbk/profiles/
 

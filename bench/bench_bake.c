@@ -14,10 +14,12 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "bake/pipeline/bake.h"
+#include "lbk/bake.h"
+#include "bake/util/parallel.h"
 #include "lbk/container.h"
 #include "lbk/lightmap.h"
 #include "lbk/pixel.h"
+#include "tests/support/bake_file.c"
 
 static const char *scenes_dir(void)
 {
@@ -57,11 +59,11 @@ static int load_texels(const char *path, texels *t)
             for (uint64_t i = 0; i < v.texel_count; i++) {
                 lbk_ahd_texel tx;
                 float rgb[3];
-                if (lbk_lmap_texel(&v, i, &tx, NULL)) {
+                if (lbk_lmap_texel_get(&v, i, &tx, NULL)) {
                     rc = -1;
                     break;
                 }
-                lbk_unpack_r11g11b10f(tx.irradiance_z, rgb);
+                lbk_r11g11b10f_unpack(tx.irradiance_z, rgb);
                 t->lum[i] = lum(rgb);
             }
         }
@@ -84,27 +86,25 @@ static double rel_rmse(const texels *x, const texels *ref)
     return v2 > 0 ? sqrt(d2 / v2) : NAN;
 }
 
-static void base_options(bk_bake_options *o, const char *in, const char *out, const char *sky)
+static void base_options(tb_job *o, const char *in, const char *out, const char *sky)
 {
     memset(o, 0, sizeof *o);
-    o->input = in;
-    o->output = out;
-    o->preset = "fast";
-    o->seed = 1;
-    o->target_error = 1e-6; /* the sample budget decides */
+    o->in = in;
+    o->out = out;
+    o->d.preset = LBK_BAKE_PRESET_FAST;
+    o->d.seed = 1;
+    o->d.target_error = 1e-6; /* the sample budget decides */
     if (sky) {
-        o->sky_set = 1;
-        sscanf(sky, "%f,%f,%f", &o->sky[0], &o->sky[1], &o->sky[2]);
+        o->d.sky_override = 1;
+        sscanf(sky, "%f,%f,%f", &o->d.sky[0], &o->d.sky[1], &o->d.sky[2]);
     }
 }
 
-static int bake(const bk_bake_options *o, bk_bake_summary *sum)
+static int bake(const tb_job *o, lbk_bake_report *sum)
 {
-    bk_progress p;
-    bk_progress_init(&p, 1);
     char err[512] = "";
-    int rc = bk_bake(o, &p, sum, err, sizeof err);
-    if (rc) fprintf(stderr, "bench_bake: %s: %s\n", o->input, err);
+    int rc = tb_bake(o, sum, err, sizeof err);
+    if (rc) fprintf(stderr, "bench_bake: %s: %s\n", o->in, err);
     return rc;
 }
 
@@ -119,10 +119,10 @@ static void error_vs_time(const char *label, const char *rel, const char *sky, i
     }
     snprintf(ref_out, sizeof ref_out, "%s/ref.lbk", tmpdir);
     snprintf(out, sizeof out, "%s/run.lbk", tmpdir);
-    bk_bake_options o;
+    tb_job o;
     base_options(&o, in, ref_out, sky);
-    o.max_samples = ref_samples;
-    bk_bake_summary ref_sum;
+    o.d.max_samples = ref_samples;
+    lbk_bake_report ref_sum;
     if (bake(&o, &ref_sum)) return;
     texels ref;
     if (load_texels(ref_out, &ref)) {
@@ -130,31 +130,31 @@ static void error_vs_time(const char *label, const char *rel, const char *sky, i
         return;
     }
     printf("%s: reference %d samples/receiver budget, %.1f s, %llu texels, est. error %.2f%%\n", label, ref_samples,
-           ref_sum.seconds, (unsigned long long)ref_sum.texels, 100 * ref_sum.final_error);
+           ref_sum.seconds, (unsigned long long)ref_sum.counts.texels, 100 * ref_sum.transport.est_rel_rmse);
     printf("  %8s %9s %10s %10s %10s %8s\n", "samples", "seconds", "estimated", "measured", "meas.-ref", "est/meas");
     for (int i = 0; i < nb; i++) {
-        o.output = out;
-        o.max_samples = budgets[i];
-        bk_bake_summary sum;
+        o.out = out;
+        o.d.max_samples = budgets[i];
+        lbk_bake_report sum;
         if (bake(&o, &sum)) break;
         texels t;
         if (load_texels(out, &t)) break;
         double m = rel_rmse(&t, &ref);
         /* the reference's own noise is independent of this bake's: remove it in quadrature */
-        double mc = sqrt(fmax(m * m - ref_sum.final_error * ref_sum.final_error, 0));
-        printf("  %8d %9.2f %9.2f%% %9.2f%% %9.2f%% %8.2f\n", budgets[i], sum.seconds, 100 * sum.final_error, 100 * m,
-               100 * mc, sum.final_error / m);
+        double mc = sqrt(fmax(m * m - ref_sum.transport.est_rel_rmse * ref_sum.transport.est_rel_rmse, 0));
+        printf("  %8d %9.2f %9.2f%% %9.2f%% %9.2f%% %8.2f\n", budgets[i], sum.seconds, 100 * sum.transport.est_rel_rmse, 100 * m,
+               100 * mc, sum.transport.est_rel_rmse / m);
         free(t.lum);
     }
     /* and a wall-clock budget, the way artists use it */
-    o.max_samples = ref_samples;
-    o.time_limit = quick() ? 0.5 : 2;
-    bk_bake_summary sum;
+    o.d.max_samples = ref_samples;
+    o.d.time_limit = quick() ? 0.5 : 2;
+    lbk_bake_report sum;
     texels t;
     if (!bake(&o, &sum) && !load_texels(out, &t)) {
         double m = rel_rmse(&t, &ref);
-        printf("  --time-limit %.1f: %.2f s total, estimated %.2f%%, measured %.2f%%, ratio %.2f\n", o.time_limit,
-               sum.seconds, 100 * sum.final_error, 100 * m, sum.final_error / m);
+        printf("  --time-limit %.1f: %.2f s total, estimated %.2f%%, measured %.2f%%, ratio %.2f\n", o.d.time_limit,
+               sum.seconds, 100 * sum.transport.est_rel_rmse, 100 * m, sum.transport.est_rel_rmse / m);
         free(t.lum);
     }
     free(ref.lum);
@@ -169,16 +169,16 @@ static void wall_time(const char *preset)
         return;
     }
     snprintf(out, sizeof out, "%s/rwd_%s.lbk", tmpdir, preset);
-    bk_bake_options o;
+    tb_job o;
     base_options(&o, in, out, "1,1,1");
-    o.preset = preset;
-    o.target_error = -1; /* the preset's own stop rules */
-    bk_bake_summary sum;
+    o.d.preset = strcmp(preset, "high") ? LBK_BAKE_PRESET_FAST : LBK_BAKE_PRESET_HIGH;
+    o.d.target_error = -1; /* the preset's own stop rules */
+    lbk_bake_report sum;
     if (bake(&o, &sum)) return;
     printf("room_with_doors --preset %-4s: %6.1f s wall (all cores), est. error %.2f%%, %llu texels, %llu GLG + "
            "%llu LLG probes, %llu bytes%s\n",
-           preset, sum.seconds, 100 * sum.final_error, (unsigned long long)sum.texels,
-           (unsigned long long)sum.glg_probes, (unsigned long long)sum.llg_probes, (unsigned long long)sum.file_bytes,
+           preset, sum.seconds, 100 * sum.transport.est_rel_rmse, (unsigned long long)sum.counts.texels,
+           (unsigned long long)sum.counts.glg_probes, (unsigned long long)sum.counts.llg_probes, (unsigned long long)sum.counts.file_bytes,
            !strcmp(preset, "fast") ? (sum.seconds <= 60 ? "  [goal <= 60 s: met]" : "  [goal <= 60 s: MISSED]") : "");
 }
 
@@ -189,14 +189,14 @@ int main(void)
     char cmd[300];
     snprintf(cmd, sizeof cmd, "mkdir -p %s", tmpdir);
     if (system(cmd)) return 1;
-    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    int cores = bk_online_cores();
     double load[1] = {0};
     FILE *f = fopen("/proc/loadavg", "r");
     if (f) {
         if (fscanf(f, "%lf", &load[0]) != 1) load[0] = 0;
         fclose(f);
     }
-    printf("bench_bake: %ld cores online, load average %.2f%s\n", cores, load[0], quick() ? " (quick)" : "");
+    printf("bench_bake: %d cores online, load average %.2f%s\n", cores, load[0], quick() ? " (quick)" : "");
 
     /* Pass p traces 32·2^p rays per receiver (both halves), so P passes cost 32·(2^P − 1): the
      * budgets below stop after exactly 1, 2, 3, … passes. */

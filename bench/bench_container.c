@@ -6,7 +6,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "lbk/container.h"
 #include "lbk/lightmap.h"
@@ -16,12 +15,7 @@
 #include "lbk/report.h"
 #include "lbk/validate.h"
 
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
+#include "bake/util/clock.h"
 
 static uint32_t rng_state = 12345;
 static uint32_t rnd(void)
@@ -60,7 +54,7 @@ static void build_lmap(uint32_t pages, uint32_t side, void **out, size_t *size)
     fill_texels(t, side, side);
     lbk_lmap_page_desc *p = malloc(sizeof *p * pages);
     for (uint32_t i = 0; i < pages; i++) p[i] = (lbk_lmap_page_desc){side, side, t};
-    CHECK(lbk_lmap_build(p, pages, 0, NULL, out, size));
+    CHECK(lbk_lmap_build(&(lbk_lmap_build_desc){.pages = p, .page_count = pages}, NULL, out, size));
     free(p);
     free(t);
 }
@@ -78,7 +72,8 @@ static void build_small_sections(uint32_t objects, void **meta, size_t *meta_n, 
     for (int i = 0; i < 16; i++)
         rec[i] = (lbk_report_record){0, (uint64_t)(i + 1) << 24, (uint32_t)(i + 1) * 16, 3, 0.5f / (float)(i + 1),
                                      0.4f / (float)(i + 1)};
-    lbk_report rep = {LBK_BAKE_TARGET_REACHED, 0, 1024, 0, 0.04f, rec, 16};
+    lbk_report rep = {.status = LBK_BAKE_TARGET_REACHED, .max_samples_per_texel = 1024, .target_rel_rmse = 0.04f,
+        .records = rec, .record_count = 16};
     CHECK(lbk_report_build(&rep, NULL, rept, rept_n));
     lbk_object *o = calloc(objects, sizeof *o);
     char (*names)[32] = calloc(objects, 32);
@@ -112,11 +107,11 @@ static int count_issues(void *user, const lbk_issue *issue)
 /* validate, then open + decode every section; returns total seconds, *validate_s the first part. */
 static double load_once(const void *file, size_t size, unsigned *issues, double *validate_s)
 {
-    double t0 = now();
+    double t0 = bk_now();
     lbk_validate_summary s;
     *issues = 0;
     CHECK(lbk_validate_memory(file, size, NULL, count_issues, issues, &s));
-    *validate_s = now() - t0;
+    *validate_s = bk_now() - t0;
     lbk_reader *r;
     CHECK(lbk_reader_open_memory(file, size, NULL, &r));
     volatile uint8_t sink = 0;
@@ -128,16 +123,16 @@ static double load_once(const void *file, size_t size, unsigned *issues, double 
     }
     lbk_reader_close(r);
     (void)sink;
-    return now() - t0;
+    return bk_now() - t0;
 }
 
 static double memcpy_once(void *dst, const void *src, size_t n)
 {
-    double t0 = now();
+    double t0 = bk_now();
     memcpy(dst, src, n);
     volatile uint8_t sink = ((uint8_t *)dst)[n / 2];
     (void)sink;
-    return now() - t0;
+    return bk_now() - t0;
 }
 
 static void throughput(void)
@@ -152,16 +147,17 @@ static void throughput(void)
            "ratio", "issues");
     for (int zstd = 0; zstd < 2; zstd++) {
         lbk_writer *w;
-        CHECK(lbk_writer_create(NULL, &w));
-        lbk_section_options o = {LBK_SECTION_FLAG_REQUIRED, zstd ? LBK_COMPRESSION_ZSTD : 0, 3};
-        CHECK(lbk_writer_add_section(w, LBK_SECTION_META, meta, meta_n, NULL));
-        CHECK(lbk_writer_add_section(w, LBK_SECTION_REPT, rept, rept_n, NULL));
-        CHECK(lbk_writer_add_section(w, LBK_SECTION_OBJS, objs, objs_n, &o));
-        CHECK(lbk_writer_add_section(w, LBK_SECTION_LMAP, lmap, lmap_n, &o));
+        CHECK(lbk_writer_open(NULL, &w));
+        lbk_section_options o = {.flags = LBK_SECTION_FLAG_REQUIRED, .compression = zstd ? LBK_COMPRESSION_ZSTD : 0,
+            .zstd_level = 3};
+        CHECK(lbk_writer_section_add(w, LBK_SECTION_META, meta, meta_n, NULL));
+        CHECK(lbk_writer_section_add(w, LBK_SECTION_REPT, rept, rept_n, NULL));
+        CHECK(lbk_writer_section_add(w, LBK_SECTION_OBJS, objs, objs_n, &o));
+        CHECK(lbk_writer_section_add(w, LBK_SECTION_LMAP, lmap, lmap_n, &o));
         void *file;
         size_t size;
         CHECK(lbk_writer_to_memory(w, &file, &size));
-        lbk_writer_destroy(w);
+        lbk_writer_close(w);
         size_t decoded = meta_n + rept_n + objs_n + lmap_n;
         void *dst = malloc(decoded);
         memset(dst, 1, decoded);
@@ -197,18 +193,18 @@ static void overhead_row(const char *label, void *lmap, size_t lmap_n, void *llg
     size_t meta_n = 0, rept_n = 0, objs_n = 0;
     if (objects) build_small_sections(objects, &meta, &meta_n, &rept, &rept_n, &objs, &objs_n, grids, chart, per_row);
     lbk_writer *w;
-    CHECK(lbk_writer_create(NULL, &w));
-    CHECK(lbk_writer_add_section(w, LBK_SECTION_LMAP, lmap, lmap_n, NULL));
-    CHECK(lbk_writer_add_section(w, LBK_SECTION_LLG, llg, llg_n, NULL));
+    CHECK(lbk_writer_open(NULL, &w));
+    CHECK(lbk_writer_section_add(w, LBK_SECTION_LMAP, lmap, lmap_n, NULL));
+    CHECK(lbk_writer_section_add(w, LBK_SECTION_LLG, llg, llg_n, NULL));
     if (objects) {
-        CHECK(lbk_writer_add_section(w, LBK_SECTION_META, meta, meta_n, NULL));
-        CHECK(lbk_writer_add_section(w, LBK_SECTION_REPT, rept, rept_n, NULL));
-        CHECK(lbk_writer_add_section(w, LBK_SECTION_OBJS, objs, objs_n, NULL));
+        CHECK(lbk_writer_section_add(w, LBK_SECTION_META, meta, meta_n, NULL));
+        CHECK(lbk_writer_section_add(w, LBK_SECTION_REPT, rept, rept_n, NULL));
+        CHECK(lbk_writer_section_add(w, LBK_SECTION_OBJS, objs, objs_n, NULL));
     }
     void *file;
     size_t size;
     CHECK(lbk_writer_to_memory(w, &file, &size));
-    lbk_writer_destroy(w);
+    lbk_writer_close(w);
     lbk_validate_summary s;
     CHECK(lbk_validate_memory(file, size, NULL, NULL, NULL, &s));
     const uint64_t payload = texels * 8 + probe_count * 28;
@@ -241,7 +237,7 @@ static void overhead(void)
     for (int i = 0; i < GRIDS; i++)
         g[i] = (lbk_llg_grid_desc){{(float)i, 0, 0}, {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {1, 1, 1},
                                    {DIM, DIM, DIM}, probes, NULL, 0};
-    CHECK(lbk_llg_build(g, GRIDS, 0, NULL, &llg, &llg_n));
+    CHECK(lbk_llg_build(&(lbk_llg_build_desc){.grids = g, .grid_count = GRIDS}, NULL, &llg, &llg_n));
     free(probes);
     const uint64_t texels = 1024 * 1024, probe_count = GRIDS * DIM * DIM * DIM;
     printf("overhead: 1,048,576 texels (8 B each) + %llu SH9 probes (28 B each) = %.3f MB of payload\n",

@@ -4,25 +4,22 @@
  * the clustered layout against its payload. Synthetic level at about the size of the seed's
  * ESTATE: 1M texels, 50k GLG and 20k LLG probes, 64 light sets with local footprints plus a
  * dense region where up to 16 sets overlap. */
+#define LBK_STATIC_LINKING_ONLY /* lbk_dls_stats: experimental (lbk/dls.h) */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "lbk/ahd.h"
 #include "lbk/dls.h"
 #include "lbk/sh.h"
 
+#include "bake/util/clock.h"
+#include "bake/util/rng.h"
+
 #define NSETS 64
 
-static uint64_t rng_next(uint64_t *s)
-{
-    uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
+static uint64_t rng_next(uint64_t *s) { return bk_mix64(*s += BK_GOLDEN64); } /* splitmix64 */
 static float uni(uint64_t *s) { return (float)(rng_next(s) >> 40) / 16777216.0f; }
 
 static void random_texel(uint64_t *rng, float scale, uint8_t out[8])
@@ -36,7 +33,7 @@ static void random_texel(uint64_t *rng, float scale, uint8_t out[8])
     lbk_ahd_linear_add_light(&lin, dir, rgb);
     lbk_ahd_texel t;
     lbk_ahd_from_linear(&lin, &t);
-    lbk_ahd_texel_store(&t, out);
+    lbk_ahd_texel_pack(&t, out);
 }
 
 static void random_probe(uint64_t *rng, float scale, uint8_t out[28])
@@ -49,13 +46,6 @@ static void random_probe(uint64_t *rng, float scale, uint8_t out[28])
         lbk_sh9_add_sample(&sh, d, rgb, 3.14159265f);
     }
     lbk_sh9_pack(&sh, out);
-}
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 /* ---- naive per-target gather ---------------------------------------------------------------- */
@@ -138,7 +128,7 @@ static void naive_texels(const naive *nv, const float *w, const uint32_t *bz, co
             float wj = w[p[0]];
             if (wj == 0.0f) continue;
             lbk_ahd_texel e;
-            lbk_ahd_texel_load(p + 1, &e);
+            lbk_ahd_texel_unpack(p + 1, &e);
             lbk_ahd_to_linear(&e, &l);
             lbk_ahd_linear_add_scaled(&acc, &l, wj);
         }
@@ -214,19 +204,19 @@ int main(void)
             payload_total += len;
         }
     }
-    lbk_dls_build_desc desc = {NSETS, sets, {T, G, L}};
+    lbk_dls_build_desc desc = {.set_count = NSETS, .sets = sets, .target_count = {T, G, L}};
     void *bytes;
     size_t size;
     lbk_dls_stats st;
-    double t0 = now();
+    double t0 = bk_now();
     lbk_result r = lbk_dls_build(&desc, NULL, &bytes, &size, &st);
-    double t_build = now() - t0;
+    double t_build = bk_now() - t0;
     if (r != LBK_OK) {
         fprintf(stderr, "build failed: %s\n", lbk_result_name(r));
         return 1;
     }
     lbk_dls_view *v;
-    lbk_dls_view_open(bytes, size, NULL, &v);
+    lbk_dls_open(bytes, size, NULL, &v);
     printf("level: %llu texels, %llu GLG, %llu LLG probes, %d sets, %llu entries; build %.2f s\n",
            (unsigned long long)T, (unsigned long long)G, (unsigned long long)L, NSETS, (unsigned long long)payload_total, t_build);
     printf("clusters: %u (dedicated %u, packed %u with %u sub-groups, prefix-2 %u, prefix-3 %u, prefix-8 %u)\n", st.cluster_count,
@@ -249,7 +239,7 @@ int main(void)
         uint8_t b[8];
         random_texel(&rng, 1.0f, b);
         lbk_ahd_texel tx;
-        lbk_ahd_texel_load(b, &tx);
+        lbk_ahd_texel_unpack(b, &tx);
         bz[t] = tx.irradiance_z;
         memcpy(brgba + 4 * t, tx.rgba, 4);
     }
@@ -258,7 +248,7 @@ int main(void)
     lbk_dls_runtime_desc rd = {.dls = v, .base_irradiance_z = bz, .base_rgba = brgba, .base_glg = bg, .base_llg = bl,
                                .out_irradiance_z = oz, .out_rgba = orgba, .out_glg = og, .out_llg = ol};
     lbk_dls_runtime *rt;
-    if (lbk_dls_runtime_create(&rd, &rt) != LBK_OK) return 1;
+    if (lbk_dls_runtime_open(&rd, &rt) != LBK_OK) return 1;
     naive nv[3];
     for (uint32_t sp = 0; sp < 3; sp++) naive_build(&nv[sp], v, sp);
     uint64_t naive_index = 0;
@@ -274,12 +264,12 @@ int main(void)
     /* memcpy of the output bytes */
     double best_copy = 1e9;
     for (int i = 0; i < reps; i++) {
-        t0 = now();
+        t0 = bk_now();
         memcpy(oz, bz, T * 4);
         memcpy(orgba, brgba, T * 4);
         memcpy(og, bg, G * 28);
         memcpy(ol, bl, L * 28);
-        double dt = now() - t0;
+        double dt = bk_now() - t0;
         if (dt < best_copy) best_copy = dt;
     }
 
@@ -304,23 +294,23 @@ int main(void)
             } else {
                 lbk_dls_apply(rt, NULL, NULL, NULL); /* previous frame: everything off */
             }
-            t0 = now();
+            t0 = bk_now();
             lbk_dls_apply(rt, w2, NULL, NULL);
-            double dt = now() - t0;
+            double dt = bk_now() - t0;
             if (dt < best_rt) best_rt = dt;
-            t0 = now();
+            t0 = bk_now();
             naive_texels(&nv[0], w2, bz, brgba, nz, nrgba);
             naive_probes(&nv[1], w2, bg, ng);
             naive_probes(&nv[2], w2, bl, nl);
-            dt = now() - t0;
+            dt = bk_now() - t0;
             if (dt < best_nv) best_nv = dt;
         }
         int same = !memcmp(oz, nz, T * 4) && !memcmp(orgba, nrgba, T * 4) && !memcmp(og, ng, G * 28) && !memcmp(ol, nl, L * 28);
         printf("%s:\n  clustered %.3f ms, naive gather %.3f ms: %.1fx faster; clustered at %.3f of memcpy speed%s\n", scen[sc].name,
                best_rt * 1e3, best_nv * 1e3, best_nv / best_rt, best_copy / best_rt, same ? "" : " (OUTPUTS DIFFER)");
     }
-    lbk_dls_runtime_destroy(rt);
-    lbk_dls_view_close(v);
+    lbk_dls_runtime_close(rt);
+    lbk_dls_close(v);
     free(bytes);
     for (uint32_t sp = 0; sp < 3; sp++) free(nv[sp].offset), free(nv[sp].stream);
     for (uint32_t s = 0; s < NSETS; s++)

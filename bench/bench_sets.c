@@ -3,6 +3,7 @@
  * ancillary bytes (cluster records, set lists, runs, prefix data, names), the share of texels
  * the sparse storage kept, and the bake time of the sets against the base bake, measured in
  * this run. The seed reports about 132 KB of ancillary data for its largest map. */
+#define LBK_STATIC_LINKING_ONLY /* lbk_dls_stats: experimental (lbk/dls.h) */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -10,12 +11,14 @@
 
 #include <math.h>
 
-#include "bake/pipeline/bake.h"
+#include "bake/util/clock.h"
+#include "lbk/bake.h"
 #include "lbk/ahd.h"
 #include "lbk/container.h"
 #include "lbk/dls.h"
 #include "lbk/door.h"
 #include "lbk/lightmap.h"
+#include "tests/support/bake_file.c"
 /* The generator lives with the tests; benches link the tools only, so take its source. */
 #include "tests/support/door_scenes.c"
 
@@ -34,18 +37,16 @@ static int run(const level *lv, const char *dir)
         fprintf(stderr, "%s: %s\n", lv->name, err);
         return 1;
     }
-    bk_bake_options bo;
+    tb_job bo;
     memset(&bo, 0, sizeof bo);
-    bo.input = gltf;
-    bo.output = out;
-    bo.seed = 1;
-    bo.target_error = -1;
-    bo.dls_threshold = lv->threshold;
-    bk_progress pr;
-    bk_progress_init(&pr, 1);
-    bk_bake_summary sum;
+    bo.in = gltf;
+    bo.out = out;
+    bo.d.seed = 1;
+    bo.d.target_error = -1;
+    bo.d.dls_threshold = lv->threshold;
+    lbk_bake_report sum;
     double t0 = bk_now();
-    int rc = bk_bake(&bo, &pr, &sum, err, sizeof err);
+    int rc = tb_bake(&bo, &sum, err, sizeof err);
     double secs = bk_now() - t0;
     unlink(gltf);
     if (rc) {
@@ -61,9 +62,9 @@ static int run(const level *lv, const char *dir)
     memset(&st, 0, sizeof st);
     if (lbk_reader_section_by_type(rd, LBK_SECTION_DLS, &d, &n) == LBK_OK) {
         lbk_dls_view *v;
-        if (lbk_dls_view_open(d, n, NULL, &v) == LBK_OK) {
-            lbk_dls_compute_stats(v, &st);
-            lbk_dls_view_close(v);
+        if (lbk_dls_open(d, n, NULL, &v) == LBK_OK) {
+            lbk_dls_stats_get(v, &st);
+            lbk_dls_close(v);
         }
     }
     lbk_reader_close(rd);
@@ -71,7 +72,7 @@ static int run(const level *lv, const char *dir)
     uint64_t tex = st.target_count[LBK_DLS_SPACE_TEXEL];
     printf("%-22s %6llu texels  %2u sets %u doors  LMAP %8zu B  DLS payload %8llu B  ancillary %6llu B (%5.2f%% of "
            "payload, %.2f index bits/touched texel)  touched %5.1f%% of texels  clusters %u  bake %.1f s\n",
-           lv->name, (unsigned long long)sum.texels, sum.sets, sum.doors, lmap, (unsigned long long)st.payload_bytes,
+           lv->name, (unsigned long long)sum.counts.texels, sum.counts.light_sets, sum.counts.doors, lmap, (unsigned long long)st.payload_bytes,
            (unsigned long long)st.ancillary_bytes,
            st.payload_bytes ? 100.0 * (double)st.ancillary_bytes / (double)st.payload_bytes : 0.0,
            st.index_bits_per_target[LBK_DLS_SPACE_TEXEL], tex ? 100.0 * (double)st.touched[0] / (double)tex : 0.0,
@@ -107,15 +108,13 @@ static int bake_open(const char *dir, const char *name, const ds_options *o, int
     snprintf(gltf, sizeof gltf, "%s/%s.gltf", dir, name);
     snprintf(path, sizeof path, "%s/%s.lbk", dir, name);
     if (ds_write_room_scene(DS_ROOM_GLB, gltf, o, err, sizeof err)) return 1;
-    bk_bake_options bo;
+    tb_job bo;
     memset(&bo, 0, sizeof bo);
-    bo.input = gltf, bo.output = path, bo.seed = seed, bo.target_error = 1e-9, bo.max_samples = samples;
-    bo.door_method = method;
-    bk_progress pr;
-    bk_progress_init(&pr, 1);
-    bk_bake_summary sum;
+    bo.in = gltf, bo.out = path, bo.d.seed = seed, bo.d.target_error = 1e-9, bo.d.max_samples = samples;
+    bo.d.door_method = method;
+    lbk_bake_report sum;
     double t0 = bk_now();
-    int rc = bk_bake(&bo, &pr, &sum, err, sizeof err);
+    int rc = tb_bake(&bo, &sum, err, sizeof err);
     out->seconds = bk_now() - t0;
     unlink(gltf);
     if (rc) {
@@ -135,7 +134,7 @@ static int bake_open(const char *dir, const char *name, const ds_options *o, int
     out->lum = malloc(out->n * sizeof *out->lum);
     for (uint64_t i = 0; i < out->n; i++) {
         lbk_ahd_texel t;
-        lbk_lmap_texel(&lm, i, &t, NULL);
+        lbk_lmap_texel_get(&lm, i, &t, NULL);
         z[i] = t.irradiance_z;
         memcpy(&rgba[4 * i], t.rgba, 4);
     }
@@ -145,7 +144,7 @@ static int bake_open(const char *dir, const char *name, const ds_options *o, int
     lbk_door_view *door = NULL;
     if (lbk_reader_section_by_type(rd, LBK_SECTION_DLS, &dd, &dn) == LBK_OK &&
         lbk_reader_section_by_type(rd, LBK_SECTION_DOOR, &doord, &doorn) == LBK_OK &&
-        lbk_dls_view_open(dd, dn, NULL, &dv) == LBK_OK && lbk_door_view_open(doord, doorn, NULL, &door) == LBK_OK) {
+        lbk_dls_open(dd, dn, NULL, &dv) == LBK_OK && lbk_door_open(doord, doorn, NULL, &door) == LBK_OK) {
         uint64_t ng = lbk_dls_target_count(dv, LBK_DLS_SPACE_GLG), nl = lbk_dls_target_count(dv, LBK_DLS_SPACE_LLG);
         uint8_t *bg = calloc(ng + 1, 28), *og = calloc(ng + 1, 28), *bl = calloc(nl + 1, 28), *ol = calloc(nl + 1, 28);
         lbk_dls_runtime_desc rd2;
@@ -155,17 +154,17 @@ static int bake_open(const char *dir, const char *name, const ds_options *o, int
         rd2.out_llg = ol;
         lbk_dls_runtime *rt;
         float w[64] = {0}, dw[8] = {1, 1, 1, 1, 1, 1, 1, 1};
-        if (lbk_dls_runtime_create(&rd2, &rt) == LBK_OK) {
+        if (lbk_dls_runtime_open(&rd2, &rt) == LBK_OK) {
             lbk_dls_apply(rt, w, dw, NULL);
-            lbk_dls_runtime_destroy(rt);
+            lbk_dls_runtime_close(rt);
             memcpy(z, oz, out->n * 4);
             memcpy(rgba, orgba, out->n * 4);
         }
         free(bg), free(og), free(bl), free(ol);
     }
     for (uint64_t i = 0; i < out->n; i++) out->lum[i] = texel_lum(z[i], &rgba[4 * i]);
-    if (door) lbk_door_view_close(door);
-    if (dv) lbk_dls_view_close(dv);
+    if (door) lbk_door_close(door);
+    if (dv) lbk_dls_close(dv);
     lbk_reader_close(rd);
     unlink(path);
     free(z), free(oz), free(rgba), free(orgba);

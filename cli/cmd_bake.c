@@ -1,11 +1,16 @@
-/* lbk bake: the CLI over bk_bake(). */
+/* lbk bake: the command line over liblbkbake (lbk/bake.h): options from flags, the progress
+ * bar and messages on stderr, the container and the JSON report written, exit codes. */
 #include <errno.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
-#include "bake/pipeline/bake.h"
 #include "cli/cli.h"
+#include "cli/progress.h"
+#include "lbk/bake.h"
 
 static void help(FILE *f)
 {
@@ -40,6 +45,8 @@ static void help(FILE *f)
           "  --revision STR          revision string stored in the provenance\n"
           "  --timestamp             store the bake time in the provenance (output no longer\n"
           "                          byte-identical across runs)\n"
+          "  --allow-outside DIR     the scene may also read buffers/images/sky from DIR (by default\n"
+          "                          every file it names must lie in its own folder)\n"
           "  -q, --quiet             no progress output\n"
           "  -h, --help              this text\n"
           "\n"
@@ -57,17 +64,178 @@ static int parse_double(const char *s, double *out)
     return 1;
 }
 
+/* A decimal integer in [lo, hi] and nothing else: "1.5", "-1", " 3", "0x10", "1e3" are refused
+ * (strtoull alone would turn "-1" into 2^64 - 1). */
+static int parse_uint(const char *s, unsigned long long lo, unsigned long long hi, unsigned long long *out)
+{
+    if (!s || !*s) return 0;
+    for (const char *c = s; *c; c++)
+        if (*c < '0' || *c > '9') return 0;
+    char *end;
+    errno = 0;
+    unsigned long long v = strtoull(s, &end, 10);
+    if (errno || *end || v < lo || v > hi) return 0;
+    *out = v;
+    return 1;
+}
+
+/* True when both paths name one existing file (the same inode: hard links count). */
+static int same_file(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    return a && b && stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
+
+typedef struct bake_args {
+    lbk_bake_desc d;
+    const char *input, *output, *json_report;
+} bake_args;
+
+/* What the callbacks share: the bar, and the error text the CLI prints after the bake. */
+typedef struct bake_ui {
+    cli_progress bar;
+    int phase;             /* the bar's current phase; -1 before the first */
+    char error[1024];
+} bake_ui;
+
+static int on_progress(void *user, const lbk_bake_progress *p)
+{
+    bake_ui *ui = user;
+    if ((int)p->phase != ui->phase) {
+        ui->phase = (int)p->phase;
+        cli_progress_phase(&ui->bar, lbk_bake_phase_name(p->phase));
+    } else {
+        cli_progress_update(&ui->bar, p->fraction);
+    }
+    return 0;
+}
+
+static void on_message(void *user, lbk_bake_severity severity, const char *message)
+{
+    bake_ui *ui = user;
+    switch (severity) {
+    case LBK_BAKE_SEVERITY_INFO: cli_progress_note(&ui->bar, "  %s", message); break;
+    case LBK_BAKE_SEVERITY_NOTE: cli_progress_note(&ui->bar, "lbk bake: note: %s", message); break;
+    case LBK_BAKE_SEVERITY_WARNING: cli_progress_note(&ui->bar, "lbk bake: warning: %s", message); break;
+    default: snprintf(ui->error, sizeof ui->error, "%s", message); break;
+    }
+}
+
+/* README "Exit codes". */
+static int exit_code(lbk_result r)
+{
+    switch (r) {
+    case LBK_OK: return LBK_EXIT_OK;
+    case LBK_ERR_IO: return LBK_EXIT_IO;
+    case LBK_ERR_BAD_INPUT: return LBK_EXIT_INPUT;
+    default: return LBK_EXIT_INTERNAL;
+    }
+}
+
+/* The JSON report into a new temporary file beside json_path (its name in tmp); 0 or -1 with
+ * the cause printed. */
+static int write_report_tmp(const lbk_bake_report *rep, const char *container, const char *json_path, char *tmp,
+                            size_t tmp_size)
+{
+    char *text = NULL;
+    size_t size = 0;
+    lbk_result r = lbk_bake_report_json(rep, container, NULL, &text, &size);
+    if (r) {
+        fprintf(stderr, "lbk bake: the report: %s\n", lbk_result_message(r));
+        return -1;
+    }
+    int n = snprintf(tmp, tmp_size, "%s.tmp-XXXXXX", json_path);
+    int fd = n > 0 && (size_t)n < tmp_size ? mkstemp(tmp) : -1;
+    int ok = fd >= 0;
+    if (ok) {
+        size_t done = 0;
+        while (ok && done < size) {
+            ssize_t w = write(fd, text + done, size - done);
+            if (w < 0 && errno == EINTR) continue;
+            ok = w > 0;
+            if (ok) done += (size_t)w;
+        }
+        ok = ok && write(fd, "\n", 1) == 1 && fchmod(fd, 0644) == 0 && fsync(fd) == 0;
+        int saved = errno;
+        if (close(fd) != 0 && ok) ok = 0, saved = errno;
+        if (!ok) unlink(tmp);
+        errno = saved;
+    }
+    int saved = errno;
+    lbk_free(NULL, text);
+    if (!ok) {
+        fprintf(stderr, "lbk bake: writing %s: %s\n", json_path, strerror(saved));
+        tmp[0] = 0;
+        return -1;
+    }
+    return 0;
+}
+
+static int bake(bake_args *o, int quiet)
+{
+    bake_ui ui;
+    memset(&ui, 0, sizeof ui);
+    ui.phase = -1;
+    cli_progress_init(&ui.bar, quiet);
+    o->d.progress = on_progress;
+    o->d.message = on_message;
+    o->d.user = &ui;
+    lbk_bake_output *out = NULL;
+    lbk_result r = lbk_bake_from_file(o->input, &o->d, &out);
+    if (r) {
+        fprintf(stderr, "lbk bake: %s\n", ui.error[0] ? ui.error : lbk_result_message(r));
+        return exit_code(r);
+    }
+    /* Nothing is written on error, the report included: its text goes to a temporary file
+     * beside it first, and replaces the old report only once the container is in place. */
+    const lbk_bake_report *rep = lbk_bake_output_report(out);
+    char json_tmp[4096] = "";
+    if (o->json_report && write_report_tmp(rep, o->output, o->json_report, json_tmp, sizeof json_tmp)) {
+        lbk_bake_output_free(out);
+        return LBK_EXIT_IO;
+    }
+    r = lbk_bake_output_write_file(out, o->output);
+    if (r) {
+        int saved = errno;
+        if (json_tmp[0]) unlink(json_tmp);
+        if (r == LBK_ERR_IO)
+            fprintf(stderr, "lbk bake: writing %s: %s\n", o->output, strerror(saved));
+        else
+            fprintf(stderr, "lbk bake: writing %s: %s\n", o->output, lbk_result_message(r));
+        lbk_bake_output_free(out);
+        return exit_code(r == LBK_ERR_IO ? r : LBK_ERR_INTERNAL);
+    }
+    if (json_tmp[0] && rename(json_tmp, o->json_report) != 0) {
+        fprintf(stderr, "lbk bake: %s was written, but not the report %s: %s\n", o->output, o->json_report,
+                strerror(errno));
+        unlink(json_tmp);
+        lbk_bake_output_free(out);
+        return LBK_EXIT_IO;
+    }
+    cli_progress_done(&ui.bar);
+    const lbk_bake_counts *c = &rep->counts;
+    if (!quiet)
+        printf("%s: %llu objects, %llu texels in %llu pages, %llu GLG probes, %llu LLG probes in %llu grids, "
+               "%u dynamic sets (light sets and door states), %u doors; estimated error %.2f%%; %llu bytes\n",
+               o->output, (unsigned long long)c->objects, (unsigned long long)c->texels,
+               (unsigned long long)c->pages, (unsigned long long)c->glg_probes,
+               (unsigned long long)c->llg_probes, (unsigned long long)c->llgs, c->light_sets, c->doors,
+               100 * rep->transport.est_rel_rmse, (unsigned long long)c->file_bytes);
+    lbk_bake_output_free(out);
+    return LBK_EXIT_OK;
+}
+
 int lbk_cmd_bake(int argc, char **argv)
 {
-    bk_bake_options o;
+    bake_args o;
     memset(&o, 0, sizeof o);
-    o.seed = 1;
-    o.target_error = -1;
+    o.d.seed = 1;
     int quiet = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
         double d;
+        unsigned long long u;
 #define NEED_VALUE                                                         \
     do {                                                                   \
         if (!v) {                                                          \
@@ -75,6 +243,15 @@ int lbk_cmd_bake(int argc, char **argv)
             return LBK_EXIT_USAGE;                                         \
         }                                                                  \
         i++;                                                               \
+    } while (0)
+#define NEED_UINT(lo, hi)                                                                          \
+    do {                                                                                           \
+        NEED_VALUE;                                                                                \
+        if (!parse_uint(v, (lo), (hi), &u)) {                                                      \
+            fprintf(stderr, "lbk bake: %s: '%s' is not a whole number in [%llu, %llu]\n", a, v,     \
+                    (unsigned long long)(lo), (unsigned long long)(hi));                           \
+            return LBK_EXIT_USAGE;                                                                 \
+        }                                                                                          \
     } while (0)
 #define NEED_NUMBER(lo, hi)                                                                       \
     do {                                                                                          \
@@ -97,25 +274,25 @@ int lbk_cmd_bake(int argc, char **argv)
                 fprintf(stderr, "lbk bake: unknown preset '%s' (fast, high)\n", v);
                 return LBK_EXIT_USAGE;
             }
-            o.preset = v;
+            o.d.preset = strcmp(v, "high") ? LBK_BAKE_PRESET_FAST : LBK_BAKE_PRESET_HIGH;
         } else if (!strcmp(a, "--target-error")) {
             NEED_NUMBER(1e-6, 10);
-            o.target_error = d;
+            o.d.target_error = d;
         } else if (!strcmp(a, "--time-limit")) {
             NEED_NUMBER(0.001, 1e7);
-            o.time_limit = d;
+            o.d.time_limit = d;
         } else if (!strcmp(a, "--samples")) {
-            NEED_NUMBER(1, 1 << 24);
-            o.max_samples = (int)d;
+            NEED_UINT(1, 1 << 24);
+            o.d.max_samples = (int)u;
         } else if (!strcmp(a, "--max-bounces")) {
-            NEED_NUMBER(1, 1000);
-            o.max_bounces = (int)d;
+            NEED_UINT(1, 1000);
+            o.d.max_bounces = (int)u;
         } else if (!strcmp(a, "--texel-density")) {
             NEED_NUMBER(1e-6, 1e7);
-            o.texel_density = (float)d;
+            o.d.texel_density = (float)d;
         } else if (!strcmp(a, "--glg-spacing")) {
             NEED_NUMBER(1e-6, 1e6);
-            o.glg_spacing = (float)d;
+            o.d.glg_spacing = (float)d;
         } else if (!strcmp(a, "--sky")) {
             NEED_VALUE;
             float r, g, b;
@@ -125,48 +302,44 @@ int lbk_cmd_bake(int argc, char **argv)
                     fprintf(stderr, "lbk bake: --sky: radiance must be finite and >= 0\n");
                     return LBK_EXIT_USAGE;
                 }
-                o.sky_set = 1;
-                o.sky[0] = r, o.sky[1] = g, o.sky[2] = b;
+                o.d.sky_override = 1;
+                o.d.sky[0] = r, o.d.sky[1] = g, o.d.sky[2] = b;
             } else {
-                o.sky_set = 1;
-                o.sky_exr = v;
+                o.d.sky_override = 1;
+                o.d.sky_exr = v;
             }
         } else if (!strcmp(a, "--no-glg")) {
-            o.no_glg = 1;
+            o.d.no_glg = 1;
         } else if (!strcmp(a, "--octahedral")) {
-            o.octahedral_probes = 1;
+            o.d.octahedral_probes = 1;
         } else if (!strcmp(a, "--dls-threshold")) {
             NEED_NUMBER(0, 1);
-            o.dls_threshold = d > 0 ? d : -1;
+            o.d.dls_threshold = d > 0 ? d : -1;
         } else if (!strcmp(a, "--door-method")) {
             NEED_VALUE;
-            if (!strcmp(v, "difference")) o.door_method = 0;
-            else if (!strcmp(v, "guided")) o.door_method = 1;
+            if (!strcmp(v, "difference")) o.d.door_method = LBK_BAKE_DOOR_DIFFERENCE;
+            else if (!strcmp(v, "guided")) o.d.door_method = LBK_BAKE_DOOR_GUIDED;
             else {
                 fprintf(stderr, "lbk bake: unknown door method '%s' (difference, guided)\n", v);
                 return LBK_EXIT_USAGE;
             }
         } else if (!strcmp(a, "--threads")) {
-            NEED_NUMBER(1, 1024);
-            o.threads = (int)d;
+            NEED_UINT(1, 1024);
+            o.d.threads = (int)u;
         } else if (!strcmp(a, "--seed")) {
+            NEED_UINT(0, ULLONG_MAX);
+            o.d.seed = u;
+        } else if (!strcmp(a, "--allow-outside")) {
             NEED_VALUE;
-            char *end;
-            errno = 0;
-            unsigned long long s = strtoull(v, &end, 0);
-            if (errno || end == v || *end) {
-                fprintf(stderr, "lbk bake: --seed: '%s' is not an unsigned integer\n", v);
-                return LBK_EXIT_USAGE;
-            }
-            o.seed = s;
+            o.d.allow_outside = v;
         } else if (!strcmp(a, "--json-report")) {
             NEED_VALUE;
             o.json_report = v;
         } else if (!strcmp(a, "--revision")) {
             NEED_VALUE;
-            o.revision = v;
+            o.d.revision = v;
         } else if (!strcmp(a, "--timestamp")) {
-            o.timestamp = 1;
+            o.d.timestamp = 1;
         } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
             quiet = 1;
         } else if (a[0] == '-' && a[1]) {
@@ -180,27 +353,23 @@ int lbk_cmd_bake(int argc, char **argv)
         }
 #undef NEED_VALUE
 #undef NEED_NUMBER
+#undef NEED_UINT
     }
     if (!o.input || !o.output) {
         fprintf(stderr, "lbk bake: need a scene and -o OUT.lbk (lbk bake --help)\n");
         return LBK_EXIT_USAGE;
     }
-    bk_progress progress;
-    bk_progress_init(&progress, quiet);
-    bk_bake_summary sum;
-    char err[512] = "";
-    int rc = bk_bake(&o, &progress, &sum, err, sizeof err);
-    if (rc) {
-        fprintf(stderr, "lbk bake: %s\n", err[0] ? err : "failed");
-        return rc;
+    /* An output must never replace an input (`-o scene.gltf` once destroyed the scene). */
+    const char *inputs[] = {o.input, o.d.sky_exr};
+    for (int k = 0; k < 2; k++) {
+        if (same_file(o.output, inputs[k]) || same_file(o.json_report, inputs[k])) {
+            fprintf(stderr, "lbk bake: refusing to overwrite the input %s with an output\n", inputs[k]);
+            return LBK_EXIT_USAGE;
+        }
     }
-    bk_progress_done(&progress);
-    if (!quiet)
-        printf("%s: %llu objects, %llu texels in %llu pages, %llu GLG probes, %llu LLG probes in %llu grids, "
-               "%u dynamic sets (light sets and door states), %u doors; estimated error %.2f%%; %llu bytes\n",
-               o.output, (unsigned long long)sum.objects, (unsigned long long)sum.texels,
-               (unsigned long long)sum.pages, (unsigned long long)sum.glg_probes,
-               (unsigned long long)sum.llg_probes, (unsigned long long)sum.llgs, sum.sets, sum.doors,
-               100 * sum.final_error, (unsigned long long)sum.file_bytes);
-    return LBK_EXIT_OK;
+    if (o.json_report && (same_file(o.json_report, o.output) || !strcmp(o.json_report, o.output))) {
+        fprintf(stderr, "lbk bake: --json-report and -o name the same file %s\n", o.output);
+        return LBK_EXIT_USAGE;
+    }
+    return bake(&o, quiet);
 }

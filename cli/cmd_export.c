@@ -1,14 +1,16 @@
-/* lbk export: pages, planes, objects and probes as EXR/PNG/CSV/JSON. */
+/* lbk export: pages, planes, objects and probes as EXR/PNG/CSV/JSON, or the level as glTF. */
 #include <stdio.h>
 #include <string.h>
 
 #include "cli/cli.h"
 #include "tools/convert/export.h"
+#include "tools/convert/gltf_export.h"
 
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: lbk export IN.lbk [--exr DIR] [--png DIR] [--per-object] [-q]   (at least one of --exr, --png)\n"
+            "usage: lbk export IN.lbk [--exr DIR] [--png DIR] [--per-object] [--gltf OUT.glb --scene SCENE] [-q]\n"
+            "       (at least one of --exr, --png, --gltf)\n"
             "\n"
             "Units: irradiance in lux-like units (lm/m^2); probe SH in radiance (nits, cd/m^2). Images are\n"
             "linear float EXR (ZIP, 32-bit) with row 0 at the top, x right: texel (x, y) of a page.\n"
@@ -22,17 +24,26 @@ static void usage(FILE *f)
             "                                         plane1.R/G/B/A (ratio, direction x, y, z bytes / 255)\n"
             "  --png DIR      page_NNN.png tone-mapped previews of page_NNN.exr: one exposure for all pages,\n"
             "                 1 / (99th percentile of Rec.709 luminance over all texels), then sRGB, 8 bits\n"
-            "  --per-object   also DIR/objects/III_name.exr (and .png): each lightmapped object's irradiance\n"
-            "                 at its rectangle's resolution; pixel (i, j) is TEXCOORD_1 ((i+0.5)/w, (j+0.5)/h)\n"
-            "                 (III = the object's index in the object table)\n"
+            "  --per-object   also DIR/objects/III_name.exr (and .png): each lightmapped object's rectangle cut out\n"
+            "                 of its page: pixel (i, j) is page texel (rect_x + i, rect_y + j) (III = the object's\n"
+            "                 index in the object table); where that texel lies on the mesh is given by the LMUV\n"
+            "                 section (spec/container.md 16), not by the object's TEXCOORD_1 alone\n"
             "  both dirs get probes.csv and probes.json (GLG and LLG probes: position, irradiance at the six\n"
             "  axis normals, the SH9 coefficients) and glg_top.png (top view looking down -Y: x right,\n"
             "  z down; tetra edges grey; probes coloured black-blue-cyan-green-yellow-red by luminance of\n"
             "  their mean irradiance, red = 99th percentile, white above)\n"
+            "  --gltf OUT.glb the level as glTF 2.0 (binary), read again from --scene SCENE.gltf|.glb (the file it\n"
+            "                 was baked from; checked object by object): one node per object, world-space geometry,\n"
+            "                 TEXCOORD_1 = normalised page uv on every lightmapped primitive (vertices split where\n"
+            "                 generated charts split); beside it OUT.lightmap_NNN.exr (R,G,B irradiance along the\n"
+            "                 normal, lux), OUT.lightmap_NNN.ahd.exr (raw AHD planes) and OUT.lightmap_NNN.png\n"
+            "                 (preview, also the base colour texture of unlit preview materials); GLG and LLG probes\n"
+            "                 as accessors named in the extras (tools/convert/README.md \"glTF export\")\n"
             "  -q, --quiet    no summary\n"
             "  -h, --help     this text\n"
             "\n"
-            "exit codes: 0 written, 2 usage, 3 I/O error (read or write), 4 the input is not a valid container,\n"
+            "exit codes: 0 written, 2 usage, 3 I/O error (read or write), 4 the input is not a valid container\n"
+            "            (or --scene cannot be read or is not the scene it was baked from),\n"
             "            5 internal error\n");
 }
 
@@ -40,6 +51,7 @@ int lbk_cmd_export(int argc, char **argv)
 {
     const char *in = NULL;
     tl_export_options o = {NULL, NULL, 0};
+    tl_gltf_options g = {NULL, NULL, NULL};
     int quiet = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -61,6 +73,17 @@ int lbk_cmd_export(int argc, char **argv)
                 return LBK_EXIT_USAGE;
             }
             *dst = argv[++i];
+        } else if (!strcmp(a, "--gltf") || !strcmp(a, "--scene")) {
+            if (i + 1 >= argc) {
+                fprintf(stderr, "lbk export: %s needs a file\n", a);
+                return LBK_EXIT_USAGE;
+            }
+            const char **dst = !strcmp(a, "--gltf") ? &g.output : &g.scene;
+            if (*dst) {
+                fprintf(stderr, "lbk export: %s given twice\n", a);
+                return LBK_EXIT_USAGE;
+            }
+            *dst = argv[++i];
         } else if (a[0] == '-' && a[1]) {
             fprintf(stderr, "lbk export: unknown option '%s' (see lbk export --help)\n", a);
             return LBK_EXIT_USAGE;
@@ -71,8 +94,12 @@ int lbk_cmd_export(int argc, char **argv)
             return LBK_EXIT_USAGE;
         }
     }
-    if (!in || (!o.exr_dir && !o.png_dir)) {
-        fprintf(stderr, "lbk export: need IN.lbk and --exr DIR and/or --png DIR (see lbk export --help)\n");
+    if (!in || (!o.exr_dir && !o.png_dir && !g.output)) {
+        fprintf(stderr, "lbk export: need IN.lbk and --exr DIR, --png DIR and/or --gltf OUT.glb (see lbk export --help)\n");
+        return LBK_EXIT_USAGE;
+    }
+    if (!g.output != !g.scene) {
+        fprintf(stderr, "lbk export: --gltf and --scene go together (the container holds no geometry)\n");
         return LBK_EXIT_USAGE;
     }
     char err[TL_ERR_LEN];
@@ -83,14 +110,32 @@ int lbk_cmd_export(int argc, char **argv)
         return st == TL_OPEN_IO ? LBK_EXIT_IO : st == TL_OPEN_INVALID ? LBK_EXIT_INPUT : LBK_EXIT_INTERNAL;
     }
     tl_export_stats s;
-    int rc = tl_export(&b, &o, &s, err);
-    tl_bake_close(&b);
+    int rc = o.exr_dir || o.png_dir ? tl_export(&b, &o, &s, err) : 0;
     if (rc) {
+        tl_bake_close(&b);
         fprintf(stderr, "lbk export: %s\n", err);
         return LBK_EXIT_IO;
     }
-    if (!quiet)
+    if (!quiet && (o.exr_dir || o.png_dir))
         printf("%s: %u EXR, %u PNG, %u listing files (preview exposure %.6g)\n", in, s.exr_files, s.png_files,
                s.text_files, s.exposure);
+    if (g.output) {
+        const char *base = strrchr(in, '/');
+        g.container = base ? base + 1 : in;
+        tl_gltf_stats gs;
+        rc = tl_gltf_export(&b, &g, &gs, err);
+        if (rc) {
+            tl_bake_close(&b);
+            fprintf(stderr, "lbk export: %s\n", err);
+            return rc == TL_GLTF_IO ? LBK_EXIT_IO : rc == TL_GLTF_INPUT ? LBK_EXIT_INPUT : LBK_EXIT_INTERNAL;
+        }
+        if (!quiet)
+            printf("%s: %u nodes, %u primitives (%u lightmapped: %u authored, %u generated), %llu triangles, %llu "
+                   "vertices; %u pages (%u EXR, %u PNG, preview exposure %.6g)\n",
+                   g.output, gs.nodes, gs.primitives, gs.lightmapped, gs.authored, gs.generated,
+                   (unsigned long long)gs.triangles, (unsigned long long)gs.vertices, gs.pages, gs.exr_files,
+                   gs.png_files, gs.exposure);
+    }
+    tl_bake_close(&b);
     return LBK_EXIT_OK;
 }

@@ -266,7 +266,7 @@ int lbk_cmd_inspect(int argc, char **argv)
     uint64_t sections_disk = 0, prev_end = r.header_bytes + r.table_bytes;
     for (uint32_t i = 0; i < r.count; i++) {
         section_row *s = &r.rows[i];
-        lbk_reader_section_info(reader, i, &s->info);
+        lbk_reader_section_get(reader, i, &s->info);
         lbk_fourcc_string(s->info.type, s->type);
         inspect_describe_fn fn = inspect_describer(s->info.type);
         s->known = fn != NULL;

@@ -37,8 +37,8 @@ int main(int argc, char **argv)
         return LBK_EXIT_OK;
     }
     if (!strcmp(argv[1], "--version")) {
-        printf("lbk %s (container format %d.%d)\n", LBK_LIBRARY_VERSION_STRING, LBK_VERSION_MAJOR,
-               LBK_VERSION_MINOR);
+        printf("lbk %s (container format %d.%d)\n", lbk_version_string(), LBK_FORMAT_VERSION_MAJOR,
+               LBK_FORMAT_VERSION_MINOR);
         return LBK_EXIT_OK;
     }
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)

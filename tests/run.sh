@@ -1,29 +1,76 @@
 #!/bin/sh
 # Runs every test binary, each with its own log, and prints one closing line:
-# "N passed, N failed" counts test binaries' cmocka cases summed.
+# "tests: N passed, N failed, N skipped", the test binaries' cmocka cases summed (a skipped
+# case is counted as skipped, never as passed, and never disappears from the totals).
+# FUZZ: the libFuzzer harness, run for FUZZ_RUNS inputs. TSAN_BIN: the folder of the
+# ThreadSanitizer builds, whose cases of tests/tsan/determinism.list are run last.
 set -u
 : "${BUILD:=build}"
-pass=0; fail=0; failed=""
-for t in "$@"; do
-  log="$BUILD/tests/$t.log"
+pass=0; fail=0; skip=0; failed=""
+mkdir -p "$BUILD/tests"
+
+# run_one NAME LOG CMD...: runs CMD into LOG and adds its cmocka cases to the totals.
+run_one() {
+  name=$1; log=$2; shift 2
   t0=$(date +%s)
-  if "$BUILD/tests/$t" >"$log" 2>&1; then st=0; else st=$?; fi
+  if "$@" >"$log" 2>&1 </dev/null; then st=0; else st=$?; fi
   secs=$(( $(date +%s) - t0 ))
-  p=$(grep -c '^\[       OK \]' "$log"); f=$(grep -c '^\[  FAILED  \]' "$log")
+  # one line per case until cmocka's "[==========] N test(s) run." (its summary lists them again)
+  set -- $(awk '/^\[==========\] .* run\./ { exit } /^\[       OK \]/ { p++ } /^\[  FAILED  \]/ { f++ }
+                /^\[  SKIPPED \]/ { s++ } END { print p + 0, f + 0, s + 0 }' "$log")
+  p=$1; f=$2; s=$3
   [ "$st" -ne 0 ] && [ "$f" -eq 0 ] && f=1
-  pass=$((pass + p)); fail=$((fail + f))
-  if [ "$st" -ne 0 ]; then failed="$failed $t"; echo "FAIL $t (exit $st)"; tail -n 30 "$log"; else echo "ok   $t ($p cases, ${secs} s)"; fi
+  # a run that passes no case at all tests nothing (a filter that matches no case, say)
+  [ "$st" -eq 0 ] && [ "$p" -eq 0 ] && [ "$s" -eq 0 ] && { f=1; st=1; echo "no case ran" >>"$log"; }
+  pass=$((pass + p)); fail=$((fail + f)); skip=$((skip + s))
+  if [ "$st" -ne 0 ]; then
+    failed="$failed $name"; echo "FAIL $name (exit $st)"; tail -n 30 "$log"
+  else
+    extra=""; [ "$s" -gt 0 ] && extra=", $s skipped"
+    echo "ok   $name ($p cases$extra, ${secs} s)"
+  fi
+}
+
+for t in "$@"; do
+  run_one "$t" "$BUILD/tests/$t.log" "$BUILD/tests/$t"
 done
+
 # The libFuzzer harness over the seed corpus for a fixed number of inputs (seeded, so runs
 # repeat); inputs it finds go to a scratch directory, never into tests/fuzz/corpus.
 if [ -n "${FUZZ:-}" ] && [ -x "$FUZZ" ]; then
   runs="${FUZZ_RUNS:-20000}"; scratch="$BUILD/fuzz-scratch"; log="$BUILD/tests/fuzz_container.log"
-  rm -rf "$scratch"; mkdir -p "$scratch" "$BUILD/tests"
-  if "$FUZZ" -runs="$runs" -seed=1 -rss_limit_mb=2048 "$scratch" tests/fuzz/corpus >"$log" 2>&1; then
+  rm -rf "$scratch"; mkdir -p "$scratch"
+  if "$FUZZ" -runs="$runs" -seed=1 -max_len=65536 -rss_limit_mb=2048 "$scratch" tests/fuzz/corpus >"$log" 2>&1; then
     pass=$((pass + 1)); echo "ok   fuzz_container ($runs inputs)"
   else
     fail=$((fail + 1)); failed="$failed fuzz_container"; echo "FAIL fuzz_container"; tail -n 30 "$log"
   fi
 fi
-echo "tests: $pass passed, $fail failed"
+
+# ThreadSanitizer: any report fails the run (halt_on_error); the suppressions cover Embree and
+# TBB internals only (see the file).
+if [ -n "${TSAN_BIN:-}" ]; then
+  export TSAN_OPTIONS="halt_on_error=1 exitcode=66 second_deadlock_stack=1 suppressions=$(pwd)/tests/tsan/suppressions.txt ${TSAN_OPTIONS:-}"
+  while read -r bin filter; do
+    case "$bin" in ''|'#'*) continue;; esac
+    export LBK_TEST_FILTER="$filter"
+    run_one "tsan $bin:$filter" "$BUILD/tests/tsan_${bin}_${filter}.log" "$TSAN_BIN/$bin"
+  done <tests/tsan/determinism.list
+  unset LBK_TEST_FILTER
+fi
+
+
+# The Khronos glTF-Validator over `lbk export --gltf` of the shared scenes (0 errors each).
+scenes="${LBK_SCENES:-../shared/scenes}"
+log="$BUILD/tests/gltf_validator.log"
+if [ -z "${GLTF_VALIDATOR:-}" ]; then
+  skip=$((skip + 1)); echo "SKIPPED gltf_validator (npm/node not found: apt-get install npm)"
+elif [ ! -d "$scenes" ]; then
+  skip=$((skip + 1)); echo "SKIPPED gltf_validator (no shared scenes at $scenes; set LBK_SCENES)"
+elif sh tests/tools/gltf_validator.sh "$BUILD/lbk" "${LBK:-$BUILD/lbk-asan}" "$GLTF_VALIDATOR" "$BUILD/gltf-validator" >"$log" 2>&1; then
+  pass=$((pass + 1)); echo "ok   gltf_validator ($(grep -c ' 0 errors' "$log") exports, 0 errors)"
+else
+  fail=$((fail + 1)); failed="$failed gltf_validator"; echo "FAIL gltf_validator"; tail -n 30 "$log"
+fi
+echo "tests: $pass passed, $fail failed, $skip skipped"
 [ -z "$failed" ]

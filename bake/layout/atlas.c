@@ -1,6 +1,8 @@
 /* Lightmap atlas packing (see atlas.h for the layout rules). */
 #include "bake/layout/atlas.h"
 
+#include "bake/layout/pack.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,224 +17,14 @@
 static int round4(int v) { return (v + 3) & ~3; }
 
 /* ---------------------------------------------------------------------------------------- */
-/* Skyline bottom-left packer                                                               */
-
-typedef struct pk_rect {
-    int w, h;
-    uint32_t id;     /* caller's index, the final tie-break */
-    int x, y;        /* result */
-    int placed;
-} pk_rect;
-
-typedef struct skyline {
-    int *x, *y, *w;  /* segments covering [0, width) left to right */
-    int n, cap;
-    int width, height;
-} skyline;
-
-static int sky_init(skyline *s, int width, int height, int cap)
-{
-    s->cap = cap + 2;
-    s->x = malloc((size_t)s->cap * sizeof(int));
-    s->y = malloc((size_t)s->cap * sizeof(int));
-    s->w = malloc((size_t)s->cap * sizeof(int));
-    if (!s->x || !s->y || !s->w) return 0;
-    s->n = 1;
-    s->x[0] = 0;
-    s->y[0] = 0;
-    s->w[0] = width;
-    s->width = width;
-    s->height = height;
-    return 1;
-}
-
-static void sky_free(skyline *s)
-{
-    free(s->x);
-    free(s->y);
-    free(s->w);
-}
-
-/* The y at which a rw-wide rectangle rests when its left edge is at segment i, or -1. */
-static int sky_fit(const skyline *s, int i, int rw, int rh)
-{
-    int x = s->x[i];
-    if (x + rw > s->width) return -1;
-    int left = rw, y = 0;
-    for (int j = i; left > 0; j++) {
-        if (j >= s->n) return -1;
-        if (s->y[j] > y) y = s->y[j];
-        if (y + rh > s->height) return -1;
-        left -= s->w[j];
-    }
-    return y;
-}
-
-static int sky_place(skyline *s, int rw, int rh, int *ox, int *oy)
-{
-    int best = -1, by = 0, btop = 0;
-    for (int i = 0; i < s->n; i++) {
-        int y = sky_fit(s, i, rw, rh);
-        if (y < 0) continue;
-        int top = y + rh;
-        if (best < 0 || top < btop || (top == btop && s->x[i] < s->x[best])) {
-            best = i;
-            by = y;
-            btop = top;
-        }
-    }
-    if (best < 0) return 0;
-    int x = s->x[best];
-    /* insert the new segment at `best`, then shrink/remove the ones it covers */
-    if (s->n + 1 > s->cap) return 0; /* cannot happen: cap >= rects + 2 */
-    memmove(s->x + best + 1, s->x + best, (size_t)(s->n - best) * sizeof(int));
-    memmove(s->y + best + 1, s->y + best, (size_t)(s->n - best) * sizeof(int));
-    memmove(s->w + best + 1, s->w + best, (size_t)(s->n - best) * sizeof(int));
-    s->n++;
-    s->x[best] = x;
-    s->y[best] = by + rh;
-    s->w[best] = rw;
-    int end = x + rw;
-    int i = best + 1;
-    while (i < s->n && s->x[i] < end) {
-        int seg_end = s->x[i] + s->w[i];
-        if (seg_end <= end) {
-            memmove(s->x + i, s->x + i + 1, (size_t)(s->n - i - 1) * sizeof(int));
-            memmove(s->y + i, s->y + i + 1, (size_t)(s->n - i - 1) * sizeof(int));
-            memmove(s->w + i, s->w + i + 1, (size_t)(s->n - i - 1) * sizeof(int));
-            s->n--;
-        } else {
-            s->w[i] = seg_end - end;
-            s->x[i] = end;
-            break;
-        }
-    }
-    /* merge neighbours of equal height */
-    for (int j = 0; j + 1 < s->n;) {
-        if (s->y[j] == s->y[j + 1]) {
-            s->w[j] += s->w[j + 1];
-            memmove(s->x + j + 1, s->x + j + 2, (size_t)(s->n - j - 2) * sizeof(int));
-            memmove(s->y + j + 1, s->y + j + 2, (size_t)(s->n - j - 2) * sizeof(int));
-            memmove(s->w + j + 1, s->w + j + 2, (size_t)(s->n - j - 2) * sizeof(int));
-            s->n--;
-        } else {
-            j++;
-        }
-    }
-    *ox = x;
-    *oy = by;
-    return 1;
-}
-
-static int cmp_rect(const void *a, const void *b)
-{
-    const pk_rect *p = a, *q = b;
-    if (p->h != q->h) return p->h > q->h ? -1 : 1;
-    if (p->w != q->w) return p->w > q->w ? -1 : 1;
-    return (p->id > q->id) - (p->id < q->id);
-}
-
-/* Places the (sorted) rectangles that fit into a width×height area, in order; returns the
- * number placed (-1: out of memory) and the extent used. Already placed ones are skipped. */
-static int pack_into(pk_rect *r, int n, int width, int height, int *used_w, int *used_h)
-{
-    skyline s;
-    if (!sky_init(&s, width, height, n)) {
-        sky_free(&s);
-        return -1;
-    }
-    int placed = 0, uw = 0, uh = 0;
-    for (int i = 0; i < n; i++) {
-        if (r[i].placed) continue;
-        int x, y;
-        if (r[i].w > width || r[i].h > height || !sky_place(&s, r[i].w, r[i].h, &x, &y)) continue;
-        r[i].x = x;
-        r[i].y = y;
-        r[i].placed = 1;
-        placed++;
-        if (x + r[i].w > uw) uw = x + r[i].w;
-        if (y + r[i].h > uh) uh = y + r[i].h;
-    }
-    sky_free(&s);
-    *used_w = uw;
-    *used_h = uh;
-    return placed;
-}
-
-/* Packs all n rectangles into the smallest-area rectangle of width <= max_w and height
- * <= max_h found among a few candidate widths (each rounded up to `align`). Returns 1 with
- * positions set, 0 if no candidate holds them all, -1 out of memory. */
-static int pack_tight(pk_rect *r, int n, int max_w, int max_h, int align, int *out_w, int *out_h)
-{
-    if (n == 0) {
-        *out_w = *out_h = 0;
-        return 1;
-    }
-    qsort(r, (size_t)n, sizeof *r, cmp_rect);
-    double area = 0.0;
-    int widest = 0, sum_w = 0;
-    for (int i = 0; i < n; i++) {
-        area += (double)r[i].w * r[i].h;
-        if (r[i].w > widest) widest = r[i].w;
-        sum_w = sum_w + r[i].w > max_w ? max_w : sum_w + r[i].w;
-    }
-    static const double factors[] = {1.0, 1.05, 1.1, 1.2, 1.3, 1.45, 1.6, 1.8, 2.0, 2.5, 3.0, 4.0};
-    int cands[sizeof factors / sizeof factors[0] + 2];
-    int nc = 0;
-    for (size_t f = 0; f < sizeof factors / sizeof factors[0]; f++) {
-        double w = ceil(sqrt(area) * factors[f]);
-        cands[nc++] = w > max_w ? max_w : (int)w;
-    }
-    cands[nc++] = sum_w;
-    cands[nc++] = max_w;
-    pk_rect *trial = malloc((size_t)n * sizeof *trial);
-    if (!trial) return -1;
-    int found = 0;
-    long long best_area = 0;
-    int best_w = 0, best_h = 0, best_side = 0;
-    for (int c = 0; c < nc; c++) {
-        int w = cands[c] < widest ? widest : cands[c];
-        w = (w + align - 1) / align * align;
-        if (w > max_w) w = max_w / align * align;
-        if (w < widest) continue;
-        for (int i = 0; i < n; i++) {
-            trial[i] = r[i];
-            trial[i].placed = 0;
-        }
-        int uw, uh;
-        int placed = pack_into(trial, n, w, max_h, &uw, &uh);
-        if (placed < 0) {
-            free(trial);
-            return -1;
-        }
-        if (placed != n) continue;
-        int aw = (uw + align - 1) / align * align, ah = (uh + align - 1) / align * align;
-        if (ah > max_h) continue;
-        long long a = (long long)aw * ah;
-        int side = aw > ah ? aw : ah;
-        if (!found || a < best_area || (a == best_area && side < best_side)) {
-            found = 1;
-            best_area = a;
-            best_w = aw;
-            best_h = ah;
-            best_side = side;
-            memcpy(r, trial, (size_t)n * sizeof *r);
-        }
-    }
-    free(trial);
-    if (!found) return 0;
-    *out_w = best_w;
-    *out_h = best_h;
-    return 1;
-}
-
-/* ---------------------------------------------------------------------------------------- */
 /* Per object: charts → object rectangle                                                    */
 
 typedef struct obj_pack {
     bk_uv_object uv;
-    int w, h;                /* object rectangle */
+    int w, h;                /* object rectangle, before its own turn */
     int *chart_x, *chart_y;  /* block position of each chart inside the rectangle */
+    uint8_t *chart_turned;   /* chart placed a quarter turn (generated charts only) */
+    int turned;              /* the whole rectangle placed a quarter turn in its page */
     float requested;         /* density asked for */
     float fit_scale;         /* extra factor so the object fits one max page */
 } obj_pack;
@@ -242,7 +34,9 @@ static void obj_pack_free(obj_pack *p)
     bk_uv_object_free(&p->uv);
     free(p->chart_x);
     free(p->chart_y);
+    free(p->chart_turned);
     p->chart_x = p->chart_y = NULL;
+    p->chart_turned = NULL;
 }
 
 static int content_size(float extent)
@@ -251,10 +45,13 @@ static int content_size(float extent)
     return c < 1.0 ? 1 : (int)c;
 }
 
+/* Authored layouts keep their orientation: the runtime maps TEXCOORD_1 into the rectangle. */
+static int may_turn(const bk_uv_object *uv) { return uv->source == BK_UV_GENERATED; }
+
 /* Generates charts at `density` and packs them; returns LBK_OK with *fits = 0 when the
  * result exceeds max_page (the caller lowers the density). */
 static lbk_result pack_object(const bk_scene *scene, uint32_t object, double density, const bk_uv_options *uvo,
-                              int margin, int max_page, obj_pack *p, int *fits)
+                              int margin, int max_page, int score_align, obj_pack *p, int *fits)
 {
     *fits = 1;
     obj_pack_free(p);
@@ -264,10 +61,11 @@ static lbk_result pack_object(const bk_scene *scene, uint32_t object, double den
     p->w = p->h = 0;
     if (n == 0) return LBK_OK;
     if (n > (size_t)INT32_MAX / 2) return LBK_ERR_LIMIT;
-    pk_rect *rc = malloc(n * sizeof *rc);
+    bk_pack_rect *rc = malloc(n * sizeof *rc);
     p->chart_x = malloc(n * sizeof *p->chart_x);
     p->chart_y = malloc(n * sizeof *p->chart_y);
-    if (!rc || !p->chart_x || !p->chart_y) {
+    p->chart_turned = malloc(n * sizeof *p->chart_turned);
+    if (!rc || !p->chart_x || !p->chart_y || !p->chart_turned) {
         free(rc);
         return LBK_ERR_OUT_OF_MEMORY;
     }
@@ -279,13 +77,14 @@ static lbk_result pack_object(const bk_scene *scene, uint32_t object, double den
             *fits = 0;
             return LBK_OK;
         }
+        memset(&rc[i], 0, sizeof rc[i]);
         rc[i].w = (int)bw;
         rc[i].h = (int)bh;
         rc[i].id = (uint32_t)i;
-        rc[i].placed = 0;
+        rc[i].turnable = (uint8_t)may_turn(&p->uv);
     }
     int ow, oh;
-    int ok = pack_tight(rc, (int)n, max_page, max_page, 1, &ow, &oh);
+    int ok = bk_pack_tight(rc, (int)n, max_page, max_page, 1, score_align, &ow, &oh);
     if (ok < 0) {
         free(rc);
         return LBK_ERR_OUT_OF_MEMORY;
@@ -298,6 +97,7 @@ static lbk_result pack_object(const bk_scene *scene, uint32_t object, double den
     for (size_t i = 0; i < n; i++) {
         p->chart_x[rc[i].id] = rc[i].x;
         p->chart_y[rc[i].id] = rc[i].y;
+        p->chart_turned[rc[i].id] = rc[i].turned;
     }
     free(rc);
     p->w = ow;
@@ -442,16 +242,19 @@ static lbk_result build_vertices(const bk_scene *scene, bk_atlas *a)
 }
 
 /* ---------------------------------------------------------------------------------------- */
+/* The atlas: objects → rectangles within the budget → pages → charts in page coordinates    */
 
-lbk_result bk_atlas_build(const bk_scene *scene, const uint8_t *lightmapped, const bk_atlas_options *opt,
-                          bk_atlas *out)
+/* The options with their defaults and caps applied. */
+typedef struct atlas_limits {
+    int page, max_page;  /* default and largest page side, multiples of 4 */
+    int margin;          /* ceil(padding / 2) */
+    int lone;            /* one object only: its rectangle becomes the page (sides multiples of 4) */
+    uint64_t budget;     /* texels */
+    bk_uv_options uv;
+} atlas_limits;
+
+static lbk_result resolve_limits(const bk_atlas_options *opt, atlas_limits *l)
 {
-    if (!out) return LBK_ERR_INVALID_ARGUMENT;
-    memset(out, 0, sizeof *out);
-    if (!scene || (scene->object_count && !scene->objects) || (scene->tri_count && !scene->tris))
-        return LBK_ERR_INVALID_ARGUMENT;
-    if (scene->tri_count > (size_t)INT32_MAX || scene->object_count > (size_t)INT32_MAX) return LBK_ERR_LIMIT;
-
     int page = opt && opt->page_size > 0 ? opt->page_size : DEFAULT_PAGE;
     int max_page = opt && opt->max_page_size > 0 ? opt->max_page_size : DEFAULT_MAX_PAGE;
     if (max_page > 16384) max_page = 16384;
@@ -461,81 +264,106 @@ lbk_result bk_atlas_build(const bk_scene *scene, const uint8_t *lightmapped, con
     if (page > max_page) page = max_page;
     int padding = opt && opt->padding > 0 ? opt->padding : DEFAULT_PADDING;
     if (padding > 64) padding = 64;
-    int margin = (padding + 1) / 2;
-    uint64_t budget = opt && opt->texel_budget > 0 ? opt->texel_budget : DEFAULT_BUDGET;
-    bk_uv_options uvo = {0};
-    if (opt) uvo = opt->uv;
-    if (uvo.max_chart_texels <= 0 || uvo.max_chart_texels > page - 2 * margin) uvo.max_chart_texels = page - 2 * margin;
-    if (uvo.max_chart_texels < 1) return LBK_ERR_INVALID_ARGUMENT;
+    l->page = page;
+    l->max_page = max_page;
+    l->margin = (padding + 1) / 2;
+    l->budget = opt && opt->texel_budget > 0 ? opt->texel_budget : DEFAULT_BUDGET;
+    memset(&l->uv, 0, sizeof l->uv);
+    if (opt) l->uv = opt->uv;
+    int room = page - 2 * l->margin;
+    if (l->uv.max_chart_texels <= 0 || l->uv.max_chart_texels > room) l->uv.max_chart_texels = room;
+    return l->uv.max_chart_texels < 1 ? LBK_ERR_INVALID_ARGUMENT : LBK_OK;
+}
 
-    out->padding = 2 * margin;
-    out->margin = margin;
-    out->density_scale = 1.0f;
-    out->scene_object_count = scene->object_count;
-    out->scene_tri_count = scene->tri_count;
-
+/* One slot per lightmapped object (out->objects, out->object_slot) with the density it asks
+ * for; *op_out gets the matching packing state, zeroed. */
+static lbk_result select_objects(const bk_scene *scene, const uint8_t *lightmapped, const bk_atlas_options *opt,
+                                 bk_atlas *out, obj_pack **op_out)
+{
     size_t nobj = 0;
     for (size_t i = 0; i < scene->object_count; i++)
         if (!lightmapped || lightmapped[i]) nobj++;
     obj_pack *op = calloc(nobj ? nobj : 1, sizeof *op);
+    *op_out = op;
     out->object_slot = malloc((scene->object_count ? scene->object_count : 1) * sizeof *out->object_slot);
     out->objects = calloc(nobj ? nobj : 1, sizeof *out->objects);
-    lbk_result r = (op && out->object_slot && out->objects) ? LBK_OK : LBK_ERR_OUT_OF_MEMORY;
+    if (!op || !out->object_slot || !out->objects) return LBK_ERR_OUT_OF_MEMORY;
+    out->object_count = nobj;
     size_t slot = 0;
-    for (size_t i = 0; r == LBK_OK && i < scene->object_count; i++) {
+    for (size_t i = 0; i < scene->object_count; i++) {
         out->object_slot[i] = -1;
         if (lightmapped && !lightmapped[i]) continue;
         const bk_object *ob = &scene->objects[i];
-        if ((uint64_t)ob->first_tri + ob->tri_count > scene->tri_count) r = LBK_ERR_INVALID_ARGUMENT;
+        if ((uint64_t)ob->first_tri + ob->tri_count > scene->tri_count) return LBK_ERR_INVALID_ARGUMENT;
         out->object_slot[i] = (int32_t)slot;
         out->objects[slot].object = (uint32_t)i;
         op[slot].requested = bk_atlas_requested_density(scene, (uint32_t)i, opt);
         op[slot].fit_scale = 1.0f;
         slot++;
     }
-    out->object_count = nobj;
+    return LBK_OK;
+}
 
-    /* charts and object rectangles, shrinking densities until within budget */
+/* Charts of one object at its density × scale, lowering the object's own fit_scale until its
+ * rectangle fits one max page. */
+static lbk_result pack_object_to_fit(const bk_scene *scene, uint32_t object, double scale, const atlas_limits *l,
+                                     obj_pack *p)
+{
+    for (int attempt = 0; attempt < 24; attempt++) {
+        int fits;
+        double d = p->requested * scale * p->fit_scale;
+        lbk_result r = pack_object(scene, object, d, &l->uv, l->margin, l->max_page, l->lone ? 4 : 1, p, &fits);
+        if (r != LBK_OK || fits) return r;
+        p->fit_scale *= 0.8f;
+    }
+    return LBK_ERR_LIMIT;
+}
+
+/* Charts and object rectangles of every object; when their texels exceed the budget, every
+ * density is scaled by the same factor and all are packed again (noted in out->note). */
+static lbk_result pack_objects_within_budget(const bk_scene *scene, bk_atlas *out, obj_pack *op, const atlas_limits *l)
+{
     double scale = 1.0;
-    for (int round = 0; r == LBK_OK && round < 12; round++) {
+    for (int round = 0;; round++) {
         double total = 0.0;
-        for (size_t s = 0; r == LBK_OK && s < nobj; s++) {
-            for (int attempt = 0; attempt < 24; attempt++) {
-                int fits;
-                double d = op[s].requested * scale * op[s].fit_scale;
-                r = pack_object(scene, out->objects[s].object, d, &uvo, margin, max_page, &op[s], &fits);
-                if (r != LBK_OK || fits) break;
-                op[s].fit_scale *= 0.8f;
-                if (attempt == 23) r = LBK_ERR_LIMIT;
-            }
+        for (size_t s = 0; s < out->object_count; s++) {
+            lbk_result r = pack_object_to_fit(scene, out->objects[s].object, scale, l, &op[s]);
+            if (r != LBK_OK) return r;
             total += (double)op[s].w * op[s].h;
         }
-        if (r != LBK_OK || total <= (double)budget) break;
-        double f = sqrt((double)budget / total) * 0.98;
-        scale *= f;
-        if (round == 11) r = LBK_ERR_LIMIT;
+        if (total <= (double)l->budget) break;
+        if (round == 11) return LBK_ERR_LIMIT;
+        scale *= sqrt((double)l->budget / total) * 0.98;
     }
-    if (r == LBK_OK && scale < 1.0) {
+    if (scale < 1.0) {
         out->density_scale = (float)scale;
-        snprintf(out->note, sizeof out->note,
-                 "texel budget %llu exceeded: every density scaled by %.4f", (unsigned long long)budget, scale);
+        snprintf(out->note, sizeof out->note, "texel budget %llu exceeded: every density scaled by %.4f",
+                 (unsigned long long)l->budget, scale);
     }
+    return LBK_OK;
+}
 
-    /* page size: one object rectangle may need more than the default */
-    int psize = page;
-    for (size_t s = 0; r == LBK_OK && s < nobj; s++) {
+/* The page side: the default, or more when one object rectangle needs it (at most max_page). */
+static int page_side(const obj_pack *op, size_t nobj, const atlas_limits *l)
+{
+    int psize = l->page;
+    for (size_t s = 0; s < nobj; s++) {
         int m = op[s].w > op[s].h ? op[s].w : op[s].h;
-        if (m > psize) psize = round4(m) > max_page ? max_page : round4(m);
+        if (m > psize) psize = round4(m) > l->max_page ? l->max_page : round4(m);
     }
+    return psize;
+}
 
-    /* object rectangles → pages */
-    pk_rect *rc = NULL;
+/* Fills the object records from their packing (uv source, densities, notes) and returns the
+ * rectangles of the objects that have charts, sorted for the packer. */
+static lbk_result object_rects(bk_atlas *out, const obj_pack *op, int max_page, bk_pack_rect **rc_out, int *nrect_out)
+{
+    size_t nobj = out->object_count;
+    bk_pack_rect *rc = malloc((nobj ? nobj : 1) * sizeof *rc);
+    *rc_out = rc;
+    if (!rc) return LBK_ERR_OUT_OF_MEMORY;
     int nrect = 0;
-    if (r == LBK_OK) {
-        rc = malloc((nobj ? nobj : 1) * sizeof *rc);
-        if (!rc) r = LBK_ERR_OUT_OF_MEMORY;
-    }
-    for (size_t s = 0; r == LBK_OK && s < nobj; s++) {
+    for (size_t s = 0; s < nobj; s++) {
         bk_atlas_object *o = &out->objects[s];
         o->page = -1;
         o->uv_source = op[s].uv.source;
@@ -544,38 +372,35 @@ lbk_result bk_atlas_build(const bk_scene *scene, const uint8_t *lightmapped, con
         o->degenerate_tris = (uint32_t)op[s].uv.degenerate_count;
         snprintf(o->note, sizeof o->note, "%s", op[s].uv.note);
         if (op[s].fit_scale < 1.0f) {
-            size_t l = strlen(o->note);
-            snprintf(o->note + l, sizeof o->note - l, "%sdensity lowered to %g texels/m to fit a %d page",
-                     l ? "; " : "", o->density, max_page);
+            size_t len = strlen(o->note);
+            snprintf(o->note + len, sizeof o->note - len, "%sdensity lowered to %g texels/m to fit a %d page",
+                     len ? "; " : "", o->density, max_page);
         }
         if (op[s].uv.chart_count == 0) continue;
+        memset(&rc[nrect], 0, sizeof rc[nrect]);
         rc[nrect].w = op[s].w;
         rc[nrect].h = op[s].h;
         rc[nrect].id = (uint32_t)s;
-        rc[nrect].placed = 0;
+        rc[nrect].turnable = (uint8_t)may_turn(&op[s].uv);
         nrect++;
     }
-    if (r == LBK_OK) qsort(rc, (size_t)nrect, sizeof *rc, cmp_rect);
-    int *rect_page = NULL;
+    bk_pack_sort(rc, nrect);
+    *nrect_out = nrect;
+    return LBK_OK;
+}
+
+/* Fills psize × psize pages one after the other with the sorted rectangles (out->pages);
+ * rect_page[i] gets the page of rc[i]. */
+static lbk_result fill_pages(bk_atlas *out, bk_pack_rect *rc, int nrect, int psize, int *rect_page)
+{
+    out->pages = malloc((size_t)(nrect ? nrect : 1) * sizeof *out->pages);
+    if (!out->pages) return LBK_ERR_OUT_OF_MEMORY;
     size_t npages = 0;
-    if (r == LBK_OK) {
-        rect_page = malloc((size_t)(nrect ? nrect : 1) * sizeof *rect_page);
-        out->pages = malloc((size_t)(nrect ? nrect : 1) * sizeof *out->pages);
-        if (!rect_page || !out->pages) r = LBK_ERR_OUT_OF_MEMORY;
-    }
-    int remaining = nrect;
-    while (r == LBK_OK && remaining > 0) {
+    for (int remaining = nrect; remaining > 0;) {
         int uw, uh;
-        /* snapshot which were placed before this page */
-        int placed = pack_into(rc, nrect, psize, psize, &uw, &uh);
-        if (placed < 0) {
-            r = LBK_ERR_OUT_OF_MEMORY;
-            break;
-        }
-        if (placed == 0) {
-            r = LBK_ERR_LIMIT; /* cannot happen: every rectangle fits an empty page */
-            break;
-        }
+        int placed = bk_pack_into(rc, nrect, psize, psize, &uw, &uh);
+        if (placed < 0) return LBK_ERR_OUT_OF_MEMORY;
+        if (placed == 0) return LBK_ERR_LIMIT; /* cannot happen: every rectangle fits an empty page */
         for (int i = 0; i < nrect; i++)
             if (rc[i].placed == 1) {
                 rect_page[i] = (int)npages;
@@ -583,111 +408,198 @@ lbk_result bk_atlas_build(const bk_scene *scene, const uint8_t *lightmapped, con
             }
         out->pages[npages].width = psize;
         out->pages[npages].height = psize;
-        npages++;
+        out->page_count = ++npages;
         remaining -= placed;
     }
-    /* shrink the last page: repack its rectangles as tightly as possible */
-    if (r == LBK_OK && npages > 0) {
-        int last = (int)npages - 1, cnt = 0;
-        pk_rect *lr = malloc((size_t)nrect * sizeof *lr);
-        int *idx = malloc((size_t)nrect * sizeof *idx);
-        if (!lr || !idx) r = LBK_ERR_OUT_OF_MEMORY;
-        for (int i = 0; r == LBK_OK && i < nrect; i++)
-            if (rect_page[i] == last) {
-                lr[cnt] = rc[i];
-                lr[cnt].id = (uint32_t)i;
-                lr[cnt].placed = 0;
-                cnt++;
-            }
-        int pw = 0, ph = 0;
-        int ok = r == LBK_OK ? pack_tight(lr, cnt, psize, psize, 4, &pw, &ph) : -1;
-        if (r == LBK_OK && ok < 0) r = LBK_ERR_OUT_OF_MEMORY;
-        if (r == LBK_OK && ok == 1) {
-            for (int i = 0; i < cnt; i++) {
-                rc[lr[i].id].x = lr[i].x;
-                rc[lr[i].id].y = lr[i].y;
-            }
-            out->pages[last].width = pw;
-            out->pages[last].height = ph;
-        } else if (r == LBK_OK) {
-            /* keep the first packing; shrink to its extent */
-            int uw = 0, uh = 0;
-            for (int i = 0; i < nrect; i++)
-                if (rect_page[i] == last) {
-                    if (rc[i].x + rc[i].w > uw) uw = rc[i].x + rc[i].w;
-                    if (rc[i].y + rc[i].h > uh) uh = rc[i].y + rc[i].h;
-                }
-            out->pages[last].width = round4(uw);
-            out->pages[last].height = round4(uh);
+    return LBK_OK;
+}
+
+/* The last page is usually part full: repack its rectangles as tightly as possible, or, when
+ * that finds nothing, keep the first packing and crop the page to its extent. */
+static lbk_result shrink_last_page(bk_atlas *out, bk_pack_rect *rc, int nrect, const int *rect_page, int psize)
+{
+    if (out->page_count == 0) return LBK_OK;
+    int last = (int)out->page_count - 1, cnt = 0;
+    bk_pack_rect *lr = malloc((size_t)nrect * sizeof *lr);
+    if (!lr) return LBK_ERR_OUT_OF_MEMORY;
+    for (int i = 0; i < nrect; i++)
+        if (rect_page[i] == last) {
+            lr[cnt] = rc[i];
+            lr[cnt].id = (uint32_t)i;
+            lr[cnt].placed = 0;
+            cnt++;
         }
-        free(lr);
-        free(idx);
+    int pw = 0, ph = 0;
+    int ok = bk_pack_tight(lr, cnt, psize, psize, 4, 4, &pw, &ph);
+    if (ok == 1) {
+        for (int i = 0; i < cnt; i++) {
+            rc[lr[i].id].x = lr[i].x;
+            rc[lr[i].id].y = lr[i].y;
+            rc[lr[i].id].turned = lr[i].turned;
+        }
+        out->pages[last].width = pw;
+        out->pages[last].height = ph;
+    } else if (ok == 0) {
+        int uw = 0, uh = 0;
+        for (int i = 0; i < nrect; i++)
+            if (rect_page[i] == last) {
+                int fw = rc[i].turned ? rc[i].h : rc[i].w, fh = rc[i].turned ? rc[i].w : rc[i].h;
+                if (rc[i].x + fw > uw) uw = rc[i].x + fw;
+                if (rc[i].y + fh > uh) uh = rc[i].y + fh;
+            }
+        out->pages[last].width = round4(uw);
+        out->pages[last].height = round4(uh);
     }
-    out->page_count = npages;
-    for (size_t p = 0; p < npages; p++)
-        out->texels += (uint64_t)out->pages[p].width * (uint64_t)out->pages[p].height;
-    for (int i = 0; r == LBK_OK && i < nrect; i++) {
-        bk_atlas_object *o = &out->objects[rc[i].id];
-        o->page = rect_page[i];
-        o->x = rc[i].x;
-        o->y = rc[i].y;
-        o->w = rc[i].w;
-        o->h = rc[i].h;
+    free(lr);
+    return ok < 0 ? LBK_ERR_OUT_OF_MEMORY : LBK_OK;
+}
+
+/* Object rectangles → pages: out->pages, out->texels and each object's page and rectangle. */
+static lbk_result pack_pages(bk_atlas *out, obj_pack *op, const atlas_limits *l)
+{
+    int psize = page_side(op, out->object_count, l);
+    bk_pack_rect *rc = NULL;
+    int nrect = 0;
+    lbk_result r = object_rects(out, op, l->max_page, &rc, &nrect);
+    int *rect_page = r == LBK_OK ? malloc((size_t)(nrect ? nrect : 1) * sizeof *rect_page) : NULL;
+    if (r == LBK_OK && !rect_page) r = LBK_ERR_OUT_OF_MEMORY;
+    if (r == LBK_OK) r = fill_pages(out, rc, nrect, psize, rect_page);
+    if (r == LBK_OK) r = shrink_last_page(out, rc, nrect, rect_page, psize);
+    if (r == LBK_OK) {
+        for (size_t p = 0; p < out->page_count; p++)
+            out->texels += (uint64_t)out->pages[p].width * (uint64_t)out->pages[p].height;
+        for (int i = 0; i < nrect; i++) {
+            bk_atlas_object *o = &out->objects[rc[i].id];
+            o->page = rect_page[i];
+            o->x = rc[i].x;
+            o->y = rc[i].y;
+            o->w = rc[i].turned ? rc[i].h : rc[i].w;
+            o->h = rc[i].turned ? rc[i].w : rc[i].h;
+            op[rc[i].id].turned = rc[i].turned;
+        }
     }
     free(rc);
     free(rect_page);
+    return r;
+}
 
-    /* charts and triangles in page coordinates */
-    size_t nchart = 0, ntri = 0;
+/* A quarter turn of point (x, y) of a rectangle w wide: (y, w − x), a rotation (not a
+ * mirror) that maps [0, w] × [0, h] onto [0, h] × [0, w]. */
+static void quarter_turn(double *x, double *y, double w)
+{
+    double nx = *y;
+    *y = w - *x;
+    *x = nx;
+}
+
+/* Chart k of object s in page coordinates: its content rectangle, and its triangles appended
+ * from entry t. A chart turned inside its object and an object turned in its page compose. */
+static void place_chart(const bk_scene *scene, bk_atlas *out, const obj_pack *op, size_t s, size_t k, uint32_t c,
+                        size_t t, int margin)
+{
+    const bk_atlas_object *o = &out->objects[s];
+    const bk_uv_object *u = &op[s].uv;
+    bk_atlas_chart *ch = &out->charts[c];
+    int cw = content_size(u->charts[k].width), chh = content_size(u->charts[k].height);
+    int tc = op[s].chart_turned[k] != 0, to = op[s].turned != 0;
+    /* content rectangle inside the object's rectangle as packed, then in the page */
+    int cx = op[s].chart_x[k] + margin, cy = op[s].chart_y[k] + margin;
+    int cwt = tc ? chh : cw, cht = tc ? cw : chh;
+    ch->slot = (uint32_t)s;
+    ch->page = o->page;
+    ch->x = o->x + (to ? cy : cx);
+    ch->y = o->y + (to ? op[s].w - cx - cwt : cy);
+    ch->w = to ? cht : cwt;
+    ch->h = to ? cwt : cht;
+    ch->quarter_turns = (uint8_t)(tc + to);
+    ch->first = (uint32_t)t;
+    ch->count = u->charts[k].count;
+    if (u->source == BK_UV_AUTHORED) { /* one chart, never turned: its origin is uv1_min (LMUV) */
+        bk_atlas_object *ao = &out->objects[s];
+        ao->uv1_scale = u->uv1_scale;
+        for (int q = 0; q < 2; q++) {
+            ao->uv1_offset[q] = (q ? ch->y : ch->x) - u->uv1_min[q] * u->uv1_scale;
+            ao->uv1_min[q] = u->uv1_min[q];
+            ao->uv1_max[q] = u->uv1_max[q];
+        }
+    }
+    for (uint32_t j = 0; j < u->charts[k].count; j++, t++) {
+        size_t src = (size_t)u->charts[k].first + j;
+        out->tris[t] = u->tris[src];
+        out->tri_chart[t] = c;
+        out->scene_tri_entry[u->tris[src]] = (int32_t)t;
+        for (int q = 0; q < 3; q++) {
+            double x = u->uv[6 * src + 2 * (size_t)q], y = u->uv[6 * src + 2 * (size_t)q + 1];
+            if (tc) quarter_turn(&x, &y, cw);
+            x += cx;
+            y += cy;
+            if (to) quarter_turn(&x, &y, op[s].w);
+            out->tri_uv[6 * t + 2 * (size_t)q] = (float)(o->x + x);
+            out->tri_uv[6 * t + 2 * (size_t)q + 1] = (float)(o->y + y);
+        }
+    }
+    (void)scene;
+}
+
+/* Charts and triangles in page coordinates: every chart's block sits at its object's
+ * rectangle plus its offset inside it, its content one margin further in. */
+static lbk_result place_charts(const bk_scene *scene, bk_atlas *out, const obj_pack *op, int margin)
+{
+    size_t nobj = out->object_count, nchart = 0, ntri = 0;
     for (size_t s = 0; s < nobj; s++) {
         nchart += op[s].uv.chart_count;
         ntri += op[s].uv.tri_count;
     }
-    if (r == LBK_OK && (nchart > (size_t)INT32_MAX || ntri > (size_t)INT32_MAX)) r = LBK_ERR_LIMIT;
-    if (r == LBK_OK) {
-        out->charts = malloc((nchart ? nchart : 1) * sizeof *out->charts);
-        out->tris = malloc((ntri ? ntri : 1) * sizeof *out->tris);
-        out->tri_chart = malloc((ntri ? ntri : 1) * sizeof *out->tri_chart);
-        out->tri_uv = malloc((ntri ? ntri : 1) * 6 * sizeof *out->tri_uv);
-        out->scene_tri_entry = malloc((scene->tri_count ? scene->tri_count : 1) * sizeof *out->scene_tri_entry);
-        if (!out->charts || !out->tris || !out->tri_chart || !out->tri_uv || !out->scene_tri_entry)
-            r = LBK_ERR_OUT_OF_MEMORY;
-    }
-    if (r == LBK_OK) {
-        for (size_t i = 0; i < scene->tri_count; i++) out->scene_tri_entry[i] = -1;
-        size_t c = 0, t = 0;
-        for (size_t s = 0; s < nobj; s++) {
-            bk_atlas_object *o = &out->objects[s];
-            const bk_uv_object *u = &op[s].uv;
-            o->first_chart = (uint32_t)c;
-            o->chart_count = (uint32_t)u->chart_count;
-            for (size_t k = 0; k < u->chart_count; k++, c++) {
-                bk_atlas_chart *ch = &out->charts[c];
-                ch->slot = (uint32_t)s;
-                ch->page = o->page;
-                ch->x = o->x + op[s].chart_x[k] + margin;
-                ch->y = o->y + op[s].chart_y[k] + margin;
-                ch->w = content_size(u->charts[k].width);
-                ch->h = content_size(u->charts[k].height);
-                ch->first = (uint32_t)t;
-                ch->count = u->charts[k].count;
-                for (uint32_t j = 0; j < u->charts[k].count; j++, t++) {
-                    size_t src = (size_t)u->charts[k].first + j;
-                    out->tris[t] = u->tris[src];
-                    out->tri_chart[t] = (uint32_t)c;
-                    out->scene_tri_entry[u->tris[src]] = (int32_t)t;
-                    for (int q = 0; q < 3; q++) {
-                        out->tri_uv[6 * t + 2 * (size_t)q] = (float)ch->x + u->uv[6 * src + 2 * (size_t)q];
-                        out->tri_uv[6 * t + 2 * (size_t)q + 1] = (float)ch->y + u->uv[6 * src + 2 * (size_t)q + 1];
-                    }
-                }
-            }
+    if (nchart > (size_t)INT32_MAX || ntri > (size_t)INT32_MAX) return LBK_ERR_LIMIT;
+    out->charts = malloc((nchart ? nchart : 1) * sizeof *out->charts);
+    out->tris = malloc((ntri ? ntri : 1) * sizeof *out->tris);
+    out->tri_chart = malloc((ntri ? ntri : 1) * sizeof *out->tri_chart);
+    out->tri_uv = malloc((ntri ? ntri : 1) * 6 * sizeof *out->tri_uv);
+    out->scene_tri_entry = malloc((scene->tri_count ? scene->tri_count : 1) * sizeof *out->scene_tri_entry);
+    if (!out->charts || !out->tris || !out->tri_chart || !out->tri_uv || !out->scene_tri_entry)
+        return LBK_ERR_OUT_OF_MEMORY;
+    for (size_t i = 0; i < scene->tri_count; i++) out->scene_tri_entry[i] = -1;
+    size_t c = 0, t = 0;
+    for (size_t s = 0; s < nobj; s++) {
+        bk_atlas_object *o = &out->objects[s];
+        o->first_chart = (uint32_t)c;
+        o->chart_count = (uint32_t)op[s].uv.chart_count;
+        for (size_t k = 0; k < op[s].uv.chart_count; k++, c++) {
+            place_chart(scene, out, op, s, k, (uint32_t)c, t, margin);
+            t += op[s].uv.charts[k].count;
         }
-        out->chart_count = nchart;
-        out->tri_count = ntri;
-        r = build_vertices(scene, out);
     }
-    for (size_t s = 0; s < nobj; s++) obj_pack_free(&op[s]);
+    out->chart_count = nchart;
+    out->tri_count = ntri;
+    return LBK_OK;
+}
+
+lbk_result bk_atlas_build(const bk_scene *scene, const uint8_t *lightmapped, const bk_atlas_options *opt,
+                          bk_atlas *out)
+{
+    if (!out) return LBK_ERR_INVALID_ARGUMENT;
+    memset(out, 0, sizeof *out);
+    if (!scene || (scene->object_count && !scene->objects) || (scene->tri_count && !scene->tris))
+        return LBK_ERR_INVALID_ARGUMENT;
+    if (scene->tri_count > (size_t)INT32_MAX || scene->object_count > (size_t)INT32_MAX) return LBK_ERR_LIMIT;
+    atlas_limits lim;
+    lbk_result r = resolve_limits(opt, &lim);
+    if (r != LBK_OK) return r;
+
+    out->padding = 2 * lim.margin;
+    out->margin = lim.margin;
+    out->density_scale = 1.0f;
+    out->scene_object_count = scene->object_count;
+    out->scene_tri_count = scene->tri_count;
+    obj_pack *op = NULL;
+    r = select_objects(scene, lightmapped, opt, out, &op);
+    lim.lone = out->object_count == 1;
+    if (r == LBK_OK) r = pack_objects_within_budget(scene, out, op, &lim);
+    if (r == LBK_OK) r = pack_pages(out, op, &lim);
+    if (r == LBK_OK) r = place_charts(scene, out, op, lim.margin);
+    if (r == LBK_OK) r = build_vertices(scene, out);
+    if (op)
+        for (size_t s = 0; s < out->object_count; s++) obj_pack_free(&op[s]);
     free(op);
     if (r != LBK_OK) bk_atlas_free(out);
     return r;

@@ -10,14 +10,23 @@
  * - Each chart owns a block of its content size (ceil of its extent, at least 1×1) plus a
  *   margin of ceil(padding/2) texels on every side; blocks never overlap, so the content of
  *   two charts is at least `padding` (default 2) texels apart and every chart has a ring of
- *   margin texels of its own for dilation (bilinear filtering reads one texel around).
+ *   margin texels of its own: bilinear filtering reads one texel around the content, and
+ *   texels.h bakes exactly those texels (its conservative coverage), so padding 2 is enough
+ *   for filtering never to read another chart.
  * - Page size: page_size (default 1024, rounded up to a multiple of 4; more if one object
  *   needs it, up to max_page_size). The last page is shrunk to the area it uses (both sides
  *   multiples of 4 for block compression), and repacked to be as small as it can be, so a
  *   small scene gets one small page.
- * - Packing: skyline bottom-left, rectangles sorted by height, then width, then index. The
- *   chart packing inside an object tries a few widths and keeps the smallest area.
- *   Deterministic: no floating-point decisions depend on anything but the input.
+ * - Packing: MaxRects, best short side fit (pack.h), rectangles sorted by longer side, then
+ *   shorter side, then index; inside an object the packing tries a sweep of widths, each with
+ *   the least height found by bisection, and keeps the smallest area (both sides rounded up to
+ *   4 when the object is the only one, since its rectangle then becomes the page).
+ *   Generated charts may be placed turned by a quarter (a rotation, never a mirror), and so may
+ *   the rectangle of an object whose charts are all generated; the two turns compose
+ *   (bk_atlas_chart.quarter_turns). Authored TEXCOORD_1 layouts are never turned: the runtime
+ *   maps them linearly into the object's rectangle. Triangle corners (tri_uv, vertex_uv) are
+ *   in final page coordinates, so the tangent frame (texels.h: T = dP/du on the page) turns
+ *   with the chart. Deterministic: integer decisions on the input only, no threads.
  * - Density per object: density_override if > 0, else bk_object.texel_density if > 0, else
  *   default_density. If the summed object rectangles exceed texel_budget, every density is
  *   scaled by the same factor (density_scale < 1, reported) until they fit. An object too
@@ -64,13 +73,18 @@ typedef struct bk_atlas_object {
     uint32_t first_chart, chart_count;
     uint32_t degenerate_tris;
     char note[192];          /* uv1 rejection reason, density changes; "" */
+    /* BK_UV_AUTHORED: page texel coordinate X = uv1_offset[0] + uv1_scale · u1, Y likewise (the
+     * rule of spec/container.md §16.3 in real arithmetic); uv1_min/max: the uv1 bounding box */
+    double uv1_scale, uv1_offset[2], uv1_min[2], uv1_max[2];
 } bk_atlas_object;
 
 typedef struct bk_atlas_chart {
     uint32_t slot;           /* index into bk_atlas.objects */
     int32_t page;
-    int32_t x, y, w, h;      /* content rectangle in page texels; every covered texel is inside */
+    int32_t x, y, w, h;      /* content rectangle in page texels: every corner of its triangles is
+                                inside; baked texels reach one texel further (texels.h) */
     uint32_t first, count;   /* range in bk_atlas.tris */
+    uint8_t quarter_turns;   /* 0-2: turned by the packer (inside its object, with its object) */
 } bk_atlas_chart;
 
 typedef struct bk_atlas {

@@ -3,13 +3,12 @@
 
 #include <float.h>
 #include <math.h>
-#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "bake/layout/uv_math.h"
 #include "bake/layout/uv_raster.h"
+#include "bake/util/parallel.h"
 
 /* ---------------------------------------------------------------------------------------- */
 /* Tangent frame                                                                            */
@@ -126,6 +125,80 @@ static void make_receiver(const bk_scene *s, const bk_atlas *a, uint32_t e, cons
     r->flags = BK_TEXEL_VALID;
 }
 
+/* Claims for each triangle of the chart the texels whose centre it covers (distance -1) or
+ * that bilinear filtering reads somewhere on it (squared distance to its closest point); the
+ * nearest claim wins, the first on ties. idx / bst: the chart's page in index / best. */
+static void rasterise_chart(const bk_atlas *a, const bk_atlas_chart *ch, int32_t *idx, float *bst)
+{
+    int pw = a->pages[ch->page].width, ph = a->pages[ch->page].height;
+    for (uint32_t e = ch->first; e < ch->first + ch->count; e++) {
+        bk_rtri t;
+        if (!bk_rtri_setup(a->tri_uv + 6 * (size_t)e, &t)) continue;
+        double mnx = fmin(t.x[0], fmin(t.x[1], t.x[2])), mxx = fmax(t.x[0], fmax(t.x[1], t.x[2]));
+        double mny = fmin(t.y[0], fmin(t.y[1], t.y[2])), mxy = fmax(t.y[0], fmax(t.y[1], t.y[2]));
+        int x0 = (int)fmax(0.0, floor(mnx) - 1), x1 = (int)fmin((double)pw - 1, floor(mxx) + 1);
+        int y0 = (int)fmax(0.0, floor(mny) - 1), y1 = (int)fmin((double)ph - 1, floor(mxy) + 1);
+        for (int y = y0; y <= y1; y++)
+            for (int x = x0; x <= x1; x++) {
+                double cx = x + 0.5, cy = y + 0.5;
+                float d;
+                if (bk_rtri_inside(&t, cx, cy, NULL)) {
+                    d = -1.0f;
+                } else {
+                    /* the bilinear footprint: filtering at some point of the triangle reads it */
+                    if (!bk_rtri_meets_square(&t, cx, cy, 1.0)) continue;
+                    d = (float)bk_rtri_closest(&t, cx, cy, NULL, NULL, NULL);
+                }
+                size_t i = (size_t)y * (size_t)pw + (size_t)x;
+                if (d < bst[i]) {
+                    bst[i] = d;
+                    idx[i] = (int32_t)e;
+                }
+            }
+    }
+}
+
+/* One receiver per claimed texel, pages in order and rows top to bottom; index switches from
+ * the owning triangle entry to the receiver. A texel whose centre lies outside its triangle
+ * samples the triangle's closest point and is marked BK_TEXEL_EDGE. */
+static lbk_result emit_receivers(const bk_scene *s, const bk_atlas *a, const float *best, bk_texels *out)
+{
+    size_t total = out->page_offset[out->page_count], count = 0;
+    for (size_t i = 0; i < total; i++) count += out->index[i] >= 0;
+    out->receivers = malloc((count ? count : 1) * sizeof *out->receivers);
+    if (!out->receivers) return LBK_ERR_OUT_OF_MEMORY;
+    size_t r = 0;
+    for (size_t p = 0; p < out->page_count; p++) {
+        int pw = a->pages[p].width, ph = a->pages[p].height;
+        int32_t *idx = out->index + out->page_offset[p];
+        const float *bst = best + out->page_offset[p];
+        for (int y = 0; y < ph; y++)
+            for (int x = 0; x < pw; x++) {
+                size_t i = (size_t)y * (size_t)pw + (size_t)x;
+                if (idx[i] < 0) continue;
+                uint32_t e = (uint32_t)idx[i];
+                bk_rtri t;
+                bk_rtri_setup(a->tri_uv + 6 * (size_t)e, &t);
+                double w[3];
+                int edge = 0;
+                if (!(bst[i] < 0.0f) || !bk_rtri_inside(&t, x + 0.5, y + 0.5, w)) {
+                    bk_rtri_closest(&t, x + 0.5, y + 0.5, w, NULL, NULL);
+                    edge = 1;
+                }
+                bk_texel *rc = &out->receivers[r];
+                make_receiver(s, a, e, w, rc);
+                if (edge) rc->flags |= BK_TEXEL_EDGE;
+                rc->page = (uint32_t)p;
+                rc->x = (uint16_t)x;
+                rc->y = (uint16_t)y;
+                idx[i] = (int32_t)r;
+                r++;
+            }
+    }
+    out->count = count;
+    return LBK_OK;
+}
+
 lbk_result bk_texels_build(const bk_scene *s, const bk_atlas *a, bk_texels *out)
 {
     if (!out) return LBK_ERR_INVALID_ARGUMENT;
@@ -165,75 +238,12 @@ lbk_result bk_texels_build(const bk_scene *s, const bk_atlas *a, bk_texels *out)
     for (size_t c = 0; c < a->chart_count; c++) {
         const bk_atlas_chart *ch = &a->charts[c];
         if (ch->page < 0 || (size_t)ch->page >= np) continue;
-        int pw = a->pages[ch->page].width, ph = a->pages[ch->page].height;
-        int32_t *idx = out->index + out->page_offset[ch->page];
-        float *bst = best + out->page_offset[ch->page];
-        for (uint32_t e = ch->first; e < ch->first + ch->count; e++) {
-            bk_rtri t;
-            if (!bk_rtri_setup(a->tri_uv + 6 * (size_t)e, &t)) continue;
-            double mnx = fmin(t.x[0], fmin(t.x[1], t.x[2])), mxx = fmax(t.x[0], fmax(t.x[1], t.x[2]));
-            double mny = fmin(t.y[0], fmin(t.y[1], t.y[2])), mxy = fmax(t.y[0], fmax(t.y[1], t.y[2]));
-            int x0 = (int)fmax(0.0, floor(mnx) - 1), x1 = (int)fmin((double)pw - 1, floor(mxx) + 1);
-            int y0 = (int)fmax(0.0, floor(mny) - 1), y1 = (int)fmin((double)ph - 1, floor(mxy) + 1);
-            for (int y = y0; y <= y1; y++)
-                for (int x = x0; x <= x1; x++) {
-                    double cx = x + 0.5, cy = y + 0.5;
-                    float d;
-                    if (bk_rtri_inside(&t, cx, cy, NULL)) {
-                        d = -1.0f;
-                    } else {
-                        double qx, qy;
-                        double d2 = bk_rtri_closest(&t, cx, cy, NULL, &qx, &qy);
-                        if (!(fabs(qx - cx) < 0.5 && fabs(qy - cy) < 0.5)) continue;
-                        d = (float)d2;
-                    }
-                    size_t i = (size_t)y * (size_t)pw + (size_t)x;
-                    if (d < bst[i]) {
-                        bst[i] = d;
-                        idx[i] = (int32_t)e;
-                    }
-                }
-        }
+        rasterise_chart(a, ch, out->index + out->page_offset[ch->page], best + out->page_offset[ch->page]);
     }
-    size_t count = 0;
-    for (size_t i = 0; i < total; i++) count += out->index[i] >= 0;
-    out->receivers = malloc((count ? count : 1) * sizeof *out->receivers);
-    if (!out->receivers) {
-        free(best);
-        bk_texels_free(out);
-        return LBK_ERR_OUT_OF_MEMORY;
-    }
-    size_t r = 0;
-    for (size_t p = 0; p < np; p++) {
-        int pw = a->pages[p].width, ph = a->pages[p].height;
-        int32_t *idx = out->index + out->page_offset[p];
-        const float *bst = best + out->page_offset[p];
-        for (int y = 0; y < ph; y++)
-            for (int x = 0; x < pw; x++) {
-                size_t i = (size_t)y * (size_t)pw + (size_t)x;
-                if (idx[i] < 0) continue;
-                uint32_t e = (uint32_t)idx[i];
-                bk_rtri t;
-                bk_rtri_setup(a->tri_uv + 6 * (size_t)e, &t);
-                double w[3];
-                int edge = 0;
-                if (!(bst[i] < 0.0f) || !bk_rtri_inside(&t, x + 0.5, y + 0.5, w)) {
-                    bk_rtri_closest(&t, x + 0.5, y + 0.5, w, NULL, NULL);
-                    edge = 1;
-                }
-                bk_texel *rc = &out->receivers[r];
-                make_receiver(s, a, e, w, rc);
-                if (edge) rc->flags |= BK_TEXEL_EDGE;
-                rc->page = (uint32_t)p;
-                rc->x = (uint16_t)x;
-                rc->y = (uint16_t)y;
-                idx[i] = (int32_t)r;
-                r++;
-            }
-    }
-    out->count = count;
+    lbk_result res = emit_receivers(s, a, best, out);
     free(best);
-    return LBK_OK;
+    if (res != LBK_OK) bk_texels_free(out);
+    return res;
 }
 
 /* ---------------------------------------------------------------------------------------- */
@@ -245,8 +255,7 @@ typedef struct push_job {
     const bk_tracer *tracer;
     float reach;
     float far_dist;
-    size_t begin, end;
-    bk_pushout_stats stats;
+    bk_pushout_stats *thread_stats; /* one per thread, summed at the end */
 } push_job;
 
 /* Fixed hemisphere directions (local frame, z up): a Fibonacci spiral, deterministic. */
@@ -296,7 +305,7 @@ static void hit_point(const bk_scene *s, const bk_hit *h, float out[3])
     for (int c = 0; c < 3; c++) out[c] = (float)(w0 * p[0][c] + h->u * p[1][c] + h->v * p[2][c]);
 }
 
-static void push_one(push_job *j, bk_texel *r)
+static void push_one(const push_job *j, bk_texel *r, bk_pushout_stats *st)
 {
     const bk_scene *s = j->scene;
     double ng[3], t[3], b[3];
@@ -347,7 +356,7 @@ static void push_one(push_job *j, bk_texel *r)
         memcpy(cur_n, best.ng, sizeof cur_n);
         r->flags |= BK_TEXEL_PUSHED;
     }
-    if (r->flags & BK_TEXEL_PUSHED) j->stats.pushed++;
+    if (r->flags & BK_TEXEL_PUSHED) st->pushed++;
     /* inside closed geometry? */
     float org[3];
     bk_offset_ray_origin_scaled(r->position, cur_n, bk_tracer_tri_scale(j->tracer, cur_tri), org);
@@ -365,16 +374,15 @@ static void push_one(push_job *j, bk_texel *r)
     if (2 * back >= LONG_RAYS) {
         r->flags &= ~(uint32_t)BK_TEXEL_VALID;
         r->flags |= BK_TEXEL_INSIDE;
-        j->stats.inside++;
+        st->inside++;
     }
-    j->stats.tested++;
+    st->tested++;
 }
 
-static void *push_worker(void *arg)
+static void push_chunk(void *user, size_t begin, size_t end, int thread)
 {
-    push_job *j = arg;
-    for (size_t i = j->begin; i < j->end; i++) push_one(j, &j->tx->receivers[i]);
-    return NULL;
+    const push_job *j = user;
+    for (size_t i = begin; i < end; i++) push_one(j, &j->tx->receivers[i], &j->thread_stats[thread]);
 }
 
 lbk_result bk_texels_push_out(bk_texels *tx, const bk_scene *scene, const bk_tracer *tracer,
@@ -383,10 +391,7 @@ lbk_result bk_texels_push_out(bk_texels *tx, const bk_scene *scene, const bk_tra
     if (stats) memset(stats, 0, sizeof *stats);
     if (!tx || !scene || !tracer) return LBK_ERR_INVALID_ARGUMENT;
     float reach = opt && opt->reach > 0.0f && isfinite(opt->reach) ? opt->reach : 1.5f;
-    long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    int threads = opt && opt->threads > 0 ? opt->threads : (cores > 0 && cores < 1024 ? (int)cores : 1);
-    if (threads > 256) threads = 256;
-    if ((size_t)threads > tx->count) threads = tx->count ? (int)tx->count : 1;
+    int threads = bk_thread_count(opt ? opt->threads : 0);
     /* long rays: beyond the scene's extent */
     double diag = 0.0;
     for (int c = 0; c < 3; c++) {
@@ -395,40 +400,18 @@ lbk_result bk_texels_push_out(bk_texels *tx, const bk_scene *scene, const bk_tra
     }
     float far_dist = diag > 0.0 ? (float)(2.0 * sqrt(diag)) : FLT_MAX;
     if (!isfinite(far_dist) || far_dist <= 0.0f) far_dist = FLT_MAX;
-    push_job *jobs = calloc((size_t)threads, sizeof *jobs);
-    pthread_t *tid = calloc((size_t)threads, sizeof *tid);
-    if (!jobs || !tid) {
-        free(jobs);
-        free(tid);
-        return LBK_ERR_OUT_OF_MEMORY;
-    }
-    size_t per = (tx->count + (size_t)threads - 1) / (size_t)threads;
-    int started = 0;
-    for (int k = 0; k < threads; k++) {
-        jobs[k].tx = tx;
-        jobs[k].scene = scene;
-        jobs[k].tracer = tracer;
-        jobs[k].reach = reach;
-        jobs[k].far_dist = far_dist;
-        jobs[k].begin = (size_t)k * per < tx->count ? (size_t)k * per : tx->count;
-        jobs[k].end = jobs[k].begin + per < tx->count ? jobs[k].begin + per : tx->count;
-    }
-    for (int k = 1; k < threads; k++) {
-        if (pthread_create(&tid[k], NULL, push_worker, &jobs[k]) != 0) break;
-        started = k;
-    }
-    push_worker(&jobs[0]);
-    for (int k = 1; k <= started; k++) pthread_join(tid[k], NULL);
-    /* jobs whose thread could not start run here */
-    for (int k = started + 1; k < threads; k++) push_worker(&jobs[k]);
+    push_job job = {tx, scene, tracer, reach, far_dist, calloc((size_t)threads, sizeof(bk_pushout_stats))};
+    if (!job.thread_stats) return LBK_ERR_OUT_OF_MEMORY;
+    /* 64 receivers a chunk (up to 3·13 short and 16 long rays each): coarse enough to hide the
+     * shared counter, fine enough to balance walls against cluttered corners */
+    bk_parallel_chunks(0, tx->count, 64, threads, push_chunk, &job);
     if (stats)
         for (int k = 0; k < threads; k++) {
-            stats->tested += jobs[k].stats.tested;
-            stats->pushed += jobs[k].stats.pushed;
-            stats->inside += jobs[k].stats.inside;
+            stats->tested += job.thread_stats[k].tested;
+            stats->pushed += job.thread_stats[k].pushed;
+            stats->inside += job.thread_stats[k].inside;
         }
-    free(jobs);
-    free(tid);
+    free(job.thread_stats);
     return LBK_OK;
 }
 

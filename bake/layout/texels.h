@@ -3,13 +3,18 @@
  *
  * Coverage (bk_texels_build): every chart triangle is rasterised into its page. A texel is
  * covered when its centre lies inside a triangle (top-left fill rule, uv_raster.h) or, for
- * the texels along chart borders, when the triangle's closest point to the centre lies
- * inside the texel square (|dx|, |dy| < 0.5; conservative). A centre inside wins over a
- * nearest point; among nearest points the closest wins; ties go to the lower triangle entry.
- * The sample point is the world point at the centre (or at the closest point), its normal
- * the interpolated shading normal (the geometric normal where that is zero).
+ * the texels along chart borders, when bilinear filtering at some point of a triangle reads
+ * it: the triangle meets the open square of half-size 1 around the texel centre
+ * (bk_rtri_meets_square). So every texel a renderer filters for a point of a chart holds a
+ * baked sample of that chart (conservative rasterisation of the bilinear footprint: a ring of
+ * one texel around the texels the chart overlaps, inside the chart's own margin, atlas.h).
+ * A centre inside wins over a nearest point; among nearest points the closest wins; ties go
+ * to the lower triangle entry. The sample point is the world point at the centre (or at the
+ * triangle's closest point), its normal the interpolated shading normal (the geometric
+ * normal where that is zero).
  *
- * TANGENT FRAME CONVENTION (the AHD encoder and the runtime must use the same):
+ * TANGENT FRAME CONVENTION (the AHD encoder and the runtime must use the same; normative in
+ * spec/container.md §5.6, lbk_ahd_tangent_frame in lbk/ahd.h computes it for renderers):
  *   N = the unit interpolated shading normal of the receiver (+Z of the local frame);
  *   T = dP/du of the triangle, P the world position and u the lightmap texel x coordinate
  *       (to the right on the page; uv.x), made orthogonal to N and unit length (+X);

@@ -133,4 +133,24 @@ static inline double bk_rtri_closest(const bk_rtri *t, double px, double py, dou
     return (x - px) * (x - px) + (y - py) * (y - py);
 }
 
+/* 1 when the (closed) triangle meets the open square |x − cx| < r, |y − cy| < r: separating
+ * axes are the square's two and the triangle's three edge normals. With r = 1 around a texel
+ * centre this is "bilinear filtering at some point of the triangle reads this texel". */
+static inline int bk_rtri_meets_square(const bk_rtri *t, double cx, double cy, double r)
+{
+    double mnx = fmin(t->x[0], fmin(t->x[1], t->x[2])), mxx = fmax(t->x[0], fmax(t->x[1], t->x[2]));
+    double mny = fmin(t->y[0], fmin(t->y[1], t->y[2])), mxy = fmax(t->y[0], fmax(t->y[1], t->y[2]));
+    if (mxx <= cx - r || mnx >= cx + r || mxy <= cy - r || mny >= cy + r) return 0;
+    for (int k = 0; k < 3; k++) {
+        int a = k, b = (k + 1) % 3;
+        /* outward normal of edge a→b (the triangle is counter-clockwise): the whole triangle
+         * projects at or below the edge, so the square must reach below it */
+        double nx = t->y[b] - t->y[a], ny = t->x[a] - t->x[b];
+        double edge = nx * t->x[a] + ny * t->y[a];
+        double sq_min = nx * cx + ny * cy - r * (fabs(nx) + fabs(ny));
+        if (sq_min >= edge) return 0;
+    }
+    return 1;
+}
+
 #endif

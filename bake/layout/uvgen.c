@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bake/layout/chart_merge.h"
 #include "bake/layout/uv_math.h"
 #include "bake/layout/uv_raster.h"
 
@@ -631,21 +632,25 @@ static void note_append(bk_uv_object *o, const char *msg)
 /* ---------------------------------------------------------------------------------------- */
 /* Authored uv1                                                                             */
 
-/* Returns LBK_OK with *used = 1 when the authored layout was taken, *used = 0 (note set)
- * when it must be generated instead. */
-static lbk_result try_authored(gen_ctx *g, double density, int cap, bk_uv_object *o, int *used)
+/* What the authored uv1 of the object's live triangles spans. */
+typedef struct uv1_extent {
+    double world_area, uv_area;
+    double mnu, mxu, mnv, mxv;
+    uint32_t live;
+} uv1_extent;
+
+/* Measures the uv1 layout; 0 (note set) when a coordinate is outside [0,1] (an authored
+ * lightmap layout lives in the unit square). */
+static int uv1_measure(const gen_ctx *g, bk_uv_object *o, uv1_extent *e)
 {
     const bk_scene *s = g->s;
-    *used = 0;
-    if (!s->uv1) {
-        note_append(o, "uv1 rejected: the scene has no uv1 array");
-        return LBK_OK;
-    }
-    double aw = 0.0, auv = 0.0, mnu = DBL_MAX, mxu = -DBL_MAX, mnv = DBL_MAX, mxv = -DBL_MAX;
-    uint32_t live = 0;
+    e->world_area = e->uv_area = 0.0;
+    e->mnu = e->mnv = DBL_MAX;
+    e->mxu = e->mxv = -DBL_MAX;
+    e->live = 0;
     for (uint32_t i = 0; i < g->n; i++) {
         if (!g->ti[i].live) continue;
-        live++;
+        e->live++;
         double q[3][2];
         for (int k = 0; k < 3; k++) {
             uint32_t v = s->tris[3 * ((size_t)g->first + i) + (size_t)k];
@@ -656,21 +661,85 @@ static lbk_result try_authored(gen_ctx *g, double density, int cap, bk_uv_object
                 char msg[128];
                 snprintf(msg, sizeof msg, "uv1 rejected: coordinate (%g, %g) outside [0,1]", q[k][0], q[k][1]);
                 note_append(o, msg);
-                return LBK_OK;
+                return 0;
             }
-            mnu = fmin(mnu, q[k][0]); mxu = fmax(mxu, q[k][0]);
-            mnv = fmin(mnv, q[k][1]); mxv = fmax(mxv, q[k][1]);
+            e->mnu = fmin(e->mnu, q[k][0]); e->mxu = fmax(e->mxu, q[k][0]);
+            e->mnv = fmin(e->mnv, q[k][1]); e->mxv = fmax(e->mxv, q[k][1]);
         }
-        aw += g->ti[i].area;
-        auv += 0.5 * fabs((q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[1][1] - q[0][1]) * (q[2][0] - q[0][0]));
+        e->world_area += g->ti[i].area;
+        e->uv_area += 0.5 * fabs((q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[1][1] - q[0][1]) * (q[2][0] - q[0][0]));
     }
-    if (live == 0) return LBK_OK;
-    if (!(auv > 0.0)) {
+    return 1;
+}
+
+/* The live triangles' uv1 in texels (offset to the layout's corner, scaled by sc, clamped to
+ * w × h) into uv, their indices into tl; returns how many, *collapsed_area the world area of
+ * those whose texel area is below a millionth of what their world area asks for. */
+static uint32_t uv1_to_texels(const gen_ctx *g, const uv1_extent *e, double sc, double w, double h, double density,
+                              float *uv, uint32_t *tl, double *collapsed_area)
+{
+    const bk_scene *s = g->s;
+    *collapsed_area = 0.0;
+    uint32_t m = 0;
+    for (uint32_t i = 0; i < g->n; i++) {
+        if (!g->ti[i].live) continue;
+        for (int k = 0; k < 3; k++) {
+            uint32_t v = s->tris[3 * ((size_t)g->first + i) + (size_t)k];
+            double x = (s->uv1[2 * (size_t)v] - e->mnu) * sc, y = (s->uv1[2 * (size_t)v + 1] - e->mnv) * sc;
+            uv[6 * (size_t)m + 2 * (size_t)k] = (float)fmin(fmax(x, 0.0), w);
+            uv[6 * (size_t)m + 2 * (size_t)k + 1] = (float)fmin(fmax(y, 0.0), h);
+        }
+        const float *q = uv + 6 * (size_t)m;
+        double a2 = fabs(((double)q[2] - q[0]) * ((double)q[5] - q[1]) - ((double)q[3] - q[1]) * ((double)q[4] - q[0]));
+        if (a2 * 0.5 < 1e-6 * g->ti[i].area * density * density) *collapsed_area += g->ti[i].area;
+        tl[m++] = i;
+    }
+    return m;
+}
+
+/* LBK_OK with *acceptable = 0 (note set) when too much of the layout is collapsed or claimed
+ * twice; an authored layout with either would bake wrong light, so it is generated instead. */
+static lbk_result uv1_check_layout(const float *uv, uint32_t m, double w, double h, double collapsed_area,
+                                   double world_area, bk_uv_object *o, int *acceptable)
+{
+    char msg[128];
+    *acceptable = 0;
+    if (collapsed_area > UV_COLLAPSED_AREA_FRACTION * world_area) {
+        snprintf(msg, sizeof msg, "uv1 rejected: triangles with zero uv area cover %.1f%% of the surface",
+                 100.0 * collapsed_area / world_area);
+        note_append(o, msg);
+        return LBK_OK;
+    }
+    size_t covered = 0;
+    size_t over = bk_uv_count_overlaps(uv, m, (int)ceil(w) + 1, (int)ceil(h) + 1, &covered);
+    if (over == (size_t)-1) return LBK_ERR_OUT_OF_MEMORY;
+    if ((double)over > UV_OVERLAP_FRACTION * (double)covered) {
+        snprintf(msg, sizeof msg, "uv1 rejected: overlapping triangles (%zu of %zu texels claimed twice)", over,
+                 covered);
+        note_append(o, msg);
+        return LBK_OK;
+    }
+    *acceptable = 1;
+    return LBK_OK;
+}
+
+/* Returns LBK_OK with *used = 1 when the authored layout was taken, *used = 0 (note set)
+ * when it must be generated instead. */
+static lbk_result try_authored(gen_ctx *g, double density, int cap, bk_uv_object *o, int *used)
+{
+    *used = 0;
+    if (!g->s->uv1) {
+        note_append(o, "uv1 rejected: the scene has no uv1 array");
+        return LBK_OK;
+    }
+    uv1_extent e;
+    if (!uv1_measure(g, o, &e) || e.live == 0) return LBK_OK;
+    if (!(e.uv_area > 0.0)) {
         note_append(o, "uv1 rejected: zero uv area");
         return LBK_OK;
     }
-    double sc = density * sqrt(aw / auv);
-    double w = (mxu - mnu) * sc, h = (mxv - mnv) * sc;
+    double sc = density * sqrt(e.world_area / e.uv_area);
+    double w = (e.mxu - e.mnu) * sc, h = (e.mxv - e.mnv) * sc;
     if (fmax(w, h) > cap) {
         double f = cap / fmax(w, h);
         sc *= f;
@@ -681,61 +750,27 @@ static lbk_result try_authored(gen_ctx *g, double density, int cap, bk_uv_object
                  density * f, cap);
         note_append(o, msg);
     }
-    float *uv = malloc((size_t)live * 6 * sizeof *uv);
-    uint32_t *tl = malloc((size_t)live * sizeof *tl);
-    if (!uv || !tl) {
-        free(uv);
-        free(tl);
-        return LBK_ERR_OUT_OF_MEMORY;
-    }
-    double collapsed_area = 0.0;
-    uint32_t m = 0;
-    for (uint32_t i = 0; i < g->n; i++) {
-        if (!g->ti[i].live) continue;
-        for (int k = 0; k < 3; k++) {
-            uint32_t v = s->tris[3 * ((size_t)g->first + i) + (size_t)k];
-            double x = (s->uv1[2 * (size_t)v] - mnu) * sc, y = (s->uv1[2 * (size_t)v + 1] - mnv) * sc;
-            uv[6 * (size_t)m + 2 * (size_t)k] = (float)fmin(fmax(x, 0.0), w);
-            uv[6 * (size_t)m + 2 * (size_t)k + 1] = (float)fmin(fmax(y, 0.0), h);
+    float *uv = malloc((size_t)e.live * 6 * sizeof *uv);
+    uint32_t *tl = malloc((size_t)e.live * sizeof *tl);
+    lbk_result r = uv && tl ? LBK_OK : LBK_ERR_OUT_OF_MEMORY;
+    int acceptable = 0;
+    if (r == LBK_OK) {
+        double collapsed_area;
+        uint32_t m = uv1_to_texels(g, &e, sc, w, h, density, uv, tl, &collapsed_area);
+        r = uv1_check_layout(uv, m, w, h, collapsed_area, e.world_area, o, &acceptable);
+        if (r == LBK_OK && acceptable) {
+            out_builder b = {o, 0, 0};
+            r = out_add_chart(&b, tl, uv, m, (float)w, (float)h, g->first);
         }
-        const float *q = uv + 6 * (size_t)m;
-        double a2 = fabs(((double)q[2] - q[0]) * ((double)q[5] - q[1]) - ((double)q[3] - q[1]) * ((double)q[4] - q[0]));
-        /* "collapsed": its texel area is below a millionth of what its world area asks for */
-        if (a2 * 0.5 < 1e-6 * g->ti[i].area * density * density) collapsed_area += g->ti[i].area;
-        tl[m++] = i;
     }
-    if (collapsed_area > UV_COLLAPSED_AREA_FRACTION * aw) {
-        char msg[128];
-        snprintf(msg, sizeof msg, "uv1 rejected: triangles with zero uv area cover %.1f%% of the surface",
-                 100.0 * collapsed_area / aw);
-        note_append(o, msg);
-        free(uv);
-        free(tl);
-        return LBK_OK;
-    }
-    size_t covered = 0;
-    size_t over = bk_uv_count_overlaps(uv, m, (int)ceil(w) + 1, (int)ceil(h) + 1, &covered);
-    if (over == (size_t)-1) {
-        free(uv);
-        free(tl);
-        return LBK_ERR_OUT_OF_MEMORY;
-    }
-    if ((double)over > UV_OVERLAP_FRACTION * (double)covered) {
-        char msg[128];
-        snprintf(msg, sizeof msg, "uv1 rejected: overlapping triangles (%zu of %zu texels claimed twice)", over,
-                 covered);
-        note_append(o, msg);
-        free(uv);
-        free(tl);
-        return LBK_OK;
-    }
-    out_builder b = {o, 0, 0};
-    lbk_result r = out_add_chart(&b, tl, uv, m, (float)w, (float)h, g->first);
     free(uv);
     free(tl);
-    if (r != LBK_OK) return r;
-    o->density = (float)(sc * sqrt(auv / aw));
+    if (r != LBK_OK || !acceptable) return r;
+    o->density = (float)(sc * sqrt(e.uv_area / e.world_area));
     o->source = BK_UV_AUTHORED;
+    o->uv1_scale = sc;
+    o->uv1_min[0] = e.mnu, o->uv1_min[1] = e.mnv;
+    o->uv1_max[0] = e.mxu, o->uv1_max[1] = e.mxv;
     *used = 1;
     return LBK_OK;
 }
@@ -858,6 +893,11 @@ lbk_result bk_uvgen_object(const bk_scene *scene, uint32_t object, float density
             snprintf(msg, sizeof msg, "density lowered from %g to %g texels/m: a triangle exceeds %d texels", d, nd, cap);
             note_append(out, msg);
             d = nd;
+        }
+        if (r == LBK_OK) {
+            bk_chart_graph cg = {g.first, g.n, g.wid, g.adj_start, g.adj};
+            size_t merged;
+            r = bk_merge_small_charts(scene, &cg, d, cap, out, &merged);
         }
         out->density = (float)d;
         out->source = BK_UV_GENERATED;

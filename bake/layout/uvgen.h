@@ -19,7 +19,10 @@
  * moved to the origin. A chart whose projection overlaps itself at texel resolution, or
  * whose longer side exceeds max_chart_texels, is split at the median of its triangles along
  * its longer side (then into connected pieces) until it fits. A single triangle that is
- * still too large makes the whole object use a lower density (reported in note).
+ * still too large makes the whole object use a lower density (reported in note). Finally small
+ * charts (at most 16 texels of content, or one texel thin) are unfolded onto a neighbour
+ * across their longest shared edge when that makes the pair's blocks smaller (chart_merge.h):
+ * small objects no longer shatter into 1–3-texel charts, each with its own margin ring.
  *
  * Degenerate triangles (zero or non-finite area, indices out of range) get no chart: they
  * are counted in degenerate_count and receive no texels.
@@ -65,6 +68,9 @@ typedef struct bk_uv_object {
     uint32_t *tris;          /* scene triangle indices, grouped by chart */
     float *uv;               /* 6 per entry of tris: the 3 corners' chart coordinates, texels */
     size_t degenerate_count; /* the object's triangles without a chart */
+    /* BK_UV_AUTHORED: the one chart's coordinates are (uv1 − uv1_min) · uv1_scale texels, per
+     * axis; uv1_min/uv1_max bound the uv1 of the triangles that have area (0 otherwise) */
+    double uv1_scale, uv1_min[2], uv1_max[2];
 } bk_uv_object;
 
 /* Charts for scene object `object` at `density` texels per metre (> 0, finite). opt may be

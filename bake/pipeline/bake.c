@@ -1,134 +1,109 @@
 /* The bake pipeline: import → classify → atlas + texels → GLG / LLG placement → transport →
- * encode → container. Each phase is its own module; this file only wires them together, owns
- * the presets, and decides which sections the scene needs. */
-#include "bake/pipeline/bake.h"
-
+ * sets → encode. Each phase is its own module; this file wires them together behind
+ * lbk_bake_from_file / lbk_bake_from_scene (lbk/bake.h), owns the presets, routes messages and
+ * progress to the caller's callbacks, and decides which sections the scene needs. */
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
-#include <cjson/cJSON.h>
-
-#include "bake/layout/atlas.h"
-#include "bake/sets/bake_sets.h"
-#include "bake/layout/classify.h"
-#include "bake/pipeline/encode.h"
+#include "bake/pipeline/pipeline.h"
 #include "bake/scene/exr_read.h"
-#include "bake/probes/glg_place.h"
 #include "bake/scene/import.h"
-#include "bake/probes/llg_place.h"
-#include "bake/probes/octa_bake.h"
-#include "bake/scene/scene.h"
-#include "bake/layout/texels.h"
-#include "bake/transport/tracer.h"
-#include "bake/transport/transport.h"
-#include "cli/cli.h"
-#include "lbk/ahd.h"
-#include "lbk/container.h"
-#include "lbk/glg.h"
-#include "lbk/lightmap.h"
-#include "lbk/llg.h"
-#include "lbk/meta.h"
-#include "lbk/objects.h"
-#include "lbk/octa.h"
-#include "lbk/report.h"
-#include "lbk/sh.h"
+#include "bake/scene/scene_desc.h"
+#include "bake/util/clock.h"
 
-/* What a preset sets; every field can be overridden from the command line. */
-typedef struct preset {
-    const char *name;
-    float texel_density;   /* texels per metre */
-    float glg_spacing;     /* metres (halved once near geometry) */
-    int max_samples;       /* gather rays per receiver, both halves, whole run */
-    double target_error;   /* relative RMSE */
-    int llg_visibility_rays;
-} preset;
-
-static const preset presets[] = {
-    {"fast", 8.0f, 2.0f, 1024, 0.03, 32},
-    {"high", 16.0f, 1.0f, 16384, 0.01, 128},
+const bk_preset bk_presets[LBK_BAKE_PRESET_COUNT_] = {
+    [LBK_BAKE_PRESET_FAST] = {"fast", 8.0f, 2.0f, 1024, 0.03, 32},
+    [LBK_BAKE_PRESET_HIGH] = {"high", 16.0f, 1.0f, 16384, 0.01, 128},
 };
 
-typedef struct bake {
-    const bk_bake_options *opt;
-    const preset *pre;
-    bk_progress *progress;
-    char *err;
-    size_t err_len;
-    bk_scene scene;
-    bk_object_class *classes;
-    bk_atlas atlas;
-    bk_texels texels;
-    bk_tracer *tracer;
-    bk_glg glg;
-    int have_glg;
-    bk_llg *llgs;
-    size_t llg_count;
-    int32_t *object_llg;            /* per scene object: LLG index or -1 */
-    /* receivers handed to transport: valid texels, then GLG probes, then LLG probes */
-    bk_receiver *receivers;
-    size_t receiver_count, texel_receivers, glg_first, llg_first;
-    uint32_t *texel_of_receiver;    /* receiver → index in texels.receivers */
-    lbk_sh9_rgb *radiance;
-    bk_transport_stats stats;
-    bk_transport_sample *samples;
-    size_t sample_count, sample_cap;
-    double phase_seconds[8];
-    const char *phase_names[8];
-    int phase_count;
-    double phase_start;
-    bk_set_bakes sets;              /* dynamic light sets and doors (bake_sets.c) */
-    float origin[3];                /* world position of the bake frame's origin (recentre()) */
-    uint64_t saturated, flushed;    /* texel channels outside the R11G11B10F range (stored units) */
-    float scale[3];                 /* LMAP, GLG, LLG scales (spec §5.7); DLS payloads use them */
-    float octp_scale;
-} bake;
+/* The size of version 1 of lbk_bake_desc, what size 0 means. When fields are added, this stays
+ * the offset of the first new one. */
+#define BK_DESC_SIZE_V1 sizeof(lbk_bake_desc)
 
-static int fail(bake *b, int code, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
-static int fail(bake *b, int code, const char *fmt, ...)
+/* ---- talking to the caller ------------------------------------------------------------- */
+
+lbk_result bk_pipeline_fail(bk_pipeline *b, lbk_result code, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(b->err, b->err_len, fmt, ap);
+    vsnprintf(b->err, sizeof b->err, fmt, ap);
     va_end(ap);
     return code;
 }
 
-static void phase(bake *b, const char *name)
+lbk_result bk_pipeline_failed(bk_pipeline *b, lbk_result r, const char *what)
+{
+    if (r == LBK_ERR_CANCELLED) return r;
+    bk_pipeline_fail(b, r, "%s: %s", what, lbk_result_message(r));
+    return r == LBK_ERR_OUT_OF_MEMORY ? r : LBK_ERR_INTERNAL;
+}
+
+int bk_pipeline_progress(bk_pipeline *b, double fraction)
+{
+    if (b->cancelled) return 1;
+    if (!b->opt->progress || b->phase_count == 0) return 0;
+    lbk_bake_progress p;
+    memset(&p, 0, sizeof p);
+    p.phase = b->phases[b->phase_count - 1];
+    p.fraction = fraction >= 0 ? (fraction <= 1 ? fraction : 1) : 0;
+    p.elapsed_seconds = bk_now() - b->start;
+    p.est_rel_rmse = b->est;
+    if (b->opt->progress(b->opt->user, &p)) b->cancelled = 1;
+    return b->cancelled;
+}
+
+static void events_message(void *user, lbk_bake_severity severity, const char *text)
+{
+    const bk_pipeline *b = user;
+    if (b->opt->message) b->opt->message(b->opt->user, severity, text);
+}
+
+static int events_progress(void *user, double fraction)
+{
+    return bk_pipeline_progress(user, fraction);
+}
+
+/* Starts a phase: closes the previous one's time, then a checkpoint at 0. */
+static lbk_result phase(bk_pipeline *b, lbk_bake_phase ph)
 {
     double now = bk_now();
     if (b->phase_count > 0) b->phase_seconds[b->phase_count - 1] = now - b->phase_start;
-    if (b->phase_count < 8) b->phase_names[b->phase_count++] = name;
+    if (b->phase_count < BK_MAX_PHASES) b->phases[b->phase_count++] = ph;
     b->phase_start = now;
-    bk_progress_phase(b->progress, name);
+    return bk_pipeline_progress(b, 0) ? LBK_ERR_CANCELLED : LBK_OK;
+}
+
+static lbk_result checkpoint(bk_pipeline *b, double fraction)
+{
+    return bk_pipeline_progress(b, fraction) ? LBK_ERR_CANCELLED : LBK_OK;
 }
 
 static void import_warning(void *user, const char *message)
 {
-    bake *b = user;
-    bk_progress_note(b->progress, "lbk bake: warning: %s", message);
+    bk_pipeline *b = user;
+    bk_events_say(&b->events, LBK_BAKE_SEVERITY_WARNING, "%s", message);
 }
 
-static void transport_progress(void *user, const char *ph, double fraction)
+static int transport_progress(void *user, const char *ph, double fraction)
 {
     (void)ph;
-    bake *b = user;
-    bk_progress_update(b->progress, fraction);
+    return bk_pipeline_progress(user, fraction);
 }
 
 static void base_albedo(void *user, uint32_t tri, float albedo[3])
 {
-    bake *b = user;
+    bk_pipeline *b = user;
     bk_set_bakes_base_albedo(&b->sets, &b->scene, tri, albedo);
 }
 
 static void transport_report(void *user, const bk_transport_sample *s)
 {
-    bake *b = user;
+    bk_pipeline *b = user;
+    b->est = s->est_rel_rmse;
     if (b->sample_count == b->sample_cap) {
         size_t cap = b->sample_cap ? 2 * b->sample_cap : 16;
         bk_transport_sample *n = realloc(b->samples, cap * sizeof *n);
@@ -137,11 +112,53 @@ static void transport_report(void *user, const bk_transport_sample *s)
         b->sample_cap = cap;
     }
     b->samples[b->sample_count++] = *s;
-    bk_progress_note(b->progress, "  pass %d: %7.0f samples/receiver  est. error %6.2f%%  %2d bounces  %7.1f s",
-                     s->pass, s->samples_per_receiver, 100 * s->est_rel_rmse, s->bounces, s->seconds);
+    bk_events_say(&b->events, LBK_BAKE_SEVERITY_INFO,
+                  "pass %d: %7.0f samples/receiver  est. error %6.2f%%  %2d bounces  %7.1f s", s->pass,
+                  s->samples_per_receiver, 100 * s->est_rel_rmse, s->bounces, s->seconds);
 }
 
-/* ---- phases ---------------------------------------------------------------------------- */
+/* ---- import ---------------------------------------------------------------------------- */
+
+static lbk_result import_file(bk_pipeline *b, const char *path)
+{
+    bk_import_options io;
+    memset(&io, 0, sizeof io);
+    io.warn = import_warning;
+    io.warn_user = b;
+    io.allow_outside = b->opt->allow_outside;
+    FILE *probe = fopen(path, "rb");
+    if (!probe) return bk_pipeline_fail(b, LBK_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    fclose(probe);
+    char msg[512];
+    if (bk_import_gltf(path, &io, &b->scene, msg, sizeof msg)) return bk_pipeline_fail(b, LBK_ERR_BAD_INPUT, "%s", msg);
+    return LBK_OK;
+}
+
+/* The desc's sky, when it overrides the scene's: a uniform radiance or an EXR. */
+static lbk_result apply_sky(bk_pipeline *b)
+{
+    if (!b->opt->sky_override) return LBK_OK;
+    if (!b->opt->sky_exr) {
+        memcpy(b->scene.sky, b->opt->sky, sizeof b->scene.sky);
+        b->scene.sky_image = -1;
+        return LBK_OK;
+    }
+    char msg[512];
+    bk_image im;
+    memset(&im, 0, sizeof im);
+    if (bk_exr_read(b->opt->sky_exr, (size_t)64 << 20, &im, msg, sizeof msg))
+        return bk_pipeline_fail(b, LBK_ERR_BAD_INPUT, "sky: %s", msg);
+    bk_image *n = realloc(b->scene.images, (b->scene.image_count + 1) * sizeof *n);
+    if (!n) {
+        free(im.rgba);
+        return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
+    }
+    b->scene.images = n;
+    b->scene.images[b->scene.image_count] = im;
+    b->scene.sky_image = (int)b->scene.image_count++;
+    b->scene.sky[0] = b->scene.sky[1] = b->scene.sky[2] = 0;
+    return LBK_OK;
+}
 
 /* A scene whose every triangle has zero area would bake to an empty container: refuse it. */
 static int has_triangle_with_area(const bk_scene *s)
@@ -163,7 +180,7 @@ static int has_triangle_with_area(const bk_scene *s)
  * added back. The shift is an integer number of metres, along each axis where the level lies
  * farther from the origin than twice its extent: then every p − c is exact in float (Sterbenz),
  * and so is p − c + c, so geometry hashes and written positions are unchanged. */
-static void recentre(bake *b)
+static void recentre(bk_pipeline *b)
 {
     bk_scene *s = &b->scene;
     double extent = 0, c[3];
@@ -187,162 +204,164 @@ static void recentre(bake *b)
     }
 }
 
-static void to_world(const bake *b, const float local[3], float world[3])
+void bk_pipeline_to_world(const bk_pipeline *b, const float local[3], float world[3])
 {
     for (int k = 0; k < 3; k++) world[k] = local[k] + b->origin[k];
 }
 
-static int do_import(bake *b)
+/* What every scene must have, however it came in. */
+static lbk_result check_scene(bk_pipeline *b)
 {
-    phase(b, "import");
-    bk_import_options io;
-    memset(&io, 0, sizeof io);
-    io.warn = import_warning;
-    io.warn_user = b;
-    char msg[512];
-    FILE *probe = fopen(b->opt->input, "rb");
-    if (!probe) return fail(b, LBK_EXIT_IO, "%s: cannot open: %s", b->opt->input, strerror(errno));
-    fclose(probe);
-    if (bk_import_gltf(b->opt->input, &io, &b->scene, msg, sizeof msg))
-        return fail(b, LBK_EXIT_INPUT, "%s", msg);
-    if (b->opt->sky_exr) {
-        bk_image im;
-        memset(&im, 0, sizeof im);
-        if (bk_exr_read(b->opt->sky_exr, (size_t)64 << 20, &im, msg, sizeof msg))
-            return fail(b, LBK_EXIT_INPUT, "--sky: %s", msg);
-        bk_image *n = realloc(b->scene.images, (b->scene.image_count + 1) * sizeof *n);
-        if (!n) {
-            free(im.rgba);
-            return fail(b, LBK_EXIT_INTERNAL, "out of memory");
-        }
-        b->scene.images = n;
-        b->scene.images[b->scene.image_count] = im;
-        b->scene.sky_image = (int)b->scene.image_count++;
-        b->scene.sky[0] = b->scene.sky[1] = b->scene.sky[2] = 0;
-    } else if (b->opt->sky_set) {
-        memcpy(b->scene.sky, b->opt->sky, sizeof b->scene.sky);
-        b->scene.sky_image = -1;
-    }
-    if (b->scene.tri_count == 0) return fail(b, LBK_EXIT_INPUT, "%s: the scene has no triangles", b->opt->input);
+    if (b->scene.tri_count == 0) return bk_pipeline_fail(b, LBK_ERR_BAD_INPUT, "%s: the scene has no triangles", b->input);
     if (!has_triangle_with_area(&b->scene))
-        return fail(b, LBK_EXIT_INPUT, "%s: all %zu triangles are degenerate (zero area): nothing to light",
-                    b->opt->input, b->scene.tri_count);
+        return bk_pipeline_fail(b, LBK_ERR_BAD_INPUT, "%s: all %zu triangles are degenerate (zero area): nothing to light",
+                                b->input, b->scene.tri_count);
     recentre(b);
     if (!bk_scene_has_light(&b->scene))
-        return fail(b, LBK_EXIT_INPUT,
-                    "%s: the scene has no light: no KHR_lights_punctual light, no emissive material "
-                    "and no sky (add one, or pass --sky R,G,B)",
-                    b->opt->input);
-    bk_progress_update(b->progress, 1);
-    return 0;
+        return bk_pipeline_fail(b, LBK_ERR_BAD_INPUT,
+                                "%s: the scene has no light: no KHR_lights_punctual light, no emissive material "
+                                "and no sky (add one, or give the bake a sky: lbk bake --sky R,G,B)",
+                                b->input);
+    return checkpoint(b, 1);
 }
 
-static float density_for(const bake *b)
+static lbk_result do_import(bk_pipeline *b, const char *path, const lbk_bake_scene *desc)
 {
-    return b->opt->texel_density > 0 ? b->opt->texel_density : 0;
+    lbk_result r = phase(b, LBK_BAKE_PHASE_IMPORT);
+    if (r) return r;
+    if (path) {
+        r = import_file(b, path);
+    } else {
+        r = bk_scene_from_desc(desc, &b->events, &b->scene, b->err, sizeof b->err);
+        if (r == LBK_ERR_OUT_OF_MEMORY) bk_pipeline_fail(b, r, "out of memory");
+    }
+    if (!r) r = apply_sky(b);
+    if (!r) r = check_scene(b);
+    return r;
 }
 
-static int do_layout(bake *b)
+/* ---- layout ---------------------------------------------------------------------------- */
+
+/* A representation per object; lightmapped[i] marks the atlas's objects. */
+static lbk_result layout_classify(bk_pipeline *b, uint8_t *lightmapped, size_t *n_lm, size_t *n_llg)
 {
-    phase(b, "layout");
     const bk_scene *s = &b->scene;
-    b->classes = calloc(s->object_count ? s->object_count : 1, sizeof *b->classes);
-    uint8_t *lightmapped = calloc(s->object_count ? s->object_count : 1, 1);
-    b->object_llg = malloc((s->object_count ? s->object_count : 1) * sizeof *b->object_llg);
-    if (!b->classes || !lightmapped || !b->object_llg) {
-        free(lightmapped);
-        return fail(b, LBK_EXIT_INTERNAL, "out of memory");
-    }
     lbk_result r = bk_classify_objects(s, NULL, b->classes);
-    if (r) {
-        free(lightmapped);
-        return fail(b, LBK_EXIT_INTERNAL, "classifying objects: %s", lbk_result_message(r));
-    }
-    size_t n_lm = 0, n_llg = 0;
+    if (r) return bk_pipeline_failed(b, r, "classifying objects");
+    *n_lm = *n_llg = 0;
     for (size_t i = 0; i < s->object_count; i++) {
         lightmapped[i] = b->classes[i].rep == BK_REP_LIGHTMAP;
-        n_lm += lightmapped[i];
-        n_llg += b->classes[i].rep == BK_REP_LLG;
+        *n_lm += lightmapped[i];
+        *n_llg += b->classes[i].rep == BK_REP_LLG;
         b->object_llg[i] = -1;
     }
-    bk_progress_update(b->progress, 0.1);
+    return LBK_OK;
+}
 
+static lbk_result layout_atlas(bk_pipeline *b, const uint8_t *lightmapped)
+{
+    const bk_scene *s = &b->scene;
     bk_atlas_options ao;
     memset(&ao, 0, sizeof ao);
     ao.default_density = b->pre->texel_density;
-    ao.density_override = density_for(b);
-    if (n_lm) {
-        r = bk_atlas_build(s, lightmapped, &ao, &b->atlas);
-        if (r) {
-            free(lightmapped);
-            return fail(b, r == LBK_ERR_LIMIT ? LBK_EXIT_INPUT : LBK_EXIT_INTERNAL, "lightmap atlas: %s",
-                        lbk_result_message(r));
-        }
-        if (b->atlas.note[0]) bk_progress_note(b->progress, "lbk bake: note: %s", b->atlas.note);
-        for (size_t i = 0; i < b->atlas.object_count; i++)
-            if (b->atlas.objects[i].note[0])
-                bk_progress_note(b->progress, "lbk bake: note: object '%s': %s",
-                                 s->objects[b->atlas.objects[i].object].name, b->atlas.objects[i].note);
-    }
-    free(lightmapped);
-    bk_progress_update(b->progress, 0.4);
-
-    r = bk_tracer_create(s, b->opt->threads, &b->tracer);
-    if (r) return fail(b, LBK_EXIT_INTERNAL, "ray tracer (Embree): %s", lbk_result_message(r));
-
-    if (n_lm) {
-        r = bk_texels_build(s, &b->atlas, &b->texels);
-        if (r) return fail(b, LBK_EXIT_INTERNAL, "lightmap texels: %s", lbk_result_message(r));
-        bk_pushout_options po;
-        memset(&po, 0, sizeof po);
-        po.threads = b->opt->threads ? b->opt->threads : 0;
-        bk_pushout_stats ps;
-        r = bk_texels_push_out(&b->texels, s, b->tracer, &po, &ps);
-        if (r) return fail(b, LBK_EXIT_INTERNAL, "texel push-out: %s", lbk_result_message(r));
-    }
-    bk_progress_update(b->progress, 0.6);
-
-    /* GLG: the level's empty space, for movers and volumetrics. */
-    if (!b->opt->no_glg) {
-        bk_glg_options go;
-        memset(&go, 0, sizeof go);
-        go.spacing = b->opt->glg_spacing > 0 ? b->opt->glg_spacing : b->pre->glg_spacing;
-        r = bk_glg_build(s, b->tracer, &go, b->opt->threads, &b->glg);
-        if (r) return fail(b, LBK_EXIT_INTERNAL, "global light grid: %s", lbk_result_message(r));
-        b->have_glg = b->glg.status == BK_GLG_OK && b->glg.probe_count >= 4 && b->glg.tet_count > 0;
-        if (!b->have_glg) {
-            static const char *why[] = {"ok", "the scene has no geometry", "there is no free space for 4 probes",
-                                        "the free space is flat (one layer of probes)", "the tetrahedralisation failed"};
-            int st = b->glg.status >= 0 && b->glg.status <= 4 ? b->glg.status : 4;
-            bk_progress_note(b->progress, "lbk bake: no global light grid: %s", why[st]);
-        }
-    }
-    bk_progress_update(b->progress, 0.8);
-
-    /* LLGs for props. */
-    if (n_llg) {
-        b->llgs = calloc(n_llg, sizeof *b->llgs);
-        if (!b->llgs) return fail(b, LBK_EXIT_INTERNAL, "out of memory");
-        bk_llg_options lo;
-        memset(&lo, 0, sizeof lo);
-        lo.visibility_rays = b->pre->llg_visibility_rays;
-        for (size_t i = 0; i < s->object_count; i++) {
-            if (b->classes[i].rep != BK_REP_LLG) continue;
-            r = bk_llg_place(s, (uint32_t)i, &lo, b->opt->threads, &b->llgs[b->llg_count]);
-            if (r) {
-                bk_progress_note(b->progress, "lbk bake: warning: object '%s': no local light grid (%s)",
-                                 s->objects[i].name, lbk_result_message(r));
-                b->classes[i].rep = BK_REP_NONE;
-                continue;
-            }
-            b->object_llg[i] = (int32_t)b->llg_count++;
-        }
-    }
-    bk_progress_update(b->progress, 1);
-    return 0;
+    ao.density_override = b->opt->texel_density > 0 ? b->opt->texel_density : 0;
+    lbk_result r = bk_atlas_build(s, lightmapped, &ao, &b->atlas);
+    if (r == LBK_ERR_LIMIT) return bk_pipeline_fail(b, LBK_ERR_BAD_INPUT, "lightmap atlas: %s", lbk_result_message(r));
+    if (r) return bk_pipeline_failed(b, r, "lightmap atlas");
+    if (b->atlas.note[0]) bk_events_say(&b->events, LBK_BAKE_SEVERITY_NOTE, "%s", b->atlas.note);
+    if (!b->opt->no_seam_stitch && (r = bk_seams_find(s, &b->atlas, &b->seams)) != LBK_OK)
+        return bk_pipeline_failed(b, r, "lightmap seams");
+    for (size_t i = 0; i < b->atlas.object_count; i++)
+        if (b->atlas.objects[i].note[0])
+            bk_events_say(&b->events, LBK_BAKE_SEVERITY_NOTE, "object '%s': %s", s->objects[b->atlas.objects[i].object].name,
+                          b->atlas.objects[i].note);
+    return LBK_OK;
 }
 
-static int build_receivers(bake *b)
+static lbk_result layout_texels(bk_pipeline *b)
+{
+    lbk_result r = bk_texels_build(&b->scene, &b->atlas, &b->texels);
+    if (r) return bk_pipeline_failed(b, r, "lightmap texels");
+    bk_pushout_options po;
+    memset(&po, 0, sizeof po);
+    po.threads = b->opt->threads ? b->opt->threads : 0;
+    bk_pushout_stats ps;
+    r = bk_texels_push_out(&b->texels, &b->scene, b->tracer, &po, &ps);
+    return r ? bk_pipeline_failed(b, r, "texel push-out") : LBK_OK;
+}
+
+/* GLG: the level's empty space, for movers and volumetrics. */
+static lbk_result layout_glg(bk_pipeline *b)
+{
+    bk_glg_options go;
+    memset(&go, 0, sizeof go);
+    go.spacing = b->opt->glg_spacing > 0 ? b->opt->glg_spacing : b->pre->glg_spacing;
+    lbk_result r = bk_glg_build(&b->scene, b->tracer, &go, b->opt->threads, &b->glg);
+    if (r) return bk_pipeline_failed(b, r, "global light grid");
+    b->have_glg = b->glg.status == BK_GLG_OK && b->glg.probe_count >= 4 && b->glg.tet_count > 0;
+    if (!b->have_glg) {
+        static const char *why[] = {"ok", "the scene has no geometry", "there is no free space for 4 probes",
+                                    "the free space is flat (one layer of probes)", "the tetrahedralisation failed"};
+        int st = b->glg.status >= 0 && b->glg.status <= 4 ? b->glg.status : 4;
+        bk_events_say(&b->events, LBK_BAKE_SEVERITY_NOTE, "no global light grid: %s", why[st]);
+    }
+    return LBK_OK;
+}
+
+/* LLGs for props; an object whose grid cannot be placed loses its lighting, with a warning. */
+static lbk_result layout_llgs(bk_pipeline *b, size_t n_llg)
+{
+    const bk_scene *s = &b->scene;
+    b->llgs = calloc(n_llg, sizeof *b->llgs);
+    if (!b->llgs) return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
+    bk_llg_options lo;
+    memset(&lo, 0, sizeof lo);
+    lo.visibility_rays = b->pre->llg_visibility_rays;
+    for (size_t i = 0; i < s->object_count; i++) {
+        if (b->classes[i].rep != BK_REP_LLG) continue;
+        lbk_result r = bk_llg_place(s, (uint32_t)i, &lo, b->opt->threads, &b->llgs[b->llg_count]);
+        if (r) {
+            bk_events_say(&b->events, LBK_BAKE_SEVERITY_WARNING, "object '%s': no local light grid (%s)", s->objects[i].name,
+                          lbk_result_message(r));
+            b->classes[i].rep = BK_REP_NONE;
+            continue;
+        }
+        b->object_llg[i] = (int32_t)b->llg_count++;
+    }
+    return LBK_OK;
+}
+
+static lbk_result do_layout(bk_pipeline *b)
+{
+    lbk_result r = phase(b, LBK_BAKE_PHASE_LAYOUT);
+    if (r) return r;
+    const size_t n_obj = b->scene.object_count ? b->scene.object_count : 1;
+    b->classes = calloc(n_obj, sizeof *b->classes);
+    b->object_llg = malloc(n_obj * sizeof *b->object_llg);
+    uint8_t *lightmapped = calloc(n_obj, 1);
+    size_t n_lm = 0, n_llg = 0;
+    r = b->classes && b->object_llg && lightmapped ? LBK_OK : bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
+    if (!r) r = layout_classify(b, lightmapped, &n_lm, &n_llg);
+    if (!r) r = checkpoint(b, 0.1);
+    if (!r && n_lm) r = layout_atlas(b, lightmapped);
+    free(lightmapped);
+    if (!r) r = checkpoint(b, 0.4);
+    if (!r) {
+        r = bk_tracer_create(&b->scene, b->opt->threads, &b->tracer);
+        if (r) r = bk_pipeline_failed(b, r, "ray tracer (Embree)");
+    }
+    if (!r && n_lm) r = layout_texels(b);
+    if (!r) r = checkpoint(b, 0.6);
+    if (!r && !b->opt->no_glg) r = layout_glg(b);
+    if (!r) r = checkpoint(b, 0.8);
+    if (!r && n_llg) r = layout_llgs(b, n_llg);
+    if (!r) r = checkpoint(b, 1);
+    return r;
+}
+
+/* ---- light ----------------------------------------------------------------------------- */
+
+static lbk_result build_receivers(bk_pipeline *b)
 {
     size_t n = 0;
     for (size_t i = 0; i < b->texels.count; i++) n += (b->texels.receivers[i].flags & BK_TEXEL_VALID) != 0;
@@ -355,7 +374,8 @@ static int build_receivers(bake *b)
     b->receivers = calloc(n ? n : 1, sizeof *b->receivers);
     b->texel_of_receiver = calloc(b->texel_receivers ? b->texel_receivers : 1, sizeof *b->texel_of_receiver);
     b->radiance = calloc(n ? n : 1, sizeof *b->radiance);
-    if (!b->receivers || !b->texel_of_receiver || !b->radiance) return fail(b, LBK_EXIT_INTERNAL, "out of memory");
+    if (!b->receivers || !b->texel_of_receiver || !b->radiance)
+        return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
     size_t k = 0;
     for (size_t i = 0; i < b->texels.count; i++) {
         const bk_texel *t = &b->texels.receivers[i];
@@ -372,22 +392,22 @@ static int build_receivers(bake *b)
             for (uint32_t y = 0; y < l->dims[1]; y++)
                 for (uint32_t x = 0; x < l->dims[0]; x++, k++) bk_llg_probe_position(l, x, y, z, b->receivers[k].position);
     }
-    return 0;
+    return LBK_OK;
 }
 
-static void bk_bake_transport_options(const bk_bake_options *opt, int preset_max_samples, double preset_target,
-                               bk_transport_options *to)
+static void transport_options(const bk_pipeline *b, bk_transport_options *to)
 {
+    const lbk_bake_desc *opt = b->opt;
     memset(to, 0, sizeof *to);
     to->seed = opt->seed;
     to->threads = opt->threads;
     to->max_bounces = opt->max_bounces;
-    to->max_samples = opt->max_samples > 0 ? opt->max_samples : preset_max_samples;
-    to->target_error = opt->target_error > 0 ? opt->target_error : preset_target;
+    to->max_samples = opt->max_samples > 0 ? opt->max_samples : b->pre->max_samples;
+    to->target_error = opt->target_error > 0 ? opt->target_error : b->pre->target_error;
     to->time_limit = opt->time_limit;
 }
 
-static void set_inputs(const bake *b, bk_set_inputs *in)
+void bk_pipeline_set_inputs(const bk_pipeline *b, bk_set_inputs *in)
 {
     memset(in, 0, sizeof *in);
     in->scene = &b->scene;
@@ -404,22 +424,23 @@ static void set_inputs(const bake *b, bk_set_inputs *in)
     in->texel_of_receiver = b->texel_of_receiver;
     in->texels = &b->texels;
     in->atlas_margin = b->atlas.margin;
+    in->seams = b->opt->no_seam_stitch ? NULL : &b->seams;
     in->base_radiance = b->radiance;
-    bk_bake_transport_options(b->opt, b->pre->max_samples, b->pre->target_error, &in->transport);
+    transport_options(b, &in->transport);
     in->base_samples_per_receiver = b->stats.samples_per_receiver;
     in->threshold = b->opt->dls_threshold;
-    in->progress = b->progress;
-    in->door_method = b->opt->door_method;
+    in->events = &b->events;
+    in->door_method = (int)b->opt->door_method;
     memcpy(in->origin, b->origin, sizeof in->origin);
 }
 
-static int do_transport(bake *b)
+static lbk_result do_transport(bk_pipeline *b)
 {
-    phase(b, "light");
-    int rc = build_receivers(b);
-    if (rc) return rc;
+    lbk_result r = phase(b, LBK_BAKE_PHASE_LIGHT);
+    if (!r) r = build_receivers(b);
+    if (r) return r;
     bk_transport_options to;
-    bk_bake_transport_options(b->opt, b->pre->max_samples, b->pre->target_error, &to);
+    transport_options(b, &to);
     to.progress = transport_progress;
     to.report = transport_report;
     to.user = b;
@@ -427,467 +448,97 @@ static int do_transport(bake *b)
     bk_transport_output out;
     memset(&out, 0, sizeof out);
     out.radiance = b->radiance;
-    lbk_result r = bk_transport_run(&b->scene, b->tracer, b->receivers, b->receiver_count, &to, &out, &b->stats);
-    if (r) return fail(b, LBK_EXIT_INTERNAL, "light transport: %s", lbk_result_message(r));
+    r = bk_transport_run(&b->scene, b->tracer, b->receivers, b->receiver_count, &to, &out, &b->stats);
+    if (r) return bk_pipeline_failed(b, r, "light transport");
     if (b->stats.nonfinite)
-        bk_progress_note(b->progress, "lbk bake: warning: %llu non-finite samples were dropped",
-                         (unsigned long long)b->stats.nonfinite);
-    return 0;
-}
-
-typedef struct section_list {
-    uint32_t type[16];
-    void *data[16];
-    size_t size[16];
-    int count;
-} section_list;
-
-static void sections_free(section_list *sl)
-{
-    for (int i = 0; i < sl->count; i++) lbk_free(NULL, sl->data[i]);
-    sl->count = 0;
-}
-
-static lbk_result sections_add(section_list *sl, uint32_t type, lbk_result r, void *data, size_t size)
-{
-    if (r) return r;
-    sl->type[sl->count] = type;
-    sl->data[sl->count] = data;
-    sl->size[sl->count++] = size;
+        bk_events_say(&b->events, LBK_BAKE_SEVERITY_WARNING, "%llu non-finite samples were dropped",
+                      (unsigned long long)b->stats.nonfinite);
     return LBK_OK;
 }
 
-static lbk_result build_lmap(bake *b, section_list *sl)
+static lbk_result do_sets(bk_pipeline *b)
 {
-    const bk_texels *tx = &b->texels;
-    size_t nt = tx->count;
-    lbk_ahd_linear *lin = calloc(nt ? nt : 1, sizeof *lin);
-    uint8_t *has = calloc(nt ? nt : 1, 1);
-    lbk_ahd_texel **pages = calloc(tx->page_count, sizeof *pages);
-    lbk_lmap_page_desc *desc = calloc(tx->page_count, sizeof *desc);
-    lbk_result r = LBK_ERR_OUT_OF_MEMORY;
-    if (!lin || !has || !pages || !desc) goto done;
-    for (size_t k = 0; k < b->texel_receivers; k++) {
-        uint32_t ti = b->texel_of_receiver[k];
-        bk_texel_linear(&tx->receivers[ti], &b->radiance[k], &lin[ti]);
-        has[ti] = 1;
-    }
-    /* the scale puts the brightest texel (base or any light set) at 2^13..2^14 stored */
-    double set_max[3];
-    bk_set_bakes_max(&b->sets, set_max);
-    const float scale = b->scale[0] = bk_scale_for(fmax(bk_texel_max(lin, has, nt), set_max[0]));
-    const float inv = 1.0f / scale;
-    bk_count_out_of_range(lin, has, nt, inv, &b->saturated, &b->flushed);
-    if (b->saturated)
-        bk_progress_note(b->progress,
-                         "lbk bake: warning: %llu texel channels exceed 65024 times the lightmap scale %g, the "
-                         "largest R11G11B10F value, and are stored saturated",
-                         (unsigned long long)b->saturated, (double)scale);
-    if (b->flushed)
-        bk_progress_note(b->progress,
-                         "lbk bake: warning: %llu lit texel channels are below 2^-21 times the lightmap scale %g "
-                         "and are stored as 0: the level's irradiance spans more than the format's range "
-                         "(~7e10) within one lightmap",
-                         (unsigned long long)b->flushed, (double)scale);
-    r = bk_encode_pages(tx, b->atlas.margin, lin, has, inv, pages);
-    if (r) goto done;
-    for (size_t p = 0; p < tx->page_count; p++) {
-        desc[p].width = (uint32_t)tx->pages[p].width;
-        desc[p].height = (uint32_t)tx->pages[p].height;
-        desc[p].texels = pages[p];
-    }
-    void *data;
-    size_t size;
-    r = lbk_lmap_build(desc, (uint32_t)tx->page_count, scale, NULL, &data, &size);
-    r = sections_add(sl, LBK_SECTION_LMAP, r, data, size);
-done:
-    if (pages)
-        for (size_t p = 0; p < tx->page_count; p++) free(pages[p]);
-    free(pages), free(desc), free(lin), free(has);
+    lbk_result r = phase(b, LBK_BAKE_PHASE_SETS);
+    if (r) return r;
+    bk_set_inputs in;
+    bk_pipeline_set_inputs(b, &in);
+    return bk_set_bakes_run(&b->sets, &in, b->err, sizeof b->err);
+}
+
+/* ---- the call -------------------------------------------------------------------------- */
+
+static lbk_result run(bk_pipeline *b, const char *path, const lbk_bake_scene *desc)
+{
+    lbk_result r = do_import(b, path, desc);
+    if (!r) r = do_layout(b);
+    if (!r) r = bk_set_bakes_prepare(&b->sets, &b->scene, &b->events, b->err, sizeof b->err);
+    if (!r) r = do_transport(b);
+    if (!r && b->sets.set_count) r = do_sets(b);
+    if (!r) r = phase(b, LBK_BAKE_PHASE_WRITE);
+    if (!r) r = bk_pipeline_encode(b);
+    if (b->phase_count > 0) b->phase_seconds[b->phase_count - 1] = bk_now() - b->phase_start;
+    if (!r) r = bk_pipeline_report(b, b->out);
+    if (r == LBK_ERR_OUT_OF_MEMORY && !b->err[0]) bk_pipeline_fail(b, r, "out of memory");
     return r;
 }
 
-static lbk_result build_glg(bake *b, section_list *sl)
+static int finite_nonneg(double v) { return isfinite(v) && v >= 0; }
+
+static lbk_result check_desc(bk_pipeline *b)
 {
-    uint8_t(*vis)[4] = calloc(b->glg.tet_count, sizeof *vis);
-    float(*world)[3] = calloc(b->glg.probe_count, sizeof *world);
-    if (!vis || !world) {
-        free(vis), free(world);
-        return LBK_ERR_OUT_OF_MEMORY;
-    }
-    bk_glg_visibility_unorm8(&b->glg, vis);
-    for (size_t i = 0; i < b->glg.probe_count; i++) to_world(b, &b->glg.positions[3 * i], world[i]);
-    lbk_glg_desc d;
-    memset(&d, 0, sizeof d);
-    d.probe_count = (uint32_t)b->glg.probe_count;
-    d.tetra_count = (uint32_t)b->glg.tet_count;
-    d.positions = (const float(*)[3])world;
-    d.probes = &b->radiance[b->glg_first];
-    d.tetras = (const uint32_t(*)[4])b->glg.tets;
-    d.adjacency = (const uint32_t(*)[4])b->glg.neighbours;
-    d.visibility = (const uint8_t(*)[4])vis;
-    double set_max[3];
-    bk_set_bakes_max(&b->sets, set_max);
-    d.scale = b->scale[1] = bk_scale_for(fmax(bk_probe_max(d.probes, d.probe_count), set_max[1]));
-    void *data;
-    size_t size;
-    lbk_result r = lbk_glg_build(&d, NULL, &data, &size);
-    free(vis), free(world);
-    return sections_add(sl, LBK_SECTION_GLG, r, data, size);
+    const lbk_bake_desc *d = &b->desc;
+#define BAD(...) return bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT, __VA_ARGS__)
+    if ((unsigned)d->preset >= LBK_BAKE_PRESET_COUNT_) BAD("lbk_bake_desc.preset: unknown preset %d", (int)d->preset);
+    if ((unsigned)d->door_method >= LBK_BAKE_DOOR_METHOD_COUNT_)
+        BAD("lbk_bake_desc.door_method: unknown method %d", (int)d->door_method);
+    if (d->threads < 0) BAD("lbk_bake_desc.threads: %d is negative", d->threads);
+    if (!isfinite(d->target_error)) BAD("lbk_bake_desc.target_error is not finite");
+    if (!finite_nonneg(d->time_limit)) BAD("lbk_bake_desc.time_limit: %g is not a finite number >= 0", d->time_limit);
+    if (d->max_samples < 0 || d->max_bounces < 0) BAD("lbk_bake_desc: max_samples and max_bounces must be >= 0");
+    if (!finite_nonneg(d->texel_density)) BAD("lbk_bake_desc.texel_density: %g is not a finite number >= 0", d->texel_density);
+    if (!finite_nonneg(d->glg_spacing)) BAD("lbk_bake_desc.glg_spacing: %g is not a finite number >= 0", d->glg_spacing);
+    if (!isfinite(d->dls_threshold)) BAD("lbk_bake_desc.dls_threshold is not finite");
+    if (d->sky_override && !d->sky_exr)
+        for (int k = 0; k < 3; k++)
+            if (!finite_nonneg(d->sky[k]) || !(d->sky[k] < 1e30f)) BAD("lbk_bake_desc.sky: radiance must be finite and >= 0");
+#undef BAD
+    return LBK_OK;
 }
 
-static lbk_result build_octp(bake *b, section_list *sl)
+/* The caller's desc at this library's size: a shorter one (an older caller) is zero-extended,
+ * a longer one (a newer caller) is accepted when everything past what we know is zero. */
+static lbk_result copy_desc(bk_pipeline *b, const lbk_bake_desc *d)
 {
-    lbk_octp_probe_desc *p = calloc(b->glg.probe_count, sizeof *p);
-    if (!p) return LBK_ERR_OUT_OF_MEMORY;
-    float diag = 0;
-    for (int a = 0; a < 3; a++) {
-        float e = b->scene.bounds_max[a] - b->scene.bounds_min[a];
-        diag += e * e;
+    memset(&b->desc, 0, sizeof b->desc);
+    if (d) {
+        size_t n = d->size ? d->size : BK_DESC_SIZE_V1;
+        if (n < sizeof d->size) return LBK_ERR_INVALID_ARGUMENT; /* nothing in it can be trusted, not even message */
+        memcpy(&b->desc, d, n < sizeof b->desc ? n : sizeof b->desc);
+        for (size_t i = sizeof b->desc; i < n; i++)
+            if (((const unsigned char *)d)[i])
+                return bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT,
+                                        "lbk_bake_desc: a field this library (%zu bytes of lbk_bake_desc) does not know is set",
+                                        sizeof b->desc);
     }
-    diag = sqrtf(diag);
-    if (!(diag > 0) || !isfinite(diag)) diag = 1;
-    for (size_t i = 0; i < b->glg.probe_count; i++)
-    {
-        bk_octa_probe(b->tracer, &b->glg.positions[3 * i], &b->radiance[b->glg_first + i], diag, &p[i]);
-        to_world(b, &b->glg.positions[3 * i], p[i].position);
-    }
-    void *data;
-    size_t size;
-    double m = 0;
-    for (size_t i = 0; i < b->glg.probe_count; i++)
-        for (int t = 0; t < 16; t++)
-            for (int c = 0; c < 3; c++)
-                if (p[i].irradiance[t][c] > m && isfinite(p[i].irradiance[t][c])) m = p[i].irradiance[t][c];
-    b->octp_scale = bk_scale_for(m);
-    lbk_result r = lbk_octp_build(p, (uint32_t)b->glg.probe_count, b->octp_scale, NULL, &data, &size);
-    free(p);
-    return sections_add(sl, LBK_SECTION_OCTP, r, data, size);
+    b->desc.size = sizeof b->desc;
+    return check_desc(b);
 }
 
-static lbk_result build_llg(bake *b, section_list *sl)
+static lbk_result output_create(bk_pipeline *b)
 {
-    lbk_llg_grid_desc *g = calloc(b->llg_count, sizeof *g);
-    lbk_llg_vertex **verts = calloc(b->llg_count, sizeof *verts);
-    lbk_result r = LBK_ERR_OUT_OF_MEMORY;
-    if (!g || !verts) goto done;
-    size_t probe = b->llg_first;
-    for (size_t i = 0; i < b->llg_count; i++) {
-        const bk_llg *l = &b->llgs[i];
-        to_world(b, l->centre, g[i].centre);
-        memcpy(g[i].axes, l->axes, sizeof g[i].axes);
-        memcpy(g[i].half_extent, l->half_extents, sizeof g[i].half_extent);
-        memcpy(g[i].dims, l->dims, sizeof g[i].dims);
-        g[i].probes = &b->radiance[probe];
-        probe += bk_llg_probe_count(l);
-        verts[i] = calloc(l->vertex_count ? l->vertex_count : 1, sizeof **verts);
-        if (!verts[i]) goto done;
-        bk_llg_vertex_records(l, verts[i]);
-        g[i].vertices = verts[i];
-        g[i].vertex_count = (uint32_t)l->vertex_count;
-    }
-    void *data;
-    size_t size;
-    double set_max[3];
-    bk_set_bakes_max(&b->sets, set_max);
-    b->scale[2] = bk_scale_for(fmax(bk_probe_max(&b->radiance[b->llg_first], b->receiver_count - b->llg_first), set_max[2]));
-    r = lbk_llg_build(g, (uint32_t)b->llg_count, b->scale[2], NULL, &data, &size);
-    r = sections_add(sl, LBK_SECTION_LLG, r, data, size);
-done:
-    if (verts)
-        for (size_t i = 0; i < b->llg_count; i++) free(verts[i]);
-    free(verts), free(g);
-    return r;
+    lbk_allocator a;
+    memset(&a, 0, sizeof a);
+    if (b->opt->allocator && b->opt->allocator->alloc && b->opt->allocator->free) a = *b->opt->allocator;
+    lbk_bake_output tmp;
+    memset(&tmp, 0, sizeof tmp);
+    tmp.allocator = a;
+    b->out = bk_output_alloc(&tmp, sizeof *b->out);
+    if (!b->out) return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
+    *b->out = tmp;
+    return LBK_OK;
 }
 
-typedef struct named {
-    const char *name;
-    uint32_t index;
-} named;
-
-static int by_name_then_index(const void *a, const void *b)
-{
-    const named *x = a, *y = b;
-    int c = strcmp(x->name, y->name);
-    return c ? c : (x->index > y->index) - (x->index < y->index);
-}
-
-/* OBJS names must be unique for tools to match objects across revisions (spec §8.2): the k-th
- * repeat of a name in scene order becomes "name#k" (k from 2). */
-static int unique_names(const bk_scene *s, char (*names)[sizeof s->objects[0].name + 24])
-{
-    size_t n = s->object_count;
-    named *order = malloc((n ? n : 1) * sizeof *order);
-    if (!order) return -1;
-    for (size_t i = 0; i < n; i++) order[i] = (named){s->objects[i].name, (uint32_t)i};
-    qsort(order, n, sizeof *order, by_name_then_index);
-    size_t k = 1;
-    for (size_t i = 0; i < n; i++) {
-        k = i > 0 && !strcmp(order[i - 1].name, order[i].name) ? k + 1 : 1;
-        if (k == 1)
-            snprintf(names[order[i].index], sizeof names[0], "%s", order[i].name);
-        else
-            snprintf(names[order[i].index], sizeof names[0], "%s#%zu", order[i].name, k);
-    }
-    free(order);
-    return 0;
-}
-
-static lbk_result build_objects(bake *b, section_list *sl)
-{
-    const bk_scene *s = &b->scene;
-    lbk_object *objs = calloc(s->object_count ? s->object_count : 1, sizeof *objs);
-    char(*names)[sizeof s->objects[0].name + 24] = calloc(s->object_count ? s->object_count : 1, sizeof *names);
-    float *xyz = NULL;
-    size_t xyz_cap = 0;
-    lbk_result r = LBK_ERR_OUT_OF_MEMORY;
-    if (!objs || !names || unique_names(s, names)) goto done;
-    for (size_t i = 0; i < s->object_count; i++) {
-        const bk_object *o = &s->objects[i];
-        lbk_object *t = &objs[i];
-        t->name.data = names[i];
-        t->name.size = strlen(names[i]);
-        if (o->tri_count > xyz_cap) {
-            free(xyz);
-            xyz_cap = o->tri_count;
-            xyz = malloc(xyz_cap * 9 * sizeof *xyz);
-            if (!xyz) goto done;
-        }
-        for (uint32_t k = 0; k < o->tri_count; k++)
-            for (int c = 0; c < 3; c++)
-                to_world(b, &s->positions[3 * (size_t)s->tris[3 * ((size_t)o->first_tri + k) + c]], &xyz[9 * k + 3 * c]);
-        t->geometry_hash = lbk_objects_geometry_hash(xyz, o->tri_count);
-        t->representation = LBK_REPRESENTATION_NONE;
-        int32_t slot = b->atlas.object_slot && i < b->atlas.scene_object_count ? b->atlas.object_slot[i] : -1;
-        if (b->classes[i].rep == BK_REP_LIGHTMAP && slot >= 0 && b->atlas.objects[slot].page >= 0) {
-            const bk_atlas_object *ao = &b->atlas.objects[slot];
-            t->representation = LBK_REPRESENTATION_LIGHTMAP;
-            t->index = (uint32_t)ao->page;
-            t->rect_x = (uint32_t)ao->x, t->rect_y = (uint32_t)ao->y;
-            t->rect_w = (uint32_t)ao->w, t->rect_h = (uint32_t)ao->h;
-        } else if (b->classes[i].rep == BK_REP_LLG && b->object_llg[i] >= 0) {
-            t->representation = LBK_REPRESENTATION_LLG;
-            t->index = (uint32_t)b->object_llg[i];
-        }
-    }
-    void *data;
-    size_t size;
-    r = lbk_objects_build(objs, (uint32_t)s->object_count, NULL, &data, &size);
-    r = sections_add(sl, LBK_SECTION_OBJS, r, data, size);
-done:
-    free(objs), free(names), free(xyz);
-    return r;
-}
-
-static lbk_result build_meta(bake *b, section_list *sl)
-{
-    char hash[17], seed[32], density[32], spacing[32], samples[32], target[32], bounces[32], tlimit[32], ts[32];
-    lbk_meta_hash_hex(b->scene.source_hash, hash);
-    snprintf(seed, sizeof seed, "%llu", (unsigned long long)b->opt->seed);
-    snprintf(density, sizeof density, "%g", b->opt->texel_density > 0 ? b->opt->texel_density : b->pre->texel_density);
-    snprintf(spacing, sizeof spacing, "%g", b->opt->glg_spacing > 0 ? b->opt->glg_spacing : b->pre->glg_spacing);
-    snprintf(samples, sizeof samples, "%d", b->opt->max_samples > 0 ? b->opt->max_samples : b->pre->max_samples);
-    snprintf(target, sizeof target, "%g", b->opt->target_error > 0 ? b->opt->target_error : b->pre->target_error);
-    snprintf(bounces, sizeof bounces, "%d", b->opt->max_bounces);
-    snprintf(tlimit, sizeof tlimit, "%g", b->opt->time_limit);
-    const char *base = strrchr(b->opt->input, '/');
-    base = base ? base + 1 : b->opt->input;
-    lbk_meta_pair p[16];
-    size_t n = 0;
-    p[n++] = (lbk_meta_pair){LBK_META_WRITER, "lbk bake"};
-    p[n++] = (lbk_meta_pair){LBK_META_WRITER_VERSION, LBK_LIBRARY_VERSION_STRING};
-    p[n++] = (lbk_meta_pair){LBK_META_SCENE_HASH, hash};
-    p[n++] = (lbk_meta_pair){"scene.name", base};
-    p[n++] = (lbk_meta_pair){"bake.preset", b->pre->name};
-    p[n++] = (lbk_meta_pair){"bake.seed", seed};
-    p[n++] = (lbk_meta_pair){"bake.texel_density", density};
-    p[n++] = (lbk_meta_pair){"bake.glg_spacing", spacing};
-    p[n++] = (lbk_meta_pair){"bake.max_samples", samples};
-    p[n++] = (lbk_meta_pair){"bake.target_error", target};
-    p[n++] = (lbk_meta_pair){"bake.max_bounces", bounces};
-    p[n++] = (lbk_meta_pair){"bake.time_limit", tlimit};
-    if (b->opt->revision) p[n++] = (lbk_meta_pair){LBK_META_REVISION, b->opt->revision};
-    if (b->opt->timestamp) {
-        time_t now = time(NULL);
-        struct tm tmv;
-        gmtime_r(&now, &tmv);
-        strftime(ts, sizeof ts, "%Y-%m-%dT%H:%M:%SZ", &tmv);
-        p[n++] = (lbk_meta_pair){LBK_META_TIMESTAMP, ts};
-    }
-    void *data;
-    size_t size;
-    lbk_result r = lbk_meta_build(p, n, NULL, &data, &size);
-    return sections_add(sl, LBK_SECTION_META, r, data, size);
-}
-
-static uint32_t bake_status(const bake *b)
-{
-    switch (b->stats.stop) {
-    case BK_STOP_TARGET: return LBK_BAKE_TARGET_REACHED;
-    case BK_STOP_TIME: return LBK_BAKE_TIME_LIMIT;
-    default: return LBK_BAKE_SAMPLE_LIMIT;
-    }
-}
-
-static lbk_result build_report(bake *b, section_list *sl)
-{
-    size_t n = b->sample_count ? b->sample_count : 1;
-    lbk_report_record *rec = calloc(n, sizeof *rec);
-    if (!rec) return LBK_ERR_OUT_OF_MEMORY;
-    int has_probes = b->receiver_count > b->texel_receivers;
-    for (size_t i = 0; i < b->sample_count; i++) {
-        const bk_transport_sample *s = &b->samples[i];
-        /* Wall-clock seconds would make the file differ run to run; the stored report measures
-         * work in samples and rays (times are in --json-report). */
-        rec[i].samples_per_texel = (uint32_t)fmin(s->samples_per_receiver, 4e9);
-        rec[i].bounces = (uint32_t)(s->bounces > 0 ? s->bounces : 0);
-        rec[i].texel_rel_rmse = b->texel_receivers ? (float)s->est_rel_rmse : 0;
-        rec[i].probe_rel_rmse = has_probes ? (float)s->est_rel_rmse : 0;
-        if (i > 0 && rec[i].samples_per_texel < rec[i - 1].samples_per_texel) rec[i].samples_per_texel = rec[i - 1].samples_per_texel;
-        if (i > 0 && rec[i].bounces < rec[i - 1].bounces) rec[i].bounces = rec[i - 1].bounces;
-        rec[i].rays_traced = (uint64_t)((double)b->stats.rays * (s->samples_per_receiver /
-                                                                 fmax(b->stats.samples_per_receiver, 1)));
-        if (i > 0 && rec[i].rays_traced < rec[i - 1].rays_traced) rec[i].rays_traced = rec[i - 1].rays_traced;
-    }
-    if (b->sample_count) rec[b->sample_count - 1].rays_traced = b->stats.rays;
-    lbk_report rp;
-    memset(&rp, 0, sizeof rp);
-    rp.status = bake_status(b);
-    rp.max_samples_per_texel = (uint32_t)(b->opt->max_samples > 0 ? b->opt->max_samples : b->pre->max_samples);
-    /* Passes double their samples, so the budget stops the bake at the last pass that fits in it:
-     * the limit recorded is what that pass reached. */
-    if (rp.status == LBK_BAKE_SAMPLE_LIMIT && b->sample_count) rp.max_samples_per_texel = rec[b->sample_count - 1].samples_per_texel;
-    rp.time_limit_seconds = b->opt->time_limit;
-    rp.target_rel_rmse = (float)(b->opt->target_error > 0 ? b->opt->target_error : b->pre->target_error);
-    rp.records = rec;
-    rp.record_count = (uint32_t)n;
-    void *data;
-    size_t size;
-    lbk_result r = lbk_report_build(&rp, NULL, &data, &size);
-    free(rec);
-    return sections_add(sl, LBK_SECTION_REPT, r, data, size);
-}
-
-static int do_encode_and_write(bake *b, bk_bake_summary *sum)
-{
-    phase(b, "write");
-    section_list sl;
-    memset(&sl, 0, sizeof sl);
-    lbk_result r = build_meta(b, &sl);
-    if (!r && b->sample_count) r = build_report(b, &sl);
-    if (!r) r = build_objects(b, &sl);
-    if (!r && b->texels.page_count && b->texel_receivers) r = build_lmap(b, &sl);
-    if (!r && b->have_glg) r = build_glg(b, &sl);
-    if (!r && b->llg_count) r = build_llg(b, &sl);
-    if (!r && b->opt->octahedral_probes && b->have_glg) r = build_octp(b, &sl);
-    if (!r && b->sets.set_count) {
-        bk_set_inputs in;
-        set_inputs(b, &in);
-        memcpy(in.scale, b->scale, sizeof in.scale);
-        void *dls = NULL, *door = NULL;
-        size_t dls_size = 0, door_size = 0;
-        r = bk_set_bakes_sections(&b->sets, &in, &dls, &dls_size, &door, &door_size);
-        if (!r && dls) r = sections_add(&sl, LBK_SECTION_DLS, r, dls, dls_size);
-        if (!r && door) r = sections_add(&sl, LBK_SECTION_DOOR, r, door, door_size);
-    }
-    bk_progress_update(b->progress, 0.5);
-    lbk_writer *w = NULL;
-    if (!r) r = lbk_writer_create(NULL, &w);
-    for (int i = 0; !r && i < sl.count; i++) {
-        lbk_section_options so;
-        memset(&so, 0, sizeof so);
-        /* Lighting payloads stay uncompressed so a runtime can upload them in place; `lbk
-         * convert` makes compressed packs. The small CPU-side tables are required to read them. */
-        if (sl.type[i] == LBK_SECTION_OBJS || sl.type[i] == LBK_SECTION_DLS || sl.type[i] == LBK_SECTION_DOOR)
-            so.flags = LBK_SECTION_FLAG_REQUIRED;
-        r = lbk_writer_add_section(w, sl.type[i], sl.data[i], sl.size[i], &so);
-    }
-    sections_free(&sl);
-    if (r) {
-        lbk_writer_destroy(w);
-        return fail(b, LBK_EXIT_INTERNAL, "encoding the container: %s", lbk_result_message(r));
-    }
-    r = lbk_writer_to_file(w, b->opt->output);
-    lbk_writer_destroy(w);
-    if (r) return fail(b, LBK_EXIT_IO, "writing %s: %s", b->opt->output, lbk_result_message(r));
-    FILE *f = fopen(b->opt->output, "rb");
-    if (f) {
-        fseek(f, 0, SEEK_END);
-        sum->file_bytes = (uint64_t)ftell(f);
-        fclose(f);
-    }
-    bk_progress_update(b->progress, 1);
-    return 0;
-}
-
-static int write_json_report(bake *b, const bk_bake_summary *sum)
-{
-    cJSON *root = cJSON_CreateObject();
-    cJSON_AddStringToObject(root, "schema", "lbk-bake-report/1");
-    cJSON_AddStringToObject(root, "input", b->opt->input);
-    cJSON_AddStringToObject(root, "output", b->opt->output);
-    cJSON_AddStringToObject(root, "preset", b->pre->name);
-    cJSON_AddNumberToObject(root, "seed", (double)b->opt->seed);
-    cJSON_AddStringToObject(root, "status", lbk_bake_status_name(bake_status(b)));
-    cJSON_AddNumberToObject(root, "target_error", b->opt->target_error > 0 ? b->opt->target_error : b->pre->target_error);
-    cJSON_AddNumberToObject(root, "time_limit", b->opt->time_limit);
-    cJSON *samples = cJSON_AddArrayToObject(root, "samples");
-    for (size_t i = 0; i < b->sample_count; i++) {
-        const bk_transport_sample *s = &b->samples[i];
-        cJSON *o = cJSON_CreateObject();
-        cJSON_AddNumberToObject(o, "seconds", s->seconds);
-        cJSON_AddNumberToObject(o, "samples_per_receiver", s->samples_per_receiver);
-        cJSON_AddNumberToObject(o, "est_rel_rmse", s->est_rel_rmse);
-        cJSON_AddNumberToObject(o, "bounces", s->bounces);
-        cJSON_AddNumberToObject(o, "pass", s->pass);
-        cJSON_AddItemToArray(samples, o);
-    }
-    cJSON *st = cJSON_AddObjectToObject(root, "transport");
-    cJSON_AddNumberToObject(st, "seconds", b->stats.seconds);
-    cJSON_AddNumberToObject(st, "passes", b->stats.passes);
-    cJSON_AddNumberToObject(st, "rays", (double)b->stats.rays);
-    cJSON_AddNumberToObject(st, "bounces", b->stats.bounces);
-    cJSON_AddNumberToObject(st, "bounce_ratio_q", b->stats.q);
-    cJSON_AddNumberToObject(st, "tail_fraction", b->stats.tail_fraction);
-    cJSON_AddNumberToObject(st, "cache_cells", (double)b->stats.cells);
-    cJSON_AddNumberToObject(st, "nonfinite_dropped", (double)b->stats.nonfinite);
-    cJSON_AddNumberToObject(st, "texel_channels_saturated", (double)b->saturated);
-    cJSON_AddNumberToObject(st, "texel_channels_flushed", (double)b->flushed);
-    /* the radiometric scale of each lighting section written (spec §5.7); 0: section absent */
-    cJSON *sc = cJSON_AddObjectToObject(root, "scales");
-    cJSON_AddNumberToObject(sc, "lmap", sum->texels ? b->scale[0] : 0);
-    cJSON_AddNumberToObject(sc, "glg", sum->glg_probes ? b->scale[1] : 0);
-    cJSON_AddNumberToObject(sc, "llg", sum->llgs ? b->scale[2] : 0);
-    cJSON_AddNumberToObject(sc, "octp", b->opt->octahedral_probes && sum->glg_probes ? b->octp_scale : 0);
-    cJSON *c = cJSON_AddObjectToObject(root, "counts");
-    cJSON_AddNumberToObject(c, "objects", (double)sum->objects);
-    cJSON_AddNumberToObject(c, "texels", (double)sum->texels);
-    cJSON_AddNumberToObject(c, "pages", (double)sum->pages);
-    cJSON_AddNumberToObject(c, "glg_probes", (double)sum->glg_probes);
-    cJSON_AddNumberToObject(c, "llgs", (double)sum->llgs);
-    cJSON_AddNumberToObject(c, "llg_probes", (double)sum->llg_probes);
-    cJSON_AddNumberToObject(c, "light_sets", sum->sets);
-    cJSON_AddNumberToObject(c, "doors", sum->doors);
-    cJSON_AddNumberToObject(c, "file_bytes", (double)sum->file_bytes);
-    cJSON *ph = cJSON_AddArrayToObject(root, "phases");
-    for (int i = 0; i < b->phase_count; i++) {
-        cJSON *o = cJSON_CreateObject();
-        cJSON_AddStringToObject(o, "name", b->phase_names[i]);
-        cJSON_AddNumberToObject(o, "seconds", b->phase_seconds[i]);
-        cJSON_AddItemToArray(ph, o);
-    }
-    char *text = cJSON_Print(root);
-    cJSON_Delete(root);
-    if (!text) return fail(b, LBK_EXIT_INTERNAL, "out of memory");
-    FILE *f = fopen(b->opt->json_report, "w");
-    int ok = f && fputs(text, f) >= 0 && fputc('\n', f) != EOF;
-    if (f && fclose(f)) ok = 0;
-    free(text);
-    if (!ok) return fail(b, LBK_EXIT_IO, "writing %s failed", b->opt->json_report);
-    return 0;
-}
-
-static void bake_free(bake *b)
+static void pipeline_free(bk_pipeline *b)
 {
     bk_set_bakes_free(&b->sets);
     free(b->samples);
@@ -900,50 +551,68 @@ static void bake_free(bake *b)
     bk_glg_free(&b->glg);
     if (b->tracer) bk_tracer_destroy(b->tracer);
     bk_texels_free(&b->texels);
+    bk_seams_free(&b->seams);
     bk_atlas_free(&b->atlas);
     free(b->classes);
     bk_scene_free(&b->scene);
 }
 
-int bk_bake(const bk_bake_options *opt, bk_progress *progress, bk_bake_summary *summary, char *err, size_t err_len)
+static lbk_result bake(const char *path, const lbk_bake_scene *desc, const lbk_bake_desc *options, lbk_bake_output **out)
 {
-    bake b;
-    memset(&b, 0, sizeof b);
-    memset(summary, 0, sizeof *summary);
-    b.opt = opt;
-    b.progress = progress;
-    b.err = err;
-    b.err_len = err_len;
-    b.pre = &presets[0];
-    if (opt->preset && !strcmp(opt->preset, "high")) b.pre = &presets[1];
-    double start = bk_now();
-    int rc = do_import(&b);
-    if (!rc) rc = do_layout(&b);
-    if (!rc) rc = bk_set_bakes_prepare(&b.sets, &b.scene, progress, err, err_len);
-    if (!rc) rc = do_transport(&b);
-    if (!rc && b.sets.set_count) {
-        phase(&b, "sets");
-        bk_set_inputs in;
-        set_inputs(&b, &in);
-        rc = bk_set_bakes_run(&b.sets, &in, err, err_len);
+    if (!out) return LBK_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    bk_pipeline *b = calloc(1, sizeof *b);
+    if (!b) return LBK_ERR_OUT_OF_MEMORY;
+    b->start = bk_now();
+    b->est = -1;
+    b->opt = &b->desc;
+    b->events.message = events_message;
+    b->events.progress = events_progress;
+    b->events.user = b;
+    b->scene.sky_image = -1;
+    lbk_result r = copy_desc(b, options);
+    b->pre = &bk_presets[r ? 0 : b->desc.preset];
+    if (path) {
+        const char *base = strrchr(path, '/');
+        b->input = path;
+        b->scene_name = base ? base + 1 : path;
+    } else {
+        b->input = b->scene_name = desc && desc->name && desc->name[0] ? desc->name : "scene";
     }
-    if (!rc) {
-        summary->objects = b.scene.object_count;
-        summary->texels = b.atlas.texels;
-        summary->pages = b.atlas.page_count;
-        summary->glg_probes = b.have_glg ? b.glg.probe_count : 0;
-        summary->llgs = b.llg_count;
-        summary->llg_probes = b.receiver_count - b.llg_first;
-        summary->sets = b.sets.set_count;
-        summary->doors = b.sets.door_count;
-        summary->final_error = b.stats.est_rel_rmse;
-        rc = do_encode_and_write(&b, summary);
-        summary->texel_channels_saturated = b.saturated;
-        summary->texel_channels_flushed = b.flushed;
+    if (!r && !path && !desc) r = bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT, "no scene");
+    if (!r) r = output_create(b);
+    if (!r) r = run(b, path, desc);
+    if (r) {
+        if (r != LBK_ERR_CANCELLED)
+            bk_events_say(&b->events, LBK_BAKE_SEVERITY_ERROR, "%s", b->err[0] ? b->err : lbk_result_message(r));
+        lbk_bake_output_free(b->out);
+    } else {
+        *out = b->out;
     }
-    if (b.phase_count > 0) b.phase_seconds[b.phase_count - 1] = bk_now() - b.phase_start;
-    summary->seconds = bk_now() - start;
-    if (!rc && opt->json_report) rc = write_json_report(&b, summary);
-    bake_free(&b);
-    return rc;
+    pipeline_free(b);
+    free(b);
+    return r;
+}
+
+lbk_result lbk_bake_from_file(const char *path, const lbk_bake_desc *desc, lbk_bake_output **out)
+{
+    if (!path) {
+        if (out) *out = NULL;
+        return LBK_ERR_INVALID_ARGUMENT;
+    }
+    return bake(path, NULL, desc, out);
+}
+
+lbk_result lbk_bake_from_scene(const lbk_bake_scene *scene, const lbk_bake_desc *desc, lbk_bake_output **out)
+{
+    if (!scene) {
+        if (out) *out = NULL;
+        return LBK_ERR_INVALID_ARGUMENT;
+    }
+    return bake(NULL, scene, desc, out);
+}
+
+const char *lbk_bake_preset_name(lbk_bake_preset preset)
+{
+    return (unsigned)preset < LBK_BAKE_PRESET_COUNT_ ? bk_presets[preset].name : "unknown";
 }

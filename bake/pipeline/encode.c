@@ -18,10 +18,19 @@ void bk_texel_linear(const bk_texel *t, const lbk_sh9_rgb *radiance_world, lbk_a
     lbk_ahd_linear_from_sh9(&local, out);
 }
 
-/* AHD pages from per-texel linear forms: dilate, then encode. `lin` is indexed by texel
- * receiver (texels.receivers), `has` says which ones hold a value. */
-lbk_result bk_encode_pages(const bk_texels *tx, int margin, const lbk_ahd_linear *lin, const uint8_t *has,
-                           float inv_scale, lbk_ahd_texel **pages_out)
+lbk_result bk_finish_page(float *data, uint8_t *mask, int width, int height, int margin, const bk_seams *seams,
+                          uint32_t page, int threads)
+{
+    bk_dilate(data, 12, mask, width, height, margin + 2);
+    if (seams && bk_seams_stitch(seams, page, width, height, data, mask, threads) == (size_t)-1)
+        return LBK_ERR_OUT_OF_MEMORY;
+    return LBK_OK;
+}
+
+/* AHD pages from per-texel linear forms: dilate, stitch, then encode. `lin` is indexed by
+ * texel receiver (texels.receivers), `has` says which ones hold a value. */
+lbk_result bk_encode_pages(const bk_texels *tx, int margin, const bk_seams *seams, int threads,
+                           const lbk_ahd_linear *lin, const uint8_t *has, float inv_scale, lbk_ahd_texel **pages_out)
 {
     for (size_t p = 0; p < tx->page_count; p++) {
         int w = tx->pages[p].width, h = tx->pages[p].height;
@@ -40,7 +49,11 @@ lbk_result bk_encode_pages(const bk_texels *tx, int margin, const lbk_ahd_linear
             for (int k = 0; k < 12; k++) data[12 * i + k] = c[k] * inv_scale;
             mask[i] = 1;
         }
-        bk_dilate(data, 12, mask, w, h, margin + 2);
+        lbk_result r = bk_finish_page(data, mask, w, h, margin, seams, (uint32_t)p, threads);
+        if (r != LBK_OK) {
+            free(data), free(mask), free(page);
+            return r;
+        }
         for (size_t i = 0; i < n; i++) {
             if (!mask[i]) continue;
             lbk_ahd_linear l;

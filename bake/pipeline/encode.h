@@ -5,6 +5,7 @@
 
 #include <stdint.h>
 
+#include "bake/layout/seams.h"
 #include "bake/layout/texels.h"
 #include "lbk/ahd.h"
 #include "lbk/sh.h"
@@ -13,13 +14,23 @@
  * world-space incident radiance SH (frame convention: bake/layout/texels.h). */
 void bk_texel_linear(const bk_texel *t, const lbk_sh9_rgb *radiance_world, lbk_ahd_linear *out);
 
+/* The payload of one page made ready to encode, in place: dilation (margin + 2 passes, so
+ * bilinear filtering never reads an empty texel near a chart) and then, when seams is not
+ * NULL, seam stitching of that page (bake/layout/seams.h). data: 12 floats per texel
+ * (lbk_ahd_linear), mask as for bk_dilate. Shared by the base bake and the dynamic sets, so
+ * that both are treated alike. threads: for the stitching (0: all cores; the result is the same
+ * for any count). Errors: LBK_ERR_OUT_OF_MEMORY. */
+lbk_result bk_finish_page(float *data, uint8_t *mask, int width, int height, int margin, const bk_seams *seams,
+                          uint32_t page, int threads);
+
 /* AHD pages from per-texel linear forms (physical): `lin` and `has` are indexed like
  * tx->receivers; texels without a value are filled by dilation (margin + 2 passes) where a chart
- * is near, else zero. Every value is multiplied by inv_scale (1/the LMAP scale, a power of two:
- * exact) before dilation and encoding, so the texels are in stored units.
+ * is near, else zero; then the seams are stitched (seams may be NULL: not stitched). Every
+ * value is multiplied by inv_scale (1/the LMAP scale, a power of two: exact) before dilation
+ * and encoding, so the texels are in stored units.
  * pages_out[p] receives a malloc'ed width×height array per page (free each with free()). */
-lbk_result bk_encode_pages(const bk_texels *tx, int margin, const lbk_ahd_linear *lin, const uint8_t *has,
-                           float inv_scale, lbk_ahd_texel **pages_out);
+lbk_result bk_encode_pages(const bk_texels *tx, int margin, const bk_seams *seams, int threads,
+                           const lbk_ahd_linear *lin, const uint8_t *has, float inv_scale, lbk_ahd_texel **pages_out);
 
 /* The radiometric scale of a lighting section (spec/container.md §5.7) whose largest value
  * (texels: irradiance along the normal; probes: SH DC; any channel) is max_value: the power of

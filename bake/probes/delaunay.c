@@ -287,48 +287,43 @@ done:
     return status;
 }
 
-int bk_delaunay(const float *points, size_t count, const bk_delaunay_options *options,
-                bk_tetmesh *out)
+/* ---- bk_delaunay, step by step ---------------------------------------------------------- */
+
+static int finite_point(const float *p) { return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]); }
+
+/* Bounding box of the finite points; returns how many there are. */
+static size_t finite_bounds(const float *points, size_t count, double lo[3], double hi[3])
 {
-    memset(out, 0, sizeof *out);
-    int status = BK_DELAUNAY_OK;
-    cell_key *keys = NULL;
-    uint32_t *rep = NULL, *distinct = NULL, *face_tmp = NULL;
-    double *pts = NULL;
-    tet_list tl = {0};
-    face_rec *faces = NULL;
-
-    out->input_count = count;
-    if (count > 0xFFFFFFF0u) return BK_DELAUNAY_FAILED;
-    out->input_to_point = malloc((count ? count : 1) * sizeof *out->input_to_point);
-    rep = malloc((count ? count : 1) * sizeof *rep);
-    keys = malloc((count ? count : 1) * sizeof *keys);
-    if (!out->input_to_point || !rep || !keys) { status = BK_DELAUNAY_NO_MEMORY; goto fail; }
-    for (size_t i = 0; i < count; i++) out->input_to_point[i] = BK_TET_NONE;
-
-    double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
+    for (int k = 0; k < 3; k++) {
+        lo[k] = DBL_MAX;
+        hi[k] = -DBL_MAX;
+    }
     size_t finite = 0;
     for (size_t i = 0; i < count; i++) {
         const float *p = points + 3 * i;
-        if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) continue;
+        if (!finite_point(p)) continue;
         finite++;
         for (int k = 0; k < 3; k++) {
             if (p[k] < lo[k]) lo[k] = p[k];
             if (p[k] > hi[k]) hi[k] = p[k];
         }
     }
-    if (finite < 4) { status = BK_DELAUNAY_TOO_FEW; goto fail; }
-    double diag = sqrt((hi[0]-lo[0])*(hi[0]-lo[0]) + (hi[1]-lo[1])*(hi[1]-lo[1]) + (hi[2]-lo[2])*(hi[2]-lo[2]));
-    if (!(diag > 0.0)) { status = BK_DELAUNAY_TOO_FEW; goto fail; }
-    double eps = options && options->merge_distance > 0.0 ? options->merge_distance : 1e-6 * diag;
-    if (eps < diag * 1e-12) eps = diag * 1e-12;  /* keeps cell keys within int64 */
+    return finite;
+}
 
-    /* merge points within eps: bin into cells of size eps, look in the 27 around each */
+/* Merges points within eps: binned into cells of size eps, each point looks in the 27 cells
+ * around it for an earlier representative. rep[i] gets i's representative (itself when it is
+ * one, BK_TET_NONE when not finite), *distinct how many representatives there are. */
+static int merge_close_points(const float *points, size_t count, const double lo[3], double eps, uint32_t *rep,
+                              size_t *distinct, size_t *merged)
+{
+    cell_key *keys = malloc((count ? count : 1) * sizeof *keys);
+    if (!keys) return BK_DELAUNAY_NO_MEMORY;
     size_t nk = 0;
     for (size_t i = 0; i < count; i++) {
         const float *p = points + 3 * i;
         rep[i] = BK_TET_NONE;
-        if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) continue;
+        if (!finite_point(p)) continue;
         keys[nk].x = (int64_t)floor((p[0] - lo[0]) / eps);
         keys[nk].y = (int64_t)floor((p[1] - lo[1]) / eps);
         keys[nk].z = (int64_t)floor((p[2] - lo[2]) / eps);
@@ -339,7 +334,7 @@ int bk_delaunay(const float *points, size_t count, const bk_delaunay_options *op
     size_t nd = 0;
     for (size_t i = 0; i < count; i++) {
         const float *p = points + 3 * i;
-        if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) continue;
+        if (!finite_point(p)) continue;
         int64_t cx = (int64_t)floor((p[0] - lo[0]) / eps), cy = (int64_t)floor((p[1] - lo[1]) / eps);
         int64_t cz = (int64_t)floor((p[2] - lo[2]) / eps);
         uint32_t best = BK_TET_NONE;
@@ -355,60 +350,81 @@ int bk_delaunay(const float *points, size_t count, const bk_delaunay_options *op
             }
         }
         if (best == BK_TET_NONE) { rep[i] = (uint32_t)i; nd++; }
-        else { rep[i] = best; out->merged_count++; }
+        else { rep[i] = best; (*merged)++; }
     }
-    free(keys); keys = NULL;
-    if (nd < 4) { status = BK_DELAUNAY_TOO_FEW; goto fail; }
+    free(keys);
+    *distinct = nd;
+    return BK_DELAUNAY_OK;
+}
 
-    /* distinct points, centred on the bounding box so far-from-origin levels keep precision */
-    distinct = malloc(nd * sizeof *distinct);
-    pts = malloc(3 * nd * sizeof *pts);
-    if (!distinct || !pts) { status = BK_DELAUNAY_NO_MEMORY; goto fail; }
+/* The nd representatives in input order (*distinct_out: their input indices) as doubles,
+ * centred on the bounding box so far-from-origin levels keep precision. */
+static int centred_distinct_points(const float *points, size_t count, const uint32_t *rep, size_t nd,
+                                   const double lo[3], const double hi[3], uint32_t **distinct_out,
+                                   double **pts_out)
+{
+    uint32_t *distinct = *distinct_out = malloc(nd * sizeof *distinct);
+    double *pts = *pts_out = malloc(3 * nd * sizeof *pts);
+    if (!distinct || !pts) return BK_DELAUNAY_NO_MEMORY;
     double centre[3] = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
-    nd = 0;
+    size_t d = 0;
     for (size_t i = 0; i < count; i++) {
         if (rep[i] != i) continue;
-        distinct[nd] = (uint32_t)i;
-        for (int k = 0; k < 3; k++) pts[3 * nd + k] = (double)points[3 * i + k] - centre[k];
-        nd++;
+        distinct[d] = (uint32_t)i;
+        for (int k = 0; k < 3; k++) pts[3 * d + k] = (double)points[3 * i + k] - centre[k];
+        d++;
     }
+    return BK_DELAUNAY_OK;
+}
 
-    /* Points within the merge distance of their least-squares plane span no volume. qhull would
-     * find float-rounding-thin tetrahedra there instead of refusing. */
-    {
-        double mean[3] = {0, 0, 0}, cov[9] = {0}, val[3], vec[3][3], dev = 0.0;
-        for (size_t d = 0; d < nd; d++) for (int k = 0; k < 3; k++) mean[k] += pts[3 * d + k] / (double)nd;
-        for (size_t d = 0; d < nd; d++)
-            for (int r = 0; r < 3; r++) for (int c = 0; c < 3; c++)
-                cov[3 * r + c] += (pts[3 * d + r] - mean[r]) * (pts[3 * d + c] - mean[c]);
-        bk_sym3_eigen(cov, val, vec);
-        for (size_t d = 0; d < nd; d++) {
-            double x = 0.0;
-            for (int k = 0; k < 3; k++) x += (pts[3 * d + k] - mean[k]) * vec[2][k];
-            if (fabs(x) > dev) dev = fabs(x);
-        }
-        if (dev <= eps) { status = BK_DELAUNAY_FLAT; goto fail; }
+/* Points within eps of their least-squares plane span no volume. qhull would find
+ * float-rounding-thin tetrahedra there instead of refusing. */
+static int spans_no_volume(const double *pts, size_t nd, double eps)
+{
+    double mean[3] = {0, 0, 0}, cov[9] = {0}, val[3], vec[3][3], dev = 0.0;
+    for (size_t d = 0; d < nd; d++) for (int k = 0; k < 3; k++) mean[k] += pts[3 * d + k] / (double)nd;
+    for (size_t d = 0; d < nd; d++)
+        for (int r = 0; r < 3; r++) for (int c = 0; c < 3; c++)
+            cov[3 * r + c] += (pts[3 * d + r] - mean[r]) * (pts[3 * d + c] - mean[c]);
+    bk_sym3_eigen(cov, val, vec);
+    for (size_t d = 0; d < nd; d++) {
+        double x = 0.0;
+        for (int k = 0; k < 3; k++) x += (pts[3 * d + k] - mean[k]) * vec[2][k];
+        if (fabs(x) > dev) dev = fabs(x);
     }
+    return dev <= eps;
+}
 
-    status = run_qhull(pts, nd, &tl);
-    if (status != BK_DELAUNAY_OK) goto fail;
+/* 1 when the tetrahedron is flat by FLAT_VOLUME_RATIO; *orientation gets its orient(). */
+static int tet_is_flat(const double *a, const double *b, const double *c, const double *d, double *orientation)
+{
+    double o = orient(a, b, c, d);
+    double l = 0.0;
+    const double *q[4] = {a, b, c, d};
+    for (int x = 0; x < 4; x++) for (int y = x + 1; y < 4; y++) {
+        double e = (q[x][0]-q[y][0])*(q[x][0]-q[y][0]) + (q[x][1]-q[y][1])*(q[x][1]-q[y][1]) + (q[x][2]-q[y][2])*(q[x][2]-q[y][2]);
+        if (e > l) l = e;
+    }
+    *orientation = o;
+    return !(fabs(o) / 6.0 > FLAT_VOLUME_RATIO * l * sqrt(l));
+}
 
-    /* orient positively, drop flat tetrahedra, canonical order */
+/* qhull's tetrahedra oriented positively, flat ones dropped, duplicates removed, in canonical
+ * order: records of 8 (sorted vertex tuple, then the oriented tuple) in *recs_out. */
+static int canonical_tets(const tet_list *tl, const double *pts, uint32_t **recs_out, size_t *count_out,
+                          size_t *dropped_flat)
+{
+    uint32_t *recs = *recs_out = malloc((tl->n ? tl->n : 1) * 8 * sizeof *recs);
+    if (!recs) return BK_DELAUNAY_NO_MEMORY;
     size_t nt = 0;
-    uint32_t *recs = malloc((tl.n ? tl.n : 1) * 8 * sizeof *recs);
-    if (!recs) { status = BK_DELAUNAY_NO_MEMORY; goto fail; }
-    for (size_t t = 0; t < tl.n; t++) {
-        uint32_t *v = tl.v + 4 * t;
-        const double *a = pts + 3 * (size_t)v[0], *b = pts + 3 * (size_t)v[1];
-        const double *c = pts + 3 * (size_t)v[2], *d = pts + 3 * (size_t)v[3];
-        double o = orient(a, b, c, d);
-        double l = 0.0;
-        const double *q[4] = {a, b, c, d};
-        for (int x = 0; x < 4; x++) for (int y = x + 1; y < 4; y++) {
-            double e = (q[x][0]-q[y][0])*(q[x][0]-q[y][0]) + (q[x][1]-q[y][1])*(q[x][1]-q[y][1]) + (q[x][2]-q[y][2])*(q[x][2]-q[y][2]);
-            if (e > l) l = e;
+    for (size_t t = 0; t < tl->n; t++) {
+        const uint32_t *v = tl->v + 4 * t;
+        double o;
+        if (tet_is_flat(pts + 3 * (size_t)v[0], pts + 3 * (size_t)v[1], pts + 3 * (size_t)v[2],
+                        pts + 3 * (size_t)v[3], &o)) {
+            (*dropped_flat)++;
+            continue;
         }
-        if (!(fabs(o) / 6.0 > FLAT_VOLUME_RATIO * l * sqrt(l))) { out->dropped_flat++; continue; }
         uint32_t *r = recs + 8 * nt++;
         memcpy(r, v, 4 * sizeof *r);
         /* insertion sort of the tuple */
@@ -423,28 +439,33 @@ int bk_delaunay(const float *points, size_t count, const bk_delaunay_options *op
         memmove(recs + 8 * unique, recs + 8 * t, 8 * sizeof *recs);
         unique++;
     }
-    nt = unique;
-    if (nt == 0) { free(recs); status = BK_DELAUNAY_FLAT; goto fail; }
+    *count_out = unique;
+    return unique ? BK_DELAUNAY_OK : BK_DELAUNAY_FLAT;
+}
 
-    /* vertices actually used, in input order */
-    face_tmp = calloc(nd, sizeof *face_tmp);   /* distinct index -> vertex index + 1 */
-    if (!face_tmp) { free(recs); status = BK_DELAUNAY_NO_MEMORY; goto fail; }
-    for (size_t t = 0; t < nt; t++) for (int k = 0; k < 4; k++) face_tmp[recs[8 * t + k]] = 1;
+/* The mesh from the canonical records: the distinct points some tetrahedron uses become the
+ * vertices (in input order), every input point maps to its representative's vertex, the
+ * tetrahedra are renumbered onto them and their volume summed. */
+static int mesh_from_tets(const float *points, size_t count, const uint32_t *rep, const uint32_t *distinct,
+                          size_t nd, const uint32_t *recs, size_t nt, bk_tetmesh *out)
+{
+    uint32_t *vertex_of = calloc(nd, sizeof *vertex_of); /* distinct index -> vertex index + 1 */
+    if (!vertex_of) return BK_DELAUNAY_NO_MEMORY;
+    for (size_t t = 0; t < nt; t++) for (int k = 0; k < 4; k++) vertex_of[recs[8 * t + k]] = 1;
     size_t np = 0;
-    for (size_t d = 0; d < nd; d++) if (face_tmp[d]) face_tmp[d] = (uint32_t)++np;
+    for (size_t d = 0; d < nd; d++) if (vertex_of[d]) vertex_of[d] = (uint32_t)++np;
     out->unused_count = nd - np;
     out->point_count = np;
     out->points = malloc(3 * np * sizeof *out->points);
     out->point_source = malloc(np * sizeof *out->point_source);
     out->tets = malloc(4 * nt * sizeof *out->tets);
-    out->neighbours = malloc(4 * nt * sizeof *out->neighbours);
-    faces = malloc(4 * nt * sizeof *faces);
-    if (!out->points || !out->point_source || !out->tets || !out->neighbours || !faces) {
-        free(recs); status = BK_DELAUNAY_NO_MEMORY; goto fail;
+    if (!out->points || !out->point_source || !out->tets) {
+        free(vertex_of);
+        return BK_DELAUNAY_NO_MEMORY;
     }
     for (size_t d = 0; d < nd; d++) {
-        if (!face_tmp[d]) continue;
-        uint32_t v = face_tmp[d] - 1, src = distinct[d];
+        if (!vertex_of[d]) continue;
+        uint32_t v = vertex_of[d] - 1, src = distinct[d];
         out->point_source[v] = src;
         memcpy(out->points + 3 * (size_t)v, points + 3 * (size_t)src, 3 * sizeof(float));
     }
@@ -453,19 +474,31 @@ int bk_delaunay(const float *points, size_t count, const bk_delaunay_options *op
             /* rep[i] is an input index; find its distinct slot by binary search */
             size_t a = 0, b = nd;
             while (a < b) { size_t mid = (a + b) / 2; if (distinct[mid] < rep[i]) a = mid + 1; else b = mid; }
-            out->input_to_point[i] = face_tmp[a] ? face_tmp[a] - 1 : BK_TET_NONE;
+            out->input_to_point[i] = vertex_of[a] ? vertex_of[a] - 1 : BK_TET_NONE;
         }
     out->tet_count = nt;
     for (size_t t = 0; t < nt; t++) {
-        for (int k = 0; k < 4; k++) out->tets[4 * t + k] = face_tmp[recs[8 * t + 4 + k]] - 1;
+        for (int k = 0; k < 4; k++) out->tets[4 * t + k] = vertex_of[recs[8 * t + 4 + k]] - 1;
         const float *P = out->points;
         const uint32_t *v = out->tets + 4 * t;
         out->volume += bk_tet_signed_volume(P + 3 * (size_t)v[0], P + 3 * (size_t)v[1],
                                             P + 3 * (size_t)v[2], P + 3 * (size_t)v[3]);
     }
-    free(recs);
+    free(vertex_of);
+    return BK_DELAUNAY_OK;
+}
 
-    /* adjacency by face hashing (sorting): faces shared by exactly two tetrahedra are linked */
+/* Adjacency by face sorting: faces shared by exactly two tetrahedra are linked, faces shared
+ * by more are counted as non-manifold. */
+static int link_neighbours(bk_tetmesh *out)
+{
+    size_t nt = out->tet_count;
+    out->neighbours = malloc((nt ? 4 * nt : 1) * sizeof *out->neighbours);
+    face_rec *faces = malloc((nt ? 4 * nt : 1) * sizeof *faces);
+    if (!out->neighbours || !faces) {
+        free(faces);
+        return BK_DELAUNAY_NO_MEMORY;
+    }
     for (size_t t = 0; t < nt; t++)
         for (uint32_t i = 0; i < 4; i++) {
             face_rec *f = faces + 4 * t + i;
@@ -487,21 +520,57 @@ int bk_delaunay(const float *points, size_t count, const bk_delaunay_options *op
         }
         s = e;
     }
-
-    free(faces); free(face_tmp); free(tl.v); free(pts); free(distinct); free(rep);
+    free(faces);
     return BK_DELAUNAY_OK;
+}
 
-fail:
-    free(faces); free(face_tmp); free(tl.v); free(pts); free(distinct); free(rep); free(keys);
-    {
-        uint32_t *keep = out->input_to_point;
-        size_t merged = out->merged_count;
-        out->input_to_point = NULL;
-        bk_tetmesh_free(out);
-        out->input_to_point = keep;
-        out->input_count = count;
-        out->merged_count = merged;
-        if (keep) for (size_t i = 0; i < count; i++) keep[i] = BK_TET_NONE;
-    }
+/* A failed run keeps only what says why: the input count, the merges and an all-unused
+ * input_to_point. */
+static void clear_failed_mesh(bk_tetmesh *out, size_t count)
+{
+    uint32_t *keep = out->input_to_point;
+    size_t merged = out->merged_count;
+    out->input_to_point = NULL;
+    bk_tetmesh_free(out);
+    out->input_to_point = keep;
+    out->input_count = count;
+    out->merged_count = merged;
+    if (keep) for (size_t i = 0; i < count; i++) keep[i] = BK_TET_NONE;
+}
+
+int bk_delaunay(const float *points, size_t count, const bk_delaunay_options *options,
+                bk_tetmesh *out)
+{
+    memset(out, 0, sizeof *out);
+    out->input_count = count;
+    if (count > 0xFFFFFFF0u) return BK_DELAUNAY_FAILED;
+    int status = BK_DELAUNAY_OK;
+    uint32_t *rep = NULL, *distinct = NULL, *recs = NULL;
+    double *pts = NULL;
+    tet_list tl = {0};
+    size_t nd = 0, nt = 0;
+    out->input_to_point = malloc((count ? count : 1) * sizeof *out->input_to_point);
+    rep = malloc((count ? count : 1) * sizeof *rep);
+    if (!out->input_to_point || !rep) { status = BK_DELAUNAY_NO_MEMORY; goto done; }
+    for (size_t i = 0; i < count; i++) out->input_to_point[i] = BK_TET_NONE;
+
+    double lo[3], hi[3];
+    if (finite_bounds(points, count, lo, hi) < 4) { status = BK_DELAUNAY_TOO_FEW; goto done; }
+    double diag = sqrt((hi[0]-lo[0])*(hi[0]-lo[0]) + (hi[1]-lo[1])*(hi[1]-lo[1]) + (hi[2]-lo[2])*(hi[2]-lo[2]));
+    if (!(diag > 0.0)) { status = BK_DELAUNAY_TOO_FEW; goto done; }
+    double eps = options && options->merge_distance > 0.0 ? options->merge_distance : 1e-6 * diag;
+    if (eps < diag * 1e-12) eps = diag * 1e-12;  /* keeps cell keys within int64 */
+
+    status = merge_close_points(points, count, lo, eps, rep, &nd, &out->merged_count);
+    if (status == BK_DELAUNAY_OK && nd < 4) status = BK_DELAUNAY_TOO_FEW;
+    if (status == BK_DELAUNAY_OK) status = centred_distinct_points(points, count, rep, nd, lo, hi, &distinct, &pts);
+    if (status == BK_DELAUNAY_OK && spans_no_volume(pts, nd, eps)) status = BK_DELAUNAY_FLAT;
+    if (status == BK_DELAUNAY_OK) status = run_qhull(pts, nd, &tl);
+    if (status == BK_DELAUNAY_OK) status = canonical_tets(&tl, pts, &recs, &nt, &out->dropped_flat);
+    if (status == BK_DELAUNAY_OK) status = mesh_from_tets(points, count, rep, distinct, nd, recs, nt, out);
+    if (status == BK_DELAUNAY_OK) status = link_neighbours(out);
+done:
+    free(recs); free(tl.v); free(pts); free(distinct); free(rep);
+    if (status != BK_DELAUNAY_OK) clear_failed_mesh(out, count);
     return status;
 }

@@ -6,6 +6,7 @@
 
 #include "bake/probes/delaunay.h"
 #include "bake/probes/probe_math.h"
+#include "bake/util/parallel.h"
 
 #include <float.h>
 #include <math.h>
@@ -105,9 +106,8 @@ static void probe_rays(const place_ctx *c, const float p[3], int *front, int *ba
     }
 }
 
-static void test_candidate(void *vctx, size_t i)
+static void test_candidate(const place_ctx *c, size_t i)
 {
-    const place_ctx *c = vctx;
     float p[3] = {c->cand[3 * i], c->cand[3 * i + 1], c->cand[3 * i + 2]};
     uint8_t verdict = 0;
     for (int iter = 0;; iter++) {
@@ -127,6 +127,11 @@ static void test_candidate(void *vctx, size_t i)
     }
     memcpy(c->out + 3 * i, p, sizeof p);
     c->verdict[i] = verdict;
+}
+
+static void test_candidates(void *vctx, size_t begin, size_t end, int thread)
+{
+    for (size_t i = begin; i < end; i++) test_candidate(vctx, i);
 }
 
 void bk_glg_probes_free(bk_glg_probes *p)
@@ -211,7 +216,7 @@ static lbk_result place_once(place_ctx *c, const double lo[3], const double ext[
     if (!out->positions || !c->verdict) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
     c->cand = cand.p;
     c->out = out->positions;
-    if (c->tracer) bk_probe_parallel_for(cand.n, threads, test_candidate, c);
+    if (c->tracer) bk_parallel_chunks(0, cand.n, 16, bk_thread_count(threads), test_candidates, c);
     else { memcpy(out->positions, cand.p, cand.n * 3 * sizeof(float)); memset(c->verdict, 0, cand.n); }
     size_t n = 0;
     for (size_t i = 0; i < cand.n; i++) {
@@ -325,9 +330,8 @@ static size_t face_samples(int level, float (*bary)[3])
     return m;
 }
 
-static void face_vis_one(void *vctx, size_t t)
+static void face_vis_one(const vis_ctx *c, size_t t)
 {
-    const vis_ctx *c = vctx;
     float bary[256][3];
     size_t m = face_samples(c->level, bary);
     const uint32_t *v = c->tets + 4 * t;
@@ -347,13 +351,18 @@ static void face_vis_one(void *vctx, size_t t)
     }
 }
 
+static void face_vis_chunk(void *vctx, size_t begin, size_t end, int thread)
+{
+    for (size_t t = begin; t < end; t++) face_vis_one(vctx, t);
+}
+
 void bk_glg_face_visibility(const bk_tracer *tracer, const float *positions, size_t tet_count,
                             const uint32_t *tets, int level, int threads, float *vis)
 {
     if (level <= 0) level = 1;
     if (level > 4) level = 4;
     vis_ctx c = {tracer, positions, tets, level, vis};
-    bk_probe_parallel_for(tet_count, threads, face_vis_one, &c);
+    bk_parallel_chunks(0, tet_count, 16, bk_thread_count(threads), face_vis_chunk, &c);
 }
 
 void bk_glg_free(bk_glg *g)

@@ -4,6 +4,7 @@
 
 #include "bake/probes/probe_math.h"
 #include "bake/transport/tracer.h"
+#include "bake/util/parallel.h"
 
 #include <float.h>
 #include <math.h>
@@ -127,9 +128,8 @@ typedef struct vis_ctx {
     float *vis, *bent;
 } vis_ctx;
 
-static void vertex_visibility(void *vctx, size_t v)
+static void vertex_visibility(const vis_ctx *c, size_t v)
 {
-    const vis_ctx *c = vctx;
     const float *n = c->nrm + 3 * v, *p = c->pos + 3 * v;
     /* orthonormal basis (Duff et al. 2017) */
     float sign = n[2] >= 0.0f ? 1.0f : -1.0f;
@@ -165,33 +165,29 @@ static void vertex_visibility(void *vctx, size_t v)
     for (int k = 0; k < 3; k++) c->bent[3 * v + k] = l > 0.0 ? (float)(sum[k] / l) : n[k];
 }
 
+static void vertex_visibility_chunk(void *vctx, size_t begin, size_t end, int thread)
+{
+    for (size_t v = begin; v < end; v++) vertex_visibility(vctx, v);
+}
+
 static int cmp_u32(const void *pa, const void *pb)
 {
     uint32_t a = *(const uint32_t *)pa, b = *(const uint32_t *)pb;
     return (a > b) - (a < b);
 }
 
-lbk_result bk_llg_place(const bk_scene *scene, uint32_t object, const bk_llg_options *options,
-                        int threads, bk_llg *out)
+/* The lattice box (the OBB with thin axes floored, plus the margin) and the probe counts per
+ * axis, the spacing grown until the lattice fits the probe cap. */
+static void lattice_dims(const bk_object *obj, const bk_llg_options *o, bk_llg *out)
 {
-    if (!scene || !out || object >= scene->object_count) return LBK_ERR_INVALID_ARGUMENT;
-    memset(out, 0, sizeof *out);
-    const bk_object *obj = &scene->objects[object];
-    bk_llg_options o = options ? *options : (bk_llg_options){0};
-    out->object = object;
-    lbk_result res = bk_obb_from_triangles(scene, obj->first_tri, obj->tri_count, out->centre,
-                                           out->axes, out->obb_half_extents);
-    if (res != LBK_OK) return res;
-
-    /* lattice box: floor thin axes, add the margin */
     float big = fmaxf(out->obb_half_extents[0], fmaxf(out->obb_half_extents[1], out->obb_half_extents[2]));
-    float floor_he = o.min_half_extent > 0 ? o.min_half_extent : (big > 0 ? 0.05f * big : 1e-3f);
-    float margin = o.margin > 0 ? o.margin : 0.1f * fmaxf(big, floor_he);
+    float floor_he = o->min_half_extent > 0 ? o->min_half_extent : (big > 0 ? 0.05f * big : 1e-3f);
+    float margin = o->margin > 0 ? o->margin : 0.1f * fmaxf(big, floor_he);
     for (int a = 0; a < 3; a++) out->half_extents[a] = fmaxf(out->obb_half_extents[a], floor_he) + margin;
-    double spacing = o.spacing > 0 && isfinite(o.spacing) ? o.spacing : 1.5;
+    double spacing = o->spacing > 0 && isfinite(o->spacing) ? o->spacing : 1.5;
     if (obj->lighting == BK_LIGHTING_LLG && obj->texel_density > 0 && isfinite(obj->texel_density))
         spacing = 1.0 / obj->texel_density;
-    size_t cap = o.max_probes ? o.max_probes : 512;
+    size_t cap = o->max_probes ? o->max_probes : 512;
     if (cap < 8) cap = 8;
     for (;;) {
         size_t total = 1;
@@ -208,45 +204,41 @@ lbk_result bk_llg_place(const bk_scene *scene, uint32_t object, const bk_llg_opt
         spacing *= 1.1;  /* lower the resolution until the grid fits */
     }
     out->spacing = (float)spacing;
+}
 
-    /* the object's vertices, compacted; its own Embree scene */
+/* The global indices of the vertices of obj's usable triangles, ascending, each once. */
+static uint32_t *object_vertex_ids(const bk_scene *scene, const bk_object *obj, size_t *count)
+{
     size_t nt = obj->tri_count, nv = 0;
     uint32_t *ids = malloc((nt ? 3 * nt : 1) * sizeof *ids);
-    if (!ids) return LBK_ERR_OUT_OF_MEMORY;
+    if (!ids) return NULL;
     for (size_t t = obj->first_tri; t < (size_t)obj->first_tri + nt; t++)
         if (tri_usable(scene, t))
             for (int k = 0; k < 3; k++) ids[nv++] = scene->tris[3 * t + (size_t)k];
     qsort(ids, nv, sizeof *ids, cmp_u32);
     size_t u = 0;
     for (size_t i = 0; i < nv; i++) if (u == 0 || ids[u - 1] != ids[i]) ids[u++] = ids[i];
-    nv = u;
-    bk_scene sub = {0};
-    sub.vertex_count = nv;
-    sub.positions = malloc((nv ? nv : 1) * 3 * sizeof(float));
-    float *nrm = calloc(nv ? nv : 1, 3 * sizeof(float));
-    double *acc = calloc(nv ? nv : 1, 4 * sizeof(double));   /* Σ area·centroid, Σ area */
-    float *toward = malloc((nv ? nv : 1) * 3 * sizeof(float));
-    sub.tris = malloc((nt ? nt : 1) * 3 * sizeof(uint32_t));
-    out->vertices = ids;
-    out->vertex_count = nv;
-    out->visibility = malloc((nv ? nv : 1) * sizeof(float));
-    out->bent_normals = malloc((nv ? nv : 1) * 3 * sizeof(float));
-    if (!sub.positions || !nrm || !acc || !toward || !sub.tris || !out->visibility || !out->bent_normals) {
-        res = LBK_ERR_OUT_OF_MEMORY;
-        goto done;
-    }
-    for (size_t i = 0; i < nv; i++) memcpy(sub.positions + 3 * i, scene->positions + 3 * (size_t)ids[i], 3 * sizeof(float));
-    for (size_t t = obj->first_tri; t < (size_t)obj->first_tri + nt; t++) {
+    *count = u;
+    return ids;
+}
+
+/* The object's triangles on its compact vertices (sub->tris), with per vertex the area-weighted
+ * sum of face normals (nrm, the fallback for missing vertex normals) and Σ area·centroid,
+ * Σ area of the incident triangles (acc). */
+static void accumulate_faces(const bk_scene *scene, const bk_object *obj, const uint32_t *ids, bk_scene *sub,
+                             float *nrm, double *acc)
+{
+    size_t nv = sub->vertex_count;
+    for (size_t t = obj->first_tri; t < (size_t)obj->first_tri + obj->tri_count; t++) {
         if (!tri_usable(scene, t)) continue;
-        uint32_t *dst = sub.tris + 3 * sub.tri_count++;
+        uint32_t *dst = sub->tris + 3 * sub->tri_count++;
         for (int k = 0; k < 3; k++) {
             uint32_t g = scene->tris[3 * t + (size_t)k];
-            uint32_t *hit = bsearch(&g, ids, nv, sizeof *ids, cmp_u32);
+            const uint32_t *hit = bsearch(&g, ids, nv, sizeof *ids, cmp_u32);
             dst[k] = (uint32_t)(hit - ids);
         }
-        /* area-weighted face normal accumulation: the fallback for missing vertex normals */
-        const float *a = sub.positions + 3 * (size_t)dst[0], *b = sub.positions + 3 * (size_t)dst[1];
-        const float *c = sub.positions + 3 * (size_t)dst[2];
+        const float *a = sub->positions + 3 * (size_t)dst[0], *b = sub->positions + 3 * (size_t)dst[1];
+        const float *c = sub->positions + 3 * (size_t)dst[2];
         float e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
         float cr[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
         for (int k = 0; k < 3; k++) for (int j = 0; j < 3; j++) nrm[3 * (size_t)dst[k] + j] += cr[j];
@@ -257,9 +249,12 @@ lbk_result bk_llg_place(const bk_scene *scene, uint32_t object, const bk_llg_opt
             q[3] += area;
         }
     }
-    for (size_t i = 0; i < nv; i++)
-        for (int j = 0; j < 3; j++)
-            toward[3 * i + j] = acc[4 * i + 3] > 0.0 ? (float)(acc[4 * i + j] / acc[4 * i + 3]) : sub.positions[3 * i + j];
+}
+
+/* Unit vertex normals: the scene's where it has a usable one, else the accumulated face
+ * normal, else +z. */
+static void vertex_normals(const bk_scene *scene, const uint32_t *ids, size_t nv, float *nrm)
+{
     for (size_t i = 0; i < nv; i++) {
         float *n = nrm + 3 * i;
         if (scene->normals) {
@@ -271,16 +266,73 @@ lbk_result bk_llg_place(const bk_scene *scene, uint32_t object, const bk_llg_opt
         if (isfinite(l) && l > 0.0f) for (int k = 0; k < 3; k++) n[k] /= l;
         else { n[0] = 0; n[1] = 0; n[2] = 1; }
     }
+}
+
+/* The object alone as a scene on its nv compact vertices (ids), with unit vertex normals and,
+ * per vertex, the area-weighted centroid of its triangles (toward) for the visibility rays. */
+static lbk_result compact_object_mesh(const bk_scene *scene, const bk_object *obj, const uint32_t *ids, size_t nv,
+                                      bk_scene *sub, float **nrm_out, float **toward_out)
+{
+    sub->vertex_count = nv;
+    sub->positions = malloc((nv ? nv : 1) * 3 * sizeof(float));
+    sub->tris = malloc((obj->tri_count ? obj->tri_count : 1) * 3 * sizeof(uint32_t));
+    float *nrm = *nrm_out = calloc(nv ? nv : 1, 3 * sizeof(float));
+    float *toward = *toward_out = malloc((nv ? nv : 1) * 3 * sizeof(float));
+    double *acc = calloc(nv ? nv : 1, 4 * sizeof(double));
+    if (!sub->positions || !sub->tris || !nrm || !toward || !acc) {
+        free(acc);
+        return LBK_ERR_OUT_OF_MEMORY;
+    }
+    for (size_t i = 0; i < nv; i++) memcpy(sub->positions + 3 * i, scene->positions + 3 * (size_t)ids[i], 3 * sizeof(float));
+    accumulate_faces(scene, obj, ids, sub, nrm, acc);
+    for (size_t i = 0; i < nv; i++)
+        for (int j = 0; j < 3; j++)
+            toward[3 * i + j] = acc[4 * i + 3] > 0.0 ? (float)(acc[4 * i + j] / acc[4 * i + 3]) : sub->positions[3 * i + j];
+    free(acc);
+    vertex_normals(scene, ids, nv, nrm);
+    return LBK_OK;
+}
+
+/* Visibility and bent normal of every vertex against the object alone (its own Embree scene). */
+static lbk_result self_visibility(const bk_scene *sub, const float *nrm, const float *toward, int rays, int threads,
+                                  bk_llg *out)
+{
     bk_tracer *tracer = NULL;
-    res = bk_tracer_create(&sub, 1, &tracer);
-    if (res != LBK_OK) goto done;
+    lbk_result res = bk_tracer_create(sub, 1, &tracer);
+    if (res != LBK_OK) return res;
+    vis_ctx vc = {tracer, sub->positions, nrm, toward, rays, out->visibility, out->bent_normals};
+    bk_parallel_chunks(0, sub->vertex_count, 64, bk_thread_count(threads), vertex_visibility_chunk, &vc);
+    bk_tracer_destroy(tracer);
+    return LBK_OK;
+}
+
+lbk_result bk_llg_place(const bk_scene *scene, uint32_t object, const bk_llg_options *options,
+                        int threads, bk_llg *out)
+{
+    if (!scene || !out || object >= scene->object_count) return LBK_ERR_INVALID_ARGUMENT;
+    memset(out, 0, sizeof *out);
+    const bk_object *obj = &scene->objects[object];
+    bk_llg_options o = options ? *options : (bk_llg_options){0};
+    out->object = object;
+    lbk_result res = bk_obb_from_triangles(scene, obj->first_tri, obj->tri_count, out->centre,
+                                           out->axes, out->obb_half_extents);
+    if (res != LBK_OK) return res;
+    lattice_dims(obj, &o, out);
+
+    size_t nv = 0;
+    out->vertices = object_vertex_ids(scene, obj, &nv);
+    if (!out->vertices) return LBK_ERR_OUT_OF_MEMORY;
+    out->vertex_count = nv;
+    out->visibility = malloc((nv ? nv : 1) * sizeof(float));
+    out->bent_normals = malloc((nv ? nv : 1) * 3 * sizeof(float));
+    bk_scene sub = {0};
+    float *nrm = NULL, *toward = NULL;
+    res = compact_object_mesh(scene, obj, out->vertices, nv, &sub, &nrm, &toward);
+    if (res == LBK_OK && (!out->visibility || !out->bent_normals)) res = LBK_ERR_OUT_OF_MEMORY;
     int rays = o.visibility_rays > 0 ? o.visibility_rays : 64;
     if (rays > 4096) rays = 4096;
-    vis_ctx vc = {tracer, sub.positions, nrm, toward, rays, out->visibility, out->bent_normals};
-    bk_probe_parallel_for(nv, threads, vertex_visibility, &vc);
-    bk_tracer_destroy(tracer);
-done:
-    free(sub.positions); free(sub.tris); free(nrm); free(acc); free(toward);
+    if (res == LBK_OK) res = self_visibility(&sub, nrm, toward, rays, threads, out);
+    free(sub.positions); free(sub.tris); free(nrm); free(toward);
     if (res != LBK_OK) bk_llg_free(out);
     return res;
 }

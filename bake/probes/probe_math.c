@@ -53,51 +53,6 @@ void bk_sym3_eigen(const double a_in[9], double values[3], double vectors[3][3])
     vectors[2][2] = x[0] * y[1] - x[1] * y[0];
 }
 
-#include <pthread.h>
-#include <unistd.h>
-
-typedef struct pf_job {
-    size_t begin, end;
-    void (*fn)(void *ctx, size_t i);
-    void *ctx;
-} pf_job;
-
-static void *pf_run(void *arg)
-{
-    pf_job *j = arg;
-    for (size_t i = j->begin; i < j->end; i++) j->fn(j->ctx, i);
-    return NULL;
-}
-
-void bk_probe_parallel_for(size_t n, int threads, void (*fn)(void *ctx, size_t i), void *ctx)
-{
-    if (threads <= 0) {
-        long c = sysconf(_SC_NPROCESSORS_ONLN);
-        threads = c > 0 ? (int)c : 1;
-    }
-    if (threads > 64) threads = 64;
-    if ((size_t)threads > n) threads = (int)(n ? n : 1);
-    if (threads <= 1) {
-        for (size_t i = 0; i < n; i++) fn(ctx, i);
-        return;
-    }
-    pf_job jobs[64];
-    pthread_t tid[64];
-    int started[64] = {0};
-    for (int t = 0; t < threads; t++) {
-        jobs[t].begin = n * (size_t)t / (size_t)threads;
-        jobs[t].end = n * (size_t)(t + 1) / (size_t)threads;
-        jobs[t].fn = fn;
-        jobs[t].ctx = ctx;
-    }
-    for (int t = 1; t < threads; t++) started[t] = pthread_create(&tid[t], NULL, pf_run, &jobs[t]) == 0;
-    pf_run(&jobs[0]);
-    for (int t = 1; t < threads; t++) {
-        if (started[t]) pthread_join(tid[t], NULL);
-        else pf_run(&jobs[t]);
-    }
-}
-
 void bk_sphere_direction(size_t i, size_t n, float dir[3])
 {
     /* offset the azimuth so no direction is axis-aligned (axis-aligned rays graze walls) */

@@ -2,20 +2,13 @@
 #ifndef BK_PROBE_MATH_H
 #define BK_PROBE_MATH_H
 
+#include <stddef.h>
+
 /* Eigen-decomposition of the symmetric 3×3 matrix a (row-major) by cyclic Jacobi rotations.
  * values descending; vectors[k] is the unit eigenvector of values[k]. Each vector's sign is
  * fixed so that its largest-magnitude component is positive (the first one on ties), and then
  * vectors[2] = vectors[0] × vectors[1] (right-handed frame). Deterministic. */
 void bk_sym3_eigen(const double a[9], double values[3], double vectors[3][3]);
-
-
-
-#include <stddef.h>
-
-/* Runs fn(ctx, i) for i in [0, n) on up to `threads` threads (0: all cores), contiguous static
- * chunks. fn must only write to per-index outputs; the result never depends on the thread
- * count. Falls back to the calling thread when threads cannot be started. */
-void bk_probe_parallel_for(size_t n, int threads, void (*fn)(void *ctx, size_t i), void *ctx);
 
 /* Unit direction i of n spread evenly over the sphere (spherical Fibonacci), deterministic. */
 void bk_sphere_direction(size_t i, size_t n, float dir[3]);

@@ -39,6 +39,7 @@
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
+#include <cerrno>
 #include <cstdlib>
 #include <cstring>
 #include <map>
@@ -121,16 +122,56 @@ bool read_capped(const std::string &p, size_t cap, std::vector<unsigned char> *o
     return true;
 }
 
+// Where a scene may read from: its own folder (symlinks resolved), plus one folder the caller
+// allows. A scene from an untrusted source must not read /etc/passwd through "../../..".
+struct ResourcePolicy {
+    std::string root;   // realpath of the scene's folder, with a trailing '/'
+    std::string allow;  // realpath of the allowed outside folder with '/', or empty
+};
+
+bool under(const std::string &real, const std::string &dir)
+{
+    return !dir.empty() && real.compare(0, dir.size(), dir) == 0;
+}
+
+std::string real_dir(const std::string &d)
+{
+    char *r = realpath(d.c_str(), nullptr);
+    if (!r) return std::string();
+    std::string out(r);
+    free(r);
+    if (out.empty() || out.back() != '/') out += '/';
+    return out;
+}
+
+// True if `p` (after resolving every symlink) lies inside the policy's folders; else *why says so.
+bool resource_allowed(const ResourcePolicy &pol, const std::string &p, std::string *why)
+{
+    char *r = realpath(p.c_str(), nullptr);
+    if (!r) {
+        *why = std::string("cannot open: ") + strerror(errno);
+        return false;
+    }
+    std::string real(r);
+    free(r);
+    if (under(real, pol.root) || under(real, pol.allow)) return true;
+    *why = "resolves to " + real + ", outside the scene's folder " + pol.root +
+           " (resources must lie inside it; --allow-outside DIR permits one more folder)";
+    return false;
+}
+
 struct FsState {
     size_t cap;
+    const ResourcePolicy *policy;
 };
 
 bool fs_exists(const std::string &p, void *) { return is_regular_file(p, nullptr); }
 std::string fs_expand(const std::string &p, void *) { return p; }
 bool fs_read(std::vector<unsigned char> *out, std::string *err, const std::string &p, void *user)
 {
+    const FsState *st = static_cast<FsState *>(user);
     std::string why;
-    if (read_capped(p, static_cast<FsState *>(user)->cap, out, &why)) return true;
+    if (resource_allowed(*st->policy, p, &why) && read_capped(p, st->cap, out, &why)) return true;
     if (err) *err += p + ": " + why;
     return false;
 }
@@ -264,25 +305,66 @@ const nlohmann::json *jarr(const nlohmann::json &o, const char *key)
     return (it != o.end() && it->is_array()) ? &*it : nullptr;
 }
 
-struct DepthExceeded {};
+// Deepest nesting of arrays and objects in JSON text, in one linear scan (brackets inside
+// strings do not count). nlohmann's callback parser would check depth for us, but it re-scans
+// the open container each time an element closes, which made 80 k empty nodes take ~17 s and
+// 10^6 nodes effectively never finish; the plain parser after this scan is linear.
+static int json_max_depth(const char *p, size_t n)
+{
+    int depth = 0, deepest = 0;
+    bool in_string = false;
+    for (size_t i = 0; i < n; i++) {
+        const char c = p[i];
+        if (in_string) {
+            if (c == '\\') i++;
+            else if (c == '"') in_string = false;
+        } else if (c == '"') {
+            in_string = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > deepest) deepest = depth;
+        } else if (c == ']' || c == '}') {
+            depth--;
+        }
+    }
+    return deepest;
+}
+
+// Buffers and images name files relative to the scene (or embed data: URIs). An absolute path
+// or another URI scheme (file://, http://) would reach outside it: refuse them up front, with the
+// entry named; `..` escapes and symlinks are caught when the file is opened (resource_allowed).
+void check_uris(const nlohmann::json &doc, const std::string &file)
+{
+    for (const char *kind : {"buffers", "images"}) {
+        const nlohmann::json *arr = jarr(doc, kind);
+        if (!arr) continue;
+        for (size_t i = 0; i < arr->size(); i++) {
+            const nlohmann::json &e = (*arr)[i];
+            if (!e.is_object() || !e.contains("uri") || !e["uri"].is_string()) continue;
+            const std::string uri = e["uri"].get<std::string>();
+            if (uri.compare(0, 5, "data:") == 0) continue;
+            const size_t colon = uri.find(':'), slash = uri.find('/');
+            const bool scheme = colon != std::string::npos && (slash == std::string::npos || colon < slash);
+            if (uri.empty() || uri[0] == '/' || uri[0] == '\\' || scheme)
+                fail("%s: %.*s %zu: uri %s is not a path relative to the scene's folder (absolute paths and "
+                     "URI schemes other than data: are refused)",
+                     file.c_str(), (int)strlen(kind) - 1, kind, i, qstr(uri).c_str());
+        }
+    }
+}
 
 Prepass prepass(const char *json_begin, size_t json_len, const std::string &file)
 {
     Prepass pp;
-    nlohmann::json::parser_callback_t depth_guard = [](int depth, nlohmann::json::parse_event_t,
-                                                       nlohmann::json &) {
-        if (depth > kMaxJsonDepth) throw DepthExceeded{};
-        return true;
-    };
+    if (json_max_depth(json_begin, json_len) > kMaxJsonDepth)
+        fail("%s: JSON nested deeper than %d levels", file.c_str(), kMaxJsonDepth);
     nlohmann::json doc;
     try {
-        doc = nlohmann::json::parse(json_begin, json_begin + json_len, depth_guard, true);
-    } catch (const DepthExceeded &) {
-        fail("%s: JSON nested deeper than %d levels", file.c_str(), kMaxJsonDepth);
+        doc = nlohmann::json::parse(json_begin, json_begin + json_len, nullptr, true);
     } catch (const nlohmann::json::exception &e) {
         fail("%s: invalid JSON: %s", file.c_str(), e.what());
     }
     if (!doc.is_object()) fail("%s: the JSON root is not an object", file.c_str());
+    check_uris(doc, file);
 
     // Image bufferViews: tinygltf forms a pointer into the buffer before we see it.
     const nlohmann::json *buffers = jarr(doc, "buffers");
@@ -409,10 +491,10 @@ GlbParts split_glb(const std::vector<unsigned char> &f, const std::string &file)
     return g;
 }
 
-std::vector<unsigned char> make_glb(const std::string &json, const GlbParts &g)
+std::vector<unsigned char> make_glb(const std::string &json_text, const GlbParts &g)
 {
     std::vector<unsigned char> out;
-    size_t jpad = (json.size() + 3) & ~(size_t)3;
+    size_t jpad = (json_text.size() + 3) & ~(size_t)3;
     size_t bpad = (g.bin_len + 3) & ~(size_t)3;
     size_t total = 12 + 8 + jpad + (g.bin ? 8 + bpad : 0);
     out.reserve(total);
@@ -421,8 +503,8 @@ std::vector<unsigned char> make_glb(const std::string &json, const GlbParts &g)
     put32(out, (uint32_t)total);
     put32(out, (uint32_t)jpad);
     put32(out, 0x4E4F534Au);
-    out.insert(out.end(), json.begin(), json.end());
-    out.insert(out.end(), jpad - json.size(), ' ');
+    out.insert(out.end(), json_text.begin(), json_text.end());
+    out.insert(out.end(), jpad - json_text.size(), ' ');
     if (g.bin) {
         put32(out, (uint32_t)bpad);
         put32(out, 0x004E4942u);
@@ -455,8 +537,11 @@ bool keep_encoded_image(tinygltf::Image *image, const int idx, std::string *, st
 struct Prim {  // one triangle primitive, in mesh-local space, ready to instance
     std::vector<float> pos, nrm, uv0, uv1;
     std::vector<uint32_t> tris;
+    std::vector<uint32_t> src;     // per vertex: its index in the glTF primitive (flat shading splits them)
     bool has_nrm = false, has_uv1 = false;
     uint32_t material = 0;
+    uint32_t gltf_index = 0;       // index in the glTF mesh's primitives
+    uint32_t source_vertices = 0;  // vertices of the glTF primitive (POSITION count or Draco points)
 };
 
 struct MeshData {
@@ -503,6 +588,7 @@ private:
     bk_scene *s_;
     tinygltf::Model m_;
     Prepass pp_;
+    ResourcePolicy policy_;
     XXH3_state_t hash_;
     std::vector<int> image_map_;      // glTF image -> scene image (-1: none)
     std::vector<bk_image> images_;
@@ -573,6 +659,12 @@ void Importer::load()
     if (!read_capped(path_, o_.max_file_bytes, &bytes, &why)) fail("%s: %s", file, why.c_str());
     if (bytes.empty()) fail("%s: empty file", file);
     XXH3_64bits_update(&hash_, bytes.data(), bytes.size());
+    policy_.root = real_dir(dir_of(path_));
+    if (policy_.root.empty()) fail("%s: cannot resolve its folder: %s", file, strerror(errno));
+    if (o_.allow_outside && *o_.allow_outside) {
+        policy_.allow = real_dir(o_.allow_outside);
+        if (policy_.allow.empty()) fail("%s: allowed folder %s: %s", file, o_.allow_outside, strerror(errno));
+    }
 
     bool glb = bytes.size() >= 4 && !memcmp(bytes.data(), "glTF", 4);
     GlbParts g;
@@ -583,7 +675,7 @@ void Importer::load()
     pp_ = prepass(glb ? g.json : reinterpret_cast<const char *>(bytes.data()), json_len, path_);
 
     tinygltf::TinyGLTF loader;
-    FsState fss{o_.max_file_bytes};
+    FsState fss{o_.max_file_bytes, &policy_};
     tinygltf::FsCallbacks fs{fs_exists, fs_expand, fs_read, fs_write, &fss};
     loader.SetFsCallbacks(fs);
     ImageLoaderCtx ictx{&pp_.needed_images, o_.skip_textures != 0};
@@ -1171,19 +1263,23 @@ void Importer::prepare_prim(int mi, int pi, Prim &p, bool *is_triangles)
     }
     if (p.uv0.empty()) p.uv0.assign(nv * 2, 0.0f);
     if (p.uv1.empty()) p.uv1.assign(nv * 2, 0.0f);
+    p.source_vertices = (uint32_t)nv;
+    p.src.resize(nv);
+    for (size_t i = 0; i < nv; i++) p.src[i] = (uint32_t)i;
     if (!p.has_nrm) {
         // Flat shading: give every triangle its own three vertices; normals come at instancing.
         size_t nt = p.tris.size() / 3;
         std::vector<float> pos(nt * 9), uv0(nt * 6), uv1(nt * 6);
-        std::vector<uint32_t> tris(nt * 3);
+        std::vector<uint32_t> tris(nt * 3), src(nt * 3);
         for (size_t t = 0; t < nt * 3; t++) {
             uint32_t v = p.tris[t];
             memcpy(&pos[t * 3], &p.pos[(size_t)v * 3], 12);
             memcpy(&uv0[t * 2], &p.uv0[(size_t)v * 2], 8);
             memcpy(&uv1[t * 2], &p.uv1[(size_t)v * 2], 8);
             tris[t] = (uint32_t)t;
+            src[t] = v;
         }
-        p.pos.swap(pos); p.uv0.swap(uv0); p.uv1.swap(uv1); p.tris.swap(tris);
+        p.pos.swap(pos); p.uv0.swap(uv0); p.uv1.swap(uv1); p.tris.swap(tris); p.src.swap(src);
     }
 }
 
@@ -1205,6 +1301,7 @@ void Importer::prepare_mesh(int mi)
             continue;
         }
         md.all_uv1 = md.all_uv1 && p.has_uv1;
+        p.gltf_index = (uint32_t)pi;
         uint32_t base = (uint32_t)(hash_pos.size() / 3);
         hash_pos.insert(hash_pos.end(), p.pos.begin(), p.pos.end());
         for (uint32_t v : p.tris) hash_idx.push_back(base + v);
@@ -1264,7 +1361,12 @@ void Importer::emit_geometry()
     s_->tri_material = alloc_array<uint32_t>(total_t, 1);
     s_->tri_object = alloc_array<uint32_t>(total_t, 1);
     s_->objects = alloc_array<bk_object>(kept.size(), 1);
-    size_t v0 = 0, t0 = 0;
+    s_->vertex_source = alloc_array<uint32_t>(total_v, 1);
+    size_t total_p = 0;
+    for (const Instance &in : kept)
+        for (const Prim &p : meshes_[(size_t)m_.nodes[(size_t)in.node].mesh].prims) total_p += !p.tris.empty();
+    s_->primitives = alloc_array<bk_primitive>(total_p, 1);
+    size_t v0 = 0, t0 = 0, p0 = 0;
     for (size_t oi = 0; oi < kept.size(); oi++) {
         const Instance &in = kept[oi];
         const tinygltf::Node &nd = m_.nodes[(size_t)in.node];
@@ -1287,8 +1389,21 @@ void Importer::emit_geometry()
         double det = dets[oi];
         inverse_transpose3(A, det, N);
         bool flip = det < 0;
+        ob.node = in.node;
+        ob.mirrored = flip ? 1 : 0;
         for (const Prim &p : md.prims) {
             size_t nv = p.pos.size() / 3, nt = p.tris.size() / 3;
+            if (nt) {
+                bk_primitive &sp = s_->primitives[p0++];
+                sp.object = (uint32_t)oi;
+                sp.gltf_primitive = p.gltf_index;
+                sp.source_vertex_count = p.source_vertices;
+                sp.first_tri = (uint32_t)t0;
+                sp.tri_count = (uint32_t)nt;
+                sp.first_vertex = (uint32_t)v0;
+                sp.vertex_count = (uint32_t)nv;
+            }
+            if (nv) memcpy(&s_->vertex_source[v0], p.src.data(), nv * sizeof(uint32_t));
             for (size_t v = 0; v < nv; v++) {
                 double lp[3] = {p.pos[v * 3], p.pos[v * 3 + 1], p.pos[v * 3 + 2]}, wp[3];
                 xform_point(in.world, lp, wp);
@@ -1347,6 +1462,7 @@ void Importer::emit_geometry()
     s_->vertex_count = total_v;
     s_->tri_count = total_t;
     s_->object_count = kept.size();
+    s_->primitive_count = total_p;
 }
 
 void Importer::emit_lights()
@@ -1440,7 +1556,7 @@ void Importer::read_sky()
     std::string p = rel[0] == '/' ? rel : dir_of(path_) + "/" + rel;
     std::vector<unsigned char> bytes;
     std::string why;
-    if (!read_capped(p, o_.max_file_bytes, &bytes, &why))
+    if (!resource_allowed(policy_, p, &why) || !read_capped(p, o_.max_file_bytes, &bytes, &why))
         fail("%s: %s: lbk_sky %s: %s", file, where.c_str(), qstr(rel).c_str(), why.c_str());
     XXH3_64bits_update(&hash_, bytes.data(), bytes.size());
     bytes.clear();

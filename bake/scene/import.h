@@ -34,6 +34,9 @@ typedef struct bk_import_options {
     int max_sky_size;              /* the sky EXR is box-filtered down to at most this width [2048] */
     size_t max_image_pixels;       /* a texture or EXR larger than this (before filtering) is an
                                       error, so a forged header cannot make us allocate [64 Mi] */
+    /* Resources (buffers, images, the lbk_sky EXR) must resolve, symlinks included, inside the
+     * scene file's folder; this names one more folder they may come from. NULL: none. */
+    const char *allow_outside;
     /* Optional: receives each warning (one line, no newline). */
     void (*warn)(void *user, const char *message);
     void *warn_user;

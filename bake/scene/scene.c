@@ -19,6 +19,8 @@ void bk_scene_free(bk_scene *scene)
     free(scene->tris);
     free(scene->tri_material);
     free(scene->tri_object);
+    free(scene->vertex_source);
+    free(scene->primitives);
     free(scene->materials);
     free(scene->objects);
     free(scene->lights);

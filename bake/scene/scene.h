@@ -41,7 +41,23 @@ typedef struct bk_object {         /* one glTF node that instantiates a mesh */
     char door[64];                 /* extras lbk_door ("" none): the object is a door, closed state */
     int has_uv1;                   /* TEXCOORD_1 present on all its primitives */
     float local_to_world[16];      /* column-major, as glTF */
+    /* provenance (import fills it; meaningful only when bk_scene.primitives is set) */
+    int32_t node;                  /* the glTF node */
+    int mirrored;                  /* negative determinant: import swapped corners 1 and 2 of every
+                                      triangle to keep counter-clockwise front faces in world space */
 } bk_object;
+
+/* One glTF triangle primitive as an object instanced it (provenance for lightmap UVs, spec
+ * container.md §16: an engine rebuilds the primitive from the glTF). Its triangles are the
+ * primitive's in order (strip/fan restarts dropped), its vertices the primitive's in order
+ * (split per triangle corner when the primitive has no NORMAL: flat shading). */
+typedef struct bk_primitive {
+    uint32_t object;               /* scene object */
+    uint32_t gltf_primitive;       /* index in the glTF mesh's primitives array */
+    uint32_t source_vertex_count;  /* vertices of the glTF primitive (POSITION count, or Draco points) */
+    uint32_t first_tri, tri_count; /* range in bk_scene.tris, tri_count >= 1 */
+    uint32_t first_vertex, vertex_count; /* range of bk_scene vertices */
+} bk_primitive;
 
 enum bk_light_type { BK_LIGHT_POINT = 0, BK_LIGHT_SPOT, BK_LIGHT_DIRECTIONAL };
 
@@ -74,6 +90,10 @@ typedef struct bk_scene {
     uint32_t *tris;                /* 3 vertex indices per triangle */
     uint32_t *tri_material;        /* per triangle */
     uint32_t *tri_object;          /* per triangle */
+    /* provenance (NULL / 0 for scenes not made by import): vertex_source[v] is vertex v's index
+     * in its glTF primitive; primitives in scene order, objects' triangles ascending */
+    uint32_t *vertex_source;
+    size_t primitive_count; bk_primitive *primitives;
     /* tables */
     size_t material_count;  bk_material *materials;
     size_t object_count;    bk_object *objects;

@@ -18,7 +18,6 @@
 
 #include "bake/sets/door_guided.h"
 #include "bake/pipeline/encode.h"
-#include "cli/cli.h"
 #include "lbk/ahd.h"
 #include "lbk/container.h"
 #include "lbk/dls.h"
@@ -150,15 +149,162 @@ static void door_obb(const bk_scene *s, const char *door, bs_door *d)
     memcpy(d->axes, ax, sizeof ax);
 }
 
-int bk_set_bakes_prepare(bk_set_bakes *sets, const bk_scene *scene, bk_progress *progress, char *err,
-                         size_t err_len)
+/* Light set j of the `k` sorted names: its lights and emissive objects (names point into the
+ * scene), and whether any of them emits at all. */
+static lbk_result fill_light_set(bs_set *st, const bk_scene *scene, const char *name)
+{
+    snprintf(st->name, sizeof st->name, "%s", name);
+    st->kind = LBK_DLS_KIND_LIGHTS;
+    st->door = -1;
+    uint32_t lc = 0;
+    int bright = 0;
+    for (size_t i = 0; i < scene->light_count; i++)
+        if (!strcmp(scene->lights[i].light_set, name)) lc++;
+    for (size_t i = 0; i < scene->object_count; i++)
+        if (!strcmp(scene->objects[i].light_set, name)) lc++;
+    st->light_names = calloc(lc ? lc : 1, sizeof *st->light_names);
+    if (!st->light_names) return LBK_ERR_OUT_OF_MEMORY;
+    for (size_t i = 0; i < scene->light_count; i++) {
+        const bk_light *l = &scene->lights[i];
+        if (strcmp(l->light_set, name)) continue;
+        st->light_names[st->light_count++] = l->name;
+        if (l->color[0] > 0 || l->color[1] > 0 || l->color[2] > 0) bright = 1;
+    }
+    for (size_t i = 0; i < scene->object_count; i++) {
+        const bk_object *o = &scene->objects[i];
+        if (strcmp(o->light_set, name)) continue;
+        st->light_names[st->light_count++] = o->name;
+        if (object_emits(scene, o)) bright = 1;
+    }
+    st->zero = !bright;
+    return LBK_OK;
+}
+
+/* Door p (sorted name `name`) and its open and closed sets, after the light sets. */
+static lbk_result fill_door(bs_impl *im, const bk_scene *scene, size_t p, const char *name, char *err, size_t err_len)
+{
+    const size_t k = im->light_set_count;
+    bs_door *d = &im->doors[p];
+    snprintf(d->name, sizeof d->name, "%s", name);
+    door_obb(scene, name, d);
+    d->open_set = (uint32_t)(k + 2 * p);
+    d->closed_set = (uint32_t)(k + 2 * p + 1);
+    bs_set *so = &im->sets[d->open_set], *sc = &im->sets[d->closed_set];
+    snprintf(so->name, sizeof so->name, "door/%s/open", name);
+    snprintf(sc->name, sizeof sc->name, "door/%s/closed", name);
+    so->kind = LBK_DLS_KIND_DOOR_OPEN;
+    sc->kind = LBK_DLS_KIND_DOOR_CLOSED;
+    so->door = sc->door = (int)p;
+    for (size_t j = 0; j < k; j++)
+        if (!strcmp(im->sets[j].name, so->name) || !strcmp(im->sets[j].name, sc->name)) {
+            snprintf(err, err_len, "light set '%s' has the name lbk gives to door '%s': rename one", im->sets[j].name,
+                     name);
+            return LBK_ERR_BAD_INPUT;
+        }
+    return LBK_OK;
+}
+
+/* Member m of combination ci: a door (co->door) or a light set (co->light_set). */
+static lbk_result combination_member(bs_impl *im, size_t ci, const char *nm, bs_combo *co, int *ndoor, char *err,
+                                     size_t err_len)
+{
+    int door = -1, ls = -1;
+    for (size_t p = 0; p < im->door_count; p++)
+        if (!strcmp(im->doors[p].name, nm)) door = (int)p;
+    for (size_t j = 0; j < im->light_set_count; j++)
+        if (!strcmp(im->sets[j].name, nm)) ls = (int)j;
+    if (door >= 0 && ls >= 0) {
+        snprintf(err, err_len, "lbk_combinations[%zu]: '%s' names both a door and a light set: rename one", ci, nm);
+        return LBK_ERR_BAD_INPUT;
+    }
+    if (door < 0 && ls < 0) {
+        snprintf(err, err_len, "lbk_combinations[%zu]: '%s' is neither a door (lbk_door) nor a light set (lbk_light_set)",
+                 ci, nm);
+        return LBK_ERR_BAD_INPUT;
+    }
+    if (door >= 0) {
+        co->door[(*ndoor)++] = door;
+    } else if (co->light_set >= 0) {
+        snprintf(err, err_len, "lbk_combinations[%zu]: two light sets add up linearly and have no combination "
+                 "state; pair a light set with a door", ci);
+        return LBK_ERR_BAD_INPUT;
+    } else {
+        co->light_set = ls;
+    }
+    return LBK_OK;
+}
+
+/* Combination state ci (seed §6.2) and its set, after the door sets. */
+static lbk_result fill_combination(bs_impl *im, const bk_scene *scene, size_t ci, char *err, size_t err_len)
+{
+    const bk_combination *cb = &scene->combinations[ci];
+    bs_combo *co = &im->combos[ci];
+    co->door[0] = co->door[1] = co->light_set = -1;
+    int ndoor = 0;
+    for (int m = 0; m < 2; m++) {
+        lbk_result r = combination_member(im, ci, cb->members[m], co, &ndoor, err, err_len);
+        if (r) return r;
+    }
+    if (ndoor == 2 && co->door[0] == co->door[1]) {
+        snprintf(err, err_len, "lbk_combinations[%zu]: door '%s' paired with itself", ci, cb->members[0]);
+        return LBK_ERR_BAD_INPUT;
+    }
+    if (ndoor == 2 && co->door[0] > co->door[1]) {
+        int t = co->door[0];
+        co->door[0] = co->door[1], co->door[1] = t;
+    }
+    for (size_t cj = 0; cj < ci; cj++)
+        if (im->combos[cj].door[0] == co->door[0] && im->combos[cj].door[1] == co->door[1] &&
+            im->combos[cj].light_set == co->light_set) {
+            snprintf(err, err_len, "lbk_combinations[%zu]: the same pair as lbk_combinations[%zu]", ci, cj);
+            return LBK_ERR_BAD_INPUT;
+        }
+    co->set = (uint32_t)(im->light_set_count + 2 * im->door_count + ci);
+    bs_set *st = &im->sets[co->set];
+    snprintf(st->name, sizeof st->name, "combo/%s+%s", cb->members[0], cb->members[1]);
+    st->kind = LBK_DLS_KIND_COMBINATION;
+    st->door = -1;
+    st->members[0] = im->doors[co->door[0]].open_set;
+    st->members[1] = co->door[1] >= 0 ? im->doors[co->door[1]].open_set : (uint32_t)co->light_set;
+    st->member_count = 2;
+    for (size_t j = 0; j < im->light_set_count; j++)
+        if (!strcmp(im->sets[j].name, st->name)) {
+            snprintf(err, err_len, "light set '%s' has the name lbk gives to a combination state: rename it", st->name);
+            return LBK_ERR_BAD_INPUT;
+        }
+    return LBK_OK;
+}
+
+/* The sets of a scene with k light set names and nd door names (both sorted, distinct). */
+static lbk_result fill_sets(bs_impl *im, const bk_scene *scene, const char **names, size_t k, const char **doors,
+                            size_t nd, char *err, size_t err_len)
+{
+    size_t nc = scene->combination_count;
+    im->combos = calloc(nc ? nc : 1, sizeof *im->combos);
+    im->sets = calloc(k + 2 * nd + nc, sizeof *im->sets);
+    im->doors = calloc(nd ? nd : 1, sizeof *im->doors);
+    if (!im->combos || !im->sets || !im->doors) return LBK_ERR_OUT_OF_MEMORY;
+    im->set_count = k + 2 * nd + nc;
+    im->combo_count = nc;
+    im->light_set_count = k;
+    im->door_count = nd;
+    lbk_result r = LBK_OK;
+    for (size_t j = 0; !r && j < k; j++) r = fill_light_set(&im->sets[j], scene, names[j]);
+    for (size_t p = 0; !r && p < nd; p++) r = fill_door(im, scene, p, doors[p], err, err_len);
+    for (size_t ci = 0; !r && ci < nc; ci++) r = fill_combination(im, scene, ci, err, err_len);
+    return r;
+}
+
+lbk_result bk_set_bakes_prepare(bk_set_bakes *sets, const bk_scene *scene, const bk_events *events, char *err,
+                                size_t err_len)
 {
     memset(sets, 0, sizeof *sets);
     size_t n = scene->light_count + scene->object_count;
     const char **names = malloc((n ? n : 1) * sizeof *names);
     const char **doors = malloc((scene->object_count ? scene->object_count : 1) * sizeof *doors);
     bs_impl *im = calloc(1, sizeof *im);
-    if (!names || !doors || !im) goto oom;
+    lbk_result r = LBK_ERR_OUT_OF_MEMORY;
+    if (!names || !doors || !im) goto fail;
     size_t k = 0, nd = 0;
     for (size_t i = 0; i < scene->light_count; i++)
         if (scene->lights[i].light_set[0]) names[k++] = scene->lights[i].light_set;
@@ -168,146 +314,30 @@ int bk_set_bakes_prepare(bk_set_bakes *sets, const bk_scene *scene, bk_progress 
     }
     k = unique_sorted(names, k);
     nd = unique_sorted(doors, nd);
-    size_t nc = scene->combination_count;
-    if (nc && !nd) {
+    if (scene->combination_count && !nd) {
         snprintf(err, err_len, "lbk_combinations: the scene has no door (lbk_door); a combination state needs one");
-        free(names), free(doors), free(im);
-        return LBK_EXIT_INPUT;
+        r = LBK_ERR_BAD_INPUT;
+        goto fail;
     }
     if (k + 2 * nd == 0) {
         free(names), free(doors), free(im);
-        return 0;
+        return LBK_OK;
     }
-    im->set_count = k + 2 * nd + nc;
-    im->combo_count = nc;
-    im->combos = calloc(nc ? nc : 1, sizeof *im->combos);
-    if (!im->combos) goto oom;
-    im->light_set_count = k;
-    im->door_count = nd;
-    im->sets = calloc(im->set_count, sizeof *im->sets);
-    im->doors = calloc(nd ? nd : 1, sizeof *im->doors);
-    if (!im->sets || !im->doors) goto oom;
-    for (size_t j = 0; j < k; j++) {
-        bs_set *st = &im->sets[j];
-        snprintf(st->name, sizeof st->name, "%s", names[j]);
-        st->kind = LBK_DLS_KIND_LIGHTS;
-        st->door = -1;
-        uint32_t lc = 0;
-        int bright = 0;
-        for (size_t i = 0; i < scene->light_count; i++)
-            if (!strcmp(scene->lights[i].light_set, names[j])) lc++;
-        for (size_t i = 0; i < scene->object_count; i++)
-            if (!strcmp(scene->objects[i].light_set, names[j])) lc++;
-        st->light_names = calloc(lc ? lc : 1, sizeof *st->light_names);
-        if (!st->light_names) goto oom;
-        for (size_t i = 0; i < scene->light_count; i++) {
-            const bk_light *l = &scene->lights[i];
-            if (strcmp(l->light_set, names[j])) continue;
-            st->light_names[st->light_count++] = l->name;
-            if (l->color[0] > 0 || l->color[1] > 0 || l->color[2] > 0) bright = 1;
-        }
-        for (size_t i = 0; i < scene->object_count; i++) {
-            const bk_object *o = &scene->objects[i];
-            if (strcmp(o->light_set, names[j])) continue;
-            st->light_names[st->light_count++] = o->name;
-            if (object_emits(scene, o)) bright = 1;
-        }
-        st->zero = !bright;
-    }
-    for (size_t p = 0; p < nd; p++) {
-        bs_door *d = &im->doors[p];
-        snprintf(d->name, sizeof d->name, "%s", doors[p]);
-        door_obb(scene, doors[p], d);
-        d->open_set = (uint32_t)(k + 2 * p);
-        d->closed_set = (uint32_t)(k + 2 * p + 1);
-        bs_set *so = &im->sets[d->open_set], *sc = &im->sets[d->closed_set];
-        snprintf(so->name, sizeof so->name, "door/%s/open", doors[p]);
-        snprintf(sc->name, sizeof sc->name, "door/%s/closed", doors[p]);
-        so->kind = LBK_DLS_KIND_DOOR_OPEN;
-        sc->kind = LBK_DLS_KIND_DOOR_CLOSED;
-        so->door = sc->door = (int)p;
-        for (size_t j = 0; j < k; j++)
-            if (!strcmp(im->sets[j].name, so->name) || !strcmp(im->sets[j].name, sc->name)) {
-                snprintf(err, err_len, "light set '%s' has the name lbk gives to door '%s': rename one",
-                         im->sets[j].name, doors[p]);
-                goto bad_input;
-            }
-    }
-    for (size_t ci = 0; ci < nc; ci++) {
-        const bk_combination *cb = &scene->combinations[ci];
-        bs_combo *co = &im->combos[ci];
-        co->door[0] = co->door[1] = co->light_set = -1;
-        int ndoor = 0;
-        for (int m = 0; m < 2; m++) {
-            const char *nm = cb->members[m];
-            int door = -1, ls = -1;
-            for (size_t p = 0; p < nd; p++)
-                if (!strcmp(im->doors[p].name, nm)) door = (int)p;
-            for (size_t j = 0; j < k; j++)
-                if (!strcmp(im->sets[j].name, nm)) ls = (int)j;
-            if (door >= 0 && ls >= 0) {
-                snprintf(err, err_len, "lbk_combinations[%zu]: '%s' names both a door and a light set: rename one", ci, nm);
-                goto bad_input;
-            }
-            if (door < 0 && ls < 0) {
-                snprintf(err, err_len, "lbk_combinations[%zu]: '%s' is neither a door (lbk_door) nor a light set (lbk_light_set)",
-                         ci, nm);
-                goto bad_input;
-            }
-            if (door >= 0) co->door[ndoor++] = door;
-            else if (co->light_set >= 0) {
-                snprintf(err, err_len, "lbk_combinations[%zu]: two light sets add up linearly and have no combination "
-                         "state; pair a light set with a door", ci);
-                goto bad_input;
-            } else co->light_set = ls;
-        }
-        if (ndoor == 2 && co->door[0] == co->door[1]) {
-            snprintf(err, err_len, "lbk_combinations[%zu]: door '%s' paired with itself", ci, cb->members[0]);
-            goto bad_input;
-        }
-        if (ndoor == 2 && co->door[0] > co->door[1]) {
-            int t = co->door[0];
-            co->door[0] = co->door[1], co->door[1] = t;
-        }
-        for (size_t cj = 0; cj < ci; cj++)
-            if (im->combos[cj].door[0] == co->door[0] && im->combos[cj].door[1] == co->door[1] &&
-                im->combos[cj].light_set == co->light_set) {
-                snprintf(err, err_len, "lbk_combinations[%zu]: the same pair as lbk_combinations[%zu]", ci, cj);
-                goto bad_input;
-            }
-        co->set = (uint32_t)(k + 2 * nd + ci);
-        bs_set *st = &im->sets[co->set];
-        snprintf(st->name, sizeof st->name, "combo/%s+%s", cb->members[0], cb->members[1]);
-        st->kind = LBK_DLS_KIND_COMBINATION;
-        st->door = -1;
-        st->members[0] = im->doors[co->door[0]].open_set;
-        st->members[1] = co->door[1] >= 0 ? im->doors[co->door[1]].open_set : (uint32_t)co->light_set;
-        st->member_count = 2;
-        for (size_t j = 0; j < k; j++)
-            if (!strcmp(im->sets[j].name, st->name)) {
-                snprintf(err, err_len, "light set '%s' has the name lbk gives to a combination state: rename it", st->name);
-                goto bad_input;
-            }
-    }
+    r = fill_sets(im, scene, names, k, doors, nd, err, err_len);
+    if (r) goto fail;
     free(names), free(doors);
     sets->impl = im;
     sets->set_count = (uint32_t)im->set_count;
     sets->door_count = (uint32_t)im->door_count;
-    if (progress)
-        bk_progress_note(progress, "lbk bake: %zu dynamic light sets, %zu doors, %zu combination states",
-                         im->light_set_count, im->door_count, im->combo_count);
-    return 0;
-bad_input:
+    bk_events_say(events, LBK_BAKE_SEVERITY_NOTE, "%zu dynamic light sets, %zu doors, %zu combination states",
+                  im->light_set_count, im->door_count, im->combo_count);
+    return LBK_OK;
+fail:
+    if (r == LBK_ERR_OUT_OF_MEMORY) snprintf(err, err_len, "out of memory");
     free(names), free(doors);
     sets->impl = im;
     bk_set_bakes_free(sets);
-    return LBK_EXIT_INPUT;
-oom:
-    free(names), free(doors);
-    sets->impl = im;
-    bk_set_bakes_free(sets);
-    snprintf(err, err_len, "out of memory");
-    return LBK_EXIT_INTERNAL;
+    return r;
 }
 
 /* ---- hooks ----------------------------------------------------------------------------- */
@@ -398,28 +428,21 @@ static int is_door_texel(const bk_set_inputs *in, size_t k)
     return t->object < in->scene->object_count && in->scene->objects[t->object].door[0];
 }
 
-/* Chooses and encodes a set's entries from its per-receiver contribution (radiance SH) and the
- * direct part of it. Rule (bake/sets/SETS.md): threshold = fraction × mean indirect irradiance
- * (luminance) of the texels the set lights directly; an entry is stored where the contribution
- * exceeds it. Door receivers are left out of door sets (when the door is open it is not there). */
-static lbk_result emit_set(const bk_set_inputs *in, bs_set *st, const lbk_sh9_rgb *contrib, const lbk_sh9_rgb *direct,
-                           double fraction, int skip_doors)
+/* The set's texels as clamped linear AHD (lin, door texels zeroed in door sets) and its
+ * absolute threshold (bake/sets/SETS.md): fraction × mean indirect irradiance (luminance) of
+ * the texels the set lights directly; with no direct light the mean contribution; with no texel
+ * lit the mean over the probes. */
+static lbk_result set_threshold(const bk_set_inputs *in, const lbk_sh9_rgb *contrib, const lbk_sh9_rgb *direct,
+                                double fraction, int skip_doors, lbk_ahd_linear *lin, double *thr)
 {
     const bk_texels *tx = in->texels;
     size_t nt = in->texel_receivers;
-    lbk_ahd_linear *lin = calloc(nt ? nt : 1, sizeof *lin);
-    double *lum = calloc(nt ? nt : 1, sizeof *lum);
-    if (!lin || !lum) {
-        free(lin), free(lum);
+    double *lum = calloc(nt ? nt : 1, sizeof *lum), *dl = calloc(nt ? nt : 1, sizeof *dl);
+    if (!lum || !dl) {
+        free(lum), free(dl);
         return LBK_ERR_OUT_OF_MEMORY;
     }
-    /* threshold from the directly lit texels */
     double dmax = 0;
-    double *dl = calloc(nt ? nt : 1, sizeof *dl);
-    if (!dl) {
-        free(lin), free(lum);
-        return LBK_ERR_OUT_OF_MEMORY;
-    }
     for (size_t k = 0; k < nt; k++) {
         const bk_texel *t = &tx->receivers[in->texel_of_receiver[k]];
         bk_texel_linear(t, &contrib[k], &lin[k]);
@@ -451,65 +474,67 @@ static lbk_result emit_set(const bk_set_inputs *in, bs_set *st, const lbk_sh9_rg
         double ps = 0;
         size_t pn = 0;
         for (size_t k = nt; k < in->receiver_count; k++) {
-            lbk_sh9_rgb s = contrib[k];
-            sh_clamp(&s);
-            double l = probe_lum(&s);
+            lbk_sh9_rgb sh = contrib[k];
+            sh_clamp(&sh);
+            double l = probe_lum(&sh);
             if (l > 0) ps += l, pn++;
         }
         reference = pn ? ps / (double)pn : 0;
     }
-    double thr = fraction * reference;
-    st->threshold = thr;
-    free(dl);
+    *thr = fraction * reference;
+    free(lum), free(dl);
+    return LBK_OK;
+}
 
-    lbk_result r = LBK_ERR_OUT_OF_MEMORY;
-    bs_vec tv = {NULL, NULL, 0, 0, sizeof(lbk_ahd_linear)}, gv = {NULL, NULL, 0, 0, sizeof(lbk_sh9_rgb)},
-           lv = {NULL, NULL, 0, 0, sizeof(lbk_sh9_rgb)};
-    /* texels, page by page, dilated like the base (bk_encode_pages) so bilinear filtering at
-     * chart borders sees the set's light in the gutter too */
-    if (nt && tx->page_count) {
-        int32_t *recv_of_texel = NULL;
-        recv_of_texel = malloc((tx->count ? tx->count : 1) * sizeof *recv_of_texel);
-        if (!recv_of_texel) goto done;
-        for (size_t i = 0; i < tx->count; i++) recv_of_texel[i] = -1;
-        for (size_t k = 0; k < nt; k++) recv_of_texel[in->texel_of_receiver[k]] = (int32_t)k;
-        for (size_t p = 0; p < tx->page_count; p++) {
-            int w = tx->pages[p].width, h = tx->pages[p].height;
-            size_t n = (size_t)w * (size_t)h;
-            float *data = calloc(n * 12 + 1, sizeof *data);
-            uint8_t *mask = calloc(n + 1, 1);
-            if (!data || !mask) {
-                free(data), free(mask), free(recv_of_texel);
-                goto done;
-            }
-            for (size_t i = 0; i < n; i++) {
-                int32_t ti = tx->index[tx->page_offset[p] + i];
-                if (ti < 0 || recv_of_texel[ti] < 0) continue;
-                memcpy(&data[12 * i], lin[recv_of_texel[ti]].c, 12 * sizeof(float));
-                mask[i] = 1;
-            }
-            bk_dilate(data, 12, mask, w, h, in->atlas_margin + 2);
-            for (size_t i = 0; i < n && thr >= 0; i++) {
-                if (!mask[i]) continue;
-                lbk_ahd_linear l;
-                memcpy(l.c, &data[12 * i], sizeof l.c);
-                float ez[3];
-                lin_ez(&l, ez);
-                double li = lum3(ez);
-                if (!(li > thr) || !(li > 0)) continue;
-                if (vec_push(&tv, (uint32_t)(tx->page_offset[p] + i), &l)) {
-                    free(data), free(mask), free(recv_of_texel);
-                    goto done;
-                }
-            }
-            free(data), free(mask);
+/* Texel entries above thr, page by page, dilated like the base (bk_encode_pages) so bilinear
+ * filtering at chart borders sees the set's light in the gutter too. */
+static lbk_result emit_texels(const bk_set_inputs *in, const lbk_ahd_linear *lin, double thr, bs_vec *tv)
+{
+    const bk_texels *tx = in->texels;
+    size_t nt = in->texel_receivers;
+    if (!nt || !tx->page_count) return LBK_OK;
+    int32_t *recv_of_texel = malloc((tx->count ? tx->count : 1) * sizeof *recv_of_texel);
+    if (!recv_of_texel) return LBK_ERR_OUT_OF_MEMORY;
+    for (size_t i = 0; i < tx->count; i++) recv_of_texel[i] = -1;
+    for (size_t k = 0; k < nt; k++) recv_of_texel[in->texel_of_receiver[k]] = (int32_t)k;
+    lbk_result r = LBK_OK;
+    for (size_t p = 0; !r && p < tx->page_count; p++) {
+        int w = tx->pages[p].width, h = tx->pages[p].height;
+        size_t n = (size_t)w * (size_t)h;
+        float *data = calloc(n * 12 + 1, sizeof *data);
+        uint8_t *mask = calloc(n + 1, 1);
+        if (!data || !mask) r = LBK_ERR_OUT_OF_MEMORY;
+        for (size_t i = 0; !r && i < n; i++) {
+            int32_t ti = tx->index[tx->page_offset[p] + i];
+            if (ti < 0 || recv_of_texel[ti] < 0) continue;
+            memcpy(&data[12 * i], lin[recv_of_texel[ti]].c, 12 * sizeof(float));
+            mask[i] = 1;
         }
-        free(recv_of_texel);
+        if (!r) r = bk_finish_page(data, mask, w, h, in->atlas_margin, in->seams, (uint32_t)p, in->transport.threads);
+        for (size_t i = 0; !r && i < n && thr >= 0; i++) {
+            if (!mask[i]) continue;
+            lbk_ahd_linear l;
+            memcpy(l.c, &data[12 * i], sizeof l.c);
+            float ez[3];
+            lin_ez(&l, ez);
+            double li = lum3(ez);
+            if (!(li > thr) || !(li > 0)) continue;
+            if (vec_push(tv, (uint32_t)(tx->page_offset[p] + i), &l)) r = LBK_ERR_OUT_OF_MEMORY;
+        }
+        free(data), free(mask);
     }
+    free(recv_of_texel);
+    return r;
+}
+
+/* GLG and LLG probe entries above thr; door props get no door-set entries. */
+static lbk_result emit_probes(const bk_set_inputs *in, const lbk_sh9_rgb *contrib, double thr, int skip_doors,
+                              bs_vec *gv, bs_vec *lv)
+{
     size_t grid = 0, grid_end = in->llg_first;
     int door_grid = 0;
-    for (size_t k = nt; k < in->receiver_count; k++) {
-        /* which LLG this probe belongs to: door props get no door-set entries */
+    for (size_t k = in->texel_receivers; k < in->receiver_count; k++) {
+        /* which LLG this probe belongs to */
         while (k >= in->llg_first && k >= grid_end && grid < in->llg_grids) {
             const bk_llg *g = &in->llgs[grid++];
             grid_end += bk_llg_probe_count(g);
@@ -522,50 +547,80 @@ static lbk_result emit_set(const bk_set_inputs *in, bs_set *st, const lbk_sh9_rg
         if (!(l > thr) || !(l > 0)) continue;
         int bad;
         if (k >= in->glg_first && k < in->glg_first + in->glg_count)
-            bad = vec_push(&gv, (uint32_t)(k - in->glg_first), &s);
+            bad = vec_push(gv, (uint32_t)(k - in->glg_first), &s);
         else if (k >= in->llg_first && k < in->llg_first + in->llg_count)
-            bad = vec_push(&lv, (uint32_t)(k - in->llg_first), &s);
+            bad = vec_push(lv, (uint32_t)(k - in->llg_first), &s);
         else
             continue;
-        if (bad) goto done;
+        if (bad) return LBK_ERR_OUT_OF_MEMORY;
     }
-    st->count[LBK_DLS_SPACE_TEXEL] = tv.count, st->targets[LBK_DLS_SPACE_TEXEL] = tv.targets;
-    st->values[LBK_DLS_SPACE_TEXEL] = tv.values;
-    st->count[LBK_DLS_SPACE_GLG] = gv.count, st->targets[LBK_DLS_SPACE_GLG] = gv.targets;
-    st->values[LBK_DLS_SPACE_GLG] = gv.values;
-    st->count[LBK_DLS_SPACE_LLG] = lv.count, st->targets[LBK_DLS_SPACE_LLG] = lv.targets;
-    st->values[LBK_DLS_SPACE_LLG] = lv.values;
-    tv.targets = gv.targets = lv.targets = NULL;
-    tv.values = gv.values = lv.values = NULL;
-    r = LBK_OK;
-done:
+    return LBK_OK;
+}
+
+/* Chooses a set's entries from its per-receiver contribution (radiance SH) and the direct part
+ * of it: where the contribution exceeds the set's threshold (set_threshold). Door receivers are
+ * left out of door sets (when the door is open it is not there). */
+static lbk_result emit_set(const bk_set_inputs *in, bs_set *st, const lbk_sh9_rgb *contrib, const lbk_sh9_rgb *direct,
+                           double fraction, int skip_doors)
+{
+    size_t nt = in->texel_receivers;
+    lbk_ahd_linear *lin = calloc(nt ? nt : 1, sizeof *lin);
+    if (!lin) return LBK_ERR_OUT_OF_MEMORY;
+    double thr = 0;
+    lbk_result r = set_threshold(in, contrib, direct, fraction, skip_doors, lin, &thr);
+    st->threshold = thr;
+    bs_vec tv = {NULL, NULL, 0, 0, sizeof(lbk_ahd_linear)}, gv = {NULL, NULL, 0, 0, sizeof(lbk_sh9_rgb)},
+           lv = {NULL, NULL, 0, 0, sizeof(lbk_sh9_rgb)};
+    if (!r) r = emit_texels(in, lin, thr, &tv);
+    if (!r) r = emit_probes(in, contrib, thr, skip_doors, &gv, &lv);
+    if (!r) {
+        st->count[LBK_DLS_SPACE_TEXEL] = tv.count, st->targets[LBK_DLS_SPACE_TEXEL] = tv.targets;
+        st->values[LBK_DLS_SPACE_TEXEL] = tv.values;
+        st->count[LBK_DLS_SPACE_GLG] = gv.count, st->targets[LBK_DLS_SPACE_GLG] = gv.targets;
+        st->values[LBK_DLS_SPACE_GLG] = gv.values;
+        st->count[LBK_DLS_SPACE_LLG] = lv.count, st->targets[LBK_DLS_SPACE_LLG] = lv.targets;
+        st->values[LBK_DLS_SPACE_LLG] = lv.values;
+        tv.targets = gv.targets = lv.targets = NULL;
+        tv.values = gv.values = lv.values = NULL;
+    }
     free(tv.targets), free(tv.values), free(gv.targets), free(gv.values), free(lv.targets), free(lv.values);
-    free(lin), free(lum);
+    free(lin);
     return r;
 }
 
 /* ---- runs ------------------------------------------------------------------------------ */
 
-/* The user state of every set run: progress over all runs, and the door albedo hook. */
+/* The user state of every set run: progress over all runs, the door albedo hook, and where an
+ * error's text goes. */
 typedef struct run_ctx {
     const bk_set_inputs *in;
     int run, runs;
     const bk_scene *scene;   /* scene of the current run (the hook's triangle indices) */
     int black_doors;         /* 1: door triangles get albedo 0 ... */
     const char *keep;        /* ... except this door's */
+    char *err;
+    size_t err_len;
 } run_ctx;
 
-static void run_progress(void *user, const char *phase, double fraction)
+static int run_progress(void *user, const char *phase, double fraction)
 {
     (void)phase;
     run_ctx *rc = user;
-    if (rc->in->progress) bk_progress_update(rc->in->progress, (rc->run + fraction) / (rc->runs ? rc->runs : 1));
+    return bk_events_progress(rc->in->events, (rc->run + fraction) / (rc->runs ? rc->runs : 1));
 }
 
 static void run_albedo(void *user, uint32_t tri, float albedo[3])
 {
     const run_ctx *rc = user;
     if (rc->black_doors && tri_door_black(rc->scene, rc->keep, tri)) albedo[0] = albedo[1] = albedo[2] = 0;
+}
+
+/* What a failed step returns: cancellation and out of memory as they are, else internal. */
+static lbk_result failure(run_ctx *rc, lbk_result r, const char *fmt, const char *name)
+{
+    if (r == LBK_ERR_CANCELLED) return r;
+    snprintf(rc->err, rc->err_len, fmt, name, lbk_result_message(r));
+    return r == LBK_ERR_OUT_OF_MEMORY ? r : LBK_ERR_INTERNAL;
 }
 
 /* A scene without the triangles of one or two doors (arrays are shared with `s` except the triangle
@@ -610,8 +665,8 @@ static void filtered_free(filtered_scene *f)
 }
 
 /* One transport run at the base receivers. */
-static int run_one(run_ctx *rc, const bk_scene *scene, const bk_tracer *tracer, const bk_transport_options *base,
-                   lbk_sh9_rgb *radiance, lbk_sh9_rgb *direct, const char *what, char *err, size_t err_len)
+static lbk_result run_one(run_ctx *rc, const bk_scene *scene, const bk_tracer *tracer, const bk_transport_options *base,
+                          lbk_sh9_rgb *radiance, lbk_sh9_rgb *direct, const char *what)
 {
     const bk_set_inputs *in = rc->in;
     bk_transport_options opt = *base;
@@ -627,17 +682,13 @@ static int run_one(run_ctx *rc, const bk_scene *scene, const bk_tracer *tracer, 
     bk_transport_stats st;
     lbk_result r = bk_transport_run(scene, tracer, in->receivers, in->receiver_count, &opt, &out, &st);
     rc->run++;
-    if (r) {
-        snprintf(err, err_len, "light transport for %s: %s", what, lbk_result_message(r));
-        return LBK_EXIT_INTERNAL;
-    }
-    if (st.nonfinite && in->progress)
-        bk_progress_note(in->progress, "lbk bake: warning: %s: %llu non-finite samples were dropped", what,
-                         (unsigned long long)st.nonfinite);
-    if (in->progress)
-        bk_progress_note(in->progress, "  %-30s %2d passes %7.0f samples/receiver  est. error %6.2f%%  %6.1f s", what,
-                         st.passes, st.samples_per_receiver, 100 * st.est_rel_rmse, st.seconds);
-    return 0;
+    if (r) return failure(rc, r, "light transport for %s: %s", what);
+    if (st.nonfinite)
+        bk_events_say(in->events, LBK_BAKE_SEVERITY_WARNING, "%s: %llu non-finite samples were dropped", what,
+                      (unsigned long long)st.nonfinite);
+    bk_events_say(in->events, LBK_BAKE_SEVERITY_INFO, "%-30s %2d passes %7.0f samples/receiver  est. error %6.2f%%  %6.1f s",
+                  what, st.passes, st.samples_per_receiver, 100 * st.est_rel_rmse, st.seconds);
+    return LBK_OK;
 }
 
 static void sh_sub(lbk_sh9_rgb *dst, const lbk_sh9_rgb *b, size_t n)
@@ -656,45 +707,41 @@ static void sh_add(lbk_sh9_rgb *dst, const lbk_sh9_rgb *b, size_t n)
 
 /* The scene with one or two doors removed (door2 may be NULL) and its own tracer; on success the
  * caller destroys *tr and frees *fs. */
-static int open_without(const bk_set_inputs *in, const char *door, const char *door2, filtered_scene *fs,
-                        bk_tracer **tr, char *err, size_t err_len)
+static lbk_result open_without(run_ctx *rc, const char *door, const char *door2, filtered_scene *fs, bk_tracer **tr)
 {
-    if (scene_without_doors(in->scene, door, door2, fs)) {
-        snprintf(err, err_len, "out of memory");
-        return LBK_EXIT_INTERNAL;
-    }
-    lbk_result r = bk_tracer_create(&fs->scene, in->transport.threads, tr);
+    lbk_result r = scene_without_doors(rc->in->scene, door, door2, fs);
+    if (r) return failure(rc, r, "scene without door '%s': %s", door);
+    r = bk_tracer_create(&fs->scene, rc->in->transport.threads, tr);
     if (r) {
         filtered_free(fs);
-        snprintf(err, err_len, "ray tracer without door '%s': %s", door, lbk_result_message(r));
-        return LBK_EXIT_INTERNAL;
+        return failure(rc, r, "ray tracer without door '%s': %s", door);
     }
-    return 0;
+    return LBK_OK;
 }
 
 /* A run over the scene with one or two doors removed (its own tracer). */
-static int run_without(run_ctx *rc, const char *door, const char *door2, const bk_transport_options *opt,
-                       lbk_sh9_rgb *rad, lbk_sh9_rgb *dir, const char *what, char *err, size_t err_len)
+static lbk_result run_without(run_ctx *rc, const char *door, const char *door2, const bk_transport_options *opt,
+                              lbk_sh9_rgb *rad, lbk_sh9_rgb *dir, const char *what)
 {
     filtered_scene fs;
     bk_tracer *tr = NULL;
-    int code = open_without(rc->in, door, door2, &fs, &tr, err, err_len);
-    if (code) return code;
-    code = run_one(rc, &fs.scene, tr, opt, rad, dir, what, err, err_len);
+    lbk_result r = open_without(rc, door, door2, &fs, &tr);
+    if (r) return r;
+    r = run_one(rc, &fs.scene, tr, opt, rad, dir, what);
     bk_tracer_destroy(tr);
     filtered_free(&fs);
-    return code;
+    return r;
 }
 
 /* S_O of door d by the guided estimator (bake/sets/door_guided.h) into rad/dir. */
-static int guided_open(run_ctx *rc, const bs_door *d, const float *texel_size, const uint8_t *door_texel,
-                       lbk_sh9_rgb *rad, lbk_sh9_rgb *dir, char *err, size_t err_len)
+static lbk_result guided_open(run_ctx *rc, const bs_door *d, const float *texel_size, const uint8_t *door_texel,
+                              lbk_sh9_rgb *rad, lbk_sh9_rgb *dir)
 {
     const bk_set_inputs *in = rc->in;
     filtered_scene fs;
     bk_tracer *tr = NULL;
-    int code = open_without(in, d->name, NULL, &fs, &tr, err, err_len);
-    if (code) return code;
+    lbk_result r = open_without(rc, d->name, NULL, &fs, &tr);
+    if (r) return r;
     bk_door_guided_inputs gi;
     memset(&gi, 0, sizeof gi);
     gi.scene = &fs.scene;
@@ -713,187 +760,246 @@ static int guided_open(run_ctx *rc, const bs_door *d, const float *texel_size, c
     gi.samples = (int)fmin(fmax(spp, 16), 4096);
     gi.use_sky = !in->transport.no_sky;
     bk_door_guided_stats st;
-    lbk_result r = bk_door_guided_run(&gi, rad, dir, &st, NULL);
+    r = bk_door_guided_run(&gi, rad, dir, &st, NULL);
     bk_tracer_destroy(tr);
     filtered_free(&fs);
     rc->run++;
-    if (r) {
-        snprintf(err, err_len, "guided door estimator for '%s': %s", d->name, lbk_result_message(r));
-        return LBK_EXIT_INTERNAL;
-    }
-    if (in->progress)
-        bk_progress_note(in->progress,
-                         "  door '%s' open (guided)        %zu photons → %d boxes, %.0f portal samples, %d bounces "
-                         "(q %.2f); energy direct %.3g, 1st bounce %.3g, later %.3g; %6.1f s",
-                         d->name, st.photons, st.boxes, st.portal_samples, st.bounces, st.q, st.stage_energy[0],
-                         st.stage_energy[1], st.stage_energy[2], st.seconds);
-    return 0;
+    if (r) return failure(rc, r, "guided door estimator for '%s': %s", d->name);
+    bk_events_say(in->events, LBK_BAKE_SEVERITY_INFO,
+                  "door '%s' open (guided)        %zu photons → %d boxes, %.0f portal samples, %d bounces "
+                  "(q %.2f); energy direct %.3g, 1st bounce %.3g, later %.3g; %6.1f s",
+                  d->name, st.photons, st.boxes, st.portal_samples, st.bounces, st.q, st.stage_energy[0],
+                  st.stage_energy[1], st.stage_energy[2], st.seconds);
+    /* the estimator has no checkpoint of its own */
+    return bk_events_progress(in->events, (double)rc->run / (rc->runs ? rc->runs : 1)) ? LBK_ERR_CANCELLED : LBK_OK;
 }
 
-int bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *err, size_t err_len)
+/* Everything bk_set_bakes_run's steps share: the runs' state and their buffers, n receivers each. */
+typedef struct set_run {
+    run_ctx rc;
+    bs_impl *im;
+    const bk_set_inputs *in;
+    size_t n;                       /* receivers (at least 1: the buffer sizes) */
+    double fraction;                /* sparse storage threshold (emit_set) */
+    bk_transport_options fixed;     /* the door runs' fixed budget */
+    lbk_sh9_rgb *rad, *dir;         /* the current run */
+    lbk_sh9_rgb *ref, *ref_dir;     /* every door closed and black */
+    lbk_sh9_rgb **keep, **keep_dir; /* open runs of doors in door–door combinations */
+    float *texel_size;              /* guided: per texel receiver */
+    uint8_t *door_texel;
+    lbk_sh9_rgb *ls_closed, *ls_closed_dir; /* door–light set combinations: the set, doors closed */
+    char what[256];
+} set_run;
+
+static lbk_result out_of_memory(set_run *s)
+{
+    snprintf(s->rc.err, s->rc.err_len, "out of memory");
+    return LBK_ERR_OUT_OF_MEMORY;
+}
+
+static lbk_result emit(set_run *s, bs_set *st, int skip_doors)
+{
+    return emit_set(s->in, st, s->rad, s->dir, s->fraction, skip_doors) ? out_of_memory(s) : LBK_OK;
+}
+
+/* Light sets: their lights alone (transport leaves out the sky and every other emitter); doors
+ * stay closed with their albedo (seed §4.1: the other elements in their default state, here
+ * including the bounce off them). */
+static lbk_result bake_light_sets(set_run *s)
+{
+    for (size_t j = 0; j < s->im->light_set_count; j++) {
+        bs_set *st = &s->im->sets[j];
+        if (st->zero) continue; /* no light: no entries and no run */
+        bk_transport_options opt = s->in->transport;
+        opt.light_set = st->name;
+        s->rc.black_doors = 0;
+        snprintf(s->what, sizeof s->what, "light set '%s'", st->name);
+        lbk_result r = run_one(&s->rc, s->in->scene, s->in->tracer, &opt, s->rad, s->dir, s->what);
+        if (r) return r;
+        r = emit(s, st, 0);
+        if (r) return r;
+    }
+    return LBK_OK;
+}
+
+/* Doors are differences of runs with the same seed and the same passes (a fixed budget equal to
+ * what the base reached, no error target, no time limit), so the receivers' gather rays are the
+ * same and most of the noise cancels. This sets up those runs and bakes their reference: every
+ * door closed with albedo 0, the base's path space (seed §4.1). */
+static lbk_result bake_door_reference(set_run *s, int guided)
+{
+    const bk_set_inputs *in = s->in;
+    s->fixed = in->transport;
+    s->fixed.light_set = NULL;
+    s->fixed.target_error = -1;
+    s->fixed.time_limit = 0;
+    if (in->base_samples_per_receiver > 0) s->fixed.max_samples = (int)fmin(in->base_samples_per_receiver, 1 << 24);
+    s->ref = malloc(s->n * sizeof *s->ref), s->ref_dir = malloc(s->n * sizeof *s->ref_dir);
+    s->keep = calloc(s->im->door_count, sizeof *s->keep);
+    s->keep_dir = calloc(s->im->door_count, sizeof *s->keep_dir);
+    if (!s->ref || !s->ref_dir || !s->keep || !s->keep_dir) return out_of_memory(s);
+    if (guided) {
+        s->texel_size = calloc(in->texel_receivers ? in->texel_receivers : 1, sizeof *s->texel_size);
+        s->door_texel = calloc(in->texel_receivers ? in->texel_receivers : 1, 1);
+        if (!s->texel_size || !s->door_texel) return out_of_memory(s);
+        for (size_t k = 0; k < in->texel_receivers; k++) {
+            s->texel_size[k] = in->texels->receivers[in->texel_of_receiver[k]].texel_size;
+            s->door_texel[k] = (uint8_t)is_door_texel(in, k);
+        }
+    }
+    s->rc.black_doors = 1;
+    s->rc.keep = NULL;
+    return run_one(&s->rc, in->scene, in->tracer, &s->fixed, s->ref, s->ref_dir, "doors closed, black (reference)");
+}
+
+/* Door p's two sets: S_O (open: the light through the opening) and S_C (closed: its bounce). */
+static lbk_result bake_door(set_run *s, size_t p, int guided)
+{
+    const bs_impl *im = s->im;
+    const bs_door *d = &im->doors[p];
+    const size_t count = s->in->receiver_count;
+    int keep_it = 0;
+    for (size_t c = 0; c < im->combo_count; c++)
+        keep_it |= im->combos[c].door[1] >= 0 && (im->combos[c].door[0] == (int)p || im->combos[c].door[1] == (int)p);
+    lbk_result r;
+    if (guided) {
+        /* S_O by the seed's guided estimator: no full run */
+        r = guided_open(&s->rc, d, s->texel_size, s->door_texel, s->rad, s->dir);
+        if (r) return r;
+    } else {
+        /* S_O = L(door p removed, others closed and black) − reference */
+        s->rc.keep = NULL;
+        snprintf(s->what, sizeof s->what, "door '%s' open", d->name);
+        r = run_without(&s->rc, d->name, NULL, &s->fixed, s->rad, s->dir, s->what);
+        if (r) return r;
+        if (keep_it) {
+            s->keep[p] = malloc(s->n * sizeof **s->keep), s->keep_dir[p] = malloc(s->n * sizeof **s->keep_dir);
+            if (!s->keep[p] || !s->keep_dir[p]) return out_of_memory(s);
+            memcpy(s->keep[p], s->rad, s->n * sizeof *s->rad);
+            memcpy(s->keep_dir[p], s->dir, s->n * sizeof *s->dir);
+        }
+        sh_sub(s->rad, s->ref, count);
+        sh_sub(s->dir, s->ref_dir, count);
+    }
+    r = emit(s, &s->im->sets[d->open_set], 1);
+    if (r) return r;
+
+    /* S_C = L(door p closed with its albedo, others black) − reference */
+    s->rc.keep = d->name;
+    snprintf(s->what, sizeof s->what, "door '%s' closed (bounce)", d->name);
+    r = run_one(&s->rc, s->in->scene, s->in->tracer, &s->fixed, s->rad, s->dir, s->what);
+    if (r) return r;
+    sh_sub(s->rad, s->ref, count);
+    sh_sub(s->dir, s->ref_dir, count);
+    return emit(s, &s->im->sets[d->closed_set], 1);
+}
+
+/* Doors A, B: S_AB = L(A, B open) − L(A open) − L(B open) + L(ref), into rad/dir. */
+static lbk_result bake_door_pair(set_run *s, const bs_combo *co)
+{
+    const bs_door *da = &s->im->doors[co->door[0]], *db = &s->im->doors[co->door[1]];
+    const size_t count = s->in->receiver_count;
+    s->rc.black_doors = 1;
+    s->rc.keep = NULL;
+    for (int m = 0; m < 2; m++) {
+        int p = co->door[m];
+        if (s->keep[p]) continue;
+        /* guided mode has no open run yet: the combination needs a correlated one */
+        s->keep[p] = malloc(s->n * sizeof **s->keep), s->keep_dir[p] = malloc(s->n * sizeof **s->keep_dir);
+        if (!s->keep[p] || !s->keep_dir[p]) return out_of_memory(s);
+        snprintf(s->what, sizeof s->what, "door '%s' open (for a combination)", s->im->doors[p].name);
+        lbk_result r = run_without(&s->rc, s->im->doors[p].name, NULL, &s->fixed, s->keep[p], s->keep_dir[p], s->what);
+        if (r) return r;
+    }
+    snprintf(s->what, sizeof s->what, "doors '%s' and '%s' open", da->name, db->name);
+    lbk_result r = run_without(&s->rc, da->name, db->name, &s->fixed, s->rad, s->dir, s->what);
+    if (r) return r;
+    sh_sub(s->rad, s->keep[co->door[0]], count);
+    sh_sub(s->rad, s->keep[co->door[1]], count);
+    sh_add(s->rad, s->ref, count);
+    sh_sub(s->dir, s->keep_dir[co->door[0]], count);
+    sh_sub(s->dir, s->keep_dir[co->door[1]], count);
+    sh_add(s->dir, s->ref_dir, count);
+    return LBK_OK;
+}
+
+/* Door A, light set X: S_AX = L_X(A open) − L_X(A closed) (the set's lights alone, other doors
+ * closed with their albedo, as the set's own bake), into rad/dir. */
+static lbk_result bake_door_light_set(set_run *s, const bs_combo *co)
+{
+    const bs_set *ls = &s->im->sets[co->light_set];
+    const bs_door *da = &s->im->doors[co->door[0]];
+    bk_transport_options opt = s->fixed;
+    opt.light_set = ls->name;
+    s->rc.black_doors = 0;
+    snprintf(s->what, sizeof s->what, "light set '%s', door '%s' open", ls->name, da->name);
+    lbk_result r = run_without(&s->rc, da->name, NULL, &opt, s->rad, s->dir, s->what);
+    if (r) return r;
+    snprintf(s->what, sizeof s->what, "light set '%s' (fixed budget)", ls->name);
+    if (!s->ls_closed) s->ls_closed = malloc(s->n * sizeof *s->ls_closed), s->ls_closed_dir = malloc(s->n * sizeof *s->ls_closed_dir);
+    if (!s->ls_closed || !s->ls_closed_dir) return out_of_memory(s);
+    r = run_one(&s->rc, s->in->scene, s->in->tracer, &opt, s->ls_closed, s->ls_closed_dir, s->what);
+    if (r) return r;
+    sh_sub(s->rad, s->ls_closed, s->in->receiver_count);
+    sh_sub(s->dir, s->ls_closed_dir, s->in->receiver_count);
+    return LBK_OK;
+}
+
+/* Combination states (seed §6.2) by inclusion–exclusion of correlated runs. With both open the
+ * runtime then shows base + S_A + S_B + S_AB = L(A, B open). Clamped like every difference
+ * (emit_set). */
+static lbk_result bake_combinations(set_run *s)
+{
+    for (size_t c = 0; c < s->im->combo_count; c++) {
+        const bs_combo *co = &s->im->combos[c];
+        lbk_result r;
+        if (co->door[1] >= 0) {
+            r = bake_door_pair(s, co);
+        } else {
+            if (s->im->sets[co->light_set].zero) continue; /* a black set: nothing to combine, no entries */
+            r = bake_door_light_set(s, co);
+        }
+        if (!r) r = emit(s, &s->im->sets[co->set], 1);
+        if (r) return r;
+    }
+    return LBK_OK;
+}
+
+static void set_run_free(set_run *s)
+{
+    if (s->keep)
+        for (size_t p = 0; p < s->im->door_count; p++) free(s->keep[p]), free(s->keep_dir[p]);
+    free(s->keep), free(s->keep_dir), free(s->texel_size), free(s->door_texel), free(s->ls_closed), free(s->ls_closed_dir);
+    free(s->rad), free(s->dir), free(s->ref), free(s->ref_dir);
+}
+
+lbk_result bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *err, size_t err_len)
 {
     bs_impl *im = sets->impl;
-    if (!im) return 0;
-    size_t n = in->receiver_count ? in->receiver_count : 1;
-    double fraction = in->threshold == 0 ? BS_DEFAULT_THRESHOLD : in->threshold < 0 ? 0 : in->threshold;
+    if (!im) return LBK_OK;
+    set_run s;
+    memset(&s, 0, sizeof s);
+    s.im = im;
+    s.in = in;
+    s.n = in->receiver_count ? in->receiver_count : 1;
+    s.fraction = in->threshold == 0 ? BS_DEFAULT_THRESHOLD : in->threshold < 0 ? 0 : in->threshold;
+    s.rc.in = in;
+    s.rc.err = err;
+    s.rc.err_len = err_len;
+    for (size_t j = 0; j < im->light_set_count; j++) s.rc.runs += !im->sets[j].zero;
+    s.rc.runs += im->door_count ? 1 + 2 * (int)im->door_count : 0;
+    for (size_t c = 0; c < im->combo_count; c++) s.rc.runs += im->combos[c].door[1] >= 0 ? 3 : 2;
     const int guided = in->door_method == BK_DOOR_GUIDED;
-    run_ctx rc;
-    memset(&rc, 0, sizeof rc);
-    rc.in = in;
-    for (size_t j = 0; j < im->light_set_count; j++) rc.runs += !im->sets[j].zero;
-    rc.runs += im->door_count ? 1 + 2 * (int)im->door_count : 0;
-    for (size_t c = 0; c < im->combo_count; c++) rc.runs += im->combos[c].door[1] >= 0 ? 3 : 2;
-    lbk_sh9_rgb *rad = malloc(n * sizeof *rad), *dir = malloc(n * sizeof *dir);
-    lbk_sh9_rgb *ref = NULL, *ref_dir = NULL;
-    lbk_sh9_rgb **keep = NULL, **keep_dir = NULL; /* open runs of doors in door–door combinations */
-    float *texel_size = NULL;
-    uint8_t *door_texel = NULL;
-    int code = 0;
-    char what[256];
-    lbk_sh9_rgb *ls_closed = NULL, *ls_closed_dir = NULL;
-    if (!rad || !dir) goto oom;
-
-    /* Light sets: their lights alone (transport leaves out the sky and every other emitter);
-     * doors stay closed with their albedo (seed §4.1: the other elements in their default
-     * state, here including the bounce off them). */
-    for (size_t j = 0; j < im->light_set_count; j++) {
-        bs_set *st = &im->sets[j];
-        if (st->zero) continue; /* no light: no entries and no run */
-        bk_transport_options opt = in->transport;
-        opt.light_set = st->name;
-        rc.black_doors = 0;
-        snprintf(what, sizeof what, "light set '%s'", st->name);
-        code = run_one(&rc, in->scene, in->tracer, &opt, rad, dir, what, err, err_len);
-        if (code) goto out;
-        if (emit_set(in, st, rad, dir, fraction, 0)) goto oom;
+    s.rad = malloc(s.n * sizeof *s.rad), s.dir = malloc(s.n * sizeof *s.dir);
+    lbk_result r = s.rad && s.dir ? LBK_OK : out_of_memory(&s);
+    if (!r) r = bake_light_sets(&s);
+    if (!r && im->door_count) {
+        r = bake_door_reference(&s, guided);
+        for (size_t p = 0; !r && p < im->door_count; p++) r = bake_door(&s, p, guided);
+        if (!r) r = bake_combinations(&s);
     }
-
-    if (im->door_count) {
-        /* Doors: differences of runs with the same seed and the same passes (a fixed budget
-         * equal to what the base reached, no error target, no time limit), so the receivers'
-         * gather rays are the same and most of the noise cancels. */
-        bk_transport_options fixed = in->transport;
-        fixed.light_set = NULL;
-        fixed.target_error = -1;
-        fixed.time_limit = 0;
-        if (in->base_samples_per_receiver > 0) fixed.max_samples = (int)fmin(in->base_samples_per_receiver, 1 << 24);
-        ref = malloc(n * sizeof *ref), ref_dir = malloc(n * sizeof *ref_dir);
-        keep = calloc(im->door_count, sizeof *keep);
-        keep_dir = calloc(im->door_count, sizeof *keep_dir);
-        if (!ref || !ref_dir || !keep || !keep_dir) goto oom;
-        if (guided) {
-            texel_size = calloc(in->texel_receivers ? in->texel_receivers : 1, sizeof *texel_size);
-            door_texel = calloc(in->texel_receivers ? in->texel_receivers : 1, 1);
-            if (!texel_size || !door_texel) goto oom;
-            for (size_t k = 0; k < in->texel_receivers; k++) {
-                texel_size[k] = in->texels->receivers[in->texel_of_receiver[k]].texel_size;
-                door_texel[k] = (uint8_t)is_door_texel(in, k);
-            }
-        }
-        /* reference: every door closed with albedo 0, the base's path space (seed §4.1) */
-        rc.black_doors = 1;
-        rc.keep = NULL;
-        code = run_one(&rc, in->scene, in->tracer, &fixed, ref, ref_dir, "doors closed, black (reference)", err, err_len);
-        if (code) goto out;
-        for (size_t p = 0; p < im->door_count; p++) {
-            bs_door *d = &im->doors[p];
-            int keep_it = 0;
-            for (size_t c = 0; c < im->combo_count; c++)
-                keep_it |= im->combos[c].door[1] >= 0 && (im->combos[c].door[0] == (int)p || im->combos[c].door[1] == (int)p);
-            if (guided) {
-                /* S_O by the seed's guided estimator: no full run */
-                code = guided_open(&rc, d, texel_size, door_texel, rad, dir, err, err_len);
-                if (code) goto out;
-            } else {
-                /* S_O = L(door p removed, others closed and black) − reference */
-                rc.keep = NULL;
-                snprintf(what, sizeof what, "door '%s' open", d->name);
-                code = run_without(&rc, d->name, NULL, &fixed, rad, dir, what, err, err_len);
-                if (code) goto out;
-                if (keep_it) {
-                    keep[p] = malloc(n * sizeof **keep), keep_dir[p] = malloc(n * sizeof **keep_dir);
-                    if (!keep[p] || !keep_dir[p]) goto oom;
-                    memcpy(keep[p], rad, n * sizeof *rad);
-                    memcpy(keep_dir[p], dir, n * sizeof *dir);
-                }
-                sh_sub(rad, ref, in->receiver_count);
-                sh_sub(dir, ref_dir, in->receiver_count);
-            }
-            if (emit_set(in, &im->sets[d->open_set], rad, dir, fraction, 1)) goto oom;
-
-            /* S_C = L(door p closed with its albedo, others black) − reference */
-            rc.keep = d->name;
-            snprintf(what, sizeof what, "door '%s' closed (bounce)", d->name);
-            code = run_one(&rc, in->scene, in->tracer, &fixed, rad, dir, what, err, err_len);
-            if (code) goto out;
-            sh_sub(rad, ref, in->receiver_count);
-            sh_sub(dir, ref_dir, in->receiver_count);
-            if (emit_set(in, &im->sets[d->closed_set], rad, dir, fraction, 1)) goto oom;
-        }
-
-        /* Combination states (seed §6.2) by inclusion–exclusion of correlated runs:
-         *   doors A, B:        S_AB = L(A, B open) − L(A open) − L(B open) + L(ref);
-         *   door A, light set: S_AX = L_X(A open) − L_X(A closed) (the set's lights alone, other
-         *                      doors closed with their albedo, as the set's own bake).
-         * With both open the runtime then shows base + S_A + S_B + S_AB = L(A, B open). Clamped
-         * like every difference (emit_set). */
-        for (size_t c = 0; c < im->combo_count; c++) {
-            const bs_combo *co = &im->combos[c];
-            bs_set *st = &im->sets[co->set];
-            const bs_door *da = &im->doors[co->door[0]];
-            if (co->door[1] >= 0) {
-                const bs_door *db = &im->doors[co->door[1]];
-                rc.black_doors = 1;
-                rc.keep = NULL;
-                for (int m = 0; m < 2; m++) {
-                    int p = co->door[m];
-                    if (keep[p]) continue;
-                    /* guided mode has no open run yet: the combination needs a correlated one */
-                    keep[p] = malloc(n * sizeof **keep), keep_dir[p] = malloc(n * sizeof **keep_dir);
-                    if (!keep[p] || !keep_dir[p]) goto oom;
-                    snprintf(what, sizeof what, "door '%s' open (for a combination)", im->doors[p].name);
-                    code = run_without(&rc, im->doors[p].name, NULL, &fixed, keep[p], keep_dir[p], what, err, err_len);
-                    if (code) goto out;
-                }
-                snprintf(what, sizeof what, "doors '%s' and '%s' open", da->name, db->name);
-                code = run_without(&rc, da->name, db->name, &fixed, rad, dir, what, err, err_len);
-                if (code) goto out;
-                sh_sub(rad, keep[co->door[0]], in->receiver_count);
-                sh_sub(rad, keep[co->door[1]], in->receiver_count);
-                sh_add(rad, ref, in->receiver_count);
-                sh_sub(dir, keep_dir[co->door[0]], in->receiver_count);
-                sh_sub(dir, keep_dir[co->door[1]], in->receiver_count);
-                sh_add(dir, ref_dir, in->receiver_count);
-            } else {
-                const bs_set *ls = &im->sets[co->light_set];
-                if (ls->zero) continue; /* a black set: nothing to combine, no entries */
-                bk_transport_options opt = fixed;
-                opt.light_set = ls->name;
-                rc.black_doors = 0;
-                snprintf(what, sizeof what, "light set '%s', door '%s' open", ls->name, da->name);
-                code = run_without(&rc, da->name, NULL, &opt, rad, dir, what, err, err_len);
-                if (code) goto out;
-                snprintf(what, sizeof what, "light set '%s' (fixed budget)", ls->name);
-                if (!ls_closed) ls_closed = malloc(n * sizeof *ls_closed), ls_closed_dir = malloc(n * sizeof *ls_closed_dir);
-                if (!ls_closed || !ls_closed_dir) goto oom;
-                code = run_one(&rc, in->scene, in->tracer, &opt, ls_closed, ls_closed_dir, what, err, err_len);
-                if (code) goto out;
-                sh_sub(rad, ls_closed, in->receiver_count);
-                sh_sub(dir, ls_closed_dir, in->receiver_count);
-            }
-            if (emit_set(in, st, rad, dir, fraction, 1)) goto oom;
-        }
-    }
-    goto out;
-oom:
-    snprintf(err, err_len, "out of memory");
-    code = LBK_EXIT_INTERNAL;
-out:
-    if (keep)
-        for (size_t p = 0; p < im->door_count; p++) free(keep[p]), free(keep_dir[p]);
-    free(keep), free(keep_dir), free(texel_size), free(door_texel), free(ls_closed), free(ls_closed_dir);
-    free(rad), free(dir), free(ref), free(ref_dir);
-    return code;
+    set_run_free(&s);
+    return r;
 }
 
 /* ---- sections -------------------------------------------------------------------------- */
@@ -915,33 +1021,18 @@ void bk_set_bakes_max(const bk_set_bakes *sets, double max[LBK_DLS_SPACE_COUNT_]
     }
 }
 
-lbk_result bk_set_bakes_sections(bk_set_bakes *sets, const bk_set_inputs *in, void **dls, size_t *dls_size,
-                                 void **door, size_t *door_size)
+/* Every set's entries as DLS payloads, enc[set · spaces + space] (malloc'ed), stored in the
+ * scale of the target space's base section (spec §12.2; dividing by a power of two is exact). */
+static lbk_result encode_payloads(const bs_impl *im, const bk_set_inputs *in, uint8_t **enc)
 {
-    *dls = *door = NULL;
-    *dls_size = *door_size = 0;
-    bs_impl *im = sets->impl;
-    if (!im || !im->set_count) return LBK_OK;
-    lbk_dls_set_desc *sd = calloc(im->set_count, sizeof *sd);
-    uint8_t **enc = calloc(im->set_count * LBK_DLS_SPACE_COUNT_, sizeof *enc); /* encoded payloads */
-    if (!sd || !enc) {
-        free(sd), free(enc);
-        return LBK_ERR_OUT_OF_MEMORY;
-    }
-    lbk_result r = LBK_OK;
-    for (size_t j = 0; j < im->set_count && !r; j++)
-        for (int s = 0; s < LBK_DLS_SPACE_COUNT_ && !r; s++) {
+    for (size_t j = 0; j < im->set_count; j++)
+        for (int s = 0; s < LBK_DLS_SPACE_COUNT_; s++) {
             const bs_set *st = &im->sets[j];
             const size_t n = st->count[s];
             if (!n) continue;
             const size_t stride = s == LBK_DLS_SPACE_TEXEL ? LBK_DLS_TEXEL_PAYLOAD : LBK_DLS_PROBE_PAYLOAD;
             uint8_t *e = enc[j * LBK_DLS_SPACE_COUNT_ + (size_t)s] = malloc(n * stride);
-            if (!e) {
-                r = LBK_ERR_OUT_OF_MEMORY;
-                break;
-            }
-            /* stored in the scale of the target space's base section (spec §12.2); dividing by a
-             * power of two is exact */
+            if (!e) return LBK_ERR_OUT_OF_MEMORY;
             const float inv = 1.0f / (in->scale[s] > 0 ? in->scale[s] : 1.0f);
             for (size_t i = 0; i < n; i++) {
                 if (s == LBK_DLS_SPACE_TEXEL) {
@@ -950,7 +1041,7 @@ lbk_result bk_set_bakes_sections(bk_set_bakes *sets, const bk_set_inputs *in, vo
                     lbk_ahd_linear_add_scaled(&l, (const lbk_ahd_linear *)st->values[s] + i, inv);
                     lbk_ahd_texel t;
                     lbk_ahd_from_linear(&l, &t);
-                    lbk_ahd_texel_store(&t, e + stride * i);
+                    lbk_ahd_texel_pack(&t, e + stride * i);
                 } else {
                     lbk_sh9_rgb sh;
                     memset(&sh, 0, sizeof sh);
@@ -959,6 +1050,13 @@ lbk_result bk_set_bakes_sections(bk_set_bakes *sets, const bk_set_inputs *in, vo
                 }
             }
         }
+    return LBK_OK;
+}
+
+static lbk_result build_dls(const bs_impl *im, const bk_set_inputs *in, uint8_t *const *enc, void **dls, size_t *dls_size)
+{
+    lbk_dls_set_desc *sd = calloc(im->set_count, sizeof *sd);
+    if (!sd) return LBK_ERR_OUT_OF_MEMORY;
     for (size_t j = 0; j < im->set_count; j++) {
         const bs_set *st = &im->sets[j];
         sd[j].name = st->name;
@@ -973,8 +1071,7 @@ lbk_result bk_set_bakes_sections(bk_set_bakes *sets, const bk_set_inputs *in, vo
             sd[j].entries[s].payloads = enc[j * LBK_DLS_SPACE_COUNT_ + (size_t)s];
         }
     }
-    lbk_dls_build_desc bd;
-    memset(&bd, 0, sizeof bd);
+    lbk_dls_build_desc bd = LBK_DLS_BUILD_DESC_INIT;
     bd.set_count = (uint32_t)im->set_count;
     bd.sets = sd;
     const bk_texels *tx = in->texels;
@@ -982,49 +1079,63 @@ lbk_result bk_set_bakes_sections(bk_set_bakes *sets, const bk_set_inputs *in, vo
         tx && tx->page_count && in->texel_receivers ? (uint64_t)tx->page_offset[tx->page_count] : 0;
     bd.target_count[LBK_DLS_SPACE_GLG] = in->glg_count;
     bd.target_count[LBK_DLS_SPACE_LLG] = in->llg_count;
-    if (!r) r = lbk_dls_build(&bd, NULL, dls, dls_size, NULL);
-    for (size_t i = 0; i < im->set_count * LBK_DLS_SPACE_COUNT_; i++) free(enc[i]);
-    free(enc), free(sd);
-    if (r || !im->door_count) return r;
+    lbk_result r = lbk_dls_build(&bd, NULL, dls, dls_size, NULL);
+    free(sd);
+    return r;
+}
+
+/* The DOOR section: each door's box (in world space) and sets, and the combination states. */
+static lbk_result build_door(const bs_impl *im, const bk_set_inputs *in, void **door, size_t *door_size)
+{
+    size_t nc = im->combo_count ? im->combo_count : 1;
     lbk_door_desc *dd = calloc(im->door_count, sizeof *dd);
-    if (!dd) {
-        lbk_free(NULL, *dls);
-        *dls = NULL;
-        return LBK_ERR_OUT_OF_MEMORY;
+    lbk_door_state_desc *states = calloc(nc, sizeof *states);
+    uint32_t *state_doors = calloc(2 * nc, sizeof *state_doors);
+    lbk_result r = LBK_ERR_OUT_OF_MEMORY;
+    if (dd && states && state_doors) {
+        for (size_t p = 0; p < im->door_count; p++) {
+            const bs_door *d = &im->doors[p];
+            dd[p].name = d->name;
+            for (int k = 0; k < 3; k++) dd[p].centre[k] = d->centre[k] + in->origin[k];
+            memcpy(dd[p].axes, d->axes, sizeof d->axes);
+            memcpy(dd[p].half_extents, d->half, sizeof d->half);
+            dd[p].open_set = d->open_set;
+            dd[p].closed_set = d->closed_set;
+        }
+        for (size_t c = 0; c < im->combo_count; c++) {
+            const bs_combo *co = &im->combos[c];
+            state_doors[2 * c] = (uint32_t)co->door[0];
+            state_doors[2 * c + 1] = (uint32_t)co->door[1];
+            states[c].door_count = co->door[1] >= 0 ? 2 : 1;
+            states[c].doors = &state_doors[2 * c];
+            states[c].set = co->set;
+        }
+        lbk_door_build_desc db = LBK_DOOR_BUILD_DESC_INIT;
+        db.door_count = (uint32_t)im->door_count;
+        db.doors = dd;
+        db.state_count = (uint32_t)im->combo_count;
+        db.states = states;
+        r = lbk_door_build(&db, NULL, door, door_size);
     }
-    for (size_t p = 0; p < im->door_count; p++) {
-        const bs_door *d = &im->doors[p];
-        dd[p].name = d->name;
-        for (int k = 0; k < 3; k++) dd[p].centre[k] = d->centre[k] + in->origin[k];
-        memcpy(dd[p].axes, d->axes, sizeof d->axes);
-        memcpy(dd[p].half_extents, d->half, sizeof d->half);
-        dd[p].open_set = d->open_set;
-        dd[p].closed_set = d->closed_set;
-    }
-    lbk_door_state_desc *states = calloc(im->combo_count ? im->combo_count : 1, sizeof *states);
-    uint32_t *state_doors = calloc(2 * (im->combo_count ? im->combo_count : 1), sizeof *state_doors);
-    if (!states || !state_doors) {
-        free(dd), free(states), free(state_doors);
-        lbk_free(NULL, *dls);
-        *dls = NULL;
-        return LBK_ERR_OUT_OF_MEMORY;
-    }
-    for (size_t c = 0; c < im->combo_count; c++) {
-        const bs_combo *co = &im->combos[c];
-        state_doors[2 * c] = (uint32_t)co->door[0];
-        state_doors[2 * c + 1] = (uint32_t)co->door[1];
-        states[c].door_count = co->door[1] >= 0 ? 2 : 1;
-        states[c].doors = &state_doors[2 * c];
-        states[c].set = co->set;
-    }
-    lbk_door_build_desc db;
-    memset(&db, 0, sizeof db);
-    db.door_count = (uint32_t)im->door_count;
-    db.doors = dd;
-    db.state_count = (uint32_t)im->combo_count;
-    db.states = states;
-    r = lbk_door_build(&db, NULL, door, door_size);
     free(dd), free(states), free(state_doors);
+    return r;
+}
+
+lbk_result bk_set_bakes_sections(bk_set_bakes *sets, const bk_set_inputs *in, void **dls, size_t *dls_size,
+                                 void **door, size_t *door_size)
+{
+    *dls = *door = NULL;
+    *dls_size = *door_size = 0;
+    bs_impl *im = sets->impl;
+    if (!im || !im->set_count) return LBK_OK;
+    uint8_t **enc = calloc(im->set_count * LBK_DLS_SPACE_COUNT_, sizeof *enc); /* encoded payloads */
+    if (!enc) return LBK_ERR_OUT_OF_MEMORY;
+    lbk_result r = encode_payloads(im, in, enc);
+    if (!r) r = build_dls(im, in, enc, dls, dls_size);
+    for (size_t i = 0; i < im->set_count * LBK_DLS_SPACE_COUNT_; i++) free(enc[i]);
+    free(enc);
+    if (r || !im->door_count) return r;
+    r = build_door(im, in, door, door_size);
     if (r) {
         lbk_free(NULL, *dls);
         *dls = NULL;

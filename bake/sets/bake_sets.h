@@ -9,9 +9,10 @@
 #include <stdint.h>
 
 #include "bake/probes/llg_place.h"
-#include "bake/util/progress.h"
 #include "bake/scene/scene.h"
+#include "bake/layout/seams.h"
 #include "bake/layout/texels.h"
+#include "bake/util/events.h"
 #include "bake/transport/tracer.h"
 #include "bake/transport/transport.h"
 #include "lbk/sh.h"
@@ -42,13 +43,14 @@ typedef struct bk_set_inputs {
     const uint32_t *texel_of_receiver;/* receiver → index in texels->receivers */
     const bk_texels *texels;          /* page layout: DLS texel index = page_offset[page] + y·w + x */
     int atlas_margin;                 /* dilation passes for set pages */
+    const bk_seams *seams;            /* stitched like the base pages (bk_finish_page); NULL: not */
     const lbk_sh9_rgb *base_radiance; /* the base bake, per receiver */
     bk_transport_options transport;   /* the base bake's options (seed, threads, budgets) */
     double base_samples_per_receiver; /* what the base bake reached: door bakes use this budget */
     double threshold;                 /* sparse storage: fraction of the mean indirect light of the
                                          texels a set lights directly (bake/sets/SETS.md); 0: 0.01;
                                          < 0: store every receiver with a non-zero contribution */
-    bk_progress *progress;
+    const bk_events *events;          /* messages, progress over all set runs, cancellation */
     int door_method;                  /* enum bk_door_method */
     float origin[3];                  /* the bake frame's origin in world space: add it to every
                                          position written (the scene is recentred, bake.c) */
@@ -59,9 +61,9 @@ typedef struct bk_set_inputs {
 /* Finds light sets (lights and emissive objects with lbk_light_set), doors (lbk_door) and the
  * combination states the scene asks for (bk_scene.combinations; input errors for unknown names,
  * two light sets, or a door paired with itself).
- * Returns 0 or an LBK_EXIT_* code with a message in err. */
-int bk_set_bakes_prepare(bk_set_bakes *sets, const bk_scene *scene, bk_progress *progress, char *err,
-                         size_t err_len);
+ * Returns LBK_OK, LBK_ERR_BAD_INPUT or LBK_ERR_OUT_OF_MEMORY with a message in err. */
+lbk_result bk_set_bakes_prepare(bk_set_bakes *sets, const bk_scene *scene, const bk_events *events, char *err,
+                                size_t err_len);
 /* Sets what the base bake must leave out: the sets' lights (transport's light_set filter does
  * that already) and doors' reflection (albedo 0 in the base, seed §4.1). Returns 1 when the
  * base run needs an albedo hook that calls bk_set_bakes_base_albedo (the caller owns the
@@ -69,8 +71,9 @@ int bk_set_bakes_prepare(bk_set_bakes *sets, const bk_scene *scene, bk_progress 
 int bk_set_bakes_base_hooks(bk_set_bakes *sets, const bk_scene *scene, bk_transport_options *base);
 /* The base bake's albedo rule: 0 on door triangles. */
 void bk_set_bakes_base_albedo(const bk_set_bakes *sets, const bk_scene *scene, uint32_t tri, float albedo[3]);
-/* Bakes every set's contribution at the receivers. 0 or an LBK_EXIT_* code. */
-int bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *err, size_t err_len);
+/* Bakes every set's contribution at the receivers. LBK_OK, LBK_ERR_CANCELLED (in->events said
+ * stop), or LBK_ERR_OUT_OF_MEMORY / LBK_ERR_INTERNAL with a message in err. */
+lbk_result bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *err, size_t err_len);
 /* Largest value of any set's entries per DLS space (texels: irradiance along the normal; probes:
  * SH DC), for choosing the base sections' scales. */
 void bk_set_bakes_max(const bk_set_bakes *sets, double max[3]);

@@ -1,14 +1,13 @@
 /* The guided door estimator; see door_guided.h and bake/sets/SETS.md. */
 #include "bake/sets/door_guided.h"
 
+#include "bake/util/clock.h"
 #include "bake/util/parallel.h"
 #include "bake/transport/shading.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
-#include <unistd.h>
 
 #define DG_PI 3.14159265358979323846
 
@@ -111,17 +110,10 @@ static void acc_store(const dg_ctx *c, size_t i, const dg_acc *a)
 
 /* ---- the cache: nearest texel receiver with a compatible normal ------------------------------- */
 
-static uint64_t mix64(uint64_t z)
-{
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
 static uint64_t cell_key(int64_t x, int64_t y, int64_t z)
 {
-    return mix64((uint64_t)x * 0x9E3779B97F4A7C15ull ^ mix64((uint64_t)y + 0x632BE59BD9B4E019ull) ^
-                 mix64(mix64((uint64_t)z) + 0x85157AF5ull));
+    return bk_mix64((uint64_t)x * BK_GOLDEN64 ^ bk_mix64((uint64_t)y + 0x632BE59BD9B4E019ull) ^
+                    bk_mix64(bk_mix64((uint64_t)z) + 0x85157AF5ull));
 }
 
 typedef struct key_idx { uint64_t key; uint32_t texel; } key_idx;
@@ -329,10 +321,10 @@ static void stage0(dg_ctx *c, size_t begin, size_t end, int thread)
             int want = (int)ceil(c->S * sqrt(om / (2 * DG_PI)));
             want = want < 8 ? 8 : want > c->S ? c->S : want;
             int side = (int)ceil(sqrt((double)want)), N = side * side;
-            bk_door_rng rng = bk_door_rng_make(c->in->seed, DOM_STAGE0, 0, i);
+            bk_rng rng = bk_door_rng_make(c->in->seed, DOM_STAGE0, 0, i);
             for (int j = 0; j < N; j++) {
-                double pa = ((j % side) + bk_door_rng_next(&rng)) / side;
-                double pb = ((j / side) + bk_door_rng_next(&rng)) / side;
+                double pa = ((j % side) + bk_rng_next(&rng)) / side;
+                double pb = ((j / side) + bk_rng_next(&rng)) / side;
                 double d[3], w, L[3], Ld[3];
                 if (!portal_sample(c, r.o, r.n, r.sphere, pa, pb, d, &w, L, Ld, &rays)) continue;
                 if (!bk_finite3(L)) continue;
@@ -350,7 +342,7 @@ static void stage0(dg_ctx *c, size_t begin, size_t end, int thread)
 
 /* Door-direct radiance leaving the surface a gather ray hit (seed §4.2): the punctual lights of
  * the box the point lies in (direct light culling) and one portal sample. */
-static void door_bounce(const dg_ctx *c, const dg_surf *s, bk_door_rng *rng, double L[3], uint64_t *rays)
+static void door_bounce(const dg_ctx *c, const dg_surf *s, bk_rng *rng, double L[3], uint64_t *rays)
 {
     L[0] = L[1] = L[2] = 0;
     if (s->albedo[0] <= 0 && s->albedo[1] <= 0 && s->albedo[2] <= 0) return;
@@ -366,7 +358,7 @@ static void door_bounce(const dg_ctx *c, const dg_surf *s, bk_door_rng *rng, dou
         }
     }
     double d[3], w, Lp[3], Ld[3];
-    double pa = bk_door_rng_next(rng), pb = bk_door_rng_next(rng);
+    double pa = bk_rng_next(rng), pb = bk_rng_next(rng);
     if (portal_sample(c, s->yo, s->n, 0, pa, pb, d, &w, Lp, Ld, rays) && bk_finite3(Lp)) {
         double cs = dot3(d, s->n);
         for (int a = 0; a < 3; a++) e[a] += Lp[a] * w * cs;
@@ -392,8 +384,8 @@ static void stage1(dg_ctx *c, size_t begin, size_t end, int thread)
         dg_acc a;
         memset(&a, 0, sizeof a);
         const double pu = r.sphere ? 1 / (4 * DG_PI) : 1 / (2 * DG_PI);
-        bk_door_rng rng = bk_door_rng_make(c->in->seed, DOM_STAGE1, 0, i);
-        double s1 = bk_door_rng_next(&rng), s2 = bk_door_rng_next(&rng);
+        bk_rng rng = bk_door_rng_make(c->in->seed, DOM_STAGE1, 0, i);
+        double s1 = bk_rng_next(&rng), s2 = bk_rng_next(&rng);
         for (int j = 0; j < Nu + Ng; j++) {
             double d[3];
             if (j < Nu) {
@@ -401,7 +393,7 @@ static void stage1(dg_ctx *c, size_t begin, size_t end, int thread)
                 double u1 = (double)j / Nu + s1, u2 = (double)j * 0.6180339887498949 + s2;
                 uniform_dir(&r, u1 - floor(u1), u2 - floor(u2), d);
             } else {
-                double g0 = bk_door_rng_next(&rng), g1 = bk_door_rng_next(&rng), g2 = bk_door_rng_next(&rng);
+                double g0 = bk_rng_next(&rng), g1 = bk_rng_next(&rng), g2 = bk_rng_next(&rng);
                 if (!bk_guide_sample(c->boxes, r.p, g0, g1, g2, d)) continue;
                 if (!r.sphere && !(dot3(d, r.n) > 0)) continue; /* below the horizon: contributes 0 */
             }
@@ -435,8 +427,8 @@ static void stage_bounce(dg_ctx *c, size_t begin, size_t end, int thread)
         dg_acc a;
         memset(&a, 0, sizeof a);
         const double w = (r.sphere ? 4 * DG_PI : 2 * DG_PI) / N;
-        bk_door_rng rng = bk_door_rng_make(c->in->seed, DOM_BOUNCE, (uint64_t)c->bounce, i);
-        double s1 = bk_door_rng_next(&rng), s2 = bk_door_rng_next(&rng);
+        bk_rng rng = bk_door_rng_make(c->in->seed, DOM_BOUNCE, (uint64_t)c->bounce, i);
+        double s1 = bk_rng_next(&rng), s2 = bk_rng_next(&rng);
         for (int j = 0; j < N; j++) {
             double d[3], u1 = (double)j / N + s1, u2 = (double)j * 0.6180339887498949 + s2;
             uniform_dir(&r, u1 - floor(u1), u2 - floor(u2), d);
@@ -474,12 +466,6 @@ static void parallel_for(dg_ctx *c, size_t n, dg_fn fn)
     bk_parallel_chunks(0, n, 16, c->threads, dg_call_run, &k);
 }
 
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-}
 
 /* ---- the run ------------------------------------------------------------------------------------ */
 
@@ -501,10 +487,144 @@ static double texel_energy(const dg_ctx *c)
     return s;
 }
 
+/* The run's buffers, the base lights (those in no light set) and the base irradiance of every
+ * texel receiver (the cache the first bounce gathers against). */
+static lbk_result ctx_setup(dg_ctx *c, const bk_door_guided_inputs *in, int want_direct)
+{
+    size_t n = in->receiver_count, nt = in->texel_receivers;
+    c->in = in;
+    c->S = in->samples > 0 ? in->samples : 64;
+    c->threads = bk_thread_count(in->threads);
+    for (size_t i = 0; i < in->scene->tri_count; i++) {
+        float sc = bk_tracer_tri_scale(in->tracer, (uint32_t)i);
+        if (sc > c->scene_scale) c->scene_scale = sc;
+    }
+    c->lights = malloc((in->scene->light_count ? in->scene->light_count : 1) * sizeof *c->lights);
+    c->base_e = calloc(3 * (nt ? nt : 1), sizeof(float));
+    c->prev_e = calloc(3 * (nt ? nt : 1), sizeof(float));
+    c->cur_e = calloc(3 * (n ? n : 1), sizeof(float));
+    c->stage_sh = calloc(n ? n : 1, sizeof *c->stage_sh);
+    c->stage_direct = want_direct ? calloc(n ? n : 1, sizeof *c->stage_direct) : NULL;
+    c->thread_rays = calloc((size_t)c->threads, sizeof *c->thread_rays);
+    c->thread_portal = calloc((size_t)c->threads, sizeof *c->thread_portal);
+    c->thread_portal_n = calloc((size_t)c->threads, sizeof *c->thread_portal_n);
+    if (!c->lights || !c->base_e || !c->prev_e || !c->cur_e || !c->stage_sh || (want_direct && !c->stage_direct) ||
+        !c->thread_rays || !c->thread_portal || !c->thread_portal_n)
+        return LBK_ERR_OUT_OF_MEMORY;
+    for (size_t i = 0; i < in->scene->light_count; i++)
+        if (!in->scene->lights[i].light_set[0]) c->lights[c->nl++] = (uint32_t)i;
+    for (size_t i = 0; i < nt; i++) {
+        const float *nf = in->receivers[i].normal;
+        double nn[3] = {nf[0], nf[1], nf[2]}, e[3];
+        sh_irradiance(&in->base_radiance[i], nn, e);
+        for (int k = 0; k < 3; k++) c->base_e[3 * i + k] = (float)e[k];
+    }
+    return grid_build(c);
+}
+
+static void ctx_free(dg_ctx *c)
+{
+    free(c->lights), free(c->base_e), free(c->prev_e), free(c->cur_e), free(c->stage_sh), free(c->stage_direct);
+    free(c->thread_rays), free(c->thread_portal), free(c->thread_portal_n);
+    free(c->grid.keys), free(c->grid.texel);
+}
+
+/* The guide boxes (seed §4.2): the caller's, or shadow photons shot from the portal clustered
+ * into `own`. *photons gets how many were shot. */
+static lbk_result guide_boxes(dg_ctx *c, bk_guide_boxes *own, size_t *photons)
+{
+    const bk_door_guided_inputs *in = c->in;
+    *photons = 0;
+    if (in->boxes) {
+        c->boxes = in->boxes;
+        return LBK_OK;
+    }
+    bk_photon_options po;
+    memset(&po, 0, sizeof po);
+    po.seed = in->seed;
+    po.count = in->photons;
+    po.use_sky = in->use_sky;
+    bk_photon *ph = NULL;
+    lbk_result res = bk_shoot_shadow_photons(in->scene, in->tracer, &in->portal, &po, &ph, photons);
+    if (res == LBK_OK) {
+        double diag = 2 * sqrt(in->portal.hu * in->portal.hu + in->portal.hv * in->portal.hv);
+        res = bk_cluster_photons(ph, *photons, BK_GUIDE_MAX_BOXES, 0.1, 0.05 * diag, own);
+    }
+    free(ph);
+    if (res == LBK_OK) c->boxes = own;
+    return res;
+}
+
+/* Stage 0 (door-direct light: portal samples) and stage 1 (the first bounce off it: half
+ * uniform, half guided gathers; all uniform without boxes). Returns stage 1's texel energy. */
+static double direct_and_first_bounce(dg_ctx *c, lbk_sh9_rgb *radiance, lbk_sh9_rgb *direct, bk_door_guided_stats *st)
+{
+    size_t n = c->in->receiver_count;
+    c->stage = 0;
+    parallel_for(c, n, stage0);
+    add_stage(c, radiance, direct, 1.0);
+    st->stage_energy[0] = texel_energy(c);
+    if (c->stage_direct) {
+        free(c->stage_direct);
+        c->stage_direct = NULL;
+    }
+    c->Ng = c->boxes->count > 0 ? c->S / 2 : 0;
+    c->Nu = c->S - c->Ng;
+    c->stage = 1;
+    parallel_for(c, n, stage1);
+    add_stage(c, radiance, NULL, 1.0);
+    st->stage_energy[1] = texel_energy(c);
+    st->bounces = 1;
+    return st->stage_energy[1];
+}
+
+/* Stages 2+: uniform gathers of the previous bounce at the texels until a bounce adds under
+ * 1 % of the total, then the rest of the series shaped like the last bounce (ratio q). */
+static void later_bounces(dg_ctx *c, lbk_sh9_rgb *radiance, double p_prev, bk_door_guided_stats *st)
+{
+    size_t n = c->in->receiver_count, nt = c->in->texel_receivers;
+    double total = st->stage_energy[0] + p_prev;
+    int max_b = c->in->max_bounces > 0 ? c->in->max_bounces : 4;
+    /* later bounces are smooth: a quarter of the budget each */
+    c->Nb = c->S / 4 > 8 ? c->S / 4 : 8;
+    double q = 0, rest = 0;
+    for (int k = 2; k <= max_b + 1 && p_prev > 0; k++) {
+        memcpy(c->prev_e, c->cur_e, 3 * nt * sizeof(float));
+        c->bounce = k;
+        parallel_for(c, n, stage_bounce);
+        add_stage(c, radiance, NULL, 1.0);
+        double p = texel_energy(c);
+        q = p_prev > 0 ? p / p_prev : 0;
+        rest += p;
+        total += p;
+        p_prev = p;
+        st->bounces = k;
+        if (!(p > 1e-2 * total)) break;
+    }
+    q = q < 0 ? 0 : q > 0.95 ? 0.95 : q;
+    if (st->bounces >= 2 && q > 0) {
+        add_stage(c, radiance, NULL, q / (1 - q));
+        rest += p_prev * q / (1 - q);
+    }
+    st->q = q;
+    st->stage_energy[2] = rest;
+}
+
+static void sum_thread_counters(const dg_ctx *c, bk_door_guided_stats *st)
+{
+    for (int t = 0; t < c->threads; t++) {
+        st->rays += c->thread_rays[t];
+        st->portal_samples += c->thread_portal[t];
+    }
+    uint64_t seen = 0;
+    for (int t = 0; t < c->threads; t++) seen += c->thread_portal_n[t];
+    st->portal_samples = seen ? st->portal_samples / (double)seen : 0;
+}
+
 lbk_result bk_door_guided_run(const bk_door_guided_inputs *in, lbk_sh9_rgb *radiance, lbk_sh9_rgb *direct,
                               bk_door_guided_stats *stats, bk_guide_boxes *boxes_out)
 {
-    double t0 = now_seconds();
+    double t0 = bk_now();
     bk_door_guided_stats st;
     memset(&st, 0, sizeof st);
     if (boxes_out) memset(boxes_out, 0, sizeof *boxes_out);
@@ -516,126 +636,22 @@ lbk_result bk_door_guided_run(const bk_door_guided_inputs *in, lbk_sh9_rgb *radi
     if (direct) memset(direct, 0, n * sizeof *direct);
     dg_ctx c;
     memset(&c, 0, sizeof c);
-    c.in = in;
-    c.S = in->samples > 0 ? in->samples : 64;
-    long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    c.threads = in->threads > 0 ? in->threads : (int)(cores < 1 ? 1 : cores > 256 ? 256 : cores);
-    for (size_t i = 0; i < in->scene->tri_count; i++) {
-        float sc = bk_tracer_tri_scale(in->tracer, (uint32_t)i);
-        if (sc > c.scene_scale) c.scene_scale = sc;
-    }
-    lbk_result res = LBK_OK;
     bk_guide_boxes own;
     memset(&own, 0, sizeof own);
-    bk_photon *ph = NULL;
-    size_t nph = 0;
-    size_t nt = in->texel_receivers;
-    c.lights = malloc((in->scene->light_count ? in->scene->light_count : 1) * sizeof *c.lights);
-    c.base_e = calloc(3 * (nt ? nt : 1), sizeof(float));
-    c.prev_e = calloc(3 * (nt ? nt : 1), sizeof(float));
-    c.cur_e = calloc(3 * (n ? n : 1), sizeof(float));
-    c.stage_sh = calloc(n ? n : 1, sizeof *c.stage_sh);
-    c.stage_direct = direct ? calloc(n ? n : 1, sizeof *c.stage_direct) : NULL;
-    c.thread_rays = calloc((size_t)c.threads, sizeof *c.thread_rays);
-    c.thread_portal = calloc((size_t)c.threads, sizeof *c.thread_portal);
-    c.thread_portal_n = calloc((size_t)c.threads, sizeof *c.thread_portal_n);
-    if (!c.lights || !c.base_e || !c.prev_e || !c.cur_e || !c.stage_sh || (direct && !c.stage_direct) ||
-        !c.thread_rays || !c.thread_portal || !c.thread_portal_n) {
-        res = LBK_ERR_OUT_OF_MEMORY;
-        goto done;
-    }
-    for (size_t i = 0; i < in->scene->light_count; i++)
-        if (!in->scene->lights[i].light_set[0]) c.lights[c.nl++] = (uint32_t)i;
-    for (size_t i = 0; i < nt; i++) {
-        const float *nf = in->receivers[i].normal;
-        double nn[3] = {nf[0], nf[1], nf[2]}, e[3];
-        sh_irradiance(&in->base_radiance[i], nn, e);
-        for (int k = 0; k < 3; k++) c.base_e[3 * i + k] = (float)e[k];
-    }
-    res = grid_build(&c);
-    if (res) goto done;
-
-    /* photons → boxes (seed §4.2) */
-    if (in->boxes) {
-        c.boxes = in->boxes;
-    } else {
-        bk_photon_options po;
-        memset(&po, 0, sizeof po);
-        po.seed = in->seed;
-        po.count = in->photons;
-        po.use_sky = in->use_sky;
-        res = bk_shoot_shadow_photons(in->scene, in->tracer, &in->portal, &po, &ph, &nph);
-        if (res) goto done;
-        double diag = 2 * sqrt(in->portal.hu * in->portal.hu + in->portal.hv * in->portal.hv);
-        res = bk_cluster_photons(ph, nph, BK_GUIDE_MAX_BOXES, 0.1, 0.05 * diag, &own);
-        if (res) goto done;
-        c.boxes = &own;
-    }
-    st.photons = nph;
-    st.boxes = c.boxes->count;
-
-    /* stage 0 */
-    c.stage = 0;
-    parallel_for(&c, n, stage0);
-    add_stage(&c, radiance, direct, 1.0);
-    st.stage_energy[0] = texel_energy(&c);
-    /* stage 1: half uniform, half guided (all uniform without boxes) */
-    if (c.stage_direct) {
-        free(c.stage_direct);
-        c.stage_direct = NULL;
-    }
-    c.Ng = c.boxes->count > 0 ? c.S / 2 : 0;
-    c.Nu = c.S - c.Ng;
-    c.stage = 1;
-    parallel_for(&c, n, stage1);
-    add_stage(&c, radiance, NULL, 1.0);
-    double p_prev = texel_energy(&c), total = st.stage_energy[0] + p_prev;
-    st.stage_energy[1] = p_prev;
-    st.bounces = 1;
-    /* stages 2+: uniform gathers of the previous bounce at the texels */
-    int max_b = in->max_bounces > 0 ? in->max_bounces : 4;
-    /* later bounces are smooth: a quarter of the budget each */
-    c.Nb = c.S / 4 > 8 ? c.S / 4 : 8;
-    double q = 0, rest = 0;
-    for (int k = 2; k <= max_b + 1 && p_prev > 0; k++) {
-        memcpy(c.prev_e, c.cur_e, 3 * nt * sizeof(float));
-        c.bounce = k;
-        parallel_for(&c, n, stage_bounce);
-        add_stage(&c, radiance, NULL, 1.0);
-        double p = texel_energy(&c);
-        q = p_prev > 0 ? p / p_prev : 0;
-        rest += p;
-        total += p;
-        p_prev = p;
-        st.bounces = k;
-        if (!(p > 1e-2 * total)) break;
-    }
-    /* the rest of the series, shaped like the last bounce */
-    q = q < 0 ? 0 : q > 0.95 ? 0.95 : q;
-    if (st.bounces >= 2 && q > 0) {
-        add_stage(&c, radiance, NULL, q / (1 - q));
-        rest += p_prev * q / (1 - q);
-    }
-    st.q = q;
-    st.stage_energy[2] = rest;
-    for (int t = 0; t < c.threads; t++) {
-        st.rays += c.thread_rays[t];
-        st.portal_samples += c.thread_portal[t];
-    }
-    uint64_t seen = 0;
-    for (int t = 0; t < c.threads; t++) seen += c.thread_portal_n[t];
-    st.portal_samples = seen ? st.portal_samples / (double)seen : 0;
-done:
-    if (!res && boxes_out && c.boxes == &own) {
-        *boxes_out = own;
-        memset(&own, 0, sizeof own);
+    lbk_result res = ctx_setup(&c, in, direct != NULL);
+    if (res == LBK_OK) res = guide_boxes(&c, &own, &st.photons);
+    if (res == LBK_OK) {
+        st.boxes = c.boxes->count;
+        later_bounces(&c, radiance, direct_and_first_bounce(&c, radiance, direct, &st), &st);
+        sum_thread_counters(&c, &st);
+        if (boxes_out && c.boxes == &own) {
+            *boxes_out = own;
+            memset(&own, 0, sizeof own);
+        }
     }
     bk_guide_boxes_free(&own);
-    free(ph);
-    free(c.lights), free(c.base_e), free(c.prev_e), free(c.cur_e), free(c.stage_sh), free(c.stage_direct);
-    free(c.thread_rays), free(c.thread_portal), free(c.thread_portal_n);
-    free(c.grid.keys), free(c.grid.texel);
-    st.seconds = now_seconds() - t0;
+    ctx_free(&c);
+    st.seconds = bk_now() - t0;
     if (stats) *stats = st;
     return res;
 }

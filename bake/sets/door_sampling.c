@@ -12,26 +12,11 @@
 
 /* ---- random numbers ------------------------------------------------------------------------ */
 
-static uint64_t mix64(uint64_t z)
-{
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
+#define DS_RNG_SALT 0x646F6F7273616D70ull /* "doorsamp": door streams differ from the transport's */
 
-bk_door_rng bk_door_rng_make(uint64_t seed, uint64_t domain, uint64_t a, uint64_t b)
+bk_rng bk_door_rng_make(uint64_t seed, uint64_t domain, uint64_t a, uint64_t b)
 {
-    uint64_t h = mix64(seed ^ 0x646F6F7273616D70ull);
-    h = mix64(h ^ (domain << 48) ^ a);
-    h = mix64(h ^ b * 0x9E3779B97F4A7C15ull);
-    bk_door_rng r = {h};
-    return r;
-}
-
-double bk_door_rng_next(bk_door_rng *r)
-{
-    r->s += 0x9E3779B97F4A7C15ull;
-    return (double)(mix64(r->s) >> 11) * (1.0 / 9007199254740992.0);
+    return bk_rng_stream(seed, DS_RNG_SALT, (domain << 48) ^ a, b);
 }
 
 /* ---- small vector helpers ------------------------------------------------------------------ */
@@ -238,14 +223,14 @@ lbk_result bk_shoot_shadow_photons(const bk_scene *scene, const bk_tracer *trace
     size_t sources = nl + (size_t)sky + (em.count ? 1 : 0);
     size_t k = 0;
     for (size_t i = 0; i < count && sources; i++) {
-        bk_door_rng rng = bk_door_rng_make(opt->seed, 7, 0, i);
+        bk_rng rng = bk_door_rng_make(opt->seed, 7, 0, i);
         /* stratified over the portal: a jittered grid of about √count × √count cells */
         size_t side = (size_t)ceil(sqrt((double)count));
-        double a = ((double)(i % side) + bk_door_rng_next(&rng)) / (double)side;
-        double b = ((double)((i / side) % side) + bk_door_rng_next(&rng)) / (double)side;
+        double a = ((double)(i % side) + bk_rng_next(&rng)) / (double)side;
+        double b = ((double)((i / side) % side) + bk_rng_next(&rng)) / (double)side;
         double q[3];
         bk_portal_point(portal, a, b, q);
-        size_t pick = (size_t)(bk_door_rng_next(&rng) * (double)sources);
+        size_t pick = (size_t)(bk_rng_next(&rng) * (double)sources);
         if (pick >= sources) pick = sources - 1;
         float qf[3] = {(float)q[0], (float)q[1], (float)q[2]};
         double scale = (double)sources * portal->area / (double)count; /* 1 / (p_source · p_point · N) */
@@ -258,7 +243,7 @@ lbk_result bk_shoot_shadow_photons(const bk_scene *scene, const bk_tracer *trace
             if (land(scene, tracer, q, back, w, lights[pick], &ph[k])) k++;
         } else if (pick == nl && sky) {
             /* a uniform direction on the sphere, the sky seen along it */
-            double z = 1 - 2 * bk_door_rng_next(&rng), phi = 2 * DS_PI * bk_door_rng_next(&rng);
+            double z = 1 - 2 * bk_rng_next(&rng), phi = 2 * DS_PI * bk_rng_next(&rng);
             double rr = sqrt(fmax(0, 1 - z * z)), d[3] = {rr * cos(phi), rr * sin(phi), z};
             float df[3] = {(float)d[0], (float)d[1], (float)d[2]};
             if (bk_tracer_occluded(tracer, qf, df, 0.0f, INFINITY)) continue;
@@ -268,7 +253,7 @@ lbk_result bk_shoot_shadow_photons(const bk_scene *scene, const bk_tracer *trace
             float w = (float)(bk_lum(L) * fabs(dot3(d, portal->n)) * 4 * DS_PI * scale);
             if (land(scene, tracer, q, back, w, BK_SOURCE_SKY, &ph[k])) k++;
         } else {
-            double u = bk_door_rng_next(&rng);
+            double u = bk_rng_next(&rng);
             size_t lo = 0, hi = em.count - 1;
             while (lo < hi) {
                 size_t mid = lo + (hi - lo) / 2;
@@ -277,7 +262,7 @@ lbk_result bk_shoot_shadow_photons(const bk_scene *scene, const bk_tracer *trace
             }
             uint32_t tri = em.tri[lo];
             double x[3], bu, bv, alb[3], le[3];
-            tri_point(scene, tri, bk_door_rng_next(&rng), bk_door_rng_next(&rng), x, &bu, &bv);
+            tri_point(scene, tri, bk_rng_next(&rng), bk_rng_next(&rng), x, &bu, &bv);
             bk_door_surface(scene, tri, bu, bv, set, alb, le);
             double dv[3] = {x[0] - q[0], x[1] - q[1], x[2] - q[2]}, dist = len3(dv);
             if (!(dist > 0)) continue;
@@ -320,22 +305,11 @@ static int cmp_u32(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-lbk_result bk_cluster_photons(const bk_photon *ph, size_t n, int max_boxes, double inflate_rel, double inflate_abs,
-                              bk_guide_boxes *out)
+/* Deterministic k-means++-like seeding: the heaviest photon, then repeatedly the one with the
+ * largest w·D² (D: distance to the nearest centre so far). Returns the number of centres, less
+ * than K when every photon already sits on one. */
+static int seed_centres(const bk_photon *ph, size_t n, int K, double c[][3], double *dmin)
 {
-    memset(out, 0, sizeof *out);
-    if (max_boxes > BK_GUIDE_MAX_BOXES) max_boxes = BK_GUIDE_MAX_BOXES;
-    if (!n || max_boxes <= 0) return LBK_OK;
-    int K = (size_t)max_boxes < n ? max_boxes : (int)n;
-    double c[BK_GUIDE_MAX_BOXES][3];
-    int *as = malloc(n * sizeof *as);
-    double *dmin = malloc(n * sizeof *dmin);
-    uint32_t *tmp = malloc(n * sizeof *tmp);
-    if (!as || !dmin || !tmp) {
-        free(as), free(dmin), free(tmp);
-        return LBK_ERR_OUT_OF_MEMORY;
-    }
-    /* deterministic start: the heaviest photon, then repeatedly the one with the largest w·D² */
     size_t best = 0;
     for (size_t i = 1; i < n; i++)
         if (ph[i].w > ph[best].w) best = i;
@@ -354,8 +328,13 @@ lbk_result bk_cluster_photons(const bk_photon *ph, size_t n, int max_boxes, doub
             if (d < dmin[i]) dmin[i] = d;
         }
     }
-    K = used;
-    /* weighted Lloyd iterations */
+    return used;
+}
+
+/* Weighted Lloyd iterations (at most 16, until no photon changes cluster); as[i] gets photon
+ * i's cluster. */
+static void lloyd_iterations(const bk_photon *ph, size_t n, int K, double c[][3], int *as)
+{
     for (int it = 0; it < 16; it++) {
         double acc[BK_GUIDE_MAX_BOXES][4];
         memset(acc, 0, sizeof acc);
@@ -378,74 +357,110 @@ lbk_result bk_cluster_photons(const bk_photon *ph, size_t n, int max_boxes, doub
                 for (int a = 0; a < 3; a++) c[k][a] = acc[k][a] / acc[k][3];
         if (!moved) break;
     }
-    /* boxes: extents, weights, light lists */
+}
+
+/* The inflated box of cluster k: extent, weight, photon count, and its distinct lights sorted
+ * into lights[0..*light_count); sky and emitter photons set bits of *source_mask instead.
+ * 0 when the cluster has no weight or the box no area (no box then). */
+static int cluster_box(const bk_photon *ph, size_t n, const int *as, int k, double inflate_rel, double inflate_abs,
+                       bk_guide_box *box, uint32_t *lights, size_t *light_count, uint32_t *source_mask)
+{
+    bk_guide_box b;
+    memset(&b, 0, sizeof b);
+    for (int a = 0; a < 3; a++) b.lo[a] = INFINITY, b.hi[a] = -INFINITY;
+    size_t nl = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (as[i] != k) continue;
+        for (int a = 0; a < 3; a++) b.lo[a] = fmin(b.lo[a], ph[i].p[a]), b.hi[a] = fmax(b.hi[a], ph[i].p[a]);
+        b.weight += ph[i].w;
+        b.photons++;
+        if (ph[i].source == BK_SOURCE_SKY) *source_mask |= 1u;
+        else if (ph[i].source == BK_SOURCE_EMITTERS) *source_mask |= 2u;
+        else lights[nl++] = ph[i].source;
+    }
+    if (!b.photons || !(b.weight > 0)) return 0;
+    qsort(lights, nl, sizeof *lights, cmp_u32);
+    size_t u = 0;
+    for (size_t i = 0; i < nl; i++)
+        if (!u || lights[i] != lights[u - 1]) lights[u++] = lights[i];
+    double ext = 0;
+    for (int a = 0; a < 3; a++) ext = fmax(ext, b.hi[a] - b.lo[a]);
+    double m = inflate_rel * ext + inflate_abs;
+    for (int a = 0; a < 3; a++) b.lo[a] -= m, b.hi[a] += m;
+    double e[3] = {b.hi[0] - b.lo[0], b.hi[1] - b.lo[1], b.hi[2] - b.lo[2]};
+    b.area = 2 * (e[0] * e[1] + e[1] * e[2] + e[2] * e[0]);
+    if (!(b.area > 0)) return 0;
+    b.light_count = (uint32_t)u;
+    *box = b;
+    *light_count = u;
+    return 1;
+}
+
+/* The nb boxes into out heaviest first (stable: ties keep cluster order), their light lists
+ * concatenated into out->lights. */
+static lbk_result store_boxes(const bk_guide_box *boxes, uint32_t *const *lists, int nb, size_t total_lights,
+                              bk_guide_boxes *out)
+{
+    int order[BK_GUIDE_MAX_BOXES];
+    for (int i = 0; i < nb; i++) order[i] = i;
+    for (int i = 1; i < nb; i++)
+        for (int j = i; j > 0 && boxes[order[j]].weight > boxes[order[j - 1]].weight; j--) {
+            int t = order[j];
+            order[j] = order[j - 1];
+            order[j - 1] = t;
+        }
+    out->lights = malloc((total_lights ? total_lights : 1) * sizeof *out->lights);
+    if (!out->lights) return LBK_ERR_OUT_OF_MEMORY;
+    size_t w = 0;
+    for (int i = 0; i < nb; i++) {
+        bk_guide_box b = boxes[order[i]];
+        b.light_first = (uint32_t)w;
+        memcpy(out->lights + w, lists[order[i]], b.light_count * sizeof(uint32_t));
+        w += b.light_count;
+        out->box[i] = b;
+        out->weight_sum += b.weight;
+    }
+    out->count = nb;
+    out->light_total = w;
+    return LBK_OK;
+}
+
+lbk_result bk_cluster_photons(const bk_photon *ph, size_t n, int max_boxes, double inflate_rel, double inflate_abs,
+                              bk_guide_boxes *out)
+{
+    memset(out, 0, sizeof *out);
+    if (max_boxes > BK_GUIDE_MAX_BOXES) max_boxes = BK_GUIDE_MAX_BOXES;
+    if (!n || max_boxes <= 0) return LBK_OK;
+    int K = (size_t)max_boxes < n ? max_boxes : (int)n;
+    double c[BK_GUIDE_MAX_BOXES][3];
+    int *as = malloc(n * sizeof *as);
+    double *dmin = malloc(n * sizeof *dmin);
+    uint32_t *tmp = malloc(n * sizeof *tmp);
+    if (!as || !dmin || !tmp) {
+        free(as), free(dmin), free(tmp);
+        return LBK_ERR_OUT_OF_MEMORY;
+    }
+    K = seed_centres(ph, n, K, c, dmin);
+    lloyd_iterations(ph, n, K, c, as);
     bk_guide_box boxes[BK_GUIDE_MAX_BOXES];
-    size_t total_lights = 0;
     uint32_t *lists[BK_GUIDE_MAX_BOXES];
-    memset(lists, 0, sizeof lists);
+    size_t total_lights = 0;
     int nb = 0;
     lbk_result res = LBK_OK;
     for (int k = 0; k < K; k++) {
-        bk_guide_box b;
-        memset(&b, 0, sizeof b);
-        for (int a = 0; a < 3; a++) b.lo[a] = INFINITY, b.hi[a] = -INFINITY;
-        size_t nl = 0;
-        for (size_t i = 0; i < n; i++) {
-            if (as[i] != k) continue;
-            for (int a = 0; a < 3; a++) b.lo[a] = fmin(b.lo[a], ph[i].p[a]), b.hi[a] = fmax(b.hi[a], ph[i].p[a]);
-            b.weight += ph[i].w;
-            b.photons++;
-            if (ph[i].source == BK_SOURCE_SKY) out->source_mask |= 1u;
-            else if (ph[i].source == BK_SOURCE_EMITTERS) out->source_mask |= 2u;
-            else tmp[nl++] = ph[i].source;
-        }
-        if (!b.photons || !(b.weight > 0)) continue;
-        qsort(tmp, nl, sizeof *tmp, cmp_u32);
-        size_t u = 0;
-        for (size_t i = 0; i < nl; i++)
-            if (!u || tmp[i] != tmp[u - 1]) tmp[u++] = tmp[i];
-        double ext = 0;
-        for (int a = 0; a < 3; a++) ext = fmax(ext, b.hi[a] - b.lo[a]);
-        double m = inflate_rel * ext + inflate_abs;
-        for (int a = 0; a < 3; a++) b.lo[a] -= m, b.hi[a] += m;
-        double e[3] = {b.hi[0] - b.lo[0], b.hi[1] - b.lo[1], b.hi[2] - b.lo[2]};
-        b.area = 2 * (e[0] * e[1] + e[1] * e[2] + e[2] * e[0]);
-        if (!(b.area > 0)) continue;
-        lists[nb] = malloc((u ? u : 1) * sizeof(uint32_t));
+        size_t nl;
+        if (!cluster_box(ph, n, as, k, inflate_rel, inflate_abs, &boxes[nb], tmp, &nl, &out->source_mask)) continue;
+        lists[nb] = malloc((nl ? nl : 1) * sizeof(uint32_t));
         if (!lists[nb]) {
             res = LBK_ERR_OUT_OF_MEMORY;
             break;
         }
-        memcpy(lists[nb], tmp, u * sizeof(uint32_t));
-        b.light_count = (uint32_t)u;
-        total_lights += u;
-        boxes[nb++] = b;
+        memcpy(lists[nb], tmp, nl * sizeof(uint32_t));
+        total_lights += nl;
+        nb++;
     }
     free(as), free(dmin), free(tmp);
-    if (!res) {
-        /* heaviest first (stable: ties keep cluster order) */
-        int order[BK_GUIDE_MAX_BOXES];
-        for (int i = 0; i < nb; i++) order[i] = i;
-        for (int i = 1; i < nb; i++)
-            for (int j = i; j > 0 && boxes[order[j]].weight > boxes[order[j - 1]].weight; j--) {
-                int t = order[j];
-                order[j] = order[j - 1];
-                order[j - 1] = t;
-            }
-        out->lights = malloc((total_lights ? total_lights : 1) * sizeof *out->lights);
-        if (!out->lights) res = LBK_ERR_OUT_OF_MEMORY;
-        size_t w = 0;
-        for (int i = 0; i < nb && !res; i++) {
-            bk_guide_box b = boxes[order[i]];
-            b.light_first = (uint32_t)w;
-            memcpy(out->lights + w, lists[order[i]], b.light_count * sizeof(uint32_t));
-            w += b.light_count;
-            out->box[i] = b;
-            out->weight_sum += b.weight;
-        }
-        out->count = res ? 0 : nb;
-        out->light_total = w;
-    }
+    if (res == LBK_OK) res = store_boxes(boxes, lists, nb, total_lights, out);
     for (int i = 0; i < nb; i++) free(lists[i]);
     return res;
 }

@@ -13,6 +13,7 @@
 #include "lbk/lbk.h"
 #include "bake/scene/scene.h"
 #include "bake/transport/tracer.h"
+#include "bake/util/rng.h"
 
 #define BK_GUIDE_MAX_BOXES 12 /* the seed's count */
 
@@ -37,10 +38,9 @@ double bk_portal_solid_angle(const bk_portal *p, const double x[3]);
 
 /* ---- scene lookups shared by the door estimator ------------------------------------------ */
 
-/* Counter-based random numbers: a stream per (seed, domain, item), independent of threads. */
-typedef struct bk_door_rng { uint64_t s; } bk_door_rng;
-bk_door_rng bk_door_rng_make(uint64_t seed, uint64_t domain, uint64_t a, uint64_t b);
-double bk_door_rng_next(bk_door_rng *r);
+/* The door estimator's stream for (seed, domain, a, item b) (bake/util/rng.h; draw with
+ * bk_rng_next), independent of threads. */
+bk_rng bk_door_rng_make(uint64_t seed, uint64_t domain, uint64_t a, uint64_t b);
 
 /* Punctual lights and the sky are evaluated by bake/transport/shading.h (bk_light_eval, bk_sky_radiance),
  * the very functions the transport uses, so both estimators see the same lights. */

@@ -1067,7 +1067,7 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
             if (chain[h].bounces < 0) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
             if (opt->progress) {
                 double f = fmax(spp / max_samples, opt->time_limit > 0 ? (now_seconds() - t0) / opt->time_limit : 0);
-                opt->progress(opt->user, "cache", f > 1 ? 1 : f);
+                if (opt->progress(opt->user, "cache", f > 1 ? 1 : f)) { res = LBK_ERR_CANCELLED; goto done; }
             }
         }
         /* final gather at the receivers, in blocks so progress can be reported */
@@ -1082,7 +1082,7 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
             if (opt->progress) {
                 double f = fmax((spp + 2.0 * c.rays * (double)e / (double)(count ? count : 1)) / max_samples,
                                 opt->time_limit > 0 ? (now_seconds() - t0) / opt->time_limit : 0);
-                opt->progress(opt->user, "gather", f > 1 ? 1 : f);
+                if (opt->progress(opt->user, "gather", f > 1 ? 1 : f)) { res = LBK_ERR_CANCELLED; goto done; }
             }
         }
         weight_sum += c.pass_weight;

@@ -68,8 +68,10 @@ typedef struct bk_transport_options {
     /* Called once per cache cell with the triangle's textured albedo; may change it (e.g. 0 for
      * doors in base bakes). Must be deterministic. NULL: none. */
     void (*albedo_hook)(void *user, uint32_t tri, float albedo[3]);
-    /* phase is "cache" or "gather"; fraction is the estimated fraction of the whole run. */
-    void (*progress)(void *user, const char *phase, double fraction);
+    /* phase is "cache" or "gather"; fraction is the estimated fraction of the whole run.
+     * Called on the calling thread after each cache chain and each block of receivers; a
+     * non-zero return stops the run with LBK_ERR_CANCELLED (outputs then undefined). */
+    int (*progress)(void *user, const char *phase, double fraction);
     void (*report)(void *user, const bk_transport_sample *sample);
     void *user;
 } bk_transport_options;
@@ -103,7 +105,8 @@ typedef struct bk_transport_stats {
 
 /* Computes radiance at `count` receivers. The tracer must have been built from `scene`.
  * Errors: LBK_ERR_INVALID_ARGUMENT (NULL scene/tracer/output->radiance with count > 0, tracer
- * over another triangle count, non-finite receiver), LBK_ERR_OUT_OF_MEMORY. */
+ * over another triangle count, non-finite receiver), LBK_ERR_OUT_OF_MEMORY, LBK_ERR_CANCELLED (the
+ * progress callback said stop). */
 lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, const bk_receiver *receivers,
                             size_t count, const bk_transport_options *options,
                             const bk_transport_output *output, bk_transport_stats *stats);

@@ -3,6 +3,19 @@
 
 #include <pthread.h>
 #include <stdatomic.h>
+#include <unistd.h>
+
+int bk_online_cores(void)
+{
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n < 1 ? 1 : n > BK_MAX_THREADS ? BK_MAX_THREADS : (int)n;
+}
+
+int bk_thread_count(int requested)
+{
+    if (requested <= 0) return bk_online_cores();
+    return requested > BK_MAX_THREADS ? BK_MAX_THREADS : requested;
+}
 
 typedef struct pl_job {
     bk_chunk_fn fn;
@@ -36,10 +49,10 @@ void bk_parallel_chunks(size_t begin, size_t end, size_t chunk, int threads, bk_
     int t = threads;
     if ((size_t)t > (n + job.chunk - 1) / job.chunk) t = (int)((n + job.chunk - 1) / job.chunk);
     if (t < 1) t = 1;
-    pthread_t tids[256];
-    pl_worker ws[256];
+    pthread_t tids[BK_MAX_THREADS];
+    pl_worker ws[BK_MAX_THREADS];
     int started = 0;
-    for (int i = 1; i < t && i < 256; i++) {
+    for (int i = 1; i < t && i < BK_MAX_THREADS; i++) {
         ws[i].job = &job; ws[i].thread = i;
         if (pthread_create(&tids[i], NULL, worker_main, &ws[i]) != 0) break;
         started = i;

@@ -7,7 +7,8 @@
  * rebuilds the baker's layout (import → classify → atlas → texels → push-out, the same calls
  * and options as bake/pipeline/bake.c do_layout) to get each texel's world sample point and
  * normal, checks that the layout matches the file (pages, page sizes, every lightmapped
- * object's rectangle), and reads the lighting from the file with liblbk: the AHD texel decoded
+ * object's rectangle, and the LMUV section rebuilt from it equal to the file's byte for byte:
+ * the page coordinate of every lightmapped vertex), and reads the lighting from the file with liblbk: the AHD texel decoded
  * along the normal (lbk_lmap_page_irradiance, tangent-space +Z) times the section's scale =
  * the irradiance (lux) a runtime would shade with. LLG objects (props lit by a local light grid)
  * are measured at up to N of their vertices (lbk_llg_vertex_irradiance: grid SH × self-
@@ -15,7 +16,8 @@
  *
  * Output (tab-separated; '#' lines are the header):
  *   # key value            scene, lbk, est_rel_rmse (the bake's own estimate, REPT last
- *                          record), spp, passes, status, lmap_scale, sensor_offset
+ *                          record), spp, passes, status, lmap_scale, lmuv_checked (LMUV
+ *                          records found equal; 0: the file has none), sensor_offset
  *   # object IDX REP NAME  REP = lightmap | llg | none (OBJS order = scene order)
  *   # material IDX NAME
  *   kind obj mat page x y  px py pz  nx ny nz  size  Er Eg Eb  flags
@@ -42,6 +44,10 @@
  * invisible too, and its value is a convention (the baker may light the moved point or, with
  * footprint sampling, its own covered surface); run.py leaves it out as well (counted).
  *
+ * The lighting comes through the public API only (liblbk's readers). The sample points do not:
+ * where the baker put a texel's sample (the nearest point for edge and ring texels, the push-out
+ * from behind walls) is in no section, so the layout is rebuilt with the current pipeline's
+ * internals (bake/pipeline/bake.c do_layout: the same calls, options and preset table).
  * It links the baker's internals (like bench_transport.c) but writes nothing the baker reads;
  * the layout it rebuilds must come from the same source tree as the lbk that baked the file
  * (the checks above fail loudly otherwise). */
@@ -53,11 +59,14 @@
 #include "bake/layout/atlas.h"
 #include "bake/layout/classify.h"
 #include "bake/layout/texels.h"
+#include "bake/pipeline/pipeline.h"
+#include "bake/pipeline/uv_section.h"
 #include "bake/scene/import.h"
 #include "bake/scene/scene.h"
 #include "bake/transport/tracer.h"
 #include "lbk/container.h"
 #include "lbk/lightmap.h"
+#include "lbk/lightmap_uv.h"
 #include "lbk/llg.h"
 #include "lbk/objects.h"
 #include "lbk/report.h"
@@ -65,8 +74,13 @@
 #define DUMP_HIDDEN 0x100u
 #define DUMP_OFFPLANE 0x200u
 
-/* The presets' texel densities (bake/pipeline/bake.c `presets`). */
-static float preset_density(const char *preset) { return preset && !strcmp(preset, "high") ? 16.0f : 8.0f; }
+/* The preset's texel density, from the pipeline's own table (bake/pipeline/bake.c); 0: unknown. */
+static float preset_density(const char *preset)
+{
+    for (int i = 0; i < LBK_BAKE_PRESET_COUNT_; i++)
+        if (preset && !strcmp(preset, bk_presets[i].name)) return bk_presets[i].texel_density;
+    return 0;
+}
 
 typedef struct dump {
     bk_scene scene;
@@ -80,6 +94,7 @@ typedef struct dump {
     int have_lmap;
     lbk_llg_view llg;
     int have_llg;
+    uint32_t lmuv_checked; /* LMUV records found equal to the rebuilt layout's */
 } dump;
 
 static int die(const char *msg, const char *detail)
@@ -118,6 +133,7 @@ static int build_layout(dump *d, const char *scene_path, const char *preset, flo
     bk_atlas_options ao;
     memset(&ao, 0, sizeof ao);
     ao.default_density = preset_density(preset);
+    if (!(ao.default_density > 0)) return die("unknown preset", preset);
     ao.density_override = density > 0 ? density : 0;
     if (n_lm && bk_atlas_build(s, lightmapped, &ao, &d->atlas)) return die("atlas failed", NULL);
     free(lightmapped);
@@ -136,7 +152,7 @@ static int open_bake(dump *d, const char *lbk_path)
     if (lbk_reader_open_file(lbk_path, NULL, &d->reader)) return die("cannot open", lbk_path);
     const void *data;
     size_t size;
-    if (lbk_reader_section_by_type(d->reader, LBK_SECTION_OBJS, &data, &size) || lbk_objects_parse(data, size, &d->objs))
+    if (lbk_reader_section_by_type(d->reader, LBK_SECTION_OBJS, &data, &size) || lbk_objects_open(data, size, &d->objs))
         return die("no readable OBJS section", lbk_path);
     if (lbk_reader_section_by_type(d->reader, LBK_SECTION_LMAP, &data, &size) == LBK_OK) {
         if (lbk_lmap_open(data, size, &d->lmap)) return die("unreadable LMAP section", lbk_path);
@@ -149,8 +165,29 @@ static int open_bake(dump *d, const char *lbk_path)
     return 0;
 }
 
+/* The LMUV section (spec §16: every lightmapped vertex's page coordinate, the coordinates the
+ * texels were rasterised with) built from the rebuilt atlas must be the file's byte for byte:
+ * the strongest check that a texel (page, x, y) here is the file's texel (page, x, y). A file
+ * without LMUV (a 1.0 bake) is checked by the rectangles alone. */
+static int check_lmuv(dump *d)
+{
+    const void *data;
+    size_t size;
+    if (lbk_reader_section_by_type(d->reader, LBK_SECTION_LMUV, &data, &size) != LBK_OK) return 0;
+    lbk_lmuv_view v;
+    if (lbk_lmuv_open(data, size, &v)) return die("unreadable LMUV section", NULL);
+    void *mine = NULL;
+    size_t mine_size = 0;
+    if (bk_uv_section_build(&d->scene, &d->atlas, d->classes, &mine, &mine_size)) return die("LMUV rebuild failed", NULL);
+    int same = mine && mine_size == size && !memcmp(mine, data, size);
+    lbk_free(NULL, mine);
+    if (!same) return die("the rebuilt lightmap coordinates (LMUV) differ from the file's (layout from another source tree?)", NULL);
+    d->lmuv_checked = v.record_count;
+    return 0;
+}
+
 /* The rebuilt layout must be the one the file was baked with. */
-static int check_layout(const dump *d)
+static int check_layout(dump *d)
 {
     const bk_scene *s = &d->scene;
     if (d->objs.count != s->object_count) return die("OBJS has another object count than the scene", NULL);
@@ -159,7 +196,7 @@ static int check_layout(const dump *d)
         if (d->lmap.page_count != d->texels.page_count) return die("page count differs from the file", NULL);
         for (uint32_t p = 0; p < d->lmap.page_count; p++) {
             lbk_lmap_page pg;
-            if (lbk_lmap_get_page(&d->lmap, p, &pg)) return die("bad LMAP page", NULL);
+            if (lbk_lmap_page_get(&d->lmap, p, &pg)) return die("bad LMAP page", NULL);
             if ((int)pg.width != d->texels.pages[p].width || (int)pg.height != d->texels.pages[p].height)
                 return die("page size differs from the file (layout from another source tree?)", NULL);
         }
@@ -177,7 +214,7 @@ static int check_layout(const dump *d)
             o.rect_w != (uint32_t)ao->w || o.rect_h != (uint32_t)ao->h)
             return die("an object's lightmap rectangle differs from the file", s->objects[i].name);
     }
-    return 0;
+    return check_lmuv(d);
 }
 
 static double sensor_offset(const bk_scene *s)
@@ -194,14 +231,15 @@ static void write_header(const dump *d, FILE *f, const char *scene_path, const c
     size_t size;
     lbk_report_view rv;
     lbk_reader *r = d->reader;
-    if (lbk_reader_section_by_type(r, LBK_SECTION_REPT, &data, &size) == LBK_OK && lbk_report_parse(data, size, &rv) == LBK_OK &&
+    if (lbk_reader_section_by_type(r, LBK_SECTION_REPT, &data, &size) == LBK_OK && lbk_report_open(data, size, &rv) == LBK_OK &&
         rv.header.record_count > 0) {
         lbk_report_record last;
-        if (lbk_report_record_at(&rv, rv.header.record_count - 1, &last) == LBK_OK)
+        if (lbk_report_record_get(&rv, rv.header.record_count - 1, &last) == LBK_OK)
             fprintf(f, "# est_rel_rmse %.6g\n# spp %u\n# passes %u\n# status %s\n", (double)last.texel_rel_rmse,
                     last.samples_per_texel, rv.header.record_count, lbk_bake_status_name(rv.header.status));
     }
     if (d->have_lmap) fprintf(f, "# lmap_scale %.9g\n", (double)d->lmap.scale);
+    fprintf(f, "# lmuv_checked %u\n", d->lmuv_checked);
     fprintf(f, "# sensor_offset %.9g\n", sensor_offset(&d->scene));
     for (uint32_t i = 0; i < d->objs.count; i++) {
         lbk_object o;
@@ -268,7 +306,7 @@ static int write_texels(const dump *d, FILE *f)
         lbk_lmap_page pg;
         float rgb[3];
         const float up[3] = {0, 0, 1}; /* tangent-space normal: the texel's own shading normal */
-        if (lbk_lmap_get_page(&d->lmap, t->page, &pg) || lbk_lmap_page_irradiance(&pg, t->x, t->y, up, rgb))
+        if (lbk_lmap_page_get(&d->lmap, t->page, &pg) || lbk_lmap_page_irradiance(&pg, t->x, t->y, up, rgb))
             return die("texel outside its page", NULL);
         uint32_t mat = d->scene.tri_material ? d->scene.tri_material[t->tri] : 0;
         double p[3] = {t->position[0], t->position[1], t->position[2]};
@@ -307,7 +345,7 @@ static int write_llg_vertices(const dump *d, FILE *f, uint32_t max_per_object)
         for (size_t k = 0; k < nc; k++)
             if (k == 0 || v[k] != v[k - 1]) v[n++] = v[k];
         lbk_llg_grid g;
-        if (lbk_llg_get_grid(&d->llg, o.index, &g) || g.vertex_count != n) {
+        if (lbk_llg_grid_get(&d->llg, o.index, &g) || g.vertex_count != n) {
             free(v);
             return die("an LLG's vertex count differs from the scene object", ob->name);
         }

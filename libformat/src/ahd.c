@@ -75,14 +75,14 @@ void lbk_ahd_from_linear(const lbk_ahd_linear *lin, lbk_ahd_texel *out)
         lum_a += (double)lum_w[c] * a[c];
         lum_ez += (double)lum_w[c] * ez[c];
     }
-    out->irradiance_z = lbk_pack_r11g11b10f(ez);
+    out->irradiance_z = lbk_r11g11b10f_pack(ez);
     out->rgba[0] = lum_ez > 0.0 ? lbk_float_to_unorm8((float)(lum_a / lum_ez)) : 255;
 }
 
 void lbk_ahd_to_linear(const lbk_ahd_texel *texel, lbk_ahd_linear *out)
 {
     float ez[3], d[3];
-    lbk_unpack_r11g11b10f(texel->irradiance_z, ez);
+    lbk_r11g11b10f_unpack(texel->irradiance_z, ez);
     decode_direction(texel->rgba, d);
     const float r = lbk_unorm8_to_float(texel->rgba[0]);
     const float k = 0.25f + 0.5f * d[2];
@@ -143,7 +143,7 @@ void lbk_ahd_linear_add_scaled(lbk_ahd_linear *dst, const lbk_ahd_linear *src, f
         for (int i = 0; i < 4; i++) dst->c[c][i] += w * src->c[c][i];
 }
 
-void lbk_ahd_texel_store(const lbk_ahd_texel *texel, uint8_t out[LBK_AHD_TEXEL_SIZE])
+void lbk_ahd_texel_pack(const lbk_ahd_texel *texel, uint8_t out[LBK_AHD_TEXEL_SIZE])
 {
     const uint32_t v = texel->irradiance_z;
     out[0] = (uint8_t)v;
@@ -153,7 +153,7 @@ void lbk_ahd_texel_store(const lbk_ahd_texel *texel, uint8_t out[LBK_AHD_TEXEL_S
     for (int i = 0; i < 4; i++) out[4 + i] = texel->rgba[i];
 }
 
-void lbk_ahd_texel_load(const uint8_t in[LBK_AHD_TEXEL_SIZE], lbk_ahd_texel *texel)
+void lbk_ahd_texel_unpack(const uint8_t in[LBK_AHD_TEXEL_SIZE], lbk_ahd_texel *texel)
 {
     texel->irradiance_z = (uint32_t)in[0] | ((uint32_t)in[1] << 8) | ((uint32_t)in[2] << 16) | ((uint32_t)in[3] << 24);
     for (int i = 0; i < 4; i++) texel->rgba[i] = in[4 + i];

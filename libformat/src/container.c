@@ -50,10 +50,13 @@ static int reader_report(void *user, uint32_t id, lbk_result r, uint32_t type, u
     return 1;
 }
 
-static lbk_result open_common(const uint8_t *data, size_t size, int mapped, const lbk_read_options *options,
+static lbk_result open_common(const uint8_t *data, size_t size, int mapped, const lbk_read_options *caller_options,
                               lbk_reader **out)
 {
-    lbk_allocator alloc = copy_allocator(options ? options->allocator : NULL);
+    lbk_read_options options;
+    lbk_result rc = LBK_SIZED_IN(&options, caller_options, lbk_read_options, skip_checksums);
+    if (rc != LBK_OK) return rc;
+    lbk_allocator alloc = copy_allocator(options.allocator);
     open_state st = {LBK_OK};
     lbk_reader *r = lbk_calloc(&alloc, 1, sizeof *r);
     if (!r) return LBK_ERR_OUT_OF_MEMORY;
@@ -67,9 +70,8 @@ static lbk_result open_common(const uint8_t *data, size_t size, int mapped, cons
     r->bytes = data;
     r->size = size;
     r->mapped = mapped;
-    r->skip_checksums = options ? options->skip_checksums : 0;
-    r->budget_left = (options && options->max_decoded_bytes) ? options->max_decoded_bytes
-                                                             : lbk_default_decode_cap(size);
+    r->skip_checksums = options.skip_checksums;
+    r->budget_left = options.max_decoded_bytes ? options.max_decoded_bytes : lbk_default_decode_cap(size);
     *out = r;
     return LBK_OK;
 }
@@ -114,7 +116,7 @@ const void *lbk_reader_bytes(const lbk_reader *r, size_t *size)
 
 uint32_t lbk_reader_section_count(const lbk_reader *r) { return r ? r->fr.count : 0; }
 
-lbk_result lbk_reader_section_info(const lbk_reader *r, uint32_t index, lbk_section_info *out)
+lbk_result lbk_reader_section_get(const lbk_reader *r, uint32_t index, lbk_section_info *out)
 {
     if (!r || !out) return LBK_ERR_INVALID_ARGUMENT;
     if (index >= r->fr.count) return LBK_ERR_NOT_FOUND;
@@ -122,7 +124,7 @@ lbk_result lbk_reader_section_info(const lbk_reader *r, uint32_t index, lbk_sect
     return LBK_OK;
 }
 
-lbk_result lbk_reader_find_section(const lbk_reader *r, uint32_t type, uint32_t *index)
+lbk_result lbk_reader_section_find(const lbk_reader *r, uint32_t type, uint32_t *index)
 {
     if (!r || !index) return LBK_ERR_INVALID_ARGUMENT;
     for (uint32_t i = 0; i < r->fr.count; i++)
@@ -161,7 +163,7 @@ lbk_result lbk_reader_section_by_type(lbk_reader *r, uint32_t type, const void *
     uint32_t index;
     if (data) *data = NULL;
     if (size) *size = 0;
-    lbk_result res = lbk_reader_find_section(r, type, &index);
+    lbk_result res = lbk_reader_section_find(r, type, &index);
     if (res != LBK_OK) return res;
     return lbk_reader_section_data(r, index, data, size);
 }
@@ -181,13 +183,16 @@ struct lbk_writer {
     writer_section s[LBK_MAX_SECTIONS];
 };
 
-lbk_result lbk_writer_create(const lbk_write_options *options, lbk_writer **out)
+lbk_result lbk_writer_open(const lbk_write_options *caller_options, lbk_writer **out)
 {
     if (!out) return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
-    uint32_t a = options && options->section_alignment ? options->section_alignment : LBK_DEFAULT_ALIGNMENT;
+    lbk_write_options options;
+    lbk_result rc = LBK_SIZED_IN(&options, caller_options, lbk_write_options, section_alignment);
+    if (rc != LBK_OK) return rc;
+    uint32_t a = options.section_alignment ? options.section_alignment : LBK_DEFAULT_ALIGNMENT;
     if (a < LBK_MIN_ALIGNMENT || a > LBK_MAX_ALIGNMENT || (a & (a - 1))) return LBK_ERR_INVALID_ARGUMENT;
-    lbk_allocator alloc = copy_allocator(options ? options->allocator : NULL);
+    lbk_allocator alloc = copy_allocator(options.allocator);
     lbk_writer *w = lbk_calloc(&alloc, 1, sizeof *w);
     if (!w) return LBK_ERR_OUT_OF_MEMORY;
     w->alloc = alloc;
@@ -196,7 +201,7 @@ lbk_result lbk_writer_create(const lbk_write_options *options, lbk_writer **out)
     return LBK_OK;
 }
 
-void lbk_writer_destroy(lbk_writer *w)
+void lbk_writer_close(lbk_writer *w)
 {
     if (!w) return;
     for (uint32_t i = 0; i < w->count; i++) lbk_dealloc(&w->alloc, w->s[i].stored);
@@ -242,13 +247,16 @@ static lbk_result compress(lbk_writer *w, const void *data, size_t size, int lev
     return LBK_OK;
 }
 
-lbk_result lbk_writer_add_section(lbk_writer *w, uint32_t type, const void *data, size_t size,
-                                  const lbk_section_options *options)
+lbk_result lbk_writer_section_add(lbk_writer *w, uint32_t type, const void *data, size_t size,
+                                  const lbk_section_options *caller_options)
 {
     if (!w || !data || size == 0 || !lbk_fourcc_printable(type)) return LBK_ERR_INVALID_ARGUMENT;
-    uint32_t flags = options ? options->flags : 0;
-    uint32_t compression = options ? options->compression : LBK_COMPRESSION_NONE;
-    int level = options && options->zstd_level ? options->zstd_level : LBK_DEFAULT_ZSTD_LEVEL;
+    lbk_section_options options;
+    lbk_result rc = LBK_SIZED_IN(&options, caller_options, lbk_section_options, zstd_level);
+    if (rc != LBK_OK) return rc;
+    uint32_t flags = options.flags;
+    uint32_t compression = options.compression;
+    int level = options.zstd_level ? options.zstd_level : LBK_DEFAULT_ZSTD_LEVEL;
     if ((flags & ~LBK_SECTION_FLAG_REQUIRED) || compression > LBK_COMPRESSION_ZSTD) return LBK_ERR_INVALID_ARGUMENT;
     if (level > ZSTD_maxCLevel() || level < ZSTD_minCLevel()) return LBK_ERR_INVALID_ARGUMENT;
     for (uint32_t i = 0; i < w->count; i++)
@@ -315,7 +323,9 @@ lbk_result lbk_writer_to_memory(lbk_writer *w, void **out, size_t *size)
     if (!f) return LBK_ERR_OUT_OF_MEMORY;
 
     uint32_t required = 0;
+    uint16_t minor = 0; /* §1.3: the lowest minor version that defines every known section here */
     for (uint32_t i = 0; i < w->count; i++) {
+        if (w->s[order[i]].type == LBK_SECTION_LMUV) minor = 1;
         const writer_section *s = &w->s[order[i]];
         uint8_t *e = f + LBK_HEADER_SIZE + (size_t)LBK_SECTION_ENTRY_SIZE * i;
         lbk_wr32(e + LBK_ENT_TYPE, s->type);
@@ -329,8 +339,8 @@ lbk_result lbk_writer_to_memory(lbk_writer *w, void **out, size_t *size)
         if (s->compression == LBK_COMPRESSION_ZSTD) required |= LBK_FEATURE_ZSTD;
     }
     memcpy(f, lbk_magic, 8);
-    lbk_wr16(f + LBK_HDR_VERSION_MAJOR, LBK_VERSION_MAJOR);
-    lbk_wr16(f + LBK_HDR_VERSION_MINOR, LBK_VERSION_MINOR);
+    lbk_wr16(f + LBK_HDR_VERSION_MAJOR, LBK_FORMAT_VERSION_MAJOR);
+    lbk_wr16(f + LBK_HDR_VERSION_MINOR, minor);
     lbk_wr32(f + LBK_HDR_HEADER_SIZE, LBK_HEADER_SIZE);
     lbk_wr64(f + LBK_HDR_FILE_SIZE, file_size);
     lbk_wr32(f + LBK_HDR_REQUIRED_FEATURES, required);

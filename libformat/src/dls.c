@@ -643,7 +643,7 @@ struct lbk_dls_view {
     uint64_t target_count[LBK_DLS_SPACE_COUNT_];
 };
 
-lbk_result lbk_dls_view_open(const void *data, size_t size, const lbk_allocator *allocator, lbk_dls_view **out)
+lbk_result lbk_dls_open(const void *data, size_t size, const lbk_allocator *allocator, lbk_dls_view **out)
 {
     if (!out || (!data && size)) return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
@@ -667,7 +667,7 @@ lbk_result lbk_dls_view_open(const void *data, size_t size, const lbk_allocator 
     return LBK_OK;
 }
 
-void lbk_dls_view_close(lbk_dls_view *view)
+void lbk_dls_close(lbk_dls_view *view)
 {
     if (view) lbk_dealloc(view->alloc, view);
 }
@@ -692,7 +692,7 @@ lbk_result lbk_dls_set_get(const lbk_dls_view *view, uint32_t set, lbk_dls_set_i
     return LBK_OK;
 }
 
-lbk_result lbk_dls_set_light(const lbk_dls_view *view, uint32_t set, uint32_t i, const char **name, uint32_t *length)
+lbk_result lbk_dls_set_light_get(const lbk_dls_view *view, uint32_t set, uint32_t i, const char **name, uint32_t *length)
 {
     if (!view || !name || !length) return LBK_ERR_INVALID_ARGUMENT;
     if (set >= view->L.count[DLS_A_SETS]) return LBK_ERR_NOT_FOUND;
@@ -704,7 +704,7 @@ lbk_result lbk_dls_set_light(const lbk_dls_view *view, uint32_t set, uint32_t i,
     return LBK_OK;
 }
 
-lbk_result lbk_dls_set_member(const lbk_dls_view *view, uint32_t set, uint32_t i, uint32_t *member)
+lbk_result lbk_dls_set_member_get(const lbk_dls_view *view, uint32_t set, uint32_t i, uint32_t *member)
 {
     if (!view || !member) return LBK_ERR_INVALID_ARGUMENT;
     if (set >= view->L.count[DLS_A_SETS]) return LBK_ERR_NOT_FOUND;
@@ -714,7 +714,7 @@ lbk_result lbk_dls_set_member(const lbk_dls_view *view, uint32_t set, uint32_t i
     return LBK_OK;
 }
 
-lbk_result lbk_dls_find_set(const lbk_dls_view *view, const char *name, uint32_t *set)
+lbk_result lbk_dls_set_find(const lbk_dls_view *view, const char *name, uint32_t *set)
 {
     if (!view || !name || !set) return LBK_ERR_INVALID_ARGUMENT;
     size_t n = strlen(name);
@@ -752,7 +752,7 @@ lbk_result lbk_dls_cluster_get(const lbk_dls_view *view, uint32_t cluster, lbk_d
     return LBK_OK;
 }
 
-lbk_result lbk_dls_cluster_set(const lbk_dls_view *view, uint32_t cluster, uint32_t i, uint32_t *set)
+lbk_result lbk_dls_cluster_set_get(const lbk_dls_view *view, uint32_t cluster, uint32_t i, uint32_t *set)
 {
     if (!view || !set) return LBK_ERR_INVALID_ARGUMENT;
     if (cluster >= view->L.count[DLS_A_CLUSTERS]) return LBK_ERR_NOT_FOUND;
@@ -837,7 +837,7 @@ static int stats_target(void *user, uint32_t target, uint32_t count, const uint3
     return 0;
 }
 
-lbk_result lbk_dls_compute_stats(const lbk_dls_view *view, lbk_dls_stats *out)
+lbk_result lbk_dls_stats_get(const lbk_dls_view *view, lbk_dls_stats *out)
 {
     if (!view || !out) return LBK_ERR_INVALID_ARGUMENT;
     memset(out, 0, sizeof *out);

@@ -264,7 +264,7 @@ static lbk_result make_gaps(lbk_dls_runtime *r)
     return LBK_OK;
 }
 
-void lbk_dls_runtime_destroy(lbk_dls_runtime *r)
+void lbk_dls_runtime_close(lbk_dls_runtime *r)
 {
     if (!r) return;
     const lbk_allocator *a = r->alloc;
@@ -280,10 +280,15 @@ void lbk_dls_runtime_destroy(lbk_dls_runtime *r)
     lbk_dealloc(a, r);
 }
 
-lbk_result lbk_dls_runtime_create(const lbk_dls_runtime_desc *desc, lbk_dls_runtime **out)
+lbk_result lbk_dls_runtime_open(const lbk_dls_runtime_desc *caller_desc, lbk_dls_runtime **out)
 {
-    if (!desc || !out || !desc->dls) return LBK_ERR_INVALID_ARGUMENT;
+    if (!caller_desc || !out) return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
+    lbk_dls_runtime_desc in;
+    lbk_result rc = LBK_SIZED_IN(&in, caller_desc, lbk_dls_runtime_desc, allocator);
+    if (rc != LBK_OK) return rc;
+    const lbk_dls_runtime_desc *desc = &in;
+    if (!desc->dls) return LBK_ERR_INVALID_ARGUMENT;
     if (desc->doors) {
         lbk_result cr = lbk_door_check_dls(desc->doors, desc->dls);
         if (cr != LBK_OK) return cr;
@@ -319,7 +324,7 @@ lbk_result lbk_dls_runtime_create(const lbk_dls_runtime_desc *desc, lbk_dls_runt
         lbk_dls_set_get(desc->dls, s, &info);
         r->kinds[s] = (uint8_t)info.kind;
         r->member_offset[s] = at;
-        for (uint32_t j = 0; j < info.member_count; j++) lbk_dls_set_member(desc->dls, s, j, &r->members[at++]);
+        for (uint32_t j = 0; j < info.member_count; j++) lbk_dls_set_member_get(desc->dls, s, j, &r->members[at++]);
         r->door_of_set[s] = LBK_DLS_NO_SET;
     }
     r->member_offset[r->nsets] = at;
@@ -374,7 +379,7 @@ lbk_result lbk_dls_runtime_create(const lbk_dls_runtime_desc *desc, lbk_dls_runt
     *out = r;
     return LBK_OK;
 fail:
-    lbk_dls_runtime_destroy(r);
+    lbk_dls_runtime_close(r);
     return res;
 }
 

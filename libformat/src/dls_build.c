@@ -702,22 +702,29 @@ static void put_array(uint8_t *out, const dls_layout *L, int a, const vec *v)
     if (v->len) memcpy(out + L->offset[a], v->p, v->len);
 }
 
-lbk_result lbk_dls_build(const lbk_dls_build_desc *desc, const lbk_dls_build_options *options, void **out,
-                         size_t *out_size, lbk_dls_stats *stats)
+lbk_result lbk_dls_build(const lbk_dls_build_desc *caller_desc, const lbk_dls_build_options *caller_options,
+                         void **out, size_t *out_size, lbk_dls_stats *stats)
 {
-    if (!desc || !out || !out_size) return LBK_ERR_INVALID_ARGUMENT;
+    if (!caller_desc || !out || !out_size) return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
     *out_size = 0;
-    const lbk_allocator *a = options ? options->allocator : NULL;
-    lbk_result r = check_desc(desc, a);
+    lbk_dls_build_desc in;
+    lbk_dls_build_options options;
+    lbk_result r = LBK_SIZED_IN(&in, caller_desc, lbk_dls_build_desc, target_count);
+    if (r == LBK_OK) r = LBK_SIZED_IN(&options, caller_options, lbk_dls_build_options, tuning);
+    if (r != LBK_OK) return r;
+    const lbk_dls_build_desc *desc = &in;
+    const lbk_dls_tuning tuning = options.tuning ? *options.tuning : (lbk_dls_tuning){0};
+    const lbk_allocator *a = options.allocator;
+    r = check_desc(desc, a);
     if (r != LBK_OK) return r;
 
     builder b;
     memset(&b, 0, sizeof b);
     b.a = a;
     b.desc = desc;
-    b.min_fill = options && options->min_dispatch_targets ? options->min_dispatch_targets : 256;
-    b.packed_cap = options && options->packed_max_targets ? options->packed_max_targets : 4096;
+    b.min_fill = tuning.min_dispatch_targets ? tuning.min_dispatch_targets : 256;
+    b.packed_cap = tuning.packed_max_targets ? tuning.packed_max_targets : 4096;
     vec *vs[] = {&b.clusters, &b.cluster_sets, &b.runs, &b.subgroups, &b.words, &b.base16, &b.base32, &b.slots, &b.texels, &b.probes};
     for (size_t i = 0; i < sizeof vs / sizeof vs[0]; i++) vs[i]->a = a;
     vec sets = {.a = a}, lrefs = {.a = a}, members = {.a = a}, strings = {.a = a};
@@ -844,13 +851,13 @@ lbk_result lbk_dls_build(const lbk_dls_build_desc *desc, const lbk_dls_build_opt
 
     /* Self-check: the output must pass the section's own rules (and gives the statistics). */
     lbk_dls_view *v;
-    r = lbk_dls_view_open(bytes, (size_t)L.size, a, &v);
+    r = lbk_dls_open(bytes, (size_t)L.size, a, &v);
     if (r != LBK_OK) {
         lbk_dealloc(a, bytes);
         return LBK_ERR_CORRUPT;
     }
-    if (stats) lbk_dls_compute_stats(v, stats);
-    lbk_dls_view_close(v);
+    if (stats) lbk_dls_stats_get(v, stats);
+    lbk_dls_close(v);
     *out = bytes;
     *out_size = (size_t)L.size;
     return LBK_OK;

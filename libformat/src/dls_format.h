@@ -140,7 +140,7 @@ enum { DOOR_S_MEMBER_FIRST = 0, DOOR_S_MEMBER_COUNT = 4, DOOR_S_SET = 8, DOOR_S_
 /* Is [off, off+len) a valid string of a blob of blob_size bytes: in range, no NUL, UTF-8? */
 bool lbk_dls_string_ok(const uint8_t *blob, uint64_t blob_size, uint32_t off, uint32_t len);
 
-/* Raw access to the arrays of a section lbk_dls_view_open accepted (for the runtime). */
+/* Raw access to the arrays of a section lbk_dls_open accepted (for the runtime). */
 typedef struct lbk_dls_raw {
     const uint8_t *d;
     uint64_t size;

@@ -292,7 +292,7 @@ struct lbk_door_view {
     door_layout L;
 };
 
-lbk_result lbk_door_view_open(const void *data, size_t size, const lbk_allocator *allocator, lbk_door_view **out)
+lbk_result lbk_door_open(const void *data, size_t size, const lbk_allocator *allocator, lbk_door_view **out)
 {
     if (!out || (!data && size)) return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
@@ -315,7 +315,7 @@ lbk_result lbk_door_view_open(const void *data, size_t size, const lbk_allocator
     return LBK_OK;
 }
 
-void lbk_door_view_close(lbk_door_view *view)
+void lbk_door_close(lbk_door_view *view)
 {
     if (view) lbk_dealloc(view->alloc, view);
 }
@@ -344,7 +344,7 @@ lbk_result lbk_door_check_dls(const lbk_door_view *doors, const lbk_dls_view *dl
         lbk_dls_set_get(dls, s, &info);
         kinds[s] = (uint8_t)info.kind;
         moff[s] = at;
-        for (uint32_t j = 0; j < info.member_count; j++) lbk_dls_set_member(dls, s, j, &mem[at++]);
+        for (uint32_t j = 0; j < info.member_count; j++) lbk_dls_set_member_get(dls, s, j, &mem[at++]);
     }
     moff[nsets] = at;
     door_chk c;
@@ -393,7 +393,7 @@ lbk_result lbk_door_state_get(const lbk_door_view *view, uint32_t st, uint32_t *
     return LBK_OK;
 }
 
-lbk_result lbk_door_state_door(const lbk_door_view *view, uint32_t st, uint32_t i, uint32_t *door)
+lbk_result lbk_door_state_door_get(const lbk_door_view *view, uint32_t st, uint32_t i, uint32_t *door)
 {
     if (!view || !door) return LBK_ERR_INVALID_ARGUMENT;
     if (st >= view->L.states) return LBK_ERR_NOT_FOUND;
@@ -411,10 +411,15 @@ static int cmp_u32(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-lbk_result lbk_door_build(const lbk_door_build_desc *desc, const lbk_allocator *a, void **out, size_t *out_size)
+lbk_result lbk_door_build(const lbk_door_build_desc *caller_desc, const lbk_allocator *a, void **out,
+                          size_t *out_size)
 {
-    if (!desc || !out || !out_size || !desc->door_count || !desc->doors || (desc->state_count && !desc->states))
-        return LBK_ERR_INVALID_ARGUMENT;
+    if (!caller_desc || !out || !out_size) return LBK_ERR_INVALID_ARGUMENT;
+    lbk_door_build_desc in;
+    lbk_result rc = LBK_SIZED_IN(&in, caller_desc, lbk_door_build_desc, states);
+    if (rc != LBK_OK) return rc;
+    const lbk_door_build_desc *desc = &in;
+    if (!desc->door_count || !desc->doors || (desc->state_count && !desc->states)) return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
     *out_size = 0;
     uint64_t strings = 0, members = 0;

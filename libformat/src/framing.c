@@ -26,6 +26,10 @@ int lbk_section_rank(uint32_t type)
     return 0;
 }
 
+/* Types added by a minor version have no rank: they sort after the 1.0 types by ascending code,
+ * exactly where a 1.0 reader expects a type it does not know (§3.2), so it accepts the order. */
+int lbk_section_known(uint32_t type) { return lbk_section_rank(type) != 0 || type == LBK_SECTION_LMUV; }
+
 uint64_t lbk_default_decode_cap(uint64_t file_size)
 {
     const uint64_t four_gib = (uint64_t)4 << 30;
@@ -96,9 +100,9 @@ static int check_header(const uint8_t *d, size_t size, lbk_framing *out, lbk_fra
     lbk_header_info *h = &out->header;
     h->version_major = lbk_rd16(d + LBK_HDR_VERSION_MAJOR);
     h->version_minor = lbk_rd16(d + LBK_HDR_VERSION_MINOR);
-    if (h->version_major != LBK_VERSION_MAJOR) {
+    if (h->version_major != LBK_FORMAT_VERSION_MAJOR) {
         REPORT(103, LBK_ERR_UNSUPPORTED_VERSION, 0, LBK_HDR_VERSION_MAJOR,
-               "major version %u is not supported (this reader knows %u)", h->version_major, LBK_VERSION_MAJOR);
+               "major version %u is not supported (this reader knows %u)", h->version_major, LBK_FORMAT_VERSION_MAJOR);
         return 1;
     }
     uint64_t stored_hc = lbk_rd64(d + LBK_HDR_HEADER_CHECKSUM), hc = XXH3_64bits(d, LBK_HDR_HEADER_CHECKSUM);
@@ -125,10 +129,10 @@ static int check_header(const uint8_t *d, size_t size, lbk_framing *out, lbk_fra
                (unsigned long long)(size - h->file_size), (unsigned long long)h->file_size, size);
         return 1;
     }
-    if (h->version_minor > LBK_VERSION_MINOR)
+    if (h->version_minor > LBK_FORMAT_VERSION_MINOR)
         REPORT(115, LBK_OK, 0, LBK_HDR_VERSION_MINOR,
                "minor version %u is newer than this reader's %u; newer optional content is skipped",
-               h->version_minor, LBK_VERSION_MINOR);
+               h->version_minor, LBK_FORMAT_VERSION_MINOR);
     h->required_features = lbk_rd32(d + LBK_HDR_REQUIRED_FEATURES);
     h->optional_features = lbk_rd32(d + LBK_HDR_OPTIONAL_FEATURES);
     if (h->required_features & ~LBK_KNOWN_REQUIRED_FEATURES) {
@@ -278,7 +282,7 @@ int lbk_framing_parse(const uint8_t *d, size_t size, lbk_framing *out, lbk_frami
                 placement_broken = 1;
             }
         }
-        if (usable && lbk_section_rank(s->type) == 0) {
+        if (usable && !lbk_section_known(s->type)) {
             if (s->flags & LBK_SECTION_FLAG_REQUIRED) {
                 REPORT(212, LBK_ERR_UNSUPPORTED_FEATURE, s->type, eo + LBK_ENT_TYPE,
                        "section %u: unknown section type '%s' is marked required", i, cc);

@@ -59,7 +59,8 @@ int lbk_framing_parse(const uint8_t *data, size_t size, lbk_framing *out, lbk_fr
 
 /* 1..9 for the v1.0 types in canonical order, 0 for unknown types. */
 int lbk_section_rank(uint32_t type);
-/* Sort key of the canonical order (§3.2): known types by rank, then unknown types by code. */
+int lbk_section_known(uint32_t type); /* a 1.0 type or one a later minor version added */
+/* Sort key of the canonical order (§3.2): 1.0 types by rank, then every other type by code. */
 uint64_t lbk_section_order_key(uint32_t type);
 /* Four printable ASCII characters (0x20..0x7e)? */
 int lbk_fourcc_printable(uint32_t type);

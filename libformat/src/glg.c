@@ -85,10 +85,15 @@ static lbk_result derive_adjacency(const lbk_allocator *a, const uint32_t (*tets
     return r;
 }
 
-lbk_result lbk_glg_build(const lbk_glg_desc *desc, const lbk_allocator *allocator, void **out, size_t *size)
+lbk_result lbk_glg_build(const lbk_glg_build_desc *caller_desc, const lbk_allocator *allocator, void **out,
+                         size_t *size)
 {
-    if (!desc || !out || !size || desc->probe_count < 4 || desc->tetra_count == 0 || !desc->positions ||
-        !desc->probes || !desc->tetras)
+    if (!caller_desc || !out || !size) return LBK_ERR_INVALID_ARGUMENT;
+    lbk_glg_build_desc in;
+    lbk_result rc = LBK_SIZED_IN(&in, caller_desc, lbk_glg_build_desc, scale);
+    if (rc != LBK_OK) return rc;
+    const lbk_glg_build_desc *desc = &in;
+    if (desc->probe_count < 4 || desc->tetra_count == 0 || !desc->positions || !desc->probes || !desc->tetras)
         return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
     *size = 0;
@@ -210,10 +215,10 @@ lbk_result lbk_glg_open(const void *data, size_t size, lbk_glg_view *out)
     return LBK_OK;
 }
 
-lbk_result lbk_glg_probe(const lbk_glg_view *view, uint32_t index, float position[3], lbk_sh9_rgb *sh)
+lbk_result lbk_glg_probe_get(const lbk_glg_view *view, uint32_t index, float position[3], lbk_sh9_rgb *sh)
 {
     if (!view || !view->data) return LBK_ERR_INVALID_ARGUMENT;
-    if (index >= view->probe_count) return LBK_ERR_RANGE;
+    if (index >= view->probe_count) return LBK_ERR_NOT_FOUND;
     if (position)
         for (int k = 0; k < 3; k++) position[k] = lbk_rdf32(view->mesh.positions + 12 * (size_t)index + 4 * k);
     if (sh) {

@@ -8,6 +8,8 @@
 #include <stdint.h>
 #include <string.h>
 
+#define LBK_STATIC_LINKING_ONLY /* the library implements its experimental declarations too */
+#include "lbk/dls.h"
 #include "lbk/validate.h"
 
 /* ---- little-endian access (the file is LE whatever the host is) -------------------------- */
@@ -68,9 +70,20 @@ void *lbk_alloc(const lbk_allocator *a, size_t size);
 void *lbk_calloc(const lbk_allocator *a, size_t count, size_t size); /* overflow-checked, zeroed */
 void lbk_dealloc(const lbk_allocator *a, void *p);
 
+/* ---- size-tagged structs (lbk.h) ----------------------------------------------------------
+ * Reads the caller's struct *src (NULL: all defaults) into *dst, a zeroed struct of the current
+ * layout with dst->size = sizeof *dst: the caller's size (0: v1_size, its layout in liblbk 1.0)
+ * decides how many bytes are copied. LBK_ERR_INVALID_ARGUMENT for a size below v1_size,
+ * LBK_ERR_UNSUPPORTED_FEATURE for non-zero bytes past the fields this library knows. */
+lbk_result lbk_sized_in(void *dst, size_t dst_size, const void *src, size_t v1_size);
+/* The layout of liblbk 1.0 ends at field `last_v1`; fields appended later leave the calls as
+ * they are. */
+#define LBK_SIZED_IN(dst, src, type, last_v1) lbk_sized_in((dst), sizeof(type), (src), LBK_V1_SIZE(type, last_v1))
+#define LBK_V1_SIZE(type, last) (offsetof(type, last) + sizeof(((type *)0)->last))
+
 /* ---- validation context ---------------------------------------------------------------------
- * validate.c walks the sections in dependency order (META, REPT, LMAP, GLG, LLG, OCTP, OBJS, DLS,
- * DOOR) and hands each section validator this context. A validator reports through lbk_vreport,
+ * validate.c walks the sections in dependency order (META, REPT, LMAP, GLG, LLG, OCTP, OBJS, LMUV,
+ * DLS, DOOR) and hands each section validator this context. A validator reports through lbk_vreport,
  * and fills in the facts later sections cross-check against. A fact stays zero when its section is
  * absent or unusable; *_ok flags say whether the section parsed. */
 typedef struct lbk_vctx {
@@ -100,6 +113,9 @@ typedef struct lbk_vctx {
     uint64_t llg_probe_count;
     int objs_ok;
     uint32_t object_count;
+    /* per OBJS object, 6 u32: representation, index, rect x, y, w, h; set by lbk_validate_objs when
+     * objs_ok (allocated with ctx->allocator, freed by validate.c); NULL if the allocation failed */
+    uint32_t *objs_facts;
     int dls_ok;
     uint32_t dls_set_count;
     /* DLS facts for DOOR, set by lbk_validate_dls when dls_ok: one allocation (dls_facts, freed by
@@ -140,6 +156,7 @@ void lbk_validate_glg(lbk_vctx *ctx, const uint8_t *data, size_t size);
 void lbk_validate_llg(lbk_vctx *ctx, const uint8_t *data, size_t size);
 void lbk_validate_octp(lbk_vctx *ctx, const uint8_t *data, size_t size);
 void lbk_validate_objs(lbk_vctx *ctx, const uint8_t *data, size_t size);
+void lbk_validate_lmuv(lbk_vctx *ctx, const uint8_t *data, size_t size);
 void lbk_validate_dls(lbk_vctx *ctx, const uint8_t *data, size_t size);
 void lbk_validate_door(lbk_vctx *ctx, const uint8_t *data, size_t size);
 

@@ -27,8 +27,8 @@ static bool lmap_next_page(lmap_cursor *c, uint32_t w, uint32_t h, uint64_t *pla
     return true;
 }
 
-lbk_result lbk_lmap_build(const lbk_lmap_page_desc *pages, uint32_t page_count, float scale,
-                          const lbk_allocator *allocator, void **out, size_t *size)
+static lbk_result build_pages(const lbk_lmap_page_desc *pages, uint32_t page_count, float scale,
+                              const lbk_allocator *allocator, void **out, size_t *size)
 {
     if (!out || !size || !pages || page_count == 0) return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
@@ -74,6 +74,18 @@ lbk_result lbk_lmap_build(const lbk_lmap_page_desc *pages, uint32_t page_count, 
     return LBK_OK;
 }
 
+lbk_result lbk_lmap_build(const lbk_lmap_build_desc *caller_desc, const lbk_allocator *allocator, void **out,
+                          size_t *size)
+{
+    if (out) *out = NULL;
+    if (size) *size = 0;
+    if (!caller_desc) return LBK_ERR_INVALID_ARGUMENT;
+    lbk_lmap_build_desc desc;
+    lbk_result rc = LBK_SIZED_IN(&desc, caller_desc, lbk_lmap_build_desc, scale);
+    if (rc != LBK_OK) return rc;
+    return build_pages(desc.pages, desc.page_count, desc.scale, allocator, out, size);
+}
+
 lbk_result lbk_lmap_open(const void *data, size_t size, lbk_lmap_view *out)
 {
     if (!out || (!data && size)) return LBK_ERR_INVALID_ARGUMENT;
@@ -105,7 +117,7 @@ lbk_result lbk_lmap_open(const void *data, size_t size, lbk_lmap_view *out)
     return LBK_OK;
 }
 
-lbk_result lbk_lmap_get_page(const lbk_lmap_view *view, uint32_t index, lbk_lmap_page *out)
+lbk_result lbk_lmap_page_get(const lbk_lmap_view *view, uint32_t index, lbk_lmap_page *out)
 {
     if (!view || !out || !view->data) return LBK_ERR_INVALID_ARGUMENT;
     if (index >= view->page_count) return LBK_ERR_NOT_FOUND;
@@ -121,10 +133,10 @@ lbk_result lbk_lmap_get_page(const lbk_lmap_view *view, uint32_t index, lbk_lmap
     return LBK_OK;
 }
 
-lbk_result lbk_lmap_page_texel(const lbk_lmap_page *page, uint32_t x, uint32_t y, lbk_ahd_texel *out)
+lbk_result lbk_lmap_page_texel_get(const lbk_lmap_page *page, uint32_t x, uint32_t y, lbk_ahd_texel *out)
 {
     if (!page || !out) return LBK_ERR_INVALID_ARGUMENT;
-    if (x >= page->width || y >= page->height) return LBK_ERR_RANGE;
+    if (x >= page->width || y >= page->height) return LBK_ERR_NOT_FOUND;
     const size_t i = (size_t)y * page->width + x;
     out->irradiance_z = lbk_rd32(page->irradiance + 4 * i);
     memcpy(out->rgba, page->rgba + 4 * i, 4);
@@ -135,17 +147,17 @@ lbk_result lbk_lmap_page_irradiance(const lbk_lmap_page *page, uint32_t x, uint3
 {
     if (!n || !rgb) return LBK_ERR_INVALID_ARGUMENT;
     lbk_ahd_texel t;
-    lbk_result r = lbk_lmap_page_texel(page, x, y, &t);
+    lbk_result r = lbk_lmap_page_texel_get(page, x, y, &t);
     if (r != LBK_OK) return r;
     lbk_ahd_irradiance(&t, n, rgb);
     for (int c = 0; c < 3; c++) rgb[c] *= page->scale;
     return LBK_OK;
 }
 
-lbk_result lbk_lmap_texel(const lbk_lmap_view *view, uint64_t texel_index, lbk_ahd_texel *out, uint32_t *page_out)
+lbk_result lbk_lmap_texel_get(const lbk_lmap_view *view, uint64_t texel_index, lbk_ahd_texel *out, uint32_t *page_out)
 {
     if (!view || !out || !view->data) return LBK_ERR_INVALID_ARGUMENT;
-    if (texel_index >= view->texel_count) return LBK_ERR_RANGE;
+    if (texel_index >= view->texel_count) return LBK_ERR_NOT_FOUND;
     /* binary search on first_texel (ascending by construction) */
     uint32_t lo = 0, hi = view->page_count;
     while (hi - lo > 1) {
@@ -155,10 +167,10 @@ lbk_result lbk_lmap_texel(const lbk_lmap_view *view, uint64_t texel_index, lbk_a
         else hi = mid;
     }
     lbk_lmap_page pg;
-    lbk_lmap_get_page(view, lo, &pg);
+    lbk_lmap_page_get(view, lo, &pg);
     const uint64_t local = texel_index - pg.first_texel;
     if (page_out) *page_out = lo;
-    return lbk_lmap_page_texel(&pg, (uint32_t)(local % pg.width), (uint32_t)(local / pg.width), out);
+    return lbk_lmap_page_texel_get(&pg, (uint32_t)(local % pg.width), (uint32_t)(local / pg.width), out);
 }
 
 /* ---- validation ------------------------------------------------------------------------------ */

@@ -37,7 +37,7 @@ static bool llg_layout_of(uint64_t grids, uint64_t probes, uint64_t vertices, ll
     return true;
 }
 
-void lbk_llg_vertex_encode(const lbk_llg_vertex *v, uint8_t out[4])
+void lbk_llg_vertex_pack(const lbk_llg_vertex *v, uint8_t out[4])
 {
     float uv[2];
     lbk_oct_encode(v->bent_normal, uv);
@@ -47,7 +47,7 @@ void lbk_llg_vertex_encode(const lbk_llg_vertex *v, uint8_t out[4])
     out[3] = 0;
 }
 
-void lbk_llg_vertex_decode(const uint8_t in[4], lbk_llg_vertex *v)
+void lbk_llg_vertex_unpack(const uint8_t in[4], lbk_llg_vertex *v)
 {
     v->visibility = lbk_unorm8_to_float(in[0]);
     const float uv[2] = {lbk_unorm8_to_float(in[1]) * 2.0f - 1.0f, lbk_unorm8_to_float(in[2]) * 2.0f - 1.0f};
@@ -56,9 +56,9 @@ void lbk_llg_vertex_decode(const uint8_t in[4], lbk_llg_vertex *v)
 
 static bool grid_desc_ok(const lbk_llg_grid_desc *g)
 {
-    if (!lbk_finite3(g->centre) || !lbk_finite3(g->half_extent)) return false;
+    if (!lbk_finite3(g->centre) || !lbk_finite3(g->half_extents)) return false;
     for (int a = 0; a < 3; a++) {
-        if (!lbk_finite3(g->axes[a]) || !(g->half_extent[a] > 0.0f)) return false;
+        if (!lbk_finite3(g->axes[a]) || !(g->half_extents[a] > 0.0f)) return false;
         if (g->dims[a] < LBK_LLG_MIN_DIM || g->dims[a] > LBK_LLG_MAX_DIM) return false;
         for (int b = 0; b < 3; b++) {
             const double dot = (double)g->axes[a][0] * g->axes[b][0] + (double)g->axes[a][1] * g->axes[b][1] +
@@ -69,8 +69,8 @@ static bool grid_desc_ok(const lbk_llg_grid_desc *g)
     return g->probes && (g->vertex_count == 0 || g->vertices);
 }
 
-lbk_result lbk_llg_build(const lbk_llg_grid_desc *grids, uint32_t grid_count, float scale,
-                         const lbk_allocator *allocator, void **out, size_t *size)
+static lbk_result build_grids(const lbk_llg_grid_desc *grids, uint32_t grid_count, float scale,
+                              const lbk_allocator *allocator, void **out, size_t *size)
 {
     if (!grids || !out || !size || grid_count == 0) return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
@@ -97,7 +97,7 @@ lbk_result lbk_llg_build(const lbk_llg_grid_desc *grids, uint32_t grid_count, fl
         uint8_t *r = d + LBK_LLG_HEADER_SIZE + (size_t)LBK_LLG_GRID_SIZE * g;
         for (int k = 0; k < 3; k++) {
             lbk_wrf32(r + GR_CENTRE + 4 * k, gd->centre[k]);
-            lbk_wrf32(r + GR_HALF + 4 * k, gd->half_extent[k]);
+            lbk_wrf32(r + GR_HALF + 4 * k, gd->half_extents[k]);
             lbk_wr16(r + GR_DIMS + 2 * k, (uint16_t)gd->dims[k]);
             for (int c = 0; c < 3; c++) lbk_wrf32(r + GR_AXES + 12 * k + 4 * c, gd->axes[k][c]);
         }
@@ -111,7 +111,7 @@ lbk_result lbk_llg_build(const lbk_llg_grid_desc *grids, uint32_t grid_count, fl
             lbk_sh9_add_scaled(&stored, &gd->probes[i], inv);
             lbk_sh9_pack(&stored, d + L.probes + (po + i) * LBK_SH9_PACKED_SIZE);
         }
-        for (uint32_t i = 0; i < gd->vertex_count; i++) lbk_llg_vertex_encode(&gd->vertices[i], d + L.vertices + (vo + i) * 4);
+        for (uint32_t i = 0; i < gd->vertex_count; i++) lbk_llg_vertex_pack(&gd->vertices[i], d + L.vertices + (vo + i) * 4);
         po += np;
         vo += gd->vertex_count;
     }
@@ -120,11 +120,23 @@ lbk_result lbk_llg_build(const lbk_llg_grid_desc *grids, uint32_t grid_count, fl
     return LBK_OK;
 }
 
+lbk_result lbk_llg_build(const lbk_llg_build_desc *caller_desc, const lbk_allocator *allocator, void **out,
+                         size_t *size)
+{
+    if (out) *out = NULL;
+    if (size) *size = 0;
+    if (!caller_desc) return LBK_ERR_INVALID_ARGUMENT;
+    lbk_llg_build_desc desc;
+    lbk_result rc = LBK_SIZED_IN(&desc, caller_desc, lbk_llg_build_desc, scale);
+    if (rc != LBK_OK) return rc;
+    return build_grids(desc.grids, desc.grid_count, desc.scale, allocator, out, size);
+}
+
 static void read_grid(const uint8_t *r, lbk_llg_grid *g)
 {
     for (int k = 0; k < 3; k++) {
         g->centre[k] = lbk_rdf32(r + GR_CENTRE + 4 * k);
-        g->half_extent[k] = lbk_rdf32(r + GR_HALF + 4 * k);
+        g->half_extents[k] = lbk_rdf32(r + GR_HALF + 4 * k);
         g->dims[k] = lbk_rd16(r + GR_DIMS + 2 * k);
         for (int c = 0; c < 3; c++) g->axes[k][c] = lbk_rdf32(r + GR_AXES + 12 * k + 4 * c);
     }
@@ -174,7 +186,7 @@ lbk_result lbk_llg_open(const void *data, size_t size, lbk_llg_view *out)
     return LBK_OK;
 }
 
-lbk_result lbk_llg_get_grid(const lbk_llg_view *view, uint32_t index, lbk_llg_grid *out)
+lbk_result lbk_llg_grid_get(const lbk_llg_view *view, uint32_t index, lbk_llg_grid *out)
 {
     if (!view || !view->data || !out) return LBK_ERR_INVALID_ARGUMENT;
     if (index >= view->grid_count) return LBK_ERR_NOT_FOUND;
@@ -187,7 +199,7 @@ void lbk_llg_probe_position(const lbk_llg_grid *g, uint32_t i, uint32_t j, uint3
     const uint32_t idx[3] = {i, j, k};
     for (int c = 0; c < 3; c++) out[c] = g->centre[c];
     for (int a = 0; a < 3; a++) {
-        const float t = g->half_extent[a] * (2.0f * (float)idx[a] / (float)(g->dims[a] - 1) - 1.0f);
+        const float t = g->half_extents[a] * (2.0f * (float)idx[a] / (float)(g->dims[a] - 1) - 1.0f);
         for (int c = 0; c < 3; c++) out[c] += g->axes[a][c] * t;
     }
 }
@@ -196,14 +208,14 @@ lbk_result lbk_llg_sample(const lbk_llg_view *view, uint32_t grid, const float p
 {
     if (!view || !view->data || !p || !out) return LBK_ERR_INVALID_ARGUMENT;
     lbk_llg_grid g;
-    lbk_result r = lbk_llg_get_grid(view, grid, &g);
+    lbk_result r = lbk_llg_grid_get(view, grid, &g);
     if (r != LBK_OK) return r;
     uint32_t i0[3];
     float f[3];
     for (int a = 0; a < 3; a++) {
         const float rel = (p[0] - g.centre[0]) * g.axes[a][0] + (p[1] - g.centre[1]) * g.axes[a][1] +
                           (p[2] - g.centre[2]) * g.axes[a][2];
-        float l = rel / g.half_extent[a];
+        float l = rel / g.half_extents[a];
         if (!(l > -1.0f)) l = -1.0f; /* also NaN (degenerate frames in unvalidated data) */
         if (l > 1.0f) l = 1.0f;
         const float gc = (l + 1.0f) * 0.5f * (float)(g.dims[a] - 1);
@@ -229,11 +241,11 @@ lbk_result lbk_llg_vertex_irradiance(const lbk_llg_view *view, uint32_t grid, ui
 {
     if (!view || !view->data || !p || !rgb) return LBK_ERR_INVALID_ARGUMENT;
     lbk_llg_grid g;
-    lbk_result r = lbk_llg_get_grid(view, grid, &g);
+    lbk_result r = lbk_llg_grid_get(view, grid, &g);
     if (r != LBK_OK) return r;
-    if (vertex >= g.vertex_count) return LBK_ERR_RANGE;
+    if (vertex >= g.vertex_count) return LBK_ERR_NOT_FOUND;
     lbk_llg_vertex v;
-    lbk_llg_vertex_decode(view->vertices + (g.vertex_offset + vertex) * 4, &v);
+    lbk_llg_vertex_unpack(view->vertices + (g.vertex_offset + vertex) * 4, &v);
     float n[3] = {0, 0, 0};
     for (int a = 0; a < 3; a++)
         for (int c = 0; c < 3; c++) n[c] += v.bent_normal[a] * g.axes[a][c];
@@ -269,7 +281,7 @@ void lbk_validate_llg(lbk_vctx *ctx, const uint8_t *d, size_t size)
         lbk_llg_grid g;
         read_grid(r, &g);
         if (!grid_reserved_zero(r)) lbk_vreport(ctx, 701, ro + GR_RES16, "LLG grid %u reserved field is not zero", gi);
-        bool finite = lbk_finite3(g.centre) && lbk_finite3(g.half_extent);
+        bool finite = lbk_finite3(g.centre) && lbk_finite3(g.half_extents);
         for (int a = 0; a < 3; a++) finite = finite && lbk_finite3(g.axes[a]);
         if (!finite) {
             lbk_vreport(ctx, 705, ro, "LLG grid %u box has a non-finite value", gi);
@@ -284,9 +296,9 @@ void lbk_validate_llg(lbk_vctx *ctx, const uint8_t *d, size_t size)
             if (worst > 1e-3)
                 lbk_vreport(ctx, 706, ro + GR_AXES, "LLG grid %u axes are not orthonormal (error %g)", gi, worst);
             for (int a = 0; a < 3; a++)
-                if (!(g.half_extent[a] > 0.0f)) {
+                if (!(g.half_extents[a] > 0.0f)) {
                     lbk_vreport(ctx, 707, ro + GR_HALF + 4 * (uint64_t)a, "LLG grid %u half extent %d is %g", gi, a,
-                                (double)g.half_extent[a]);
+                                (double)g.half_extents[a]);
                     break;
                 }
         }

@@ -78,7 +78,7 @@ lbk_result lbk_meta_build(const lbk_meta_pair *pairs, size_t count, const lbk_al
     return LBK_OK;
 }
 
-lbk_result lbk_meta_parse(const void *data, size_t size, lbk_meta_view *out)
+lbk_result lbk_meta_open(const void *data, size_t size, lbk_meta_view *out)
 {
     if (!out || (!data && size)) return LBK_ERR_INVALID_ARGUMENT;
     memset(out, 0, sizeof *out);
@@ -101,7 +101,7 @@ lbk_result lbk_meta_parse(const void *data, size_t size, lbk_meta_view *out)
     return LBK_OK;
 }
 
-lbk_result lbk_meta_entry(const lbk_meta_view *v, uint32_t index, lbk_string *key, lbk_string *value)
+lbk_result lbk_meta_entry_get(const lbk_meta_view *v, uint32_t index, lbk_string *key, lbk_string *value)
 {
     if (!v) return LBK_ERR_INVALID_ARGUMENT;
     if (index >= v->entry_count) return LBK_ERR_NOT_FOUND;
@@ -117,7 +117,7 @@ lbk_result lbk_meta_find(const lbk_meta_view *v, const char *key, lbk_string *va
     size_t kn = strlen(key);
     for (uint32_t i = 0; i < v->entry_count; i++) {
         lbk_string k;
-        lbk_meta_entry(v, i, &k, value);
+        lbk_meta_entry_get(v, i, &k, value);
         if (k.size == kn && !memcmp(k.data, key, kn)) return LBK_OK;
     }
     if (value) *value = (lbk_string){NULL, 0};

@@ -99,7 +99,7 @@ lbk_result lbk_objects_build(const lbk_object *objects, uint32_t count, const lb
     return LBK_OK;
 }
 
-lbk_result lbk_objects_parse(const void *data, size_t size, lbk_objects_view *out)
+lbk_result lbk_objects_open(const void *data, size_t size, lbk_objects_view *out)
 {
     if (!out || (!data && size)) return LBK_ERR_INVALID_ARGUMENT;
     memset(out, 0, sizeof *out);
@@ -236,7 +236,7 @@ void lbk_validate_objs(lbk_vctx *ctx, const uint8_t *d, size_t size)
         return;
     }
     lbk_objects_view v;
-    if (lbk_objects_parse(d, size, &v) != LBK_OK) return; /* unreachable after the checks above */
+    if (lbk_objects_open(d, size, &v) != LBK_OK) return; /* unreachable after the checks above */
 
     const int has_lmap = lbk_vctx_has_section(ctx, LBK_SECTION_LMAP);
     const int has_llg = lbk_vctx_has_section(ctx, LBK_SECTION_LLG);
@@ -300,4 +300,12 @@ void lbk_validate_objs(lbk_vctx *ctx, const uint8_t *d, size_t size)
     lbk_dealloc(ctx->allocator, idx);
     ctx->objs_ok = valid && n > 0;
     ctx->object_count = ctx->objs_ok ? n : 0;
+    /* facts for LMUV's rectangle checks */
+    ctx->objs_facts = ctx->objs_ok ? lbk_calloc(ctx->allocator, (size_t)n * 6, sizeof *ctx->objs_facts) : NULL;
+    for (uint32_t i = 0; ctx->objs_facts && i < n; i++) {
+        lbk_object o;
+        lbk_objects_get(&v, i, &o);
+        const uint32_t f[6] = {o.representation, o.index, o.rect_x, o.rect_y, o.rect_w, o.rect_h};
+        memcpy(ctx->objs_facts + 6 * (size_t)i, f, sizeof f);
+    }
 }

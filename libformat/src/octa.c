@@ -71,8 +71,8 @@ void lbk_oct_texel_direction(uint32_t n, uint32_t i, uint32_t j, float dir[3])
 #define IRR_S (LBK_OCTP_IRR_N + 2u)
 #define DEPTH_S (LBK_OCTP_DEPTH_N + 2u)
 
-lbk_result lbk_octp_build(const lbk_octp_probe_desc *probes, uint32_t count, float scale, const lbk_allocator *allocator,
-                          void **out, size_t *size)
+static lbk_result build_probes(const lbk_octp_probe_desc *probes, uint32_t count, float scale,
+                               const lbk_allocator *allocator, void **out, size_t *size)
 {
     if (!probes || !out || !size || count == 0) return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
@@ -96,7 +96,7 @@ lbk_result lbk_octp_build(const lbk_octp_probe_desc *probes, uint32_t count, flo
                 lbk_oct_border_source(LBK_OCTP_IRR_N, x, y, &sx, &sy);
                 const float *c = pd->irradiance[(sy - 1) * LBK_OCTP_IRR_N + (sx - 1)];
                 const float st[3] = {c[0] * inv, c[1] * inv, c[2] * inv};
-                lbk_wr32(q + LBK_OCTP_IRR_OFFSET + 4 * (y * IRR_S + x), lbk_pack_r11g11b10f(st));
+                lbk_wr32(q + LBK_OCTP_IRR_OFFSET + 4 * (y * IRR_S + x), lbk_r11g11b10f_pack(st));
             }
         for (uint32_t y = 0; y < DEPTH_S; y++)
             for (uint32_t x = 0; x < DEPTH_S; x++) {
@@ -114,6 +114,18 @@ lbk_result lbk_octp_build(const lbk_octp_probe_desc *probes, uint32_t count, flo
     *out = d;
     *size = (size_t)total;
     return LBK_OK;
+}
+
+lbk_result lbk_octp_build(const lbk_octp_build_desc *caller_desc, const lbk_allocator *allocator, void **out,
+                          size_t *size)
+{
+    if (out) *out = NULL;
+    if (size) *size = 0;
+    if (!caller_desc) return LBK_ERR_INVALID_ARGUMENT;
+    lbk_octp_build_desc desc;
+    lbk_result rc = LBK_SIZED_IN(&desc, caller_desc, lbk_octp_build_desc, scale);
+    if (rc != LBK_OK) return rc;
+    return build_probes(desc.probes, desc.probe_count, desc.scale, allocator, out, size);
 }
 
 lbk_result lbk_octp_open(const void *data, size_t size, lbk_octp_view *out)
@@ -135,15 +147,15 @@ lbk_result lbk_octp_open(const void *data, size_t size, lbk_octp_view *out)
     return LBK_OK;
 }
 
-lbk_result lbk_octp_get(const lbk_octp_view *view, uint32_t index, lbk_octp_probe_desc *out)
+lbk_result lbk_octp_probe_get(const lbk_octp_view *view, uint32_t index, lbk_octp_probe_desc *out)
 {
     if (!view || !view->data || !out) return LBK_ERR_INVALID_ARGUMENT;
-    if (index >= view->probe_count) return LBK_ERR_RANGE;
+    if (index >= view->probe_count) return LBK_ERR_NOT_FOUND;
     const uint8_t *q = view->probes + (size_t)LBK_OCTP_PROBE_SIZE * index;
     for (uint32_t j = 0; j < LBK_OCTP_IRR_N; j++)
         for (uint32_t i = 0; i < LBK_OCTP_IRR_N; i++) {
             float *c = out->irradiance[j * LBK_OCTP_IRR_N + i];
-            lbk_unpack_r11g11b10f(lbk_rd32(q + LBK_OCTP_IRR_OFFSET + 4 * ((j + 1) * IRR_S + i + 1)), c);
+            lbk_r11g11b10f_unpack(lbk_rd32(q + LBK_OCTP_IRR_OFFSET + 4 * ((j + 1) * IRR_S + i + 1)), c);
             for (int k = 0; k < 3; k++) c[k] *= view->scale;
         }
     for (uint32_t j = 0; j < LBK_OCTP_DEPTH_N; j++)
@@ -159,7 +171,7 @@ lbk_result lbk_octp_get(const lbk_octp_view *view, uint32_t index, lbk_octp_prob
 lbk_result lbk_octp_irradiance(const lbk_octp_view *view, uint32_t index, const float dir[3], float rgb[3])
 {
     if (!view || !view->data || !dir || !rgb) return LBK_ERR_INVALID_ARGUMENT;
-    if (index >= view->probe_count) return LBK_ERR_RANGE;
+    if (index >= view->probe_count) return LBK_ERR_NOT_FOUND;
     const uint8_t *q = view->probes + (size_t)LBK_OCTP_PROBE_SIZE * index;
     float uv[2];
     lbk_oct_encode(dir, uv);
@@ -179,7 +191,7 @@ lbk_result lbk_octp_irradiance(const lbk_octp_view *view, uint32_t index, const 
         for (int dx = 0; dx < 2; dx++) {
             const float w = (dx ? f[0] : 1.0f - f[0]) * (dy ? f[1] : 1.0f - f[1]);
             float c[3];
-            lbk_unpack_r11g11b10f(lbk_rd32(q + 4 * ((size_t)(i0[1] + dy) * IRR_S + (size_t)(i0[0] + dx))), c);
+            lbk_r11g11b10f_unpack(lbk_rd32(q + 4 * ((size_t)(i0[1] + dy) * IRR_S + (size_t)(i0[0] + dx))), c);
             for (int k = 0; k < 3; k++) rgb[k] += w * c[k];
         }
     for (int k = 0; k < 3; k++) rgb[k] *= view->scale;

@@ -65,12 +65,12 @@ uint32_t lbk_float_to_uf10(float x) { return small_unsigned_encode(x, 5); }
 float lbk_uf11_to_float(uint32_t code) { return small_decode(code & 0x7ffu, 6); }
 float lbk_uf10_to_float(uint32_t code) { return small_decode(code & 0x3ffu, 5); }
 
-uint32_t lbk_pack_r11g11b10f(const float rgb[3])
+uint32_t lbk_r11g11b10f_pack(const float rgb[3])
 {
     return lbk_float_to_uf11(rgb[0]) | (lbk_float_to_uf11(rgb[1]) << 11) | (lbk_float_to_uf10(rgb[2]) << 22);
 }
 
-void lbk_unpack_r11g11b10f(uint32_t packed, float rgb[3])
+void lbk_r11g11b10f_unpack(uint32_t packed, float rgb[3])
 {
     rgb[0] = lbk_uf11_to_float(packed);
     rgb[1] = lbk_uf11_to_float(packed >> 11);
@@ -109,7 +109,7 @@ static double clamp_nonneg(float x, double hi)
     return (double)x > hi ? hi : (double)x;
 }
 
-uint32_t lbk_pack_rgb9e5(const float rgb[3])
+uint32_t lbk_rgb9e5_pack(const float rgb[3])
 {
     const double c[3] = {clamp_nonneg(rgb[0], LBK_RGB9E5_MAX), clamp_nonneg(rgb[1], LBK_RGB9E5_MAX),
                          clamp_nonneg(rgb[2], LBK_RGB9E5_MAX)};
@@ -130,7 +130,7 @@ uint32_t lbk_pack_rgb9e5(const float rgb[3])
     return out;
 }
 
-void lbk_unpack_rgb9e5(uint32_t packed, float rgb[3])
+void lbk_rgb9e5_unpack(uint32_t packed, float rgb[3])
 {
     const int e = (int)(packed >> 27) - 24;
     for (int i = 0; i < 3; i++) rgb[i] = ldexpf((float)((packed >> (9 * i)) & 0x1ffu), e);

@@ -213,6 +213,28 @@ static const issue_row registry[] = {
     {1007, ERROR, LBK_SECTION_OCTP, "OCTP probe position is NaN or infinite"},
     {1008, ERROR, LBK_SECTION_OCTP, "OCTP probe reserved bytes are not zero"},
     {1009, ERROR, LBK_SECTION_OCTP, "OCTP scale is not a positive finite power of two"},
+
+    /* ---- 1100–1199 LMUV (format 1.1) ----------------------------------------------------- */
+    {1100, ERROR, LBK_SECTION_LMUV, "LMUV shorter than its 32-byte header"},
+    {1101, ERROR, LBK_SECTION_LMUV, "LMUV reserved field or padding byte is not zero"},
+    {1102, ERROR, LBK_SECTION_LMUV, "LMUV has no records"},
+    {1103, ERROR, LBK_SECTION_LMUV, "LMUV size differs from the layout its header counts imply"},
+    {1104, ERROR, LBK_SECTION_LMUV, "LMUV header primitive, vertex or index count differs from what the records use"},
+    {1105, ERROR, LBK_SECTION_LMUV, "LMUV record object out of range or records not strictly ascending by object"},
+    {1106, ERROR, LBK_SECTION_LMUV, "LMUV record names an object that is not lightmapped"},
+    {1107, ERROR, LBK_SECTION_LMUV, "LMUV record kind is unknown"},
+    {1108, ERROR, LBK_SECTION_LMUV, "LMUV fields unused by the record's kind are not zero"},
+    {1109, ERROR, LBK_SECTION_LMUV, "LMUV authored scale not positive and finite, or offset or uv box not finite or inverted"},
+    {1110, ERROR, LBK_SECTION_LMUV, "LMUV authored TEXCOORD_1 box maps outside the object's rectangle"},
+    {1111, ERROR, LBK_SECTION_LMUV, "LMUV two records come from the same glTF node"},
+    {1112, ERROR, LBK_SECTION_LMUV, "LMUV primitive, vertex or index range differs from the packed layout"},
+    {1113, ERROR, LBK_SECTION_LMUV, "LMUV primitive empty, index count not a multiple of 3, or source primitives not ascending"},
+    {1114, ERROR, LBK_SECTION_LMUV, "LMUV index out of range of its primitive's vertices"},
+    {1115, ERROR, LBK_SECTION_LMUV, "LMUV remap entry out of range of the source primitive's vertices"},
+    {1116, ERROR, LBK_SECTION_LMUV, "LMUV lightmap coordinate not finite or outside the object's rectangle"},
+    {1117, WARNING, LBK_SECTION_LMUV, "LMUV vertex used by no triangle"},
+    {1118, WARNING, LBK_SECTION_LMUV, "LMUV lightmapped object has no record (an engine cannot map it)"},
+    {1119, ERROR, LBK_SECTION_LMUV, "LMUV is present but there is no OBJS section"},
 };
 
 const char *lbk_issue_template(uint32_t id, lbk_severity *severity)
@@ -225,9 +247,9 @@ const char *lbk_issue_template(uint32_t id, lbk_severity *severity)
     return NULL;
 }
 
-uint32_t lbk_issue_registry_size(void) { return (uint32_t)(sizeof registry / sizeof registry[0]); }
+uint32_t lbk_issue_registry_count(void) { return (uint32_t)(sizeof registry / sizeof registry[0]); }
 
-uint32_t lbk_issue_registry_id(uint32_t index) { return index < lbk_issue_registry_size() ? registry[index].id : 0; }
+uint32_t lbk_issue_registry_id(uint32_t index) { return index < lbk_issue_registry_count() ? registry[index].id : 0; }
 
 uint32_t lbk_issue_section(uint32_t id)
 {

@@ -43,9 +43,14 @@ static void read_record(const uint8_t *r, lbk_report_record *out)
     out->probe_rel_rmse = lbk_rdf32(r + 28);
 }
 
-lbk_result lbk_report_build(const lbk_report *rep, const lbk_allocator *allocator, void **out, size_t *size)
+lbk_result lbk_report_build(const lbk_report *caller_report, const lbk_allocator *allocator, void **out, size_t *size)
 {
-    if (!rep || !out || !size || (!rep->records && rep->record_count)) return LBK_ERR_INVALID_ARGUMENT;
+    if (!caller_report || !out || !size) return LBK_ERR_INVALID_ARGUMENT;
+    lbk_report in;
+    lbk_result rc = LBK_SIZED_IN(&in, caller_report, lbk_report, record_count);
+    if (rc != LBK_OK) return rc;
+    const lbk_report *rep = &in;
+    if (!rep->records && rep->record_count) return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
     *size = 0;
     if (rep->record_count == 0 || rep->status >= LBK_BAKE_STATUS_COUNT_ || (rep->flags & ~LBK_REPORT_HAS_TIMES))
@@ -85,7 +90,7 @@ lbk_result lbk_report_build(const lbk_report *rep, const lbk_allocator *allocato
     return LBK_OK;
 }
 
-lbk_result lbk_report_parse(const void *data, size_t size, lbk_report_view *out)
+lbk_result lbk_report_open(const void *data, size_t size, lbk_report_view *out)
 {
     if (!out || (!data && size)) return LBK_ERR_INVALID_ARGUMENT;
     memset(out, 0, sizeof *out);
@@ -95,6 +100,7 @@ lbk_result lbk_report_parse(const void *data, size_t size, lbk_report_view *out)
     uint64_t need = LBK_REPORT_HEADER_SIZE + (uint64_t)LBK_REPORT_RECORD_SIZE * n;
     if (need > size) return LBK_ERR_TRUNCATED;
     if (need != size) return LBK_ERR_CORRUPT;
+    out->header.size = sizeof out->header;
     out->header.status = lbk_rd32(d + 0);
     out->header.flags = lbk_rd32(d + 4);
     out->header.record_count = n;
@@ -105,7 +111,7 @@ lbk_result lbk_report_parse(const void *data, size_t size, lbk_report_view *out)
     return LBK_OK;
 }
 
-lbk_result lbk_report_record_at(const lbk_report_view *v, uint32_t index, lbk_report_record *out)
+lbk_result lbk_report_record_get(const lbk_report_view *v, uint32_t index, lbk_report_record *out)
 {
     if (!v || !out) return LBK_ERR_INVALID_ARGUMENT;
     if (index >= v->header.record_count) return LBK_ERR_NOT_FOUND;
@@ -123,7 +129,7 @@ void lbk_validate_rept(lbk_vctx *ctx, const uint8_t *d, size_t size)
     }
     lbk_report_view v;
     uint32_t n = lbk_rd32(d + 8);
-    if (lbk_report_parse(d, size, &v) != LBK_OK) {
+    if (lbk_report_open(d, size, &v) != LBK_OK) {
         lbk_vreport(ctx, 351, 8, "REPT of %u records needs %llu bytes, section has %zu", n,
                     (unsigned long long)(LBK_REPORT_HEADER_SIZE + (uint64_t)LBK_REPORT_RECORD_SIZE * n), size);
         return;

@@ -15,7 +15,8 @@ static const struct {
     [LBK_ERR_TRUNCATED] = {"LBK_ERR_TRUNCATED", "the data ends before the structure it describes"},
     [LBK_ERR_UNSUPPORTED_VERSION] = {"LBK_ERR_UNSUPPORTED_VERSION", "unsupported container major version"},
     [LBK_ERR_UNSUPPORTED_FEATURE] = {"LBK_ERR_UNSUPPORTED_FEATURE",
-                                     "unknown required feature flag or required section type"},
+                                     "unknown required feature flag or required section type, or an "
+                                     "options/desc field this library does not know"},
     [LBK_ERR_CORRUPT] = {"LBK_ERR_CORRUPT", "the container breaks a structural rule of the format"},
     [LBK_ERR_CHECKSUM] = {"LBK_ERR_CHECKSUM", "checksum mismatch"},
     [LBK_ERR_DECOMPRESS] = {"LBK_ERR_DECOMPRESS", "decompression failed or gave the wrong length"},
@@ -23,6 +24,9 @@ static const struct {
     [LBK_ERR_LIMIT] = {"LBK_ERR_LIMIT", "a size exceeds a limit"},
     [LBK_ERR_RANGE] = {"LBK_ERR_RANGE", "a value is outside the range the encoding can hold"},
     [LBK_ERR_OVERLAPS] = {"LBK_ERR_OVERLAPS", "more dynamic light set overlaps than the format allows"},
+    [LBK_ERR_CANCELLED] = {"LBK_ERR_CANCELLED", "cancelled by the caller"},
+    [LBK_ERR_BAD_INPUT] = {"LBK_ERR_BAD_INPUT", "the input is unusable"},
+    [LBK_ERR_INTERNAL] = {"LBK_ERR_INTERNAL", "internal error"},
 };
 
 const char *lbk_result_name(lbk_result r)

@@ -126,9 +126,9 @@ void lbk_sh9_rotate(const lbk_sh9_rgb *sh, const float r[3][3], lbk_sh9_rgb *out
 void lbk_sh9_pack(const lbk_sh9_rgb *sh, uint8_t out[LBK_SH9_PACKED_SIZE])
 {
     const float dc[3] = {sh->c[0][0], sh->c[1][0], sh->c[2][0]};
-    const uint32_t packed_dc = lbk_pack_rgb9e5(dc);
+    const uint32_t packed_dc = lbk_rgb9e5_pack(dc);
     float dq[3];
-    lbk_unpack_rgb9e5(packed_dc, dq);
+    lbk_rgb9e5_unpack(packed_dc, dq);
     out[0] = (uint8_t)packed_dc;
     out[1] = (uint8_t)(packed_dc >> 8);
     out[2] = (uint8_t)(packed_dc >> 16);
@@ -146,7 +146,7 @@ void lbk_sh9_unpack(const uint8_t in[LBK_SH9_PACKED_SIZE], lbk_sh9_rgb *sh)
     const uint32_t packed_dc = (uint32_t)in[0] | ((uint32_t)in[1] << 8) | ((uint32_t)in[2] << 16) |
                                ((uint32_t)in[3] << 24);
     float dq[3];
-    lbk_unpack_rgb9e5(packed_dc, dq);
+    lbk_rgb9e5_unpack(packed_dc, dq);
     for (int c = 0; c < 3; c++) {
         sh->c[c][0] = dq[c];
         for (int k = 1; k < LBK_SH9_COUNT; k++)

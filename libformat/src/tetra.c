@@ -45,7 +45,7 @@ static bool bary_d(const lbk_tetra_mesh *m, uint32_t t, const float p[3], uint32
 lbk_result lbk_tetra_barycentric(const lbk_tetra_mesh *mesh, uint32_t tetra, const float p[3], float bary[4])
 {
     if (!mesh || !p || !bary) return LBK_ERR_INVALID_ARGUMENT;
-    if (tetra >= mesh->tetra_count) return LBK_ERR_RANGE;
+    if (tetra >= mesh->tetra_count) return LBK_ERR_NOT_FOUND;
     uint32_t vid[4];
     double b[4];
     if (!bary_d(mesh, tetra, p, vid, b)) return LBK_ERR_CORRUPT;

@@ -74,7 +74,8 @@ static const struct {
 } dependency_order[] = {
     {LBK_SECTION_META, lbk_validate_meta}, {LBK_SECTION_REPT, lbk_validate_rept}, {LBK_SECTION_LMAP, lbk_validate_lmap},
     {LBK_SECTION_GLG, lbk_validate_glg},   {LBK_SECTION_LLG, lbk_validate_llg},   {LBK_SECTION_OCTP, lbk_validate_octp},
-    {LBK_SECTION_OBJS, lbk_validate_objs}, {LBK_SECTION_DLS, lbk_validate_dls},   {LBK_SECTION_DOOR, lbk_validate_door},
+    {LBK_SECTION_OBJS, lbk_validate_objs}, {LBK_SECTION_LMUV, lbk_validate_lmuv}, {LBK_SECTION_DLS, lbk_validate_dls},
+    {LBK_SECTION_DOOR, lbk_validate_door},
 };
 
 static const char *load_message(uint32_t id)
@@ -105,17 +106,19 @@ static void check_dependencies(lbk_vctx *ctx)
         vreport_at(ctx, 221, 0, LBK_HEADER_SIZE, "'DOOR' is present but there is no 'DLS ' section");
 }
 
-lbk_result lbk_validate_memory(const void *data, size_t size, const lbk_validate_options *options,
+lbk_result lbk_validate_memory(const void *data, size_t size, const lbk_validate_options *caller_options,
                                lbk_issue_callback callback, void *user, lbk_validate_summary *summary)
 {
     lbk_validate_summary local;
     if (!summary) summary = &local;
     memset(summary, 0, sizeof *summary);
     if (!data && size) return LBK_ERR_INVALID_ARGUMENT;
+    lbk_validate_options options;
+    lbk_result rc = LBK_SIZED_IN(&options, caller_options, lbk_validate_options, max_decoded_bytes);
+    if (rc != LBK_OK) return rc;
     const uint8_t *d = data;
     lbk_allocator alloc = {0};
-    if (options && options->allocator && options->allocator->alloc && options->allocator->free)
-        alloc = *options->allocator;
+    if (options.allocator && options.allocator->alloc && options.allocator->free) alloc = *options.allocator;
 
     lbk_framing *fr = lbk_alloc(&alloc, sizeof *fr);
     if (!fr) return LBK_ERR_OUT_OF_MEMORY;
@@ -151,8 +154,7 @@ lbk_result lbk_validate_memory(const void *data, size_t size, const lbk_validate
     check_dependencies(&ctx);
 
     /* Pass 2, dependency order: decode and run each section's validator. */
-    uint64_t budget = options && options->max_decoded_bytes ? options->max_decoded_bytes
-                                                            : lbk_default_decode_cap(size);
+    uint64_t budget = options.max_decoded_bytes ? options.max_decoded_bytes : lbk_default_decode_cap(size);
     for (size_t k = 0; k < sizeof dependency_order / sizeof dependency_order[0] && !ctx.stop; k++) {
         uint32_t i;
         for (i = 0; i < fr->count; i++)
@@ -188,6 +190,7 @@ lbk_result lbk_validate_memory(const void *data, size_t size, const lbk_validate
 done:
     lbk_dealloc(&alloc, (void *)ctx.lmap_page_width);
     lbk_dealloc(&alloc, (void *)ctx.lmap_page_height);
+    lbk_dealloc(&alloc, ctx.objs_facts);
     lbk_dealloc(&alloc, ctx.dls_facts);
     lbk_dealloc(&alloc, fr);
     return result;

@@ -11,6 +11,8 @@
 #include <string.h>
 
 #include "bake/layout/atlas.h"
+#include "bake/layout/atlas_stats.h"
+#include "bake/layout/texels.h"
 #include "support/uv_scenes.h"
 
 /* A unit-ish quad in the y = h plane as its own object. */
@@ -90,10 +92,17 @@ static void check_layout(const bk_scene *s, const bk_atlas *a, int max_page)
                         assert_int_equal(blocks[(size_t)y * (size_t)w + (size_t)x], 0);
                         blocks[(size_t)y * (size_t)w + (size_t)x] = 1;
                     }
-                /* every corner of its triangles inside the content rectangle */
+                /* every corner of its triangles inside the content rectangle; generated charts
+                 * are never mirrored (a turn is a rotation): their triangles stay counter-
+                 * clockwise in page coordinates, whatever the packer did */
+                assert_true(ch->quarter_turns <= 2);
+                if (ob->uv_source != BK_UV_GENERATED) assert_int_equal(ch->quarter_turns, 0);
                 for (uint32_t t = ch->first; t < ch->first + ch->count; t++) {
                     assert_int_equal(a->tri_chart[t], c);
                     assert_int_equal(a->scene_tri_entry[a->tris[t]], (int32_t)t);
+                    const float *q = a->tri_uv + 6 * (size_t)t;
+                    double orient = ((double)q[2] - q[0]) * ((double)q[5] - q[1]) - ((double)q[3] - q[1]) * ((double)q[4] - q[0]);
+                    if (ob->uv_source == BK_UV_GENERATED) assert_true(orient > 0.0);
                     for (int k = 0; k < 3; k++) {
                         float u = a->tri_uv[6 * t + 2 * (size_t)k], v = a->tri_uv[6 * t + 2 * (size_t)k + 1];
                         assert_true(u >= (float)ch->x && u <= (float)(ch->x + ch->w));
@@ -143,6 +152,7 @@ static void test_layout_rules(void **state)
     bk_atlas_options o = {0};
     o.default_density = 24.0f;
     o.page_size = 128; /* small pages: forces several */
+    o.max_page_size = 128;
     bk_atlas a;
     assert_int_equal(bk_atlas_build(&s, NULL, &o, &a), LBK_OK);
     assert_int_equal(a.object_count, s.object_count);
@@ -409,6 +419,114 @@ static void test_vertex_split(void **state)
     uvs_free(&s);
 }
 
+/* Long thin strips make the packer turn charts (and objects). A turn is a rotation of the
+ * chart: every triangle keeps its world edge lengths × density in texels, stays counter-
+ * clockwise, and the tangent frame rule holds on turned charts too (the texel to the right lies
+ * one texel along T, the one below one texel along B = N × T). */
+static void test_turns_keep_mapping(void **state)
+{
+    (void)state;
+    bk_scene s;
+    uvs_init(&s);
+    uvs_object(&s, "strips");
+    for (int i = 0; i < 12; i++) {
+        float len = 0.5f + 0.13f * (float)i, z = -0.3f * (float)i;
+        float p0[3] = {0, 0, z}, p1[3] = {len, 0, z}, p2[3] = {len, 0, z - 0.1f}, p3[3] = {0, 0, z - 0.1f};
+        uvs_quad(&s, p0, p1, p2, p3, 1, 0, NULL, 1.0f);
+    }
+    for (int i = 0; i < 10; i++) {
+        char name[32];
+        snprintf(name, sizeof name, "plank%d", i);
+        add_quad_object(&s, name, 5.0f + (float)i, 0, 0.15f, 0.6f + 0.2f * (float)i, 0, 1);
+    }
+    bk_atlas_options o = {0};
+    o.default_density = 20.0f;
+    bk_atlas a;
+    assert_int_equal(bk_atlas_build(&s, NULL, &o, &a), LBK_OK);
+    check_layout(&s, &a, 4096);
+    size_t turned = 0;
+    for (size_t c = 0; c < a.chart_count; c++) turned += a.charts[c].quarter_turns & 1;
+    assert_true(turned >= 3);
+    assert_true(turned < a.chart_count);
+    for (size_t t = 0; t < a.tri_count; t++) {
+        const float *q = a.tri_uv + 6 * t;
+        for (int k = 0; k < 3; k++) {
+            const float *pa = s.positions + 3 * s.tris[3 * a.tris[t] + (size_t)k];
+            const float *pb = s.positions + 3 * s.tris[3 * a.tris[t] + (size_t)((k + 1) % 3)];
+            double wl = sqrt(((double)pb[0] - pa[0]) * ((double)pb[0] - pa[0]) + ((double)pb[2] - pa[2]) * ((double)pb[2] - pa[2]));
+            double du = (double)q[2 * ((k + 1) % 3)] - q[2 * k], dv = (double)q[2 * ((k + 1) % 3) + 1] - q[2 * k + 1];
+            assert_float_equal(sqrt(du * du + dv * dv), 20.0 * wl, 1e-3 * 20.0 * wl + 1e-4);
+        }
+    }
+    bk_texels tx;
+    assert_int_equal(bk_texels_build(&s, &a, &tx), LBK_OK);
+    size_t checked = 0, checked_turned = 0;
+    for (size_t i = 0; i < tx.count; i++) {
+        const bk_texel *r = &tx.receivers[i], *right = bk_texels_at(&tx, r->page, r->x + 1, r->y),
+                      *down = bk_texels_at(&tx, r->page, r->x, r->y + 1);
+        if (!right || !down || (r->flags | right->flags | down->flags) & BK_TEXEL_EDGE) continue;
+        uint32_t c = a.tri_chart[a.scene_tri_entry[r->tri]];
+        if (c != a.tri_chart[a.scene_tri_entry[right->tri]] || c != a.tri_chart[a.scene_tri_entry[down->tri]]) continue;
+        float b[3] = {r->normal[1] * r->tangent[2] - r->normal[2] * r->tangent[1],
+                      r->normal[2] * r->tangent[0] - r->normal[0] * r->tangent[2],
+                      r->normal[0] * r->tangent[1] - r->normal[1] * r->tangent[0]};
+        for (int k = 0; k < 3; k++) {
+            assert_float_equal(right->position[k] - r->position[k], r->tangent[k] * r->texel_size, 1e-4);
+            assert_float_equal(down->position[k] - r->position[k], b[k] * r->texel_size, 1e-4);
+        }
+        checked++;
+        checked_turned += a.charts[c].quarter_turns & 1;
+    }
+    assert_true(checked > 200);
+    assert_true(checked_turned > 20);
+    bk_texels_free(&tx);
+    bk_atlas_free(&a);
+    uvs_free(&s);
+}
+
+/* A deterministic pseudo-random size in [lo, hi). */
+static float lcg_size(uint32_t *st, float lo, float hi)
+{
+    *st = *st * 1664525u + 1013904223u;
+    return lo + (hi - lo) * (float)(*st >> 8) / 16777216.0f;
+}
+
+/* Fill on many charts at the default padding 2: 150 quads of 0.3–2.5 m (16 texels/m) as
+ * objects of their own, and the same quads as 150 charts of one object. Covered texels / page
+ * texels must reach the 80 % goal (the block rings alone cost ~10 % at these sizes). */
+static void test_fill_many_charts(void **state)
+{
+    (void)state;
+    for (int one_object = 0; one_object < 2; one_object++) {
+        bk_scene s;
+        uvs_init(&s);
+        uint32_t st = 12345u;
+        if (one_object) uvs_object(&s, "all");
+        for (int i = 0; i < 150; i++) {
+            float w = lcg_size(&st, 0.3f, 2.5f), d = lcg_size(&st, 0.3f, 2.5f);
+            if (!one_object) {
+                char name[32];
+                snprintf(name, sizeof name, "q%d", i);
+                uvs_object(&s, name);
+            }
+            float x = 3.0f * (float)i, p0[3] = {x, 0, 0}, p1[3] = {x + w, 0, 0}, p2[3] = {x + w, 0, -d}, p3[3] = {x, 0, -d};
+            uvs_quad(&s, p0, p1, p2, p3, 1, 0, NULL, 1.0f);
+        }
+        bk_atlas_options o = {0};
+        o.default_density = 16.0f;
+        bk_atlas a;
+        assert_int_equal(bk_atlas_build(&s, NULL, &o, &a), LBK_OK);
+        check_layout(&s, &a, 4096);
+        bk_atlas_stats stt;
+        assert_int_equal(bk_atlas_stats_compute(&a, &stt), LBK_OK);
+        assert_int_equal(stt.charts, 150);
+        assert_true(stt.fill >= 0.80);
+        assert_true(stt.fill_rects >= stt.fill);
+        bk_atlas_free(&a);
+        uvs_free(&s);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -420,6 +538,8 @@ int main(void)
         cmocka_unit_test(test_last_page_tight),
         cmocka_unit_test(test_selection_and_limits),
         cmocka_unit_test(test_vertex_split),
+        cmocka_unit_test(test_turns_keep_mapping),
+        cmocka_unit_test(test_fill_many_charts),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

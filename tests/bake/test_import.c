@@ -1141,6 +1141,106 @@ static void test_malformed_structure(void **state)
     assert_non_null(strstr(err, "cap"));
 }
 
+/* Import is linear in the JSON's size: 10^5 nodes (most of them empty, as a DoS file would have
+ * them) import; with the callback depth check they took minutes (quadratic: 20 k 1.4 s, 80 k
+ * 17 s). Brackets inside strings are not nesting. The time ratio 10^5 : 10^6 is in bench_import. */
+static void test_many_nodes(void **state)
+{
+    (void)state;
+    write_quad_bin();
+    enum { N = 100000 };
+    size_t cap = (size_t)N * 24 + 4096, n = 0;
+    char *json = malloc(cap);
+    assert_non_null(json);
+    n += (size_t)snprintf(json + n, cap - n,
+                          "{\"asset\":{\"version\":\"2.0\"},"
+                          "\"buffers\":[{\"uri\":\"quad.bin\",\"byteLength\":108}],"
+                          "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},"
+                          "{\"buffer\":0,\"byteOffset\":48,\"byteLength\":12}],"
+                          "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
+                          "{\"bufferView\":1,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],"
+                          "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
+                          "\"nodes\":[{\"mesh\":0,\"name\":\"");
+    for (int i = 0; i < 300; i++) json[n++] = '['; /* deeper than the depth cap, but inside a string */
+    n += (size_t)snprintf(json + n, cap - n, "\"}");
+    for (int i = 0; i < N; i++) n += (size_t)snprintf(json + n, cap - n, ",{}");
+    n += (size_t)snprintf(json + n, cap - n, "],\"scenes\":[{\"nodes\":[0");
+    for (int i = 1; i <= N; i++) n += (size_t)snprintf(json + n, cap - n, ",%d", i);
+    n += (size_t)snprintf(json + n, cap - n, "]}],\"scene\":0}");
+    assert_true(n < cap);
+    write_file("many_nodes.gltf", json, n);
+    free(json);
+    bk_scene s;
+    char err[1024];
+    int rc = import_tmp("many_nodes.gltf", &s, NULL, err, sizeof err);
+    if (rc) printf("many_nodes.gltf: %s\n", err);
+    assert_int_equal(rc, 0);
+    assert_int_equal(s.object_count, 1);
+    assert_int_equal(s.tri_count, 2);
+    bk_scene_free(&s);
+}
+
+/* Resources resolve inside the scene's folder only: `..` escapes and symlinks pointing out are
+ * refused with a message naming the cause unless allow_outside admits their folder; absolute
+ * paths and URI schemes are always refused. */
+static void write_buffer_gltf(const char *name, const char *uri)
+{
+    char json[1024];
+    snprintf(json, sizeof json,
+             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"uri\":\"%s\",\"byteLength\":108}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},"
+             "{\"buffer\":0,\"byteOffset\":48,\"byteLength\":12}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
+             "{\"bufferView\":1,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
+             "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0}",
+             uri);
+    write_text(name, json);
+}
+
+static void test_resource_policy(void **state)
+{
+    (void)state;
+    write_quad_bin(); /* tmp/quad.bin, outside tmp/sub */
+    char sub[512], link[600], abs_uri[600], target[600];
+    tmp_path(sub, sizeof sub, "sub");
+    assert_int_equal(mkdir(sub, 0755), 0);
+    write_buffer_gltf("sub/escape.gltf", "../quad.bin");
+    expect_error("sub/escape.gltf", "outside the scene's folder", "quad.bin");
+    tmp_path(target, sizeof target, "quad.bin");
+    snprintf(abs_uri, sizeof abs_uri, "%s", target);
+    write_buffer_gltf("sub/absolute.gltf", abs_uri);
+    expect_error("sub/absolute.gltf", "not a path relative", "buffer 0");
+    write_buffer_gltf("sub/scheme.gltf", "file:///etc/passwd");
+    expect_error("sub/scheme.gltf", "not a path relative", NULL);
+    snprintf(link, sizeof link, "%s/link.bin", sub);
+    assert_int_equal(symlink(target, link), 0);
+    write_buffer_gltf("sub/symlink.gltf", "link.bin");
+    expect_error("sub/symlink.gltf", "outside the scene's folder", NULL);
+    /* the same files with the outside folder allowed */
+    bk_import_options o;
+    memset(&o, 0, sizeof o);
+    char tmpdir[512];
+    tmp_path(tmpdir, sizeof tmpdir, "");
+    o.allow_outside = tmpdir;
+    const char *names[] = {"sub/escape.gltf", "sub/symlink.gltf"};
+    for (int i = 0; i < 2; i++) {
+        bk_scene s;
+        char err[1024];
+        int rc = import_tmp(names[i], &s, &o, err, sizeof err);
+        if (rc) printf("%s: %s\n", names[i], err);
+        assert_int_equal(rc, 0);
+        assert_int_equal(s.tri_count, 2);
+        bk_scene_free(&s);
+    }
+    /* a link that stays inside is fine without permission */
+    char inner[600];
+    snprintf(inner, sizeof inner, "%s/inner.bin", sub);
+    assert_int_equal(symlink("link.bin", inner), 0); /* inner -> link -> outside: still outside */
+    write_buffer_gltf("sub/inner.gltf", "inner.bin");
+    expect_error("sub/inner.gltf", "outside the scene's folder", NULL);
+}
+
 static void test_malformed_glb(void **state)
 {
     (void)state;
@@ -1318,6 +1418,8 @@ int main(void)
         cmocka_unit_test(test_required_extension),
         cmocka_unit_test(test_malformed_accessors),
         cmocka_unit_test(test_malformed_structure),
+        cmocka_unit_test(test_many_nodes),
+        cmocka_unit_test(test_resource_policy),
         cmocka_unit_test(test_malformed_glb),
         cmocka_unit_test(test_draco_corrupt),
         cmocka_unit_test(test_scene_utilities),

@@ -5,6 +5,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -117,6 +118,57 @@ static void test_glg_room_placement(void **state)
     psc_free(&s);
 }
 
+/* The tetrahedra tile the convex hull of the probes: no gap, no overlap. The probes inside the
+ * room's walls span a box, and when its 8 corners are probes the hull is that box, so its volume
+ * is Δx·Δy·Δz (no qhull needed). Both sides are computed in double from float positions, so the
+ * comparison allows their rounding (u = 2^-53, γ_n = n·u / (1 − n·u), Higham ch. 3):
+ *   - one tetra: orient = Σ ± u_i·v_j·w_k over 6 terms; each term passes 3 subtractions (the
+ *     edge vectors), 3 products and 2 additions, and /6 adds one more: |err| ≤ γ_9 · P / 6 with
+ *     P the permanent of the absolute edge matrix; γ_10 covers the rounding of P itself;
+ *   - the sum of N positive volumes: ≤ γ_N · Σ vol;
+ *   - the box: 3 subtractions and 2 products, ≤ γ_5 · box.
+ * A missing or doubled tetra (volume ≫ that bound: 145 tetras give about 4e-12 here) fails. */
+static double gamma_n(double n) { return n * (DBL_EPSILON / 2) / (1 - n * (DBL_EPSILON / 2)); }
+
+static void assert_tets_fill_box_hull(const bk_glg *g)
+{
+    float lo[3], hi[3];
+    memcpy(lo, g->positions, sizeof lo);
+    memcpy(hi, g->positions, sizeof hi);
+    for (size_t i = 0; i < g->probe_count; i++)
+        for (int k = 0; k < 3; k++) {
+            lo[k] = fminf(lo[k], g->positions[3 * i + k]);
+            hi[k] = fmaxf(hi[k], g->positions[3 * i + k]);
+        }
+    unsigned corners = 0; /* bit c: corner (x: bit 0, y: bit 1, z: bit 2 of c; set = hi) is a probe */
+    for (size_t i = 0; i < g->probe_count; i++) {
+        int c = 0, on = 1;
+        for (int k = 0; k < 3; k++) {
+            float x = g->positions[3 * i + k];
+            on &= x == lo[k] || x == hi[k];
+            c |= (x == hi[k]) << k;
+        }
+        if (on) corners |= 1u << c;
+    }
+    assert_int_equal(corners, 0xff); /* the hull is the box */
+    const double box = ((double)hi[0] - lo[0]) * ((double)hi[1] - lo[1]) * ((double)hi[2] - lo[2]);
+    double sum = 0.0, perm = 0.0;
+    for (size_t t = 0; t < g->tet_count; t++) {
+        const float *p[4];
+        for (int i = 0; i < 4; i++) p[i] = g->positions + 3 * (size_t)g->tets[4 * t + (size_t)i];
+        sum += bk_tet_signed_volume(p[0], p[1], p[2], p[3]);
+        double e[3][3];
+        for (int r = 0; r < 3; r++)
+            for (int k = 0; k < 3; k++) e[r][k] = fabs((double)p[r + 1][k] - p[0][k]);
+        perm += e[0][0] * (e[1][1] * e[2][2] + e[1][2] * e[2][1]) + e[0][1] * (e[1][0] * e[2][2] + e[1][2] * e[2][0]) +
+                e[0][2] * (e[1][0] * e[2][1] + e[1][1] * e[2][0]);
+    }
+    const double bound = gamma_n(10) * perm / 6 + gamma_n((double)g->tet_count) * sum + gamma_n(5) * box;
+    print_message("tetra volumes %.17g, hull (box) %.17g, |difference| %.3g, bound %.3g\n", sum, box, fabs(sum - box),
+                  bound);
+    assert_true(fabs(sum - box) <= bound);
+}
+
 static void test_glg_cap_and_build(void **state)
 {
     (void)state;
@@ -132,19 +184,16 @@ static void test_glg_cap_and_build(void **state)
     assert_true(g.probe_count <= 60 && g.probe_count >= 4);
     assert_int_equal(g.refine_levels, 0);      /* coarsened near surfaces first */
     assert_true(g.tet_count > 0);
-    double vol = 0.0;
     for (size_t t = 0; t < g.tet_count; t++) {
         const uint32_t *v = g.tets + 4 * t;
-        double tv = bk_tet_signed_volume(g.positions + 3 * (size_t)v[0], g.positions + 3 * (size_t)v[1],
-                                         g.positions + 3 * (size_t)v[2], g.positions + 3 * (size_t)v[3]);
-        assert_true(tv > 0.0);
-        vol += tv;
+        assert_true(bk_tet_signed_volume(g.positions + 3 * (size_t)v[0], g.positions + 3 * (size_t)v[1],
+                                         g.positions + 3 * (size_t)v[2], g.positions + 3 * (size_t)v[3]) > 0.0);
         for (int i = 0; i < 4; i++) {
             float f = g.face_visibility[4 * t + (size_t)i];
             assert_true(f >= 0.0f && f <= 1.0f);
         }
     }
-    assert_true(vol > 0.0 && vol < 10.0 * 6.0 * 8.0);
+    assert_tets_fill_box_hull(&g);
     /* the container's GLG builder accepts the mesh as is (orientation, adjacency, visibility) */
     uint8_t (*vis8)[4] = malloc(g.tet_count * sizeof *vis8);
     lbk_sh9_rgb *sh = calloc(g.probe_count, sizeof *sh);
@@ -152,9 +201,9 @@ static void test_glg_cap_and_build(void **state)
     for (size_t t = 0; t < g.tet_count; t++)
         for (int i = 0; i < 4; i++)
             assert_int_equal(vis8[t][i], (int)lrintf(g.face_visibility[4 * t + (size_t)i] * 255.0f));
-    lbk_glg_desc desc = {(uint32_t)g.probe_count, (uint32_t)g.tet_count, (const float (*)[3])g.positions, sh,
-                         (const uint32_t (*)[4])g.tets, (const uint32_t (*)[4])g.neighbours,
-                         (const uint8_t (*)[4])vis8, 0};
+    lbk_glg_build_desc desc = {.probe_count = (uint32_t)g.probe_count, .tetra_count = (uint32_t)g.tet_count,
+        .positions = (const float (*)[3])g.positions, .probes = sh, .tetras = (const uint32_t (*)[4])g.tets,
+        .adjacency = (const uint32_t (*)[4])g.neighbours, .visibility = (const uint8_t (*)[4])vis8};
     void *bytes = NULL;
     size_t size = 0;
     assert_int_equal(lbk_glg_build(&desc, NULL, &bytes, &size), LBK_OK);
@@ -199,6 +248,7 @@ static void test_glg_extreme_scales(void **state)
                 assert_true(box_distance_outside(q, BLOCK_LO, BLOCK_HI) > 0.0);
             }
             for (size_t t = 0; t < 4 * g.tet_count; t++) assert_true(isfinite(g.face_visibility[t]));
+            if (c < 2) assert_tets_fill_box_hull(&g); /* at 1 mm the probes do not span a box */
         }
         bk_glg_free(&g);
         bk_tracer_destroy(tr);
@@ -354,18 +404,19 @@ static void test_llg_obb_rotated_box(void **state)
         memset(&gd, 0, sizeof gd);
         memcpy(gd.centre, l.centre, sizeof gd.centre);
         memcpy(gd.axes, l.axes, sizeof gd.axes);
-        memcpy(gd.half_extent, l.half_extents, sizeof gd.half_extent);
+        memcpy(gd.half_extents, l.half_extents, sizeof gd.half_extents);
         memcpy(gd.dims, l.dims, sizeof gd.dims);
         gd.probes = sh;
         gd.vertices = recs;
         gd.vertex_count = (uint32_t)l.vertex_count;
         void *bytes = NULL;
         size_t size = 0;
-        assert_int_equal(lbk_llg_build(&gd, 1, 0, NULL, &bytes, &size), LBK_OK);
+        assert_int_equal(lbk_llg_build(&(lbk_llg_build_desc){.grids = &gd,
+            .grid_count = 1}, NULL, &bytes, &size), LBK_OK);
         lbk_llg_view view;
         lbk_llg_grid grid;
         assert_int_equal(lbk_llg_open(bytes, size, &view), LBK_OK);
-        assert_int_equal(lbk_llg_get_grid(&view, 0, &grid), LBK_OK);
+        assert_int_equal(lbk_llg_grid_get(&view, 0, &grid), LBK_OK);
         for (uint32_t k = 0; k < l.dims[2]; k++) for (uint32_t j = 0; j < l.dims[1]; j++)
             for (uint32_t i = 0; i < l.dims[0]; i++) {
                 float a[3], b[3];

@@ -488,11 +488,27 @@ static void on_report(void *user, const bk_transport_sample *s)
     rec *r = (rec *)user;
     if (r->n < 32) r->s[r->n++] = *s;
 }
-static void on_progress(void *user, const char *phase, double f)
+static int on_progress(void *user, const char *phase, double f)
 {
     (void)user;
     assert_true(strcmp(phase, "cache") == 0 || strcmp(phase, "gather") == 0);
     assert_true(f >= 0 && f <= 1);
+    return 0;
+}
+
+typedef struct cancel_at {
+    int calls, stop_at;
+    rec reports;
+} cancel_at;
+static int cancel_progress(void *user, const char *phase, double f)
+{
+    (void)phase, (void)f;
+    cancel_at *c = user;
+    return ++c->calls >= c->stop_at;
+}
+static void cancel_report(void *user, const bk_transport_sample *s)
+{
+    on_report(&((cancel_at *)user)->reports, s);
 }
 
 static void test_stop_rules_and_report(void **state)
@@ -535,6 +551,23 @@ static void test_stop_rules_and_report(void **state)
     assert_int_equal(c.st.stop, BK_STOP_TIME);
     assert_int_equal(c.st.passes, 1);
     run_free(&c);
+    /* a progress callback that says stop: the run returns at that checkpoint, before any pass
+     * completes (the third checkpoint is inside pass 0's gather) */
+    o = fixed_opt(4);
+    cancel_at ca = {0, 3, {0}};
+    o.progress = cancel_progress;
+    o.report = cancel_report;
+    o.user = &ca;
+    bk_tracer *t = NULL;
+    assert_int_equal(bk_tracer_create(&s, 0, &t), LBK_OK);
+    lbk_sh9_rgb *rad = calloc(ROOM_N, sizeof *rad);
+    bk_transport_output out = {rad, NULL, NULL};
+    bk_transport_stats st;
+    assert_int_equal(bk_transport_run(&s, t, r, ROOM_N, &o, &out, &st), LBK_ERR_CANCELLED);
+    assert_int_equal(ca.calls, 3);
+    assert_int_equal(ca.reports.n, 0);
+    free(rad);
+    bk_tracer_destroy(t);
     tsc_free(&s);
 }
 

@@ -439,6 +439,75 @@ static void test_deterministic(void **state)
     uvs_free(&s);
 }
 
+/* Small charts go into a neighbour: a 50 cm panel (2×2 cells, 5 × 5 texels at 10 texels/m)
+ * with a 10 cm strip bevelled at 45° along one side (5 × 1 texels) and a 25 × 10 cm tab folded
+ * down 90° on one cell edge (3 × 1 texels) becomes one chart: each merge makes the chart's
+ * block (content plus its ring) smaller than the two blocks were (7×7 + 7×3 → 8×7, then + 5×3
+ * → 8×8). The hinge unfolding keeps every edge length (× density) and the merged chart has no
+ * overlap. Two 1 m panels at 90° (10 × 10 texels each) stay two charts, and so does a 90° jamb
+ * one texel wide (a hard edge is crossed by tiny charts only). */
+static void test_merge_small_charts(void **state)
+{
+    (void)state;
+    bk_scene s;
+    uvs_init(&s);
+    uvs_object(&s, "panel+bevel+tab");
+    float p0[3] = {0, 0, 0}, p1[3] = {0.5f, 0, 0}, p2[3] = {0.5f, 0, -0.5f}, p3[3] = {0, 0, -0.5f};
+    uvs_quad(&s, p0, p1, p2, p3, 2, 0, NULL, 1.0f);
+    const float b = 0.1f / sqrtf(2.0f);
+    /* shares the panel's vertices along x = 0.5 (the same positions, welded exactly) */
+    float q0[3] = {0.5f, 0, 0}, q1[3] = {0.5f + b, -b, 0}, q2[3] = {0.5f + b, -b, -0.5f}, q3[3] = {0.5f, 0, -0.5f};
+    uvs_quad(&s, q0, q1, q2, q3, 2, 0, NULL, 1.0f);
+    float t0[3] = {0.25f, 0, 0}, t1[3] = {0, 0, 0}, t2[3] = {0.125f, -0.1f, 0};
+    uvs_tri(&s, t0, t1, t2, 0);
+    uvs_update_bounds(&s);
+    bk_uv_object u;
+    assert_int_equal(bk_uvgen_object(&s, 0, 10.0f, NULL, &u), LBK_OK);
+    check_invariants(&s, &u);
+    assert_int_equal(u.chart_count, 1);
+    assert_int_equal(u.tri_count, s.tri_count);
+    for (size_t i = 0; i < u.tri_count; i++) {
+        const float *q = u.uv + 6 * i;
+        for (int k = 0; k < 3; k++) {
+            const float *pa = s.positions + 3 * s.tris[3 * u.tris[i] + (size_t)k];
+            const float *pb = s.positions + 3 * s.tris[3 * u.tris[i] + (size_t)((k + 1) % 3)];
+            double wl = 0.0;
+            for (int c = 0; c < 3; c++) wl += ((double)pb[c] - pa[c]) * ((double)pb[c] - pa[c]);
+            double du = (double)q[2 * ((k + 1) % 3)] - q[2 * k], dv = (double)q[2 * ((k + 1) % 3) + 1] - q[2 * k + 1];
+            assert_float_equal(sqrt(du * du + dv * dv), 10.0 * sqrt(wl), 1e-3);
+        }
+    }
+    /* 0.25 m² + 0.05 m² + 0.0125 m² at 10 texels/m */
+    assert_float_equal(chart_uv_area(&u), 100.0 * (0.25 + 0.05 + 0.0125), 0.02);
+    bk_uv_object_free(&u);
+    uvs_free(&s);
+
+    uvs_init(&s);
+    uvs_object(&s, "L");
+    float f0[3] = {0, 0, 0}, f1[3] = {1, 0, 0}, f2[3] = {1, 0, -1}, f3[3] = {0, 0, -1};
+    float w0[3] = {0, 0, 0}, w1[3] = {0, 0, -1}, w2[3] = {0, 1, -1}, w3[3] = {0, 1, 0};
+    uvs_quad(&s, f0, f1, f2, f3, 1, 0, NULL, 1.0f);
+    uvs_quad(&s, w0, w1, w2, w3, 1, 0, NULL, 1.0f);
+    assert_int_equal(bk_uvgen_object(&s, 0, 10.0f, NULL, &u), LBK_OK);
+    check_invariants(&s, &u);
+    assert_int_equal(u.chart_count, 2);
+    bk_uv_object_free(&u);
+    uvs_free(&s);
+
+    /* a 10 cm jamb at 90° along a 1 m panel: small (10 × 1 texels) but not tiny, and the fold is
+     * a hard edge, so it keeps its own chart */
+    uvs_init(&s);
+    uvs_object(&s, "jamb");
+    float j0[3] = {1, 0, 0}, j1[3] = {1, -0.1f, 0}, j2[3] = {1, -0.1f, -1}, j3[3] = {1, 0, -1};
+    uvs_quad(&s, f0, f1, f2, f3, 1, 0, NULL, 1.0f);
+    uvs_quad(&s, j0, j1, j2, j3, 1, 0, NULL, 1.0f);
+    assert_int_equal(bk_uvgen_object(&s, 0, 10.0f, NULL, &u), LBK_OK);
+    check_invariants(&s, &u);
+    assert_int_equal(u.chart_count, 2);
+    bk_uv_object_free(&u);
+    uvs_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -454,6 +523,7 @@ int main(void)
         cmocka_unit_test(test_sphere_charts),
         cmocka_unit_test(test_spiral_overlap_split),
         cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_merge_small_charts),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -12,11 +12,13 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cjson/cJSON.h>
 
-#include "bake/pipeline/bake.h"
+#include "lbk/bake.h"
+#include "tests/support/bake_file.h"
 #include "cli/cli.h"
 #include "lbk/container.h"
 #include "lbk/lightmap.h"
@@ -53,23 +55,21 @@ static int teardown(void **state)
 }
 
 /* Test budgets: the fast preset with fewer samples, so the suite stays quick under ASan. */
-static void test_options(bk_bake_options *o, const char *in, const char *out)
+static void test_options(tb_job *o, const char *in, const char *out)
 {
     memset(o, 0, sizeof *o);
-    o->input = in;
-    o->output = out;
-    o->preset = "fast";
-    o->seed = 1;
-    o->target_error = -1;
-    o->max_samples = 64;
-    o->threads = 2;
+    o->in = in;
+    o->out = out;
+    o->d.preset = LBK_BAKE_PRESET_FAST;
+    o->d.seed = 1;
+    o->d.target_error = -1;
+    o->d.max_samples = 64;
+    o->d.threads = 2;
 }
 
-static int bake_quiet(const bk_bake_options *o, bk_bake_summary *sum, char *err, size_t err_len)
+static lbk_result bake_quiet(const tb_job *o, lbk_bake_report *sum, char *err, size_t err_len)
 {
-    bk_progress p;
-    bk_progress_init(&p, 1);
-    return bk_bake(o, &p, sum, err, err_len);
+    return tb_bake(o, sum, err, err_len);
 }
 
 static void *read_file(const char *path, size_t *size)
@@ -110,7 +110,7 @@ static void assert_valid(const char *path)
 static int has_section(lbk_reader *r, uint32_t type)
 {
     uint32_t idx;
-    return lbk_reader_find_section(r, type, &idx) == LBK_OK;
+    return lbk_reader_section_find(r, type, &idx) == LBK_OK;
 }
 
 typedef struct expect {
@@ -128,13 +128,13 @@ static void bake_and_check(const expect *e)
         skip();
     }
     snprintf(out, sizeof out, "%s/scene.lbk", tmpdir);
-    bk_bake_options o;
+    tb_job o;
     test_options(&o, in, out);
     if (e->sky) {
-        o.sky_set = 1;
-        sscanf(e->sky, "%f,%f,%f", &o.sky[0], &o.sky[1], &o.sky[2]);
+        o.d.sky_override = 1;
+        sscanf(e->sky, "%f,%f,%f", &o.d.sky[0], &o.d.sky[1], &o.d.sky[2]);
     }
-    bk_bake_summary sum;
+    lbk_bake_report sum;
     int rc = bake_quiet(&o, &sum, err, sizeof err);
     if (rc) print_message("bake %s: %s\n", e->path, err);
     assert_int_equal(rc, 0);
@@ -149,8 +149,8 @@ static void bake_and_check(const expect *e)
     assert_false(has_section(r, LBK_SECTION_DOOR));
     assert_false(has_section(r, LBK_SECTION_OCTP));
     assert_true(has_section(r, LBK_SECTION_OBJS));
-    assert_true(sum.llgs >= (uint64_t)e->min_llgs);
-    assert_true(isfinite(sum.final_error) && sum.final_error >= 0);
+    assert_true(sum.counts.llgs >= (uint64_t)e->min_llgs);
+    assert_true(isfinite(sum.transport.est_rel_rmse) && sum.transport.est_rel_rmse >= 0);
     /* every lightmap texel decodes to finite, non-negative irradiance */
     if (e->lightmap) {
         const void *data;
@@ -159,10 +159,10 @@ static void bake_and_check(const expect *e)
         lbk_lmap_view v;
         assert_int_equal(lbk_lmap_open(data, size, &v), LBK_OK);
         uint64_t lit = 0;
-        for (uint64_t t = 0; t < sum.texels; t++) {
+        for (uint64_t t = 0; t < sum.counts.texels; t++) {
             lbk_ahd_texel tx;
             uint32_t page;
-            assert_int_equal(lbk_lmap_texel(&v, t, &tx, &page), LBK_OK);
+            assert_int_equal(lbk_lmap_texel_get(&v, t, &tx, &page), LBK_OK);
             float rgb[3], n[3] = {0, 0, 1};
             lbk_ahd_irradiance(&tx, n, rgb);
             for (int c = 0; c < 3; c++) assert_true(isfinite(rgb[c]) && rgb[c] >= 0);
@@ -193,12 +193,12 @@ static void test_water_bottle_draco(void **state)
     snprintf(in, sizeof in, "%s/water_bottle_draco/WaterBottle.gltf", scenes_dir());
     if (access(in, R_OK) != 0) skip();
     snprintf(out, sizeof out, "%s/bottle.lbk", tmpdir);
-    bk_bake_options o;
+    tb_job o;
     test_options(&o, in, out);
-    bk_bake_summary sum;
+    lbk_bake_report sum;
     assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
     assert_valid(out);
-    assert_int_equal(sum.objects, 1);
+    assert_int_equal(sum.counts.objects, 1);
 }
 
 /* Same input and seed → the same bytes at 1 and 2 threads; another seed → other bytes. */
@@ -209,16 +209,16 @@ static void test_deterministic_across_threads(void **state)
     snprintf(a, sizeof a, "%s/t1.lbk", tmpdir);
     snprintf(b, sizeof b, "%s/t2.lbk", tmpdir);
     snprintf(c, sizeof c, "%s/t3.lbk", tmpdir);
-    bk_bake_options o;
-    bk_bake_summary sum;
+    tb_job o;
+    lbk_bake_report sum;
     test_options(&o, "scenes/cornell_box/CornellBox-Original.gltf", a);
-    o.threads = 1;
+    o.d.threads = 1;
     assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
-    o.threads = 2;
-    o.output = b;
+    o.d.threads = 2;
+    o.out = b;
     assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
-    o.seed = 2;
-    o.output = c;
+    o.d.seed = 2;
+    o.out = c;
     assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
     size_t na, nb, nc;
     void *da = read_file(a, &na), *db = read_file(b, &nb), *dc = read_file(c, &nc);
@@ -239,10 +239,10 @@ static void test_no_light_is_refused(void **state)
     snprintf(in, sizeof in, "%s/room_with_doors/room.glb", scenes_dir());
     if (access(in, R_OK) != 0) skip();
     snprintf(out, sizeof out, "%s/nolight.lbk", tmpdir);
-    bk_bake_options o;
+    tb_job o;
     test_options(&o, in, out);
-    bk_bake_summary sum;
-    assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), LBK_EXIT_INPUT);
+    lbk_bake_report sum;
+    assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), LBK_ERR_BAD_INPUT);
     assert_non_null(strstr(err, "no light"));
     assert_int_not_equal(access(out, F_OK), 0);
 }
@@ -253,10 +253,10 @@ static void test_missing_input_is_io_error(void **state)
     (void)state;
     char out[512], err[512] = "";
     snprintf(out, sizeof out, "%s/missing.lbk", tmpdir);
-    bk_bake_options o;
+    tb_job o;
     test_options(&o, "/nonexistent/level.glb", out);
-    bk_bake_summary sum;
-    assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), LBK_EXIT_IO);
+    lbk_bake_report sum;
+    assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), LBK_ERR_IO);
     assert_non_null(strstr(err, "/nonexistent/level.glb"));
     assert_int_not_equal(access(out, F_OK), 0);
 }
@@ -269,25 +269,25 @@ static void test_target_error_and_reports(void **state)
     char out[512], json[512], err[512];
     snprintf(out, sizeof out, "%s/target.lbk", tmpdir);
     snprintf(json, sizeof json, "%s/target.json", tmpdir);
-    bk_bake_options o;
+    tb_job o;
     test_options(&o, "scenes/cornell_box/CornellBox-Original.gltf", out);
-    o.max_samples = 4096;
-    o.target_error = 0.9;
-    o.json_report = json;
-    bk_bake_summary sum;
+    o.d.max_samples = 4096;
+    o.d.target_error = 0.9;
+    o.json = json;
+    lbk_bake_report sum;
     assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
-    assert_true(sum.final_error <= 0.9);
+    assert_true(sum.transport.est_rel_rmse <= 0.9);
     lbk_reader *r;
     assert_int_equal(lbk_reader_open_file(out, NULL, &r), LBK_OK);
     const void *data;
     size_t size;
     assert_int_equal(lbk_reader_section_by_type(r, LBK_SECTION_REPT, &data, &size), LBK_OK);
     lbk_report_view v;
-    assert_int_equal(lbk_report_parse(data, size, &v), LBK_OK);
+    assert_int_equal(lbk_report_open(data, size, &v), LBK_OK);
     assert_int_equal(v.header.status, LBK_BAKE_TARGET_REACHED);
     assert_int_equal(v.header.record_count, 1);
     lbk_report_record rec;
-    assert_int_equal(lbk_report_record_at(&v, 0, &rec), LBK_OK);
+    assert_int_equal(lbk_report_record_get(&v, 0, &rec), LBK_OK);
     assert_true(rec.texel_rel_rmse <= 0.9f && rec.texel_rel_rmse > 0);
     assert_true(rec.samples_per_texel > 0 && rec.samples_per_texel < 4096);
     assert_true(rec.rays_traced > 0);
@@ -326,12 +326,12 @@ static void test_time_limit(void **state)
     (void)state;
     char out[512], err[512];
     snprintf(out, sizeof out, "%s/time.lbk", tmpdir);
-    bk_bake_options o;
+    tb_job o;
     test_options(&o, "scenes/cornell_box/CornellBox-Original.gltf", out);
-    o.max_samples = 1 << 20;
-    o.target_error = 1e-6;
-    o.time_limit = 0.001;
-    bk_bake_summary sum;
+    o.d.max_samples = 1 << 20;
+    o.d.target_error = 1e-6;
+    o.d.time_limit = 0.001;
+    lbk_bake_report sum;
     assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
     assert_valid(out);
     lbk_reader *r;
@@ -340,7 +340,7 @@ static void test_time_limit(void **state)
     size_t size;
     assert_int_equal(lbk_reader_section_by_type(r, LBK_SECTION_REPT, &data, &size), LBK_OK);
     lbk_report_view v;
-    assert_int_equal(lbk_report_parse(data, size, &v), LBK_OK);
+    assert_int_equal(lbk_report_open(data, size, &v), LBK_OK);
     assert_int_equal(v.header.status, LBK_BAKE_TIME_LIMIT);
     assert_int_equal(v.header.record_count, 1);
     lbk_reader_close(r);
@@ -354,10 +354,10 @@ static void test_octahedral_probes(void **state)
     (void)state;
     char out[512], err[512];
     snprintf(out, sizeof out, "%s/octa.lbk", tmpdir);
-    bk_bake_options o;
+    tb_job o;
     test_options(&o, "scenes/cornell_box/CornellBox-Original.gltf", out);
-    o.octahedral_probes = 1;
-    bk_bake_summary sum;
+    o.d.octahedral_probes = 1;
+    lbk_bake_report sum;
     assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
     assert_valid(out);
     lbk_reader *r;
@@ -367,10 +367,10 @@ static void test_octahedral_probes(void **state)
     assert_int_equal(lbk_reader_section_by_type(r, LBK_SECTION_OCTP, &data, &size), LBK_OK);
     lbk_octp_view v;
     assert_int_equal(lbk_octp_open(data, size, &v), LBK_OK);
-    assert_true(sum.glg_probes > 0);
-    for (uint32_t i = 0; i < (uint32_t)sum.glg_probes; i++) {
+    assert_true(sum.counts.glg_probes > 0);
+    for (uint32_t i = 0; i < (uint32_t)sum.counts.glg_probes; i++) {
         lbk_octp_probe_desc p;
-        assert_int_equal(lbk_octp_get(&v, i, &p), LBK_OK);
+        assert_int_equal(lbk_octp_probe_get(&v, i, &p), LBK_OK);
         for (int k = 0; k < 144; k++) {
             assert_true(p.depth[k][0] > 0 && p.depth[k][0] < 4.0f);
             assert_true(p.depth[k][1] >= p.depth[k][0] * p.depth[k][0] * 0.99f);
@@ -425,14 +425,14 @@ static void test_tools_on_baker_output(void **state)
         skip();
     }
     char in[512], out[512], err[512];
-    bk_bake_options o;
-    bk_bake_summary sum;
+    tb_job o;
+    lbk_bake_report sum;
     snprintf(in, sizeof in, "%s/cornell_box_bjs/cornellBox-2.80-Eevee-gltf.gltf", scenes_dir());
     if (access(in, R_OK) != 0) skip();
     snprintf(out, sizeof out, "%s/tools_bjs.lbk", tmpdir);
     test_options(&o, in, out);
-    o.max_samples = 32;
-    o.octahedral_probes = 1;
+    o.d.max_samples = 32;
+    o.d.octahedral_probes = 1;
     assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
     check_tools_on(out);
 
@@ -446,10 +446,69 @@ static void test_tools_on_baker_output(void **state)
     assert_int_equal(ds_write_room_scene(DS_ROOM_GLB, in, &d, err, sizeof err), 0);
     snprintf(out, sizeof out, "%s/tools_sets.lbk", tmpdir);
     test_options(&o, in, out);
-    o.max_samples = 32;
+    o.d.max_samples = 32;
     assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
-    assert_true(sum.sets >= 4 && sum.doors == 1);
+    assert_true(sum.counts.light_sets >= 4 && sum.counts.doors == 1);
     check_tools_on(out);
+}
+
+/* `lbk bake` maps the library's results to the README's exit codes and prints the library's
+ * message: 3 for a missing input, 4 for a scene without light, 2 for a bad flag; nothing is
+ * written on failure. */
+static void test_cli_exit_codes(void **state)
+{
+    (void)state;
+    if (!getenv("LBK")) skip();
+    char out[512], in[512];
+    snprintf(out, sizeof out, "%s/cli_fail.lbk", tmpdir);
+    assert_int_equal(run_cli("bake /nonexistent/level.glb -o %s -q", out), LBK_EXIT_IO);
+    snprintf(in, sizeof in, "%s/room_with_doors/room.glb", scenes_dir());
+    if (access(in, R_OK) == 0) assert_int_equal(run_cli("bake %s -o %s -q --samples 32", in, out), LBK_EXIT_INPUT);
+    assert_int_equal(run_cli("bake %s -o %s --samples zero", in, out), LBK_EXIT_USAGE);
+    assert_int_not_equal(access(out, F_OK), 0);
+    char cmd[1200];
+    snprintf(cmd, sizeof cmd, "%s bake /nonexistent/level.glb -o %s 2>&1 | grep -q '^lbk bake: /nonexistent/level.glb: cannot open'",
+             getenv("LBK"), out);
+    assert_int_equal(system(cmd), 0);
+}
+
+/* Careless use: an output naming an input (or a hard link to it) is refused and the input is
+ * untouched; integer options are strict; an unwritable --json-report fails before anything is
+ * written, so neither the container nor the report appears, and the message names the OS cause. */
+static long file_size(const char *p)
+{
+    struct stat st;
+    return stat(p, &st) == 0 ? (long)st.st_size : -1;
+}
+
+static void test_cli_careless_use(void **state)
+{
+    (void)state;
+    if (!getenv("LBK")) skip();
+    char in[512], link[512], out[512], cmd[2048];
+    snprintf(in, sizeof in, "%s/careless.gltf", tmpdir);
+    snprintf(link, sizeof link, "%s/careless_link.lbk", tmpdir);
+    snprintf(out, sizeof out, "%s/careless.lbk", tmpdir);
+    snprintf(cmd, sizeof cmd, "cp scenes/cornell_box/CornellBox-Original.gltf %s && ln -f %s %s", in, in, link);
+    assert_int_equal(system(cmd), 0);
+    const long before = file_size(in);
+    assert_true(before > 0);
+    assert_int_equal(run_cli("bake %s -o %s -q --samples 32", in, in), LBK_EXIT_USAGE);
+    assert_int_equal(run_cli("bake %s -o %s -q --samples 32", in, link), LBK_EXIT_USAGE);
+    assert_int_equal(run_cli("bake %s -o %s -q --samples 32 --json-report %s", in, out, in), LBK_EXIT_USAGE);
+    assert_int_equal(file_size(in), before);
+    const char *bad[] = {"--threads 1.5", "--threads -2", "--seed -1", "--seed 1e3", "--samples 0x20",
+                         "--samples ' 32'", "--max-bounces 2.0"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)
+        assert_int_equal(run_cli("bake %s -o %s -q %s", in, out, bad[i]), LBK_EXIT_USAGE);
+    assert_int_equal(run_cli("bake %s -o %s -q --samples 32 --json-report %s/no/such/dir/r.json", in, out, tmpdir),
+                     LBK_EXIT_IO);
+    assert_int_equal(file_size(out), -1);
+    snprintf(cmd, sizeof cmd,
+             "%s bake %s -o %s -q --samples 32 --json-report %s/no/r.json 2>&1 | grep -q 'No such file or directory'",
+             getenv("LBK"), in, out, tmpdir);
+    assert_int_equal(system(cmd), 0);
+    assert_int_equal(file_size(out), -1);
 }
 
 /* Two nodes named "crate" (and a third): OBJS gets "crate", "crate#2", "crate#3" in scene order
@@ -484,10 +543,10 @@ static void test_duplicate_names_made_unique(void **state)
     gw_geom_free(&floor_g);
     gw_geom_free(&box);
     gw_free(sc);
-    bk_bake_options o;
-    bk_bake_summary sum;
+    tb_job o;
+    lbk_bake_report sum;
     test_options(&o, in, out);
-    o.max_samples = 32;
+    o.d.max_samples = 32;
     assert_int_equal(bake_quiet(&o, &sum, err, sizeof err), 0);
     int issues = 0;
     lbk_validate_summary vs;
@@ -499,7 +558,7 @@ static void test_duplicate_names_made_unique(void **state)
     size_t size;
     assert_int_equal(lbk_reader_section_by_type(r, LBK_SECTION_OBJS, &data, &size), LBK_OK);
     lbk_objects_view v;
-    assert_int_equal(lbk_objects_parse(data, size, &v), LBK_OK);
+    assert_int_equal(lbk_objects_open(data, size, &v), LBK_OK);
     assert_int_equal(v.count, 4);
     static const char *want[] = {"crate", "floor", "crate#2", "crate#3"};
     for (uint32_t i = 0; i < 4; i++) {
@@ -527,6 +586,8 @@ int main(void)
         cmocka_unit_test(test_octahedral_probes),
         cmocka_unit_test(test_tools_on_baker_output),
         cmocka_unit_test(test_duplicate_names_made_unique),
+        cmocka_unit_test(test_cli_exit_codes),
+        cmocka_unit_test(test_cli_careless_use),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

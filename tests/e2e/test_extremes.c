@@ -1,5 +1,5 @@
 /* Stability suite through the whole pipeline: each test writes a small glTF level
- * (tests/support/gltf_writer), runs bk_bake() on it, validates the container with
+ * (tests/support/gltf_writer), bakes it through liblbkbake (lbk/bake.h), validates the container with
  * lbk_validate_file, decodes every lightmap texel and every GLG/LLG probe (finite, non-negative
  * irradiance and fluence), and compares the lighting with what it must be:
  *
@@ -16,7 +16,7 @@
  *    no error, and the analytic E = π·L on the floor;
  *  - albedo 0.99 closed furnace (the stiff case): every texel and probe within the furnace
  *    bound of TRANSPORT.md plus the codec rounding;
- *  - unusable input (all triangles degenerate, NaN positions): LBK_EXIT_INPUT, nothing written.
+ *  - unusable input (all triangles degenerate, NaN positions): LBK_ERR_BAD_INPUT, nothing written.
  *
  * Budgets are small (fast preset, 64 samples, a few hundred texels) so the binary stays well
  * under a minute with ASan. */
@@ -32,8 +32,8 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "bake/pipeline/bake.h"
-#include "cli/cli.h"
+#include "lbk/bake.h"
+#include "tests/support/bake_file.h"
 #include "lbk/container.h"
 #include "lbk/glg.h"
 #include "lbk/lightmap.h"
@@ -72,7 +72,7 @@ static void path_in_tmp(char *out, size_t n, const char *name)
 /* ---- decoding a baked container ---------------------------------------------------------- */
 
 typedef struct baked {
-    bk_bake_summary sum;
+    lbk_bake_report sum;
     double est;                 /* estimated relative RMSE of the bake */
     uint32_t passes;            /* REPT records = transport passes */
     int has_lmap, has_glg, has_llg;
@@ -133,10 +133,10 @@ static void decode(const char *path, baked *b)
     size_t size;
     if (lbk_reader_section_by_type(r, LBK_SECTION_REPT, &data, &size) == LBK_OK) {
         lbk_report_view v;
-        assert_int_equal(lbk_report_parse(data, size, &v), LBK_OK);
+        assert_int_equal(lbk_report_open(data, size, &v), LBK_OK);
         b->passes = v.header.record_count;
         lbk_report_record rec;
-        assert_int_equal(lbk_report_record_at(&v, v.header.record_count - 1, &rec), LBK_OK);
+        assert_int_equal(lbk_report_record_get(&v, v.header.record_count - 1, &rec), LBK_OK);
         assert_true(isfinite(rec.texel_rel_rmse) && rec.texel_rel_rmse >= 0);
         assert_true(isfinite(rec.probe_rel_rmse) && rec.probe_rel_rmse >= 0);
     }
@@ -151,8 +151,8 @@ static void decode(const char *path, baked *b)
         static const float normals[5][3] = {{0, 0, 1}, {0.6f, 0, 0.8f}, {0, -0.6f, 0.8f}, {1, 0, 0}, {0, 0, -1}};
         for (uint64_t t = 0; t < v.texel_count; t++) {
             lbk_ahd_texel tx;
-            assert_int_equal(lbk_lmap_texel(&v, t, &tx, NULL), LBK_OK);
-            lbk_unpack_r11g11b10f(tx.irradiance_z, b->ez[t]);
+            assert_int_equal(lbk_lmap_texel_get(&v, t, &tx, NULL), LBK_OK);
+            lbk_r11g11b10f_unpack(tx.irradiance_z, b->ez[t]);
             for (int c = 0; c < 3; c++) b->ez[t][c] *= v.scale;
             for (int n = 0; n < 5; n++) {
                 float e[3];
@@ -175,7 +175,7 @@ static void decode(const char *path, baked *b)
         assert_non_null(b->glg_dc);
         for (uint32_t p = 0; p < v.probe_count; p++) {
             lbk_sh9_rgb sh;
-            assert_int_equal(lbk_glg_probe(&v, p, b->glg_pos[p], &sh), LBK_OK);
+            assert_int_equal(lbk_glg_probe_get(&v, p, b->glg_pos[p], &sh), LBK_OK);
             assert_sh_clean(&sh);
             for (int c = 0; c < 3; c++) b->glg_dc[p][c] = sh.c[c][0];
         }
@@ -211,37 +211,35 @@ static void decode(const char *path, baked *b)
 
 /* ---- baking ------------------------------------------------------------------------------- */
 
-static void test_options(bk_bake_options *o, const char *in, const char *out)
+static void test_options(tb_job *o, const char *in, const char *out)
 {
     memset(o, 0, sizeof *o);
-    o->input = in;
-    o->output = out;
-    o->preset = "fast";
-    o->seed = 1;
+    o->in = in;
+    o->out = out;
+    o->d.preset = LBK_BAKE_PRESET_FAST;
+    o->d.seed = 1;
     /* only the sample budget stops the bake, so equal scenes run equal passes */
-    o->target_error = 1e-6;
-    o->max_samples = 64;
-    o->threads = 2;
+    o->d.target_error = 1e-6;
+    o->d.max_samples = 64;
+    o->d.threads = 2;
 }
 
-static int run_bake(const bk_bake_options *o, bk_bake_summary *sum, char *err, size_t n)
+static lbk_result run_bake(const tb_job *o, lbk_bake_report *sum, char *err, size_t n)
 {
-    bk_progress p;
-    bk_progress_init(&p, 1);
-    return bk_bake(o, &p, sum, err, n);
+    return tb_bake(o, sum, err, n);
 }
 
 /* Bakes, asserts success, decodes. */
-static void bake_ok(const bk_bake_options *o, baked *b)
+static void bake_ok(const tb_job *o, baked *b)
 {
     char err[512] = "";
     memset(b, 0, sizeof *b);
     int rc = run_bake(o, &b->sum, err, sizeof err);
-    if (rc) print_message("bake %s: %s\n", o->input, err);
+    if (rc) print_message("bake %s: %s\n", o->in, err);
     assert_int_equal(rc, 0);
-    assert_true(isfinite(b->sum.final_error) && b->sum.final_error >= 0);
-    b->est = b->sum.final_error;
-    decode(o->output, b);
+    assert_true(isfinite(b->sum.transport.est_rel_rmse) && b->sum.transport.est_rel_rmse >= 0);
+    b->est = b->sum.transport.est_rel_rmse;
+    decode(o->out, b);
 }
 
 /* ---- the levels --------------------------------------------------------------------------- */
@@ -336,10 +334,10 @@ static void bake_room(const room_spec *rs, const char *name, baked *b)
     snprintf(in, sizeof in, "%s/%s.gltf", tmpdir, name);
     snprintf(out, sizeof out, "%s/%s.lbk", tmpdir, name);
     write_room(in, rs);
-    bk_bake_options o;
+    tb_job o;
     test_options(&o, in, out);
-    o.texel_density = (float)(ROOM_DENSITY / rs->scale);
-    o.glg_spacing = (float)(ROOM_SPACING * rs->scale);
+    o.d.texel_density = (float)(ROOM_DENSITY / rs->scale);
+    o.d.glg_spacing = (float)(ROOM_SPACING * rs->scale);
     bake_ok(&o, b);
     assert_true(b->has_lmap);
     assert_true(b->texel_count > 0);
@@ -516,8 +514,8 @@ static void test_intensity_extremes(void **state)
         assert_true(peak >= 0x1p13f && peak < 0x1p14f * (1 + 0x1p-6f)); /* the scale rule */
         assert_int_equal(top, 0);
         assert_int_equal(zero, 0);
-        assert_int_equal(b.sum.texel_channels_saturated, 0);
-        assert_int_equal(b.sum.texel_channels_flushed, 0);
+        assert_int_equal(b.sum.transport.texel_channels_saturated, 0);
+        assert_int_equal(b.sum.transport.texel_channels_flushed, 0);
         baked_free(&b);
     }
     baked_free(&unit);
@@ -608,10 +606,10 @@ static void test_regular_grid_glg(void **state)
     gw_geom_free(&room);
     gw_free(sc);
 
-    bk_bake_options o;
+    tb_job o;
     test_options(&o, in, out);
-    o.texel_density = 2;
-    o.glg_spacing = 1;
+    o.d.texel_density = 2;
+    o.d.glg_spacing = 1;
     baked b;
     bake_ok(&o, &b);
     assert_true(b.has_glg);
@@ -664,13 +662,13 @@ static void test_flat_level_has_no_glg(void **state)
     gw_geom_free(&g);
     gw_free(sc);
 
-    bk_bake_options o;
+    tb_job o;
     test_options(&o, in, out);
-    o.texel_density = 4;
+    o.d.texel_density = 4;
     baked b;
     bake_ok(&o, &b);
     assert_false(b.has_glg);
-    assert_int_equal(b.sum.glg_probes, 0);
+    assert_int_equal(b.sum.counts.glg_probes, 0);
     assert_true(b.has_lmap);
     double want = M_PI * lum(sky), d2 = 0, sum = 0;
     size_t n = 0;
@@ -711,11 +709,11 @@ static void test_albedo_099_furnace(void **state)
     gw_geom_free(&g);
     gw_free(sc);
 
-    bk_bake_options o;
+    tb_job o;
     test_options(&o, in, out);
-    o.max_samples = 512;
-    o.texel_density = 8;
-    o.glg_spacing = 0.5f;
+    o.d.max_samples = 512;
+    o.d.texel_density = 8;
+    o.d.glg_spacing = 0.5f;
     baked b;
     bake_ok(&o, &b);
     assert_true(b.has_glg);
@@ -753,15 +751,15 @@ static void assert_refused(const char *name, const gw_scene *sc, const char *nee
     snprintf(in, sizeof in, "%s/%s.gltf", tmpdir, name);
     snprintf(out, sizeof out, "%s/%s.lbk", tmpdir, name);
     assert_int_equal(gw_write(sc, in), 0);
-    bk_bake_options o;
+    tb_job o;
     test_options(&o, in, out);
     float sky[3] = {1, 1, 1};
-    o.sky_set = 1;
-    memcpy(o.sky, sky, sizeof sky);
-    bk_bake_summary sum;
+    o.d.sky_override = 1;
+    memcpy(o.d.sky, sky, sizeof sky);
+    lbk_bake_report sum;
     int rc = run_bake(&o, &sum, err, sizeof err);
     print_message("  %s: exit %d: %s\n", name, rc, err);
-    assert_int_equal(rc, LBK_EXIT_INPUT);
+    assert_int_equal(rc, LBK_ERR_BAD_INPUT);
     assert_non_null(strstr(err, needle));
     assert_int_not_equal(access(out, F_OK), 0);
 }

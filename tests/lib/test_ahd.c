@@ -111,7 +111,7 @@ static void linear_form_identities(void **state)
         lbk_ahd_linear lin;
         lbk_ahd_to_linear(&tex, &lin);
         float ez[3];
-        lbk_unpack_r11g11b10f(tex.irradiance_z, ez);
+        lbk_r11g11b10f_unpack(tex.irradiance_z, ez);
         /* the linear form reproduces the stored +Z irradiance and the ratio by luminance */
         const float up[3] = {0, 0, 1};
         float e[3];
@@ -270,8 +270,8 @@ static void reencode_stable(void **state)
         lbk_ahd_from_linear(&back, &b);
         for (int i = 0; i < 4; i++) assert_true(abs((int)a.rgba[i] - (int)b.rgba[i]) <= 1);
         float ea[3], eb[3];
-        lbk_unpack_r11g11b10f(a.irradiance_z, ea);
-        lbk_unpack_r11g11b10f(b.irradiance_z, eb);
+        lbk_r11g11b10f_unpack(a.irradiance_z, ea);
+        lbk_r11g11b10f_unpack(b.irradiance_z, eb);
         for (int c = 0; c < 3; c++) assert_true(fabsf(ea[c] - eb[c]) <= 0.04f * ea[c] + 1e-30f);
         exact += memcmp(&a, &b, sizeof a) == 0;
     }
@@ -326,7 +326,7 @@ static void special_inputs(void **state)
     lin.c[1][0] = -INFINITY;
     lbk_ahd_from_linear(&lin, &tex);
     float ez[3];
-    lbk_unpack_r11g11b10f(tex.irradiance_z, ez);
+    lbk_r11g11b10f_unpack(tex.irradiance_z, ez);
     for (int c = 0; c < 3; c++) assert_true(isfinite(ez[c]) && ez[c] >= 0.0f);
     /* negative irradiance (e.g. a subtracted set) clamps to black */
     memset(&lin, 0, sizeof lin);
@@ -346,11 +346,11 @@ static void special_inputs(void **state)
     assert_true(out.c[0][0] == 0.0f);
     uint8_t bytes[8];
     tex.irradiance_z = 0x11223344u;
-    lbk_ahd_texel_store(&tex, bytes);
+    lbk_ahd_texel_pack(&tex, bytes);
     const uint8_t expect[8] = {0x44, 0x33, 0x22, 0x11, 0, 128, 127, 0};
     assert_memory_equal(bytes, expect, 8);
     lbk_ahd_texel back;
-    lbk_ahd_texel_load(bytes, &back);
+    lbk_ahd_texel_unpack(bytes, &back);
     assert_memory_equal(&back, &tex, sizeof tex);
 }
 

@@ -96,13 +96,13 @@ static size_t flip_payload(uint32_t type, const uint8_t *payload, size_t n, int 
             memcpy(p, payload, n);
             p[byte] ^= (uint8_t)(1u << bit);
             lbk_writer *w;
-            assert_int_equal(lbk_writer_create(NULL, &w), LBK_OK);
-            lbk_section_options o = {0, zstd ? LBK_COMPRESSION_ZSTD : 0, 1};
-            assert_int_equal(lbk_writer_add_section(w, type, p, n, &o), LBK_OK);
+            assert_int_equal(lbk_writer_open(NULL, &w), LBK_OK);
+            lbk_section_options o = {.compression = zstd ? LBK_COMPRESSION_ZSTD : 0, .zstd_level = 1};
+            assert_int_equal(lbk_writer_section_add(w, type, p, n, &o), LBK_OK);
             void *bytes;
             size_t size;
             assert_int_equal(lbk_writer_to_memory(w, &bytes, &size), LBK_OK);
-            lbk_writer_destroy(w);
+            lbk_writer_close(w);
             reported += invalid_by_validator(bytes, size);
             lbk_free(NULL, bytes);
         }

@@ -2,6 +2,7 @@
  * encode) within the codecs' quantisation on random sets and random weights; incremental applies
  * that skip unchanged clusters give the bytes of a full apply; all-zero weights give exactly the
  * base; a set without entries adds no data; door weights drive kinds 1–3. */
+#define LBK_STATIC_LINKING_ONLY /* lbk_dls_stats: experimental (lbk/dls.h) */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -47,7 +48,7 @@ static void random_sets(dlsfx *fx, uint64_t seed, uint32_t nsets)
 static void scene_build(scene *sc, uint64_t seed)
 {
     assert_int_equal(lbk_dls_build(&sc->fx.desc, NULL, &sc->bytes, &sc->size, NULL), LBK_OK);
-    assert_int_equal(lbk_dls_view_open(sc->bytes, sc->size, NULL, &sc->view), LBK_OK);
+    assert_int_equal(lbk_dls_open(sc->bytes, sc->size, NULL, &sc->view), LBK_OK);
     uint64_t rng = seed * 977 + 1;
     uint64_t nt = sc->fx.desc.target_count[0];
     sc->base_z = malloc(nt * 4), sc->out_z = calloc(nt, 4), sc->ref_z = calloc(nt, 4);
@@ -56,7 +57,7 @@ static void scene_build(scene *sc, uint64_t seed)
         uint8_t b[8];
         dlsfx_random_texel(&rng, 2.0f, b);
         lbk_ahd_texel tx;
-        lbk_ahd_texel_load(b, &tx);
+        lbk_ahd_texel_unpack(b, &tx);
         sc->base_z[t] = tx.irradiance_z;
         memcpy(sc->base_rgba + 4 * t, tx.rgba, 4);
     }
@@ -69,7 +70,7 @@ static void scene_build(scene *sc, uint64_t seed)
 
 static void scene_free(scene *sc)
 {
-    lbk_dls_view_close(sc->view);
+    lbk_dls_close(sc->view);
     free(sc->bytes);
     free(sc->base_z), free(sc->out_z), free(sc->ref_z);
     free(sc->base_rgba), free(sc->out_rgba), free(sc->ref_rgba);
@@ -90,7 +91,7 @@ static lbk_dls_runtime *runtime(scene *sc, const lbk_door_view *doors)
                               .out_glg = sc->out_probe[0],
                               .out_llg = sc->out_probe[1]};
     lbk_dls_runtime *r;
-    assert_int_equal(lbk_dls_runtime_create(&d, &r), LBK_OK);
+    assert_int_equal(lbk_dls_runtime_open(&d, &r), LBK_OK);
     return r;
 }
 
@@ -119,7 +120,7 @@ static void dense_sum(scene *sc, const float *w)
                 for (uint32_t s = 0; s < fx->set_count; s++) {
                     if (!idx[s][t] || w[s] == 0.0f) continue;
                     lbk_ahd_texel e;
-                    lbk_ahd_texel_load((const uint8_t *)fx->sets[s].entries[0].payloads + 8ull * (idx[s][t] - 1), &e);
+                    lbk_ahd_texel_unpack((const uint8_t *)fx->sets[s].entries[0].payloads + 8ull * (idx[s][t] - 1), &e);
                     lbk_ahd_linear l;
                     lbk_ahd_to_linear(&e, &l);
                     lbk_ahd_linear_add_scaled(&acc, &l, w[s]);
@@ -207,7 +208,7 @@ static void test_apply_matches_dense_sum(void **state)
         random_sets(&sc.fx, seed, 22);
         scene_build(&sc, seed);
         lbk_dls_stats st;
-        lbk_dls_compute_stats(sc.view, &st);
+        lbk_dls_stats_get(sc.view, &st);
         /* the random sets reach the dedicated, packed and both class (2) forms */
         assert_true(st.clusters_by_form[LBK_DLS_FORM_DEDICATED] > 0);
         assert_true(st.clusters_by_form[LBK_DLS_FORM_PACKED] > 0);
@@ -224,7 +225,7 @@ static void test_apply_matches_dense_sum(void **state)
             assert_int_equal(compare(&sc, &same, &total), 0);
             assert_true(same * 100 >= total * 99);
         }
-        lbk_dls_runtime_destroy(r);
+        lbk_dls_runtime_close(r);
         scene_free(&sc);
     }
 }
@@ -238,7 +239,7 @@ static uint32_t clusters_touching(const lbk_dls_view *v, const bool *changed)
         bool any = false;
         for (uint32_t j = 0; j < info.set_count; j++) {
             uint32_t s;
-            lbk_dls_cluster_set(v, ci, j, &s);
+            lbk_dls_cluster_set_get(v, ci, j, &s);
             any |= changed[s];
         }
         n += any;
@@ -282,7 +283,7 @@ static void test_skipping_equals_full_apply(void **state)
     memcpy(inc_rgba, sc.out_rgba, sc.fx.desc.target_count[0] * 4);
     uint8_t *inc_glg = malloc(sc.fx.desc.target_count[1] * 28);
     memcpy(inc_glg, sc.out_probe[0], sc.fx.desc.target_count[1] * 28);
-    lbk_dls_runtime_destroy(r);
+    lbk_dls_runtime_close(r);
     memset(sc.out_z, 0xAB, sc.fx.desc.target_count[0] * 4);
     r = runtime(&sc, NULL);
     assert_int_equal(lbk_dls_apply(r, w2, NULL, NULL), LBK_OK);
@@ -294,7 +295,7 @@ static void test_skipping_equals_full_apply(void **state)
     assert_int_equal(lbk_dls_apply(r, w2, NULL, &st), LBK_OK);
     assert_int_equal(st.targets_written, all);
     free(inc_z), free(inc_rgba), free(inc_glg);
-    lbk_dls_runtime_destroy(r);
+    lbk_dls_runtime_close(r);
     scene_free(&sc);
 }
 
@@ -317,7 +318,7 @@ static void test_zero_weights_give_exact_base(void **state)
     assert_memory_equal(sc.out_rgba, sc.base_rgba, sc.fx.desc.target_count[0] * 4);
     assert_memory_equal(sc.out_probe[0], sc.base_probe[0], sc.fx.desc.target_count[1] * 28);
     assert_memory_equal(sc.out_probe[1], sc.base_probe[1], sc.fx.desc.target_count[2] * 28);
-    lbk_dls_runtime_destroy(r);
+    lbk_dls_runtime_close(r);
     scene_free(&sc);
 }
 
@@ -335,8 +336,8 @@ static void test_empty_set_adds_no_data(void **state)
     scene_build(&a, 13);
     scene_build(&b, 13);
     lbk_dls_stats sa, sb;
-    lbk_dls_compute_stats(a.view, &sa);
-    lbk_dls_compute_stats(b.view, &sb);
+    lbk_dls_stats_get(a.view, &sa);
+    lbk_dls_stats_get(b.view, &sb);
     assert_int_equal(sb.set_count, sa.set_count + 1);
     assert_int_equal(sb.cluster_count, sa.cluster_count);
     assert_int_equal(sb.payload_bytes, sa.payload_bytes);
@@ -344,7 +345,7 @@ static void test_empty_set_adds_no_data(void **state)
     for (uint32_t ci = 0; ci < lbk_dls_cluster_count(b.view); ci++) {
         for (uint32_t j = 0;; j++) {
             uint32_t s;
-            if (lbk_dls_cluster_set(b.view, ci, j, &s) != LBK_OK) break;
+            if (lbk_dls_cluster_set_get(b.view, ci, j, &s) != LBK_OK) break;
             assert_int_not_equal(s, 10);
         }
     }
@@ -358,8 +359,8 @@ static void test_empty_set_adds_no_data(void **state)
     assert_int_equal(lbk_dls_apply(rb, wb, NULL, NULL), LBK_OK);
     assert_memory_equal(a.out_z, b.out_z, a.fx.desc.target_count[0] * 4);
     assert_memory_equal(a.out_probe[1], b.out_probe[1], a.fx.desc.target_count[2] * 28);
-    lbk_dls_runtime_destroy(ra);
-    lbk_dls_runtime_destroy(rb);
+    lbk_dls_runtime_close(ra);
+    lbk_dls_runtime_close(rb);
     scene_free(&a);
     scene_free(&b);
 }
@@ -385,12 +386,12 @@ static void test_door_weights(void **state)
                           .closed_set = 2};
     uint32_t door0 = 0;
     lbk_door_state_desc state0 = {1, &door0, 3};
-    lbk_door_build_desc dd = {1, &door, 1, &state0};
+    lbk_door_build_desc dd = {.door_count = 1, .doors = &door, .state_count = 1, .states = &state0};
     void *db;
     size_t dsize;
     assert_int_equal(lbk_door_build(&dd, NULL, &db, &dsize), LBK_OK);
     lbk_door_view *dv;
-    assert_int_equal(lbk_door_view_open(db, dsize, NULL, &dv), LBK_OK);
+    assert_int_equal(lbk_door_open(db, dsize, NULL, &dv), LBK_OK);
     assert_int_equal(lbk_door_check_dls(dv, sc.view), LBK_OK);
     lbk_door_info di;
     assert_int_equal(lbk_door_get(dv, 0, &di), LBK_OK);
@@ -416,21 +417,21 @@ static void test_door_weights(void **state)
     assert_true(same * 100 >= total * 99);
     const float bad_w = NAN;
     assert_int_equal(lbk_dls_apply(r, sw, &bad_w, NULL), LBK_ERR_INVALID_ARGUMENT);
-    lbk_dls_runtime_destroy(r);
+    lbk_dls_runtime_close(r);
 
     /* A door whose open set is a plain light set disagrees with the DLS. */
     door.open_set = 0;
     void *db2;
     assert_int_equal(lbk_door_build(&dd, NULL, &db2, &dsize), LBK_OK);
     lbk_door_view *dv2;
-    assert_int_equal(lbk_door_view_open(db2, dsize, NULL, &dv2), LBK_OK);
+    assert_int_equal(lbk_door_open(db2, dsize, NULL, &dv2), LBK_OK);
     assert_int_equal(lbk_door_check_dls(dv2, sc.view), LBK_ERR_CORRUPT);
     lbk_dls_runtime_desc rd = {.dls = sc.view, .doors = dv2};
     lbk_dls_runtime *r2;
-    assert_int_equal(lbk_dls_runtime_create(&rd, &r2), LBK_ERR_CORRUPT);
-    lbk_door_view_close(dv2);
+    assert_int_equal(lbk_dls_runtime_open(&rd, &r2), LBK_ERR_CORRUPT);
+    lbk_door_close(dv2);
     free(db2);
-    lbk_door_view_close(dv);
+    lbk_door_close(dv);
     free(db);
     scene_free(&sc);
 }
@@ -445,7 +446,7 @@ static void test_missing_buffers_rejected(void **state)
     lbk_dls_runtime_desc d = {.dls = sc.view, .base_irradiance_z = sc.base_z, .base_rgba = sc.base_rgba,
                               .out_irradiance_z = sc.out_z, .out_rgba = sc.out_rgba};
     lbk_dls_runtime *r;
-    assert_int_equal(lbk_dls_runtime_create(&d, &r), LBK_ERR_INVALID_ARGUMENT); /* probes have clusters */
+    assert_int_equal(lbk_dls_runtime_open(&d, &r), LBK_ERR_INVALID_ARGUMENT); /* probes have clusters */
     scene_free(&sc);
 }
 
@@ -454,12 +455,12 @@ static void test_missing_buffers_rejected(void **state)
 static void rescale_texel(uint8_t b[8], int e)
 {
     lbk_ahd_texel t;
-    lbk_ahd_texel_load(b, &t);
+    lbk_ahd_texel_unpack(b, &t);
     float v[3];
-    lbk_unpack_r11g11b10f(t.irradiance_z, v);
+    lbk_r11g11b10f_unpack(t.irradiance_z, v);
     for (int c = 0; c < 3; c++) v[c] = ldexpf(v[c], e);
-    t.irradiance_z = lbk_pack_r11g11b10f(v);
-    lbk_ahd_texel_store(&t, b);
+    t.irradiance_z = lbk_r11g11b10f_pack(v);
+    lbk_ahd_texel_pack(&t, b);
 }
 
 static void rescale_probe(uint8_t b[28], int e)
@@ -487,7 +488,7 @@ static void test_apply_in_another_scale(void **state)
     random_weights(&rng, w, 22);
     lbk_dls_runtime *r = runtime(&sc, NULL);
     assert_int_equal(lbk_dls_apply(r, w, NULL, NULL), LBK_OK);
-    lbk_dls_runtime_destroy(r);
+    lbk_dls_runtime_close(r);
     uint32_t *z1 = malloc(nt * 4);
     uint8_t *rgba1 = malloc(nt * 4), *p1[2] = {malloc(np[0] * 28), malloc(np[1] * 28)};
     memcpy(z1, sc.out_z, nt * 4), memcpy(rgba1, sc.out_rgba, nt * 4);
@@ -497,9 +498,9 @@ static void test_apply_in_another_scale(void **state)
         uint8_t b[8];
         lbk_ahd_texel tx = {sc.base_z[t], {0}};
         memcpy(tx.rgba, sc.base_rgba + 4 * t, 4);
-        lbk_ahd_texel_store(&tx, b);
+        lbk_ahd_texel_pack(&tx, b);
         rescale_texel(b, 8);
-        lbk_ahd_texel_load(b, &tx);
+        lbk_ahd_texel_unpack(b, &tx);
         sc.base_z[t] = tx.irradiance_z;
     }
     for (int p = 0; p < 2; p++)
@@ -510,18 +511,18 @@ static void test_apply_in_another_scale(void **state)
                 if (sp == 0) rescale_texel(sc.fx.payloads[s][sp] + 8 * i, 8);
                 else rescale_probe(sc.fx.payloads[s][sp] + 28 * i, 8);
             }
-    lbk_dls_view_close(sc.view);
+    lbk_dls_close(sc.view);
     free(sc.bytes);
     assert_int_equal(lbk_dls_build(&sc.fx.desc, NULL, &sc.bytes, &sc.size, NULL), LBK_OK);
-    assert_int_equal(lbk_dls_view_open(sc.bytes, sc.size, NULL, &sc.view), LBK_OK);
+    assert_int_equal(lbk_dls_open(sc.bytes, sc.size, NULL, &sc.view), LBK_OK);
     r = runtime(&sc, NULL);
     assert_int_equal(lbk_dls_apply(r, w, NULL, NULL), LBK_OK);
-    lbk_dls_runtime_destroy(r);
+    lbk_dls_runtime_close(r);
     uint64_t lit = 0;
     for (uint64_t t = 0; t < nt; t++) {
         float a[3], b[3];
-        lbk_unpack_r11g11b10f(z1[t], a);
-        lbk_unpack_r11g11b10f(sc.out_z[t], b);
+        lbk_r11g11b10f_unpack(z1[t], a);
+        lbk_r11g11b10f_unpack(sc.out_z[t], b);
         for (int c = 0; c < 3; c++) assert_true(ldexpf(a[c], 8) == b[c]);
         assert_memory_equal(rgba1 + 4 * t, sc.out_rgba + 4 * t, 4);
         lit += a[0] > 0;

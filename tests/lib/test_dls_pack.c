@@ -2,6 +2,7 @@
  * beyond), cluster sizes at and around the 16- and 8-target base boundaries, an independent
  * decoder of the prefix bits written from spec/container.md §12, determinism, the clustering
  * rule and the statistics numbers. */
+#define LBK_STATIC_LINKING_ONLY /* lbk_dls_tuning: experimental (lbk/dls.h) */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -131,7 +132,7 @@ static void build_ok(const dlsfx *fx, const lbk_dls_build_options *opt, void **b
                      lbk_dls_view **v)
 {
     assert_int_equal(lbk_dls_build(&fx->desc, opt, bytes, size, st), LBK_OK);
-    assert_int_equal(lbk_dls_view_open(*bytes, *size, NULL, v), LBK_OK);
+    assert_int_equal(lbk_dls_open(*bytes, *size, NULL, v), LBK_OK);
 }
 
 /* ---- tests ----------------------------------------------------------------------------------- */
@@ -176,7 +177,7 @@ static void test_every_overlap_count(void **state)
             assert_int_equal(checked, info.form >= LBK_DLS_FORM_PREFIX2 ? 1 : 0);
             assert_int_equal(st.histogram[0][k], n);
             assert_int_equal(st.histogram[0][0], 1000 - n);
-            lbk_dls_view_close(v);
+            lbk_dls_close(v);
             free(bytes);
             dlsfx_free(&fx);
         }
@@ -216,7 +217,7 @@ static void mixed_counts(uint32_t lo, uint32_t hi, uint32_t space, uint32_t form
         uint32_t checked = 0;
         assert_int_equal(verify_prefix_bits(bytes, &checked), 0);
         assert_int_equal(checked, 1);
-        lbk_dls_view_close(v);
+        lbk_dls_close(v);
         free(bytes);
         dlsfx_free(&fx);
     }
@@ -258,7 +259,7 @@ static void test_more_than_16_overlaps(void **state)
         uint32_t checked = 0;
         assert_int_equal(verify_prefix_bits(bytes, &checked), 0);
         assert_int_equal(checked, 1);
-        lbk_dls_view_close(v);
+        lbk_dls_close(v);
         free(bytes);
         dlsfx_free(&fx);
     }
@@ -302,7 +303,7 @@ static void test_prefix_entry_cap_splits(void **state)
     uint32_t checked = 0;
     assert_int_equal(verify_prefix_bits(bytes, &checked), 0);
     assert_int_equal(checked, 2);
-    lbk_dls_view_close(v);
+    lbk_dls_close(v);
     free(bytes);
     dlsfx_free(&fx);
 }
@@ -345,7 +346,7 @@ static void test_random_all_spaces(void **state)
         uint64_t entries = 0;
         for (uint32_t s = 0; s < fx.set_count; s++) entries += fx.sets[s].entries[0].count;
         assert_int_equal(st.entries[0], entries);
-        lbk_dls_view_close(v);
+        lbk_dls_close(v);
         free(bytes);
         dlsfx_free(&fx);
     }
@@ -429,7 +430,7 @@ static void test_stats_numbers(void **state)
     assert_int_equal(size, 4448);
     assert_int_equal(st.section_bytes, 4448);
     assert_int_equal(st.ancillary_bytes, 4448 - 4000);
-    lbk_dls_view_close(v);
+    lbk_dls_close(v);
     free(bytes);
     dlsfx_free(&fx);
 }
@@ -462,22 +463,23 @@ static void test_clustering_keeps_set_lists_small(void **state)
         assert_int_equal(info.set_count, 6);
         assert_int_equal(info.target_count, 300);
         uint32_t s0;
-        lbk_dls_cluster_set(v, ci, 0, &s0);
+        lbk_dls_cluster_set_get(v, ci, 0, &s0);
         assert_int_equal(s0, 10 * ci);
     }
     assert_int_equal(verify_space(&fx, v, 0), 0);
-    lbk_dls_view_close(v);
+    lbk_dls_close(v);
     free(bytes);
 
     /* With a dispatch minimum of 1000 targets the two families share one cluster of 12 sets. */
-    lbk_dls_build_options opt = {.min_dispatch_targets = 1000};
+    const lbk_dls_tuning tune = {.min_dispatch_targets = 1000};
+    const lbk_dls_build_options opt = {.size = sizeof opt, .tuning = &tune};
     build_ok(&fx, &opt, &bytes, &size, &st, &v);
     assert_int_equal(lbk_dls_cluster_count(v), 1);
     lbk_dls_cluster_info info;
     lbk_dls_cluster_get(v, 0, &info);
     assert_int_equal(info.set_count, 12);
     assert_int_equal(verify_space(&fx, v, 0), 0);
-    lbk_dls_view_close(v);
+    lbk_dls_close(v);
     free(bytes);
     dlsfx_free(&fx);
 }
@@ -490,7 +492,8 @@ static void test_packed_cap(void **state)
     dlsfx fx;
     dlsfx_init(&fx, 10, 2000, 0, 0);
     for (uint32_t s = 0; s < 10; s++) dlsfx_add_range(&fx, &rng, s, 0, 150 * s, 100);
-    lbk_dls_build_options opt = {.min_dispatch_targets = 10000, .packed_max_targets = 300};
+    const lbk_dls_tuning tune = {.min_dispatch_targets = 10000, .packed_max_targets = 300};
+    const lbk_dls_build_options opt = {.size = sizeof opt, .tuning = &tune};
     void *bytes;
     size_t size;
     lbk_dls_stats st;
@@ -505,7 +508,7 @@ static void test_packed_cap(void **state)
         assert_int_equal(info.overlaps, 1);
     }
     assert_int_equal(verify_space(&fx, v, 0), 0);
-    lbk_dls_view_close(v);
+    lbk_dls_close(v);
     free(bytes);
     dlsfx_free(&fx);
 }
@@ -543,17 +546,17 @@ static void test_invalid_inputs(void **state)
     dlsfx_combination(&fx, 2, 2, ok);
     assert_int_equal(lbk_dls_build(&fx.desc, NULL, &bytes, &size, NULL), LBK_OK);
     lbk_dls_view *v;
-    assert_int_equal(lbk_dls_view_open(bytes, size, NULL, &v), LBK_OK);
+    assert_int_equal(lbk_dls_open(bytes, size, NULL, &v), LBK_OK);
     uint32_t m0, m1;
-    assert_int_equal(lbk_dls_set_member(v, 2, 0, &m0), LBK_OK);
-    assert_int_equal(lbk_dls_set_member(v, 2, 1, &m1), LBK_OK);
+    assert_int_equal(lbk_dls_set_member_get(v, 2, 0, &m0), LBK_OK);
+    assert_int_equal(lbk_dls_set_member_get(v, 2, 1, &m1), LBK_OK);
     assert_int_equal(m0, 0); /* stored ascending */
     assert_int_equal(m1, 1);
     uint32_t found;
-    assert_int_equal(lbk_dls_find_set(v, "set1", &found), LBK_OK);
+    assert_int_equal(lbk_dls_set_find(v, "set1", &found), LBK_OK);
     assert_int_equal(found, 1);
-    assert_int_equal(lbk_dls_find_set(v, "nope", &found), LBK_ERR_NOT_FOUND);
-    lbk_dls_view_close(v);
+    assert_int_equal(lbk_dls_set_find(v, "nope", &found), LBK_ERR_NOT_FOUND);
+    lbk_dls_close(v);
     free(bytes);
     fx.sets[1].kind = LBK_DLS_KIND_COMBINATION; /* members must not be combinations (and need ≥ 2) */
     assert_int_equal(lbk_dls_build(&fx.desc, NULL, &bytes, &size, NULL), LBK_ERR_INVALID_ARGUMENT);

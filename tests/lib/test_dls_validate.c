@@ -125,7 +125,7 @@ static void expect(mutator m, uint32_t id, facts f)
     assert_non_null(lbk_issue_template(id, &sev));
     if (sev != LBK_SEVERITY_WARNING) assert_true(errors > 0);
     lbk_dls_view *v;
-    if (sev != LBK_SEVERITY_WARNING && id != 803) assert_int_not_equal(lbk_dls_view_open(b.d, b.n, NULL, &v), LBK_OK);
+    if (sev != LBK_SEVERITY_WARNING && id != 803) assert_int_not_equal(lbk_dls_open(b.d, b.n, NULL, &v), LBK_OK);
     free(b.d);
 }
 
@@ -345,7 +345,7 @@ static uint32_t validate_door_case(const door_case *c, bool with_dls, issues *ou
     size_t dn;
     door_dls(&dls, &dn);
     lbk_door_state_desc st = {1, &c->state_door, c->state_set};
-    lbk_door_build_desc dd = {2, c->doors, 1, &st};
+    lbk_door_build_desc dd = {.door_count = 2, .doors = c->doors, .state_count = 1, .states = &st};
     void *door;
     size_t n;
     lbk_result r = lbk_door_build(&dd, NULL, &door, &n);
@@ -413,7 +413,7 @@ static void test_door_validation(void **state)
     door_default(&c);
     c.doors[0].centre[1] = NAN;
     lbk_door_state_desc st = {1, &c.state_door, 3};
-    lbk_door_build_desc dd = {2, c.doors, 1, &st};
+    lbk_door_build_desc dd = {.door_count = 2, .doors = c.doors, .state_count = 1, .states = &st};
     void *out;
     size_t n;
     assert_int_equal(lbk_door_build(&dd, NULL, &out, &n), LBK_ERR_INVALID_ARGUMENT);
@@ -438,8 +438,8 @@ static void test_door_validation(void **state)
     assert_true(has(&raw, 912));
     assert_true(has(&raw, 902));
     lbk_door_view *v;
-    assert_int_equal(lbk_door_view_open(d, n, NULL, &v), LBK_ERR_CORRUPT);
-    for (size_t t = 0; t < n; t++) assert_int_not_equal(lbk_door_view_open(d, t, NULL, &v), LBK_OK);
+    assert_int_equal(lbk_door_open(d, n, NULL, &v), LBK_ERR_CORRUPT);
+    for (size_t t = 0; t < n; t++) assert_int_not_equal(lbk_door_open(d, t, NULL, &v), LBK_OK);
     free(out);
 }
 

@@ -67,7 +67,8 @@ static void build(fixture *f, const uint8_t (*vis)[4])
     memset(probes, 0, sizeof probes);
     for (int i = 0; i < NP; i++)
         for (int c = 0; c < 3; c++) probes[i].c[c][0] = field(pos[i]) * (float)(c + 1);
-    lbk_glg_desc desc = {NP, NT, (const float(*)[3])pos, probes, (const uint32_t(*)[4])tets, NULL, vis, 0};
+    lbk_glg_build_desc desc = {.probe_count = NP, .tetra_count = NT, .positions = (const float(*)[3])pos,
+        .probes = probes, .tetras = (const uint32_t(*)[4])tets, .visibility = vis};
     assert_int_equal(lbk_glg_build(&desc, NULL, &f->bytes, &f->size), LBK_OK);
     assert_int_equal(lbk_glg_open(f->bytes, f->size, &f->view), LBK_OK);
 }
@@ -254,7 +255,8 @@ static void builder_rejects_bad_meshes(void **state)
     uint32_t bad[NT][4];
     memcpy(bad, tets, sizeof bad);
     bad[3][2] = bad[3][1]; /* zero volume */
-    lbk_glg_desc d = {NP, NT, (const float(*)[3])pos, probes, (const uint32_t(*)[4])bad, NULL, NULL, 0};
+    lbk_glg_build_desc d = {.probe_count = NP, .tetra_count = NT, .positions = (const float(*)[3])pos,
+        .probes = probes, .tetras = (const uint32_t(*)[4])bad};
     assert_int_equal(lbk_glg_build(&d, NULL, &out, &size), LBK_ERR_INVALID_ARGUMENT);
     memcpy(bad, tets, sizeof bad);
     bad[3][2] = NP; /* out of range */
@@ -265,7 +267,8 @@ static void builder_rejects_bad_meshes(void **state)
     assert_int_equal(lbk_glg_build(&d, NULL, &out, &size), LBK_ERR_INVALID_ARGUMENT);
     /* derived adjacency: 8 cubes × 6 tetras have 6·2·4 = 48 hull faces (2 per cube face on the
      * surface: 6 sides × 4 squares × 2 triangles) */
-    lbk_glg_desc good = {NP, NT, (const float(*)[3])pos, probes, (const uint32_t(*)[4])tets, NULL, NULL, 0};
+    lbk_glg_build_desc good = {.probe_count = NP, .tetra_count = NT, .positions = (const float(*)[3])pos,
+        .probes = probes, .tetras = (const uint32_t(*)[4])tets};
     assert_int_equal(lbk_glg_build(&good, NULL, &out, &size), LBK_OK);
     lbk_glg_view v;
     assert_int_equal(lbk_glg_open(out, size, &v), LBK_OK);

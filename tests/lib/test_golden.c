@@ -33,17 +33,17 @@ static int build_golden(const char *name, void **out, size_t *size)
     void *meta, *objs, *bytes;
     size_t mn, on;
     if (fixture_meta(&meta, &mn) || fixture_objects(&objs, &on)) return 1;
-    lbk_write_options wo = {NULL, 16};
+    lbk_write_options wo = {.section_alignment = 16};
     lbk_writer *w;
-    int rc = lbk_writer_create(&wo, &w) != LBK_OK || lbk_writer_add_section(w, LBK_SECTION_OBJS, objs, on, NULL) ||
-             lbk_writer_add_section(w, LBK_SECTION_META, meta, mn, NULL) ||
+    int rc = lbk_writer_open(&wo, &w) != LBK_OK || lbk_writer_section_add(w, LBK_SECTION_OBJS, objs, on, NULL) ||
+             lbk_writer_section_add(w, LBK_SECTION_META, meta, mn, NULL) ||
              lbk_writer_to_memory(w, &bytes, size) != LBK_OK;
     if (!rc) {
         *out = malloc(*size);
         memcpy(*out, bytes, *size);
         lbk_free(NULL, bytes);
     }
-    lbk_writer_destroy(w);
+    lbk_writer_close(w);
     lbk_free(NULL, meta);
     lbk_free(NULL, objs);
     return rc;

@@ -76,13 +76,13 @@ typedef struct section {
 static issues validate_sections(const section *s, size_t n, int zstd)
 {
     lbk_writer *w;
-    assert_int_equal(lbk_writer_create(NULL, &w), LBK_OK);
-    lbk_section_options o = {0, zstd ? LBK_COMPRESSION_ZSTD : 0, 1};
-    for (size_t i = 0; i < n; i++) assert_int_equal(lbk_writer_add_section(w, s[i].type, s[i].data, s[i].size, &o), LBK_OK);
+    assert_int_equal(lbk_writer_open(NULL, &w), LBK_OK);
+    lbk_section_options o = {.compression = zstd ? LBK_COMPRESSION_ZSTD : 0, .zstd_level = 1};
+    for (size_t i = 0; i < n; i++) assert_int_equal(lbk_writer_section_add(w, s[i].type, s[i].data, s[i].size, &o), LBK_OK);
     void *bytes;
     size_t size;
     assert_int_equal(lbk_writer_to_memory(w, &bytes, &size), LBK_OK);
-    lbk_writer_destroy(w);
+    lbk_writer_close(w);
     issues c = {{0}, 0};
     lbk_validate_summary sum;
     assert_int_equal(lbk_validate_memory(bytes, size, NULL, collect, &c, &sum), LBK_OK);
@@ -132,12 +132,12 @@ static void test_meta_round_trip(void **state)
     size_t n;
     assert_int_equal(lbk_meta_build(pairs, 6, NULL, &b, &n), LBK_OK);
     lbk_meta_view v;
-    assert_int_equal(lbk_meta_parse(b, n, &v), LBK_OK);
+    assert_int_equal(lbk_meta_open(b, n, &v), LBK_OK);
     assert_int_equal(v.entry_count, 6);
     const char *sorted[] = {"bake.seed", "revision", "scene.hash", "timestamp", "writer", "writer.version"};
     for (uint32_t i = 0; i < 6; i++) {
         lbk_string k, val;
-        assert_int_equal(lbk_meta_entry(&v, i, &k, &val), LBK_OK);
+        assert_int_equal(lbk_meta_entry_get(&v, i, &k, &val), LBK_OK);
         assert_int_equal(k.size, strlen(sorted[i]));
         assert_memory_equal(k.data, sorted[i], k.size);
     }
@@ -146,18 +146,18 @@ static void test_meta_round_trip(void **state)
     assert_int_equal(val.size, strlen(pairs[4].value));
     assert_memory_equal(val.data, pairs[4].value, val.size);
     assert_int_equal(lbk_meta_find(&v, "writer.versio", &val), LBK_ERR_NOT_FOUND);
-    assert_int_equal(lbk_meta_entry(&v, 6, NULL, NULL), LBK_ERR_NOT_FOUND);
+    assert_int_equal(lbk_meta_entry_get(&v, 6, NULL, NULL), LBK_ERR_NOT_FOUND);
     issues c = validate_one(LBK_SECTION_META, b, n);
     assert_int_equal(c.count, 0);
     /* parse rejects what would be unsafe to view */
-    assert_int_equal(lbk_meta_parse(b, n - 1, &v), LBK_ERR_TRUNCATED);
-    assert_int_equal(lbk_meta_parse(b, 15, &v), LBK_ERR_TRUNCATED);
+    assert_int_equal(lbk_meta_open(b, n - 1, &v), LBK_ERR_TRUNCATED);
+    assert_int_equal(lbk_meta_open(b, 15, &v), LBK_ERR_TRUNCATED);
     uint8_t *m = malloc(n + 1);
     memcpy(m, b, n);
     m[n] = 0;
-    assert_int_equal(lbk_meta_parse(m, n + 1, &v), LBK_ERR_CORRUPT);
+    assert_int_equal(lbk_meta_open(m, n + 1, &v), LBK_ERR_CORRUPT);
     wr32(m + 16 + 4, 0x7fffffff); /* key length past the blob */
-    assert_int_equal(lbk_meta_parse(m, n, &v), LBK_ERR_CORRUPT);
+    assert_int_equal(lbk_meta_open(m, n, &v), LBK_ERR_CORRUPT);
     free(m);
     lbk_free(NULL, b);
 }
@@ -250,7 +250,8 @@ static const lbk_report_record records[3] = {
 static void test_report_round_trip(void **state)
 {
     (void)state;
-    lbk_report rep = {LBK_BAKE_TARGET_REACHED, LBK_REPORT_HAS_TIMES, 64, 600.0, 0.1f, records, 3};
+    lbk_report rep = {.status = LBK_BAKE_TARGET_REACHED, .flags = LBK_REPORT_HAS_TIMES, .max_samples_per_texel = 64,
+        .time_limit_seconds = 600.0, .target_rel_rmse = 0.1f, .records = records, .record_count = 3};
     void *b;
     size_t n;
     assert_int_equal(lbk_report_build(&rep, NULL, &b, &n), LBK_OK);
@@ -262,24 +263,24 @@ static void test_report_round_trip(void **state)
     assert_int_equal(rd32(d + 12), 64);
     assert_int_equal(rd32(d + 28), 0);
     lbk_report_view v;
-    assert_int_equal(lbk_report_parse(b, n, &v), LBK_OK);
+    assert_int_equal(lbk_report_open(b, n, &v), LBK_OK);
     assert_int_equal(v.header.status, LBK_BAKE_TARGET_REACHED);
     assert_true(v.header.time_limit_seconds == 600.0);
     assert_true(v.header.target_rel_rmse == 0.1f);
     for (uint32_t i = 0; i < 3; i++) {
         lbk_report_record r;
-        assert_int_equal(lbk_report_record_at(&v, i, &r), LBK_OK);
+        assert_int_equal(lbk_report_record_get(&v, i, &r), LBK_OK);
         assert_memory_equal(&r, &records[i], sizeof r);
     }
     lbk_report_record r;
-    assert_int_equal(lbk_report_record_at(&v, 3, &r), LBK_ERR_NOT_FOUND);
+    assert_int_equal(lbk_report_record_get(&v, 3, &r), LBK_ERR_NOT_FOUND);
     assert_string_equal(lbk_bake_status_name(2), "time limit");
     assert_string_equal(lbk_bake_status_name(9), "unknown");
     issues c = validate_one(LBK_SECTION_REPT, b, n);
     assert_int_equal(c.count, 0);
     c = validate_sections(&(section){LBK_SECTION_REPT, b, n}, 1, 1); /* zstd */
     assert_int_equal(c.count, 0);
-    assert_int_equal(lbk_report_parse(b, n - 1, &v), LBK_ERR_TRUNCATED);
+    assert_int_equal(lbk_report_open(b, n - 1, &v), LBK_ERR_TRUNCATED);
     lbk_free(NULL, b);
 }
 
@@ -289,7 +290,7 @@ static void test_report_builder_rejects(void **state)
     void *b;
     size_t n;
     lbk_report_record rr[2] = {records[0], records[1]};
-    lbk_report rep = {LBK_BAKE_CONVERGED, LBK_REPORT_HAS_TIMES, 0, 0, 0, rr, 2};
+    lbk_report rep = {.status = LBK_BAKE_CONVERGED, .flags = LBK_REPORT_HAS_TIMES, .records = rr, .record_count = 2};
     assert_int_equal(lbk_report_build(&rep, NULL, &b, &n), LBK_OK);
     lbk_free(NULL, b);
     rep.flags = 0; /* times present but not declared */
@@ -313,7 +314,7 @@ static void test_report_builder_rejects(void **state)
     assert_int_equal(lbk_report_build(&rep, NULL, &b, &n), LBK_ERR_INVALID_ARGUMENT);
     /* -0 is written as +0: one encoding per value */
     lbk_report_record z = {-0.0, 0, 0, 0, -0.0f, 0};
-    lbk_report rz = {LBK_BAKE_CONVERGED, 0, 0, -0.0, 0, &z, 1};
+    lbk_report rz = {.status = LBK_BAKE_CONVERGED, .time_limit_seconds = -0.0, .records = &z, .record_count = 1};
     assert_int_equal(lbk_report_build(&rz, NULL, &b, &n), LBK_OK);
     for (size_t i = 0; i < n; i++)
         if (i != 8) assert_int_equal(((uint8_t *)b)[i], 0); /* byte 8: record_count = 1 */
@@ -323,7 +324,8 @@ static void test_report_builder_rejects(void **state)
 static void test_report_validator_rules(void **state)
 {
     (void)state;
-    lbk_report rep = {LBK_BAKE_TARGET_REACHED, LBK_REPORT_HAS_TIMES, 64, 600.0, 0.1f, records, 3};
+    lbk_report rep = {.status = LBK_BAKE_TARGET_REACHED, .flags = LBK_REPORT_HAS_TIMES, .max_samples_per_texel = 64,
+        .time_limit_seconds = 600.0, .target_rel_rmse = 0.1f, .records = records, .record_count = 3};
     void *b;
     size_t n;
     assert_int_equal(lbk_report_build(&rep, NULL, &b, &n), LBK_OK);
@@ -390,7 +392,7 @@ static void test_objects_round_trip(void **state)
     assert_int_equal(rd32(d + 16 + 40 + 0), 5); /* packed: second name after "crate" */
     assert_memory_equal(d + 16 + 120, "cratestatue \xe2\x98\x83sky", 18);
     lbk_objects_view v;
-    assert_int_equal(lbk_objects_parse(b, n, &v), LBK_OK);
+    assert_int_equal(lbk_objects_open(b, n, &v), LBK_OK);
     assert_int_equal(v.count, 3);
     for (uint32_t i = 0; i < 3; i++) {
         lbk_object o;
@@ -408,7 +410,7 @@ static void test_objects_round_trip(void **state)
     assert_int_equal(idx, 2);
     assert_int_equal(lbk_objects_find(&v, (lbk_string){"sk", 2}, &idx), LBK_ERR_NOT_FOUND);
     assert_string_equal(lbk_representation_name(1), "llg");
-    assert_int_equal(lbk_objects_parse(b, n - 1, &v), LBK_ERR_TRUNCATED);
+    assert_int_equal(lbk_objects_open(b, n - 1, &v), LBK_ERR_TRUNCATED);
     lbk_free(NULL, b);
 
     /* builder rejections */
@@ -463,12 +465,13 @@ static void build_lmap_llg(void **lmap, size_t *lmap_n, void **llg, size_t *llg_
     static lbk_ahd_texel texels[16 * 8];
     for (int i = 0; i < 16 * 8; i++) texels[i] = (lbk_ahd_texel){0, {255, 128, 128, 255}};
     lbk_lmap_page_desc pages[2] = {{16, 8, texels}, {4, 4, texels}};
-    assert_int_equal(lbk_lmap_build(pages, 2, 0, NULL, lmap, lmap_n), LBK_OK);
+    assert_int_equal(lbk_lmap_build(&(lbk_lmap_build_desc){.pages = pages,
+        .page_count = 2}, NULL, lmap, lmap_n), LBK_OK);
     static lbk_sh9_rgb probes[8];
     memset(probes, 0, sizeof probes);
     lbk_llg_grid_desc g = {{0, 0, 0}, {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {1, 1, 1}, {2, 2, 2}, probes, NULL, 0};
     lbk_llg_grid_desc grids[2] = {g, g};
-    assert_int_equal(lbk_llg_build(grids, 2, 0, NULL, llg, llg_n), LBK_OK);
+    assert_int_equal(lbk_llg_build(&(lbk_llg_build_desc){.grids = grids, .grid_count = 2}, NULL, llg, llg_n), LBK_OK);
 }
 
 static void test_objects_validator_rules(void **state)

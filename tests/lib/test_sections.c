@@ -115,7 +115,8 @@ static void lmap_fixture(void **out, size_t *size, lbk_ahd_texel *t0, lbk_ahd_te
         t1[i].rgba[3] = 128;
     }
     const lbk_lmap_page_desc pages[2] = {{3, 2, t0}, {5, 4, t1}};
-    assert_int_equal(lbk_lmap_build(pages, 2, 0, NULL, out, size), LBK_OK);
+    assert_int_equal(lbk_lmap_build(&(lbk_lmap_build_desc){.pages = pages,
+        .page_count = 2}, NULL, out, size), LBK_OK);
 }
 
 static void lmap_round_trip_and_rules(void **state)
@@ -133,7 +134,7 @@ static void lmap_round_trip_and_rules(void **state)
     assert_int_equal(v.page_count, 2);
     assert_int_equal(v.texel_count, 26);
     lbk_lmap_page pg;
-    assert_int_equal(lbk_lmap_get_page(&v, 1, &pg), LBK_OK);
+    assert_int_equal(lbk_lmap_page_get(&v, 1, &pg), LBK_OK);
     assert_int_equal(pg.width, 5);
     assert_int_equal(pg.first_texel, 6);
     assert_int_equal(pg.irradiance_offset, 144);
@@ -141,15 +142,15 @@ static void lmap_round_trip_and_rules(void **state)
     for (uint64_t i = 0; i < 26; i++) {
         lbk_ahd_texel t;
         uint32_t page;
-        assert_int_equal(lbk_lmap_texel(&v, i, &t, &page), LBK_OK);
+        assert_int_equal(lbk_lmap_texel_get(&v, i, &t, &page), LBK_OK);
         const lbk_ahd_texel *e = i < 6 ? &t0[i] : &t1[i - 6];
         assert_int_equal(page, i < 6 ? 0 : 1);
         assert_int_equal(t.irradiance_z, e->irradiance_z);
         assert_memory_equal(t.rgba, e->rgba, 4);
     }
     lbk_ahd_texel t;
-    assert_int_equal(lbk_lmap_texel(&v, 26, &t, NULL), LBK_ERR_RANGE);
-    assert_int_equal(lbk_lmap_page_texel(&pg, 5, 0, &t), LBK_ERR_RANGE);
+    assert_int_equal(lbk_lmap_texel_get(&v, 26, &t, NULL), LBK_ERR_NOT_FOUND);
+    assert_int_equal(lbk_lmap_page_texel_get(&pg, 5, 0, &t), LBK_ERR_NOT_FOUND);
     /* validator: clean, and the facts */
     issues is;
     lbk_vctx facts;
@@ -197,7 +198,8 @@ static void glg_fixture(uint32_t probes, void **out, size_t *size)
     memset(sh, 0, sizeof sh);
     for (int i = 0; i < 9; i++)
         for (int c = 0; c < 3; c++) sh[i].c[c][0] = 1.0f + (float)i;
-    lbk_glg_desc d = {probes, 6, cube_pos, sh, cube_tets, NULL, NULL, 0};
+    lbk_glg_build_desc d = {.probe_count = probes, .tetra_count = 6, .positions = cube_pos, .probes = sh,
+        .tetras = cube_tets};
     assert_int_equal(lbk_glg_build(&d, NULL, out, size), LBK_OK);
 }
 
@@ -219,9 +221,9 @@ static void glg_rules(void **state)
     assert_int_equal(lbk_glg_open(b, n, &v), LBK_OK);
     float p[3];
     lbk_sh9_rgb sh;
-    assert_int_equal(lbk_glg_probe(&v, 7, p, &sh), LBK_OK);
+    assert_int_equal(lbk_glg_probe_get(&v, 7, p, &sh), LBK_OK);
     assert_true(p[0] == 1.0f && p[1] == 1.0f && p[2] == 1.0f && sh.c[2][0] == 8.0f);
-    assert_int_equal(lbk_glg_probe(&v, 8, p, &sh), LBK_ERR_RANGE);
+    assert_int_equal(lbk_glg_probe_get(&v, 8, p, &sh), LBK_ERR_NOT_FOUND);
     uint8_t *c;
     expect_only(lbk_validate_glg, b, 31, 600);
     c = dup_bytes(b, n); c[20] = 1; expect_only(lbk_validate_glg, c, n, 601); free(c);
@@ -267,14 +269,14 @@ static void llg_fixture(void **out, size_t *size)
     memset(g, 0, sizeof g);
     for (int k = 0; k < 2; k++) {
         g[k].axes[0][0] = g[k].axes[1][1] = g[k].axes[2][2] = 1.0f;
-        g[k].half_extent[0] = g[k].half_extent[1] = g[k].half_extent[2] = 1.0f + (float)k;
+        g[k].half_extents[0] = g[k].half_extents[1] = g[k].half_extents[2] = 1.0f + (float)k;
         g[k].dims[0] = g[k].dims[1] = k ? 3 : 2;
         g[k].dims[2] = 3;
         g[k].probes = probes + (k ? 12 : 0);
     }
     g[1].vertices = verts;
     g[1].vertex_count = 3;
-    assert_int_equal(lbk_llg_build(g, 2, 0, NULL, out, size), LBK_OK);
+    assert_int_equal(lbk_llg_build(&(lbk_llg_build_desc){.grids = g, .grid_count = 2}, NULL, out, size), LBK_OK);
 }
 
 static void llg_rules(void **state)
@@ -295,11 +297,11 @@ static void llg_rules(void **state)
     lbk_llg_view v;
     assert_int_equal(lbk_llg_open(b, n, &v), LBK_OK);
     lbk_llg_grid g;
-    assert_int_equal(lbk_llg_get_grid(&v, 1, &g), LBK_OK);
+    assert_int_equal(lbk_llg_grid_get(&v, 1, &g), LBK_OK);
     assert_int_equal(g.probe_offset, 12);
     assert_int_equal(g.vertex_offset, 0);
     assert_int_equal(g.vertex_count, 3);
-    assert_true(g.half_extent[2] == 2.0f);
+    assert_true(g.half_extents[2] == 2.0f);
     const uint8_t *vx = v.vertices + 4;
     assert_int_equal(vx[0], 64); /* 0.25 · 255 = 63.75 → 64 */
     uint8_t *c;
@@ -336,7 +338,7 @@ static void octp_fixture(lbk_octp_probe_desc *pd, void **out, size_t *size)
             pd[p].depth[i][1] = pd[p].depth[i][0] * pd[p].depth[i][0]; /* rounds */
         }
     }
-    assert_int_equal(lbk_octp_build(pd, 2, 0, NULL, out, size), LBK_OK);
+    assert_int_equal(lbk_octp_build(&(lbk_octp_build_desc){.probes = pd, .probe_count = 2}, NULL, out, size), LBK_OK);
 }
 
 static void octa_mapping(void **state)
@@ -383,7 +385,7 @@ static void octp_rules(void **state)
     assert_int_equal(n, 16 + 2048);
     lbk_octp_view v;
     assert_int_equal(lbk_octp_open(b, n, &v), LBK_OK);
-    assert_int_equal(lbk_octp_get(&v, 1, &back), LBK_OK);
+    assert_int_equal(lbk_octp_probe_get(&v, 1, &back), LBK_OK);
     assert_memory_equal(back.irradiance, pd[1].irradiance, sizeof back.irradiance);
     assert_memory_equal(back.position, pd[1].position, sizeof back.position);
     for (int i = 0; i < 144; i++) {
@@ -428,10 +430,11 @@ static void container_clean(void **state)
     octp_fixture(pd, &s[3], &n[3]);
     const uint32_t types[4] = {LBK_SECTION_LMAP, LBK_SECTION_GLG, LBK_SECTION_LLG, LBK_SECTION_OCTP};
     lbk_writer *w;
-    assert_int_equal(lbk_writer_create(NULL, &w), LBK_OK);
+    assert_int_equal(lbk_writer_open(NULL, &w), LBK_OK);
     for (int i = 0; i < 4; i++) {
-        lbk_section_options o = {0, i == 1 ? LBK_COMPRESSION_ZSTD : LBK_COMPRESSION_NONE, 3};
-        assert_int_equal(lbk_writer_add_section(w, types[i], s[i], n[i], &o), LBK_OK);
+        lbk_section_options o = {.compression = i == 1 ? LBK_COMPRESSION_ZSTD : LBK_COMPRESSION_NONE,
+            .zstd_level = 3};
+        assert_int_equal(lbk_writer_section_add(w, types[i], s[i], n[i], &o), LBK_OK);
     }
     void *file;
     size_t fsize;
@@ -447,7 +450,7 @@ static void container_clean(void **state)
     for (uint32_t id = 700; id <= 713; id++) assert_non_null(lbk_issue_template(id, NULL));
     for (uint32_t id = 1000; id <= 1009; id++) assert_non_null(lbk_issue_template(id, NULL));
     lbk_free(NULL, file);
-    lbk_writer_destroy(w);
+    lbk_writer_close(w);
     for (int i = 0; i < 4; i++) lbk_free(NULL, s[i]);
 }
 
@@ -463,7 +466,8 @@ static void scaled_sections(void **state)
     size_t n1, ns;
     lmap_fixture(&b1, &n1, t0, t1);
     const lbk_lmap_page_desc pages[2] = {{3, 2, t0}, {5, 4, t1}};
-    assert_int_equal(lbk_lmap_build(pages, 2, 0x1p-20f, NULL, &bs, &ns), LBK_OK);
+    assert_int_equal(lbk_lmap_build(&(lbk_lmap_build_desc){.pages = pages, .page_count = 2,
+        .scale = 0x1p-20f}, NULL, &bs, &ns), LBK_OK);
     assert_int_equal(ns, n1);
     assert_memory_equal((uint8_t *)bs + 8, (uint8_t *)b1 + 8, n1 - 8); /* only the scale differs */
     assert_true(lbk_rdf32((uint8_t *)bs + 4) == 0x1p-20f && lbk_rdf32((uint8_t *)b1 + 4) == 1.0f);
@@ -471,7 +475,7 @@ static void scaled_sections(void **state)
     lbk_lmap_page pg;
     assert_int_equal(lbk_lmap_open(bs, ns, &lv), LBK_OK);
     assert_true(lv.scale == 0x1p-20f);
-    assert_int_equal(lbk_lmap_get_page(&lv, 0, &pg), LBK_OK);
+    assert_int_equal(lbk_lmap_page_get(&lv, 0, &pg), LBK_OK);
     assert_true(pg.scale == 0x1p-20f);
     const float nz[3] = {0, 0.6f, 0.8f};
     for (uint32_t i = 0; i < 6; i++) {
@@ -485,7 +489,8 @@ static void scaled_sections(void **state)
     assert_int_equal(is.n, 0);
     void *none;
     size_t none_n;
-    assert_int_equal(lbk_lmap_build(pages, 2, 3.0f, NULL, &none, &none_n), LBK_ERR_INVALID_ARGUMENT);
+    assert_int_equal(lbk_lmap_build(&(lbk_lmap_build_desc){.pages = pages, .page_count = 2,
+        .scale = 3.0f}, NULL, &none, &none_n), LBK_ERR_INVALID_ARGUMENT);
     lbk_free(NULL, b1);
 
     /* GLG: physical SH in, physical out; the stored probe is value / scale */
@@ -496,7 +501,8 @@ static void scaled_sections(void **state)
             sh[i].c[c][0] = 3e5f * (float)(i + 1) * (float)(c + 1);
             sh[i].c[c][3] = 1e5f * (float)(i + 1); /* within √3·DC */
         }
-    lbk_glg_desc d = {8, 6, cube_pos, sh, cube_tets, NULL, NULL, 0x1p8f};
+    lbk_glg_build_desc d = {.probe_count = 8, .tetra_count = 6, .positions = cube_pos, .probes = sh,
+        .tetras = cube_tets, .scale = 0x1p8f};
     void *gb;
     size_t gn;
     assert_int_equal(lbk_glg_build(&d, NULL, &gb, &gn), LBK_OK);
@@ -511,7 +517,7 @@ static void scaled_sections(void **state)
         lbk_sh9_pack(&want, packed);
         assert_memory_equal(gv.probes + LBK_SH9_PACKED_SIZE * i, packed, LBK_SH9_PACKED_SIZE);
         lbk_sh9_unpack(packed, &stored);
-        assert_int_equal(lbk_glg_probe(&gv, i, NULL, &got), LBK_OK);
+        assert_int_equal(lbk_glg_probe_get(&gv, i, NULL, &got), LBK_OK);
         for (int c = 0; c < 3; c++)
             for (int k = 0; k < 9; k++) assert_true(got.c[c][k] == stored.c[c][k] * 0x1p8f);
         /* RGB9E5 DC within 2^-9 of the largest channel (up to 7.2e6: far above 65408, the format maximum at scale 1) */
@@ -535,14 +541,15 @@ static void scaled_sections(void **state)
     lbk_llg_grid_desc g;
     memset(&g, 0, sizeof g);
     g.axes[0][0] = g.axes[1][1] = g.axes[2][2] = 1.0f;
-    g.half_extent[0] = g.half_extent[1] = g.half_extent[2] = 1.0f;
+    g.half_extents[0] = g.half_extents[1] = g.half_extents[2] = 1.0f;
     g.dims[0] = g.dims[1] = g.dims[2] = 2;
     g.probes = lp;
     g.vertices = &vert;
     g.vertex_count = 1;
     void *lb;
     size_t ln;
-    assert_int_equal(lbk_llg_build(&g, 1, 0x1p-30f, NULL, &lb, &ln), LBK_OK);
+    assert_int_equal(lbk_llg_build(&(lbk_llg_build_desc){.grids = &g, .grid_count = 1,
+        .scale = 0x1p-30f}, NULL, &lb, &ln), LBK_OK);
     lbk_llg_view llv;
     assert_int_equal(lbk_llg_open(lb, ln, &llv), LBK_OK);
     assert_true(llv.scale == 0x1p-30f);
@@ -566,11 +573,12 @@ static void scaled_sections(void **state)
     for (int p = 0; p < 2; p++)
         for (int i = 0; i < 16; i++)
             for (int k = 0; k < 3; k++) pd[p].irradiance[i][k] *= 0x1p20f;
-    assert_int_equal(lbk_octp_build(pd, 2, 0x1p20f, NULL, &ob, &on), LBK_OK);
+    assert_int_equal(lbk_octp_build(&(lbk_octp_build_desc){.probes = pd, .probe_count = 2,
+        .scale = 0x1p20f}, NULL, &ob, &on), LBK_OK);
     lbk_octp_view ov;
     assert_int_equal(lbk_octp_open(ob, on, &ov), LBK_OK);
     assert_true(ov.scale == 0x1p20f);
-    assert_int_equal(lbk_octp_get(&ov, 1, &back), LBK_OK);
+    assert_int_equal(lbk_octp_probe_get(&ov, 1, &back), LBK_OK);
     assert_memory_equal(back.irradiance, pd[1].irradiance, sizeof back.irradiance);
     float dir[3], rgb[3];
     lbk_oct_texel_direction(4, 2, 1, dir);
@@ -595,7 +603,7 @@ static void scaled_sections(void **state)
         free(c);
     }
     glg_fixture(8, &gb, &gn);
-    assert_int_equal(lbk_llg_build(&g, 1, 0, NULL, &lb, &ln), LBK_OK);
+    assert_int_equal(lbk_llg_build(&(lbk_llg_build_desc){.grids = &g, .grid_count = 1}, NULL, &lb, &ln), LBK_OK);
     for (int k = 0; k < 6; k++) {
         uint8_t *c = dup_bytes(gb, gn);
         lbk_wr32(c + 8, bad[k]);
@@ -608,7 +616,8 @@ static void scaled_sections(void **state)
         assert_int_equal(lbk_llg_open(c, ln, &llv), LBK_ERR_CORRUPT);
         free(c);
     }
-    assert_int_equal(lbk_octp_build(pd, 2, NAN, NULL, &none, &none_n), LBK_ERR_INVALID_ARGUMENT);
+    assert_int_equal(lbk_octp_build(&(lbk_octp_build_desc){.probes = pd, .probe_count = 2,
+        .scale = NAN}, NULL, &none, &none_n), LBK_ERR_INVALID_ARGUMENT);
     lbk_free(NULL, gb), lbk_free(NULL, lb), lbk_free(NULL, ob), lbk_free(NULL, bs);
 }
 

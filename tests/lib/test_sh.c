@@ -210,7 +210,7 @@ static void pack_extremes_and_special_dc(void **state)
     /* DC layout: RGB9E5 of (L00 R, G, B) little-endian at bytes 0..3 */
     const uint32_t dc = (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
     const float dcin[3] = {sh.c[0][0], sh.c[1][0], sh.c[2][0]};
-    assert_int_equal(dc, lbk_pack_rgb9e5(dcin));
+    assert_int_equal(dc, lbk_rgb9e5_pack(dcin));
 
     /* zero / negative / NaN / tiny DC: higher bands of that channel are 0 */
     memset(&sh, 0, sizeof sh);

@@ -32,7 +32,8 @@ int fixture_report(void **out, size_t *size)
         {0.0, 4000000, 16, 2, 0.25f, 0.125f},
         {0.0, 8000000, 32, 2, 0.125f, 0.0625f},
     };
-    const lbk_report rep = {LBK_BAKE_TARGET_REACHED, 0, 256, 0.0, 0.15f, records, 4};
+    const lbk_report rep = {.status = LBK_BAKE_TARGET_REACHED, .max_samples_per_texel = 256,
+        .time_limit_seconds = 0.0, .target_rel_rmse = 0.15f, .records = records, .record_count = 4};
     return lbk_report_build(&rep, NULL, out, size) != LBK_OK;
 }
 
@@ -52,15 +53,15 @@ int fixture_small_container(uint32_t alignment, void **out, size_t *size)
     size_t meta_n, rept_n, objs_n;
     lbk_writer *w = NULL;
     int rc = 1;
-    lbk_write_options wo = {NULL, alignment};
-    lbk_section_options zstd = {0, LBK_COMPRESSION_ZSTD, 3};
+    lbk_write_options wo = {.section_alignment = alignment};
+    lbk_section_options zstd = {.compression = LBK_COMPRESSION_ZSTD, .zstd_level = 3};
     if (fixture_meta(&meta, &meta_n) || fixture_report(&rept, &rept_n) || fixture_objects(&objs, &objs_n)) goto out;
-    if (lbk_writer_create(&wo, &w) != LBK_OK) goto out;
+    if (lbk_writer_open(&wo, &w) != LBK_OK) goto out;
     /* Added out of canonical order on purpose: the writer sorts. */
-    if (lbk_writer_add_section(w, LBK_FOURCC('X', 'T', 'R', 'A'), fixture_xtra, sizeof fixture_xtra, NULL) ||
-        lbk_writer_add_section(w, LBK_SECTION_OBJS, objs, objs_n, NULL) ||
-        lbk_writer_add_section(w, LBK_SECTION_REPT, rept, rept_n, &zstd) ||
-        lbk_writer_add_section(w, LBK_SECTION_META, meta, meta_n, NULL))
+    if (lbk_writer_section_add(w, LBK_FOURCC('X', 'T', 'R', 'A'), fixture_xtra, sizeof fixture_xtra, NULL) ||
+        lbk_writer_section_add(w, LBK_SECTION_OBJS, objs, objs_n, NULL) ||
+        lbk_writer_section_add(w, LBK_SECTION_REPT, rept, rept_n, &zstd) ||
+        lbk_writer_section_add(w, LBK_SECTION_META, meta, meta_n, NULL))
         goto out;
     void *bytes;
     if (lbk_writer_to_memory(w, &bytes, size) != LBK_OK) goto out;
@@ -69,7 +70,7 @@ int fixture_small_container(uint32_t alignment, void **out, size_t *size)
     lbk_free(NULL, bytes);
     rc = *out == NULL;
 out:
-    lbk_writer_destroy(w);
+    lbk_writer_close(w);
     lbk_free(NULL, meta);
     lbk_free(NULL, rept);
     lbk_free(NULL, objs);

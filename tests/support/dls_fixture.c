@@ -33,7 +33,7 @@ void dlsfx_random_texel(uint64_t *rng, float scale, uint8_t out[8])
     lbk_ahd_linear_add_light(&lin, dir, rgb);
     lbk_ahd_texel t;
     lbk_ahd_from_linear(&lin, &t);
-    lbk_ahd_texel_store(&t, out);
+    lbk_ahd_texel_pack(&t, out);
 }
 
 void dlsfx_random_probe(uint64_t *rng, float scale, uint8_t out[28])

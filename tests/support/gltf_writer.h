@@ -1,6 +1,6 @@
 /* A tiny glTF 2.0 writer for baker tests and benches: builds a .gltf whose buffer is embedded as
- * a base64 data: URI, so a test can generate a level, run the whole pipeline (bk_bake) on it and
- * delete it afterwards. Only what the stability tests need: one triangle primitive per mesh
+ * a base64 data: URI, so a test can generate a level, run the whole pipeline
+ * (lbk_bake_from_file) on it and delete it afterwards. Only what the stability tests need: one triangle primitive per mesh
  * node, POSITION (+ indices or not), materials with baseColorFactor / emissiveFactor /
  * KHR_materials_emissive_strength / doubleSided, KHR_lights_punctual point lights, node
  * translation, node extras lbk_lighting and scene extras lbk_sky.

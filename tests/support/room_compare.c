@@ -25,8 +25,8 @@ rc_result rc_compare_room(rc_side a, rc_side b)
 {
     for (int k = 3; k < 5; k++) assert_int_equal(a.rect[k], b.rect[k]);
     lbk_lmap_page pa, pb;
-    assert_int_equal(lbk_lmap_get_page(a.lmap, a.rect[0], &pa), LBK_OK);
-    assert_int_equal(lbk_lmap_get_page(b.lmap, b.rect[0], &pb), LBK_OK);
+    assert_int_equal(lbk_lmap_page_get(a.lmap, a.rect[0], &pa), LBK_OK);
+    assert_int_equal(lbk_lmap_page_get(b.lmap, b.rect[0], &pb), LBK_OK);
     double diff = 0, sa = 0, sb = 0;
     for (uint32_t y = 0; y < a.rect[4]; y++)
         for (uint32_t x = 0; x < a.rect[3]; x++) {

@@ -62,7 +62,7 @@ static void add(lbk_writer *w, uint32_t type, void *data, size_t size, uint32_t 
 {
     lbk_section_options so = {0};
     so.flags = flags;
-    CHECK(lbk_writer_add_section(w, type, data, size, &so));
+    CHECK(lbk_writer_section_add(w, type, data, size, &so));
     lbk_free(NULL, data);
 }
 
@@ -72,7 +72,7 @@ tf_blob tf_build_scene(int kind, const tf_options *opt_in)
     memset(&opt, 0, sizeof opt);
     if (opt_in) opt = *opt_in;
     lbk_writer *w = NULL;
-    CHECK(lbk_writer_create(NULL, &w));
+    CHECK(lbk_writer_open(NULL, &w));
     void *data;
     size_t size;
 
@@ -144,17 +144,18 @@ tf_blob tf_build_scene(int kind, const tf_options *opt_in)
                 lbk_ahd_from_linear(&lin, t);
                 if (p == opt.texel_page && x == opt.texel_x && y == opt.texel_y) {
                     float rgb[3];
-                    lbk_unpack_r11g11b10f(t->irradiance_z, rgb);
+                    lbk_r11g11b10f_unpack(t->irradiance_z, rgb);
                     for (int c = 0; c < 3; c++) {
                         if (opt.texel_factor != 0.0f) rgb[c] *= opt.texel_factor;
                         rgb[c] += opt.texel_delta;
                     }
-                    t->irradiance_z = lbk_pack_r11g11b10f(rgb);
+                    t->irradiance_z = lbk_r11g11b10f_pack(rgb);
                 }
             }
         pages[p] = (lbk_lmap_page_desc){pw[p], ph[p], tex[p]};
     }
-    CHECK(lbk_lmap_build(pages, 2, ldexpf(1.0f, opt.scale_log2), NULL, &data, &size));
+    const lbk_lmap_build_desc lb = {.pages = pages, .page_count = 2, .scale = ldexpf(1.0f, opt.scale_log2)};
+    CHECK(lbk_lmap_build(&lb, NULL, &data, &size));
     add(w, LBK_SECTION_LMAP, data, size, LBK_SECTION_FLAG_REQUIRED);
     const uint64_t texel_count = (uint64_t)pw[0] * ph[0] + (uint64_t)pw[1] * ph[1];
 
@@ -167,7 +168,7 @@ tf_blob tf_build_scene(int kind, const tf_options *opt_in)
                     for (int k = 0; k < 9; k++) sh[i].c[c][k] *= opt.probe_scale;
         }
         static const uint32_t tetras[5][4] = {{1, 2, 4, 7}, {0, 1, 2, 4}, {3, 1, 2, 7}, {5, 1, 4, 7}, {6, 2, 4, 7}};
-        lbk_glg_desc g = {0};
+        lbk_glg_build_desc g = {0};
         g.probe_count = 8;
         g.tetra_count = 5;
         g.positions = tf_probe_positions;
@@ -191,7 +192,7 @@ tf_blob tf_build_scene(int kind, const tf_options *opt_in)
                 for (int k = 0; k < 4; k++) lin.c[ch][k] = ldexpf(lin.c[ch][k], -opt.scale_log2);
             lbk_ahd_texel t;
             lbk_ahd_from_linear(&lin, &t);
-            lbk_ahd_texel_store(&t, payload + (size_t)i * LBK_DLS_TEXEL_PAYLOAD);
+            lbk_ahd_texel_pack(&t, payload + (size_t)i * LBK_DLS_TEXEL_PAYLOAD);
         }
         const uint32_t ptargets[2] = {0, 7};
         uint8_t ppay[2 * LBK_DLS_PROBE_PAYLOAD];
@@ -227,6 +228,6 @@ tf_blob tf_build_scene(int kind, const tf_options *opt_in)
 
     tf_blob b = {NULL, 0};
     CHECK(lbk_writer_to_memory(w, &b.data, &b.size));
-    lbk_writer_destroy(w);
+    lbk_writer_close(w);
     return b;
 }

@@ -143,11 +143,11 @@ static const uint8_t *section_bytes(const void *file, size_t size, uint32_t type
     lbk_reader *rd = NULL;
     assert_int_equal(lbk_reader_open_memory(file, size, NULL, &rd), LBK_OK);
     uint32_t idx;
-    if (lbk_reader_find_section(rd, type, &idx) != LBK_OK) {
+    if (lbk_reader_section_find(rd, type, &idx) != LBK_OK) {
         lbk_reader_close(rd);
         return NULL;
     }
-    assert_int_equal(lbk_reader_section_info(rd, idx, info), LBK_OK);
+    assert_int_equal(lbk_reader_section_get(rd, idx, info), LBK_OK);
     lbk_reader_close(rd);
     return (const uint8_t *)file + info->offset;
 }
@@ -182,11 +182,11 @@ static void test_profile_rules_visible(void **state)
     assert_int_equal(lbk_reader_open_memory(out, out_size, NULL, &rd), LBK_OK);
     assert_int_equal(lbk_reader_header(rd)->section_alignment, 1024);
     uint32_t idx;
-    assert_int_equal(lbk_reader_find_section(rd, LBK_SECTION_META, &idx), LBK_ERR_NOT_FOUND);
-    assert_int_equal(lbk_reader_find_section(rd, LBK_SECTION_REPT, &idx), LBK_ERR_NOT_FOUND);
+    assert_int_equal(lbk_reader_section_find(rd, LBK_SECTION_META, &idx), LBK_ERR_NOT_FOUND);
+    assert_int_equal(lbk_reader_section_find(rd, LBK_SECTION_REPT, &idx), LBK_ERR_NOT_FOUND);
     for (uint32_t i = 0; i < lbk_reader_section_count(rd); i++) {
         lbk_section_info si;
-        assert_int_equal(lbk_reader_section_info(rd, i, &si), LBK_OK);
+        assert_int_equal(lbk_reader_section_get(rd, i, &si), LBK_OK);
         assert_int_equal(si.offset % 1024, 0);
         uint32_t want = (si.type == LBK_SECTION_LMAP || si.type == LBK_SECTION_GLG) ? LBK_COMPRESSION_NONE
                                                                                      : LBK_COMPRESSION_ZSTD;
@@ -242,13 +242,13 @@ static void test_round_trip_same_content(void **state)
     uint32_t shipped = 0;
     for (uint32_t i = 0; i < lbk_reader_section_count(ri); i++) {
         lbk_section_info si;
-        assert_int_equal(lbk_reader_section_info(ri, i, &si), LBK_OK);
+        assert_int_equal(lbk_reader_section_get(ri, i, &si), LBK_OK);
         uint32_t j;
         if (si.type == LBK_SECTION_META || si.type == LBK_SECTION_REPT) {
-            assert_int_equal(lbk_reader_find_section(ro, si.type, &j), LBK_ERR_NOT_FOUND);
+            assert_int_equal(lbk_reader_section_find(ro, si.type, &j), LBK_ERR_NOT_FOUND);
             continue;
         }
-        assert_int_equal(lbk_reader_find_section(ro, si.type, &j), LBK_OK);
+        assert_int_equal(lbk_reader_section_find(ro, si.type, &j), LBK_OK);
         shipped++;
         if (si.type == LBK_SECTION_LMAP || si.type == LBK_SECTION_DLS) continue;
         const void *a, *b;
@@ -347,13 +347,13 @@ static void texel_entries(const void *file, size_t size, dls_entries *out)
     size_t n;
     assert_int_equal(lbk_reader_section_by_type(rd, LBK_SECTION_DLS, &d, &n), LBK_OK);
     lbk_dls_view *v = NULL;
-    assert_int_equal(lbk_dls_view_open(d, n, NULL, &v), LBK_OK);
+    assert_int_equal(lbk_dls_open(d, n, NULL, &v), LBK_OK);
     for (uint32_t c = 0; c < lbk_dls_cluster_count(v); c++) {
         lbk_dls_cluster_info ci;
         assert_int_equal(lbk_dls_cluster_get(v, c, &ci), LBK_OK);
         if (ci.space == LBK_DLS_SPACE_TEXEL) assert_int_equal(lbk_dls_cluster_decode(v, c, grab, out), LBK_OK);
     }
-    lbk_dls_view_close(v);
+    lbk_dls_close(v);
     lbk_reader_close(rd);
 }
 
@@ -383,17 +383,17 @@ static void test_row_pitch_widening(void **state)
     assert_int_equal(vb.texel_count, 64 * 32 + 64 * 16);
     for (uint32_t pg = 0; pg < 2; pg++) {
         lbk_lmap_page pa, pb;
-        assert_int_equal(lbk_lmap_get_page(&va, pg, &pa), LBK_OK);
-        assert_int_equal(lbk_lmap_get_page(&vb, pg, &pb), LBK_OK);
+        assert_int_equal(lbk_lmap_page_get(&va, pg, &pa), LBK_OK);
+        assert_int_equal(lbk_lmap_page_get(&vb, pg, &pb), LBK_OK);
         assert_int_equal(pb.width, 64);
         assert_int_equal((4 * pb.width) % 256, 0);
         assert_int_equal(pb.height, pa.height);
         for (uint32_t y = 0; y < pb.height; y++)
             for (uint32_t x = 0; x < pb.width; x++) {
                 lbk_ahd_texel ta, tb;
-                assert_int_equal(lbk_lmap_page_texel(&pb, x, y, &tb), LBK_OK);
+                assert_int_equal(lbk_lmap_page_texel_get(&pb, x, y, &tb), LBK_OK);
                 if (x < pa.width) {
-                    assert_int_equal(lbk_lmap_page_texel(&pa, x, y, &ta), LBK_OK);
+                    assert_int_equal(lbk_lmap_page_texel_get(&pa, x, y, &ta), LBK_OK);
                     assert_int_equal(ta.irradiance_z, tb.irradiance_z);
                     assert_memory_equal(ta.rgba, tb.rgba, 4);
                 } else {

@@ -179,11 +179,11 @@ static double expected_texel_error(const tf_options *ob, double *ref)
     open_blob(&a, &ba);
     open_blob(&b, &bb);
     lbk_lmap_page pa, pb;
-    assert_int_equal(lbk_lmap_get_page(&ba.lmap, ob->texel_page, &pa), LBK_OK);
-    assert_int_equal(lbk_lmap_get_page(&bb.lmap, ob->texel_page, &pb), LBK_OK);
+    assert_int_equal(lbk_lmap_page_get(&ba.lmap, ob->texel_page, &pa), LBK_OK);
+    assert_int_equal(lbk_lmap_page_get(&bb.lmap, ob->texel_page, &pb), LBK_OK);
     lbk_ahd_texel ta, tb;
-    lbk_lmap_page_texel(&pa, ob->texel_x, ob->texel_y, &ta);
-    lbk_lmap_page_texel(&pb, ob->texel_x, ob->texel_y, &tb);
+    lbk_lmap_page_texel_get(&pa, ob->texel_x, ob->texel_y, &ta);
+    lbk_lmap_page_texel_get(&pb, ob->texel_x, ob->texel_y, &tb);
     float va[TL_TEXEL_NORMALS][3], vb[TL_TEXEL_NORMALS][3];
     tl_texel_eval(&ta, pa.scale, va);
     tl_texel_eval(&tb, pb.scale, vb);

@@ -194,7 +194,7 @@ static void test_export_pages_equal_decoded(void **state)
     export_fixture("pages", 0, 0, &b, dir, sizeof dir);
     for (uint32_t p = 0; p < 2; p++) {
         lbk_lmap_page pg;
-        assert_int_equal(lbk_lmap_get_page(&b.lmap, p, &pg), LBK_OK);
+        assert_int_equal(lbk_lmap_page_get(&b.lmap, p, &pg), LBK_OK);
         const char *rgb[] = {"R", "G", "B"};
         const char *ahd[] = {"plane0.R", "plane0.G", "plane0.B", "plane1.R", "plane1.G", "plane1.B", "plane1.A"};
         int w, h;
@@ -209,7 +209,7 @@ static void test_export_pages_equal_decoded(void **state)
         assert_int_equal(tl_exr_read(path, 3, rgb, &w, &h, &dom, err), 0);
         for (uint32_t i = 0; i < pg.width * pg.height; i++) {
             float want[3];
-            lbk_unpack_r11g11b10f(rd32(pg.irradiance + 4 * i), want);
+            lbk_r11g11b10f_unpack(rd32(pg.irradiance + 4 * i), want);
             for (int c = 0; c < 3; c++) {
                 assert_true(ez[3 * i + c] == want[c]);
                 assert_true(planes[7 * i + c] == want[c]);
@@ -237,11 +237,11 @@ static void test_export_per_object(void **state)
     assert_int_equal(w, 32);
     assert_int_equal(h, 16);
     lbk_lmap_page pg;
-    lbk_lmap_get_page(&b.lmap, 0, &pg);
+    lbk_lmap_page_get(&b.lmap, 0, &pg);
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
             float want[3];
-            lbk_unpack_r11g11b10f(rd32(pg.irradiance + 4 * ((size_t)y * 64 + 32 + x)), want);
+            lbk_r11g11b10f_unpack(rd32(pg.irradiance + 4 * ((size_t)y * 64 + 32 + x)), want);
             for (int c = 0; c < 3; c++) assert_true(px[3 * (y * w + x) + c] == want[c]);
         }
     free(px);
@@ -328,7 +328,7 @@ static void test_probe_listings(void **state)
         /* +Z irradiance of the listing equals the SH9 of the file evaluated at +Z */
         float pz[3], want[3];
         lbk_sh9_rgb sh;
-        lbk_glg_probe(&b.glg, (uint32_t)i, pz, &sh);
+        lbk_glg_probe_get(&b.glg, (uint32_t)i, pz, &sh);
         const float up[3] = {0, 0, 1};
         lbk_sh9_irradiance(&sh, up, want);
         const cJSON *e = cJSON_GetObjectItem(cJSON_GetObjectItem(p, "irradiance"), "pz");
@@ -370,17 +370,17 @@ static void test_export_import_round_trip(void **state)
     tl_bake nb;
     assert_int_equal(tl_bake_open_memory(out, out_size, &nb, err), TL_OPEN_OK);
     lbk_lmap_page po, pn;
-    lbk_lmap_get_page(&b.lmap, 1, &po);
-    lbk_lmap_get_page(&nb.lmap, 1, &pn);
+    lbk_lmap_page_get(&b.lmap, 1, &po);
+    lbk_lmap_page_get(&nb.lmap, 1, &pn);
     for (int i = 0; i < w * h; i++) {
         float was[3], now[3];
-        lbk_unpack_r11g11b10f(rd32(po.irradiance + 4 * i), was);
-        lbk_unpack_r11g11b10f(rd32(pn.irradiance + 4 * i), now);
+        lbk_r11g11b10f_unpack(rd32(po.irradiance + 4 * i), was);
+        lbk_r11g11b10f_unpack(rd32(pn.irradiance + 4 * i), now);
         for (int c = 0; c < 3; c++) assert_true(now[c] == 2.0f * was[c]);
         assert_memory_equal(po.rgba + 4 * i, pn.rgba + 4 * i, 4); /* plane 1 from the .ahd.exr, unchanged */
     }
-    lbk_lmap_get_page(&b.lmap, 0, &po);
-    lbk_lmap_get_page(&nb.lmap, 0, &pn);
+    lbk_lmap_page_get(&b.lmap, 0, &po);
+    lbk_lmap_page_get(&nb.lmap, 0, &pn);
     assert_memory_equal(po.irradiance, pn.irradiance, 4 * 64 * 32);
     free(px);
     tl_bake_close(&nb);

@@ -87,14 +87,15 @@ static tl_open_status open_views(tl_bake *b, char err[TL_ERR_LEN])
     int dls = 0, door = 0;
     (void)dls;
     (void)door;
-    VIEW(LBK_SECTION_META, b->has_meta, lbk_meta_parse(d, n, &b->meta));
-    VIEW(LBK_SECTION_OBJS, b->has_objs, lbk_objects_parse(d, n, &b->objs));
+    VIEW(LBK_SECTION_META, b->has_meta, lbk_meta_open(d, n, &b->meta));
+    VIEW(LBK_SECTION_OBJS, b->has_objs, lbk_objects_open(d, n, &b->objs));
     VIEW(LBK_SECTION_LMAP, b->has_lmap, lbk_lmap_open(d, n, &b->lmap));
     VIEW(LBK_SECTION_GLG, b->has_glg, lbk_glg_open(d, n, &b->glg));
     VIEW(LBK_SECTION_LLG, b->has_llg, lbk_llg_open(d, n, &b->llg));
     VIEW(LBK_SECTION_OCTP, b->has_octp, lbk_octp_open(d, n, &b->octp));
-    VIEW(LBK_SECTION_DLS, dls, lbk_dls_view_open(d, n, NULL, &b->dls));
-    VIEW(LBK_SECTION_DOOR, door, lbk_door_view_open(d, n, NULL, &b->door));
+    VIEW(LBK_SECTION_LMUV, b->has_lmuv, lbk_lmuv_open(d, n, &b->lmuv));
+    VIEW(LBK_SECTION_DLS, dls, lbk_dls_open(d, n, NULL, &b->dls));
+    VIEW(LBK_SECTION_DOOR, door, lbk_door_open(d, n, NULL, &b->door));
 #undef VIEW
     return TL_OPEN_OK;
 }
@@ -132,8 +133,8 @@ tl_open_status tl_bake_open_file(const char *path, tl_bake *b, char err[TL_ERR_L
 
 void tl_bake_close(tl_bake *b)
 {
-    if (b->door) lbk_door_view_close(b->door);
-    if (b->dls) lbk_dls_view_close(b->dls);
+    if (b->door) lbk_door_close(b->door);
+    if (b->dls) lbk_dls_close(b->dls);
     if (b->reader) lbk_reader_close(b->reader);
     free(b->bytes);
     memset(b, 0, sizeof *b);

@@ -13,6 +13,7 @@
 #include "lbk/door.h"
 #include "lbk/glg.h"
 #include "lbk/lightmap.h"
+#include "lbk/lightmap_uv.h"
 #include "lbk/llg.h"
 #include "lbk/meta.h"
 #include "lbk/objects.h"
@@ -29,13 +30,14 @@ typedef struct tl_bake {
     void *bytes; /* owned file bytes */
     size_t size;
     lbk_reader *reader;
-    int has_meta, has_objs, has_lmap, has_glg, has_llg, has_octp;
+    int has_meta, has_objs, has_lmap, has_glg, has_llg, has_octp, has_lmuv;
     lbk_meta_view meta;
     lbk_objects_view objs;
     lbk_lmap_view lmap;
     lbk_glg_view glg;
     lbk_llg_view llg;
     lbk_octp_view octp;
+    lbk_lmuv_view lmuv;
     lbk_dls_view *dls;   /* NULL when absent */
     lbk_door_view *door; /* NULL when absent */
 } tl_bake;

@@ -64,10 +64,10 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
     lbk_result r = lbk_reader_open_memory(in, in_size, NULL, &rd);
     if (r != LBK_OK) return tl_fail(err, TL_CONVERT_BAD_INPUT, "input: %s", lbk_result_message(r));
 
-    lbk_write_options wo = {0};
+    lbk_write_options wo = LBK_WRITE_OPTIONS_INIT;
     wo.section_alignment = p->alignment;
     lbk_writer *w = NULL;
-    r = lbk_writer_create(&wo, &w);
+    r = lbk_writer_open(&wo, &w);
     if (r != LBK_OK) {
         lbk_reader_close(rd);
         return tl_fail(err, TL_CONVERT_INTERNAL, "writer: %s", lbk_result_message(r));
@@ -82,7 +82,7 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
         lbk_section_info si;
         const void *data = NULL;
         size_t size = 0;
-        if ((r = lbk_reader_section_info(rd, i, &si)) != LBK_OK || (r = lbk_reader_section_data(rd, i, &data, &size)) != LBK_OK) {
+        if ((r = lbk_reader_section_get(rd, i, &si)) != LBK_OK || (r = lbk_reader_section_data(rd, i, &data, &size)) != LBK_OK) {
             st = tl_fail(err, TL_CONVERT_BAD_INPUT, "input section %u: %s", i, lbk_result_message(r));
             break;
         }
@@ -117,11 +117,11 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
             data = rewritten;
             size = rewritten_size;
         }
-        lbk_section_options so = {0};
+        lbk_section_options so = LBK_SECTION_OPTIONS_INIT;
         so.flags = si.flags;
         so.compression = rule.compression;
         so.zstd_level = rule.zstd_level;
-        r = lbk_writer_add_section(w, si.type, data, size, &so);
+        r = lbk_writer_section_add(w, si.type, data, size, &so);
         free(rewritten);
         if (r != LBK_OK) st = tl_fail(err, TL_CONVERT_INTERNAL, "writing section %u: %s", i, lbk_result_message(r));
     }
@@ -135,7 +135,7 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
         r = lbk_writer_to_memory(w, &bytes, &bytes_size);
         if (r != LBK_OK) st = tl_fail(err, TL_CONVERT_INTERNAL, "serialising the pack: %s", lbk_result_message(r));
     }
-    lbk_writer_destroy(w);
+    lbk_writer_close(w);
     lbk_reader_close(rd);
     tl_texel_remap_free(&remap);
     if (st != TL_CONVERT_OK) {
@@ -153,8 +153,8 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
             tl_convert_section *cs = &report->sections[i];
             uint32_t idx;
             lbk_section_info si;
-            if (cs->dropped || lbk_reader_find_section(ord, cs->type, &idx) != LBK_OK ||
-                lbk_reader_section_info(ord, idx, &si) != LBK_OK)
+            if (cs->dropped || lbk_reader_section_find(ord, cs->type, &idx) != LBK_OK ||
+                lbk_reader_section_get(ord, idx, &si) != LBK_OK)
                 continue;
             cs->out_stored = si.stored_size;
             cs->out_decoded = si.decoded_size;

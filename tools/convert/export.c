@@ -46,8 +46,8 @@ static int decode_page(const lbk_lmap_page *pg, page_images *im)
         for (uint32_t x = 0; x < pg->width; x++) {
             const size_t i = (size_t)y * pg->width + x;
             lbk_ahd_texel t;
-            lbk_lmap_page_texel(pg, x, y, &t);
-            lbk_unpack_r11g11b10f(t.irradiance_z, im->ez + 3 * i);
+            lbk_lmap_page_texel_get(pg, x, y, &t);
+            lbk_r11g11b10f_unpack(t.irradiance_z, im->ez + 3 * i);
             /* the stored highlight direction, decoded as lbk/ahd.h does */
             float d[3] = {2.0f * t.rgba[1] / 255.0f - 1.0f, 2.0f * t.rgba[2] / 255.0f - 1.0f, t.rgba[3] / 255.0f};
             float len = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
@@ -134,12 +134,12 @@ static int gather_probes(const tl_bake *b, probe_row **rows, size_t *count)
         probe_row *r = &(*rows)[(*count)++];
         r->grid = -1;
         r->index = i;
-        lbk_glg_probe(&b->glg, i, r->pos, &r->sh);
+        lbk_glg_probe_get(&b->glg, i, r->pos, &r->sh);
         tl_probe_eval(&r->sh, r->irr);
     }
     for (uint32_t g = 0; b->has_llg && g < b->llg.grid_count; g++) {
         lbk_llg_grid grid;
-        lbk_llg_get_grid(&b->llg, g, &grid);
+        lbk_llg_grid_get(&b->llg, g, &grid);
         for (uint32_t k = 0; k < grid.dims[2]; k++)
             for (uint32_t j = 0; j < grid.dims[1]; j++)
                 for (uint32_t i = 0; i < grid.dims[0]; i++) {
@@ -321,9 +321,9 @@ int tl_export(const tl_bake *b, const tl_export_options *o, tl_export_stats *st,
         uint64_t k = 0;
         for (uint32_t p = 0; p < np; p++) {
             lbk_lmap_page pg;
-            lbk_lmap_get_page(&b->lmap, p, &pg);
+            lbk_lmap_page_get(&b->lmap, p, &pg);
             for (uint32_t i = 0; i < pg.width * pg.height; i++, k++)
-                lbk_unpack_r11g11b10f(pg.irradiance[4 * i] | (uint32_t)pg.irradiance[4 * i + 1] << 8 |
+                lbk_r11g11b10f_unpack(pg.irradiance[4 * i] | (uint32_t)pg.irradiance[4 * i + 1] << 8 |
                                           (uint32_t)pg.irradiance[4 * i + 2] << 16 | (uint32_t)pg.irradiance[4 * i + 3] << 24,
                                       all + 3 * k);
         }
@@ -341,7 +341,7 @@ int tl_export(const tl_bake *b, const tl_export_options *o, tl_export_stats *st,
     int rc = 0;
     for (uint32_t p = 0; p < np && !rc; p++) {
         lbk_lmap_page pg;
-        lbk_lmap_get_page(&b->lmap, p, &pg);
+        lbk_lmap_page_get(&b->lmap, p, &pg);
         page_images im;
         memset(&im, 0, sizeof im);
         if (decode_page(&pg, &im)) {

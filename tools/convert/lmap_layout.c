@@ -76,7 +76,7 @@ static int import_page(const char *dir, uint32_t p, uint32_t w, uint32_t h, floa
             if (v[c] < 0) v[c] = 0; /* irradiance cannot be negative; painting tools overshoot */
             v[c] /= scale;           /* the EXR is physical, the section stores value / scale (exact) */
         }
-        tex[i].irradiance_z = lbk_pack_r11g11b10f(v);
+        tex[i].irradiance_z = lbk_r11g11b10f_pack(v);
     }
     free(px);
     tl_page_exr_path(path, sizeof path, dir, p, ".ahd.exr");
@@ -125,7 +125,7 @@ int tl_lmap_rewrite(const void *lmap, size_t size, const tl_lmap_layout_options 
     uint64_t first = 0;
     for (uint32_t p = 0; p < n; p++) {
         lbk_lmap_page pg;
-        lbk_lmap_get_page(&v, p, &pg);
+        lbk_lmap_page_get(&v, p, &pg);
         remap->old_width[p] = pg.width;
         remap->height[p] = pg.height;
         remap->old_first[p] = pg.first_texel;
@@ -141,7 +141,7 @@ int tl_lmap_rewrite(const void *lmap, size_t size, const tl_lmap_layout_options 
         /* nothing to rewrite; still honour the page alignment check */
         for (uint32_t p = 0; p < n && o->page_alignment; p++) {
             lbk_lmap_page pg;
-            lbk_lmap_get_page(&v, p, &pg);
+            lbk_lmap_page_get(&v, p, &pg);
             if (pg.irradiance_offset % o->page_alignment || pg.rgba_offset % o->page_alignment)
                 return tl_fail(err, TL_CONVERT_UNSUPPORTED,
                             "page %u planes start at LMAP bytes %llu and %llu, not multiples of page_alignment %u; "
@@ -158,7 +158,7 @@ int tl_lmap_rewrite(const void *lmap, size_t size, const tl_lmap_layout_options 
     if (!descs || !tex) st = tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
     for (uint32_t p = 0; p < n && st == TL_CONVERT_OK; p++) {
         lbk_lmap_page pg;
-        lbk_lmap_get_page(&v, p, &pg);
+        lbk_lmap_page_get(&v, p, &pg);
         const uint32_t w = pg.width, h = pg.height, nw = remap->new_width[p];
         lbk_ahd_texel *src = calloc((size_t)w * h, sizeof *src);
         tex[p] = calloc((size_t)nw * h, sizeof(lbk_ahd_texel)); /* new columns: zero texels */
@@ -168,7 +168,7 @@ int tl_lmap_rewrite(const void *lmap, size_t size, const tl_lmap_layout_options 
             break;
         }
         for (uint32_t y = 0; y < h; y++)
-            for (uint32_t x = 0; x < w; x++) lbk_lmap_page_texel(&pg, x, y, &src[(size_t)y * w + x]);
+            for (uint32_t x = 0; x < w; x++) lbk_lmap_page_texel_get(&pg, x, y, &src[(size_t)y * w + x]);
         if (o->from_exr_dir) {
             int got = import_page(o->from_exr_dir, p, w, h, v.scale, src, err);
             if (got < 0) st = -got;
@@ -181,14 +181,15 @@ int tl_lmap_rewrite(const void *lmap, size_t size, const tl_lmap_layout_options 
     if (st == TL_CONVERT_OK) {
         void *built = NULL;
         size_t built_size = 0;
-        r = lbk_lmap_build(descs, n, v.scale, NULL, &built, &built_size);
+        const lbk_lmap_build_desc bd = {.size = sizeof bd, .pages = descs, .page_count = n, .scale = v.scale};
+        r = lbk_lmap_build(&bd, NULL, &built, &built_size);
         if (r != LBK_OK) st = tl_fail(err, TL_CONVERT_INTERNAL, "rebuilding LMAP: %s", lbk_result_message(r));
         else {
             lbk_lmap_view nv;
             lbk_lmap_open(built, built_size, &nv);
             for (uint32_t p = 0; p < n && o->page_alignment && st == TL_CONVERT_OK; p++) {
                 lbk_lmap_page pg;
-                lbk_lmap_get_page(&nv, p, &pg);
+                lbk_lmap_page_get(&nv, p, &pg);
                 if (pg.irradiance_offset % o->page_alignment || pg.rgba_offset % o->page_alignment)
                     st = tl_fail(err, TL_CONVERT_UNSUPPORTED,
                               "page %u planes start at LMAP bytes %llu and %llu, not multiples of page_alignment %u; "
@@ -267,7 +268,7 @@ int tl_dls_remap_texels(const void *dls, size_t size, const tl_texel_remap *rema
     *out = NULL;
     *out_size = 0;
     lbk_dls_view *view = NULL;
-    lbk_result r = lbk_dls_view_open(dls, size, NULL, &view);
+    lbk_result r = lbk_dls_open(dls, size, NULL, &view);
     if (r != LBK_OK) return tl_fail(err, TL_CONVERT_BAD_INPUT, "DLS: %s", lbk_result_message(r));
     const uint32_t ns = lbk_dls_set_count(view);
     int st = TL_CONVERT_OK;
@@ -291,7 +292,7 @@ int tl_dls_remap_texels(const void *dls, size_t size, const tl_texel_remap *rema
         for (uint32_t i = 0; i < si.light_count; i++) {
             const char *ln;
             uint32_t ll;
-            lbk_dls_set_light(view, s, i, &ln, &ll);
+            lbk_dls_set_light_get(view, s, i, &ln, &ll);
             lights[s][i] = calloc(ll + 1, 1);
             if (!lights[s][i]) {
                 st = tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
@@ -299,7 +300,7 @@ int tl_dls_remap_texels(const void *dls, size_t size, const tl_texel_remap *rema
             }
             memcpy(lights[s][i], ln, ll);
         }
-        for (uint32_t i = 0; i < si.member_count; i++) lbk_dls_set_member(view, s, i, &members[s][i]);
+        for (uint32_t i = 0; i < si.member_count; i++) lbk_dls_set_member_get(view, s, i, &members[s][i]);
         sets[s].name = names[s];
         sets[s].kind = si.kind;
         sets[s].light_count = si.light_count;
@@ -318,8 +319,7 @@ int tl_dls_remap_texels(const void *dls, size_t size, const tl_texel_remap *rema
         else if (r != LBK_OK) st = tl_fail(err, TL_CONVERT_BAD_INPUT, "DLS cluster %u: %s", c, lbk_result_message(r));
     }
     if (st == TL_CONVERT_OK) {
-        lbk_dls_build_desc bd;
-        memset(&bd, 0, sizeof bd);
+        lbk_dls_build_desc bd = LBK_DLS_BUILD_DESC_INIT;
         bd.set_count = ns;
         bd.sets = sets;
         for (uint32_t sp = 0; sp < LBK_DLS_SPACE_COUNT_; sp++) bd.target_count[sp] = lbk_dls_target_count(view, sp);
@@ -357,6 +357,6 @@ int tl_dls_remap_texels(const void *dls, size_t size, const tl_texel_remap *rema
     free(names);
     free(lights);
     free(members);
-    lbk_dls_view_close(view);
+    lbk_dls_close(view);
     return st;
 }

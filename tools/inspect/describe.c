@@ -16,6 +16,7 @@ inspect_describe_fn inspect_describer(uint32_t type)
     case LBK_SECTION_OCTP: return inspect_describe_octp;
     case LBK_SECTION_DLS: return inspect_describe_dls;
     case LBK_SECTION_DOOR: return inspect_describe_door;
+    case LBK_SECTION_LMUV: return inspect_describe_lmuv;
     default: return NULL;
     }
 }

@@ -32,6 +32,7 @@ void inspect_describe_llg(const uint8_t *data, size_t size, inspect_stats *out);
 void inspect_describe_octp(const uint8_t *data, size_t size, inspect_stats *out);
 void inspect_describe_dls(const uint8_t *data, size_t size, inspect_stats *out);
 void inspect_describe_door(const uint8_t *data, size_t size, inspect_stats *out);
+void inspect_describe_lmuv(const uint8_t *data, size_t size, inspect_stats *out);
 
 /* log2 of a lighting section's scale (a power of two, spec/container.md §5.7). */
 int inspect_scale_log2(float scale);

@@ -1,5 +1,6 @@
 /* DLS in `lbk inspect`: sets, clusters, payload and ancillary bytes. GPU: the entries' payloads
  * and the per-target index data the apply dispatches read; set names and tables stay on the CPU. */
+#define LBK_STATIC_LINKING_ONLY /* lbk_dls_stats: experimental (lbk/dls.h) */
 #include <stdio.h>
 
 #include "tools/inspect/describe.h"
@@ -8,9 +9,9 @@
 void inspect_describe_dls(const uint8_t *data, size_t size, inspect_stats *out)
 {
     lbk_dls_view *v;
-    if (lbk_dls_view_open(data, size, NULL, &v) != LBK_OK) return;
+    if (lbk_dls_open(data, size, NULL, &v) != LBK_OK) return;
     lbk_dls_stats st;
-    if (lbk_dls_compute_stats(v, &st) == LBK_OK) {
+    if (lbk_dls_stats_get(v, &st) == LBK_OK) {
         out->parsed = 1;
         out->dls_sets = st.set_count;
         out->dls_light_sets = st.sets_by_kind[LBK_DLS_KIND_LIGHTS];
@@ -31,5 +32,5 @@ void inspect_describe_dls(const uint8_t *data, size_t size, inspect_stats *out)
                  (unsigned long long)st.payload_bytes, (unsigned long long)st.ancillary_bytes,
                  st.index_bits_per_target[LBK_DLS_SPACE_TEXEL], h[0], h[1], h[2], h[3], h[4]);
     }
-    lbk_dls_view_close(v);
+    lbk_dls_close(v);
 }

@@ -7,7 +7,7 @@
 void inspect_describe_meta(const uint8_t *data, size_t size, inspect_stats *out)
 {
     lbk_meta_view v;
-    if (lbk_meta_parse(data, size, &v) != LBK_OK) return;
+    if (lbk_meta_open(data, size, &v) != LBK_OK) return;
     out->parsed = 1;
     lbk_string writer = {"?", 1}, version = {"", 0}, scene = {"", 0};
     lbk_meta_find(&v, LBK_META_WRITER, &writer);

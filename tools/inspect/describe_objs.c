@@ -7,7 +7,7 @@
 void inspect_describe_objs(const uint8_t *data, size_t size, inspect_stats *out)
 {
     lbk_objects_view v;
-    if (lbk_objects_parse(data, size, &v) != LBK_OK) return;
+    if (lbk_objects_open(data, size, &v) != LBK_OK) return;
     out->parsed = 1;
     out->objects = v.count;
     uint32_t by_rep[LBK_REPRESENTATION_COUNT_ + 1] = {0};

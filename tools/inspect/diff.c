@@ -79,7 +79,7 @@ static int add_sample(tl_err_stats *s, const float *a, const float *b, int n, co
 static void texel_values(const lbk_lmap_page *pg, uint32_t x, uint32_t y, float out[TL_TEXEL_NORMALS][3])
 {
     lbk_ahd_texel t;
-    lbk_lmap_page_texel(pg, x, y, &t);
+    lbk_lmap_page_texel_get(pg, x, y, &t);
     tl_texel_eval(&t, pg->scale, out);
 }
 
@@ -118,7 +118,7 @@ static int diff_sections(const tl_bake *a, const tl_bake *b, tl_diff_result *r)
     for (int side = 0; side < 2; side++)
         for (uint32_t i = 0; i < lbk_reader_section_count(both[side]->reader); i++) {
             lbk_section_info si;
-            lbk_reader_section_info(both[side]->reader, i, &si);
+            lbk_reader_section_get(both[side]->reader, i, &si);
             int seen = 0;
             for (size_t k = 0; k < nt; k++) seen |= types[k] == si.type;
             if (!seen) types[nt++] = si.type;
@@ -158,8 +158,8 @@ static int diff_params(const tl_bake *a, const tl_bake *b, tl_diff_result *r)
     size_t i = 0, j = 0;
     while (i < na || j < nb) {
         lbk_string ka = {0}, va = {0}, kb = {0}, vb = {0};
-        if (i < na) lbk_meta_entry(&a->meta, (uint32_t)i, &ka, &va);
-        if (j < nb) lbk_meta_entry(&b->meta, (uint32_t)j, &kb, &vb);
+        if (i < na) lbk_meta_entry_get(&a->meta, (uint32_t)i, &ka, &va);
+        if (j < nb) lbk_meta_entry_get(&b->meta, (uint32_t)j, &kb, &vb);
         int c;
         if (i >= na) c = 1;
         else if (j >= nb) c = -1;
@@ -210,7 +210,7 @@ static void compare_object(const tl_bake *a, const tl_bake *b, const lbk_object 
     if (oa->representation == LBK_REPRESENTATION_LIGHTMAP && ob->representation == LBK_REPRESENTATION_LIGHTMAP &&
         a->has_lmap && b->has_lmap) {
         lbk_lmap_page pa, pb;
-        if (lbk_lmap_get_page(&a->lmap, oa->index, &pa) != LBK_OK || lbk_lmap_get_page(&b->lmap, ob->index, &pb) != LBK_OK)
+        if (lbk_lmap_page_get(&a->lmap, oa->index, &pa) != LBK_OK || lbk_lmap_page_get(&b->lmap, ob->index, &pb) != LBK_OK)
             return;
         d->compared = 1;
         const int same_size = oa->rect_w == ob->rect_w && oa->rect_h == ob->rect_h;
@@ -228,7 +228,7 @@ static void compare_object(const tl_bake *a, const tl_bake *b, const lbk_object 
     if (oa->representation == LBK_REPRESENTATION_LLG && ob->representation == LBK_REPRESENTATION_LLG && a->has_llg &&
         b->has_llg) {
         lbk_llg_grid ga, gb;
-        if (lbk_llg_get_grid(&a->llg, oa->index, &ga) != LBK_OK || lbk_llg_get_grid(&b->llg, ob->index, &gb) != LBK_OK)
+        if (lbk_llg_grid_get(&a->llg, oa->index, &ga) != LBK_OK || lbk_llg_grid_get(&b->llg, ob->index, &gb) != LBK_OK)
             return;
         d->compared = 1;
         const int same = ga.dims[0] == gb.dims[0] && ga.dims[1] == gb.dims[1] && ga.dims[2] == gb.dims[2];
@@ -344,8 +344,8 @@ static int diff_pages(const tl_bake *a, const tl_bake *b, const tol *t, int keep
         tl_diff_page *d = &r->pages[r->page_count++];
         d->index = p;
         lbk_lmap_page pa, pb;
-        if (p < na) lbk_lmap_get_page(&a->lmap, p, &pa), d->wa = pa.width, d->ha = pa.height;
-        if (p < nb) lbk_lmap_get_page(&b->lmap, p, &pb), d->wb = pb.width, d->hb = pb.height;
+        if (p < na) lbk_lmap_page_get(&a->lmap, p, &pa), d->wa = pa.width, d->ha = pa.height;
+        if (p < nb) lbk_lmap_page_get(&b->lmap, p, &pb), d->wb = pb.width, d->hb = pb.height;
         if (p >= nb) {
             d->status = TL_DIFF_REMOVED;
             r->pages_changed++;
@@ -392,8 +392,8 @@ static int glg_same_layout(const tl_bake *a, const tl_bake *b)
     for (uint32_t i = 0; i < a->glg.probe_count; i++) {
         float pa[3], pb[3];
         lbk_sh9_rgb s;
-        lbk_glg_probe(&a->glg, i, pa, &s);
-        lbk_glg_probe(&b->glg, i, pb, &s);
+        lbk_glg_probe_get(&a->glg, i, pa, &s);
+        lbk_glg_probe_get(&b->glg, i, pb, &s);
         if (pa[0] != pb[0] || pa[1] != pb[1] || pa[2] != pb[2]) return 0;
     }
     return 1;
@@ -418,8 +418,8 @@ static void diff_glg(const tl_bake *a, const tl_bake *b, const tol *t, tl_diff_r
     for (uint32_t i = 0; i < a->glg.probe_count; i++) {
         float pos[3], pb[3];
         lbk_sh9_rgb sa, sb;
-        lbk_glg_probe(&a->glg, i, pos, &sa);
-        if (same) lbk_glg_probe(&b->glg, i, pb, &sb);
+        lbk_glg_probe_get(&a->glg, i, pos, &sa);
+        if (same) lbk_glg_probe_get(&b->glg, i, pb, &sb);
         else if (lbk_glg_sample(&b->glg, pos, &hint, &sb, NULL) != LBK_OK) memset(&sb, 0, sizeof sb);
         float va[TL_PROBE_NORMALS][3], vb[TL_PROBE_NORMALS][3];
         tl_probe_eval(&sa, va);
@@ -477,7 +477,7 @@ static int collect_set(const lbk_dls_view *v, uint32_t set, uint32_t space, set_
         int member = 0;
         for (uint32_t i = 0; i < ci.set_count; i++) {
             uint32_t s;
-            lbk_dls_cluster_set(v, c, i, &s);
+            lbk_dls_cluster_set_get(v, c, i, &s);
             member |= s == set;
         }
         if (member && lbk_dls_cluster_decode(v, c, gather, e) != LBK_OK) return -1;
@@ -508,9 +508,9 @@ static keyed *sorted_keys(const tl_bake *bk, const set_entries *e)
         if (e->space == LBK_DLS_SPACE_TEXEL && bk->has_lmap) {
             lbk_ahd_texel t;
             uint32_t page;
-            if (lbk_lmap_texel(&bk->lmap, e->targets[i], &t, &page) == LBK_OK) {
+            if (lbk_lmap_texel_get(&bk->lmap, e->targets[i], &t, &page) == LBK_OK) {
                 lbk_lmap_page pg;
-                lbk_lmap_get_page(&bk->lmap, page, &pg);
+                lbk_lmap_page_get(&bk->lmap, page, &pg);
                 uint64_t local = e->targets[i] - pg.first_texel;
                 key = ((uint64_t)page << 32) | ((local / pg.width) << 16) | (local % pg.width);
             }
@@ -533,7 +533,7 @@ static void eval_payload(uint32_t space, const uint8_t *p, float scale, float *o
 {
     if (space == LBK_DLS_SPACE_TEXEL) {
         lbk_ahd_texel t;
-        if (p) lbk_ahd_texel_load(p, &t);
+        if (p) lbk_ahd_texel_unpack(p, &t);
         else memset(&t, 0, sizeof t);
         tl_texel_eval(&t, scale, (float(*)[3])out);
     } else {
@@ -554,8 +554,8 @@ static int space_comparable(const tl_bake *a, const tl_bake *b, uint32_t space)
     if (!a->has_llg || !b->has_llg || a->llg.grid_count != b->llg.grid_count) return 0;
     for (uint32_t g = 0; g < a->llg.grid_count; g++) {
         lbk_llg_grid ga, gb;
-        lbk_llg_get_grid(&a->llg, g, &ga);
-        lbk_llg_get_grid(&b->llg, g, &gb);
+        lbk_llg_grid_get(&a->llg, g, &ga);
+        lbk_llg_grid_get(&b->llg, g, &gb);
         if (memcmp(ga.dims, gb.dims, sizeof ga.dims)) return 0;
     }
     return 1;
@@ -617,15 +617,15 @@ static int set_meta_equal(const tl_bake *a, uint32_t sa, const tl_bake *b, uint3
     for (uint32_t i = 0; i < ia.light_count; i++) {
         const char *na, *nb;
         uint32_t la, lb;
-        lbk_dls_set_light(a->dls, sa, i, &na, &la);
-        lbk_dls_set_light(b->dls, sb, i, &nb, &lb);
+        lbk_dls_set_light_get(a->dls, sa, i, &na, &la);
+        lbk_dls_set_light_get(b->dls, sb, i, &nb, &lb);
         if (la != lb || memcmp(na, nb, la)) return 0;
     }
     for (uint32_t i = 0; i < ia.member_count; i++) {
         uint32_t ma, mb;
         char xa[128], xb[128];
-        lbk_dls_set_member(a->dls, sa, i, &ma);
-        lbk_dls_set_member(b->dls, sb, i, &mb);
+        lbk_dls_set_member_get(a->dls, sa, i, &ma);
+        lbk_dls_set_member_get(b->dls, sb, i, &mb);
         set_name(a->dls, ma, xa, sizeof xa);
         set_name(b->dls, mb, xb, sizeof xb);
         if (strcmp(xa, xb)) return 0;
@@ -645,7 +645,7 @@ static int diff_sets(const tl_bake *a, const tl_bake *b, const tol *t, tl_diff_r
         tl_diff_set *d = &r->sets[r->set_count++];
         set_name(a->dls, s, d->name, sizeof d->name);
         uint32_t sb;
-        if (!b->dls || lbk_dls_find_set(b->dls, d->name, &sb) != LBK_OK) {
+        if (!b->dls || lbk_dls_set_find(b->dls, d->name, &sb) != LBK_OK) {
             d->status = TL_DIFF_REMOVED;
             r->sets_changed++;
             continue;
@@ -673,7 +673,7 @@ static int diff_sets(const tl_bake *a, const tl_bake *b, const tol *t, tl_diff_r
         char name[128];
         set_name(b->dls, s, name, sizeof name);
         uint32_t x;
-        if (a->dls && lbk_dls_find_set(a->dls, name, &x) == LBK_OK) continue;
+        if (a->dls && lbk_dls_set_find(a->dls, name, &x) == LBK_OK) continue;
         tl_diff_set *d = &r->sets[r->set_count++];
         memcpy(d->name, name, sizeof name);
         d->status = TL_DIFF_ADDED;

@@ -35,7 +35,9 @@
  *   4. I_c = 2·max(0, g_c·d), a_c = max(0, e0_c − I_c/4), Ez_c = a_c + I_c·k;
  *   5. plane 0 = R11G11B10F(Ez) (rules of lbk/pixel.h), r = lum(a)/lum(Ez) (1 when lum(Ez) ≤ 0).
  * Exact (up to quantisation) for any lighting whose channels share one gradient direction and
- * whose ambient and directional parts share a chroma; the measured error bounds are in the spec. */
+ * whose ambient and directional parts share a chroma; the measured error bounds are in the spec.
+ *
+ * Thread safety: every function is pure (no state): safe to call from any thread. */
 #ifndef LBK_AHD_H
 #define LBK_AHD_H
 
@@ -78,9 +80,28 @@ LBK_API void lbk_ahd_linear_add_light(lbk_ahd_linear *lin, const float dir[3], c
 /* dst += w · src. */
 LBK_API void lbk_ahd_linear_add_scaled(lbk_ahd_linear *dst, const lbk_ahd_linear *src, float w);
 
+/* ---- tangent frame (spec §5.6 "Tangent frame") -------------------------------------------------
+ * d, the highlight direction, is stored in the frame of the surface point the texel was lit from:
+ *   N = the unit interpolated shading normal (+Z);
+ *   T = dP/dX, the derivative of the world position along the lightmap coordinate X (to the right
+ *       on the page, spec §16.1; normalised u = X / width has the same direction), made orthogonal
+ *       to N and unit length (+X);
+ *   B = N × T (+Y): always right-handed, no handedness sign is stored, also for mirrored
+ *       authored TEXCOORD_1 (for generated charts B points along +Y, down the page).
+ * A world direction w has tangent coordinates (w·T, w·B, w·N). When dP/dX is zero or within
+ * 1e-6 (relative) of parallel to N, T is the first vector of the branchless orthonormal basis of N
+ * (Duff et al. 2017): with s = sign(N.z) (+1 at 0) and a = −1/(s + N.z),
+ * T = (1 + s·N.x²·a, s·N.x·N.y·a, −s·N.x). A renderer rebuilds T per vertex or per pixel from the
+ * lightmap coordinates' derivatives the same way. */
+/* The frame for a normal n (normalised here; a zero n means +Z) and dP/dX. Computed in double. */
+LBK_API void lbk_ahd_tangent_frame(const float n[3], const float dpdx[3], float t[3], float b[3]);
+/* dP/dX of a triangle from its world positions and lightmap coordinates (any units of X: only the
+ * direction matters); zero when the coordinates span no area. */
+LBK_API void lbk_ahd_triangle_dpdx(const float p[3][3], const float coord[3][2], float dpdx[3]);
+
 /* The 8 bytes as the spec's texel view (u32 LE then RGBA) — for tools that keep texels packed. */
-LBK_API void lbk_ahd_texel_store(const lbk_ahd_texel *texel, uint8_t out[LBK_AHD_TEXEL_SIZE]);
-LBK_API void lbk_ahd_texel_load(const uint8_t in[LBK_AHD_TEXEL_SIZE], lbk_ahd_texel *texel);
+LBK_API void lbk_ahd_texel_pack(const lbk_ahd_texel *texel, uint8_t out[LBK_AHD_TEXEL_SIZE]);
+LBK_API void lbk_ahd_texel_unpack(const uint8_t in[LBK_AHD_TEXEL_SIZE], lbk_ahd_texel *texel);
 
 #ifdef __cplusplus
 }

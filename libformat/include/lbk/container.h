@@ -1,5 +1,11 @@
 /* Container framing: header, section table, per-section compression and checksums.
- * Layout: spec/container.md §2–§4. Payload layouts live in the per-concept headers. */
+ * Layout: spec/container.md §2–§4. Payload layouts live in the per-concept headers.
+ *
+ * Thread safety: a reader's const functions (header, bytes, section count/get/find) may run
+ * concurrently; lbk_reader_section_data and lbk_reader_section_by_type decode and cache on first
+ * access, so they need the reader to themselves until every section they return was accessed
+ * once (or a lock around them). A writer is used by one thread at a time. Distinct readers and
+ * writers are independent. */
 #ifndef LBK_CONTAINER_H
 #define LBK_CONTAINER_H
 
@@ -49,11 +55,11 @@ typedef struct lbk_section_info {
 
 /* ---- reading ---------------------------------------------------------------------------- */
 
-/* A reader is not thread-safe: lbk_reader_section_data decodes and caches on first access.
- * Share one between threads only after every section was accessed once, or lock around it. */
 typedef struct lbk_reader lbk_reader;
 
+/* Size-tagged (lbk.h): set size with LBK_READ_OPTIONS_INIT; NULL options mean defaults. */
 typedef struct lbk_read_options {
+    size_t size;
     const lbk_allocator *allocator; /* NULL: malloc/free */
     /* Cap on the total bytes the reader may allocate for decoded sections.
      * 0: min(4 GiB, 1024 × file size + 64 MiB) — see spec/container.md §4.3. */
@@ -62,6 +68,7 @@ typedef struct lbk_read_options {
      * (a console loader that verified the file once at install time). */
     int skip_checksums;
 } lbk_read_options;
+#define LBK_READ_OPTIONS_INIT LBK_SIZED_INIT(lbk_read_options)
 
 /* Maps the file read-only and checks the header and section table (magic, version, features,
  * header and table checksums, ordering, alignment, bounds). Payload bytes are not touched. */
@@ -75,9 +82,9 @@ LBK_API const lbk_header_info *lbk_reader_header(const lbk_reader *reader);
 /* The whole file as mapped / passed in. */
 LBK_API const void *lbk_reader_bytes(const lbk_reader *reader, size_t *size);
 LBK_API uint32_t lbk_reader_section_count(const lbk_reader *reader);
-LBK_API lbk_result lbk_reader_section_info(const lbk_reader *reader, uint32_t index, lbk_section_info *out);
+LBK_API lbk_result lbk_reader_section_get(const lbk_reader *reader, uint32_t index, lbk_section_info *out);
 /* Index of the section of a given type; LBK_ERR_NOT_FOUND if absent. */
-LBK_API lbk_result lbk_reader_find_section(const lbk_reader *reader, uint32_t type, uint32_t *index);
+LBK_API lbk_result lbk_reader_section_find(const lbk_reader *reader, uint32_t type, uint32_t *index);
 /* The decoded bytes of a section. Uncompressed sections are returned in place (zero copy, aligned
  * as the header says); zstd sections are decoded once and cached. Verifies the checksum of the
  * stored bytes on first access unless options->skip_checksums. The pointer lives as long as the
@@ -90,30 +97,32 @@ LBK_API lbk_result lbk_reader_section_by_type(lbk_reader *reader, uint32_t type,
 
 typedef struct lbk_writer lbk_writer;
 
+/* Size-tagged (lbk.h), both; NULL options mean defaults. */
 typedef struct lbk_write_options {
+    size_t size;
     const lbk_allocator *allocator; /* NULL: malloc/free */
     uint32_t section_alignment;     /* power of two in [16, 65536]; 0: 64 */
 } lbk_write_options;
+#define LBK_WRITE_OPTIONS_INIT LBK_SIZED_INIT(lbk_write_options)
 
 typedef struct lbk_section_options {
+    size_t size;
     uint32_t flags;        /* LBK_SECTION_FLAG_*; 0: optional */
     uint32_t compression;  /* lbk_compression; 0: none */
     int zstd_level;        /* 0: 19 */
 } lbk_section_options;
+#define LBK_SECTION_OPTIONS_INIT LBK_SIZED_INIT(lbk_section_options)
 
-LBK_API lbk_result lbk_writer_create(const lbk_write_options *options, lbk_writer **out);
-LBK_API void lbk_writer_destroy(lbk_writer *writer);
+LBK_API lbk_result lbk_writer_open(const lbk_write_options *options, lbk_writer **out);
+LBK_API void lbk_writer_close(lbk_writer *writer);
 /* Copies the bytes. Each type may be added once. Sections are written in the canonical order of
  * spec/container.md §3 regardless of the order they are added in, so output is deterministic. */
-LBK_API lbk_result lbk_writer_add_section(lbk_writer *writer, uint32_t type, const void *data, size_t size,
+LBK_API lbk_result lbk_writer_section_add(lbk_writer *writer, uint32_t type, const void *data, size_t size,
                                           const lbk_section_options *options);
 /* Serialises into one buffer allocated with the writer's allocator; free it with lbk_free. */
 LBK_API lbk_result lbk_writer_to_memory(lbk_writer *writer, void **out, size_t *size);
 /* Writes atomically: a temp file beside path, fsync, rename, fsync of the directory. */
 LBK_API lbk_result lbk_writer_to_file(lbk_writer *writer, const char *path);
-
-/* Frees memory that the library returned through the given allocator (NULL: free). */
-LBK_API void lbk_free(const lbk_allocator *allocator, void *ptr);
 
 #ifdef __cplusplus
 }

@@ -4,9 +4,16 @@
  *
  * Three parts:
  *   - the builder (lbk_dls_build): sets + sparse per-set entries → DLS section bytes;
- *   - the view (lbk_dls_view_open): a checked, read-only view of DLS section bytes;
- *   - the runtime (lbk_dls_runtime_create / lbk_dls_apply): final texels and probes for weights.
- * Doors (lbk/door.h) are DLS sets of kinds 1–3 whose weights follow the door's opening. */
+ *   - the view (lbk_dls_open / lbk_dls_close): a checked, read-only view of DLS section bytes;
+ *   - the runtime (lbk_dls_runtime_open / lbk_dls_apply / lbk_dls_runtime_close): final texels
+ *     and probes for weights.
+ * Doors (lbk/door.h) are DLS sets of kinds 1–3 whose weights follow the door's opening.
+ * The builder's tuning and statistics are experimental (LBK_STATIC_LINKING_ONLY, at the end).
+ *
+ * Thread safety: the builder and every view function are safe to call from any thread, and a
+ * view may be shared once open (it is read-only). A runtime is used by one thread at a time
+ * (lbk_dls_apply rewrites its state and the output buffers); lbk_dls_effective_weights only
+ * reads it. */
 #ifndef LBK_DLS_H
 #define LBK_DLS_H
 
@@ -29,7 +36,7 @@ typedef enum lbk_dls_set_kind {
  * page (as LMAP numbers them); GLG probes by GLG probe index; LLG probes by index into the
  * concatenated LLG probe array. */
 typedef enum lbk_dls_space {
-    LBK_DLS_SPACE_TEXEL = 0, /* payload: 8-byte AHD texel (lbk_ahd_texel_store layout) */
+    LBK_DLS_SPACE_TEXEL = 0, /* payload: 8-byte AHD texel (lbk_ahd_texel_pack layout) */
     LBK_DLS_SPACE_GLG = 1,   /* payload: 28-byte SH9 probe (lbk_sh9_pack layout) */
     LBK_DLS_SPACE_LLG = 2,   /* payload: 28-byte SH9 probe */
     LBK_DLS_SPACE_COUNT_
@@ -58,7 +65,8 @@ typedef enum lbk_dls_form {
 /* ---- building -------------------------------------------------------------------------- */
 
 /* One set's entries in one target space. targets: distinct indices < the space's target count,
- * in any order; payloads: count × payload size (8 or 28 bytes), entry i for targets[i]. */
+ * in any order; payloads: count × payload size (8 or 28 bytes), entry i for targets[i].
+ * lbk_dls_sparse and lbk_dls_set_desc are array elements (frozen). */
 typedef struct lbk_dls_sparse {
     uint64_t count;
     const uint32_t *targets;
@@ -75,50 +83,33 @@ typedef struct lbk_dls_set_desc {
     lbk_dls_sparse entries[LBK_DLS_SPACE_COUNT_]; /* indexed by lbk_dls_space */
 } lbk_dls_set_desc;
 
+/* Size-tagged (lbk.h): set size with LBK_DLS_BUILD_DESC_INIT. */
 typedef struct lbk_dls_build_desc {
+    size_t size;
     uint32_t set_count;
     const lbk_dls_set_desc *sets;
     /* Size of each target space: LMAP texels, GLG probes, LLG probes (≤ 2^32 each). */
     uint64_t target_count[LBK_DLS_SPACE_COUNT_];
 } lbk_dls_build_desc;
+#define LBK_DLS_BUILD_DESC_INIT LBK_SIZED_INIT(lbk_dls_build_desc)
 
+typedef struct lbk_dls_tuning lbk_dls_tuning; /* experimental: LBK_STATIC_LINKING_ONLY */
+typedef struct lbk_dls_stats lbk_dls_stats;   /* experimental: LBK_STATIC_LINKING_ONLY */
+
+/* Size-tagged (lbk.h): set size with LBK_DLS_BUILD_OPTIONS_INIT; NULL options mean defaults. */
 typedef struct lbk_dls_build_options {
-    const lbk_allocator *allocator;   /* NULL: malloc/free; also allocates the output */
-    /* Packed (class 1) and prefix clusters grow by adding the combination that adds the fewest
-     * new sets until they hold this many targets; past it only combinations adding no set join.
-     * 0: 256. */
-    uint32_t min_dispatch_targets;
-    /* Cap on the targets of one class (1) packed cluster. 0: 4096. */
-    uint32_t packed_max_targets;
+    size_t size;
+    const lbk_allocator *allocator; /* NULL: malloc/free; also allocates the output */
+    const lbk_dls_tuning *tuning;   /* NULL: the defaults (experimental) */
 } lbk_dls_build_options;
-
-/* Statistics for `lbk inspect` (Table 1 of seed 001). */
-#define LBK_DLS_HISTOGRAM_BINS 18 /* [0] untouched targets, [1..16] that many sets, [17] more */
-typedef struct lbk_dls_stats {
-    uint32_t set_count;
-    uint32_t sets_by_kind[LBK_DLS_KIND_COUNT_];
-    uint32_t cluster_count;
-    uint32_t clusters_by_form[LBK_DLS_FORM_COUNT_];
-    uint32_t packed_subgroups;                      /* class (1) sub-groups over all clusters */
-    uint64_t target_count[LBK_DLS_SPACE_COUNT_];    /* size of each space */
-    uint64_t touched[LBK_DLS_SPACE_COUNT_];         /* targets with at least one entry */
-    uint64_t targets_by_form[LBK_DLS_FORM_COUNT_];
-    uint64_t entries[LBK_DLS_SPACE_COUNT_];
-    uint64_t histogram[LBK_DLS_SPACE_COUNT_][LBK_DLS_HISTOGRAM_BINS];
-    uint64_t section_bytes;
-    uint64_t payload_bytes;     /* the entries' 8/28-byte payloads */
-    uint64_t ancillary_bytes;   /* everything else: section_bytes − payload_bytes */
-    /* The per-target index data of each space: cluster records and set lists, runs, sub-group
-     * records, prefix words, bases and slots of the clusters of that space. */
-    uint64_t index_bytes[LBK_DLS_SPACE_COUNT_];
-    double index_bits_per_target[LBK_DLS_SPACE_COUNT_]; /* 8 × index_bytes / touched (0 if none) */
-} lbk_dls_stats;
+#define LBK_DLS_BUILD_OPTIONS_INIT LBK_SIZED_INIT(lbk_dls_build_options)
 
 /* Builds the DLS section. Deterministic: the output depends only on the content of desc (the
  * order of each set's entries does not matter). Errors: LBK_ERR_INVALID_ARGUMENT (bad kind,
  * name, members, duplicate target in a set), LBK_ERR_RANGE (target ≥ target_count),
  * LBK_ERR_OVERLAPS (a target touched by more than 255 sets), LBK_ERR_LIMIT, LBK_ERR_OUT_OF_MEMORY.
- * *out is allocated with options->allocator; free it with lbk_free. stats may be NULL. */
+ * *out is allocated with options->allocator; free it with lbk_free. stats: NULL, or the
+ * experimental statistics of the result (as lbk_dls_stats_get). */
 LBK_API lbk_result lbk_dls_build(const lbk_dls_build_desc *desc, const lbk_dls_build_options *options,
                                  void **out, size_t *out_size, lbk_dls_stats *stats);
 
@@ -129,9 +120,9 @@ typedef struct lbk_dls_view lbk_dls_view;
 /* Checks every structural rule of spec/container.md §12 (the DLS rules of spec/validation.md
  * except the cross-section ones) and returns LBK_ERR_CORRUPT / LBK_ERR_TRUNCATED if any fails.
  * The bytes are not copied and must outlive the view. */
-LBK_API lbk_result lbk_dls_view_open(const void *data, size_t size, const lbk_allocator *allocator,
-                                     lbk_dls_view **out);
-LBK_API void lbk_dls_view_close(lbk_dls_view *view);
+LBK_API lbk_result lbk_dls_open(const void *data, size_t size, const lbk_allocator *allocator,
+                                lbk_dls_view **out);
+LBK_API void lbk_dls_close(lbk_dls_view *view);
 
 typedef struct lbk_dls_set_info {
     const char *name;       /* not NUL-terminated */
@@ -154,16 +145,16 @@ typedef struct lbk_dls_cluster_info {
 
 LBK_API uint32_t lbk_dls_set_count(const lbk_dls_view *view);
 LBK_API lbk_result lbk_dls_set_get(const lbk_dls_view *view, uint32_t set, lbk_dls_set_info *out);
-LBK_API lbk_result lbk_dls_set_light(const lbk_dls_view *view, uint32_t set, uint32_t i, const char **name,
-                                     uint32_t *length);
-LBK_API lbk_result lbk_dls_set_member(const lbk_dls_view *view, uint32_t set, uint32_t i, uint32_t *member);
+LBK_API lbk_result lbk_dls_set_light_get(const lbk_dls_view *view, uint32_t set, uint32_t i, const char **name,
+                                         uint32_t *length);
+LBK_API lbk_result lbk_dls_set_member_get(const lbk_dls_view *view, uint32_t set, uint32_t i, uint32_t *member);
 /* LBK_ERR_NOT_FOUND when no set has that name. */
-LBK_API lbk_result lbk_dls_find_set(const lbk_dls_view *view, const char *name, uint32_t *set);
+LBK_API lbk_result lbk_dls_set_find(const lbk_dls_view *view, const char *name, uint32_t *set);
 /* Target space sizes the section was built for. */
 LBK_API uint64_t lbk_dls_target_count(const lbk_dls_view *view, uint32_t space);
 LBK_API uint32_t lbk_dls_cluster_count(const lbk_dls_view *view);
 LBK_API lbk_result lbk_dls_cluster_get(const lbk_dls_view *view, uint32_t cluster, lbk_dls_cluster_info *out);
-LBK_API lbk_result lbk_dls_cluster_set(const lbk_dls_view *view, uint32_t cluster, uint32_t i, uint32_t *set);
+LBK_API lbk_result lbk_dls_cluster_set_get(const lbk_dls_view *view, uint32_t cluster, uint32_t i, uint32_t *set);
 
 /* Decodes a cluster target by target, in payload order: for each target its index, its entry
  * count, the set index of each entry and the entries' payloads (count × payload size, in set
@@ -172,8 +163,6 @@ typedef int (*lbk_dls_target_fn)(void *user, uint32_t target, uint32_t count, co
                                  const uint8_t *payloads);
 LBK_API lbk_result lbk_dls_cluster_decode(const lbk_dls_view *view, uint32_t cluster, lbk_dls_target_fn fn,
                                           void *user);
-
-LBK_API lbk_result lbk_dls_compute_stats(const lbk_dls_view *view, lbk_dls_stats *out);
 
 /* ---- reference runtime ----------------------------------------------------------------- */
 
@@ -185,8 +174,9 @@ typedef struct lbk_dls_runtime lbk_dls_runtime;
  * A space with no DLS entries may be NULL (its output is then not written). The output buffers
  * are caller-owned and must persist unchanged between lbk_dls_apply calls: apply rewrites only
  * the targets whose sets changed (call lbk_dls_runtime_invalidate after touching them). Outputs
- * must not overlap the bases. */
+ * must not overlap the bases. Size-tagged (lbk.h): set size with LBK_DLS_RUNTIME_DESC_INIT. */
 typedef struct lbk_dls_runtime_desc {
+    size_t size;
     const lbk_dls_view *dls;
     const struct lbk_door_view *doors; /* optional: door weights drive the kind 1/2 sets */
     const uint32_t *base_irradiance_z; const uint8_t *base_rgba; /* lbk_dls_target_count(TEXEL) */
@@ -197,7 +187,9 @@ typedef struct lbk_dls_runtime_desc {
     uint8_t *out_llg;
     const lbk_allocator *allocator;
 } lbk_dls_runtime_desc;
+#define LBK_DLS_RUNTIME_DESC_INIT LBK_SIZED_INIT(lbk_dls_runtime_desc)
 
+/* Filled by lbk_dls_apply (frozen). */
 typedef struct lbk_dls_apply_stats {
     uint32_t clusters_applied;  /* decoded, weighted, summed, re-encoded */
     uint32_t clusters_copied;   /* every weight of the cluster 0: base copied */
@@ -207,8 +199,8 @@ typedef struct lbk_dls_apply_stats {
 
 /* Checks that the views agree (door sets exist and have the right kinds) and that every needed
  * buffer is present. The views and buffers must outlive the runtime. */
-LBK_API lbk_result lbk_dls_runtime_create(const lbk_dls_runtime_desc *desc, lbk_dls_runtime **out);
-LBK_API void lbk_dls_runtime_destroy(lbk_dls_runtime *runtime);
+LBK_API lbk_result lbk_dls_runtime_open(const lbk_dls_runtime_desc *desc, lbk_dls_runtime **out);
+LBK_API void lbk_dls_runtime_close(lbk_dls_runtime *runtime);
 /* The next apply rewrites every target. */
 LBK_API void lbk_dls_runtime_invalidate(lbk_dls_runtime *runtime);
 
@@ -234,3 +226,53 @@ LBK_API lbk_result lbk_dls_effective_weights(const lbk_dls_runtime *runtime, con
 }
 #endif
 #endif
+
+/* ---- experimental: no ABI promise (as zstd's ZSTD_STATIC_LINKING_ONLY) ---------------------
+ * Define LBK_STATIC_LINKING_ONLY before including this header to get the builder's tuning knobs
+ * and the section statistics. They may change in any release; link liblbk statically. */
+#if defined(LBK_STATIC_LINKING_ONLY) && !defined(LBK_DLS_H_STATIC)
+#define LBK_DLS_H_STATIC
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* How lbk_dls_build groups small combinations into dispatches (spec/container.md §12).
+ * Zero-initialised: the defaults. */
+struct lbk_dls_tuning {
+    /* Packed (class 1) and prefix clusters grow by adding the combination that adds the fewest
+     * new sets until they hold this many targets; past it only combinations adding no set join.
+     * 0: 256. */
+    uint32_t min_dispatch_targets;
+    /* Cap on the targets of one class (1) packed cluster. 0: 4096. */
+    uint32_t packed_max_targets;
+};
+
+/* Statistics of a DLS section for `lbk inspect` and for tuning (Table 1 of seed 001). */
+#define LBK_DLS_HISTOGRAM_BINS 18 /* [0] untouched targets, [1..16] that many sets, [17] more */
+struct lbk_dls_stats {
+    uint32_t set_count;
+    uint32_t sets_by_kind[LBK_DLS_KIND_COUNT_];
+    uint32_t cluster_count;
+    uint32_t clusters_by_form[LBK_DLS_FORM_COUNT_];
+    uint32_t packed_subgroups;                      /* class (1) sub-groups over all clusters */
+    uint64_t target_count[LBK_DLS_SPACE_COUNT_];    /* size of each space */
+    uint64_t touched[LBK_DLS_SPACE_COUNT_];         /* targets with at least one entry */
+    uint64_t targets_by_form[LBK_DLS_FORM_COUNT_];
+    uint64_t entries[LBK_DLS_SPACE_COUNT_];
+    uint64_t histogram[LBK_DLS_SPACE_COUNT_][LBK_DLS_HISTOGRAM_BINS];
+    uint64_t section_bytes;
+    uint64_t payload_bytes;     /* the entries' 8/28-byte payloads */
+    uint64_t ancillary_bytes;   /* everything else: section_bytes − payload_bytes */
+    /* The per-target index data of each space: cluster records and set lists, runs, sub-group
+     * records, prefix words, bases and slots of the clusters of that space. */
+    uint64_t index_bytes[LBK_DLS_SPACE_COUNT_];
+    double index_bits_per_target[LBK_DLS_SPACE_COUNT_]; /* 8 × index_bytes / touched (0 if none) */
+};
+
+LBK_API lbk_result lbk_dls_stats_get(const lbk_dls_view *view, lbk_dls_stats *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* LBK_STATIC_LINKING_ONLY */

@@ -6,9 +6,12 @@
  * weights probe i by bary_i · vis_i / 255 and renormalises; when every product is 0 the plain
  * barycentrics are used. Outside the hull the walk's clamped barycentrics are used (lbk/tetra.h).
  *
- * Scale (spec §5.7): packed probe × scale = physical radiance. The builder takes physical SH and
- * divides by the scale before packing; lbk_glg_probe and lbk_glg_sample return physical SH; the
- * raw bytes at view->probes are in stored units (as are DLS GLG payloads). */
+ * Scale: packed probe × scale = radiance (lbk.h, "radiometric scale"): the build desc's SH and
+ * lbk_glg_probe_get / lbk_glg_sample are physical; the bytes at view->probes and DLS GLG payloads
+ * are stored units.
+ *
+ * Thread safety: every function is safe to call from any thread; views are read-only (the
+ * sampling hint is the caller's). */
 #ifndef LBK_GLG_H
 #define LBK_GLG_H
 
@@ -21,7 +24,9 @@ extern "C" {
 
 #define LBK_GLG_HEADER_SIZE 32u
 
-typedef struct lbk_glg_desc {
+/* Size-tagged (lbk.h): set size with LBK_GLG_BUILD_DESC_INIT. */
+typedef struct lbk_glg_build_desc {
+    size_t size;
     uint32_t probe_count; /* ≥ 4 */
     uint32_t tetra_count; /* ≥ 1 */
     const float (*positions)[3];      /* probe_count, finite */
@@ -30,13 +35,15 @@ typedef struct lbk_glg_desc {
     const uint32_t (*adjacency)[4];   /* NULL: derived from shared faces */
     const uint8_t (*visibility)[4];   /* NULL: all 255 */
     float scale;                      /* 0: 1; else a positive normal power of two */
-} lbk_glg_desc;
+} lbk_glg_build_desc;
+#define LBK_GLG_BUILD_DESC_INIT LBK_SIZED_INIT(lbk_glg_build_desc)
 
 /* Serialises a GLG (deterministic). Tetras of negative volume are re-oriented by swapping their
  * vertices 2 and 3 (with their adjacency and visibility entries); zero volume, out-of-range
  * indices, non-finite positions or a face shared by more than two tetras give
  * LBK_ERR_INVALID_ARGUMENT. Free the buffer with lbk_free. */
-LBK_API lbk_result lbk_glg_build(const lbk_glg_desc *desc, const lbk_allocator *allocator, void **out, size_t *size);
+LBK_API lbk_result lbk_glg_build(const lbk_glg_build_desc *desc, const lbk_allocator *allocator, void **out,
+                                 size_t *size);
 
 typedef struct lbk_glg_view {
     const uint8_t *data;
@@ -51,7 +58,8 @@ typedef struct lbk_glg_view {
 /* Structure only (header, sizes, reserved and padding bytes); lbk_validate checks the mesh. */
 LBK_API lbk_result lbk_glg_open(const void *data, size_t size, lbk_glg_view *out);
 /* Position and physical radiance SH (unpacked × scale) of one probe; either may be NULL. */
-LBK_API lbk_result lbk_glg_probe(const lbk_glg_view *view, uint32_t index, float position[3], lbk_sh9_rgb *sh);
+LBK_API lbk_result lbk_glg_probe_get(const lbk_glg_view *view, uint32_t index, float position[3],
+                                     lbk_sh9_rgb *sh);
 
 typedef struct lbk_glg_sample_info {
     lbk_tetra_location location;

@@ -3,9 +3,9 @@
  * Layout: spec/container.md §11.
  *
  * Lattice: dims (nx, ny, nz), each 2..64. Probe (i, j, k) sits at
- *     centre + Σ_a axis_a · half_extent_a · (2·idx_a / (n_a − 1) − 1)
+ *     centre + Σ_a axis_a · half_extents_a · (2·idx_a / (n_a − 1) − 1)
  * and is stored at probe_offset + i + nx·(j + ny·k) of the section's shared probe array.
- * Sampling a world point p: local l_a = ((p − centre)·axis_a) / half_extent_a, clamped to
+ * Sampling a world point p: local l_a = ((p − centre)·axis_a) / half_extents_a, clamped to
  * [−1, 1] (points outside the box take the value at the nearest box point), lattice coordinate
  * g_a = (l_a + 1)/2 · (n_a − 1), trilinear blend of the 8 unpacked probes around g.
  *
@@ -18,10 +18,11 @@
  * (lbk_sh9_irradiance) of the trilinearly interpolated radiance at the vertex position. Because
  * the data are in the box frame, instances of a model share them.
  *
- * Scale (spec §5.7): one f32 power of two in the header; packed probe × scale = physical
- * radiance. The builder takes physical SH and divides before packing; lbk_llg_sample and
- * lbk_llg_vertex_irradiance return physical values; the raw bytes at view->probes (and DLS LLG
- * payloads) are in stored units. */
+ * Scale: packed probe × scale = radiance (lbk.h, "radiometric scale"): the grid descs' SH,
+ * lbk_llg_sample and lbk_llg_vertex_irradiance are physical; the bytes at view->probes and DLS
+ * LLG payloads are stored units.
+ *
+ * Thread safety: every function is safe to call from any thread; views are read-only. */
 #ifndef LBK_LLG_H
 #define LBK_LLG_H
 
@@ -41,20 +42,29 @@ typedef struct lbk_llg_vertex {
     float bent_normal[3]; /* unit, grid frame */
 } lbk_llg_vertex;
 
+/* One grid (an array element: frozen). */
 typedef struct lbk_llg_grid_desc {
     float centre[3];
     float axes[3][3];       /* orthonormal rows: axis0, axis1, axis2 */
-    float half_extent[3];   /* > 0 */
+    float half_extents[3];   /* > 0 */
     uint32_t dims[3];       /* 2..64 each */
     const lbk_sh9_rgb *probes;        /* dims[0]·dims[1]·dims[2], i fastest */
     const lbk_llg_vertex *vertices;   /* vertex_count (may be 0) */
     uint32_t vertex_count;
 } lbk_llg_grid_desc;
 
-/* Serialises grids (deterministic). scale: 0 means 1, else a positive normal power of two (the
- * probes are divided by it before packing). Free the buffer with lbk_free. */
-LBK_API lbk_result lbk_llg_build(const lbk_llg_grid_desc *grids, uint32_t grid_count, float scale,
-                                 const lbk_allocator *allocator, void **out, size_t *size);
+/* Size-tagged (lbk.h): set size with LBK_LLG_BUILD_DESC_INIT. */
+typedef struct lbk_llg_build_desc {
+    size_t size;
+    const lbk_llg_grid_desc *grids;
+    uint32_t grid_count;
+    float scale; /* 0: 1; else a positive normal power of two (the probes are divided by it) */
+} lbk_llg_build_desc;
+#define LBK_LLG_BUILD_DESC_INIT LBK_SIZED_INIT(lbk_llg_build_desc)
+
+/* Serialises the grids (deterministic). Free the buffer with lbk_free. */
+LBK_API lbk_result lbk_llg_build(const lbk_llg_build_desc *desc, const lbk_allocator *allocator, void **out,
+                                 size_t *size);
 
 typedef struct lbk_llg_view {
     const uint8_t *data;
@@ -67,7 +77,7 @@ typedef struct lbk_llg_view {
 } lbk_llg_view;
 
 typedef struct lbk_llg_grid {
-    float centre[3], axes[3][3], half_extent[3];
+    float centre[3], axes[3][3], half_extents[3];
     uint32_t dims[3];
     uint64_t probe_offset, vertex_offset;
     uint32_t vertex_count;
@@ -75,12 +85,12 @@ typedef struct lbk_llg_grid {
 
 /* Structure only (sizes, offsets, reserved bytes); lbk_validate checks the frames. */
 LBK_API lbk_result lbk_llg_open(const void *data, size_t size, lbk_llg_view *out);
-LBK_API lbk_result lbk_llg_get_grid(const lbk_llg_view *view, uint32_t index, lbk_llg_grid *out);
+LBK_API lbk_result lbk_llg_grid_get(const lbk_llg_view *view, uint32_t index, lbk_llg_grid *out);
 LBK_API void lbk_llg_probe_position(const lbk_llg_grid *grid, uint32_t i, uint32_t j, uint32_t k, float out[3]);
 /* Trilinear physical radiance SH at world position p. */
 LBK_API lbk_result lbk_llg_sample(const lbk_llg_view *view, uint32_t grid, const float p[3], lbk_sh9_rgb *out);
-LBK_API void lbk_llg_vertex_encode(const lbk_llg_vertex *v, uint8_t out[4]);
-LBK_API void lbk_llg_vertex_decode(const uint8_t in[4], lbk_llg_vertex *v);
+LBK_API void lbk_llg_vertex_pack(const lbk_llg_vertex *v, uint8_t out[4]);
+LBK_API void lbk_llg_vertex_unpack(const uint8_t in[4], lbk_llg_vertex *v);
 /* E = V · E_sh(bent normal in world) at world position p for vertex `vertex` of grid `grid`. */
 LBK_API lbk_result lbk_llg_vertex_irradiance(const lbk_llg_view *view, uint32_t grid, uint32_t vertex, const float p[3],
                                              float rgb[3]);

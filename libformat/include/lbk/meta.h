@@ -1,4 +1,6 @@
-/* META: provenance key/value pairs. Layout: spec/container.md §6. */
+/* META: provenance key/value pairs. Layout: spec/container.md §6.
+ *
+ * Thread safety: every function is safe to call from any thread; views are read-only. */
 #ifndef LBK_META_H
 #define LBK_META_H
 
@@ -19,6 +21,7 @@ extern "C" {
 #define LBK_META_REVISION "revision"             /* optional free text, e.g. a VCS revision */
 #define LBK_META_TIMESTAMP "timestamp"           /* only when asked for: "YYYY-MM-DDTHH:MM:SSZ" (UTC) */
 
+/* Builder input (an array element: frozen). */
 typedef struct lbk_meta_pair {
     const char *key;   /* NUL-terminated */
     const char *value; /* NUL-terminated UTF-8; may be empty */
@@ -40,8 +43,8 @@ typedef struct lbk_meta_view {
 
 /* Checks the sizes and that every string lies inside the blob (not the key rules: that is
  * lbk_validate's job), then fills the view. LBK_ERR_TRUNCATED / LBK_ERR_CORRUPT otherwise. */
-LBK_API lbk_result lbk_meta_parse(const void *data, size_t size, lbk_meta_view *out);
-LBK_API lbk_result lbk_meta_entry(const lbk_meta_view *view, uint32_t index, lbk_string *key, lbk_string *value);
+LBK_API lbk_result lbk_meta_open(const void *data, size_t size, lbk_meta_view *out);
+LBK_API lbk_result lbk_meta_entry_get(const lbk_meta_view *view, uint32_t index, lbk_string *key, lbk_string *value);
 /* The value of a key; LBK_ERR_NOT_FOUND if absent. */
 LBK_API lbk_result lbk_meta_find(const lbk_meta_view *view, const char *key, lbk_string *value);
 

@@ -1,5 +1,7 @@
 /* OBJS: the object table — name, geometry hash and representation of every baked object, so
- * tools can match objects across revisions. Layout: spec/container.md §8. */
+ * tools can match objects across revisions. Layout: spec/container.md §8.
+ *
+ * Thread safety: every function is safe to call from any thread; views are read-only. */
 #ifndef LBK_OBJECTS_H
 #define LBK_OBJECTS_H
 
@@ -19,6 +21,7 @@ typedef enum lbk_representation {
     LBK_REPRESENTATION_COUNT_
 } lbk_representation;
 
+/* Builder input and lbk_objects_get output (an array element: frozen). */
 typedef struct lbk_object {
     lbk_string name;          /* unique within the file; UTF-8, no NUL, not empty */
     uint64_t geometry_hash;   /* lbk_objects_geometry_hash of its world-space triangles */
@@ -42,7 +45,7 @@ typedef struct lbk_objects_view {
 } lbk_objects_view;
 
 /* Checks the sizes and that every name lies inside the blob, then fills the view. */
-LBK_API lbk_result lbk_objects_parse(const void *data, size_t size, lbk_objects_view *out);
+LBK_API lbk_result lbk_objects_open(const void *data, size_t size, lbk_objects_view *out);
 LBK_API lbk_result lbk_objects_get(const lbk_objects_view *view, uint32_t index, lbk_object *out);
 /* First object with this name; LBK_ERR_NOT_FOUND if none. */
 LBK_API lbk_result lbk_objects_find(const lbk_objects_view *view, lbk_string name, uint32_t *index);

@@ -18,9 +18,10 @@
  *   left   (0, y)   ← (1, S − y)        right  (S, y)   ← (N, S − y)      for 1 ≤ y ≤ N
  *   corners (0,0) ← (N,N), (S,0) ← (1,N), (0,S) ← (N,1), (S,S) ← (1,1).
  *
- * Scale (spec §5.7): the section header holds one f32 power of two; stored irradiance × scale =
- * physical irradiance. lbk_octp_build takes physical irradiance and divides before encoding;
- * lbk_octp_get and lbk_octp_irradiance return physical irradiance. Depth moments are unscaled. */
+ * Scale: stored irradiance × scale = irradiance in lux (lbk.h, "radiometric scale"): the probe
+ * descs, lbk_octp_probe_get and lbk_octp_irradiance are physical; depth moments are not scaled.
+ *
+ * Thread safety: every function is safe to call from any thread; views are read-only. */
 #ifndef LBK_OCTA_H
 #define LBK_OCTA_H
 
@@ -46,16 +47,26 @@ LBK_API void lbk_oct_border_source(uint32_t n, uint32_t x, uint32_t y, uint32_t 
 /* Direction at the centre of interior texel (i, j) of an N×N map. */
 LBK_API void lbk_oct_texel_direction(uint32_t n, uint32_t i, uint32_t j, float dir[3]);
 
-/* Builder input: interior data only; borders are filled by the builder. */
+/* Builder input: interior data only; borders are filled by the builder. An array element (frozen),
+ * also what lbk_octp_probe_get fills. */
 typedef struct lbk_octp_probe_desc {
     float position[3];
     float irradiance[4 * 4][3];  /* interior, row-major (j·4 + i) */
     float depth[12 * 12][2];     /* interior: mean distance, mean squared distance (≥ 0) */
 } lbk_octp_probe_desc;
 
-/* scale: 0 means 1, else a positive normal power of two. */
-LBK_API lbk_result lbk_octp_build(const lbk_octp_probe_desc *probes, uint32_t count, float scale,
-                                  const lbk_allocator *allocator, void **out, size_t *size);
+/* Size-tagged (lbk.h): set size with LBK_OCTP_BUILD_DESC_INIT. */
+typedef struct lbk_octp_build_desc {
+    size_t size;
+    const lbk_octp_probe_desc *probes;
+    uint32_t probe_count;
+    float scale; /* 0: 1; else a positive normal power of two */
+} lbk_octp_build_desc;
+#define LBK_OCTP_BUILD_DESC_INIT LBK_SIZED_INIT(lbk_octp_build_desc)
+
+/* Serialises the probes (deterministic). Free the buffer with lbk_free. */
+LBK_API lbk_result lbk_octp_build(const lbk_octp_build_desc *desc, const lbk_allocator *allocator, void **out,
+                                  size_t *size);
 
 typedef struct lbk_octp_view {
     const uint8_t *data;
@@ -67,7 +78,7 @@ typedef struct lbk_octp_view {
 
 LBK_API lbk_result lbk_octp_open(const void *data, size_t size, lbk_octp_view *out);
 /* Decodes one probe's interior back into the builder form (physical irradiance). */
-LBK_API lbk_result lbk_octp_get(const lbk_octp_view *view, uint32_t index, lbk_octp_probe_desc *out);
+LBK_API lbk_result lbk_octp_probe_get(const lbk_octp_view *view, uint32_t index, lbk_octp_probe_desc *out);
 /* Bilinear physical irradiance lookup in direction dir (uses the border, never reads outside the probe). */
 LBK_API lbk_result lbk_octp_irradiance(const lbk_octp_view *view, uint32_t index, const float dir[3], float rgb[3]);
 

@@ -18,7 +18,9 @@
  *
  * unorm8: code = rne(clamp(x, 0, 1) · 255), NaN → 0; value = code / 255.
  * snorm8: code = rne(clamp(x, −1, 1) · 127) stored as two's complement int8, NaN → 0;
- *         value = max(code / 127, −1) (so −128 and −127 both mean −1, as on GPUs). */
+ *         value = max(code / 127, −1) (so −128 and −127 both mean −1, as on GPUs).
+ *
+ * Thread safety: every function is pure (no state): safe to call from any thread. */
 #ifndef LBK_PIXEL_H
 #define LBK_PIXEL_H
 
@@ -42,15 +44,15 @@ LBK_API float lbk_uf11_to_float(uint32_t code); /* uses the low 11 bits */
 LBK_API float lbk_uf10_to_float(uint32_t code); /* uses the low 10 bits */
 
 /* DXGI_FORMAT_R11G11B10_FLOAT packed into one u32: R bits 0–10, G bits 11–21, B bits 22–31. */
-LBK_API uint32_t lbk_pack_r11g11b10f(const float rgb[3]);
-LBK_API void lbk_unpack_r11g11b10f(uint32_t packed, float rgb[3]);
+LBK_API uint32_t lbk_r11g11b10f_pack(const float rgb[3]);
+LBK_API void lbk_r11g11b10f_unpack(uint32_t packed, float rgb[3]);
 
 /* DXGI_FORMAT_R9G9B9E5_SHAREDEXP: R bits 0–8, G 9–17, B 18–26, shared exponent 27–31 (bias 15),
  * value = mantissa · 2^(exponent − 24), no implicit leading one. The exponent is chosen from the
  * largest channel after clamping; if rounding that channel's mantissa gives 512 the exponent is
  * raised by one. Each mantissa is rounded to nearest even at the chosen exponent. */
-LBK_API uint32_t lbk_pack_rgb9e5(const float rgb[3]);
-LBK_API void lbk_unpack_rgb9e5(uint32_t packed, float rgb[3]);
+LBK_API uint32_t lbk_rgb9e5_pack(const float rgb[3]);
+LBK_API void lbk_rgb9e5_unpack(uint32_t packed, float rgb[3]);
 
 /* IEEE-754 binary16. */
 LBK_API uint16_t lbk_float_to_half(float x);

@@ -1,4 +1,6 @@
-/* REPT: the bake report — estimated error against time/samples. Layout: spec/container.md §7. */
+/* REPT: the bake report — estimated error against time/samples. Layout: spec/container.md §7.
+ *
+ * Thread safety: every function is safe to call from any thread; views are read-only. */
 #ifndef LBK_REPORT_H
 #define LBK_REPORT_H
 
@@ -24,7 +26,8 @@ typedef enum lbk_bake_status {
  * and the section is byte-reproducible (§1.2); a writer promising identical bytes clears it. */
 #define LBK_REPORT_HAS_TIMES 0x1u
 
-/* One progress sample, taken after a sampling pass; all cumulative values never decrease. */
+/* One progress sample, taken after a sampling pass; all cumulative values never decrease.
+ * An array element (frozen). */
 typedef struct lbk_report_record {
     double elapsed_seconds;     /* since the start of transport; 0 without LBK_REPORT_HAS_TIMES */
     uint64_t rays_traced;       /* cumulative rays (a machine-independent measure of work) */
@@ -34,7 +37,10 @@ typedef struct lbk_report_record {
     float probe_rel_rmse;       /* estimated relative RMSE of probe SH (GLG/LLG), ≥ 0; 0 without probes */
 } lbk_report_record;
 
+/* Builder input, and the header of a view. Size-tagged (lbk.h): set size with LBK_REPORT_INIT;
+ * lbk_report_open sets it to sizeof(lbk_report). */
 typedef struct lbk_report {
+    size_t size;
     uint32_t status;               /* lbk_bake_status */
     uint32_t flags;                /* LBK_REPORT_HAS_TIMES */
     uint32_t max_samples_per_texel;/* sample limit; 0: none */
@@ -43,6 +49,7 @@ typedef struct lbk_report {
     const lbk_report_record *records;
     uint32_t record_count;         /* ≥ 1 */
 } lbk_report;
+#define LBK_REPORT_INIT LBK_SIZED_INIT(lbk_report)
 
 /* Builds REPT bytes. Rejects (LBK_ERR_RANGE) NaN/Inf/negative values, decreasing cumulative
  * values, non-zero times without HAS_TIMES, unknown status or flags, zero records.
@@ -52,13 +59,13 @@ LBK_API lbk_result lbk_report_build(const lbk_report *report, const lbk_allocato
 
 /* A read-only view: the header fields decoded, records read on demand. */
 typedef struct lbk_report_view {
-    lbk_report header;        /* records == NULL: use lbk_report_record_at */
+    lbk_report header;        /* records == NULL: use lbk_report_record_get */
     const uint8_t *record_bytes;
 } lbk_report_view;
 
 /* Checks the sizes (LBK_ERR_TRUNCATED / LBK_ERR_CORRUPT) and fills the view. */
-LBK_API lbk_result lbk_report_parse(const void *data, size_t size, lbk_report_view *out);
-LBK_API lbk_result lbk_report_record_at(const lbk_report_view *view, uint32_t index, lbk_report_record *out);
+LBK_API lbk_result lbk_report_open(const void *data, size_t size, lbk_report_view *out);
+LBK_API lbk_result lbk_report_record_get(const lbk_report_view *view, uint32_t index, lbk_report_record *out);
 
 /* "converged", "target reached", "time limit", "sample limit", or "unknown". */
 LBK_API const char *lbk_bake_status_name(uint32_t status);

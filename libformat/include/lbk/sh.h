@@ -16,7 +16,9 @@
  * Ramamoorthi & Hanrahan 2001): E(n) = Σ_k A_l(k) L_k Y_k(n), A0 = π, A1 = 2π/3, A2 = π/4.
  *
  * Every function here is linear in the coefficients except pack/unpack, so lighting from
- * several sources is summed coefficient by coefficient (lbk_sh9_add_scaled). */
+ * several sources is summed coefficient by coefficient (lbk_sh9_add_scaled).
+ *
+ * Thread safety: every function is pure (no state): safe to call from any thread. */
 #ifndef LBK_SH_H
 #define LBK_SH_H
 

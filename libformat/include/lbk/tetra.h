@@ -13,7 +13,10 @@
  * most tetra_count + 64 steps (a Delaunay mesh needs at most tetra_count); after that, or on a
  * cycle caused by a non-Delaunay or malicious mesh, every tetra is scanned and the one whose
  * smallest barycentric is largest is used. Out-of-range indices and tetras of non-positive volume
- * met on the way give LBK_ERR_CORRUPT; nothing is read outside the arrays. */
+ * met on the way give LBK_ERR_CORRUPT; nothing is read outside the arrays. A tetra index past
+ * the end is LBK_ERR_NOT_FOUND.
+ *
+ * Thread safety: every function only reads the mesh: safe to call from any thread. */
 #ifndef LBK_TETRA_H
 #define LBK_TETRA_H
 

@@ -1,4 +1,7 @@
-/* Validation: every check of spec/validation.md, reported with a stable ID. */
+/* Validation: every check of spec/validation.md, reported with a stable ID.
+ *
+ * Thread safety: every function is safe to call from any thread (a run keeps its state in its
+ * own call; the callback is called on the caller's thread). */
 #ifndef LBK_VALIDATE_H
 #define LBK_VALIDATE_H
 
@@ -14,6 +17,7 @@ typedef enum lbk_severity {
     LBK_SEVERITY_FATAL = 2    /* the file cannot be read at all; later checks were skipped */
 } lbk_severity;
 
+/* What the callback gets (frozen). */
 typedef struct lbk_issue {
     uint32_t id;           /* stable number from spec/validation.md */
     lbk_severity severity;
@@ -27,10 +31,13 @@ typedef struct lbk_issue {
  * (META, REPT, LMAP, GLG, LLG, OCTP, OBJS, DLS, DOOR; spec/validation.md). Return non-zero to stop. */
 typedef int (*lbk_issue_callback)(void *user, const lbk_issue *issue);
 
+/* Size-tagged (lbk.h): set size with LBK_VALIDATE_OPTIONS_INIT; NULL options mean defaults. */
 typedef struct lbk_validate_options {
-    const lbk_allocator *allocator;
+    size_t size;
+    const lbk_allocator *allocator; /* NULL: malloc/free */
     uint64_t max_decoded_bytes; /* as lbk_read_options; 0: default */
 } lbk_validate_options;
+#define LBK_VALIDATE_OPTIONS_INIT LBK_SIZED_INIT(lbk_validate_options)
 
 typedef struct lbk_validate_summary {
     uint32_t fatal, errors, warnings;
@@ -46,7 +53,7 @@ LBK_API lbk_result lbk_validate_file(const char *path, const lbk_validate_option
 /* The registry: severity and message template of an ID; NULL if unknown. */
 LBK_API const char *lbk_issue_template(uint32_t id, lbk_severity *severity);
 /* Enumerates the registry: number of IDs, and the ID at a position (ascending; 0 past the end). */
-LBK_API uint32_t lbk_issue_registry_size(void);
+LBK_API uint32_t lbk_issue_registry_count(void);
 LBK_API uint32_t lbk_issue_registry_id(uint32_t index);
 /* Section type an ID belongs to (0: header and section table); 0 if unknown. */
 LBK_API uint32_t lbk_issue_section(uint32_t id);

@@ -1,52 +1,52 @@
-#include "bake/util/progress.h"
+#include "cli/progress.h"
 
 #include <stdarg.h>
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
 
-double bk_now(void)
+static double now_seconds(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-void bk_progress_init(bk_progress *p, int quiet)
+void cli_progress_init(cli_progress *p, int quiet)
 {
     memset(p, 0, sizeof *p);
     p->out = quiet ? NULL : stderr;
     p->tty = p->out && isatty(fileno(p->out));
-    p->start = p->phase_start = bk_now();
+    p->start = p->phase_start = now_seconds();
     p->last_decile = -1;
 }
 
-static void clear_line(bk_progress *p)
+static void clear_line(cli_progress *p)
 {
     if (p->tty) fputs("\r\033[K", p->out);
 }
 
-void bk_progress_phase(bk_progress *p, const char *phase)
+void cli_progress_phase(cli_progress *p, const char *phase)
 {
     if (!p->out) return;
     if (p->tty && p->phase[0]) {
         clear_line(p);
-        fprintf(p->out, "  %-8s done in %.1f s\n", p->phase, bk_now() - p->phase_start);
+        fprintf(p->out, "  %-8s done in %.1f s\n", p->phase, now_seconds() - p->phase_start);
     }
     snprintf(p->phase, sizeof p->phase, "%s", phase);
-    p->phase_start = bk_now();
+    p->phase_start = now_seconds();
     p->last_decile = -1;
     p->last_draw = 0;
     if (!p->tty) fprintf(p->out, "lbk bake: %s...\n", phase);
     fflush(p->out);
 }
 
-void bk_progress_update(bk_progress *p, double f)
+void cli_progress_update(cli_progress *p, double f)
 {
     if (!p->out) return;
     if (!(f >= 0)) f = 0;
     if (f > 1) f = 1;
-    double now = bk_now();
+    double now = now_seconds();
     if (p->tty) {
         if (now - p->last_draw < 0.1 && f < 1) return; /* redraw at most 10 times a second */
         p->last_draw = now;
@@ -67,7 +67,7 @@ void bk_progress_update(bk_progress *p, double f)
     fflush(p->out);
 }
 
-void bk_progress_note(bk_progress *p, const char *fmt, ...)
+void cli_progress_note(cli_progress *p, const char *fmt, ...)
 {
     if (!p->out) return;
     clear_line(p);
@@ -80,13 +80,13 @@ void bk_progress_note(bk_progress *p, const char *fmt, ...)
     fflush(p->out);
 }
 
-void bk_progress_done(bk_progress *p)
+void cli_progress_done(cli_progress *p)
 {
     if (!p->out) return;
     if (p->tty && p->phase[0]) {
         clear_line(p);
-        fprintf(p->out, "  %-8s done in %.1f s\n", p->phase, bk_now() - p->phase_start);
+        fprintf(p->out, "  %-8s done in %.1f s\n", p->phase, now_seconds() - p->phase_start);
     }
-    fprintf(p->out, "lbk bake: finished in %.1f s\n", bk_now() - p->start);
+    fprintf(p->out, "lbk bake: finished in %.1f s\n", now_seconds() - p->start);
     fflush(p->out);
 }

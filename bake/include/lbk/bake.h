@@ -1,0 +1,323 @@
+/* liblbkbake — the light bake kit's baker as a library: a glTF file or an in-memory scene in,
+ * a container (lbk_writer or bytes) and the bake report (data, or JSON) out. `lbk bake` is a
+ * thin command line over it. Link with `pkg-config --cflags --libs lbk-bake`.
+ *
+ * Conventions are liblbk's (lbk/lbk.h): every fallible call returns lbk_result, nothing
+ * prints or exits, there is no global state, handles are opaque, and zero-initialised structs
+ * mean defaults. The structs a caller fills (lbk_bake_desc, lbk_bake_scene) carry their own
+ * size so they can grow without breaking callers compiled against an older header.
+ *
+ * Results of a bake call:
+ *   LBK_OK                    *out holds the output;
+ *   LBK_ERR_CANCELLED         the progress callback returned non-zero; *out is NULL;
+ *   LBK_ERR_BAD_INPUT         the scene is unusable: a glTF the importer rejects, no light, no
+ *                             triangle with area, a scene description that breaks its rules, a
+ *                             bad lbk_* extra, an unreadable sky EXR (`lbk bake` exit code 4);
+ *   LBK_ERR_IO                the input file cannot be opened (exit code 3);
+ *   LBK_ERR_INVALID_ARGUMENT  NULL pointers, a size field larger than this library knows with
+ *                             non-zero bytes past it, an unknown enum value;
+ *   LBK_ERR_OUT_OF_MEMORY, LBK_ERR_INTERNAL
+ *                             the bake failed on its own (exit code 5).
+ * Every failure except LBK_ERR_CANCELLED sends one LBK_BAKE_SEVERITY_ERROR message that says
+ * why (naming the file, node, object or extras key at fault) — unless the desc itself cannot be
+ * read (NULL `out`, a size below sizeof(size_t)). The library never writes a file unless asked
+ * (lbk_bake_output_write_file, lbk_bake_report_write_json).
+ *
+ * Determinism: the same input, desc and seed give byte-identical containers for any thread
+ * count (every random number is a counter-based hash of the seed and the work item, every
+ * reduction runs in item order). Nothing time-dependent enters the container unless asked:
+ * `timestamp` stores the bake time in META, and with `time_limit` the number of passes depends
+ * on the machine. The report's seconds are wall clock and differ run to run.
+ *
+ * Threads: `threads` workers (0: one per online core); the calling thread is one of them.
+ * Callbacks run on the calling thread only, never concurrently. Independent bakes may run
+ * in parallel on different threads (nothing is shared between calls). */
+#ifndef LBK_BAKE_H
+#define LBK_BAKE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "lbk/container.h"
+#include "lbk/lbk.h"
+#include "lbk/report.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#if defined(LBK_BAKE_BUILDING_SHARED) && defined(__GNUC__)
+#define LBK_BAKE_API __attribute__((visibility("default")))
+#else
+#define LBK_BAKE_API
+#endif
+
+/* ---- options ----------------------------------------------------------------------------- */
+
+/* Quality presets (README "Presets"); every value can be overridden in lbk_bake_desc. */
+typedef enum lbk_bake_preset {
+    LBK_BAKE_PRESET_FAST = 0, /* 8 texels/m, GLG spacing 2 m, 1024 samples, target error 3 % */
+    LBK_BAKE_PRESET_HIGH = 1, /* 16 texels/m, GLG spacing 1 m, 16384 samples, target error 1 % */
+    LBK_BAKE_PRESET_COUNT_
+} lbk_bake_preset;
+
+/* How a door's open contribution is baked (bake/sets/SETS.md). */
+typedef enum lbk_bake_door_method {
+    LBK_BAKE_DOOR_DIFFERENCE = 0, /* correlated differences of full runs */
+    LBK_BAKE_DOOR_GUIDED = 1,     /* seed 001's guided estimator (portal sampling, shadow photons) */
+    LBK_BAKE_DOOR_METHOD_COUNT_
+} lbk_bake_door_method;
+
+/* The bake's phases, in order; LBK_BAKE_PHASE_SETS only with light sets or doors. */
+typedef enum lbk_bake_phase {
+    LBK_BAKE_PHASE_IMPORT = 0, /* read the glTF or convert the description; check the scene */
+    LBK_BAKE_PHASE_LAYOUT,     /* representation per object, atlas, texels, GLG and LLG probes */
+    LBK_BAKE_PHASE_LIGHT,      /* light transport of the base bake, progressive passes */
+    LBK_BAKE_PHASE_SETS,       /* one bake per light set and door state */
+    LBK_BAKE_PHASE_WRITE,      /* encode the sections into the container */
+    LBK_BAKE_PHASE_COUNT_
+} lbk_bake_phase;
+
+typedef struct lbk_bake_progress {
+    lbk_bake_phase phase;
+    double fraction;        /* of the current phase, in [0, 1]; a new phase starts at 0 */
+    double elapsed_seconds; /* since the bake call started, wall clock */
+    double est_rel_rmse;    /* the base bake's estimated relative RMSE after its latest pass;
+                               < 0 before the first pass */
+} lbk_bake_progress;
+
+/* Called at every checkpoint (each phase start, each step of layout, each block of receivers
+ * in a transport pass, each set bake). Return 0 to go on; non-zero cancels: the bake stops at
+ * that checkpoint, frees everything and returns LBK_ERR_CANCELLED. */
+typedef int (*lbk_bake_progress_fn)(void *user, const lbk_bake_progress *progress);
+
+typedef enum lbk_bake_severity {
+    LBK_BAKE_SEVERITY_INFO = 0,  /* the log of the bake: one line per transport pass and per
+                                    set bake ("pass 2:  224 samples/receiver  est. error ...") */
+    LBK_BAKE_SEVERITY_NOTE,      /* a decision worth knowing (no GLG and why, an atlas note) */
+    LBK_BAKE_SEVERITY_WARNING,   /* the bake goes on but lost something: import warnings,
+                                    saturated or flushed texels, an object without its LLG */
+    LBK_BAKE_SEVERITY_ERROR      /* why the call fails (sent once, just before it returns) */
+} lbk_bake_severity;
+
+/* One line of text, no newline, no "lbk bake:" prefix; valid during the call only. */
+typedef void (*lbk_bake_message_fn)(void *user, lbk_bake_severity severity, const char *message);
+
+/* Zero-initialised = defaults (given in brackets). */
+typedef struct lbk_bake_desc {
+    size_t size;                /* sizeof(lbk_bake_desc) as the caller compiled it; 0: the size
+                                   of version 1 (this one), so `lbk_bake_desc d = {0};` is valid
+                                   with every later library */
+    lbk_bake_preset preset;     /* [fast] */
+    int threads;                /* worker threads [0: one per online core] */
+    uint64_t seed;              /* used as given, 0 included (`lbk bake` passes 1 unless --seed) */
+    double target_error;        /* stop when the estimated relative RMSE reaches this; <= 0: preset */
+    double time_limit;          /* seconds for the transport; at least one pass completes [0: none] */
+    int max_samples;            /* gather samples per receiver, whole run [0: preset] */
+    int max_bounces;            /* explicit bounces before the analytic tail [0: 64] */
+    float texel_density;        /* texels per metre for every object [0: the object's own
+                                   (lbk_texel_density, lbk_bake_object.texel_density), then preset] */
+    float glg_spacing;          /* global light grid spacing in metres [0: preset] */
+    int sky_override;           /* 1: `sky` (or `sky_exr`) replaces the scene's sky */
+    float sky[3];               /* uniform sky radiance, nits */
+    const char *sky_exr;        /* with sky_override: an equirectangular EXR instead of `sky` */
+    int no_glg;                 /* 1: leave out the global light grid */
+    int octahedral_probes;      /* 1: also write OCTP probes at the GLG positions */
+    int no_seam_stitch;         /* 1: leave lightmap seams unstitched (for comparisons, bench_atlas) [0] */
+    double dls_threshold;       /* light sets and doors store a receiver where their light exceeds
+                                   this fraction of the mean indirect light of the texels they
+                                   light directly [0: 0.01]; < 0: every non-zero receiver */
+    lbk_bake_door_method door_method; /* [difference] */
+    const char *revision;       /* stored in META [NULL: none] */
+    int timestamp;              /* 1: store the bake time in META (no longer byte-identical) */
+    const char *allow_outside;  /* files a glTF names (buffers, images, its lbk_sky EXR) must lie in
+                                   its folder (spec/authoring.md); this folder is allowed too [NULL] */
+    lbk_bake_progress_fn progress; /* [NULL: none, no cancellation] */
+    lbk_bake_message_fn message;   /* [NULL: messages are dropped] */
+    void *user;                    /* passed to both callbacks */
+    const lbk_allocator *allocator;/* the output, its report and the container bytes [malloc];
+                                      the bake's working memory is the C heap */
+} lbk_bake_desc;
+
+/* ---- in-memory scenes ----------------------------------------------------------------------
+ * A scene as plain data, for callers that are not glTF-based (an editor, a test). World space,
+ * metres, linear colour, y up as in glTF; the units of spec/authoring.md (emission in nits,
+ * point and spot lights in candela, directional lights in lux). The description is read
+ * during the call only; nothing is kept. Textures are not supported: colours are per material.
+ *
+ * The conversion follows the glTF importer rule for rule, so a description and a glTF file of
+ * the same scene bake to the same sections (tests/install/bake_check.c): triangles without
+ * normals are flat-shaded (each gets its own three vertices and its face normal); given normals
+ * are normalised; base colours above 1 are clamped (with a warning). META differs: its
+ * scene.hash is the XXH3-64 of the description's arrays (not of a file) and its scene.name is
+ * lbk_bake_scene.name. A description also gets no LMUV section (spec §16): LMUV maps lightmap
+ * UVs onto a glTF file's own nodes, primitives and vertices, which a description does not have. */
+
+typedef enum lbk_bake_lighting {
+    LBK_BAKE_LIGHTING_AUTO = 0, /* the baker's heuristic (bake/layout/classify.h) */
+    LBK_BAKE_LIGHTING_LIGHTMAP, /* AHD lightmap texels */
+    LBK_BAKE_LIGHTING_LLG,      /* a local light grid */
+    LBK_BAKE_LIGHTING_NONE      /* not lit by the bake (it still casts shadows and bounces light) */
+} lbk_bake_lighting;
+
+typedef struct lbk_bake_material {
+    const char *name;        /* [NULL: "material<i>"] */
+    float base_color[3];     /* linear albedo, each in [0, 1] (above 1: clamped, warned) */
+    float emission[3];       /* radiance in nits, >= 0 */
+    int double_sided;
+} lbk_bake_material;
+
+/* An object: a named range of triangles with its options (the glTF node extras lbk_*). */
+typedef struct lbk_bake_object {
+    const char *name;            /* [NULL: "object<i>"]; up to 127 bytes */
+    uint32_t first_triangle;     /* objects must tile the triangles in order: object i starts */
+    uint32_t triangle_count;     /* where object i-1 ended, the last ends at triangle_count */
+    uint32_t material;           /* for its triangles when lbk_bake_scene.triangle_materials is NULL */
+    lbk_bake_lighting lighting;  /* lbk_lighting */
+    float texel_density;         /* lbk_texel_density: texels per metre [0: the default] */
+    const char *light_set;       /* lbk_light_set: its emission forms that set [NULL/"": none] */
+    const char *door;            /* lbk_door: the object is that door, closed [NULL/"": none] */
+} lbk_bake_object;
+
+typedef enum lbk_bake_light_type {
+    LBK_BAKE_LIGHT_POINT = 0,
+    LBK_BAKE_LIGHT_SPOT,
+    LBK_BAKE_LIGHT_DIRECTIONAL
+} lbk_bake_light_type;
+
+typedef struct lbk_bake_light {
+    const char *name;            /* [NULL: "light<i>"] */
+    lbk_bake_light_type type;
+    float color[3];              /* colour × intensity: candela (point, spot) or lux (directional) */
+    float position[3];           /* point, spot */
+    float direction[3];          /* the direction light travels (spot, directional; normalised;
+                                    zero for a spot or directional light: the light is skipped,
+                                    with a warning, as the importer does) */
+    float range;                 /* [0: infinite] */
+    float inner_cone, outer_cone;/* spot: radians, 0 <= inner <= outer <= pi/2, outer > 0 */
+    const char *light_set;       /* lbk_light_set [NULL/"": static, in the base bake] */
+} lbk_bake_light;
+
+typedef struct lbk_bake_scene {
+    size_t size;                 /* as lbk_bake_desc.size: 0 = version 1 (this one) */
+    const char *name;            /* META scene.name and the report's input [NULL: "scene"] */
+    size_t vertex_count;
+    const float *positions;      /* 3 per vertex, finite */
+    const float *normals;        /* 3 per vertex, or NULL: flat shading */
+    const float *uv1;            /* 2 per vertex: authored lightmap UVs (TEXCOORD_1), or NULL */
+    size_t triangle_count;       /* at most 16 Mi */
+    const uint32_t *indices;     /* 3 per triangle, counter-clockwise front faces */
+    const uint32_t *triangle_materials; /* one per triangle, or NULL: each object's material */
+    size_t material_count;
+    const lbk_bake_material *materials; /* at least one */
+    size_t object_count;         /* 0: one object named `name` holding every triangle */
+    const lbk_bake_object *objects;
+    size_t light_count;
+    const lbk_bake_light *lights;
+    float sky[3];                /* uniform sky radiance in nits (lbk_sky) [0: none] */
+    size_t combination_count;    /* lbk_combinations: pairs of door / light set names */
+    const char *const (*combinations)[2];
+} lbk_bake_scene;
+
+/* ---- baking ------------------------------------------------------------------------------ */
+
+typedef struct lbk_bake_output lbk_bake_output;
+
+/* Bakes a .gltf / .glb file (spec/authoring.md). desc may be NULL (defaults). */
+LBK_BAKE_API lbk_result lbk_bake_from_file(const char *path, const lbk_bake_desc *desc, lbk_bake_output **out);
+/* Bakes an in-memory scene description. desc may be NULL (defaults). */
+LBK_BAKE_API lbk_result lbk_bake_from_scene(const lbk_bake_scene *scene, const lbk_bake_desc *desc,
+                                            lbk_bake_output **out);
+LBK_BAKE_API void lbk_bake_output_free(lbk_bake_output *out);
+
+/* The container: its sections are in this writer (owned by the output). A caller may add
+ * sections of its own before serialising it. */
+LBK_BAKE_API lbk_writer *lbk_bake_output_writer(lbk_bake_output *out);
+/* The container's bytes, allocated with desc->allocator; free them with lbk_free(allocator, *bytes). */
+LBK_BAKE_API lbk_result lbk_bake_output_container(lbk_bake_output *out, void **bytes, size_t *size);
+/* Writes the container atomically (a temporary file beside path, fsync, rename): on failure
+ * nothing is left at path. Same bytes as lbk_bake_output_container. */
+LBK_BAKE_API lbk_result lbk_bake_output_write_file(lbk_bake_output *out, const char *path);
+
+/* ---- the report -------------------------------------------------------------------------- */
+
+/* One progressive pass of the base bake (the samples of REPT and of the JSON report). */
+typedef struct lbk_bake_pass {
+    int pass;                    /* 0-based */
+    double seconds;              /* since the transport started, wall clock */
+    double samples_per_receiver; /* cumulative gather samples per texel/probe, both halves */
+    double est_rel_rmse;         /* estimated relative RMSE after this pass */
+    int bounces;                 /* explicit bounces before the analytic tail */
+} lbk_bake_pass;
+
+typedef struct lbk_bake_phase_time {
+    lbk_bake_phase phase;
+    double seconds;
+} lbk_bake_phase_time;
+
+/* Totals of the base bake's transport. */
+typedef struct lbk_bake_transport {
+    double seconds;
+    int passes;
+    uint64_t rays;               /* every ray traced */
+    int bounces;                 /* explicit bounces of the last pass */
+    double bounce_ratio_q;       /* per-bounce energy ratio used for the analytic tail */
+    double tail_fraction;        /* share of the indirect energy from the tail */
+    uint64_t cache_cells;
+    uint64_t nonfinite_dropped;  /* NaN/Inf samples dropped (0 in every test) */
+    uint64_t texel_channels_saturated; /* above R11G11B10F's largest value × the LMAP scale */
+    uint64_t texel_channels_flushed;   /* lit but below its smallest step: stored 0 */
+    double est_rel_rmse;         /* the final estimate */
+} lbk_bake_transport;
+
+/* The radiometric scale of each lighting section written (spec §5.7); 0: section absent. */
+typedef struct lbk_bake_scales {
+    float lmap, glg, llg, octp;
+} lbk_bake_scales;
+
+typedef struct lbk_bake_counts {
+    uint64_t objects, texels, pages, glg_probes, llgs, llg_probes;
+    uint32_t light_sets;         /* DLS sets, door states and combinations included */
+    uint32_t doors;
+    uint64_t file_bytes;         /* the container as baked */
+} lbk_bake_counts;
+
+/* What lbk_bake_report_write_json writes (spec/bake-report-json.md), as data. */
+typedef struct lbk_bake_report {
+    size_t size;                 /* sizeof(lbk_bake_report) of the library that filled it */
+    const char *input;           /* the path baked, or the scene description's name */
+    lbk_bake_preset preset;
+    uint64_t seed;
+    uint32_t status;             /* why the transport stopped: an lbk_bake_status (lbk/report.h) */
+    double target_error;         /* the target used (the preset's when the desc left it 0) */
+    double time_limit;
+    const lbk_bake_pass *passes; /* one per pass, in order */
+    size_t pass_count;
+    lbk_bake_transport transport;
+    lbk_bake_scales scales;
+    lbk_bake_counts counts;
+    const lbk_bake_phase_time *phases; /* the phases run, in order */
+    size_t phase_count;
+    double seconds;              /* the whole bake call */
+} lbk_bake_report;
+
+/* Owned by the output, valid until lbk_bake_output_free. */
+LBK_BAKE_API const lbk_bake_report *lbk_bake_output_report(const lbk_bake_output *out);
+/* The report as JSON text (schema lbk-bake-report/1), NUL-terminated, allocated with
+ * `allocator` (NULL: malloc); free with lbk_free(allocator, *text). `container_path` is the
+ * "output" field: where the caller wrote the container (NULL: ""). */
+LBK_BAKE_API lbk_result lbk_bake_report_json(const lbk_bake_report *report, const char *container_path,
+                                             const lbk_allocator *allocator, char **text, size_t *size);
+/* The same text (plus a newline) into json_path. */
+LBK_BAKE_API lbk_result lbk_bake_report_write_json(const lbk_bake_report *report, const char *container_path,
+                                                   const char *json_path);
+
+/* "import", "layout", "light", "sets", "write"; "unknown" otherwise. */
+LBK_BAKE_API const char *lbk_bake_phase_name(lbk_bake_phase phase);
+/* "fast", "high"; "unknown" otherwise. */
+LBK_BAKE_API const char *lbk_bake_preset_name(lbk_bake_preset preset);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,111 @@
+/* The bake pipeline's shared state (internal to bake/pipeline/): one bk_pipeline per lbk_bake_*
+ * call, filled phase by phase. bake.c runs the phases, sections.c encodes the container,
+ * report.c fills the report and writes its JSON, output.c owns what the caller gets back. */
+#ifndef BK_PIPELINE_H
+#define BK_PIPELINE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "bake/layout/atlas.h"
+#include "bake/layout/seams.h"
+#include "bake/layout/classify.h"
+#include "bake/layout/texels.h"
+#include "bake/probes/glg_place.h"
+#include "bake/probes/llg_place.h"
+#include "bake/scene/scene.h"
+#include "bake/sets/bake_sets.h"
+#include "bake/transport/tracer.h"
+#include "bake/transport/transport.h"
+#include "bake/util/events.h"
+#include "lbk/bake.h"
+#include "lbk/sh.h"
+
+/* What a preset sets; every field can be overridden in lbk_bake_desc. */
+typedef struct bk_preset {
+    const char *name;
+    float texel_density;   /* texels per metre */
+    float glg_spacing;     /* metres (halved once near geometry) */
+    int max_samples;       /* gather rays per receiver, both halves, whole run */
+    double target_error;   /* relative RMSE */
+    int llg_visibility_rays;
+} bk_preset;
+
+extern const bk_preset bk_presets[LBK_BAKE_PRESET_COUNT_];
+
+#define BK_MAX_PHASES 8
+
+typedef struct bk_pipeline {
+    lbk_bake_desc desc;             /* the caller's, at this library's size */
+    const lbk_bake_desc *opt;       /* &desc */
+    const bk_preset *pre;
+    const char *input;              /* the path, or the description's name: messages and report */
+    const char *scene_name;         /* META scene.name: the file's base name, or the description's name */
+    char err[1024];                 /* why the call fails (sent as the ERROR message) */
+    bk_events events;               /* to the desc's callbacks */
+    double start;                   /* bk_now() at the call */
+    double est;                     /* latest estimated relative RMSE of the base bake; < 0: none */
+    int cancelled;
+    bk_scene scene;
+    bk_object_class *classes;
+    bk_atlas atlas;
+    bk_seams seams;                 /* stitched after transport unless opt->no_seam_stitch */
+    bk_texels texels;
+    bk_tracer *tracer;
+    bk_glg glg;
+    int have_glg;
+    bk_llg *llgs;
+    size_t llg_count;
+    int32_t *object_llg;            /* per scene object: LLG index or -1 */
+    /* receivers handed to transport: valid texels, then GLG probes, then LLG probes */
+    bk_receiver *receivers;
+    size_t receiver_count, texel_receivers, glg_first, llg_first;
+    uint32_t *texel_of_receiver;    /* receiver → index in texels.receivers */
+    lbk_sh9_rgb *radiance;
+    bk_transport_stats stats;
+    bk_transport_sample *samples;
+    size_t sample_count, sample_cap;
+    double phase_seconds[BK_MAX_PHASES];
+    lbk_bake_phase phases[BK_MAX_PHASES];
+    int phase_count;
+    double phase_start;
+    bk_set_bakes sets;              /* dynamic light sets and doors (bake_sets.c) */
+    float origin[3];                /* world position of the bake frame's origin (recentre()) */
+    uint64_t saturated, flushed;    /* texel channels outside the R11G11B10F range (stored units) */
+    float scale[3];                 /* LMAP, GLG, LLG scales (spec §5.7); DLS payloads use them */
+    float octp_scale;
+    lbk_bake_output *out;           /* what the caller gets: the writer (sections.c), the report */
+    uint64_t container_bytes;
+} bk_pipeline;
+
+struct lbk_bake_output {
+    lbk_allocator allocator;        /* all zero: malloc */
+    lbk_writer *writer;
+    lbk_bake_report report;
+    lbk_bake_pass *passes;
+    lbk_bake_phase_time phases[BK_MAX_PHASES];
+    char *input;
+};
+
+/* Formats the error text; returns code. */
+lbk_result bk_pipeline_fail(bk_pipeline *b, lbk_result code, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+/* A module's failure: out of memory and cancellation as they are, anything else internal;
+ * the text is "<what>: <the result's message>". */
+lbk_result bk_pipeline_failed(bk_pipeline *b, lbk_result r, const char *what);
+/* A checkpoint: reports progress; non-zero when the caller cancelled. */
+int bk_pipeline_progress(bk_pipeline *b, double fraction);
+void bk_pipeline_to_world(const bk_pipeline *b, const float local[3], float world[3]);
+/* Why the base transport stopped, as REPT and the report say it (an lbk_bake_status). */
+uint32_t bk_pipeline_status(const bk_pipeline *b);
+/* What the set bakes share with the base bake. */
+void bk_pipeline_set_inputs(const bk_pipeline *b, bk_set_inputs *in);
+
+/* The write phase: every section into b->writer (sections.c). */
+lbk_result bk_pipeline_encode(bk_pipeline *b);
+/* The report of a finished bake into out (report.c). */
+lbk_result bk_pipeline_report(const bk_pipeline *b, lbk_bake_output *out);
+/* Allocation through the output's allocator (output.c). */
+void *bk_output_alloc(const lbk_bake_output *out, size_t size);
+void bk_output_free_mem(const lbk_bake_output *out, void *p);
+
+#endif

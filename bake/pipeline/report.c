@@ -1,0 +1,196 @@
+/* The bake report: filled from the pipeline as data (lbk_bake_report), and its JSON
+ * (spec/bake-report-json.md, schema lbk-bake-report/1: fields are only ever added). */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cjson/cJSON.h>
+
+#include "bake/pipeline/pipeline.h"
+#include "bake/util/clock.h"
+
+static const char *const phase_names[LBK_BAKE_PHASE_COUNT_] = {
+    [LBK_BAKE_PHASE_IMPORT] = "import", [LBK_BAKE_PHASE_LAYOUT] = "layout", [LBK_BAKE_PHASE_LIGHT] = "light",
+    [LBK_BAKE_PHASE_SETS] = "sets",     [LBK_BAKE_PHASE_WRITE] = "write",
+};
+
+const char *lbk_bake_phase_name(lbk_bake_phase phase)
+{
+    return (unsigned)phase < LBK_BAKE_PHASE_COUNT_ ? phase_names[phase] : "unknown";
+}
+
+static void fill_transport(const bk_pipeline *b, lbk_bake_transport *t)
+{
+    t->seconds = b->stats.seconds;
+    t->passes = b->stats.passes;
+    t->rays = b->stats.rays;
+    t->bounces = b->stats.bounces;
+    t->bounce_ratio_q = b->stats.q;
+    t->tail_fraction = b->stats.tail_fraction;
+    t->cache_cells = b->stats.cells;
+    t->nonfinite_dropped = b->stats.nonfinite;
+    t->texel_channels_saturated = b->saturated;
+    t->texel_channels_flushed = b->flushed;
+    t->est_rel_rmse = b->stats.est_rel_rmse;
+}
+
+static void fill_counts(const bk_pipeline *b, lbk_bake_counts *c)
+{
+    c->objects = b->scene.object_count;
+    c->texels = b->atlas.texels;
+    c->pages = b->atlas.page_count;
+    c->glg_probes = b->have_glg ? b->glg.probe_count : 0;
+    c->llgs = b->llg_count;
+    c->llg_probes = b->receiver_count - b->llg_first;
+    c->light_sets = b->sets.set_count;
+    c->doors = b->sets.door_count;
+    c->file_bytes = b->container_bytes;
+}
+
+lbk_result bk_pipeline_report(const bk_pipeline *b, lbk_bake_output *out)
+{
+    lbk_bake_report *r = &out->report;
+    memset(r, 0, sizeof *r);
+    r->size = sizeof *r;
+    size_t len = strlen(b->input);
+    out->input = bk_output_alloc(out, len + 1);
+    out->passes = bk_output_alloc(out, (b->sample_count ? b->sample_count : 1) * sizeof *out->passes);
+    if (!out->input || !out->passes) return LBK_ERR_OUT_OF_MEMORY;
+    memcpy(out->input, b->input, len + 1);
+    r->input = out->input;
+    r->preset = b->opt->preset;
+    r->seed = b->opt->seed;
+    r->status = bk_pipeline_status(b);
+    r->target_error = b->opt->target_error > 0 ? b->opt->target_error : b->pre->target_error;
+    r->time_limit = b->opt->time_limit;
+    for (size_t i = 0; i < b->sample_count; i++) {
+        const bk_transport_sample *s = &b->samples[i];
+        out->passes[i] = (lbk_bake_pass){s->pass, s->seconds, s->samples_per_receiver, s->est_rel_rmse, s->bounces};
+    }
+    r->passes = out->passes;
+    r->pass_count = b->sample_count;
+    fill_transport(b, &r->transport);
+    fill_counts(b, &r->counts);
+    r->scales.lmap = r->counts.texels ? b->scale[0] : 0;
+    r->scales.glg = r->counts.glg_probes ? b->scale[1] : 0;
+    r->scales.llg = r->counts.llgs ? b->scale[2] : 0;
+    r->scales.octp = b->opt->octahedral_probes && r->counts.glg_probes ? b->octp_scale : 0;
+    for (int i = 0; i < b->phase_count; i++) out->phases[i] = (lbk_bake_phase_time){b->phases[i], b->phase_seconds[i]};
+    r->phases = out->phases;
+    r->phase_count = (size_t)b->phase_count;
+    r->seconds = bk_now() - b->start;
+    return LBK_OK;
+}
+
+/* ---- JSON -------------------------------------------------------------------------------- */
+
+static void json_transport(cJSON *root, const lbk_bake_report *r)
+{
+    const lbk_bake_transport *t = &r->transport;
+    cJSON *st = cJSON_AddObjectToObject(root, "transport");
+    cJSON_AddNumberToObject(st, "seconds", t->seconds);
+    cJSON_AddNumberToObject(st, "passes", t->passes);
+    cJSON_AddNumberToObject(st, "rays", (double)t->rays);
+    cJSON_AddNumberToObject(st, "bounces", t->bounces);
+    cJSON_AddNumberToObject(st, "bounce_ratio_q", t->bounce_ratio_q);
+    cJSON_AddNumberToObject(st, "tail_fraction", t->tail_fraction);
+    cJSON_AddNumberToObject(st, "cache_cells", (double)t->cache_cells);
+    cJSON_AddNumberToObject(st, "nonfinite_dropped", (double)t->nonfinite_dropped);
+    cJSON_AddNumberToObject(st, "texel_channels_saturated", (double)t->texel_channels_saturated);
+    cJSON_AddNumberToObject(st, "texel_channels_flushed", (double)t->texel_channels_flushed);
+}
+
+static void json_counts(cJSON *root, const lbk_bake_report *r)
+{
+    /* the radiometric scale of each lighting section written (spec §5.7); 0: section absent */
+    cJSON *sc = cJSON_AddObjectToObject(root, "scales");
+    cJSON_AddNumberToObject(sc, "lmap", r->scales.lmap);
+    cJSON_AddNumberToObject(sc, "glg", r->scales.glg);
+    cJSON_AddNumberToObject(sc, "llg", r->scales.llg);
+    cJSON_AddNumberToObject(sc, "octp", r->scales.octp);
+    const lbk_bake_counts *n = &r->counts;
+    cJSON *c = cJSON_AddObjectToObject(root, "counts");
+    cJSON_AddNumberToObject(c, "objects", (double)n->objects);
+    cJSON_AddNumberToObject(c, "texels", (double)n->texels);
+    cJSON_AddNumberToObject(c, "pages", (double)n->pages);
+    cJSON_AddNumberToObject(c, "glg_probes", (double)n->glg_probes);
+    cJSON_AddNumberToObject(c, "llgs", (double)n->llgs);
+    cJSON_AddNumberToObject(c, "llg_probes", (double)n->llg_probes);
+    cJSON_AddNumberToObject(c, "light_sets", n->light_sets);
+    cJSON_AddNumberToObject(c, "doors", n->doors);
+    cJSON_AddNumberToObject(c, "file_bytes", (double)n->file_bytes);
+}
+
+static cJSON *json_report(const lbk_bake_report *r, const char *container_path)
+{
+    cJSON *root = cJSON_CreateObject();
+    cJSON_AddStringToObject(root, "schema", "lbk-bake-report/1");
+    cJSON_AddStringToObject(root, "input", r->input ? r->input : "");
+    cJSON_AddStringToObject(root, "output", container_path ? container_path : "");
+    cJSON_AddStringToObject(root, "preset", lbk_bake_preset_name(r->preset));
+    cJSON_AddNumberToObject(root, "seed", (double)r->seed);
+    cJSON_AddStringToObject(root, "status", lbk_bake_status_name(r->status));
+    cJSON_AddNumberToObject(root, "target_error", r->target_error);
+    cJSON_AddNumberToObject(root, "time_limit", r->time_limit);
+    cJSON *samples = cJSON_AddArrayToObject(root, "samples");
+    for (size_t i = 0; i < r->pass_count; i++) {
+        const lbk_bake_pass *s = &r->passes[i];
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddNumberToObject(o, "seconds", s->seconds);
+        cJSON_AddNumberToObject(o, "samples_per_receiver", s->samples_per_receiver);
+        cJSON_AddNumberToObject(o, "est_rel_rmse", s->est_rel_rmse);
+        cJSON_AddNumberToObject(o, "bounces", s->bounces);
+        cJSON_AddNumberToObject(o, "pass", s->pass);
+        cJSON_AddItemToArray(samples, o);
+    }
+    json_transport(root, r);
+    json_counts(root, r);
+    cJSON *ph = cJSON_AddArrayToObject(root, "phases");
+    for (size_t i = 0; i < r->phase_count; i++) {
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "name", lbk_bake_phase_name(r->phases[i].phase));
+        cJSON_AddNumberToObject(o, "seconds", r->phases[i].seconds);
+        cJSON_AddItemToArray(ph, o);
+    }
+    return root;
+}
+
+/* cJSON_Print's text (malloc'ed; cJSON has no per-call allocator), or NULL. */
+static char *print_report(const lbk_bake_report *r, const char *container_path)
+{
+    cJSON *root = json_report(r, container_path);
+    char *text = root ? cJSON_Print(root) : NULL;
+    cJSON_Delete(root);
+    return text;
+}
+
+lbk_result lbk_bake_report_json(const lbk_bake_report *report, const char *container_path, const lbk_allocator *allocator,
+                                char **text, size_t *size)
+{
+    if (!report || !text) return LBK_ERR_INVALID_ARGUMENT;
+    *text = NULL;
+    char *t = print_report(report, container_path);
+    if (!t) return LBK_ERR_OUT_OF_MEMORY;
+    size_t n = strlen(t);
+    lbk_bake_output tmp;
+    memset(&tmp, 0, sizeof tmp);
+    if (allocator && allocator->alloc && allocator->free) tmp.allocator = *allocator;
+    *text = bk_output_alloc(&tmp, n + 1);
+    if (*text) memcpy(*text, t, n + 1);
+    free(t);
+    if (!*text) return LBK_ERR_OUT_OF_MEMORY;
+    if (size) *size = n;
+    return LBK_OK;
+}
+
+lbk_result lbk_bake_report_write_json(const lbk_bake_report *report, const char *container_path, const char *json_path)
+{
+    if (!report || !json_path) return LBK_ERR_INVALID_ARGUMENT;
+    char *text = print_report(report, container_path);
+    if (!text) return LBK_ERR_OUT_OF_MEMORY;
+    FILE *f = fopen(json_path, "w");
+    int ok = f && fputs(text, f) >= 0 && fputc('\n', f) != EOF;
+    if (f && fclose(f)) ok = 0;
+    free(text);
+    return ok ? LBK_OK : LBK_ERR_IO;
+}
