@@ -248,14 +248,34 @@ def channel_ratios(got, want):
     return [sum(g[c] for g in got) / max(1e-30, sum(w[c] for w in want)) for c in range(3)]
 
 
-def run(work, lbk, dump, threads, out=print):
+def lbk_vs_formula(sc, work, lbk, dump, threads, tag):
+    """lbk on the same scene: its own texels, the formula evaluated at each -> (ratio, rms, n)."""
+    name = sc["name"]
+    lbk_file = os.path.join(work, name + tag + ".lbk")
+    common.run_timed([lbk, "bake", sc["gltf"], "-o", lbk_file, "--threads", str(threads or 0)] + sc["lbk_args"],
+                     os.path.join(work, name + tag + ".lbk.log"))
+    ltsv = os.path.join(work, name + tag + ".lbk.tsv")
+    dargs = [a for a in sc["lbk_args"] if a != "--sky"]
+    dargs = dargs[dargs.index("--texel-density"):] if "--texel-density" in dargs else []
+    common.run_timed([dump, sc["gltf"], lbk_file, ltsv] + dargs, os.path.join(work, name + tag + ".dump.log"))
+    rec = common.Receivers(ltsv)
+    sel = [i for i in range(len(rec)) if sc["lbk_select"](rec.pos[i], rec.nrm[i])]
+    lw = [sc["formula"](rec.pos[i], rec.nrm[i]) for i in sel]
+    lg = [rec.rgb[i] for i in sel]
+    lratio, lrms = ratio_stats(lg, lw)
+    return lratio, lrms, len(sel)
+
+
+def run(work, lbk, dump, threads, out=print, alt=None):
     """Prints the table; returns whether Cycles passed every check (lbk's columns are findings
-    about lbk, not checks of the harness)."""
+    about lbk, not checks of the harness). alt: (name, lbk, dump) of a second baker whose own
+    texels get the same columns."""
     os.makedirs(work, exist_ok=True)
     ok = True
     out("unit and orientation proofs (Cycles and lbk against closed-form irradiance):")
-    out("  %-8s %-11s %5s %9s %9s %9s  %-22s %9s %9s %6s" % ("scene", "receivers", "n", "Cyc/true", "Cyc rms", "flipped",
-                                                             "Cyc R/G/B ratio", "lbk/true", "lbk rms", "texels"))
+    out("  %-8s %-11s %5s %9s %9s %9s  %-22s %9s %9s %6s%s" % (
+        "scene", "receivers", "n", "Cyc/true", "Cyc rms", "flipped", "Cyc R/G/B ratio", "lbk/true", "lbk rms", "texels",
+        "" if not alt else " %9s %9s" % ((alt[0] + "/true")[-9:], (alt[0] + " rms")[-9:])))
     for make in SCENES:
         sc = make(work)
         name = sc["name"]
@@ -266,25 +286,17 @@ def run(work, lbk, dump, threads, out=print):
         runs = common.run_cycles(sc["gltf"], tsv, cdir, [(sc["spp"], 1)], sky=sc["sky"], threads=threads)
         got = common.read_f32_rgb(os.path.join(cdir, runs[0]["file"]))
         flipped = common.read_f32_rgb(os.path.join(cdir, "flipped_" + runs[0]["file"]))
-        # lbk on the same scene: its own texels, the formula evaluated at each
-        lbk_file = os.path.join(work, name + ".lbk")
-        common.run_timed([lbk, "bake", sc["gltf"], "-o", lbk_file, "--threads", str(threads or 0)] + sc["lbk_args"],
-                         os.path.join(work, name + ".lbk.log"))
-        ltsv = os.path.join(work, name + ".lbk.tsv")
-        dargs = [a for a in sc["lbk_args"] if a != "--sky"]
-        dargs = dargs[dargs.index("--texel-density"):] if "--texel-density" in dargs else []
-        common.run_timed([dump, sc["gltf"], lbk_file, ltsv] + dargs, os.path.join(work, name + ".dump.log"))
-        rec = common.Receivers(ltsv)
-        sel = [i for i in range(len(rec)) if sc["lbk_select"](rec.pos[i], rec.nrm[i])]
-        lw = [sc["formula"](rec.pos[i], rec.nrm[i]) for i in sel]
-        lg = [rec.rgb[i] for i in sel]
-        lratio, lrms = ratio_stats(lg, lw)
+        lratio, lrms, nsel = lbk_vs_formula(sc, work, lbk, dump, threads, "")
+        if alt:
+            aratio, arms, _ = lbk_vs_formula(sc, work, alt[1], alt[2], threads, ".alt")
         for gi, g in enumerate(sorted(set(sc["groups"]))):
             idx = [i for i, x in enumerate(sc["groups"]) if x == g]
             r, rms = ratio_stats([got[i] for i in idx], [want[i] for i in idx])
             _, frms = ratio_stats([flipped[i] for i in idx], [want[i] for i in idx])
             ch = channel_ratios([got[i] for i in idx], [want[i] for i in idx])
-            lbk_cols = "%9.4f %8.2f%% %6d" % (lratio, 100 * lrms, len(sel)) if gi == 0 else ""
+            lbk_cols = "%9.4f %8.2f%% %6d" % (lratio, 100 * lrms, nsel) if gi == 0 else ""
+            if alt and gi == 0:
+                lbk_cols += " %9.4f %8.2f%%" % (aratio, 100 * arms)
             out("  %-8s %-11s %5d %9.4f %8.2f%% %8.1f%%  %-22s %s" % (
                 name, g, len(idx), r, 100 * rms, 100 * frms, "/".join("%.3f" % x for x in ch), lbk_cols))
             # the proof: Cycles within 2 % of the formula (its noise is below 0.3 % except in the

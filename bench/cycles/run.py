@@ -12,7 +12,10 @@ quadrature (sqrt(max(0, MSE - sigma_ref^2))). README.md describes it all and the
 Environment (or the options of the same name): LBK (lbk binary), LBK_TEXEL_DUMP (texel_dump
 built from the same tree), BLENDER, LBK_SCENES (../shared/scenes), CYCLES_CLOCK (cpu|wall: the
 clock "equal time" is measured on, default cpu), LBK_BENCH_QUICK=1 (references 8x shorter),
-BENCH_CYCLES_SCENES (comma-separated subset), BENCH_CYCLES_THREADS (default: all cores).
+BENCH_CYCLES_SCENES (comma-separated subset), BENCH_CYCLES_THREADS (default: all cores),
+LBK_ALT (a second lbk binary, e.g. an experiment, baked with seed 1 and measured against the same
+references: extra columns; it must give the same receivers), LBK_ALT_DUMP (its texel_dump, default
+LBK_TEXEL_DUMP), LBK_ALT_NAME (its column label, default "alt").
 """
 import argparse
 import json
@@ -79,14 +82,14 @@ def pct(x):
     return "%6.1f %%" % (100 * x) if x == x else "    n/a"
 
 
-def bake_lbk(sc, work, opt, seed):
-    out = os.path.join(work, "%s.seed%d.lbk" % (sc["name"], seed))
+def bake_lbk(sc, work, opt, seed, alt=False):
+    out = os.path.join(work, "%s.seed%d%s.lbk" % (sc["name"], seed, ".alt" if alt else ""))
     rep = out + ".json"
-    cmd = [opt.lbk, "bake", sc["path"], "-o", out, "--json-report", rep, "--seed", str(seed),
+    cmd = [opt.alt if alt else opt.lbk, "bake", sc["path"], "-o", out, "--json-report", rep, "--seed", str(seed),
            "--threads", str(opt.threads)] + sc["lbk"]
     wall, cpu = common.run_timed(cmd, out + ".log")
     tsv = out + ".tsv"
-    common.run_timed([opt.dump, sc["path"], out, tsv] + density_args(sc["lbk"]), tsv + ".log")
+    common.run_timed([opt.alt_dump if alt else opt.dump, sc["path"], out, tsv] + density_args(sc["lbk"]), tsv + ".log")
     return common.Receivers(tsv), wall, cpu, json.load(open(rep))
 
 
@@ -102,6 +105,16 @@ def run_scene(sc, work, opt, out):
     rec2, _, _, _ = bake_lbk(sc, work, opt, 2)
     if rec2.pos != rec.pos:
         sys.exit("bench-cycles: %s: the seed-2 bake has other receivers" % sc["name"])
+    # the second baker (LBK_ALT), seed 1, against the same references
+    alt_lum, alt_txt = None, ""
+    if opt.alt:
+        reca, alt_wall, alt_cpu, _ = bake_lbk(sc, work, opt, 1, alt=True)
+        if reca.pos != rec.pos or reca.flags != rec.flags:
+            sys.exit("bench-cycles: %s: the %s bake has other receivers (LBK_ALT must share the layout)" % (
+                sc["name"], opt.alt_name))
+        alt_lum = [common.lum(x) for x in reca.rgb]
+        alt_txt = "; %s %.1f s wall, %.1f s CPU (%s spp, estimated error %.1f %%)" % (
+            opt.alt_name, alt_wall, alt_cpu, reca.meta.get("spp", "?"), 100 * float(reca.meta.get("est_rel_rmse", "nan")))
     target = lbk_cpu if opt.clock == "cpu" else lbk_wall
     ref_spp = max(64, sc["ref_spp"] // (8 if opt.quick else 1))
     cdir = os.path.join(work, sc["name"] + ".cycles")
@@ -125,18 +138,29 @@ def run_scene(sc, work, opt, out):
         "%d spp, %.1f s CPU, %.1f s wall; reference 2 x %d spp (%.0f s CPU)" % (
             sc["name"], lbk_wall, lbk_cpu, rec.meta.get("spp", "?"), rec.meta.get("status", "?"), 100 * est,
             opt.clock.upper() if opt.clock == "cpu" else opt.clock, eq["spp"], eq["cpu_s"], eq["wall_s"], ref_spp,
-            ref_cpu))
-    out("  %-22s %-8s %6s %9s %9s %9s %9s %9s %10s %6s %9s" % (
-        "object", "rep", "n", "lbk err", "lbk bias", "lbk noise", "lbk est", "Cyc err", "lbk/Cyc", "goal", "ref noise"))
+            ref_cpu) + alt_txt)
+    an = opt.alt_name[:5]
+    alt_head = "" if not opt.alt else " %9s %9s %8s" % (an + " err", an + " bias", an + "/Cyc")
+    out("  %-22s %-8s %6s %9s %9s %9s %9s %9s %10s %6s %9s%s" % (
+        "object", "rep", "n", "lbk err", "lbk bias", "lbk noise", "lbk est", "Cyc err", "lbk/Cyc", "goal", "ref noise",
+        alt_head))
     rows = []
 
+    def alt_group(idx):
+        return Group(idx, alt_lum, lum2, r1, r2, ceq) if alt_lum else None
+
+    def alt_cols(ga, g):
+        return "" if not ga else " %9s %9s %8.2f" % (pct(ga.lbk), "%+7.1f %%" % (100 * ga.lbk_bias),
+                                                     ga.lbk / g.cyc if g.cyc > 0 else float("inf"))
+
     def row(label, rep, idx):
-        g = Group(idx, lum, lum2, r1, r2, ceq)
+        g, ga = Group(idx, lum, lum2, r1, r2, ceq), alt_group(idx)
         ratio = g.lbk / g.cyc if g.cyc > 0 else float("inf")
-        out("  %-22s %-8s %6d %9s %9s %9s %9s %9s %10.2f %6s %9s" % (
+        out("  %-22s %-8s %6d %9s %9s %9s %9s %9s %10.2f %6s %9s%s" % (
             label[:22], rep, g.n, pct(g.lbk), "%+7.1f %%" % (100 * g.lbk_bias), pct(g.lbk_noise), pct(est),
-            pct(g.cyc), ratio, "n/r" if g.unresolved else "yes" if ratio <= 0.5 else "no", pct(g.ref_noise)))
-        return g, ratio
+            pct(g.cyc), ratio, "n/r" if g.unresolved else "yes" if ratio <= 0.5 else "no", pct(g.ref_noise),
+            alt_cols(ga, g)))
+        return g, ratio, ga
 
     visible = [i for i in range(len(rec)) if not rec.flags[i] & (common.HIDDEN | common.OFFPLANE)]
     for o in sorted(set(rec.obj)):
@@ -144,10 +168,12 @@ def run_scene(sc, work, opt, out):
         if not idx:
             continue
         rep, name = rec.objects.get(o, ("?", "object%d" % o))
-        g, ratio = row(name, rep, idx)
+        g, ratio, ga = row(name, rep, idx)
         rows.append({"scene": sc["name"], "object": name, "rep": rep, "n": g.n, "lbk_err": g.lbk,
                      "lbk_bias": g.lbk_bias, "lbk_noise": g.lbk_noise, "lbk_est": est, "cycles_err": g.cyc,
                      "ratio": ratio, "ref_noise": g.ref_noise, "mean_lux": g.mean, "unresolved": g.unresolved})
+        if ga:
+            rows[-1].update({"alt_err": ga.lbk, "alt_bias": ga.lbk_bias})
         mats = sorted(set(rec.mat[i] for i in idx))
         if len(mats) > 1:
             for m in mats:
@@ -156,8 +182,10 @@ def run_scene(sc, work, opt, out):
                     row("  . " + rec.materials.get(m, str(m)), "", sub)
     tex = [i for i in visible if rec.kind[i] == "T"]
     g = Group(tex, lum, lum2, r1, r2, ceq)
-    out("  %-22s %-8s %6d %9s %9s %9s %9s %9s %10.2f" % ("all texels", "", g.n, pct(g.lbk), "%+7.1f %%" % (
-        100 * g.lbk_bias), pct(g.lbk_noise), pct(est), pct(g.cyc), g.lbk / g.cyc if g.cyc > 0 else float("inf")))
+    ga = alt_group(tex)
+    out(("  %-22s %-8s %6d %9s %9s %9s %9s %9s %10.2f %6s %9s%s" % ("all texels", "", g.n, pct(g.lbk), "%+7.1f %%" % (
+        100 * g.lbk_bias), pct(g.lbk_noise), pct(est), pct(g.cyc), g.lbk / g.cyc if g.cyc > 0 else float("inf"), "",
+        "", alt_cols(ga, g))).rstrip())
     # the estimate normalises by the RMS of the values (TRANSPORT.md); compare like with like
     within = 0.5 <= est / g.lbk_rms <= 2 if g.lbk_rms > 0 else False
     out("  estimate vs measured (all texels, RMSE/RMS as the estimate): estimated %.2f %%, measured error %.2f %% "
@@ -185,7 +213,8 @@ def run_scene(sc, work, opt, out):
                   "cycles_equal_spp": eq["spp"], "cycles_equal_cpu_s": eq["cpu_s"], "cycles_equal_wall_s": eq["wall_s"],
                   "ref_spp": ref_spp, "all_texels": {"lbk_err": g.lbk, "lbk_bias": g.lbk_bias, "cycles_err": g.cyc,
                                                      "lbk_err_rms": g.lbk_rms, "lbk_noise_rms": g.lbk_noise_rms,
-                                                     "ref_noise": g.ref_noise}, "est_within_2x": within}
+                                                     "ref_noise": g.ref_noise}, "est_within_2x": within,
+                  "alt_all_texels": {"err": ga.lbk, "bias": ga.lbk_bias} if ga else None}
 
 
 def main():
@@ -200,7 +229,12 @@ def main():
     ap.add_argument("--only", default=env("BENCH_CYCLES_SCENES", ""))
     ap.add_argument("--quick", action="store_true", default=env("LBK_BENCH_QUICK", "0") not in ("", "0"))
     ap.add_argument("--no-analytic", action="store_true")
+    # a second baker measured against the same references (seed 1 only); it must share the layout
+    ap.add_argument("--alt", default=env("LBK_ALT", ""))
+    ap.add_argument("--alt-dump", default=env("LBK_ALT_DUMP", ""))
+    ap.add_argument("--alt-name", default=env("LBK_ALT_NAME", "alt"))
     opt = ap.parse_args()
+    opt.alt_dump = opt.alt_dump or opt.dump
     os.makedirs(opt.work, exist_ok=True)
     t0 = time.perf_counter()
     lines = []
@@ -209,10 +243,12 @@ def main():
         print(s, flush=True)
         lines.append(s)
     ver = subprocess.run([common.blender(), "--version"], capture_output=True, text=True).stdout.split("\n")[0]
-    out("lbk vs Cycles (%s, CPU, %d threads each) at equal %s time; lbk: %s" % (ver, opt.threads, opt.clock, opt.lbk))
+    out("lbk vs Cycles (%s, CPU, %d threads each) at equal %s time; lbk: %s%s" % (
+        ver, opt.threads, opt.clock, opt.lbk, "; %s: %s" % (opt.alt_name, opt.alt) if opt.alt else ""))
     ok = True
     if not opt.no_analytic:
-        ok = analytic.run(os.path.join(opt.work, "analytic"), opt.lbk, opt.dump, opt.threads, out)
+        ok = analytic.run(os.path.join(opt.work, "analytic"), opt.lbk, opt.dump, opt.threads, out,
+                          alt=(opt.alt_name, opt.alt, opt.alt_dump) if opt.alt else None)
         if not ok:
             out("  ANALYTIC CHECK FAILED: Cycles' units or the sensor orientation are wrong; the comparison is void")
     only = [s for s in opt.only.split(",") if s]
