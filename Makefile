@@ -57,7 +57,7 @@ TOOL_OBJ  := $(filter-out $(BUILD)/rel/$(TOOL_MAIN:.c=.o) $(BAKE_OBJ),$(TOOL_CSR
 LIB_ASAN  := $(LIB_SRC:%.c=$(BUILD)/asan/%.o)
 TOOL_ASAN := $(filter-out $(BUILD)/asan/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUILD)/asan/%.o)) $(TOOL_CXXSRC:%.cc=$(BUILD)/asan/%.o)
 
-.PHONY: all lib bake-lib deps deps-bench demo test check bench bench-cycles fuzz install install-check clean help gltf-validator
+.PHONY: all lib bake-lib deps deps-bench demo test check bench bench-cycles bench-render fuzz install install-check clean help gltf-validator
 all: $(BUILD)/lbk $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc \
      $(BUILD)/liblbkbake.a $(BUILD)/liblbkbake.so $(BUILD)/lbk-bake.pc
 
@@ -74,6 +74,7 @@ help:
 	@echo "make bench      benchmarks, printed as ratios against baselines measured in the same run"
 	@echo "make bench-cycles  lbk against Blender Cycles at equal time (part of make bench; bench/cycles/README.md)"
 	@echo "make bench-cycles-plane0  the same, with the AHD plane-0 experiment measured beside it"
+	@echo "make bench-render  lbk render against Blender Cycles"
 	@echo "make fuzz       libFuzzer harness for the container reader (clang)"
 	@echo "make install PREFIX=/usr/local"
 
@@ -319,6 +320,7 @@ bench: deps-tools deps-bench
 	@for b in $(BENCHES); do echo "== $$b"; $(BUILD)/bench/$$b || exit 1; done
 	@echo "== blender_import"; sh bench/blender_import.sh $(BUILD)/lbk $(BUILD)/bench-blender
 	@echo "== bench-cycles"; $(MAKE) --no-print-directory bench-cycles
+	@echo "== render (lbk render vs Blender Cycles)"; $(MAKE) --no-print-directory bench-render
 
 # lbk against Cycles (bench/cycles/README.md). LBK_TREE=/path/to/other/checkout compares that
 # tree's baker instead: its build/lbk (built there first) and texel_dump linked against its
@@ -354,6 +356,12 @@ bench-cycles-plane0: deps-tools deps-bench
 	  rm -rf $(BUILD)/plane0-src.new
 	@$(MAKE) --no-print-directory -C $(BUILD)/plane0-src $(BUILD)/lbk
 	@LBK_ALT=$(BUILD)/plane0-src/$(BUILD)/lbk LBK_ALT_NAME=plane0 $(MAKE) --no-print-directory bench-cycles
+
+# lbk render against converged Cycles renders (bench/render/README.md); the Cycles scene converter
+# comes from LBK_CYCLES_HARNESS (default bench/cycles).
+LBK_CYCLES_HARNESS ?= bench/cycles
+bench-render: $(BUILD)/lbk
+	@LBK_CYCLES_HARNESS=$(LBK_CYCLES_HARNESS) python3 bench/render/run.py --lbk $(BUILD)/lbk --out $(BUILD)/bench-render $(BENCH_RENDER_ARGS)
 
 # ---- demo -----------------------------------------------------------------------------------
 demo: deps-tools

@@ -18,5 +18,6 @@ int lbk_cmd_validate(int argc, char **argv);
 int lbk_cmd_diff(int argc, char **argv);
 int lbk_cmd_convert(int argc, char **argv);
 int lbk_cmd_export(int argc, char **argv);
+int lbk_cmd_render(int argc, char **argv);
 
 #endif

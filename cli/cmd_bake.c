@@ -39,6 +39,9 @@ static void help(FILE *f)
           "  --door-method difference|guided\n"
           "                          how the light through an open door is baked: differences of\n"
           "                          full runs (default) or the seed's guided estimator (bake/sets/SETS.md)\n"
+          "  --denoise auto|off      edge-aware denoising of lightmap texels and GLG probes, guided\n"
+          "                          by the transport's own noise estimate (default auto: on in both\n"
+          "                          presets; bake/transport/DENOISE.md)\n"
           "  --threads N             worker threads (default: all cores)\n"
           "  --seed N                random seed (default 1)\n"
           "  --json-report FILE      write the error-against-time report as JSON\n"
@@ -321,6 +324,14 @@ int lbk_cmd_bake(int argc, char **argv)
             else if (!strcmp(v, "guided")) o.d.door_method = LBK_BAKE_DOOR_GUIDED;
             else {
                 fprintf(stderr, "lbk bake: unknown door method '%s' (difference, guided)\n", v);
+                return LBK_EXIT_USAGE;
+            }
+        } else if (!strcmp(a, "--denoise")) {
+            NEED_VALUE;
+            if (!strcmp(v, "auto")) o.d.denoise = LBK_BAKE_DENOISE_AUTO;
+            else if (!strcmp(v, "off")) o.d.denoise = LBK_BAKE_DENOISE_OFF;
+            else {
+                fprintf(stderr, "lbk bake: unknown denoise mode '%s' (auto, off)\n", v);
                 return LBK_EXIT_USAGE;
             }
         } else if (!strcmp(a, "--threads")) {

@@ -16,6 +16,7 @@ static const struct {
     {"diff", lbk_cmd_diff, "compare the lighting of two bakes"},
     {"convert", lbk_cmd_convert, "make a console-ready pack with a profile"},
     {"export", lbk_cmd_export, "write pages and probes as EXR/PNG/CSV"},
+    {"render", lbk_cmd_render, "render a view of a baked level (reference renderer)"},
 };
 
 static void usage(FILE *f)

@@ -13,6 +13,7 @@
 #include "bake/scene/exr_read.h"
 #include "bake/scene/import.h"
 #include "bake/scene/scene_desc.h"
+#include "bake/transport/denoise.h"
 #include "bake/util/clock.h"
 
 const bk_preset bk_presets[LBK_BAKE_PRESET_COUNT_] = {
@@ -431,6 +432,7 @@ void bk_pipeline_set_inputs(const bk_pipeline *b, bk_set_inputs *in)
     in->threshold = b->opt->dls_threshold;
     in->events = &b->events;
     in->door_method = (int)b->opt->door_method;
+    in->denoiser = b->denoiser;
     memcpy(in->origin, b->origin, sizeof in->origin);
 }
 
@@ -448,6 +450,11 @@ static lbk_result do_transport(bk_pipeline *b)
     bk_transport_output out;
     memset(&out, 0, sizeof out);
     out.radiance = b->radiance;
+    if (b->opt->denoise != LBK_BAKE_DENOISE_OFF) {
+        b->variance = calloc(b->receiver_count ? b->receiver_count : 1, sizeof *b->variance);
+        if (!b->variance) return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
+        out.variance = b->variance;
+    }
     r = bk_transport_run(&b->scene, b->tracer, b->receivers, b->receiver_count, &to, &out, &b->stats);
     if (r) return bk_pipeline_failed(b, r, "light transport");
     if (b->stats.nonfinite)
@@ -465,6 +472,62 @@ static lbk_result do_sets(bk_pipeline *b)
     return bk_set_bakes_run(&b->sets, &in, b->err, sizeof b->err);
 }
 
+/* The denoising weights (texels and GLG probes) from the base + every light set and door (the
+ * guide), applied to the base here and to every set by bk_set_bakes_emit with the same weights
+ * (bake/transport/DENOISE.md). */
+static lbk_result do_denoise(bk_pipeline *b)
+{
+    if (b->opt->denoise == LBK_BAKE_DENOISE_OFF) return LBK_OK;
+    const lbk_sh9_rgb *set_sum;
+    const float *set_var;
+    bk_set_bakes_guide(&b->sets, &set_sum, &set_var);
+    lbk_sh9_rgb *guide = NULL;
+    float *guide_var = NULL;
+    if (set_sum) {
+        size_t n = b->receiver_count ? b->receiver_count : 1;
+        guide = malloc(n * sizeof *guide);
+        guide_var = malloc(n * sizeof *guide_var);
+        if (!guide || !guide_var) {
+            free(guide), free(guide_var);
+            return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
+        }
+        for (size_t i = 0; i < b->receiver_count; i++) {
+            for (int c = 0; c < 3; c++)
+                for (int k = 0; k < 9; k++) guide[i].c[c][k] = b->radiance[i].c[c][k] + set_sum[i].c[c][k];
+            guide_var[i] = b->variance[i] + set_var[i];
+        }
+    }
+    bk_denoise_inputs in;
+    memset(&in, 0, sizeof in);
+    in.scene = &b->scene;
+    in.tracer = b->tracer;
+    in.atlas = &b->atlas;
+    in.texels = &b->texels;
+    in.texel_of_receiver = b->texel_of_receiver;
+    in.texel_count = b->texel_receivers;
+    in.glg = b->have_glg ? &b->glg : NULL;
+    in.glg_first = b->glg_first;
+    in.receiver_count = b->receiver_count;
+    in.radiance = guide ? guide : b->radiance;
+    in.variance = guide_var ? guide_var : b->variance;
+    bk_denoise_options o;
+    memset(&o, 0, sizeof o);
+    o.threads = b->opt->threads;
+    lbk_result r = bk_denoiser_create(&in, &o, &b->denoiser);
+    free(guide), free(guide_var);
+    if (!r) r = bk_denoiser_apply(b->denoiser, b->radiance);
+    if (r) return bk_pipeline_failed(b, r, "denoising");
+    return LBK_OK;
+}
+
+/* The sets' entries, denoised with the same weights as the base (bake_sets.c). */
+static lbk_result emit_sets(bk_pipeline *b)
+{
+    bk_set_inputs in;
+    bk_pipeline_set_inputs(b, &in);
+    return bk_set_bakes_emit(&b->sets, &in, b->err, sizeof b->err);
+}
+
 /* ---- the call -------------------------------------------------------------------------- */
 
 static lbk_result run(bk_pipeline *b, const char *path, const lbk_bake_scene *desc)
@@ -474,6 +537,8 @@ static lbk_result run(bk_pipeline *b, const char *path, const lbk_bake_scene *de
     if (!r) r = bk_set_bakes_prepare(&b->sets, &b->scene, &b->events, b->err, sizeof b->err);
     if (!r) r = do_transport(b);
     if (!r && b->sets.set_count) r = do_sets(b);
+    if (!r) r = do_denoise(b);
+    if (!r && b->sets.set_count) r = emit_sets(b);
     if (!r) r = phase(b, LBK_BAKE_PHASE_WRITE);
     if (!r) r = bk_pipeline_encode(b);
     if (b->phase_count > 0) b->phase_seconds[b->phase_count - 1] = bk_now() - b->phase_start;
@@ -491,6 +556,7 @@ static lbk_result check_desc(bk_pipeline *b)
     if ((unsigned)d->preset >= LBK_BAKE_PRESET_COUNT_) BAD("lbk_bake_desc.preset: unknown preset %d", (int)d->preset);
     if ((unsigned)d->door_method >= LBK_BAKE_DOOR_METHOD_COUNT_)
         BAD("lbk_bake_desc.door_method: unknown method %d", (int)d->door_method);
+    if ((unsigned)d->denoise >= LBK_BAKE_DENOISE_COUNT_) BAD("lbk_bake_desc.denoise: unknown mode %d", (int)d->denoise);
     if (d->threads < 0) BAD("lbk_bake_desc.threads: %d is negative", d->threads);
     if (!isfinite(d->target_error)) BAD("lbk_bake_desc.target_error is not finite");
     if (!finite_nonneg(d->time_limit)) BAD("lbk_bake_desc.time_limit: %g is not a finite number >= 0", d->time_limit);
@@ -541,6 +607,8 @@ static lbk_result output_create(bk_pipeline *b)
 static void pipeline_free(bk_pipeline *b)
 {
     bk_set_bakes_free(&b->sets);
+    bk_denoiser_destroy(b->denoiser);
+    free(b->variance);
     free(b->samples);
     free(b->radiance);
     free(b->texel_of_receiver);

@@ -62,6 +62,8 @@ typedef struct bk_pipeline {
     size_t receiver_count, texel_receivers, glg_first, llg_first;
     uint32_t *texel_of_receiver;    /* receiver → index in texels.receivers */
     lbk_sh9_rgb *radiance;
+    float *variance;                /* per receiver, from the transport: the denoiser's input */
+    struct bk_denoiser *denoiser;   /* weights of the base + every set (do_denoise), for all of them */
     bk_transport_stats stats;
     bk_transport_sample *samples;
     size_t sample_count, sample_cap;

@@ -302,6 +302,7 @@ static lbk_result build_meta(bk_pipeline *b, section_list *sl)
     p[n++] = (lbk_meta_pair){"bake.target_error", target};
     p[n++] = (lbk_meta_pair){"bake.max_bounces", bounces};
     p[n++] = (lbk_meta_pair){"bake.time_limit", tlimit};
+    p[n++] = (lbk_meta_pair){"bake.denoise", b->opt->denoise == LBK_BAKE_DENOISE_OFF ? "off" : "auto"};
     if (b->opt->revision) p[n++] = (lbk_meta_pair){LBK_META_REVISION, b->opt->revision};
     if (b->opt->timestamp) {
         time_t now = time(NULL);

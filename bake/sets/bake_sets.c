@@ -42,6 +42,12 @@ typedef struct bs_set {
     double threshold;              /* absolute luminance threshold used (lux) */
     uint32_t members[2];           /* kind 3: the member sets */
     uint32_t member_count;
+    /* the contribution kept from its run until bk_set_bakes_emit (the denoiser's weights need
+     * every set first): radiance per receiver, direct luminance per texel receiver */
+    lbk_sh9_rgb *stash;
+    double *stash_direct;
+    double stash_fraction;
+    int stash_skip_doors;
 } bs_set;
 
 typedef struct bs_door {
@@ -65,6 +71,10 @@ typedef struct bs_impl {
     size_t light_set_count;
     bs_combo *combos;
     size_t combo_count;
+    /* the denoiser's guide (bake/transport/DENOISE.md): Σ of the light sets' and doors'
+     * contributions, and Σ of the light-set runs' variances (independent runs); NULL before any */
+    lbk_sh9_rgb *guide;
+    float *guide_var;
 } bs_impl;
 
 /* ---- prepare --------------------------------------------------------------------------- */
@@ -432,16 +442,13 @@ static int is_door_texel(const bk_set_inputs *in, size_t k)
  * absolute threshold (bake/sets/SETS.md): fraction × mean indirect irradiance (luminance) of
  * the texels the set lights directly; with no direct light the mean contribution; with no texel
  * lit the mean over the probes. */
-static lbk_result set_threshold(const bk_set_inputs *in, const lbk_sh9_rgb *contrib, const lbk_sh9_rgb *direct,
+static lbk_result set_threshold(const bk_set_inputs *in, const lbk_sh9_rgb *contrib, const double *dl,
                                 double fraction, int skip_doors, lbk_ahd_linear *lin, double *thr)
 {
     const bk_texels *tx = in->texels;
     size_t nt = in->texel_receivers;
-    double *lum = calloc(nt ? nt : 1, sizeof *lum), *dl = calloc(nt ? nt : 1, sizeof *dl);
-    if (!lum || !dl) {
-        free(lum), free(dl);
-        return LBK_ERR_OUT_OF_MEMORY;
-    }
+    double *lum = calloc(nt ? nt : 1, sizeof *lum);
+    if (!lum) return LBK_ERR_OUT_OF_MEMORY;
     double dmax = 0;
     for (size_t k = 0; k < nt; k++) {
         const bk_texel *t = &tx->receivers[in->texel_of_receiver[k]];
@@ -451,10 +458,6 @@ static lbk_result set_threshold(const bk_set_inputs *in, const lbk_sh9_rgb *cont
         float ez[3];
         lin_ez(&lin[k], ez);
         lum[k] = lum3(ez);
-        lbk_ahd_linear dlin;
-        bk_texel_linear(t, &direct[k], &dlin);
-        lin_ez(&dlin, ez);
-        dl[k] = lum3(ez);
         if (lum[k] > 0 && dl[k] > dmax) dmax = dl[k];
     }
     double sum = 0, all = 0;
@@ -482,7 +485,7 @@ static lbk_result set_threshold(const bk_set_inputs *in, const lbk_sh9_rgb *cont
         reference = pn ? ps / (double)pn : 0;
     }
     *thr = fraction * reference;
-    free(lum), free(dl);
+    free(lum);
     return LBK_OK;
 }
 
@@ -557,17 +560,18 @@ static lbk_result emit_probes(const bk_set_inputs *in, const lbk_sh9_rgb *contri
     return LBK_OK;
 }
 
-/* Chooses a set's entries from its per-receiver contribution (radiance SH) and the direct part
- * of it: where the contribution exceeds the set's threshold (set_threshold). Door receivers are
- * left out of door sets (when the door is open it is not there). */
-static lbk_result emit_set(const bk_set_inputs *in, bs_set *st, const lbk_sh9_rgb *contrib, const lbk_sh9_rgb *direct,
+/* Chooses a set's entries from its per-receiver contribution (radiance SH) and the luminance
+ * of its direct part per texel receiver (dl): where the contribution exceeds the set's threshold
+ * (set_threshold). Door receivers are left out of door sets (when the door is open it is not
+ * there). */
+static lbk_result emit_set(const bk_set_inputs *in, bs_set *st, const lbk_sh9_rgb *contrib, const double *dl,
                            double fraction, int skip_doors)
 {
     size_t nt = in->texel_receivers;
     lbk_ahd_linear *lin = calloc(nt ? nt : 1, sizeof *lin);
     if (!lin) return LBK_ERR_OUT_OF_MEMORY;
     double thr = 0;
-    lbk_result r = set_threshold(in, contrib, direct, fraction, skip_doors, lin, &thr);
+    lbk_result r = set_threshold(in, contrib, dl, fraction, skip_doors, lin, &thr);
     st->threshold = thr;
     bs_vec tv = {NULL, NULL, 0, 0, sizeof(lbk_ahd_linear)}, gv = {NULL, NULL, 0, 0, sizeof(lbk_sh9_rgb)},
            lv = {NULL, NULL, 0, 0, sizeof(lbk_sh9_rgb)};
@@ -588,6 +592,69 @@ static lbk_result emit_set(const bk_set_inputs *in, bs_set *st, const lbk_sh9_rg
     return r;
 }
 
+/* Keeps a set's contribution for bk_set_bakes_emit and adds it to the denoiser's guide
+ * (combination sets are corrections of their members: not in the guide). `variance` is the
+ * run's own (light sets) or NULL (differences of correlated runs: unknown). */
+static lbk_result stash_set(const bk_set_inputs *in, bs_impl *im, bs_set *st, const lbk_sh9_rgb *contrib,
+                            const lbk_sh9_rgb *direct, const float *variance, double fraction, int skip_doors)
+{
+    size_t n = in->receiver_count, nt = in->texel_receivers;
+    free(st->stash), free(st->stash_direct);
+    st->stash = malloc((n ? n : 1) * sizeof *st->stash);
+    st->stash_direct = malloc((nt ? nt : 1) * sizeof *st->stash_direct);
+    if (!st->stash || !st->stash_direct) return LBK_ERR_OUT_OF_MEMORY;
+    memcpy(st->stash, contrib, n * sizeof *st->stash);
+    for (size_t k = 0; k < nt; k++) {
+        lbk_ahd_linear dlin;
+        float ez[3];
+        bk_texel_linear(&in->texels->receivers[in->texel_of_receiver[k]], &direct[k], &dlin);
+        lin_ez(&dlin, ez);
+        st->stash_direct[k] = lum3(ez);
+    }
+    st->stash_fraction = fraction;
+    st->stash_skip_doors = skip_doors;
+    if (st->kind == LBK_DLS_KIND_COMBINATION) return LBK_OK;
+    if (!im->guide) {
+        im->guide = calloc(n ? n : 1, sizeof *im->guide);
+        im->guide_var = calloc(n ? n : 1, sizeof *im->guide_var);
+        if (!im->guide || !im->guide_var) return LBK_ERR_OUT_OF_MEMORY;
+    }
+    for (size_t i = 0; i < n; i++) {
+        for (int c = 0; c < 3; c++)
+            for (int k = 0; k < 9; k++) im->guide[i].c[c][k] += contrib[i].c[c][k];
+        if (variance && isfinite(variance[i])) im->guide_var[i] += variance[i];
+    }
+    return LBK_OK;
+}
+
+void bk_set_bakes_guide(const bk_set_bakes *sets, const lbk_sh9_rgb **sum, const float **variance)
+{
+    const bs_impl *im = sets->impl;
+    *sum = im ? im->guide : NULL;
+    *variance = im ? im->guide_var : NULL;
+}
+
+lbk_result bk_set_bakes_emit(bk_set_bakes *sets, const bk_set_inputs *in, char *err, size_t err_len)
+{
+    bs_impl *im = sets->impl;
+    if (!im) return LBK_OK;
+    lbk_result r = LBK_OK;
+    for (size_t j = 0; j < im->set_count && !r; j++) {
+        bs_set *st = &im->sets[j];
+        if (!st->stash) continue;
+        /* every set with the same weights, so sets toggled at run time add up to what a
+         * denoised bake of the sum would be */
+        if (in->denoiser) r = bk_denoiser_apply(in->denoiser, st->stash);
+        if (!r) r = emit_set(in, st, st->stash, st->stash_direct, st->stash_fraction, st->stash_skip_doors);
+        free(st->stash), free(st->stash_direct);
+        st->stash = NULL, st->stash_direct = NULL;
+    }
+    free(im->guide), free(im->guide_var);
+    im->guide = NULL, im->guide_var = NULL;
+    if (r) snprintf(err, err_len, "light sets: %s", lbk_result_message(r));
+    return r;
+}
+
 /* ---- runs ------------------------------------------------------------------------------ */
 
 /* The user state of every set run: progress over all runs, the door albedo hook, and where an
@@ -596,6 +663,7 @@ typedef struct run_ctx {
     const bk_set_inputs *in;
     int run, runs;
     const bk_scene *scene;   /* scene of the current run (the hook's triangle indices) */
+    float *variance;         /* NULL, or where run_one writes the run's per-receiver variance */
     int black_doors;         /* 1: door triangles get albedo 0 ... */
     const char *keep;        /* ... except this door's */
     char *err;
@@ -679,6 +747,7 @@ static lbk_result run_one(run_ctx *rc, const bk_scene *scene, const bk_tracer *t
     memset(&out, 0, sizeof out);
     out.radiance = radiance;
     out.direct = direct;
+    out.variance = rc->variance;
     bk_transport_stats st;
     lbk_result r = bk_transport_run(scene, tracer, in->receivers, in->receiver_count, &opt, &out, &st);
     rc->run++;
@@ -783,6 +852,7 @@ typedef struct set_run {
     double fraction;                /* sparse storage threshold (emit_set) */
     bk_transport_options fixed;     /* the door runs' fixed budget */
     lbk_sh9_rgb *rad, *dir;         /* the current run */
+    float *var;                     /* its variance (light-set runs: the denoiser's guide) */
     lbk_sh9_rgb *ref, *ref_dir;     /* every door closed and black */
     lbk_sh9_rgb **keep, **keep_dir; /* open runs of doors in door–door combinations */
     float *texel_size;              /* guided: per texel receiver */
@@ -797,9 +867,10 @@ static lbk_result out_of_memory(set_run *s)
     return LBK_ERR_OUT_OF_MEMORY;
 }
 
-static lbk_result emit(set_run *s, bs_set *st, int skip_doors)
+/* Keeps the current run's contribution for bk_set_bakes_emit (stash_set). */
+static lbk_result emit(set_run *s, bs_set *st, const float *variance, int skip_doors)
 {
-    return emit_set(s->in, st, s->rad, s->dir, s->fraction, skip_doors) ? out_of_memory(s) : LBK_OK;
+    return stash_set(s->in, s->im, st, s->rad, s->dir, variance, s->fraction, skip_doors) ? out_of_memory(s) : LBK_OK;
 }
 
 /* Light sets: their lights alone (transport leaves out the sky and every other emitter); doors
@@ -814,9 +885,11 @@ static lbk_result bake_light_sets(set_run *s)
         opt.light_set = st->name;
         s->rc.black_doors = 0;
         snprintf(s->what, sizeof s->what, "light set '%s'", st->name);
+        s->rc.variance = s->var;
         lbk_result r = run_one(&s->rc, s->in->scene, s->in->tracer, &opt, s->rad, s->dir, s->what);
+        s->rc.variance = NULL;
         if (r) return r;
-        r = emit(s, st, 0);
+        r = emit(s, st, s->var, 0);
         if (r) return r;
     }
     return LBK_OK;
@@ -881,7 +954,7 @@ static lbk_result bake_door(set_run *s, size_t p, int guided)
         sh_sub(s->rad, s->ref, count);
         sh_sub(s->dir, s->ref_dir, count);
     }
-    r = emit(s, &s->im->sets[d->open_set], 1);
+    r = emit(s, &s->im->sets[d->open_set], NULL, 1);
     if (r) return r;
 
     /* S_C = L(door p closed with its albedo, others black) − reference */
@@ -891,7 +964,7 @@ static lbk_result bake_door(set_run *s, size_t p, int guided)
     if (r) return r;
     sh_sub(s->rad, s->ref, count);
     sh_sub(s->dir, s->ref_dir, count);
-    return emit(s, &s->im->sets[d->closed_set], 1);
+    return emit(s, &s->im->sets[d->closed_set], NULL, 1);
 }
 
 /* Doors A, B: S_AB = L(A, B open) − L(A open) − L(B open) + L(ref), into rad/dir. */
@@ -959,7 +1032,7 @@ static lbk_result bake_combinations(set_run *s)
             if (s->im->sets[co->light_set].zero) continue; /* a black set: nothing to combine, no entries */
             r = bake_door_light_set(s, co);
         }
-        if (!r) r = emit(s, &s->im->sets[co->set], 1);
+        if (!r) r = emit(s, &s->im->sets[co->set], NULL, 1);
         if (r) return r;
     }
     return LBK_OK;
@@ -970,7 +1043,7 @@ static void set_run_free(set_run *s)
     if (s->keep)
         for (size_t p = 0; p < s->im->door_count; p++) free(s->keep[p]), free(s->keep_dir[p]);
     free(s->keep), free(s->keep_dir), free(s->texel_size), free(s->door_texel), free(s->ls_closed), free(s->ls_closed_dir);
-    free(s->rad), free(s->dir), free(s->ref), free(s->ref_dir);
+    free(s->rad), free(s->dir), free(s->ref), free(s->ref_dir), free(s->var);
 }
 
 lbk_result bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *err, size_t err_len)
@@ -990,8 +1063,8 @@ lbk_result bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *e
     s.rc.runs += im->door_count ? 1 + 2 * (int)im->door_count : 0;
     for (size_t c = 0; c < im->combo_count; c++) s.rc.runs += im->combos[c].door[1] >= 0 ? 3 : 2;
     const int guided = in->door_method == BK_DOOR_GUIDED;
-    s.rad = malloc(s.n * sizeof *s.rad), s.dir = malloc(s.n * sizeof *s.dir);
-    lbk_result r = s.rad && s.dir ? LBK_OK : out_of_memory(&s);
+    s.rad = malloc(s.n * sizeof *s.rad), s.dir = malloc(s.n * sizeof *s.dir), s.var = malloc(s.n * sizeof *s.var);
+    lbk_result r = s.rad && s.dir && s.var ? LBK_OK : out_of_memory(&s);
     if (!r) r = bake_light_sets(&s);
     if (!r && im->door_count) {
         r = bake_door_reference(&s, guided);
@@ -1150,9 +1223,10 @@ void bk_set_bakes_free(bk_set_bakes *sets)
     if (im) {
         for (size_t j = 0; j < im->set_count; j++) {
             free(im->sets[j].light_names);
+            free(im->sets[j].stash), free(im->sets[j].stash_direct);
             for (int s = 0; s < LBK_DLS_SPACE_COUNT_; s++) free(im->sets[j].targets[s]), free(im->sets[j].values[s]);
         }
-        free(im->sets), free(im->doors), free(im->combos), free(im);
+        free(im->sets), free(im->doors), free(im->combos), free(im->guide), free(im->guide_var), free(im);
     }
     memset(sets, 0, sizeof *sets);
 }

@@ -12,6 +12,7 @@
 #include "bake/scene/scene.h"
 #include "bake/layout/seams.h"
 #include "bake/layout/texels.h"
+#include "bake/transport/denoise.h"
 #include "bake/util/events.h"
 #include "bake/transport/tracer.h"
 #include "bake/transport/transport.h"
@@ -52,6 +53,9 @@ typedef struct bk_set_inputs {
                                          < 0: store every receiver with a non-zero contribution */
     const bk_events *events;          /* messages, progress over all set runs, cancellation */
     int door_method;                  /* enum bk_door_method */
+    const bk_denoiser *denoiser;      /* bk_set_bakes_emit: the denoiser built from the base + the
+                                         guide (bk_set_bakes_guide), applied to every set with the
+                                         same weights; NULL: not denoised */
     float origin[3];                  /* the bake frame's origin in world space: add it to every
                                          position written (the scene is recentred, bake.c) */
     float scale[3];                   /* sections only: the LMAP, GLG and LLG scales (spec §5.7);
@@ -71,9 +75,18 @@ lbk_result bk_set_bakes_prepare(bk_set_bakes *sets, const bk_scene *scene, const
 int bk_set_bakes_base_hooks(bk_set_bakes *sets, const bk_scene *scene, bk_transport_options *base);
 /* The base bake's albedo rule: 0 on door triangles. */
 void bk_set_bakes_base_albedo(const bk_set_bakes *sets, const bk_scene *scene, uint32_t tri, float albedo[3]);
-/* Bakes every set's contribution at the receivers. LBK_OK, LBK_ERR_CANCELLED (in->events said
- * stop), or LBK_ERR_OUT_OF_MEMORY / LBK_ERR_INTERNAL with a message in err. */
+/* Bakes every set's contribution at the receivers and keeps it (one radiance SH per receiver
+ * per set) for bk_set_bakes_emit. LBK_OK, LBK_ERR_CANCELLED (in->events said stop), or
+ * LBK_ERR_OUT_OF_MEMORY / LBK_ERR_INTERNAL with a message in err. */
 lbk_result bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *err, size_t err_len);
+/* After bk_set_bakes_run: the denoiser's guide, Σ of the light sets' and doors' contributions
+ * per receiver and Σ of the light-set runs' variances (bake/transport/DENOISE.md); both NULL
+ * without sets. Valid until bk_set_bakes_emit. */
+void bk_set_bakes_guide(const bk_set_bakes *sets, const lbk_sh9_rgb **sum, const float **variance);
+/* Denoises every kept contribution with in->denoiser (NULL: none) and chooses its sparse
+ * entries (threshold, dilation); frees what bk_set_bakes_run kept. LBK_OK or an error with a
+ * message in err. */
+lbk_result bk_set_bakes_emit(bk_set_bakes *sets, const bk_set_inputs *in, char *err, size_t err_len);
 /* Largest value of any set's entries per DLS space (texels: irradiance along the normal; probes:
  * SH DC), for choosing the base sections' scales. */
 void bk_set_bakes_max(const bk_set_bakes *sets, double max[3]);

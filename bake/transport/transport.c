@@ -1119,6 +1119,12 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
             if (output->irradiance) output->irradiance[3 * i + a] *= inv;
         }
     }
+    /* per-receiver variance of X from the two halves (the denoiser's input) */
+    if (output->variance)
+        for (size_t i = 0; i < count; i++) {
+            double a = c.x_acc[0][i] / weight_sum, bh = c.x_acc[1][i] / weight_sum;
+            output->variance[i] = (float)(0.25 * (a - bh) * (a - bh));
+        }
     if (c.light_count) {
         float *pl = c.punct_lum;
         c.punct_lum = NULL; /* recv_punctual now writes into the outputs */

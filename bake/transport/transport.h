@@ -83,6 +83,11 @@ typedef struct bk_transport_output {
                                 radiance − direct is the indirect part */
     float *irradiance;       /* 3 per receiver, estimated directly (not from the SH): texels the
                                 irradiance E(n) = ∫_H L cos; probes the fluence ∫_S² L dω */
+    /* 1 per receiver: the estimated variance of the result's error scalar X (luminance of the
+     * irradiance, texels; fluence/4, probes; TRANSPORT.md §Error estimate), ((A − B)/2)² from the
+     * two halves A, B: unbiased, one degree of freedom, 0 where only noise-free punctual light
+     * arrives. The denoiser's input (bake/transport/denoise.h). */
+    float *variance;
 } bk_transport_output;
 
 enum bk_transport_stop { BK_STOP_TARGET = 0, BK_STOP_TIME, BK_STOP_BUDGET };

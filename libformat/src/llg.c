@@ -257,6 +257,39 @@ lbk_result lbk_llg_vertex_irradiance(const lbk_llg_view *view, uint32_t grid, ui
     return LBK_OK;
 }
 
+/* §11 "Vertex order": mark the used vertices of each primitive in map, then number them. */
+lbk_result lbk_llg_vertex_map(const lbk_llg_source_primitive *primitives, uint32_t primitive_count, uint32_t *map,
+                              uint64_t map_count, uint32_t *record_count)
+{
+    if ((!primitives && primitive_count) || (!map && map_count) || !record_count) return LBK_ERR_INVALID_ARGUMENT;
+    uint64_t need = 0;
+    for (uint32_t p = 0; p < primitive_count; p++) {
+        const lbk_llg_source_primitive *q = &primitives[p];
+        if (q->index_count % 3 || (q->index_count && !q->indices)) return LBK_ERR_INVALID_ARGUMENT;
+        for (uint32_t i = 0; i < q->index_count; i++)
+            if (q->indices[i] >= q->vertex_count) return LBK_ERR_INVALID_ARGUMENT;
+        need += q->flat ? q->index_count : q->vertex_count;
+    }
+    if (need != map_count) return LBK_ERR_INVALID_ARGUMENT;
+    uint64_t n = 0;
+    uint32_t *m = map;
+    for (uint32_t p = 0; p < primitive_count; p++) {
+        const lbk_llg_source_primitive *q = &primitives[p];
+        const uint32_t count = q->flat ? q->index_count : q->vertex_count;
+        for (uint32_t v = 0; v < count; v++) m[v] = q->flat ? 0 : LBK_LLG_NO_VERTEX;
+        if (!q->flat)
+            for (uint32_t i = 0; i < q->index_count; i++) m[q->indices[i]] = 0;
+        for (uint32_t v = 0; v < count; v++)
+            if (m[v] == 0) {
+                if (n >= LBK_LLG_NO_VERTEX - 1) return LBK_ERR_LIMIT;
+                m[v] = (uint32_t)n++;
+            }
+        m += count;
+    }
+    *record_count = (uint32_t)n;
+    return LBK_OK;
+}
+
 void lbk_validate_llg(lbk_vctx *ctx, const uint8_t *d, size_t size)
 {
     if (size < LBK_LLG_HEADER_SIZE) {

@@ -315,7 +315,7 @@ static baked bake_and_score(const bk_scene *s, float density, int samples, int a
     o.first_pass_samples = samples;
     o.max_samples = 2 * samples;
     o.max_cells = 512;
-    bk_transport_output out = {rad, NULL, NULL};
+    bk_transport_output out = {.radiance = rad};
     bk_transport_stats st;
     assert_int_equal(bk_transport_run(s, t, rc, tx.count, &o, &out, &st), LBK_OK);
     bk_tracer_destroy(t);

@@ -194,12 +194,43 @@ static void builder_rejects(void **state)
         .grid_count = 1}, NULL, &out, &size), LBK_ERR_INVALID_ARGUMENT);
 }
 
+/* The vertex order of §11 on hand-made primitives: unused vertices get no record, flat
+ * primitives one per corner, numbering runs on across primitives; bad input is refused. */
+static void vertex_order(void **state)
+{
+    (void)state;
+    const uint32_t tri_a[6] = {4, 1, 2, 2, 1, 4}; /* vertices 0 and 3 unused */
+    const uint32_t tri_b[3] = {1, 0, 1};          /* flat: corners 0..2 */
+    const uint32_t tri_c[3] = {2, 0, 1};
+    const lbk_llg_source_primitive prim[3] = {
+        {.vertex_count = 5, .index_count = 6, .indices = tri_a},
+        {.vertex_count = 2, .index_count = 3, .indices = tri_b, .flat = 1},
+        {.vertex_count = 3, .index_count = 3, .indices = tri_c},
+    };
+    uint32_t map[11], n = 0;
+    assert_int_equal(lbk_llg_vertex_map(prim, 3, map, 11, &n), LBK_OK);
+    const uint32_t X = LBK_LLG_NO_VERTEX;
+    const uint32_t want[11] = {X, 0, 1, X, 2, /* flat */ 3, 4, 5, /* third */ 6, 7, 8};
+    assert_memory_equal(map, want, sizeof want);
+    assert_int_equal(n, 9);
+    assert_int_equal(lbk_llg_vertex_map(prim, 3, map, 10, &n), LBK_ERR_INVALID_ARGUMENT); /* map_count */
+    lbk_llg_source_primitive bad = prim[0];
+    bad.vertex_count = 4; /* index 4 out of range */
+    assert_int_equal(lbk_llg_vertex_map(&bad, 1, map, 4, &n), LBK_ERR_INVALID_ARGUMENT);
+    bad = prim[0];
+    bad.index_count = 5;
+    assert_int_equal(lbk_llg_vertex_map(&bad, 1, map, 5, &n), LBK_ERR_INVALID_ARGUMENT);
+    assert_int_equal(lbk_llg_vertex_map(NULL, 0, NULL, 0, &n), LBK_OK);
+    assert_int_equal(n, 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(lattice_and_trilinear),
         cmocka_unit_test(vertex_visibility),
         cmocka_unit_test(builder_rejects),
+        cmocka_unit_test(vertex_order),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -68,6 +68,13 @@ typedef enum lbk_bake_door_method {
     LBK_BAKE_DOOR_METHOD_COUNT_
 } lbk_bake_door_method;
 
+/* Denoising of the baked texels and probes (bake/transport/DENOISE.md). */
+typedef enum lbk_bake_denoise {
+    LBK_BAKE_DENOISE_AUTO = 0, /* on: edge-aware, guided by the transport's own noise estimate */
+    LBK_BAKE_DENOISE_OFF = 1,  /* the transport's estimate as it is */
+    LBK_BAKE_DENOISE_COUNT_
+} lbk_bake_denoise;
+
 /* The bake's phases, in order; LBK_BAKE_PHASE_SETS only with light sets or doors. */
 typedef enum lbk_bake_phase {
     LBK_BAKE_PHASE_IMPORT = 0, /* read the glTF or convert the description; check the scene */
@@ -128,6 +135,8 @@ typedef struct lbk_bake_desc {
                                    this fraction of the mean indirect light of the texels they
                                    light directly [0: 0.01]; < 0: every non-zero receiver */
     lbk_bake_door_method door_method; /* [difference] */
+    lbk_bake_denoise denoise;   /* [auto: lightmap texels and GLG probes denoised, both presets;
+                                   bake/transport/DENOISE.md] */
     const char *revision;       /* stored in META [NULL: none] */
     int timestamp;              /* 1: store the bake time in META (no longer byte-identical) */
     const char *allow_outside;  /* files a glTF names (buffers, images, its lbk_sky EXR) must lie in

@@ -95,6 +95,35 @@ LBK_API void lbk_llg_vertex_unpack(const uint8_t in[4], lbk_llg_vertex *v);
 LBK_API lbk_result lbk_llg_vertex_irradiance(const lbk_llg_view *view, uint32_t grid, uint32_t vertex, const float p[3],
                                              float rgb[3]);
 
+/* ---- vertex order (spec §11 "Vertex order") -------------------------------------------------
+ * A grid's vertex records follow the object's glTF mesh: its triangle primitives in order
+ * (mode 4, 5 or 6 with at least one triangle; points and lines are skipped), within each its
+ * vertices in index order, keeping only the vertices some triangle uses. A primitive without
+ * NORMAL is flat shaded: every triangle corner is a vertex of its own, corner c of triangle t
+ * being vertex 3t + c, all used. lbk_llg_vertex_map turns that rule into a lookup table. */
+
+/* One triangle primitive of the object's mesh (an array element: frozen). */
+typedef struct lbk_llg_source_primitive {
+    uint32_t vertex_count;   /* vertices of the glTF primitive (POSITION count, or Draco points) */
+    uint32_t index_count;    /* 3 × its triangles */
+    const uint32_t *indices; /* its triangle list as glTF defines it: strips and fans expanded,
+                                strip triangles with a repeated index (restarts) dropped */
+    uint32_t flat;           /* non-zero: no NORMAL, one record per corner (an engine that split the
+                                corners already passes its split vertices with flat = 0: same order) */
+} lbk_llg_source_primitive;
+
+#define LBK_LLG_NO_VERTEX 0xFFFFFFFFu
+
+/* Fills map, primitive after primitive, with one entry per vertex (flat: per corner, i.e. per
+ * index): the vertex's record within its grid (add lbk_llg_grid.vertex_offset to index the
+ * section's array), or LBK_LLG_NO_VERTEX for a vertex no triangle uses. map_count must be
+ * Σ (flat ? index_count : vertex_count). *record_count gets the number of records, which equals
+ * the grid's vertex_count when the mesh is the one that was baked. LBK_ERR_INVALID_ARGUMENT for
+ * NULL arrays, an index_count that is not a multiple of 3, an index ≥ vertex_count or another
+ * map_count; LBK_ERR_LIMIT past 2^32 − 2 records. Reads nothing but its arguments. */
+LBK_API lbk_result lbk_llg_vertex_map(const lbk_llg_source_primitive *primitives, uint32_t primitive_count,
+                                      uint32_t *map, uint64_t map_count, uint32_t *record_count);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1,0 +1,109 @@
+/* Denoising of the transport's result: lightmap texels in lightmap space, GLG probes along their
+ * tetrahedral edges. Method, parameters, what was measured and the guarantees:
+ * bake/transport/DENOISE.md.
+ *
+ * The filter lives with the transport because it finishes the transport's estimate: it uses the
+ * transport's own per-receiver variance (bk_transport_output.variance) to decide how far apart
+ * two receivers' values may be before they are no longer "the same light seen through noise",
+ * and runs on the transport's output (incident radiance SH9 per receiver) before anything
+ * encodes it.
+ *
+ * Linearity (light sets and doors): the weights are computed once, from a guide (its
+ * luminance, its variance and the geometry; the pipeline passes base + every light set and
+ * door contribution), and kept in a bk_denoiser; bk_denoiser_apply then filters any
+ * per-receiver SH with those same weights, so denoise(base + set) = denoise(base) +
+ * denoise(set) up to float rounding and a light set toggled at run time adds exactly what it
+ * would have added to a denoised sum. Every weight is >= 0 and each output is a normalised
+ * combination (weights sum to 1), so an output never leaves the range of the inputs it
+ * averages: the furnace (every input within its bound) stays within its bound.
+ *
+ * Texels are averaged only with texels of the same chart (never across a chart border) on the
+ * same page; probes only with tetrahedral neighbours they can see (an unoccluded segment
+ * between the two). LLG probes are not filtered.
+ *
+ * Determinism: every output is computed by one thread from inputs that do not change during
+ * the step (ping-pong buffers), in a fixed order; results do not depend on the thread count. */
+#ifndef BK_DENOISE_H
+#define BK_DENOISE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "lbk/lbk.h"
+#include "lbk/sh.h"
+#include "bake/layout/atlas.h"
+#include "bake/layout/texels.h"
+#include "bake/probes/glg_place.h"
+#include "bake/scene/scene.h"
+#include "bake/transport/tracer.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The texel filters compared in DENOISE.md. */
+enum bk_denoise_method {
+    BK_DENOISE_AUTO = 0,    /* the measured choice (DENOISE.md) */
+    BK_DENOISE_ATROUS,      /* variance-guided à-trous (edge-avoiding wavelets, SVGF-style) */
+    BK_DENOISE_NLM,         /* joint non-local means with variance-normalised patch distances */
+    BK_DENOISE_BLUR         /* geometry-only cross-bilateral (no luminance stop): a control
+                               that must fail the contact-shadow test */
+};
+
+typedef struct bk_denoise_options {   /* zero = defaults */
+    int method;              /* enum bk_denoise_method */
+    int threads;             /* 0: all online cores (results do not depend on it) */
+    int iterations;          /* à-trous levels (steps 1, 2, 4, ...); 0: 4 */
+    int radius;              /* NLM search half-window (BLUR: its window); 0: 5, at most 16 */
+    float sigma_lum;         /* NLM: k of the patch distance, 0: 1; à-trous and probes: the stop
+                                in noise standard deviations, 0: 4 */
+    float sigma_normal;      /* normal stop exponent, max(0, n·n')^s; 0: 32 */
+    float sigma_plane;       /* distance off the tangent plane, texel sizes; 0: 0.5 */
+    float sigma_albedo;      /* albedo stop (Euclidean RGB distance); 0: no albedo stop (DENOISE.md) */
+    float clamp;             /* an output moves at most clamp × its noise std from its input;
+                                0: 2; < 0: no clamp */
+    int no_probes;           /* 1: leave GLG probes as they are */
+} bk_denoise_options;
+
+/* Everything the weights are built from. Receivers are numbered as in the bake (bake.c): texel
+ * receivers [0, texel_count) map to texels->receivers[texel_of_receiver[k]], GLG probes are
+ * receivers [glg_first, glg_first + glg->probe_count). */
+typedef struct bk_denoise_inputs {
+    const bk_scene *scene;            /* albedo guide (materials, uv0); NULL: no albedo */
+    const bk_tracer *tracer;          /* probe edge visibility; NULL: no probe filtering */
+    const bk_atlas *atlas;            /* chart of each texel's triangle */
+    const bk_texels *texels;          /* NULL or texel_count 0: no texel filtering */
+    const uint32_t *texel_of_receiver;
+    size_t texel_count;
+    const bk_glg *glg;                /* NULL: no probe filtering */
+    size_t glg_first;
+    size_t receiver_count;            /* size of the radiance and variance arrays */
+    const lbk_sh9_rgb *radiance;      /* the guide, per receiver: the base bake (+ the sets) */
+    const float *variance;            /* per receiver (bk_transport_output.variance, summed) */
+} bk_denoise_inputs;
+
+typedef struct bk_denoise_stats {
+    double seconds;                   /* building the weights (bk_denoiser_create) */
+    size_t texels, probes;            /* receivers filtered */
+    size_t probe_edges, probe_edges_visible;
+    size_t clamped;                   /* texels and probes whose move was limited by the clamp */
+} bk_denoise_stats;
+
+typedef struct bk_denoiser bk_denoiser;
+
+/* Builds the weights from the guide in `in`. *out must be destroyed with bk_denoiser_destroy.
+ * Errors: LBK_ERR_INVALID_ARGUMENT (NULL in/out/radiance/variance, texels without atlas or
+ * mapping, receiver ranges outside receiver_count), LBK_ERR_OUT_OF_MEMORY. */
+lbk_result bk_denoiser_create(const bk_denoise_inputs *in, const bk_denoise_options *opt, bk_denoiser **out);
+
+/* Filters `radiance` (receiver_count entries, numbered like the inputs) in place with the
+ * stored weights: texel and GLG receivers change, every other receiver is left as it is. */
+lbk_result bk_denoiser_apply(const bk_denoiser *d, lbk_sh9_rgb *radiance);
+
+void bk_denoiser_stats(const bk_denoiser *d, bk_denoise_stats *stats);
+void bk_denoiser_destroy(bk_denoiser *d);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
