@@ -275,7 +275,7 @@ def run(work, lbk, dump, threads, out=print, alt=None):
     out("unit and orientation proofs (Cycles and lbk against closed-form irradiance):")
     out("  %-8s %-11s %5s %9s %9s %9s  %-22s %9s %9s %6s%s" % (
         "scene", "receivers", "n", "Cyc/true", "Cyc rms", "flipped", "Cyc R/G/B ratio", "lbk/true", "lbk rms", "texels",
-        "" if not alt else " %9s %9s" % ((alt[0] + "/true")[-9:], (alt[0] + " rms")[-9:])))
+        "" if not alt else " %9s %9s" % ("alt/true", "alt rms")))
     for make in SCENES:
         sc = make(work)
         name = sc["name"]

@@ -113,7 +113,7 @@ def run_scene(sc, work, opt, out):
             sys.exit("bench-cycles: %s: the %s bake has other receivers (LBK_ALT must share the layout)" % (
                 sc["name"], opt.alt_name))
         alt_lum = [common.lum(x) for x in reca.rgb]
-        alt_txt = "; %s %.1f s wall, %.1f s CPU (%s spp, estimated error %.1f %%)" % (
+        alt_txt = "; alt = %s: %.1f s wall, %.1f s CPU (%s spp, estimated error %.1f %%)" % (
             opt.alt_name, alt_wall, alt_cpu, reca.meta.get("spp", "?"), 100 * float(reca.meta.get("est_rel_rmse", "nan")))
     target = lbk_cpu if opt.clock == "cpu" else lbk_wall
     ref_spp = max(64, sc["ref_spp"] // (8 if opt.quick else 1))
@@ -139,8 +139,7 @@ def run_scene(sc, work, opt, out):
             sc["name"], lbk_wall, lbk_cpu, rec.meta.get("spp", "?"), rec.meta.get("status", "?"), 100 * est,
             opt.clock.upper() if opt.clock == "cpu" else opt.clock, eq["spp"], eq["cpu_s"], eq["wall_s"], ref_spp,
             ref_cpu) + alt_txt)
-    an = opt.alt_name[:5]
-    alt_head = "" if not opt.alt else " %9s %9s %8s" % (an + " err", an + " bias", an + "/Cyc")
+    alt_head = "" if not opt.alt else " %9s %9s %8s" % ("alt err", "alt bias", "alt/Cyc")
     out("  %-22s %-8s %6s %9s %9s %9s %9s %9s %10s %6s %9s%s" % (
         "object", "rep", "n", "lbk err", "lbk bias", "lbk noise", "lbk est", "Cyc err", "lbk/Cyc", "goal", "ref noise",
         alt_head))
@@ -244,7 +243,7 @@ def main():
         lines.append(s)
     ver = subprocess.run([common.blender(), "--version"], capture_output=True, text=True).stdout.split("\n")[0]
     out("lbk vs Cycles (%s, CPU, %d threads each) at equal %s time; lbk: %s%s" % (
-        ver, opt.threads, opt.clock, opt.lbk, "; %s: %s" % (opt.alt_name, opt.alt) if opt.alt else ""))
+        ver, opt.threads, opt.clock, opt.lbk, "; alt = %s: %s" % (opt.alt_name, opt.alt) if opt.alt else ""))
     ok = True
     if not opt.no_analytic:
         ok = analytic.run(os.path.join(opt.work, "analytic"), opt.lbk, opt.dump, opt.threads, out,
