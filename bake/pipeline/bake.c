@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bake/pipeline/encode.h"
 #include "bake/pipeline/pipeline.h"
 #include "bake/scene/exr_read.h"
 #include "bake/scene/import.h"
@@ -455,7 +456,12 @@ static lbk_result do_transport(bk_pipeline *b)
         if (!b->variance) return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
         out.variance = b->variance;
     }
+    float *irradiance = malloc((b->receiver_count ? b->receiver_count : 1) * 3 * sizeof *irradiance);
+    if (!irradiance) return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
+    out.irradiance = irradiance;
     r = bk_transport_run(&b->scene, b->tracer, b->receivers, b->receiver_count, &to, &out, &b->stats);
+    if (!r) bk_texels_match_irradiance(&b->texels, b->texel_of_receiver, b->texel_receivers, b->radiance, irradiance);
+    free(irradiance);
     if (r) return bk_pipeline_failed(b, r, "light transport");
     if (b->stats.nonfinite)
         bk_events_say(&b->events, LBK_BAKE_SEVERITY_WARNING, "%llu non-finite samples were dropped",

@@ -18,6 +18,28 @@ void bk_texel_linear(const bk_texel *t, const lbk_sh9_rgb *radiance_world, lbk_a
     lbk_ahd_linear_from_sh9(&local, out);
 }
 
+double bk_texel_match_irradiance(const bk_texel *t, lbk_sh9_rgb *radiance_world, const float e[3])
+{
+    lbk_ahd_linear lin;
+    bk_texel_linear(t, radiance_world, &lin);
+    double worst = 0;
+    for (int c = 0; c < 3; c++) {
+        const double band1 = (double)lin.c[c][0] + lin.c[c][3];
+        if (!(band1 > 1e-30) || !isfinite(e[c])) continue;
+        const double f = fmin(fmax((double)e[c] / band1, 0.0), 4.0 / 3.0);
+        for (int k = 0; k < 9; k++) radiance_world->c[c][k] = (float)(radiance_world->c[c][k] * f);
+        worst = fmax(worst, fabs(f - 1));
+    }
+    return worst;
+}
+
+void bk_texels_match_irradiance(const bk_texels *tx, const uint32_t *texel_of_receiver, size_t n,
+                                lbk_sh9_rgb *radiance, const float *irradiance)
+{
+    for (size_t k = 0; k < n; k++)
+        bk_texel_match_irradiance(&tx->receivers[texel_of_receiver[k]], &radiance[k], &irradiance[3 * k]);
+}
+
 lbk_result bk_finish_page(float *data, uint8_t *mask, int width, int height, int margin, const bk_seams *seams,
                           uint32_t page, int threads)
 {

@@ -14,6 +14,22 @@
  * world-space incident radiance SH (frame convention: bake/layout/texels.h). */
 void bk_texel_linear(const bk_texel *t, const lbk_sh9_rgb *radiance_world, lbk_ahd_linear *out);
 
+/* Makes a texel's stored irradiance along its normal the transport's direct estimate `e` (RGB,
+ * bk_transport_output.irradiance) instead of the band-1 value of its radiance SH: the radiance
+ * is scaled per channel by f = e / E_band1(n), f clamped to [0, 4/3]. Why: the AHD model (lbk/ahd.h)
+ * holds band-1 irradiance, which is 3/4 of the truth for light arriving head-on and more than the
+ * truth at grazing angles, so concentrated sources (emitters, windows, a light above a floor)
+ * were stored up to 25 % low; scaling keeps the highlight direction and the ambient/directional
+ * split, so only the value along the normal changes (other normals, normal maps, stay band-1).
+ * The bound: for radiance that is non-negative and zero below the horizon, each direction adds
+ * (1/4 + cos θ/2) ≥ (3/4)·cos θ to the band-1 value for cos θ to the truth, so f ≤ 4/3; a larger
+ * ratio can only be noise. Channels whose band-1 value is not positive are left alone.
+ * Returns the largest |f − 1| applied (for statistics). */
+double bk_texel_match_irradiance(const bk_texel *t, lbk_sh9_rgb *radiance_world, const float e[3]);
+/* The same for receivers [0, n), the texels texel_of_receiver names; irradiance: 3 per receiver. */
+void bk_texels_match_irradiance(const bk_texels *tx, const uint32_t *texel_of_receiver, size_t n,
+                                lbk_sh9_rgb *radiance, const float *irradiance);
+
 /* The payload of one page made ready to encode, in place: dilation (margin + 2 passes, so
  * bilinear filtering never reads an empty texel near a chart) and then, when seams is not
  * NULL, seam stitching of that page (bake/layout/seams.h). data: 12 floats per texel

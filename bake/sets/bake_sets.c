@@ -749,7 +749,14 @@ static lbk_result run_one(run_ctx *rc, const bk_scene *scene, const bk_tracer *t
     out.direct = direct;
     out.variance = rc->variance;
     bk_transport_stats st;
+    /* every run stores the direct irradiance estimate along texel normals like the base
+     * (bk_texels_match_irradiance), so base + contributions stay exact along the normal */
+    float *irradiance = malloc((in->receiver_count ? in->receiver_count : 1) * 3 * sizeof *irradiance);
+    if (!irradiance) return failure(rc, LBK_ERR_OUT_OF_MEMORY, "light transport for %s: %s", what);
+    out.irradiance = irradiance;
     lbk_result r = bk_transport_run(scene, tracer, in->receivers, in->receiver_count, &opt, &out, &st);
+    if (!r) bk_texels_match_irradiance(in->texels, in->texel_of_receiver, in->texel_receivers, radiance, irradiance);
+    free(irradiance);
     rc->run++;
     if (r) return failure(rc, r, "light transport for %s: %s", what);
     if (st.nonfinite)
@@ -828,8 +835,11 @@ static lbk_result guided_open(run_ctx *rc, const bs_door *d, const float *texel_
     double spp = in->base_samples_per_receiver > 0 ? in->base_samples_per_receiver : 64;
     gi.samples = (int)fmin(fmax(spp, 16), 4096);
     gi.use_sky = !in->transport.no_sky;
+    gi.irradiance = malloc((in->receiver_count ? in->receiver_count : 1) * 3 * sizeof *gi.irradiance);
     bk_door_guided_stats st;
-    r = bk_door_guided_run(&gi, rad, dir, &st, NULL);
+    r = gi.irradiance ? bk_door_guided_run(&gi, rad, dir, &st, NULL) : LBK_ERR_OUT_OF_MEMORY;
+    if (!r) bk_texels_match_irradiance(in->texels, in->texel_of_receiver, in->texel_receivers, rad, gi.irradiance);
+    free(gi.irradiance);
     bk_tracer_destroy(tr);
     filtered_free(&fs);
     rc->run++;

@@ -472,11 +472,13 @@ static void parallel_for(dg_ctx *c, size_t n, dg_fn fn)
 static void add_stage(const dg_ctx *c, lbk_sh9_rgb *radiance, lbk_sh9_rgb *direct, double f)
 {
     for (size_t i = 0; i < c->in->receiver_count; i++)
-        for (int ch = 0; ch < 3; ch++)
+        for (int ch = 0; ch < 3; ch++) {
+            if (c->in->irradiance) c->in->irradiance[3 * i + ch] += (float)(f * c->cur_e[3 * i + ch]);
             for (int k = 0; k < 9; k++) {
                 radiance[i].c[ch][k] += (float)(f * c->stage_sh[i].c[ch][k]);
                 if (direct && c->stage_direct) direct[i].c[ch][k] += (float)(f * c->stage_direct[i].c[ch][k]);
             }
+        }
 }
 
 static double texel_energy(const dg_ctx *c)
@@ -634,6 +636,7 @@ lbk_result bk_door_guided_run(const bk_door_guided_inputs *in, lbk_sh9_rgb *radi
     size_t n = in->receiver_count;
     memset(radiance, 0, n * sizeof *radiance);
     if (direct) memset(direct, 0, n * sizeof *direct);
+    if (in->irradiance) memset(in->irradiance, 0, 3 * n * sizeof *in->irradiance);
     dg_ctx c;
     memset(&c, 0, sizeof c);
     bk_guide_boxes own;

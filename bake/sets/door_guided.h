@@ -40,6 +40,9 @@ typedef struct bk_door_guided_inputs {
     int use_sky;                      /* the base's sky shines through the door */
     int max_bounces;                  /* explicit bounces after the first; 0: 4, then the tail */
     const bk_guide_boxes *boxes;      /* optional: use these boxes instead of shooting photons */
+    float *irradiance;                /* optional output, 3 per receiver: S_O's irradiance along texel
+                                         normals (fluence for probes), estimated directly like
+                                         bk_transport_output.irradiance */
 } bk_door_guided_inputs;
 
 typedef struct bk_door_guided_stats {

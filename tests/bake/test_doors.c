@@ -208,8 +208,10 @@ static void test_guided_vs_difference(void **state)
     print_message("door open vs no-door bake: guided L1 %.4f ratio %.4f | difference L1 %.4f ratio %.4f | guided vs "
                   "difference L1 %.4f ratio %.4f | closed vs no-door L1 %.4f ratio %.4f\n",
                   g.l1, g.ratio, d.l1, d.ratio, gd.l1, gd.ratio, shut.l1, shut.ratio);
-    /* the door carries most of the light: closed, the room is much darker */
-    assert_true(shut.ratio < 0.6);
+    /* the door carries a large share of the light: closed, the room is much darker (measured
+     * 0.615 since plane 0 stores the true irradiance along the normal; 0.598 with band-1, which
+     * overstated the grazing light the outside lamp sends through the doorway onto the floor) */
+    assert_true(shut.ratio < 0.65);
     /* both estimators give the open room's light within their errors: the difference method's
      * error against N is the noise of two independent bakes; guided adds its own (measured
      * 1.5–2× at this budget, bake/sets/SETS.md) and a small bias from the texel cache */

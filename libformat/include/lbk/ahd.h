@@ -69,7 +69,9 @@ LBK_API void lbk_ahd_irradiance(const lbk_ahd_texel *texel, const float n[3], fl
 LBK_API void lbk_ahd_linear_eval(const lbk_ahd_linear *lin, const float n[3], float rgb[3]);
 
 /* Builders of the linear form. */
-/* From tangent-space radiance SH (bands 0–1 are used; band 2 has no linear part):
+/* From tangent-space radiance SH (bands 0–1 are used; band 2 has no linear part). Its value along
+ * +Z is band-1, 3/4 of the true irradiance for head-on light: a writer that knows the true Ez
+ * scales the form to it (spec §5.6, informative note; lbk's baker does):
  * e0 = π·Y00·L00, g = (2π/3)·Y1·(L11, L1−1, L10). */
 LBK_API void lbk_ahd_linear_from_sh9(const lbk_sh9_rgb *radiance, lbk_ahd_linear *out);
 /* lin += uniform ambient irradiance (what a +Z surface receives from a constant environment). */
