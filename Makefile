@@ -73,7 +73,6 @@ help:
 	@echo "WERROR=1        every compiler warning is an error (CI)"
 	@echo "make bench      benchmarks, printed as ratios against baselines measured in the same run"
 	@echo "make bench-cycles  lbk against Blender Cycles at equal time (part of make bench; bench/cycles/README.md)"
-	@echo "make bench-cycles-plane0  the same, with the AHD plane-0 experiment measured beside it"
 	@echo "make bench-render  lbk render against Blender Cycles"
 	@echo "make fuzz       libFuzzer harness for the container reader (clang)"
 	@echo "make install PREFIX=/usr/local"
@@ -342,21 +341,6 @@ endif
 bench-cycles: deps-tools deps-bench
 	@$(MAKE) --no-print-directory $(if $(LBK_TREE),,$(BUILD)/lbk) $(CYC_DUMP)
 	@LBK=$${LBK:-$(CYC_LBK)} LBK_TEXEL_DUMP=$${LBK_TEXEL_DUMP:-$(CYC_DUMP)} python3 bench/cycles/run.py
-# The plane-0 experiment (bench/cycles/README.md, "AHD plane 0"): this tree with
-# bench/cycles/plane0_direct.patch applied (in $(BUILD)/plane0-src, rebuilt when the tree moves)
-# baked beside today's lbk against the same Cycles references (LBK_ALT). Not in make bench.
-.PHONY: bench-cycles-plane0
-bench-cycles-plane0: deps-tools deps-bench
-	@rm -rf $(BUILD)/plane0-src.new && mkdir -p $(BUILD)/plane0-src.new && \
-	  git archive HEAD | tar -x -C $(BUILD)/plane0-src.new && \
-	  (cd $(BUILD)/plane0-src.new && patch -s -p1 < bench/cycles/plane0_direct.patch) && \
-	  mkdir -p $(BUILD)/plane0-src && \
-	  (cd $(BUILD)/plane0-src.new && find . -type f ! -path ./build/\* -print0 | xargs -0 sh -c \
-	    'for f; do cmp -s "$$f" "../plane0-src/$$f" || { mkdir -p "../plane0-src/$$(dirname "$$f")"; cp "$$f" "../plane0-src/$$f"; }; done' sh) && \
-	  rm -rf $(BUILD)/plane0-src.new
-	@$(MAKE) --no-print-directory -C $(BUILD)/plane0-src $(BUILD)/lbk
-	@LBK_ALT=$(BUILD)/plane0-src/$(BUILD)/lbk LBK_ALT_NAME=plane0 $(MAKE) --no-print-directory bench-cycles
-
 # lbk render against converged Cycles renders (bench/render/README.md); the Cycles scene converter
 # comes from LBK_CYCLES_HARNESS (default bench/cycles).
 LBK_CYCLES_HARNESS ?= bench/cycles
