@@ -216,8 +216,58 @@ static int door_methods(const char *dir)
     return bad;
 }
 
+/* One time budget (--time-limit T covers base, light sets and doors, issue 11 item 3): the
+ * sets + door level, 2 threads, high preset (which alone would run far past T), baked with T and
+ * timed from outside; printed as wall / T, and the share each run got. Goal: wall ≤ T plus the
+ * write phase; the transport always finishes one pass per run, so T below the sum of one pass
+ * per run cannot be met. */
+static int time_budget(const char *dir)
+{
+    const ds_options o = {DS_DOOR_TAGGED, DS_INSIDE_SETS, 1, 1, 0.5f, 4, 0, 0, 0};
+    char gltf[256], out[256], err[512];
+    snprintf(gltf, sizeof gltf, "%s/budget.gltf", dir);
+    snprintf(out, sizeof out, "%s/budget.lbk", dir);
+    if (ds_write_room_scene(DS_ROOM_GLB, gltf, &o, err, sizeof err)) return fprintf(stderr, "budget: %s\n", err), 1;
+    printf("one time budget (sets A+B+C0 + door, preset high, 2 threads):\n");
+    const double limits[2] = {8, 16};
+    for (int k = 0; k < 2; k++) {
+        lbk_bake_desc d;
+        memset(&d, 0, sizeof d);
+        d.size = sizeof d;
+        d.preset = LBK_BAKE_PRESET_HIGH;
+        d.seed = 1;
+        d.threads = 2;
+        d.time_limit = limits[k];
+        lbk_bake_output *bo;
+        const double t0 = bk_now();
+        lbk_result r = lbk_bake_from_file(gltf, &d, &bo);
+        if (r == LBK_OK) r = lbk_bake_output_write_file(bo, out);
+        const double wall = bk_now() - t0;
+        if (r) return fprintf(stderr, "budget: %s\n", lbk_result_message(r)), unlink(gltf), 1;
+        const lbk_bake_report *sum = lbk_bake_output_report(bo);
+        double sets = 0;
+        for (size_t i = 0; i < sum->set_run_count; i++) sets += sum->set_runs[i].seconds;
+        printf("  --time-limit %4.0f: wall %6.2f s = %.2f x T; base transport %.2f s, %zu set/door runs %.2f s; phases:",
+               limits[k], wall, wall / limits[k], sum->transport.seconds, sum->set_run_count, sets);
+        for (size_t i = 0; i < sum->phase_count; i++)
+            printf(" %s %.2f", lbk_bake_phase_name(sum->phases[i].phase), sum->phases[i].seconds);
+        printf("\n");
+        lbk_bake_output_free(bo);
+        unlink(out);
+    }
+    unlink(gltf);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc > 1 && !strcmp(argv[1], "--time-budget")) {
+        char d3[] = "/tmp/lbk_bench_budget_XXXXXX";
+        if (!mkdtemp(d3)) return 1;
+        int r = time_budget(d3);
+        rmdir(d3);
+        return r;
+    }
     if (argc > 1 && !strcmp(argv[1], "--doors")) {
         char d2[] = "/tmp/lbk_bench_doors_XXXXXX";
         if (!mkdtemp(d2)) return 1;
@@ -238,6 +288,7 @@ int main(int argc, char **argv)
     int bad = 0;
     for (size_t i = 0; i < sizeof levels / sizeof levels[0]; i++) bad |= run(&levels[i], dir);
     bad |= door_methods(dir);
+    bad |= time_budget(dir);
     rmdir(dir);
     return bad;
 }

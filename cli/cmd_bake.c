@@ -6,11 +6,13 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "cli/cli.h"
 #include "cli/progress.h"
 #include "lbk/bake.h"
+#include "tools/common/file_util.h"
 
 static void help(FILE *f)
 {
@@ -25,7 +27,8 @@ static void help(FILE *f)
           "  -o, --output FILE       container to write (atomically; nothing is written on error)\n"
           "  --preset fast|high      quality preset (default fast; see README \"Presets\")\n"
           "  --target-error X        stop when the estimated relative RMSE drops below X (e.g. 0.02)\n"
-          "  --time-limit S          stop the transport after S seconds and write what converged\n"
+          "  --time-limit S          one budget of S seconds for the whole bake (base, light sets,\n"
+          "                          doors: equal shares of what is left), then write what converged\n"
           "  --samples N             sample budget per receiver (overrides the preset)\n"
           "  --max-bounces N         bounce cap before the analytic tail (overrides the preset)\n"
           "  --texel-density D       lightmap texels per metre (overrides the scene's lbk_texel_density)\n"
@@ -174,8 +177,23 @@ static int write_report_tmp(const lbk_bake_report *rep, const char *container, c
     return 0;
 }
 
+static void say_removed(void *user, const char *file)
+{
+    fprintf(stderr, "lbk %s: removed %s, a temporary file an interrupted write left behind\n", (const char *)user, file);
+}
+
+/* Temporary files of earlier writes to our outputs that were killed between writing and renaming.
+ * Only those older than a minute before this process started: a concurrent bake to the same
+ * path may be writing its own right now. */
+static void remove_stale(const bake_args *o, time_t started)
+{
+    tl_remove_stale_temps(o->output, started - 60, say_removed, "bake");
+    if (o->json_report) tl_remove_stale_temps(o->json_report, started - 60, say_removed, "bake");
+}
+
 static int bake(bake_args *o, int quiet)
 {
+    const time_t started = time(NULL);
     bake_ui ui;
     memset(&ui, 0, sizeof ui);
     ui.phase = -1;
@@ -197,6 +215,7 @@ static int bake(bake_args *o, int quiet)
         lbk_bake_output_free(out);
         return LBK_EXIT_IO;
     }
+    remove_stale(o, started);
     r = lbk_bake_output_write_file(out, o->output);
     if (r) {
         int saved = errno;

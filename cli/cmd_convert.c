@@ -3,6 +3,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "cli/cli.h"
 #include "tools/convert/convert.h"
@@ -43,6 +44,7 @@ static const char *compression_name(uint32_t c) { return c == LBK_COMPRESSION_ZS
 
 int lbk_cmd_convert(int argc, char **argv)
 {
+    const time_t started = time(NULL); /* stale temporary files: older than a minute before this */
     const char *in = NULL, *out = NULL, *profile_arg = NULL, *exr_dir = NULL;
     int quiet = 0;
     for (int i = 1; i < argc; i++) {
@@ -107,6 +109,8 @@ int lbk_cmd_convert(int argc, char **argv)
                : st == TL_CONVERT_UNSUPPORTED ? LBK_EXIT_INPUT
                                               : LBK_EXIT_INTERNAL;
     }
+    if (tl_remove_stale_temps(out, started - 60, NULL, NULL) > 0)
+        fprintf(stderr, "lbk convert: removed temporary files an interrupted write to %s left behind\n", out);
     if (tl_write_file_atomic(out, pack, pack_size, err)) {
         free(pack);
         fprintf(stderr, "lbk convert: %s\n", err);

@@ -407,6 +407,9 @@ static void transport_options(const bk_pipeline *b, bk_transport_options *to)
     to->max_samples = opt->max_samples > 0 ? opt->max_samples : b->pre->max_samples;
     to->target_error = opt->target_error > 0 ? opt->target_error : b->pre->target_error;
     to->time_limit = opt->time_limit;
+    to->class_end[BK_CLASS_TEXEL] = b->texel_receivers;
+    to->class_end[BK_CLASS_GLG] = b->llg_first;
+    to->class_end[BK_CLASS_LLG] = b->receiver_count;
 }
 
 void bk_pipeline_set_inputs(const bk_pipeline *b, bk_set_inputs *in)
@@ -434,6 +437,7 @@ void bk_pipeline_set_inputs(const bk_pipeline *b, bk_set_inputs *in)
     in->events = &b->events;
     in->door_method = (int)b->opt->door_method;
     in->denoiser = b->denoiser;
+    in->deadline = b->opt->time_limit > 0 ? b->start + b->opt->time_limit : 0;
     memcpy(in->origin, b->origin, sizeof in->origin);
 }
 
@@ -444,6 +448,12 @@ static lbk_result do_transport(bk_pipeline *b)
     if (r) return r;
     bk_transport_options to;
     transport_options(b, &to);
+    if (b->opt->time_limit > 0) {
+        /* one budget for the whole bake (from its start): the base gets an equal share of what
+         * is left with every light-set and door run still to come */
+        const int runs = 1 + bk_set_bakes_planned_runs(&b->sets);
+        to.time_limit = fmax(1e-3, (b->start + b->opt->time_limit - bk_now()) / runs);
+    }
     to.progress = transport_progress;
     to.report = transport_report;
     to.user = b;

@@ -25,6 +25,9 @@ void lbk_bake_output_free(lbk_bake_output *out)
     if (!out) return;
     lbk_writer_close(out->writer);
     bk_output_free_mem(out, out->passes);
+    bk_output_free_mem(out, out->pass_errors);
+    bk_output_free_mem(out, out->set_runs);
+    bk_output_free_mem(out, out->set_labels);
     bk_output_free_mem(out, out->input);
     lbk_allocator a = out->allocator;
     lbk_bake_output tmp;

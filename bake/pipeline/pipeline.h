@@ -85,6 +85,9 @@ struct lbk_bake_output {
     lbk_writer *writer;
     lbk_bake_report report;
     lbk_bake_pass *passes;
+    lbk_bake_class_errors *pass_errors;
+    lbk_bake_set_run *set_runs;
+    char *set_labels;               /* the set runs' labels, 64 bytes each */
     lbk_bake_phase_time phases[BK_MAX_PHASES];
     char *input;
 };

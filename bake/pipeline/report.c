@@ -1,5 +1,6 @@
 /* The bake report: filled from the pipeline as data (lbk_bake_report), and its JSON
  * (spec/bake-report-json.md, schema lbk-bake-report/1: fields are only ever added). */
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -55,7 +56,8 @@ lbk_result bk_pipeline_report(const bk_pipeline *b, lbk_bake_output *out)
     size_t len = strlen(b->input);
     out->input = bk_output_alloc(out, len + 1);
     out->passes = bk_output_alloc(out, (b->sample_count ? b->sample_count : 1) * sizeof *out->passes);
-    if (!out->input || !out->passes) return LBK_ERR_OUT_OF_MEMORY;
+    out->pass_errors = bk_output_alloc(out, (b->sample_count ? b->sample_count : 1) * sizeof *out->pass_errors);
+    if (!out->input || !out->passes || !out->pass_errors) return LBK_ERR_OUT_OF_MEMORY;
     memcpy(out->input, b->input, len + 1);
     r->input = out->input;
     r->preset = b->opt->preset;
@@ -69,6 +71,31 @@ lbk_result bk_pipeline_report(const bk_pipeline *b, lbk_bake_output *out)
     }
     r->passes = out->passes;
     r->pass_count = b->sample_count;
+    r->pass_errors = out->pass_errors;
+    for (size_t i = 0; i < b->sample_count; i++) {
+        const bk_transport_sample *s = &b->samples[i];
+        out->pass_errors[i] = (lbk_bake_class_errors){s->class_rel_rmse[BK_CLASS_TEXEL], s->class_rel_rmse[BK_CLASS_GLG],
+                                                      s->class_rel_rmse[BK_CLASS_LLG], s->probe_rel_rmse};
+    }
+    r->errors = (lbk_bake_class_errors){b->stats.class_rel_rmse[BK_CLASS_TEXEL], b->stats.class_rel_rmse[BK_CLASS_GLG],
+                                        b->stats.class_rel_rmse[BK_CLASS_LLG], b->stats.probe_rel_rmse};
+    size_t nrun;
+    const bk_set_run_error *runs = bk_set_bakes_run_errors(&b->sets, &nrun);
+    if (nrun) {
+        out->set_runs = bk_output_alloc(out, nrun * sizeof *out->set_runs);
+        out->set_labels = bk_output_alloc(out, nrun * sizeof runs->label);
+        if (!out->set_runs || !out->set_labels) return LBK_ERR_OUT_OF_MEMORY;
+        for (size_t i = 0; i < nrun; i++) {
+            char *label = out->set_labels + i * sizeof runs->label;
+            memcpy(label, runs[i].label, sizeof runs->label);
+            out->set_runs[i] = (lbk_bake_set_run){label, runs[i].est_rel_rmse,
+                                                  {runs[i].class_rel_rmse[BK_CLASS_TEXEL], runs[i].class_rel_rmse[BK_CLASS_GLG],
+                                                   runs[i].class_rel_rmse[BK_CLASS_LLG], runs[i].probe_rel_rmse},
+                                                  runs[i].seconds};
+        }
+    }
+    r->set_runs = out->set_runs;
+    r->set_run_count = nrun;
     fill_transport(b, &r->transport);
     fill_counts(b, &r->counts);
     r->scales.lmap = r->counts.texels ? b->scale[0] : 0;
@@ -121,8 +148,20 @@ static void json_counts(cJSON *root, const lbk_bake_report *r)
     cJSON_AddNumberToObject(c, "file_bytes", (double)n->file_bytes);
 }
 
+/* "errors": {"texels", "glg", "llg", "probes"}: the estimated relative RMSE per receiver class. */
+static void json_classes(cJSON *parent, const lbk_bake_class_errors *e)
+{
+    cJSON *o = cJSON_AddObjectToObject(parent, "errors");
+    cJSON_AddNumberToObject(o, "texels", e->texels);
+    cJSON_AddNumberToObject(o, "glg", e->glg);
+    cJSON_AddNumberToObject(o, "llg", e->llg);
+    cJSON_AddNumberToObject(o, "probes", e->probes);
+}
+
 static cJSON *json_report(const lbk_bake_report *r, const char *container_path)
 {
+    /* a report struct from before the per-class fields were appended has none of them */
+    const int appended = r->size >= offsetof(lbk_bake_report, set_run_count) + sizeof r->set_run_count;
     cJSON *root = cJSON_CreateObject();
     cJSON_AddStringToObject(root, "schema", "lbk-bake-report/1");
     cJSON_AddStringToObject(root, "input", r->input ? r->input : "");
@@ -141,7 +180,19 @@ static cJSON *json_report(const lbk_bake_report *r, const char *container_path)
         cJSON_AddNumberToObject(o, "est_rel_rmse", s->est_rel_rmse);
         cJSON_AddNumberToObject(o, "bounces", s->bounces);
         cJSON_AddNumberToObject(o, "pass", s->pass);
+        if (appended && r->pass_errors) json_classes(o, &r->pass_errors[i]);
         cJSON_AddItemToArray(samples, o);
+    }
+    if (appended) json_classes(root, &r->errors);
+    cJSON *sr = cJSON_AddArrayToObject(root, "set_runs");
+    for (size_t i = 0; appended && i < r->set_run_count; i++) {
+        const lbk_bake_set_run *e = &r->set_runs[i];
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "label", e->label ? e->label : "");
+        cJSON_AddNumberToObject(o, "est_rel_rmse", e->est_rel_rmse);
+        json_classes(o, &e->classes);
+        cJSON_AddNumberToObject(o, "seconds", e->seconds);
+        cJSON_AddItemToArray(sr, o);
     }
     json_transport(root, r);
     json_counts(root, r);

@@ -329,8 +329,8 @@ static lbk_result build_report(bk_pipeline *b, section_list *sl)
          * work in samples and rays (times are in --json-report). */
         rec[i].samples_per_texel = (uint32_t)fmin(s->samples_per_receiver, 4e9);
         rec[i].bounces = (uint32_t)(s->bounces > 0 ? s->bounces : 0);
-        rec[i].texel_rel_rmse = b->texel_receivers ? (float)s->est_rel_rmse : 0;
-        rec[i].probe_rel_rmse = has_probes ? (float)s->est_rel_rmse : 0;
+        rec[i].texel_rel_rmse = b->texel_receivers ? (float)s->class_rel_rmse[BK_CLASS_TEXEL] : 0;
+        rec[i].probe_rel_rmse = has_probes ? (float)s->probe_rel_rmse : 0;
         if (i > 0 && rec[i].samples_per_texel < rec[i - 1].samples_per_texel) rec[i].samples_per_texel = rec[i - 1].samples_per_texel;
         if (i > 0 && rec[i].bounces < rec[i - 1].bounces) rec[i].bounces = rec[i - 1].bounces;
         rec[i].rays_traced = (uint64_t)((double)b->stats.rays * (s->samples_per_receiver /

@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "bake/sets/door_guided.h"
+#include "bake/util/clock.h"
 #include "bake/pipeline/encode.h"
 #include "lbk/ahd.h"
 #include "lbk/container.h"
@@ -75,6 +76,8 @@ typedef struct bs_impl {
      * contributions, and Σ of the light-set runs' variances (independent runs); NULL before any */
     lbk_sh9_rgb *guide;
     float *guide_var;
+    bk_set_run_error *run_errors; /* every transport run's estimate, in order */
+    size_t run_error_count;
 } bs_impl;
 
 /* ---- prepare --------------------------------------------------------------------------- */
@@ -661,6 +664,9 @@ lbk_result bk_set_bakes_emit(bk_set_bakes *sets, const bk_set_inputs *in, char *
  * error's text goes. */
 typedef struct run_ctx {
     const bk_set_inputs *in;
+    bs_impl *im;             /* where run_one logs each run's estimate */
+    double t_start;          /* bk_now() when the runs began, and the transport's share of the */
+    double transport_secs;   /* time since: the rest (scenes without doors, tracers) is overhead */
     int run, runs;
     const bk_scene *scene;   /* scene of the current run (the hook's triangle indices) */
     float *variance;         /* NULL, or where run_one writes the run's per-receiver variance */
@@ -732,12 +738,45 @@ static void filtered_free(filtered_scene *f)
     free(f->tris), free(f->tri_material), free(f->tri_object);
 }
 
+static lbk_result log_run(run_ctx *rc, const char *what, const bk_transport_stats *st)
+{
+    bs_impl *im = rc->im;
+    if (!im) return LBK_OK;
+    bk_set_run_error *n = realloc(im->run_errors, (im->run_error_count + 1) * sizeof *n);
+    if (!n) return LBK_ERR_OUT_OF_MEMORY;
+    im->run_errors = n;
+    bk_set_run_error *e = &n[im->run_error_count++];
+    memset(e, 0, sizeof *e);
+    snprintf(e->label, sizeof e->label, "%s", what);
+    e->est_rel_rmse = st->est_rel_rmse;
+    memcpy(e->class_rel_rmse, st->class_rel_rmse, sizeof e->class_rel_rmse);
+    e->probe_rel_rmse = st->probe_rel_rmse;
+    e->seconds = st->seconds;
+    return LBK_OK;
+}
+
+const bk_set_run_error *bk_set_bakes_run_errors(const bk_set_bakes *sets, size_t *count)
+{
+    const bs_impl *im = sets ? sets->impl : NULL;
+    *count = im ? im->run_error_count : 0;
+    return im ? im->run_errors : NULL;
+}
+
 /* One transport run at the base receivers. */
 static lbk_result run_one(run_ctx *rc, const bk_scene *scene, const bk_tracer *tracer, const bk_transport_options *base,
                           lbk_sh9_rgb *radiance, lbk_sh9_rgb *direct, const char *what)
 {
     const bk_set_inputs *in = rc->in;
     bk_transport_options opt = *base;
+    if (in->deadline > 0) {
+        /* the bake's one budget: an equal share of what is left per remaining run (door runs
+         * too: their differences stay unbiased, only noisier, if their passes differ) */
+        const int left = rc->runs - rc->run > 0 ? rc->runs - rc->run : 1;
+        const double now = bk_now();
+        /* what each run costs besides its transport (a scene without a door, its tracer), so far */
+        const double overhead = rc->run > 0 ? fmax(0, (now - rc->t_start - rc->transport_secs) / rc->run) : 0;
+        opt.time_limit = fmax(1e-3, (in->deadline - now) / left - overhead);
+    }
     opt.progress = run_progress;
     opt.report = NULL;
     opt.albedo_hook = rc->black_doors ? run_albedo : NULL;
@@ -758,13 +797,14 @@ static lbk_result run_one(run_ctx *rc, const bk_scene *scene, const bk_tracer *t
     if (!r) bk_texels_match_irradiance(in->texels, in->texel_of_receiver, in->texel_receivers, radiance, irradiance);
     free(irradiance);
     rc->run++;
+    rc->transport_secs += st.seconds;
     if (r) return failure(rc, r, "light transport for %s: %s", what);
     if (st.nonfinite)
         bk_events_say(in->events, LBK_BAKE_SEVERITY_WARNING, "%s: %llu non-finite samples were dropped", what,
                       (unsigned long long)st.nonfinite);
     bk_events_say(in->events, LBK_BAKE_SEVERITY_INFO, "%-30s %2d passes %7.0f samples/receiver  est. error %6.2f%%  %6.1f s",
                   what, st.passes, st.samples_per_receiver, 100 * st.est_rel_rmse, st.seconds);
-    return LBK_OK;
+    return log_run(rc, what, &st);
 }
 
 static void sh_sub(lbk_sh9_rgb *dst, const lbk_sh9_rgb *b, size_t n)
@@ -1056,6 +1096,17 @@ static void set_run_free(set_run *s)
     free(s->rad), free(s->dir), free(s->ref), free(s->ref_dir), free(s->var);
 }
 
+int bk_set_bakes_planned_runs(const bk_set_bakes *sets)
+{
+    const bs_impl *im = sets ? sets->impl : NULL;
+    if (!im) return 0;
+    int runs = 0;
+    for (size_t j = 0; j < im->light_set_count; j++) runs += !im->sets[j].zero;
+    runs += im->door_count ? 1 + 2 * (int)im->door_count : 0;
+    for (size_t c = 0; c < im->combo_count; c++) runs += im->combos[c].door[1] >= 0 ? 3 : 2;
+    return runs;
+}
+
 lbk_result bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *err, size_t err_len)
 {
     bs_impl *im = sets->impl;
@@ -1067,11 +1118,11 @@ lbk_result bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *e
     s.n = in->receiver_count ? in->receiver_count : 1;
     s.fraction = in->threshold == 0 ? BS_DEFAULT_THRESHOLD : in->threshold < 0 ? 0 : in->threshold;
     s.rc.in = in;
+    s.rc.im = im;
     s.rc.err = err;
     s.rc.err_len = err_len;
-    for (size_t j = 0; j < im->light_set_count; j++) s.rc.runs += !im->sets[j].zero;
-    s.rc.runs += im->door_count ? 1 + 2 * (int)im->door_count : 0;
-    for (size_t c = 0; c < im->combo_count; c++) s.rc.runs += im->combos[c].door[1] >= 0 ? 3 : 2;
+    s.rc.runs = bk_set_bakes_planned_runs(sets);
+    s.rc.t_start = bk_now();
     const int guided = in->door_method == BK_DOOR_GUIDED;
     s.rad = malloc(s.n * sizeof *s.rad), s.dir = malloc(s.n * sizeof *s.dir), s.var = malloc(s.n * sizeof *s.var);
     lbk_result r = s.rad && s.dir && s.var ? LBK_OK : out_of_memory(&s);
@@ -1236,7 +1287,7 @@ void bk_set_bakes_free(bk_set_bakes *sets)
             free(im->sets[j].stash), free(im->sets[j].stash_direct);
             for (int s = 0; s < LBK_DLS_SPACE_COUNT_; s++) free(im->sets[j].targets[s]), free(im->sets[j].values[s]);
         }
-        free(im->sets), free(im->doors), free(im->combos), free(im->guide), free(im->guide_var), free(im);
+        free(im->sets), free(im->doors), free(im->combos), free(im->guide), free(im->guide_var), free(im->run_errors), free(im);
     }
     memset(sets, 0, sizeof *sets);
 }

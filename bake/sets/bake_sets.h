@@ -56,6 +56,9 @@ typedef struct bk_set_inputs {
     const bk_denoiser *denoiser;      /* bk_set_bakes_emit: the denoiser built from the base + the
                                          guide (bk_set_bakes_guide), applied to every set with the
                                          same weights; NULL: not denoised */
+    double deadline;                  /* bk_now() time by which the last run should end (the bake's
+                                         one time budget, --time-limit); 0: none. Each run gets an
+                                         equal share of what is left (at least one pass each) */
     float origin[3];                  /* the bake frame's origin in world space: add it to every
                                          position written (the scene is recentred, bake.c) */
     float scale[3];                   /* sections only: the LMAP, GLG and LLG scales (spec §5.7);
@@ -83,6 +86,22 @@ lbk_result bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *e
  * per receiver and Σ of the light-set runs' variances (bake/transport/DENOISE.md); both NULL
  * without sets. Valid until bk_set_bakes_emit. */
 void bk_set_bakes_guide(const bk_set_bakes *sets, const lbk_sh9_rgb **sum, const float **variance);
+
+/* How many transport runs bk_set_bakes_run will make (for the time budget's shares). */
+int bk_set_bakes_planned_runs(const bk_set_bakes *sets);
+
+/* One transport run of bk_set_bakes_run (a light set, a door state, a reference): its label as in
+ * the bake's messages and its final estimated error, pooled and per receiver class. */
+typedef struct bk_set_run_error {
+    char label[64];
+    double est_rel_rmse;
+    double class_rel_rmse[BK_RECEIVER_CLASSES];
+    double probe_rel_rmse;
+    double seconds;
+} bk_set_run_error;
+
+/* The runs so far, in the order they ran (owned by sets). */
+const bk_set_run_error *bk_set_bakes_run_errors(const bk_set_bakes *sets, size_t *count);
 /* Denoises every kept contribution with in->denoiser (NULL: none) and chooses its sparse
  * entries (threshold, dilation); frees what bk_set_bakes_run kept. LBK_OK or an error with a
  * message in err. */

@@ -1049,7 +1049,7 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
     }
     if (c.light_count) parallel_for(&c, count, 64, recv_punctual); /* luminance only, for the error */
 
-    double weight_sum = 0, spp = 0, err = 0, last_pass_time = 0;
+    double weight_sum = 0, spp = 0, err = 0, last_pass_time = 0, class_err[BK_RECEIVER_CLASSES] = {0}, probe_err = 0;
     int pass = 0, stop = BK_STOP_BUDGET;
     tp_chain_result chain[2] = {{0, 0, 0, 0}, {0, 0, 0, 0}};
     for (;; pass++) {
@@ -1088,20 +1088,28 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
         weight_sum += c.pass_weight;
         spp += 2.0 * c.rays;
         /* error: two independent half estimates per receiver (TRANSPORT.md) */
-        double num = 0, den = 0;
+        double num = 0, den = 0, cnum[BK_RECEIVER_CLASSES] = {0}, cden[BK_RECEIVER_CLASSES] = {0};
+        int cls = 0;
         for (size_t i = 0; i < count; i++) {
+            while (cls < BK_RECEIVER_CLASSES - 1 && i >= opt->class_end[cls] && opt->class_end[BK_RECEIVER_CLASSES - 1]) cls++;
             double a = c.x_acc[0][i] / weight_sum, b = c.x_acc[1][i] / weight_sum;
-            num += 0.25 * (a - b) * (a - b);
-            double m = 0.5 * (a + b);
-            den += m * m;
+            double m = 0.5 * (a + b), v = 0.25 * (a - b) * (a - b);
+            num += v, den += m * m;
+            cnum[cls] += v, cden[cls] += m * m;
         }
         err = den > 0 ? sqrt(num / den) : 0;
+        for (int k = 0; k < BK_RECEIVER_CLASSES; k++) class_err[k] = cden[k] > 0 ? sqrt(cnum[k] / cden[k]) : 0;
+        probe_err = cden[1] + cden[2] > 0 ? sqrt((cnum[1] + cnum[2]) / (cden[1] + cden[2])) : 0;
         last_pass_time = now_seconds() - pass_start;
         if (opt->report) {
-            bk_transport_sample smp = {now_seconds() - t0, spp, err, chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces, pass};
+            bk_transport_sample smp = {now_seconds() - t0, spp, err, chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces, pass,
+                                       {class_err[0], class_err[1], class_err[2]}, probe_err};
             opt->report(opt->user, &smp);
         }
-        if (target > 0 && err <= target) { stop = BK_STOP_TARGET; break; }
+        /* the target is about lightmap texels (REPT's texel_rel_rmse, spec §7.2) when there are
+         * any; probes' own estimates are reported beside it */
+        const double stop_err = opt->class_end[BK_RECEIVER_CLASSES - 1] && opt->class_end[BK_CLASS_TEXEL] ? class_err[BK_CLASS_TEXEL] : err;
+        if (target > 0 && stop_err <= target) { stop = BK_STOP_TARGET; break; }
         double next_spp = spp + 2.0 * (s0 << (pass + 1 < 20 ? pass + 1 : 20));
         if (next_spp > max_samples || pass >= 24) { stop = BK_STOP_BUDGET; break; }
         /* the next pass costs about twice this one: start it only if it can finish in time */
@@ -1137,6 +1145,8 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
         stats->passes = pass + 1;
         stats->samples_per_receiver = spp;
         stats->est_rel_rmse = err;
+        for (int k = 0; k < BK_RECEIVER_CLASSES; k++) stats->class_rel_rmse[k] = class_err[k];
+        stats->probe_rel_rmse = probe_err;
         stats->bounces = chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces;
         stats->q = 0.5 * (chain[0].q + chain[1].q);
         double tot = chain[0].total_energy + chain[1].total_energy;

@@ -38,12 +38,19 @@ typedef struct bk_receiver {
 } bk_receiver;
 
 /* One point of the error-against-time record, written after every pass. */
+/* Receiver classes, in the order the pipeline lists receivers (bk_transport_options.class_end). */
+enum { BK_CLASS_TEXEL, BK_CLASS_GLG, BK_CLASS_LLG, BK_RECEIVER_CLASSES };
+
 typedef struct bk_transport_sample {
     double seconds;               /* since bk_transport_run started */
     double samples_per_receiver;  /* gather rays per receiver so far (both halves, all passes) */
     double est_rel_rmse;          /* estimated relative RMSE of the result so far (TRANSPORT.md) */
     int bounces;                  /* bounces computed explicitly in the last pass (tail excluded) */
     int pass;
+    /* the same estimate per receiver class (options.class_end; 0 for an empty class): texels,
+     * GLG probes, LLG probes, and the probes together */
+    double class_rel_rmse[BK_RECEIVER_CLASSES];
+    double probe_rel_rmse;
 } bk_transport_sample;
 
 typedef struct bk_transport_options {
@@ -74,6 +81,11 @@ typedef struct bk_transport_options {
     int (*progress)(void *user, const char *phase, double fraction);
     void (*report)(void *user, const bk_transport_sample *sample);
     void *user;
+    /* Receivers [0, class_end[0]) are texels, [class_end[0], class_end[1]) GLG probes,
+     * [class_end[1], class_end[2]) LLG probes: the error is then also estimated per class
+     * (bk_transport_sample.class_rel_rmse), and target_error applies to the texels' estimate
+     * (all receivers' when there are no texels). All 0: one class, the estimate over all. */
+    size_t class_end[BK_RECEIVER_CLASSES];
 } bk_transport_options;
 
 /* Caller-owned output arrays, `count` entries each; NULL pointers are skipped. */
@@ -97,6 +109,8 @@ typedef struct bk_transport_stats {
     int passes;
     double samples_per_receiver;
     double est_rel_rmse;
+    double class_rel_rmse[BK_RECEIVER_CLASSES]; /* per class, as in bk_transport_sample */
+    double probe_rel_rmse;
     int bounces;             /* explicit bounces of the last pass */
     double q;                /* per-bounce energy ratio used for the tail (last pass, mean of halves) */
     double tail_fraction;    /* share of the cache's indirect energy that came from the tail */

@@ -305,7 +305,14 @@ static void test_target_error_and_reports(void **state)
     assert_int_equal(cJSON_GetArraySize(samples), 1);
     cJSON *s0 = cJSON_GetArrayItem(samples, 0);
     assert_true(cJSON_GetObjectItem(s0, "seconds")->valuedouble > 0);
-    assert_float_equal(cJSON_GetObjectItem(s0, "est_rel_rmse")->valuedouble, rec.texel_rel_rmse, 1e-6);
+    /* REPT's fields are the per-class estimates (spec §7.1), est_rel_rmse pools every receiver */
+    cJSON *e0 = cJSON_GetObjectItem(s0, "errors");
+    assert_non_null(e0);
+    assert_float_equal(cJSON_GetObjectItem(e0, "texels")->valuedouble, rec.texel_rel_rmse, 1e-6);
+    assert_float_equal(cJSON_GetObjectItem(e0, "probes")->valuedouble, rec.probe_rel_rmse, 1e-6);
+    assert_float_equal(cJSON_GetObjectItem(cJSON_GetObjectItem(root, "errors"), "texels")->valuedouble,
+                       rec.texel_rel_rmse, 1e-6);
+    assert_true(cJSON_GetObjectItem(e0, "texels")->valuedouble <= cJSON_GetObjectItem(root, "target_error")->valuedouble);
     assert_string_equal(cJSON_GetObjectItem(root, "status")->valuestring, "target reached");
     /* the scales are the ones in the file: LMAP's as the lightmap view reports it */
     double lmap_scale = cJSON_GetObjectItem(cJSON_GetObjectItem(root, "scales"), "lmap")->valuedouble;

@@ -1,7 +1,9 @@
 /* Whole-file reading and atomic writing for the tools. */
 #include "tools/common/file_util.h"
 
+#include <dirent.h>
 #include <errno.h>
+#include <signal.h>
 #include <fcntl.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -99,4 +101,68 @@ int tl_write_file_atomic(const char *path, const void *data, size_t size, char e
 int tl_write_text(const char *path, const char *text, char err[TL_ERR_LEN])
 {
     return tl_write_file_atomic(path, text, strlen(text), err);
+}
+
+/* "XXXXXX" of mkstemp: exactly six letters or digits. */
+static int mkstemp_tail(const char *s)
+{
+    int n = 0;
+    for (; s[n]; n++)
+        if (!((s[n] >= 'a' && s[n] <= 'z') || (s[n] >= 'A' && s[n] <= 'Z') || (s[n] >= '0' && s[n] <= '9'))) return 0;
+    return n == 6;
+}
+
+/* A decimal pid of a process that is gone (kill(pid, 0) says ESRCH). */
+static int dead_pid_tail(const char *s)
+{
+    if (!*s || strlen(s) > 10) return 0;
+    long pid = 0;
+    for (const char *p = s; *p; p++) {
+        if (*p < '0' || *p > '9') return 0;
+        pid = pid * 10 + (*p - '0');
+    }
+    return pid > 0 && pid != (long)getpid() && kill((pid_t)pid, 0) != 0 && errno == ESRCH;
+}
+
+int tl_remove_stale_temps(const char *path, time_t before, void (*removed)(void *user, const char *file), void *user)
+{
+    const char *slash = strrchr(path, '/');
+    const char *base = slash ? slash + 1 : path;
+    char dir[4096];
+    if (slash) {
+        size_t n = (size_t)(slash - path);
+        if (n >= sizeof dir) return 0;
+        memcpy(dir, path, n);
+        dir[n ? n : 1] = 0;
+        if (!n) dir[0] = '/';
+    } else {
+        strcpy(dir, ".");
+    }
+    const size_t blen = strlen(base);
+    DIR *d = opendir(dir);
+    if (!d || !blen) {
+        if (d) closedir(d);
+        return 0;
+    }
+    int count = 0;
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        const char *name = e->d_name;
+        if (strncmp(name, base, blen) != 0) continue;
+        const char *tail = name + blen;
+        int lib = strncmp(tail, ".tmp-", 5) == 0 && mkstemp_tail(tail + 5);
+        int tool = !lib && strncmp(tail, ".tmp.", 5) == 0 && dead_pid_tail(tail + 5);
+        if (!lib && !tool) continue;
+        char full[8192];
+        snprintf(full, sizeof full, "%s/%s", dir, name);
+        struct stat st;
+        if (lstat(full, &st) != 0 || !S_ISREG(st.st_mode)) continue;
+        if (lib && !(st.st_mtime < before)) continue; /* may belong to a write still running */
+        if (unlink(full) == 0) {
+            count++;
+            if (removed) removed(user, full);
+        }
+    }
+    closedir(d);
+    return count;
 }

@@ -119,7 +119,10 @@ typedef struct lbk_bake_desc {
     int threads;                /* worker threads [0: one per online core] */
     uint64_t seed;              /* used as given, 0 included (`lbk bake` passes 1 unless --seed) */
     double target_error;        /* stop when the estimated relative RMSE reaches this; <= 0: preset */
-    double time_limit;          /* seconds for the transport; at least one pass completes [0: none] */
+    double time_limit;          /* seconds for the whole bake from the call, base + every light-set
+                                   and door run: each run gets an equal share of what is left;
+                                   every run completes at least one pass, and the guided door
+                                   estimator and writing are not limited [0: none] */
     int max_samples;            /* gather samples per receiver, whole run [0: preset] */
     int max_bounces;            /* explicit bounces before the analytic tail [0: 64] */
     float texel_density;        /* texels per metre for every object [0: the object's own
@@ -291,6 +294,22 @@ typedef struct lbk_bake_counts {
     uint64_t file_bytes;         /* the container as baked */
 } lbk_bake_counts;
 
+/* Estimated relative RMSE per receiver class (0 for a class the bake has none of): lightmap
+ * texels (irradiance), GLG and LLG probes (fluence), and both probe classes together. */
+typedef struct lbk_bake_class_errors {
+    double texels, glg, llg, probes;
+} lbk_bake_class_errors;
+
+/* One transport run of the light sets and doors (a light set, a door open or closed, a
+ * combination, the doors-closed reference), with its own final estimate. A door state's or a
+ * combination's stored contribution is a difference of such runs: its error is larger. */
+typedef struct lbk_bake_set_run {
+    const char *label;           /* as in the bake's messages, e.g. "light set 'A'" */
+    double est_rel_rmse;         /* over all its receivers */
+    lbk_bake_class_errors classes;
+    double seconds;
+} lbk_bake_set_run;
+
 /* What lbk_bake_report_write_json writes (spec/bake-report-json.md), as data. */
 typedef struct lbk_bake_report {
     size_t size;                 /* sizeof(lbk_bake_report) of the library that filled it */
@@ -308,6 +327,11 @@ typedef struct lbk_bake_report {
     const lbk_bake_phase_time *phases; /* the phases run, in order */
     size_t phase_count;
     double seconds;              /* the whole bake call */
+    /* appended after the first version of this struct: read only when size covers them */
+    lbk_bake_class_errors errors;        /* the base bake's final estimate per class */
+    const lbk_bake_class_errors *pass_errors; /* per pass, parallel to passes */
+    const lbk_bake_set_run *set_runs;    /* every light-set and door run, in order */
+    size_t set_run_count;
 } lbk_bake_report;
 
 /* Owned by the output, valid until lbk_bake_output_free. */
