@@ -341,6 +341,7 @@ endif
 bench-cycles: deps-tools deps-bench
 	@$(MAKE) --no-print-directory $(if $(LBK_TREE),,$(BUILD)/lbk) $(CYC_DUMP)
 	@LBK=$${LBK:-$(CYC_LBK)} LBK_TEXEL_DUMP=$${LBK_TEXEL_DUMP:-$(CYC_DUMP)} python3 bench/cycles/run.py
+
 # lbk render against converged Cycles renders (bench/render/README.md); the Cycles scene converter
 # comes from LBK_CYCLES_HARNESS (default bench/cycles).
 LBK_CYCLES_HARNESS ?= bench/cycles
