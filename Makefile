@@ -70,7 +70,7 @@ TOOL_OBJ  := $(filter-out $(BUILD)/rel/$(TOOL_MAIN:.c=.o) $(BAKE_OBJ),$(TOOL_CSR
 LIB_ASAN  := $(LIB_SRC:%.c=$(BUILD)/asan/%.o)
 TOOL_ASAN := $(filter-out $(BUILD)/asan/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUILD)/asan/%.o)) $(TOOL_CXXSRC:%.cc=$(BUILD)/asan/%.o)
 
-.PHONY: all lib bake-lib deps demo test check bench bench-render mesa-bc-check fuzz install install-check clean help gltf-validator gpu test-build
+.PHONY: all lib bake-lib deps deps-bench demo test check bench bench-cycles bench-render mesa-bc-check fuzz install install-check clean help gltf-validator gpu test-build
 all: $(BUILD)/lbk $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc \
      $(BUILD)/liblbkbake.a $(BUILD)/liblbkbake.so $(BUILD)/lbk-bake.pc
 
@@ -85,7 +85,8 @@ help:
 	@echo "make install-lib PREFIX=/usr/local   liblbk only (needs a C compiler, zstd, xxHash)"
 	@echo "WERROR=1        every compiler warning is an error (CI)"
 	@echo "make bench      benchmarks, printed as ratios against baselines measured in the same run"
-	@echo "make bench-render  lbk render against Blender Cycles (LBK_CYCLES_HARNESS=bench/cycles of the cycles branch)"
+	@echo "make bench-cycles  lbk against Blender Cycles at equal time (part of make bench; bench/cycles/README.md)"
+	@echo "make bench-render  lbk render against Blender Cycles"
 	@echo "make mesa-bc-check  BC6H/BC4 codecs against Mesa's (optional: libegl-dev libgl-dev)"
 	@echo "make fuzz       libFuzzer harness for the container reader (clang)"
 	@echo "make gpu        the Vulkan DLS apply tool build/lbk-gpu-apply (make test runs the GPU tests on lavapipe)"
@@ -127,6 +128,11 @@ deps-tools:
 deps-test:
 	@$(call deps_sh,$(DEB_TEST_PKGS),)
 	@$(call deps_sh,$(GPU_PKGS),,the GPU tests will be SKIPPED (counted so))
+
+# What `make bench-cycles` needs besides the build: Blender (Cycles) and Python 3.
+BENCH_DEB_PKGS := blender python3
+deps-bench:
+	@$(call deps_sh,$(BENCH_DEB_PKGS),)
 
 # ---- compile rules --------------------------------------------------------------------------
 $(BUILD)/rel/libformat/%.o: libformat/%.c
@@ -380,14 +386,36 @@ mesa-bc-check: $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a
 	$(CXX) -o $(BUILD)/bench/mesa_bc_check $(BUILD)/bench/mesa_bc_check.o $(TOOL_OBJ) $(BUILD)/liblbkbake.a \
 	    $(BUILD)/liblbk.a $(TOOL_LIBS) -lEGL -lGL
 	$(BUILD)/bench/mesa_bc_check
-bench: deps-tools
+bench: deps-tools deps-bench
 	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BENCHES:%=$(BUILD)/bench/%)
 	@for b in $(BENCHES); do echo "== $$b"; $(BUILD)/bench/$$b || exit 1; done
 	@echo "== blender_import"; sh bench/blender_import.sh $(BUILD)/lbk $(BUILD)/bench-blender
+	@echo "== bench-cycles"; $(MAKE) --no-print-directory bench-cycles
 	@echo "== render (lbk render vs Blender Cycles)"; $(MAKE) --no-print-directory bench-render
 
+# lbk against Cycles (bench/cycles/README.md). LBK_TREE=/path/to/other/checkout compares that
+# tree's baker instead: its build/lbk (built there first) and texel_dump linked against its
+# baker objects, so the rebuilt layout is the one its lbk bakes.
+ifdef LBK_TREE
+CYC_LBK  := $(LBK_TREE)/$(BUILD)/lbk
+CYC_DUMP := $(BUILD)/bench/cycles/texel_dump-tree
+$(CYC_DUMP): bench/cycles/texel_dump.c FORCE
+	@$(MAKE) --no-print-directory -C $(LBK_TREE) $(BUILD)/lbk
+	@mkdir -p $(@D)
+	$(CC) $(CSTD) -O2 -g $(WARN) -I$(LBK_TREE)/libformat/include -I$(LBK_TREE)/bake/include -I$(LBK_TREE) \
+	    -I/usr/include/draco -I/usr/include/stb -c $< -o $@.o
+	$(CXX) -o $@ $@.o $$(ls $(LBK_TREE)/$(BUILD)/rel/bake/*/*.o | sort) $(LBK_TREE)/$(BUILD)/liblbk.a $(TOOL_LIBS)
+FORCE:
+else
+CYC_LBK  ?= $(BUILD)/lbk
+CYC_DUMP ?= $(BUILD)/bench/cycles/texel_dump
+endif
+bench-cycles: deps-tools deps-bench
+	@$(MAKE) --no-print-directory $(if $(LBK_TREE),,$(BUILD)/lbk) $(CYC_DUMP)
+	@LBK=$${LBK:-$(CYC_LBK)} LBK_TEXEL_DUMP=$${LBK_TEXEL_DUMP:-$(CYC_DUMP)} python3 bench/cycles/run.py
+
 # lbk render against converged Cycles renders (bench/render/README.md); the Cycles scene converter
-# comes from LBK_CYCLES_HARNESS (bench/cycles of the cycles branch until it is merged).
+# comes from LBK_CYCLES_HARNESS (default bench/cycles).
 LBK_CYCLES_HARNESS ?= bench/cycles
 bench-render: $(BUILD)/lbk
 	@LBK_CYCLES_HARNESS=$(LBK_CYCLES_HARNESS) python3 bench/render/run.py --lbk $(BUILD)/lbk --out $(BUILD)/bench-render $(BENCH_RENDER_ARGS)
