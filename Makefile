@@ -9,10 +9,14 @@ CLANG    ?= clang
 
 # Debian packages: liblbk alone (`make install-lib`), the baker and CLI, the tests on top.
 DEB_LIB_PKGS  := build-essential libzstd-dev libxxhash-dev
+# The GPU path (gpu/): Vulkan headers and loader, glslang, and Mesa's lavapipe (a CPU Vulkan
+# device) so that its tests run on a machine without a GPU.
+GPU_PKGS      := libvulkan-dev mesa-vulkan-drivers glslang-tools
 DEB_TOOL_PKGS := $(DEB_LIB_PKGS) libembree-dev libopenexr-dev libdraco-dev libtinygltf-dev libstb-dev \
                  nlohmann-json3-dev libqhull-dev libspng-dev libcjson-dev \
                  libastcenc-dev
-DEB_PKGS      := $(DEB_TOOL_PKGS) pkg-config libcmocka-dev clang libclang-rt-14-dev
+DEB_TEST_PKGS := $(DEB_TOOL_PKGS) pkg-config libcmocka-dev clang libclang-rt-14-dev
+DEB_PKGS      := $(DEB_TEST_PKGS) $(GPU_PKGS)
 
 WARN     := -Wall -Wextra -Wshadow -Wstrict-prototypes -Wmissing-prototypes -Wno-unused-parameter
 # The glTF shim: its own code warns like the C code; tinygltf, Draco, stb and nlohmann come in
@@ -27,6 +31,9 @@ endif
 CSTD     := -std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE
 OPT      ?= -O2 -g
 SAN      := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
+# liblbk's arithmetic is defined operation by operation (the DLS apply paths must give the same
+# bytes): never contract a multiply and an add into a fused one.
+LIB_FP   := -ffp-contract=off
 
 # xxHash's x86 runtime dispatch (AVX2/AVX-512 checksums) when the installed libxxhash has it
 XXH_DISPATCH := $(shell printf '\043include <xxh_x86dispatch.h>\nint main(void){return (int)XXH3_64bits_dispatch("", 0);}\n' | \
@@ -63,7 +70,7 @@ TOOL_OBJ  := $(filter-out $(BUILD)/rel/$(TOOL_MAIN:.c=.o) $(BAKE_OBJ),$(TOOL_CSR
 LIB_ASAN  := $(LIB_SRC:%.c=$(BUILD)/asan/%.o)
 TOOL_ASAN := $(filter-out $(BUILD)/asan/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUILD)/asan/%.o)) $(TOOL_CXXSRC:%.cc=$(BUILD)/asan/%.o)
 
-.PHONY: all lib bake-lib deps demo test check bench bench-render mesa-bc-check fuzz install install-check clean help gltf-validator
+.PHONY: all lib bake-lib deps deps-bench demo test check bench bench-cycles bench-render mesa-bc-check fuzz install install-check clean help gltf-validator gpu test-build
 all: $(BUILD)/lbk $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc \
      $(BUILD)/liblbkbake.a $(BUILD)/liblbkbake.so $(BUILD)/lbk-bake.pc
 
@@ -78,9 +85,11 @@ help:
 	@echo "make install-lib PREFIX=/usr/local   liblbk only (needs a C compiler, zstd, xxHash)"
 	@echo "WERROR=1        every compiler warning is an error (CI)"
 	@echo "make bench      benchmarks, printed as ratios against baselines measured in the same run"
-	@echo "make bench-render  lbk render against Blender Cycles (LBK_CYCLES_HARNESS=bench/cycles of the cycles branch)"
+	@echo "make bench-cycles  lbk against Blender Cycles at equal time (part of make bench; bench/cycles/README.md)"
+	@echo "make bench-render  lbk render against Blender Cycles"
 	@echo "make mesa-bc-check  BC6H/BC4 codecs against Mesa's (optional: libegl-dev libgl-dev)"
 	@echo "make fuzz       libFuzzer harness for the container reader (clang)"
+	@echo "make gpu        the Vulkan DLS apply tool build/lbk-gpu-apply (make test runs the GPU tests on lavapipe)"
 	@echo "make install PREFIX=/usr/local"
 
 # ---- dependencies -------------------------------------------------------------------------
@@ -88,7 +97,8 @@ help:
 # sudo when not root). The targets that need packages (test, demo, bench, fuzz) only check: they
 # install the missing ones themselves when run as root with CI set (.ci/run) or when
 # LBK_INSTALL_DEPS=1, and say which and why; otherwise they print the one command to run and stop.
-# $(1): the packages; $(2): the reason to install without asking, empty to ask first.
+# $(1): the packages; $(2): the reason to install without asking, empty to ask first; $(3): what
+# happens without them, for packages that are optional (then a note instead of a stop).
 define deps_sh
 missing=$$(for p in $(1); do dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; done); \
 [ -z "$$missing" ] && exit 0; missing=$$(echo $$missing); \
@@ -96,6 +106,10 @@ if [ "$$(id -u)" = 0 ]; then sudo=; else sudo="sudo "; fi; \
 why="$(2)"; \
 [ -z "$$why" ] && [ "$${LBK_INSTALL_DEPS:-}" = 1 ] && why="LBK_INSTALL_DEPS=1"; \
 [ -z "$$why" ] && [ -n "$${CI:-}" ] && [ -z "$$sudo" ] && why="CI=$$CI, running as root"; \
+if [ -z "$$why" ] && [ -n "$(3)" ]; then \
+  echo "lbk: not installed: $$missing; $(3)"; \
+  echo "lbk: (make deps, or LBK_INSTALL_DEPS=1 make $(MAKECMDGOALS), installs them)"; exit 0; \
+fi; \
 if [ -z "$$why" ]; then \
   echo "lbk: make $(MAKECMDGOALS) needs Debian packages that are not installed: $$missing"; \
   echo "lbk: install them with"; echo "  $${sudo}apt-get install -y $$missing"; \
@@ -109,19 +123,27 @@ deps:
 	@$(call deps_sh,$(DEB_PKGS),make deps)
 deps-tools:
 	@$(call deps_sh,$(DEB_TOOL_PKGS),)
+# The GPU packages are optional for make test: without them (and not allowed to install them)
+# tests/gpu/test_gpu.c is built without Vulkan and its cases count as skipped.
 deps-test:
-	@$(call deps_sh,$(DEB_PKGS),)
+	@$(call deps_sh,$(DEB_TEST_PKGS),)
+	@$(call deps_sh,$(GPU_PKGS),,the GPU tests will be SKIPPED (counted so))
+
+# What `make bench-cycles` needs besides the build: Blender (Cycles) and Python 3.
+BENCH_DEB_PKGS := blender python3
+deps-bench:
+	@$(call deps_sh,$(BENCH_DEB_PKGS),)
 
 # ---- compile rules --------------------------------------------------------------------------
 $(BUILD)/rel/libformat/%.o: libformat/%.c
 	@mkdir -p $(@D)
-	$(CC) $(CSTD) $(OPT) $(WARN) $(LIB_INC) -MMD -MP -c $< -o $@
+	$(CC) $(CSTD) $(OPT) $(LIB_FP) $(WARN) $(LIB_INC) -MMD -MP -c $< -o $@
 $(BUILD)/pic/libformat/%.o: libformat/%.c
 	@mkdir -p $(@D)
-	$(CC) $(CSTD) $(OPT) $(WARN) -fPIC -fvisibility=hidden -DLBK_BUILDING_SHARED $(LIB_INC) -MMD -MP -c $< -o $@
+	$(CC) $(CSTD) $(OPT) $(LIB_FP) $(WARN) -fPIC -fvisibility=hidden -DLBK_BUILDING_SHARED $(LIB_INC) -MMD -MP -c $< -o $@
 $(BUILD)/asan/libformat/%.o: libformat/%.c
 	@mkdir -p $(@D)
-	$(CC) $(CSTD) -O1 -g $(SAN) $(WARN) $(LIB_INC) -MMD -MP -c $< -o $@
+	$(CC) $(CSTD) -O1 -g $(LIB_FP) $(SAN) $(WARN) $(LIB_INC) -MMD -MP -c $< -o $@
 $(BUILD)/pic/bake/%.o: bake/%.c
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) $(OPT) $(WARN) -fPIC -fvisibility=hidden -DLBK_BAKE_BUILDING_SHARED $(TOOL_INC) -MMD -MP -c $< -o $@
@@ -172,6 +194,40 @@ $(BUILD)/lbk: $(BUILD)/rel/$(TOOL_MAIN:.c=.o) $(TOOL_OBJ) $(BUILD)/liblbkbake.a 
 $(BUILD)/lbk-asan: $(BUILD)/asan/$(TOOL_MAIN:.c=.o) $(TOOL_ASAN) $(LIB_ASAN)
 	$(CXX) $(SAN) -o $@ $^ $(TOOL_LIBS)
 
+# ---- the GPU path (gpu/) --------------------------------------------------------------------
+# Built when the Vulkan headers and glslang are there (make deps installs them); without them
+# tests/gpu/test_gpu.c compiles to SKIPPED tests. Shaders become C arrays (glslang --vn).
+GLSLANG    ?= glslangValidator
+HAVE_VULKAN := $(shell test -f /usr/include/vulkan/vulkan.h && command -v $(GLSLANG) >/dev/null 2>&1 && echo 1)
+GPU_SHADERS := $(sort $(wildcard gpu/shaders/*.comp))
+GPU_SPV_H   := $(GPU_SHADERS:gpu/shaders/%.comp=$(BUILD)/gpu/%.spv.h)
+GPU_HOST    := $(sort $(wildcard gpu/host/*.c))
+$(BUILD)/gpu/%.spv.h: gpu/shaders/%.comp $(wildcard gpu/shaders/*.glsl)
+	@mkdir -p $(@D)
+	$(GLSLANG) -V --target-env vulkan1.1 --vn $*_spv -o $@ $< >/dev/null
+# test_gpu and bench_gpu compile differently with and without Vulkan: rebuild them when that changes.
+GPU_STAMP := $(BUILD)/gpu/vulkan-$(if $(HAVE_VULKAN),on,off)
+$(GPU_STAMP):
+	@mkdir -p $(@D) && rm -f $(BUILD)/gpu/vulkan-* && touch $@
+$(BUILD)/tests/test_gpu $(BUILD)/bench/bench_gpu: $(GPU_STAMP)
+ifeq ($(HAVE_VULKAN),1)
+GPU_REL  := $(GPU_HOST:%.c=$(BUILD)/rel/%.o)
+GPU_ASAN := $(GPU_HOST:%.c=$(BUILD)/asan/%.o)
+$(GPU_REL) $(GPU_ASAN): $(GPU_SPV_H)
+$(GPU_REL) $(GPU_ASAN) $(BUILD)/tests/test_gpu: TOOL_INC += -I$(BUILD)/gpu -DLBK_HAVE_VULKAN=1
+$(BUILD)/tests/test_gpu: $(GPU_ASAN)
+$(BUILD)/tests/test_gpu: TEST_EXTRA = $(GPU_ASAN) -lvulkan
+$(BUILD)/bench/bench_gpu: $(GPU_REL)
+$(BUILD)/bench/bench_gpu: TOOL_INC += -I$(BUILD)/gpu -DLBK_HAVE_VULKAN=1
+$(BUILD)/bench/bench_gpu: BENCH_EXTRA = $(GPU_REL) -lvulkan
+$(BUILD)/lbk-gpu-apply: gpu/lbk_gpu_apply.c $(GPU_REL) $(BUILD)/liblbk.a
+	$(CC) $(CSTD) $(OPT) $(WARN) $(TOOL_INC) -I$(BUILD)/gpu -DLBK_HAVE_VULKAN=1 -o $@ $< $(GPU_REL) $(BUILD)/liblbk.a -lvulkan $(LIB_LIBS)
+gpu: $(BUILD)/lbk-gpu-apply
+else
+gpu:
+	@echo "lbk: the GPU path needs $(GPU_PKGS) (make deps installs them)"; exit 1
+endif
+
 # ---- tests (ASan + UBSan) ------------------------------------------------------------------
 TEST_SUPPORT_OBJ := $(TEST_SUPPORT:%.c=$(BUILD)/asan/%.o)
 $(TEST_SUPPORT_OBJ): TOOL_INC += -Itests
@@ -181,7 +237,7 @@ test_src_of = $(foreach s,$(TEST_SRC),$(if $(filter $(1).c,$(notdir $(s))),$(s))
 $(BUILD)/tests/%: $$(call test_src_of,$$*) $(TEST_SUPPORT_OBJ) $(TOOL_ASAN) $(LIB_ASAN)
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) -O1 -g $(SAN) $(WARN) $(TOOL_INC) -Itests -c $< -o $@.o
-	$(CXX) $(SAN) -o $@ $@.o $(TEST_SUPPORT_OBJ) $(TOOL_ASAN) $(LIB_ASAN) $(TOOL_LIBS) -lcmocka
+	$(CXX) $(SAN) -o $@ $@.o $(TEST_SUPPORT_OBJ) $(TOOL_ASAN) $(LIB_ASAN) $(TEST_EXTRA) $(TOOL_LIBS) -lcmocka
 
 # The install check: the libraries installed into $(BUILD)/inst, programs built against them with
 # pkg-config only, linked once with the .so and once with the .a: install_check (liblbk) and
@@ -221,13 +277,15 @@ gltf-validator:
 	else echo "lbk: npm/node not found: the glTF-Validator check will be SKIPPED (apt-get install npm)"; fi
 
 test: deps-test
-	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BUILD)/lbk-asan $(TESTS:%=$(BUILD)/tests/%) $(BUILD)/fuzz_container \
-	    install-check install-lib-check $(TSAN_TESTS:%=$(BUILD)/tsan/bin/%)
+	@$(MAKE) --no-print-directory test-build
 	@$(MAKE) --no-print-directory gltf-validator
 	@LBK=$(BUILD)/lbk-asan BUILD=$(BUILD) FUZZ=$(BUILD)/fuzz_container TSAN_BIN=$(BUILD)/tsan/bin \
 	  GLTF_VALIDATOR=$$(test -f $(GLTF_VALIDATOR)/package.json && echo $(GLTF_VALIDATOR)) \
 	  sh tests/run.sh $(TESTS) install_check_shared install_check_static install_lib_check \
-	    bake_check_shared bake_check_static
+	    bake_check_shared bake_check_static; \
+	st=$$?; n=$$(sed -n 's/^\[  SKIPPED \] \([0-9]*\) test(s).*/\1/p' $(BUILD)/tests/test_gpu.log 2>/dev/null); \
+	if [ "$${n:-0}" -gt 0 ]; then echo "tests: $$n GPU tests SKIPPED, not run: $$(grep -m1 -o 'SKIPPED: .*' $(BUILD)/tests/test_gpu.log)"; fi; \
+	exit $$st
 check: test
 
 # ---- ThreadSanitizer: the determinism cases of tests/tsan/determinism.list -------------------
@@ -245,7 +303,7 @@ $(TEST_SUPPORT_TSAN): TOOL_INC += -Itests
 .SECONDARY: $(LIB_TSAN) $(TOOL_TSAN)
 $(BUILD)/tsan/libformat/%.o: libformat/%.c
 	@mkdir -p $(@D)
-	$(CC) $(CSTD) -O1 -g $(TSAN) $(WARN) $(LIB_INC) -MMD -MP -c $< -o $@
+	$(CC) $(CSTD) -O1 -g $(LIB_FP) $(TSAN) $(WARN) $(LIB_INC) -MMD -MP -c $< -o $@
 $(BUILD)/tsan/%.o: %.c
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) -O1 -g $(TSAN) $(WARN) $(TOOL_INC) -MMD -MP -c $< -o $@
@@ -260,6 +318,12 @@ $(BUILD)/tsan/bin/%: $$(call test_src_of,$$*) $(TEST_SUPPORT_TSAN) $(TOOL_TSAN) 
 tsan: deps-test
 	@$(MAKE) --no-print-directory $(TSAN_TESTS:%=$(BUILD)/tsan/bin/%)
 	@BUILD=$(BUILD) TSAN_BIN=$(BUILD)/tsan/bin sh tests/run.sh
+
+# What `make test` builds (after TSAN_TESTS is defined); make test builds it through a sub-make,
+# so that HAVE_VULKAN sees what deps-test installed.
+test-build: $(BUILD)/lbk $(BUILD)/lbk-asan $(TESTS:%=$(BUILD)/tests/%) $(BUILD)/fuzz_container \
+            install-check install-lib-check $(TSAN_TESTS:%=$(BUILD)/tsan/bin/%) \
+            $(if $(HAVE_VULKAN),$(BUILD)/lbk-gpu-apply)
 
 # ---- liblbk alone: zstd, xxHash and a C compiler, nothing else -----------------------------
 # install-lib builds and installs only the container library (static, shared, headers, lbk.pc).
@@ -293,7 +357,7 @@ install-lib-check:
 FUZZ_FLAGS := -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined -g -O1
 $(BUILD)/fuzz_container: tests/fuzz/fuzz_container.c $(LIB_SRC)
 	@mkdir -p $(@D)
-	$(CLANG) $(CSTD) $(FUZZ_FLAGS) $(WARN) $(LIB_INC) -o $@ $^ $(LIB_LIBS)
+	$(CLANG) $(CSTD) $(FUZZ_FLAGS) $(LIB_FP) $(WARN) $(LIB_INC) -o $@ $^ $(LIB_LIBS)
 # The seed corpus (tests/fuzz/README.md): the golden files, the containers make_corpus.c builds
 # (every section type) and two small real bakes. Regenerate by hand; the files are committed.
 .PHONY: fuzz-corpus
@@ -314,7 +378,7 @@ fuzz: deps-test
 $(BUILD)/bench/%: bench/%.c $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) -O2 -g $(WARN) $(TOOL_INC) -c $< -o $@.o
-	$(CXX) -o $@ $@.o $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a $(TOOL_LIBS)
+	$(CXX) -o $@ $@.o $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a $(BENCH_EXTRA) $(TOOL_LIBS)
 # The BC codecs against Mesa's (llvmpipe, surfaceless EGL): optional, needs libegl-dev libgl-dev.
 mesa-bc-check: $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a
 	@mkdir -p $(BUILD)/bench
@@ -322,14 +386,36 @@ mesa-bc-check: $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a
 	$(CXX) -o $(BUILD)/bench/mesa_bc_check $(BUILD)/bench/mesa_bc_check.o $(TOOL_OBJ) $(BUILD)/liblbkbake.a \
 	    $(BUILD)/liblbk.a $(TOOL_LIBS) -lEGL -lGL
 	$(BUILD)/bench/mesa_bc_check
-bench: deps-tools
+bench: deps-tools deps-bench
 	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BENCHES:%=$(BUILD)/bench/%)
 	@for b in $(BENCHES); do echo "== $$b"; $(BUILD)/bench/$$b || exit 1; done
 	@echo "== blender_import"; sh bench/blender_import.sh $(BUILD)/lbk $(BUILD)/bench-blender
+	@echo "== bench-cycles"; $(MAKE) --no-print-directory bench-cycles
 	@echo "== render (lbk render vs Blender Cycles)"; $(MAKE) --no-print-directory bench-render
 
+# lbk against Cycles (bench/cycles/README.md). LBK_TREE=/path/to/other/checkout compares that
+# tree's baker instead: its build/lbk (built there first) and texel_dump linked against its
+# baker objects, so the rebuilt layout is the one its lbk bakes.
+ifdef LBK_TREE
+CYC_LBK  := $(LBK_TREE)/$(BUILD)/lbk
+CYC_DUMP := $(BUILD)/bench/cycles/texel_dump-tree
+$(CYC_DUMP): bench/cycles/texel_dump.c FORCE
+	@$(MAKE) --no-print-directory -C $(LBK_TREE) $(BUILD)/lbk
+	@mkdir -p $(@D)
+	$(CC) $(CSTD) -O2 -g $(WARN) -I$(LBK_TREE)/libformat/include -I$(LBK_TREE)/bake/include -I$(LBK_TREE) \
+	    -I/usr/include/draco -I/usr/include/stb -c $< -o $@.o
+	$(CXX) -o $@ $@.o $$(ls $(LBK_TREE)/$(BUILD)/rel/bake/*/*.o | sort) $(LBK_TREE)/$(BUILD)/liblbk.a $(TOOL_LIBS)
+FORCE:
+else
+CYC_LBK  ?= $(BUILD)/lbk
+CYC_DUMP ?= $(BUILD)/bench/cycles/texel_dump
+endif
+bench-cycles: deps-tools deps-bench
+	@$(MAKE) --no-print-directory $(if $(LBK_TREE),,$(BUILD)/lbk) $(CYC_DUMP)
+	@LBK=$${LBK:-$(CYC_LBK)} LBK_TEXEL_DUMP=$${LBK_TEXEL_DUMP:-$(CYC_DUMP)} python3 bench/cycles/run.py
+
 # lbk render against converged Cycles renders (bench/render/README.md); the Cycles scene converter
-# comes from LBK_CYCLES_HARNESS (bench/cycles of the cycles branch until it is merged).
+# comes from LBK_CYCLES_HARNESS (default bench/cycles).
 LBK_CYCLES_HARNESS ?= bench/cycles
 bench-render: $(BUILD)/lbk
 	@LBK_CYCLES_HARNESS=$(LBK_CYCLES_HARNESS) python3 bench/render/run.py --lbk $(BUILD)/lbk --out $(BUILD)/bench-render $(BENCH_RENDER_ARGS)

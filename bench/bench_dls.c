@@ -1,321 +1,311 @@
-/* DLS apply: the clustered reference runtime against a naive per-target gather over the same
- * data (seed 001 §3.3: 4-byte address per target, u8 count, per overlap u8 set index + payload),
- * both measured in this run, next to a memcpy of the output bytes; and the ancillary bytes of
- * the clustered layout against its payload. Synthetic level at about the size of the seed's
- * ESTATE: 1M texels, 50k GLG and 20k LLG probes, 64 light sets with local footprints plus a
- * dense region where up to 16 sets overlap. */
-#define LBK_STATIC_LINKING_ONLY /* lbk_dls_stats: experimental (lbk/dls.h) */
+/* DLS apply (lbk_dls_apply) against memcpy, measured in the same run.
+ *
+ * Level: the synthetic ESTATE-sized level of tests/support/estate_level.h (seed 001 Table 1:
+ * 2.64 M texels, 280 k probes, 132 sets).
+ *
+ * Measured: apply when every set's weight changes (the seed's synchronous debug mode, its
+ * 1.47 ms on a PS4 GPU) and when one set changes, on 1 and 2 threads (the job API), as the
+ * bandwidth of the bytes apply must move — each applied target's base read and output written,
+ * each entry it blends read — against memcpy moving the same traffic (a copy of half as many
+ * bytes, reading and writing each) on as many threads. Also the same on the door/light-set
+ * levels of the room_with_doors scene (tests/support/door_scenes.h) as lbk bake writes them.
+ * `bench_dls --quick` skips the baked levels. */
+#define LBK_STATIC_LINKING_ONLY /* lbk_dls_stats, lbk_dls_runtime_path: experimental (lbk/dls.h) */
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-#include "lbk/ahd.h"
-#include "lbk/dls.h"
-#include "lbk/sh.h"
+#include <time.h>
+#include <unistd.h>
 
 #include "bake/util/clock.h"
+#include "bake/util/parallel.h"
 #include "bake/util/rng.h"
+#include "lbk/ahd.h"
+#include "lbk/bake.h"
+#include "lbk/container.h"
+#include "lbk/dls.h"
+#include "lbk/door.h"
+#include "lbk/lightmap.h"
+#include "lbk/sh.h"
+/* The generators live with the tests; benches link the tools only, so take their source. */
+#include "tests/support/bake_file.c"
+#include "tests/support/dls_fixture.c"
+#include "tests/support/door_scenes.c"
+#include "tests/support/estate_level.c"
 
-#define NSETS 64
+#define NSETS ESTATE_SETS
+#define PAGES ESTATE_PAGES
+#define T ESTATE_TEXELS
+#define G ESTATE_GLG
+#define L ESTATE_LLG
 
-static uint64_t rng_next(uint64_t *s) { return bk_mix64(*s += BK_GOLDEN64); } /* splitmix64 */
-static float uni(uint64_t *s) { return (float)(rng_next(s) >> 40) / 16777216.0f; }
+/* ---- timing -------------------------------------------------------------------------------- */
 
-static void random_texel(uint64_t *rng, float scale, uint8_t out[8])
+/* Wall and CPU seconds (the process's, over all its threads). On a shared machine the CPU time
+ * of one thread is the steadier number: wall time includes the time other processes had. */
+typedef struct clocks {
+    double wall, cpu;
+} clocks;
+
+static clocks clocks_now(void)
 {
-    lbk_ahd_linear lin;
-    memset(&lin, 0, sizeof lin);
-    float amb[3] = {scale * uni(rng), scale * uni(rng), scale * uni(rng)};
-    float x = 2 * uni(rng) - 1, y = 2 * uni(rng) - 1, z = 0.3f + uni(rng), n = 1 / sqrtf(x * x + y * y + z * z);
-    float dir[3] = {x * n, y * n, z * n}, rgb[3] = {scale * uni(rng), scale * uni(rng), scale * uni(rng)};
-    lbk_ahd_linear_add_ambient(&lin, amb);
-    lbk_ahd_linear_add_light(&lin, dir, rgb);
-    lbk_ahd_texel t;
-    lbk_ahd_from_linear(&lin, &t);
-    lbk_ahd_texel_pack(&t, out);
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (clocks){bk_now(), (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec};
 }
 
-static void random_probe(uint64_t *rng, float scale, uint8_t out[28])
+static void clocks_best(clocks *best, clocks t0, int threads)
 {
-    lbk_sh9_rgb sh;
-    memset(&sh, 0, sizeof sh);
-    for (int i = 0; i < 3; i++) {
-        float x = 2 * uni(rng) - 1, y = 2 * uni(rng) - 1, z = 2 * uni(rng) - 1, n = sqrtf(x * x + y * y + z * z) + 1e-6f;
-        float d[3] = {x / n, y / n, z / n}, rgb[3] = {scale * uni(rng), scale * uni(rng), scale * uni(rng)};
-        lbk_sh9_add_sample(&sh, d, rgb, 3.14159265f);
+    const clocks t1 = clocks_now();
+    const double wall = t1.wall - t0.wall, cpu = (t1.cpu - t0.cpu) / threads;
+    if (wall < best->wall) best->wall = wall;
+    if (cpu < best->cpu) best->cpu = cpu;
+}
+
+typedef struct memcpy_job {
+    uint8_t *dst;
+    const uint8_t *src;
+    size_t n;
+} memcpy_job;
+
+static void memcpy_chunk(void *user, size_t begin, size_t end, int thread)
+{
+    const memcpy_job *m = user;
+    const size_t part = (m->n + 15) / 16;
+    for (size_t i = begin; i < end; i++) {
+        const size_t a = i * part, b = a + part < m->n ? a + part : m->n;
+        if (a < b) memcpy(m->dst + a, m->src + a, b - a);
     }
-    lbk_sh9_pack(&sh, out);
+    (void)thread;
 }
 
-/* ---- naive per-target gather ---------------------------------------------------------------- */
+/* Best of `reps` memcpys moving `traffic` bytes (a copy of traffic / 2) on `threads` threads. */
+static clocks memcpy_time(uint64_t traffic, int threads, int reps)
+{
+    const size_t n = (size_t)(traffic / 2) + 64;
+    uint8_t *src = malloc(n), *dst = malloc(n);
+    memset(src, 1, n), memset(dst, 2, n);
+    memcpy_job m = {dst, src, n};
+    clocks best = {1e9, 1e9};
+    for (int i = 0; i < reps; i++) {
+        const clocks t0 = clocks_now();
+        if (threads == 1) memcpy(dst, src, n);
+        else bk_parallel_chunks(0, 16, 1, threads, memcpy_chunk, &m);
+        clocks_best(&best, t0, threads);
+    }
+    free(src), free(dst);
+    return best;
+}
 
-typedef struct naive {
-    uint64_t n;            /* targets */
-    uint32_t psize;
-    uint64_t *offset;      /* per target: record position (the seed counts 4 bytes; we need 8 here) */
-    uint8_t *stream;       /* record: u8 count, then count × (u8 set, payload) */
+static void job_chunk(void *user, size_t begin, size_t end, int thread)
+{
+    for (size_t j = begin; j < end; j++) lbk_dls_apply_job(user, (uint32_t)j);
+    (void)thread;
+}
+
+static lbk_result apply_threads(lbk_dls_runtime *rt, const float *w, const float *dw, int threads)
+{
+    uint32_t n;
+    lbk_result r = lbk_dls_apply_begin(rt, w, dw, &n);
+    if (r != LBK_OK) return r;
+    if (threads == 1) job_chunk(rt, 0, n, 0);
+    else bk_parallel_chunks(0, n, 1, threads, job_chunk, rt);
+    return lbk_dls_apply_end(rt, NULL);
+}
+
+/* The bytes an apply of these weights moves: per cluster with a changed set, its targets' base
+ * and output, and every entry it blends (all of them: every set is on in these scenarios). */
+static uint64_t traffic(const lbk_dls_view *v, const float *w_old, const float *w_new)
+{
+    uint64_t bytes = 0;
+    for (uint32_t c = 0; c < lbk_dls_cluster_count(v); c++) {
+        lbk_dls_cluster_info ci;
+        lbk_dls_cluster_get(v, c, &ci);
+        bool changed = !w_old;
+        for (uint32_t j = 0; j < ci.set_count && !changed; j++) {
+            uint32_t s;
+            lbk_dls_cluster_set_get(v, c, j, &s);
+            changed = w_old[s] != w_new[s];
+        }
+        const uint64_t psize = ci.space == LBK_DLS_SPACE_TEXEL ? 8 : 28;
+        if (changed) bytes += psize * (2 * (uint64_t)ci.target_count + ci.entry_count);
+    }
+    return bytes;
+}
+
+typedef struct scenario_result {
+    clocks apply, copy;
     uint64_t bytes;
-} naive;
+} scenario_result;
 
-typedef struct naive_fill {
-    naive *nv;
-    int pass;
-    uint32_t *count;
-} naive_fill;
-
-static int naive_cb(void *user, uint32_t target, uint32_t count, const uint32_t *sets, const uint8_t *payloads)
+/* Every set's weight changes between applies (on, 0.5…0.6), or only set `one` (≥ 0). */
+static int measure(lbk_dls_runtime *rt, const lbk_dls_view *v, uint32_t nsets, const float *dw, int one, int threads,
+                   int reps, scenario_result *out)
 {
-    naive_fill *f = user;
-    if (f->pass == 0) {
-        f->count[target] = count;
-        return 0;
+    float w0[256], w1[256];
+    out->apply = (clocks){1e9, 1e9};
+    for (int i = 0; i < reps; i++) {
+        for (uint32_t s = 0; s < nsets; s++) w0[s] = 0.5f + 0.01f * (float)(i % 7), w1[s] = w0[s] + 0.005f;
+        if (one >= 0) {
+            memcpy(w1, w0, nsets * sizeof *w0);
+            w1[one] = 0.25f;
+        }
+        if (apply_threads(rt, w0, dw, threads) != LBK_OK) return 1; /* the previous frame */
+        const clocks t0 = clocks_now();
+        if (apply_threads(rt, w1, dw, threads) != LBK_OK) return 1;
+        clocks_best(&out->apply, t0, threads);
+        out->bytes = traffic(v, w0, w1);
     }
-    uint8_t *p = f->nv->stream + f->nv->offset[target];
-    *p++ = (uint8_t)count;
-    for (uint32_t j = 0; j < count; j++) {
-        *p++ = (uint8_t)sets[j];
-        memcpy(p, payloads + (size_t)j * f->nv->psize, f->nv->psize);
-        p += f->nv->psize;
-    }
+    out->copy = memcpy_time(out->bytes, threads, reps + 2);
     return 0;
 }
 
-static void naive_build(naive *nv, const lbk_dls_view *v, uint32_t space)
+/* Ratios to memcpy by wall time and by CPU time per thread. */
+static void report(const char *what, int threads, const scenario_result *r)
 {
-    nv->n = lbk_dls_target_count(v, space);
-    nv->psize = space == 0 ? 8 : 28;
-    uint32_t *count = calloc(nv->n, 4);
-    naive_fill f = {nv, 0, count};
-    for (int pass = 0; pass < 2; pass++) {
-        f.pass = pass;
-        if (pass == 1) {
-            nv->offset = malloc(nv->n * 8);
-            uint64_t at = 0;
-            for (uint64_t t = 0; t < nv->n; t++) {
-                nv->offset[t] = at;
-                at += 1 + (uint64_t)count[t] * (1 + nv->psize);
-            }
-            nv->bytes = at;
-            nv->stream = calloc(at, 1);
-        }
-        for (uint32_t c = 0; c < lbk_dls_cluster_count(v); c++) {
-            lbk_dls_cluster_info info;
-            lbk_dls_cluster_get(v, c, &info);
-            if (info.space == space) lbk_dls_cluster_decode(v, c, naive_cb, &f);
-        }
-    }
-    free(count);
+    printf("  %-18s %d thread%s: %7.2f MB moved in %8.3f ms wall (%5.2f GB/s), %8.3f ms CPU/thread; memcpy of that "
+           "traffic %7.3f ms wall, %7.3f ms CPU: %.3f of memcpy (wall), %.3f (CPU)\n",
+           what, threads, threads > 1 ? "s" : " ", r->bytes / 1e6, r->apply.wall * 1e3, r->bytes / r->apply.wall / 1e9,
+           r->apply.cpu * 1e3, r->copy.wall * 1e3, r->copy.cpu * 1e3, r->copy.wall / r->apply.wall, r->copy.cpu / r->apply.cpu);
 }
 
-static void naive_texels(const naive *nv, const float *w, const uint32_t *bz, const uint8_t *brgba, uint32_t *oz, uint8_t *orgba)
+/* ---- the synthetic level's applies --------------------------------------------------------- */
+
+static int estate(void)
 {
-    for (uint64_t t = 0; t < nv->n; t++) {
-        const uint8_t *p = nv->stream + nv->offset[t];
-        uint32_t n = *p++;
-        int active = 0;
-        for (uint32_t j = 0; j < n; j++) active |= w[p[j * 9]] != 0.0f;
-        if (!active) {
-            oz[t] = bz[t];
-            memcpy(orgba + 4 * t, brgba + 4 * t, 4);
-            continue;
-        }
-        lbk_ahd_texel b = {bz[t], {0}};
-        memcpy(b.rgba, brgba + 4 * t, 4);
-        lbk_ahd_linear acc, l;
-        lbk_ahd_to_linear(&b, &acc);
-        for (uint32_t j = 0; j < n; j++, p += 9) {
-            float wj = w[p[0]];
-            if (wj == 0.0f) continue;
-            lbk_ahd_texel e;
-            lbk_ahd_texel_unpack(p + 1, &e);
-            lbk_ahd_to_linear(&e, &l);
-            lbk_ahd_linear_add_scaled(&acc, &l, wj);
-        }
-        lbk_ahd_texel o;
-        lbk_ahd_from_linear(&acc, &o);
-        oz[t] = o.irradiance_z;
-        memcpy(orgba + 4 * t, o.rgba, 4);
-    }
-}
-
-static void naive_probes(const naive *nv, const float *w, const uint8_t *base, uint8_t *out)
-{
-    for (uint64_t t = 0; t < nv->n; t++) {
-        const uint8_t *p = nv->stream + nv->offset[t];
-        uint32_t n = *p++;
-        int active = 0;
-        for (uint32_t j = 0; j < n; j++) active |= w[p[j * 29]] != 0.0f;
-        if (!active) {
-            memcpy(out + 28 * t, base + 28 * t, 28);
-            continue;
-        }
-        lbk_sh9_rgb acc, l;
-        lbk_sh9_unpack(base + 28 * t, &acc);
-        for (uint32_t j = 0; j < n; j++, p += 29) {
-            float wj = w[p[0]];
-            if (wj == 0.0f) continue;
-            lbk_sh9_unpack(p + 1, &l);
-            lbk_sh9_add_scaled(&acc, &l, wj);
-        }
-        lbk_sh9_pack(&acc, out + 28 * t);
-    }
-}
-
-/* ---- main ------------------------------------------------------------------------------------ */
-
-int main(void)
-{
-    const uint64_t T = 1000000, G = 50000, L = 20000;
-    const uint64_t counts[3] = {T, G, L};
-    uint64_t rng = 12345;
-
-    /* Sets: local footprints in index space (texel order follows the atlas, so nearby texels are
-     * nearby in the level), sets 48..63 all overlapping one 4000-texel region (a room full of
-     * individually switchable lights). */
-    static lbk_dls_set_desc sets[NSETS];
-    static char names[NSETS][16];
-    uint32_t *tg[NSETS][3];
-    uint8_t *pl[NSETS][3];
-    uint64_t payload_total = 0;
-    for (uint32_t s = 0; s < NSETS; s++) {
-        snprintf(names[s], sizeof names[s], "lights%02u", s);
-        sets[s].name = names[s];
-        sets[s].kind = LBK_DLS_KIND_LIGHTS;
-        for (uint32_t sp = 0; sp < 3; sp++) {
-            uint64_t n = counts[sp];
-            uint64_t radius, centre;
-            if (s >= 48) {
-                radius = sp == 0 ? 2000 : 100;
-                centre = n / 2;
-            } else {
-                radius = (uint64_t)((sp == 0 ? 4000.0 : 200.0) * (0.5 + 4 * uni(&rng)));
-                centre = radius + rng_next(&rng) % (n - 2 * radius);
-            }
-            uint64_t len = 2 * radius;
-            tg[s][sp] = malloc(len * 4);
-            pl[s][sp] = malloc(len * (sp == 0 ? 8 : 28));
-            for (uint64_t i = 0; i < len; i++) {
-                tg[s][sp][i] = (uint32_t)(centre - radius + i);
-                if (sp == 0) random_texel(&rng, 0.5f, pl[s][sp] + 8 * i);
-                else random_probe(&rng, 0.5f, pl[s][sp] + 28 * i);
-            }
-            sets[s].entries[sp] = (lbk_dls_sparse){len, tg[s][sp], pl[s][sp]};
-            payload_total += len;
-        }
-    }
-    lbk_dls_build_desc desc = {.set_count = NSETS, .sets = sets, .target_count = {T, G, L}};
-    void *bytes;
-    size_t size;
-    lbk_dls_stats st;
-    double t0 = bk_now();
-    lbk_result r = lbk_dls_build(&desc, NULL, &bytes, &size, &st);
-    double t_build = bk_now() - t0;
-    if (r != LBK_OK) {
-        fprintf(stderr, "build failed: %s\n", lbk_result_name(r));
-        return 1;
-    }
-    lbk_dls_view *v;
-    lbk_dls_open(bytes, size, NULL, &v);
-    printf("level: %llu texels, %llu GLG, %llu LLG probes, %d sets, %llu entries; build %.2f s\n",
-           (unsigned long long)T, (unsigned long long)G, (unsigned long long)L, NSETS, (unsigned long long)payload_total, t_build);
-    printf("clusters: %u (dedicated %u, packed %u with %u sub-groups, prefix-2 %u, prefix-3 %u, prefix-8 %u)\n", st.cluster_count,
-           st.clusters_by_form[0], st.clusters_by_form[1], st.packed_subgroups, st.clusters_by_form[2], st.clusters_by_form[3],
-           st.clusters_by_form[4]);
-    printf("texel overlap histogram:");
-    for (int b = 0; b < LBK_DLS_HISTOGRAM_BINS; b++) printf(" %llu", (unsigned long long)st.histogram[0][b]);
-    printf("\n");
-    printf("DLS section %llu bytes: payload %llu, ancillary %llu (%.2f%% of payload); texel index data %llu bytes = %.2f bits per touched texel\n",
-           (unsigned long long)st.section_bytes, (unsigned long long)st.payload_bytes, (unsigned long long)st.ancillary_bytes,
-           100.0 * (double)st.ancillary_bytes / (double)st.payload_bytes, (unsigned long long)st.index_bytes[0],
-           st.index_bits_per_target[0]);
-
-    /* base and output buffers */
-    uint32_t *bz = malloc(T * 4), *oz = malloc(T * 4), *nz = malloc(T * 4);
-    uint8_t *brgba = malloc(T * 4), *orgba = malloc(T * 4), *nrgba = malloc(T * 4);
-    uint8_t *bg = malloc(G * 28), *og = malloc(G * 28), *ng = malloc(G * 28);
-    uint8_t *bl = malloc(L * 28), *ol = malloc(L * 28), *nl = malloc(L * 28);
+    estate_level lv;
+    if (estate_build(&lv)) return 1;
+    estate_describe(&lv);
+    uint64_t rng = 99;
+    uint8_t *base0 = malloc(T * 4), *base1 = malloc(T * 4), *out0 = malloc(T * 4), *out1 = malloc(T * 4);
+    uint8_t *bg = malloc(G * 28), *og = malloc(G * 28), *bl = malloc(L * 28), *ol = malloc(L * 28);
     for (uint64_t t = 0; t < T; t++) {
         uint8_t b[8];
-        random_texel(&rng, 1.0f, b);
-        lbk_ahd_texel tx;
-        lbk_ahd_texel_unpack(b, &tx);
-        bz[t] = tx.irradiance_z;
-        memcpy(brgba + 4 * t, tx.rgba, 4);
+        dlsfx_random_texel(&rng, 2.0f, b);
+        memcpy(base0 + 4 * t, b, 4), memcpy(base1 + 4 * t, b + 4, 4);
     }
-    for (uint64_t t = 0; t < G; t++) random_probe(&rng, 1.0f, bg + 28 * t);
-    for (uint64_t t = 0; t < L; t++) random_probe(&rng, 1.0f, bl + 28 * t);
-    lbk_dls_runtime_desc rd = {.dls = v, .base_irradiance_z = bz, .base_rgba = brgba, .base_glg = bg, .base_llg = bl,
-                               .out_irradiance_z = oz, .out_rgba = orgba, .out_glg = og, .out_llg = ol};
-    lbk_dls_runtime *rt;
-    if (lbk_dls_runtime_open(&rd, &rt) != LBK_OK) return 1;
-    naive nv[3];
-    for (uint32_t sp = 0; sp < 3; sp++) naive_build(&nv[sp], v, sp);
-    uint64_t naive_index = 0;
-    for (uint32_t sp = 0; sp < 3; sp++) /* 4-byte address + count byte per target, a set byte per entry */
-        naive_index += nv[sp].n * 5 + (nv[sp].bytes - nv[sp].n) / (1 + nv[sp].psize);
-    printf("naive gather layout: %.1f MB of addresses, counts and set indices (clustered: %.3f MB)\n", naive_index / 1e6,
-           st.ancillary_bytes / 1e6);
-
-    float w[NSETS], w2[NSETS];
-    const int reps = 5;
-    const uint64_t out_bytes = T * 8 + (G + L) * 28;
-
-    /* memcpy of the output bytes */
-    double best_copy = 1e9;
-    for (int i = 0; i < reps; i++) {
-        t0 = bk_now();
-        memcpy(oz, bz, T * 4);
-        memcpy(orgba, brgba, T * 4);
-        memcpy(og, bg, G * 28);
-        memcpy(ol, bl, L * 28);
-        double dt = bk_now() - t0;
-        if (dt < best_copy) best_copy = dt;
+    for (uint64_t t = 0; t < G; t++) dlsfx_random_probe(&rng, 2.0f, bg + 28 * t);
+    for (uint64_t t = 0; t < L; t++) dlsfx_random_probe(&rng, 2.0f, bl + 28 * t);
+    lbk_dls_page pages[PAGES];
+    for (uint32_t p = 0; p < PAGES; p++) {
+        const uint64_t f = estate_page_first(p);
+        pages[p] = (lbk_dls_page){.width = estate_page_w[p], .height = estate_page_h[p], .base_irradiance = base0 + 4 * f,
+                                  .base_rgba = base1 + 4 * f, .out_irradiance = out0 + 4 * f, .out_rgba = out1 + 4 * f};
     }
-
-    struct scenario {
-        const char *name;
-        int all_on, one_changed, half_off;
-    } scen[] = {{"all sets on, all changed (seed's debug mode)", 1, 0, 0},
-                {"half the sets off, all changed", 0, 0, 1},
-                {"one set changed since the last frame", 1, 1, 0}};
-    printf("memcpy of the %.1f MB output: %.3f ms (%.2f GB/s)\n", out_bytes / 1e6, best_copy * 1e3, out_bytes / best_copy / 1e9);
-    for (size_t sc = 0; sc < sizeof scen / sizeof scen[0]; sc++) {
-        double best_rt = 1e9, best_nv = 1e9;
-        for (int i = 0; i < reps; i++) {
-            for (int s = 0; s < NSETS; s++) {
-                w[s] = scen[sc].half_off && (s & 1) ? 0.0f : 0.5f + 0.01f * (float)(i + 1);
-                w2[s] = w[s];
-            }
-            if (scen[sc].one_changed) {
-                for (int s = 0; s < NSETS; s++) w[s] = w2[s] = 0.7f;
-                lbk_dls_apply(rt, w, NULL, NULL); /* previous frame */
-                w2[5] = 0.3f + 0.01f * (float)i;
-            } else {
-                lbk_dls_apply(rt, NULL, NULL, NULL); /* previous frame: everything off */
-            }
-            t0 = bk_now();
-            lbk_dls_apply(rt, w2, NULL, NULL);
-            double dt = bk_now() - t0;
-            if (dt < best_rt) best_rt = dt;
-            t0 = bk_now();
-            naive_texels(&nv[0], w2, bz, brgba, nz, nrgba);
-            naive_probes(&nv[1], w2, bg, ng);
-            naive_probes(&nv[2], w2, bl, nl);
-            dt = bk_now() - t0;
-            if (dt < best_nv) best_nv = dt;
+    int bad = 0;
+    for (int path = 0; path < 2 && !bad; path++) {
+        lbk_dls_runtime_desc d = {.size = sizeof d, .dls = lv.view, .base_glg = bg, .base_llg = bl, .out_glg = og,
+                                  .out_llg = ol, .page_count = PAGES, .pages = pages,
+                                  .flags = path ? LBK_DLS_RUNTIME_SCALAR : 0};
+        lbk_dls_runtime *rt;
+        if (lbk_dls_runtime_open(&d, &rt) != LBK_OK) return 1;
+        printf(" path %s:\n", lbk_dls_runtime_path(rt));
+        scenario_result r;
+        for (int threads = 1; threads <= (path ? 1 : 2) && !bad; threads++) {
+            bad |= measure(rt, lv.view, NSETS, NULL, -1, threads, path ? 1 : 4, &r);
+            report("every set changes", threads, &r);
+            if (path) break;
+            bad |= measure(rt, lv.view, NSETS, NULL, 5, threads, 8, &r);
+            report("one set changes", threads, &r);
         }
-        int same = !memcmp(oz, nz, T * 4) && !memcmp(orgba, nrgba, T * 4) && !memcmp(og, ng, G * 28) && !memcmp(ol, nl, L * 28);
-        printf("%s:\n  clustered %.3f ms, naive gather %.3f ms: %.1fx faster; clustered at %.3f of memcpy speed%s\n", scen[sc].name,
-               best_rt * 1e3, best_nv * 1e3, best_nv / best_rt, best_copy / best_rt, same ? "" : " (OUTPUTS DIFFER)");
+        uint32_t nranges = lbk_dls_dirty_range_count(rt, 0), nrects = 0;
+        for (uint32_t p = 0; p < PAGES; p++) nrects += lbk_dls_dirty_rect_count(rt, p);
+        if (!path) printf("  after the last apply: %u dirty texel ranges, %u rectangles over %d pages\n", nranges, nrects, PAGES);
+        lbk_dls_runtime_close(rt);
     }
+    free(base0), free(base1), free(out0), free(out1), free(bg), free(og), free(bl), free(ol);
+    estate_free(&lv);
+    return bad;
+}
+
+/* ---- the baked door/light-set levels ------------------------------------------------------- */
+
+static int baked(const char *dir, const char *name, const ds_options *o)
+{
+    char gltf[256], path[256], err[512];
+    snprintf(gltf, sizeof gltf, "%s/%s.gltf", dir, name);
+    snprintf(path, sizeof path, "%s/%s.lbk", dir, name);
+    if (ds_write_room_scene(DS_ROOM_GLB, gltf, o, err, sizeof err)) {
+        fprintf(stderr, "%s: %s\n", name, err);
+        return 1;
+    }
+    tb_job bo;
+    memset(&bo, 0, sizeof bo);
+    bo.in = gltf, bo.out = path;
+    bo.d.seed = 1, bo.d.target_error = 1e-9, bo.d.max_samples = 64;
+    lbk_bake_report sum;
+    int rc = tb_bake(&bo, &sum, err, sizeof err);
+    unlink(gltf);
+    if (rc) {
+        fprintf(stderr, "%s: bake failed: %s\n", name, err);
+        return 1;
+    }
+    lbk_reader *rd;
+    const void *d;
+    size_t n;
+    lbk_lmap_view lm;
+    lbk_dls_view *dv = NULL;
+    lbk_door_view *door = NULL;
+    int bad = lbk_reader_open_file(path, NULL, &rd) != LBK_OK;
+    bad = bad || lbk_reader_section_by_type(rd, LBK_SECTION_LMAP, &d, &n) || lbk_lmap_open(d, n, &lm);
+    bad = bad || lbk_reader_section_by_type(rd, LBK_SECTION_DLS, &d, &n) || lbk_dls_open(d, n, NULL, &dv);
+    if (!bad && lbk_reader_section_by_type(rd, LBK_SECTION_DOOR, &d, &n) == LBK_OK) bad = lbk_door_open(d, n, NULL, &door) != LBK_OK;
+    if (bad) {
+        fprintf(stderr, "%s: cannot read %s\n", name, path);
+        return 1;
+    }
+    /* pages in place: the LMAP planes are the bases, outputs laid out the same way */
+    lbk_dls_page *pages = calloc(lm.page_count, sizeof *pages);
+    uint8_t **outs = calloc(2 * lm.page_count, sizeof *outs);
+    for (uint32_t p = 0; p < lm.page_count; p++) {
+        lbk_lmap_page pg;
+        lbk_lmap_page_get(&lm, p, &pg);
+        outs[2 * p] = malloc(4 * (size_t)pg.width * pg.height), outs[2 * p + 1] = malloc(4 * (size_t)pg.width * pg.height);
+        pages[p] = (lbk_dls_page){.width = pg.width, .height = pg.height, .base_irradiance = pg.irradiance,
+                                  .base_rgba = pg.rgba, .out_irradiance = outs[2 * p], .out_rgba = outs[2 * p + 1]};
+    }
+    const uint64_t ng = lbk_dls_target_count(dv, 1), nl = lbk_dls_target_count(dv, 2);
+    uint8_t *bg = calloc(ng + 1, 28), *og = calloc(ng + 1, 28), *bl = calloc(nl + 1, 28), *ol = calloc(nl + 1, 28);
+    lbk_dls_runtime_desc rdsc = {.size = sizeof rdsc, .dls = dv, .doors = door, .base_glg = bg, .base_llg = bl,
+                                 .out_glg = og, .out_llg = ol, .page_count = lm.page_count, .pages = pages};
+    lbk_dls_runtime *rt;
+    if (lbk_dls_runtime_open(&rdsc, &rt) != LBK_OK) return 1;
+    lbk_dls_stats st;
+    lbk_dls_stats_get(dv, &st);
+    printf(" %s: %llu texels, %llu GLG + %llu LLG probes, %u sets, %u clusters, %.1f KB DLS\n", name,
+           (unsigned long long)lm.texel_count, (unsigned long long)ng, (unsigned long long)nl, st.set_count, st.cluster_count,
+           st.section_bytes / 1e3);
+    const float dw[8] = {0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f};
+    scenario_result r;
+    bad |= measure(rt, dv, st.set_count, door ? dw : NULL, -1, 1, 50, &r);
+    report("every set changes", 1, &r);
+    bad |= measure(rt, dv, st.set_count, door ? dw : NULL, 0, 1, 50, &r);
+    report("one set changes", 1, &r);
     lbk_dls_runtime_close(rt);
-    lbk_dls_close(v);
-    free(bytes);
-    for (uint32_t sp = 0; sp < 3; sp++) free(nv[sp].offset), free(nv[sp].stream);
-    for (uint32_t s = 0; s < NSETS; s++)
-        for (uint32_t sp = 0; sp < 3; sp++) free(tg[s][sp]), free(pl[s][sp]);
-    free(bz), free(oz), free(nz), free(brgba), free(orgba), free(nrgba);
-    free(bg), free(og), free(ng), free(bl), free(ol), free(nl);
-    return 0;
+    for (uint32_t p = 0; p < 2 * lm.page_count; p++) free(outs[p]);
+    free(outs), free(pages), free(bg), free(og), free(bl), free(ol);
+    if (door) lbk_door_close(door);
+    lbk_dls_close(dv);
+    lbk_reader_close(rd);
+    unlink(path);
+    return bad;
+}
+
+int main(int argc, char **argv)
+{
+    const int quick = argc > 1 && !strcmp(argv[1], "--quick");
+    int bad = estate();
+    if (!quick && !bad) {
+        char dir[] = "/tmp/lbk_bench_dls_XXXXXX";
+        if (!mkdtemp(dir)) return 1;
+        printf("levels baked by lbk bake from room_with_doors (door_scenes.h):\n");
+        ds_options sets = {DS_DOOR_PLAIN, DS_INSIDE_SETS, 0, 1, 0.5f, 8, 0, 0, 0};
+        ds_options door = {DS_DOOR_TAGGED, DS_INSIDE_SETS, 1, 1, 0.5f, 8, 0, 0, 0};
+        bad |= baked(dir, "sets A+B", &sets);
+        bad |= baked(dir, "sets A+B+C0 + door", &door);
+        rmdir(dir);
+    }
+    return bad;
 }

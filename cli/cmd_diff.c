@@ -6,13 +6,14 @@
 #include <string.h>
 
 #include "cli/cli.h"
+#include "cli/options.h"
 #include "tools/inspect/diff.h"
 
 static void usage(FILE *f)
 {
     fprintf(f,
             "usage: lbk diff A.lbk B.lbk [--mode noise|tolerance] [--false-alarm P] [--abs-tol X] [--rel-tol Y]\n"
-            "                [--json] [--heatmap DIR] [-v]\n"
+            "                [--json] [--heatmap DIR] [--max-memory SIZE] [-v]\n"
             "\n"
             "Compares decoded lighting, not bytes. Objects are matched by name and geometry hash (then by\n"
             "name alone, then by hash alone = renamed), never by position in the file; pages by index;\n"
@@ -41,6 +42,7 @@ static void usage(FILE *f)
             "  --heatmap DIR   DIR/page_NNN.diff.png per page: black = within tolerance, blue..white = error\n"
             "                  over tolerance relative to the page's largest, grey = not compared\n"
             "  -v, --verbose   list unchanged items too\n"
+            CLI_MAX_MEMORY_HELP
             "  -h, --help      this text\n"
             "\n"
             "exit codes: 0 equal (within noise / tolerance), 1 the bakes differ (lighting, objects, pages, probes,\n"
@@ -69,7 +71,11 @@ int lbk_cmd_diff(int argc, char **argv)
     tl_diff_options o = {0};
     o.mode = TL_DIFF_MODE_AUTO;
     int mode_given = 0, tol_given = 0;
+    uint64_t max_memory = 0;
     for (int i = 1; i < argc; i++) {
+        const int mm = cli_max_memory_option("diff", argc, argv, &i, &max_memory);
+        if (mm < 0) return LBK_EXIT_USAGE;
+        if (mm) continue;
         const char *a = argv[i];
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             usage(stdout);
@@ -124,7 +130,7 @@ int lbk_cmd_diff(int argc, char **argv)
     char err[TL_ERR_LEN];
     tl_bake bake[2];
     for (int k = 0; k < 2; k++) {
-        tl_open_status st = tl_bake_open_file(path[k], &bake[k], err);
+        tl_open_status st = tl_bake_open_file_capped(path[k], max_memory, &bake[k], err);
         if (st != TL_OPEN_OK) {
             fprintf(stderr, "lbk diff: %s\n", err);
             if (k) tl_bake_close(&bake[0]);

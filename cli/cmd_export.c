@@ -3,13 +3,14 @@
 #include <string.h>
 
 #include "cli/cli.h"
+#include "cli/options.h"
 #include "tools/convert/export.h"
 #include "tools/convert/gltf_export.h"
 
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: lbk export IN.lbk [--exr DIR] [--png DIR] [--per-object] [--gltf OUT.glb --scene SCENE] [-q]\n"
+            "usage: lbk export IN.lbk [--exr DIR] [--png DIR] [--per-object] [--gltf OUT.glb --scene SCENE] [--max-memory SIZE] [-q]\n"
             "       (at least one of --exr, --png, --gltf)\n"
             "\n"
             "Units: irradiance in lux-like units (lm/m^2); probe SH in radiance (nits, cd/m^2). Images are\n"
@@ -40,6 +41,7 @@ static void usage(FILE *f)
             "                 (preview, also the base colour texture of unlit preview materials); GLG and LLG probes\n"
             "                 as accessors named in the extras (tools/convert/README.md \"glTF export\")\n"
             "  -q, --quiet    no summary\n"
+            CLI_MAX_MEMORY_HELP
             "  -h, --help     this text\n"
             "\n"
             "exit codes: 0 written, 2 usage, 3 I/O error (read or write), 4 the input is not a valid container\n"
@@ -53,7 +55,11 @@ int lbk_cmd_export(int argc, char **argv)
     tl_export_options o = {NULL, NULL, 0};
     tl_gltf_options g = {NULL, NULL, NULL};
     int quiet = 0;
+    uint64_t max_memory = 0;
     for (int i = 1; i < argc; i++) {
+        const int mm = cli_max_memory_option("export", argc, argv, &i, &max_memory);
+        if (mm < 0) return LBK_EXIT_USAGE;
+        if (mm) continue;
         const char *a = argv[i];
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             usage(stdout);
@@ -104,7 +110,7 @@ int lbk_cmd_export(int argc, char **argv)
     }
     char err[TL_ERR_LEN];
     tl_bake b;
-    tl_open_status st = tl_bake_open_file(in, &b, err);
+    tl_open_status st = tl_bake_open_file_capped(in, max_memory, &b, err);
     if (st != TL_OPEN_OK) {
         fprintf(stderr, "lbk export: %s\n", err);
         return st == TL_OPEN_IO ? LBK_EXIT_IO : st == TL_OPEN_INVALID ? LBK_EXIT_INPUT : LBK_EXIT_INTERNAL;

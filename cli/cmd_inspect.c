@@ -9,6 +9,7 @@
 #include <cjson/cJSON.h>
 
 #include "cli/cli.h"
+#include "cli/options.h"
 #include "tools/common/bake_data.h"
 #include "tools/inspect/budget.h"
 #include "tools/inspect/describe.h"
@@ -27,7 +28,7 @@ typedef struct section_row {
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: lbk inspect FILE [--json] [--budget SIZE|FILE]\n"
+            "usage: lbk inspect FILE [--json] [--budget SIZE|FILE] [--max-memory SIZE]\n"
             "\n"
             "Memory per level: for each section the bytes on disk, decoded bytes and GPU-resident\n"
             "bytes, plus header, table and padding bytes (the disk column adds up to the file size),\n"
@@ -42,6 +43,7 @@ static void usage(FILE *f)
             "  --budget FILE    ... or the limits of a budget file: total, per section type, per object,\n"
             "                   per light set (spec/inspect-json.md \"Budget files\"); every item over its\n"
             "                   limit is named\n"
+            CLI_MAX_MEMORY_HELP
             "  --help           this text\n"
             "\n"
             "exit codes: 0 ok (within budget), 1 over budget, 2 usage, 3 I/O error, 4 not a readable\n"
@@ -312,7 +314,11 @@ int lbk_cmd_inspect(int argc, char **argv)
 {
     const char *path = NULL, *budget_arg = NULL;
     int json = 0;
+    uint64_t max_memory = 0;
     for (int i = 1; i < argc; i++) {
+        const int mm = cli_max_memory_option("inspect", argc, argv, &i, &max_memory);
+        if (mm < 0) return LBK_EXIT_USAGE;
+        if (mm) continue;
         if (!strcmp(argv[i], "--json")) json = 1;
         else if (!strcmp(argv[i], "--budget")) {
             if (i + 1 >= argc) {
@@ -347,7 +353,9 @@ int lbk_cmd_inspect(int argc, char **argv)
     }
     lbk_reader *reader;
     errno = 0;
-    lbk_result res = lbk_reader_open_file(path, NULL, &reader);
+    lbk_read_options ro = LBK_READ_OPTIONS_INIT;
+    ro.max_decoded_bytes = max_memory;
+    lbk_result res = lbk_reader_open_file(path, &ro, &reader);
     if (res == LBK_ERR_IO) {
         fprintf(stderr, "lbk inspect: %s: %s\n", path, errno ? strerror(errno) : lbk_result_message(res));
         return LBK_EXIT_IO;
@@ -401,7 +409,7 @@ int lbk_cmd_inspect(int argc, char **argv)
     tl_level_memory mem;
     int have_mem = 0;
     if (json || budget_arg) {
-        tl_open_status st = tl_bake_open_file(path, &bake, err);
+        tl_open_status st = tl_bake_open_file_capped(path, max_memory, &bake, err);
         if (st == TL_OPEN_OK) {
             if (tl_level_memory_get(&bake, &mem) == 0) have_mem = 1, r.memory = &mem;
             else r.memory_error = "out of memory";

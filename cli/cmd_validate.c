@@ -8,6 +8,7 @@
 #include <cjson/cJSON.h>
 
 #include "cli/cli.h"
+#include "cli/options.h"
 #include "lbk/validate.h"
 
 static const char *severity_name(lbk_severity s)
@@ -18,13 +19,14 @@ static const char *severity_name(lbk_severity s)
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: lbk validate FILE [--json] [--quiet]\n"
+            "usage: lbk validate FILE [--json] [--quiet] [--max-memory SIZE]\n"
             "\n"
             "Runs every check of spec/validation.md on a container and lists each issue with its\n"
             "ID, severity, section, byte offset and message, then a summary line.\n"
             "\n"
             "  --json    one JSON document (schema \"lbk-validate/1\", spec/inspect-json.md)\n"
             "  --quiet   print nothing; only the exit code tells\n"
+            CLI_MAX_MEMORY_HELP
             "  --help    this text\n"
             "\n"
             "exit codes: 0 valid (warnings allowed), 1 invalid, 2 usage, 3 I/O error, 5 internal\n");
@@ -65,7 +67,11 @@ int lbk_cmd_validate(int argc, char **argv)
 {
     const char *path = NULL;
     validate_out o = {0};
+    uint64_t max_memory = 0;
     for (int i = 1; i < argc; i++) {
+        const int mm = cli_max_memory_option("validate", argc, argv, &i, &max_memory);
+        if (mm < 0) return LBK_EXIT_USAGE;
+        if (mm) continue;
         if (!strcmp(argv[i], "--json")) o.json = 1;
         else if (!strcmp(argv[i], "--quiet") || !strcmp(argv[i], "-q")) o.quiet = 1;
         else if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
@@ -103,7 +109,9 @@ int lbk_cmd_validate(int argc, char **argv)
     }
     lbk_validate_summary s;
     errno = 0;
-    lbk_result r = lbk_validate_file(path, NULL, on_issue, &o, &s);
+    lbk_validate_options vo = LBK_VALIDATE_OPTIONS_INIT;
+    vo.max_decoded_bytes = max_memory;
+    lbk_result r = lbk_validate_file(path, &vo, on_issue, &o, &s);
     if (r == LBK_ERR_IO || r == LBK_ERR_LIMIT) {
         if (!o.quiet) fprintf(stderr, "lbk validate: %s: %s\n", path, errno ? strerror(errno) : lbk_result_message(r));
         cJSON_Delete(doc);

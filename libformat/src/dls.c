@@ -762,6 +762,16 @@ lbk_result lbk_dls_cluster_set_get(const lbk_dls_view *view, uint32_t cluster, u
     return LBK_OK;
 }
 
+lbk_result lbk_dls_array_get(const lbk_dls_view *view, uint32_t array, uint64_t *offset, uint64_t *count)
+{
+    if (!view) return LBK_ERR_INVALID_ARGUMENT;
+    if (array >= LBK_DLS_ARRAY_COUNT_) return LBK_ERR_NOT_FOUND;
+    /* lbk_dls_array numbers the arrays as the spec orders them, as DLS_A_* does */
+    if (offset) *offset = view->L.offset[array];
+    if (count) *count = view->L.count[array];
+    return LBK_OK;
+}
+
 void lbk_dls_view_raw(const lbk_dls_view *v, lbk_dls_raw *raw)
 {
     raw->d = v->d;

@@ -25,7 +25,8 @@ enum {
     DLS_H_TARGET_COUNT = 72         /* u64 × 3: texels, GLG probes, LLG probes */
 };
 
-/* The arrays follow the header in this order, each at the next multiple of 16. */
+/* The arrays follow the header in this order, each at the next multiple of 16 (the order of the
+ * public lbk_dls_array too). */
 enum {
     DLS_A_SETS,
     DLS_A_LIGHT_REFS,

@@ -12,7 +12,9 @@
  *
  * Random bytes rarely get past the checksums, so every input is tried twice: as it is, and with
  * its file_size, section checksums, table and header checksums recomputed, which lets the
- * fuzzer mutate section contents and reach every section reader. */
+ * fuzzer mutate section contents and reach every section reader. A DLS section that opens
+ * also goes through the runtime (the job planner and the kernels walk its runs, sub-groups and
+ * prefix data): applies whole and split into jobs, and the dirty regions. */
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -298,6 +300,20 @@ static void apply_dls(const lbk_dls_view *dv, const lbk_door_view *doors, const 
     lbk_dls_effective_weights(rt, w, dw, eff);
     lbk_dls_runtime_invalidate(rt);
     if (lbk_dls_apply(rt, NULL, NULL, &st) != LBK_OK && valid) abort();
+    /* the same apply split into jobs (run in reverse order), then the regions it reports */
+    for (uint32_t i = 1; i < sets; i += 3) w[i] = 2.0f;
+    uint32_t jobs;
+    if (lbk_dls_apply_begin(rt, w, dw, &jobs) == LBK_OK) {
+        for (uint32_t j = jobs; j-- > 0;) lbk_dls_apply_job(rt, j);
+        if (lbk_dls_apply_end(rt, &st) != LBK_OK && valid) abort();
+    } else if (valid) {
+        abort();
+    }
+    for (uint32_t sp = 0; sp < 3; sp++)
+        for (uint32_t i = 0; i < lbk_dls_dirty_range_count(rt, sp); i++) {
+            lbk_dls_range rg;
+            if (lbk_dls_dirty_range_get(rt, sp, i, &rg) != LBK_OK) abort();
+        }
     touch(out_z, 4 * tx), touch(out_rgba, 4 * tx), touch(out_glg, 28 * gp), touch(out_llg, 28 * lp);
     lbk_dls_runtime_close(rt);
 done:

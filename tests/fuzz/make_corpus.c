@@ -5,7 +5,10 @@
  *   every_raw.lbk, every_zstd.lbk      every section type (META, REPT, OBJS, LMAP, GLG, LLG,
  *                                      OCTP, DLS, DOOR), consistent across sections, so the
  *                                      fuzzer starts from inputs that reach every section
- *                                      reader, sampler and cross-section check.
+ *                                      reader, sampler and cross-section check;
+ *   dls.lbk                            META, OBJS, LMAP, GLG, LLG, DLS, DOOR: 24 sets over 600 texels and 64 + 64 probes,
+ *                                      clusters of every form (dedicated, packed, prefix-2, -3,
+ *                                      -8), so the runtime's planner and kernels see them all.
  * Each file must pass lbk_validate with no finding; the program fails otherwise. */
 #include <stdio.h>
 #include <string.h>
@@ -159,6 +162,95 @@ static int build_dls_door(void **dls, size_t *dls_n, void **door, size_t *door_n
     return r != LBK_OK;
 }
 
+/* dls.lbk: DLS + DOOR with clusters of every form, for the runtime (job planner, kernels). 24 sets
+ * over 600 texels and 64 + 64 probes: a wide single-set region (dedicated), small
+ * combinations of 1–4 sets (packed), and a corner where 6, 12 and 20 sets overlap (prefix-2, -3,
+ * -8); set 1 a door's open set, 2 its bounce, 23 the combination {0, 1}. */
+static int write_dls(void)
+{
+    enum { NSETS = 24, T = 600, G = 64, L = 64 };
+    static uint32_t targets[NSETS][3][T];
+    static uint8_t payloads[NSETS][3][T * 28];
+    static lbk_dls_set_desc sets[NSETS];
+    static char names[NSETS][8];
+    const uint32_t count[3] = {T, G, L};
+    uint32_t rng = 12345;
+    for (uint32_t s = 0; s < NSETS; s++) {
+        snprintf(names[s], sizeof names[s], "s%u", s);
+        sets[s].name = names[s];
+        for (uint32_t sp = 0; sp < 3; sp++) {
+            uint32_t n = 0;
+            for (uint32_t t = 0; t < count[sp]; t++) {
+                rng = rng * 1664525u + 1013904223u;
+                const int wide = s == 0 && t < count[sp] / 2;              /* set 0 alone: dedicated */
+                const int small = s < 8 && (rng >> 28) == s % 4 + 1;       /* scattered small combinations */
+                const int deep = t >= count[sp] - 20 && (s < 6 + (count[sp] - t) % 3 * 7); /* 6, 13, 20 deep */
+                if (!(wide || small || deep)) continue;
+                targets[s][sp][n] = t;
+                uint8_t *p = payloads[s][sp] + (size_t)n * (sp ? 28 : 8);
+                for (uint32_t b = 0; b < (sp ? 28u : 8u); b++) p[b] = (uint8_t)(rng >> (b % 24));
+                if (sp == 0) p[1] &= 0xfb, p[2] &= 0xdf, p[3] &= 0x7f; /* no exponent-31 channel in Ez (rule 850) */
+                n++;
+            }
+            sets[s].entries[sp] = (lbk_dls_sparse){n, targets[s][sp], payloads[s][sp]};
+        }
+    }
+    sets[1].kind = LBK_DLS_KIND_DOOR_OPEN;
+    sets[2].kind = LBK_DLS_KIND_DOOR_CLOSED;
+    static const uint32_t members[2] = {0, 1};
+    sets[NSETS - 1].kind = LBK_DLS_KIND_COMBINATION, sets[NSETS - 1].member_count = 2, sets[NSETS - 1].members = members;
+    lbk_dls_build_desc dd = {.set_count = NSETS, .sets = sets, .target_count = {T, G, L}};
+    const lbk_door_desc door = {.name = "door", .axes = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, .half_extents = {1, 1, 0.1f},
+                                .open_set = 1, .closed_set = 2};
+    const uint32_t door0 = 0;
+    const lbk_door_state_desc state = {1, &door0, NSETS - 1};
+    const lbk_door_build_desc od = {.door_count = 1, .doors = &door, .state_count = 1, .states = &state};
+    /* the spaces the sets light: a 30 × 20 page, a 4 × 4 × 4 GLG lattice cut into Kuhn tetrahedra
+     * (6 per cube around its main diagonal, conforming across cubes) and a 4 × 4 × 4 LLG grid */
+    static lbk_ahd_texel page[T];
+    for (int i = 0; i < T; i++) page[i] = texel(i % 64);
+    const lbk_lmap_page_desc pd = {30, 20, page};
+    static float pos[G][3];
+    static lbk_sh9_rgb sh[G];
+    for (int i = 0; i < G; i++) {
+        pos[i][0] = (float)(i & 3), pos[i][1] = (float)(i >> 2 & 3), pos[i][2] = (float)(i >> 4 & 3);
+        probe_sh(i % 8, &sh[i]);
+    }
+    static uint32_t tets[27 * 6][4];
+    static const int kuhn[6][3] = {{1, 2, 4}, {1, 4, 2}, {2, 1, 4}, {2, 4, 1}, {4, 1, 2}, {4, 2, 1}};
+    uint32_t nt = 0;
+    for (int z = 0; z < 3; z++)
+        for (int y = 0; y < 3; y++)
+            for (int x = 0; x < 3; x++)
+                for (int k = 0; k < 6; k++) {
+                    const int c0 = x + 4 * y + 16 * z;
+                    int c = c0, bits = 0;
+                    tets[nt][0] = (uint32_t)c0;
+                    for (int j = 0; j < 3; j++) {
+                        bits |= kuhn[k][j];
+                        c = c0 + (bits & 1) + 4 * (bits >> 1 & 1) + 16 * (bits >> 2 & 1);
+                        tets[nt][j + 1] = (uint32_t)c;
+                    }
+                    nt++;
+                }
+    const lbk_glg_build_desc gd = {.probe_count = G, .tetra_count = nt, .positions = (const float (*)[3])pos, .probes = sh, .tetras = (const uint32_t (*)[4])tets};
+    const lbk_llg_grid_desc grid = {{1.5f, 1.5f, 1.5f}, {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {2, 2, 2}, {4, 4, 4}, sh, NULL, 0};
+    const lbk_object objs[2] = {{{"room", 4}, 1, LBK_REPRESENTATION_LIGHTMAP, 0, 0, 0, 30, 20},
+                                {{"prop", 4}, 2, LBK_REPRESENTATION_LLG, 0, 0, 0, 0, 0}};
+    const lbk_meta_pair meta = {"writer", "make_corpus"};
+    section sec[7] = {{LBK_SECTION_LMAP, 0, 0}, {LBK_SECTION_GLG, 0, 0}, {LBK_SECTION_LLG, 0, 0}, {LBK_SECTION_DLS, 0, 0},
+                      {LBK_SECTION_DOOR, 0, 0}, {LBK_SECTION_META, 0, 0}, {LBK_SECTION_OBJS, 0, 0}};
+    int r = lbk_meta_build(&meta, 1, NULL, &sec[5].data, &sec[5].size) || lbk_objects_build(objs, 2, NULL, &sec[6].data, &sec[6].size) ||
+            lbk_lmap_build(&(lbk_lmap_build_desc){.pages = &pd, .page_count = 1}, NULL, &sec[0].data, &sec[0].size) ||
+            lbk_glg_build(&gd, NULL, &sec[1].data, &sec[1].size) ||
+            lbk_llg_build(&(lbk_llg_build_desc){.grids = &grid, .grid_count = 1}, NULL, &sec[2].data, &sec[2].size) ||
+            lbk_dls_build(&dd, NULL, &sec[3].data, &sec[3].size, NULL) || lbk_door_build(&od, NULL, &sec[4].data, &sec[4].size);
+    if (r) fprintf(stderr, "make_corpus: dls.lbk: a section builder failed\n");
+    else r = write_container("tests/fuzz/corpus/dls.lbk", sec, 7, 1);
+    for (int i = 0; i < 7; i++) lbk_free(NULL, sec[i].data);
+    return r;
+}
+
 int main(void)
 {
     static lbk_ahd_texel texels[8 * 4];
@@ -193,5 +285,5 @@ int main(void)
              write_container("tests/fuzz/corpus/every_zstd.lbk", s, 9, 1);
     for (int i = 0; i < 9; i++) lbk_free(NULL, s[i].data);
     if (rc) fprintf(stderr, "make_corpus: a container failed to build or validate\n");
-    return rc;
+    return rc || write_dls();
 }

@@ -132,15 +132,24 @@ int tl_bake_texel_eval(const tl_bake *b, uint32_t page, uint32_t x, uint32_t y, 
     return 0;
 }
 
-static tl_open_status open_views(tl_bake *b, char err[TL_ERR_LEN])
+static tl_open_status open_views(tl_bake *b, uint64_t max_decoded_bytes, char err[TL_ERR_LEN])
 {
     first_issue f = {0};
     lbk_validate_summary sum = {0};
+    lbk_read_options ro = LBK_READ_OPTIONS_INIT;
+    ro.max_decoded_bytes = max_decoded_bytes;
+    lbk_validate_options vo = LBK_VALIDATE_OPTIONS_INIT;
+    vo.max_decoded_bytes = max_decoded_bytes;
     /* open first, then validate through the reader: every section is checksummed and decoded
      * once, and the views below use those bytes */
-    lbk_result r = lbk_reader_open_memory(b->bytes, b->size, NULL, &b->reader);
+    lbk_result r = lbk_reader_open_memory(b->bytes, b->size, &ro, &b->reader);
     if (r == LBK_OK) r = lbk_reader_validate(b->reader, keep_first, &f, &sum);
-    else if (r != LBK_ERR_OUT_OF_MEMORY) r = lbk_validate_memory(b->bytes, b->size, NULL, keep_first, &f, &sum);
+    else if (r != LBK_ERR_OUT_OF_MEMORY) r = lbk_validate_memory(b->bytes, b->size, &vo, keep_first, &f, &sum);
+    if (r == LBK_ERR_LIMIT) {
+        snprintf(err, TL_ERR_LEN, "its sections would decode to more than the memory cap (%llu bytes; --max-memory)",
+                 (unsigned long long)max_decoded_bytes);
+        return TL_OPEN_INVALID;
+    }
     if (r != LBK_OK) {
         snprintf(err, TL_ERR_LEN, "validation could not run: %s", lbk_result_message(r));
         return TL_OPEN_INTERNAL;
@@ -191,12 +200,17 @@ tl_open_status tl_bake_open_memory(const void *data, size_t size, tl_bake *b, ch
     }
     memcpy(b->bytes, data, size);
     b->size = size;
-    tl_open_status st = open_views(b, err);
+    tl_open_status st = open_views(b, 0, err);
     if (st != TL_OPEN_OK) tl_bake_close(b);
     return st;
 }
 
 tl_open_status tl_bake_open_file(const char *path, tl_bake *b, char err[TL_ERR_LEN])
+{
+    return tl_bake_open_file_capped(path, 0, b, err);
+}
+
+tl_open_status tl_bake_open_file_capped(const char *path, uint64_t max_decoded_bytes, tl_bake *b, char err[TL_ERR_LEN])
 {
     memset(b, 0, sizeof *b);
     char e2[TL_ERR_LEN];
@@ -204,7 +218,7 @@ tl_open_status tl_bake_open_file(const char *path, tl_bake *b, char err[TL_ERR_L
         snprintf(err, TL_ERR_LEN, "%s", e2);
         return TL_OPEN_IO;
     }
-    tl_open_status st = open_views(b, e2);
+    tl_open_status st = open_views(b, max_decoded_bytes, e2);
     if (st != TL_OPEN_OK) {
         snprintf(err, TL_ERR_LEN, "%.80s: %.170s", path, e2);
         tl_bake_close(b);

@@ -49,6 +49,10 @@ typedef struct tl_bake {
 
 /* Reads and validates a file and opens every section view. */
 tl_open_status tl_bake_open_file(const char *path, tl_bake *out, char err[TL_ERR_LEN]);
+/* The same with a cap on the bytes decoded sections may take (lbk_read_options.max_decoded_bytes;
+ * 0: liblbk's default, spec §4.3): a file that would need more is refused before it is
+ * allocated (`--max-memory`). */
+tl_open_status tl_bake_open_file_capped(const char *path, uint64_t max_decoded_bytes, tl_bake *out, char err[TL_ERR_LEN]);
 /* Same over a copy of caller bytes. */
 tl_open_status tl_bake_open_memory(const void *data, size_t size, tl_bake *out, char err[TL_ERR_LEN]);
 void tl_bake_close(tl_bake *bake);

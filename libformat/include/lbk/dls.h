@@ -6,14 +6,16 @@
  *   - the builder (lbk_dls_build): sets + sparse per-set entries → DLS section bytes;
  *   - the view (lbk_dls_open / lbk_dls_close): a checked, read-only view of DLS section bytes;
  *   - the runtime (lbk_dls_runtime_open / lbk_dls_apply / lbk_dls_runtime_close): final texels
- *     and probes for weights.
+ *     and probes for weights, in place in the engine's upload buffers, with the regions that
+ *     changed; lbk_dls_apply_begin / _job / _end split one apply over the caller's threads.
  * Doors (lbk/door.h) are DLS sets of kinds 1–3 whose weights follow the door's opening.
  * The builder's tuning and statistics are experimental (LBK_STATIC_LINKING_ONLY, at the end).
  *
  * Thread safety: the builder and every view function are safe to call from any thread, and a
  * view may be shared once open (it is read-only). A runtime is used by one thread at a time
- * (lbk_dls_apply rewrites its state and the output buffers); lbk_dls_effective_weights only
- * reads it. */
+ * (lbk_dls_apply rewrites its state and the output buffers), except that the jobs between
+ * lbk_dls_apply_begin and lbk_dls_apply_end may run concurrently on any threads;
+ * lbk_dls_effective_weights and the dirty getters only read it. */
 #ifndef LBK_DLS_H
 #define LBK_DLS_H
 
@@ -156,6 +158,29 @@ LBK_API uint32_t lbk_dls_cluster_count(const lbk_dls_view *view);
 LBK_API lbk_result lbk_dls_cluster_get(const lbk_dls_view *view, uint32_t cluster, lbk_dls_cluster_info *out);
 LBK_API lbk_result lbk_dls_cluster_set_get(const lbk_dls_view *view, uint32_t cluster, uint32_t i, uint32_t *set);
 
+/* The 14 arrays of the section (spec/container.md §12.3), for a GPU path that uploads the section
+ * bytes as they are and reads clusters, runs, prefix words, bases, slots and payloads in its
+ * shaders (gpu/). */
+typedef enum lbk_dls_array {
+    LBK_DLS_ARRAY_SETS = 0,
+    LBK_DLS_ARRAY_LIGHT_REFS,
+    LBK_DLS_ARRAY_MEMBERS,
+    LBK_DLS_ARRAY_CLUSTERS,
+    LBK_DLS_ARRAY_CLUSTER_SETS,
+    LBK_DLS_ARRAY_RUNS,
+    LBK_DLS_ARRAY_SUBGROUPS,
+    LBK_DLS_ARRAY_PREFIX_WORDS,
+    LBK_DLS_ARRAY_BASE16,
+    LBK_DLS_ARRAY_BASE32,
+    LBK_DLS_ARRAY_SLOTS,
+    LBK_DLS_ARRAY_TEXEL_ENTRIES,
+    LBK_DLS_ARRAY_PROBE_ENTRIES,
+    LBK_DLS_ARRAY_STRINGS,
+    LBK_DLS_ARRAY_COUNT_
+} lbk_dls_array;
+/* Byte offset (a multiple of 16) within the section bytes and element count of one array. */
+LBK_API lbk_result lbk_dls_array_get(const lbk_dls_view *view, uint32_t array, uint64_t *offset, uint64_t *count);
+
 /* Decodes a cluster target by target, in payload order: for each target its index, its entry
  * count, the set index of each entry and the entries' payloads (count × payload size, in set
  * order). Return non-zero from fn to stop early. */
@@ -164,17 +189,38 @@ typedef int (*lbk_dls_target_fn)(void *user, uint32_t target, uint32_t count, co
 LBK_API lbk_result lbk_dls_cluster_decode(const lbk_dls_view *view, uint32_t cluster, lbk_dls_target_fn fn,
                                           void *user);
 
-/* ---- reference runtime ----------------------------------------------------------------- */
+/* ---- runtime ----------------------------------------------------------------------------
+ * L = L_B + Σ_j w_j S_j for every target, on the CPU, into caller-owned output buffers that an
+ * engine uploads as they are. Four parts: open a runtime over the base data and the outputs;
+ * apply weights (in one call, or split into jobs the caller runs on its own threads); read back
+ * which regions changed; close. The GPU path of the same definition is gpu/ (README, "GPU"). */
 
 struct lbk_door_view;
 typedef struct lbk_dls_runtime lbk_dls_runtime;
 
-/* Texels are planar like an LMAP page pair, over the global texel index: irradiance_z[i] is the
- * R11G11B10F word (host order), rgba[4i..4i+3] the second plane. Probes are 28-byte packed SH9.
- * A space with no DLS entries may be NULL (its output is then not written). The output buffers
- * are caller-owned and must persist unchanged between lbk_dls_apply calls: apply rewrites only
+/* One LMAP page's planes (an array element: frozen). The base planes are where apply reads L_B —
+ * lbk_lmap_page_get's irradiance and rgba pointers, used in place — and the output planes where
+ * it writes L: mapped staging or upload memory, laid out as the GPU image wants it. Pitches are
+ * bytes from one row to the next (0: 4·width, tightly packed as in LMAP); plane 0 holds the u32
+ * R11G11B10F words (little-endian, as in LMAP), plane 1 the RGBA bytes. */
+typedef struct lbk_dls_page {
+    uint32_t width, height;
+    const uint8_t *base_irradiance, *base_rgba;
+    uint8_t *out_irradiance, *out_rgba;
+    size_t base_irradiance_pitch, base_rgba_pitch, out_irradiance_pitch, out_rgba_pitch;
+} lbk_dls_page;
+
+/* lbk_dls_runtime_desc.flags */
+#define LBK_DLS_RUNTIME_SCALAR 0x1u /* use the scalar path even where a SIMD one exists (same bytes) */
+
+/* Texels come either as pages (page_count ≥ 1, in LMAP page order, Σ width·height = the texel
+ * count; the four texel arrays are then NULL) or as the four arrays over the global texel index:
+ * irradiance_z[i] the R11G11B10F word (host order), rgba[4i..4i+3] the second plane. Probes are
+ * 28-byte packed SH9 in GLG / concatenated LLG order. A space with no DLS entries may be left out
+ * (its output is then not written). The outputs persist between applies: apply rewrites only
  * the targets whose sets changed (call lbk_dls_runtime_invalidate after touching them). Outputs
- * must not overlap the bases. Size-tagged (lbk.h): set size with LBK_DLS_RUNTIME_DESC_INIT. */
+ * must not overlap the bases or each other. Size-tagged (lbk.h): set size with
+ * LBK_DLS_RUNTIME_DESC_INIT. */
 typedef struct lbk_dls_runtime_desc {
     size_t size;
     const lbk_dls_view *dls;
@@ -186,6 +232,11 @@ typedef struct lbk_dls_runtime_desc {
     uint8_t *out_glg;
     uint8_t *out_llg;
     const lbk_allocator *allocator;
+    /* appended after the 1.0 layout (size 0 or the 1.0 size: these read as zero) */
+    uint32_t page_count;          /* ≥ 1: texels in `pages` instead of the four arrays */
+    const lbk_dls_page *pages;
+    uint32_t flags;               /* LBK_DLS_RUNTIME_* */
+    uint32_t job_targets;         /* targets per job of lbk_dls_apply_begin; 0: 4096 */
 } lbk_dls_runtime_desc;
 #define LBK_DLS_RUNTIME_DESC_INIT LBK_SIZED_INIT(lbk_dls_runtime_desc)
 
@@ -197,16 +248,17 @@ typedef struct lbk_dls_apply_stats {
     uint64_t targets_written;   /* by clusters and by base copies of untouched targets */
 } lbk_dls_apply_stats;
 
-/* Checks that the views agree (door sets exist and have the right kinds) and that every needed
- * buffer is present. The views and buffers must outlive the runtime. */
+/* Checks that the views agree (door sets exist and have the right kinds), that every needed
+ * buffer is present and that the pages cover the texels. The views and buffers must outlive the
+ * runtime. */
 LBK_API lbk_result lbk_dls_runtime_open(const lbk_dls_runtime_desc *desc, lbk_dls_runtime **out);
 LBK_API void lbk_dls_runtime_close(lbk_dls_runtime *runtime);
 /* The next apply rewrites every target. */
 LBK_API void lbk_dls_runtime_invalidate(lbk_dls_runtime *runtime);
 
-/* Computes L = L_B + Σ_j w_j S_j into the output buffers, cluster by cluster (decode base and
- * entries to the additive linear forms lbk_ahd_linear / lbk_sh9_rgb, weight, sum, re-encode).
- * Effective weight w_j of set j:
+/* Computes L = L_B + Σ_j w_j S_j into the outputs, cluster by cluster (spec/container.md §12.8:
+ * decode base and entries to the additive linear forms lbk_ahd_linear / lbk_sh9_rgb, weight,
+ * sum, re-encode). Effective weight w_j of set j:
  *   kind 0 (lights):      set_weights[j];
  *   kind 1 (door open):   door_weights[p] if door p of the DOOR view names j, else set_weights[j];
  *   kind 2 (door closed): 1 − door_weights[p] if door p names j, else set_weights[j];
@@ -215,12 +267,45 @@ LBK_API void lbk_dls_runtime_invalidate(lbk_dls_runtime *runtime);
  * door_weights one per door (NULL: all doors closed, ω = 0). Weights must be finite.
  * The first call (and the first after invalidate) writes every target: untouched ones get the
  * base bytes. Later calls skip each cluster none of whose sets' effective weights changed; a
- * cluster whose weights are all 0 gets exactly the base bytes. stats may be NULL. */
+ * cluster whose weights are all 0 gets exactly the base bytes. The bytes are those of the
+ * scalar definition whichever path (scalar, AVX2) runs and however the work is split.
+ * stats may be NULL. */
 LBK_API lbk_result lbk_dls_apply(lbk_dls_runtime *runtime, const float *set_weights, const float *door_weights,
                                  lbk_dls_apply_stats *stats);
 /* The effective weights apply would use (lbk_dls_set_count floats). */
 LBK_API lbk_result lbk_dls_effective_weights(const lbk_dls_runtime *runtime, const float *set_weights,
                                              const float *door_weights, float *out);
+
+/* lbk_dls_apply split for the caller's threads (engines run these on their job system):
+ * begin takes the weights and says how many jobs there are (each about desc.job_targets
+ * targets); every job in [0, *job_count) must then run exactly once, in any order, on any
+ * threads, concurrently (jobs write disjoint bytes and only read the runtime); end collects the
+ * dirty regions and stats. The bytes do not depend on the split, the order or the threads.
+ * begin fails (and changes nothing) on bad weights or when the previous begin was not ended. */
+LBK_API lbk_result lbk_dls_apply_begin(lbk_dls_runtime *runtime, const float *set_weights, const float *door_weights,
+                                       uint32_t *job_count);
+LBK_API void lbk_dls_apply_job(lbk_dls_runtime *runtime, uint32_t job);
+LBK_API lbk_result lbk_dls_apply_end(lbk_dls_runtime *runtime, lbk_dls_apply_stats *stats);
+
+/* What the last apply wrote, to re-upload only that: per space, ranges of target indices (texels
+ * in the global texel index), and with pages, rectangles per page. Both cover every target the
+ * apply wrote and may cover unchanged ones too: overlapping, touching and — past the caps —
+ * nearby regions are merged. Sorted (ranges by first, rectangles by y then x), disjoint.
+ * Empty when nothing changed. Frozen. */
+typedef struct lbk_dls_range {
+    uint64_t first, count;
+} lbk_dls_range;
+typedef struct lbk_dls_rect {
+    uint32_t x, y, width, height;
+} lbk_dls_rect;
+#define LBK_DLS_DIRTY_RANGES 64u /* at most this many ranges per space */
+#define LBK_DLS_DIRTY_RECTS 16u  /* at most this many rectangles per page */
+LBK_API uint32_t lbk_dls_dirty_range_count(const lbk_dls_runtime *runtime, uint32_t space);
+LBK_API lbk_result lbk_dls_dirty_range_get(const lbk_dls_runtime *runtime, uint32_t space, uint32_t i,
+                                           lbk_dls_range *out);
+LBK_API uint32_t lbk_dls_dirty_rect_count(const lbk_dls_runtime *runtime, uint32_t page);
+LBK_API lbk_result lbk_dls_dirty_rect_get(const lbk_dls_runtime *runtime, uint32_t page, uint32_t i,
+                                          lbk_dls_rect *out);
 
 #ifdef __cplusplus
 }
@@ -271,6 +356,10 @@ struct lbk_dls_stats {
 };
 
 LBK_API lbk_result lbk_dls_stats_get(const lbk_dls_view *view, lbk_dls_stats *out);
+
+/* The path lbk_dls_apply computes with: "scalar" or "avx2" (chosen at open from the CPU and
+ * LBK_DLS_RUNTIME_SCALAR; every path writes the same bytes). */
+LBK_API const char *lbk_dls_runtime_path(const lbk_dls_runtime *runtime);
 
 #ifdef __cplusplus
 }

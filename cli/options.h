@@ -1,0 +1,19 @@
+/* Options several subcommands share. */
+#ifndef LBK_CLI_OPTIONS_H
+#define LBK_CLI_OPTIONS_H
+
+#include <stdint.h>
+
+/* `--max-memory SIZE` (bytes, or with kB, KiB, MB, MiB, GB, GiB): the cap on the bytes a reader
+ * may allocate for decoded sections, so an untrusted file cannot make it allocate far more than
+ * it holds. When argv[*i] is that option, stores the size in *out, advances *i past the value and
+ * returns 1; returns 0 for any other argument and -1 (message printed, prefixed with `cmd`) for a
+ * missing or malformed value. Default 0: liblbk's cap, min(4 GiB, 1024 × file size + 64 MiB)
+ * (spec/container.md §4.3). */
+int cli_max_memory_option(const char *cmd, int argc, char **argv, int *i, uint64_t *out);
+
+#define CLI_MAX_MEMORY_HELP                                                                          \
+    "  --max-memory SIZE  refuse a file whose sections decode to more than SIZE (bytes, or kB, KiB, MB,\n" \
+    "                     MiB, GB, GiB); default min(4 GiB, 1024 x file size + 64 MiB)\n"
+
+#endif

@@ -1,0 +1,59 @@
+/* The per-target arithmetic of lbk_dls_apply (spec/container.md §12.8), behind one table of
+ * functions so that the scalar definition and the SIMD paths are interchangeable. Private.
+ *
+ * Every path computes, per target, exactly the operations of the definition — decode base and
+ * entries with lbk_ahd_to_linear / lbk_sh9_unpack, acc = base; acc += w_j·S_j for the active
+ * entries in ascending set order (a multiply, then an add: never fused), encode once with
+ * lbk_ahd_from_linear / lbk_sh9_pack — in the same order and precision, so every path gives the
+ * same bytes as the scalar one (tests/lib/test_dls_kernels.c checks it lane by lane). The
+ * files that implement a path are compiled without contraction into fused multiply-adds
+ * (-ffp-contract=off and the pragma below). */
+#ifndef LBK_DLS_KERNEL_H
+#define LBK_DLS_KERNEL_H
+
+#include <stdint.h>
+
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT OFF /* GCC: -std=c11 (or -ffp-contract=off) keeps contraction off */
+#endif
+
+/* `count` targets that are consecutive in cluster order and contiguous in memory: bases at
+ * base0/base1 (texels: the Ez and RGBA planes) or base0 (28-byte probes), outputs likewise. Target t's entries
+ * start at entries + t·stride·payload; the m active ones are entry idx[j] of the target with
+ * weight w[j] ≠ 0, idx ascending. */
+typedef struct dls_batch {
+    uint32_t count, stride, m;
+    const uint32_t *idx;
+    const float *w;
+    const uint8_t *entries;
+    const uint8_t *base0, *base1; /* texels: plane 0 (Ez) and plane 1 (RGBA); probes: base0 */
+    uint8_t *out0, *out1;
+} dls_batch;
+
+/* Variable entries per target (prefix forms): target t has n[t] entries starting at
+ * entries + off[t]·payload, entry e of it with weight we[off[t] + e − off[0]] (0 for a set that
+ * is off). A target whose entries all weigh 0 gets exactly its base bytes. */
+typedef struct dls_var_batch {
+    uint32_t count;
+    const uint32_t *n, *off;
+    const float *we;
+    const uint8_t *entries;
+    const uint8_t *base0, *base1;
+    uint8_t *out0, *out1;
+} dls_var_batch;
+
+typedef struct dls_kernels {
+    const char *name;
+    void (*texels)(const dls_batch *b);
+    void (*probes)(const dls_batch *b);
+    void (*texels_var)(const dls_var_batch *b);
+    void (*probes_var)(const dls_var_batch *b);
+} dls_kernels;
+
+/* The definition, one target at a time; always available. */
+const dls_kernels *dls_kernels_scalar(void);
+/* 8 targets per step with AVX2 (x86-64, chosen at run time); NULL where the compiler or the CPU
+ * lacks it. */
+const dls_kernels *dls_kernels_avx2(void);
+
+#endif

@@ -1,0 +1,115 @@
+/* The definition of the per-target DLS arithmetic (spec/container.md §12.8), one target at a
+ * time, written with the public codecs themselves: the other paths must match it bit for bit. */
+#include <string.h>
+
+#include "dls_kernel.h"
+#include "internal.h"
+#include "lbk/ahd.h"
+#include "lbk/pixel.h"
+#include "lbk/sh.h"
+
+static void texel_linear(const uint8_t *z, const uint8_t *rgba, lbk_ahd_linear *out)
+{
+    lbk_ahd_texel t;
+    t.irradiance_z = lbk_rd32(z);
+    memcpy(t.rgba, rgba, 4);
+    lbk_ahd_to_linear(&t, out);
+}
+
+static void texel_add(lbk_ahd_linear *acc, const uint8_t *entry, float w)
+{
+    lbk_ahd_linear l;
+    texel_linear(entry, entry + 4, &l);
+    for (int c = 0; c < 3; c++)
+        for (int i = 0; i < 4; i++) acc->c[c][i] += w * l.c[c][i];
+}
+
+static void texel_store(const lbk_ahd_linear *acc, uint8_t *z, uint8_t *rgba)
+{
+    lbk_ahd_texel o;
+    lbk_ahd_from_linear(acc, &o);
+    lbk_wr32(z, o.irradiance_z);
+    memcpy(rgba, o.rgba, 4);
+}
+
+static void probe_add(lbk_sh9_rgb *acc, const uint8_t *entry, float w)
+{
+    lbk_sh9_rgb l;
+    lbk_sh9_unpack(entry, &l);
+    for (int c = 0; c < 3; c++)
+        for (int k = 0; k < LBK_SH9_COUNT; k++) acc->c[c][k] += w * l.c[c][k];
+}
+
+static void texels(const dls_batch *b)
+{
+    for (uint32_t t = 0; t < b->count; t++) {
+        const uint8_t *e = b->entries + (size_t)t * b->stride * LBK_DLS_TEXEL_PAYLOAD;
+        lbk_ahd_linear acc;
+        texel_linear(b->base0 + 4 * (size_t)t, b->base1 + 4 * (size_t)t, &acc);
+        for (uint32_t j = 0; j < b->m; j++) texel_add(&acc, e + (size_t)b->idx[j] * LBK_DLS_TEXEL_PAYLOAD, b->w[j]);
+        texel_store(&acc, b->out0 + 4 * (size_t)t, b->out1 + 4 * (size_t)t);
+    }
+}
+
+static void probes(const dls_batch *b)
+{
+    for (uint32_t t = 0; t < b->count; t++) {
+        const uint8_t *e = b->entries + (size_t)t * b->stride * LBK_DLS_PROBE_PAYLOAD;
+        lbk_sh9_rgb acc;
+        lbk_sh9_unpack(b->base0 + LBK_DLS_PROBE_PAYLOAD * (size_t)t, &acc);
+        for (uint32_t j = 0; j < b->m; j++) probe_add(&acc, e + (size_t)b->idx[j] * LBK_DLS_PROBE_PAYLOAD, b->w[j]);
+        lbk_sh9_pack(&acc, b->out0 + LBK_DLS_PROBE_PAYLOAD * (size_t)t);
+    }
+}
+
+static bool any_weight(const float *w, uint32_t n)
+{
+    for (uint32_t j = 0; j < n; j++)
+        if (w[j] != 0.0f) return true;
+    return false;
+}
+
+static void texels_var(const dls_var_batch *b)
+{
+    for (uint32_t t = 0; t < b->count; t++) {
+        const float *w = b->we + (b->off[t] - b->off[0]);
+        uint8_t *oz = b->out0 + 4 * (size_t)t, *orgba = b->out1 + 4 * (size_t)t;
+        const uint8_t *bz = b->base0 + 4 * (size_t)t, *brgba = b->base1 + 4 * (size_t)t;
+        if (!any_weight(w, b->n[t])) { /* exactly the base, as for an all-zero dispatch */
+            memcpy(oz, bz, 4);
+            memcpy(orgba, brgba, 4);
+            continue;
+        }
+        const uint8_t *e = b->entries + (size_t)b->off[t] * LBK_DLS_TEXEL_PAYLOAD;
+        lbk_ahd_linear acc;
+        texel_linear(bz, brgba, &acc);
+        for (uint32_t j = 0; j < b->n[t]; j++)
+            if (w[j] != 0.0f) texel_add(&acc, e + (size_t)j * LBK_DLS_TEXEL_PAYLOAD, w[j]);
+        texel_store(&acc, oz, orgba);
+    }
+}
+
+static void probes_var(const dls_var_batch *b)
+{
+    for (uint32_t t = 0; t < b->count; t++) {
+        const float *w = b->we + (b->off[t] - b->off[0]);
+        uint8_t *out = b->out0 + LBK_DLS_PROBE_PAYLOAD * (size_t)t;
+        const uint8_t *base = b->base0 + LBK_DLS_PROBE_PAYLOAD * (size_t)t;
+        if (!any_weight(w, b->n[t])) {
+            memcpy(out, base, LBK_DLS_PROBE_PAYLOAD);
+            continue;
+        }
+        const uint8_t *e = b->entries + (size_t)b->off[t] * LBK_DLS_PROBE_PAYLOAD;
+        lbk_sh9_rgb acc;
+        lbk_sh9_unpack(base, &acc);
+        for (uint32_t j = 0; j < b->n[t]; j++)
+            if (w[j] != 0.0f) probe_add(&acc, e + (size_t)j * LBK_DLS_PROBE_PAYLOAD, w[j]);
+        lbk_sh9_pack(&acc, out);
+    }
+}
+
+const dls_kernels *dls_kernels_scalar(void)
+{
+    static const dls_kernels k = {"scalar", texels, probes, texels_var, probes_var};
+    return &k;
+}
