@@ -6,6 +6,7 @@
 #include <time.h>
 
 #include "cli/cli.h"
+#include "cli/options.h"
 #include "tools/common/lmap_decode.h"
 #include "tools/convert/convert.h"
 #include "tools/common/file_util.h"
@@ -15,7 +16,7 @@ static void usage(FILE *f)
     char known[256];
     tl_profile_list(NULL, known, sizeof known);
     fprintf(f,
-            "usage: lbk convert IN.lbk -o OUT.lbk --profile NAME|FILE [--from-exr DIR] [-q]\n"
+            "usage: lbk convert IN.lbk -o OUT.lbk --profile NAME|FILE [--from-exr DIR] [--max-memory SIZE] [-q]\n"
             "       lbk convert --list-profiles\n"
             "\n"
             "Repacks a container for a platform: section alignment, per-section compression (none for\n"
@@ -33,6 +34,7 @@ static void usage(FILE *f)
             "                         page_NNN.exr (R,G,B = irradiance along +Z) replaces plane 0 of page NNN;\n"
             "                         page_NNN.ahd.exr (plane1.R/G/B/A), when present, replaces plane 1\n"
             "  --list-profiles        print the profiles found on the search path and exit\n"
+            CLI_MAX_MEMORY_HELP
             "  -q, --quiet            no summary on stdout\n"
             "  -h, --help             this text\n"
             "\n"
@@ -48,7 +50,11 @@ int lbk_cmd_convert(int argc, char **argv)
     const time_t started = time(NULL); /* stale temporary files: older than a minute before this */
     const char *in = NULL, *out = NULL, *profile_arg = NULL, *exr_dir = NULL;
     int quiet = 0;
+    uint64_t max_memory = 0;
     for (int i = 1; i < argc; i++) {
+        const int mm = cli_max_memory_option("convert", argc, argv, &i, &max_memory);
+        if (mm < 0) return LBK_EXIT_USAGE;
+        if (mm) continue;
         const char *a = argv[i];
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             usage(stdout);
@@ -97,7 +103,7 @@ int lbk_cmd_convert(int argc, char **argv)
         fprintf(stderr, "lbk convert: %s\n", err);
         return LBK_EXIT_IO;
     }
-    tl_convert_options opt = {&profile, exr_dir};
+    tl_convert_options opt = {.profile = &profile, .from_exr_dir = exr_dir, .max_decoded_bytes = max_memory};
     void *pack = NULL;
     size_t pack_size = 0;
     tl_convert_report rep;

@@ -172,7 +172,7 @@ static tl_profile profile_from(const char *text)
 static void convert_ok(const void *in, size_t in_size, const tl_profile *p, void **out, size_t *out_size)
 {
     char err[TL_ERR_LEN] = "";
-    tl_convert_options o = {p, NULL};
+    tl_convert_options o = {.profile = p};
     tl_convert_status st = tl_convert_memory(in, in_size, &o, out, out_size, NULL, err);
     if (st != TL_CONVERT_OK) fail_msg("convert failed (%d): %s", (int)st, err);
 }
@@ -312,7 +312,7 @@ static void test_bad_input_and_invalid_pack(void **state)
     char err[TL_ERR_LEN] = "";
     void *out = NULL;
     size_t out_size = 0;
-    tl_convert_options o = {&p, NULL};
+    tl_convert_options o = {.profile = &p};
     uint8_t *bad = malloc(in.size);
     memcpy(bad, in.data, in.size);
     bad[in.size - 1] ^= 0x10; /* inside the last section: its checksum fails */
@@ -441,7 +441,7 @@ static void test_page_alignment_checked(void **state)
     char err[TL_ERR_LEN] = "";
     void *out = NULL;
     size_t out_size;
-    tl_convert_options o = {&p, NULL};
+    tl_convert_options o = {.profile = &p};
     assert_int_equal(tl_convert_memory(in.data, in.size, &o, &out, &out_size, NULL, err), TL_CONVERT_UNSUPPORTED);
     assert_non_null(strstr(err, "not multiples of page_alignment 4096"));
     tf_blob_free(&in);

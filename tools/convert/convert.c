@@ -101,7 +101,9 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
     const tl_profile *p = opt->profile;
 
     lbk_reader *rd = NULL;
-    lbk_result r = lbk_reader_open_memory(in, in_size, NULL, &rd);
+    lbk_read_options ro = LBK_READ_OPTIONS_INIT;
+    ro.max_decoded_bytes = opt->max_decoded_bytes;
+    lbk_result r = lbk_reader_open_memory(in, in_size, &ro, &rd);
     if (r != LBK_OK) {
         if (validate_bytes(in, in_size, NULL, "input", err)) return TL_CONVERT_BAD_INPUT;
         return tl_fail(err, TL_CONVERT_BAD_INPUT, "input: %s", lbk_result_message(r));

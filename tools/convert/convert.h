@@ -38,6 +38,7 @@ typedef struct tl_convert_report {
 typedef struct tl_convert_options {
     const tl_profile *profile;
     const char *from_exr_dir; /* NULL: no import */
+    uint64_t max_decoded_bytes; /* cap on the input's decoded sections (--max-memory); 0: liblbk's */
 } tl_convert_options;
 
 /* Converts a container held in memory. *out is malloc'ed (free()). The output is validated before
