@@ -160,7 +160,7 @@ static void run_profiles(const char *scene, const void *bytes, size_t size, uint
             printf("%-22s %-17s %s\n", scene, label, err);
             continue;
         }
-        tl_convert_options co = {&pr, NULL};
+        tl_convert_options co = {.profile = &pr};
         tl_convert_report rep;
         void *pack;
         size_t pack_size;

@@ -305,7 +305,7 @@ static void test_pack_equals_source(void **state)
     for (int k = 0; k < 2; k++) {
         tl_profile p;
         assert_int_equal(tl_profile_resolve(k ? "console-current" : "pc", "tools/convert/profiles", &p, err), 0);
-        tl_convert_options co = {&p, NULL};
+        tl_convert_options co = {.profile = &p};
         void *pack;
         size_t pack_size;
         assert_int_equal(tl_convert_memory(a.data, a.size, &co, &pack, &pack_size, NULL, err), TL_CONVERT_OK);

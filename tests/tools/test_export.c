@@ -350,7 +350,7 @@ static void test_export_import_round_trip(void **state)
     tl_profile keep;
     const char *text = "name = keep\nalignment = 64\n[sections]\ndefault = none\n";
     assert_int_equal(tl_profile_parse(text, strlen(text), "keep", &keep, err), 0);
-    tl_convert_options co = {&keep, dir};
+    tl_convert_options co = {.profile = &keep, .from_exr_dir = dir};
     void *out;
     size_t out_size;
     tl_convert_report rep;
@@ -418,7 +418,7 @@ static void test_import_errors(void **state)
     tl_profile keep;
     const char *text = "name = keep\nalignment = 64\n[sections]\ndefault = none\n";
     assert_int_equal(tl_profile_parse(text, strlen(text), "keep", &keep, err), 0);
-    tl_convert_options co = {&keep, dir};
+    tl_convert_options co = {.profile = &keep, .from_exr_dir = dir};
     void *out = NULL;
     size_t out_size;
     assert_int_equal(tl_convert_memory(blob.data, blob.size, &co, &out, &out_size, NULL, err), TL_CONVERT_BAD_EXR);
