@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cjson/cJSON.h>
@@ -220,6 +221,33 @@ static void test_export_pages_equal_decoded(void **state)
         }
         free(ez), free(planes), free(dom);
     }
+    tl_bake_close(&b);
+}
+
+/* Nothing on error: a write that fails (here a folder sits where page_000.png must go) removes
+ * the folders this run created (new/exr and its new parent), and leaves a folder that existed
+ * before as it was. */
+static void test_export_failure_leaves_no_new_folder(void **state)
+{
+    (void)state;
+    tl_bake b;
+    tf_blob blob = tf_build_scene(TF_SCENE_FULL, NULL);
+    char err[TL_ERR_LEN], exr[160], png[160], blocker[200], parent[160];
+    if (tl_bake_open_memory(blob.data, blob.size, &b, err) != TL_OPEN_OK) fail_msg("%s", err);
+    tf_blob_free(&blob);
+    snprintf(parent, sizeof parent, "%s/new", tmpdir);
+    snprintf(exr, sizeof exr, "%s/new/exr", tmpdir);
+    snprintf(png, sizeof png, "%s/old_png", tmpdir);
+    snprintf(blocker, sizeof blocker, "%s/page_000.png", png);
+    assert_int_equal(mkdir(png, 0755), 0);
+    assert_int_equal(mkdir(blocker, 0755), 0);
+    tl_export_options o = {exr, png, 0};
+    tl_export_stats st;
+    assert_int_equal(tl_export(&b, &o, &st, err), -1);
+    assert_non_null(strstr(err, "page_000.png"));
+    struct stat sb;
+    assert_int_not_equal(stat(parent, &sb), 0); /* new/ and new/exr are gone */
+    assert_int_equal(stat(blocker, &sb), 0);    /* the old folder keeps what it had */
     tl_bake_close(&b);
 }
 
@@ -482,6 +510,7 @@ int main(void)
         cmocka_unit_test(test_export_import_round_trip),
         cmocka_unit_test(test_import_errors),
         cmocka_unit_test(test_export_cli),
+        cmocka_unit_test(test_export_failure_leaves_no_new_folder),
     };
     return cmocka_run_group_tests(tests, setup_dir, teardown_dir);
 }

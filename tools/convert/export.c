@@ -1,10 +1,14 @@
 /* lbk export: EXR/PNG/CSV/JSON views of a bake (tools/convert/README.md "Export"). */
+#define _XOPEN_SOURCE 700 /* nftw, for removing a folder this run created (tl_export) */
 #include "tools/convert/export.h"
 
+#include <errno.h>
+#include <ftw.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include <cjson/cJSON.h>
 
@@ -296,11 +300,8 @@ static int write_glg_plot(const char *dir, const tl_bake *b, const probe_row *ro
 
 /* ---- driver -------------------------------------------------------------------------------- */
 
-int tl_export(const tl_bake *b, const tl_export_options *o, tl_export_stats *st, char err[TL_ERR_LEN])
+static int export_run(const tl_bake *b, const tl_export_options *o, tl_export_stats *st, char err[TL_ERR_LEN])
 {
-    tl_export_stats local;
-    if (!st) st = &local;
-    memset(st, 0, sizeof *st);
     const char *dirs[2] = {o->exr_dir, o->png_dir};
     for (int d = 0; d < 2; d++) {
         if (!dirs[d]) continue;
@@ -392,5 +393,48 @@ int tl_export(const tl_bake *b, const tl_export_options *o, tl_export_stats *st,
         if (!rc) rc = write_glg_plot(dirs[d], b, rows, nrows, st, err);
     }
     free(rows);
+    return rc;
+}
+
+static int remove_entry(const char *path, const struct stat *sb, int type, struct FTW *ftw)
+{
+    (void)sb, (void)type, (void)ftw;
+    return remove(path);
+}
+
+/* The outermost folder of `dir` that does not exist yet (what tl_mkdirs will create), or "". */
+static void first_missing(const char *dir, char *out, size_t n)
+{
+    out[0] = 0;
+    const size_t len = strlen(dir);
+    if (!len || len >= n) return;
+    memcpy(out, dir, len + 1);
+    for (size_t i = 1; i <= len; i++)
+        if (out[i] == '/' || out[i] == 0) {
+            const char saved = out[i];
+            out[i] = 0;
+            struct stat sb;
+            if (stat(out, &sb) != 0 && errno == ENOENT) return; /* out is that folder */
+            out[i] = saved;
+        }
+    out[0] = 0;
+}
+
+/* Nothing on error: a folder this run created is removed again with what was written into it
+ * (everything in it is ours); a folder that existed before keeps what it had, plus whatever of
+ * this run's files were complete (each is written atomically). */
+int tl_export(const tl_bake *b, const tl_export_options *o, tl_export_stats *st, char err[TL_ERR_LEN])
+{
+    tl_export_stats local;
+    if (!st) st = &local;
+    memset(st, 0, sizeof *st);
+    const char *dirs[2] = {o->exr_dir, o->png_dir};
+    char created[2][4096] = {"", ""};
+    for (int d = 0; d < 2; d++)
+        if (dirs[d]) first_missing(dirs[d], created[d], sizeof created[d]);
+    const int rc = export_run(b, o, st, err);
+    if (rc)
+        for (int d = 0; d < 2; d++)
+            if (created[d][0]) nftw(created[d], remove_entry, 16, FTW_DEPTH | FTW_PHYS);
     return rc;
 }
