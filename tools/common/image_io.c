@@ -317,8 +317,11 @@ void tl_heat_color(float t, uint8_t rgb[3])
     }
 }
 
-int tl_mkdirs(const char *dir, char err[TL_ERR_LEN])
+int tl_mkdirs(const char *dir, char err[TL_ERR_LEN]) { return tl_mkdirs_created(dir, NULL, 0, err); }
+
+int tl_mkdirs_created(const char *dir, char *created, size_t created_len, char err[TL_ERR_LEN])
 {
+    if (created && created_len) created[0] = 0;
     char buf[4096];
     size_t n = strlen(dir);
     if (n == 0 || n >= sizeof buf) return tl_fail(err, -1, "bad output directory '%s'", dir);
@@ -327,7 +330,11 @@ int tl_mkdirs(const char *dir, char err[TL_ERR_LEN])
         if (buf[i] == '/' || buf[i] == '\0') {
             char saved = buf[i];
             buf[i] = '\0';
-            if (mkdir(buf, 0777) != 0 && errno != EEXIST) return tl_fail(err, -1, "cannot create directory %s: %s", buf, strerror(errno));
+            if (mkdir(buf, 0777) == 0) {
+                if (created && created_len && !created[0]) snprintf(created, created_len, "%s", buf);
+            } else if (errno != EEXIST) {
+                return tl_fail(err, -1, "cannot create directory %s: %s", buf, strerror(errno));
+            }
             buf[i] = saved;
         }
     }

@@ -48,5 +48,8 @@ void tl_heat_color(float t, uint8_t rgb[3]);
 
 /* mkdir -p for an output directory. */
 int tl_mkdirs(const char *dir, char err[TL_ERR_LEN]);
+/* The same; `created` (created_len bytes, may be NULL) gets the outermost folder this call made
+ * (the first missing prefix of `dir`), or "" when `dir` already existed. */
+int tl_mkdirs_created(const char *dir, char *created, size_t created_len, char err[TL_ERR_LEN]);
 
 #endif

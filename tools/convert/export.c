@@ -2,13 +2,11 @@
 #define _XOPEN_SOURCE 700 /* nftw, for removing a folder this run created (tl_export) */
 #include "tools/convert/export.h"
 
-#include <errno.h>
 #include <ftw.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include <cjson/cJSON.h>
 
@@ -302,16 +300,6 @@ static int write_glg_plot(const char *dir, const tl_bake *b, const probe_row *ro
 
 static int export_run(const tl_bake *b, const tl_export_options *o, tl_export_stats *st, char err[TL_ERR_LEN])
 {
-    const char *dirs[2] = {o->exr_dir, o->png_dir};
-    for (int d = 0; d < 2; d++) {
-        if (!dirs[d]) continue;
-        if (tl_mkdirs(dirs[d], err)) return -1;
-        if (o->per_object) {
-            char sub[4096];
-            snprintf(sub, sizeof sub, "%s/objects", dirs[d]);
-            if (tl_mkdirs(sub, err)) return -1;
-        }
-    }
     const uint32_t np = b->has_lmap ? b->lmap.page_count : 0;
     /* one exposure for every preview so pages compare by eye: the p99 over all texels */
     st->exposure = 1.0f;
@@ -386,6 +374,7 @@ static int export_run(const tl_bake *b, const tl_export_options *o, tl_export_st
     probe_row *rows = NULL;
     size_t nrows = 0;
     if (gather_probes(b, &rows, &nrows)) return tl_fail(err, -1, "out of memory");
+    const char *dirs[2] = {o->exr_dir, o->png_dir};
     for (int d = 0; d < 2 && !rc; d++) {
         if (!dirs[d] || nrows == 0) continue;
         if (d == 1 && o->exr_dir && !strcmp(o->exr_dir, o->png_dir)) continue; /* same directory: once */
@@ -402,24 +391,6 @@ static int remove_entry(const char *path, const struct stat *sb, int type, struc
     return remove(path);
 }
 
-/* The outermost folder of `dir` that does not exist yet (what tl_mkdirs will create), or "". */
-static void first_missing(const char *dir, char *out, size_t n)
-{
-    out[0] = 0;
-    const size_t len = strlen(dir);
-    if (!len || len >= n) return;
-    memcpy(out, dir, len + 1);
-    for (size_t i = 1; i <= len; i++)
-        if (out[i] == '/' || out[i] == 0) {
-            const char saved = out[i];
-            out[i] = 0;
-            struct stat sb;
-            if (stat(out, &sb) != 0 && errno == ENOENT) return; /* out is that folder */
-            out[i] = saved;
-        }
-    out[0] = 0;
-}
-
 /* Nothing on error: a folder this run created is removed again with what was written into it
  * (everything in it is ours); a folder that existed before keeps what it had, plus whatever of
  * this run's files were complete (each is written atomically). */
@@ -429,12 +400,20 @@ int tl_export(const tl_bake *b, const tl_export_options *o, tl_export_stats *st,
     if (!st) st = &local;
     memset(st, 0, sizeof *st);
     const char *dirs[2] = {o->exr_dir, o->png_dir};
-    char created[2][4096] = {"", ""};
-    for (int d = 0; d < 2; d++)
-        if (dirs[d]) first_missing(dirs[d], created[d], sizeof created[d]);
-    const int rc = export_run(b, o, st, err);
+    char created[4][4096] = {"", "", "", ""}; /* per folder and its objects/ */
+    int rc = 0;
+    for (int d = 0; d < 2 && !rc; d++) {
+        if (!dirs[d]) continue;
+        rc = tl_mkdirs_created(dirs[d], created[2 * d], sizeof created[2 * d], err);
+        if (!rc && o->per_object) {
+            char sub[4096];
+            snprintf(sub, sizeof sub, "%s/objects", dirs[d]);
+            rc = tl_mkdirs_created(sub, created[2 * d + 1], sizeof created[2 * d + 1], err);
+        }
+    }
+    if (!rc) rc = export_run(b, o, st, err);
     if (rc)
-        for (int d = 0; d < 2; d++)
-            if (created[d][0]) nftw(created[d], remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+        for (int k = 0; k < 4; k++)
+            if (created[k][0]) nftw(created[k], remove_entry, 16, FTW_DEPTH | FTW_PHYS);
     return rc;
 }
