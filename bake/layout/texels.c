@@ -270,10 +270,8 @@ static lbk_result footprint_pairs(const bk_scene *s, const bk_atlas *a, const bk
         for (uint32_t e = ch->first; e < ch->first + ch->count; e++) {
             bk_rtri t;
             if (!bk_rtri_setup(a->tri_uv + 6 * (size_t)e, &t)) continue;
-            double mnx = fmin(t.x[0], fmin(t.x[1], t.x[2])), mxx = fmax(t.x[0], fmax(t.x[1], t.x[2]));
-            double mny = fmin(t.y[0], fmin(t.y[1], t.y[2])), mxy = fmax(t.y[0], fmax(t.y[1], t.y[2]));
-            int x0 = (int)fmax(0.0, floor(mnx) - 1), x1 = (int)fmin((double)pw - 1, floor(mxx) + 1);
-            int y0 = (int)fmax(0.0, floor(mny) - 1), y1 = (int)fmin((double)ph - 1, floor(mxy) + 1);
+            int x0, x1, y0, y1;
+            bk_rtri_texel_box(&t, pw, ph, &x0, &x1, &y0, &y1);
             for (int y = y0; y <= y1; y++)
                 for (int x = x0; x <= x1; x++) {
                     size_t i = (size_t)y * (size_t)pw + (size_t)x;
@@ -371,10 +369,8 @@ static void rasterise_owners(const bk_atlas *a, bk_texels *out, float *best)
         for (uint32_t e = ch->first; e < ch->first + ch->count; e++) {
             bk_rtri t;
             if (!bk_rtri_setup(a->tri_uv + 6 * (size_t)e, &t)) continue;
-            double mnx = fmin(t.x[0], fmin(t.x[1], t.x[2])), mxx = fmax(t.x[0], fmax(t.x[1], t.x[2]));
-            double mny = fmin(t.y[0], fmin(t.y[1], t.y[2])), mxy = fmax(t.y[0], fmax(t.y[1], t.y[2]));
-            int x0 = (int)fmax(0.0, floor(mnx) - 1), x1 = (int)fmin((double)pw - 1, floor(mxx) + 1);
-            int y0 = (int)fmax(0.0, floor(mny) - 1), y1 = (int)fmin((double)ph - 1, floor(mxy) + 1);
+            int x0, x1, y0, y1;
+            bk_rtri_texel_box(&t, pw, ph, &x0, &x1, &y0, &y1);
             for (int y = y0; y <= y1; y++)
                 for (int x = x0; x <= x1; x++) {
                     double cx = x + 0.5, cy = y + 0.5;

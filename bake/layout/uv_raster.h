@@ -60,6 +60,16 @@ static inline int bk_rtri_setup(const float *uv, bk_rtri *t)
     return 1;
 }
 
+/* The texels of a width × height page whose square may touch the triangle: its bounding box grown
+ * by one texel (the conservative rasteriser's reach), clamped to the page; empty when x0 > x1. */
+static inline void bk_rtri_texel_box(const bk_rtri *t, int width, int height, int *x0, int *x1, int *y0, int *y1)
+{
+    double mnx = fmin(t->x[0], fmin(t->x[1], t->x[2])), mxx = fmax(t->x[0], fmax(t->x[1], t->x[2]));
+    double mny = fmin(t->y[0], fmin(t->y[1], t->y[2])), mxy = fmax(t->y[0], fmax(t->y[1], t->y[2]));
+    *x0 = (int)fmax(0.0, floor(mnx) - 1), *x1 = (int)fmin((double)width - 1, floor(mxx) + 1);
+    *y0 = (int)fmax(0.0, floor(mny) - 1), *y1 = (int)fmin((double)height - 1, floor(mxy) + 1);
+}
+
 /* 1 when (px, py) is inside under the fill rule; w receives barycentric weights of the
  * triangle's ORIGINAL corner order (before any flip) when non-NULL. */
 static inline int bk_rtri_inside(const bk_rtri *t, double px, double py, double w[3])
