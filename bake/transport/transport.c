@@ -143,6 +143,14 @@ typedef struct tp_emitter {
     uint32_t cell;      /* its side-0 cell */
 } tp_emitter;
 
+/* One receiver class: its receivers [begin, end), the sum of its passes' weights and the samples
+ * per receiver so far, whether it still samples, and why it stopped (enum bk_transport_stop). */
+typedef struct tp_class {
+    size_t begin, end;
+    double weight_sum, spp;
+    int active, stop;
+} tp_class;
+
 typedef struct tp_ctx {
     const bk_scene *scene;
     const bk_tracer *tracer;
@@ -188,7 +196,11 @@ typedef struct tp_ctx {
     const bk_transport_output *out;
     double pass_weight;
     /* the run's settings and progress */
-    double t0, max_samples, target, tail_tol, weight_sum, spp;
+    double t0, max_samples, target, tail_tol, spp;
+    /* receiver classes (options.class_end; one class of every receiver without it): each
+     * samples until its own estimate reaches the target or its budget runs out */
+    tp_class cls[BK_RECEIVER_CLASSES];
+    int ncls;
     int max_bounces, s0;
     /* counters: per thread, summed after each parallel step */
     uint64_t *thread_rays, *thread_shadow, *thread_nonfinite;
@@ -1420,6 +1432,9 @@ static lbk_result check_inputs(const bk_scene *scene, const bk_tracer *tracer, c
         for (int k = 0; k < 3; k++)
             if (!isfinite(r->position[k]) || !isfinite(r->normal[k])) return LBK_ERR_INVALID_ARGUMENT;
     }
+    const size_t *end = opt->class_end;
+    if (end[BK_RECEIVER_CLASSES - 1] && (end[BK_RECEIVER_CLASSES - 1] != count || end[0] > end[1] || end[1] > end[2]))
+        return LBK_ERR_INVALID_ARGUMENT;
     return footprints_valid(scene, opt, receivers, count) ? LBK_OK : LBK_ERR_INVALID_ARGUMENT;
 }
 
@@ -1477,16 +1492,16 @@ static int report_progress(const tp_ctx *c, const char *phase, double done_spp)
     return opt->progress(opt->user, phase, f > 1 ? 1 : f);
 }
 
-/* Cache rays per cell and bounce in pass p: about as many as the receivers trace this pass
+/* Cache rays per cell and bounce in pass p: about as many as the active receivers trace this pass
  * (over ~4 bounces), within [min(4·2^(p/2), cap), cap], cap = cache_rays·2^p; both estimates
  * shrink together. */
-static int pass_cache_rays(const tp_ctx *c, int pass)
+static int pass_cache_rays(const tp_ctx *c, int pass, size_t active)
 {
     int sp = pass < 20 ? pass : 20;
     double nc = c->cell_count ? (double)c->cell_count : 1;
     double cap = fmin((double)(c->opt->cache_rays > 0 ? c->opt->cache_rays : 16) * ldexp(1.0, sp), 65536.0);
     double lo = fmin(cap, 4.0 * ldexp(1.0, sp / 2));
-    double want = ceil((double)c->s0 * ldexp(1.0, sp) * (double)c->recv_count / (4.0 * nc));
+    double want = ceil((double)c->s0 * ldexp(1.0, sp) * (double)active / (4.0 * nc));
     return (int)fmax(lo, fmin(cap, want));
 }
 
@@ -1494,7 +1509,10 @@ static int pass_cache_rays(const tp_ctx *c, int pass)
  * progress can be reported). */
 static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
 {
-    int cache_rays = pass_cache_rays(c, pass);
+    size_t active = 0;
+    for (int k = 0; k < c->ncls; k++)
+        if (c->cls[k].active) active += c->cls[k].end - c->cls[k].begin;
+    int cache_rays = pass_cache_rays(c, pass, active);
     for (int h = 0; h < 2; h++) {
         chain[h] = run_chain(c, h, pass, cache_rays, c->tail_tol, c->max_bounces);
         if (chain[h].bounces < 0) return LBK_ERR_OUT_OF_MEMORY;
@@ -1504,15 +1522,23 @@ static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
     c->rays = c->s0 << (pass < 20 ? pass : 20);
     if (lattice_init(&c->lat, (uint32_t)c->rays) != LBK_OK) return LBK_ERR_OUT_OF_MEMORY;
     c->pass_weight = ldexp(1.0, pass);
-    size_t count = c->recv_count, block = count / 8 + 1;
-    for (size_t b = 0; b < count; b += block) {
-        size_t e = b + block < count ? b + block : count;
-        parallel_range(c, b, e, 16, recv_gather);
-        if (report_progress(c, "gather", c->spp + 2.0 * c->rays * (double)e / (double)(count ? count : 1)))
-            return LBK_ERR_CANCELLED;
+    size_t block = active / 8 + 1, done = 0;
+    for (int k = 0; k < c->ncls; k++) {
+        if (!c->cls[k].active) continue;
+        for (size_t b = c->cls[k].begin; b < c->cls[k].end; b += block) {
+            size_t e = b + block < c->cls[k].end ? b + block : c->cls[k].end;
+            parallel_range(c, b, e, 16, recv_gather);
+            done += e - b;
+            if (report_progress(c, "gather", c->spp + 2.0 * c->rays * (double)done / (double)(active ? active : 1)))
+                return LBK_ERR_CANCELLED;
+        }
     }
-    c->weight_sum += c->pass_weight;
-    c->spp += 2.0 * c->rays;
+    for (int k = 0; k < c->ncls; k++) {
+        if (!c->cls[k].active) continue;
+        c->cls[k].weight_sum += c->pass_weight;
+        c->cls[k].spp += 2.0 * c->rays;
+        if (c->cls[k].spp > c->spp) c->spp = c->cls[k].spp;
+    }
     mark_rough(c);
     return LBK_OK;
 }
@@ -1530,18 +1556,20 @@ typedef struct tp_errors {
 
 static void estimate_error(const tp_ctx *c, double *noise, double *bias, tp_errors *ce)
 {
-    const bk_transport_options *opt = c->opt;
     double num = 0, den = 0, bb = 0, cnum[BK_RECEIVER_CLASSES] = {0}, cden[BK_RECEIVER_CLASSES] = {0};
-    int cls = 0;
-    for (size_t i = 0; i < c->recv_count; i++) {
-        while (cls < BK_RECEIVER_CLASSES - 1 && i >= opt->class_end[cls] && opt->class_end[BK_RECEIVER_CLASSES - 1]) cls++;
-        double a = c->x_acc[0][i] / c->weight_sum, b = c->x_acc[1][i] / c->weight_sum;
-        double m = 0.5 * (a + b), v = 0.25 * (a - b) * (a - b);
-        num += v;
-        den += m * m;
-        cnum[cls] += v;
-        cden[cls] += m * m;
-        bb += (c->b_acc[0][i] / c->weight_sum) * (c->b_acc[1][i] / c->weight_sum);
+    for (int k = 0; k < c->ncls; k++) {
+        const tp_class *cl = &c->cls[k];
+        if (!(cl->weight_sum > 0)) continue;
+        const double inv = 1 / cl->weight_sum;
+        for (size_t i = cl->begin; i < cl->end; i++) {
+            double a = c->x_acc[0][i] * inv, b = c->x_acc[1][i] * inv;
+            double m = 0.5 * (a + b), v = 0.25 * (a - b) * (a - b);
+            cnum[k] += v;
+            cden[k] += m * m;
+            bb += (c->b_acc[0][i] * inv) * (c->b_acc[1][i] * inv);
+        }
+        num += cnum[k];
+        den += cden[k];
     }
     *noise = den > 0 ? sqrt(num / den) : 0;
     *bias = den > 0 && bb > 0 ? sqrt(bb / den) : 0;
@@ -1549,18 +1577,32 @@ static void estimate_error(const tp_ctx *c, double *noise, double *bias, tp_erro
     ce->probe = cden[1] + cden[2] > 0 ? sqrt((cnum[1] + cnum[2]) / (cden[1] + cden[2])) : 0;
 }
 
-/* Stop after this pass? (target reached, the next pass over budget, or past the time limit:
- * the next pass costs about twice this one, so it starts only if it can finish in time.) */
-static int stop_after(const tp_ctx *c, int pass, double err, double pass_seconds, int *stop)
+/* Which classes stop after this pass: a class whose estimate reached the target, or whose next
+ * pass would pass the sample budget; every class when the next pass (about twice the cost of
+ * this one) could not finish within the time limit. Returns 1 when none samples any more. */
+static int stop_after(tp_ctx *c, int pass, const tp_errors *ce, double pass_seconds)
 {
     const bk_transport_options *opt = c->opt;
-    if (c->target > 0 && err <= c->target) { *stop = BK_STOP_TARGET; return 1; }
-    double next_spp = c->spp + 2.0 * (c->s0 << (pass + 1 < 20 ? pass + 1 : 20));
-    if (next_spp > c->max_samples || pass >= 24) { *stop = BK_STOP_BUDGET; return 1; }
-    if (opt->time_limit > 0 && now_seconds() - c->t0 + 2.1 * pass_seconds > opt->time_limit) {
-        *stop = BK_STOP_TIME;
-        return 1;
+    const int late = opt->time_limit > 0 && now_seconds() - c->t0 + 2.1 * pass_seconds > opt->time_limit;
+    int left = 0;
+    for (int k = 0; k < c->ncls; k++) {
+        tp_class *cl = &c->cls[k];
+        if (!cl->active) continue;
+        double next_spp = cl->spp + 2.0 * (c->s0 << (pass + 1 < 20 ? pass + 1 : 20));
+        if (c->target > 0 && ce->cls[k] <= c->target) cl->stop = BK_STOP_TARGET;
+        else if (next_spp > c->max_samples || pass >= 24) cl->stop = BK_STOP_BUDGET;
+        else if (late) cl->stop = BK_STOP_TIME;
+        else { left++; continue; }
+        cl->active = 0;
     }
+    return left == 0;
+}
+
+/* The weight sum of receiver i's passes. */
+static double recv_weight(const tp_ctx *c, size_t i)
+{
+    for (int k = 0; k < c->ncls; k++)
+        if (i < c->cls[k].end) return c->cls[k].weight_sum;
     return 0;
 }
 
@@ -1568,8 +1610,9 @@ static int stop_after(const tp_ctx *c, int pass, double err, double pass_seconds
 static void finish_outputs(tp_ctx *c)
 {
     const bk_transport_output *output = c->out;
-    float inv = (float)(1.0 / c->weight_sum);
-    for (size_t i = 0; i < c->recv_count; i++)
+    for (size_t i = 0; i < c->recv_count; i++) {
+        double w = recv_weight(c, i);
+        float inv = (float)(w > 0 ? 1.0 / w : 0.0);
         for (int a = 0; a < 3; a++) {
             for (int k = 0; k < 9; k++) {
                 output->radiance[i].c[a][k] *= inv;
@@ -1577,10 +1620,11 @@ static void finish_outputs(tp_ctx *c)
             }
             if (output->irradiance) output->irradiance[3 * i + a] *= inv;
         }
+    }
     /* per-receiver variance of X from the two halves (the denoiser's input) */
     if (output->variance)
         for (size_t i = 0; i < c->recv_count; i++) {
-            double a = c->x_acc[0][i] / c->weight_sum, b = c->x_acc[1][i] / c->weight_sum;
+            double w = recv_weight(c, i), a = w > 0 ? c->x_acc[0][i] / w : 0, b = w > 0 ? c->x_acc[1][i] / w : 0;
             output->variance[i] = (float)(0.25 * (a - b) * (a - b));
         }
     if (c->light_count) {
@@ -1591,14 +1635,42 @@ static void finish_outputs(tp_ctx *c)
     }
 }
 
-static void fill_stats(const tp_ctx *c, int passes, double err, double bias, const tp_errors *ce,
-                       const tp_chain_result chain[2], int stop, bk_transport_stats *stats)
+/* The classes from options.class_end (validated by check_inputs); without it one class. */
+static void init_classes(tp_ctx *c)
 {
+    const size_t *end = c->opt->class_end;
+    c->ncls = end[BK_RECEIVER_CLASSES - 1] ? BK_RECEIVER_CLASSES : 1;
+    for (int k = 0; k < c->ncls; k++) {
+        tp_class *cl = &c->cls[k];
+        cl->begin = k ? c->cls[k - 1].end : 0;
+        cl->end = c->ncls == 1 ? c->recv_count : end[k];
+        cl->active = cl->end > cl->begin;
+        cl->stop = BK_STOP_BUDGET;
+    }
+}
+
+/* What the run reports as its samples and its reason to stop: the texels' when there are any
+ * (REPT's samples_per_texel and status are about lightmap texels, spec §7), else the class
+ * that sampled longest. */
+static const tp_class *lead_class(const tp_ctx *c)
+{
+    const tp_class *best = &c->cls[0];
+    if (best->end > best->begin) return best;
+    for (int k = 1; k < c->ncls; k++)
+        if (c->cls[k].end > c->cls[k].begin && c->cls[k].spp > best->spp) best = &c->cls[k];
+    return best;
+}
+
+static void fill_stats(const tp_ctx *c, int passes, double err, double bias, const tp_errors *ce,
+                       const tp_chain_result chain[2], bk_transport_stats *stats)
+{
+    const tp_class *lead = lead_class(c);
     for (int k = 0; k < BK_RECEIVER_CLASSES; k++) stats->class_rel_rmse[k] = ce->cls[k];
     stats->probe_rel_rmse = ce->probe;
     stats->seconds = now_seconds() - c->t0;
     stats->passes = passes;
-    stats->samples_per_receiver = c->spp;
+    stats->samples_per_receiver = lead->spp;
+    for (int k = 0; k < c->ncls; k++) stats->class_samples[k] = c->cls[k].spp;
     stats->est_rel_rmse = err;
     stats->est_cache_bias = bias;
     stats->bounces = chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces;
@@ -1611,7 +1683,7 @@ static void fill_stats(const tp_ctx *c, int passes, double err, double bias, con
         stats->shadow_rays += c->thread_shadow[t];
         stats->nonfinite += c->thread_nonfinite[t];
     }
-    stats->stop = stop;
+    stats->stop = lead->stop;
     stats->nee = c->nee;
 }
 
@@ -1646,6 +1718,7 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
     c.tail_tol = fmax(0.1 * (c.target > 0 ? c.target : 0.001), 1e-5);
     res = ctx_init(&c);
     if (res != LBK_OK) goto done;
+    init_classes(&c);
 
     for (size_t i = 0; i < count; i++) {
         memset(&output->radiance[i], 0, sizeof output->radiance[i]);
@@ -1656,7 +1729,7 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
 
     double err = 0, bias = 0;
     tp_errors ce = {{0}, 0};
-    int pass = 0, stop = BK_STOP_BUDGET;
+    int pass = 0;
     tp_chain_result chain[2] = {{0, 0, 0, 0}, {0, 0, 0, 0}};
     for (;; pass++) {
         double pass_start = now_seconds();
@@ -1664,18 +1737,16 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
         if (res != LBK_OK) goto done;
         estimate_error(&c, &err, &bias, &ce);
         if (opt->report) {
-            bk_transport_sample smp = {now_seconds() - t0, c.spp, err,
+            bk_transport_sample smp = {now_seconds() - t0, lead_class(&c)->spp, err,
                                        chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces, pass,
-                                       {ce.cls[0], ce.cls[1], ce.cls[2]}, ce.probe};
+                                       {ce.cls[0], ce.cls[1], ce.cls[2]}, ce.probe,
+                                       {c.cls[0].spp, c.cls[1].spp, c.cls[2].spp}};
             opt->report(opt->user, &smp);
         }
-        /* the target is about lightmap texels (REPT's texel_rel_rmse, spec §7.2) when there are
-         * any; probes' own estimates are reported beside it */
-        const double stop_err = opt->class_end[BK_RECEIVER_CLASSES - 1] && opt->class_end[BK_CLASS_TEXEL] ? ce.cls[BK_CLASS_TEXEL] : err;
-        if (stop_after(&c, pass, stop_err, now_seconds() - pass_start, &stop)) break;
+        if (stop_after(&c, pass, &ce, now_seconds() - pass_start)) break;
     }
     finish_outputs(&c);
-    if (stats) fill_stats(&c, pass + 1, err, bias, &ce, chain, stop, stats);
+    if (stats) fill_stats(&c, pass + 1, err, bias, &ce, chain, stats);
 done:
     free_ctx(&c);
     return res;
