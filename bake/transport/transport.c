@@ -1579,7 +1579,10 @@ static void estimate_error(const tp_ctx *c, double *noise, double *bias, tp_erro
 
 /* Which classes stop after this pass: a class whose estimate reached the target, or whose next
  * pass would pass the sample budget; every class when the next pass (about twice the cost of
- * this one) could not finish within the time limit. Returns 1 when none samples any more. */
+ * this one) could not finish within the time limit. Returns 1 when none samples any more.
+ * Probes stop on their target only once the texels have stopped: the estimate measures their
+ * fluence, not the directions of their SH (in a furnace it is exactly 0 at any count while 32
+ * directions leave the SH's bands 1–2 visibly wrong), so they get at least the texels' samples. */
 static int stop_after(tp_ctx *c, int pass, const tp_errors *ce, double pass_seconds)
 {
     const bk_transport_options *opt = c->opt;
@@ -1589,7 +1592,8 @@ static int stop_after(tp_ctx *c, int pass, const tp_errors *ce, double pass_seco
         tp_class *cl = &c->cls[k];
         if (!cl->active) continue;
         double next_spp = cl->spp + 2.0 * (c->s0 << (pass + 1 < 20 ? pass + 1 : 20));
-        if (c->target > 0 && ce->cls[k] <= c->target) cl->stop = BK_STOP_TARGET;
+        const int texels_sampling = k > 0 && c->cls[0].active;
+        if (c->target > 0 && ce->cls[k] <= c->target && !texels_sampling) cl->stop = BK_STOP_TARGET;
         else if (next_spp > c->max_samples || pass >= 24) cl->stop = BK_STOP_BUDGET;
         else if (late) cl->stop = BK_STOP_TIME;
         else { left++; continue; }
