@@ -279,7 +279,7 @@ gltf-validator:
 test: deps-test
 	@$(MAKE) --no-print-directory test-build
 	@$(MAKE) --no-print-directory gltf-validator
-	@LBK=$(BUILD)/lbk-asan BUILD=$(BUILD) FUZZ=$(BUILD)/fuzz_container TSAN_BIN=$(BUILD)/tsan/bin \
+	@LBK=$(BUILD)/lbk-asan LBK_FAULT_SHIM=$(BUILD)/fault_shim.so BUILD=$(BUILD) FUZZ=$(BUILD)/fuzz_container TSAN_BIN=$(BUILD)/tsan/bin \
 	  GLTF_VALIDATOR=$$(test -f $(GLTF_VALIDATOR)/package.json && echo $(GLTF_VALIDATOR)) \
 	  sh tests/run.sh $(TESTS) install_check_shared install_check_static install_lib_check \
 	    bake_check_shared bake_check_static; \
@@ -321,7 +321,7 @@ tsan: deps-test
 
 # What `make test` builds (after TSAN_TESTS is defined); make test builds it through a sub-make,
 # so that HAVE_VULKAN sees what deps-test installed.
-test-build: $(BUILD)/lbk $(BUILD)/lbk-asan $(TESTS:%=$(BUILD)/tests/%) $(BUILD)/fuzz_container \
+test-build: $(BUILD)/lbk $(BUILD)/lbk-asan $(TESTS:%=$(BUILD)/tests/%) $(BUILD)/fuzz_container $(BUILD)/fault_shim.so \
             install-check install-lib-check $(TSAN_TESTS:%=$(BUILD)/tsan/bin/%) \
             $(if $(HAVE_VULKAN),$(BUILD)/lbk-gpu-apply)
 
@@ -352,6 +352,12 @@ install-lib-check:
 	$(CC) $(CSTD) $(WARN) tests/install/install_check.c -o $(BUILD)/tests/install_lib_check \
 	    $$($(LIBPC) --cflags lbk) $(LIBSTAGE)/opt/lbk/lib/liblbk.a \
 	    $$($(LIBPC) --static --libs-only-other --libs-only-l lbk | sed 's/-llbk//') -lcmocka
+
+# ---- fault injection: an LD_PRELOAD library that fails or kills at the N-th write call -------
+# (tests/faults/fault_shim.c; test_faults runs the CLI's writers through it)
+$(BUILD)/fault_shim.so: tests/faults/fault_shim.c
+	@mkdir -p $(@D)
+	$(CC) -std=c11 -O1 -g $(WARN) -fPIC -shared $< -o $@ -ldl
 
 # ---- fuzzing (clang libFuzzer) --------------------------------------------------------------
 FUZZ_FLAGS := -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined -g -O1
