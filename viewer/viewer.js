@@ -1,0 +1,361 @@
+/* lbk view: the level with its baked lighting, as a runtime applies it.
+ *
+ * Data: data.js sets window.LBK_DATA = {lbk: base64 container, glb: base64 glTF (lbk export --gltf
+ * of the scene: world-space nodes in OBJS order, TEXCOORD_1 = normalised page uv), name}. The
+ * container is read by lbk_reader.js (the page's own reader of spec/container.md).
+ *
+ * Lightmapped surfaces: the two LMAP planes are uploaded as stored (R32UI R11G11B10F words, RGBA8UI
+ * bytes) and the fragment shader does what tools/render/shade.c does per pixel: bilinear over the
+ * four texels around (X − ½, Y − ½) (clamped to the page), each decoded by spec §5.6 to the linear
+ * form and blended there, evaluated along the shading normal (+Z of the tangent frame, no normal
+ * maps), × the section's scale. Radiance = albedo · E / π. LLG objects: V · E_sh(bent normal) of
+ * the grid's trilinear SH at each vertex (spec §11), interpolated. Other objects: the GLG at each
+ * vertex. Display: radiance × 2^stops, clamped, sRGB-encoded.
+ *
+ * URL hash (for tests and links): cam=fx,fy,fz,ax,ay,az,ux,uy,uz,yfov_degrees, stops=S, mode=M,
+ * size=WxH. window.lbkViewReady becomes true when the first frame is drawn. */
+(function () {
+  'use strict';
+  const $ = (id) => document.getElementById(id);
+  const status = (s) => { $('status').textContent = s; };
+  const fail = (e) => {
+    $('error').textContent = String(e && e.message || e); status('error'); console.error(e);
+    document.title = 'lbk view: failed, ' + window.lbkErrors.length + ' errors';
+  };
+
+  function b64(s) {
+    const bin = atob(s), u8 = new Uint8Array(bin.length);
+    for (let i = 0; i < bin.length; i++) u8[i] = bin.charCodeAt(i);
+    return u8;
+  }
+  function params() {
+    const out = {};
+    for (const kv of location.hash.replace(/^#/, '').split('&')) {
+      const i = kv.indexOf('=');
+      if (i > 0) out[decodeURIComponent(kv.slice(0, i))] = decodeURIComponent(kv.slice(i + 1));
+    }
+    return out;
+  }
+
+  const VERT = `
+    attribute vec2 uv2;
+    varying vec2 vCoord;
+    varying vec3 vNormal;
+    varying vec3 vColor;
+    attribute vec3 lbkColor;
+    uniform vec2 pageSize;
+    void main() {
+      vCoord = uv2 * pageSize;
+      vNormal = normalize(normal);
+      vColor = lbkColor;
+      gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0);
+    }`;
+  /* R11G11B10F decode (spec §5.1) and the AHD linear form (§5.6) */
+  const FRAG = `
+    precision highp float;
+    precision highp usampler2D;
+    uniform usampler2D plane0;
+    uniform usampler2D plane1;
+    uniform vec2 pageSize;
+    uniform float scale;
+    uniform vec3 albedo;
+    uniform vec3 emission;
+    uniform float exposure;
+    uniform int mode;
+    uniform int lightmapped;
+    varying vec2 vCoord;
+    varying vec3 vNormal;
+    varying vec3 vColor;
+    float small(uint code, uint mbits) {
+      uint e = code >> mbits, m = code & ((1u << mbits) - 1u);
+      if (e == 0u) return float(m) * exp2(-14.0 - float(mbits));
+      if (e == 31u) return 65024.0;
+      return (1.0 + float(m) / float(1u << mbits)) * exp2(float(e) - 15.0);
+    }
+    /* e0 + g.z per channel: the linear form along +Z (the shading normal) */
+    vec3 texelE(ivec2 t) {
+      uint w = texelFetch(plane0, t, 0).r;
+      uvec4 b = texelFetch(plane1, t, 0);
+      vec3 ez = vec3(small(w & 2047u, 6u), small((w >> 11) & 2047u, 6u), small(w >> 22, 5u));
+      vec3 d = vec3(2.0 * float(b.g) / 255.0 - 1.0, 2.0 * float(b.b) / 255.0 - 1.0, float(b.a) / 255.0);
+      float len = length(d);
+      d = len < 0.5 ? vec3(0.0, 0.0, 1.0) : d / len;
+      float r = float(b.r) / 255.0;
+      float k = 0.25 + 0.5 * d.z;
+      vec3 amb = r * ez, inten = (1.0 - r) * ez / k;
+      return amb + 0.25 * inten + 0.5 * inten * d.z;
+    }
+    vec3 lightmapE() {
+      vec2 f = vCoord - 0.5;
+      vec2 i0 = floor(f), a = f - i0;
+      vec3 e = vec3(0.0);
+      for (int k = 0; k < 4; k++) {
+        vec2 o = vec2(float(k & 1), float((k >> 1) & 1));
+        float w = (o.x > 0.5 ? a.x : 1.0 - a.x) * (o.y > 0.5 ? a.y : 1.0 - a.y);
+        ivec2 t = ivec2(clamp(i0 + o, vec2(0.0), pageSize - 1.0));
+        e += w * texelE(t);
+      }
+      return max(e * scale, 0.0);
+    }
+    float srgb(float x) { x = clamp(x, 0.0, 1.0); return x <= 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1.0 / 2.4) - 0.055; }
+    void main() {
+      if (!gl_FrontFacing && lightmapped == 1) { gl_FragColor = vec4(0.0, 0.0, 0.0, 1.0); return; }
+      vec3 E = lightmapped == 1 ? lightmapE() : vColor;
+      vec3 c;
+      if (mode == 1) c = E * exposure;
+      else if (mode == 3) c = albedo;
+      else if (mode == 2) {
+        vec2 g = abs(fract(vCoord) - 0.5);
+        float line = lightmapped == 1 && max(g.x, g.y) > 0.45 ? 1.0 : 0.0;
+        c = mix(albedo * 0.6, vec3(1.0, 0.3, 0.1), line);
+      } else c = (albedo * E / 3.14159265358979 + emission) * exposure;
+      gl_FragColor = vec4(srgb(c.r), srgb(c.g), srgb(c.b), 1.0);
+    }`;
+
+  /* ---- probes on the CPU: GLG (tetra barycentrics with visibility, §10), LLG (§11) ----------- */
+  const Y0 = 0.282094791773878, Y1 = 0.488602511902920, Y2a = 1.092548430592079, Y20 = 0.315391565252520, Y22 = 0.546274215296040;
+  const A0 = Math.PI, A1 = 2 * Math.PI / 3, A2 = Math.PI / 4;
+  function shIrradiance(sh, o, n) {
+    const [x, y, z] = n;
+    const b = [A0 * Y0, A1 * Y1 * y, A1 * Y1 * z, A1 * Y1 * x, A2 * Y2a * x * y, A2 * Y2a * y * z,
+               A2 * Y20 * (3 * z * z - 1), A2 * Y2a * x * z, A2 * Y22 * (x * x - y * y)];
+    const e = [0, 0, 0];
+    for (let c = 0; c < 3; c++) for (let k = 0; k < 9; k++) e[c] += sh[o + 27 * 0 + c * 9 + k] * b[k];
+    return e.map((v) => Math.max(0, v));
+  }
+  function glgSample(glg, p) {
+    const P = glg.positions, T = glg.tetra_count;
+    let best = -Infinity, bestT = 0, bestB = null;
+    for (let t = 0; t < T; t++) {
+      const v = [0, 1, 2, 3].map((i) => glg.tetras[4 * t + i]);
+      const q = v.map((i) => [P[3 * i], P[3 * i + 1], P[3 * i + 2]]);
+      const det = (a, b, c, d) => {
+        const u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]], w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]], s = [d[0] - a[0], d[1] - a[1], d[2] - a[2]];
+        return u[0] * (w[1] * s[2] - w[2] * s[1]) - u[1] * (w[0] * s[2] - w[2] * s[0]) + u[2] * (w[0] * s[1] - w[1] * s[0]);
+      };
+      const vol = det(q[0], q[1], q[2], q[3]);
+      if (!(vol > 0)) continue;
+      const b = [0, 1, 2, 3].map((i) => { const r = q.slice(); r[i] = p; return det(r[0], r[1], r[2], r[3]) / vol; });
+      const m = Math.min(...b);
+      if (m > best) { best = m; bestT = t; bestB = b; }
+      if (m >= -1e-6) break;
+    }
+    const out = new Float32Array(27);
+    if (!bestB) return out;
+    let b = bestB.map((x) => Math.max(0, x)), s = b.reduce((x, y) => x + y, 0);
+    b = b.map((x) => x / (s || 1));
+    let w = b.map((x, i) => x * glg.visibility[4 * bestT + i] / 255), ws = w.reduce((x, y) => x + y, 0);
+    w = ws > 0 ? w.map((x) => x / ws) : b;
+    for (let i = 0; i < 4; i++) {
+      const pr = glg.tetras[4 * bestT + i];
+      for (let k = 0; k < 27; k++) out[k] += w[i] * glg.sh[27 * pr + k];
+    }
+    return out;
+  }
+  function llgSample(g, p) {
+    const i0 = [], f = [];
+    for (let a = 0; a < 3; a++) {
+      const ax = g.axes[a];
+      let l = ((p[0] - g.centre[0]) * ax[0] + (p[1] - g.centre[1]) * ax[1] + (p[2] - g.centre[2]) * ax[2]) / g.half_extents[a];
+      l = Math.min(1, Math.max(-1, l));
+      const gc = (l + 1) / 2 * (g.n[a] - 1);
+      const i = Math.min(Math.floor(gc), g.n[a] - 2);
+      i0.push(i); f.push(gc - i);
+    }
+    const out = new Float32Array(27);
+    for (let c = 0; c < 8; c++) {
+      const o = [c & 1, (c >> 1) & 1, (c >> 2) & 1];
+      const w = (o[0] ? f[0] : 1 - f[0]) * (o[1] ? f[1] : 1 - f[1]) * (o[2] ? f[2] : 1 - f[2]);
+      const idx = (i0[0] + o[0]) + g.n[0] * ((i0[1] + o[1]) + g.n[1] * (i0[2] + o[2]));
+      for (let k = 0; k < 27; k++) out[k] += w * g.sh[27 * idx + k];
+    }
+    return out;
+  }
+
+  async function main() {
+    const P = params();
+    const data = window.LBK_DATA;
+    if (!data) throw new Error('data.js did not load (open the folder that lbk view wrote)');
+    const deps = { decompress: (u8) => fzstd.decompress(u8), xxh3: (u8) => hashwasm.xxhash3(u8) };
+    const lbk = await LbkReader.open(b64(data.lbk), deps);
+    const [meta, rept, objs, lmap, glg, llg] = await Promise.all([lbk.meta(), lbk.report(), lbk.objects(), lbk.lightmap(), lbk.glg(), lbk.llg()]);
+    panel(data, lbk, meta, rept, objs, lmap, glg);
+
+    const wrap = $('canvas-wrap');
+    let w = wrap.clientWidth, h = wrap.clientHeight;
+    if (P.size) { /* a fixed-size canvas without the panel: for screenshots (tests) */
+      [w, h] = P.size.split('x').map(Number);
+      document.body.classList.add('shot');
+    }
+    const renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
+    if (!renderer.capabilities.isWebGL2) throw new Error('this page needs WebGL 2');
+    renderer.setPixelRatio(1);
+    renderer.setSize(w, h);
+    renderer.outputEncoding = THREE.LinearEncoding; /* the shader writes sRGB itself */
+    wrap.appendChild(renderer.domElement);
+    const scene = new THREE.Scene();
+    scene.background = new THREE.Color(0, 0, 0);
+
+    /* pages: planes as stored */
+    const pages = (lmap ? lmap.pages : []).map((pg) => {
+      if (pg.format0 || pg.format1) return null; /* block pages: not decoded by this viewer yet */
+      const t0 = new THREE.DataTexture(new Uint32Array(pg.plane0.buffer, pg.plane0.byteOffset, pg.width * pg.height), pg.width, pg.height,
+                                       THREE.RedIntegerFormat, THREE.UnsignedIntType);
+      t0.internalFormat = 'R32UI';
+      const t1 = new THREE.DataTexture(new Uint8Array(pg.plane1), pg.width, pg.height, THREE.RGBAIntegerFormat, THREE.UnsignedByteType);
+      t1.internalFormat = 'RGBA8UI';
+      for (const t of [t0, t1]) { t.magFilter = t.minFilter = THREE.NearestFilter; t.generateMipmaps = false; t.flipY = false; t.needsUpdate = true; }
+      return { t0, t1, size: new THREE.Vector2(pg.width, pg.height) };
+    });
+
+    const blank = 'data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAQAAAC1HAwCAAAAC0lEQVR42mNkYAAAAAYAAjCB0C8AAAAASUVORK5CYII=';
+    const manager = new THREE.LoadingManager();
+    manager.setURLModifier((url) => (/^data:/.test(url) ? url : blank)); /* the preview PNGs are not needed */
+    const gltf = await new Promise((res, rej) => new THREE.GLTFLoader(manager).parse(b64(data.glb).buffer, '', res, rej));
+    const uniformsCommon = { exposure: { value: 1 }, mode: { value: 0 } };
+    const box = new THREE.Box3();
+    const dummy = pages.find((p) => p) || null;
+    const dummyTex = () => { const t = new THREE.DataTexture(new Uint32Array(1), 1, 1, THREE.RedIntegerFormat, THREE.UnsignedIntType); t.internalFormat = 'R32UI'; t.needsUpdate = true; return t; };
+    const dummyTex1 = () => { const t = new THREE.DataTexture(new Uint8Array(4), 1, 1, THREE.RGBAIntegerFormat, THREE.UnsignedByteType); t.internalFormat = 'RGBA8UI'; t.needsUpdate = true; return t; };
+    const meshes = [];
+    gltf.scene.traverse((m) => { if (m.isMesh) meshes.push(m); });
+    for (const m of meshes) {
+      let node = m, info = null;
+      while (node && !(info = node.userData && node.userData.lbk)) node = node.parent;
+      const prim = m.geometry.userData && m.geometry.userData.lbk;
+      const matx = m.material.userData && m.material.userData.lbk;
+      const albedo = matx && matx.albedo ? new THREE.Vector3().fromArray(matx.albedo) : new THREE.Vector3(m.material.color.r, m.material.color.g, m.material.color.b);
+      const emission = new THREE.Vector3().fromArray(matx && matx.emission ? matx.emission : [0, 0, 0]);
+      const g = m.geometry;
+      const n = g.attributes.position.count, colors = new Float32Array(3 * n);
+      const rep = info ? info.representation : 'none';
+      const pageIdx = prim && prim.lightmap ? prim.lightmap.page : -1;
+      const page = pageIdx >= 0 ? pages[pageIdx] : null;
+      if (rep !== 'lightmap' || !page) {
+        const pos = g.attributes.position, nor = g.attributes.normal;
+        const grid = rep === 'llg' && llg ? llg.grids[info.llg_grid] : null;
+        const vis = g.attributes._lbk_llg_visibility, bent = g.attributes._lbk_llg_bent_normal;
+        for (let i = 0; i < n; i++) {
+          const p = [pos.getX(i), pos.getY(i), pos.getZ(i)];
+          let e = [0, 0, 0];
+          if (grid && vis && bent) {
+            const b = new THREE.Vector3(bent.getX(i), bent.getY(i), bent.getZ(i)).normalize();
+            e = shIrradiance(llgSample(grid, p), 0, [b.x, b.y, b.z]).map((v) => v * vis.getX(i));
+          } else if (glg && nor) {
+            e = shIrradiance(glgSample(glg, p), 0, [nor.getX(i), nor.getY(i), nor.getZ(i)]);
+          }
+          colors.set(e, 3 * i);
+        }
+      }
+      g.setAttribute('lbkColor', new THREE.BufferAttribute(colors, 3));
+      if (!g.attributes.uv2) g.setAttribute('uv2', new THREE.BufferAttribute(new Float32Array(2 * n), 2));
+      const src = page || dummy;
+      const mat = new THREE.ShaderMaterial({
+        vertexShader: VERT, fragmentShader: FRAG, side: THREE.DoubleSide,
+        uniforms: { plane0: { value: page ? page.t0 : dummyTex() }, plane1: { value: page ? page.t1 : dummyTex1() },
+                    pageSize: { value: src ? src.size.clone() : new THREE.Vector2(1, 1) }, scale: { value: lmap ? lmap.scale : 1 },
+                    albedo: { value: albedo }, emission: { value: emission }, lightmapped: { value: page ? 1 : 0 },
+                    exposure: uniformsCommon.exposure, mode: uniformsCommon.mode } });
+      m.material = mat;
+      box.expandByObject(m);
+    }
+    scene.add(gltf.scene);
+
+    /* probe glyphs: one sphere per GLG probe, coloured by its irradiance per normal */
+    const glyphs = new THREE.Group();
+    if (glg) {
+      const r = box.getSize(new THREE.Vector3()).length() * 0.006;
+      const sg = new THREE.SphereGeometry(r, 12, 8);
+      for (let i = 0; i < glg.probe_count; i++) {
+        const gi = sg.clone(), nor = gi.attributes.normal, c = new Float32Array(3 * nor.count);
+        for (let v = 0; v < nor.count; v++) c.set(shIrradiance(glg.sh, 27 * i, [nor.getX(v), nor.getY(v), nor.getZ(v)]), 3 * v);
+        gi.setAttribute('lbkColor', new THREE.BufferAttribute(c, 3));
+        gi.setAttribute('uv2', new THREE.BufferAttribute(new Float32Array(2 * nor.count), 2));
+        const mat = new THREE.ShaderMaterial({ vertexShader: VERT, fragmentShader: FRAG,
+          uniforms: { plane0: { value: dummyTex() }, plane1: { value: dummyTex1() }, pageSize: { value: new THREE.Vector2(1, 1) },
+                      scale: { value: 1 }, albedo: { value: new THREE.Vector3(1, 1, 1) }, emission: { value: new THREE.Vector3() }, lightmapped: { value: 0 },
+                      exposure: uniformsCommon.exposure, mode: { value: 1 } } });
+        const s = new THREE.Mesh(gi, mat);
+        s.position.set(glg.positions[3 * i], glg.positions[3 * i + 1], glg.positions[3 * i + 2]);
+        glyphs.add(s);
+      }
+    }
+    glyphs.visible = false;
+    scene.add(glyphs);
+
+    const camera = new THREE.PerspectiveCamera(50, w / h, 0.01, 1e5);
+    const controls = new THREE.OrbitControls(camera, renderer.domElement);
+    if (P.cam) {
+      const c = P.cam.split(',').map(Number);
+      camera.position.set(c[0], c[1], c[2]); camera.up.set(c[6], c[7], c[8]); camera.fov = c[9];
+      controls.target.set(c[3], c[4], c[5]);
+    } else {
+      const ctr = box.getCenter(new THREE.Vector3()), size = box.getSize(new THREE.Vector3());
+      camera.position.copy(ctr).add(new THREE.Vector3(0, 0, size.length() * 0.9));
+      controls.target.copy(ctr);
+    }
+    const far = box.getSize(new THREE.Vector3()).length() * 4 + camera.position.distanceTo(controls.target);
+    camera.near = far * 1e-5; camera.far = far;
+    camera.updateProjectionMatrix();
+    controls.update();
+
+    /* default exposure: 1 / (99th percentile of the lit texels' radiance for albedo 1), like lbk render's PNG */
+    let defaultStops = 0;
+    if (lmap && lmap.pages.length && !lmap.pages[0].format0) {
+      const lin = LbkReader.pageLinear(lmap, 0), vals = [];
+      for (let t = 0; t < lin.length / 12; t += 1) {
+        const l = 0.2126 * (lin[12 * t] + lin[12 * t + 3]) + 0.7152 * (lin[12 * t + 4] + lin[12 * t + 7]) + 0.0722 * (lin[12 * t + 8] + lin[12 * t + 11]);
+        if (l > 0) vals.push(l / Math.PI);
+      }
+      vals.sort((a, b) => a - b);
+      if (vals.length) defaultStops = -Math.log2(vals[Math.floor(0.99 * (vals.length - 1))]);
+    }
+    const stops = P.stops !== undefined ? Number(P.stops) : Math.round(defaultStops * 10) / 10;
+    $('exposure').value = String(stops);
+    if (P.mode !== undefined) $('mode').value = P.mode;
+    const apply = () => {
+      uniformsCommon.exposure.value = Math.pow(2, Number($('exposure').value));
+      $('exposure-v').textContent = Number($('exposure').value).toFixed(1);
+      uniformsCommon.mode.value = Number($('mode').value);
+      glyphs.visible = $('probes').checked;
+      draw();
+    };
+    const draw = () => renderer.render(scene, camera);
+    for (const id of ['exposure', 'mode', 'probes']) $(id).addEventListener('input', apply);
+    controls.addEventListener('change', draw);
+    window.addEventListener('resize', () => {
+      if (P.size) return;
+      renderer.setSize(wrap.clientWidth, wrap.clientHeight);
+      camera.aspect = wrap.clientWidth / wrap.clientHeight; camera.updateProjectionMatrix(); draw();
+    });
+    apply();
+    status(data.name || 'level');
+    window.lbkViewReady = true;
+    document.title = 'lbk view: ready, ' + window.lbkErrors.length + ' errors';
+  }
+
+  function fmt(n) { return n.toLocaleString('en-US'); }
+  function panel(data, lbk, meta, rept, objs, lmap, glg) {
+    const rows = lbk.sections.map((s) => `<tr><td>${s.type}</td><td class="n">${fmt(s.stored_size)}</td><td class="n">${fmt(s.decoded_size)}</td><td>${s.compression ? 'zstd' : ''}</td></tr>`);
+    const total = lbk.sections.reduce((a, s) => a + s.decoded_size, 0);
+    $('sections').innerHTML = '<tr><td></td><td class="n">file</td><td class="n">decoded</td><td></td></tr>' + rows.join('') +
+      `<tr><td>total</td><td class="n">${fmt(lbk.file_size)}</td><td class="n">${fmt(total)}</td><td></td></tr>`;
+    const lit = objs ? objs.filter((o) => o.representation === 'lightmap').length : 0;
+    $('level').innerHTML = `format ${lbk.version.join('.')}; ${objs ? objs.length : 0} objects (${lit} lightmapped)` +
+      (lmap ? `; ${lmap.pages.length} page(s), ${fmt(lmap.texel_count)} texels` : '') + (glg ? `; ${glg.probe_count} GLG probes` : '') +
+      (meta && meta['scene.name'] ? `<br>scene ${meta['scene.name']}` : '') + (meta && meta['bake.preset'] ? `, preset ${meta['bake.preset']}` : '');
+    if (!rept) { $('report').textContent = 'no REPT section'; return; }
+    const r = rept.records, cv = $('plot'), ctx = cv.getContext('2d');
+    const xs = r.map((x) => rept.has_times ? x.elapsed_seconds : x.samples_per_texel), ys = r.map((x) => x.texel_rel_rmse);
+    const xmax = Math.max(...xs, 1e-9), ymax = Math.max(...ys, 1e-9);
+    ctx.strokeStyle = '#9cf'; ctx.beginPath();
+    r.forEach((_, i) => { const X = 30 + xs[i] / xmax * (cv.width - 40), Y = cv.height - 20 - ys[i] / ymax * (cv.height - 30); i ? ctx.lineTo(X, Y) : ctx.moveTo(X, Y); });
+    ctx.stroke();
+    ctx.fillStyle = '#aaa'; ctx.font = '10px sans-serif';
+    ctx.fillText(ymax.toPrecision(3), 2, 12); ctx.fillText(rept.has_times ? 's' : 'samples/texel', cv.width - 70, cv.height - 5);
+    const last = r[r.length - 1];
+    $('report').innerHTML = `status: ${rept.status}; ${r.length} passes; last: ${last.samples_per_texel} samples/texel, texel rel. RMSE ${last.texel_rel_rmse.toPrecision(3)}, probe ${last.probe_rel_rmse.toPrecision(3)}`;
+  }
+
+  main().catch(fail);
+})();
