@@ -214,7 +214,9 @@
              lightmap: async () => parseLightmap(await payload('LMAP')),
              glg: async () => parseGlg(await payload('GLG ')),
              llg: async () => parseLlg(await payload('LLG ')),
-             octp: async () => parseOctp(await payload('OCTP')) };
+             octp: async () => parseOctp(await payload('OCTP')),
+             dls: async () => parseDls(await payload('DLS ')),
+             doors: async () => parseDoor(await payload('DOOR')) };
   }
 
   function view(p) { return new DataView(p.buffer, p.byteOffset, p.byteLength); }
@@ -392,5 +394,274 @@
     return { scale, probes };
   }
 
-  return { open, LbkError, pageLinear, linearEval, sh9Unpack, r11g11b10f, rgb9e5, half, unorm8, snorm8, ahdToLinear };
+
+  /* ---- encoders (§5.1–§5.6, as liblbk implements them: DLS apply re-encodes, §12.8) ------------ */
+  const fbuf = new DataView(new ArrayBuffer(4));
+  function fbits(x) { fbuf.setFloat32(0, x, true); return fbuf.getUint32(0, true); }
+  /* round to nearest, ties to even, of a finite double */
+  function rne(x) {
+    const f = Math.floor(x), d = x - f;
+    if (d > 0.5) return f + 1;
+    if (d < 0.5) return f;
+    return f % 2 === 0 ? f : f + 1;
+  }
+  function smallFromMagnitude(a, mbits) {
+    const maxCode = ((30 << mbits) | ((1 << mbits) - 1)) >>> 0;
+    const exp = a >>> 23;
+    if (exp >= 113) {
+      if (exp > 142) return maxCode;
+      const shift = 23 - mbits;
+      const t = (a - (112 << 23)) >>> 0;
+      const r = ((t + ((1 << (shift - 1)) - 1) + ((t >>> shift) & 1)) >>> 0) >>> shift;
+      return r > maxCode ? maxCode : r;
+    }
+    const sig = exp === 0 ? (a & 0x7fffff) : ((a & 0x7fffff) | 0x800000);
+    const e = exp === 0 ? -126 : exp - 127;
+    const rshift = 23 - 14 - mbits - e;
+    if (rshift > 24) return 0;
+    let q = rshift >= 32 ? 0 : sig >>> rshift;
+    const rem = sig & ((1 << rshift) - 1), half = 1 << (rshift - 1);
+    if (rem > half || (rem === half && (q & 1))) q++;
+    return q;
+  }
+  function smallEncode(x, mbits) {
+    const u = fbits(x);
+    if ((u & 0x7fffffff) > 0x7f800000) return 0;
+    if (u >>> 31) return 0;
+    if (u === 0x7f800000) return ((30 << mbits) | ((1 << mbits) - 1)) >>> 0;
+    return smallFromMagnitude(u, mbits);
+  }
+  function r11g11b10fPack(rgb) {
+    return (smallEncode(rgb[0], 6) | (smallEncode(rgb[1], 6) << 11) | (smallEncode(rgb[2], 5) << 22)) >>> 0;
+  }
+  function unorm8Encode(x) {
+    if (!(x > 0)) return 0;
+    if (x >= 1) return 255;
+    return rne(x * 255);
+  }
+  function snorm8Encode(x) {
+    if (x !== x) return 0;
+    if (x >= 1) return 127;
+    if (x <= -1) return 0x81;
+    return rne(x * 127) & 255;
+  }
+  function rgb9e5Pack(rgb) {
+    const c = rgb.map((x) => (!(x > 0) ? 0 : Math.min(x, 65408)));
+    const maxc = Math.max(c[0], c[1], c[2]);
+    let es = 0;
+    if (maxc > 0) {
+      let e = Math.floor(Math.log2(maxc)); /* floor(log2 maxc), corrected where log2 rounds */
+      if (Math.pow(2, e) > maxc) e--;
+      if (Math.pow(2, e + 1) <= maxc) e++;
+      es = (e < -16 ? -16 : e) + 16;
+      if (rne(maxc * Math.pow(2, 24 - es)) >= 512) es++;
+    }
+    let out = es * 134217728; /* << 27 without the sign */
+    for (let i = 0; i < 3; i++) out += rne(c[i] * Math.pow(2, 24 - es)) * Math.pow(2, 9 * i);
+    return out >>> 0;
+  }
+  const LUM = [f32(0.2126), f32(0.7152), f32(0.0722)];
+  const BIG = f32(1e30);
+  function sanitize(x) { return x !== x ? 0 : x > BIG ? BIG : x < -BIG ? -BIG : x; }
+  /* lbk_ahd_from_linear: lin = 12 floats [ch·4 + {e0, gx, gy, gz}] → [Ez word, r, G, B, A] */
+  function ahdFromLinear(lin, o) {
+    const e0 = [0, 0, 0], g = [[0, 0, 0], [0, 0, 0], [0, 0, 0]];
+    for (let c = 0; c < 3; c++) {
+      e0[c] = sanitize(lin[o + 4 * c]);
+      for (let i = 0; i < 3; i++) g[c][i] = sanitize(lin[o + 4 * c + 1 + i]);
+    }
+    const sv = [0, 0, 0];
+    for (let c = 0; c < 3; c++) for (let i = 0; i < 3; i++) sv[i] += LUM[c] * g[c][i];
+    let dir = [0, 0, 1];
+    const len = Math.sqrt(sv[0] * sv[0] + sv[1] * sv[1] + sv[2] * sv[2]);
+    if (len >= 1e-30) {
+      if (sv[2] >= 0) dir = [sv[0] / len, sv[1] / len, sv[2] / len];
+      else {
+        const lxy = Math.sqrt(sv[0] * sv[0] + sv[1] * sv[1]);
+        if (lxy >= 1e-30) dir = [sv[0] / lxy, sv[1] / lxy, 0];
+      }
+    }
+    const G = unorm8Encode(f32((dir[0] + 1) * 0.5)), B = unorm8Encode(f32((dir[1] + 1) * 0.5)), A = unorm8Encode(f32(dir[2]));
+    const d = ahdDirection(G, B, A);
+    const k = f32(0.25 + f32(0.5 * d[2]));
+    const a = [0, 0, 0], ez = [0, 0, 0];
+    let lumA = 0, lumEz = 0;
+    for (let c = 0; c < 3; c++) {
+      const gd = f32(f32(f32(g[c][0] * d[0]) + f32(g[c][1] * d[1])) + f32(g[c][2] * d[2]));
+      const inten = gd > 0 ? f32(2 * gd) : 0;
+      const amb = f32(e0[c] - f32(0.25 * inten));
+      a[c] = amb > 0 ? amb : 0;
+      ez[c] = f32(a[c] + f32(inten * k));
+      lumA += LUM[c] * a[c];
+      lumEz += LUM[c] * ez[c];
+    }
+    return [r11g11b10fPack(ez), lumEz > 0 ? unorm8Encode(f32(lumA / lumEz)) : 255, G, B, A];
+  }
+  /* lbk_sh9_pack of 27 floats [ch·9 + k] (stored units) into out[o..o+28) */
+  function sh9Pack(sh, out, o) {
+    const w = rgb9e5Pack([sh[0], sh[9], sh[18]]);
+    const dq = rgb9e5(w);
+    out[o] = w & 255; out[o + 1] = (w >>> 8) & 255; out[o + 2] = (w >>> 16) & 255; out[o + 3] = w >>> 24;
+    for (let k = 1; k < 9; k++)
+      for (let c = 0; c < 3; c++)
+        out[o + 4 + 3 * (k - 1) + c] = dq[c] > 0 ? snorm8Encode(f32(sh[9 * c + k] / f32(BAND_SCALE[k] * dq[c]))) : 0;
+  }
+
+  /* ---- DLS (§12) and DOOR (§13) ----------------------------------------------------------------- */
+  const FORMS = { 2: [2, 5, 16, 16], 3: [3, 9, 10, 8], 4: [8, 17, 4, 16] }; /* b, bias, F, B */
+  function parseDls(p) {
+    if (!p) return null;
+    const dv = view(p); need(p, 96, 'DLS');
+    const H = (i) => dv.getUint32(4 * i, true);
+    const nSets = H(0), nRefs = H(1), nMembers = H(2), nClusters = H(3), nClusterSets = H(4), nRuns = H(5), nSub = H(6),
+          nWords = H(7), nB16 = H(8), nB32 = H(9);
+    const nSlots = u64(dv, 40), nTexE = u64(dv, 48), nProbeE = u64(dv, 56), nStr = u64(dv, 64);
+    const targets = [u64(dv, 72), u64(dv, 80), u64(dv, 88)];
+    const sizes = [32 * nSets, 8 * nRefs, 4 * nMembers, 64 * nClusters, 4 * nClusterSets, 8 * nRuns, 16 * nSub, 4 * nWords,
+                   2 * nB16, 4 * nB32, nSlots, 8 * nTexE, 28 * nProbeE, nStr];
+    const at = [];
+    let pos = 96;
+    for (const n of sizes) { pos = align16(pos); at.push(pos); pos += n; }
+    if (align16(pos) !== p.length) fail('DLS: size does not match its counts');
+    const u32 = (arr, i) => dv.getUint32(at[arr] + 4 * i, true);
+    const strings = p.subarray(at[13], at[13] + nStr);
+    const sets = [];
+    for (let i = 0; i < nSets; i++) {
+      const o = at[0] + 32 * i, r = (k) => dv.getUint32(o + 4 * k, true);
+      if (r(0) + r(1) > nStr || r(5) + r(6) > nMembers || r(2) > 3) fail('DLS set ' + i + ': out of range');
+      const members = [];
+      for (let m = 0; m < r(6); m++) members.push(u32(2, r(5) + m));
+      sets.push({ name: utf8.decode(strings.subarray(r(0), r(0) + r(1))), kind: r(2), members });
+    }
+    const clusters = [];
+    for (let i = 0; i < nClusters; i++) {
+      const o = at[3] + 64 * i, r = (k) => dv.getUint32(o + 4 * k, true);
+      const c = { form: r(0), space: r(1), overlaps: r(2), set_first: r(3), set_count: r(4), run_first: r(5), run_count: r(6),
+                  target_count: r(7), aux_first: r(8), aux_count: r(9), base_first: r(10), entry_count: r(11),
+                  entry_first: u64(dv, o + 48), slot_first: u64(dv, o + 56) };
+      if (c.form > 4 || c.space > 2 || c.set_first + c.set_count > nClusterSets || c.run_first + c.run_count > nRuns) fail('DLS cluster ' + i + ': out of range');
+      c.sets = [];
+      for (let k = 0; k < c.set_count; k++) { const s = u32(4, c.set_first + k); if (s >= nSets) fail('DLS cluster set'); c.sets.push(s); }
+      clusters.push(c);
+    }
+    const runTargets = (first, count, out) => {
+      for (let r = first; r < first + count; r++) {
+        const st = u32(5, 2 * r), ln = u32(5, 2 * r + 1);
+        for (let t = st; t < st + ln; t++) out.push(t);
+      }
+      return out;
+    };
+    /* calls fn(target, [[set, entry index], ...]) for every target of cluster c, in cluster order */
+    function forEachTarget(c, fn) {
+      const targetsOf = runTargets(c.run_first, c.run_count, []);
+      if (targetsOf.length !== c.target_count) fail('DLS: run lengths do not add up to target_count');
+      const nE = c.space === 0 ? nTexE : nProbeE;
+      if (c.entry_first + c.entry_count > nE) fail('DLS: cluster entries outside the entry array');
+      if (c.form === 0) {
+        const k = c.set_count;
+        targetsOf.forEach((t, i) => fn(t, c.sets.map((s, j) => [s, c.entry_first + i * k + j])));
+      } else if (c.form === 1) {
+        const k = c.overlaps;
+        for (let g = c.aux_first; g < c.aux_first + c.aux_count; g++) {
+          const o = at[6] + 16 * g, rf = dv.getUint32(o, true), rc = dv.getUint32(o + 4, true), tf = dv.getUint32(o + 8, true);
+          const slot = [p[o + 12], p[o + 13], p[o + 14], p[o + 15]];
+          runTargets(rf, rc, []).forEach((t, i) =>
+            fn(t, slot.slice(0, k).map((sl, j) => [c.sets[sl], c.entry_first + (tf + i) * k + j])));
+        }
+      } else {
+        const [b, bias, F, Bt] = FORMS[c.form];
+        let off = 0;
+        targetsOf.forEach((t, i) => {
+          if (i % Bt === 0) {
+            const base = c.form === 4 ? u32(9, c.base_first + i / Bt) : dv.getUint16(at[8] + 2 * (c.base_first + i / Bt), true);
+            if (base !== off) fail('DLS: a prefix base is not the running entry count');
+          }
+          const word = u32(7, c.aux_first + Math.floor(i / F));
+          const cnt = ((word >>> (b * (i % F))) & ((1 << b) - 1)) + bias;
+          const list = [];
+          for (let e = 0; e < cnt; e++) {
+            const sl = p[at[10] + c.slot_first + off + e];
+            if (sl >= c.set_count) fail('DLS: slot outside the set list');
+            list.push([c.sets[sl], c.entry_first + off + e]);
+          }
+          off += cnt;
+          fn(t, list);
+        });
+      }
+    }
+    return { sets, clusters, targets, forEachTarget, texel_entries: p.subarray(at[11], at[11] + 8 * nTexE),
+             probe_entries: p.subarray(at[12], at[12] + 28 * nProbeE) };
+  }
+  function parseDoor(p) {
+    if (!p) return null;
+    const dv = view(p); need(p, 32, 'DOOR');
+    const E = dv.getUint32(0, true), S = dv.getUint32(4, true), SD = dv.getUint32(8, true), nStr = u64(dv, 16);
+    const strAt = align16(align16(align16(32 + 80 * E) + 16 * S) + 4 * SD);
+    need(p, strAt + nStr, 'DOOR strings');
+    const doors = [];
+    for (let i = 0; i < E; i++) {
+      const o = 32 + 80 * i, no = dv.getUint32(o, true), nl = dv.getUint32(o + 4, true);
+      if (no + nl > nStr) fail('DOOR: name outside the blob');
+      doors.push({ name: utf8.decode(p.subarray(strAt + no, strAt + no + nl)), open_set: dv.getUint32(o + 68, true),
+                   closed_set: dv.getUint32(o + 72, true) });
+    }
+    return doors;
+  }
+  /* lbk_dls_effective_weights: per set, from the caller's set weights and door openings */
+  function effectiveWeights(dls, doors, setWeights, doorWeights) {
+    const n = dls.sets.length, w = new Float32Array(n), doorOf = new Array(n).fill(-1);
+    (doors || []).forEach((d, i) => { doorOf[d.open_set] = i; if (d.closed_set !== 0xffffffff) doorOf[d.closed_set] = i; });
+    for (let s = 0; s < n; s++) {
+      let x = setWeights ? f32(setWeights[s] || 0) : 0;
+      if (doorOf[s] >= 0) {
+        const om = doorWeights ? f32(doorWeights[doorOf[s]] || 0) : 0;
+        x = dls.sets[s].kind === 1 ? om : f32(1 - om);
+      }
+      w[s] = x;
+    }
+    for (let s = 0; s < n; s++) {
+      if (dls.sets[s].kind !== 3) continue;
+      let x = 1;
+      for (const m of dls.sets[s].members) x = f32(x * w[m]);
+      w[s] = x;
+    }
+    return w;
+  }
+  /* §12.8 for the given weights, from the base: returns {z, rgba, glg, llg} (new arrays; stored
+   * units) — the bytes lbk_dls_apply writes. base: {z: Uint32Array, rgba: Uint8Array, glg, llg:
+   * Uint8Array of packed SH9}, any may be null when its space has no cluster. */
+  function dlsApply(dls, doors, base, setWeights, doorWeights) {
+    const w = effectiveWeights(dls, doors, setWeights, doorWeights);
+    const out = { z: base.z && base.z.slice(), rgba: base.rgba && base.rgba.slice(), glg: base.glg && base.glg.slice(),
+                  llg: base.llg && base.llg.slice() };
+    const te = view(dls.texel_entries), lin = new Float32Array(12), el = new Float32Array(12);
+    for (const c of dls.clusters) {
+      if (!c.sets.some((s) => w[s] !== 0)) continue; /* all weights 0: the base, as copied */
+      dls.forEachTarget(c, (t, list) => {
+        const on = list.filter(([s]) => w[s] !== 0);
+        if (!on.length) return;
+        if (c.space === 0) {
+          ahdToLinear(base.z[t], base.rgba.subarray(4 * t, 4 * t + 4), lin, 0);
+          for (const [s, e] of on) {
+            ahdToLinear(te.getUint32(8 * e, true), dls.texel_entries.subarray(8 * e + 4, 8 * e + 8), el, 0);
+            for (let k = 0; k < 12; k++) lin[k] = f32(lin[k] + f32(w[s] * el[k]));
+          }
+          const r = ahdFromLinear(lin, 0);
+          out.z[t] = r[0];
+          out.rgba.set(r.slice(1), 4 * t);
+        } else {
+          const b = c.space === 1 ? base.glg : base.llg, o = c.space === 1 ? out.glg : out.llg;
+          const acc = sh9Unpack(b, 28 * t, 1);
+          for (const [s, e] of on) {
+            const sh = sh9Unpack(dls.probe_entries, 28 * e, 1);
+            for (let k = 0; k < 27; k++) acc[k] = f32(acc[k] + f32(w[s] * sh[k]));
+          }
+          sh9Pack(acc, o, 28 * t);
+        }
+      });
+    }
+    return out;
+  }
+
+  return { open, LbkError, pageLinear, parseDls, parseDoor, dlsApply, effectiveWeights, ahdFromLinear, sh9Pack, r11g11b10fPack, rgb9e5Pack, linearEval, sh9Unpack, r11g11b10f, rgb9e5, half, unorm8, snorm8, ahdToLinear };
 }));

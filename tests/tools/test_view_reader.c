@@ -20,6 +20,8 @@
 
 #include "lbk/ahd.h"
 #include "lbk/container.h"
+#include "lbk/dls.h"
+#include "lbk/door.h"
 #include "lbk/glg.h"
 #include "lbk/lightmap.h"
 #include "lbk/llg.h"
@@ -281,6 +283,150 @@ static void test_js_reader_matches_liblbk(void **state)
     assert_true(probe_lines > 50);
 }
 
+/* ---- DLS apply (§12.8): the page's dlsApply against lbk_dls_apply --------------------------- */
+
+static void hex_line(FILE *f, const char *tag, const void *p, size_t n)
+{
+    fputs(tag, f), hexs(f, p, n), fputc('\n', f);
+}
+
+/* liblbk's outputs for the weights, in dump.js's --apply lines */
+static void dump_apply(FILE *f, lbk_reader *r, const float *sw, size_t ns, const float *dw)
+{
+    const void *d, *dd = NULL, *lm = NULL, *gl = NULL, *ll = NULL;
+    size_t n, ndd = 0, nlm = 0, ngl = 0, nll = 0;
+    assert_true(section(r, LBK_SECTION_DLS, &d, &n));
+    section(r, LBK_SECTION_DOOR, &dd, &ndd);
+    section(r, LBK_SECTION_LMAP, &lm, &nlm);
+    section(r, LBK_SECTION_GLG, &gl, &ngl);
+    section(r, LBK_SECTION_LLG, &ll, &nll);
+    lbk_dls_view *dls;
+    lbk_door_view *doors = NULL;
+    assert_int_equal(lbk_dls_open(d, n, NULL, &dls), LBK_OK);
+    if (dd) assert_int_equal(lbk_door_open(dd, ndd, NULL, &doors), LBK_OK);
+    lbk_dls_runtime_desc rd = LBK_DLS_RUNTIME_DESC_INIT;
+    rd.dls = dls, rd.doors = doors;
+    const uint64_t nt = lbk_dls_target_count(dls, 0), ng = lbk_dls_target_count(dls, 1), nl = lbk_dls_target_count(dls, 2);
+    uint32_t *z = NULL, *oz = NULL;
+    uint8_t *rgba = NULL, *orgba = NULL, *og = NULL, *ol = NULL;
+    if (nt) {
+        lbk_lmap_view v;
+        assert_int_equal(lbk_lmap_open(lm, nlm, &v), LBK_OK);
+        z = malloc(4 * nt), oz = malloc(4 * nt), rgba = malloc(4 * nt), orgba = malloc(4 * nt);
+        for (uint64_t t = 0; t < nt; t++) {
+            lbk_ahd_texel tx;
+            assert_int_equal(lbk_lmap_texel_get(&v, t, &tx, NULL), LBK_OK);
+            z[t] = tx.irradiance_z;
+            memcpy(rgba + 4 * t, tx.rgba, 4);
+        }
+        rd.base_irradiance_z = z, rd.base_rgba = rgba, rd.out_irradiance_z = oz, rd.out_rgba = orgba;
+    }
+    if (ng) {
+        lbk_glg_view v;
+        assert_int_equal(lbk_glg_open(gl, ngl, &v), LBK_OK);
+        rd.base_glg = v.probes, rd.out_glg = og = malloc(28 * ng);
+    }
+    if (nl) {
+        lbk_llg_view v;
+        assert_int_equal(lbk_llg_open(ll, nll, &v), LBK_OK);
+        rd.base_llg = v.probes, rd.out_llg = ol = malloc(28 * nl);
+    }
+    lbk_dls_runtime *rt;
+    assert_int_equal(lbk_dls_runtime_open(&rd, &rt), LBK_OK);
+    assert_int_equal(lbk_dls_set_count(dls), ns);
+    float w[64];
+    assert_int_equal(lbk_dls_effective_weights(rt, sw, dw, w), LBK_OK);
+    fputs("W", f), fxs(f, w, ns), fputc('\n', f);
+    assert_int_equal(lbk_dls_apply(rt, sw, dw, NULL), LBK_OK);
+    if (nt) {
+        uint8_t *le = malloc(4 * nt);
+        for (uint64_t t = 0; t < nt; t++)
+            for (int k = 0; k < 4; k++) le[4 * t + k] = (uint8_t)(oz[t] >> (8 * k));
+        hex_line(f, "AZ", le, 4 * nt), hex_line(f, "AR", orgba, 4 * nt);
+        free(le);
+    }
+    if (ng) hex_line(f, "AG", og, 28 * ng);
+    if (nl) hex_line(f, "AL", ol, 28 * nl);
+    lbk_dls_runtime_close(rt);
+    lbk_dls_close(dls);
+    if (doors) lbk_door_close(doors);
+    free(z), free(oz), free(rgba), free(orgba), free(og), free(ol);
+}
+
+/* The apply lines of both sides for the set weights and door openings; 0 when they are equal. */
+static int compare_apply(const char *file, const float *sw, size_t ns, const float *dw, size_t nd)
+{
+    char in[256], c_out[256], js_out[256], cmd[2048], ws[512] = "", ds[256] = "";
+    snprintf(in, sizeof in, "tests/fuzz/corpus/%s", file);
+    snprintf(c_out, sizeof c_out, OUT_DIR "/%s.apply.c.txt", file);
+    snprintf(js_out, sizeof js_out, OUT_DIR "/%s.apply.js.txt", file);
+    for (size_t i = 0; i < ns; i++) snprintf(ws + strlen(ws), sizeof ws - strlen(ws), "%s%.9g", i ? "," : "", sw[i]);
+    for (size_t i = 0; i < nd; i++) snprintf(ds + strlen(ds), sizeof ds - strlen(ds), "%s%.9g", i ? "," : "", dw[i]);
+    lbk_reader *r;
+    assert_int_equal(lbk_reader_open_file(in, NULL, &r), LBK_OK);
+    FILE *f = fopen(c_out, "w");
+    assert_non_null(f);
+    dump_apply(f, r, sw, ns, nd ? dw : NULL);
+    fclose(f);
+    lbk_reader_close(r);
+    snprintf(cmd, sizeof cmd, "node viewer/test/dump.js '%s' '%s' --apply '%s' '%s'", in, js_out, ws, ds);
+    assert_int_equal(system(cmd), 0);
+    size_t na, nb;
+    char *a = slurp(c_out, &na), *b = slurp(js_out, &nb);
+    assert_non_null(a);
+    assert_non_null(b);
+    /* the JS dump holds the full decode first: compare from its first apply line */
+    const char *bw = strstr(b, "\nW ");
+    assert_non_null(bw);
+    const char *where;
+    const long line = first_difference(a, bw + 1, &where);
+    if (line >= 0) print_error("%s apply (%s | %s): line %ld differs (liblbk: %.120s)\n", file, ws, ds, line + 1, where);
+    free(a), free(b);
+    return line >= 0;
+}
+
+static void test_js_dls_apply_matches_liblbk(void **state)
+{
+    (void)state;
+    if (!have_node()) skip();
+    mkdir(OUT_DIR, 0755);
+    /* bake_sets: lights A, B, door d1 (open/closed) and the combination d1+A */
+    const float w0[5] = {1, 1, 0, 0, 0}, w1[5] = {0.25f, 0.7f, 0, 0, 0}, w2[5] = {0, 0, 0, 0, 0}, w3[5] = {1.5f, -0.5f, 0, 0, 0};
+    const float d0[1] = {0.0f}, d1[1] = {0.3f}, d2[1] = {1.0f};
+    assert_int_equal(compare_apply("bake_sets.lbk", w0, 5, d0, 1), 0);
+    assert_int_equal(compare_apply("bake_sets.lbk", w1, 5, d1, 1), 0);
+    size_t n1, n2;
+    char *on = slurp(OUT_DIR "/bake_sets.lbk.apply.c.txt", &n1);
+    assert_int_equal(compare_apply("bake_sets.lbk", w2, 5, d2, 1), 0);
+    char *off = slurp(OUT_DIR "/bake_sets.lbk.apply.c.txt", &n2);
+    assert_true(n1 == n2 && strcmp(on, off) != 0); /* the weights change the outputs */
+    free(on), free(off);
+    assert_int_equal(compare_apply("bake_sets.lbk", w3, 5, d1, 1), 0);
+    /* dls.lbk (make_corpus): every cluster form */
+    lbk_reader *r;
+    const void *d;
+    size_t n;
+    assert_int_equal(lbk_reader_open_file("tests/fuzz/corpus/dls.lbk", NULL, &r), LBK_OK);
+    assert_true(section(r, LBK_SECTION_DLS, &d, &n));
+    lbk_dls_view *v;
+    assert_int_equal(lbk_dls_open(d, n, NULL, &v), LBK_OK);
+    const uint32_t ns = lbk_dls_set_count(v);
+    uint32_t forms = 0;
+    for (uint32_t c = 0; c < lbk_dls_cluster_count(v); c++) {
+        lbk_dls_cluster_info ci;
+        assert_int_equal(lbk_dls_cluster_get(v, c, &ci), LBK_OK);
+        forms |= 1u << ci.form;
+    }
+    lbk_dls_close(v);
+    lbk_reader_close(r);
+    print_message("dls.lbk: %u sets, cluster forms mask 0x%x\n", (unsigned)ns, (unsigned)forms);
+    assert_true(ns <= 64);
+    float ws[64];
+    for (uint32_t i = 0; i < ns; i++) ws[i] = (float)((i * 37) % 11) / 7.0f - 0.2f; /* some 0, some off the grid */
+    const float dws[8] = {0.5f, 0.25f, 1, 0, 0.75f, 0.1f, 0.9f, 0.33f};
+    assert_int_equal(compare_apply("dls.lbk", ws, ns, dws, 8), 0);
+}
+
 /* One flipped bit anywhere is detected (spec §4.2): the reader refuses the file. */
 static void test_js_reader_rejects_a_flipped_bit(void **state)
 {
@@ -309,6 +455,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_js_reader_matches_liblbk),
         cmocka_unit_test(test_js_reader_rejects_a_flipped_bit),
+        cmocka_unit_test(test_js_dls_apply_matches_liblbk),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -17,8 +17,32 @@ function dx(x) { fb.setFloat64(0, x, true); return fb.getUint32(4, true).toStrin
 const hex = (s) => Buffer.from(s, 'utf8').toString('hex');
 const fl = (arr) => Array.from(arr, fx).join(' ');
 
+/* --apply W0,W1,... D0,...: the DLS outputs (§12.8) for those set weights and door openings, as the
+ * hex of the stored bytes per space (texel words little-endian, RGBA, GLG, LLG probes) */
+async function dumpApply(lbk, lm, glg, llg, setArg, doorArg, out) {
+  const dls = await lbk.dls(), doors = await lbk.doors();
+  const nums = (s) => (s ? s.split(',').filter((x) => x !== '').map(Number) : []);
+  const base = { z: null, rgba: null, glg: null, llg: null };
+  if (lm) {
+    base.z = new Uint32Array(lm.texel_count); base.rgba = new Uint8Array(4 * lm.texel_count);
+    for (const pg of lm.pages) {
+      base.z.set(new Uint32Array(pg.plane0.buffer.slice(pg.plane0.byteOffset, pg.plane0.byteOffset + pg.plane0.length)), pg.first_texel);
+      base.rgba.set(pg.plane1, 4 * pg.first_texel);
+    }
+  }
+  const p = await lbk.payload('GLG '), q = await lbk.payload('LLG ');
+  if (glg) { const o = 32 + Math.ceil(12 * glg.probe_count / 16) * 16; base.glg = p.slice(o, o + 28 * glg.probe_count); }
+  if (llg) { const o = Math.ceil((32 + 96 * llg.grids.length) / 16) * 16, n = llg.grids.reduce((a, g) => a + g.sh.length / 27, 0); base.llg = q.slice(o, o + 28 * n); }
+  const r = R.dlsApply(dls, doors, base, nums(setArg), nums(doorArg));
+  const h = (u8) => Buffer.from(u8.buffer, u8.byteOffset, u8.byteLength).toString('hex');
+  out.push('W ' + fl(R.effectiveWeights(dls, doors, nums(setArg), nums(doorArg))));
+  if (r.z) out.push('AZ ' + h(r.z)), out.push('AR ' + h(r.rgba));
+  if (r.glg) out.push('AG ' + h(r.glg));
+  if (r.llg) out.push('AL ' + h(r.llg));
+}
+
 async function main() {
-  const [file, outPath] = process.argv.slice(2);
+  const [file, outPath, applyFlag, setArg, doorArg] = process.argv.slice(2);
   if (!file || !outPath) { console.error('usage: dump.js FILE.lbk OUT.txt'); process.exit(2); }
   const deps = { decompress: (u8) => fzstd.decompress(u8), xxh3: (u8) => xxhash3(u8) };
   const lbk = await R.open(fs.readFileSync(file), deps);
@@ -67,6 +91,7 @@ async function main() {
     out.push('OCTP ' + oct.probes.length + ' ' + fx(oct.scale));
     for (const p of oct.probes) out.push('O ' + fl(p.position) + ' ' + fl(p.irradiance) + ' ' + fl(p.depth));
   }
+  if (applyFlag === '--apply') await dumpApply(lbk, lm, glg, llg, setArg, doorArg, out);
   fs.writeFileSync(outPath, out.join('\n') + '\n');
 }
 main().catch((e) => { console.error('lbk reader: ' + e.message); process.exit(1); });
