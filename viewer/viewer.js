@@ -56,6 +56,7 @@
     precision highp usampler2D;
     uniform usampler2D plane0;
     uniform usampler2D plane1;
+    uniform usampler2D footprint;
     uniform vec2 pageSize;
     uniform float scale;
     uniform vec3 albedo;
@@ -109,6 +110,10 @@
         float line = lightmapped == 1 && max(g.x, g.y) > 0.45 ? 1.0 : 0.0;
         c = mix(albedo * 0.6, vec3(1.0, 0.3, 0.1), line);
       } else c = (albedo * E / 3.14159265358979 + emission) * exposure;
+      if (mode == 4) {
+        float m = lightmapped == 1 ? float(texelFetch(footprint, ivec2(clamp(floor(vCoord), vec2(0.0), pageSize - 1.0)), 0).r) : 0.0;
+        c = mix(c, vec3(0.1, 0.9, 1.0), 0.6 * m);
+      }
       gl_FragColor = vec4(srgb(c.r), srgb(c.g), srgb(c.b), 1.0);
     }`;
 
@@ -172,13 +177,71 @@
     return out;
   }
 
+  function unpackProbes(u8, scale) {
+    const n = u8.length / 28, out = new Float32Array(27 * n);
+    for (let i = 0; i < n; i++) out.set(LbkReader.sh9Unpack(u8, 28 * i, scale), 27 * i);
+    return out;
+  }
+  /* the stored base of every DLS space, as lbk_dls_apply reads it */
+  async function dlsBase(lbk, lmap, glg, llg) {
+    const base = { z: null, rgba: null, glg: null, llg: null };
+    if (lmap) {
+      base.z = new Uint32Array(lmap.texel_count); base.rgba = new Uint8Array(4 * lmap.texel_count);
+      for (const pg of lmap.pages) {
+        if (pg.format0 || pg.format1) continue;
+        const v = new DataView(pg.plane0.buffer, pg.plane0.byteOffset, pg.plane0.length);
+        for (let t = 0; t < pg.width * pg.height; t++) base.z[pg.first_texel + t] = v.getUint32(4 * t, true);
+        base.rgba.set(pg.plane1, 4 * pg.first_texel);
+      }
+    }
+    const a16 = (x) => Math.ceil(x / 16) * 16;
+    if (glg) { const p = await lbk.payload('GLG '), o = a16(32 + 12 * glg.probe_count); base.glg = p.slice(o, o + 28 * glg.probe_count); }
+    if (llg) {
+      const p = await lbk.payload('LLG '), o = a16(32 + 96 * llg.grids.length), n = llg.grids.reduce((a, g) => a + g.sh.length / 27, 0);
+      base.llg = p.slice(o, o + 28 * n);
+    }
+    return base;
+  }
+  /* One slider per light set (kind 0; default 1, on, as lbk render) and per door (ω, default 0,
+   * closed); hash parameters sets=NAME:W,... and doors=NAME:W,... set them. */
+  function dlsControls(dls, doors, P) {
+    const box = $('sets'), sel = $('footprint-set');
+    const given = (s) => { const m = {}; for (const kv of (s || '').split(',')) { const i = kv.lastIndexOf(':'); if (i > 0) m[kv.slice(0, i)] = Number(kv.slice(i + 1)); } return m; };
+    const gs = given(P.sets), gd = given(P.doors);
+    const sliders = [], doorSliders = [];
+    const add = (label, value) => {
+      const l = document.createElement('label'), r = document.createElement('input'), v = document.createElement('span');
+      r.type = 'range'; r.min = '0'; r.max = '1'; r.step = '0.01'; r.value = String(value);
+      const show = () => { v.textContent = ' ' + Number(r.value).toFixed(2); };
+      r.addEventListener('input', show); show();
+      l.append(label + ' ', r, v); box.appendChild(l);
+      return r;
+    };
+    if (!dls) { box.textContent = 'no DLS section: the lighting is static'; }
+    else {
+      dls.sets.forEach((s, i) => {
+        if (s.kind === 0) sliders.push([i, add('set ' + s.name, s.name in gs ? gs[s.name] : 1)]);
+        if (s.kind === 0 || s.kind === 1) {
+          const o = document.createElement('option'); o.value = String(i); o.textContent = s.name; sel.appendChild(o);
+        }
+      });
+      (doors || []).forEach((d) => doorSliders.push(add('door ' + d.name, d.name in gd ? gd[d.name] : 0)));
+    }
+    return {
+      setWeights: () => { const w = new Array(dls ? dls.sets.length : 0).fill(0); for (const [i, r] of sliders) w[i] = Number(r.value); return w; },
+      doorWeights: () => doorSliders.map((r) => Number(r.value)),
+    };
+  }
+
   async function main() {
     const P = params();
     const data = window.LBK_DATA;
     if (!data) throw new Error('data.js did not load (open the folder that lbk view wrote)');
     const deps = { decompress: (u8) => fzstd.decompress(u8), xxh3: (u8) => hashwasm.xxhash3(u8) };
     const lbk = await LbkReader.open(b64(data.lbk), deps);
-    const [meta, rept, objs, lmap, glg, llg] = await Promise.all([lbk.meta(), lbk.report(), lbk.objects(), lbk.lightmap(), lbk.glg(), lbk.llg()]);
+    const [meta, rept, objs, lmap, glg, llg, dls, doors] = await Promise.all([lbk.meta(), lbk.report(), lbk.objects(), lbk.lightmap(),
+      lbk.glg(), lbk.llg(), lbk.dls(), lbk.doors()]);
+    const base = await dlsBase(lbk, lmap, glg, llg);
     panel(data, lbk, meta, rept, objs, lmap, glg);
 
     const wrap = $('canvas-wrap');
@@ -199,13 +262,15 @@
     /* pages: planes as stored */
     const pages = (lmap ? lmap.pages : []).map((pg) => {
       if (pg.format0 || pg.format1) return null; /* block pages: not decoded by this viewer yet */
-      const t0 = new THREE.DataTexture(new Uint32Array(pg.plane0.buffer, pg.plane0.byteOffset, pg.width * pg.height), pg.width, pg.height,
+      const t0 = new THREE.DataTexture(new Uint32Array(pg.width * pg.height), pg.width, pg.height,
                                        THREE.RedIntegerFormat, THREE.UnsignedIntType);
       t0.internalFormat = 'R32UI';
       const t1 = new THREE.DataTexture(new Uint8Array(pg.plane1), pg.width, pg.height, THREE.RGBAIntegerFormat, THREE.UnsignedByteType);
       t1.internalFormat = 'RGBA8UI';
-      for (const t of [t0, t1]) { t.magFilter = t.minFilter = THREE.NearestFilter; t.generateMipmaps = false; t.flipY = false; t.needsUpdate = true; }
-      return { t0, t1, size: new THREE.Vector2(pg.width, pg.height) };
+      const t2 = new THREE.DataTexture(new Uint8Array(pg.width * pg.height), pg.width, pg.height, THREE.RedIntegerFormat, THREE.UnsignedByteType);
+      t2.internalFormat = 'R8UI'; /* the light-set footprint: 1 where the chosen set has an entry */
+      for (const t of [t0, t1, t2]) { t.magFilter = t.minFilter = THREE.NearestFilter; t.generateMipmaps = false; t.flipY = false; t.needsUpdate = true; }
+      return { t0, t1, t2, first: pg.first_texel, n: pg.width * pg.height, size: new THREE.Vector2(pg.width, pg.height) };
     });
 
     const blank = 'data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAQAAAC1HAwCAAAAC0lEQVR42mNkYAAAAAYAAjCB0C8AAAAASUVORK5CYII=';
@@ -217,6 +282,8 @@
     const dummy = pages.find((p) => p) || null;
     const dummyTex = () => { const t = new THREE.DataTexture(new Uint32Array(1), 1, 1, THREE.RedIntegerFormat, THREE.UnsignedIntType); t.internalFormat = 'R32UI'; t.needsUpdate = true; return t; };
     const dummyTex1 = () => { const t = new THREE.DataTexture(new Uint8Array(4), 1, 1, THREE.RGBAIntegerFormat, THREE.UnsignedByteType); t.internalFormat = 'RGBA8UI'; t.needsUpdate = true; return t; };
+    const dummyTex2 = () => { const t = new THREE.DataTexture(new Uint8Array(1), 1, 1, THREE.RedIntegerFormat, THREE.UnsignedByteType); t.internalFormat = 'R8UI'; t.needsUpdate = true; return t; };
+    const probeLit = []; /* meshes lit per vertex from the probes: recomputed when the sets change */
     const meshes = [];
     gltf.scene.traverse((m) => { if (m.isMesh) meshes.push(m); });
     for (const m of meshes) {
@@ -231,28 +298,14 @@
       const rep = info ? info.representation : 'none';
       const pageIdx = prim && prim.lightmap ? prim.lightmap.page : -1;
       const page = pageIdx >= 0 ? pages[pageIdx] : null;
-      if (rep !== 'lightmap' || !page) {
-        const pos = g.attributes.position, nor = g.attributes.normal;
-        const grid = rep === 'llg' && llg ? llg.grids[info.llg_grid] : null;
-        const vis = g.attributes._lbk_llg_visibility, bent = g.attributes._lbk_llg_bent_normal;
-        for (let i = 0; i < n; i++) {
-          const p = [pos.getX(i), pos.getY(i), pos.getZ(i)];
-          let e = [0, 0, 0];
-          if (grid && vis && bent) {
-            const b = new THREE.Vector3(bent.getX(i), bent.getY(i), bent.getZ(i)).normalize();
-            e = shIrradiance(llgSample(grid, p), 0, [b.x, b.y, b.z]).map((v) => v * vis.getX(i));
-          } else if (glg && nor) {
-            e = shIrradiance(glgSample(glg, p), 0, [nor.getX(i), nor.getY(i), nor.getZ(i)]);
-          }
-          colors.set(e, 3 * i);
-        }
-      }
       g.setAttribute('lbkColor', new THREE.BufferAttribute(colors, 3));
+      if (rep !== 'lightmap' || !page) probeLit.push({ g, grid: rep === 'llg' ? info.llg_grid : -1 });
       if (!g.attributes.uv2) g.setAttribute('uv2', new THREE.BufferAttribute(new Float32Array(2 * n), 2));
       const src = page || dummy;
       const mat = new THREE.ShaderMaterial({
         vertexShader: VERT, fragmentShader: FRAG, side: THREE.DoubleSide,
         uniforms: { plane0: { value: page ? page.t0 : dummyTex() }, plane1: { value: page ? page.t1 : dummyTex1() },
+                    footprint: { value: page ? page.t2 : dummyTex2() },
                     pageSize: { value: src ? src.size.clone() : new THREE.Vector2(1, 1) }, scale: { value: lmap ? lmap.scale : 1 },
                     albedo: { value: albedo }, emission: { value: emission }, lightmapped: { value: page ? 1 : 0 },
                     exposure: uniformsCommon.exposure, mode: uniformsCommon.mode } });
@@ -260,6 +313,64 @@
       box.expandByObject(m);
     }
     scene.add(gltf.scene);
+
+    /* E per vertex of the probe-lit meshes from the current probes (glgNow, llgNow) */
+    let glgNow = glg, llgNow = llg;
+    const relight = () => {
+      for (const { g, grid: gi } of probeLit) {
+        const pos = g.attributes.position, nor = g.attributes.normal, col = g.attributes.lbkColor;
+        const grid = gi >= 0 && llgNow ? llgNow.grids[gi] : null;
+        const vis = g.attributes._lbk_llg_visibility, bent = g.attributes._lbk_llg_bent_normal;
+        for (let i = 0; i < pos.count; i++) {
+          const p = [pos.getX(i), pos.getY(i), pos.getZ(i)];
+          let e = [0, 0, 0];
+          if (grid && vis && bent) {
+            const b = new THREE.Vector3(bent.getX(i), bent.getY(i), bent.getZ(i)).normalize();
+            e = shIrradiance(llgSample(grid, p), 0, [b.x, b.y, b.z]).map((v) => v * vis.getX(i));
+          } else if (glgNow && nor) {
+            e = shIrradiance(glgSample(glgNow, p), 0, [nor.getX(i), nor.getY(i), nor.getZ(i)]);
+          }
+          col.array.set(e, 3 * i);
+        }
+        col.needsUpdate = true;
+      }
+    };
+    /* light sets and doors: §12.8 in the page (lbk_reader.js dlsApply), then the planes re-uploaded */
+    const controls0 = dlsControls(dls, doors, P);
+    let lastOut = base;
+    const applySets = () => {
+      let out = base;
+      if (dls) out = LbkReader.dlsApply(dls, doors, base, controls0.setWeights(), controls0.doorWeights());
+      pages.forEach((pg) => {
+        if (!pg) return;
+        pg.t0.image.data.set(out.z.subarray(pg.first, pg.first + pg.n)); pg.t0.needsUpdate = true;
+        pg.t1.image.data.set(out.rgba.subarray(4 * pg.first, 4 * (pg.first + pg.n))); pg.t1.needsUpdate = true;
+      });
+      if (glg && out.glg) glgNow = Object.assign({}, glg, { sh: unpackProbes(out.glg, glg.scale) });
+      if (llg && out.llg) {
+        const all = unpackProbes(out.llg, llg.scale);
+        let o = 0;
+        llgNow = Object.assign({}, llg, { grids: llg.grids.map((gr) => { const n = gr.sh.length; const sh = all.subarray(o, o + n); o += n; return Object.assign({}, gr, { sh }); }) });
+      }
+      relight();
+      lastOut = out;
+    };
+    const footprint = () => {
+      const sel = Number($('footprint-set').value);
+      pages.forEach((pg) => { if (pg) pg.t2.image.data.fill(0); });
+      if (dls && sel >= 0)
+        for (const c of dls.clusters) {
+          if (c.space !== 0 || c.sets.indexOf(sel) < 0) continue;
+          dls.forEachTarget(c, (t, list) => {
+            if (!list.some(([s]) => s === sel)) return;
+            const pg = pages.find((q) => q && t >= q.first && t < q.first + q.n);
+            if (pg) pg.t2.image.data[t - pg.first] = 1;
+          });
+        }
+      pages.forEach((pg) => { if (pg) pg.t2.needsUpdate = true; });
+    };
+    applySets();
+    footprint();
 
     /* probe glyphs: one sphere per GLG probe, coloured by its irradiance per normal */
     const glyphs = new THREE.Group();
@@ -272,7 +383,7 @@
         gi.setAttribute('lbkColor', new THREE.BufferAttribute(c, 3));
         gi.setAttribute('uv2', new THREE.BufferAttribute(new Float32Array(2 * nor.count), 2));
         const mat = new THREE.ShaderMaterial({ vertexShader: VERT, fragmentShader: FRAG,
-          uniforms: { plane0: { value: dummyTex() }, plane1: { value: dummyTex1() }, pageSize: { value: new THREE.Vector2(1, 1) },
+          uniforms: { plane0: { value: dummyTex() }, plane1: { value: dummyTex1() }, footprint: { value: dummyTex2() }, pageSize: { value: new THREE.Vector2(1, 1) },
                       scale: { value: 1 }, albedo: { value: new THREE.Vector3(1, 1, 1) }, emission: { value: new THREE.Vector3() }, lightmapped: { value: 0 },
                       exposure: uniformsCommon.exposure, mode: { value: 1 } } });
         const s = new THREE.Mesh(gi, mat);
@@ -301,13 +412,14 @@
 
     /* default exposure: 1 / (99th percentile of the lit texels' radiance for albedo 1), like lbk render's PNG */
     let defaultStops = 0;
-    if (lmap && lmap.pages.length && !lmap.pages[0].format0) {
-      const lin = LbkReader.pageLinear(lmap, 0), vals = [];
-      for (let t = 0; t < lin.length / 12; t += 1) {
-        const l = 0.2126 * (lin[12 * t] + lin[12 * t + 3]) + 0.7152 * (lin[12 * t + 4] + lin[12 * t + 7]) + 0.0722 * (lin[12 * t + 8] + lin[12 * t + 11]);
+    if (lastOut.z) {
+      const lin = new Float32Array(12), vals = [];
+      for (let t = 0; t < lastOut.z.length; t++) {
+        LbkReader.ahdToLinear(lastOut.z[t], lastOut.rgba.subarray(4 * t, 4 * t + 4), lin, 0);
+        const l = (0.2126 * (lin[0] + lin[3]) + 0.7152 * (lin[4] + lin[7]) + 0.0722 * (lin[8] + lin[11])) * lmap.scale;
         if (l > 0) vals.push(l / Math.PI);
       }
-      vals.sort((a, b) => a - b);
+      vals.sort((x, y) => x - y);
       if (vals.length) defaultStops = -Math.log2(vals[Math.floor(0.99 * (vals.length - 1))]);
     }
     const stops = P.stops !== undefined ? Number(P.stops) : Math.round(defaultStops * 10) / 10;
@@ -322,6 +434,8 @@
     };
     const draw = () => renderer.render(scene, camera);
     for (const id of ['exposure', 'mode', 'probes']) $(id).addEventListener('input', apply);
+    $('sets').addEventListener('input', () => { applySets(); draw(); });
+    $('footprint-set').addEventListener('input', () => { footprint(); draw(); });
     controls.addEventListener('change', draw);
     window.addEventListener('resize', () => {
       if (P.size) return;

@@ -202,6 +202,7 @@ static int have_chromium(void) { return system("command -v chromium >/dev/null 2
 #define W 160
 #define H 120
 #define STOPS 4.0
+#define SETS_STOPS (-1.0)
 static const float cam_from[3] = {0.1f, 1.05f, 3.0f}, cam_at[3] = {0.0f, 1.0f, 0.0f}, cam_up[3] = {0.0f, 1.0f, 0.0f};
 #define FOV_DEG 45.0f
 
@@ -324,6 +325,104 @@ static void test_view_screenshot_matches_lbk_render(void **state)
     assert_int_equal(interior, 0);
 }
 
+/* ---- light-set slider: the page changes the pixels lbk render --set changes ------------------ */
+
+#define SETS_LEVEL "tests/fuzz/corpus/bake_sets.lbk"
+#define SETS_SCENE "tests/fuzz/sets_scene.gltf"
+#define SETS_OUT "build/tests/view_sets"
+
+/* A W × H screenshot of the sets page with extra hash parameters, as 8-bit RGB (malloc'ed). */
+static uint8_t *sets_shot(const char *extra, const char *png)
+{
+    char cwd[1024], cmd[4096], err[TL_ERR_LEN];
+    assert_non_null(getcwd(cwd, sizeof cwd));
+    unlink(png);
+    snprintf(cmd, sizeof cmd,
+             CHROMIUM " --window-size=%d,%d --screenshot=%s 'file://%s/" SETS_OUT
+                      "/index.html#cam=%g,%g,%g,%g,%g,%g,%g,%g,%g,%g&stops=%g&size=%dx%d%s' >/dev/null 2>&1",
+             3 * W, 3 * H, png, cwd, cam_from[0], cam_from[1], cam_from[2], cam_at[0], cam_at[1], cam_at[2], cam_up[0],
+             cam_up[1], cam_up[2], FOV_DEG, SETS_STOPS, W, H, extra);
+    assert_int_equal(system(cmd), 0);
+    int w, h;
+    uint8_t *shot;
+    assert_int_equal(tl_png_read_rgb8(png, &w, &h, &shot, err), 0);
+    assert_int_equal(w, 3 * W);
+    for (int y = 0; y < H; y++) memmove(shot + 3 * W * y, shot + 3 * w * y, 3 * W);
+    return shot;
+}
+
+static float *sets_render(const tl_weight *sets, size_t n)
+{
+    char err[TL_ERR_LEN];
+    tl_render_options o;
+    memset(&o, 0, sizeof o);
+    o.width = W, o.height = H, o.samples = 1, o.threads = 1;
+    memcpy(o.camera.from, cam_from, sizeof cam_from);
+    memcpy(o.camera.at, cam_at, sizeof cam_at);
+    memcpy(o.camera.up, cam_up, sizeof cam_up);
+    o.camera.yfov = FOV_DEG * 3.14159265358979f / 180.0f;
+    o.sky_override = 1;
+    o.sets = sets, o.set_count = n;
+    tl_image img;
+    const int rc = tl_render(SETS_SCENE, SETS_LEVEL, &o, &img, err);
+    if (rc) print_error("tl_render: %s\n", err);
+    assert_int_equal(rc, TL_RENDER_OK);
+    float *rgb = img.rgb;
+    img.rgb = NULL;
+    tl_image_free(&img);
+    return rgb;
+}
+
+/* Set B from on (1, lbk render's default) to 0.25. lbk render applies it through lbk_dls_apply,
+ * the page through its own apply (bit-identical texels and probes: test_view_reader). So:
+ *  - a pixel lbk render leaves bit-identical (its surface's texels or probes untouched by B) the
+ *    page leaves identical: the page decodes the same unchanged bytes;
+ *  - a pixel whose 8-bit sRGB value lbk render changes by 2 codes or more, the page changes too
+ *    (a change of less may vanish in either side's rounding to 8 bits);
+ * except on silhouettes (on_edge), where rasterisation and ray casting may see different surfaces.
+ * Also: the slider changes a real part of the view. */
+static void test_view_set_slider_changes_what_lbk_render_changes(void **state)
+{
+    (void)state;
+    if (!have_chromium()) skip();
+    char err[TL_ERR_LEN];
+    tl_view_options vo = {SETS_LEVEL, SETS_SCENE, SETS_OUT};
+    assert_int_equal(tl_view_write(&vo, NULL, err), TL_VIEW_OK);
+    uint8_t *p0 = sets_shot("", "build/tests/view_sets_on.png");
+    uint8_t *p1 = sets_shot("&sets=B:0.25", "build/tests/view_sets_dim.png");
+    const tl_weight dim = {"B", 0.25f};
+    float *r0 = sets_render(NULL, 0), *r1 = sets_render(&dim, 1);
+    const float k = powf(2.0f, (float)SETS_STOPS);
+    static uint8_t ref0[W * H * 3];
+    for (int i = 0; i < 3 * W * H; i++) ref0[i] = (uint8_t)lrintf(srgb(r0[i] * k) * 255.0f);
+    int render_same = 0, render_changed = 0, page_changed = 0, wrong_same = 0, wrong_changed = 0, edge = 0;
+    for (int i = 0; i < W * H; i++) {
+        int same = 1, big = 0, pch = 0;
+        for (int c = 0; c < 3; c++) {
+            same &= r0[3 * i + c] == r1[3 * i + c];
+            const int a = (int)lrintf(srgb(r0[3 * i + c] * k) * 255.0f), b = (int)lrintf(srgb(r1[3 * i + c] * k) * 255.0f);
+            big |= abs(a - b) >= 2;
+            pch |= p0[3 * i + c] != p1[3 * i + c];
+        }
+        render_same += same, render_changed += big, page_changed += pch;
+        const int bad_same = same && pch, bad_changed = big && !pch;
+        if ((bad_same || bad_changed) && on_edge(ref0, i % W, i / W)) {
+            edge++;
+            continue;
+        }
+        wrong_same += bad_same, wrong_changed += bad_changed;
+    }
+    print_message("set B 1 -> 0.25: lbk render leaves %d pixels identical, changes %d by >= 2 codes; the page changes %d; "
+                  "disagreements: %d off edges (%d unchanged-but-changed, %d changed-but-unchanged), %d on edges\n",
+                  render_same, render_changed, page_changed, wrong_same + wrong_changed, wrong_same, wrong_changed, edge);
+    free(p0), free(p1), free(r0), free(r1);
+    assert_true(render_changed > W * H / 20); /* B lights a real part of the view */
+    assert_true(render_same > W * H / 20);    /* and leaves a real part alone */
+    assert_int_equal(wrong_same, 0);
+    assert_int_equal(wrong_changed, 0);
+    assert_true(edge <= W * H / 100);
+}
+
 int main(void)
 {
     signal(SIGPIPE, SIG_IGN);
@@ -333,6 +432,7 @@ int main(void)
         cmocka_unit_test(test_view_server),
         cmocka_unit_test(test_view_page_loads_without_errors),
         cmocka_unit_test(test_view_screenshot_matches_lbk_render),
+        cmocka_unit_test(test_view_set_slider_changes_what_lbk_render_changes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
