@@ -385,11 +385,17 @@
           const c = r11g11b10f(dv.getUint32(o + 4 * ((j + 1) * 6 + x + 1), true));
           for (let ch = 0; ch < 3; ch++) irr[3 * (j * 4 + x) + ch] = f32(c[ch] * scale);
         }
+      const full = new Float32Array(108); /* all 6 × 6 stored texels (the border too), physical */
+      for (let t = 0; t < 36; t++) {
+        const c = r11g11b10f(dv.getUint32(o + 4 * t, true));
+        for (let ch = 0; ch < 3; ch++) full[3 * t + ch] = f32(c[ch] * scale);
+      }
       const depth = new Float32Array(288);
       for (let j = 0; j < 12; j++)
         for (let x = 0; x < 12; x++)
           for (let m = 0; m < 2; m++) depth[2 * (j * 12 + x) + m] = half(dv.getUint16(o + 144 + 4 * ((j + 1) * 14 + x + 1) + 2 * m, true));
-      probes.push({ position: [dv.getFloat32(o + 928, true), dv.getFloat32(o + 932, true), dv.getFloat32(o + 936, true)], irradiance: irr, depth });
+      probes.push({ position: [dv.getFloat32(o + 928, true), dv.getFloat32(o + 932, true), dv.getFloat32(o + 936, true)], irradiance: irr,
+                    irradiance_full: full, depth });
     }
     return { scale, probes };
   }

@@ -13,7 +13,8 @@
  * vertex. Display: radiance × 2^stops, clamped, sRGB-encoded.
  *
  * URL hash (for tests and links): cam=fx,fy,fz,ax,ay,az,ux,uy,uz,yfov_degrees, stops=S, mode=M,
- * size=WxH. window.lbkViewReady becomes true when the first frame is drawn. */
+ * size=WxH, sets=NAME:W,..., doors=NAME:W,..., show=glg,llg,octp,sphere, sphere=fx,fy,fz (fractions of the
+ * level's half extents from its centre). window.lbkViewReady becomes true when the first frame is drawn. */
 (function () {
   'use strict';
   const $ = (id) => document.getElementById(id);
@@ -177,6 +178,23 @@
     return out;
   }
 
+  /* lbk_octp_irradiance: the octahedral map of §14, bilinear on the 6 × 6 stored grid (border included) */
+  function octIrradiance(p, d) {
+    const sum = Math.abs(d[0]) + Math.abs(d[1]) + Math.abs(d[2]);
+    let u = 0, v = 0;
+    if (sum > 0) {
+      const x = d[0] / sum, y = d[1] / sum, sg = (a) => (a >= 0 ? 1 : -1);
+      if (d[2] >= 0) { u = x; v = y; } else { u = (1 - Math.abs(y)) * sg(x); v = (1 - Math.abs(x)) * sg(y); }
+    }
+    const st = [u, v].map((a) => Math.min(5, Math.max(0, (a + 1) * 0.5 * 4 + 0.5)));
+    const i0 = st.map((a) => Math.min(4, Math.floor(a))), f = st.map((a, k) => a - i0[k]);
+    const rgb = [0, 0, 0];
+    for (let dy = 0; dy < 2; dy++) for (let dx = 0; dx < 2; dx++) {
+      const w = (dx ? f[0] : 1 - f[0]) * (dy ? f[1] : 1 - f[1]), o = 3 * ((i0[1] + dy) * 6 + i0[0] + dx);
+      for (let k = 0; k < 3; k++) rgb[k] += w * p.irradiance_full[o + k];
+    }
+    return rgb;
+  }
   function unpackProbes(u8, scale) {
     const n = u8.length / 28, out = new Float32Array(27 * n);
     for (let i = 0; i < n; i++) out.set(LbkReader.sh9Unpack(u8, 28 * i, scale), 27 * i);
@@ -239,8 +257,8 @@
     if (!data) throw new Error('data.js did not load (open the folder that lbk view wrote)');
     const deps = { decompress: (u8) => fzstd.decompress(u8), xxh3: (u8) => hashwasm.xxhash3(u8) };
     const lbk = await LbkReader.open(b64(data.lbk), deps);
-    const [meta, rept, objs, lmap, glg, llg, dls, doors] = await Promise.all([lbk.meta(), lbk.report(), lbk.objects(), lbk.lightmap(),
-      lbk.glg(), lbk.llg(), lbk.dls(), lbk.doors()]);
+    const [meta, rept, objs, lmap, glg, llg, dls, doors, octp] = await Promise.all([lbk.meta(), lbk.report(), lbk.objects(), lbk.lightmap(),
+      lbk.glg(), lbk.llg(), lbk.dls(), lbk.doors(), lbk.octp()]);
     const base = await dlsBase(lbk, lmap, glg, llg);
     panel(data, lbk, meta, rept, objs, lmap, glg);
 
@@ -372,28 +390,73 @@
     applySets();
     footprint();
 
-    /* probe glyphs: one sphere per GLG probe, coloured by its irradiance per normal */
-    const glyphs = new THREE.Group();
-    if (glg) {
-      const r = box.getSize(new THREE.Vector3()).length() * 0.006;
-      const sg = new THREE.SphereGeometry(r, 12, 8);
-      for (let i = 0; i < glg.probe_count; i++) {
+    /* probe glyphs: a small sphere per probe, each vertex coloured by the probe's irradiance for
+     * its normal (GLG, LLG lattice: SH9 of §5.5; OCTP: the octahedral map, bilinear with its border) */
+    const diag = box.getSize(new THREE.Vector3()).length();
+    const glyphMaterial = (mode) => new THREE.ShaderMaterial({ vertexShader: VERT, fragmentShader: FRAG,
+      uniforms: { plane0: { value: dummyTex() }, plane1: { value: dummyTex1() }, footprint: { value: dummyTex2() },
+                  pageSize: { value: new THREE.Vector2(1, 1) }, scale: { value: 1 }, albedo: { value: new THREE.Vector3(1, 1, 1) },
+                  emission: { value: new THREE.Vector3() }, lightmapped: { value: 0 }, exposure: uniformsCommon.exposure, mode } });
+    const glyphMode = { value: 1 }; /* glyphs show irradiance ×(exposure); in radiance mode × 1/π */
+    const sphere = (r) => { const g = new THREE.SphereGeometry(r, 12, 8); g.setAttribute('uv2', new THREE.BufferAttribute(new Float32Array(2 * g.attributes.position.count), 2)); return g; };
+    const glyphGroup = (positions, colourOf) => {
+      const grp = new THREE.Group(), sg = sphere(diag * 0.006);
+      positions.forEach((pos, i) => {
         const gi = sg.clone(), nor = gi.attributes.normal, c = new Float32Array(3 * nor.count);
-        for (let v = 0; v < nor.count; v++) c.set(shIrradiance(glg.sh, 27 * i, [nor.getX(v), nor.getY(v), nor.getZ(v)]), 3 * v);
+        for (let v = 0; v < nor.count; v++) c.set(colourOf(i, [nor.getX(v), nor.getY(v), nor.getZ(v)]), 3 * v);
         gi.setAttribute('lbkColor', new THREE.BufferAttribute(c, 3));
-        gi.setAttribute('uv2', new THREE.BufferAttribute(new Float32Array(2 * nor.count), 2));
-        const mat = new THREE.ShaderMaterial({ vertexShader: VERT, fragmentShader: FRAG,
-          uniforms: { plane0: { value: dummyTex() }, plane1: { value: dummyTex1() }, footprint: { value: dummyTex2() }, pageSize: { value: new THREE.Vector2(1, 1) },
-                      scale: { value: 1 }, albedo: { value: new THREE.Vector3(1, 1, 1) }, emission: { value: new THREE.Vector3() }, lightmapped: { value: 0 },
-                      exposure: uniformsCommon.exposure, mode: { value: 1 } } });
-        const s = new THREE.Mesh(gi, mat);
-        s.position.set(glg.positions[3 * i], glg.positions[3 * i + 1], glg.positions[3 * i + 2]);
-        glyphs.add(s);
+        const m = new THREE.Mesh(gi, glyphMaterial(glyphMode));
+        m.position.set(pos[0], pos[1], pos[2]);
+        grp.add(m);
+      });
+      grp.visible = false;
+      scene.add(grp);
+      return grp;
+    };
+    const groups = {};
+    const buildGlyphs = () => {
+      for (const k of Object.keys(groups)) scene.remove(groups[k]);
+      if (glgNow) {
+        const pos = []; for (let i = 0; i < glgNow.probe_count; i++) pos.push([glgNow.positions[3 * i], glgNow.positions[3 * i + 1], glgNow.positions[3 * i + 2]]);
+        groups.glg = glyphGroup(pos, (i, n) => shIrradiance(glgNow.sh, 27 * i, n));
       }
-    }
-    glyphs.visible = false;
-    scene.add(glyphs);
+      if (llgNow) {
+        const pos = [], at = [];
+        llgNow.grids.forEach((g) => {
+          for (let k = 0; k < g.n[2]; k++) for (let j = 0; j < g.n[1]; j++) for (let i = 0; i < g.n[0]; i++) {
+            const t = [i / (g.n[0] - 1) * 2 - 1, j / (g.n[1] - 1) * 2 - 1, k / (g.n[2] - 1) * 2 - 1], p = g.centre.slice();
+            for (let a = 0; a < 3; a++) for (let c = 0; c < 3; c++) p[c] += g.axes[a][c] * g.half_extents[a] * t[a];
+            pos.push(p); at.push([g, i + g.n[0] * (j + g.n[1] * k)]);
+          }
+        });
+        groups.llg = glyphGroup(pos, (q, n) => shIrradiance(at[q][0].sh, 27 * at[q][1], n));
+      }
+      if (octp) groups.octp = glyphGroup(octp.probes.map((p) => p.position), (i, n) => octIrradiance(octp.probes[i], n));
+      for (const [k, id] of [['glg', 'probes'], ['llg', 'probes-llg'], ['octp', 'probes-octp']]) if (groups[k]) groups[k].visible = $(id).checked;
+    };
+    buildGlyphs();
 
+    /* the test sphere: white, lit from the GLG per vertex (as lbk render --probe-spheres) */
+    const ctr0 = box.getCenter(new THREE.Vector3()), size0 = box.getSize(new THREE.Vector3());
+    const sg = new THREE.SphereGeometry(diag * 0.05, 32, 16);
+    sg.setAttribute('uv2', new THREE.BufferAttribute(new Float32Array(2 * sg.attributes.position.count), 2));
+    sg.setAttribute('lbkColor', new THREE.BufferAttribute(new Float32Array(3 * sg.attributes.position.count), 3));
+    const testSphere = new THREE.Mesh(sg, glyphMaterial(uniformsCommon.mode));
+    testSphere.visible = false;
+    scene.add(testSphere);
+    const placeSphere = () => {
+      const f = ['sx', 'sy', 'sz'].map((id) => Number($(id).value));
+      testSphere.position.set(ctr0.x + f[0] * size0.x / 2, ctr0.y + f[1] * size0.y / 2, ctr0.z + f[2] * size0.z / 2);
+      testSphere.visible = $('sphere').checked;
+      if (!testSphere.visible || !glgNow) return;
+      const pos = sg.attributes.position, nor = sg.attributes.normal, col = sg.attributes.lbkColor;
+      let hint = 0;
+      for (let v = 0; v < pos.count; v++) {
+        const p = [pos.getX(v) + testSphere.position.x, pos.getY(v) + testSphere.position.y, pos.getZ(v) + testSphere.position.z];
+        col.array.set(shIrradiance(glgSample(glgNow, p, hint), 0, [nor.getX(v), nor.getY(v), nor.getZ(v)]), 3 * v);
+      }
+      col.needsUpdate = true;
+    };
     const camera = new THREE.PerspectiveCamera(50, w / h, 0.01, 1e5);
     const controls = new THREE.OrbitControls(camera, renderer.domElement);
     if (P.cam) {
@@ -425,16 +488,22 @@
     const stops = P.stops !== undefined ? Number(P.stops) : Math.round(defaultStops * 10) / 10;
     $('exposure').value = String(stops);
     if (P.mode !== undefined) $('mode').value = P.mode;
+    for (const k of (P.show || '').split(',')) { /* show=glg,llg,octp,sphere */
+      const id = { glg: 'probes', llg: 'probes-llg', octp: 'probes-octp', sphere: 'sphere' }[k];
+      if (id) $(id).checked = true;
+    }
+    if (P.sphere) P.sphere.split(',').forEach((v, i) => { $(['sx', 'sy', 'sz'][i]).value = v; });
     const apply = () => {
       uniformsCommon.exposure.value = Math.pow(2, Number($('exposure').value));
       $('exposure-v').textContent = Number($('exposure').value).toFixed(1);
       uniformsCommon.mode.value = Number($('mode').value);
-      glyphs.visible = $('probes').checked;
+      for (const [k, id] of [['glg', 'probes'], ['llg', 'probes-llg'], ['octp', 'probes-octp']]) if (groups[k]) groups[k].visible = $(id).checked;
+      placeSphere();
       draw();
     };
     const draw = () => renderer.render(scene, camera);
-    for (const id of ['exposure', 'mode', 'probes']) $(id).addEventListener('input', apply);
-    $('sets').addEventListener('input', () => { applySets(); draw(); });
+    for (const id of ['exposure', 'mode', 'probes', 'probes-llg', 'probes-octp', 'sphere', 'sx', 'sy', 'sz']) $(id).addEventListener('input', apply);
+    $('sets').addEventListener('input', () => { applySets(); buildGlyphs(); placeSphere(); draw(); });
     $('footprint-set').addEventListener('input', () => { footprint(); draw(); });
     controls.addEventListener('change', draw);
     window.addEventListener('resize', () => {
