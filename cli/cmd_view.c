@@ -1,10 +1,14 @@
 /* lbk view LEVEL.lbk SCENE.glb [--out DIR] [--port P]: the bake in a browser (tools/view/view.h). */
 #define _XOPEN_SOURCE 700 /* nftw, mkdtemp */
 #include <ftw.h>
+#include <poll.h>
+#include <errno.h>
+#include <fcntl.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "cli/cli.h"
@@ -15,13 +19,14 @@
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: lbk view LEVEL.lbk SCENE.gltf|.glb [--out DIR] [--port P] [-q]\n"
+            "usage: lbk view LEVEL.lbk SCENE.gltf|.glb [--out DIR] [--port P] [--report BAKE.json] [-q]\n"
             "\n"
             "Shows the bake in a web browser: the level with its baked lighting decoded as a runtime does\n"
             "(AHD lightmaps in the shader, LLG objects per vertex, other objects from the global grid), an\n"
             "orbit camera (drag, wheel), exposure, views (albedo x irradiance, irradiance, texel grid, albedo),\n"
             "GLG probe glyphs, and a panel with the sections' sizes and the bake report. The page reads the\n"
-            ".lbk itself (viewer/lbk_reader.js, written from spec/container.md). SCENE is the file the level\n"
+            ".lbk itself (viewer/lbk_reader.js, written from spec/container.md); the panel also shows\n"
+            "lbk inspect --json of LEVEL (memory per section and object). SCENE is the file the level\n"
             "was baked from (checked object by object, as lbk export --gltf does).\n"
             "\n"
             "  --out DIR   write the page into DIR (index.html, data.js with the level, the scripts, level.glb\n"
@@ -29,6 +34,8 @@ static void usage(FILE *f)
             "  --port P    serve the page on http://127.0.0.1:P/ (only this machine; Ctrl-C stops) [%d];\n"
             "              0 picks a free port. Without --out the page goes to a temporary folder that is\n"
             "              removed when the server stops. With --out and without --port: write only\n"
+            "  --report F  the bake's report (lbk bake --json-report F): the page plots its error against\n"
+            "              wall-clock time (without it: REPT's error against samples per texel)\n"
             "  -q, --quiet no summary\n"
             "  -h, --help  this text\n"
             "\n"
@@ -36,6 +43,50 @@ static void usage(FILE *f)
             "            4 the input is not a valid container or SCENE is not the scene it was baked from,\n"
             "            5 internal error\n",
             DEFAULT_PORT);
+}
+
+/* `lbk inspect --json LEVEL` of this same binary (/proc/self/exe), for the page's panel: its
+ * numbers exactly, without a second copy of inspect's logic. NULL when it cannot run or fails
+ * (the page then shows its own reader's section sizes); at most 16 MiB of output. */
+static char *inspect_json(const char *level)
+{
+    if (level[0] == '-') return NULL; /* would read as an option; such a name gets no inspect panel */
+    int fd[2];
+    if (pipe(fd)) return NULL;
+    const pid_t pid = fork();
+    if (pid < 0) {
+        close(fd[0]), close(fd[1]);
+        return NULL;
+    }
+    if (pid == 0) {
+        dup2(fd[1], 1);
+        close(fd[0]), close(fd[1]);
+        const int devnull = open("/dev/null", O_WRONLY);
+        if (devnull >= 0) dup2(devnull, 2);
+        execl("/proc/self/exe", "lbk", "inspect", "--json", level, (char *)NULL);
+        _exit(127);
+    }
+    close(fd[1]);
+    size_t cap = 1 << 16, n = 0;
+    char *buf = malloc(cap);
+    ssize_t r = 0;
+    while (buf && (r = read(fd[0], buf + n, cap - 1 - n)) > 0) {
+        n += (size_t)r;
+        if (n + 1 == cap) {
+            char *b = cap < (16u << 20) ? realloc(buf, cap *= 2) : NULL;
+            if (!b) free(buf);
+            buf = b;
+        }
+    }
+    close(fd[0]);
+    int st = 0;
+    while (waitpid(pid, &st, 0) < 0 && errno == EINTR) {}
+    if (!buf || r < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
+        free(buf);
+        return NULL;
+    }
+    buf[n] = 0;
+    return buf;
 }
 
 static volatile int stop_flag;
@@ -80,7 +131,7 @@ static int serve(const char *dir, long port, int quiet)
 
 int lbk_cmd_view(int argc, char **argv)
 {
-    tl_view_options o = {NULL, NULL, NULL};
+    tl_view_options o = {.container = NULL};
     long port = -1;
     int quiet = 0;
     for (int i = 1; i < argc; i++) {
@@ -90,13 +141,19 @@ int lbk_cmd_view(int argc, char **argv)
             return LBK_EXIT_OK;
         } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
             quiet = 1;
-        } else if (!strcmp(a, "--out") || !strcmp(a, "--port")) {
+        } else if (!strcmp(a, "--out") || !strcmp(a, "--port") || !strcmp(a, "--report")) {
             if (i + 1 >= argc) {
                 fprintf(stderr, "lbk view: %s needs a value\n", a);
                 return LBK_EXIT_USAGE;
             }
             const char *v = argv[++i];
-            if (!strcmp(a, "--out")) {
+            if (!strcmp(a, "--report")) {
+                if (o.report_path) {
+                    fprintf(stderr, "lbk view: --report given twice\n");
+                    return LBK_EXIT_USAGE;
+                }
+                o.report_path = v;
+            } else if (!strcmp(a, "--out")) {
                 if (o.out_dir) {
                     fprintf(stderr, "lbk view: --out given twice\n");
                     return LBK_EXIT_USAGE;
@@ -133,7 +190,10 @@ int lbk_cmd_view(int argc, char **argv)
     }
     char err[TL_ERR_LEN];
     tl_view_stats s;
+    char *inspect = inspect_json(o.container);
+    o.inspect_json = inspect;
     int rc = tl_view_write(&o, &s, err);
+    free(inspect);
     if (rc) {
         fprintf(stderr, "lbk view: %s\n", err);
         rc = rc == TL_VIEW_IO ? LBK_EXIT_IO : rc == TL_VIEW_INPUT ? LBK_EXIT_INPUT : LBK_EXIT_INTERNAL;

@@ -518,26 +518,54 @@
   }
 
   function fmt(n) { return n.toLocaleString('en-US'); }
+  const esc = (t) => String(t).replace(/[&<>"]/g, (c) => ({ '&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;' }[c]));
+  function plot(xs, ys, xlabel) {
+    const cv = $('plot'), ctx = cv.getContext('2d');
+    ctx.clearRect(0, 0, cv.width, cv.height);
+    const xmax = Math.max(...xs, 1e-9), ymax = Math.max(...ys, 1e-9);
+    ctx.strokeStyle = '#9cf'; ctx.beginPath();
+    xs.forEach((x, i) => { const X = 30 + x / xmax * (cv.width - 40), Y = cv.height - 20 - ys[i] / ymax * (cv.height - 30); i ? ctx.lineTo(X, Y) : ctx.moveTo(X, Y); });
+    ctx.stroke();
+    ctx.fillStyle = '#aaa'; ctx.font = '10px sans-serif';
+    ctx.fillText(ymax.toPrecision(3), 2, 12); ctx.fillText('0', 22, cv.height - 8);
+    ctx.fillText(xmax.toPrecision(3) + ' ' + xlabel, cv.width - 110, cv.height - 5);
+  }
+  /* The panel: lbk inspect --json's numbers when lbk view embedded them (else the page's own
+   * reader's section sizes), the level, and the error curve (the bake's JSON report against wall
+   * clock when given, else REPT against samples per texel). */
   function panel(data, lbk, meta, rept, objs, lmap, glg) {
-    const rows = lbk.sections.map((s) => `<tr><td>${s.type}</td><td class="n">${fmt(s.stored_size)}</td><td class="n">${fmt(s.decoded_size)}</td><td>${s.compression ? 'zstd' : ''}</td></tr>`);
-    const total = lbk.sections.reduce((a, s) => a + s.decoded_size, 0);
-    $('sections').innerHTML = '<tr><td></td><td class="n">file</td><td class="n">decoded</td><td></td></tr>' + rows.join('') +
-      `<tr><td>total</td><td class="n">${fmt(lbk.file_size)}</td><td class="n">${fmt(total)}</td><td></td></tr>`;
+    const I = data.inspect;
+    if (I && I.schema === 'lbk-inspect/1') {
+      const rows = I.sections.map((s) => `<tr><td>${esc(s.type)}</td><td class="n">${fmt(s.disk_bytes)}</td><td class="n">${fmt(s.decoded_bytes)}</td><td class="n">${fmt(s.gpu_bytes)}</td></tr>`);
+      const t = I.totals || {}, L = I.level || {};
+      $('sections').innerHTML = '<tr><td>lbk inspect</td><td class="n">disk</td><td class="n">decoded</td><td class="n">GPU</td></tr>' + rows.join('') +
+        `<tr><td>total</td><td class="n">${fmt(t.disk_bytes || 0)}</td><td class="n">${fmt(t.decoded_bytes || 0)}</td><td class="n">${fmt(t.gpu_bytes || 0)}</td></tr>` +
+        `<tr><td colspan="3">GPU memory without / with DLS</td><td class="n">${fmt(L.memory_without_dls_bytes || 0)}<br>${fmt(L.memory_with_dls_bytes || 0)}</td></tr>` +
+        (I.objects || []).map((o) => `<tr><td colspan="2">${esc(o.name)}</td><td class="n">${fmt(o.texels)} texels</td><td class="n">${fmt(o.total_bytes)}</td></tr>`).join('');
+    } else {
+      const rows = lbk.sections.map((s) => `<tr><td>${esc(s.type)}</td><td class="n">${fmt(s.stored_size)}</td><td class="n">${fmt(s.decoded_size)}</td><td>${s.compression ? 'zstd' : ''}</td></tr>`);
+      const total = lbk.sections.reduce((a, s) => a + s.decoded_size, 0);
+      $('sections').innerHTML = '<tr><td></td><td class="n">file</td><td class="n">decoded</td><td></td></tr>' + rows.join('') +
+        `<tr><td>total</td><td class="n">${fmt(lbk.file_size)}</td><td class="n">${fmt(total)}</td><td></td></tr>`;
+    }
     const lit = objs ? objs.filter((o) => o.representation === 'lightmap').length : 0;
     $('level').innerHTML = `format ${lbk.version.join('.')}; ${objs ? objs.length : 0} objects (${lit} lightmapped)` +
       (lmap ? `; ${lmap.pages.length} page(s), ${fmt(lmap.texel_count)} texels` : '') + (glg ? `; ${glg.probe_count} GLG probes` : '') +
-      (meta && meta['scene.name'] ? `<br>scene ${meta['scene.name']}` : '') + (meta && meta['bake.preset'] ? `, preset ${meta['bake.preset']}` : '');
+      (meta && meta['scene.name'] ? `<br>scene ${esc(meta['scene.name'])}` : '') + (meta && meta['bake.preset'] ? `, preset ${esc(meta['bake.preset'])}` : '');
+    const J = data.report;
+    if (J && J.schema === 'lbk-bake-report/1' && Array.isArray(J.samples) && J.samples.length) {
+      plot(J.samples.map((x) => x.seconds), J.samples.map((x) => x.est_rel_rmse), 's');
+      const e = J.errors || {};
+      $('report').innerHTML = `bake report: ${esc(J.status)}; ${J.samples.length} passes in ${(J.transport && J.transport.seconds || 0).toPrecision(3)} s; ` +
+        `final rel. RMSE texels ${Number(e.texels || 0).toPrecision(3)}, probes ${Number(e.probes || 0).toPrecision(3)}` +
+        (J.phases ? '<br>' + J.phases.map((p) => `${esc(p.name)} ${Number(p.seconds).toPrecision(2)} s`).join(', ') : '');
+      return;
+    }
     if (!rept) { $('report').textContent = 'no REPT section'; return; }
-    const r = rept.records, cv = $('plot'), ctx = cv.getContext('2d');
-    const xs = r.map((x) => rept.has_times ? x.elapsed_seconds : x.samples_per_texel), ys = r.map((x) => x.texel_rel_rmse);
-    const xmax = Math.max(...xs, 1e-9), ymax = Math.max(...ys, 1e-9);
-    ctx.strokeStyle = '#9cf'; ctx.beginPath();
-    r.forEach((_, i) => { const X = 30 + xs[i] / xmax * (cv.width - 40), Y = cv.height - 20 - ys[i] / ymax * (cv.height - 30); i ? ctx.lineTo(X, Y) : ctx.moveTo(X, Y); });
-    ctx.stroke();
-    ctx.fillStyle = '#aaa'; ctx.font = '10px sans-serif';
-    ctx.fillText(ymax.toPrecision(3), 2, 12); ctx.fillText(rept.has_times ? 's' : 'samples/texel', cv.width - 70, cv.height - 5);
+    const r = rept.records;
+    plot(r.map((x) => rept.has_times ? x.elapsed_seconds : x.samples_per_texel), r.map((x) => x.texel_rel_rmse), rept.has_times ? 's' : 'samples/texel');
     const last = r[r.length - 1];
-    $('report').innerHTML = `status: ${rept.status}; ${r.length} passes; last: ${last.samples_per_texel} samples/texel, texel rel. RMSE ${last.texel_rel_rmse.toPrecision(3)}, probe ${last.probe_rel_rmse.toPrecision(3)}`;
+    $('report').innerHTML = `REPT: ${rept.status}; ${r.length} passes; last: ${last.samples_per_texel} samples/texel, texel rel. RMSE ${last.texel_rel_rmse.toPrecision(3)}, probe ${last.probe_rel_rmse.toPrecision(3)}`;
   }
 
   main().catch(fail);

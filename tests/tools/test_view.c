@@ -36,7 +36,7 @@
 static int write_page(void)
 {
     char err[TL_ERR_LEN];
-    tl_view_options o = {LEVEL, SCENE, OUT};
+    tl_view_options o = {.container = LEVEL, .scene = SCENE, .out_dir = OUT};
     tl_view_stats s;
     const int rc = tl_view_write(&o, &s, err);
     if (rc) print_error("tl_view_write: %s\n", err);
@@ -69,7 +69,21 @@ static void test_view_out_folder(void **state)
     size_t n;
     char err[TL_ERR_LEN];
     assert_int_equal(tl_read_file(OUT "/data.js", &d, &n, err), 0);
-    assert_memory_equal(d, "window.LBK_DATA = {\"name\": \"bake_cornell.lbk\",", 45);
+    assert_memory_equal(d, "window.LBK_DATA = {\"name\": \"bake_cornell.lbk\",\n\"inspect\": null,\n\"report\": null,", 79);
+    free(d);
+    /* with inspect's JSON (re-printed compactly) and a bake report file */
+    assert_int_equal(tl_write_text("build/tests/view_report.json", "{ \"schema\": \"lbk-bake-report/1\",\n \"samples\": [] }", err), 0);
+    tl_view_options o = {.container = LEVEL, .scene = SCENE, .out_dir = OUT, .inspect_json = "{ \"schema\" : \"lbk-inspect/1\" }",
+                         .report_path = "build/tests/view_report.json"};
+    assert_int_equal(tl_view_write(&o, NULL, err), TL_VIEW_OK);
+    assert_int_equal(tl_read_file(OUT "/data.js", &d, &n, err), 0);
+    const char *want = "\"inspect\": {\"schema\":\"lbk-inspect/1\"},\n\"report\": {\"schema\":\"lbk-bake-report/1\",\"samples\":[]},";
+    assert_true(n > 200);
+    char head[201];
+    memcpy(head, d, 200);
+    head[200] = 0;
+    if (!strstr(head, want)) print_error("data.js starts: %s\n", head);
+    assert_non_null(strstr(head, want));
     free(d);
     struct stat st;
     assert_int_equal(stat(OUT "/level.glb", &st), 0);
@@ -87,11 +101,14 @@ static void test_view_refuses_bad_inputs(void **state)
     ((unsigned char *)d)[n / 2] ^= 1;
     assert_int_equal(tl_write_file_atomic("build/tests/view_bad.lbk", d, n, err), 0);
     free(d);
-    tl_view_options o = {"build/tests/view_bad.lbk", SCENE, "build/tests/view_bad"};
+    tl_view_options o = {.container = "build/tests/view_bad.lbk", .scene = SCENE, .out_dir = "build/tests/view_bad"};
     assert_int_equal(tl_view_write(&o, NULL, err), TL_VIEW_INPUT);
-    tl_view_options foreign = {LEVEL, "tests/fuzz/sets_scene.gltf", "build/tests/view_bad"};
+    tl_view_options foreign = {.container = LEVEL, .scene = "tests/fuzz/sets_scene.gltf", .out_dir = "build/tests/view_bad"};
     assert_int_equal(tl_view_write(&foreign, NULL, err), TL_VIEW_INPUT);
-    tl_view_options missing = {"build/tests/no_such.lbk", SCENE, "build/tests/view_bad"};
+    /* the panel's JSON inputs must be JSON: they go into data.js as values */
+    tl_view_options not_json = {.container = LEVEL, .scene = SCENE, .out_dir = "build/tests/view_bad", .inspect_json = "{\"a\": 1} </script>"};
+    assert_int_equal(tl_view_write(&not_json, NULL, err), TL_VIEW_INPUT);
+    tl_view_options missing = {.container = "build/tests/no_such.lbk", .scene = SCENE, .out_dir = "build/tests/view_bad"};
     assert_int_equal(tl_view_write(&missing, NULL, err), TL_VIEW_IO);
 }
 
@@ -386,7 +403,7 @@ static void test_view_set_slider_changes_what_lbk_render_changes(void **state)
     (void)state;
     if (!have_chromium()) skip();
     char err[TL_ERR_LEN];
-    tl_view_options vo = {SETS_LEVEL, SETS_SCENE, SETS_OUT};
+    tl_view_options vo = {.container = SETS_LEVEL, .scene = SETS_SCENE, .out_dir = SETS_OUT};
     assert_int_equal(tl_view_write(&vo, NULL, err), TL_VIEW_OK);
     uint8_t *p0 = sets_shot("", "build/tests/view_sets_on.png");
     uint8_t *p1 = sets_shot("&sets=B:0.25", "build/tests/view_sets_dim.png");

@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <cjson/cJSON.h>
+
 #include "tools/common/bake_data.h"
 #include "tools/common/file_util.h"
 #include "tools/convert/gltf_export.h"
@@ -45,17 +47,48 @@ static void json_name(const char *path, char *out, size_t size)
     out[i] = 0;
 }
 
+/* JSON text re-printed by cJSON (so only a JSON value reaches data.js), or "null" when absent;
+ * NULL with err when the text is not JSON. Free with cJSON_free (or free for "null" copies). */
+static char *json_value(const char *text, size_t size, const char *what, char err[TL_ERR_LEN])
+{
+    if (!text) {
+        char *n = cJSON_malloc(5);
+        if (n) memcpy(n, "null", 5);
+        return n;
+    }
+    const char *end = NULL;
+    cJSON *doc = cJSON_ParseWithLengthOpts(text, size, &end, 0);
+    /* one value and nothing after it but white space (cJSON stops after the first value) */
+    while (doc && end && (size_t)(end - text) < size && (*end == ' ' || *end == '\n' || *end == '\r' || *end == '\t')) end++;
+    if (doc && (!end || (size_t)(end - text) < size)) {
+        cJSON_Delete(doc);
+        doc = NULL;
+    }
+    if (!doc) {
+        snprintf(err, TL_ERR_LEN, "%s is not JSON", what);
+        return NULL;
+    }
+    char *out = cJSON_PrintUnformatted(doc);
+    cJSON_Delete(doc);
+    if (!out) snprintf(err, TL_ERR_LEN, "out of memory");
+    return out;
+}
+
 static int write_data_js(const char *path, const char *name, const void *lbk, size_t lbk_size, const void *glb,
-                         size_t glb_size, uint64_t *written, char err[TL_ERR_LEN])
+                         size_t glb_size, const char *inspect, const char *report, uint64_t *written,
+                         char err[TL_ERR_LEN])
 {
     char *a = base64(lbk, lbk_size), *b = base64(glb, glb_size);
     int rc = TL_VIEW_INTERNAL;
     char *text = NULL;
     if (a && b) {
-        const size_t n = strlen(a) + strlen(b) + strlen(name) + 128;
+        const size_t n = strlen(a) + strlen(b) + strlen(name) + strlen(inspect) + strlen(report) + 160;
         text = malloc(n);
         if (text) {
-            snprintf(text, n, "window.LBK_DATA = {\"name\": \"%s\",\n\"lbk\": \"%s\",\n\"glb\": \"%s\"};\n", name, a, b);
+            snprintf(text, n,
+                     "window.LBK_DATA = {\"name\": \"%s\",\n\"inspect\": %s,\n\"report\": %s,\n\"lbk\": \"%s\",\n"
+                     "\"glb\": \"%s\"};\n",
+                     name, inspect, report, a, b);
             *written = strlen(text);
             rc = tl_write_text(path, text, err) ? TL_VIEW_IO : TL_VIEW_OK;
         }
@@ -106,7 +139,7 @@ int tl_view_write(const tl_view_options *o, tl_view_stats *stats, char err[TL_ER
     if (!rc) rc = join(data_path, sizeof data_path, o->out_dir, "data.js", err);
     if (!rc) {
         const char *base = strrchr(o->container, '/');
-        tl_gltf_options g = {glb_path, o->scene, base ? base + 1 : o->container};
+        tl_gltf_options g = {.output = glb_path, .scene = o->scene, .container = base ? base + 1 : o->container};
         tl_gltf_stats gs;
         rc = tl_gltf_export(&bake, &g, &gs, err);
         if (rc) rc = rc == TL_GLTF_IO ? TL_VIEW_IO : rc == TL_GLTF_INPUT ? TL_VIEW_INPUT : TL_VIEW_INTERNAL;
@@ -116,13 +149,22 @@ int tl_view_write(const tl_view_options *o, tl_view_stats *stats, char err[TL_ER
     void *lbk = NULL, *glb = NULL;
     size_t lbk_size = 0, glb_size = 0;
     if (!rc && (tl_read_file(o->container, &lbk, &lbk_size, err) || tl_read_file(glb_path, &glb, &glb_size, err))) rc = TL_VIEW_IO;
+    char *inspect = NULL, *report = NULL;
+    if (!rc) {
+        void *rep = NULL;
+        size_t rep_size = 0;
+        if (o->report_path && tl_read_file(o->report_path, &rep, &rep_size, err)) rc = TL_VIEW_IO;
+        if (!rc && !(inspect = json_value(o->inspect_json, o->inspect_json ? strlen(o->inspect_json) : 0, "the inspect output", err))) rc = TL_VIEW_INPUT;
+        if (!rc && !(report = json_value(rep, rep_size, o->report_path, err))) rc = TL_VIEW_INPUT;
+        free(rep);
+    }
     if (!rc) {
         char name[256];
         json_name(o->container, name, sizeof name);
-        rc = write_data_js(data_path, name, lbk, lbk_size, glb, glb_size, &s.data_bytes, err);
+        rc = write_data_js(data_path, name, lbk, lbk_size, glb, glb_size, inspect, report, &s.data_bytes, err);
         if (!rc) s.files++;
     }
-    free(lbk), free(glb);
+    free(lbk), free(glb), cJSON_free(inspect), cJSON_free(report);
     if (!rc) rc = write_assets(o->out_dir, &s.files, err);
     if (stats) *stats = s;
     return rc;

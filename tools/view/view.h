@@ -15,6 +15,8 @@ typedef struct tl_view_options {
     const char *container; /* LEVEL.lbk */
     const char *scene;     /* the .gltf/.glb it was baked from */
     const char *out_dir;   /* created when missing; files of an earlier run are replaced */
+    const char *inspect_json; /* optional: `lbk inspect --json` of the container (text), shown in the panel */
+    const char *report_path;  /* optional: the bake's `--json-report` file (error against wall-clock time) */
 } tl_view_options;
 
 typedef struct tl_view_stats {
