@@ -47,7 +47,7 @@ static void usage(FILE *f)
 
 /* `lbk inspect --json LEVEL` of this same binary (/proc/self/exe), for the page's panel: its
  * numbers exactly, without a second copy of inspect's logic. NULL when it cannot run or fails
- * (the page then shows its own reader's section sizes); at most 16 MiB of output. */
+ * (the page then shows its own reader's section sizes); at most 32 MiB of output. */
 static char *inspect_json(const char *level)
 {
     if (level[0] == '-') return NULL; /* would read as an option; such a name gets no inspect panel */

@@ -210,8 +210,9 @@ static void test_view_server(void **state)
 
 static int have_chromium(void) { return system("command -v chromium >/dev/null 2>&1") == 0; }
 
-/* --no-sandbox: the tests may run as root; SwiftShader gives WebGL 2 without a GPU. */
-#define CHROMIUM "chromium --headless=new --no-sandbox --disable-gpu-sandbox --use-gl=angle --use-angle=swiftshader " \
+/* --no-sandbox: the tests may run as root; SwiftShader gives WebGL 2 without a GPU; timeout: a hung
+ * browser fails the case instead of stopping the suite. */
+#define CHROMIUM "timeout 120 chromium --headless=new --no-sandbox --disable-gpu-sandbox --use-gl=angle --use-angle=swiftshader " \
                  "--enable-unsafe-swiftshader --hide-scrollbars --force-device-scale-factor=1 " \
                  "--virtual-time-budget=20000 --user-data-dir=build/tests/view_chromium_profile"
 
@@ -440,6 +441,38 @@ static void test_view_set_slider_changes_what_lbk_render_changes(void **state)
     assert_true(edge <= W * H / 100);
 }
 
+/* ---- the command --------------------------------------------------------------------------- */
+
+/* lbk view through the lbk binary ($LBK, else build/lbk-asan, which make test-build builds): the
+ * command runs `lbk inspect --json` of its own binary for the panel, so it is tested as a process. */
+static void test_view_command(void **state)
+{
+    (void)state;
+    const char *lbk = getenv("LBK") ? getenv("LBK") : "build/lbk-asan";
+    if (access(lbk, X_OK)) skip();
+    char cmd[2048], err[TL_ERR_LEN];
+    snprintf(cmd, sizeof cmd, "%s view >/dev/null 2>&1", lbk);
+    assert_int_equal(WEXITSTATUS(system(cmd)), 2); /* usage */
+    snprintf(cmd, sizeof cmd, "%s view " LEVEL " " SCENE " --port 70000 >/dev/null 2>&1", lbk);
+    assert_int_equal(WEXITSTATUS(system(cmd)), 2);
+    snprintf(cmd, sizeof cmd, "%s view " LEVEL " " SCENE " --frobnicate >/dev/null 2>&1", lbk);
+    assert_int_equal(WEXITSTATUS(system(cmd)), 2);
+    snprintf(cmd, sizeof cmd, "%s view " LEVEL " tests/fuzz/sets_scene.gltf --out build/tests/view_cmd_bad >/dev/null 2>&1", lbk);
+    assert_int_equal(WEXITSTATUS(system(cmd)), 4); /* not the scene it was baked from */
+    snprintf(cmd, sizeof cmd, "%s view --help | grep -q 127.0.0.1", lbk);
+    assert_int_equal(system(cmd), 0);
+    snprintf(cmd, sizeof cmd, "%s view " LEVEL " " SCENE " --out build/tests/view_cmd -q", lbk);
+    assert_int_equal(system(cmd), 0);
+    void *d;
+    size_t n;
+    assert_int_equal(tl_read_file("build/tests/view_cmd/data.js", &d, &n, err), 0);
+    char head[160];
+    memcpy(head, d, sizeof head - 1);
+    head[sizeof head - 1] = 0;
+    free(d);
+    assert_non_null(strstr(head, "\"inspect\": {\"schema\":\"lbk-inspect/1\""));
+}
+
 int main(void)
 {
     signal(SIGPIPE, SIG_IGN);
@@ -447,6 +480,7 @@ int main(void)
         cmocka_unit_test(test_view_out_folder),
         cmocka_unit_test(test_view_refuses_bad_inputs),
         cmocka_unit_test(test_view_server),
+        cmocka_unit_test(test_view_command),
         cmocka_unit_test(test_view_page_loads_without_errors),
         cmocka_unit_test(test_view_screenshot_matches_lbk_render),
         cmocka_unit_test(test_view_set_slider_changes_what_lbk_render_changes),
