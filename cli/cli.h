@@ -19,5 +19,6 @@ int lbk_cmd_diff(int argc, char **argv);
 int lbk_cmd_convert(int argc, char **argv);
 int lbk_cmd_export(int argc, char **argv);
 int lbk_cmd_render(int argc, char **argv);
+int lbk_cmd_view(int argc, char **argv);
 
 #endif

@@ -17,6 +17,7 @@ static const struct {
     {"convert", lbk_cmd_convert, "make a console-ready pack with a profile"},
     {"export", lbk_cmd_export, "write pages and probes as EXR/PNG/CSV"},
     {"render", lbk_cmd_render, "render a view of a baked level (reference renderer)"},
+    {"view", lbk_cmd_view, "look at a bake in a browser (a page folder, or served on 127.0.0.1)"},
 };
 
 static void usage(FILE *f)
