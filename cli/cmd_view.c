@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "cli/cli.h"
+#include "cli/options.h"
 #include "tools/view/view.h"
 
 #define DEFAULT_PORT 8765
@@ -100,10 +101,9 @@ static int remove_entry(const char *path, const struct stat *st, int flag, struc
 
 static int parse_port(const char *s, long *out)
 {
-    char *end;
-    const long v = strtol(s, &end, 10);
-    if (!*s || *end || v < 0 || v > 65535) return -1;
-    *out = v;
+    unsigned long long v;
+    if (!cli_parse_uint(s, 0, 65535, &v)) return -1; /* strtol took " 80" and "+80" */
+    *out = (long)v;
     return 0;
 }
 
