@@ -1680,6 +1680,7 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
         if (output->direct) memset(&output->direct[i], 0, sizeof output->direct[i]);
         if (output->irradiance) output->irradiance[3 * i] = output->irradiance[3 * i + 1] = output->irradiance[3 * i + 2] = 0;
     }
+    if (c.oct_count) memset(output->octa_irradiance, 0, c.oct_count * 48 * sizeof(float));
     if (c.light_count) parallel_for(&c, count, 64, recv_punctual); /* luminance only, for the error */
 
     double err = 0, bias = 0;
