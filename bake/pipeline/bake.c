@@ -317,12 +317,17 @@ static lbk_result layout_glg(bk_pipeline *b)
     return LBK_OK;
 }
 
-/* OCTP: a probe volume over the level at the GLG's spacing (bake/probes/octa_bake.h). */
+/* OCTP: a probe volume over the level at the GLG's spacing, or finer in a small level
+ * (bake/probes/octa_bake.h). */
 static lbk_result layout_octa(bk_pipeline *b)
 {
     bk_octa_options oo;
     memset(&oo, 0, sizeof oo);
     oo.spacing = b->opt->glg_spacing > 0 ? b->opt->glg_spacing : b->pre->glg_spacing;
+    /* at least 8 probes along the level's longest side: a small room gets a usable volume */
+    float ext = 0;
+    for (int a = 0; a < 3; a++) ext = fmaxf(ext, b->scene.bounds_max[a] - b->scene.bounds_min[a]);
+    if (ext > 0 && ext / 8 < oo.spacing) oo.spacing = ext / 8;
     lbk_result r = bk_octa_place(&b->scene, b->tracer, b->scene.bounds_min, b->scene.bounds_max, &oo, &b->octa);
     return r ? bk_pipeline_failed(b, r, "octahedral probe volume") : LBK_OK;
 }

@@ -108,7 +108,7 @@ lbk_result bk_octa_place(const bk_scene *scene, const bk_tracer *tracer, const f
         uint64_t n = 1;
         for (int a = 0; a < 3; a++) {
             const float e = bmax[a] - bmin[a];
-            double d = ceil((double)e / s) + 1;
+            double d = ceil((double)e / s); /* outermost probes half a spacing inside */
             if (!(d >= 2)) d = 2;
             l->dims[a] = d > OCTA_MAX_DIM ? OCTA_MAX_DIM + 1 : (uint32_t)d;
             n *= l->dims[a];

@@ -20,7 +20,7 @@
 #define BK_OCTA_INSIDE_FRACTION 0.25f
 
 typedef struct bk_octa_options {
-    float spacing;      /* metres; 0: 1 */
+    float spacing;      /* metres; 0: 1 (the baker passes min(GLG spacing, largest extent / 8)) */
     uint32_t max_probes; /* 0: 32768; the spacing grows by 1.25 until the grid fits */
 } bk_octa_options;
 
@@ -31,7 +31,9 @@ typedef struct bk_octa_volume {
     lbk_octp_probe_info *info;   /* offset, state, back-face fraction, nearest hit */
 } bk_octa_volume;
 
-/* Grid over [bmin, bmax] (centred, spacing as above, miss distance min(255, grid diagonal)),
+/* Grid over [bmin, bmax]: max(2, ceil(extent/spacing)) probes per axis, centred (so the outermost
+ * probes stand half a spacing inside a box that is a whole number of spacings), spacing as above,
+ * miss distance min(255, grid diagonal);
  * then per probe: classification rays from the grid point; inside (back-face fraction >
  * BK_OCTA_INSIDE_FRACTION) → moved through the nearest back face to 0.1·spacing beyond it,
  * too close to a front face (< 0.1·spacing) → moved away from it; offsets bounded by 0.45 ×

@@ -119,8 +119,8 @@ static void classify_and_relocate(void **state)
     tsc_update_bounds(&s);
     bk_tracer *t = NULL;
     assert_int_equal(bk_tracer_create(&s, 0, &t), LBK_OK);
-    /* a grid of spacing 0.5 over [-3, 3]³: 13³ probes at multiples of 0.5 */
-    const float bmin[3] = {-3, -3, -3}, bmax[3] = {3, 3, 3};
+    /* a grid of spacing 0.5 over [-3.25, 3.25]³: 13³ probes at multiples of 0.5 */
+    const float bmin[3] = {-3.25f, -3.25f, -3.25f}, bmax[3] = {3.25f, 3.25f, 3.25f};
     bk_octa_volume v;
     bk_octa_options oo = {0.5f, 0};
     assert_int_equal(bk_octa_place(&s, t, bmin, bmax, &oo, &v), LBK_OK);
