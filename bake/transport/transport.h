@@ -75,6 +75,7 @@ typedef struct bk_transport_sample {
      * GLG probes, LLG probes, and the probes together */
     double class_rel_rmse[BK_RECEIVER_CLASSES];
     double probe_rel_rmse;
+    double class_samples[BK_RECEIVER_CLASSES]; /* samples per receiver of each class so far */
 } bk_transport_sample;
 
 typedef struct bk_transport_options {
@@ -118,9 +119,11 @@ typedef struct bk_transport_options {
     void (*report)(void *user, const bk_transport_sample *sample);
     void *user;
     /* Receivers [0, class_end[0]) are texels, [class_end[0], class_end[1]) GLG probes,
-     * [class_end[1], class_end[2]) LLG probes: the error is then also estimated per class
-     * (bk_transport_sample.class_rel_rmse), and target_error applies to the texels' estimate
-     * (all receivers' when there are no texels). All 0: one class, the estimate over all. */
+     * [class_end[1], class_end[2]) LLG probes (class_end[2] = count): the error is then
+     * estimated per class (bk_transport_sample.class_rel_rmse) and each class samples until
+     * its own estimate reaches target_error (or its budget or the time runs out): probes,
+     * which gather over the whole sphere, go on after the texels have stopped.
+     * All 0: one class, the estimate over all. */
     size_t class_end[BK_RECEIVER_CLASSES];
     /* Octahedral probes (OCTP, bake/probes/octa_bake.h): octa_count points (3 floats each)
      * gathered over the sphere in the same final-gather passes as the receivers, on their own
@@ -162,6 +165,11 @@ typedef struct bk_transport_stats {
                                 est_rel_rmse, which the two halves measure */
     double class_rel_rmse[BK_RECEIVER_CLASSES]; /* per class, as in bk_transport_sample */
     double probe_rel_rmse;
+    /* gather rays per receiver of each class (both halves, all its passes): classes sample
+     * until their own estimate reaches the target; samples_per_receiver and stop are the
+     * texels' (the first class with receivers when there are no texels: the one that sampled
+     * longest) */
+    double class_samples[BK_RECEIVER_CLASSES];
     int bounces;             /* explicit bounces of the last pass */
     double q;                /* per-bounce energy ratio used for the tail (last pass, mean of halves) */
     double tail_fraction;    /* share of the cache's indirect energy that came from the tail */
