@@ -134,7 +134,9 @@ static void write_probe(uint8_t *q, const lbk_octp_probe_desc *pd, float inv, fl
                 if (m1 > miss * miss) m1 = miss * miss;
             }
             uint8_t *t = q + LBK_OCTP_DEPTH_OFFSET + 4 * (y * DEPTH_S + x);
-            const uint16_t h0 = lbk_float_to_half(m0);
+            uint16_t h0 = lbk_float_to_half(m0);
+            /* rounding to nearest may land above the miss distance: take the half below it */
+            while (volume && h0 > 0 && lbk_half_to_float(h0) > miss) h0--;
             lbk_wr16(t, h0);
             lbk_wr16(t + 2, volume ? m2_half(lbk_half_to_float(h0), m1) : lbk_float_to_half(m1));
         }

@@ -664,6 +664,25 @@ static void octp_volume_rules(void **state)
     lbk_octp_view v;
     assert_int_equal(lbk_octp_open(b, n, &v), LBK_OK);
     assert_int_equal(v.level_count, 1);
+    {
+        /* a miss distance no half holds (2√3, what the baker's diagonal gives): every probe at
+         * it (all rays missed) still validates — m1 is rounded down, m2 up (1015) */
+        lbk_octp_probe_desc pm[27];
+        memcpy(pm, pd, sizeof pm);
+        const float miss = 3.46410161f;
+        for (int i = 0; i < 27; i++)
+            for (int t = 0; t < 144; t++) pm[i].depth[t][0] = miss, pm[i].depth[t][1] = miss * miss;
+        const lbk_octp_level lm = {{0, 0, 0}, 1.0f, {3, 3, 3}, 0, miss};
+        lbk_octp_build_desc dm = LBK_OCTP_BUILD_DESC_INIT;
+        dm.probes = pm, dm.probe_count = 27, dm.levels = &lm, dm.level_count = 1, dm.info = in;
+        void *bm;
+        size_t nm;
+        assert_int_equal(lbk_octp_build(&dm, NULL, &bm, &nm), LBK_OK);
+        issues im;
+        run(lbk_validate_octp, bm, nm, &im, NULL);
+        assert_int_equal(im.n, 0);
+        lbk_free(NULL, bm);
+    }
     assert_int_equal(v.levels[0].dims[2], 3);
     /* trilinear reproduces a linear field exactly (no normal: no back-face weight; depth =
      * miss: Chebyshev weight 1) */
