@@ -734,6 +734,45 @@ static void octp_volume_rules(void **state)
     lbk_free(NULL, b);
 }
 
+/* Two clip levels: level 0 (spacing 1 over [0, 2]³) holds 10 everywhere, level 1 (spacing 2 over
+ * [−1, 3]³) 20: inside level 0 its value, blended linearly over its last cell (§14.3 step 7),
+ * level 1 beyond it. */
+static void octp_levels_blend(void **state)
+{
+    (void)state;
+    static lbk_octp_probe_desc pd[54];
+    lbk_octp_probe_info in[54];
+    memset(in, 0, sizeof in);
+    for (int i = 0; i < 54; i++) {
+        memset(&pd[i], 0, sizeof pd[i]);
+        for (int t = 0; t < 16; t++) pd[i].irradiance[t][0] = pd[i].irradiance[t][1] = pd[i].irradiance[t][2] = i < 27 ? 10.0f : 20.0f;
+        for (int t = 0; t < 144; t++) pd[i].depth[t][0] = 16, pd[i].depth[t][1] = 256;
+    }
+    const lbk_octp_level lv[2] = {{{0, 0, 0}, 1.0f, {3, 3, 3}, 0, 16.0f}, {{-1, -1, -1}, 2.0f, {3, 3, 3}, 0, 16.0f}};
+    lbk_octp_build_desc d = LBK_OCTP_BUILD_DESC_INIT;
+    d.probes = pd, d.probe_count = 54, d.levels = lv, d.level_count = 2, d.info = in;
+    void *b;
+    size_t n;
+    assert_int_equal(lbk_octp_build(&d, NULL, &b, &n), LBK_OK);
+    issues is;
+    run(lbk_validate_octp, b, n, &is, NULL);
+    assert_int_equal(is.n, 0);
+    lbk_octp_view v;
+    assert_int_equal(lbk_octp_open(b, n, &v), LBK_OK);
+    assert_int_equal(v.levels[1].first_probe, 27);
+    assert_float_equal(sample_at(&v, 1, 1, 1, 0), 10, 1e-5);   /* one cell from every edge */
+    assert_float_equal(sample_at(&v, 0.5f, 1, 1, 0), 15, 1e-5); /* half a cell: half and half */
+    assert_float_equal(sample_at(&v, 0.5f, 1, 1, LBK_OCTP_SAMPLE_NO_BLEND), 10, 1e-5);
+    assert_float_equal(sample_at(&v, 2, 1, 1, 0), 20, 1e-5);    /* on level 0's boundary */
+    assert_float_equal(sample_at(&v, 2.5f, 1, 1, 0), 20, 1e-5); /* level 1 only */
+    assert_float_equal(sample_at(&v, 9, 9, 9, 0), 20, 1e-5);    /* outside both: clamped coarsest */
+    /* spacing must grow from level to level */
+    const lbk_octp_level bad[2] = {lv[1], lv[0]};
+    d.levels = bad;
+    assert_int_equal(lbk_octp_build(&d, NULL, &b, &n), LBK_ERR_INVALID_ARGUMENT);
+    lbk_free(NULL, (void *)v.data);
+}
+
 /* All four in one container through the public validator: valid, and the table IDs known. */
 static void container_clean(void **state)
 {
@@ -944,7 +983,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(lmap_round_trip_and_rules), cmocka_unit_test(glg_rules), cmocka_unit_test(llg_rules),
         cmocka_unit_test(octa_mapping),              cmocka_unit_test(octp_rules),
-        cmocka_unit_test(octp_volume_rules), cmocka_unit_test(container_clean),
+        cmocka_unit_test(octp_volume_rules),
+        cmocka_unit_test(octp_levels_blend), cmocka_unit_test(container_clean),
         cmocka_unit_test(scaled_sections),      cmocka_unit_test(lmap_fast_scan_exact), cmocka_unit_test(lmap_block_pages),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
