@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "cli/cli.h"
+#include "cli/options.h"
 #include "cli/progress.h"
 #include "lbk/bake.h"
 #include "tools/common/file_util.h"
@@ -68,21 +69,6 @@ static int parse_double(const char *s, double *out)
     errno = 0;
     double v = strtod(s, &end);
     if (errno || end == s || *end) return 0;
-    *out = v;
-    return 1;
-}
-
-/* A decimal integer in [lo, hi] and nothing else: "1.5", "-1", " 3", "0x10", "1e3" are refused
- * (strtoull alone would turn "-1" into 2^64 - 1). */
-static int parse_uint(const char *s, unsigned long long lo, unsigned long long hi, unsigned long long *out)
-{
-    if (!s || !*s) return 0;
-    for (const char *c = s; *c; c++)
-        if (*c < '0' || *c > '9') return 0;
-    char *end;
-    errno = 0;
-    unsigned long long v = strtoull(s, &end, 10);
-    if (errno || *end || v < lo || v > hi) return 0;
     *out = v;
     return 1;
 }
@@ -326,7 +312,7 @@ int lbk_cmd_bake(int argc, char **argv)
 #define NEED_UINT(lo, hi)                                                                          \
     do {                                                                                           \
         NEED_VALUE;                                                                                \
-        if (!parse_uint(v, (lo), (hi), &u)) {                                                      \
+        if (!cli_parse_uint(v, (lo), (hi), &u)) {                                                      \
             fprintf(stderr, "lbk bake: %s: '%s' is not a whole number in [%llu, %llu]\n", a, v,     \
                     (unsigned long long)(lo), (unsigned long long)(hi));                           \
             return LBK_EXIT_USAGE;                                                                 \

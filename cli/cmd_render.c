@@ -1,10 +1,12 @@
 /* lbk render: a view of a baked level through liblbk's runtime API (tools/render). */
 #include <math.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "cli/cli.h"
+#include "cli/options.h"
 #include "tools/render/render.h"
 
 #define MAX_NAMED 64
@@ -40,6 +42,7 @@ static void usage(FILE *f)
             "                          pass the --sky the level was baked with)\n"
             "  --seams FILE.exr        chart-boundary mask of the view (channels lightmapped, seam) for the bench\n"
             "  --threads N             default: all cores\n"
+            CLI_MAX_MEMORY_HELP
             "  -q, --quiet             no summary\n"
             "  -h, --help              this text\n"
             "\n"
@@ -102,8 +105,23 @@ static int bad(const char *what, const char *value)
     return LBK_EXIT_USAGE;
 }
 
+/* WxH, both strict positive integers up to 16384. */
+static int parse_size(const char *v, int *w, int *h)
+{
+    const char *x = strchr(v, 'x');
+    char wbuf[16];
+    unsigned long long a, b;
+    if (!x || (size_t)(x - v) >= sizeof wbuf) return -1;
+    memcpy(wbuf, v, (size_t)(x - v));
+    wbuf[x - v] = 0;
+    if (!cli_parse_uint(wbuf, 1, 16384, &a) || !cli_parse_uint(x + 1, 1, 16384, &b)) return -1;
+    *w = (int)a, *h = (int)b;
+    return 0;
+}
+
 static int parse(int argc, char **argv, args *a)
 {
+    unsigned long long u;
     a->camera = -1;
     a->fov = 60.0f;
     a->o.camera.up[1] = 1.0f;
@@ -116,14 +134,19 @@ static int parse(int argc, char **argv, args *a)
         else if (!strcmp(k, "-o")) a->exr = v;
         else if (!strcmp(k, "--png")) a->png = v;
         else if (!strcmp(k, "--seams")) a->seams = v, a->o.seams = 1;
-        else if (!strcmp(k, "--camera")) { if ((a->camera = atoi(v)) < 0 || !strchr("0123456789", v[0])) return bad("camera", v); }
+        else if (!strcmp(k, "--camera")) { if (!cli_parse_uint(v, 0, INT_MAX, &u)) return bad("camera", v); a->camera = (int)u; }
         else if (!strcmp(k, "--look-from")) { if (parse_floats(v, a->o.camera.from, 3)) return bad("position", v); a->have_from = 1; }
         else if (!strcmp(k, "--look-at")) { if (parse_floats(v, a->o.camera.at, 3)) return bad("position", v); a->have_at = 1; }
         else if (!strcmp(k, "--up")) { if (parse_floats(v, a->o.camera.up, 3)) return bad("direction", v); }
         else if (!strcmp(k, "--fov")) { if (parse_floats(v, &a->fov, 1) || !(a->fov > 0 && a->fov < 178)) return bad("field of view", v); }
-        else if (!strcmp(k, "--size")) { if (sscanf(v, "%dx%d", &a->o.width, &a->o.height) != 2 || a->o.width < 1 || a->o.height < 1) return bad("size", v); }
-        else if (!strcmp(k, "--samples")) { if ((a->o.samples = atoi(v)) < 1 || a->o.samples > 64) return bad("samples", v); }
-        else if (!strcmp(k, "--threads")) { if ((a->o.threads = atoi(v)) < 0) return bad("threads", v); }
+        else if (!strcmp(k, "--size")) { if (parse_size(v, &a->o.width, &a->o.height)) return bad("size", v); }
+        else if (!strcmp(k, "--samples")) { if (!cli_parse_uint(v, 1, 64, &u)) return bad("samples", v); a->o.samples = (int)u; }
+        else if (!strcmp(k, "--threads")) { if (!cli_parse_uint(v, 0, 1024, &u)) return bad("threads", v); a->o.threads = (int)u; }
+        else if (!strcmp(k, "--max-memory")) {
+            int mm = cli_max_memory_option("render", argc, argv, &i, &a->o.max_decoded_bytes);
+            if (mm < 0) return LBK_EXIT_USAGE;
+            continue;
+        }
         else if (!strcmp(k, "--sky")) { if (parse_floats(v, a->o.sky, 3) || a->o.sky[0] < 0 || a->o.sky[1] < 0 || a->o.sky[2] < 0) return bad("sky", v); a->o.sky_override = 1; }
         else if (!strcmp(k, "--set")) { if (a->o.set_count >= MAX_NAMED || parse_named(v, &a->sets[a->o.set_count++])) return bad("light set weight", v); }
         else if (!strcmp(k, "--door")) { if (a->o.door_count >= MAX_NAMED || parse_named(v, &a->doors[a->o.door_count++])) return bad("door weight", v); }

@@ -1,3 +1,5 @@
+#include <stdlib.h>
+#include <errno.h>
 #include "cli/options.h"
 
 #include <stdio.h>
@@ -15,5 +17,18 @@ int cli_max_memory_option(const char *cmd, int argc, char **argv, int *i, uint64
     }
     *out = v;
     ++*i;
+    return 1;
+}
+
+int cli_parse_uint(const char *s, unsigned long long lo, unsigned long long hi, unsigned long long *out)
+{
+    if (!s || !*s) return 0;
+    for (const char *c = s; *c; c++)
+        if (*c < '0' || *c > '9') return 0;
+    char *end;
+    errno = 0;
+    unsigned long long v = strtoull(s, &end, 10);
+    if (errno || *end || v < lo || v > hi) return 0;
+    *out = v;
     return 1;
 }

@@ -12,6 +12,10 @@
  * (spec/container.md §4.3). */
 int cli_max_memory_option(const char *cmd, int argc, char **argv, int *i, uint64_t *out);
 
+/* A decimal integer in [lo, hi] and nothing else: "1.5", "-1", " 3", "0x10", "1e3" are refused
+ * (strtoull alone would turn "-1" into 2^64 - 1, atoi "1.5" into 1). 1 and *out set, or 0. */
+int cli_parse_uint(const char *s, unsigned long long lo, unsigned long long hi, unsigned long long *out);
+
 #define CLI_MAX_MEMORY_HELP                                                                          \
     "  --max-memory SIZE  refuse a file whose sections decode to more than SIZE (bytes, or kB, KiB, MB,\n" \
     "                     MiB, GB, GiB); default min(4 GiB, 1024 x file size + 64 MiB)\n"

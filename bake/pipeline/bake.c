@@ -136,6 +136,7 @@ static lbk_result import_file(bk_pipeline *b, const char *path)
     io.warn = import_warning;
     io.warn_user = b;
     io.allow_outside = b->opt->allow_outside;
+    io.recentre = 1;
     FILE *probe = fopen(path, "rb");
     if (!probe) return bk_pipeline_fail(b, LBK_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
     fclose(probe);
@@ -191,7 +192,8 @@ static int has_triangle_with_area(const bk_scene *s)
 /* A level far from the origin (1e5 m) leaves floats a 7.8 mm step there, and ray offsets scale
  * with coordinate magnitude (~6 cm), which brightened such a level by 20 % (test_extremes).
  * So the bake runs in a frame centred on the level, and every stored position gets the origin
- * added back. The shift is an integer number of metres, along each axis where the level lies
+ * added back. The importer already chose the frame in double precision (bk_scene.origin); this
+ * is for scenes given as floats (lbk_bake_from_scene). The shift is an integer number of metres, along each axis where the level lies
  * farther from the origin than twice its extent: then every p − c is exact in float (Sterbenz),
  * and so is p − c + c, so geometry hashes and written positions are unchanged. */
 static void recentre(bk_pipeline *b)
@@ -206,6 +208,7 @@ static void recentre(bk_pipeline *b)
         c[k] = isfinite(mid) && fabs(mid) > 2 * extent ? nearbyint(mid) : 0;
         any |= c[k] != 0;
     }
+    for (int k = 0; k < 3; k++) b->origin[k] = (float)(s->origin[k] + c[k]); /* integers below 2^24: exact */
     if (!any) return;
     for (size_t v = 0; v < s->vertex_count; v++)
         for (int k = 0; k < 3; k++) s->positions[3 * v + k] = (float)((double)s->positions[3 * v + k] - c[k]);
@@ -214,7 +217,7 @@ static void recentre(bk_pipeline *b)
     for (int k = 0; k < 3; k++) {
         s->bounds_min[k] = (float)((double)s->bounds_min[k] - c[k]);
         s->bounds_max[k] = (float)((double)s->bounds_max[k] - c[k]);
-        b->origin[k] = (float)c[k];
+        s->origin[k] += c[k];
     }
 }
 

@@ -42,6 +42,7 @@ typedef struct exr_job {
     int prefixed;
     float *rgba;
     float *lum;  /* only when the file has Y */
+    float *unused; /* where the channels we do not read are decoded to (see decode_chunk) */
 } exr_job;
 
 static int fail_code(exr_job *j, const char *what, exr_result_t rv)
@@ -67,11 +68,18 @@ static int decode_chunk(exr_job *j, const exr_chunk_info_t *ci, int px, int py)
     for (int c = 0; c < dec.channel_count; c++) {
         exr_coding_channel_info_t *ch = &dec.channels[c];
         int slot = channel_slot(ch->channel_name, j->prefixed);
-        ch->decode_to_ptr = NULL;
-        if (slot < 0) continue;
         ch->user_bytes_per_element = 4;
         ch->user_data_type = EXR_PIXEL_FLOAT;
-        if (slot == 4) {
+        if (slot < 0) {
+            /* decoded and dropped: OpenEXRCore 3.1 documents a NULL decode_to_ptr as "skip this
+             * channel", but its unpackers then write through the null pointer (a PIZ or B44 file
+             * with one channel we do not use crashed the reader: fuzz_exr) */
+            ch->user_data_type = ch->data_type; /* as stored: no conversion (UINT included) */
+            ch->user_bytes_per_element = ch->bytes_per_element;
+            ch->user_pixel_stride = 4;
+            ch->user_line_stride = 4 * j->width;
+            ch->decode_to_ptr = (uint8_t *)(j->unused + oy * (size_t)j->width + ox);
+        } else if (slot == 4) {
             ch->user_pixel_stride = 4;
             ch->user_line_stride = 4 * j->width;
             ch->decode_to_ptr = (uint8_t *)(j->lum + oy * (size_t)j->width + ox);
@@ -161,6 +169,16 @@ int bk_exr_read(const char *path, size_t max_pixels, bk_image *out, char *err, s
     }
     j.x0 = dw.min.x; j.y0 = dw.min.y; j.width = (int)w; j.height = (int)h;
 
+    /* Subsampled channels are not supported, used or not (the scratch plane of decode_chunk
+     * has one value per pixel). */
+    for (int c = 0; c < chl->num_channels; c++) {
+        const exr_attr_chlist_entry_t *e = &chl->entries[c];
+        if (e->x_sampling != 1 || e->y_sampling != 1) {
+            snprintf(err, err_len, "%s: EXR channel \"%s\" is subsampled (not supported)", path,
+                     e->name.str ? e->name.str : "");
+            goto done;
+        }
+    }
     /* Plain R/G/B win over layered ones; fall back to the first layer that has them. */
     int have[5] = {0}, have_prefixed[5] = {0};
     for (int c = 0; c < chl->num_channels; c++) {
@@ -171,10 +189,6 @@ int bk_exr_read(const char *path, size_t max_pixels, bk_image *out, char *err, s
             if (slot < 0) continue;
             if (e->pixel_type != EXR_PIXEL_HALF && e->pixel_type != EXR_PIXEL_FLOAT) {
                 snprintf(err, err_len, "%s: EXR channel \"%s\" is not half or float", path, name);
-                goto done;
-            }
-            if (e->x_sampling != 1 || e->y_sampling != 1) {
-                snprintf(err, err_len, "%s: EXR channel \"%s\" is subsampled (not supported)", path, name);
                 goto done;
             }
             (pass ? have_prefixed : have)[slot] = 1;
@@ -192,7 +206,8 @@ int bk_exr_read(const char *path, size_t max_pixels, bk_image *out, char *err, s
     size_t npix = (size_t)w * (size_t)h;
     j.rgba = calloc(npix, 4 * sizeof(float));
     if (use_y) j.lum = calloc(npix, sizeof(float));
-    if (!j.rgba || (use_y && !j.lum)) {
+    j.unused = malloc(npix * sizeof(float));
+    if (!j.rgba || (use_y && !j.lum) || !j.unused) {
         snprintf(err, err_len, "%s: out of memory for a %dx%d EXR", path, j.width, j.height);
         goto done;
     }
@@ -224,6 +239,7 @@ int bk_exr_read(const char *path, size_t max_pixels, bk_image *out, char *err, s
 done:
     free(j.rgba);
     free(j.lum);
+    free(j.unused);
     exr_finish(&j.ctxt);
     return ret;
 }

@@ -635,6 +635,7 @@ private:
                        const std::string &what);
     void decode_draco(int mi, int pi, const DracoInfo &di, Prim &p, std::vector<uint32_t> &idx, size_t *nverts);
     void emit_geometry();
+    void choose_origin(const std::vector<Instance> &kept);
     void emit_lights();
     void read_sky();
     void read_combinations();
@@ -1345,6 +1346,29 @@ T *alloc_array(size_t n, size_t per)
     return p;
 }
 
+// The level's origin (bk_scene.origin), from its double-precision world bounds, before any
+// position becomes a float: a 1 mm object 1e5 m away (a node translation, a JSON double) keeps
+// its shape, where world-space floats (7.8 mm apart there) would collapse it. Per axis an
+// integer number of metres, and only where the level lies farther from 0 than twice its
+// extent (the rule of the pipeline's recentre, which then finds nothing left to do).
+void Importer::choose_origin(const std::vector<Instance> &kept)
+{
+    double mn[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, mx[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    for (const Instance &in : kept)
+        for (const Prim &p : meshes_[(size_t)m_.nodes[(size_t)in.node].mesh].prims)
+            for (size_t v = 0; v < p.pos.size() / 3; v++) {
+                double lp[3] = {p.pos[v * 3], p.pos[v * 3 + 1], p.pos[v * 3 + 2]}, wp[3];
+                xform_point(in.world, lp, wp);
+                for (int k = 0; k < 3; k++) mn[k] = std::min(mn[k], wp[k]), mx[k] = std::max(mx[k], wp[k]);
+            }
+    double extent = 0;
+    for (int k = 0; k < 3; k++) extent = std::max(extent, mx[k] - mn[k]);
+    for (int k = 0; k < 3; k++) {
+        double mid = 0.5 * (mn[k] + mx[k]);
+        s_->origin[k] = std::isfinite(mid) && std::isfinite(extent) && std::fabs(mid) > 2 * extent ? std::nearbyint(mid) : 0;
+    }
+}
+
 void Importer::emit_geometry()
 {
     const char *file = path_.c_str();
@@ -1373,6 +1397,7 @@ void Importer::emit_geometry()
         kept.push_back(in);
         dets.push_back(det);
     }
+    if (o_.recentre) choose_origin(kept);
     s_->positions = alloc_array<float>(total_v, 3);
     s_->normals = alloc_array<float>(total_v, 3);
     s_->uv0 = alloc_array<float>(total_v, 2);
@@ -1428,7 +1453,7 @@ void Importer::emit_geometry()
                 double lp[3] = {p.pos[v * 3], p.pos[v * 3 + 1], p.pos[v * 3 + 2]}, wp[3];
                 xform_point(in.world, lp, wp);
                 for (int k = 0; k < 3; k++) {
-                    float x = (float)wp[k];
+                    float x = (float)(wp[k] - s_->origin[k]);
                     if (!std::isfinite(x)) fail("%s: %s: a vertex position overflows after the node transform", file, lbl.c_str());
                     s_->positions[(v0 + v) * 3 + k] = x;
                 }
@@ -1526,7 +1551,7 @@ void Importer::emit_lights()
         xform_point(li.world, o, wp);
         upper3(li.world, A);
         xform_dir(A, dz, wd);
-        for (int k = 0; k < 3; k++) bl.position[k] = (float)wp[k];
+        for (int k = 0; k < 3; k++) bl.position[k] = (float)(wp[k] - s_->origin[k]);
         if (!normalize3(wd)) {
             if (bl.type != BK_LIGHT_POINT) {
                 if (o_.report) o_.report->skipped_nodes++;

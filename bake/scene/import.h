@@ -37,6 +37,10 @@ typedef struct bk_import_options {
     /* Resources (buffers, images, the lbk_sky EXR) must resolve, symlinks included, inside the
      * scene file's folder; this names one more folder they may come from. NULL: none. */
     const char *allow_outside;
+    /* 1: positions relative to a level origin chosen in double precision (bk_scene.origin; what
+     * the bake uses, so a 1 mm object 1e5 m away keeps its shape); 0: world positions as floats
+     * (origin 0), what tools comparing with world-space data want. */
+    int recentre;
     /* Optional: receives each warning (one line, no newline). */
     void (*warn)(void *user, const char *message);
     void *warn_user;

@@ -117,6 +117,11 @@ typedef struct bk_scene {
     size_t input_count;            /* every file import read, in the order read (0 for scenes */
     bk_input_file *inputs;         /* not made by import) */
     float bounds_min[3], bounds_max[3];
+    /* positions (vertices, lights, bounds) are relative to this point: world = position + origin.
+     * The importer sets it for a level far from 0 (an integer number of metres per axis) before
+     * positions become floats; 0 for scenes made otherwise. bk_object.local_to_world maps to the
+     * world itself (its translation includes the origin). */
+    double origin[3];
     /* combination states to bake (scene extras lbk_combinations); names are checked by the set
      * bakes (bake/sets/bake_sets.c), not by import */
     size_t combination_count;

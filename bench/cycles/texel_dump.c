@@ -123,6 +123,7 @@ static int build_layout(dump *d, const char *scene_path, const char *preset, flo
     char msg[512];
     bk_import_options io;
     memset(&io, 0, sizeof io);
+    io.recentre = 1; /* as the pipeline imports; written positions get the origin back */
     if (bk_import_gltf(scene_path, &io, &d->scene, msg, sizeof msg)) return die("import", msg);
     if (far_from_origin(&d->scene)) return die("the level lies far from the origin (the baker recentres it)", NULL);
     bk_scene *s = &d->scene;
@@ -399,7 +400,8 @@ static int write_texels(const dump *d, FILE *f)
         uint32_t flags = t->flags | (enclosed(d->tracer, p, t->normal, sensor_offset(&d->scene)) ? DUMP_HIDDEN : 0) |
                          (off_plane(&d->scene, t) ? DUMP_OFFPLANE : 0);
         fprintf(f, "T\t%u\t%u\t%u\t%u\t%u\t%.9g\t%.9g\t%.9g\t%.7g\t%.7g\t%.7g\t%.6g\t%.7g\t%.7g\t%.7g\t%u\n", t->object,
-                mat, t->page, t->x, t->y, p[0], p[1], p[2], t->normal[0], t->normal[1], t->normal[2], t->texel_size,
+                mat, t->page, t->x, t->y, p[0] + d->scene.origin[0], p[1] + d->scene.origin[1],
+                p[2] + d->scene.origin[2], t->normal[0], t->normal[1], t->normal[2], t->texel_size,
                 rgb[0], rgb[1], rgb[2], flags);
     }
     return 0;
@@ -437,8 +439,9 @@ static int write_llg_vertices(const dump *d, FILE *f, uint32_t max_per_object)
         size_t step = n > max_per_object && max_per_object ? (n + max_per_object - 1) / max_per_object : 1;
         for (size_t k = 0; k < n; k += step) {
             const float *p = s->positions + 3 * (size_t)v[k], *nn = s->normals + 3 * (size_t)v[k];
+            const float pw[3] = {(float)(p[0] + s->origin[0]), (float)(p[1] + s->origin[1]), (float)(p[2] + s->origin[2])};
             float rgb[3];
-            if (lbk_llg_vertex_irradiance(&d->llg, o.index, (uint32_t)k, p, rgb)) {
+            if (lbk_llg_vertex_irradiance(&d->llg, o.index, (uint32_t)k, pw, rgb)) {
                 free(v);
                 return die("LLG vertex irradiance failed", ob->name);
             }
@@ -447,7 +450,8 @@ static int write_llg_vertices(const dump *d, FILE *f, uint32_t max_per_object)
             const double pd[3] = {p[0], p[1], p[2]};
             uint32_t flags = enclosed(d->tracer, pd, nn, sensor_offset(s)) ? DUMP_HIDDEN : 0;
             fprintf(f, "V\t%u\t%u\t%u\t%zu\t0\t%.9g\t%.9g\t%.9g\t%.7g\t%.7g\t%.7g\t0\t%.7g\t%.7g\t%.7g\t%u\n", i, mat,
-                    o.index, k, p[0], p[1], p[2], nn[0], nn[1], nn[2], rgb[0], rgb[1], rgb[2], flags);
+                    o.index, k, pw[0], pw[1], pw[2], nn[0], nn[1], nn[2],
+                    rgb[0], rgb[1], rgb[2], flags);
         }
         free(v);
     }

@@ -15,6 +15,7 @@
 
 #include <spng.h>
 
+#include "bake/scene/exr_read.h"
 #include "bake/scene/import.h"
 #include "bake/scene/scene.h"
 #include "support/scene_builders.h"
@@ -1400,6 +1401,43 @@ static void test_scene_utilities(void **state)
     assert_int_equal(bk_geometry_hash(pos, 3, idx, 3), bk_geometry_hash(pos, 3, idx, 3));
 }
 
+/* EXRs with a channel the sky reader does not use, PIZ and B44 compressed: Blender 3.4's
+ * half-float files of tests/fuzz/corpus_exr (pixel (x, y) = (x/8, y/4, 0.5, 1)) with the name of
+ * the first channel, A, changed to Z. OpenEXRCore 3.1 wrote through a null pointer for a channel
+ * left undecoded (fuzz_exr found it); the reader now decodes such channels into a scratch plane.
+ * The data stay in the file's order while the list is read sorted (B, G, R, Z), so what the reader
+ * gets is R = y/4, G = 0.5, B = 1 and no alpha (1); B44 is lossy. */
+static void test_exr_unused_channel(void **state)
+{
+    (void)state;
+    static const char *const files[] = {"tests/fuzz/corpus_exr/regress_piz_unused_channel.exr",
+                                        "tests/fuzz/corpus_exr/regress_b44_unused_channel.exr"};
+    for (int f = 0; f < 2; f++) {
+        bk_image im;
+        char err[512];
+        int rc = bk_exr_read(files[f], 1 << 20, &im, err, sizeof err);
+        if (rc) printf("%s\n", err);
+        assert_int_equal(rc, 0);
+        assert_int_equal(im.width, 8);
+        assert_int_equal(im.height, 4);
+        const float tol = f ? 0.02f : 0.0f;
+        int seen[4] = {0, 0, 0, 0};
+        for (int y = 0; y < 4; y++)
+            for (int x = 0; x < 8; x++) {
+                const float *p = &im.rgba[4 * (8 * y + x)];
+                int row = (int)lrintf(4 * p[0]);
+                assert_true(row >= 0 && row < 4);
+                assert_float_equal(p[0], row / 4.0f, tol);
+                seen[row] = 1;
+                assert_float_equal(p[1], 0.5f, tol);
+                assert_float_equal(p[2], 1.0f, tol);
+                assert_float_equal(p[3], 1.0f, 0.0f);
+            }
+        assert_true(seen[0] && seen[1] && seen[2] && seen[3]);
+        free(im.rgba);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1413,6 +1451,7 @@ int main(void)
         cmocka_unit_test(test_extras),
         cmocka_unit_test(test_sky_extras),
         cmocka_unit_test(test_sky_exr),
+        cmocka_unit_test(test_exr_unused_channel),
         cmocka_unit_test(test_textures),
         cmocka_unit_test(test_glb_embedded_texture),
         cmocka_unit_test(test_required_extension),

@@ -342,6 +342,21 @@ static void command_line(void **state)
     assert_int_equal(cmd(7, bad_size), LBK_EXIT_USAGE);
     const char *no_output[] = {"render", LEAK_SCENE, lbk, NULL};
     assert_int_equal(cmd(3, no_output), LBK_EXIT_USAGE);
+    /* strict numbers: atoi took "1.5" as 1 */
+    const char *bad_threads[] = {"render", LEAK_SCENE, lbk, "-o", exr, "--threads", "1.5", NULL};
+    assert_int_equal(cmd(7, bad_threads), LBK_EXIT_USAGE);
+    const char *bad_samples[] = {"render", LEAK_SCENE, lbk, "-o", exr, "--samples", "-1", NULL};
+    assert_int_equal(cmd(7, bad_samples), LBK_EXIT_USAGE);
+    /* --max-memory: a zstd pack whose sections decode past the cap is refused before they are
+     * allocated; the default cap renders it */
+    char pack[128];
+    snprintf(pack, sizeof pack, "%s/leak_zstd.lbk", tmpdir);
+    const char *conv[] = {"convert", lbk, "-o", pack, "--profile", "archive", "-q", NULL};
+    assert_int_equal(lbk_cmd_convert(7, (char **)conv), LBK_EXIT_OK);
+    const char *capped[] = {"render", LEAK_SCENE, pack, "-o", exr, "--size", "8x6", "-q", "--max-memory", "1kB", NULL};
+    assert_int_equal(cmd(10, capped), LBK_EXIT_INPUT);
+    const char *uncapped[] = {"render", LEAK_SCENE, pack, "-o", exr, "--size", "8x6", "-q", NULL};
+    assert_int_equal(cmd(8, uncapped), LBK_EXIT_OK);
 }
 
 int main(void)

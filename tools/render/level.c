@@ -232,7 +232,7 @@ static int load(const char *scene_path, const char *lbk_path, const tl_render_op
     if (bk_import_gltf(scene_path, NULL, &L->scene, msg, sizeof msg)) return tl_fail(err, TL_RENDER_INPUT, "%.250s", msg);
     const bk_scene *s = &L->scene;
     if (!s->primitives) return tl_fail(err, TL_RENDER_INTERNAL, "the scene import gave no primitive table");
-    tl_open_status st = tl_bake_open_file(lbk_path, &L->bake, err);
+    tl_open_status st = tl_bake_open_file_capped(lbk_path, o->max_decoded_bytes, &L->bake, err);
     if (st != TL_OPEN_OK) return st == TL_OPEN_IO ? TL_RENDER_IO : st == TL_OPEN_INVALID ? TL_RENDER_INPUT : TL_RENDER_INTERNAL;
     L->glg = L->bake.glg, L->has_glg = L->bake.has_glg;
     L->llg = L->bake.llg, L->has_llg = L->bake.has_llg;

@@ -55,6 +55,9 @@ typedef struct tl_render_options {
     const tl_sphere *spheres;
     size_t sphere_count;
     int seams;                /* 1: also fill tl_image.seam (seams.c) */
+    /* cap on the bytes the container's decoded sections may take (lbk_read_options
+     * .max_decoded_bytes, `--max-memory`); 0: liblbk's default */
+    uint64_t max_decoded_bytes;
 } tl_render_options;
 
 typedef struct tl_image {
