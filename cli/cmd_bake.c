@@ -36,7 +36,7 @@ static void help(FILE *f)
           "  --glg-spacing M         global light grid spacing in metres\n"
           "  --sky R,G,B | FILE.exr  sky radiance (overrides the scene's lbk_sky)\n"
           "  --no-glg                leave out the global light grid\n"
-          "  --octahedral            also write GIBS-style octahedral probes (OCTP)\n"
+          "  --octahedral            also write a GIBS-style octahedral probe volume (OCTP, format 1.3)\n"
           "  --block-align           charts on 4-texel boundaries, so no 4x4 block of a block-compressed pack\n"
           "                          (lbk convert --profile console-current, handheld) holds two charts\n"
           "  --dls-threshold X       light sets and doors store a texel/probe only where their light\n"

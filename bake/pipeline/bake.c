@@ -326,6 +326,21 @@ static lbk_result layout_glg(bk_pipeline *b)
     return LBK_OK;
 }
 
+/* OCTP: a probe volume over the level at the GLG's spacing, or finer in a small level
+ * (bake/probes/octa_bake.h). */
+static lbk_result layout_octa(bk_pipeline *b)
+{
+    bk_octa_options oo;
+    memset(&oo, 0, sizeof oo);
+    oo.spacing = b->opt->glg_spacing > 0 ? b->opt->glg_spacing : b->pre->glg_spacing;
+    /* at least 8 probes along the level's longest side: a small room gets a usable volume */
+    float ext = 0;
+    for (int a = 0; a < 3; a++) ext = fmaxf(ext, b->scene.bounds_max[a] - b->scene.bounds_min[a]);
+    if (ext > 0 && ext / 8 < oo.spacing) oo.spacing = ext / 8;
+    lbk_result r = bk_octa_place(&b->scene, b->tracer, b->scene.bounds_min, b->scene.bounds_max, &oo, &b->octa);
+    return r ? bk_pipeline_failed(b, r, "octahedral probe volume") : LBK_OK;
+}
+
 /* LLGs for props; an object whose grid cannot be placed loses its lighting, with a warning. */
 static lbk_result layout_llgs(bk_pipeline *b, size_t n_llg)
 {
@@ -371,6 +386,7 @@ static lbk_result do_layout(bk_pipeline *b)
     if (!r && n_lm) r = layout_texels(b);
     if (!r) r = checkpoint(b, 0.6);
     if (!r && !b->opt->no_glg) r = layout_glg(b);
+    if (!r && b->opt->octahedral_probes) r = layout_octa(b);
     if (!r) r = checkpoint(b, 0.8);
     if (!r && n_llg) r = layout_llgs(b, n_llg);
     if (!r) r = checkpoint(b, 1);
@@ -511,9 +527,21 @@ static lbk_result do_transport(bk_pipeline *b)
     float *irradiance = malloc((b->receiver_count ? b->receiver_count : 1) * 3 * sizeof *irradiance);
     if (!irradiance) return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
     out.irradiance = irradiance;
+    if (b->octa.count) {
+        b->octa_irradiance = calloc((size_t)b->octa.count * 48, sizeof(float));
+        if (!b->octa_irradiance) {
+            free(irradiance);
+            return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
+        }
+        to.octa_points = b->octa.positions;
+        to.octa_count = b->octa.count;
+        out.octa_irradiance = b->octa_irradiance;
+    }
     r = bk_transport_run(&b->scene, b->tracer, b->receivers, b->receiver_count, &to, &out, &b->stats);
     if (!r) bk_texels_match_irradiance(&b->texels, b->texel_of_receiver, b->texel_receivers, b->radiance, irradiance);
     free(irradiance);
+    b->octa_rel_rmse = b->stats.octa_rel_rmse;
+    b->octa_rays = b->stats.octa_rays;
     if (r) return bk_pipeline_failed(b, r, "light transport");
     if (b->stats.nonfinite)
         bk_events_say(&b->events, LBK_BAKE_SEVERITY_WARNING, "%llu non-finite samples were dropped",
@@ -676,6 +704,8 @@ static void pipeline_free(bk_pipeline *b)
     free(b->llgs);
     free(b->object_llg);
     bk_glg_free(&b->glg);
+    bk_octa_volume_free(&b->octa);
+    free(b->octa_irradiance);
     if (b->tracer) bk_tracer_destroy(b->tracer);
     bk_texels_free(&b->texels);
     bk_seams_free(&b->seams);

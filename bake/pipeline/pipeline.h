@@ -12,6 +12,7 @@
 #include "bake/layout/classify.h"
 #include "bake/layout/texels.h"
 #include "bake/probes/glg_place.h"
+#include "bake/probes/octa_bake.h"
 #include "bake/probes/llg_place.h"
 #include "bake/scene/scene.h"
 #include "bake/sets/bake_sets.h"
@@ -77,6 +78,9 @@ typedef struct bk_pipeline {
     uint64_t saturated, flushed;    /* texel channels outside the R11G11B10F range (stored units) */
     float scale[3];                 /* LMAP, GLG, LLG scales (spec §5.7); DLS payloads use them */
     float octp_scale;
+    bk_octa_volume octa;            /* OCTP probe volume (--octahedral), scene frame */
+    float *octa_irradiance;         /* octa.count × 16 × 3, from the transport */
+    double octa_rel_rmse, octa_rays;
     lbk_bake_output *out;           /* what the caller gets: the writer (sections.c), the report */
     uint64_t container_bytes;
 } bk_pipeline;

@@ -101,7 +101,18 @@ lbk_result bk_pipeline_report(const bk_pipeline *b, lbk_bake_output *out)
     r->scales.lmap = r->counts.texels ? b->scale[0] : 0;
     r->scales.glg = r->counts.glg_probes ? b->scale[1] : 0;
     r->scales.llg = r->counts.llgs ? b->scale[2] : 0;
-    r->scales.octp = b->opt->octahedral_probes && r->counts.glg_probes ? b->octp_scale : 0;
+    r->scales.octp = b->octa.count && b->octa_irradiance ? b->octp_scale : 0;
+    if (r->scales.octp > 0) {
+        r->octp.probes = b->octa.count;
+        for (uint32_t i = 0; i < b->octa.count; i++) {
+            const lbk_octp_probe_info *in = &b->octa.info[i];
+            r->octp.inside += in->state == LBK_OCTP_INSIDE;
+            r->octp.no_nearby += in->state == LBK_OCTP_NO_NEARBY;
+            r->octp.relocated += in->offset[0] != 0 || in->offset[1] != 0 || in->offset[2] != 0;
+        }
+        r->octp.rel_rmse = b->octa_rel_rmse;
+        r->octp.rays = b->octa_rays;
+    }
     for (int i = 0; i < b->phase_count; i++) out->phases[i] = (lbk_bake_phase_time){b->phases[i], b->phase_seconds[i]};
     r->phases = out->phases;
     r->phase_count = (size_t)b->phase_count;
@@ -196,6 +207,15 @@ static cJSON *json_report(const lbk_bake_report *r, const char *container_path)
     }
     json_transport(root, r);
     json_counts(root, r);
+    if (r->size >= offsetof(lbk_bake_report, octp) + sizeof r->octp && r->octp.probes) {
+        cJSON *o = cJSON_AddObjectToObject(root, "octp");
+        cJSON_AddNumberToObject(o, "probes", r->octp.probes);
+        cJSON_AddNumberToObject(o, "inside", r->octp.inside);
+        cJSON_AddNumberToObject(o, "no_nearby", r->octp.no_nearby);
+        cJSON_AddNumberToObject(o, "relocated", r->octp.relocated);
+        cJSON_AddNumberToObject(o, "rel_rmse", r->octp.rel_rmse);
+        cJSON_AddNumberToObject(o, "rays_per_probe", r->octp.rays);
+    }
     cJSON *ph = cJSON_AddArrayToObject(root, "phases");
     for (size_t i = 0; i < r->phase_count; i++) {
         cJSON *o = cJSON_CreateObject();

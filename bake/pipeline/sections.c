@@ -134,32 +134,39 @@ static lbk_result build_glg(bk_pipeline *b, section_list *sl)
     return sections_add(sl, LBK_SECTION_GLG, r, data, size);
 }
 
+/* OCTP: the probe volume, its transport-gathered irradiance texels and its traced depth
+ * moments; inside probes keep zero data (a sampler skips them). */
 static lbk_result build_octp(bk_pipeline *b, section_list *sl)
 {
-    lbk_octp_probe_desc *p = calloc(b->glg.probe_count, sizeof *p);
-    if (!p) return LBK_ERR_OUT_OF_MEMORY;
-    float diag = 0;
-    for (int a = 0; a < 3; a++) {
-        float e = b->scene.bounds_max[a] - b->scene.bounds_min[a];
-        diag += e * e;
+    const bk_octa_volume *v = &b->octa;
+    lbk_octp_probe_desc *p = calloc(v->count, sizeof *p);
+    lbk_octp_probe_info *info = malloc((size_t)v->count * sizeof *info);
+    if (!p || !info) {
+        free(p), free(info);
+        return LBK_ERR_OUT_OF_MEMORY;
     }
-    diag = sqrtf(diag);
-    if (!(diag > 0) || !isfinite(diag)) diag = 1;
-    for (size_t i = 0; i < b->glg.probe_count; i++)
-    {
-        bk_octa_probe(b->tracer, &b->glg.positions[3 * i], &b->radiance[b->glg_first + i], diag, &p[i]);
-        bk_pipeline_to_world(b, &b->glg.positions[3 * i], p[i].position);
+    double m = 0;
+    for (uint32_t i = 0; i < v->count; i++) {
+        info[i] = v->info[i];
+        info[i].rays = b->octa_rays < 4e9 ? (uint32_t)b->octa_rays : UINT32_MAX;
+        if (info[i].state == LBK_OCTP_INSIDE) continue;
+        bk_octa_depth(b->tracer, &v->positions[3 * i], v->level.miss_distance, p[i].depth);
+        for (int t = 0; t < 16; t++)
+            for (int c = 0; c < 3; c++) {
+                const float e = b->octa_irradiance[((size_t)i * 16 + (size_t)t) * 3 + (size_t)c];
+                p[i].irradiance[t][c] = e > 0 && isfinite(e) ? e : 0;
+                if (p[i].irradiance[t][c] > m) m = p[i].irradiance[t][c];
+            }
     }
+    lbk_octp_level level = v->level;
+    bk_pipeline_to_world(b, v->level.origin, level.origin);
+    b->octp_scale = bk_scale_for(m);
     void *data;
     size_t size;
-    double m = 0;
-    for (size_t i = 0; i < b->glg.probe_count; i++)
-        for (int t = 0; t < 16; t++)
-            for (int c = 0; c < 3; c++)
-                if (p[i].irradiance[t][c] > m && isfinite(p[i].irradiance[t][c])) m = p[i].irradiance[t][c];
-    b->octp_scale = bk_scale_for(m);
-    lbk_result r = lbk_octp_build(&(lbk_octp_build_desc){.probes = p, .probe_count = (uint32_t)b->glg.probe_count, .scale = b->octp_scale}, NULL, &data, &size);
-    free(p);
+    lbk_result r = lbk_octp_build(&(lbk_octp_build_desc){.size = sizeof(lbk_octp_build_desc), .probes = p, .probe_count = v->count, .scale = b->octp_scale,
+                                                          .levels = &level, .level_count = 1, .info = info},
+                                  NULL, &data, &size);
+    free(p), free(info);
     return sections_add(sl, LBK_SECTION_OCTP, r, data, size);
 }
 
@@ -353,7 +360,7 @@ static lbk_result build_sections(bk_pipeline *b, section_list *sl)
     if (!r && b->texels.page_count && b->texel_receivers) r = build_lmap(b, sl);
     if (!r && b->have_glg) r = build_glg(b, sl);
     if (!r && b->llg_count) r = build_llg(b, sl);
-    if (!r && b->opt->octahedral_probes && b->have_glg) r = build_octp(b, sl);
+    if (!r && b->octa.count && b->octa_irradiance) r = build_octp(b, sl);
     if (!r && b->sets.set_count) r = build_sets(b, sl);
     return r;
 }

@@ -1,20 +1,50 @@
-/* GIBS-style octahedral probes (seed 003) at the GLG probe positions: 4×4 irradiance texels
- * from each probe's baked SH9 radiance, and 12×12 depth moments (mean distance and mean squared
- * distance to the nearest surface in the texel's cone) traced with the scene's tracer. */
+/* GIBS-style octahedral probe volume (seed 003; spec/container.md §14, volume form): a regular
+ * grid over the level, each probe classified and relocated (bk_octa_place), its 16 irradiance
+ * texels gathered by the transport (bk_transport_options.octa_points) and its 12×12 depth
+ * moments traced here (bk_octa_depth). Method and measurements: bake/probes/PROBES.md §OCTP. */
 #ifndef BK_OCTA_BAKE_H
 #define BK_OCTA_BAKE_H
 
 #include <stddef.h>
 
+#include "bake/scene/scene.h"
 #include "bake/transport/tracer.h"
 #include "lbk/octa.h"
-#include "lbk/sh.h"
 
-/* Rays per depth texel (stratified over the texel); distances are capped at max_distance, the
- * value a miss records. Deterministic and independent of threads (single-threaded: cheap). */
-#define BK_OCTA_DEPTH_RAYS 4
+/* Depth rays per texel: a 4×4 stratified grid over the texel's square of the octahedral map
+ * (the texel's cone); distances are capped at the level's miss distance, what a miss records. */
+#define BK_OCTA_DEPTH_SIDE 4
+/* Classification rays per probe (spherical Fibonacci, fixed). */
+#define BK_OCTA_CLASSIFY_RAYS 128
+/* More than this fraction of back-face hits: the probe is inside closed geometry. */
+#define BK_OCTA_INSIDE_FRACTION 0.25f
 
-void bk_octa_probe(const bk_tracer *tracer, const float position[3], const lbk_sh9_rgb *radiance,
-                   float max_distance, lbk_octp_probe_desc *out);
+typedef struct bk_octa_options {
+    float spacing;      /* metres; 0: 1 (the baker passes min(GLG spacing, largest extent / 8)) */
+    uint32_t max_probes; /* 0: 32768; the spacing grows by 1.25 until the grid fits */
+} bk_octa_options;
+
+typedef struct bk_octa_volume {
+    lbk_octp_level level;        /* one level (first_probe 0), in the scene's frame */
+    uint32_t count;              /* probes: dims product */
+    float *positions;            /* 3 per probe: grid point + offset */
+    lbk_octp_probe_info *info;   /* offset, state, back-face fraction, nearest hit */
+} bk_octa_volume;
+
+/* Grid over [bmin, bmax]: max(2, ceil(extent/spacing)) probes per axis, centred (so the outermost
+ * probes stand half a spacing inside a box that is a whole number of spacings), spacing as above,
+ * miss distance min(255, grid diagonal);
+ * then per probe: classification rays from the grid point; inside (back-face fraction >
+ * BK_OCTA_INSIDE_FRACTION) → moved through the nearest back face to 0.1·spacing beyond it,
+ * too close to a front face (< 0.1·spacing) → moved away from it; offsets bounded by 0.45 ×
+ * spacing per axis, at most 3 moves, re-classified after each; still inside → LBK_OCTP_INSIDE
+ * (offset 0); no hit within a cell diagonal → LBK_OCTP_NO_NEARBY. Deterministic. */
+lbk_result bk_octa_place(const bk_scene *scene, const bk_tracer *tracer, const float bmin[3], const float bmax[3],
+                         const bk_octa_options *options, bk_octa_volume *out);
+void bk_octa_volume_free(bk_octa_volume *v);
+
+/* 12×12 interior depth moments (mean, mean² of min(hit distance, miss)) from p, 16 rays per
+ * texel (BK_OCTA_DEPTH_SIDE²). */
+void bk_octa_depth(const bk_tracer *tracer, const float p[3], float miss, float depth[12 * 12][2]);
 
 #endif

@@ -4,6 +4,7 @@
 #include "bake/util/parallel.h"
 #include "bake/transport/shading.h"
 #include "bake/transport/solid.h"
+#include "lbk/octa.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -195,6 +196,15 @@ typedef struct tp_ctx {
     double *b_acc[2];      /* per receiver, per half: Σ_p w_p·bk_lum(cache bias probe of pass p) */
     const bk_transport_output *out;
     double pass_weight;
+    /* octahedral probes (options.octa_*): gathered like sphere receivers, outside the outputs
+     * and the error estimate of the receivers */
+    size_t oct_count;
+    int oct_rays;          /* this pass: rays per half */
+    double oct_total;      /* rays per probe so far, both halves */
+    double oct_weight;     /* Σ of the pass weights they were gathered in */
+    tp_lattice oct_lat;
+    double oct_dir[16][3]; /* texel directions, lbk_oct_texel_direction(4, i, j) */
+    double *oct_acc[2];    /* per probe texel, per half: Σ_p w_p·bk_lum(E_p) */
     /* the run's settings and progress */
     double t0, max_samples, target, tail_tol, spp;
     /* receiver classes (options.class_end; one class of every receiver without it): each
@@ -1034,11 +1044,20 @@ static long gather_hit(tp_ctx *c, const float *sum, const uint8_t *rough, const 
  * hemisphere (texels) or the sphere (probes) — the SH projection needs a pdf that does not
  * vanish at the horizon — each with one light sample when NEE is on. A texel with a footprint
  * starts each ray from its own random point of the footprint. */
-static void recv_half(tp_ctx *c, size_t i, int h, tp_recv_sums *rs, tp_count *cnt)
+static void oct_add(const tp_ctx *c, double (*oct)[3], const double d[3], const double L[3])
 {
-    const int S = c->rays;
+    for (int t = 0; t < 16; t++) {
+        const double cs = d[0] * c->oct_dir[t][0] + d[1] * c->oct_dir[t][1] + d[2] * c->oct_dir[t][2];
+        if (cs > 0)
+            for (int a = 0; a < 3; a++) oct[t][a] += L[a] * cs;
+    }
+}
+
+/* oct: NULL, or the 16 octahedral texels' Σ L·max(0, cos) (an octahedral probe). */
+static void recv_half(tp_ctx *c, const bk_receiver *r, size_t i, int h, int S, const tp_lattice *lat,
+                      tp_recv_sums *rs, double (*oct)[3], tp_count *cnt)
+{
     const float *sum = c->l_sum[h];
-    const bk_receiver *r = &c->recv[i];
     tp_rng rng = rng_make(c->seed, DOM_RECV, (uint64_t)h, (uint64_t)c->pass, 0, i);
     tp_rng cont = rng_make(c->seed, DOM_RECV_NEAR, (uint64_t)h, (uint64_t)c->pass, 0, i);
     tp_rng pos = rng_make(c->seed, DOM_RECV_POS, (uint64_t)h, (uint64_t)c->pass, 0, i);
@@ -1071,7 +1090,7 @@ static void recv_half(tp_ctx *c, size_t i, int h, tp_recv_sums *rs, tp_count *cn
                 bk_onb(g.n, t, b);
             }
             double u1, cp, sp;
-            lattice(&c->lat, (uint32_t)(j0 + jj), &shift, &u1, &cp, &sp);
+            lattice(lat, (uint32_t)(j0 + jj), &shift, &u1, &cp, &sp);
             double z = sphere ? 1 - 2 * u1 : u1;
             double rr = sqrt(fmax(0.0, 1 - z * z));
             zz[jj] = z;
@@ -1088,7 +1107,10 @@ static void recv_half(tp_ctx *c, size_t i, int h, tp_recv_sums *rs, tp_count *cn
             double L[3], Ld[3];
             long hc = gather_hit(c, sum, c->rough, &hits[jj], dd[jj], solid, &cont, cnt, L, Ld);
             if (!bk_finite3(L) || !bk_finite3(Ld)) cnt->bad++;
-            else accumulate(dd[jj], sphere ? 1 : zz[jj], L, Ld, rs->e, rs->sh_t, rs->sh_d);
+            else {
+                accumulate(dd[jj], sphere ? 1 : zz[jj], L, Ld, rs->e, rs->sh_t, rs->sh_d);
+                if (oct) oct_add(c, oct, dd[jj], L);
+            }
             if (hc >= 0 && (j0 + jj) % TP_PROBE_EVERY == 0) {
                 double q[3];
                 const tp_near_mode md = {sum, c->rough, 1, TP_NEAR_DEPTH};
@@ -1101,11 +1123,14 @@ static void recv_half(tp_ctx *c, size_t i, int h, tp_recv_sums *rs, tp_count *cn
             /* one light sample per gather ray; its value Le·w/p is turned into the gather's
              * units (radiance, later × solid/S) by 1/solid */
             double u0, uu1, ld[3], cl, val[3];
-            lattice_uv(&c->lat, (uint32_t)(j0 + jj), t1, t2, &u0, &uu1);
+            lattice_uv(lat, (uint32_t)(j0 + jj), t1, t2, &u0, &uu1);
             if (nee_sample(c, org + 3 * jj, nn[jj], pg_kind, u0, uu1, ld, &cl, val, &cnt->shadow)) {
                 for (int a = 0; a < 3; a++) val[a] /= solid;
                 if (!bk_finite3(val)) cnt->bad++;
-                else accumulate(ld, cl, val, val, rs->e, rs->sh_t, rs->sh_d);
+                else {
+                    accumulate(ld, cl, val, val, rs->e, rs->sh_t, rs->sh_d);
+                    if (oct) oct_add(c, oct, ld, val);
+                }
             }
         }
     }
@@ -1126,7 +1151,7 @@ static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
         for (int h = 0; h < 2; h++) {
             tp_recv_sums rs;
             memset(&rs, 0, sizeof rs);
-            recv_half(c, i, h, &rs, &cnt);
+            recv_half(c, r, i, h, S, &c->lat, &rs, NULL, &cnt);
             double e[3], eb[3];
             for (int a = 0; a < 3; a++) {
                 e[a] = rs.e[a] * solid / S;
@@ -1159,6 +1184,73 @@ static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
     c->thread_nonfinite[thread] += cnt.bad;
 }
 
+/* Octahedral probe k: both halves of this pass, oct_rays each, on its own random streams (item
+ * recv_count + k); the texels' irradiance E_t = 4π/S·Σ L·max(0, n_t·d). */
+static void octa_gather(tp_ctx *c, size_t begin, size_t end, int thread)
+{
+    const int S = c->oct_rays;
+    const double w = c->pass_weight;
+    tp_count cnt = {0, 0, 0};
+    for (size_t k = begin; k < end; k++) {
+        bk_receiver r;
+        memset(&r, 0, sizeof r);
+        memcpy(r.position, &c->opt->octa_points[3 * k], sizeof r.position);
+        double both[16][3];
+        memset(both, 0, sizeof both);
+        for (int h = 0; h < 2; h++) {
+            tp_recv_sums rs;
+            double oct[16][3];
+            memset(&rs, 0, sizeof rs);
+            memset(oct, 0, sizeof oct);
+            recv_half(c, &r, c->recv_count + k, h, S, &c->oct_lat, &rs, oct, &cnt);
+            for (int t = 0; t < 16; t++) {
+                double e[3];
+                for (int a = 0; a < 3; a++) {
+                    e[a] = oct[t][a] * 4 * TP_PI / S;
+                    both[t][a] += 0.5 * e[a];
+                }
+                c->oct_acc[h][16 * k + (size_t)t] += w * bk_lum(e);
+            }
+        }
+        for (int t = 0; t < 16; t++)
+            for (int a = 0; a < 3; a++) c->out->octa_irradiance[(16 * k + (size_t)t) * 3 + (size_t)a] += (float)(w * both[t][a]);
+    }
+    c->thread_rays[thread] += cnt.rays + cnt.shadow;
+    c->thread_shadow[thread] += cnt.shadow;
+    c->thread_nonfinite[thread] += cnt.bad;
+}
+
+/* After the passes: the weighted mean, punctual light (noise-free, one shadow ray per light),
+ * and the texels' relative RMSE from the two halves (as TRANSPORT.md's estimate, over every
+ * texel of every octahedral probe). */
+static double octa_finish(tp_ctx *c)
+{
+    float *out = c->out->octa_irradiance;
+    const float inv = (float)(1.0 / c->oct_weight);
+    double num = 0, den = 0;
+    for (size_t k = 0; k < c->oct_count; k++) {
+        tp_origin g;
+        origin_from(c, &c->opt->octa_points[3 * k], (const float[3]){0, 0, 0}, &g);
+        double pe[16][3];
+        memset(pe, 0, sizeof pe);
+        for (size_t li = 0; li < c->light_count; li++) {
+            double val[3], ld[3], dist;
+            if (!bk_light_eval(c->lights[li], g.p, val, ld, &dist)) continue;
+            if (!bk_light_visible(c->tracer, g.o, ld, dist)) continue;
+            oct_add(c, pe, ld, val);
+        }
+        for (int t = 0; t < 16; t++) {
+            float *e = &out[(16 * k + (size_t)t) * 3];
+            for (int a = 0; a < 3; a++) e[a] = e[a] * inv + (float)pe[t][a];
+            const double A = c->oct_acc[0][16 * k + (size_t)t] / c->oct_weight, B = c->oct_acc[1][16 * k + (size_t)t] / c->oct_weight;
+            const double m = 0.5 * (A + B) + bk_lum(pe[t]);
+            num += 0.25 * (A - B) * (A - B);
+            den += m * m;
+        }
+    }
+    return den > 0 ? sqrt(num / den) : 0;
+}
+
 /* ---- setup ------------------------------------------------------------------------------------ */
 
 static int online_cores(void)
@@ -1188,6 +1280,9 @@ static void free_ctx(tp_ctx *c)
     free(c->punct_lum);
     free(c->thread_rays); free(c->thread_nonfinite);
     lattice_free(&c->lat);
+    lattice_free(&c->oct_lat);
+    free(c->oct_acc[0]);
+    free(c->oct_acc[1]);
 }
 
 /* Longest edge of triangle i. */
@@ -1479,6 +1574,13 @@ static lbk_result ctx_init(tp_ctx *c)
     c->cell_lum = calloc(nc, sizeof(float));
     c->cell_var = calloc(nc, sizeof(float));
     if (!c->rough || !c->cell_lum || !c->cell_var) return LBK_ERR_OUT_OF_MEMORY;
+    for (int h = 0; h < 2 && c->oct_count; h++)
+        if (!(c->oct_acc[h] = calloc(16 * c->oct_count, sizeof(double)))) return LBK_ERR_OUT_OF_MEMORY;
+    for (uint32_t t = 0; t < 16; t++) {
+        float d[3];
+        lbk_oct_texel_direction(4, t % 4, t / 4, d);
+        for (int a = 0; a < 3; a++) c->oct_dir[t][a] = d[a];
+    }
     c->punct_lum = calloc(n, sizeof(float));
     return c->punct_lum ? LBK_OK : LBK_ERR_OUT_OF_MEMORY;
 }
@@ -1533,6 +1635,14 @@ static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
                 return LBK_ERR_CANCELLED;
         }
     }
+    if (c->oct_count) {
+        const int f = c->opt->octa_ray_factor > 0 ? c->opt->octa_ray_factor : 4;
+        c->oct_rays = c->rays * (f > 64 ? 64 : f);
+        if (lattice_init(&c->oct_lat, (uint32_t)c->oct_rays) != LBK_OK) return LBK_ERR_OUT_OF_MEMORY;
+        parallel_range(c, 0, c->oct_count, 1, octa_gather);
+        c->oct_total += 2.0 * c->oct_rays;
+    }
+    c->oct_weight += c->pass_weight;
     for (int k = 0; k < c->ncls; k++) {
         if (!c->cls[k].active) continue;
         c->cls[k].weight_sum += c->pass_weight;
@@ -1714,6 +1824,7 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
     c.recv_count = count;
     c.fscene = opt->footprint_scene ? opt->footprint_scene : scene;
     c.out = output;
+    c.oct_count = output->octa_irradiance && opt->octa_points ? opt->octa_count : 0;
     c.t0 = t0;
     c.max_bounces = opt->max_bounces > 0 ? opt->max_bounces : 64;
     c.max_samples = opt->max_samples > 0 ? opt->max_samples : 4096;
@@ -1729,6 +1840,7 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
         if (output->direct) memset(&output->direct[i], 0, sizeof output->direct[i]);
         if (output->irradiance) output->irradiance[3 * i] = output->irradiance[3 * i + 1] = output->irradiance[3 * i + 2] = 0;
     }
+    if (c.oct_count) memset(output->octa_irradiance, 0, c.oct_count * 48 * sizeof(float));
     if (c.light_count) parallel_for(&c, count, 64, recv_punctual); /* luminance only, for the error */
 
     double err = 0, bias = 0;
@@ -1750,7 +1862,12 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
         if (stop_after(&c, pass, &ce, now_seconds() - pass_start)) break;
     }
     finish_outputs(&c);
-    if (stats) fill_stats(&c, pass + 1, err, bias, &ce, chain, stats);
+    const double oct_err = c.oct_count ? octa_finish(&c) : 0;
+    if (stats) {
+        fill_stats(&c, pass + 1, err, bias, &ce, chain, stats);
+        stats->octa_rel_rmse = oct_err;
+        stats->octa_rays = c.oct_total;
+    }
 done:
     free_ctx(&c);
     return res;

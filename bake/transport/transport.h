@@ -125,6 +125,15 @@ typedef struct bk_transport_options {
      * which gather over the whole sphere, go on after the texels have stopped.
      * All 0: one class, the estimate over all. */
     size_t class_end[BK_RECEIVER_CLASSES];
+    /* Octahedral probes (OCTP, bake/probes/octa_bake.h): octa_count points (3 floats each)
+     * gathered over the sphere in the same final-gather passes as the receivers, on their own
+     * random streams, but outside the receivers' outputs, error estimate and stop rule (so a bake
+     * with them gives the receivers the same bytes). Each traces octa_ray_factor (0: 4, at most
+     * 64) × the pass's rays per half and yields 16 cosine-convolved irradiance texels
+     * (bk_transport_output.octa_irradiance). NULL: none. */
+    const float *octa_points;
+    size_t octa_count;
+    int octa_ray_factor;
 } bk_transport_options;
 
 /* Caller-owned output arrays, `count` entries each; NULL pointers are skipped. */
@@ -139,6 +148,9 @@ typedef struct bk_transport_output {
      * two halves A, B: unbiased, one degree of freedom, 0 where only noise-free punctual light
      * arrives. The denoiser's input (bake/transport/denoise.h). */
     float *variance;
+    /* octa_count × 16 × 3 (options.octa_points): irradiance E(n_t) = ∫ L·max(0, n_t·ω) dω for the
+     * 16 directions n_t = lbk_oct_texel_direction(4, t % 4, t / 4), punctual light included */
+    float *octa_irradiance;
 } bk_transport_output;
 
 enum bk_transport_stop { BK_STOP_TARGET = 0, BK_STOP_TIME, BK_STOP_BUDGET };
@@ -167,6 +179,9 @@ typedef struct bk_transport_stats {
     int nee;                 /* 1 when emitters were light-sampled (next-event estimation) */
     uint64_t nonfinite;      /* sample values that were NaN/Inf and were dropped (should be 0) */
     int stop;                /* enum bk_transport_stop */
+    double octa_rel_rmse;    /* estimated relative RMSE of the octahedral texels (the two halves,
+                                over every texel; TRANSPORT.md's estimate) */
+    double octa_rays;        /* gather rays per octahedral probe, both halves, all passes */
 } bk_transport_stats;
 
 /* Computes radiance at `count` receivers. The tracer must have been built from `scene`.

@@ -233,6 +233,7 @@ lbk_result lbk_reader_section_by_type(lbk_reader *r, uint32_t type, const void *
 typedef struct writer_section {
     uint32_t type, flags, compression;
     uint32_t features; /* required features the payload needs (LMAP: block pages) */
+    uint16_t minor;    /* the lowest minor version defining the payload (§1.3) */
     uint8_t *stored;
     uint64_t stored_size, decoded_size, checksum;
 } writer_section;
@@ -340,6 +341,8 @@ lbk_result lbk_writer_section_add(lbk_writer *w, uint32_t type, const void *data
     s->flags = flags;
     s->compression = compression;
     s->features = type == LBK_SECTION_LMAP ? lbk_lmap_required_features(data, size) : 0;
+    /* an OCTP probe volume (level_count ≠ 0 at byte 8) is 1.3 content, §14 */
+    s->minor = type == LBK_SECTION_OCTP && size >= 12 && lbk_rd32((const uint8_t *)data + 8) != 0 ? 3 : 0;
     s->stored = stored;
     s->stored_size = stored_size;
     s->decoded_size = size;
@@ -389,7 +392,8 @@ lbk_result lbk_writer_to_memory(lbk_writer *w, void **out, size_t *size)
     for (uint32_t i = 0; i < w->count; i++) {
         const writer_section *s = &w->s[order[i]];
         if (s->type == LBK_SECTION_LMUV && minor < 1) minor = 1;
-        if (s->features & LBK_FEATURE_LMAP_BLOCK) minor = 2;
+        if ((s->features & LBK_FEATURE_LMAP_BLOCK) && minor < 2) minor = 2;
+        if (s->minor > minor) minor = s->minor;
         required |= s->features;
         uint8_t *e = f + LBK_HEADER_SIZE + (size_t)LBK_SECTION_ENTRY_SIZE * i;
         lbk_wr32(e + LBK_ENT_TYPE, s->type);

@@ -166,6 +166,9 @@ uint64_t lbk_lmap_hash_prescan(const uint8_t *d, size_t size, const lbk_allocato
 void lbk_validate_glg(lbk_vctx *ctx, const uint8_t *data, size_t size);
 void lbk_validate_llg(lbk_vctx *ctx, const uint8_t *data, size_t size);
 void lbk_validate_octp(lbk_vctx *ctx, const uint8_t *data, size_t size);
+/* Bilinear lookups in one stored OCTP probe (1024 bytes at q): stored irradiance units, metres. */
+void lbk_octp_probe_irradiance(const uint8_t *q, const float dir[3], float rgb[3]);
+void lbk_octp_probe_depth(const uint8_t *q, const float dir[3], float m[2]);
 void lbk_validate_objs(lbk_vctx *ctx, const uint8_t *data, size_t size);
 void lbk_validate_lmuv(lbk_vctx *ctx, const uint8_t *data, size_t size);
 void lbk_validate_dls(lbk_vctx *ctx, const uint8_t *data, size_t size);

@@ -9,7 +9,7 @@
 /* Per-element issues (one per texel or probe) are reported for the first few elements of each
  * kind only, then once with the number left unreported, so a damaged 16k×16k page does not
  * produce 268 million callbacks. */
-#define LBK_RATE_KINDS 4
+#define LBK_RATE_KINDS 8
 #define LBK_RATE_MAX 8u
 
 typedef struct lbk_rate {

@@ -213,6 +213,19 @@ static int sample_octp(const void *d, size_t n, int valid)
             else if (valid) abort();
         }
     }
+    /* a volume: the sampler at points in, around and far outside the levels */
+    for (uint32_t l = 0; l < v.level_count; l++)
+        for (int k = 0; k < 7; k++) {
+            lbk_octp_sample_desc sd = LBK_OCTP_SAMPLE_DESC_INIT;
+            for (int a = 0; a < 3; a++) {
+                sd.position[a] = v.levels[l].origin[a] + v.levels[l].spacing * (float)(k - 2) * 1.7f;
+                sd.normal[a] = DIRS[k][a];
+            }
+            float rgb[3], w;
+            r = lbk_octp_sample(&v, &sd, rgb, &w);
+            if (r == LBK_OK) touch_floats(rgb, 3);
+            else if (valid && r != LBK_ERR_INVALID_ARGUMENT) abort();
+        }
     return LBK_OK;
 }
 

@@ -618,6 +618,161 @@ static void octp_rules(void **state)
     lbk_free(NULL, b);
 }
 
+/* A 3×3×3 volume, spacing 1 from (0, 0, 0): every texel of probe (x, y, z) holds
+ * 1 + x + 2y + 4z (exact in uf10/11), depth = the miss distance 8 (nothing near). */
+static void octv_fixture(lbk_octp_probe_desc *pd, lbk_octp_probe_info *in, void **out, size_t *size)
+{
+    for (int i = 0; i < 27; i++) {
+        memset(&pd[i], 0, sizeof pd[i]);
+        memset(&in[i], 0, sizeof in[i]);
+        const float v = (float)(1 + i % 3 + 2 * (i / 3 % 3) + 4 * (i / 9));
+        for (int t = 0; t < 16; t++)
+            for (int k = 0; k < 3; k++) pd[i].irradiance[t][k] = v;
+        for (int t = 0; t < 144; t++) pd[i].depth[t][0] = 8, pd[i].depth[t][1] = 64;
+        in[i].nearest = 8;
+        in[i].rays = 64;
+    }
+    const lbk_octp_level lv = {{0, 0, 0}, 1.0f, {3, 3, 3}, 0, 8.0f};
+    lbk_octp_build_desc d = LBK_OCTP_BUILD_DESC_INIT;
+    d.probes = pd, d.probe_count = 27, d.levels = &lv, d.level_count = 1, d.info = in;
+    assert_int_equal(lbk_octp_build(&d, NULL, out, size), LBK_OK);
+}
+
+static float sample_at(const lbk_octp_view *v, float x, float y, float z, uint32_t flags)
+{
+    lbk_octp_sample_desc sd = LBK_OCTP_SAMPLE_DESC_INIT;
+    sd.position[0] = x, sd.position[1] = y, sd.position[2] = z;
+    sd.flags = flags;
+    float rgb[3], w;
+    assert_int_equal(lbk_octp_sample(v, &sd, rgb, &w), LBK_OK);
+    assert_true(rgb[0] == rgb[1] && rgb[1] == rgb[2] && w > 0);
+    return rgb[0];
+}
+
+static void octp_volume_rules(void **state)
+{
+    (void)state;
+    lbk_octp_probe_desc pd[27];
+    lbk_octp_probe_info in[27];
+    void *b;
+    size_t n;
+    octv_fixture(pd, in, &b, &n);
+    assert_int_equal(n, 16 + 48 + 27 * 1024);
+    issues is;
+    run(lbk_validate_octp, b, n, &is, NULL);
+    assert_int_equal(is.n, 0);
+    lbk_octp_view v;
+    assert_int_equal(lbk_octp_open(b, n, &v), LBK_OK);
+    assert_int_equal(v.level_count, 1);
+    {
+        /* a miss distance no half holds (2√3, what the baker's diagonal gives): every probe at
+         * it (all rays missed) still validates — m1 is rounded down, m2 up (1015) */
+        lbk_octp_probe_desc pm[27];
+        memcpy(pm, pd, sizeof pm);
+        const float miss = 3.46410161f;
+        for (int i = 0; i < 27; i++)
+            for (int t = 0; t < 144; t++) pm[i].depth[t][0] = miss, pm[i].depth[t][1] = miss * miss;
+        const lbk_octp_level lm = {{0, 0, 0}, 1.0f, {3, 3, 3}, 0, miss};
+        lbk_octp_build_desc dm = LBK_OCTP_BUILD_DESC_INIT;
+        dm.probes = pm, dm.probe_count = 27, dm.levels = &lm, dm.level_count = 1, dm.info = in;
+        void *bm;
+        size_t nm;
+        assert_int_equal(lbk_octp_build(&dm, NULL, &bm, &nm), LBK_OK);
+        issues im;
+        run(lbk_validate_octp, bm, nm, &im, NULL);
+        assert_int_equal(im.n, 0);
+        lbk_free(NULL, bm);
+    }
+    assert_int_equal(v.levels[0].dims[2], 3);
+    /* trilinear reproduces a linear field exactly (no normal: no back-face weight; depth =
+     * miss: Chebyshev weight 1) */
+    assert_float_equal(sample_at(&v, 0.5f, 0.25f, 1.75f, 0), 1 + 0.5 + 0.5 + 7, 1e-5);
+    assert_float_equal(sample_at(&v, 2, 2, 2, 0), 1 + 2 + 4 + 8, 1e-5); /* the far corner probe */
+    lbk_free(NULL, b);
+    /* an inactive probe (inside geometry) is skipped: the cell's other 7 renormalised */
+    in[13].state = LBK_OCTP_INSIDE; /* (1, 1, 1) */
+    for (int t = 0; t < 16; t++) pd[13].irradiance[t][0] = pd[13].irradiance[t][1] = pd[13].irradiance[t][2] = 60000;
+    const lbk_octp_level lv = {{0, 0, 0}, 1.0f, {3, 3, 3}, 0, 8.0f};
+    lbk_octp_build_desc d = LBK_OCTP_BUILD_DESC_INIT;
+    d.probes = pd, d.probe_count = 27, d.levels = &lv, d.level_count = 1, d.info = in;
+    assert_int_equal(lbk_octp_build(&d, NULL, &b, &n), LBK_OK);
+    assert_int_equal(lbk_octp_open(b, n, &v), LBK_OK);
+    /* at (0.5, 0.5, 0.5) the 8 corners weigh 1/8 each; without (1,1,1) (value 8): the mean of
+     * 1, 2, 3, 4, 5, 6, 7 (the others of the linear field) = 4 */
+    assert_float_equal(sample_at(&v, 0.5f, 0.5f, 0.5f, 0), 4, 1e-5);
+    lbk_free(NULL, b);
+    in[13].state = LBK_OCTP_ACTIVE;
+    for (int t = 0; t < 16; t++) pd[13].irradiance[t][0] = pd[13].irradiance[t][1] = pd[13].irradiance[t][2] = 8;
+    /* Chebyshev: probe (1,1,1) has a wall 0.1 m away in every direction (variance 1e-4): from
+     * (0.5, 0.5, 0.5), 0.87 m away, its weight is (1e-4/(1e-4 + 0.77²))³ → floored and crushed
+     * (≤ 1e-6³/0.04), so the result is the other 7's mean within 1e-6 relative */
+    for (int t = 0; t < 144; t++) pd[13].depth[t][0] = 0.1f, pd[13].depth[t][1] = 0.0101f;
+    assert_int_equal(lbk_octp_build(&d, NULL, &b, &n), LBK_OK);
+    assert_int_equal(lbk_octp_open(b, n, &v), LBK_OK);
+    assert_float_equal(sample_at(&v, 0.5f, 0.5f, 0.5f, 0), 4, 4e-6);
+    /* without the Chebyshev weight it counts again: 1..8 mean 4.5 */
+    assert_float_equal(sample_at(&v, 0.5f, 0.5f, 0.5f, LBK_OCTP_SAMPLE_NO_CHEBYSHEV), 4.5f, 1e-5);
+    /* the validator's volume rules */
+    uint8_t *c;
+    const size_t p0 = 16 + 48;
+    c = dup_bytes(b, n); lbk_wr32(c + 8, 4); expect_only(lbk_validate_octp, c, n, 1010); free(c);
+    c = dup_bytes(b, n); lbk_wr32(c + 16 + 16, 1); expect_only(lbk_validate_octp, c, n, 1011); free(c);
+    c = dup_bytes(b, n); lbk_wrf32(c + 16 + 12, -1.0f); expect_only(lbk_validate_octp, c, n, 1011); free(c);
+    c = dup_bytes(b, n); lbk_wrf32(c + 16 + 32, 300.0f); expect_only(lbk_validate_octp, c, n, 1011); free(c);
+    c = dup_bytes(b, n); lbk_wr32(c + 16 + 28, 1); expect_only(lbk_validate_octp, c, n, 1012); free(c);
+    c = dup_bytes(b, n); lbk_wr32(c, 26); expect_has(lbk_validate_octp, c, n, 1012); free(c);
+    c = dup_bytes(b, n); c[16 + 40] = 1; expect_only(lbk_validate_octp, c, n, 1001); free(c);
+    c = dup_bytes(b, n); lbk_wrf32(c + p0 + 940, 0.6f); expect_only(lbk_validate_octp, c, n, 1013); free(c);
+    c = dup_bytes(b, n); lbk_wrf32(c + p0 + 928, 0.01f); expect_only(lbk_validate_octp, c, n, 1013); free(c);
+    c = dup_bytes(b, n); lbk_wr32(c + p0 + 952, 3); expect_only(lbk_validate_octp, c, n, 1014); free(c);
+    c = dup_bytes(b, n); lbk_wrf32(c + p0 + 960, 1.5f); expect_only(lbk_validate_octp, c, n, 1014); free(c);
+    /* m2 < m1²: texel (3, 3) of probe 0 (and its border copies, hence 1006 too) */
+    c = dup_bytes(b, n); lbk_wr16(c + p0 + 144 + 4 * (3 * 14 + 3) + 2, 0x3c00); expect_has(lbk_validate_octp, c, n, 1015); free(c);
+    c = dup_bytes(b, n); c[p0 + 1023] = 1; expect_only(lbk_validate_octp, c, n, 1008); free(c);
+    expect_has(lbk_validate_octp, b, n - 1024, 1003);
+    assert_int_equal(lbk_octp_open(b, 40, &v), LBK_ERR_TRUNCATED);
+    lbk_free(NULL, b);
+}
+
+/* Two clip levels: level 0 (spacing 1 over [0, 2]³) holds 10 everywhere, level 1 (spacing 2 over
+ * [−1, 3]³) 20: inside level 0 its value, blended linearly over its last cell (§14.3 step 7),
+ * level 1 beyond it. */
+static void octp_levels_blend(void **state)
+{
+    (void)state;
+    static lbk_octp_probe_desc pd[54];
+    lbk_octp_probe_info in[54];
+    memset(in, 0, sizeof in);
+    for (int i = 0; i < 54; i++) {
+        memset(&pd[i], 0, sizeof pd[i]);
+        for (int t = 0; t < 16; t++) pd[i].irradiance[t][0] = pd[i].irradiance[t][1] = pd[i].irradiance[t][2] = i < 27 ? 10.0f : 20.0f;
+        for (int t = 0; t < 144; t++) pd[i].depth[t][0] = 16, pd[i].depth[t][1] = 256;
+    }
+    const lbk_octp_level lv[2] = {{{0, 0, 0}, 1.0f, {3, 3, 3}, 0, 16.0f}, {{-1, -1, -1}, 2.0f, {3, 3, 3}, 0, 16.0f}};
+    lbk_octp_build_desc d = LBK_OCTP_BUILD_DESC_INIT;
+    d.probes = pd, d.probe_count = 54, d.levels = lv, d.level_count = 2, d.info = in;
+    void *b;
+    size_t n;
+    assert_int_equal(lbk_octp_build(&d, NULL, &b, &n), LBK_OK);
+    issues is;
+    run(lbk_validate_octp, b, n, &is, NULL);
+    assert_int_equal(is.n, 0);
+    lbk_octp_view v;
+    assert_int_equal(lbk_octp_open(b, n, &v), LBK_OK);
+    assert_int_equal(v.levels[1].first_probe, 27);
+    assert_float_equal(sample_at(&v, 1, 1, 1, 0), 10, 1e-5);   /* one cell from every edge */
+    assert_float_equal(sample_at(&v, 0.5f, 1, 1, 0), 15, 1e-5); /* half a cell: half and half */
+    assert_float_equal(sample_at(&v, 0.5f, 1, 1, LBK_OCTP_SAMPLE_NO_BLEND), 10, 1e-5);
+    assert_float_equal(sample_at(&v, 2, 1, 1, 0), 20, 1e-5);    /* on level 0's boundary */
+    assert_float_equal(sample_at(&v, 2.5f, 1, 1, 0), 20, 1e-5); /* level 1 only */
+    assert_float_equal(sample_at(&v, 9, 9, 9, 0), 20, 1e-5);    /* outside both: clamped coarsest */
+    /* spacing must grow from level to level */
+    const lbk_octp_level bad[2] = {lv[1], lv[0]};
+    d.levels = bad;
+    assert_int_equal(lbk_octp_build(&d, NULL, &b, &n), LBK_ERR_INVALID_ARGUMENT);
+    lbk_free(NULL, (void *)v.data);
+}
+
 /* All four in one container through the public validator: valid, and the table IDs known. */
 static void container_clean(void **state)
 {
@@ -827,7 +982,9 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(lmap_round_trip_and_rules), cmocka_unit_test(glg_rules), cmocka_unit_test(llg_rules),
-        cmocka_unit_test(octa_mapping),              cmocka_unit_test(octp_rules), cmocka_unit_test(container_clean),
+        cmocka_unit_test(octa_mapping),              cmocka_unit_test(octp_rules),
+        cmocka_unit_test(octp_volume_rules),
+        cmocka_unit_test(octp_levels_blend), cmocka_unit_test(container_clean),
         cmocka_unit_test(scaled_sections),      cmocka_unit_test(lmap_fast_scan_exact), cmocka_unit_test(lmap_block_pages),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -132,7 +132,7 @@ typedef struct lbk_bake_desc {
     float sky[3];               /* uniform sky radiance, nits */
     const char *sky_exr;        /* with sky_override: an equirectangular EXR instead of `sky` */
     int no_glg;                 /* 1: leave out the global light grid */
-    int octahedral_probes;      /* 1: also write OCTP probes at the GLG positions */
+    int octahedral_probes;      /* 1: also write OCTP, a probe volume at the GLG spacing (spec §14) */
     int no_seam_stitch;         /* 1: leave lightmap seams unstitched (for comparisons, bench_atlas) [0] */
     double dls_threshold;       /* light sets and doors store a receiver where their light exceeds
                                    this fraction of the mean indirect light of the texels they
@@ -304,6 +304,13 @@ typedef struct lbk_bake_class_errors {
     double texels, glg, llg, probes;
 } lbk_bake_class_errors;
 
+/* The OCTP probe volume (--octahedral; 0 everywhere when none was written). */
+typedef struct lbk_bake_octp {
+    uint32_t probes, inside, no_nearby, relocated; /* all; inactive; marked; moved off the grid */
+    double rel_rmse;     /* estimated relative RMSE of the irradiance texels (two halves) */
+    double rays;         /* gather rays per probe (both halves, all passes) */
+} lbk_bake_octp;
+
 /* One transport run of the light sets and doors (a light set, a door open or closed, a
  * combination, the doors-closed reference), with its own final estimate. A door state's or a
  * combination's stored contribution is a difference of such runs: its error is larger. */
@@ -336,6 +343,8 @@ typedef struct lbk_bake_report {
     const lbk_bake_class_errors *pass_errors; /* per pass, parallel to passes */
     const lbk_bake_set_run *set_runs;    /* every light-set and door run, in order */
     size_t set_run_count;
+    /* appended with the OCTP probe volume: read only when size covers them */
+    lbk_bake_octp octp;
 } lbk_bake_report;
 
 /* Owned by the output, valid until lbk_bake_output_free. */

@@ -77,7 +77,7 @@ extern "C" {
  * with the lowest minor version that defines everything in it (spec §1.3): 2 when an LMAP page is
  * block-encoded, 1 when it holds LMUV, else 0, so a file without newer content keeps the bytes an
  * older writer gave it. */
-#define LBK_FORMAT_VERSION_MINOR 2
+#define LBK_FORMAT_VERSION_MINOR 3
 
 /* This library's version (semantic versioning of the API and ABI). */
 #define LBK_LIBRARY_VERSION_MAJOR 1
