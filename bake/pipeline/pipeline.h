@@ -78,6 +78,9 @@ typedef struct bk_pipeline {
     float scale[3];                 /* LMAP, GLG, LLG scales (spec §5.7); DLS payloads use them */
     float octp_scale;
     lbk_bake_output *out;           /* what the caller gets: the writer (sections.c), the report */
+    struct bk_dist *dist;           /* a distributed bake's unit or merge (bake/dist/dist.h); NULL: local */
+    void *part;                     /* a unit's part, once its runs are done */
+    size_t part_size;
     uint64_t container_bytes;
 } bk_pipeline;
 

@@ -190,6 +190,10 @@ typedef struct tp_ctx {
     int max_bounces, s0;
     /* counters: per thread, summed after each parallel step */
     uint64_t *thread_rays, *thread_shadow, *thread_nonfinite;
+    /* the receivers this run gathers ([0, recv_count) unless options.split cuts it) and what
+     * the caches alone traced (a distributed run's global part) */
+    size_t g_begin, g_end;
+    uint64_t cache_rays, cache_shadow, cache_nonfinite;
 } tp_ctx;
 
 /* ---- parallel-for --------------------------------------------------------------------------- */
@@ -1412,11 +1416,27 @@ static int pass_cache_rays(const tp_ctx *c, int pass)
 
 /* One pass: both halves' caches, then the final gather at the receivers (in blocks, so
  * progress can be reported). */
+static void count_totals(const tp_ctx *c, uint64_t t[3])
+{
+    t[0] = t[1] = t[2] = 0;
+    for (int k = 0; k < c->threads; k++) {
+        t[0] += c->thread_rays[k];
+        t[1] += c->thread_shadow[k];
+        t[2] += c->thread_nonfinite[k];
+    }
+}
+
 static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
 {
     int cache_rays = pass_cache_rays(c, pass);
     for (int h = 0; h < 2; h++) {
+        uint64_t before[3], after[3];
+        count_totals(c, before);
         chain[h] = run_chain(c, h, pass, cache_rays, c->tail_tol, c->max_bounces);
+        count_totals(c, after);
+        c->cache_rays += after[0] - before[0];
+        c->cache_shadow += after[1] - before[1];
+        c->cache_nonfinite += after[2] - before[2];
         if (chain[h].bounces < 0) return LBK_ERR_OUT_OF_MEMORY;
         if (report_progress(c, "cache", c->spp)) return LBK_ERR_CANCELLED;
     }
@@ -1427,7 +1447,10 @@ static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
     size_t count = c->recv_count, block = count / 8 + 1;
     for (size_t b = 0; b < count; b += block) {
         size_t e = b + block < count ? b + block : count;
-        parallel_range(c, b, e, 16, recv_gather);
+        /* a distributed run gathers only its own receivers; each receiver's result depends on
+         * nothing but its own streams, so the cut changes no value */
+        size_t gb = b > c->g_begin ? b : c->g_begin, ge = e < c->g_end ? e : c->g_end;
+        if (gb < ge) parallel_range(c, gb, ge, 16, recv_gather);
         if (report_progress(c, "gather", c->spp + 2.0 * c->rays * (double)e / (double)(count ? count : 1)))
             return LBK_ERR_CANCELLED;
     }
@@ -1447,25 +1470,30 @@ typedef struct tp_errors {
  * product is an unbiased estimate of each receiver's squared bias. Relative to the RMS of the
  * receivers' values. */
 
-static void estimate_error(const tp_ctx *c, double *noise, double *bias, tp_errors *ce)
+static void estimate_error_of(const bk_transport_options *opt, size_t count, double *const x_acc[2],
+                              double *const b_acc[2], double weight_sum, double *noise, double *bias, tp_errors *ce)
 {
-    const bk_transport_options *opt = c->opt;
     double num = 0, den = 0, bb = 0, cnum[BK_RECEIVER_CLASSES] = {0}, cden[BK_RECEIVER_CLASSES] = {0};
     int cls = 0;
-    for (size_t i = 0; i < c->recv_count; i++) {
+    for (size_t i = 0; i < count; i++) {
         while (cls < BK_RECEIVER_CLASSES - 1 && i >= opt->class_end[cls] && opt->class_end[BK_RECEIVER_CLASSES - 1]) cls++;
-        double a = c->x_acc[0][i] / c->weight_sum, b = c->x_acc[1][i] / c->weight_sum;
+        double a = x_acc[0][i] / weight_sum, b = x_acc[1][i] / weight_sum;
         double m = 0.5 * (a + b), v = 0.25 * (a - b) * (a - b);
         num += v;
         den += m * m;
         cnum[cls] += v;
         cden[cls] += m * m;
-        bb += (c->b_acc[0][i] / c->weight_sum) * (c->b_acc[1][i] / c->weight_sum);
+        bb += (b_acc[0][i] / weight_sum) * (b_acc[1][i] / weight_sum);
     }
     *noise = den > 0 ? sqrt(num / den) : 0;
     *bias = den > 0 && bb > 0 ? sqrt(bb / den) : 0;
     for (int k = 0; k < BK_RECEIVER_CLASSES; k++) ce->cls[k] = cden[k] > 0 ? sqrt(cnum[k] / cden[k]) : 0;
     ce->probe = cden[1] + cden[2] > 0 ? sqrt((cnum[1] + cnum[2]) / (cden[1] + cden[2])) : 0;
+}
+
+static void estimate_error(const tp_ctx *c, double *noise, double *bias, tp_errors *ce)
+{
+    estimate_error_of(c->opt, c->recv_count, c->x_acc, c->b_acc, c->weight_sum, noise, bias, ce);
 }
 
 /* Stop after this pass? (target reached, the next pass over budget, or past the time limit:
@@ -1505,7 +1533,7 @@ static void finish_outputs(tp_ctx *c)
     if (c->light_count) {
         float *pl = c->punct_lum;
         c->punct_lum = NULL; /* recv_punctual now writes into the outputs */
-        parallel_for(c, c->recv_count, 64, recv_punctual);
+        parallel_range(c, c->g_begin, c->g_end, 64, recv_punctual);
         c->punct_lum = pl;
     }
 }
@@ -1534,6 +1562,93 @@ static void fill_stats(const tp_ctx *c, int passes, double err, double bias, con
     stats->nee = c->nee;
 }
 
+/* ---- distributed runs (bk_transport_split) ------------------------------------------------ */
+
+static lbk_result record_pass(const tp_ctx *c, int pass, const tp_chain_result chain[2])
+{
+    const bk_transport_split *sp = c->opt->split;
+    bk_transport_pass_record pr;
+    memset(&pr, 0, sizeof pr);
+    pr.pass = pass;
+    pr.bounces = chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces;
+    pr.samples_per_receiver = c->spp;
+    pr.weight_sum = c->weight_sum;
+    for (int h = 0; h < 2; h++) pr.x_acc[h] = c->x_acc[h], pr.b_acc[h] = c->b_acc[h];
+    return sp->record_pass(sp->user, &pr);
+}
+
+static void totals_of(const tp_ctx *c, int passes, const tp_chain_result chain[2], int stop, bk_transport_totals *t)
+{
+    memset(t, 0, sizeof *t);
+    uint64_t all[3];
+    count_totals(c, all);
+    t->passes = passes;
+    t->stop = stop;
+    t->nee = c->nee;
+    t->bounces = chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces;
+    t->q = 0.5 * (chain[0].q + chain[1].q);
+    double tot = chain[0].total_energy + chain[1].total_energy;
+    t->tail_fraction = tot > 0 ? (chain[0].tail_energy + chain[1].tail_energy) / tot : 0;
+    t->cells = c->cell_count;
+    t->cache_rays = c->cache_rays, t->cache_shadow = c->cache_shadow, t->cache_nonfinite = c->cache_nonfinite;
+    t->recv_rays = all[0] - c->cache_rays, t->recv_shadow = all[1] - c->cache_shadow;
+    t->recv_nonfinite = all[2] - c->cache_nonfinite;
+}
+
+/* The merge: every pass's estimate and report from the units' accumulators, then their outputs,
+ * then the stats, as the run over all receivers computed them. */
+static lbk_result replay_run(size_t count, const bk_transport_options *opt, const bk_transport_output *output,
+                             bk_transport_stats *stats, double t0)
+{
+    const bk_transport_split *sp = opt->split;
+    bk_transport_totals t;
+    memset(&t, 0, sizeof t);
+    lbk_result res = sp->replay_totals(sp->user, count, &t);
+    if (res) return res;
+    bk_transport_pass_record pr;
+    memset(&pr, 0, sizeof pr);
+    const size_t n = count ? count : 1;
+    for (int h = 0; h < 2; h++) {
+        pr.x_acc[h] = calloc(n, sizeof(double));
+        pr.b_acc[h] = calloc(n, sizeof(double));
+        if (!pr.x_acc[h] || !pr.b_acc[h]) res = LBK_ERR_OUT_OF_MEMORY;
+    }
+    double err = 0, bias = 0, spp = 0;
+    tp_errors ce = {{0}, 0};
+    for (int pass = 0; !res && pass < t.passes; pass++) {
+        pr.pass = pass;
+        res = sp->replay_pass(sp->user, &pr);
+        if (res) break;
+        estimate_error_of(opt, count, pr.x_acc, pr.b_acc, pr.weight_sum, &err, &bias, &ce);
+        spp = pr.samples_per_receiver;
+        if (opt->report) {
+            bk_transport_sample smp = {now_seconds() - t0, spp, err, pr.bounces, pass, {ce.cls[0], ce.cls[1], ce.cls[2]}, ce.probe};
+            opt->report(opt->user, &smp);
+        }
+        if (opt->progress && opt->progress(opt->user, "gather", (double)(pass + 1) / t.passes)) res = LBK_ERR_CANCELLED;
+    }
+    for (int h = 0; h < 2; h++) free(pr.x_acc[h]), free(pr.b_acc[h]);
+    if (!res) res = sp->replay_outputs(sp->user, output);
+    if (res || !stats) return res;
+    for (int k = 0; k < BK_RECEIVER_CLASSES; k++) stats->class_rel_rmse[k] = ce.cls[k];
+    stats->probe_rel_rmse = ce.probe;
+    stats->seconds = now_seconds() - t0;
+    stats->passes = t.passes;
+    stats->samples_per_receiver = spp;
+    stats->est_rel_rmse = err;
+    stats->est_cache_bias = bias;
+    stats->bounces = t.bounces;
+    stats->q = t.q;
+    stats->tail_fraction = t.tail_fraction;
+    stats->cells = (size_t)t.cells;
+    stats->rays = t.cache_rays + t.recv_rays;
+    stats->shadow_rays = t.cache_shadow + t.recv_shadow;
+    stats->nonfinite = t.cache_nonfinite + t.recv_nonfinite;
+    stats->stop = t.stop;
+    stats->nee = t.nee;
+    return LBK_OK;
+}
+
 lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, const bk_receiver *receivers,
                             size_t count, const bk_transport_options *options,
                             const bk_transport_output *output, bk_transport_stats *stats)
@@ -1545,6 +1660,10 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
     if (stats) memset(stats, 0, sizeof *stats);
     lbk_result res = check_inputs(scene, tracer, receivers, count, opt, output);
     if (res != LBK_OK) return res;
+    const bk_transport_split *split = opt->split;
+    if (split && (!(opt->target_error < 0) || opt->time_limit > 0 || split->begin > split->end || split->end > count))
+        return LBK_ERR_INVALID_ARGUMENT; /* a stop that needs every receiver cannot be cut */
+    if (split && split->replay) return replay_run(count, opt, output, stats, t0);
 
     tp_ctx c;
     memset(&c, 0, sizeof c);
@@ -1563,6 +1682,8 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
     c.target = opt->target_error == 0 ? 0.01 : opt->target_error;
     c.s0 = opt->first_pass_samples > 0 ? opt->first_pass_samples : 16;
     c.tail_tol = fmax(0.1 * (c.target > 0 ? c.target : 0.001), 1e-5);
+    c.g_begin = split ? split->begin : 0;
+    c.g_end = split ? split->end : count;
     res = ctx_init(&c);
     if (res != LBK_OK) goto done;
 
@@ -1571,7 +1692,7 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
         if (output->direct) memset(&output->direct[i], 0, sizeof output->direct[i]);
         if (output->irradiance) output->irradiance[3 * i] = output->irradiance[3 * i + 1] = output->irradiance[3 * i + 2] = 0;
     }
-    if (c.light_count) parallel_for(&c, count, 64, recv_punctual); /* luminance only, for the error */
+    if (c.light_count) parallel_range(&c, c.g_begin, c.g_end, 64, recv_punctual); /* luminance only, for the error */
 
     double err = 0, bias = 0;
     tp_errors ce = {{0}, 0};
@@ -1582,6 +1703,7 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
         res = run_pass(&c, pass, chain);
         if (res != LBK_OK) goto done;
         estimate_error(&c, &err, &bias, &ce);
+        if (split && (res = record_pass(&c, pass, chain)) != LBK_OK) goto done;
         if (opt->report) {
             bk_transport_sample smp = {now_seconds() - t0, c.spp, err,
                                        chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces, pass,
@@ -1595,6 +1717,11 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
     }
     finish_outputs(&c);
     if (stats) fill_stats(&c, pass + 1, err, bias, &ce, chain, stop, stats);
+    if (split) {
+        bk_transport_totals t;
+        totals_of(&c, pass + 1, chain, stop, &t);
+        res = split->record_done(split->user, output, &t);
+    }
 done:
     free_ctx(&c);
     return res;

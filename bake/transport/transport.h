@@ -77,6 +77,45 @@ typedef struct bk_transport_sample {
     double probe_rel_rmse;
 } bk_transport_sample;
 
+/* ---- distributed bakes (bake/dist/DIST.md) ----------------------------------------------
+ * A run cut by receivers: a unit gathers only receivers [begin, end) and hands what it computed
+ * to `record_*`; the merge replays every unit's record instead of tracing (`replay_*`), so the
+ * error estimates, the report and the stats are computed from the same numbers in the same
+ * order as a run over all receivers (byte-identical). Only runs whose stop does not depend on
+ * the estimate can be cut: target_error < 0 and no time_limit (else LBK_ERR_INVALID_ARGUMENT). */
+
+/* One finished pass. x_acc/b_acc: per receiver, per half, the pass-weighted accumulators of the
+ * error scalar and the bias probe (indexed by receiver; a unit's are valid in [begin, end)). */
+typedef struct bk_transport_pass_record {
+    int pass, bounces;
+    double samples_per_receiver, weight_sum;
+    double *x_acc[2], *b_acc[2];
+} bk_transport_pass_record;
+
+/* What a run adds up to. The cache's part is global (every unit traces it alike); the
+ * receivers' part is the unit's own. */
+typedef struct bk_transport_totals {
+    int passes, stop, nee, bounces;
+    double q, tail_fraction;
+    uint64_t cells;
+    uint64_t cache_rays, cache_shadow, cache_nonfinite;
+    uint64_t recv_rays, recv_shadow, recv_nonfinite;
+} bk_transport_totals;
+
+struct bk_transport_output;
+typedef struct bk_transport_split {
+    int replay;            /* 0: record (a unit), 1: replay (the merge) */
+    size_t begin, end;     /* record: the receivers this unit gathers */
+    void *user;
+    lbk_result (*record_pass)(void *user, const bk_transport_pass_record *pass);
+    lbk_result (*record_done)(void *user, const struct bk_transport_output *out, const bk_transport_totals *totals);
+    /* replay: totals summed over the units; then every pass (arrays of `count` entries
+     * allocated by the transport, filled by the callee); then the outputs of every receiver */
+    lbk_result (*replay_totals)(void *user, size_t count, bk_transport_totals *totals);
+    lbk_result (*replay_pass)(void *user, bk_transport_pass_record *pass);
+    lbk_result (*replay_outputs)(void *user, const struct bk_transport_output *out);
+} bk_transport_split;
+
 typedef struct bk_transport_options {
     uint64_t seed;
     int threads;             /* 0: all online cores */
@@ -122,6 +161,9 @@ typedef struct bk_transport_options {
      * (bk_transport_sample.class_rel_rmse), and target_error applies to the texels' estimate
      * (all receivers' when there are no texels). All 0: one class, the estimate over all. */
     size_t class_end[BK_RECEIVER_CLASSES];
+    /* NULL: a whole run; else a distributed one (above). Copied with the options, so every
+     * light-set and door run of a unit or merge is cut the same way. */
+    const bk_transport_split *split;
 } bk_transport_options;
 
 /* Caller-owned output arrays, `count` entries each; NULL pointers are skipped. */
