@@ -16,7 +16,10 @@ DEB_TOOL_PKGS := $(DEB_LIB_PKGS) libembree-dev libopenexr-dev libdraco-dev libti
                  nlohmann-json3-dev libqhull-dev libspng-dev libcjson-dev \
                  libastcenc-dev
 DEB_TEST_PKGS := $(DEB_TOOL_PKGS) pkg-config libcmocka-dev clang libclang-rt-14-dev
-DEB_PKGS      := $(DEB_TEST_PKGS) $(GPU_PKGS)
+# A single-node Slurm cluster for the distributed-bake test (tests/e2e/slurm_dist.sh, which
+# also installs them itself when run as root).
+SLURM_PKGS    := munge slurmd slurmctld slurm-client
+DEB_PKGS      := $(DEB_TEST_PKGS) $(GPU_PKGS) $(SLURM_PKGS)
 
 WARN     := -Wall -Wextra -Wshadow -Wstrict-prototypes -Wmissing-prototypes -Wno-unused-parameter
 # The glTF shim: its own code warns like the C code; tinygltf, Draco, stb and nlohmann come in

@@ -67,8 +67,10 @@ static int write_makefile(const char *path, const char *lbk, const char *plan, c
 static int write_sbatch(const char *path, const char *lbk, const char *plan, const char *output, unsigned units,
                         char err[TL_ERR_LEN])
 {
-    char t[8192];
-    snprintf(t, sizeof t,
+    size_t cap = 2048 + 3 * (strlen(lbk) + strlen(plan) + 4 * strlen(output));
+    char *t = malloc(cap);
+    if (!t) return snprintf(err, TL_ERR_LEN, "out of memory"), -1;
+    snprintf(t, cap,
              "#!/bin/sh\n"
              "# A distributed bake on Slurm, written by lbk plan: `sh THIS` submits a job array of %u\n"
              "# units and a merge that runs when all of them succeeded (afterok). SBATCH_FLAGS adds\n"
@@ -84,7 +86,9 @@ static int write_sbatch(const char *path, const char *lbk, const char *plan, con
              "merge=${merge%%%%;*}\n"
              "echo \"lbk: units job $unit, merge job $merge\"\n",
              units, lbk, plan, output, units - 1);
-    return tl_write_text(path, t, err);
+    int r = tl_write_text(path, t, err);
+    free(t);
+    return r;
 }
 
 int cli_plan_write(const bake_args *o, int argc, char **argv, const char *cmd)

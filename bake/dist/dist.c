@@ -121,7 +121,8 @@ lbk_result bk_part_parse(const void *bytes, size_t size, bk_part_view *v, char *
         return say(err, err_len, "not a part file (no LBKPART header)");
     if (get32(p + 8) != BK_PART_VERSION) return say(err, err_len, "part format version %u (this lbk reads %u)", get32(p + 8), BK_PART_VERSION);
     if (get32(p + 12) != BK_PART_HEADER_SIZE || get32(p + 60) != 0) return say(err, err_len, "corrupt part header");
-    if (XXH64(p, 80, 0) != get64(p + 80)) return say(err, err_len, "corrupt part header (checksum)");
+    if (XXH64(p, 88, 0) != get64(p + 88)) return say(err, err_len, "corrupt part header (checksum)");
+    v->options_hash = get64(p + 80);
     v->plan_hash = get64(p + 16);
     v->units = get32(p + 24);
     v->unit = get32(p + 28);
@@ -165,7 +166,7 @@ bad:
 
 struct bk_dist {
     int replay;
-    uint64_t plan_hash;
+    uint64_t plan_hash, options_hash;
     uint32_t units, unit;
     uint64_t count, begin, end;
     int have_count;
@@ -365,7 +366,8 @@ static lbk_result play_outputs(void *user, const bk_transport_output *o)
     return LBK_OK;
 }
 
-lbk_result bk_dist_create(int replay, uint64_t plan_hash, uint32_t units, uint32_t unit, const bk_part_view *parts, bk_dist **out)
+lbk_result bk_dist_create(int replay, uint64_t plan_hash, uint64_t options_hash, uint32_t units, uint32_t unit,
+                          const bk_part_view *parts, bk_dist **out)
 {
     *out = NULL;
     if (units == 0 || units > BK_PART_MAX_UNITS || (!replay && unit >= units) || (replay && !parts)) return LBK_ERR_INVALID_ARGUMENT;
@@ -373,6 +375,7 @@ lbk_result bk_dist_create(int replay, uint64_t plan_hash, uint32_t units, uint32
     if (!d) return LBK_ERR_OUT_OF_MEMORY;
     d->replay = replay;
     d->plan_hash = plan_hash;
+    d->options_hash = options_hash;
     d->units = units;
     d->unit = unit;
     d->parts = parts;
@@ -443,7 +446,8 @@ lbk_result bk_dist_finish(bk_dist *d, void **bytes, size_t *size, char *err, siz
     put64(p + 64, d->out.n);
     if (d->out.n) memcpy(p + BK_PART_HEADER_SIZE, d->out.p, d->out.n);
     put64(p + 72, XXH64(p + BK_PART_HEADER_SIZE, d->out.n, 0));
-    put64(p + 80, XXH64(p, 80, 0));
+    put64(p + 80, d->options_hash);
+    put64(p + 88, XXH64(p, 88, 0));
     *bytes = p;
     *size = total;
     return LBK_OK;

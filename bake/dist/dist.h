@@ -15,7 +15,7 @@
 
 #define BK_PART_MAGIC "LBKPART\0"
 #define BK_PART_VERSION 1u
-#define BK_PART_HEADER_SIZE 88u
+#define BK_PART_HEADER_SIZE 96u
 #define BK_PART_RUN_HEADER_SIZE 96u
 #define BK_PART_PASS_HEADER_SIZE 24u
 #define BK_PART_MAX_UNITS 65536u
@@ -27,7 +27,7 @@ enum { BK_PART_RADIANCE = 1, BK_PART_DIRECT = 2, BK_PART_IRRADIANCE = 4, BK_PART
 
 /* A validated part, its runs indexed (pointers into the caller's bytes). */
 typedef struct bk_part_view {
-    uint64_t plan_hash, receiver_count, begin, end;
+    uint64_t plan_hash, options_hash, receiver_count, begin, end;
     uint32_t units, unit, run_count;
     const uint8_t **runs;     /* run_count run records */
 } bk_part_view;
@@ -43,8 +43,10 @@ typedef struct bk_dist bk_dist;
 
 /* A unit's recorder (replay 0) or the merge's player over n part views (replay 1, one per unit,
  * in unit order, validated by the caller against each other). */
-lbk_result bk_dist_create(int replay, uint64_t plan_hash, uint32_t units, uint32_t unit, const bk_part_view *parts,
-                          bk_dist **out);
+/* options_hash: the bake options' identity (bake.c), stamped into the part (record) or
+ * checked against every part (replay). */
+lbk_result bk_dist_create(int replay, uint64_t plan_hash, uint64_t options_hash, uint32_t units, uint32_t unit,
+                          const bk_part_view *parts, bk_dist **out);
 void bk_dist_destroy(bk_dist *d);
 /* The bake's receiver count, once known: fixes the unit's range (record) or checks the parts
  * against it (replay). LBK_ERR_BAD_INPUT with a message when they disagree. */

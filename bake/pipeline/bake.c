@@ -21,6 +21,9 @@
 #include "bake/util/clock.h"
 #include "lbk/bake_dist.h"
 
+#define XXH_INLINE_ALL /* as the rest of the baker: liblbkbake links no xxhash of its own */
+#include <xxhash.h>
+
 const bk_preset bk_presets[LBK_BAKE_PRESET_COUNT_] = {
     [LBK_BAKE_PRESET_FAST] = {"fast", 8.0f, 2.0f, 1024, 0.03, 32},
     [LBK_BAKE_PRESET_HIGH] = {"high", 16.0f, 1.0f, 16384, 0.01, 128},
@@ -784,6 +787,35 @@ const char *lbk_bake_preset_name(lbk_bake_preset preset)
 
 /* ---- distributed bakes (lbk/bake_dist.h) --------------------------------------------------- */
 
+/* The identity of the options that shape a bake's bytes (not threads, callbacks, allocator):
+ * a part baked with other options is refused by the merge instead of replayed under them. */
+static void hash_str(XXH64_state_t *st, const char *s)
+{
+    XXH64_update(st, s ? s : "", s ? strlen(s) + 1 : 1);
+}
+
+static uint64_t options_hash(const lbk_bake_desc *options)
+{
+    lbk_bake_desc d;
+    memset(&d, 0, sizeof d);
+    if (options) memcpy(&d, options, options->size && options->size < sizeof d ? options->size : sizeof d);
+    XXH64_state_t *st = XXH64_createState();
+    if (!st) return 0;
+    XXH64_reset(st, 0x6c626b70);
+    const int64_t ints[] = {d.preset, (int64_t)d.seed, d.max_samples, d.max_bounces, d.sky_override, d.no_glg,
+                            d.octahedral_probes, d.no_seam_stitch, d.door_method, d.denoise, d.timestamp, d.block_align};
+    const double reals[] = {d.target_error, d.time_limit, d.texel_density, d.glg_spacing, d.sky[0], d.sky[1], d.sky[2],
+                            d.dls_threshold};
+    XXH64_update(st, ints, sizeof ints);
+    XXH64_update(st, reals, sizeof reals);
+    hash_str(st, d.sky_exr);
+    hash_str(st, d.revision);
+    hash_str(st, d.allow_outside);
+    uint64_t h = XXH64_digest(st);
+    XXH64_freeState(st);
+    return h;
+}
+
 lbk_result lbk_bake_unit_from_file(const char *path, const lbk_bake_desc *desc, uint64_t plan_hash, uint32_t units,
                                    uint32_t unit, void **part, size_t *part_size)
 {
@@ -792,7 +824,7 @@ lbk_result lbk_bake_unit_from_file(const char *path, const lbk_bake_desc *desc, 
     *part_size = 0;
     if (!path || units == 0 || units > BK_PART_MAX_UNITS || unit >= units) return LBK_ERR_INVALID_ARGUMENT;
     bk_dist *d = NULL;
-    lbk_result r = bk_dist_create(0, plan_hash, units, unit, NULL, &d);
+    lbk_result r = bk_dist_create(0, plan_hash, options_hash(desc), units, unit, NULL, &d);
     if (r) return r;
     lbk_bake_output *out = NULL;
     r = bake(path, NULL, desc, &out, d, part, part_size);
@@ -915,7 +947,14 @@ lbk_result lbk_bake_merge_from_file(const char *path, const lbk_bake_desc *desc,
     if (!views) return LBK_ERR_OUT_OF_MEMORY;
     lbk_result r = order_parts(desc, plan_hash, units, parts, part_sizes, part_count, views);
     bk_dist *d = NULL;
-    if (!r) r = bk_dist_create(1, plan_hash, units, 0, views, &d);
+    const uint64_t oh = options_hash(desc);
+    for (uint32_t u = 0; !r && u < units; u++)
+        if (views[u].options_hash != oh) {
+            say_error(desc, "unit %u's part was baked with other bake options than this merge's (seed, samples, "
+                      "density, ...): it belongs to another bake", u);
+            r = LBK_ERR_BAD_INPUT;
+        }
+    if (!r) r = bk_dist_create(1, plan_hash, oh, units, 0, views, &d);
     if (!r) r = bake(path, NULL, desc, out, d, NULL, NULL);
     bk_dist_destroy(d);
     for (uint32_t u = 0; u < units; u++) free(views[u].runs);

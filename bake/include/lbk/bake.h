@@ -118,7 +118,9 @@ typedef struct lbk_bake_desc {
     lbk_bake_preset preset;     /* [fast] */
     int threads;                /* worker threads [0: one per online core] */
     uint64_t seed;              /* used as given, 0 included (`lbk bake` passes 1 unless --seed) */
-    double target_error;        /* stop when the estimated relative RMSE reaches this; <= 0: preset */
+    double target_error;        /* stop when the estimated relative RMSE reaches this; 0: preset;
+                                   < 0: no target, every pass max_samples allows (a fixed schedule:
+                                   what a distributed bake needs, lbk/bake_dist.h) */
     double time_limit;          /* seconds for the whole bake from the call, base + every light-set
                                    and door run: each run gets an equal share of what is left;
                                    every run completes at least one pass, and the guided door
