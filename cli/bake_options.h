@@ -11,6 +11,7 @@ typedef struct bake_args {
     /* a distributed bake's plan (cmd_dist.c) */
     const char *plan, *makefile, *sbatch;
     unsigned units;
+    int continued;              /* --continue (--resume with a new stop) */
     /* lbk merge: cli_bake_run merges these parts instead of baking */
     int merge;
     uint64_t plan_hash;

@@ -59,6 +59,11 @@ static void help(FILE *f)
           "  --allow-outside DIR     the scene may also read buffers/images/sky from DIR (by default\n"
           "                          every file it names must lie in its own folder)\n"
           "  -q, --quiet             no progress output\n"
+          "  --checkpoint DIR        after every pass, the bake's state into DIR (atomically)\n"
+          "  --resume DIR            continue a killed bake from its last finished pass: the result\n"
+          "                          is byte-identical to an uninterrupted bake (same options)\n"
+          "  --continue DIR          add passes to a finished bake's checkpoints, up to a lower\n"
+          "                          --target-error or a larger --samples (bake/dist/DIST.md)\n"
           "  --plan PLAN.json --units N [--makefile FILE] [--sbatch FILE]\n"
           "                          bake nothing: write the plan of a distributed bake in N units\n"
           "                          (same as lbk plan; needs --samples N --target-error none)\n"
@@ -304,6 +309,15 @@ int cli_bake_parse(int argc, char **argv, bake_args *out, int *quiet_out)
         } else if (!strcmp(a, "--target-error") && v && !strcmp(v, "none")) {
             i++;
             o.d.target_error = -1;
+        } else if (!strcmp(a, "--checkpoint") || !strcmp(a, "--resume") || !strcmp(a, "--continue")) {
+            NEED_VALUE;
+            if (o.d.checkpoint_dir) {
+                fprintf(stderr, "lbk bake: one of --checkpoint, --resume, --continue\n");
+                return LBK_EXIT_USAGE;
+            }
+            o.d.checkpoint_dir = v;
+            o.d.resume = strcmp(a, "--checkpoint") != 0;
+            o.continued = !strcmp(a, "--continue");
         } else if (!strcmp(a, "--plan")) {
             NEED_VALUE;
             o.plan = v;
@@ -427,7 +441,17 @@ int lbk_cmd_bake(int argc, char **argv)
     int quiet = 0;
     int rc = cli_bake_parse(argc, argv, &o, &quiet);
     if (rc >= 0) return rc;
-    if (o.plan || o.units || o.makefile || o.sbatch) return cli_plan_write(&o, argc, argv, "bake");
+    if (o.plan || o.units || o.makefile || o.sbatch) {
+        if (o.d.checkpoint_dir) {
+            fprintf(stderr, "lbk bake: a plan's units write parts, not checkpoints: leave out --checkpoint/--resume/--continue\n");
+            return LBK_EXIT_USAGE;
+        }
+        return cli_plan_write(&o, argc, argv, "bake");
+    }
+    if (o.continued && !(o.d.target_error > 0) && o.d.max_samples <= 0) {
+        fprintf(stderr, "lbk bake: --continue needs the new stop: a lower --target-error and/or a larger --samples\n");
+        return LBK_EXIT_USAGE;
+    }
     if (!o.input || !o.output) {
         fprintf(stderr, "lbk bake: need a scene and -o OUT.lbk (lbk bake --help)\n");
         return LBK_EXIT_USAGE;

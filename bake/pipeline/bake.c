@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bake/dist/checkpoint.h"
 #include "bake/dist/dist.h"
 #include "bake/pipeline/encode.h"
 #include "bake/pipeline/pipeline.h"
@@ -431,6 +432,7 @@ static void transport_options(const bk_pipeline *b, bk_transport_options *to)
     to->class_end[BK_CLASS_GLG] = b->llg_first;
     to->class_end[BK_CLASS_LLG] = b->receiver_count;
     to->split = b->dist ? bk_dist_split(b->dist) : NULL;
+    to->checkpoint = b->ckpt && !b->dist ? bk_ckpt_transport(b->ckpt) : NULL;
 }
 
 void bk_pipeline_set_inputs(const bk_pipeline *b, bk_set_inputs *in)
@@ -612,6 +614,15 @@ static lbk_result run(bk_pipeline *b, const char *path, const lbk_bake_scene *de
     if (!r && b->sets.set_count) r = emit_sets(b);
     if (!r) r = phase(b, LBK_BAKE_PHASE_WRITE);
     if (!r) r = bk_pipeline_encode(b);
+    if (r && r != LBK_ERR_CANCELLED && b->ckpt && bk_ckpt_error(b->ckpt)[0])
+        r = bk_pipeline_fail(b, bk_ckpt_code(b->ckpt), "%s", bk_ckpt_error(b->ckpt));
+    if (!r && b->ckpt) {
+        int runs = 0, passes = 0;
+        bk_ckpt_counts(b->ckpt, &runs, &passes);
+        if (b->opt->resume)
+            bk_events_say(&b->events, LBK_BAKE_SEVERITY_NOTE, "resumed %d transport runs from %s (%d passes not traced again)",
+                          runs, b->opt->checkpoint_dir, passes);
+    }
     if (b->phase_count > 0) b->phase_seconds[b->phase_count - 1] = bk_now() - b->phase_start;
     if (!r) r = bk_pipeline_report(b, b->out);
     if (r == LBK_ERR_OUT_OF_MEMORY && !b->err[0]) bk_pipeline_fail(b, r, "out of memory");
@@ -697,6 +708,8 @@ static void pipeline_free(bk_pipeline *b)
     bk_scene_free(&b->scene);
 }
 
+static uint64_t options_hash(const lbk_bake_desc *options, int budgets);
+
 /* What a distributed bake cannot cut (lbk/bake_dist.h): a stop that needs every receiver. */
 static lbk_result check_dist(bk_pipeline *b)
 {
@@ -742,6 +755,12 @@ static lbk_result bake(const char *path, const lbk_bake_scene *desc, const lbk_b
     }
     if (!r && !path && !desc) r = bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT, "no scene");
     if (!r && dist) r = check_dist(b);
+    if (!r && !dist && b->desc.checkpoint_dir) {
+        /* the budgets may change between a bake and its --continue; nothing else may */
+        r = bk_ckpt_create(b->desc.checkpoint_dir, b->desc.resume, options_hash(&b->desc, 0), &b->ckpt, b->err, sizeof b->err);
+    } else if (!r && b->desc.resume) {
+        r = bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT, "lbk_bake_desc.resume needs checkpoint_dir");
+    }
     if (!r) r = output_create(b);
     if (!r) r = run(b, path, desc);
     if (r) {
@@ -757,6 +776,7 @@ static lbk_result bake(const char *path, const lbk_bake_scene *desc, const lbk_b
         *out = b->out;
     }
     free(b->part);
+    bk_ckpt_destroy(b->ckpt);
     pipeline_free(b);
     free(b);
     return r;
@@ -794,7 +814,7 @@ static void hash_str(XXH64_state_t *st, const char *s)
     XXH64_update(st, s ? s : "", s ? strlen(s) + 1 : 1);
 }
 
-static uint64_t options_hash(const lbk_bake_desc *options)
+static uint64_t options_hash(const lbk_bake_desc *options, int budgets)
 {
     lbk_bake_desc d;
     memset(&d, 0, sizeof d);
@@ -802,6 +822,7 @@ static uint64_t options_hash(const lbk_bake_desc *options)
     XXH64_state_t *st = XXH64_createState();
     if (!st) return 0;
     XXH64_reset(st, 0x6c626b70);
+    if (!budgets) d.target_error = d.time_limit = 0, d.max_samples = 0;
     const int64_t ints[] = {d.preset, (int64_t)d.seed, d.max_samples, d.max_bounces, d.sky_override, d.no_glg,
                             d.octahedral_probes, d.no_seam_stitch, d.door_method, d.denoise, d.timestamp, d.block_align};
     const double reals[] = {d.target_error, d.time_limit, d.texel_density, d.glg_spacing, d.sky[0], d.sky[1], d.sky[2],
@@ -824,7 +845,7 @@ lbk_result lbk_bake_unit_from_file(const char *path, const lbk_bake_desc *desc, 
     *part_size = 0;
     if (!path || units == 0 || units > BK_PART_MAX_UNITS || unit >= units) return LBK_ERR_INVALID_ARGUMENT;
     bk_dist *d = NULL;
-    lbk_result r = bk_dist_create(0, plan_hash, options_hash(desc), units, unit, NULL, &d);
+    lbk_result r = bk_dist_create(0, plan_hash, options_hash(desc, 1), units, unit, NULL, &d);
     if (r) return r;
     lbk_bake_output *out = NULL;
     r = bake(path, NULL, desc, &out, d, part, part_size);
@@ -947,7 +968,7 @@ lbk_result lbk_bake_merge_from_file(const char *path, const lbk_bake_desc *desc,
     if (!views) return LBK_ERR_OUT_OF_MEMORY;
     lbk_result r = order_parts(desc, plan_hash, units, parts, part_sizes, part_count, views);
     bk_dist *d = NULL;
-    const uint64_t oh = options_hash(desc);
+    const uint64_t oh = options_hash(desc, 1);
     for (uint32_t u = 0; !r && u < units; u++)
         if (views[u].options_hash != oh) {
             say_error(desc, "unit %u's part was baked with other bake options than this merge's (seed, samples, "

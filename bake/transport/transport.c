@@ -194,6 +194,7 @@ typedef struct tp_ctx {
      * the caches alone traced (a distributed run's global part) */
     size_t g_begin, g_end;
     uint64_t cache_rays, cache_shadow, cache_nonfinite;
+    bk_transport_sample samples[BK_TRANSPORT_MAX_PASSES]; /* what each pass reported (checkpoints) */
 } tp_ctx;
 
 /* ---- parallel-for --------------------------------------------------------------------------- */
@@ -1649,6 +1650,74 @@ static lbk_result replay_run(size_t count, const bk_transport_options *opt, cons
     return LBK_OK;
 }
 
+/* ---- checkpoints (bk_transport_checkpoint) ------------------------------------------------ */
+
+static void state_arrays(tp_ctx *c, bk_transport_state *st)
+{
+    st->count = c->recv_count;
+    for (int h = 0; h < 2; h++) st->x_acc[h] = c->x_acc[h], st->b_acc[h] = c->b_acc[h];
+    st->radiance = c->out->radiance;
+    st->direct = c->out->direct;
+    st->irradiance = c->out->irradiance;
+}
+
+static lbk_result save_state(tp_ctx *c, int pass, const tp_chain_result chain[2])
+{
+    const bk_transport_checkpoint *ck = c->opt->checkpoint;
+    bk_transport_state *st = calloc(1, sizeof *st);
+    if (!st) return LBK_ERR_OUT_OF_MEMORY;
+    state_arrays(c, st);
+    st->passes = pass + 1;
+    st->weight_sum = c->weight_sum;
+    st->spp = c->spp;
+    for (int h = 0; h < 2; h++) {
+        st->chain_bounces[h] = chain[h].bounces;
+        st->chain_q[h] = chain[h].q;
+        st->chain_tail[h] = chain[h].tail_energy;
+        st->chain_total[h] = chain[h].total_energy;
+    }
+    uint64_t all[3];
+    count_totals(c, all);
+    st->rays = all[0], st->shadow = all[1], st->nonfinite = all[2];
+    st->cache_rays = c->cache_rays, st->cache_shadow = c->cache_shadow, st->cache_nonfinite = c->cache_nonfinite;
+    memcpy(st->samples, c->samples, sizeof st->samples);
+    lbk_result r = ck->save(ck->user, st);
+    free(st);
+    return r;
+}
+
+/* The run's last saved state, if any: *passes gets how many passes it holds (0: none). */
+static lbk_result load_state(tp_ctx *c, tp_chain_result chain[2], int *passes)
+{
+    const bk_transport_checkpoint *ck = c->opt->checkpoint;
+    *passes = 0;
+    bk_transport_state *st = calloc(1, sizeof *st);
+    if (!st) return LBK_ERR_OUT_OF_MEMORY;
+    state_arrays(c, st);
+    int got = ck->load(ck->user, st);
+    lbk_result r = got < 0 ? (lbk_result)(-got) : LBK_OK;
+    if (got == 1 && (st->passes < 1 || st->passes > BK_TRANSPORT_MAX_PASSES)) r = LBK_ERR_BAD_INPUT;
+    if (got == 1 && !r) {
+        *passes = st->passes;
+        c->weight_sum = st->weight_sum;
+        c->spp = st->spp;
+        for (int h = 0; h < 2; h++) {
+            chain[h].bounces = st->chain_bounces[h];
+            chain[h].q = st->chain_q[h];
+            chain[h].tail_energy = st->chain_tail[h];
+            chain[h].total_energy = st->chain_total[h];
+        }
+        /* the counters as they stood after that pass (the punctual pass before it, just redone,
+         * is in them already) */
+        for (int t = 0; t < c->threads; t++) c->thread_rays[t] = c->thread_shadow[t] = c->thread_nonfinite[t] = 0;
+        c->thread_rays[0] = st->rays, c->thread_shadow[0] = st->shadow, c->thread_nonfinite[0] = st->nonfinite;
+        c->cache_rays = st->cache_rays, c->cache_shadow = st->cache_shadow, c->cache_nonfinite = st->cache_nonfinite;
+        memcpy(c->samples, st->samples, sizeof c->samples);
+    }
+    free(st);
+    return r;
+}
+
 lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, const bk_receiver *receivers,
                             size_t count, const bk_transport_options *options,
                             const bk_transport_output *output, bk_transport_stats *stats)
@@ -1698,23 +1767,39 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
     tp_errors ce = {{0}, 0};
     int pass = 0, stop = BK_STOP_BUDGET;
     tp_chain_result chain[2] = {{0, 0, 0, 0}, {0, 0, 0, 0}};
+    if (opt->checkpoint && !split) {
+        int done = 0;
+        res = load_state(&c, chain, &done);
+        if (res != LBK_OK) goto done;
+        if (done > 0) {
+            /* resumed: the saved passes' reports again, then the stop rule after the last one */
+            if (opt->report)
+                for (int p = 0; p < done; p++) opt->report(opt->user, &c.samples[p]);
+            estimate_error(&c, &err, &bias, &ce);
+            const double stop_err = opt->class_end[BK_RECEIVER_CLASSES - 1] && opt->class_end[BK_CLASS_TEXEL] ? ce.cls[BK_CLASS_TEXEL] : err;
+            pass = done - 1;
+            if (stop_after(&c, pass, stop_err, 0, &stop)) goto finished;
+            pass = done;
+        }
+    }
     for (;; pass++) {
         double pass_start = now_seconds();
         res = run_pass(&c, pass, chain);
         if (res != LBK_OK) goto done;
         estimate_error(&c, &err, &bias, &ce);
         if (split && (res = record_pass(&c, pass, chain)) != LBK_OK) goto done;
-        if (opt->report) {
-            bk_transport_sample smp = {now_seconds() - t0, c.spp, err,
-                                       chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces, pass,
-                                       {ce.cls[0], ce.cls[1], ce.cls[2]}, ce.probe};
-            opt->report(opt->user, &smp);
-        }
+        bk_transport_sample smp = {now_seconds() - t0, c.spp, err,
+                                   chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces, pass,
+                                   {ce.cls[0], ce.cls[1], ce.cls[2]}, ce.probe};
+        if (pass < BK_TRANSPORT_MAX_PASSES) c.samples[pass] = smp;
+        if (opt->report) opt->report(opt->user, &smp);
+        if (opt->checkpoint && !split && (res = save_state(&c, pass, chain)) != LBK_OK) goto done;
         /* the target is about lightmap texels (REPT's texel_rel_rmse, spec §7.2) when there are
          * any; probes' own estimates are reported beside it */
         const double stop_err = opt->class_end[BK_RECEIVER_CLASSES - 1] && opt->class_end[BK_CLASS_TEXEL] ? ce.cls[BK_CLASS_TEXEL] : err;
         if (stop_after(&c, pass, stop_err, now_seconds() - pass_start, &stop)) break;
     }
+finished:
     finish_outputs(&c);
     if (stats) fill_stats(&c, pass + 1, err, bias, &ce, chain, stop, stats);
     if (split) {

@@ -102,6 +102,36 @@ typedef struct bk_transport_totals {
     uint64_t recv_rays, recv_shadow, recv_nonfinite;
 } bk_transport_totals;
 
+/* ---- checkpoints (resume after a crash, continue to a lower error) -------------------------
+ * After every pass the run's whole state is handed to `save`; at the start of a run `load` may
+ * hand back the state of its last saved pass, and the run goes on from there: the passes that
+ * follow are the ones an uninterrupted run makes (every pass depends only on the seed and its
+ * index, never on the caches of the pass before), so the result is byte-identical. */
+#define BK_TRANSPORT_MAX_PASSES 32
+typedef struct bk_transport_state {
+    int passes;                 /* passes finished */
+    double weight_sum, spp;
+    int chain_bounces[2];
+    double chain_q[2], chain_tail[2], chain_total[2];
+    uint64_t cache_rays, cache_shadow, cache_nonfinite, rays, shadow, nonfinite;
+    size_t count;
+    /* per receiver (count): the halves' accumulators and the outputs' running sums (before the
+     * final normalisation); radiance always, direct/irradiance as the run's outputs have them */
+    double *x_acc[2], *b_acc[2];
+    void *radiance, *direct;    /* lbk_sh9_rgb arrays */
+    float *irradiance;
+    bk_transport_sample samples[BK_TRANSPORT_MAX_PASSES]; /* what each pass reported */
+} bk_transport_state;
+
+typedef struct bk_transport_checkpoint {
+    void *user;
+    lbk_result (*save)(void *user, const bk_transport_state *state);
+    /* fills state (its arrays allocated by the transport for state->count receivers, NULL where
+     * the run has no such output): 1 when a saved state was loaded, 0 when there is none, else
+     * an lbk_result error (negated) */
+    int (*load)(void *user, bk_transport_state *state);
+} bk_transport_checkpoint;
+
 struct bk_transport_output;
 typedef struct bk_transport_split {
     int replay;            /* 0: record (a unit), 1: replay (the merge) */
@@ -164,6 +194,8 @@ typedef struct bk_transport_options {
     /* NULL: a whole run; else a distributed one (above). Copied with the options, so every
      * light-set and door run of a unit or merge is cut the same way. */
     const bk_transport_split *split;
+    /* NULL: none; else checkpoints after every pass and resumption (above). Not with split. */
+    const bk_transport_checkpoint *checkpoint;
 } bk_transport_options;
 
 /* Caller-owned output arrays, `count` entries each; NULL pointers are skipped. */

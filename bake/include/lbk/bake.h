@@ -155,6 +155,14 @@ typedef struct lbk_bake_desc {
     int block_align;            /* 1: every chart starts and ends on a 4-texel boundary, so a 4×4
                                    block of a block-compressed pack (lbk convert, BC6H/ASTC) never
                                    holds two charts [0: packed tight] */
+    /* added in 1.2 */
+    const char *checkpoint_dir; /* after every pass of every transport run, its state into this
+                                   folder (made if missing), atomically [NULL: none] */
+    int resume;                 /* 1 with checkpoint_dir: runs with a checkpoint continue from
+                                   their last finished pass (a killed bake ends byte-identical to
+                                   an uninterrupted one; a finished bake given a lower
+                                   target_error or a larger max_samples adds passes) [0: a fresh
+                                   bake, checkpoints of an earlier one in the folder removed] */
 } lbk_bake_desc;
 
 /* ---- in-memory scenes ----------------------------------------------------------------------
