@@ -73,7 +73,7 @@ TOOL_OBJ  := $(filter-out $(BUILD)/rel/$(TOOL_MAIN:.c=.o) $(BAKE_OBJ),$(TOOL_CSR
 LIB_ASAN  := $(LIB_SRC:%.c=$(BUILD)/asan/%.o)
 TOOL_ASAN := $(filter-out $(BUILD)/asan/$(TOOL_MAIN:.c=.o),$(TOOL_CSRC:%.c=$(BUILD)/asan/%.o)) $(TOOL_CXXSRC:%.cc=$(BUILD)/asan/%.o)
 
-.PHONY: all lib bake-lib deps deps-bench demo test check bench bench-cycles bench-render mesa-bc-check fuzz install install-check clean help gltf-validator gpu test-build
+.PHONY: all lib bake-lib deps deps-bench demo test check bench bench-cycles bench-render mesa-bc-check fuzz fuzz-long install install-check clean help gltf-validator gpu test-build
 all: $(BUILD)/lbk $(BUILD)/liblbk.a $(BUILD)/liblbk.so $(BUILD)/lbk.pc \
      $(BUILD)/liblbkbake.a $(BUILD)/liblbkbake.so $(BUILD)/lbk-bake.pc
 
@@ -91,7 +91,8 @@ help:
 	@echo "make bench-cycles  lbk against Blender Cycles at equal time (part of make bench; bench/cycles/README.md)"
 	@echo "make bench-render  lbk render against Blender Cycles"
 	@echo "make mesa-bc-check  BC6H/BC4 codecs against Mesa's (optional: libegl-dev libgl-dev)"
-	@echo "make fuzz       libFuzzer harness for the container reader (clang)"
+	@echo "make fuzz       the libFuzzer harnesses (container, glTF import, sky EXR, profiles), FUZZ_SECONDS each"
+	@echo "make fuzz-long  the same for FUZZ_HOURS (default 1) each"
 	@echo "make gpu        the Vulkan DLS apply tool build/lbk-gpu-apply (make test runs the GPU tests on lavapipe)"
 	@echo "make install PREFIX=/usr/local"
 
@@ -282,7 +283,8 @@ gltf-validator:
 test: deps-test
 	@$(MAKE) --no-print-directory test-build
 	@$(MAKE) --no-print-directory gltf-validator
-	@LBK=$(BUILD)/lbk-asan BUILD=$(BUILD) FUZZ=$(BUILD)/fuzz_container TSAN_BIN=$(BUILD)/tsan/bin \
+	@LBK=$(BUILD)/lbk-asan LBK_FAULT_SHIM=$(BUILD)/fault_shim.so BUILD=$(BUILD) FUZZ=$(BUILD)/fuzz_container TSAN_BIN=$(BUILD)/tsan/bin \
+	  FUZZ_MORE="$(foreach h,$(FUZZ_HARNESSES),$(h:fuzz_%=%)=$(BUILD)/$(h))" \
 	  GLTF_VALIDATOR=$$(test -f $(GLTF_VALIDATOR)/package.json && echo $(GLTF_VALIDATOR)) \
 	  sh tests/run.sh $(TESTS) install_check_shared install_check_static install_lib_check \
 	    bake_check_shared bake_check_static; \
@@ -324,7 +326,8 @@ tsan: deps-test
 
 # What `make test` builds (after TSAN_TESTS is defined); make test builds it through a sub-make,
 # so that HAVE_VULKAN sees what deps-test installed.
-test-build: $(BUILD)/lbk $(BUILD)/lbk-asan $(TESTS:%=$(BUILD)/tests/%) $(BUILD)/fuzz_container \
+test-build: $(BUILD)/lbk $(BUILD)/lbk-asan $(TESTS:%=$(BUILD)/tests/%) $(BUILD)/fuzz_container $(BUILD)/fault_shim.so \
+            $(FUZZ_HARNESSES:%=$(BUILD)/%) \
             install-check install-lib-check $(TSAN_TESTS:%=$(BUILD)/tsan/bin/%) \
             $(if $(HAVE_VULKAN),$(BUILD)/lbk-gpu-apply)
 
@@ -356,11 +359,43 @@ install-lib-check:
 	    $$($(LIBPC) --cflags lbk) $(LIBSTAGE)/opt/lbk/lib/liblbk.a \
 	    $$($(LIBPC) --static --libs-only-other --libs-only-l lbk | sed 's/-llbk//') -lcmocka
 
+# ---- fault injection: an LD_PRELOAD library that fails or kills at the N-th write call -------
+# (tests/faults/fault_shim.c; test_faults runs the CLI's writers through it)
+$(BUILD)/fault_shim.so: tests/faults/fault_shim.c
+	@mkdir -p $(@D)
+	$(CC) -std=c11 -O1 -g $(WARN) -fPIC -shared $< -o $@ -ldl
+
 # ---- fuzzing (clang libFuzzer) --------------------------------------------------------------
 FUZZ_FLAGS := -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined -g -O1
 $(BUILD)/fuzz_container: tests/fuzz/fuzz_container.c $(LIB_SRC)
 	@mkdir -p $(@D)
 	$(CLANG) $(CSTD) $(FUZZ_FLAGS) $(LIB_FP) $(WARN) $(LIB_INC) -o $@ $^ $(LIB_LIBS)
+# The other harnesses (tests/fuzz/README.md): their objects instrumented once under fuzz-obj/.
+CLANGXX   ?= clang++
+FUZZ_OBJ_FLAGS := -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -g -O1
+FUZZ_LIB_OBJ := $(LIB_SRC:%.c=$(BUILD)/fuzz-obj/%.o)
+FUZZ_HARNESSES := fuzz_gltf fuzz_exr fuzz_profile
+$(BUILD)/fuzz-obj/libformat/%.o: libformat/%.c
+	@mkdir -p $(@D)
+	$(CLANG) $(CSTD) $(FUZZ_OBJ_FLAGS) $(LIB_FP) $(WARN) $(LIB_INC) -MMD -MP -c $< -o $@
+$(BUILD)/fuzz-obj/%.o: %.c
+	@mkdir -p $(@D)
+	$(CLANG) $(CSTD) $(FUZZ_OBJ_FLAGS) $(WARN) $(TOOL_INC) -Wno-unused-command-line-argument -MMD -MP -c $< -o $@
+$(BUILD)/fuzz-obj/%.o: %.cc
+	@mkdir -p $(@D)
+	$(CLANGXX) -std=c++17 $(FUZZ_OBJ_FLAGS) $(CXXWARN) $(TOOL_CXXINC) -MMD -MP -c $< -o $@
+FUZZ_GLTF_OBJ := $(addprefix $(BUILD)/fuzz-obj/,tests/fuzz/fuzz_gltf.o bake/scene/gltf_import.o bake/scene/scene.o \
+                   bake/scene/exr_read.o)
+FUZZ_EXR_OBJ := $(addprefix $(BUILD)/fuzz-obj/,tests/fuzz/fuzz_exr.o bake/scene/exr_read.o bake/scene/scene.o)
+FUZZ_PROFILE_OBJ := $(addprefix $(BUILD)/fuzz-obj/,tests/fuzz/fuzz_profile.o tools/convert/profile.o \
+                      tools/common/lmap_decode.o tools/common/error_util.o tools/common/astc_codec.o)
+$(BUILD)/fuzz_gltf: $(FUZZ_GLTF_OBJ) $(FUZZ_LIB_OBJ)
+	$(CLANGXX) -fsanitize=fuzzer,address,undefined -o $@ $^ $(BAKE_LIBS) $(LIB_LIBS)
+$(BUILD)/fuzz_exr: $(FUZZ_EXR_OBJ) $(FUZZ_LIB_OBJ)
+	$(CLANGXX) -fsanitize=fuzzer,address,undefined -o $@ $^ $(BAKE_LIBS) $(LIB_LIBS)
+$(BUILD)/fuzz_profile: $(FUZZ_PROFILE_OBJ) $(FUZZ_LIB_OBJ)
+	$(CLANGXX) -fsanitize=fuzzer,address,undefined -o $@ $^ -lastcenc $(LIB_LIBS)
+-include $(wildcard $(BUILD)/fuzz-obj/*/*.d $(BUILD)/fuzz-obj/*/*/*.d)
 # The seed corpus (tests/fuzz/README.md): the golden files, the containers make_corpus.c builds
 # (every section type) and two small real bakes. Regenerate by hand; the files are committed.
 .PHONY: fuzz-corpus
@@ -375,7 +410,17 @@ fuzz-corpus: $(BUILD)/liblbk.a $(BUILD)/lbk
 fuzz: deps-test
 	@$(MAKE) --no-print-directory $(BUILD)/fuzz_container
 	@mkdir -p $(BUILD)/fuzz-corpus
-	$(BUILD)/fuzz_container -max_total_time=$${FUZZ_SECONDS:-60} -max_len=65536 $(BUILD)/fuzz-corpus tests/fuzz/corpus
+	$(BUILD)/fuzz_container -max_total_time=$${FUZZ_SECONDS:-60} -max_len=65536 -artifact_prefix=$(BUILD)/ $(BUILD)/fuzz-corpus tests/fuzz/corpus
+	@for h in $(FUZZ_HARNESSES); do n=$${h#fuzz_}; $(MAKE) --no-print-directory $(BUILD)/$$h && mkdir -p $(BUILD)/fuzz-corpus-$$n && \
+	  $(BUILD)/$$h -max_total_time=$${FUZZ_SECONDS:-60} -max_len=65536 -rss_limit_mb=2048 -artifact_prefix=$(BUILD)/ \
+	    $(BUILD)/fuzz-corpus-$$n \
+	    tests/fuzz/corpus_$$n || exit 1; done
+# Hours of fuzzing (FUZZ_HOURS, default 1, per harness, one after the other): a finding stops it
+# with the reproducer in build/ (crash-*, leak-*, timeout-*); what the runs found stays in
+# build/fuzz-corpus*.
+.PHONY: fuzz-long
+fuzz-long:
+	@$(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$$(( $${FUZZ_HOURS:-1} * 3600 ))
 
 # ---- benchmarks -----------------------------------------------------------------------------
 $(BUILD)/bench/%: bench/%.c $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a

@@ -200,6 +200,74 @@ static void remove_stale(const bake_args *o, time_t started)
     if (o->json_report) tl_remove_stale_temps(o->json_report, started - 60, say_removed, "bake");
 }
 
+/* A hard link to the old report under a temporary name of the stale-temp pattern (so that a
+ * crash leaves nothing tl_remove_stale_temps does not clean); 0 and name[0] = 0 when there is
+ * no old report; -1 when the link cannot be made. */
+static int keep_old_report(const char *json, char *name, size_t name_size)
+{
+    name[0] = 0;
+    struct stat st;
+    if (lstat(json, &st) != 0) return errno == ENOENT ? 0 : -1;
+    for (int tries = 0; tries < 8; tries++) {
+        int n = snprintf(name, name_size, "%s.tmp-XXXXXX", json);
+        int fd = n > 0 && (size_t)n < name_size ? mkstemp(name) : -1;
+        if (fd < 0) break;
+        close(fd);
+        unlink(name); /* mkstemp only picked a free name; the link takes it */
+        if (link(json, name) == 0) return 0;
+        if (errno != EEXIST) break;
+    }
+    name[0] = 0;
+    return -1;
+}
+
+/* Puts the report (already complete in json_tmp, or NULL) and the container in place so that an
+ * error leaves both old files: the report goes first, with the old one kept by a hard link, then
+ * the container, the commit point; when the container cannot be written the old report is put
+ * back. A kill between the two renames leaves the new report beside the old container (two
+ * files cannot be replaced atomically together) and the link, which the next run removes. */
+static int commit_outputs(const bake_args *o, lbk_bake_output *out, const char *json_tmp)
+{
+    char old_report[4096] = "";
+    if (json_tmp && keep_old_report(o->json_report, old_report, sizeof old_report) != 0) {
+        fprintf(stderr, "lbk bake: keeping the old report %s while writing: %s\n", o->json_report, strerror(errno));
+        unlink(json_tmp);
+        return LBK_EXIT_IO;
+    }
+    if (json_tmp && rename(json_tmp, o->json_report) != 0) {
+        fprintf(stderr, "lbk bake: writing %s: %s\n", o->json_report, strerror(errno));
+        unlink(json_tmp);
+        if (old_report[0]) unlink(old_report);
+        return LBK_EXIT_IO;
+    }
+    struct stat before;
+    int had = stat(o->output, &before) == 0;
+    lbk_result r = lbk_bake_output_write_file(out, o->output);
+    int saved = errno;
+    if (r == LBK_OK) {
+        if (old_report[0]) unlink(old_report);
+        return LBK_EXIT_OK;
+    }
+    /* the container's rename happened and only the sync of its folder failed: the new file is
+     * complete and in place, and the new report belongs to it */
+    struct stat after;
+    if (r == LBK_ERR_IO && stat(o->output, &after) == 0 && (!had || after.st_ino != before.st_ino)) {
+        if (old_report[0]) unlink(old_report);
+        fprintf(stderr, "lbk bake: %s was written, but syncing its folder failed (it may not survive a power loss): %s\n",
+                o->output, strerror(saved));
+        return LBK_EXIT_IO;
+    }
+    if (json_tmp) {
+        if (old_report[0] ? rename(old_report, o->json_report) != 0 : unlink(o->json_report) != 0)
+            fprintf(stderr, "lbk bake: could not put the old report %s back: %s\n", o->json_report, strerror(errno));
+    }
+    if (r == LBK_ERR_IO)
+        fprintf(stderr, "lbk bake: writing %s: %s\n", o->output, strerror(saved));
+    else
+        fprintf(stderr, "lbk bake: writing %s: %s\n", o->output, lbk_result_message(r));
+    return exit_code(r == LBK_ERR_IO ? r : LBK_ERR_INTERNAL);
+}
+
 static int bake(bake_args *o, int quiet)
 {
     const time_t started = time(NULL);
@@ -219,8 +287,7 @@ static int bake(bake_args *o, int quiet)
         fprintf(stderr, "lbk %s: %s\n", cmd, ui.error[0] ? ui.error : lbk_result_message(r));
         return r == LBK_ERR_INVALID_ARGUMENT && o->merge ? LBK_EXIT_USAGE : exit_code(r);
     }
-    /* Nothing is written on error, the report included: its text goes to a temporary file
-     * beside it first, and replaces the old report only once the container is in place. */
+    /* Nothing is written on error, the report included (commit_outputs). */
     const lbk_bake_report *rep = lbk_bake_output_report(out);
     char json_tmp[4096] = "";
     if (o->json_report && write_report_tmp(rep, o->output, o->json_report, json_tmp, sizeof json_tmp)) {
@@ -228,23 +295,10 @@ static int bake(bake_args *o, int quiet)
         return LBK_EXIT_IO;
     }
     remove_stale(o, started);
-    r = lbk_bake_output_write_file(out, o->output);
-    if (r) {
-        int saved = errno;
-        if (json_tmp[0]) unlink(json_tmp);
-        if (r == LBK_ERR_IO)
-            fprintf(stderr, "lbk bake: writing %s: %s\n", o->output, strerror(saved));
-        else
-            fprintf(stderr, "lbk bake: writing %s: %s\n", o->output, lbk_result_message(r));
+    int code = commit_outputs(o, out, json_tmp[0] ? json_tmp : NULL);
+    if (code != LBK_EXIT_OK) {
         lbk_bake_output_free(out);
-        return exit_code(r == LBK_ERR_IO ? r : LBK_ERR_INTERNAL);
-    }
-    if (json_tmp[0] && rename(json_tmp, o->json_report) != 0) {
-        fprintf(stderr, "lbk bake: %s was written, but not the report %s: %s\n", o->output, o->json_report,
-                strerror(errno));
-        unlink(json_tmp);
-        lbk_bake_output_free(out);
-        return LBK_EXIT_IO;
+        return code;
     }
     cli_progress_done(&ui.bar);
     const lbk_bake_counts *c = &rep->counts;

@@ -47,6 +47,20 @@ if [ -n "${FUZZ:-}" ] && [ -x "$FUZZ" ]; then
   fi
 fi
 
+# The other harnesses (FUZZ_MORE: NAME=BINARY pairs; corpus tests/fuzz/corpus_NAME), each for a
+# fixed number of inputs (FUZZ_MORE_RUNS, default 2000: the glTF importer runs ~150 inputs/s).
+for h in ${FUZZ_MORE:-}; do
+  name=${h%%=*}; bin=${h#*=}
+  [ -x "$bin" ] || continue
+  runs="${FUZZ_MORE_RUNS:-2000}"; scratch="$BUILD/fuzz-scratch-$name"; log="$BUILD/tests/fuzz_$name.log"
+  rm -rf "$scratch"; mkdir -p "$scratch"
+  if "$bin" -runs="$runs" -seed=1 -max_len=65536 -rss_limit_mb=2048 "$scratch" "tests/fuzz/corpus_$name" >"$log" 2>&1; then
+    pass=$((pass + 1)); echo "ok   fuzz_$name ($runs inputs)"
+  else
+    fail=$((fail + 1)); failed="$failed fuzz_$name"; echo "FAIL fuzz_$name"; tail -n 30 "$log"
+  fi
+done
+
 # ThreadSanitizer: any report fails the run (halt_on_error); the suppressions cover Embree and
 # TBB internals only (see the file).
 if [ -n "${TSAN_BIN:-}" ]; then

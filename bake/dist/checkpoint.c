@@ -18,8 +18,8 @@
 #define CK_MAGIC "LBKCKPT\0"
 #define CK_VERSION 1u
 #define CK_HEADER 64u
-#define CK_SAMPLE 64u
-#define CK_SCALARS (8 * 2 + 4 * 2 + 8 * 6 + 8 * 6)
+#define CK_SAMPLE 88u
+#define CK_SCALARS (8 * 6 + 4 * 6 + 4 * 2 + 8 * 6 + 8 * 6)
 
 struct bk_ckpt {
     char dir[4096];
@@ -75,7 +75,7 @@ static lbk_result ck_save(void *user, const bk_transport_state *s)
     uint8_t *buf = malloc(CK_HEADER + pay);
     if (!buf) return LBK_ERR_OUT_OF_MEMORY;
     cur k = {buf + CK_HEADER};
-    w(&k, &s->weight_sum, 8), w(&k, &s->spp, 8), w(&k, s->chain_bounces, 8);
+    w(&k, s->weight_sum, 24), w(&k, s->spp, 24), w(&k, s->active, 12), w(&k, s->stop, 12), w(&k, s->chain_bounces, 8);
     w(&k, s->chain_q, 16), w(&k, s->chain_tail, 16), w(&k, s->chain_total, 16);
     const uint64_t counts[6] = {s->cache_rays, s->cache_shadow, s->cache_nonfinite, s->rays, s->shadow, s->nonfinite};
     w(&k, counts, sizeof counts);
@@ -83,7 +83,7 @@ static lbk_result ck_save(void *user, const bk_transport_state *s)
         const bk_transport_sample *sm = &s->samples[p];
         w(&k, &sm->seconds, 8), w(&k, &sm->samples_per_receiver, 8), w(&k, &sm->est_rel_rmse, 8);
         int32_t ib[2] = {sm->bounces, sm->pass};
-        w(&k, ib, 8), w(&k, sm->class_rel_rmse, 24), w(&k, &sm->probe_rel_rmse, 8);
+        w(&k, ib, 8), w(&k, sm->class_rel_rmse, 24), w(&k, &sm->probe_rel_rmse, 8), w(&k, sm->class_samples, 24);
     }
     for (int h = 0; h < 2; h++) w(&k, s->x_acc[h], 8 * n), w(&k, s->b_acc[h], 8 * n);
     w(&k, s->radiance, n * sizeof(lbk_sh9_rgb));
@@ -151,7 +151,7 @@ static int ck_load(void *user, bk_transport_state *s)
     const size_t n = s->count;
     cur k = {buf};
     s->passes = passes;
-    r(&k, &s->weight_sum, 8), r(&k, &s->spp, 8), r(&k, s->chain_bounces, 8);
+    r(&k, s->weight_sum, 24), r(&k, s->spp, 24), r(&k, s->active, 12), r(&k, s->stop, 12), r(&k, s->chain_bounces, 8);
     r(&k, s->chain_q, 16), r(&k, s->chain_tail, 16), r(&k, s->chain_total, 16);
     uint64_t counts[6];
     r(&k, counts, sizeof counts);
@@ -161,7 +161,7 @@ static int ck_load(void *user, bk_transport_state *s)
         bk_transport_sample *sm = &s->samples[p];
         r(&k, &sm->seconds, 8), r(&k, &sm->samples_per_receiver, 8), r(&k, &sm->est_rel_rmse, 8);
         int32_t ib[2];
-        r(&k, ib, 8), r(&k, sm->class_rel_rmse, 24), r(&k, &sm->probe_rel_rmse, 8);
+        r(&k, ib, 8), r(&k, sm->class_rel_rmse, 24), r(&k, &sm->probe_rel_rmse, 8), r(&k, sm->class_samples, 24);
         sm->bounces = ib[0], sm->pass = ib[1];
     }
     for (int hh2 = 0; hh2 < 2; hh2++) r(&k, s->x_acc[hh2], 8 * n), r(&k, s->b_acc[hh2], 8 * n);

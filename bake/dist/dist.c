@@ -192,7 +192,7 @@ static lbk_result rec_pass(void *user, const bk_transport_pass_record *pr)
     put32(w, (uint32_t)pr->pass);
     put32(w + 4, (uint32_t)pr->bounces);
     putd(w + 8, pr->samples_per_receiver);
-    putd(w + 16, pr->weight_sum);
+    for (int k = 0; k < 3; k++) putd(w + 16 + 8 * k, pr->weight_sum[k]), putd(w + 40 + 8 * k, pr->class_samples[k]);
     w += BK_PART_PASS_HEADER_SIZE;
     for (size_t i = 0; i < n; i++, w += 32) {
         size_t r = (size_t)d->begin + i;
@@ -327,7 +327,7 @@ static lbk_result play_pass(void *user, bk_transport_pass_record *pr)
         if (u == 0) {
             pr->bounces = (int)get32(w + 4);
             pr->samples_per_receiver = getd(w + 8);
-            pr->weight_sum = getd(w + 16);
+            for (int k = 0; k < 3; k++) pr->weight_sum[k] = getd(w + 16 + 8 * k), pr->class_samples[k] = getd(w + 40 + 8 * k);
         } else if (memcmp(w, d->parts[0].runs[d->run] + BK_PART_RUN_HEADER_SIZE +
                                  (size_t)pr->pass * (BK_PART_PASS_HEADER_SIZE + 32 * (size_t)(d->parts[0].end - d->parts[0].begin)),
                           BK_PART_PASS_HEADER_SIZE)) {

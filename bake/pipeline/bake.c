@@ -122,9 +122,15 @@ static void transport_report(void *user, const bk_transport_sample *s)
         b->sample_cap = cap;
     }
     b->samples[b->sample_count++] = *s;
-    bk_events_say(&b->events, LBK_BAKE_SEVERITY_INFO,
-                  "pass %d: %7.0f samples/receiver  est. error %6.2f%%  %2d bounces  %7.1f s", s->pass,
-                  s->samples_per_receiver, 100 * s->est_rel_rmse, s->bounces, s->seconds);
+    if (b->llg_first > b->texel_receivers || b->receiver_count > b->llg_first)
+        bk_events_say(&b->events, LBK_BAKE_SEVERITY_INFO,
+                      "pass %d: %7.0f samples/texel  est. error %6.2f%%, probes %6.2f%% at %.0f samples  %2d bounces  %7.1f s",
+                      s->pass, s->samples_per_receiver, 100 * s->class_rel_rmse[BK_CLASS_TEXEL], 100 * s->probe_rel_rmse,
+                      fmax(s->class_samples[BK_CLASS_GLG], s->class_samples[BK_CLASS_LLG]), s->bounces, s->seconds);
+    else
+        bk_events_say(&b->events, LBK_BAKE_SEVERITY_INFO,
+                      "pass %d: %7.0f samples/receiver  est. error %6.2f%%  %2d bounces  %7.1f s", s->pass,
+                      s->samples_per_receiver, 100 * s->est_rel_rmse, s->bounces, s->seconds);
 }
 
 /* ---- import ---------------------------------------------------------------------------- */

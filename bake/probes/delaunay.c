@@ -227,7 +227,11 @@ static int run_qhull(const double *pts, size_t n, tet_list *out)
     coordT *coords = malloc(3 * n * sizeof *coords);
     uint32_t *ids = NULL, *nids = NULL, *common = NULL;
     angle_item *scratch = NULL;
-    FILE *sink = fopen("/dev/null", "w");
+    /* qhull wants a stream for its messages; an in-memory one needs no file system (a fopen of
+     * /dev/null fails in a sandbox or on a full descriptor table, and was then reported as out
+     * of memory). What qhull writes past the buffer is dropped. */
+    char sink_text[1024];
+    FILE *sink = fmemopen(sink_text, sizeof sink_text, "w");
     if (!qh || !coords || !sink) { status = BK_DELAUNAY_NO_MEMORY; goto done; }
     memcpy(coords, pts, 3 * n * sizeof *coords);
     qh_zero(qh, sink);

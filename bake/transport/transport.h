@@ -75,6 +75,7 @@ typedef struct bk_transport_sample {
      * GLG probes, LLG probes, and the probes together */
     double class_rel_rmse[BK_RECEIVER_CLASSES];
     double probe_rel_rmse;
+    double class_samples[BK_RECEIVER_CLASSES]; /* samples per receiver of each class so far */
 } bk_transport_sample;
 
 /* ---- distributed bakes (bake/dist/DIST.md) ----------------------------------------------
@@ -88,7 +89,8 @@ typedef struct bk_transport_sample {
  * error scalar and the bias probe (indexed by receiver; a unit's are valid in [begin, end)). */
 typedef struct bk_transport_pass_record {
     int pass, bounces;
-    double samples_per_receiver, weight_sum;
+    double samples_per_receiver;  /* the lead class's (bk_transport_stats.samples_per_receiver) */
+    double weight_sum[BK_RECEIVER_CLASSES], class_samples[BK_RECEIVER_CLASSES]; /* per class */
     double *x_acc[2], *b_acc[2];
 } bk_transport_pass_record;
 
@@ -110,7 +112,8 @@ typedef struct bk_transport_totals {
 #define BK_TRANSPORT_MAX_PASSES 32
 typedef struct bk_transport_state {
     int passes;                 /* passes finished */
-    double weight_sum, spp;
+    double weight_sum[BK_RECEIVER_CLASSES], spp[BK_RECEIVER_CLASSES]; /* per receiver class */
+    int active[BK_RECEIVER_CLASSES], stop[BK_RECEIVER_CLASSES];
     int chain_bounces[2];
     double chain_q[2], chain_tail[2], chain_total[2];
     uint64_t cache_rays, cache_shadow, cache_nonfinite, rays, shadow, nonfinite;
@@ -187,9 +190,11 @@ typedef struct bk_transport_options {
     void (*report)(void *user, const bk_transport_sample *sample);
     void *user;
     /* Receivers [0, class_end[0]) are texels, [class_end[0], class_end[1]) GLG probes,
-     * [class_end[1], class_end[2]) LLG probes: the error is then also estimated per class
-     * (bk_transport_sample.class_rel_rmse), and target_error applies to the texels' estimate
-     * (all receivers' when there are no texels). All 0: one class, the estimate over all. */
+     * [class_end[1], class_end[2]) LLG probes (class_end[2] = count): the error is then
+     * estimated per class (bk_transport_sample.class_rel_rmse) and each class samples until
+     * its own estimate reaches target_error (or its budget or the time runs out): probes,
+     * which gather over the whole sphere, go on after the texels have stopped.
+     * All 0: one class, the estimate over all. */
     size_t class_end[BK_RECEIVER_CLASSES];
     /* NULL: a whole run; else a distributed one (above). Copied with the options, so every
      * light-set and door run of a unit or merge is cut the same way. */
@@ -224,6 +229,11 @@ typedef struct bk_transport_stats {
                                 est_rel_rmse, which the two halves measure */
     double class_rel_rmse[BK_RECEIVER_CLASSES]; /* per class, as in bk_transport_sample */
     double probe_rel_rmse;
+    /* gather rays per receiver of each class (both halves, all its passes): classes sample
+     * until their own estimate reaches the target; samples_per_receiver and stop are the
+     * texels' (the first class with receivers when there are no texels: the one that sampled
+     * longest) */
+    double class_samples[BK_RECEIVER_CLASSES];
     int bounces;             /* explicit bounces of the last pass */
     double q;                /* per-bounce energy ratio used for the tail (last pass, mean of halves) */
     double tail_fraction;    /* share of the cache's indirect energy that came from the tail */

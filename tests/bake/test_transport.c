@@ -685,6 +685,78 @@ static void test_nee_unbiased_and_quieter(void **state)
 }
 
 /* The stream path (rtcIntersect1M in chunks) returns exactly what single calls return. */
+/* Receiver classes sample to their own target: probes gather over the whole sphere and are
+ * noisier than texels at equal samples, so when the texels reach the target the probes have
+ * not; they go on alone. Both classes end at or below the target, the probes with more samples,
+ * the run's samples and stop reason are the texels', and the probes' error measured between
+ * two seeds is within 2x of their estimate (the estimate is what the probes get). */
+static void class_run(const bk_scene *s, const bk_receiver *r, size_t nt, size_t n, uint64_t seed, rec *rp,
+                      run_out *ro)
+{
+    bk_transport_options o = fixed_opt(10);
+    o.seed = seed;
+    o.target_error = 0.04;
+    o.class_end[BK_CLASS_TEXEL] = nt;
+    o.class_end[BK_CLASS_GLG] = n;
+    o.class_end[BK_CLASS_LLG] = n;
+    o.report = on_report;
+    o.user = rp;
+    *ro = run(s, r, n, &o);
+}
+
+static void test_classes_sample_to_their_own_target(void **state)
+{
+    (void)state;
+    bk_scene s;
+    nee_room(&s);
+    enum { ALL = 256, NT = 48, NP = 32 };
+    bk_receiver all[ALL], r[NT + NP];
+    nee_receivers(all, ALL);
+    size_t nt = 0, np = 0;
+    for (size_t i = 0; i < ALL; i++) {
+        int probe = all[i].normal[0] == 0 && all[i].normal[1] == 0 && all[i].normal[2] == 0;
+        if (!probe && nt < NT) r[nt++] = all[i];
+    }
+    for (size_t i = 0; i < ALL && np < NP; i++)
+        if (all[i].normal[0] == 0 && all[i].normal[1] == 0 && all[i].normal[2] == 0) r[NT + np++] = all[i];
+    assert_int_equal(nt, NT);
+    assert_int_equal(np, NP);
+    rec ra, rb;
+    memset(&ra, 0, sizeof ra);
+    memset(&rb, 0, sizeof rb);
+    run_out a, b;
+    class_run(&s, r, NT, NT + NP, 3, &ra, &a);
+    class_run(&s, r, NT, NT + NP, 4, &rb, &b);
+    const bk_transport_stats *st = &a.st;
+    print_message("texels %.2f %% at %.0f samples, probes %.2f %% at %.0f samples, %d passes\n",
+                  100 * st->class_rel_rmse[BK_CLASS_TEXEL], st->class_samples[BK_CLASS_TEXEL],
+                  100 * st->class_rel_rmse[BK_CLASS_GLG], st->class_samples[BK_CLASS_GLG], st->passes);
+    assert_int_equal(st->stop, BK_STOP_TARGET);
+    assert_true(st->class_rel_rmse[BK_CLASS_TEXEL] <= 0.04 && st->class_rel_rmse[BK_CLASS_GLG] <= 0.04);
+    assert_true(st->class_samples[BK_CLASS_GLG] > st->class_samples[BK_CLASS_TEXEL]);
+    assert_true(st->samples_per_receiver == st->class_samples[BK_CLASS_TEXEL]);
+    assert_true(st->class_samples[BK_CLASS_LLG] == 0 && st->class_rel_rmse[BK_CLASS_LLG] == 0);
+    /* the case is one where it matters: at the pass the texels stopped, the probes were above */
+    int texel_stop = -1;
+    for (int i = 0; i < ra.n && texel_stop < 0; i++)
+        if (ra.s[i].class_rel_rmse[BK_CLASS_TEXEL] <= 0.04) texel_stop = i;
+    assert_true(texel_stop >= 0 && texel_stop < ra.n - 1);
+    assert_true(ra.s[texel_stop].class_rel_rmse[BK_CLASS_GLG] > 0.04);
+    /* the records after it keep the texels' samples and estimate */
+    for (int i = texel_stop + 1; i < ra.n; i++) {
+        assert_true(ra.s[i].samples_per_receiver == ra.s[texel_stop].samples_per_receiver);
+        assert_true(ra.s[i].class_rel_rmse[BK_CLASS_TEXEL] == ra.s[texel_stop].class_rel_rmse[BK_CLASS_TEXEL]);
+    }
+    /* measured: the difference of two seeds has twice one bake's variance */
+    double measured = rel_rms_diff(a.irr + 3 * NT, b.irr + 3 * NT, r + NT, NP) / sqrt(2.0);
+    print_message("probes: estimated %.2f %%, measured between seeds %.2f %%\n", 100 * st->class_rel_rmse[BK_CLASS_GLG],
+                  100 * measured);
+    assert_true(measured <= 2 * st->class_rel_rmse[BK_CLASS_GLG] && measured >= 0.5 * st->class_rel_rmse[BK_CLASS_GLG]);
+    run_free(&a);
+    run_free(&b);
+    tsc_free(&s);
+}
+
 static void test_stream_equals_single(void **state)
 {
     (void)state;
@@ -734,6 +806,16 @@ static void test_invalid_arguments(void **state)
     assert_int_equal(bk_transport_run(&s, NULL, r, 1, NULL, &out, NULL), LBK_ERR_INVALID_ARGUMENT);
     bk_transport_output none = {NULL, NULL, NULL, NULL};
     assert_int_equal(bk_transport_run(&s, t, r, 1, NULL, &none, NULL), LBK_ERR_INVALID_ARGUMENT);
+    /* class ranges must be ordered and end at the receiver count */
+    bk_transport_options co;
+    memset(&co, 0, sizeof co);
+    co.max_samples = 32;
+    co.class_end[0] = 1; co.class_end[1] = 0; co.class_end[2] = 1;
+    assert_int_equal(bk_transport_run(&s, t, r, 1, &co, &out, NULL), LBK_ERR_INVALID_ARGUMENT);
+    co.class_end[1] = 1; co.class_end[2] = 2;
+    assert_int_equal(bk_transport_run(&s, t, r, 1, &co, &out, NULL), LBK_ERR_INVALID_ARGUMENT);
+    co.class_end[2] = 1;
+    assert_int_equal(bk_transport_run(&s, t, r, 1, &co, &out, NULL), LBK_OK);
     r[0].position[1] = NAN;
     assert_int_equal(bk_transport_run(&s, t, r, 1, NULL, &out, NULL), LBK_ERR_INVALID_ARGUMENT);
     /* zero receivers is fine */
@@ -752,6 +834,7 @@ int main(void)
         cmocka_unit_test(test_closed_box_no_leak),
         cmocka_unit_test(test_light_sets),
         cmocka_unit_test(test_nee_unbiased_and_quieter),
+        cmocka_unit_test(test_classes_sample_to_their_own_target),
         cmocka_unit_test(test_stream_equals_single),
         cmocka_unit_test(test_intensity_extremes),
         cmocka_unit_test(test_scale_and_offset_extremes),

@@ -60,6 +60,7 @@ int tl_read_file(const char *path, void **data, size_t *size, char err[TL_ERR_LE
 
 int tl_write_file_atomic(const char *path, const void *data, size_t size, char err[TL_ERR_LEN])
 {
+    tl_remove_stale_temps(path, 0, NULL, NULL); /* what a killed earlier write of it left */
     size_t plen = strlen(path);
     char *tmp = malloc(plen + 32);
     if (!tmp) {

@@ -13,7 +13,8 @@ int tl_read_file(const char *path, void **data, size_t *size, char err[TL_ERR_LE
 int tl_write_file_atomic(const char *path, const void *data, size_t size, char err[TL_ERR_LEN]);
 /* Removes the temporary files an interrupted write to `path` left beside it: `PATH.tmp-XXXXXX`
  * (liblbk's lbk_writer_to_file, six letters or digits) last modified before `before`, and
- * `PATH.tmp.PID` (tl_write_file_atomic) whose process no longer exists. Nothing else is touched
+ * `PATH.tmp.PID` (tl_write_file_atomic, which removes those of `path` itself before it writes)
+ * whose process no longer exists. Nothing else is touched
  * (other names, non-regular files). `removed` (may be NULL) gets each removed file's path.
  * Returns how many were removed. */
 int tl_remove_stale_temps(const char *path, time_t before, void (*removed)(void *user, const char *file), void *user);

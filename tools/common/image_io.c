@@ -3,6 +3,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,6 +13,7 @@
 #include <spng.h>
 
 #include "tools/common/error_util.h"
+#include "tools/common/file_util.h"
 
 static int find_name(const char *const *names, int count, const char *name)
 {
@@ -28,16 +30,62 @@ static void exr_silent(exr_const_context_t ctx, int code, const char *msg)
 }
 
 
+/* The EXR is encoded into memory (OpenEXRCore's custom stream) and written with
+ * tl_write_file_atomic: a failure names the OS's cause and leaves the old file. */
+typedef struct exr_mem { unsigned char *data; size_t size, cap; int failed; } exr_mem;
+
+static int64_t exr_mem_write(exr_const_context_t ctx, void *user, const void *buf, uint64_t sz, uint64_t offset,
+                             exr_stream_error_func_ptr_t error_cb)
+{
+    exr_mem *m = user;
+    if (offset > SIZE_MAX - sz || offset + sz > ((uint64_t)1 << 34)) {
+        m->failed = 1;
+        if (error_cb) error_cb(ctx, EXR_ERR_OUT_OF_MEMORY, "EXR larger than 16 GiB");
+        return -1;
+    }
+    size_t end = (size_t)(offset + sz);
+    if (end > m->cap) {
+        size_t cap = m->cap ? m->cap : (size_t)1 << 16;
+        while (cap < end) cap *= 2;
+        unsigned char *d = realloc(m->data, cap);
+        if (!d) {
+            m->failed = 1;
+            if (error_cb) error_cb(ctx, EXR_ERR_OUT_OF_MEMORY, "out of memory");
+            return -1;
+        }
+        memset(d + m->cap, 0, cap - m->cap);
+        m->data = d, m->cap = cap;
+    }
+    memcpy(m->data + offset, buf, (size_t)sz);
+    if (end > m->size) m->size = end;
+    return (int64_t)sz;
+}
+
+static int exr_encode(const char *path, int width, int height, int channel_count, const char *const *names,
+                      const float *pixels, exr_mem *mem, char err[TL_ERR_LEN]);
+
 int tl_exr_write(const char *path, int width, int height, int channel_count, const char *const *names,
                  const float *pixels, char err[TL_ERR_LEN])
+{
+    exr_mem mem = {NULL, 0, 0, 0};
+    int rc = exr_encode(path, width, height, channel_count, names, pixels, &mem, err);
+    if (!rc) rc = tl_write_file_atomic(path, mem.data, mem.size, err);
+    free(mem.data);
+    return rc;
+}
+
+static int exr_encode(const char *path, int width, int height, int channel_count, const char *const *names,
+                      const float *pixels, exr_mem *mem, char err[TL_ERR_LEN])
 {
     if (width <= 0 || height <= 0 || channel_count <= 0 || !names || !pixels)
         return tl_fail(err, -1, "%s: nothing to write (%dx%d, %d channels)", path, width, height, channel_count);
     exr_context_t ctx = NULL;
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
     init.error_handler_fn = exr_silent;
-    exr_result_t rv = exr_start_write(&ctx, path, EXR_INTERMEDIATE_TEMP_FILE, &init);
-    if (rv != EXR_ERR_SUCCESS) return tl_fail(err, -1, "%s: cannot create EXR (%s)", path, exr_get_default_error_message(rv));
+    init.user_data = mem;
+    init.write_fn = exr_mem_write;
+    exr_result_t rv = exr_start_write(&ctx, path, EXR_WRITE_FILE_DIRECTLY, &init);
+    if (rv != EXR_ERR_SUCCESS) return tl_fail(err, -1, "%s: cannot encode EXR (%s)", path, exr_get_default_error_message(rv));
     int part = 0;
     rv = exr_add_part(ctx, "lbk", EXR_STORAGE_SCANLINE, &part);
     if (rv == EXR_ERR_SUCCESS) rv = exr_initialize_required_attr_simple(ctx, part, width, height, EXR_COMPRESSION_ZIP);
@@ -77,7 +125,8 @@ int tl_exr_write(const char *path, int width, int height, int channel_count, con
     if (enc_live || enc.channels) exr_encoding_destroy(ctx, &enc);
     exr_result_t fin = exr_finish(&ctx);
     if (rv == EXR_ERR_SUCCESS) rv = fin;
-    if (rv != EXR_ERR_SUCCESS) return tl_fail(err, -1, "%s: EXR write failed (%s)", path, exr_get_default_error_message(rv));
+    if (rv != EXR_ERR_SUCCESS || mem->failed)
+        return tl_fail(err, -1, "%s: EXR encode failed (%s)", path, exr_get_default_error_message(rv));
     return 0;
 }
 
@@ -203,14 +252,13 @@ out:
 
 /* ---- PNG ---------------------------------------------------------------------------------- */
 
+/* Encoded in memory, then written atomically: a failed write leaves the old file. */
 int tl_png_write_rgb8(const char *path, int width, int height, const uint8_t *rgb, char err[TL_ERR_LEN])
 {
     if (width <= 0 || height <= 0) return tl_fail(err, -1, "%s: empty image", path);
-    FILE *f = fopen(path, "wb");
-    if (!f) return tl_fail(err, -1, "%s: %s", path, strerror(errno));
     spng_ctx *ctx = spng_ctx_new(SPNG_CTX_ENCODER);
     int rc = ctx ? 0 : SPNG_EMEM;
-    if (!rc) rc = spng_set_png_file(ctx, f);
+    if (!rc) rc = spng_set_option(ctx, SPNG_ENCODE_TO_BUFFER, 1);
     struct spng_ihdr ihdr = {0};
     ihdr.width = (uint32_t)width;
     ihdr.height = (uint32_t)height;
@@ -218,14 +266,17 @@ int tl_png_write_rgb8(const char *path, int width, int height, const uint8_t *rg
     ihdr.color_type = SPNG_COLOR_TYPE_TRUECOLOR;
     if (!rc) rc = spng_set_ihdr(ctx, &ihdr);
     if (!rc) rc = spng_encode_image(ctx, rgb, (size_t)width * (size_t)height * 3, SPNG_FMT_PNG, SPNG_ENCODE_FINALIZE);
+    size_t size = 0;
+    void *png = NULL;
+    if (!rc) png = spng_get_png_buffer(ctx, &size, &rc);
     spng_ctx_free(ctx);
-    int close_rc = fclose(f);
-    if (rc) {
-        remove(path);
-        return tl_fail(err, -1, "%s: PNG encode failed (%s)", path, spng_strerror(rc));
+    if (rc || !png) {
+        free(png);
+        return tl_fail(err, -1, "%s: PNG encode failed (%s)", path, spng_strerror(rc ? rc : SPNG_EMEM));
     }
-    if (close_rc) return tl_fail(err, -1, "%s: %s", path, strerror(errno));
-    return 0;
+    int w = tl_write_file_atomic(path, png, size, err);
+    free(png);
+    return w;
 }
 
 int tl_png_read_rgb8(const char *path, int *width, int *height, uint8_t **rgb, char err[TL_ERR_LEN])
