@@ -282,7 +282,7 @@ static void test_cli_plan_units_merge(void **state)
     assert_int_equal(sh("%s plan %s -o %s/out.lbk --plan %s/plan.json --units 3 --makefile %s/Makefile %s >/dev/null", lbk,
                         scene, dir, dir, dir, opts), 0);
     /* xargs -P: the documented line */
-    assert_int_equal(sh("mkdir -p %s/parts && seq 0 2 | xargs -P 2 -I K %s bake-unit %s/plan.json K -o %s/parts/part-K.lbkpart "
+    assert_int_equal(sh("mkdir -p %s/parts && seq 0 2 | xargs -P 2 -I {} %s bake-unit %s/plan.json {} -o %s/parts/part-{}.lbkpart "
                         "--threads 1 -q", dir, lbk, dir, dir), 0);
     assert_int_equal(sh("%s merge %s/plan.json %s/parts/part-2.lbkpart %s/parts/part-0.lbkpart %s/parts/part-1.lbkpart -o "
                         "%s/xargs.lbk -q", lbk, dir, dir, dir, dir, dir), 0);
