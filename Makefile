@@ -19,7 +19,10 @@ DEB_TEST_PKGS := $(DEB_TOOL_PKGS) pkg-config libcmocka-dev clang libclang-rt-14-
 # lbk view's tests: node runs the page's container reader against liblbk, headless Chromium
 # (SwiftShader WebGL) loads the page; without them those cases are SKIPPED (counted so).
 VIEW_PKGS     := nodejs chromium
-DEB_PKGS      := $(DEB_TEST_PKGS) $(GPU_PKGS) $(VIEW_PKGS)
+# A single-node Slurm cluster for the distributed-bake test (tests/e2e/slurm_dist.sh, which
+# also installs them itself when run as root).
+SLURM_PKGS    := munge slurmd slurmctld slurm-client
+DEB_PKGS      := $(DEB_TEST_PKGS) $(GPU_PKGS) $(VIEW_PKGS) $(SLURM_PKGS)
 
 WARN     := -Wall -Wextra -Wshadow -Wstrict-prototypes -Wmissing-prototypes -Wno-unused-parameter
 # The glTF shim: its own code warns like the C code; tinygltf, Draco, stb and nlohmann come in

@@ -20,5 +20,8 @@ int lbk_cmd_convert(int argc, char **argv);
 int lbk_cmd_export(int argc, char **argv);
 int lbk_cmd_render(int argc, char **argv);
 int lbk_cmd_view(int argc, char **argv);
+int lbk_cmd_plan(int argc, char **argv);
+int lbk_cmd_bake_unit(int argc, char **argv);
+int lbk_cmd_merge(int argc, char **argv);
 
 #endif

@@ -9,10 +9,12 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "cli/bake_options.h"
 #include "cli/cli.h"
 #include "cli/options.h"
 #include "cli/progress.h"
 #include "lbk/bake.h"
+#include "lbk/bake_dist.h"
 #include "tools/common/file_util.h"
 
 static void help(FILE *f)
@@ -27,7 +29,8 @@ static void help(FILE *f)
           "options:\n"
           "  -o, --output FILE       container to write (atomically; nothing is written on error)\n"
           "  --preset fast|high      quality preset (default fast; see README \"Presets\")\n"
-          "  --target-error X        stop when the estimated relative RMSE drops below X (e.g. 0.02)\n"
+          "  --target-error X|none   stop when the estimated relative RMSE drops below X (e.g. 0.02);\n"
+          "                          none: run every pass --samples allows (a fixed schedule)\n"
           "  --time-limit S          one budget of S seconds for the whole bake (base, light sets,\n"
           "                          doors: equal shares of what is left), then write what converged\n"
           "  --samples N             sample budget per receiver (overrides the preset)\n"
@@ -57,6 +60,14 @@ static void help(FILE *f)
           "  --allow-outside DIR     the scene may also read buffers/images/sky from DIR (by default\n"
           "                          every file it names must lie in its own folder)\n"
           "  -q, --quiet             no progress output\n"
+          "  --checkpoint DIR        after every pass, the bake's state into DIR (atomically)\n"
+          "  --resume DIR            continue a killed bake from its last finished pass: the result\n"
+          "                          is byte-identical to an uninterrupted bake (same options)\n"
+          "  --continue DIR          add passes to a finished bake's checkpoints, up to a lower\n"
+          "                          --target-error or a larger --samples (bake/dist/DIST.md)\n"
+          "  --plan PLAN.json --units N [--makefile FILE] [--sbatch FILE]\n"
+          "                          bake nothing: write the plan of a distributed bake in N units\n"
+          "                          (same as lbk plan; needs --samples N --target-error none)\n"
           "  -h, --help              this text\n"
           "\n"
           "exit codes: 0 ok, 2 usage, 3 I/O error, 4 unusable scene, 5 internal error\n",
@@ -80,10 +91,6 @@ static int same_file(const char *a, const char *b)
     return a && b && stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
 }
 
-typedef struct bake_args {
-    lbk_bake_desc d;
-    const char *input, *output, *json_report;
-} bake_args;
 
 /* What the callbacks share: the bar, and the error text the CLI prints after the bake. */
 typedef struct bake_ui {
@@ -258,10 +265,13 @@ static int bake(bake_args *o, int quiet)
     o->d.message = on_message;
     o->d.user = &ui;
     lbk_bake_output *out = NULL;
-    lbk_result r = lbk_bake_from_file(o->input, &o->d, &out);
+    const char *cmd = o->cmd ? o->cmd : "bake";
+    lbk_result r = o->merge ? lbk_bake_merge_from_file(o->input, &o->d, o->plan_hash, o->units, o->parts, o->part_sizes,
+                                                       o->part_count, &out)
+                            : lbk_bake_from_file(o->input, &o->d, &out);
     if (r) {
-        fprintf(stderr, "lbk bake: %s\n", ui.error[0] ? ui.error : lbk_result_message(r));
-        return exit_code(r);
+        fprintf(stderr, "lbk %s: %s\n", cmd, ui.error[0] ? ui.error : lbk_result_message(r));
+        return r == LBK_ERR_INVALID_ARGUMENT && o->merge ? LBK_EXIT_USAGE : exit_code(r);
     }
     /* Nothing is written on error, the report included (commit_outputs). */
     const lbk_bake_report *rep = lbk_bake_output_report(out);
@@ -289,7 +299,13 @@ static int bake(bake_args *o, int quiet)
     return LBK_EXIT_OK;
 }
 
-int lbk_cmd_bake(int argc, char **argv)
+int cli_bake_flag(const char *a)
+{
+    return !strcmp(a, "--no-glg") || !strcmp(a, "--octahedral") || !strcmp(a, "--block-align") || !strcmp(a, "--timestamp") ||
+           !strcmp(a, "-q") || !strcmp(a, "--quiet") || !strcmp(a, "-h") || !strcmp(a, "--help");
+}
+
+int cli_bake_parse(int argc, char **argv, bake_args *out, int *quiet_out)
 {
     bake_args o;
     memset(&o, 0, sizeof o);
@@ -330,6 +346,30 @@ int lbk_cmd_bake(int argc, char **argv)
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             help(stdout);
             return LBK_EXIT_OK;
+        } else if (!strcmp(a, "--target-error") && v && !strcmp(v, "none")) {
+            i++;
+            o.d.target_error = -1;
+        } else if (!strcmp(a, "--checkpoint") || !strcmp(a, "--resume") || !strcmp(a, "--continue")) {
+            NEED_VALUE;
+            if (o.d.checkpoint_dir) {
+                fprintf(stderr, "lbk bake: one of --checkpoint, --resume, --continue\n");
+                return LBK_EXIT_USAGE;
+            }
+            o.d.checkpoint_dir = v;
+            o.d.resume = strcmp(a, "--checkpoint") != 0;
+            o.continued = !strcmp(a, "--continue");
+        } else if (!strcmp(a, "--plan")) {
+            NEED_VALUE;
+            o.plan = v;
+        } else if (!strcmp(a, "--units")) {
+            NEED_UINT(1, 65536);
+            o.units = (unsigned)u;
+        } else if (!strcmp(a, "--makefile")) {
+            NEED_VALUE;
+            o.makefile = v;
+        } else if (!strcmp(a, "--sbatch")) {
+            NEED_VALUE;
+            o.sbatch = v;
         } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
             NEED_VALUE;
             o.output = v;
@@ -430,6 +470,28 @@ int lbk_cmd_bake(int argc, char **argv)
 #undef NEED_NUMBER
 #undef NEED_UINT
     }
+    *out = o;
+    *quiet_out = quiet;
+    return -1;
+}
+
+int lbk_cmd_bake(int argc, char **argv)
+{
+    bake_args o;
+    int quiet = 0;
+    int rc = cli_bake_parse(argc, argv, &o, &quiet);
+    if (rc >= 0) return rc;
+    if (o.plan || o.units || o.makefile || o.sbatch) {
+        if (o.d.checkpoint_dir) {
+            fprintf(stderr, "lbk bake: a plan's units write parts, not checkpoints: leave out --checkpoint/--resume/--continue\n");
+            return LBK_EXIT_USAGE;
+        }
+        return cli_plan_write(&o, argc, argv, "bake");
+    }
+    if (o.continued && !(o.d.target_error > 0) && o.d.max_samples <= 0) {
+        fprintf(stderr, "lbk bake: --continue needs the new stop: a lower --target-error and/or a larger --samples\n");
+        return LBK_EXIT_USAGE;
+    }
     if (!o.input || !o.output) {
         fprintf(stderr, "lbk bake: need a scene and -o OUT.lbk (lbk bake --help)\n");
         return LBK_EXIT_USAGE;
@@ -448,3 +510,5 @@ int lbk_cmd_bake(int argc, char **argv)
     }
     return bake(&o, quiet);
 }
+
+int cli_bake_run(bake_args *o, int quiet) { return bake(o, quiet); }

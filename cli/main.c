@@ -11,6 +11,9 @@ static const struct {
     const char *summary;
 } commands[] = {
     {"bake", lbk_cmd_bake, "bake a glTF level into a container"},
+    {"plan", lbk_cmd_plan, "cut a bake into units for make -j, xargs -P, Slurm"},
+    {"bake-unit", lbk_cmd_bake_unit, "bake one unit of a plan into a part"},
+    {"merge", lbk_cmd_merge, "merge a plan's parts into the container"},
     {"inspect", lbk_cmd_inspect, "memory per level: sections, texels, probes, sets"},
     {"validate", lbk_cmd_validate, "check a container against spec/validation.md"},
     {"diff", lbk_cmd_diff, "compare the lighting of two bakes"},

@@ -86,5 +86,15 @@ elif sh tests/tools/gltf_validator.sh "$BUILD/lbk" "${LBK:-$BUILD/lbk-asan}" "$G
 else
   fail=$((fail + 1)); failed="$failed gltf_validator"; echo "FAIL gltf_validator"; tail -n 30 "$log"
 fi
+# A distributed bake through a single-node Slurm cluster the script starts and stops itself
+# (tests/e2e/slurm_dist.sh; installs Slurm and munge as root, SKIPPED only when not root and
+# they are missing). Release lbk: the units run in Slurm jobs, ASan adds nothing there.
+log="$BUILD/tests/slurm_dist.log"
+if [ -x "$BUILD/lbk" ] && [ -n "${LBK:-}" ]; then
+  sh tests/e2e/slurm_dist.sh "$BUILD/lbk" >"$log" 2>&1; st=$?
+  if [ $st -eq 0 ]; then pass=$((pass + 1)); echo "ok   slurm_dist ($(tail -n 1 "$log"))"
+  elif [ $st -eq 77 ]; then skip=$((skip + 1)); echo "SKIPPED slurm_dist ($(grep -m1 SKIPPED "$log"))"
+  else fail=$((fail + 1)); failed="$failed slurm_dist"; echo "FAIL slurm_dist"; tail -n 30 "$log"; fi
+fi
 echo "tests: $pass passed, $fail failed, $skip skipped"
 [ -z "$failed" ]

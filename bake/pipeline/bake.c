@@ -10,6 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bake/dist/checkpoint.h"
+#include "bake/dist/dist.h"
 #include "bake/pipeline/encode.h"
 #include "bake/pipeline/pipeline.h"
 #include "bake/pipeline/provenance.h"
@@ -18,6 +20,10 @@
 #include "bake/scene/scene_desc.h"
 #include "bake/transport/denoise.h"
 #include "bake/util/clock.h"
+#include "lbk/bake_dist.h"
+
+#define XXH_INLINE_ALL /* as the rest of the baker: liblbkbake links no xxhash of its own */
+#include <xxhash.h>
 
 const bk_preset bk_presets[LBK_BAKE_PRESET_COUNT_] = {
     [LBK_BAKE_PRESET_FAST] = {"fast", 8.0f, 2.0f, 1024, 0.03, 32},
@@ -441,7 +447,8 @@ static void transport_options(const bk_pipeline *b, bk_transport_options *to)
     to->threads = opt->threads;
     to->max_bounces = opt->max_bounces;
     to->max_samples = opt->max_samples > 0 ? opt->max_samples : b->pre->max_samples;
-    to->target_error = opt->target_error > 0 ? opt->target_error : b->pre->target_error;
+    /* < 0: no target, the passes stop at max_samples (what a distributed bake needs) */
+    to->target_error = opt->target_error > 0 ? opt->target_error : opt->target_error < 0 ? -1 : b->pre->target_error;
     to->time_limit = opt->time_limit;
     to->cell_size = b->cell_size;
     to->footprint = b->texels.footprint;
@@ -449,6 +456,8 @@ static void transport_options(const bk_pipeline *b, bk_transport_options *to)
     to->class_end[BK_CLASS_TEXEL] = b->texel_receivers;
     to->class_end[BK_CLASS_GLG] = b->llg_first;
     to->class_end[BK_CLASS_LLG] = b->receiver_count;
+    to->split = b->dist ? bk_dist_split(b->dist) : NULL;
+    to->checkpoint = b->ckpt && !b->dist ? bk_ckpt_transport(b->ckpt) : NULL;
 }
 
 void bk_pipeline_set_inputs(const bk_pipeline *b, bk_set_inputs *in)
@@ -503,6 +512,7 @@ static lbk_result do_transport(bk_pipeline *b)
     lbk_result r = phase(b, LBK_BAKE_PHASE_LIGHT);
     if (!r) r = build_receivers(b);
     if (!r) r = build_cell_sizes(b);
+    if (!r && b->dist) r = bk_dist_set_receivers(b->dist, b->receiver_count, b->err, sizeof b->err);
     if (r) return r;
     bk_transport_options to;
     transport_options(b, &to);
@@ -542,6 +552,7 @@ static lbk_result do_transport(bk_pipeline *b)
     free(irradiance);
     b->octa_rel_rmse = b->stats.octa_rel_rmse;
     b->octa_rays = b->stats.octa_rays;
+    if (r && b->dist && bk_dist_error(b->dist)[0]) return bk_pipeline_fail(b, r, "%s", bk_dist_error(b->dist));
     if (r) return bk_pipeline_failed(b, r, "light transport");
     if (b->stats.nonfinite)
         bk_events_say(&b->events, LBK_BAKE_SEVERITY_WARNING, "%llu non-finite samples were dropped",
@@ -623,10 +634,32 @@ static lbk_result run(bk_pipeline *b, const char *path, const lbk_bake_scene *de
     if (!r) r = bk_set_bakes_prepare(&b->sets, &b->scene, &b->events, b->err, sizeof b->err);
     if (!r) r = do_transport(b);
     if (!r && b->sets.set_count) r = do_sets(b);
+    if (!r && b->dist && bk_dist_error(b->dist)[0]) r = bk_pipeline_fail(b, LBK_ERR_BAD_INPUT, "%s", bk_dist_error(b->dist));
+    if (b->dist && !r) {
+        /* a unit ends with its part; the merge checks it replayed every run of the parts */
+        void *part = NULL;
+        size_t part_size = 0;
+        r = bk_dist_finish(b->dist, &part, &part_size, b->err, sizeof b->err);
+        if (!r && part) {
+            b->part = part;
+            b->part_size = part_size;
+            if (b->phase_count > 0) b->phase_seconds[b->phase_count - 1] = bk_now() - b->phase_start;
+            return LBK_OK;
+        }
+    }
     if (!r) r = do_denoise(b);
     if (!r && b->sets.set_count) r = emit_sets(b);
     if (!r) r = phase(b, LBK_BAKE_PHASE_WRITE);
     if (!r) r = bk_pipeline_encode(b);
+    if (r && r != LBK_ERR_CANCELLED && b->ckpt && bk_ckpt_error(b->ckpt)[0])
+        r = bk_pipeline_fail(b, bk_ckpt_code(b->ckpt), "%s", bk_ckpt_error(b->ckpt));
+    if (!r && b->ckpt) {
+        int runs = 0, passes = 0;
+        bk_ckpt_counts(b->ckpt, &runs, &passes);
+        if (b->opt->resume)
+            bk_events_say(&b->events, LBK_BAKE_SEVERITY_NOTE, "resumed %d transport runs from %s (%d passes not traced again)",
+                          runs, b->opt->checkpoint_dir, passes);
+    }
     if (b->phase_count > 0) b->phase_seconds[b->phase_count - 1] = bk_now() - b->phase_start;
     if (!r) r = bk_pipeline_report(b, b->out);
     if (r == LBK_ERR_OUT_OF_MEMORY && !b->err[0]) bk_pipeline_fail(b, r, "out of memory");
@@ -714,12 +747,35 @@ static void pipeline_free(bk_pipeline *b)
     bk_scene_free(&b->scene);
 }
 
-static lbk_result bake(const char *path, const lbk_bake_scene *desc, const lbk_bake_desc *options, lbk_bake_output **out)
+static uint64_t options_hash(const lbk_bake_desc *options, int budgets);
+
+/* What a distributed bake cannot cut (lbk/bake_dist.h): a stop that needs every receiver. */
+static lbk_result check_dist(bk_pipeline *b)
+{
+    const lbk_bake_desc *d = &b->desc;
+    if (!(d->target_error < 0))
+        return bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT,
+                                "a distributed bake needs a fixed sample schedule: the error target stops on a sum over "
+                                "every receiver, which no unit has (lbk: --samples N --target-error none)");
+    if (d->time_limit > 0)
+        return bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT,
+                                "a distributed bake cannot have a time limit: the passes it allows depend on the machine, "
+                                "so the units would not agree");
+    if (d->door_method == LBK_BAKE_DOOR_GUIDED)
+        return bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT,
+                                "a distributed bake needs the difference door method (the guided estimator is not cut by "
+                                "receivers yet)");
+    return LBK_OK;
+}
+
+static lbk_result bake(const char *path, const lbk_bake_scene *desc, const lbk_bake_desc *options, lbk_bake_output **out,
+                       bk_dist *dist, void **part, size_t *part_size)
 {
     if (!out) return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
     bk_pipeline *b = calloc(1, sizeof *b);
     if (!b) return LBK_ERR_OUT_OF_MEMORY;
+    b->dist = dist;
     b->start = bk_now();
     b->est = -1;
     b->opt = &b->desc;
@@ -737,15 +793,33 @@ static lbk_result bake(const char *path, const lbk_bake_scene *desc, const lbk_b
         b->input = b->scene_name = desc && desc->name && desc->name[0] ? desc->name : "scene";
     }
     if (!r && !path && !desc) r = bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT, "no scene");
+    /* the octahedral volume's accumulators are neither in parts nor in checkpoints yet */
+    if (!r && b->desc.octahedral_probes && (dist || b->desc.checkpoint_dir))
+        r = bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT,
+                             "octahedral probes (--octahedral) cannot be baked distributed or with checkpoints yet");
+    if (!r && dist) r = check_dist(b);
+    if (!r && !dist && b->desc.checkpoint_dir) {
+        /* the budgets may change between a bake and its --continue; nothing else may */
+        r = bk_ckpt_create(b->desc.checkpoint_dir, b->desc.resume, options_hash(&b->desc, 0), &b->ckpt, b->err, sizeof b->err);
+    } else if (!r && b->desc.resume) {
+        r = bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT, "lbk_bake_desc.resume needs checkpoint_dir");
+    }
     if (!r) r = output_create(b);
     if (!r) r = run(b, path, desc);
     if (r) {
         if (r != LBK_ERR_CANCELLED)
             bk_events_say(&b->events, LBK_BAKE_SEVERITY_ERROR, "%s", b->err[0] ? b->err : lbk_result_message(r));
         lbk_bake_output_free(b->out);
+    } else if (part) {
+        *part = b->part;
+        *part_size = b->part_size;
+        b->part = NULL;
+        lbk_bake_output_free(b->out);
     } else {
         *out = b->out;
     }
+    free(b->part);
+    bk_ckpt_destroy(b->ckpt);
     pipeline_free(b);
     free(b);
     return r;
@@ -757,7 +831,7 @@ lbk_result lbk_bake_from_file(const char *path, const lbk_bake_desc *desc, lbk_b
         if (out) *out = NULL;
         return LBK_ERR_INVALID_ARGUMENT;
     }
-    return bake(path, NULL, desc, out);
+    return bake(path, NULL, desc, out, NULL, NULL, NULL);
 }
 
 lbk_result lbk_bake_from_scene(const lbk_bake_scene *scene, const lbk_bake_desc *desc, lbk_bake_output **out)
@@ -766,10 +840,188 @@ lbk_result lbk_bake_from_scene(const lbk_bake_scene *scene, const lbk_bake_desc 
         if (out) *out = NULL;
         return LBK_ERR_INVALID_ARGUMENT;
     }
-    return bake(NULL, scene, desc, out);
+    return bake(NULL, scene, desc, out, NULL, NULL, NULL);
 }
 
 const char *lbk_bake_preset_name(lbk_bake_preset preset)
 {
     return (unsigned)preset < LBK_BAKE_PRESET_COUNT_ ? bk_presets[preset].name : "unknown";
+}
+
+/* ---- distributed bakes (lbk/bake_dist.h) --------------------------------------------------- */
+
+/* The identity of the options that shape a bake's bytes (not threads, callbacks, allocator):
+ * a part baked with other options is refused by the merge instead of replayed under them. */
+static void hash_str(XXH64_state_t *st, const char *s)
+{
+    XXH64_update(st, s ? s : "", s ? strlen(s) + 1 : 1);
+}
+
+static uint64_t options_hash(const lbk_bake_desc *options, int budgets)
+{
+    lbk_bake_desc d;
+    memset(&d, 0, sizeof d);
+    if (options) memcpy(&d, options, options->size && options->size < sizeof d ? options->size : sizeof d);
+    XXH64_state_t *st = XXH64_createState();
+    if (!st) return 0;
+    XXH64_reset(st, 0x6c626b70);
+    if (!budgets) d.target_error = d.time_limit = 0, d.max_samples = 0;
+    const int64_t ints[] = {d.preset, (int64_t)d.seed, d.max_samples, d.max_bounces, d.sky_override, d.no_glg,
+                            d.octahedral_probes, d.no_seam_stitch, d.door_method, d.denoise, d.timestamp, d.block_align};
+    const double reals[] = {d.target_error, d.time_limit, d.texel_density, d.glg_spacing, d.sky[0], d.sky[1], d.sky[2],
+                            d.dls_threshold};
+    XXH64_update(st, ints, sizeof ints);
+    XXH64_update(st, reals, sizeof reals);
+    hash_str(st, d.sky_exr);
+    hash_str(st, d.revision);
+    hash_str(st, d.allow_outside);
+    uint64_t h = XXH64_digest(st);
+    XXH64_freeState(st);
+    return h;
+}
+
+lbk_result lbk_bake_unit_from_file(const char *path, const lbk_bake_desc *desc, uint64_t plan_hash, uint32_t units,
+                                   uint32_t unit, void **part, size_t *part_size)
+{
+    if (!part || !part_size) return LBK_ERR_INVALID_ARGUMENT;
+    *part = NULL;
+    *part_size = 0;
+    if (!path || units == 0 || units > BK_PART_MAX_UNITS || unit >= units) return LBK_ERR_INVALID_ARGUMENT;
+    bk_dist *d = NULL;
+    lbk_result r = bk_dist_create(0, plan_hash, options_hash(desc, 1), units, unit, NULL, &d);
+    if (r) return r;
+    lbk_bake_output *out = NULL;
+    r = bake(path, NULL, desc, &out, d, part, part_size);
+    bk_dist_destroy(d);
+    return r;
+}
+
+void lbk_bake_part_free(void *part) { free(part); }
+
+lbk_result lbk_bake_part_check(const void *part, size_t size, uint64_t plan_hash, uint32_t units, lbk_bake_part_info *info,
+                               char *err, size_t err_len)
+{
+    bk_part_view v;
+    char why[256];
+    lbk_result r = bk_part_parse(part, size, &v, why, sizeof why);
+    if (r) {
+        if (err && err_len) snprintf(err, err_len, "%s", r == LBK_ERR_OUT_OF_MEMORY ? "out of memory" : why);
+        return r;
+    }
+    free(v.runs);
+    if (info) {
+        memset(info, 0, sizeof *info);
+        info->plan_hash = v.plan_hash;
+        info->units = v.units;
+        info->unit = v.unit;
+        info->runs = v.run_count;
+        info->receivers = v.receiver_count;
+        info->first = v.begin;
+        info->end = v.end;
+    }
+    if (plan_hash && v.plan_hash != plan_hash) {
+        if (err && err_len)
+            snprintf(err, err_len, "belongs to another plan (plan hash %016llx, this plan's is %016llx)",
+                     (unsigned long long)v.plan_hash, (unsigned long long)plan_hash);
+        return LBK_ERR_BAD_INPUT;
+    }
+    if (units && v.units != units) {
+        if (err && err_len) snprintf(err, err_len, "is unit %u of %u, this plan has %u units", v.unit, v.units, units);
+        return LBK_ERR_BAD_INPUT;
+    }
+    return LBK_OK;
+}
+
+static void say_error(const lbk_bake_desc *desc, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void say_error(const lbk_bake_desc *desc, const char *fmt, ...)
+{
+    if (!desc || !desc->message) return;
+    char text[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(text, sizeof text, fmt, ap);
+    va_end(ap);
+    desc->message(desc->user, LBK_BAKE_SEVERITY_ERROR, text);
+}
+
+/* Every part checked and put in unit order before anything is baked: a bad set of parts is
+ * refused in a second, not after the layout. */
+static lbk_result order_parts(const lbk_bake_desc *desc, uint64_t plan_hash, uint32_t units, const void *const *parts,
+                              const size_t *sizes, size_t count, bk_part_view *views)
+{
+    lbk_result r = LBK_OK;
+    size_t k = 0;
+    for (; k < count && !r; k++) {
+        bk_part_view v;
+        char why[256];
+        r = bk_part_parse(parts[k], sizes[k], &v, why, sizeof why);
+        if (r) {
+            say_error(desc, "part %zu: %s", k + 1, r == LBK_ERR_OUT_OF_MEMORY ? "out of memory" : why);
+            break;
+        }
+        if (v.plan_hash != plan_hash) {
+            say_error(desc, "part %zu (unit %u) belongs to another plan (plan hash %016llx, this plan's is %016llx)", k + 1,
+                      v.unit, (unsigned long long)v.plan_hash, (unsigned long long)plan_hash);
+            r = LBK_ERR_BAD_INPUT;
+        } else if (v.units != units) {
+            say_error(desc, "part %zu is unit %u of %u, this plan has %u units", k + 1, v.unit, v.units, units);
+            r = LBK_ERR_BAD_INPUT;
+        } else if (views[v.unit].runs) {
+            say_error(desc, "unit %u is given twice (parts %zu and another)", v.unit, k + 1);
+            r = LBK_ERR_BAD_INPUT;
+        } else if (v.receiver_count != views[0].receiver_count && views[0].runs) {
+            say_error(desc, "part %zu (unit %u) has %llu receivers, unit 0 has %llu", k + 1, v.unit,
+                      (unsigned long long)v.receiver_count, (unsigned long long)views[0].receiver_count);
+            r = LBK_ERR_BAD_INPUT;
+        }
+        if (r) {
+            free(v.runs);
+            break;
+        }
+        views[v.unit] = v;
+    }
+    if (r) return r;
+    char missing[256] = "";
+    size_t nmiss = 0, len = 0;
+    for (uint32_t u = 0; u < units; u++) {
+        if (views[u].runs) continue;
+        if (nmiss++ < 16 && len < sizeof missing - 16) len += (size_t)snprintf(missing + len, sizeof missing - len, "%s%u", nmiss > 1 ? ", " : "", u);
+    }
+    if (nmiss) {
+        say_error(desc, "%zu of %u units missing: %s%s (lbk bake-unit PLAN K for each)", nmiss, units, missing, nmiss > 16 ? ", ..." : "");
+        return LBK_ERR_BAD_INPUT;
+    }
+    for (uint32_t u = 1; u < units; u++)
+        if (views[u].receiver_count != views[0].receiver_count || views[u].run_count != views[0].run_count) {
+            say_error(desc, "unit %u's part disagrees with unit 0's (receivers, runs): the parts come from different "
+                      "scenes, options or lbk versions", u);
+            return LBK_ERR_BAD_INPUT;
+        }
+    return LBK_OK;
+}
+
+lbk_result lbk_bake_merge_from_file(const char *path, const lbk_bake_desc *desc, uint64_t plan_hash, uint32_t units,
+                                    const void *const *parts, const size_t *part_sizes, size_t part_count,
+                                    lbk_bake_output **out)
+{
+    if (!out) return LBK_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!path || units == 0 || units > BK_PART_MAX_UNITS || (part_count && (!parts || !part_sizes))) return LBK_ERR_INVALID_ARGUMENT;
+    bk_part_view *views = calloc(units, sizeof *views);
+    if (!views) return LBK_ERR_OUT_OF_MEMORY;
+    lbk_result r = order_parts(desc, plan_hash, units, parts, part_sizes, part_count, views);
+    bk_dist *d = NULL;
+    const uint64_t oh = options_hash(desc, 1);
+    for (uint32_t u = 0; !r && u < units; u++)
+        if (views[u].options_hash != oh) {
+            say_error(desc, "unit %u's part was baked with other bake options than this merge's (seed, samples, "
+                      "density, ...): it belongs to another bake", u);
+            r = LBK_ERR_BAD_INPUT;
+        }
+    if (!r) r = bk_dist_create(1, plan_hash, oh, units, 0, views, &d);
+    if (!r) r = bake(path, NULL, desc, out, d, NULL, NULL);
+    bk_dist_destroy(d);
+    for (uint32_t u = 0; u < units; u++) free(views[u].runs);
+    free(views);
+    return r;
 }

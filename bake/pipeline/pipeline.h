@@ -82,6 +82,10 @@ typedef struct bk_pipeline {
     float *octa_irradiance;         /* octa.count × 16 × 3, from the transport */
     double octa_rel_rmse, octa_rays;
     lbk_bake_output *out;           /* what the caller gets: the writer (sections.c), the report */
+    struct bk_dist *dist;           /* a distributed bake's unit or merge (bake/dist/dist.h); NULL: local */
+    struct bk_ckpt *ckpt;           /* checkpoints (desc.checkpoint_dir); NULL: none */
+    void *part;                     /* a unit's part, once its runs are done */
+    size_t part_size;
     uint64_t container_bytes;
 } bk_pipeline;
 

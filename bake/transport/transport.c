@@ -214,6 +214,11 @@ typedef struct tp_ctx {
     int max_bounces, s0;
     /* counters: per thread, summed after each parallel step */
     uint64_t *thread_rays, *thread_shadow, *thread_nonfinite;
+    /* the receivers this run gathers ([0, recv_count) unless options.split cuts it) and what
+     * the caches alone traced (a distributed run's global part) */
+    size_t g_begin, g_end;
+    uint64_t cache_rays, cache_shadow, cache_nonfinite;
+    bk_transport_sample samples[BK_TRANSPORT_MAX_PASSES]; /* what each pass reported (checkpoints) */
 } tp_ctx;
 
 /* ---- parallel-for --------------------------------------------------------------------------- */
@@ -1609,6 +1614,16 @@ static int pass_cache_rays(const tp_ctx *c, int pass, size_t active)
 
 /* One pass: both halves' caches, then the final gather at the receivers (in blocks, so
  * progress can be reported). */
+static void count_totals(const tp_ctx *c, uint64_t t[3])
+{
+    t[0] = t[1] = t[2] = 0;
+    for (int k = 0; k < c->threads; k++) {
+        t[0] += c->thread_rays[k];
+        t[1] += c->thread_shadow[k];
+        t[2] += c->thread_nonfinite[k];
+    }
+}
+
 static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
 {
     size_t active = 0;
@@ -1616,7 +1631,13 @@ static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
         if (c->cls[k].active) active += c->cls[k].end - c->cls[k].begin;
     int cache_rays = pass_cache_rays(c, pass, active);
     for (int h = 0; h < 2; h++) {
+        uint64_t before[3], after[3];
+        count_totals(c, before);
         chain[h] = run_chain(c, h, pass, cache_rays, c->tail_tol, c->max_bounces);
+        count_totals(c, after);
+        c->cache_rays += after[0] - before[0];
+        c->cache_shadow += after[1] - before[1];
+        c->cache_nonfinite += after[2] - before[2];
         if (chain[h].bounces < 0) return LBK_ERR_OUT_OF_MEMORY;
         if (report_progress(c, "cache", c->spp)) return LBK_ERR_CANCELLED;
     }
@@ -1629,7 +1650,10 @@ static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
         if (!c->cls[k].active) continue;
         for (size_t b = c->cls[k].begin; b < c->cls[k].end; b += block) {
             size_t e = b + block < c->cls[k].end ? b + block : c->cls[k].end;
-            parallel_range(c, b, e, 16, recv_gather);
+            /* a distributed run gathers only its own receivers; each receiver's result depends
+             * on nothing but its own streams, so the cut changes no value */
+            size_t gb = b > c->g_begin ? b : c->g_begin, ge = e < c->g_end ? e : c->g_end;
+            if (gb < ge) parallel_range(c, gb, ge, 16, recv_gather);
             done += e - b;
             if (report_progress(c, "gather", c->spp + 2.0 * c->rays * (double)done / (double)(active ? active : 1)))
                 return LBK_ERR_CANCELLED;
@@ -1664,19 +1688,20 @@ typedef struct tp_errors {
  * product is an unbiased estimate of each receiver's squared bias. Relative to the RMS of the
  * receivers' values. */
 
-static void estimate_error(const tp_ctx *c, double *noise, double *bias, tp_errors *ce)
+static void estimate_error_of(const tp_class *cls, int ncls, double *const x_acc[2], double *const b_acc[2], double *noise,
+                              double *bias, tp_errors *ce)
 {
     double num = 0, den = 0, bb = 0, cnum[BK_RECEIVER_CLASSES] = {0}, cden[BK_RECEIVER_CLASSES] = {0};
-    for (int k = 0; k < c->ncls; k++) {
-        const tp_class *cl = &c->cls[k];
+    for (int k = 0; k < ncls; k++) {
+        const tp_class *cl = &cls[k];
         if (!(cl->weight_sum > 0)) continue;
         const double inv = 1 / cl->weight_sum;
         for (size_t i = cl->begin; i < cl->end; i++) {
-            double a = c->x_acc[0][i] * inv, b = c->x_acc[1][i] * inv;
+            double a = x_acc[0][i] * inv, b = x_acc[1][i] * inv;
             double m = 0.5 * (a + b), v = 0.25 * (a - b) * (a - b);
             cnum[k] += v;
             cden[k] += m * m;
-            bb += (c->b_acc[0][i] * inv) * (c->b_acc[1][i] * inv);
+            bb += (b_acc[0][i] * inv) * (b_acc[1][i] * inv);
         }
         num += cnum[k];
         den += cden[k];
@@ -1685,6 +1710,11 @@ static void estimate_error(const tp_ctx *c, double *noise, double *bias, tp_erro
     *bias = den > 0 && bb > 0 ? sqrt(bb / den) : 0;
     for (int k = 0; k < BK_RECEIVER_CLASSES; k++) ce->cls[k] = cden[k] > 0 ? sqrt(cnum[k] / cden[k]) : 0;
     ce->probe = cden[1] + cden[2] > 0 ? sqrt((cnum[1] + cnum[2]) / (cden[1] + cden[2])) : 0;
+}
+
+static void estimate_error(const tp_ctx *c, double *noise, double *bias, tp_errors *ce)
+{
+    estimate_error_of(c->cls, c->ncls, c->x_acc, c->b_acc, noise, bias, ce);
 }
 
 /* Which classes stop after this pass: a class whose estimate reached the target, or whose next
@@ -1744,7 +1774,7 @@ static void finish_outputs(tp_ctx *c)
     if (c->light_count) {
         float *pl = c->punct_lum;
         c->punct_lum = NULL; /* recv_punctual now writes into the outputs */
-        parallel_for(c, c->recv_count, 64, recv_punctual);
+        parallel_range(c, c->g_begin, c->g_end, 64, recv_punctual);
         c->punct_lum = pl;
     }
 }
@@ -1801,6 +1831,170 @@ static void fill_stats(const tp_ctx *c, int passes, double err, double bias, con
     stats->nee = c->nee;
 }
 
+/* ---- distributed runs (bk_transport_split) ------------------------------------------------ */
+
+static lbk_result record_pass(const tp_ctx *c, int pass, const tp_chain_result chain[2])
+{
+    const bk_transport_split *sp = c->opt->split;
+    bk_transport_pass_record pr;
+    memset(&pr, 0, sizeof pr);
+    pr.pass = pass;
+    pr.bounces = chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces;
+    pr.samples_per_receiver = lead_class(c)->spp;
+    for (int k = 0; k < c->ncls; k++) pr.weight_sum[k] = c->cls[k].weight_sum, pr.class_samples[k] = c->cls[k].spp;
+    for (int h = 0; h < 2; h++) pr.x_acc[h] = c->x_acc[h], pr.b_acc[h] = c->b_acc[h];
+    return sp->record_pass(sp->user, &pr);
+}
+
+static void totals_of(const tp_ctx *c, int passes, const tp_chain_result chain[2], bk_transport_totals *t)
+{
+    memset(t, 0, sizeof *t);
+    uint64_t all[3];
+    count_totals(c, all);
+    t->passes = passes;
+    t->stop = lead_class(c)->stop;
+    t->nee = c->nee;
+    t->bounces = chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces;
+    t->q = 0.5 * (chain[0].q + chain[1].q);
+    double tot = chain[0].total_energy + chain[1].total_energy;
+    t->tail_fraction = tot > 0 ? (chain[0].tail_energy + chain[1].tail_energy) / tot : 0;
+    t->cells = c->cell_count;
+    t->cache_rays = c->cache_rays, t->cache_shadow = c->cache_shadow, t->cache_nonfinite = c->cache_nonfinite;
+    t->recv_rays = all[0] - c->cache_rays, t->recv_shadow = all[1] - c->cache_shadow;
+    t->recv_nonfinite = all[2] - c->cache_nonfinite;
+}
+
+/* The merge: every pass's estimate and report from the units' accumulators, then their outputs,
+ * then the stats, as the run over all receivers computed them. */
+static lbk_result replay_run(tp_ctx *c, bk_transport_stats *stats)
+{
+    const bk_transport_options *opt = c->opt;
+    const bk_transport_split *sp = opt->split;
+    init_classes(c);
+    bk_transport_totals t;
+    memset(&t, 0, sizeof t);
+    lbk_result res = sp->replay_totals(sp->user, c->recv_count, &t);
+    if (res) return res;
+    bk_transport_pass_record pr;
+    memset(&pr, 0, sizeof pr);
+    const size_t n = c->recv_count ? c->recv_count : 1;
+    for (int h = 0; h < 2; h++) {
+        pr.x_acc[h] = calloc(n, sizeof(double));
+        pr.b_acc[h] = calloc(n, sizeof(double));
+        if (!pr.x_acc[h] || !pr.b_acc[h]) res = LBK_ERR_OUT_OF_MEMORY;
+    }
+    double err = 0, bias = 0;
+    tp_errors ce = {{0}, 0};
+    for (int pass = 0; !res && pass < t.passes; pass++) {
+        pr.pass = pass;
+        res = sp->replay_pass(sp->user, &pr);
+        if (res) break;
+        for (int k = 0; k < c->ncls; k++) c->cls[k].weight_sum = pr.weight_sum[k], c->cls[k].spp = pr.class_samples[k];
+        estimate_error_of(c->cls, c->ncls, pr.x_acc, pr.b_acc, &err, &bias, &ce);
+        if (opt->report) {
+            bk_transport_sample smp = {now_seconds() - c->t0, pr.samples_per_receiver, err, pr.bounces, pass,
+                                       {ce.cls[0], ce.cls[1], ce.cls[2]}, ce.probe,
+                                       {c->cls[0].spp, c->cls[1].spp, c->cls[2].spp}};
+            opt->report(opt->user, &smp);
+        }
+        if (opt->progress && opt->progress(opt->user, "gather", (double)(pass + 1) / t.passes)) res = LBK_ERR_CANCELLED;
+    }
+    for (int h = 0; h < 2; h++) free(pr.x_acc[h]), free(pr.b_acc[h]);
+    if (!res) res = sp->replay_outputs(sp->user, c->out);
+    if (res || !stats) return res;
+    for (int k = 0; k < BK_RECEIVER_CLASSES; k++) stats->class_rel_rmse[k] = ce.cls[k];
+    stats->probe_rel_rmse = ce.probe;
+    stats->seconds = now_seconds() - c->t0;
+    stats->passes = t.passes;
+    stats->samples_per_receiver = pr.samples_per_receiver;
+    for (int k = 0; k < c->ncls; k++) stats->class_samples[k] = c->cls[k].spp;
+    stats->est_rel_rmse = err;
+    stats->est_cache_bias = bias;
+    stats->bounces = t.bounces;
+    stats->q = t.q;
+    stats->tail_fraction = t.tail_fraction;
+    stats->cells = (size_t)t.cells;
+    stats->rays = t.cache_rays + t.recv_rays;
+    stats->shadow_rays = t.cache_shadow + t.recv_shadow;
+    stats->nonfinite = t.cache_nonfinite + t.recv_nonfinite;
+    stats->stop = t.stop;
+    stats->nee = t.nee;
+    return LBK_OK;
+}
+
+/* ---- checkpoints (bk_transport_checkpoint) ------------------------------------------------ */
+
+static void state_arrays(tp_ctx *c, bk_transport_state *st)
+{
+    st->count = c->recv_count;
+    for (int h = 0; h < 2; h++) st->x_acc[h] = c->x_acc[h], st->b_acc[h] = c->b_acc[h];
+    st->radiance = c->out->radiance;
+    st->direct = c->out->direct;
+    st->irradiance = c->out->irradiance;
+}
+
+static lbk_result save_state(tp_ctx *c, int pass, const tp_chain_result chain[2])
+{
+    const bk_transport_checkpoint *ck = c->opt->checkpoint;
+    bk_transport_state *st = calloc(1, sizeof *st);
+    if (!st) return LBK_ERR_OUT_OF_MEMORY;
+    state_arrays(c, st);
+    st->passes = pass + 1;
+    for (int k = 0; k < BK_RECEIVER_CLASSES; k++) {
+        st->weight_sum[k] = c->cls[k].weight_sum, st->spp[k] = c->cls[k].spp;
+        st->active[k] = c->cls[k].active, st->stop[k] = c->cls[k].stop;
+    }
+    for (int h = 0; h < 2; h++) {
+        st->chain_bounces[h] = chain[h].bounces;
+        st->chain_q[h] = chain[h].q;
+        st->chain_tail[h] = chain[h].tail_energy;
+        st->chain_total[h] = chain[h].total_energy;
+    }
+    uint64_t all[3];
+    count_totals(c, all);
+    st->rays = all[0], st->shadow = all[1], st->nonfinite = all[2];
+    st->cache_rays = c->cache_rays, st->cache_shadow = c->cache_shadow, st->cache_nonfinite = c->cache_nonfinite;
+    memcpy(st->samples, c->samples, sizeof st->samples);
+    lbk_result r = ck->save(ck->user, st);
+    free(st);
+    return r;
+}
+
+/* The run's last saved state, if any: *passes gets how many passes it holds (0: none). */
+static lbk_result load_state(tp_ctx *c, tp_chain_result chain[2], int *passes)
+{
+    const bk_transport_checkpoint *ck = c->opt->checkpoint;
+    *passes = 0;
+    bk_transport_state *st = calloc(1, sizeof *st);
+    if (!st) return LBK_ERR_OUT_OF_MEMORY;
+    state_arrays(c, st);
+    int got = ck->load(ck->user, st);
+    lbk_result r = got < 0 ? (lbk_result)(-got) : LBK_OK;
+    if (got == 1 && (st->passes < 1 || st->passes > BK_TRANSPORT_MAX_PASSES)) r = LBK_ERR_BAD_INPUT;
+    if (got == 1 && !r) {
+        *passes = st->passes;
+        for (int k = 0; k < BK_RECEIVER_CLASSES; k++) {
+            c->cls[k].weight_sum = st->weight_sum[k], c->cls[k].spp = st->spp[k];
+            c->cls[k].active = st->active[k], c->cls[k].stop = st->stop[k];
+            if (k < c->ncls && c->cls[k].spp > c->spp) c->spp = c->cls[k].spp;
+        }
+        for (int h = 0; h < 2; h++) {
+            chain[h].bounces = st->chain_bounces[h];
+            chain[h].q = st->chain_q[h];
+            chain[h].tail_energy = st->chain_tail[h];
+            chain[h].total_energy = st->chain_total[h];
+        }
+        /* the counters as they stood after that pass (the punctual pass before it, just redone,
+         * is in them already) */
+        for (int t = 0; t < c->threads; t++) c->thread_rays[t] = c->thread_shadow[t] = c->thread_nonfinite[t] = 0;
+        c->thread_rays[0] = st->rays, c->thread_shadow[0] = st->shadow, c->thread_nonfinite[0] = st->nonfinite;
+        c->cache_rays = st->cache_rays, c->cache_shadow = st->cache_shadow, c->cache_nonfinite = st->cache_nonfinite;
+        memcpy(c->samples, st->samples, sizeof c->samples);
+    }
+    free(st);
+    return r;
+}
+
 lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, const bk_receiver *receivers,
                             size_t count, const bk_transport_options *options,
                             const bk_transport_output *output, bk_transport_stats *stats)
@@ -1812,6 +2006,9 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
     if (stats) memset(stats, 0, sizeof *stats);
     lbk_result res = check_inputs(scene, tracer, receivers, count, opt, output);
     if (res != LBK_OK) return res;
+    const bk_transport_split *split = opt->split;
+    if (split && (!(opt->target_error < 0) || opt->time_limit > 0 || split->begin > split->end || split->end > count))
+        return LBK_ERR_INVALID_ARGUMENT; /* a stop that needs every receiver cannot be cut */
 
     tp_ctx c;
     memset(&c, 0, sizeof c);
@@ -1831,6 +2028,12 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
     c.target = opt->target_error == 0 ? 0.01 : opt->target_error;
     c.s0 = opt->first_pass_samples > 0 ? opt->first_pass_samples : 16;
     c.tail_tol = fmax(0.1 * (c.target > 0 ? c.target : 0.001), 1e-5);
+    c.g_begin = split ? split->begin : 0;
+    c.g_end = split ? split->end : count;
+    if (split && split->replay) {
+        res = replay_run(&c, stats);
+        goto done;
+    }
     res = ctx_init(&c);
     if (res != LBK_OK) goto done;
     init_classes(&c);
@@ -1841,32 +2044,53 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
         if (output->irradiance) output->irradiance[3 * i] = output->irradiance[3 * i + 1] = output->irradiance[3 * i + 2] = 0;
     }
     if (c.oct_count) memset(output->octa_irradiance, 0, c.oct_count * 48 * sizeof(float));
-    if (c.light_count) parallel_for(&c, count, 64, recv_punctual); /* luminance only, for the error */
+    if (c.light_count) parallel_range(&c, c.g_begin, c.g_end, 64, recv_punctual); /* luminance only, for the error */
 
     double err = 0, bias = 0;
     tp_errors ce = {{0}, 0};
     int pass = 0;
     tp_chain_result chain[2] = {{0, 0, 0, 0}, {0, 0, 0, 0}};
+    if (opt->checkpoint && !split) {
+        int done_passes = 0;
+        res = load_state(&c, chain, &done_passes);
+        if (res != LBK_OK) goto done;
+        if (done_passes > 0) {
+            /* resumed: the saved passes' reports again, then the stop rule after the last one */
+            if (opt->report)
+                for (int p = 0; p < done_passes; p++) opt->report(opt->user, &c.samples[p]);
+            estimate_error(&c, &err, &bias, &ce);
+            pass = done_passes - 1;
+            if (stop_after(&c, pass, &ce, 0)) goto finished;
+            pass = done_passes;
+        }
+    }
     for (;; pass++) {
         double pass_start = now_seconds();
         res = run_pass(&c, pass, chain);
         if (res != LBK_OK) goto done;
         estimate_error(&c, &err, &bias, &ce);
-        if (opt->report) {
-            bk_transport_sample smp = {now_seconds() - t0, lead_class(&c)->spp, err,
-                                       chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces, pass,
-                                       {ce.cls[0], ce.cls[1], ce.cls[2]}, ce.probe,
-                                       {c.cls[0].spp, c.cls[1].spp, c.cls[2].spp}};
-            opt->report(opt->user, &smp);
-        }
+        if (split && (res = record_pass(&c, pass, chain)) != LBK_OK) goto done;
+        bk_transport_sample smp = {now_seconds() - t0, lead_class(&c)->spp, err,
+                                   chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces, pass,
+                                   {ce.cls[0], ce.cls[1], ce.cls[2]}, ce.probe,
+                                   {c.cls[0].spp, c.cls[1].spp, c.cls[2].spp}};
+        if (pass < BK_TRANSPORT_MAX_PASSES) c.samples[pass] = smp;
+        if (opt->report) opt->report(opt->user, &smp);
+        if (opt->checkpoint && !split && (res = save_state(&c, pass, chain)) != LBK_OK) goto done;
         if (stop_after(&c, pass, &ce, now_seconds() - pass_start)) break;
     }
+finished:
     finish_outputs(&c);
     const double oct_err = c.oct_count ? octa_finish(&c) : 0;
     if (stats) {
         fill_stats(&c, pass + 1, err, bias, &ce, chain, stats);
         stats->octa_rel_rmse = oct_err;
         stats->octa_rays = c.oct_total;
+    }
+    if (split) {
+        bk_transport_totals t;
+        totals_of(&c, pass + 1, chain, &t);
+        res = split->record_done(split->user, output, &t);
     }
 done:
     free_ctx(&c);

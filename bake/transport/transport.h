@@ -78,6 +78,77 @@ typedef struct bk_transport_sample {
     double class_samples[BK_RECEIVER_CLASSES]; /* samples per receiver of each class so far */
 } bk_transport_sample;
 
+/* ---- distributed bakes (bake/dist/DIST.md) ----------------------------------------------
+ * A run cut by receivers: a unit gathers only receivers [begin, end) and hands what it computed
+ * to `record_*`; the merge replays every unit's record instead of tracing (`replay_*`), so the
+ * error estimates, the report and the stats are computed from the same numbers in the same
+ * order as a run over all receivers (byte-identical). Only runs whose stop does not depend on
+ * the estimate can be cut: target_error < 0 and no time_limit (else LBK_ERR_INVALID_ARGUMENT). */
+
+/* One finished pass. x_acc/b_acc: per receiver, per half, the pass-weighted accumulators of the
+ * error scalar and the bias probe (indexed by receiver; a unit's are valid in [begin, end)). */
+typedef struct bk_transport_pass_record {
+    int pass, bounces;
+    double samples_per_receiver;  /* the lead class's (bk_transport_stats.samples_per_receiver) */
+    double weight_sum[BK_RECEIVER_CLASSES], class_samples[BK_RECEIVER_CLASSES]; /* per class */
+    double *x_acc[2], *b_acc[2];
+} bk_transport_pass_record;
+
+/* What a run adds up to. The cache's part is global (every unit traces it alike); the
+ * receivers' part is the unit's own. */
+typedef struct bk_transport_totals {
+    int passes, stop, nee, bounces;
+    double q, tail_fraction;
+    uint64_t cells;
+    uint64_t cache_rays, cache_shadow, cache_nonfinite;
+    uint64_t recv_rays, recv_shadow, recv_nonfinite;
+} bk_transport_totals;
+
+/* ---- checkpoints (resume after a crash, continue to a lower error) -------------------------
+ * After every pass the run's whole state is handed to `save`; at the start of a run `load` may
+ * hand back the state of its last saved pass, and the run goes on from there: the passes that
+ * follow are the ones an uninterrupted run makes (every pass depends only on the seed and its
+ * index, never on the caches of the pass before), so the result is byte-identical. */
+#define BK_TRANSPORT_MAX_PASSES 32
+typedef struct bk_transport_state {
+    int passes;                 /* passes finished */
+    double weight_sum[BK_RECEIVER_CLASSES], spp[BK_RECEIVER_CLASSES]; /* per receiver class */
+    int active[BK_RECEIVER_CLASSES], stop[BK_RECEIVER_CLASSES];
+    int chain_bounces[2];
+    double chain_q[2], chain_tail[2], chain_total[2];
+    uint64_t cache_rays, cache_shadow, cache_nonfinite, rays, shadow, nonfinite;
+    size_t count;
+    /* per receiver (count): the halves' accumulators and the outputs' running sums (before the
+     * final normalisation); radiance always, direct/irradiance as the run's outputs have them */
+    double *x_acc[2], *b_acc[2];
+    void *radiance, *direct;    /* lbk_sh9_rgb arrays */
+    float *irradiance;
+    bk_transport_sample samples[BK_TRANSPORT_MAX_PASSES]; /* what each pass reported */
+} bk_transport_state;
+
+typedef struct bk_transport_checkpoint {
+    void *user;
+    lbk_result (*save)(void *user, const bk_transport_state *state);
+    /* fills state (its arrays allocated by the transport for state->count receivers, NULL where
+     * the run has no such output): 1 when a saved state was loaded, 0 when there is none, else
+     * an lbk_result error (negated) */
+    int (*load)(void *user, bk_transport_state *state);
+} bk_transport_checkpoint;
+
+struct bk_transport_output;
+typedef struct bk_transport_split {
+    int replay;            /* 0: record (a unit), 1: replay (the merge) */
+    size_t begin, end;     /* record: the receivers this unit gathers */
+    void *user;
+    lbk_result (*record_pass)(void *user, const bk_transport_pass_record *pass);
+    lbk_result (*record_done)(void *user, const struct bk_transport_output *out, const bk_transport_totals *totals);
+    /* replay: totals summed over the units; then every pass (arrays of `count` entries
+     * allocated by the transport, filled by the callee); then the outputs of every receiver */
+    lbk_result (*replay_totals)(void *user, size_t count, bk_transport_totals *totals);
+    lbk_result (*replay_pass)(void *user, bk_transport_pass_record *pass);
+    lbk_result (*replay_outputs)(void *user, const struct bk_transport_output *out);
+} bk_transport_split;
+
 typedef struct bk_transport_options {
     uint64_t seed;
     int threads;             /* 0: all online cores */
@@ -134,6 +205,11 @@ typedef struct bk_transport_options {
     const float *octa_points;
     size_t octa_count;
     int octa_ray_factor;
+    /* NULL: a whole run; else a distributed one (above). Copied with the options, so every
+     * light-set and door run of a unit or merge is cut the same way. */
+    const bk_transport_split *split;
+    /* NULL: none; else checkpoints after every pass and resumption (above). Not with split. */
+    const bk_transport_checkpoint *checkpoint;
 } bk_transport_options;
 
 /* Caller-owned output arrays, `count` entries each; NULL pointers are skipped. */

@@ -118,7 +118,9 @@ typedef struct lbk_bake_desc {
     lbk_bake_preset preset;     /* [fast] */
     int threads;                /* worker threads [0: one per online core] */
     uint64_t seed;              /* used as given, 0 included (`lbk bake` passes 1 unless --seed) */
-    double target_error;        /* stop when the estimated relative RMSE reaches this; <= 0: preset */
+    double target_error;        /* stop when the estimated relative RMSE reaches this; 0: preset;
+                                   < 0: no target, every pass max_samples allows (a fixed schedule:
+                                   what a distributed bake needs, lbk/bake_dist.h) */
     double time_limit;          /* seconds for the whole bake from the call, base + every light-set
                                    and door run: each run gets an equal share of what is left;
                                    every run completes at least one pass, and the guided door
@@ -153,6 +155,14 @@ typedef struct lbk_bake_desc {
     int block_align;            /* 1: every chart starts and ends on a 4-texel boundary, so a 4×4
                                    block of a block-compressed pack (lbk convert, BC6H/ASTC) never
                                    holds two charts [0: packed tight] */
+    /* added in 1.2 */
+    const char *checkpoint_dir; /* after every pass of every transport run, its state into this
+                                   folder (made if missing), atomically [NULL: none] */
+    int resume;                 /* 1 with checkpoint_dir: runs with a checkpoint continue from
+                                   their last finished pass (a killed bake ends byte-identical to
+                                   an uninterrupted one; a finished bake given a lower
+                                   target_error or a larger max_samples adds passes) [0: a fresh
+                                   bake, checkpoints of an earlier one in the folder removed] */
 } lbk_bake_desc;
 
 /* ---- in-memory scenes ----------------------------------------------------------------------

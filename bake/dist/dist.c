@@ -1,0 +1,454 @@
+/* Distributed bakes: the part format (spec/part.md) and the transport's record and replay
+ * (bk_transport_split). Multi-byte values are little-endian; floats are IEEE-754 bit patterns. */
+#include "bake/dist/dist.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define XXH_INLINE_ALL /* as the rest of the baker: liblbkbake links no xxhash of its own */
+#include <xxhash.h>
+
+/* ---- little-endian bytes ------------------------------------------------------------------ */
+
+static void put64(uint8_t *p, uint64_t v)
+{
+    for (int k = 0; k < 8; k++) p[k] = (uint8_t)(v >> (8 * k));
+}
+static void put32(uint8_t *p, uint32_t v)
+{
+    for (int k = 0; k < 4; k++) p[k] = (uint8_t)(v >> (8 * k));
+}
+static uint64_t get64(const uint8_t *p)
+{
+    uint64_t v = 0;
+    for (int k = 0; k < 8; k++) v |= (uint64_t)p[k] << (8 * k);
+    return v;
+}
+static uint32_t get32(const uint8_t *p)
+{
+    uint32_t v = 0;
+    for (int k = 0; k < 4; k++) v |= (uint32_t)p[k] << (8 * k);
+    return v;
+}
+static void putd(uint8_t *p, double d)
+{
+    uint64_t v;
+    memcpy(&v, &d, 8);
+    put64(p, v);
+}
+static double getd(const uint8_t *p)
+{
+    uint64_t v = get64(p);
+    double d;
+    memcpy(&d, &v, 8);
+    return d;
+}
+static void putf(uint8_t *p, float f)
+{
+    uint32_t v;
+    memcpy(&v, &f, 4);
+    put32(p, v);
+}
+static float getf(const uint8_t *p)
+{
+    uint32_t v = get32(p);
+    float f;
+    memcpy(&f, &v, 4);
+    return f;
+}
+
+typedef struct buf {
+    uint8_t *p;
+    size_t n, cap;
+    int failed;
+} buf;
+
+static uint8_t *buf_grow(buf *b, size_t more)
+{
+    if (b->failed) return NULL;
+    if (more > SIZE_MAX / 2 - b->n) { b->failed = 1; return NULL; }
+    if (b->n + more > b->cap) {
+        size_t cap = b->cap ? b->cap : 4096;
+        while (cap < b->n + more) cap *= 2;
+        uint8_t *q = realloc(b->p, cap);
+        if (!q) { b->failed = 1; return NULL; }
+        b->p = q;
+        b->cap = cap;
+    }
+    uint8_t *at = b->p + b->n;
+    b->n += more;
+    return at;
+}
+
+/* ---- record sizes -------------------------------------------------------------------------- */
+
+static const int out_floats[4] = {27, 27, 3, 1}; /* radiance, direct, irradiance, variance */
+
+/* Bytes of a run record of n receivers; 0 on overflow. */
+static size_t run_size(uint64_t n, uint32_t passes, uint32_t mask)
+{
+    if (n > (SIZE_MAX >> 12)) return 0;
+    size_t per = (size_t)passes * 32;
+    for (int k = 0; k < 4; k++)
+        if (mask & (1u << k)) per += 4 * (size_t)out_floats[k];
+    return BK_PART_RUN_HEADER_SIZE + (size_t)passes * BK_PART_PASS_HEADER_SIZE + (size_t)n * per;
+}
+
+void bk_dist_range(uint64_t count, uint32_t units, uint32_t unit, uint64_t *begin, uint64_t *end)
+{
+    /* count < 2^40 and units <= 2^16 (checked by the callers), so the products fit */
+    *begin = units ? count * unit / units : 0;
+    *end = units ? count * (unit + 1) / units : count;
+}
+
+static lbk_result say(char *err, size_t len, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+static lbk_result say(char *err, size_t len, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    if (err && len) vsnprintf(err, len, fmt, ap);
+    va_end(ap);
+    return LBK_ERR_BAD_INPUT;
+}
+
+lbk_result bk_part_parse(const void *bytes, size_t size, bk_part_view *v, char *err, size_t err_len)
+{
+    memset(v, 0, sizeof *v);
+    const uint8_t *p = bytes;
+    if (!p || size < BK_PART_HEADER_SIZE || memcmp(p, BK_PART_MAGIC, 8))
+        return say(err, err_len, "not a part file (no LBKPART header)");
+    if (get32(p + 8) != BK_PART_VERSION) return say(err, err_len, "part format version %u (this lbk reads %u)", get32(p + 8), BK_PART_VERSION);
+    if (get32(p + 12) != BK_PART_HEADER_SIZE || get32(p + 60) != 0) return say(err, err_len, "corrupt part header");
+    if (XXH64(p, 88, 0) != get64(p + 88)) return say(err, err_len, "corrupt part header (checksum)");
+    v->options_hash = get64(p + 80);
+    v->plan_hash = get64(p + 16);
+    v->units = get32(p + 24);
+    v->unit = get32(p + 28);
+    v->receiver_count = get64(p + 32);
+    v->begin = get64(p + 40);
+    v->end = get64(p + 48);
+    v->run_count = get32(p + 56);
+    uint64_t payload = get64(p + 64);
+    if (v->units == 0 || v->units > BK_PART_MAX_UNITS || v->unit >= v->units || v->receiver_count >= ((uint64_t)1 << 40) ||
+        v->run_count > BK_PART_MAX_RUNS)
+        return say(err, err_len, "corrupt part header (unit %u of %u, %llu receivers, %u runs)", v->unit, v->units,
+                   (unsigned long long)v->receiver_count, v->run_count);
+    uint64_t b, e;
+    bk_dist_range(v->receiver_count, v->units, v->unit, &b, &e);
+    if (b != v->begin || e != v->end) return say(err, err_len, "corrupt part header (receiver range)");
+    if (payload != size - BK_PART_HEADER_SIZE)
+        return say(err, err_len, "truncated or padded part: %zu bytes, the header says %llu", size,
+                   (unsigned long long)(payload + BK_PART_HEADER_SIZE));
+    if (XXH64(p + BK_PART_HEADER_SIZE, (size_t)payload, 0) != get64(p + 72)) return say(err, err_len, "corrupt part (payload checksum)");
+    v->runs = calloc(v->run_count ? v->run_count : 1, sizeof *v->runs);
+    if (!v->runs) return LBK_ERR_OUT_OF_MEMORY;
+    size_t at = BK_PART_HEADER_SIZE;
+    for (uint32_t r = 0; r < v->run_count; r++) {
+        if (size - at < BK_PART_RUN_HEADER_SIZE) goto bad;
+        uint32_t passes = get32(p + at), mask = get32(p + at + 4);
+        if (passes == 0 || passes > BK_PART_MAX_PASSES || mask > 15 || !(mask & BK_PART_RADIANCE)) goto bad;
+        size_t n = run_size(v->end - v->begin, passes, mask);
+        if (!n || n > size - at) goto bad;
+        v->runs[r] = p + at;
+        at += n;
+    }
+    if (at != size) goto bad;
+    return LBK_OK;
+bad:
+    free(v->runs);
+    v->runs = NULL;
+    return say(err, err_len, "corrupt part (run records)");
+}
+
+/* ---- record and replay --------------------------------------------------------------------- */
+
+struct bk_dist {
+    int replay;
+    uint64_t plan_hash, options_hash;
+    uint32_t units, unit;
+    uint64_t count, begin, end;
+    int have_count;
+    bk_transport_split split;
+    /* record */
+    buf out;          /* finished runs */
+    buf passes;       /* the current run's pass records */
+    uint32_t run_count, run_passes;
+    /* replay */
+    const bk_part_view *parts;
+    uint32_t run;     /* the run being replayed */
+    uint32_t pass_done;
+    char err[512];
+};
+
+static lbk_result rec_pass(void *user, const bk_transport_pass_record *pr)
+{
+    bk_dist *d = user;
+    const size_t n = (size_t)(d->end - d->begin);
+    if (d->run_passes >= BK_PART_MAX_PASSES) return LBK_ERR_LIMIT;
+    uint8_t *w = buf_grow(&d->passes, BK_PART_PASS_HEADER_SIZE + 32 * n);
+    if (!w) return LBK_ERR_OUT_OF_MEMORY;
+    put32(w, (uint32_t)pr->pass);
+    put32(w + 4, (uint32_t)pr->bounces);
+    putd(w + 8, pr->samples_per_receiver);
+    for (int k = 0; k < 3; k++) putd(w + 16 + 8 * k, pr->weight_sum[k]), putd(w + 40 + 8 * k, pr->class_samples[k]);
+    w += BK_PART_PASS_HEADER_SIZE;
+    for (size_t i = 0; i < n; i++, w += 32) {
+        size_t r = (size_t)d->begin + i;
+        putd(w, pr->x_acc[0][r]);
+        putd(w + 8, pr->x_acc[1][r]);
+        putd(w + 16, pr->b_acc[0][r]);
+        putd(w + 24, pr->b_acc[1][r]);
+    }
+    d->run_passes++;
+    return LBK_OK;
+}
+
+static uint32_t mask_of(const bk_transport_output *o)
+{
+    return (o->radiance ? BK_PART_RADIANCE : 0) | (o->direct ? BK_PART_DIRECT : 0) | (o->irradiance ? BK_PART_IRRADIANCE : 0) |
+           (o->variance ? BK_PART_VARIANCE : 0);
+}
+
+static const float *out_array(const bk_transport_output *o, int k)
+{
+    return k == 0 ? (const float *)o->radiance : k == 1 ? (const float *)o->direct : k == 2 ? o->irradiance : o->variance;
+}
+
+static void put_totals(uint8_t *w, uint32_t passes, uint32_t mask, const bk_transport_totals *t)
+{
+    put32(w, passes);
+    put32(w + 4, mask);
+    put32(w + 8, (uint32_t)t->stop);
+    put32(w + 12, (uint32_t)t->nee);
+    put32(w + 16, (uint32_t)t->bounces);
+    put32(w + 20, 0);
+    putd(w + 24, t->q);
+    putd(w + 32, t->tail_fraction);
+    put64(w + 40, t->cells);
+    put64(w + 48, t->cache_rays);
+    put64(w + 56, t->cache_shadow);
+    put64(w + 64, t->cache_nonfinite);
+    put64(w + 72, t->recv_rays);
+    put64(w + 80, t->recv_shadow);
+    put64(w + 88, t->recv_nonfinite);
+}
+
+static void get_totals(const uint8_t *w, bk_transport_totals *t)
+{
+    memset(t, 0, sizeof *t);
+    t->passes = (int)get32(w);
+    t->stop = (int)get32(w + 8);
+    t->nee = (int)get32(w + 12);
+    t->bounces = (int)get32(w + 16);
+    t->q = getd(w + 24);
+    t->tail_fraction = getd(w + 32);
+    t->cells = get64(w + 40);
+    t->cache_rays = get64(w + 48);
+    t->cache_shadow = get64(w + 56);
+    t->cache_nonfinite = get64(w + 64);
+    t->recv_rays = get64(w + 72);
+    t->recv_shadow = get64(w + 80);
+    t->recv_nonfinite = get64(w + 88);
+}
+
+static lbk_result rec_done(void *user, const bk_transport_output *o, const bk_transport_totals *t)
+{
+    bk_dist *d = user;
+    const size_t n = (size_t)(d->end - d->begin);
+    const uint32_t mask = mask_of(o);
+    if ((uint32_t)t->passes != d->run_passes || d->run_count >= BK_PART_MAX_RUNS) return LBK_ERR_INTERNAL;
+    size_t total = run_size(n, d->run_passes, mask);
+    uint8_t *w = total ? buf_grow(&d->out, total) : NULL;
+    if (!w || d->passes.failed) return LBK_ERR_OUT_OF_MEMORY;
+    put_totals(w, d->run_passes, mask, t);
+    w += BK_PART_RUN_HEADER_SIZE;
+    memcpy(w, d->passes.p, d->passes.n);
+    w += d->passes.n;
+    for (int k = 0; k < 4; k++) {
+        if (!(mask & (1u << k))) continue;
+        const float *a = out_array(o, k) + (size_t)d->begin * out_floats[k];
+        for (size_t i = 0; i < n * (size_t)out_floats[k]; i++, w += 4) putf(w, a[i]);
+    }
+    d->passes.n = 0;
+    d->run_passes = 0;
+    d->run_count++;
+    return LBK_OK;
+}
+
+static lbk_result fail(bk_dist *d, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static lbk_result fail(bk_dist *d, const char *fmt, ...)
+{
+    if (!d->err[0]) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(d->err, sizeof d->err, fmt, ap);
+        va_end(ap);
+    }
+    return LBK_ERR_BAD_INPUT;
+}
+
+static lbk_result play_totals(void *user, size_t count, bk_transport_totals *t)
+{
+    bk_dist *d = user;
+    if (count != d->count) return fail(d, "the parts were baked with %llu receivers, this run has %zu", (unsigned long long)d->count, count);
+    if (d->run >= d->parts[0].run_count)
+        return fail(d, "the parts hold %u transport runs, this bake makes more: the parts come from another scene, "
+                    "options or lbk version", d->parts[0].run_count);
+    memset(t, 0, sizeof *t);
+    for (uint32_t u = 0; u < d->units; u++) {
+        const uint8_t *rh = d->parts[u].runs[d->run];
+        bk_transport_totals x;
+        get_totals(rh, &x);
+        if (u == 0) {
+            *t = x;
+            continue;
+        }
+        /* the caches are global: every unit must have computed the same ones */
+        if (memcmp(rh, d->parts[0].runs[d->run], 72))
+            return fail(d, "run %u: unit %u disagrees with unit 0 on what every unit computes alike (passes, caches, "
+                        "ray counts): the parts were baked by different lbk builds or from different inputs", d->run, u);
+        t->recv_rays += x.recv_rays;
+        t->recv_shadow += x.recv_shadow;
+        t->recv_nonfinite += x.recv_nonfinite;
+    }
+    d->pass_done = 0;
+    return LBK_OK;
+}
+
+static lbk_result play_pass(void *user, bk_transport_pass_record *pr)
+{
+    bk_dist *d = user;
+    for (uint32_t u = 0; u < d->units; u++) {
+        const bk_part_view *v = &d->parts[u];
+        const size_t n = (size_t)(v->end - v->begin);
+        const uint8_t *w = v->runs[d->run] + BK_PART_RUN_HEADER_SIZE + (size_t)pr->pass * (BK_PART_PASS_HEADER_SIZE + 32 * n);
+        if (u == 0) {
+            pr->bounces = (int)get32(w + 4);
+            pr->samples_per_receiver = getd(w + 8);
+            for (int k = 0; k < 3; k++) pr->weight_sum[k] = getd(w + 16 + 8 * k), pr->class_samples[k] = getd(w + 40 + 8 * k);
+        } else if (memcmp(w, d->parts[0].runs[d->run] + BK_PART_RUN_HEADER_SIZE +
+                                 (size_t)pr->pass * (BK_PART_PASS_HEADER_SIZE + 32 * (size_t)(d->parts[0].end - d->parts[0].begin)),
+                          BK_PART_PASS_HEADER_SIZE)) {
+            return fail(d, "run %u pass %d: unit %u disagrees with unit 0 on the pass", d->run, pr->pass, u);
+        }
+        w += BK_PART_PASS_HEADER_SIZE;
+        for (size_t i = 0; i < n; i++, w += 32) {
+            size_t r = (size_t)v->begin + i;
+            pr->x_acc[0][r] = getd(w);
+            pr->x_acc[1][r] = getd(w + 8);
+            pr->b_acc[0][r] = getd(w + 16);
+            pr->b_acc[1][r] = getd(w + 24);
+        }
+    }
+    return LBK_OK;
+}
+
+static lbk_result play_outputs(void *user, const bk_transport_output *o)
+{
+    bk_dist *d = user;
+    const uint32_t mask = mask_of(o);
+    for (uint32_t u = 0; u < d->units; u++) {
+        const bk_part_view *v = &d->parts[u];
+        const uint8_t *rh = v->runs[d->run];
+        const uint32_t passes = get32(rh), pmask = get32(rh + 4);
+        if (pmask != mask) return fail(d, "run %u: the part holds other outputs (%#x) than this bake needs (%#x)", d->run, pmask, mask);
+        const size_t n = (size_t)(v->end - v->begin);
+        const uint8_t *w = rh + BK_PART_RUN_HEADER_SIZE + (size_t)passes * (BK_PART_PASS_HEADER_SIZE + 32 * n);
+        for (int k = 0; k < 4; k++) {
+            if (!(mask & (1u << k))) continue;
+            float *a = (float *)out_array(o, k) + (size_t)v->begin * out_floats[k];
+            for (size_t i = 0; i < n * (size_t)out_floats[k]; i++, w += 4) a[i] = getf(w);
+        }
+    }
+    d->run++;
+    return LBK_OK;
+}
+
+lbk_result bk_dist_create(int replay, uint64_t plan_hash, uint64_t options_hash, uint32_t units, uint32_t unit,
+                          const bk_part_view *parts, bk_dist **out)
+{
+    *out = NULL;
+    if (units == 0 || units > BK_PART_MAX_UNITS || (!replay && unit >= units) || (replay && !parts)) return LBK_ERR_INVALID_ARGUMENT;
+    bk_dist *d = calloc(1, sizeof *d);
+    if (!d) return LBK_ERR_OUT_OF_MEMORY;
+    d->replay = replay;
+    d->plan_hash = plan_hash;
+    d->options_hash = options_hash;
+    d->units = units;
+    d->unit = unit;
+    d->parts = parts;
+    d->split.replay = replay;
+    d->split.user = d;
+    d->split.record_pass = rec_pass;
+    d->split.record_done = rec_done;
+    d->split.replay_totals = play_totals;
+    d->split.replay_pass = play_pass;
+    d->split.replay_outputs = play_outputs;
+    *out = d;
+    return LBK_OK;
+}
+
+void bk_dist_destroy(bk_dist *d)
+{
+    if (!d) return;
+    free(d->out.p);
+    free(d->passes.p);
+    free(d);
+}
+
+lbk_result bk_dist_set_receivers(bk_dist *d, uint64_t count, char *err, size_t err_len)
+{
+    if (count >= ((uint64_t)1 << 40)) return say(err, err_len, "too many receivers for a distributed bake");
+    d->count = count;
+    d->have_count = 1;
+    if (d->replay) {
+        if (d->parts[0].receiver_count != count)
+            return say(err, err_len, "the parts were baked with %llu receivers, this scene and options give %llu: they "
+                       "come from another scene, options or lbk version", (unsigned long long)d->parts[0].receiver_count,
+                       (unsigned long long)count);
+        return LBK_OK;
+    }
+    bk_dist_range(count, d->units, d->unit, &d->begin, &d->end);
+    d->split.begin = (size_t)d->begin;
+    d->split.end = (size_t)d->end;
+    return LBK_OK;
+}
+
+const bk_transport_split *bk_dist_split(const bk_dist *d) { return &d->split; }
+
+const char *bk_dist_error(const bk_dist *d) { return d ? d->err : ""; }
+
+lbk_result bk_dist_finish(bk_dist *d, void **bytes, size_t *size, char *err, size_t err_len)
+{
+    if (d->replay) {
+        if (d->run != d->parts[0].run_count)
+            return say(err, err_len, "the parts hold %u transport runs, this bake made %u: they come from another scene, "
+                       "options or lbk version", d->parts[0].run_count, d->run);
+        return LBK_OK;
+    }
+    if (!d->have_count || d->out.failed) return LBK_ERR_INTERNAL;
+    size_t total = BK_PART_HEADER_SIZE + d->out.n;
+    uint8_t *p = malloc(total);
+    if (!p) return LBK_ERR_OUT_OF_MEMORY;
+    memset(p, 0, BK_PART_HEADER_SIZE);
+    memcpy(p, BK_PART_MAGIC, 8);
+    put32(p + 8, BK_PART_VERSION);
+    put32(p + 12, BK_PART_HEADER_SIZE);
+    put64(p + 16, d->plan_hash);
+    put32(p + 24, d->units);
+    put32(p + 28, d->unit);
+    put64(p + 32, d->count);
+    put64(p + 40, d->begin);
+    put64(p + 48, d->end);
+    put32(p + 56, d->run_count);
+    put64(p + 64, d->out.n);
+    if (d->out.n) memcpy(p + BK_PART_HEADER_SIZE, d->out.p, d->out.n);
+    put64(p + 72, XXH64(p + BK_PART_HEADER_SIZE, d->out.n, 0));
+    put64(p + 80, d->options_hash);
+    put64(p + 88, XXH64(p, 88, 0));
+    *bytes = p;
+    *size = total;
+    return LBK_OK;
+}

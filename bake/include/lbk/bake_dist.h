@@ -1,0 +1,50 @@
+/* liblbkbake: distributed bakes (bake/dist/DIST.md). One bake cut into `units` units by
+ * receivers; every unit needs only the scene files and the same options, and returns a part
+ * (spec/part.md); the merge of all parts is byte-identical to lbk_bake_from_file with the same
+ * scene, options and seed, at any number of units.
+ *
+ * Only bakes whose passes do not depend on the error estimate can be cut (the estimate is a sum
+ * over every receiver): desc->target_error < 0 (stop at max_samples), no time_limit, and the
+ * difference door method (the guided estimator is not a transport run). Anything else:
+ * LBK_ERR_INVALID_ARGUMENT with the reason sent as the ERROR message. */
+#ifndef LBK_BAKE_DIST_H
+#define LBK_BAKE_DIST_H
+
+#include "lbk/bake.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Bakes unit `unit` of `units` of the scene at path; *part (malloc'd: free it with
+ * lbk_bake_part_free) holds the part's bytes, stamped with plan_hash (the caller's identity of
+ * the plan: scene, options, units). */
+LBK_BAKE_API lbk_result lbk_bake_unit_from_file(const char *path, const lbk_bake_desc *desc, uint64_t plan_hash,
+                                                uint32_t units, uint32_t unit, void **part, size_t *part_size);
+LBK_BAKE_API void lbk_bake_part_free(void *part);
+
+/* What a part says about itself (lbk_bake_part_check). */
+typedef struct lbk_bake_part_info {
+    uint64_t plan_hash;
+    uint32_t units, unit, runs;
+    uint64_t receivers, first, end;   /* the plan's receivers; this unit's [first, end) */
+} lbk_bake_part_info;
+
+/* Checks a part's bytes (format, checksums); with plan_hash != 0 also that it belongs to that
+ * plan and with units != 0 to a cut into that many units. LBK_ERR_BAD_INPUT with the reason
+ * in err (err_len bytes, may be 0). */
+LBK_BAKE_API lbk_result lbk_bake_part_check(const void *part, size_t size, uint64_t plan_hash, uint32_t units,
+                                            lbk_bake_part_info *info, char *err, size_t err_len);
+
+/* Merges the parts of all `units` units (any order; each exactly once) into the container of
+ * the same bake, as lbk_bake_from_file returns it. A missing, duplicated, corrupt or foreign part
+ * (another plan_hash, another cut, another scene or options): LBK_ERR_BAD_INPUT with the reason
+ * as the ERROR message, nothing returned. */
+LBK_BAKE_API lbk_result lbk_bake_merge_from_file(const char *path, const lbk_bake_desc *desc, uint64_t plan_hash,
+                                                 uint32_t units, const void *const *parts, const size_t *part_sizes,
+                                                 size_t part_count, lbk_bake_output **out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

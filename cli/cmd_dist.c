@@ -1,0 +1,394 @@
+/* lbk plan, lbk bake-unit, lbk merge: a distributed bake (bake/dist/DIST.md) over
+ * lbk/bake_dist.h. The plan names the scene and the bake options; every unit and the merge
+ * re-read them from it, so they bake with exactly the options of the plan. */
+#include <errno.h>
+#include <inttypes.h>
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "cli/bake_options.h"
+#include "cli/cli.h"
+#include "lbk/bake_dist.h"
+#include "tools/common/bake_plan.h"
+#include "tools/common/file_util.h"
+
+/* Options that do not change a byte of the container, so they stay out of the plan: where the
+ * files go, threads, progress, the plan's own. */
+static int plan_neutral(const char *a)
+{
+    static const char *const skip[] = {"-o", "--output", "--plan", "--units", "--makefile", "--sbatch", "--threads",
+                                       "--json-report", "-q", "--quiet"};
+    for (size_t i = 0; i < sizeof skip / sizeof skip[0]; i++)
+        if (!strcmp(a, skip[i])) return 1;
+    return 0;
+}
+
+static int abs_path(const char *path, char *out, size_t size)
+{
+    if (path[0] == '/') return snprintf(out, size, "%s", path) < (int)size;
+    char cwd[PATH_MAX];
+    if (!getcwd(cwd, sizeof cwd)) return 0;
+    return snprintf(out, size, "%s/%s", cwd, path) < (int)size;
+}
+
+/* Makefile lines must not hold spaces or make's specials in paths. */
+static int make_safe(const char *s)
+{
+    for (; *s; s++)
+        if (*s == ' ' || *s == '$' || *s == '#' || *s == ':' || *s == '%' || *s == '\\' || *s == '\'' || *s == '"') return 0;
+    return 1;
+}
+
+static int write_makefile(const char *path, const char *lbk, const char *plan, const char *output, unsigned units,
+                          char err[TL_ERR_LEN])
+{
+    size_t cap = 4096 + (size_t)units * (strlen(output) + 48);
+    char *t = malloc(cap);
+    if (!t) return snprintf(err, TL_ERR_LEN, "out of memory"), -1;
+    size_t n = (size_t)snprintf(t, cap,
+                                "# A distributed bake, written by lbk plan: make -j N -f THIS bakes the units in parallel\n"
+                                "# and merges them. A killed unit leaves no part: running make again bakes only the\n"
+                                "# missing ones. LBK= picks the lbk binary, UNIT_FLAGS= adds e.g. --threads 1.\n"
+                                "LBK ?= %s\nPLAN := %s\nOUT := %s\nUNIT_FLAGS ?= -q\nPARTS :=",
+                                lbk, plan, output);
+    for (unsigned k = 0; k < units; k++) n += (size_t)snprintf(t + n, cap - n, " $(OUT).parts/part-%u.lbkpart", k);
+    snprintf(t + n, cap - n,
+             "\n\n$(OUT): $(PARTS)\n\t$(LBK) merge $(PLAN) $(PARTS) -o $@ -q\n\n"
+             "$(OUT).parts/part-%%.lbkpart:\n\t@mkdir -p $(@D)\n\t$(LBK) bake-unit $(PLAN) $* -o $@ $(UNIT_FLAGS)\n\n"
+             ".PHONY: all\nall: $(OUT)\n.DEFAULT_GOAL := $(OUT)\n");
+    int r = tl_write_text(path, t, err);
+    free(t);
+    return r;
+}
+
+static int write_sbatch(const char *path, const char *lbk, const char *plan, const char *output, unsigned units,
+                        char err[TL_ERR_LEN])
+{
+    size_t cap = 2048 + 3 * (strlen(lbk) + strlen(plan) + 4 * strlen(output));
+    char *t = malloc(cap);
+    if (!t) return snprintf(err, TL_ERR_LEN, "out of memory"), -1;
+    snprintf(t, cap,
+             "#!/bin/sh\n"
+             "# A distributed bake on Slurm, written by lbk plan: `sh THIS` submits a job array of %u\n"
+             "# units and a merge that runs when all of them succeeded (afterok). SBATCH_FLAGS adds\n"
+             "# sbatch options (partition, account, time); LBK picks the lbk binary.\n"
+             "set -e\n"
+             "LBK=${LBK:-%s}\nPLAN=%s\nOUT=%s\n"
+             "mkdir -p \"$OUT.parts\"\n"
+             "unit=$(sbatch --parsable $SBATCH_FLAGS --job-name=lbk-unit --array=0-%u --output=\"$OUT.parts/unit-%%a.log\" \\\n"
+             "  --wrap=\"$LBK bake-unit $PLAN \\$SLURM_ARRAY_TASK_ID -o $OUT.parts/part-\\$SLURM_ARRAY_TASK_ID.lbkpart -q\")\n"
+             "unit=${unit%%%%;*}\n"
+             "merge=$(sbatch --parsable $SBATCH_FLAGS --job-name=lbk-merge --dependency=afterok:$unit \\\n"
+             "  --output=\"$OUT.parts/merge.log\" --wrap=\"$LBK merge $PLAN $OUT.parts/part-*.lbkpart -o $OUT -q\")\n"
+             "merge=${merge%%%%;*}\n"
+             "echo \"lbk: units job $unit, merge job $merge\"\n",
+             units, lbk, plan, output, units - 1);
+    int r = tl_write_text(path, t, err);
+    free(t);
+    return r;
+}
+
+int cli_plan_write(const bake_args *o, int argc, char **argv, const char *cmd)
+{
+    if (!o->input || !o->output || !o->plan || !o->units) {
+        fprintf(stderr, "lbk %s: a plan needs a scene, -o OUT.lbk, --plan PLAN.json and --units N (lbk plan --help)\n", cmd);
+        return LBK_EXIT_USAGE;
+    }
+    if (!(o->d.target_error < 0) || o->d.max_samples <= 0) {
+        fprintf(stderr,
+                "lbk %s: a distributed bake needs a fixed sample schedule: --samples N --target-error none (the error "
+                "target stops on a sum over every receiver, which no single unit has; bake/dist/DIST.md)\n",
+                cmd);
+        return LBK_EXIT_USAGE;
+    }
+    if (o->d.time_limit > 0) {
+        fprintf(stderr, "lbk %s: --time-limit cannot be distributed: the passes it allows depend on each machine's speed, so "
+                        "the units would not bake the same passes\n", cmd);
+        return LBK_EXIT_USAGE;
+    }
+    if (o->d.door_method == LBK_BAKE_DOOR_GUIDED) {
+        fprintf(stderr, "lbk %s: --door-method guided cannot be distributed yet (use difference)\n", cmd);
+        return LBK_EXIT_USAGE;
+    }
+    tl_plan p;
+    memset(&p, 0, sizeof p);
+    char scene[PATH_MAX], output[PATH_MAX], plan[PATH_MAX], err[TL_ERR_LEN];
+    if (!realpath(o->input, scene)) {
+        fprintf(stderr, "lbk %s: %s: %s\n", cmd, o->input, strerror(errno));
+        return LBK_EXIT_IO;
+    }
+    if (!abs_path(o->output, output, sizeof output) || !abs_path(o->plan, plan, sizeof plan)) {
+        fprintf(stderr, "lbk %s: path too long\n", cmd);
+        return LBK_EXIT_USAGE;
+    }
+    p.scene = scene;
+    p.output = output;
+    p.units = o->units;
+    if (tl_file_hash(scene, &p.scene_hash, err)) {
+        fprintf(stderr, "lbk %s: %s\n", cmd, err);
+        return LBK_EXIT_IO;
+    }
+    int seen_input = 0;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        int takes_value = a[0] == '-' && a[1] && !cli_bake_flag(a);
+        if (a[0] != '-' || !a[1]) {
+            if (!seen_input++) continue; /* the scene */
+        }
+        if (!plan_neutral(a)) {
+            if (p.option_count + 2 > TL_PLAN_MAX_OPTIONS) {
+                fprintf(stderr, "lbk %s: too many options for a plan\n", cmd);
+                return LBK_EXIT_USAGE;
+            }
+            p.options[p.option_count++] = argv[i];
+            if (takes_value && i + 1 < argc) p.options[p.option_count++] = argv[i + 1];
+        }
+        if (takes_value) i++;
+    }
+    char lbk[PATH_MAX];
+    ssize_t n = readlink("/proc/self/exe", lbk, sizeof lbk - 1);
+    snprintf(lbk + (n > 0 ? n : 0), sizeof lbk - (size_t)(n > 0 ? n : 0), "%s", n > 0 ? "" : "lbk");
+    if ((o->makefile || o->sbatch) && (!make_safe(plan) || !make_safe(output) || !make_safe(lbk))) {
+        fprintf(stderr, "lbk %s: the plan, output and lbk paths must not hold spaces or $#:%%\\'\" for a Makefile or sbatch script\n", cmd);
+        return LBK_EXIT_USAGE;
+    }
+    if (tl_plan_write(&p, plan, err) || (o->makefile && write_makefile(o->makefile, lbk, plan, output, o->units, err)) ||
+        (o->sbatch && write_sbatch(o->sbatch, lbk, plan, output, o->units, err))) {
+        fprintf(stderr, "lbk %s: %s\n", cmd, err);
+        return LBK_EXIT_IO;
+    }
+    printf("%s: %u units, plan hash %016" PRIx64 "\n", o->plan, o->units, tl_plan_hash(&p));
+    return LBK_EXIT_OK;
+}
+
+static void plan_help(FILE *f)
+{
+    fputs("usage: lbk plan SCENE.gltf -o OUT.lbk --plan PLAN.json --units N --samples S --target-error none\n"
+          "                [--makefile FILE] [--sbatch FILE] [bake options]\n"
+          "\n"
+          "Writes the plan of a distributed bake: the scene, its hash and the bake options, cut into N\n"
+          "units. Run every unit (lbk bake-unit PLAN K, anywhere the scene files are), then lbk merge:\n"
+          "the container is byte-identical to `lbk bake` with the same options. --makefile writes a\n"
+          "Makefile for make -j; --sbatch a script that submits a Slurm job array and the merge.\n"
+          "Needs a fixed sample schedule (--samples N --target-error none); no --time-limit.\n"
+          "See bake/dist/DIST.md (xargs -P, Kubernetes).\n",
+          f);
+}
+
+int lbk_cmd_plan(int argc, char **argv)
+{
+    for (int i = 1; i < argc; i++)
+        if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) return plan_help(stdout), LBK_EXIT_OK;
+    bake_args o;
+    int quiet = 0;
+    int rc = cli_bake_parse(argc, argv, &o, &quiet);
+    if (rc >= 0) return rc;
+    return cli_plan_write(&o, argc, argv, "plan");
+}
+
+/* The plan, its scene checked against the hash, and the bake options it holds (+ extra). */
+static int load_plan(const char *cmd, const char *path, const char *scene_override, tl_plan *p, bake_args *o, int *quiet,
+                     int extra_count, char **extra)
+{
+    char err[TL_ERR_LEN];
+    if (tl_plan_read(path, p, err)) {
+        fprintf(stderr, "lbk %s: %s\n", cmd, err);
+        return LBK_EXIT_INPUT;
+    }
+    const char *scene = scene_override ? scene_override : p->scene;
+    uint64_t h = 0;
+    if (tl_file_hash(scene, &h, err)) {
+        fprintf(stderr, "lbk %s: %s\n", cmd, err);
+        return LBK_EXIT_IO;
+    }
+    if (h != p->scene_hash) {
+        fprintf(stderr, "lbk %s: %s changed since the plan was made (hash %016" PRIx64 ", the plan's %016" PRIx64
+                        "): make a new plan\n", cmd, scene, h, p->scene_hash);
+        return LBK_EXIT_INPUT;
+    }
+    char *args[2 + TL_PLAN_MAX_OPTIONS + 8];
+    int n = 0;
+    args[n++] = (char *)cmd;
+    args[n++] = (char *)scene;
+    for (int i = 0; i < p->option_count; i++) args[n++] = p->options[i];
+    for (int i = 0; i < extra_count && n < (int)(sizeof args / sizeof args[0]); i++) args[n++] = extra[i];
+    int rc = cli_bake_parse(n, args, o, quiet);
+    if (rc >= 0) return rc == 0 ? LBK_EXIT_INPUT : rc;
+    o->cmd = cmd;
+    return -1;
+}
+
+static void unit_message(void *user, lbk_bake_severity severity, const char *message)
+{
+    const int quiet = *(const int *)user;
+    if (severity == LBK_BAKE_SEVERITY_ERROR) fprintf(stderr, "lbk bake-unit: %s\n", message);
+    else if (severity == LBK_BAKE_SEVERITY_WARNING) fprintf(stderr, "lbk bake-unit: warning: %s\n", message);
+    else if (!quiet) fprintf(stderr, "  %s\n", message);
+}
+
+static void unit_help(FILE *f)
+{
+    fputs("usage: lbk bake-unit PLAN.json K -o PART.lbkpart [--threads N] [--scene PATH] [-q]\n"
+          "\n"
+          "Bakes unit K (0-based) of a plan (lbk plan) into a part file, written atomically: a killed\n"
+          "unit leaves none. --scene: where the plan's scene is on this machine (its hash is checked).\n",
+          f);
+}
+
+int lbk_cmd_bake_unit(int argc, char **argv)
+{
+    const char *plan = NULL, *kstr = NULL, *out = NULL, *scene = NULL;
+    char *extra[4];
+    int n_extra = 0, quiet = 0;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) return unit_help(stdout), LBK_EXIT_OK;
+        if ((!strcmp(a, "-o") || !strcmp(a, "--output") || !strcmp(a, "--threads") || !strcmp(a, "--scene")) && i + 1 >= argc) {
+            fprintf(stderr, "lbk bake-unit: %s needs a value\n", a);
+            return LBK_EXIT_USAGE;
+        }
+        if (!strcmp(a, "-o") || !strcmp(a, "--output")) out = argv[++i];
+        else if (!strcmp(a, "--scene")) scene = argv[++i];
+        else if (!strcmp(a, "--threads")) extra[n_extra++] = argv[i], extra[n_extra++] = argv[++i];
+        else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) quiet = 1;
+        else if (a[0] == '-' && a[1]) {
+            fprintf(stderr, "lbk bake-unit: unknown option '%s' (lbk bake-unit --help)\n", a);
+            return LBK_EXIT_USAGE;
+        } else if (!plan) plan = a;
+        else if (!kstr) kstr = a;
+        else {
+            fprintf(stderr, "lbk bake-unit: unexpected argument '%s'\n", a);
+            return LBK_EXIT_USAGE;
+        }
+    }
+    if (!plan || !kstr || !out) {
+        fprintf(stderr, "lbk bake-unit: need PLAN.json K -o PART.lbkpart (lbk bake-unit --help)\n");
+        return LBK_EXIT_USAGE;
+    }
+    char *end;
+    errno = 0;
+    unsigned long k = strtoul(kstr, &end, 10);
+    if (errno || *end || kstr[0] < '0' || kstr[0] > '9') {
+        fprintf(stderr, "lbk bake-unit: K: '%s' is not a unit number\n", kstr);
+        return LBK_EXIT_USAGE;
+    }
+    tl_plan p;
+    bake_args o;
+    int dummy = 0;
+    int rc = load_plan("bake-unit", plan, scene, &p, &o, &dummy, n_extra, extra);
+    if (rc >= 0) return rc;
+    if (k >= p.units) {
+        fprintf(stderr, "lbk bake-unit: unit %lu: the plan has units 0 to %u\n", k, p.units - 1);
+        tl_plan_free(&p);
+        return LBK_EXIT_USAGE;
+    }
+    o.d.message = unit_message;
+    o.d.user = &quiet;
+    void *part = NULL;
+    size_t size = 0;
+    lbk_result r = lbk_bake_unit_from_file(o.input, &o.d, p.hash, p.units, (uint32_t)k, &part, &size);
+    tl_plan_free(&p);
+    if (r) {
+        if (r != LBK_ERR_BAD_INPUT && r != LBK_ERR_INVALID_ARGUMENT) fprintf(stderr, "lbk bake-unit: %s\n", lbk_result_message(r));
+        return r == LBK_ERR_IO ? LBK_EXIT_IO : r == LBK_ERR_BAD_INPUT ? LBK_EXIT_INPUT : r == LBK_ERR_INVALID_ARGUMENT ? LBK_EXIT_USAGE : LBK_EXIT_INTERNAL;
+    }
+    char err[TL_ERR_LEN];
+    int w = tl_write_file_atomic(out, part, size, err);
+    lbk_bake_part_free(part);
+    if (w) {
+        fprintf(stderr, "lbk bake-unit: %s\n", err);
+        return LBK_EXIT_IO;
+    }
+    if (!quiet) printf("%s: unit %lu, %zu bytes\n", out, k, size);
+    return LBK_EXIT_OK;
+}
+
+static void merge_help(FILE *f)
+{
+    fputs("usage: lbk merge PLAN.json PART.lbkpart... [-o OUT.lbk] [--threads N] [--json-report FILE]\n"
+          "                 [--scene PATH] [-q]\n"
+          "\n"
+          "Checks that the parts are every unit of the plan, each once, uncorrupted and of this plan, then\n"
+          "writes the container (default: the plan's output) atomically, byte-identical to `lbk bake`.\n"
+          "Any bad part: a message and nothing written.\n",
+          f);
+}
+
+int lbk_cmd_merge(int argc, char **argv)
+{
+    const char *plan = NULL, *out = NULL, *scene = NULL;
+    char *extra[8];
+    int n_extra = 0, quiet = 0;
+    const char **files = calloc((size_t)argc, sizeof *files);
+    size_t n_files = 0;
+    if (!files) return LBK_EXIT_INTERNAL;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) return free(files), merge_help(stdout), LBK_EXIT_OK;
+        int valued = !strcmp(a, "-o") || !strcmp(a, "--output") || !strcmp(a, "--threads") || !strcmp(a, "--scene") ||
+                     !strcmp(a, "--json-report");
+        if (valued && i + 1 >= argc) {
+            fprintf(stderr, "lbk merge: %s needs a value\n", a);
+            free(files);
+            return LBK_EXIT_USAGE;
+        }
+        if (!strcmp(a, "-o") || !strcmp(a, "--output")) out = argv[++i];
+        else if (!strcmp(a, "--scene")) scene = argv[++i];
+        else if (valued) extra[n_extra++] = argv[i], extra[n_extra++] = argv[++i];
+        else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) quiet = 1;
+        else if (a[0] == '-' && a[1]) {
+            fprintf(stderr, "lbk merge: unknown option '%s' (lbk merge --help)\n", a);
+            free(files);
+            return LBK_EXIT_USAGE;
+        } else if (!plan) plan = a;
+        else files[n_files++] = a;
+    }
+    if (!plan) {
+        fprintf(stderr, "lbk merge: need PLAN.json and the parts (lbk merge --help)\n");
+        free(files);
+        return LBK_EXIT_USAGE;
+    }
+    if (quiet) extra[n_extra++] = "-q";
+    tl_plan p;
+    bake_args o;
+    int rc = load_plan("merge", plan, scene, &p, &o, &quiet, n_extra, extra);
+    if (rc >= 0) return free(files), rc;
+    void **parts = calloc(n_files ? n_files : 1, sizeof *parts);
+    size_t *sizes = calloc(n_files ? n_files : 1, sizeof *sizes);
+    rc = parts && sizes ? -1 : LBK_EXIT_INTERNAL;
+    char err[TL_ERR_LEN];
+    for (size_t k = 0; rc < 0 && k < n_files; k++) {
+        if (tl_read_file(files[k], &parts[k], &sizes[k], err)) {
+            fprintf(stderr, "lbk merge: %s\n", err);
+            rc = LBK_EXIT_IO;
+            break;
+        }
+        lbk_bake_part_info info;
+        char why[512];
+        if (lbk_bake_part_check(parts[k], sizes[k], p.hash, p.units, &info, why, sizeof why)) {
+            fprintf(stderr, "lbk merge: %s: %s; nothing written\n", files[k], why);
+            rc = LBK_EXIT_INPUT;
+        }
+    }
+    if (rc < 0) {
+        char output[PATH_MAX];
+        snprintf(output, sizeof output, "%s", out ? out : p.output);
+        o.output = output;
+        o.merge = 1;
+        o.plan_hash = p.hash;
+        o.units = p.units;
+        o.parts = (const void *const *)parts;
+        o.part_sizes = sizes;
+        o.part_count = n_files;
+        rc = cli_bake_run(&o, quiet);
+    }
+    for (size_t k = 0; parts && k < n_files; k++) free(parts[k]);
+    free(parts);
+    free(sizes);
+    free(files);
+    tl_plan_free(&p);
+    return rc;
+}

@@ -1,0 +1,330 @@
+/* Distributed bakes (lbk/bake_dist.h, bake/dist/DIST.md): the merge of N units' parts is the
+ * container a local bake writes, byte for byte, at N = 1, 3, 7, on the Cornell box, a scene of
+ * light sets, a door and a combination (tests/fuzz/sets_scene.gltf) and the shared room; and a
+ * missing, duplicated, corrupt, truncated or foreign part is refused with a message and no
+ * output (the library's; the CLI's "nothing written" with $LBK). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "lbk/bake.h"
+#include "lbk/bake_dist.h"
+
+#define PLAN_HASH 0x1234abcd5678ef01ull
+
+typedef struct bytes {
+    void *p;
+    size_t n;
+} bytes;
+
+static char last_error[1024];
+
+static void on_message(void *user, lbk_bake_severity s, const char *m)
+{
+    (void)user;
+    if (s == LBK_BAKE_SEVERITY_ERROR) snprintf(last_error, sizeof last_error, "%s", m);
+}
+
+static lbk_bake_desc desc_of(int samples, float density, uint64_t seed)
+{
+    lbk_bake_desc d;
+    memset(&d, 0, sizeof d);
+    d.size = sizeof d;
+    d.seed = seed;
+    d.threads = 2;
+    d.max_samples = samples;
+    d.target_error = -1; /* a fixed schedule: what a distributed bake needs */
+    d.texel_density = density;
+    d.message = on_message;
+    return d;
+}
+
+static bytes local_bake(const char *scene, const lbk_bake_desc *d)
+{
+    lbk_bake_output *out = NULL;
+    last_error[0] = 0;
+    lbk_result r = lbk_bake_from_file(scene, d, &out);
+    if (r) fail_msg("bake %s: %s", scene, last_error);
+    bytes b = {NULL, 0};
+    assert_int_equal(lbk_bake_output_container(out, &b.p, &b.n), LBK_OK);
+    lbk_bake_output_free(out);
+    return b;
+}
+
+static void bake_parts(const char *scene, const lbk_bake_desc *d, uint64_t hash, uint32_t units, bytes *parts)
+{
+    for (uint32_t k = 0; k < units; k++) {
+        last_error[0] = 0;
+        lbk_result r = lbk_bake_unit_from_file(scene, d, hash, units, k, &parts[k].p, &parts[k].n);
+        if (r) fail_msg("unit %u of %u: %s (%s)", k, units, lbk_result_message(r), last_error);
+        lbk_bake_part_info info;
+        char err[256];
+        assert_int_equal(lbk_bake_part_check(parts[k].p, parts[k].n, hash, units, &info, err, sizeof err), LBK_OK);
+        assert_int_equal(info.unit, k);
+        assert_true(info.end >= info.first);
+    }
+}
+
+/* The merge's container, or NULL bytes with the result in *res (and the message in last_error). */
+static bytes merge(const char *scene, const lbk_bake_desc *d, uint64_t hash, uint32_t units, const bytes *parts, size_t n,
+                   lbk_result *res)
+{
+    const void *p[16];
+    size_t s[16];
+    for (size_t k = 0; k < n; k++) p[k] = parts[k].p, s[k] = parts[k].n;
+    lbk_bake_output *out = NULL;
+    last_error[0] = 0;
+    bytes b = {NULL, 0};
+    *res = lbk_bake_merge_from_file(scene, d, hash, units, p, s, n, &out);
+    if (*res == LBK_OK) {
+        assert_non_null(out);
+        assert_int_equal(lbk_bake_output_container(out, &b.p, &b.n), LBK_OK);
+        lbk_bake_output_free(out);
+    } else {
+        assert_null(out);
+    }
+    return b;
+}
+
+static void free_parts(bytes *parts, size_t n)
+{
+    for (size_t k = 0; k < n; k++) lbk_bake_part_free(parts[k].p);
+}
+
+/* Merges of 1, 3 and 7 units against the local bake, byte for byte; the parts' sizes printed
+ * (what moves over the network per unit). */
+static void check_scene(const char *scene, int samples, float density)
+{
+    lbk_bake_desc d = desc_of(samples, density, 7);
+    bytes local = local_bake(scene, &d);
+    const uint32_t counts[] = {1, 3, 7};
+    for (size_t c = 0; c < 3; c++) {
+        bytes parts[7];
+        memset(parts, 0, sizeof parts);
+        bake_parts(scene, &d, PLAN_HASH, counts[c], parts);
+        size_t part_bytes = 0;
+        for (uint32_t k = 0; k < counts[c]; k++) part_bytes += parts[k].n;
+        lbk_result r;
+        bytes m = merge(scene, &d, PLAN_HASH, counts[c], parts, counts[c], &r);
+        if (r) fail_msg("merge of %u units: %s", counts[c], last_error);
+        printf("%s: %u units, %zu part bytes in all, container %zu bytes\n", scene, counts[c], part_bytes, m.n);
+        assert_int_equal(m.n, local.n);
+        assert_memory_equal(m.p, local.p, local.n);
+        lbk_free(NULL, m.p);
+        free_parts(parts, counts[c]);
+    }
+    lbk_free(NULL, local.p);
+}
+
+static void test_merge_equals_local_cornell(void **state)
+{
+    (void)state;
+    check_scene("scenes/cornell_box/CornellBox-Original.gltf", 64, 4);
+}
+
+static void test_merge_equals_local_sets_doors(void **state)
+{
+    (void)state;
+    check_scene("tests/fuzz/sets_scene.gltf", 32, 2);
+}
+
+static void test_merge_equals_local_room(void **state)
+{
+    (void)state;
+    const char *dir = getenv("LBK_SCENES");
+    char path[512];
+    snprintf(path, sizeof path, "%s/room_with_doors/room.glb", dir && *dir ? dir : "../shared/scenes");
+    struct stat st;
+    if (stat(path, &st) != 0) {
+        printf("SKIPPED: %s not found (LBK_SCENES)\n", path);
+        skip();
+    }
+    lbk_bake_desc d = desc_of(32, 2, 7);
+    d.sky_override = 1;
+    d.sky[0] = d.sky[1] = d.sky[2] = 1;
+    bytes local = local_bake(path, &d);
+    bytes parts[3];
+    bake_parts(path, &d, PLAN_HASH, 3, parts);
+    lbk_result r;
+    bytes m = merge(path, &d, PLAN_HASH, 3, parts, 3, &r);
+    if (r) fail_msg("merge: %s", last_error);
+    assert_int_equal(m.n, local.n);
+    assert_memory_equal(m.p, local.p, local.n);
+    lbk_free(NULL, m.p);
+    lbk_free(NULL, local.p);
+    free_parts(parts, 3);
+}
+
+static void expect_refused(const char *scene, const lbk_bake_desc *d, uint64_t hash, uint32_t units, const bytes *parts,
+                           size_t n, const char *why)
+{
+    lbk_result r;
+    bytes m = merge(scene, d, hash, units, parts, n, &r);
+    if (m.p) lbk_free(NULL, m.p);
+    assert_int_equal(r, LBK_ERR_BAD_INPUT);
+    if (!strstr(last_error, why)) fail_msg("expected a message with '%s', got '%s'", why, last_error);
+}
+
+static void test_bad_parts_refused(void **state)
+{
+    (void)state;
+    const char *scene = "scenes/cornell_box/CornellBox-Original.gltf";
+    lbk_bake_desc d = desc_of(32, 2, 7);
+    bytes parts[3];
+    bake_parts(scene, &d, PLAN_HASH, 3, parts);
+    /* missing: units 0 and 2 only */
+    bytes two[2] = {parts[0], parts[2]};
+    expect_refused(scene, &d, PLAN_HASH, 3, two, 2, "1 of 3 units missing: 1");
+    /* duplicated */
+    bytes dup[3] = {parts[0], parts[1], parts[1]};
+    expect_refused(scene, &d, PLAN_HASH, 3, dup, 3, "unit 1 is given twice");
+    /* foreign: another plan's hash, another cut */
+    expect_refused(scene, &d, PLAN_HASH + 1, 3, parts, 3, "belongs to another plan");
+    expect_refused(scene, &d, PLAN_HASH, 4, parts, 3, "this plan has 4 units");
+    /* corrupt: one flipped payload byte, then one in the header; truncated */
+    unsigned char *c = malloc(parts[1].n);
+    assert_non_null(c);
+    memcpy(c, parts[1].p, parts[1].n);
+    c[parts[1].n / 2] ^= 0x10;
+    bytes bad[3] = {parts[0], {c, parts[1].n}, parts[2]};
+    expect_refused(scene, &d, PLAN_HASH, 3, bad, 3, "payload checksum");
+    c[parts[1].n / 2] ^= 0x10;
+    c[20] ^= 1;
+    expect_refused(scene, &d, PLAN_HASH, 3, bad, 3, "checksum");
+    c[20] ^= 1;
+    bad[1].n = parts[1].n - 4;
+    expect_refused(scene, &d, PLAN_HASH, 3, bad, 3, "truncated");
+    bad[1].n = 7;
+    expect_refused(scene, &d, PLAN_HASH, 3, bad, 3, "not a part file");
+    free(c);
+    /* parts of the same plan hash but other options (a changed seed or sample count): the units
+     * disagree on the runs, or the merge's own bake does */
+    lbk_bake_desc d2 = desc_of(32, 2, 8);
+    bytes other[3];
+    bake_parts(scene, &d2, PLAN_HASH, 3, other);
+    bytes mixed[3] = {parts[0], other[1], parts[2]};
+    expect_refused(scene, &d, PLAN_HASH, 3, mixed, 3, "other bake options");
+    lbk_bake_desc d3 = desc_of(16, 2, 7);
+    expect_refused(scene, &d3, PLAN_HASH, 3, parts, 3, "other bake options");
+    /* threads do not change a byte: a merge on another thread count takes the parts */
+    lbk_bake_desc d4 = desc_of(32, 2, 7);
+    d4.threads = 1;
+    lbk_result r4;
+    bytes m4 = merge(scene, &d4, PLAN_HASH, 3, parts, 3, &r4);
+    assert_int_equal(r4, LBK_OK);
+    lbk_free(NULL, m4.p);
+    free_parts(other, 3);
+    /* the whole set merges */
+    lbk_result r;
+    bytes m = merge(scene, &d, PLAN_HASH, 3, parts, 3, &r);
+    assert_int_equal(r, LBK_OK);
+    lbk_free(NULL, m.p);
+    free_parts(parts, 3);
+}
+
+/* What cannot be cut is refused before anything is baked. */
+static void test_unsplittable_refused(void **state)
+{
+    (void)state;
+    const char *scene = "scenes/cornell_box/CornellBox-Original.gltf";
+    bytes p = {NULL, 0};
+    lbk_bake_desc d = desc_of(32, 2, 7);
+    d.target_error = 0.05;
+    assert_int_equal(lbk_bake_unit_from_file(scene, &d, PLAN_HASH, 2, 0, &p.p, &p.n), LBK_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(last_error, "fixed sample schedule"));
+    d = desc_of(32, 2, 7);
+    d.time_limit = 10;
+    assert_int_equal(lbk_bake_unit_from_file(scene, &d, PLAN_HASH, 2, 0, &p.p, &p.n), LBK_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(last_error, "time limit"));
+    d = desc_of(32, 2, 7);
+    d.door_method = LBK_BAKE_DOOR_GUIDED;
+    assert_int_equal(lbk_bake_unit_from_file(scene, &d, PLAN_HASH, 2, 0, &p.p, &p.n), LBK_ERR_INVALID_ARGUMENT);
+    assert_null(p.p);
+    d = desc_of(32, 2, 7);
+    assert_int_equal(lbk_bake_unit_from_file(scene, &d, PLAN_HASH, 2, 2, &p.p, &p.n), LBK_ERR_INVALID_ARGUMENT);
+}
+
+/* The CLI: plan, units, merge equal to lbk bake; a bad part leaves no container. */
+static int sh(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static int sh(const char *fmt, ...)
+{
+    char cmd[4096];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(cmd, sizeof cmd, fmt, ap);
+    va_end(ap);
+    int st = system(cmd);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static void test_cli_plan_units_merge(void **state)
+{
+    (void)state;
+    const char *lbk = getenv("LBK");
+    if (!lbk || !*lbk) {
+        printf("SKIPPED: set LBK to the lbk binary (make test does)\n");
+        skip();
+    }
+    char dir[] = "/tmp/lbk-dist-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    const char *scene = "tests/fuzz/sets_scene.gltf";
+    const char *opts = "--samples 32 --target-error none --texel-density 2 --seed 3";
+    assert_int_equal(sh("%s bake %s -o %s/local.lbk %s --threads 2 -q", lbk, scene, dir, opts), 0);
+    assert_int_equal(sh("%s plan %s -o %s/out.lbk --plan %s/plan.json --units 3 --makefile %s/Makefile %s >/dev/null", lbk,
+                        scene, dir, dir, dir, opts), 0);
+    /* xargs -P: the documented line */
+    assert_int_equal(sh("mkdir -p %s/parts && seq 0 2 | xargs -P 2 -I {} %s bake-unit %s/plan.json {} -o %s/parts/part-{}.lbkpart "
+                        "--threads 1 -q", dir, lbk, dir, dir), 0);
+    assert_int_equal(sh("%s merge %s/plan.json %s/parts/part-2.lbkpart %s/parts/part-0.lbkpart %s/parts/part-1.lbkpart -o "
+                        "%s/xargs.lbk -q", lbk, dir, dir, dir, dir, dir), 0);
+    assert_int_equal(sh("cmp %s/local.lbk %s/xargs.lbk", dir, dir), 0);
+    /* make -j2 through the generated Makefile */
+    assert_int_equal(sh("make -s -j2 -f %s/Makefile LBK=%s >/dev/null", dir, lbk), 0);
+    assert_int_equal(sh("cmp %s/local.lbk %s/out.lbk", dir, dir), 0);
+    /* refusals: nothing written, a message naming the problem */
+    assert_int_equal(sh("%s merge %s/plan.json %s/parts/part-0.lbkpart %s/parts/part-1.lbkpart -o %s/bad.lbk -q 2>%s/err",
+                        lbk, dir, dir, dir, dir, dir), 4);
+    assert_int_equal(sh("grep -q 'units missing: 2' %s/err && test ! -e %s/bad.lbk", dir, dir), 0);
+    assert_int_equal(sh("cp %s/parts/part-1.lbkpart %s/c.lbkpart && printf 'X' | dd of=%s/c.lbkpart bs=1 seek=200 conv=notrunc "
+                        "2>/dev/null", dir, dir, dir), 0);
+    assert_int_equal(sh("%s merge %s/plan.json %s/parts/part-0.lbkpart %s/c.lbkpart %s/parts/part-2.lbkpart -o %s/bad.lbk "
+                        "-q 2>%s/err", lbk, dir, dir, dir, dir, dir, dir), 4);
+    assert_int_equal(sh("grep -q 'corrupt' %s/err && test ! -e %s/bad.lbk", dir, dir), 0);
+    /* a plan of a different seed: its parts are foreign */
+    assert_int_equal(sh("%s plan %s -o %s/o2.lbk --plan %s/plan2.json --units 3 --samples 32 --target-error none "
+                        "--texel-density 2 --seed 4 >/dev/null", lbk, scene, dir, dir), 0);
+    assert_int_equal(sh("%s merge %s/plan2.json %s/parts/part-0.lbkpart %s/parts/part-1.lbkpart %s/parts/part-2.lbkpart "
+                        "-o %s/bad.lbk -q 2>%s/err", lbk, dir, dir, dir, dir, dir, dir), 4);
+    assert_int_equal(sh("grep -q 'another plan' %s/err && test ! -e %s/bad.lbk", dir, dir), 0);
+    /* an edited plan, an error target, a time limit: refused */
+    assert_int_equal(sh("sed 's/\"units\":.*3/\"units\": 4/' %s/plan.json > %s/edited.json && ! %s bake-unit %s/edited.json 0 "
+                        "-o %s/x.lbkpart 2>%s/err && grep -q edited %s/err", dir, dir, lbk, dir, dir, dir, dir), 0);
+    assert_int_equal(sh("%s plan %s -o %s/o3.lbk --plan %s/p3.json --units 2 --samples 32 2>%s/err", lbk, scene, dir, dir, dir), 2);
+    assert_int_equal(sh("grep -q 'fixed sample schedule' %s/err", dir), 0);
+    assert_int_equal(sh("%s plan %s -o %s/o3.lbk --plan %s/p3.json --units 2 --samples 32 --target-error none --time-limit 5 "
+                        "2>%s/err", lbk, scene, dir, dir, dir), 2);
+    assert_int_equal(sh("grep -q 'time-limit' %s/err && test ! -e %s/p3.json", dir, dir), 0);
+    sh("rm -rf %s", dir);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_merge_equals_local_cornell),
+        cmocka_unit_test(test_merge_equals_local_sets_doors),
+        cmocka_unit_test(test_merge_equals_local_room),
+        cmocka_unit_test(test_bad_parts_refused),
+        cmocka_unit_test(test_unsplittable_refused),
+        cmocka_unit_test(test_cli_plan_units_merge),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
