@@ -68,6 +68,7 @@ static int decode_chunk(exr_job *j, const exr_chunk_info_t *ci, int px, int py)
     for (int c = 0; c < dec.channel_count; c++) {
         exr_coding_channel_info_t *ch = &dec.channels[c];
         int slot = channel_slot(ch->channel_name, j->prefixed);
+        if (slot == 4 && !j->lum) slot = -1; /* Y beside R, G, B: not read (fuzz_exr: it was written through NULL) */
         ch->user_bytes_per_element = 4;
         ch->user_data_type = EXR_PIXEL_FLOAT;
         if (slot < 0) {
