@@ -40,7 +40,7 @@ done
 if [ -n "${FUZZ:-}" ] && [ -x "$FUZZ" ]; then
   runs="${FUZZ_RUNS:-20000}"; scratch="$BUILD/fuzz-scratch"; log="$BUILD/tests/fuzz_container.log"
   rm -rf "$scratch"; mkdir -p "$scratch"
-  if "$FUZZ" -runs="$runs" -seed=1 -max_len=65536 -rss_limit_mb=2048 "$scratch" tests/fuzz/corpus >"$log" 2>&1; then
+  if "$FUZZ" -runs="$runs" -seed=1 -max_len=65536 -rss_limit_mb=2048 -artifact_prefix="$scratch/" "$scratch" tests/fuzz/corpus >"$log" 2>&1; then
     pass=$((pass + 1)); echo "ok   fuzz_container ($runs inputs)"
   else
     fail=$((fail + 1)); failed="$failed fuzz_container"; echo "FAIL fuzz_container"; tail -n 30 "$log"
@@ -54,7 +54,7 @@ for h in ${FUZZ_MORE:-}; do
   [ -x "$bin" ] || continue
   runs="${FUZZ_MORE_RUNS:-2000}"; scratch="$BUILD/fuzz-scratch-$name"; log="$BUILD/tests/fuzz_$name.log"
   rm -rf "$scratch"; mkdir -p "$scratch"
-  if "$bin" -runs="$runs" -seed=1 -max_len=65536 -rss_limit_mb=2048 "$scratch" "tests/fuzz/corpus_$name" >"$log" 2>&1; then
+  if "$bin" -runs="$runs" -seed=1 -max_len=65536 -rss_limit_mb=2048 -artifact_prefix="$scratch/" "$scratch" "tests/fuzz/corpus_$name" >"$log" 2>&1; then
     pass=$((pass + 1)); echo "ok   fuzz_$name ($runs inputs)"
   else
     fail=$((fail + 1)); failed="$failed fuzz_$name"; echo "FAIL fuzz_$name"; tail -n 30 "$log"

@@ -1931,6 +1931,8 @@ static void state_arrays(tp_ctx *c, bk_transport_state *st)
     st->radiance = c->out->radiance;
     st->direct = c->out->direct;
     st->irradiance = c->out->irradiance;
+    st->cells = c->cell_count;
+    st->rough = c->rough;
 }
 
 static lbk_result save_state(tp_ctx *c, int pass, const tp_chain_result chain[2])

@@ -124,6 +124,9 @@ typedef struct bk_transport_state {
     void *radiance, *direct;    /* lbk_sh9_rgb arrays */
     float *irradiance;
     bk_transport_sample samples[BK_TRANSPORT_MAX_PASSES]; /* what each pass reported */
+    /* per cache cell (cells): the rough marks the last pass left for the next (TRANSPORT.md) */
+    size_t cells;
+    uint8_t *rough;
 } bk_transport_state;
 
 typedef struct bk_transport_checkpoint {
