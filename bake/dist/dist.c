@@ -96,11 +96,39 @@ static size_t run_size(uint64_t n, uint32_t passes, uint32_t mask)
     return BK_PART_RUN_HEADER_SIZE + (size_t)passes * BK_PART_PASS_HEADER_SIZE + (size_t)n * per;
 }
 
-void bk_dist_range(uint64_t count, uint32_t units, uint32_t unit, uint64_t *begin, uint64_t *end)
+/* runs, units <= 2^16 and count < 2^40 (checked by the callers), so the products fit */
+void bk_dist_unit_runs(uint32_t runs, uint32_t units, uint32_t unit, uint32_t *first, uint32_t *end)
 {
-    /* count < 2^40 and units <= 2^16 (checked by the callers), so the products fit */
-    *begin = units ? count * unit / units : 0;
-    *end = units ? count * (unit + 1) / units : count;
+    if (units <= runs) {
+        *first = (uint32_t)((uint64_t)runs * unit / units);
+        *end = (uint32_t)((uint64_t)runs * (unit + 1) / units);
+    } else {
+        /* the run r with units·r/runs <= unit < units·(r+1)/runs */
+        *first = (uint32_t)(((uint64_t)runs * (unit + 1) - 1) / units);
+        *end = *first + 1;
+    }
+}
+
+void bk_dist_run_units(uint32_t runs, uint32_t units, uint32_t run, uint32_t *first, uint32_t *end)
+{
+    if (units <= runs) {
+        /* the unit k with runs·k/units <= run < runs·(k+1)/units */
+        *first = (uint32_t)(((uint64_t)units * (run + 1) - 1) / runs);
+        *end = *first + 1;
+    } else {
+        *first = (uint32_t)((uint64_t)units * run / runs);
+        *end = (uint32_t)((uint64_t)units * (run + 1) / runs);
+    }
+}
+
+void bk_dist_range(uint64_t count, uint32_t runs, uint32_t units, uint32_t unit, uint32_t run, uint64_t *begin,
+                   uint64_t *end)
+{
+    uint32_t u0, u1;
+    bk_dist_run_units(runs, units, run, &u0, &u1);
+    const uint64_t m = u1 - u0, j = unit - u0;
+    *begin = count * j / m;
+    *end = count * (j + 1) / m;
 }
 
 static lbk_result say(char *err, size_t len, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
@@ -120,24 +148,24 @@ lbk_result bk_part_parse(const void *bytes, size_t size, bk_part_view *v, char *
     if (!p || size < BK_PART_HEADER_SIZE || memcmp(p, BK_PART_MAGIC, 8))
         return say(err, err_len, "not a part file (no LBKPART header)");
     if (get32(p + 8) != BK_PART_VERSION) return say(err, err_len, "part format version %u (this lbk reads %u)", get32(p + 8), BK_PART_VERSION);
-    if (get32(p + 12) != BK_PART_HEADER_SIZE || get32(p + 60) != 0) return say(err, err_len, "corrupt part header");
+    if (get32(p + 12) != BK_PART_HEADER_SIZE || get64(p + 48) != 0 || get32(p + 60) != 0) return say(err, err_len, "corrupt part header");
     if (XXH64(p, 88, 0) != get64(p + 88)) return say(err, err_len, "corrupt part header (checksum)");
     v->options_hash = get64(p + 80);
     v->plan_hash = get64(p + 16);
     v->units = get32(p + 24);
     v->unit = get32(p + 28);
     v->receiver_count = get64(p + 32);
-    v->begin = get64(p + 40);
-    v->end = get64(p + 48);
+    v->total_runs = get32(p + 40);
+    v->first_run = get32(p + 44);
     v->run_count = get32(p + 56);
     uint64_t payload = get64(p + 64);
     if (v->units == 0 || v->units > BK_PART_MAX_UNITS || v->unit >= v->units || v->receiver_count >= ((uint64_t)1 << 40) ||
-        v->run_count > BK_PART_MAX_RUNS)
+        v->total_runs == 0 || v->total_runs > BK_PART_MAX_RUNS)
         return say(err, err_len, "corrupt part header (unit %u of %u, %llu receivers, %u runs)", v->unit, v->units,
-                   (unsigned long long)v->receiver_count, v->run_count);
-    uint64_t b, e;
-    bk_dist_range(v->receiver_count, v->units, v->unit, &b, &e);
-    if (b != v->begin || e != v->end) return say(err, err_len, "corrupt part header (receiver range)");
+                   (unsigned long long)v->receiver_count, v->total_runs);
+    uint32_t r0, r1;
+    bk_dist_unit_runs(v->total_runs, v->units, v->unit, &r0, &r1);
+    if (v->first_run != r0 || v->run_count != r1 - r0) return say(err, err_len, "corrupt part header (its runs)");
     if (payload != size - BK_PART_HEADER_SIZE)
         return say(err, err_len, "truncated or padded part: %zu bytes, the header says %llu", size,
                    (unsigned long long)(payload + BK_PART_HEADER_SIZE));
@@ -149,7 +177,10 @@ lbk_result bk_part_parse(const void *bytes, size_t size, bk_part_view *v, char *
         if (size - at < BK_PART_RUN_HEADER_SIZE) goto bad;
         uint32_t passes = get32(p + at), mask = get32(p + at + 4);
         if (passes == 0 || passes > BK_PART_MAX_PASSES || mask > 15 || !(mask & BK_PART_RADIANCE)) goto bad;
-        size_t n = run_size(v->end - v->begin, passes, mask);
+        uint64_t b, e;
+        bk_dist_range(v->receiver_count, v->total_runs, v->units, v->unit, v->first_run + r, &b, &e);
+        if (get64(p + at + 96) != b || get64(p + at + 104) != e) goto bad;
+        size_t n = run_size(e - b, passes, mask);
         if (!n || n > size - at) goto bad;
         v->runs[r] = p + at;
         at += n;
@@ -168,19 +199,50 @@ struct bk_dist {
     int replay;
     uint64_t plan_hash, options_hash;
     uint32_t units, unit;
-    uint64_t count, begin, end;
-    int have_count;
+    uint64_t count;
+    uint32_t total_runs, first_run, end_run; /* the bake's runs; this unit's [first_run, end_run) */
+    int have_cut;
     bk_transport_split split;
+    uint32_t run;     /* the run under way (record) or being replayed (replay) */
+    uint64_t begin, end; /* record: this unit's receivers in that run */
     /* record */
     buf out;          /* finished runs */
     buf passes;       /* the current run's pass records */
     uint32_t run_count, run_passes;
     /* replay */
     const bk_part_view *parts;
-    uint32_t run;     /* the run being replayed */
-    uint32_t pass_done;
+    uint32_t owners[2]; /* the units that hold the run being replayed */
     char err[512];
 };
+
+static lbk_result fail(bk_dist *d, lbk_result code, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+static lbk_result fail(bk_dist *d, lbk_result code, const char *fmt, ...)
+{
+    if (!d->err[0]) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(d->err, sizeof d->err, fmt, ap);
+        va_end(ap);
+    }
+    return code;
+}
+
+static lbk_result rec_range(void *user, size_t count, int *own, size_t *begin, size_t *end)
+{
+    bk_dist *d = user;
+    if (!d->have_cut || count != d->count)
+        return fail(d, LBK_ERR_INTERNAL, "a transport run of %zu receivers, the bake has %llu", count, (unsigned long long)d->count);
+    if (d->run >= d->total_runs)
+        return fail(d, LBK_ERR_INTERNAL, "the bake makes more than the %u transport runs it counted", d->total_runs);
+    *own = d->run >= d->first_run && d->run < d->end_run;
+    if (*own) {
+        bk_dist_range(d->count, d->total_runs, d->units, d->unit, d->run, &d->begin, &d->end);
+        *begin = (size_t)d->begin;
+        *end = (size_t)d->end;
+    }
+    d->run++;
+    return LBK_OK;
+}
 
 static lbk_result rec_pass(void *user, const bk_transport_pass_record *pr)
 {
@@ -235,6 +297,13 @@ static void put_totals(uint8_t *w, uint32_t passes, uint32_t mask, const bk_tran
     put64(w + 88, t->recv_nonfinite);
 }
 
+/* The receivers a run record holds (bytes 96–111 of its header, checked by bk_part_parse). */
+static void put_range(uint8_t *w, uint64_t begin, uint64_t end)
+{
+    put64(w + 96, begin);
+    put64(w + 104, end);
+}
+
 static void get_totals(const uint8_t *w, bk_transport_totals *t)
 {
     memset(t, 0, sizeof *t);
@@ -263,6 +332,7 @@ static lbk_result rec_done(void *user, const bk_transport_output *o, const bk_tr
     uint8_t *w = total ? buf_grow(&d->out, total) : NULL;
     if (!w || d->passes.failed) return LBK_ERR_OUT_OF_MEMORY;
     put_totals(w, d->run_passes, mask, t);
+    put_range(w, d->begin, d->end);
     w += BK_PART_RUN_HEADER_SIZE;
     memcpy(w, d->passes.p, d->passes.n);
     w += d->passes.n;
@@ -277,65 +347,70 @@ static lbk_result rec_done(void *user, const bk_transport_output *o, const bk_tr
     return LBK_OK;
 }
 
-static lbk_result fail(bk_dist *d, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static lbk_result fail(bk_dist *d, const char *fmt, ...)
+/* Run d->run's record in unit u's part, and the receivers it holds. */
+static const uint8_t *record_of(const bk_dist *d, uint32_t u, size_t *begin, size_t *n)
 {
-    if (!d->err[0]) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(d->err, sizeof d->err, fmt, ap);
-        va_end(ap);
-    }
-    return LBK_ERR_BAD_INPUT;
+    const bk_part_view *v = &d->parts[u];
+    const uint8_t *rh = v->runs[d->run - v->first_run];
+    *begin = (size_t)get64(rh + 96);
+    *n = (size_t)(get64(rh + 104) - get64(rh + 96));
+    return rh;
 }
 
 static lbk_result play_totals(void *user, size_t count, bk_transport_totals *t)
 {
     bk_dist *d = user;
-    if (count != d->count) return fail(d, "the parts were baked with %llu receivers, this run has %zu", (unsigned long long)d->count, count);
-    if (d->run >= d->parts[0].run_count)
-        return fail(d, "the parts hold %u transport runs, this bake makes more: the parts come from another scene, "
-                    "options or lbk version", d->parts[0].run_count);
+    if (count != d->count)
+        return fail(d, LBK_ERR_BAD_INPUT, "the parts were baked with %llu receivers, this run has %zu", (unsigned long long)d->count, count);
+    if (d->run >= d->total_runs)
+        return fail(d, LBK_ERR_BAD_INPUT, "the parts hold %u transport runs, this bake makes more: the parts come from another "
+                    "scene, options or lbk version", d->total_runs);
+    bk_dist_run_units(d->total_runs, d->units, d->run, &d->owners[0], &d->owners[1]);
     memset(t, 0, sizeof *t);
-    for (uint32_t u = 0; u < d->units; u++) {
-        const uint8_t *rh = d->parts[u].runs[d->run];
+    const uint8_t *first = NULL;
+    for (uint32_t u = d->owners[0]; u < d->owners[1]; u++) {
+        size_t b, n;
+        const uint8_t *rh = record_of(d, u, &b, &n);
         bk_transport_totals x;
         get_totals(rh, &x);
-        if (u == 0) {
+        if (!first) {
+            first = rh;
             *t = x;
             continue;
         }
-        /* the caches are global: every unit must have computed the same ones */
-        if (memcmp(rh, d->parts[0].runs[d->run], 72))
-            return fail(d, "run %u: unit %u disagrees with unit 0 on what every unit computes alike (passes, caches, "
-                        "ray counts): the parts were baked by different lbk builds or from different inputs", d->run, u);
+        /* the caches are global: every unit of the run must have computed the same ones */
+        if (memcmp(rh, first, 72))
+            return fail(d, LBK_ERR_BAD_INPUT, "run %u: unit %u disagrees with unit %u on what every unit of the run computes "
+                        "alike (passes, caches, ray counts): the parts were baked by different lbk builds or from different "
+                        "inputs", d->run, u, d->owners[0]);
         t->recv_rays += x.recv_rays;
         t->recv_shadow += x.recv_shadow;
         t->recv_nonfinite += x.recv_nonfinite;
     }
-    d->pass_done = 0;
     return LBK_OK;
 }
 
 static lbk_result play_pass(void *user, bk_transport_pass_record *pr)
 {
     bk_dist *d = user;
-    for (uint32_t u = 0; u < d->units; u++) {
-        const bk_part_view *v = &d->parts[u];
-        const size_t n = (size_t)(v->end - v->begin);
-        const uint8_t *w = v->runs[d->run] + BK_PART_RUN_HEADER_SIZE + (size_t)pr->pass * (BK_PART_PASS_HEADER_SIZE + 32 * n);
-        if (u == 0) {
+    const uint8_t *head = NULL;
+    for (uint32_t u = d->owners[0]; u < d->owners[1]; u++) {
+        size_t b, n;
+        const uint8_t *w = record_of(d, u, &b, &n);
+        if ((uint32_t)pr->pass >= get32(w)) return fail(d, LBK_ERR_BAD_INPUT, "run %u: unit %u has fewer passes", d->run, u);
+        w += BK_PART_RUN_HEADER_SIZE + (size_t)pr->pass * (BK_PART_PASS_HEADER_SIZE + 32 * n);
+        if (!head) {
+            head = w;
             pr->bounces = (int)get32(w + 4);
             pr->samples_per_receiver = getd(w + 8);
             for (int k = 0; k < 3; k++) pr->weight_sum[k] = getd(w + 16 + 8 * k), pr->class_samples[k] = getd(w + 40 + 8 * k);
-        } else if (memcmp(w, d->parts[0].runs[d->run] + BK_PART_RUN_HEADER_SIZE +
-                                 (size_t)pr->pass * (BK_PART_PASS_HEADER_SIZE + 32 * (size_t)(d->parts[0].end - d->parts[0].begin)),
-                          BK_PART_PASS_HEADER_SIZE)) {
-            return fail(d, "run %u pass %d: unit %u disagrees with unit 0 on the pass", d->run, pr->pass, u);
+        } else if (memcmp(w, head, BK_PART_PASS_HEADER_SIZE)) {
+            return fail(d, LBK_ERR_BAD_INPUT, "run %u pass %d: unit %u disagrees with unit %u on the pass", d->run, pr->pass, u,
+                        d->owners[0]);
         }
         w += BK_PART_PASS_HEADER_SIZE;
         for (size_t i = 0; i < n; i++, w += 32) {
-            size_t r = (size_t)v->begin + i;
+            size_t r = b + i;
             pr->x_acc[0][r] = getd(w);
             pr->x_acc[1][r] = getd(w + 8);
             pr->b_acc[0][r] = getd(w + 16);
@@ -349,16 +424,17 @@ static lbk_result play_outputs(void *user, const bk_transport_output *o)
 {
     bk_dist *d = user;
     const uint32_t mask = mask_of(o);
-    for (uint32_t u = 0; u < d->units; u++) {
-        const bk_part_view *v = &d->parts[u];
-        const uint8_t *rh = v->runs[d->run];
+    for (uint32_t u = d->owners[0]; u < d->owners[1]; u++) {
+        size_t b, n;
+        const uint8_t *rh = record_of(d, u, &b, &n);
         const uint32_t passes = get32(rh), pmask = get32(rh + 4);
-        if (pmask != mask) return fail(d, "run %u: the part holds other outputs (%#x) than this bake needs (%#x)", d->run, pmask, mask);
-        const size_t n = (size_t)(v->end - v->begin);
+        if (pmask != mask)
+            return fail(d, LBK_ERR_BAD_INPUT, "run %u: the part holds other outputs (%#x) than this bake needs (%#x)", d->run,
+                        pmask, mask);
         const uint8_t *w = rh + BK_PART_RUN_HEADER_SIZE + (size_t)passes * (BK_PART_PASS_HEADER_SIZE + 32 * n);
         for (int k = 0; k < 4; k++) {
             if (!(mask & (1u << k))) continue;
-            float *a = (float *)out_array(o, k) + (size_t)v->begin * out_floats[k];
+            float *a = (float *)out_array(o, k) + b * out_floats[k];
             for (size_t i = 0; i < n * (size_t)out_floats[k]; i++, w += 4) a[i] = getf(w);
         }
     }
@@ -381,6 +457,7 @@ lbk_result bk_dist_create(int replay, uint64_t plan_hash, uint64_t options_hash,
     d->parts = parts;
     d->split.replay = replay;
     d->split.user = d;
+    d->split.run_range = rec_range;
     d->split.record_pass = rec_pass;
     d->split.record_done = rec_done;
     d->split.replay_totals = play_totals;
@@ -398,21 +475,24 @@ void bk_dist_destroy(bk_dist *d)
     free(d);
 }
 
-lbk_result bk_dist_set_receivers(bk_dist *d, uint64_t count, char *err, size_t err_len)
+lbk_result bk_dist_set_cut(bk_dist *d, uint64_t count, uint32_t runs, char *err, size_t err_len)
 {
     if (count >= ((uint64_t)1 << 40)) return say(err, err_len, "too many receivers for a distributed bake");
+    if (runs == 0 || runs > BK_PART_MAX_RUNS) return say(err, err_len, "too many transport runs for a distributed bake");
     d->count = count;
-    d->have_count = 1;
+    d->total_runs = runs;
+    d->have_cut = 1;
     if (d->replay) {
         if (d->parts[0].receiver_count != count)
             return say(err, err_len, "the parts were baked with %llu receivers, this scene and options give %llu: they "
                        "come from another scene, options or lbk version", (unsigned long long)d->parts[0].receiver_count,
                        (unsigned long long)count);
+        if (d->parts[0].total_runs != runs)
+            return say(err, err_len, "the parts were cut from %u transport runs, this scene and options make %u: they "
+                       "come from another scene, options or lbk version", d->parts[0].total_runs, runs);
         return LBK_OK;
     }
-    bk_dist_range(count, d->units, d->unit, &d->begin, &d->end);
-    d->split.begin = (size_t)d->begin;
-    d->split.end = (size_t)d->end;
+    bk_dist_unit_runs(runs, d->units, d->unit, &d->first_run, &d->end_run);
     return LBK_OK;
 }
 
@@ -423,12 +503,16 @@ const char *bk_dist_error(const bk_dist *d) { return d ? d->err : ""; }
 lbk_result bk_dist_finish(bk_dist *d, void **bytes, size_t *size, char *err, size_t err_len)
 {
     if (d->replay) {
-        if (d->run != d->parts[0].run_count)
+        if (d->run != d->total_runs)
             return say(err, err_len, "the parts hold %u transport runs, this bake made %u: they come from another scene, "
-                       "options or lbk version", d->parts[0].run_count, d->run);
+                       "options or lbk version", d->total_runs, d->run);
         return LBK_OK;
     }
-    if (!d->have_count || d->out.failed) return LBK_ERR_INTERNAL;
+    if (!d->have_cut || d->out.failed) return LBK_ERR_INTERNAL;
+    if (d->run != d->total_runs || d->run_count != d->end_run - d->first_run) {
+        snprintf(d->err, sizeof d->err, "the bake made %u transport runs, its cut counted %u", d->run, d->total_runs);
+        return say(err, err_len, "%s", d->err), LBK_ERR_INTERNAL;
+    }
     size_t total = BK_PART_HEADER_SIZE + d->out.n;
     uint8_t *p = malloc(total);
     if (!p) return LBK_ERR_OUT_OF_MEMORY;
@@ -440,8 +524,8 @@ lbk_result bk_dist_finish(bk_dist *d, void **bytes, size_t *size, char *err, siz
     put32(p + 24, d->units);
     put32(p + 28, d->unit);
     put64(p + 32, d->count);
-    put64(p + 40, d->begin);
-    put64(p + 48, d->end);
+    put32(p + 40, d->total_runs);
+    put32(p + 44, d->first_run);
     put32(p + 56, d->run_count);
     put64(p + 64, d->out.n);
     if (d->out.n) memcpy(p + BK_PART_HEADER_SIZE, d->out.p, d->out.n);

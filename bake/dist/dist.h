@@ -1,7 +1,8 @@
-/* Distributed bakes (bake/dist/DIST.md, spec/part.md): one bake cut into units by receivers.
- * A unit runs the whole pipeline up to the light transport (import, layout, caches: global but
- * deterministic, so every unit rebuilds them alike), gathers only its receivers' share of every
- * transport run (base, light sets, doors) and records what it computed into a part. The merge
+/* Distributed bakes (bake/dist/DIST.md, spec/part.md): one bake cut into units by transport runs
+ * and, with more units than runs, by receivers. A unit runs the whole pipeline up to the light
+ * transport (import, layout), bakes its runs (their caches are global but deterministic, so
+ * units sharing a run rebuild them alike) gathering only its receivers' share, skips the other
+ * runs, and records what it computed into a part. The merge
  * runs the same pipeline, replays the parts instead of tracing, and then denoises, encodes and
  * writes as a local bake does: the container is byte-identical to `lbk bake`. */
 #ifndef BK_DIST_H
@@ -14,9 +15,9 @@
 #include "lbk/lbk.h"
 
 #define BK_PART_MAGIC "LBKPART\0"
-#define BK_PART_VERSION 1u
+#define BK_PART_VERSION 2u
 #define BK_PART_HEADER_SIZE 96u
-#define BK_PART_RUN_HEADER_SIZE 96u
+#define BK_PART_RUN_HEADER_SIZE 112u
 #define BK_PART_PASS_HEADER_SIZE 64u
 #define BK_PART_MAX_UNITS 65536u
 #define BK_PART_MAX_RUNS 65536u
@@ -27,16 +28,24 @@ enum { BK_PART_RADIANCE = 1, BK_PART_DIRECT = 2, BK_PART_IRRADIANCE = 4, BK_PART
 
 /* A validated part, its runs indexed (pointers into the caller's bytes). */
 typedef struct bk_part_view {
-    uint64_t plan_hash, options_hash, receiver_count, begin, end;
-    uint32_t units, unit, run_count;
-    const uint8_t **runs;     /* run_count run records */
+    uint64_t plan_hash, options_hash, receiver_count;
+    uint32_t units, unit, total_runs, first_run, run_count;
+    const uint8_t **runs;     /* run_count run records: runs first_run, first_run + 1, ... */
 } bk_part_view;
 
-/* The receivers of unit k of n: [count·k/n, count·(k+1)/n). */
-void bk_dist_range(uint64_t count, uint32_t units, uint32_t unit, uint64_t *begin, uint64_t *end);
+/* The cut of a bake of `runs` transport runs and `count` receivers into `units` units
+ * (DIST.md): with units <= runs, unit k bakes runs [runs·k/units, runs·(k+1)/units) whole;
+ * with more units than runs, run r is shared by units [units·r/runs, units·(r+1)/runs), each
+ * gathering an equal slice of its receivers. Every unit then computes the caches of its own
+ * runs only: max(runs, units) cache sets in all, not runs × units. */
+void bk_dist_unit_runs(uint32_t runs, uint32_t units, uint32_t unit, uint32_t *first, uint32_t *end);
+void bk_dist_run_units(uint32_t runs, uint32_t units, uint32_t run, uint32_t *first, uint32_t *end);
+/* The receivers [begin, end) unit `unit` gathers in run `run` (one of its runs). */
+void bk_dist_range(uint64_t count, uint32_t runs, uint32_t units, uint32_t unit, uint32_t run, uint64_t *begin,
+                   uint64_t *end);
 
-/* Checks a part's bytes (sizes, checksums, every run record's length) and indexes its runs;
- * LBK_ERR_BAD_INPUT with the reason in err. Free view->runs with free(). */
+/* Checks a part's bytes (sizes, checksums, its runs and every run record's length and range)
+ * and indexes its runs; LBK_ERR_BAD_INPUT with the reason in err. Free view->runs with free(). */
 lbk_result bk_part_parse(const void *bytes, size_t size, bk_part_view *view, char *err, size_t err_len);
 
 typedef struct bk_dist bk_dist;
@@ -48,9 +57,10 @@ typedef struct bk_dist bk_dist;
 lbk_result bk_dist_create(int replay, uint64_t plan_hash, uint64_t options_hash, uint32_t units, uint32_t unit,
                           const bk_part_view *parts, bk_dist **out);
 void bk_dist_destroy(bk_dist *d);
-/* The bake's receiver count, once known: fixes the unit's range (record) or checks the parts
- * against it (replay). LBK_ERR_BAD_INPUT with a message when they disagree. */
-lbk_result bk_dist_set_receivers(bk_dist *d, uint64_t count, char *err, size_t err_len);
+/* The bake's receiver count and its number of transport runs, once known: fixes the unit's cut
+ * (record) or checks the parts against them (replay). LBK_ERR_BAD_INPUT with a message when
+ * they disagree. */
+lbk_result bk_dist_set_cut(bk_dist *d, uint64_t count, uint32_t runs, char *err, size_t err_len);
 /* What every transport run is handed (bk_transport_options.split). */
 const bk_transport_split *bk_dist_split(const bk_dist *d);
 /* After the bake (record): the part's bytes (malloc'd, the caller frees). Replay: LBK_OK when

@@ -512,7 +512,9 @@ static lbk_result do_transport(bk_pipeline *b)
     lbk_result r = phase(b, LBK_BAKE_PHASE_LIGHT);
     if (!r) r = build_receivers(b);
     if (!r) r = build_cell_sizes(b);
-    if (!r && b->dist) r = bk_dist_set_receivers(b->dist, b->receiver_count, b->err, sizeof b->err);
+    if (!r && b->dist)
+        r = bk_dist_set_cut(b->dist, b->receiver_count, (uint32_t)(1 + bk_set_bakes_transport_runs(&b->sets)), b->err,
+                            sizeof b->err);
     if (r) return r;
     bk_transport_options to;
     transport_options(b, &to);
@@ -915,9 +917,10 @@ lbk_result lbk_bake_part_check(const void *part, size_t size, uint64_t plan_hash
         info->units = v.units;
         info->unit = v.unit;
         info->runs = v.run_count;
+        info->total_runs = v.total_runs;
+        info->first_run = v.first_run;
         info->receivers = v.receiver_count;
-        info->first = v.begin;
-        info->end = v.end;
+        bk_dist_range(v.receiver_count, v.total_runs, v.units, v.unit, v.first_run, &info->first, &info->end);
     }
     if (plan_hash && v.plan_hash != plan_hash) {
         if (err && err_len)
@@ -992,7 +995,7 @@ static lbk_result order_parts(const lbk_bake_desc *desc, uint64_t plan_hash, uin
         return LBK_ERR_BAD_INPUT;
     }
     for (uint32_t u = 1; u < units; u++)
-        if (views[u].receiver_count != views[0].receiver_count || views[u].run_count != views[0].run_count) {
+        if (views[u].receiver_count != views[0].receiver_count || views[u].total_runs != views[0].total_runs) {
             say_error(desc, "unit %u's part disagrees with unit 0's (receivers, runs): the parts come from different "
                       "scenes, options or lbk versions", u);
             return LBK_ERR_BAD_INPUT;

@@ -1113,6 +1113,22 @@ int bk_set_bakes_planned_runs(const bk_set_bakes *sets)
     return runs;
 }
 
+int bk_set_bakes_transport_runs(const bk_set_bakes *sets)
+{
+    const bs_impl *im = sets ? sets->impl : NULL;
+    if (!im) return 0;
+    int runs = 0;
+    for (size_t j = 0; j < im->light_set_count; j++) runs += !im->sets[j].zero;
+    if (!im->door_count) return runs;
+    runs += 1 + 2 * (int)im->door_count; /* the reference, then each door open and closed */
+    for (size_t c = 0; c < im->combo_count; c++) {
+        const bs_combo *co = &im->combos[c];
+        if (co->door[1] >= 0) runs += 1;                  /* both open (bake_door kept each open run) */
+        else runs += im->sets[co->light_set].zero ? 0 : 2; /* the set with the door open and closed */
+    }
+    return runs;
+}
+
 lbk_result bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *err, size_t err_len)
 {
     bs_impl *im = sets->impl;

@@ -89,6 +89,10 @@ void bk_set_bakes_guide(const bk_set_bakes *sets, const lbk_sh9_rgb **sum, const
 
 /* How many transport runs bk_set_bakes_run will make (for the time budget's shares). */
 int bk_set_bakes_planned_runs(const bk_set_bakes *sets);
+/* Exactly how many bk_transport_run calls bk_set_bakes_run makes with the difference door
+ * method (a distributed bake's cut, bake/dist/DIST.md): a door pair reuses its doors' open runs
+ * and a combination with a black light set makes none. */
+int bk_set_bakes_transport_runs(const bk_set_bakes *sets);
 
 /* One transport run of bk_set_bakes_run (a light set, a door state, a reference): its label as in
  * the bake's messages and its final estimated error, pooled and per receiver class. */

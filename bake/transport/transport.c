@@ -1922,6 +1922,36 @@ static lbk_result replay_run(tp_ctx *c, bk_transport_stats *stats)
     return LBK_OK;
 }
 
+/* A unit's run it has no share of (bk_transport_split.run_range): no cache, no gather; zero
+ * outputs and the passes and samples the fixed schedule gives (run_pass, stop_after with no
+ * target and no time limit), which later runs may depend on (door runs' budget). */
+static void schedule_only(tp_ctx *c, bk_transport_stats *stats)
+{
+    init_classes(c);
+    const tp_errors none = {{0}, 0};
+    int pass = 0;
+    for (;; pass++) {
+        for (int k = 0; k < c->ncls; k++) {
+            if (!c->cls[k].active) continue;
+            c->cls[k].weight_sum += ldexp(1.0, pass);
+            c->cls[k].spp += 2.0 * (c->s0 << (pass < 20 ? pass : 20));
+        }
+        if (stop_after(c, pass, &none, 0)) break;
+    }
+    const bk_transport_output *o = c->out;
+    memset(o->radiance, 0, c->recv_count * sizeof *o->radiance);
+    if (o->direct) memset(o->direct, 0, c->recv_count * sizeof *o->direct);
+    if (o->irradiance) memset(o->irradiance, 0, c->recv_count * 3 * sizeof *o->irradiance);
+    if (o->variance) memset(o->variance, 0, c->recv_count * sizeof *o->variance);
+    if (!stats) return;
+    const tp_class *lead = lead_class(c);
+    stats->passes = pass + 1;
+    stats->samples_per_receiver = lead->spp;
+    for (int k = 0; k < c->ncls; k++) stats->class_samples[k] = c->cls[k].spp;
+    stats->stop = lead->stop;
+    stats->seconds = now_seconds() - c->t0;
+}
+
 /* ---- checkpoints (bk_transport_checkpoint) ------------------------------------------------ */
 
 static void state_arrays(tp_ctx *c, bk_transport_state *st)
@@ -2009,8 +2039,15 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
     lbk_result res = check_inputs(scene, tracer, receivers, count, opt, output);
     if (res != LBK_OK) return res;
     const bk_transport_split *split = opt->split;
-    if (split && (!(opt->target_error < 0) || opt->time_limit > 0 || split->begin > split->end || split->end > count))
+    if (split && (!(opt->target_error < 0) || opt->time_limit > 0))
         return LBK_ERR_INVALID_ARGUMENT; /* a stop that needs every receiver cannot be cut */
+    size_t g_begin = 0, g_end = count;
+    int own = 1;
+    if (split && !split->replay) {
+        res = split->run_range(split->user, count, &own, &g_begin, &g_end);
+        if (res != LBK_OK) return res;
+        if (own && (g_begin > g_end || g_end > count)) return LBK_ERR_INVALID_ARGUMENT;
+    }
 
     tp_ctx c;
     memset(&c, 0, sizeof c);
@@ -2030,10 +2067,14 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
     c.target = opt->target_error == 0 ? 0.01 : opt->target_error;
     c.s0 = opt->first_pass_samples > 0 ? opt->first_pass_samples : 16;
     c.tail_tol = fmax(0.1 * (c.target > 0 ? c.target : 0.001), 1e-5);
-    c.g_begin = split ? split->begin : 0;
-    c.g_end = split ? split->end : count;
+    c.g_begin = g_begin;
+    c.g_end = g_end;
     if (split && split->replay) {
         res = replay_run(&c, stats);
+        goto done;
+    }
+    if (!own) {
+        schedule_only(&c, stats);
         goto done;
     }
     res = ctx_init(&c);

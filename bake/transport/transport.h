@@ -141,8 +141,12 @@ typedef struct bk_transport_checkpoint {
 struct bk_transport_output;
 typedef struct bk_transport_split {
     int replay;            /* 0: record (a unit), 1: replay (the merge) */
-    size_t begin, end;     /* record: the receivers this unit gathers */
     void *user;
+    /* record: called once at the start of every run, in run order: *own = 1 and the receivers
+     * [*begin, *end) this unit gathers (and records) in this run, or *own = 0: the unit has no
+     * share of the run, which then traces nothing, leaves its outputs 0 and reports only its
+     * sample schedule (stats passes and samples: a fixed schedule does not depend on tracing) */
+    lbk_result (*run_range)(void *user, size_t count, int *own, size_t *begin, size_t *end);
     lbk_result (*record_pass)(void *user, const bk_transport_pass_record *pass);
     lbk_result (*record_done)(void *user, const struct bk_transport_output *out, const bk_transport_totals *totals);
     /* replay: totals summed over the units; then every pass (arrays of `count` entries

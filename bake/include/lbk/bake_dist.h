@@ -1,5 +1,5 @@
 /* liblbkbake: distributed bakes (bake/dist/DIST.md). One bake cut into `units` units by
- * receivers; every unit needs only the scene files and the same options, and returns a part
+ * transport runs and, with more units than runs, by receivers; every unit needs only the scene files and the same options, and returns a part
  * (spec/part.md); the merge of all parts is byte-identical to lbk_bake_from_file with the same
  * scene, options and seed, at any number of units.
  *
@@ -26,8 +26,11 @@ LBK_BAKE_API void lbk_bake_part_free(void *part);
 /* What a part says about itself (lbk_bake_part_check). */
 typedef struct lbk_bake_part_info {
     uint64_t plan_hash;
-    uint32_t units, unit, runs;
-    uint64_t receivers, first, end;   /* the plan's receivers; this unit's [first, end) */
+    uint32_t units, unit;
+    uint32_t total_runs;              /* the bake's transport runs (base, light sets, doors) */
+    uint32_t first_run, runs;         /* this unit's runs [first_run, first_run + runs) */
+    uint64_t receivers, first, end;   /* the bake's receivers; this unit's [first, end) in its
+                                         first run (all of them unless units > total_runs) */
 } lbk_bake_part_info;
 
 /* Checks a part's bytes (format, checksums); with plan_hash != 0 also that it belongs to that
