@@ -91,17 +91,47 @@ static int write_sbatch(const char *path, const char *lbk, const char *plan, con
     return r;
 }
 
+static void error_message(void *user, lbk_bake_severity severity, const char *message)
+{
+    if (severity == LBK_BAKE_SEVERITY_ERROR) fprintf(stderr, "lbk %s: %s\n", (const char *)user, message);
+}
+
+/* Every file the bake reads (the glTF, its buffers and images, a sky EXR), with its hash: units
+ * and the merge refuse a changed one. -1 when done, else the exit code. */
+static int plan_inputs(const char *cmd, const char *scene, const lbk_bake_desc *desc, tl_plan *p, uint32_t *runs)
+{
+    lbk_bake_desc d = *desc;
+    d.message = error_message;
+    d.user = (void *)cmd;
+    d.progress = NULL;
+    lbk_bake_input *in = NULL;
+    size_t n = 0;
+    lbk_result r = lbk_bake_inputs_from_file(scene, &d, &in, &n, runs);
+    if (r) {
+        if (r != LBK_ERR_BAD_INPUT && r != LBK_ERR_INVALID_ARGUMENT && r != LBK_ERR_IO)
+            fprintf(stderr, "lbk %s: %s\n", cmd, lbk_result_message(r));
+        return r == LBK_ERR_IO ? LBK_EXIT_IO : r == LBK_ERR_INVALID_ARGUMENT ? LBK_EXIT_USAGE : LBK_EXIT_INPUT;
+    }
+    if (n > TL_PLAN_MAX_INPUTS || !(p->inputs = calloc(n ? n : 1, sizeof *p->inputs))) {
+        lbk_bake_inputs_free(in);
+        fprintf(stderr, "lbk %s: %s\n", cmd, n > TL_PLAN_MAX_INPUTS ? "too many input files for a plan" : "out of memory");
+        return LBK_EXIT_INTERNAL;
+    }
+    for (size_t i = 0; i < n; i++) {
+        memcpy(p->inputs[i].path, in[i].path, sizeof p->inputs[i].path);
+        memcpy(p->inputs[i].role, in[i].role, sizeof p->inputs[i].role);
+        p->inputs[i].bytes = in[i].bytes;
+        p->inputs[i].xxh3 = in[i].xxh3;
+    }
+    p->input_count = n;
+    lbk_bake_inputs_free(in);
+    return -1;
+}
+
 int cli_plan_write(const bake_args *o, int argc, char **argv, const char *cmd)
 {
     if (!o->input || !o->output || !o->plan || !o->units) {
         fprintf(stderr, "lbk %s: a plan needs a scene, -o OUT.lbk, --plan PLAN.json and --units N (lbk plan --help)\n", cmd);
-        return LBK_EXIT_USAGE;
-    }
-    if (!(o->d.target_error < 0) || o->d.max_samples <= 0) {
-        fprintf(stderr,
-                "lbk %s: a distributed bake needs a fixed sample schedule: --samples N --target-error none (the error "
-                "target stops on a sum over every receiver, which no single unit has; bake/dist/DIST.md)\n",
-                cmd);
         return LBK_EXIT_USAGE;
     }
     if (o->d.time_limit > 0) {
@@ -131,6 +161,16 @@ int cli_plan_write(const bake_args *o, int argc, char **argv, const char *cmd)
         fprintf(stderr, "lbk %s: %s\n", cmd, err);
         return LBK_EXIT_IO;
     }
+    uint32_t runs = 0;
+    int rc = plan_inputs(cmd, scene, &o->d, &p, &runs);
+    if (rc >= 0) return rc;
+    if (!(o->d.target_error < 0) && o->units > runs) {
+        fprintf(stderr, "lbk %s: with an error target each transport run stops on its own estimate over all its receivers, "
+                        "so units take whole runs: this bake makes %u (the base, light sets, door states), so --units %u or "
+                        "fewer, or a fixed schedule (--samples N --target-error none) for any number\n", cmd, runs, runs);
+        free(p.inputs);
+        return LBK_EXIT_USAGE;
+    }
     int seen_input = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -158,22 +198,25 @@ int cli_plan_write(const bake_args *o, int argc, char **argv, const char *cmd)
     if (tl_plan_write(&p, plan, err) || (o->makefile && write_makefile(o->makefile, lbk, plan, output, o->units, err)) ||
         (o->sbatch && write_sbatch(o->sbatch, lbk, plan, output, o->units, err))) {
         fprintf(stderr, "lbk %s: %s\n", cmd, err);
+        free(p.inputs);
         return LBK_EXIT_IO;
     }
-    printf("%s: %u units, plan hash %016" PRIx64 "\n", o->plan, o->units, tl_plan_hash(&p));
+    printf("%s: %u units, %zu input files, plan hash %016" PRIx64 "\n", o->plan, o->units, p.input_count, tl_plan_hash(&p));
+    free(p.inputs);
     return LBK_EXIT_OK;
 }
 
 static void plan_help(FILE *f)
 {
-    fputs("usage: lbk plan SCENE.gltf -o OUT.lbk --plan PLAN.json --units N --samples S --target-error none\n"
+    fputs("usage: lbk plan SCENE.gltf -o OUT.lbk --plan PLAN.json --units N [--samples S --target-error none]\n"
           "                [--makefile FILE] [--sbatch FILE] [bake options]\n"
           "\n"
           "Writes the plan of a distributed bake: the scene, its hash and the bake options, cut into N\n"
           "units. Run every unit (lbk bake-unit PLAN K, anywhere the scene files are), then lbk merge:\n"
           "the container is byte-identical to `lbk bake` with the same options. --makefile writes a\n"
           "Makefile for make -j; --sbatch a script that submits a Slurm job array and the merge.\n"
-          "Needs a fixed sample schedule (--samples N --target-error none); no --time-limit.\n"
+          "With an error target (the default) at most one unit per transport run (the base, each\n"
+          "light set and door state); with --samples N --target-error none any number. No --time-limit.\n"
           "See bake/dist/DIST.md (xargs -P, Kubernetes).\n",
           f);
 }
@@ -218,6 +261,20 @@ static int load_plan(const char *cmd, const char *path, const char *scene_overri
     int rc = cli_bake_parse(n, args, o, quiet);
     if (rc >= 0) return rc == 0 ? LBK_EXIT_INPUT : rc;
     o->cmd = cmd;
+    /* the bake compares what its import reads with the plan's files (lbk_bake_desc.expect_inputs) */
+    lbk_bake_input *want = calloc(p->input_count ? p->input_count : 1, sizeof *want);
+    if (!want) {
+        fprintf(stderr, "lbk %s: out of memory\n", cmd);
+        return LBK_EXIT_INTERNAL;
+    }
+    for (size_t i = 0; i < p->input_count; i++) {
+        memcpy(want[i].path, p->inputs[i].path, sizeof want[i].path);
+        memcpy(want[i].role, p->inputs[i].role, sizeof want[i].role);
+        want[i].bytes = p->inputs[i].bytes;
+        want[i].xxh3 = p->inputs[i].xxh3;
+    }
+    o->d.expect_inputs = want;
+    o->d.expect_input_count = p->input_count;
     return -1;
 }
 
@@ -283,6 +340,7 @@ int lbk_cmd_bake_unit(int argc, char **argv)
     if (k >= p.units) {
         fprintf(stderr, "lbk bake-unit: unit %lu: the plan has units 0 to %u\n", k, p.units - 1);
         tl_plan_free(&p);
+        free((void *)o.d.expect_inputs);
         return LBK_EXIT_USAGE;
     }
     o.d.message = unit_message;
@@ -291,6 +349,7 @@ int lbk_cmd_bake_unit(int argc, char **argv)
     size_t size = 0;
     lbk_result r = lbk_bake_unit_from_file(o.input, &o.d, p.hash, p.units, (uint32_t)k, &part, &size);
     tl_plan_free(&p);
+    free((void *)o.d.expect_inputs);
     if (r) {
         if (r != LBK_ERR_BAD_INPUT && r != LBK_ERR_INVALID_ARGUMENT) fprintf(stderr, "lbk bake-unit: %s\n", lbk_result_message(r));
         return r == LBK_ERR_IO ? LBK_EXIT_IO : r == LBK_ERR_BAD_INPUT ? LBK_EXIT_INPUT : r == LBK_ERR_INVALID_ARGUMENT ? LBK_EXIT_USAGE : LBK_EXIT_INTERNAL;
@@ -390,5 +449,6 @@ int lbk_cmd_merge(int argc, char **argv)
     free(sizes);
     free(files);
     tl_plan_free(&p);
+    free((void *)o.d.expect_inputs);
     return rc;
 }

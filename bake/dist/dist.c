@@ -10,54 +10,7 @@
 #define XXH_INLINE_ALL /* as the rest of the baker: liblbkbake links no xxhash of its own */
 #include <xxhash.h>
 
-/* ---- little-endian bytes ------------------------------------------------------------------ */
-
-static void put64(uint8_t *p, uint64_t v)
-{
-    for (int k = 0; k < 8; k++) p[k] = (uint8_t)(v >> (8 * k));
-}
-static void put32(uint8_t *p, uint32_t v)
-{
-    for (int k = 0; k < 4; k++) p[k] = (uint8_t)(v >> (8 * k));
-}
-static uint64_t get64(const uint8_t *p)
-{
-    uint64_t v = 0;
-    for (int k = 0; k < 8; k++) v |= (uint64_t)p[k] << (8 * k);
-    return v;
-}
-static uint32_t get32(const uint8_t *p)
-{
-    uint32_t v = 0;
-    for (int k = 0; k < 4; k++) v |= (uint32_t)p[k] << (8 * k);
-    return v;
-}
-static void putd(uint8_t *p, double d)
-{
-    uint64_t v;
-    memcpy(&v, &d, 8);
-    put64(p, v);
-}
-static double getd(const uint8_t *p)
-{
-    uint64_t v = get64(p);
-    double d;
-    memcpy(&d, &v, 8);
-    return d;
-}
-static void putf(uint8_t *p, float f)
-{
-    uint32_t v;
-    memcpy(&v, &f, 4);
-    put32(p, v);
-}
-static float getf(const uint8_t *p)
-{
-    uint32_t v = get32(p);
-    float f;
-    memcpy(&f, &v, 4);
-    return f;
-}
+#include "lbk/byteorder.h"
 
 typedef struct buf {
     uint8_t *p;
@@ -147,18 +100,18 @@ lbk_result bk_part_parse(const void *bytes, size_t size, bk_part_view *v, char *
     const uint8_t *p = bytes;
     if (!p || size < BK_PART_HEADER_SIZE || memcmp(p, BK_PART_MAGIC, 8))
         return say(err, err_len, "not a part file (no LBKPART header)");
-    if (get32(p + 8) != BK_PART_VERSION) return say(err, err_len, "part format version %u (this lbk reads %u)", get32(p + 8), BK_PART_VERSION);
-    if (get32(p + 12) != BK_PART_HEADER_SIZE || get64(p + 48) != 0 || get32(p + 60) != 0) return say(err, err_len, "corrupt part header");
-    if (XXH64(p, 88, 0) != get64(p + 88)) return say(err, err_len, "corrupt part header (checksum)");
-    v->options_hash = get64(p + 80);
-    v->plan_hash = get64(p + 16);
-    v->units = get32(p + 24);
-    v->unit = get32(p + 28);
-    v->receiver_count = get64(p + 32);
-    v->total_runs = get32(p + 40);
-    v->first_run = get32(p + 44);
-    v->run_count = get32(p + 56);
-    uint64_t payload = get64(p + 64);
+    if (lbk_rd32(p + 8) != BK_PART_VERSION) return say(err, err_len, "part format version %u (this lbk reads %u)", lbk_rd32(p + 8), BK_PART_VERSION);
+    if (lbk_rd32(p + 12) != BK_PART_HEADER_SIZE || lbk_rd64(p + 48) != 0 || lbk_rd32(p + 60) != 0) return say(err, err_len, "corrupt part header");
+    if (XXH64(p, 88, 0) != lbk_rd64(p + 88)) return say(err, err_len, "corrupt part header (checksum)");
+    v->options_hash = lbk_rd64(p + 80);
+    v->plan_hash = lbk_rd64(p + 16);
+    v->units = lbk_rd32(p + 24);
+    v->unit = lbk_rd32(p + 28);
+    v->receiver_count = lbk_rd64(p + 32);
+    v->total_runs = lbk_rd32(p + 40);
+    v->first_run = lbk_rd32(p + 44);
+    v->run_count = lbk_rd32(p + 56);
+    uint64_t payload = lbk_rd64(p + 64);
     if (v->units == 0 || v->units > BK_PART_MAX_UNITS || v->unit >= v->units || v->receiver_count >= ((uint64_t)1 << 40) ||
         v->total_runs == 0 || v->total_runs > BK_PART_MAX_RUNS)
         return say(err, err_len, "corrupt part header (unit %u of %u, %llu receivers, %u runs)", v->unit, v->units,
@@ -169,17 +122,17 @@ lbk_result bk_part_parse(const void *bytes, size_t size, bk_part_view *v, char *
     if (payload != size - BK_PART_HEADER_SIZE)
         return say(err, err_len, "truncated or padded part: %zu bytes, the header says %llu", size,
                    (unsigned long long)(payload + BK_PART_HEADER_SIZE));
-    if (XXH64(p + BK_PART_HEADER_SIZE, (size_t)payload, 0) != get64(p + 72)) return say(err, err_len, "corrupt part (payload checksum)");
+    if (XXH64(p + BK_PART_HEADER_SIZE, (size_t)payload, 0) != lbk_rd64(p + 72)) return say(err, err_len, "corrupt part (payload checksum)");
     v->runs = calloc(v->run_count ? v->run_count : 1, sizeof *v->runs);
     if (!v->runs) return LBK_ERR_OUT_OF_MEMORY;
     size_t at = BK_PART_HEADER_SIZE;
     for (uint32_t r = 0; r < v->run_count; r++) {
         if (size - at < BK_PART_RUN_HEADER_SIZE) goto bad;
-        uint32_t passes = get32(p + at), mask = get32(p + at + 4);
+        uint32_t passes = lbk_rd32(p + at), mask = lbk_rd32(p + at + 4);
         if (passes == 0 || passes > BK_PART_MAX_PASSES || mask > 15 || !(mask & BK_PART_RADIANCE)) goto bad;
         uint64_t b, e;
         bk_dist_range(v->receiver_count, v->total_runs, v->units, v->unit, v->first_run + r, &b, &e);
-        if (get64(p + at + 96) != b || get64(p + at + 104) != e) goto bad;
+        if (lbk_rd64(p + at + 96) != b || lbk_rd64(p + at + 104) != e) goto bad;
         size_t n = run_size(e - b, passes, mask);
         if (!n || n > size - at) goto bad;
         v->runs[r] = p + at;
@@ -201,7 +154,8 @@ struct bk_dist {
     uint32_t units, unit;
     uint64_t count;
     uint32_t total_runs, first_run, end_run; /* the bake's runs; this unit's [first_run, end_run) */
-    int have_cut;
+    uint32_t base_dependent;                 /* runs from this one on take the base's samples */
+    int targeted, have_cut;
     bk_transport_split split;
     uint32_t run;     /* the run under way (record) or being replayed (replay) */
     uint64_t begin, end; /* record: this unit's receivers in that run */
@@ -235,7 +189,14 @@ static lbk_result rec_range(void *user, size_t count, int *own, size_t *begin, s
     if (d->run >= d->total_runs)
         return fail(d, LBK_ERR_INTERNAL, "the bake makes more than the %u transport runs it counted", d->total_runs);
     *own = d->run >= d->first_run && d->run < d->end_run;
-    if (*own) {
+    /* the base, whole and unrecorded: an error target's stop decides the budget of this unit's
+     * door runs */
+    if (!*own && d->run == 0 && d->targeted && d->end_run > d->base_dependent) {
+        *own = 2;
+        *begin = 0;
+        *end = count;
+    }
+    if (*own == 1) {
         bk_dist_range(d->count, d->total_runs, d->units, d->unit, d->run, &d->begin, &d->end);
         *begin = (size_t)d->begin;
         *end = (size_t)d->end;
@@ -251,17 +212,17 @@ static lbk_result rec_pass(void *user, const bk_transport_pass_record *pr)
     if (d->run_passes >= BK_PART_MAX_PASSES) return LBK_ERR_LIMIT;
     uint8_t *w = buf_grow(&d->passes, BK_PART_PASS_HEADER_SIZE + 32 * n);
     if (!w) return LBK_ERR_OUT_OF_MEMORY;
-    put32(w, (uint32_t)pr->pass);
-    put32(w + 4, (uint32_t)pr->bounces);
-    putd(w + 8, pr->samples_per_receiver);
-    for (int k = 0; k < 3; k++) putd(w + 16 + 8 * k, pr->weight_sum[k]), putd(w + 40 + 8 * k, pr->class_samples[k]);
+    lbk_wr32(w, (uint32_t)pr->pass);
+    lbk_wr32(w + 4, (uint32_t)pr->bounces);
+    lbk_wrf64(w + 8, pr->samples_per_receiver);
+    for (int k = 0; k < 3; k++) lbk_wrf64(w + 16 + 8 * k, pr->weight_sum[k]), lbk_wrf64(w + 40 + 8 * k, pr->class_samples[k]);
     w += BK_PART_PASS_HEADER_SIZE;
     for (size_t i = 0; i < n; i++, w += 32) {
         size_t r = (size_t)d->begin + i;
-        putd(w, pr->x_acc[0][r]);
-        putd(w + 8, pr->x_acc[1][r]);
-        putd(w + 16, pr->b_acc[0][r]);
-        putd(w + 24, pr->b_acc[1][r]);
+        lbk_wrf64(w, pr->x_acc[0][r]);
+        lbk_wrf64(w + 8, pr->x_acc[1][r]);
+        lbk_wrf64(w + 16, pr->b_acc[0][r]);
+        lbk_wrf64(w + 24, pr->b_acc[1][r]);
     }
     d->run_passes++;
     return LBK_OK;
@@ -280,46 +241,46 @@ static const float *out_array(const bk_transport_output *o, int k)
 
 static void put_totals(uint8_t *w, uint32_t passes, uint32_t mask, const bk_transport_totals *t)
 {
-    put32(w, passes);
-    put32(w + 4, mask);
-    put32(w + 8, (uint32_t)t->stop);
-    put32(w + 12, (uint32_t)t->nee);
-    put32(w + 16, (uint32_t)t->bounces);
-    put32(w + 20, 0);
-    putd(w + 24, t->q);
-    putd(w + 32, t->tail_fraction);
-    put64(w + 40, t->cells);
-    put64(w + 48, t->cache_rays);
-    put64(w + 56, t->cache_shadow);
-    put64(w + 64, t->cache_nonfinite);
-    put64(w + 72, t->recv_rays);
-    put64(w + 80, t->recv_shadow);
-    put64(w + 88, t->recv_nonfinite);
+    lbk_wr32(w, passes);
+    lbk_wr32(w + 4, mask);
+    lbk_wr32(w + 8, (uint32_t)t->stop);
+    lbk_wr32(w + 12, (uint32_t)t->nee);
+    lbk_wr32(w + 16, (uint32_t)t->bounces);
+    lbk_wr32(w + 20, 0);
+    lbk_wrf64(w + 24, t->q);
+    lbk_wrf64(w + 32, t->tail_fraction);
+    lbk_wr64(w + 40, t->cells);
+    lbk_wr64(w + 48, t->cache_rays);
+    lbk_wr64(w + 56, t->cache_shadow);
+    lbk_wr64(w + 64, t->cache_nonfinite);
+    lbk_wr64(w + 72, t->recv_rays);
+    lbk_wr64(w + 80, t->recv_shadow);
+    lbk_wr64(w + 88, t->recv_nonfinite);
 }
 
 /* The receivers a run record holds (bytes 96–111 of its header, checked by bk_part_parse). */
 static void put_range(uint8_t *w, uint64_t begin, uint64_t end)
 {
-    put64(w + 96, begin);
-    put64(w + 104, end);
+    lbk_wr64(w + 96, begin);
+    lbk_wr64(w + 104, end);
 }
 
 static void get_totals(const uint8_t *w, bk_transport_totals *t)
 {
     memset(t, 0, sizeof *t);
-    t->passes = (int)get32(w);
-    t->stop = (int)get32(w + 8);
-    t->nee = (int)get32(w + 12);
-    t->bounces = (int)get32(w + 16);
-    t->q = getd(w + 24);
-    t->tail_fraction = getd(w + 32);
-    t->cells = get64(w + 40);
-    t->cache_rays = get64(w + 48);
-    t->cache_shadow = get64(w + 56);
-    t->cache_nonfinite = get64(w + 64);
-    t->recv_rays = get64(w + 72);
-    t->recv_shadow = get64(w + 80);
-    t->recv_nonfinite = get64(w + 88);
+    t->passes = (int)lbk_rd32(w);
+    t->stop = (int)lbk_rd32(w + 8);
+    t->nee = (int)lbk_rd32(w + 12);
+    t->bounces = (int)lbk_rd32(w + 16);
+    t->q = lbk_rdf64(w + 24);
+    t->tail_fraction = lbk_rdf64(w + 32);
+    t->cells = lbk_rd64(w + 40);
+    t->cache_rays = lbk_rd64(w + 48);
+    t->cache_shadow = lbk_rd64(w + 56);
+    t->cache_nonfinite = lbk_rd64(w + 64);
+    t->recv_rays = lbk_rd64(w + 72);
+    t->recv_shadow = lbk_rd64(w + 80);
+    t->recv_nonfinite = lbk_rd64(w + 88);
 }
 
 static lbk_result rec_done(void *user, const bk_transport_output *o, const bk_transport_totals *t)
@@ -339,7 +300,7 @@ static lbk_result rec_done(void *user, const bk_transport_output *o, const bk_tr
     for (int k = 0; k < 4; k++) {
         if (!(mask & (1u << k))) continue;
         const float *a = out_array(o, k) + (size_t)d->begin * out_floats[k];
-        for (size_t i = 0; i < n * (size_t)out_floats[k]; i++, w += 4) putf(w, a[i]);
+        for (size_t i = 0; i < n * (size_t)out_floats[k]; i++, w += 4) lbk_wrf32(w, a[i]);
     }
     d->passes.n = 0;
     d->run_passes = 0;
@@ -352,8 +313,8 @@ static const uint8_t *record_of(const bk_dist *d, uint32_t u, size_t *begin, siz
 {
     const bk_part_view *v = &d->parts[u];
     const uint8_t *rh = v->runs[d->run - v->first_run];
-    *begin = (size_t)get64(rh + 96);
-    *n = (size_t)(get64(rh + 104) - get64(rh + 96));
+    *begin = (size_t)lbk_rd64(rh + 96);
+    *n = (size_t)(lbk_rd64(rh + 104) - lbk_rd64(rh + 96));
     return rh;
 }
 
@@ -397,13 +358,13 @@ static lbk_result play_pass(void *user, bk_transport_pass_record *pr)
     for (uint32_t u = d->owners[0]; u < d->owners[1]; u++) {
         size_t b, n;
         const uint8_t *w = record_of(d, u, &b, &n);
-        if ((uint32_t)pr->pass >= get32(w)) return fail(d, LBK_ERR_BAD_INPUT, "run %u: unit %u has fewer passes", d->run, u);
+        if ((uint32_t)pr->pass >= lbk_rd32(w)) return fail(d, LBK_ERR_BAD_INPUT, "run %u: unit %u has fewer passes", d->run, u);
         w += BK_PART_RUN_HEADER_SIZE + (size_t)pr->pass * (BK_PART_PASS_HEADER_SIZE + 32 * n);
         if (!head) {
             head = w;
-            pr->bounces = (int)get32(w + 4);
-            pr->samples_per_receiver = getd(w + 8);
-            for (int k = 0; k < 3; k++) pr->weight_sum[k] = getd(w + 16 + 8 * k), pr->class_samples[k] = getd(w + 40 + 8 * k);
+            pr->bounces = (int)lbk_rd32(w + 4);
+            pr->samples_per_receiver = lbk_rdf64(w + 8);
+            for (int k = 0; k < 3; k++) pr->weight_sum[k] = lbk_rdf64(w + 16 + 8 * k), pr->class_samples[k] = lbk_rdf64(w + 40 + 8 * k);
         } else if (memcmp(w, head, BK_PART_PASS_HEADER_SIZE)) {
             return fail(d, LBK_ERR_BAD_INPUT, "run %u pass %d: unit %u disagrees with unit %u on the pass", d->run, pr->pass, u,
                         d->owners[0]);
@@ -411,10 +372,10 @@ static lbk_result play_pass(void *user, bk_transport_pass_record *pr)
         w += BK_PART_PASS_HEADER_SIZE;
         for (size_t i = 0; i < n; i++, w += 32) {
             size_t r = b + i;
-            pr->x_acc[0][r] = getd(w);
-            pr->x_acc[1][r] = getd(w + 8);
-            pr->b_acc[0][r] = getd(w + 16);
-            pr->b_acc[1][r] = getd(w + 24);
+            pr->x_acc[0][r] = lbk_rdf64(w);
+            pr->x_acc[1][r] = lbk_rdf64(w + 8);
+            pr->b_acc[0][r] = lbk_rdf64(w + 16);
+            pr->b_acc[1][r] = lbk_rdf64(w + 24);
         }
     }
     return LBK_OK;
@@ -427,7 +388,7 @@ static lbk_result play_outputs(void *user, const bk_transport_output *o)
     for (uint32_t u = d->owners[0]; u < d->owners[1]; u++) {
         size_t b, n;
         const uint8_t *rh = record_of(d, u, &b, &n);
-        const uint32_t passes = get32(rh), pmask = get32(rh + 4);
+        const uint32_t passes = lbk_rd32(rh), pmask = lbk_rd32(rh + 4);
         if (pmask != mask)
             return fail(d, LBK_ERR_BAD_INPUT, "run %u: the part holds other outputs (%#x) than this bake needs (%#x)", d->run,
                         pmask, mask);
@@ -435,7 +396,7 @@ static lbk_result play_outputs(void *user, const bk_transport_output *o)
         for (int k = 0; k < 4; k++) {
             if (!(mask & (1u << k))) continue;
             float *a = (float *)out_array(o, k) + b * out_floats[k];
-            for (size_t i = 0; i < n * (size_t)out_floats[k]; i++, w += 4) a[i] = getf(w);
+            for (size_t i = 0; i < n * (size_t)out_floats[k]; i++, w += 4) a[i] = lbk_rdf32(w);
         }
     }
     d->run++;
@@ -475,12 +436,20 @@ void bk_dist_destroy(bk_dist *d)
     free(d);
 }
 
-lbk_result bk_dist_set_cut(bk_dist *d, uint64_t count, uint32_t runs, char *err, size_t err_len)
+lbk_result bk_dist_set_cut(bk_dist *d, uint64_t count, uint32_t runs, uint32_t base_dependent, int targeted, char *err,
+                           size_t err_len)
 {
     if (count >= ((uint64_t)1 << 40)) return say(err, err_len, "too many receivers for a distributed bake");
     if (runs == 0 || runs > BK_PART_MAX_RUNS) return say(err, err_len, "too many transport runs for a distributed bake");
+    if (targeted && d->units > runs)
+        return say(err, err_len, "with an error target every transport run stops on its own estimate over all its receivers, "
+                   "so a run cannot be shared: this bake makes %u runs (the base, light sets, door states), the plan has %u "
+                   "units (use --units %u or fewer, or --samples N --target-error none)", runs, d->units, runs),
+               LBK_ERR_INVALID_ARGUMENT;
     d->count = count;
     d->total_runs = runs;
+    d->base_dependent = base_dependent;
+    d->targeted = targeted;
     d->have_cut = 1;
     if (d->replay) {
         if (d->parts[0].receiver_count != count)
@@ -518,20 +487,20 @@ lbk_result bk_dist_finish(bk_dist *d, void **bytes, size_t *size, char *err, siz
     if (!p) return LBK_ERR_OUT_OF_MEMORY;
     memset(p, 0, BK_PART_HEADER_SIZE);
     memcpy(p, BK_PART_MAGIC, 8);
-    put32(p + 8, BK_PART_VERSION);
-    put32(p + 12, BK_PART_HEADER_SIZE);
-    put64(p + 16, d->plan_hash);
-    put32(p + 24, d->units);
-    put32(p + 28, d->unit);
-    put64(p + 32, d->count);
-    put32(p + 40, d->total_runs);
-    put32(p + 44, d->first_run);
-    put32(p + 56, d->run_count);
-    put64(p + 64, d->out.n);
+    lbk_wr32(p + 8, BK_PART_VERSION);
+    lbk_wr32(p + 12, BK_PART_HEADER_SIZE);
+    lbk_wr64(p + 16, d->plan_hash);
+    lbk_wr32(p + 24, d->units);
+    lbk_wr32(p + 28, d->unit);
+    lbk_wr64(p + 32, d->count);
+    lbk_wr32(p + 40, d->total_runs);
+    lbk_wr32(p + 44, d->first_run);
+    lbk_wr32(p + 56, d->run_count);
+    lbk_wr64(p + 64, d->out.n);
     if (d->out.n) memcpy(p + BK_PART_HEADER_SIZE, d->out.p, d->out.n);
-    put64(p + 72, XXH64(p + BK_PART_HEADER_SIZE, d->out.n, 0));
-    put64(p + 80, d->options_hash);
-    put64(p + 88, XXH64(p, 88, 0));
+    lbk_wr64(p + 72, XXH64(p + BK_PART_HEADER_SIZE, d->out.n, 0));
+    lbk_wr64(p + 80, d->options_hash);
+    lbk_wr64(p + 88, XXH64(p, 88, 0));
     *bytes = p;
     *size = total;
     return LBK_OK;

@@ -57,10 +57,14 @@ typedef struct bk_dist bk_dist;
 lbk_result bk_dist_create(int replay, uint64_t plan_hash, uint64_t options_hash, uint32_t units, uint32_t unit,
                           const bk_part_view *parts, bk_dist **out);
 void bk_dist_destroy(bk_dist *d);
-/* The bake's receiver count and its number of transport runs, once known: fixes the unit's cut
- * (record) or checks the parts against them (replay). LBK_ERR_BAD_INPUT with a message when
- * they disagree. */
-lbk_result bk_dist_set_cut(bk_dist *d, uint64_t count, uint32_t runs, char *err, size_t err_len);
+/* The bake's receiver count and its transport runs, once known: fixes the unit's cut (record) or
+ * checks the parts against them (replay). Runs from base_dependent on take the base's final
+ * sample count as their budget (door states). targeted: the runs stop on an error target, so a
+ * run cannot be shared (units <= runs), and a unit with any of those runs but not the base bakes
+ * the base too, unrecorded, to learn its sample count. LBK_ERR_BAD_INPUT with a message when
+ * they disagree or the cut is impossible. */
+lbk_result bk_dist_set_cut(bk_dist *d, uint64_t count, uint32_t runs, uint32_t base_dependent, int targeted, char *err,
+                           size_t err_len);
 /* What every transport run is handed (bk_transport_options.split). */
 const bk_transport_split *bk_dist_split(const bk_dist *d);
 /* After the bake (record): the part's bytes (malloc'd, the caller frees). Replay: LBK_OK when

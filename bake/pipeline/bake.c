@@ -248,6 +248,37 @@ static lbk_result check_scene(bk_pipeline *b)
     return checkpoint(b, 1);
 }
 
+/* desc.expect_inputs: the files must be the ones listed, byte for byte (a distributed bake's
+ * units and merge against the plan). Only what the import itself read is compared: no path of
+ * the list is ever opened. */
+static lbk_result check_inputs(bk_pipeline *b)
+{
+    const lbk_bake_input *want = b->opt->expect_inputs;
+    if (!want) return LBK_OK;
+    const size_t n = b->opt->expect_input_count, got = b->scene.input_count;
+    for (size_t i = 0; i < n || i < got; i++) {
+        const bk_input_file *f = i < got ? &b->scene.inputs[i] : NULL;
+        const lbk_bake_input *w = i < n ? &want[i] : NULL;
+        if (!f)
+            return bk_pipeline_fail(b, LBK_ERR_BAD_INPUT, "the bake read %zu files, the plan lists %zu (%s '%.200s' was not "
+                                    "read): the scene changed since the plan was made; make a new plan", got, n, w->role,
+                                    w->path);
+        if (!w)
+            return bk_pipeline_fail(b, LBK_ERR_BAD_INPUT, "%s '%.200s' is not among the %zu files the plan lists: the scene "
+                                    "changed since the plan was made; make a new plan", f->role, f->path, n);
+        if (strncmp(f->path, w->path, sizeof w->path) || strncmp(f->role, w->role, sizeof w->role))
+            return bk_pipeline_fail(b, LBK_ERR_BAD_INPUT, "file %zu read is %s '%.200s', the plan lists %s '%.200s': the scene "
+                                    "changed since the plan was made; make a new plan", i + 1, f->role, f->path, w->role,
+                                    w->path);
+        if (f->bytes != w->bytes || f->hash != w->xxh3)
+            return bk_pipeline_fail(b, LBK_ERR_BAD_INPUT, "%s '%.200s' changed since the plan was made (%llu bytes, XXH3 "
+                                    "%016llx; the plan's: %llu bytes, %016llx): make a new plan", f->role, f->path,
+                                    (unsigned long long)f->bytes, (unsigned long long)f->hash,
+                                    (unsigned long long)w->bytes, (unsigned long long)w->xxh3);
+    }
+    return LBK_OK;
+}
+
 static lbk_result do_import(bk_pipeline *b, const char *path, const lbk_bake_scene *desc)
 {
     lbk_result r = phase(b, LBK_BAKE_PHASE_IMPORT);
@@ -259,6 +290,7 @@ static lbk_result do_import(bk_pipeline *b, const char *path, const lbk_bake_sce
         if (r == LBK_ERR_OUT_OF_MEMORY) bk_pipeline_fail(b, r, "out of memory");
     }
     if (!r) r = apply_sky(b);
+    if (!r) r = check_inputs(b);
     if (!r) r = check_scene(b);
     return r;
 }
@@ -512,9 +544,12 @@ static lbk_result do_transport(bk_pipeline *b)
     lbk_result r = phase(b, LBK_BAKE_PHASE_LIGHT);
     if (!r) r = build_receivers(b);
     if (!r) r = build_cell_sizes(b);
-    if (!r && b->dist)
-        r = bk_dist_set_cut(b->dist, b->receiver_count, (uint32_t)(1 + bk_set_bakes_transport_runs(&b->sets)), b->err,
+    if (!r && b->dist) {
+        int ls = 0;
+        const int runs = 1 + bk_set_bakes_transport_runs(&b->sets, &ls);
+        r = bk_dist_set_cut(b->dist, b->receiver_count, (uint32_t)runs, (uint32_t)(1 + ls), !(b->opt->target_error < 0), b->err,
                             sizeof b->err);
+    }
     if (r) return r;
     bk_transport_options to;
     transport_options(b, &to);
@@ -629,9 +664,29 @@ static lbk_result emit_sets(bk_pipeline *b)
 
 /* ---- the call -------------------------------------------------------------------------- */
 
+static lbk_result list_inputs(bk_pipeline *b)
+{
+    const bk_scene *s = &b->scene;
+    b->inputs = calloc(s->input_count ? s->input_count : 1, sizeof *b->inputs);
+    if (!b->inputs) return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
+    for (size_t i = 0; i < s->input_count; i++) {
+        snprintf(b->inputs[i].path, sizeof b->inputs[i].path, "%s", s->inputs[i].path);
+        snprintf(b->inputs[i].role, sizeof b->inputs[i].role, "%s", s->inputs[i].role);
+        b->inputs[i].bytes = s->inputs[i].bytes;
+        b->inputs[i].xxh3 = s->inputs[i].hash;
+    }
+    b->input_count = s->input_count;
+    b->transport_runs = (uint32_t)(1 + bk_set_bakes_transport_runs(&b->sets, NULL));
+    return LBK_OK;
+}
+
 static lbk_result run(bk_pipeline *b, const char *path, const lbk_bake_scene *desc)
 {
     lbk_result r = do_import(b, path, desc);
+    if (!r && b->inputs_only) {
+        r = bk_set_bakes_prepare(&b->sets, &b->scene, &b->events, b->err, sizeof b->err);
+        return r ? r : list_inputs(b);
+    }
     if (!r) r = do_layout(b);
     if (!r) r = bk_set_bakes_prepare(&b->sets, &b->scene, &b->events, b->err, sizeof b->err);
     if (!r) r = do_transport(b);
@@ -755,10 +810,6 @@ static uint64_t options_hash(const lbk_bake_desc *options, int budgets);
 static lbk_result check_dist(bk_pipeline *b)
 {
     const lbk_bake_desc *d = &b->desc;
-    if (!(d->target_error < 0))
-        return bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT,
-                                "a distributed bake needs a fixed sample schedule: the error target stops on a sum over "
-                                "every receiver, which no unit has (lbk: --samples N --target-error none)");
     if (d->time_limit > 0)
         return bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT,
                                 "a distributed bake cannot have a time limit: the passes it allows depend on the machine, "
@@ -771,13 +822,15 @@ static lbk_result check_dist(bk_pipeline *b)
 }
 
 static lbk_result bake(const char *path, const lbk_bake_scene *desc, const lbk_bake_desc *options, lbk_bake_output **out,
-                       bk_dist *dist, void **part, size_t *part_size)
+                       bk_dist *dist, void **part, size_t *part_size, lbk_bake_input **inputs, size_t *input_count,
+                       uint32_t *runs)
 {
     if (!out) return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
     bk_pipeline *b = calloc(1, sizeof *b);
     if (!b) return LBK_ERR_OUT_OF_MEMORY;
     b->dist = dist;
+    b->inputs_only = inputs != NULL;
     b->start = bk_now();
     b->est = -1;
     b->opt = &b->desc;
@@ -812,6 +865,8 @@ static lbk_result bake(const char *path, const lbk_bake_scene *desc, const lbk_b
         if (r != LBK_ERR_CANCELLED)
             bk_events_say(&b->events, LBK_BAKE_SEVERITY_ERROR, "%s", b->err[0] ? b->err : lbk_result_message(r));
         lbk_bake_output_free(b->out);
+    } else if (b->inputs_only) {
+        lbk_bake_output_free(b->out);
     } else if (part) {
         *part = b->part;
         *part_size = b->part_size;
@@ -820,6 +875,13 @@ static lbk_result bake(const char *path, const lbk_bake_scene *desc, const lbk_b
     } else {
         *out = b->out;
     }
+    if (inputs && !r) {
+        *inputs = b->inputs;
+        *input_count = b->input_count;
+        if (runs) *runs = b->transport_runs;
+        b->inputs = NULL;
+    }
+    free(b->inputs);
     free(b->part);
     bk_ckpt_destroy(b->ckpt);
     pipeline_free(b);
@@ -833,7 +895,7 @@ lbk_result lbk_bake_from_file(const char *path, const lbk_bake_desc *desc, lbk_b
         if (out) *out = NULL;
         return LBK_ERR_INVALID_ARGUMENT;
     }
-    return bake(path, NULL, desc, out, NULL, NULL, NULL);
+    return bake(path, NULL, desc, out, NULL, NULL, NULL, NULL, NULL, NULL);
 }
 
 lbk_result lbk_bake_from_scene(const lbk_bake_scene *scene, const lbk_bake_desc *desc, lbk_bake_output **out)
@@ -842,7 +904,7 @@ lbk_result lbk_bake_from_scene(const lbk_bake_scene *scene, const lbk_bake_desc 
         if (out) *out = NULL;
         return LBK_ERR_INVALID_ARGUMENT;
     }
-    return bake(NULL, scene, desc, out, NULL, NULL, NULL);
+    return bake(NULL, scene, desc, out, NULL, NULL, NULL, NULL, NULL, NULL);
 }
 
 const char *lbk_bake_preset_name(lbk_bake_preset preset)
@@ -893,12 +955,26 @@ lbk_result lbk_bake_unit_from_file(const char *path, const lbk_bake_desc *desc, 
     lbk_result r = bk_dist_create(0, plan_hash, options_hash(desc, 1), units, unit, NULL, &d);
     if (r) return r;
     lbk_bake_output *out = NULL;
-    r = bake(path, NULL, desc, &out, d, part, part_size);
+    r = bake(path, NULL, desc, &out, d, part, part_size, NULL, NULL, NULL);
     bk_dist_destroy(d);
     return r;
 }
 
 void lbk_bake_part_free(void *part) { free(part); }
+
+lbk_result lbk_bake_inputs_from_file(const char *path, const lbk_bake_desc *desc, lbk_bake_input **inputs, size_t *count,
+                                     uint32_t *runs)
+{
+    if (!inputs || !count) return LBK_ERR_INVALID_ARGUMENT;
+    *inputs = NULL;
+    *count = 0;
+    if (runs) *runs = 0;
+    if (!path) return LBK_ERR_INVALID_ARGUMENT;
+    lbk_bake_output *out = NULL;
+    return bake(path, NULL, desc, &out, NULL, NULL, NULL, inputs, count, runs);
+}
+
+void lbk_bake_inputs_free(lbk_bake_input *inputs) { free(inputs); }
 
 lbk_result lbk_bake_part_check(const void *part, size_t size, uint64_t plan_hash, uint32_t units, lbk_bake_part_info *info,
                                char *err, size_t err_len)
@@ -1022,7 +1098,7 @@ lbk_result lbk_bake_merge_from_file(const char *path, const lbk_bake_desc *desc,
             r = LBK_ERR_BAD_INPUT;
         }
     if (!r) r = bk_dist_create(1, plan_hash, oh, units, 0, views, &d);
-    if (!r) r = bake(path, NULL, desc, out, d, NULL, NULL);
+    if (!r) r = bake(path, NULL, desc, out, d, NULL, NULL, NULL, NULL, NULL);
     bk_dist_destroy(d);
     for (uint32_t u = 0; u < units; u++) free(views[u].runs);
     free(views);

@@ -86,6 +86,10 @@ typedef struct bk_pipeline {
     struct bk_ckpt *ckpt;           /* checkpoints (desc.checkpoint_dir); NULL: none */
     void *part;                     /* a unit's part, once its runs are done */
     size_t part_size;
+    int inputs_only;                /* lbk_bake_inputs_from_file: stop after the import, its files in */
+    lbk_bake_input *inputs;         /* input_count entries (malloc'd) */
+    size_t input_count;
+    uint32_t transport_runs;        /* with inputs_only: the runs the bake would make */
     uint64_t container_bytes;
 } bk_pipeline;
 

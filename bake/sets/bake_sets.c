@@ -1113,12 +1113,14 @@ int bk_set_bakes_planned_runs(const bk_set_bakes *sets)
     return runs;
 }
 
-int bk_set_bakes_transport_runs(const bk_set_bakes *sets)
+int bk_set_bakes_transport_runs(const bk_set_bakes *sets, int *light_set_runs)
 {
     const bs_impl *im = sets ? sets->impl : NULL;
+    if (light_set_runs) *light_set_runs = 0;
     if (!im) return 0;
     int runs = 0;
     for (size_t j = 0; j < im->light_set_count; j++) runs += !im->sets[j].zero;
+    if (light_set_runs) *light_set_runs = runs;
     if (!im->door_count) return runs;
     runs += 1 + 2 * (int)im->door_count; /* the reference, then each door open and closed */
     for (size_t c = 0; c < im->combo_count; c++) {

@@ -91,8 +91,10 @@ void bk_set_bakes_guide(const bk_set_bakes *sets, const lbk_sh9_rgb **sum, const
 int bk_set_bakes_planned_runs(const bk_set_bakes *sets);
 /* Exactly how many bk_transport_run calls bk_set_bakes_run makes with the difference door
  * method (a distributed bake's cut, bake/dist/DIST.md): a door pair reuses its doors' open runs
- * and a combination with a black light set makes none. */
-int bk_set_bakes_transport_runs(const bk_set_bakes *sets);
+ * and a combination with a black light set makes none. The first *light_set_runs (may be NULL)
+ * are the light sets' own; every later one (door states, combinations) has the base's final
+ * sample count as its budget. */
+int bk_set_bakes_transport_runs(const bk_set_bakes *sets, int *light_set_runs);
 
 /* One transport run of bk_set_bakes_run (a light set, a door state, a reference): its label as in
  * the bake's messages and its final estimated error, pooled and per receiver class. */

@@ -2039,15 +2039,17 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
     lbk_result res = check_inputs(scene, tracer, receivers, count, opt, output);
     if (res != LBK_OK) return res;
     const bk_transport_split *split = opt->split;
-    if (split && (!(opt->target_error < 0) || opt->time_limit > 0))
-        return LBK_ERR_INVALID_ARGUMENT; /* a stop that needs every receiver cannot be cut */
+    if (split && opt->time_limit > 0) return LBK_ERR_INVALID_ARGUMENT; /* the passes would depend on the machine */
     size_t g_begin = 0, g_end = count;
     int own = 1;
     if (split && !split->replay) {
         res = split->run_range(split->user, count, &own, &g_begin, &g_end);
         if (res != LBK_OK) return res;
         if (own && (g_begin > g_end || g_end > count)) return LBK_ERR_INVALID_ARGUMENT;
+        /* a stop on the error estimate needs every receiver of the run */
+        if (own && !(opt->target_error < 0) && (g_begin != 0 || g_end != count)) return LBK_ERR_INVALID_ARGUMENT;
     }
+    const int rec = split && !split->replay && own == 1; /* own == 2: baked whole, not recorded */
 
     tp_ctx c;
     memset(&c, 0, sizeof c);
@@ -2112,7 +2114,7 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
         res = run_pass(&c, pass, chain);
         if (res != LBK_OK) goto done;
         estimate_error(&c, &err, &bias, &ce);
-        if (split && (res = record_pass(&c, pass, chain)) != LBK_OK) goto done;
+        if (rec && (res = record_pass(&c, pass, chain)) != LBK_OK) goto done;
         bk_transport_sample smp = {now_seconds() - t0, lead_class(&c)->spp, err,
                                    chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces, pass,
                                    {ce.cls[0], ce.cls[1], ce.cls[2]}, ce.probe,
@@ -2130,7 +2132,7 @@ finished:
         stats->octa_rel_rmse = oct_err;
         stats->octa_rays = c.oct_total;
     }
-    if (split) {
+    if (rec) {
         bk_transport_totals t;
         totals_of(&c, pass + 1, chain, &t);
         res = split->record_done(split->user, output, &t);

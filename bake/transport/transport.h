@@ -143,9 +143,11 @@ typedef struct bk_transport_split {
     int replay;            /* 0: record (a unit), 1: replay (the merge) */
     void *user;
     /* record: called once at the start of every run, in run order: *own = 1 and the receivers
-     * [*begin, *end) this unit gathers (and records) in this run, or *own = 0: the unit has no
-     * share of the run, which then traces nothing, leaves its outputs 0 and reports only its
-     * sample schedule (stats passes and samples: a fixed schedule does not depend on tracing) */
+     * [*begin, *end) this unit gathers (and records) in this run (all of them when the run has
+     * an error target); *own = 2: the whole run, not recorded (a later run needs its stats); or
+     * *own = 0: the unit has no share of the run, which then traces nothing, leaves its outputs 0
+     * and reports only its sample schedule (stats passes and samples: a fixed schedule does not
+     * depend on tracing; with an error target they are meaningless) */
     lbk_result (*run_range)(void *user, size_t count, int *own, size_t *begin, size_t *end);
     lbk_result (*record_pass)(void *user, const bk_transport_pass_record *pass);
     lbk_result (*record_done)(void *user, const struct bk_transport_output *out, const bk_transport_totals *totals);

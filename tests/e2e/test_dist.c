@@ -16,6 +16,7 @@
 
 #include <cmocka.h>
 
+#include "bake/dist/dist.h"
 #include "lbk/bake.h"
 #include "lbk/bake_dist.h"
 
@@ -100,15 +101,15 @@ static void free_parts(bytes *parts, size_t n)
     for (size_t k = 0; k < n; k++) lbk_bake_part_free(parts[k].p);
 }
 
-/* Merges of 1, 3 and 7 units against the local bake, byte for byte; the parts' sizes printed
- * (what moves over the network per unit). */
-static void check_scene(const char *scene, int samples, float density)
+/* Merges of n units (each count of counts[]) against the local bake, byte for byte; the parts'
+ * sizes printed (what moves over the network per unit). */
+static void check_scene(const char *scene, int samples, float density, const uint32_t *counts, size_t ncounts)
 {
     lbk_bake_desc d = desc_of(samples, density, 7);
     bytes local = local_bake(scene, &d);
-    const uint32_t counts[] = {1, 3, 7};
-    for (size_t c = 0; c < 3; c++) {
-        bytes parts[7];
+    for (size_t c = 0; c < ncounts; c++) {
+        assert_true(counts[c] <= 16);
+        bytes parts[16];
         memset(parts, 0, sizeof parts);
         bake_parts(scene, &d, PLAN_HASH, counts[c], parts);
         size_t part_bytes = 0;
@@ -128,13 +129,90 @@ static void check_scene(const char *scene, int samples, float density)
 static void test_merge_equals_local_cornell(void **state)
 {
     (void)state;
-    check_scene("scenes/cornell_box/CornellBox-Original.gltf", 64, 4);
+    /* one transport run: every count cuts its receivers */
+    const uint32_t counts[] = {1, 3, 7};
+    check_scene("scenes/cornell_box/CornellBox-Original.gltf", 64, 4, counts, 3);
 }
 
 static void test_merge_equals_local_sets_doors(void **state)
 {
     (void)state;
-    check_scene("tests/fuzz/sets_scene.gltf", 32, 2);
+    /* 8 transport runs (base, 2 light sets, the door's reference, open and closed, the door–set
+     * combination's two): 1, 3 and 7 units take whole runs, 8 one each, 11 share 3 runs by 2 */
+    const uint32_t counts[] = {1, 3, 7, 8, 11};
+    check_scene("tests/fuzz/sets_scene.gltf", 32, 2, counts, 5);
+}
+
+/* An error target: every run stops on its own estimate, so units take whole runs (a unit with
+ * door runs bakes the base too, unrecorded: their budget is its final sample count); the merge
+ * equals the local bake with the same target at 1, 3 and 8 units. */
+static void test_merge_equals_local_error_target(void **state)
+{
+    (void)state;
+    const char *scene = "tests/fuzz/sets_scene.gltf";
+    lbk_bake_desc d = desc_of(256, 2, 7);
+    d.target_error = 0.05;
+    bytes local = local_bake(scene, &d);
+    const uint32_t counts[] = {1, 3, 8};
+    for (size_t c = 0; c < 3; c++) {
+        bytes parts[8];
+        bake_parts(scene, &d, PLAN_HASH, counts[c], parts);
+        lbk_result r;
+        bytes m = merge(scene, &d, PLAN_HASH, counts[c], parts, counts[c], &r);
+        if (r) fail_msg("merge of %u units: %s", counts[c], last_error);
+        assert_int_equal(m.n, local.n);
+        assert_memory_equal(m.p, local.p, local.n);
+        lbk_free(NULL, m.p);
+        free_parts(parts, counts[c]);
+    }
+    /* a run shared by two units would need the other's receivers to stop */
+    bytes p = {NULL, 0};
+    assert_int_equal(lbk_bake_unit_from_file(scene, &d, PLAN_HASH, 9, 0, &p.p, &p.n), LBK_ERR_INVALID_ARGUMENT);
+    if (!strstr(last_error, "this bake makes 8 runs")) fail_msg("unexpected message '%s'", last_error);
+    lbk_free(NULL, local.p);
+}
+
+/* The cut (bk_dist_*): every receiver of every run baked by exactly one unit, each unit with at
+ * least one run, and no run's caches computed by more units than needed: with units <= runs each
+ * run has one unit, with more units each unit has one run. */
+static void test_cut_tiles(void **state)
+{
+    (void)state;
+    const uint64_t counts[] = {0, 1, 5, 1000};
+    for (uint32_t runs = 1; runs <= 12; runs++)
+        for (uint32_t units = 1; units <= 20; units++)
+            for (size_t c = 0; c < 4; c++) {
+                const uint64_t count = counts[c];
+                for (uint32_t r = 0; r < runs; r++) {
+                    uint32_t u0, u1;
+                    bk_dist_run_units(runs, units, r, &u0, &u1);
+                    assert_true(u0 < u1 && u1 <= units);
+                    assert_int_equal(u1 - u0, units <= runs ? 1 : u1 - u0);
+                    uint64_t next = 0;
+                    for (uint32_t u = u0; u < u1; u++) {
+                        uint32_t r0, r1;
+                        bk_dist_unit_runs(runs, units, u, &r0, &r1);
+                        assert_true(r0 <= r && r < r1);
+                        uint64_t b, e;
+                        bk_dist_range(count, runs, units, u, r, &b, &e);
+                        assert_int_equal(b, next);
+                        assert_true(e >= b);
+                        next = e;
+                    }
+                    assert_int_equal(next, count);
+                }
+                for (uint32_t u = 0; u < units; u++) {
+                    uint32_t r0, r1;
+                    bk_dist_unit_runs(runs, units, u, &r0, &r1);
+                    assert_true(r0 < r1 && r1 <= runs);
+                    if (units > runs) assert_int_equal(r1 - r0, 1);
+                    for (uint32_t r = r0; r < r1; r++) {
+                        uint32_t u0, u1;
+                        bk_dist_run_units(runs, units, r, &u0, &u1);
+                        assert_true(u0 <= u && u < u1);
+                    }
+                }
+            }
 }
 
 static void test_merge_equals_local_room(void **state)
@@ -238,9 +316,10 @@ static void test_unsplittable_refused(void **state)
     const char *scene = "scenes/cornell_box/CornellBox-Original.gltf";
     bytes p = {NULL, 0};
     lbk_bake_desc d = desc_of(32, 2, 7);
+    /* an error target on the Cornell box's one run: it cannot be shared by 2 units */
     d.target_error = 0.05;
     assert_int_equal(lbk_bake_unit_from_file(scene, &d, PLAN_HASH, 2, 0, &p.p, &p.n), LBK_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(last_error, "fixed sample schedule"));
+    if (!strstr(last_error, "a run cannot be shared: this bake makes 1 runs")) fail_msg("unexpected message '%s'", last_error);
     d = desc_of(32, 2, 7);
     d.time_limit = 10;
     assert_int_equal(lbk_bake_unit_from_file(scene, &d, PLAN_HASH, 2, 0, &p.p, &p.n), LBK_ERR_INVALID_ARGUMENT);
@@ -308,23 +387,101 @@ static void test_cli_plan_units_merge(void **state)
     /* an edited plan, an error target, a time limit: refused */
     assert_int_equal(sh("sed 's/\"units\":.*3/\"units\": 4/' %s/plan.json > %s/edited.json && ! %s bake-unit %s/edited.json 0 "
                         "-o %s/x.lbkpart 2>%s/err && grep -q edited %s/err", dir, dir, lbk, dir, dir, dir, dir), 0);
-    assert_int_equal(sh("%s plan %s -o %s/o3.lbk --plan %s/p3.json --units 2 --samples 32 2>%s/err", lbk, scene, dir, dir, dir), 2);
-    assert_int_equal(sh("grep -q 'fixed sample schedule' %s/err", dir), 0);
+    assert_int_equal(sh("%s plan %s -o %s/o3.lbk --plan %s/p3.json --units 9 --samples 32 2>%s/err", lbk, scene, dir, dir, dir), 2);
+    assert_int_equal(sh("grep -q 'this bake makes 8 (the base, light sets, door states), so --units 8 or fewer' %s/err && "
+                        "test ! -e %s/p3.json", dir, dir), 0);
     assert_int_equal(sh("%s plan %s -o %s/o3.lbk --plan %s/p3.json --units 2 --samples 32 --target-error none --time-limit 5 "
                         "2>%s/err", lbk, scene, dir, dir, dir), 2);
     assert_int_equal(sh("grep -q 'time-limit' %s/err && test ! -e %s/p3.json", dir, dir), 0);
     sh("rm -rf %s", dir);
 }
 
+/* Every file the bake reads is in the plan (lbk_bake_inputs_from_file): a changed sky EXR, image
+ * or buffer is refused by the units and the merge, naming the file, before anything is traced. */
+static void test_changed_inputs_refused(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/lbk-dist-in-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char sky[600], cmd[2048];
+    snprintf(sky, sizeof sky, "%s/sky.exr", dir);
+    snprintf(cmd, sizeof cmd, "cp tests/fuzz/corpus_exr/blender_none_32.exr %s", sky);
+    assert_int_equal(system(cmd), 0);
+    const char *scene = "scenes/cornell_box/CornellBox-Original.gltf";
+    lbk_bake_desc d = desc_of(16, 1, 7);
+    d.sky_override = 1;
+    d.sky_exr = sky;
+    lbk_bake_input *in = NULL;
+    size_t n = 0;
+    uint32_t runs = 0;
+    assert_int_equal(lbk_bake_inputs_from_file(scene, &d, &in, &n, &runs), LBK_OK);
+    assert_int_equal(runs, 1);
+    assert_int_equal(n, 2);
+    assert_string_equal(in[0].role, "scene");
+    assert_string_equal(in[0].path, "CornellBox-Original.gltf");
+    struct stat st;
+    assert_int_equal(stat(scene, &st), 0);
+    assert_int_equal(in[0].bytes, (uint64_t)st.st_size);
+    assert_string_equal(in[1].role, "sky");
+    assert_string_equal(in[1].path, "sky.exr");
+    assert_int_equal(in[1].bytes, 784);
+    /* the same files: the unit bakes; another sky with other bytes: refused */
+    d.expect_inputs = in;
+    d.expect_input_count = n;
+    bytes p = {NULL, 0};
+    last_error[0] = 0;
+    assert_int_equal(lbk_bake_unit_from_file(scene, &d, PLAN_HASH, 2, 1, &p.p, &p.n), LBK_OK);
+    lbk_bake_part_free(p.p);
+    snprintf(cmd, sizeof cmd, "cp tests/fuzz/corpus_exr/blender_zips_32.exr %s", sky);
+    assert_int_equal(system(cmd), 0);
+    p.p = NULL;
+    assert_int_equal(lbk_bake_unit_from_file(scene, &d, PLAN_HASH, 2, 1, &p.p, &p.n), LBK_ERR_BAD_INPUT);
+    assert_null(p.p);
+    if (!strstr(last_error, "sky 'sky.exr' changed since the plan was made (581 bytes"))
+        fail_msg("unexpected message '%s'", last_error);
+    /* a file the plan does not list */
+    d.expect_input_count = 1;
+    assert_int_equal(lbk_bake_unit_from_file(scene, &d, PLAN_HASH, 2, 1, &p.p, &p.n), LBK_ERR_BAD_INPUT);
+    if (!strstr(last_error, "sky 'sky.exr' is not among the 1 files the plan lists")) fail_msg("unexpected message '%s'", last_error);
+    lbk_bake_inputs_free(in);
+
+    /* the CLI, with a scene of a .bin buffer and textures (the shared lamp), if present */
+    const char *lbk = getenv("LBK"), *scenes = getenv("LBK_SCENES");
+    char lamp[512];
+    snprintf(lamp, sizeof lamp, "%s/lights_punctual_lamp", scenes && *scenes ? scenes : "../shared/scenes");
+    if (lbk && *lbk && stat(lamp, &st) == 0) {
+        const char *o = "--samples 16 --target-error none --texel-density 1";
+        assert_int_equal(sh("cp -r %s %s/lamp && %s plan %s/lamp/LightsPunctualLamp.gltf -o %s/o.lbk --plan %s/p.json --units 2 "
+                            "%s >/dev/null", lamp, dir, lbk, dir, dir, dir, o), 0);
+        assert_int_equal(sh("grep -q '\"buffer\"' %s/p.json && grep -q 'material1_basecolor.png' %s/p.json", dir,
+                            dir), 0);
+        /* an image's bytes change (trailing bytes: its colours decode the same) */
+        assert_int_equal(sh("printf X >> %s/lamp/material1_basecolor.png && %s bake-unit %s/p.json 0 -o %s/u.lbkpart -q 2>%s/err",
+                            dir, lbk, dir, dir, dir), 4);
+        assert_int_equal(sh("grep -q \"image 'material1_basecolor.png' changed since the plan\" %s/err && test ! -e %s/u.lbkpart",
+                            dir, dir), 0);
+        /* a buffer's (read before the images, so it is the one named) */
+        assert_int_equal(sh("printf X >> %s/lamp/LightsPunctualLamp.data.bin && %s bake-unit %s/p.json 1 -o %s/u.lbkpart -q "
+                            "2>%s/err", dir, lbk, dir, dir, dir), 4);
+        assert_int_equal(sh("grep -q \"buffer 'LightsPunctualLamp.data.bin' changed since the plan\" %s/err", dir), 0);
+    } else {
+        printf("(the CLI part needs LBK and %s)\n", lamp);
+    }
+    sh("rm -rf %s", dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_cut_tiles),
         cmocka_unit_test(test_merge_equals_local_cornell),
         cmocka_unit_test(test_merge_equals_local_sets_doors),
         cmocka_unit_test(test_merge_equals_local_room),
+        cmocka_unit_test(test_merge_equals_local_error_target),
         cmocka_unit_test(test_bad_parts_refused),
         cmocka_unit_test(test_unsplittable_refused),
         cmocka_unit_test(test_cli_plan_units_merge),
+        cmocka_unit_test(test_changed_inputs_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -17,8 +17,14 @@ uint64_t tl_plan_hash(const tl_plan *p)
     if (!st) return 0;
     XXH64_reset(st, 0);
     char head[96];
-    int n = snprintf(head, sizeof head, "lbk-plan 1\n%016" PRIx64 "\n%u\n", p->scene_hash, p->units);
+    int n = snprintf(head, sizeof head, "lbk-plan 2\n%016" PRIx64 "\n%u\n", p->scene_hash, p->units);
     XXH64_update(st, head, (size_t)n);
+    for (size_t i = 0; i < p->input_count; i++) {
+        const tl_plan_input *f = &p->inputs[i];
+        char line[320];
+        n = snprintf(line, sizeof line, "%.255s\n%.7s %" PRIu64 " %016" PRIx64 "\n", f->path, f->role, f->bytes, f->xxh3);
+        XXH64_update(st, line, (size_t)n);
+    }
     for (int i = 0; i < p->option_count; i++) XXH64_update(st, p->options[i], strlen(p->options[i]) + 1);
     uint64_t h = XXH64_digest(st);
     XXH64_freeState(st);
@@ -47,9 +53,19 @@ int tl_plan_write(const tl_plan *p, const char *path, char err[TL_ERR_LEN])
     char h[17];
     int ok = root != NULL;
     ok = ok && cJSON_AddStringToObject(root, "format", "lbk-plan");
-    ok = ok && cJSON_AddNumberToObject(root, "version", 1);
+    ok = ok && cJSON_AddNumberToObject(root, "version", 2);
     ok = ok && cJSON_AddStringToObject(root, "scene", p->scene);
     ok = ok && cJSON_AddStringToObject(root, "scene_xxh64", hex64(p->scene_hash, h));
+    cJSON *files = ok ? cJSON_AddArrayToObject(root, "inputs") : NULL;
+    ok = ok && files;
+    for (size_t i = 0; ok && i < p->input_count; i++) {
+        cJSON *f = cJSON_CreateObject();
+        ok = f && cJSON_AddItemToArray(files, f);
+        ok = ok && cJSON_AddStringToObject(f, "path", p->inputs[i].path);
+        ok = ok && cJSON_AddStringToObject(f, "role", p->inputs[i].role);
+        ok = ok && cJSON_AddNumberToObject(f, "bytes", (double)p->inputs[i].bytes);
+        ok = ok && cJSON_AddStringToObject(f, "xxh3", hex64(p->inputs[i].xxh3, h));
+    }
     ok = ok && cJSON_AddStringToObject(root, "output", p->output);
     ok = ok && cJSON_AddNumberToObject(root, "units", p->units);
     cJSON *opts = ok ? cJSON_AddArrayToObject(root, "options") : NULL;
@@ -78,6 +94,34 @@ static int parse_hex64(const cJSON *j, uint64_t *v)
     return *end == 0;
 }
 
+/* The plan's "inputs": [{path, role, bytes, xxh3}, ...] (strings must fit, sizes be integers). */
+static int read_inputs(const cJSON *files, tl_plan *p)
+{
+    if (!cJSON_IsArray(files)) return 0;
+    int n = cJSON_GetArraySize(files);
+    if (n < 1 || n > TL_PLAN_MAX_INPUTS) return 0;
+    p->inputs = calloc((size_t)n, sizeof *p->inputs);
+    if (!p->inputs) return 0;
+    const cJSON *f;
+    cJSON_ArrayForEach(f, files)
+    {
+        const cJSON *path = cJSON_GetObjectItemCaseSensitive(f, "path");
+        const cJSON *role = cJSON_GetObjectItemCaseSensitive(f, "role");
+        const cJSON *bytes = cJSON_GetObjectItemCaseSensitive(f, "bytes");
+        tl_plan_input *in = &p->inputs[p->input_count];
+        if (!cJSON_IsString(path) || strlen(path->valuestring) >= sizeof in->path || !cJSON_IsString(role) ||
+            strlen(role->valuestring) >= sizeof in->role || !cJSON_IsNumber(bytes) || !(bytes->valuedouble >= 0) ||
+            bytes->valuedouble > 9007199254740992.0 || bytes->valuedouble != (double)(uint64_t)bytes->valuedouble ||
+            !parse_hex64(cJSON_GetObjectItemCaseSensitive(f, "xxh3"), &in->xxh3))
+            return 0;
+        memcpy(in->path, path->valuestring, strlen(path->valuestring) + 1);
+        memcpy(in->role, role->valuestring, strlen(role->valuestring) + 1);
+        in->bytes = (uint64_t)bytes->valuedouble;
+        p->input_count++;
+    }
+    return 1;
+}
+
 int tl_plan_read(const char *path, tl_plan *p, char err[TL_ERR_LEN])
 {
     memset(p, 0, sizeof *p);
@@ -94,7 +138,7 @@ int tl_plan_read(const char *path, tl_plan *p, char err[TL_ERR_LEN])
     const cJSON *opts = cJSON_GetObjectItemCaseSensitive(root, "options");
     uint64_t stored = 0;
     int ok = root && cJSON_IsString(fmt) && !strcmp(fmt->valuestring, "lbk-plan") && cJSON_IsNumber(ver) &&
-             ver->valuedouble == 1 && cJSON_IsString(scene) && cJSON_IsString(out) && cJSON_IsNumber(units) &&
+             ver->valuedouble == 2 && cJSON_IsString(scene) && cJSON_IsString(out) && cJSON_IsNumber(units) &&
              units->valuedouble >= 1 && units->valuedouble <= 65536 && units->valuedouble == (double)(int)units->valuedouble &&
              cJSON_IsArray(opts) && cJSON_GetArraySize(opts) <= TL_PLAN_MAX_OPTIONS &&
              parse_hex64(cJSON_GetObjectItemCaseSensitive(root, "scene_xxh64"), &p->scene_hash) &&
@@ -110,11 +154,12 @@ int tl_plan_read(const char *path, tl_plan *p, char err[TL_ERR_LEN])
             if (!ok || !cJSON_IsString(o)) { ok = 0; break; }
             if (!(p->options[p->option_count++] = strdup(o->valuestring))) ok = 0;
         }
+        if (ok) ok = read_inputs(cJSON_GetObjectItemCaseSensitive(root, "inputs"), p);
     }
     cJSON_Delete(root);
     if (!ok) {
         tl_plan_free(p);
-        snprintf(err, TL_ERR_LEN, "%s: not an lbk plan (format lbk-plan, version 1)", path);
+        snprintf(err, TL_ERR_LEN, "%s: not an lbk plan (format lbk-plan, version 2)", path);
         return -1;
     }
     p->hash = tl_plan_hash(p);
@@ -130,6 +175,7 @@ void tl_plan_free(tl_plan *p)
 {
     free(p->scene);
     free(p->output);
+    free(p->inputs);
     for (int i = 0; i < p->option_count; i++) free(p->options[i]);
     memset(p, 0, sizeof *p);
 }

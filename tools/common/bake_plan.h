@@ -11,9 +11,21 @@
 
 #define TL_PLAN_MAX_OPTIONS 128
 
+#define TL_PLAN_MAX_INPUTS 65536
+
+/* A file the bake reads (lbk_bake_input): the plan's record of it, which units compare with
+ * what their import read. */
+typedef struct tl_plan_input {
+    char path[256];
+    char role[8];
+    uint64_t bytes, xxh3;
+} tl_plan_input;
+
 typedef struct tl_plan {
     char *scene;                 /* absolute path */
     uint64_t scene_hash;         /* XXH64 of the scene file's bytes */
+    size_t input_count;          /* every file the bake reads, in the order read */
+    tl_plan_input *inputs;
     char *output;                /* the container the merge writes (as given) */
     uint32_t units;
     int option_count;
@@ -21,7 +33,8 @@ typedef struct tl_plan {
     uint64_t hash;               /* tl_plan_hash */
 } tl_plan;
 
-/* The plan's identity: the format, the scene's content hash, the units and the options. */
+/* The plan's identity: the format, the scene's content hash, its files, the units and the
+ * options. */
 uint64_t tl_plan_hash(const tl_plan *p);
 /* XXH64 of a file's bytes; 0 or -1 with err. */
 int tl_file_hash(const char *path, uint64_t *hash, char err[TL_ERR_LEN]);

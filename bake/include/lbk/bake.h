@@ -163,7 +163,22 @@ typedef struct lbk_bake_desc {
                                    an uninterrupted one; a finished bake given a lower
                                    target_error or a larger max_samples adds passes) [0: a fresh
                                    bake, checkpoints of an earlier one in the folder removed] */
+    /* added in 1.3 */
+    /* The files the bake must read, byte for byte (lbk_bake_inputs_from_file's list, e.g. from a
+     * distributed bake's plan): a bake whose import reads other files, or one with other bytes,
+     * fails with LBK_ERR_BAD_INPUT naming it, before any light is traced [NULL: no check] */
+    const struct lbk_bake_input *expect_inputs;
+    size_t expect_input_count;
 } lbk_bake_desc;
+
+/* A file a bake read (the glTF, its buffers and images, a sky EXR), as META input.files
+ * records it (spec/container.md §6.2). */
+typedef struct lbk_bake_input {
+    char path[256];   /* relative to the scene file's folder; the scene file and a sky EXR by name */
+    char role[8];     /* "scene", "buffer", "image", "sky" */
+    uint64_t bytes;
+    uint64_t xxh3;    /* XXH3-64 of its bytes */
+} lbk_bake_input;
 
 /* ---- in-memory scenes ----------------------------------------------------------------------
  * A scene as plain data, for callers that are not glTF-based (an editor, a test). World space,

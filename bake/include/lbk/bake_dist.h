@@ -3,10 +3,11 @@
  * (spec/part.md); the merge of all parts is byte-identical to lbk_bake_from_file with the same
  * scene, options and seed, at any number of units.
  *
- * Only bakes whose passes do not depend on the error estimate can be cut (the estimate is a sum
- * over every receiver): desc->target_error < 0 (stop at max_samples), no time_limit, and the
- * difference door method (the guided estimator is not a transport run). Anything else:
- * LBK_ERR_INVALID_ARGUMENT with the reason sent as the ERROR message. */
+ * A run that stops on an error target (desc->target_error >= 0) needs its estimate over all its
+ * receivers, so with one only units <= runs can be cut (each run whole in one unit); with
+ * target_error < 0 (stop at max_samples) any number. No time_limit, and the difference door
+ * method (the guided estimator is not a transport run). Anything else: LBK_ERR_INVALID_ARGUMENT
+ * with the reason sent as the ERROR message. */
 #ifndef LBK_BAKE_DIST_H
 #define LBK_BAKE_DIST_H
 
@@ -22,6 +23,15 @@ extern "C" {
 LBK_BAKE_API lbk_result lbk_bake_unit_from_file(const char *path, const lbk_bake_desc *desc, uint64_t plan_hash,
                                                 uint32_t units, uint32_t unit, void **part, size_t *part_size);
 LBK_BAKE_API void lbk_bake_part_free(void *part);
+
+/* The files a bake of the scene at path with desc reads (the import's, in the order read, then
+ * a sky EXR), with their sizes and hashes: what a plan records, so that units and the merge
+ * (desc->expect_inputs) refuse a changed buffer, texture or sky. Imports the scene (no layout, no
+ * light). *inputs: free with lbk_bake_inputs_free. runs (may be NULL): the transport runs the
+ * bake makes (the base, each light set, each door state), which the units are cut by. */
+LBK_BAKE_API lbk_result lbk_bake_inputs_from_file(const char *path, const lbk_bake_desc *desc, lbk_bake_input **inputs,
+                                                  size_t *count, uint32_t *runs);
+LBK_BAKE_API void lbk_bake_inputs_free(lbk_bake_input *inputs);
 
 /* What a part says about itself (lbk_bake_part_check). */
 typedef struct lbk_bake_part_info {
