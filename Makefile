@@ -394,7 +394,7 @@ $(BUILD)/fuzz_container: tests/fuzz/fuzz_container.c $(LIB_SRC)
 CLANGXX   ?= clang++
 FUZZ_OBJ_FLAGS := -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -g -O1
 FUZZ_LIB_OBJ := $(LIB_SRC:%.c=$(BUILD)/fuzz-obj/%.o)
-FUZZ_HARNESSES := fuzz_gltf fuzz_exr fuzz_profile
+FUZZ_HARNESSES := fuzz_gltf fuzz_exr fuzz_profile fuzz_part
 $(BUILD)/fuzz-obj/libformat/%.o: libformat/%.c
 	@mkdir -p $(@D)
 	$(CLANG) $(CSTD) $(FUZZ_OBJ_FLAGS) $(LIB_FP) $(WARN) $(LIB_INC) -MMD -MP -c $< -o $@
@@ -409,12 +409,17 @@ FUZZ_GLTF_OBJ := $(addprefix $(BUILD)/fuzz-obj/,tests/fuzz/fuzz_gltf.o bake/scen
 FUZZ_EXR_OBJ := $(addprefix $(BUILD)/fuzz-obj/,tests/fuzz/fuzz_exr.o bake/scene/exr_read.o bake/scene/scene.o)
 FUZZ_PROFILE_OBJ := $(addprefix $(BUILD)/fuzz-obj/,tests/fuzz/fuzz_profile.o tools/convert/profile.o \
                       tools/common/lmap_decode.o tools/common/error_util.o tools/common/astc_codec.o)
+# the part harness merges, so it links the whole baker
+FUZZ_PART_OBJ := $(BUILD)/fuzz-obj/tests/fuzz/fuzz_part.o $(BAKE_CSRC:%.c=$(BUILD)/fuzz-obj/%.o) \
+                 $(BAKE_CXXSRC:%.cc=$(BUILD)/fuzz-obj/%.o)
 $(BUILD)/fuzz_gltf: $(FUZZ_GLTF_OBJ) $(FUZZ_LIB_OBJ)
 	$(CLANGXX) -fsanitize=fuzzer,address,undefined -o $@ $^ $(BAKE_LIBS) $(LIB_LIBS)
 $(BUILD)/fuzz_exr: $(FUZZ_EXR_OBJ) $(FUZZ_LIB_OBJ)
 	$(CLANGXX) -fsanitize=fuzzer,address,undefined -o $@ $^ $(BAKE_LIBS) $(LIB_LIBS)
 $(BUILD)/fuzz_profile: $(FUZZ_PROFILE_OBJ) $(FUZZ_LIB_OBJ)
 	$(CLANGXX) -fsanitize=fuzzer,address,undefined -o $@ $^ -lastcenc $(LIB_LIBS)
+$(BUILD)/fuzz_part: $(FUZZ_PART_OBJ) $(FUZZ_LIB_OBJ)
+	$(CLANGXX) -fsanitize=fuzzer,address,undefined -o $@ $^ $(BAKE_LIBS) $(LIB_LIBS)
 -include $(wildcard $(BUILD)/fuzz-obj/*/*.d $(BUILD)/fuzz-obj/*/*/*.d)
 # The seed corpus (tests/fuzz/README.md): the golden files, the containers make_corpus.c builds
 # (every section type) and two small real bakes. Regenerate by hand; the files are committed.
