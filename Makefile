@@ -432,6 +432,10 @@ fuzz-corpus: $(BUILD)/liblbk.a $(BUILD)/lbk
 	    --texel-density 2 --samples 8 --glg-spacing 3 --octahedral
 	$(BUILD)/lbk bake scenes/cornell_box/CornellBox-Original.gltf -o tests/fuzz/corpus/bake_cornell.lbk -q --threads 2 \
 	    --texel-density 2 --samples 8 --glg-spacing 2.5 --octahedral
+	@d=$$(mktemp -d) && for n in 1 2; do \
+	  $(BUILD)/lbk plan tests/fuzz/part_scene.gltf -o $$d/o.lbk --plan $$d/p$$n.json --units $$n --samples 4 --target-error none \
+	    --texel-density 2 --glg-spacing 8 -q && \
+	  $(BUILD)/lbk bake-unit $$d/p$$n.json 0 -o tests/fuzz/corpus_part/unit0of$$n.lbkpart -q || exit 1; done; rm -rf $$d
 fuzz: deps-test
 	@$(MAKE) --no-print-directory $(BUILD)/fuzz_container
 	@mkdir -p $(BUILD)/fuzz-corpus
