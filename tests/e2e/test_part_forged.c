@@ -22,10 +22,10 @@
 
 #define SCENE "tests/fuzz/part_scene.gltf"
 #define PLAN_HASH 0x70617274666f7267ull
-/* spec/part.md: header 96 bytes, then per run a 96-byte header, its passes (a 64-byte header and
- * 32 bytes per receiver each), then its outputs */
+/* spec/part.md (format 2): header 96 bytes, then per run a 112-byte header, its passes (a 64-byte
+ * header and 32 bytes per receiver each), then its outputs */
 #define HEADER 96
-#define RUN_HEADER 96
+#define RUN_HEADER 112
 
 static char last_error[1024];
 

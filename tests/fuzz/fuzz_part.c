@@ -23,7 +23,7 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-enum { HEADER = 96 };
+enum { HEADER = 96, RUN_HEADER = 112 };
 static const uint64_t plan_hash = 0x6c626b2d66757a7aull; /* any non-zero value: the harness is the plan */
 
 typedef struct harness {
@@ -80,6 +80,33 @@ static void setup(void)
     H.ready = 1;
 }
 
+static uint32_t get32(const uint8_t *p)
+{
+    uint32_t v = 0;
+    for (int k = 0; k < 4; k++) v |= (uint32_t)p[k] << (8 * k);
+    return v;
+}
+
+/* Every run record's receiver range set to [0, receivers) (unit 0 of 1 holds every run whole),
+ * walking the records as far as their passes and masks give sizes. */
+static void repair_ranges(uint8_t *p, size_t size, uint64_t receivers)
+{
+    static const int floats[4] = {27, 27, 3, 1};
+    size_t at = HEADER;
+    while (size - at >= RUN_HEADER) {
+        put64(p + at + 96, 0);
+        put64(p + at + 104, receivers);
+        const uint32_t passes = get32(p + at), mask = get32(p + at + 4);
+        if (passes == 0 || passes > 32 || mask > 15 || receivers > ((uint64_t)1 << 30)) return;
+        uint64_t per = 32ull * passes;
+        for (int k = 0; k < 4; k++)
+            if (mask & (1u << k)) per += 4ull * (uint64_t)floats[k];
+        const uint64_t n = RUN_HEADER + 64ull * passes + receivers * per;
+        if (n > size - at) return;
+        at += (size_t)n;
+    }
+}
+
 /* A copy of the input that passes every identity and checksum test the fuzzer cannot forge. */
 static uint8_t *repaired(const uint8_t *data, size_t size)
 {
@@ -87,12 +114,17 @@ static uint8_t *repaired(const uint8_t *data, size_t size)
     if (!p) abort();
     memcpy(p, data, size);
     uint64_t receivers = get64(p + 32) & (((uint64_t)1 << 40) - 1);
+    uint32_t runs = get32(p + 40) % 65536 + 1;
     put64(p + 16, plan_hash);
     put32(p + 24, 1);
     put32(p + 28, 0);
     put64(p + 32, receivers);
-    put64(p + 40, 0);
-    put64(p + 48, receivers);
+    put32(p + 40, runs);      /* format 2: unit 0 of 1 holds runs [0, runs) */
+    put32(p + 44, 0);
+    put64(p + 48, 0);
+    put32(p + 56, runs);
+    put32(p + 60, 0);
+    repair_ranges(p, size, receivers);
     put64(p + 64, size - HEADER);
     put64(p + 72, XXH64(p + HEADER, size - HEADER, 0));
     put64(p + 80, H.options_hash);
