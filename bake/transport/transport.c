@@ -1703,29 +1703,50 @@ static void box_grow(double lo[3], double hi[3], const double p[3])
     }
 }
 
-/* The mean over up to 256 receivers (evenly spread by index; cell centres when there are none)
- * of the unshadowed irradiance luminance of every positional light: what δ is relative to. */
+/* The mean punctual irradiance of the positional lights (shadowed and cosine-weighted as
+ * received: the error scalar X of TRANSPORT.md, fluence/4 at probes) over `k` receivers spread
+ * evenly over [begin, end), or cell centres when there are no receivers. */
+static double slc_class_mean(const tp_ctx *c, size_t begin, size_t end, size_t k)
+{
+    const size_t n = end - begin;
+    if (k > n) k = n;
+    double sum = 0, sh[3][9] = {{0}};
+    for (size_t q = 0; q < k; q++) {
+        size_t i = begin + q * n / k;
+        tp_origin g;
+        if (c->recv_count) {
+            recv_origin(c, &c->recv[i], &g);
+        } else {
+            tp_cell_geom cg;
+            double p[3];
+            cell_geom(c, &c->cells[i], &cg);
+            cell_point_at(&cg, 0.5, 0.5, p, NULL, NULL);
+            float pf[3] = {(float)p[0], (float)p[1], (float)p[2]};
+            origin_from(c, pf, c->cells[i].n, &g);
+        }
+        double e[3] = {0, 0, 0};
+        for (size_t li = 0; li < c->light_count; li++)
+            if (c->lights[li]->type != BK_LIGHT_DIRECTIONAL) punctual_one(c, &g, li, NULL, 1, e, sh);
+        sum += bk_lum(e) * (g.sphere ? 0.25 : 1.0);
+    }
+    return k ? sum / (double)k : 0;
+}
+
+/* What δ is relative to: the smallest positive class mean of slc_class_mean, each class
+ * sampled at up to 256 receivers (fewer when the lights are many: at most 2^22 shadow rays in
+ * all, at least 16 receivers). Then one draw's relative RMSE over any class is at most √(δ/2)
+ * (SLC.md): a class of dim receivers (texels beside bright probes) gets the δ it needs. */
 static double slc_mean_irradiance(const tp_ctx *c)
 {
-    const size_t n = c->recv_count ? c->recv_count : c->cell_count, k_max = n < 256 ? n : 256;
-    double sum = 0;
-    for (size_t k = 0; k < k_max; k++) {
-        size_t i = k * n / k_max;
-        double p[3];
-        if (c->recv_count) {
-            for (int a = 0; a < 3; a++) p[a] = c->recv[i].position[a];
-        } else {
-            tp_cell_geom g;
-            cell_geom(c, &c->cells[i], &g);
-            cell_point_at(&g, 0.5, 0.5, p, NULL, NULL);
-        }
-        for (size_t li = 0; li < c->light_count; li++) {
-            double val[3], ld[3], dist;
-            if (c->lights[li]->type != BK_LIGHT_DIRECTIONAL && bk_light_eval(c->lights[li], p, val, ld, &dist))
-                sum += bk_lum(val);
-        }
+    size_t k = c->light_count ? ((size_t)1 << 22) / (c->light_count * (size_t)c->ncls) : 256;
+    k = k < 16 ? 16 : k > 256 ? 256 : k;
+    if (!c->recv_count) return slc_class_mean(c, 0, c->cell_count, k);
+    double best = 0;
+    for (int q = 0; q < c->ncls; q++) {
+        double m = slc_class_mean(c, c->cls[q].begin, c->cls[q].end, k);
+        if (m > 0 && (best == 0 || m < best)) best = m;
     }
-    return k_max ? sum / (double)k_max : 0;
+    return best;
 }
 
 /* Boxes of the points whose punctual light is culled: every receiver's punctual points, and
@@ -2298,9 +2319,9 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
         res = replay_run(&c, stats);
         goto done;
     }
+    init_classes(&c); /* (before ctx_init: culling's δ is measured per class) */
     res = ctx_init(&c);
     if (res != LBK_OK) goto done;
-    init_classes(&c);
 
     for (size_t i = 0; i < count; i++) {
         memset(&output->radiance[i], 0, sizeof output->radiance[i]);

@@ -218,16 +218,17 @@ typedef struct bk_transport_options {
      * and in the cache's first bounce is one culling draw per half and pass (unbiased, in the
      * error estimate) instead of every light with a shadow ray. */
     int slc;
-    /* δ relative to the mean unshadowed irradiance of the positional lights at the receivers:
-     * a light is accepted for certain where its irradiance exceeds δ × that mean (pass p:
-     * δ/2^p); 0: BK_SLC_DEFAULT_DELTA. Smaller: more lights per receiver, less noise. */
+    /* δ relative to the mean punctual irradiance of the positional lights at the receivers
+     * (shadowed, as received): a light is accepted for certain where its irradiance exceeds
+     * δ × that mean (pass p: δ/2^p), and one draw's level-wide relative RMSE is ≤ √(δ/2);
+     * 0: BK_SLC_DEFAULT_DELTA. Smaller: more lights per receiver, less noise. */
     double slc_delta;
 } bk_transport_options;
 
 /* The light count above which culling is on by default, and the default δ (SLC.md, measured by
  * bench_slc). */
 #define BK_SLC_AUTO_LIGHTS 64
-#define BK_SLC_DEFAULT_DELTA 0.01
+#define BK_SLC_DEFAULT_DELTA 0.1
 
 /* Caller-owned output arrays, `count` entries each; NULL pointers are skipped. */
 typedef struct bk_transport_output {

@@ -95,7 +95,7 @@ static bk_transport_options opts(int slc, uint64_t seed, int threads)
     o.max_samples = 16; /* one pass: both halves, pass 0's δ */
     o.max_cells = 2048;
     o.slc = slc;
-    o.slc_delta = 0.05;
+    o.slc_delta = 0.2;
     return o;
 }
 

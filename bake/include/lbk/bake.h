@@ -163,6 +163,13 @@ typedef struct lbk_bake_desc {
                                    an uninterrupted one; a finished bake given a lower
                                    target_error or a larger max_samples adds passes) [0: a fresh
                                    bake, checkpoints of an earlier one in the folder removed] */
+    /* added in 1.3 */
+    int light_culling;          /* stochastic light culling of punctual lights
+                                   (bake/transport/SLC.md): 1 on, -1 off [0: auto, on with more
+                                   than 64 positional lights in a run] */
+    double light_culling_delta; /* culling's δ relative to the mean punctual irradiance at the
+                                   receivers (smaller: more lights per receiver, less noise)
+                                   [0: 0.1] */
 } lbk_bake_desc;
 
 /* ---- in-memory scenes ----------------------------------------------------------------------
