@@ -47,7 +47,7 @@ static void help(FILE *f)
           "                          directly (default 0.01; 0 keeps every lit receiver)\n"
           "  --light-culling auto|on|off\n"
           "                          stochastic light culling of punctual lights (bake/transport/SLC.md;\n"
-          "                          auto, the default: on with more than 64 positional lights)\n"
+          "                          auto, the default: on with more than 32 positional lights)\n"
           "  --light-culling-delta X culling's delta relative to the mean punctual irradiance\n"
           "                          (default 0.1; smaller: more lights per texel, less noise)\n"
           "  --door-method difference|guided\n"

@@ -227,7 +227,7 @@ typedef struct bk_transport_options {
 
 /* The light count above which culling is on by default, and the default δ (SLC.md, measured by
  * bench_slc). */
-#define BK_SLC_AUTO_LIGHTS 64
+#define BK_SLC_AUTO_LIGHTS 32
 #define BK_SLC_DEFAULT_DELTA 0.1
 
 /* Caller-owned output arrays, `count` entries each; NULL pointers are skipped. */

@@ -166,7 +166,7 @@ typedef struct lbk_bake_desc {
     /* added in 1.3 */
     int light_culling;          /* stochastic light culling of punctual lights
                                    (bake/transport/SLC.md): 1 on, -1 off [0: auto, on with more
-                                   than 64 positional lights in a run] */
+                                   than 32 positional lights in a run] */
     double light_culling_delta; /* culling's δ relative to the mean punctual irradiance at the
                                    receivers (smaller: more lights per receiver, less noise)
                                    [0: 0.1] */
