@@ -190,6 +190,9 @@ typedef struct tp_ctx {
     bk_slc_draw *draw_recv[2], *draw_cell;
     uint32_t *slc_ids;
     uint64_t *thread_slc_tested;
+    double *slc_cdf;           /* positional lights by intensity, for continued points */
+    uint32_t *slc_pick_ids;
+    size_t slc_pick_count;
     /* per chain (half) state; [h] */
     float *l_prev[2], *l_cur[2], *l_sum[2];
     float *l_prev2[2];     /* bounce k−2 (what a near hit in bounce k continues into) */
@@ -600,6 +603,33 @@ static void mark_rough(tp_ctx *c)
  * k−1 at its near hit: the sources for k = 2, bounce k−2's cells beyond. */
 typedef struct tp_near_mode { const float *read; const uint8_t *rough; int sources, max_depth; } tp_near_mode;
 
+/* Light li at the continued point x (normal n, ray origin o), weighted `scale`, into e. */
+static void near_light(const tp_ctx *c, size_t li, const double x[3], const double n[3], const float o[3], double scale,
+                       double e[3], tp_count *cnt)
+{
+    double val[3], ld[3], dist;
+    if (!bk_light_eval(c->lights[li], x, val, ld, &dist)) return;
+    double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
+    if (cs <= 0) return;
+    cnt->shadow++;
+    if (bk_light_visible(c->tracer, o, ld, dist))
+        for (int a = 0; a < 3; a++) e[a] += scale * val[a] * cs;
+}
+
+/* A positional light for u ∈ [0, 1) in proportion to its intensity (slc_cdf); *scale gets 1/P. */
+static size_t slc_pick(const tp_ctx *c, double u, double *scale)
+{
+    size_t lo = 0, hi = c->slc_pick_count - 1;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (c->slc_cdf[mid] > u) hi = mid;
+        else lo = mid + 1;
+    }
+    double p = c->slc_cdf[lo] - (lo ? c->slc_cdf[lo - 1] : 0);
+    *scale = p > 0 ? 1 / p : 0;
+    return c->slc_pick_ids[lo];
+}
+
 static void near_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, long hc, int depth, tp_rng *rng,
                           tp_count *cnt, double out[3])
 {
@@ -650,17 +680,19 @@ static void near_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, 
             for (int a = 0; a < 3; a++) e[a] += val[a] * cq;
     }
     if (md->sources && c->light_count) {
-        size_t li = (size_t)(rng_next(rng) * (double)c->light_count);
-        if (li >= c->light_count) li = c->light_count - 1;
-        double val[3], ld[3], dist;
-        if (bk_light_eval(c->lights[li], x, val, ld, &dist)) {
-            double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
-            if (cs > 0) {
-                cnt->shadow++;
-                if (bk_light_visible(c->tracer, o, ld, dist))
-                    for (int a = 0; a < 3; a++) e[a] += (double)c->light_count * val[a] * cs;
-            }
+        /* one light: uniformly; with culling (many lights) a positional one in proportion to its
+         * intensity (a uniform pick among thousands almost never finds the lamp that matters)
+         * and every directional one */
+        double u = rng_next(rng), scale = (double)c->light_count;
+        size_t li = (size_t)(u * (double)c->light_count);
+        if (c->slc) {
+            li = slc_pick(c, u, &scale);
+            const uint32_t *always;
+            size_t na = bk_slc_always(c->slc_recv, &always);
+            for (size_t k = 0; k < na; k++) near_light(c, always[k], x, n, o, 1, e, cnt);
         }
+        if (li >= c->light_count) li = c->light_count - 1;
+        near_light(c, li, x, n, o, scale, e, cnt);
     }
     for (int a = 0; a < 3; a++) out[a] = cell->albedo[a] / TP_PI * e[a];
 }
@@ -1434,6 +1466,8 @@ static void free_ctx(tp_ctx *c)
     bk_slc_destroy(c->slc_cell);
     free(c->slc_ids);
     free(c->thread_slc_tested);
+    free(c->slc_cdf);
+    free(c->slc_pick_ids);
 }
 
 /* Longest edge of triangle i. */
@@ -1786,7 +1820,23 @@ static lbk_result slc_build(tp_ctx *c)
     free(boxes);
     if (res != LBK_OK) return res;
     c->slc_ids = malloc(2 * (size_t)c->threads * (c->light_count ? c->light_count : 1) * sizeof(uint32_t));
-    return c->slc_ids ? LBK_OK : LBK_ERR_OUT_OF_MEMORY;
+    c->slc_cdf = malloc((c->light_count ? c->light_count : 1) * sizeof(double));
+    c->slc_pick_ids = malloc((c->light_count ? c->light_count : 1) * sizeof(uint32_t));
+    if (!c->slc_ids || !c->slc_cdf || !c->slc_pick_ids) return LBK_ERR_OUT_OF_MEMORY;
+    double tot = 0;
+    for (size_t li = 0; li < c->light_count; li++) {
+        const float *col = c->lights[li]->color;
+        double v[3] = {isfinite(col[0]) && col[0] > 0 ? col[0] : 0, isfinite(col[1]) && col[1] > 0 ? col[1] : 0,
+                       isfinite(col[2]) && col[2] > 0 ? col[2] : 0};
+        if (c->lights[li]->type == BK_LIGHT_DIRECTIONAL || !(bk_lum(v) > 0)) continue;
+        tot += bk_lum(v);
+        c->slc_cdf[c->slc_pick_count] = tot;
+        c->slc_pick_ids[c->slc_pick_count++] = (uint32_t)li;
+    }
+    if (!c->slc_pick_count || !(tot > 0) || !isfinite(tot)) return LBK_ERR_UNSUPPORTED_FEATURE; /* (culling off) */
+    for (size_t k = 0; k < c->slc_pick_count; k++) c->slc_cdf[k] /= tot;
+    c->slc_cdf[c->slc_pick_count - 1] = 1;
+    return LBK_OK;
 }
 
 /* Whether this run culls (options.slc; auto: more than BK_SLC_AUTO_LIGHTS positional lights),
@@ -1803,7 +1853,7 @@ static lbk_result slc_init(tp_ctx *c)
     c->slc_delta = (opt->slc_delta > 0 && isfinite(opt->slc_delta) ? opt->slc_delta : BK_SLC_DEFAULT_DELTA) * mean;
     lbk_result res = slc_build(c);
     c->slc = res == LBK_OK;
-    return res;
+    return res == LBK_ERR_UNSUPPORTED_FEATURE ? LBK_OK : res; /* no positional light with power: exact */
 }
 
 /* Everything a run needs before its first pass: counters, the light selection, cells,
