@@ -42,12 +42,20 @@ typedef struct dls_var_batch {
     uint8_t *out0, *out1;
 } dls_var_batch;
 
+typedef struct lbk_ahd_linear lbk_ahd_linear;
+typedef struct lbk_sh9_rgb lbk_sh9_rgb;
+
 typedef struct dls_kernels {
     const char *name;
     void (*texels)(const dls_batch *b);
     void (*probes)(const dls_batch *b);
     void (*texels_var)(const dls_var_batch *b);
     void (*probes_var)(const dls_var_batch *b);
+    /* The codecs the kernels are made of, on `count` targets, for the tests: lbk_ahd_to_linear of
+     * the plane words z[t], rgba[t]; lbk_ahd_from_linear into them; lbk_sh9_unpack of 28-byte probes. */
+    void (*texel_decode)(const uint32_t *z, const uint32_t *rgba, uint32_t count, lbk_ahd_linear *out);
+    void (*texel_encode)(const lbk_ahd_linear *in, uint32_t count, uint32_t *z, uint32_t *rgba);
+    void (*probe_decode)(const uint8_t *probes, uint32_t count, lbk_sh9_rgb *out);
 } dls_kernels;
 
 /* The definition, one target at a time; always available. */

@@ -1,9 +1,21 @@
-/* The DLS arithmetic on 8 targets at a time with AVX2: the operations of dls_kernel_scalar.c
- * (lbk_ahd_to_linear / _from_linear, lbk_sh9_unpack / _pack and pixel.c's codecs) lane for lane,
- * in the same order and precision — float where they use float, double where they use double,
- * divisions and square roots as true IEEE operations, every rounding to nearest-even by an
- * instruction that ignores the rounding mode where the scalar code does so too — so the bytes
- * are the scalar ones. No FMA: the target is plain AVX2 and contraction is off. */
+/* The DLS arithmetic on 8 targets at a time with AVX2 and FMA: the bytes of dls_kernel_scalar.c
+ * (lbk_ahd_to_linear / _from_linear, lbk_sh9_unpack / _pack and pixel.c's codecs), lane for lane.
+ *
+ * Decoding follows the scalar operations in the same order and precision — float where they use
+ * float, double where they use double, every rounding to nearest-even by an instruction that
+ * ignores the rounding mode where the scalar code does so too — with one substitution: a float
+ * division a / b is computed as Markstein's correctly rounded quotient from y = RN(1/b)
+ * (q = RN(a·y); r = a − b·q, exact in one fused multiply-add; RN(q + r·y) = RN(a/b) when no
+ * step overflows or underflows, which holds for every decode here), so one true division serves
+ * three quotients. The FMAs are only those of that correction: the definition's own products and
+ * sums stay unfused (contraction is off).
+ *
+ * Encoding (texel_encode_fast) computes the bytes that need the encoder's double division and
+ * square roots (the direction and the ambient ratio) in float from the exact double sums, with
+ * an error below 1e-4 of a byte code (derived at texel_encode_fast), and keeps a byte only when
+ * its value lies farther than NEAR_MARGIN from a rounding boundary; a group of 8 with a lane
+ * nearer than that goes through the operation-by-operation encoder (texel_encode). So the bytes
+ * are the definition's, and the slow encoder runs for about 1 group in 60. */
 #include "dls_kernel.h"
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -19,12 +31,13 @@ const dls_kernels *dls_kernels_avx2(void) { return 0; }
 #include "internal.h"
 #include "lbk/ahd.h"
 #include "lbk/pixel.h"
+#include "lbk/sh.h"
 
 #if defined(__clang__)
-#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
+#pragma clang attribute push(__attribute__((target("avx2,fma"))), apply_to = function)
 #else
 #pragma GCC push_options
-#pragma GCC target("avx2")
+#pragma GCC target("avx2,fma")
 #endif
 #include <immintrin.h>
 
@@ -44,33 +57,19 @@ INL vf dvd(vf a, vf b) { return _mm256_div_ps(a, b); }
 INL vf sel(vf mask, vf yes, vf no) { return _mm256_blendv_ps(no, yes, mask); }
 INL vf gt(vf a, vf b) { return _mm256_cmp_ps(a, b, _CMP_GT_OQ); }
 
-/* fl32(n / d) for small integers n and an odd d, without a division or a gather: n · fl64(1/d)
- * is within 2^-52 (relative) of n/d, and n/d is either a float (only when d divides n: the callers
- * blend those cases in, so the rounding mode cannot matter) or at least 2^-32 (relative) away from
- * every float and from every point halfway between two (d odd divides n·2^k only if it divides n),
- * so the one rounding to float gives the correctly rounded quotient, as the scalar division does. */
-INL vf ratio(vi n, double recip)
+/* RN(a / b) from y = RN(1 / b), by Markstein's correction (see the top of the file). */
+INL vf quot(vf a, vf b, vf y)
 {
-    const vd r = _mm256_set1_pd(recip);
-    const vd lo = _mm256_mul_pd(_mm256_cvtepi32_pd(_mm256_castsi256_si128(n)), r);
-    const vd hi = _mm256_mul_pd(_mm256_cvtepi32_pd(_mm256_extracti128_si256(n, 1)), r);
-    return _mm256_set_m128(_mm256_cvtpd_ps(hi), _mm256_cvtpd_ps(lo));
+    const vf q = mul(a, y);
+    return _mm256_fmadd_ps(_mm256_fnmadd_ps(q, b, a), y, q);
 }
-INL vf when(vi n, int v, float x, vf q) { return sel(_mm256_castsi256_ps(_mm256_cmpeq_epi32(n, iset(v))), fset(x), q); }
+INL vf quot_by(vi n, float b) { return quot(_mm256_cvtepi32_ps(n), fset(b), fset(1.0f / b)); }
 /* lbk_unorm8_to_float: c/255 */
-INL vf unorm_f(vi c) { return when(c, 255, 1.0f, ratio(c, 1.0 / 255.0)); }
+INL vf unorm_f(vi c) { return quot_by(c, 255.0f); }
 /* decode_direction's x and y: 2c/255 − 1 */
-INL vf dir_f(vi c)
-{
-    const vi c2 = _mm256_add_epi32(c, c);
-    return sub(when(c2, 510, 2.0f, ratio(c2, 1.0 / 255.0)), fset(1.0f));
-}
+INL vf dir_f(vi c) { return sub(quot_by(_mm256_add_epi32(c, c), 255.0f), fset(1.0f)); }
 /* lbk_snorm8_to_float: max(q/127, −1) for the signed byte q */
-INL vf snorm_f(vi q)
-{
-    const vf v = when(q, 127, 1.0f, when(q, -127, -1.0f, ratio(q, 1.0 / 127.0)));
-    return _mm256_max_ps(v, fset(-1.0f));
-}
+INL vf snorm_f(vi q) { return _mm256_max_ps(quot_by(q, 127.0f), fset(-1.0f)); }
 INL vi byte_at(vi w, int i) { return _mm256_and_si256(_mm256_srli_epi32(w, 8 * i), iset(0xff)); }
 
 /* The two halves of 8 floats as doubles, and 8 doubles back to floats (rounded as (float)x). */
@@ -142,9 +141,10 @@ INL void direction(vi rgba, vf d[3], vf *k)
     const vf z = unorm_f(_mm256_srli_epi32(rgba, 24));
     const vf len = _mm256_sqrt_ps(add(add(mul(x, x), mul(y, y)), mul(z, z)));
     const vf shortv = _mm256_cmp_ps(len, fset(0.5f), _CMP_LT_OQ);
-    d[0] = sel(shortv, _mm256_setzero_ps(), dvd(x, len));
-    d[1] = sel(shortv, _mm256_setzero_ps(), dvd(y, len));
-    d[2] = sel(shortv, fset(1.0f), dvd(z, len));
+    const vf inv = dvd(fset(1.0f), len); /* len ≥ 1/255: x, y are odd multiples of 1/255 */
+    d[0] = sel(shortv, _mm256_setzero_ps(), quot(x, len, inv));
+    d[1] = sel(shortv, _mm256_setzero_ps(), quot(y, len, inv));
+    d[2] = sel(shortv, fset(1.0f), quot(z, len, inv));
     *k = add(fset(0.25f), mul(fset(0.5f), d[2]));
 }
 
@@ -158,9 +158,10 @@ INL void texel_decode(vi z, vi rgba, lin8 *out)
     const vf e[3] = {uf_decode(_mm256_and_si256(z, iset(0x7ff)), 6),
                      uf_decode(_mm256_and_si256(_mm256_srli_epi32(z, 11), iset(0x7ff)), 6),
                      uf_decode(_mm256_srli_epi32(z, 22), 5)};
+    const vf inv_k = dvd(fset(1.0f), k); /* k ∈ [1/4, 3/4] */
     for (int c = 0; c < 3; c++) {
         const vf amb = mul(r, e[c]);
-        const vf inten = dvd(mul(one_r, e[c]), k);
+        const vf inten = quot(mul(one_r, e[c]), k, inv_k);
         out->c[c][0] = add(amb, mul(fset(0.25f), inten));
         const vf h = mul(fset(0.5f), inten);
         for (int i = 0; i < 3; i++) out->c[c][1 + i] = mul(h, d[i]);
@@ -257,6 +258,111 @@ INL void texel_encode(const lin8 *lin, vi *z_out, vi *rgba_out)
                              _mm256_or_si256(_mm256_slli_epi32(uf_encode(ez[1], 6), 11), _mm256_slli_epi32(uf_encode(ez[2], 5), 22)));
 }
 
+/* Byte codes from values v within 1e-4 of the exact ones: rne(v) clamped to [0, 255]; a lane whose
+ * v lies within NEAR_MARGIN of a half-integer (or is NaN) is marked in *near. */
+#define NEAR_MARGIN 0x1p-12f
+INL vi byte_of(vf v, vf *near)
+{
+    const vf r = _mm256_round_ps(v, RNE);
+    const vf dist = _mm256_andnot_ps(fset(-0.0f), sub(v, r));
+    *near = _mm256_or_ps(*near, _mm256_cmp_ps(dist, fset(0.5f - NEAR_MARGIN), _CMP_NLE_UQ));
+    return _mm256_cvtps_epi32(_mm256_min_ps(_mm256_max_ps(r, _mm256_setzero_ps()), fset(255.0f)));
+}
+
+/* A mask of doubles (all ones or zero) as floats: a NaN with all payload bits narrows to all ones. */
+INL vf mask_f(vd lo, vd hi) { return to_f(lo, hi); }
+
+/* One half of the encoder's direction sums: s = Σ_c lum_c g_c (double, as lbk_ahd_from_linear),
+ * the squared length it divides by (|s|² in the upper hemisphere, |s_xy|² below), and whether
+ * s.z ≥ 0 and that square is in [2^−120, 2^120] (so its float and the float s are normal: the
+ * lanes outside are left to the exact encoder). */
+INL void fast_dir_half(const vd g[3][3], vd s[3], vd *den2, vd *up, vd *ok)
+{
+    const vd lw[3] = {_mm256_set1_pd((double)LBK_LUM_R), _mm256_set1_pd((double)LBK_LUM_G),
+                      _mm256_set1_pd((double)LBK_LUM_B)};
+    for (int i = 0; i < 3; i++)
+        s[i] = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(lw[0], g[0][i]), _mm256_mul_pd(lw[1], g[1][i])),
+                             _mm256_mul_pd(lw[2], g[2][i]));
+    const vd xy = _mm256_add_pd(_mm256_mul_pd(s[0], s[0]), _mm256_mul_pd(s[1], s[1]));
+    const vd len2 = _mm256_add_pd(xy, _mm256_mul_pd(s[2], s[2]));
+    *up = _mm256_cmp_pd(s[2], _mm256_setzero_pd(), _CMP_GE_OQ);
+    *den2 = _mm256_blendv_pd(xy, len2, *up);
+    *ok = _mm256_and_pd(_mm256_cmp_pd(*den2, _mm256_set1_pd(0x1p-120), _CMP_GE_OQ),
+                        _mm256_cmp_pd(*den2, _mm256_set1_pd(0x1p120), _CMP_LE_OQ));
+}
+
+/* lbk_ahd_from_linear for inputs that need no sanitising, returning the lanes whose bytes must
+ * come from texel_encode instead (bit i: lane i).
+ *
+ * The bounds. Direction: the exact code takes dir = s/|s| in double (error ~1e-16), rounds
+ * (dir + 1)/2 to float (≤ 2^−25) and codes rne(255·x). Here s rounds to float (2^−24 relative),
+ * |s|² to float (2^−24), then a float square root, reciprocal and product (2^−24 each): the
+ * direction is within 4.5·2^−24 < 2.7e-7 relative of s/|s|, and v = fl(fl(d + 1)·127.5) within
+ * 127.5·(2.7e-7 + 2^−24) + 2^−17 < 5.4e-5 of 127.5·(1 + s/|s|); with the exact side's 255·2^−25
+ * the two values differ by < 6.2e-5 (z: 255·(2.7e-7 + 2^−25) + 2^−17 < 8.4e-5). Ambient ratio: the
+ * exact code codes rne(255·fl32(a/e)) of the double luminances; here both round to float
+ * (2^−24 each; e ≥ 2^−100 so a float a's underflow is negligible against it), a float division
+ * (2^−24) and a product by 255 (2^−17 absolute): < 255·3·2^−24 + 2^−17 + 255·2^−25 < 6.2e-5. All
+ * are below NEAR_MARGIN = 2^−12 = 2.4e-4, so a value farther than that from a half-integer gives
+ * the exact code. */
+INL uint32_t texel_encode_fast(const lin8 *lin, vi *z_out, vi *rgba_out)
+{
+    vd gl[3][3], gh[3][3], sl[3], sh[3], den_l, den_h, up_l, up_h, ok_l, ok_h;
+    const vf *g[3] = {&lin->c[0][1], &lin->c[1][1], &lin->c[2][1]};
+    for (int c = 0; c < 3; c++)
+        for (int i = 0; i < 3; i++) gl[c][i] = lo_d(g[c][i]), gh[c][i] = hi_d(g[c][i]);
+    fast_dir_half(gl, sl, &den_l, &up_l, &ok_l);
+    fast_dir_half(gh, sh, &den_h, &up_h, &ok_h);
+    const vf up = mask_f(up_l, up_h);
+    vf near = _mm256_andnot_ps(mask_f(ok_l, ok_h), _mm256_castsi256_ps(iset(-1)));
+    const vf inv = dvd(fset(1.0f), _mm256_sqrt_ps(to_f(den_l, den_h)));
+    vf dz = mul(to_f(sl[2], sh[2]), inv);
+    const vi q0 = byte_of(mul(add(mul(to_f(sl[0], sh[0]), inv), fset(1.0f)), fset(127.5f)), &near);
+    const vi q1 = byte_of(mul(add(mul(to_f(sl[1], sh[1]), inv), fset(1.0f)), fset(127.5f)), &near);
+    vf near_z = _mm256_setzero_ps();
+    const vi q2 = _mm256_and_si256(byte_of(mul(dz, fset(255.0f)), &near_z), _mm256_castps_si256(up));
+    near = _mm256_or_ps(near, _mm256_and_ps(near_z, up));
+    const vi rgba = _mm256_or_si256(_mm256_slli_epi32(q0, 8), _mm256_or_si256(_mm256_slli_epi32(q1, 16), _mm256_slli_epi32(q2, 24)));
+    vf d[3], k;
+    direction(rgba, d, &k);
+    vf a[3], ez[3];
+    for (int c = 0; c < 3; c++) {
+        const vf gd = add(add(mul(g[c][0], d[0]), mul(g[c][1], d[1])), mul(g[c][2], d[2]));
+        const vf inten = _mm256_and_ps(gt(gd, _mm256_setzero_ps()), mul(fset(2.0f), gd));
+        const vf amb = sub(lin->c[c][0], mul(fset(0.25f), inten));
+        a[c] = _mm256_and_ps(gt(amb, _mm256_setzero_ps()), amb);
+        ez[c] = add(a[c], mul(inten, k));
+    }
+    const vd la_l = lum_half(lo_d(a[0]), lo_d(a[1]), lo_d(a[2])), la_h = lum_half(hi_d(a[0]), hi_d(a[1]), hi_d(a[2]));
+    const vd le_l = lum_half(lo_d(ez[0]), lo_d(ez[1]), lo_d(ez[2])), le_h = lum_half(hi_d(ez[0]), hi_d(ez[1]), hi_d(ez[2]));
+    const vd zero = _mm256_setzero_pd(), tiny = _mm256_set1_pd(0x1p-100);
+    const vf lit = mask_f(_mm256_cmp_pd(le_l, zero, _CMP_GT_OQ), _mm256_cmp_pd(le_h, zero, _CMP_GT_OQ));
+    const vf small = mask_f(_mm256_cmp_pd(le_l, tiny, _CMP_LT_OQ), _mm256_cmp_pd(le_h, tiny, _CMP_LT_OQ));
+    vf near_r = small;
+    const vi ratio = byte_of(mul(dvd(to_f(la_l, la_h), to_f(le_l, le_h)), fset(255.0f)), &near_r);
+    near = _mm256_or_ps(near, _mm256_and_ps(near_r, lit));
+    const vi r = _mm256_castps_si256(sel(lit, _mm256_castsi256_ps(ratio), _mm256_castsi256_ps(iset(255))));
+    *rgba_out = _mm256_or_si256(rgba, r);
+    *z_out = _mm256_or_si256(uf_encode(ez[0], 6),
+                             _mm256_or_si256(_mm256_slli_epi32(uf_encode(ez[1], 6), 11), _mm256_slli_epi32(uf_encode(ez[2], 5), 22)));
+    return (uint32_t)_mm256_movemask_ps(near);
+}
+
+/* Components at most 1e30 in magnitude and no NaN: what lbk_ahd_from_linear's sanitize leaves as it is. */
+INL int texel_clean(const lin8 *lin)
+{
+    vi big = _mm256_setzero_si256();
+    for (int c = 0; c < 3; c++)
+        for (int i = 0; i < 4; i++) big = _mm256_max_epu32(big, _mm256_and_si256(_mm256_castps_si256(lin->c[c][i]), iset(0x7fffffff)));
+    return _mm256_testz_si256(_mm256_cmpgt_epi32(big, iset(0x7149F2CA)), iset(-1)); /* bits of 1e30f */
+}
+
+/* lbk_ahd_from_linear of 8 lanes: the fast encoder, the exact one where it cannot decide. */
+INL void texel_encode8(const lin8 *lin, vi *z, vi *rgba)
+{
+    if (!texel_clean(lin) || texel_encode_fast(lin, z, rgba)) texel_encode(lin, z, rgba);
+}
+
 /* ---- the texel kernels ------------------------------------------------------------------- */
 
 INL vi load8(const uint8_t *p) { return _mm256_loadu_si256((const __m256i *)(const void *)p); }
@@ -282,7 +388,7 @@ INL void texel8(const uint8_t *bz, const uint8_t *brgba, uint8_t *oz, uint8_t *o
         texel_accumulate(&acc, &l, fset(w[j]));
     }
     vi z, rgba;
-    texel_encode(&acc, &z, &rgba);
+    texel_encode8(&acc, &z, &rgba);
     store8(oz, z);
     store8(orgba, rgba);
     (void)stride;
@@ -475,7 +581,7 @@ static void texels_var(const dls_var_batch *b)
             texel_accumulate(&acc, &l, _mm256_loadu_ps(wl));
         }
         vi z, rgba;
-        texel_encode(&acc, &z, &rgba);
+        texel_encode8(&acc, &z, &rgba);
         store8(oz, z);
         store8(orgba, rgba);
         for (uint32_t i = 0; i < n; i++) {
@@ -529,6 +635,56 @@ static void probes_var(const dls_var_batch *b)
     }
 }
 
+/* ---- the codecs alone (tests) -------------------------------------------------------------- */
+
+static void texel_decode_n(const uint32_t *z, const uint32_t *rgba, uint32_t count, lbk_ahd_linear *out)
+{
+    for (uint32_t t = 0; t < count; t += 8) {
+        const uint32_t n = count - t < 8 ? count - t : 8;
+        uint32_t bz[8], brgba[8];
+        float lanes[12][8];
+        for (uint32_t i = 0; i < 8; i++) bz[i] = z[t + (i < n ? i : n - 1)], brgba[i] = rgba[t + (i < n ? i : n - 1)];
+        lin8 l;
+        texel_decode(load8((const uint8_t *)bz), load8((const uint8_t *)brgba), &l);
+        for (int c = 0; c < 12; c++) _mm256_storeu_ps(lanes[c], l.c[c / 4][c % 4]);
+        for (uint32_t i = 0; i < n; i++)
+            for (int c = 0; c < 12; c++) out[t + i].c[c / 4][c % 4] = lanes[c][i];
+    }
+}
+
+static void texel_encode_n(const lbk_ahd_linear *in, uint32_t count, uint32_t *z, uint32_t *rgba)
+{
+    for (uint32_t t = 0; t < count; t += 8) {
+        const uint32_t n = count - t < 8 ? count - t : 8;
+        float lanes[12][8];
+        for (uint32_t i = 0; i < 8; i++)
+            for (int c = 0; c < 12; c++) lanes[c][i] = in[t + (i < n ? i : n - 1)].c[c / 4][c % 4];
+        lin8 l;
+        for (int c = 0; c < 12; c++) l.c[c / 4][c % 4] = _mm256_loadu_ps(lanes[c]);
+        vi vz, vrgba;
+        uint32_t oz[8], orgba[8];
+        texel_encode8(&l, &vz, &vrgba);
+        store8((uint8_t *)oz, vz), store8((uint8_t *)orgba, vrgba);
+        memcpy(z + t, oz, 4 * (size_t)n), memcpy(rgba + t, orgba, 4 * (size_t)n);
+    }
+}
+
+static void probe_decode_n(const uint8_t *p, uint32_t count, lbk_sh9_rgb *out)
+{
+    const vi lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    for (uint32_t t = 0; t < count; t += 8) {
+        const uint32_t n = count - t < 8 ? count - t : 8;
+        vi w[7];
+        sh8 l;
+        float lanes[27][8];
+        probe_gather(p + LBK_DLS_PROBE_PAYLOAD * (size_t)t, _mm256_mullo_epi32(_mm256_min_epi32(lane, iset((int)n - 1)), iset(7)), w);
+        probe_decode(w, &l);
+        for (int c = 0; c < 27; c++) _mm256_storeu_ps(lanes[c], l.c[c / 9][c % 9]);
+        for (uint32_t i = 0; i < n; i++)
+            for (int c = 0; c < 27; c++) out[t + i].c[c / 9][c % 9] = lanes[c][i];
+    }
+}
+
 #if defined(__clang__)
 #pragma clang attribute pop
 #else
@@ -537,8 +693,8 @@ static void probes_var(const dls_var_batch *b)
 
 const dls_kernels *dls_kernels_avx2(void)
 {
-    static const dls_kernels k = {"avx2", texels, probes, texels_var, probes_var};
+    static const dls_kernels k = {"avx2", texels, probes, texels_var, probes_var, texel_decode_n, texel_encode_n, probe_decode_n};
     __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2") ? &k : 0;
+    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") ? &k : 0;
 }
 #endif
