@@ -375,6 +375,15 @@ INL void texel_entries(const uint8_t *first, vi index, vi *z, vi *rgba)
     *rgba = _mm256_i32gather_epi32((const int *)(const void *)(first + 4), index, 4);
 }
 
+/* The entries of 8 consecutive targets with one entry each: 64 contiguous bytes, split into the
+ * Ez and RGBA words by shuffles instead of two gathers. */
+INL void texel_entries_packed(const uint8_t *first, vi *z, vi *rgba)
+{
+    const vf a = _mm256_castsi256_ps(load8(first)), b = _mm256_castsi256_ps(load8(first + 32));
+    *z = _mm256_permute4x64_epi64(_mm256_castps_si256(_mm256_shuffle_ps(a, b, _MM_SHUFFLE(2, 0, 2, 0))), _MM_SHUFFLE(3, 1, 2, 0));
+    *rgba = _mm256_permute4x64_epi64(_mm256_castps_si256(_mm256_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1))), _MM_SHUFFLE(3, 1, 2, 0));
+}
+
 /* Eight targets from SoA buffers; n ≤ 8 valid lanes (the others compute on copies). */
 INL void texel8(const uint8_t *bz, const uint8_t *brgba, uint8_t *oz, uint8_t *orgba,
                 const uint8_t *entries, vi index, uint32_t stride, uint32_t m, const uint32_t *idx, const float *w)
@@ -383,7 +392,8 @@ INL void texel8(const uint8_t *bz, const uint8_t *brgba, uint8_t *oz, uint8_t *o
     texel_decode(load8(bz), load8(brgba), &acc);
     for (uint32_t j = 0; j < m; j++) {
         vi ez, erg;
-        texel_entries(entries + (size_t)idx[j] * LBK_DLS_TEXEL_PAYLOAD, index, &ez, &erg);
+        if (stride == 1) texel_entries_packed(entries, &ez, &erg); /* then m = 1 and idx[0] = 0 */
+        else texel_entries(entries + (size_t)idx[j] * LBK_DLS_TEXEL_PAYLOAD, index, &ez, &erg);
         texel_decode(ez, erg, &l);
         texel_accumulate(&acc, &l, fset(w[j]));
     }
@@ -391,7 +401,6 @@ INL void texel8(const uint8_t *bz, const uint8_t *brgba, uint8_t *oz, uint8_t *o
     texel_encode8(&acc, &z, &rgba);
     store8(oz, z);
     store8(orgba, rgba);
-    (void)stride;
 }
 
 static void texels(const dls_batch *b)
@@ -414,7 +423,7 @@ static void texels(const dls_batch *b)
     }
     const vi tail_index = _mm256_mullo_epi32(_mm256_min_epi32(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), iset((int)n - 1)),
                                              iset((int)words));
-    texel8(bz, brgba, oz, orgba, b->entries + (t / 8) * step, tail_index, b->stride, b->m, b->idx, b->w);
+    texel8(bz, brgba, oz, orgba, b->entries + (t / 8) * step, tail_index, 0, b->m, b->idx, b->w); /* 0: gather */
     memcpy(b->out0 + 4 * (size_t)t, oz, 4 * (size_t)n);
     memcpy(b->out1 + 4 * (size_t)t, orgba, 4 * (size_t)n);
 }
