@@ -394,7 +394,7 @@ $(BUILD)/fuzz_container: tests/fuzz/fuzz_container.c $(LIB_SRC)
 CLANGXX   ?= clang++
 FUZZ_OBJ_FLAGS := -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -g -O1
 FUZZ_LIB_OBJ := $(LIB_SRC:%.c=$(BUILD)/fuzz-obj/%.o)
-FUZZ_HARNESSES := fuzz_gltf fuzz_exr fuzz_profile
+FUZZ_HARNESSES := fuzz_gltf fuzz_exr fuzz_profile fuzz_part
 $(BUILD)/fuzz-obj/libformat/%.o: libformat/%.c
 	@mkdir -p $(@D)
 	$(CLANG) $(CSTD) $(FUZZ_OBJ_FLAGS) $(LIB_FP) $(WARN) $(LIB_INC) -MMD -MP -c $< -o $@
@@ -409,12 +409,17 @@ FUZZ_GLTF_OBJ := $(addprefix $(BUILD)/fuzz-obj/,tests/fuzz/fuzz_gltf.o bake/scen
 FUZZ_EXR_OBJ := $(addprefix $(BUILD)/fuzz-obj/,tests/fuzz/fuzz_exr.o bake/scene/exr_read.o bake/scene/scene.o)
 FUZZ_PROFILE_OBJ := $(addprefix $(BUILD)/fuzz-obj/,tests/fuzz/fuzz_profile.o tools/convert/profile.o \
                       tools/common/lmap_decode.o tools/common/error_util.o tools/common/astc_codec.o)
+# the part harness merges, so it links the whole baker
+FUZZ_PART_OBJ := $(BUILD)/fuzz-obj/tests/fuzz/fuzz_part.o $(BAKE_CSRC:%.c=$(BUILD)/fuzz-obj/%.o) \
+                 $(BAKE_CXXSRC:%.cc=$(BUILD)/fuzz-obj/%.o)
 $(BUILD)/fuzz_gltf: $(FUZZ_GLTF_OBJ) $(FUZZ_LIB_OBJ)
 	$(CLANGXX) -fsanitize=fuzzer,address,undefined -o $@ $^ $(BAKE_LIBS) $(LIB_LIBS)
 $(BUILD)/fuzz_exr: $(FUZZ_EXR_OBJ) $(FUZZ_LIB_OBJ)
 	$(CLANGXX) -fsanitize=fuzzer,address,undefined -o $@ $^ $(BAKE_LIBS) $(LIB_LIBS)
 $(BUILD)/fuzz_profile: $(FUZZ_PROFILE_OBJ) $(FUZZ_LIB_OBJ)
 	$(CLANGXX) -fsanitize=fuzzer,address,undefined -o $@ $^ -lastcenc $(LIB_LIBS)
+$(BUILD)/fuzz_part: $(FUZZ_PART_OBJ) $(FUZZ_LIB_OBJ)
+	$(CLANGXX) -fsanitize=fuzzer,address,undefined -o $@ $^ $(BAKE_LIBS) $(LIB_LIBS)
 -include $(wildcard $(BUILD)/fuzz-obj/*/*.d $(BUILD)/fuzz-obj/*/*/*.d)
 # The seed corpus (tests/fuzz/README.md): the golden files, the containers make_corpus.c builds
 # (every section type) and two small real bakes. Regenerate by hand; the files are committed.
@@ -424,9 +429,13 @@ fuzz-corpus: $(BUILD)/liblbk.a $(BUILD)/lbk
 	cp tests/golden/*.lbk tests/fuzz/corpus/
 	$(BUILD)/make_corpus
 	$(BUILD)/lbk bake tests/fuzz/sets_scene.gltf -o tests/fuzz/corpus/bake_sets.lbk -q --threads 2 \
-	    --texel-density 2 --samples 8 --glg-spacing 3 --octahedral
+	    --texel-density 2 --samples 8 --glg-spacing 3
 	$(BUILD)/lbk bake scenes/cornell_box/CornellBox-Original.gltf -o tests/fuzz/corpus/bake_cornell.lbk -q --threads 2 \
-	    --texel-density 2 --samples 8 --glg-spacing 2.5 --octahedral
+	    --texel-density 2 --samples 8 --glg-spacing 2.5
+	@d=$$(mktemp -d) && for n in 1 2; do \
+	  $(BUILD)/lbk plan tests/fuzz/part_scene.gltf -o $$d/o.lbk --plan $$d/p$$n.json --units $$n --samples 4 --target-error none \
+	    --texel-density 2 --glg-spacing 8 -q && \
+	  $(BUILD)/lbk bake-unit $$d/p$$n.json 0 -o tests/fuzz/corpus_part/unit0of$$n.lbkpart -q || exit 1; done; rm -rf $$d
 fuzz: deps-test
 	@$(MAKE) --no-print-directory $(BUILD)/fuzz_container
 	@mkdir -p $(BUILD)/fuzz-corpus

@@ -4,26 +4,14 @@
 #include <errno.h>
 #include <inttypes.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
-
-#include <cjson/cJSON.h>
 
 #include "cli/cli.h"
 #include "cli/options.h"
 #include "tools/common/bake_data.h"
-#include "tools/inspect/budget.h"
-#include "tools/inspect/describe.h"
-#include "tools/inspect/memory.h"
+#include "tools/inspect/report.h"
 #include "lbk/container.h"
-
-typedef struct section_row {
-    lbk_section_info info;
-    char type[5];
-    int known;       /* this build has a describer for the type */
-    int readable;    /* section_data succeeded */
-    lbk_result error;
-    inspect_stats st;
-} section_row;
 
 static void usage(FILE *f)
 {
@@ -72,44 +60,7 @@ static void human_bytes(uint64_t v, char *buf, size_t n)
     else snprintf(buf, n, "%.1f MB", (double)v / 1e6);
 }
 
-static void add_stats(inspect_stats *sum, const inspect_stats *s)
-{
-    sum->lm_texels += s->lm_texels;
-    sum->lm_pages += s->lm_pages;
-    sum->glg_probes += s->glg_probes;
-    sum->glg_tetrahedra += s->glg_tetrahedra;
-    sum->llg_grids += s->llg_grids;
-    sum->llg_probes += s->llg_probes;
-    sum->llg_vertices += s->llg_vertices;
-    sum->octp_probes += s->octp_probes;
-    sum->objects += s->objects;
-    sum->dls_light_sets += s->dls_light_sets;
-    sum->dls_sets += s->dls_sets;
-    sum->dls_clusters += s->dls_clusters;
-    sum->dls_payload_bytes += s->dls_payload_bytes;
-    sum->dls_ancillary_bytes += s->dls_ancillary_bytes;
-    sum->doors += s->doors;
-    sum->door_states += s->door_states;
-}
-
-static int is_dynamic(uint32_t type) { return type == LBK_SECTION_DLS || type == LBK_SECTION_DOOR; }
-
-typedef struct report {
-    const char *path;
-    const lbk_header_info *h;
-    uint32_t count;
-    section_row rows[LBK_MAX_SECTIONS];
-    uint64_t header_bytes, table_bytes, padding_bytes, disk_total, decoded_total, gpu_total;
-    uint64_t memory_without_dls, memory_with_dls;
-    inspect_stats level;
-    int any_unreadable;
-    const tl_level_memory *memory; /* per object / light set (a valid file), else NULL */
-    const char *memory_error;
-    const tl_budget *budget;       /* --budget, else NULL */
-    const tl_budget_result *budget_result;
-} report;
-
-static void print_text(const report *r)
+static void print_text(const tl_inspect_report *r)
 {
     char a[32], b[32], c[32];
     printf("%s: lbk container %u.%u, %u section%s, alignment %u, %s bytes\n\n", r->path, r->h->version_major,
@@ -119,7 +70,7 @@ static void print_text(const report *r)
     printf("%-8s %-5s %14s %14s %14s  %s\n", "header", "", grouped(r->header_bytes, a), "-", "-", "64-byte header");
     printf("%-8s %-5s %14s %14s %14s  %s\n", "table", "", grouped(r->table_bytes, a), "-", "-", "48 bytes per section");
     for (uint32_t i = 0; i < r->count; i++) {
-        const section_row *s = &r->rows[i];
+        const tl_inspect_section *s = &r->rows[i];
         char detail[260];
         if (!s->readable) snprintf(detail, sizeof detail, "unreadable: %s", lbk_result_name(s->error));
         else if (!s->known) snprintf(detail, sizeof detail, "unknown optional section (skipped)");
@@ -168,145 +119,12 @@ static void print_text(const report *r)
     }
 }
 
-static int print_json(const report *r)
+static int print_json(const tl_inspect_report *r)
 {
-    cJSON *doc = cJSON_CreateObject();
-    if (!doc) return 0;
-    cJSON_AddStringToObject(doc, "schema", "lbk-inspect/1");
-    cJSON_AddStringToObject(doc, "file", r->path);
-    cJSON_AddNumberToObject(doc, "file_size", (double)r->h->file_size);
-    cJSON *ver = cJSON_AddObjectToObject(doc, "version");
-    if (ver) {
-        cJSON_AddNumberToObject(ver, "major", r->h->version_major);
-        cJSON_AddNumberToObject(ver, "minor", r->h->version_minor);
-    }
-    cJSON_AddNumberToObject(doc, "section_alignment", r->h->section_alignment);
-    cJSON_AddNumberToObject(doc, "required_features", r->h->required_features);
-    cJSON_AddNumberToObject(doc, "header_bytes", (double)r->header_bytes);
-    cJSON_AddNumberToObject(doc, "table_bytes", (double)r->table_bytes);
-    cJSON_AddNumberToObject(doc, "padding_bytes", (double)r->padding_bytes);
-    cJSON *secs = cJSON_AddArrayToObject(doc, "sections");
-    for (uint32_t i = 0; secs && i < r->count; i++) {
-        const section_row *s = &r->rows[i];
-        cJSON *j = cJSON_CreateObject();
-        if (!j || !cJSON_AddItemToArray(secs, j)) {
-            cJSON_Delete(j);
-            break;
-        }
-        cJSON_AddStringToObject(j, "type", s->type);
-        cJSON_AddBoolToObject(j, "required", (s->info.flags & LBK_SECTION_FLAG_REQUIRED) != 0);
-        cJSON_AddStringToObject(j, "compression", s->info.compression ? "zstd" : "none");
-        cJSON_AddNumberToObject(j, "offset", (double)s->info.offset);
-        cJSON_AddNumberToObject(j, "disk_bytes", (double)s->info.stored_size);
-        cJSON_AddNumberToObject(j, "decoded_bytes", (double)s->info.decoded_size);
-        cJSON_AddNumberToObject(j, "gpu_bytes", (double)s->st.gpu_bytes);
-        cJSON_AddBoolToObject(j, "known", s->known);
-        cJSON_AddBoolToObject(j, "readable", s->readable);
-        cJSON_AddBoolToObject(j, "parsed", s->st.parsed);
-        if (!s->readable) cJSON_AddStringToObject(j, "error", lbk_result_name(s->error));
-        cJSON_AddStringToObject(j, "detail", s->st.detail);
-    }
-    cJSON *tot = cJSON_AddObjectToObject(doc, "totals");
-    if (tot) {
-        cJSON_AddNumberToObject(tot, "disk_bytes", (double)r->disk_total);
-        cJSON_AddNumberToObject(tot, "decoded_bytes", (double)r->decoded_total);
-        cJSON_AddNumberToObject(tot, "gpu_bytes", (double)r->gpu_total);
-        cJSON_AddBoolToObject(tot, "disk_matches_file_size", r->disk_total == r->h->file_size);
-    }
-    const inspect_stats *l = &r->level;
-    cJSON *lv = cJSON_AddObjectToObject(doc, "level");
-    if (lv) {
-        cJSON_AddNumberToObject(lv, "lm_texels", (double)l->lm_texels);
-        cJSON_AddNumberToObject(lv, "lm_pages", (double)l->lm_pages);
-        uint64_t lm_gpu = 0;
-        for (uint32_t i = 0; i < r->count; i++)
-            if (r->rows[i].info.type == LBK_SECTION_LMAP) lm_gpu = r->rows[i].st.gpu_bytes;
-        cJSON_AddNumberToObject(lv, "lm_gpu_bytes_per_texel", l->lm_texels ? (double)lm_gpu / (double)l->lm_texels : 0.0);
-        cJSON_AddNumberToObject(lv, "llg_probes", (double)l->llg_probes);
-        cJSON_AddNumberToObject(lv, "llg_grids", (double)l->llg_grids);
-        cJSON_AddNumberToObject(lv, "llg_vertices", (double)l->llg_vertices);
-        cJSON_AddNumberToObject(lv, "glg_probes", (double)l->glg_probes);
-        cJSON_AddNumberToObject(lv, "glg_tetrahedra", (double)l->glg_tetrahedra);
-        cJSON_AddNumberToObject(lv, "octp_probes", (double)l->octp_probes);
-        cJSON_AddNumberToObject(lv, "objects", (double)l->objects);
-        cJSON_AddNumberToObject(lv, "dls_light_sets", (double)l->dls_light_sets);
-        cJSON_AddNumberToObject(lv, "dls_sets", (double)l->dls_sets);
-        cJSON_AddNumberToObject(lv, "dls_clusters", (double)l->dls_clusters);
-        cJSON_AddNumberToObject(lv, "dls_payload_bytes", (double)l->dls_payload_bytes);
-        cJSON_AddNumberToObject(lv, "dls_ancillary_bytes", (double)l->dls_ancillary_bytes);
-        cJSON_AddNumberToObject(lv, "doors", (double)l->doors);
-        cJSON_AddNumberToObject(lv, "door_states", (double)l->door_states);
-        cJSON_AddNumberToObject(lv, "memory_without_dls_bytes", (double)r->memory_without_dls);
-        cJSON_AddNumberToObject(lv, "memory_with_dls_bytes", (double)r->memory_with_dls);
-    }
-    if (r->memory) {
-        cJSON *objs = cJSON_AddArrayToObject(doc, "objects");
-        for (size_t i = 0; objs && i < r->memory->object_count; i++) {
-            const tl_object_memory *o = &r->memory->objects[i];
-            cJSON *j = cJSON_CreateObject();
-            if (!j || !cJSON_AddItemToArray(objs, j)) {
-                cJSON_Delete(j);
-                break;
-            }
-            cJSON_AddStringToObject(j, "name", o->name);
-            cJSON_AddStringToObject(j, "representation", lbk_representation_name(o->representation));
-            cJSON_AddNumberToObject(j, "texels", (double)o->texels);
-            cJSON_AddNumberToObject(j, "lightmap_bytes", (double)o->lightmap_bytes);
-            cJSON_AddNumberToObject(j, "llg_probes", (double)o->llg_probes);
-            cJSON_AddNumberToObject(j, "llg_vertices", (double)o->llg_vertices);
-            cJSON_AddNumberToObject(j, "llg_bytes", (double)o->llg_bytes);
-            cJSON_AddNumberToObject(j, "dls_entries", (double)o->dls_entries);
-            cJSON_AddNumberToObject(j, "dls_bytes", (double)o->dls_bytes);
-            cJSON_AddNumberToObject(j, "total_bytes", (double)o->total_bytes);
-        }
-        cJSON *sets = cJSON_AddArrayToObject(doc, "light_sets");
-        for (size_t i = 0; sets && i < r->memory->set_count; i++) {
-            const tl_set_memory *m = &r->memory->sets[i];
-            cJSON *j = cJSON_CreateObject();
-            if (!j || !cJSON_AddItemToArray(sets, j)) {
-                cJSON_Delete(j);
-                break;
-            }
-            static const char *const kinds[] = {"lights", "door_open", "door_closed", "combination"};
-            cJSON_AddStringToObject(j, "name", m->name);
-            cJSON_AddStringToObject(j, "kind", m->kind < 4 ? kinds[m->kind] : "unknown");
-            cJSON_AddNumberToObject(j, "texel_entries", (double)m->entries[0]);
-            cJSON_AddNumberToObject(j, "glg_entries", (double)m->entries[1]);
-            cJSON_AddNumberToObject(j, "llg_entries", (double)m->entries[2]);
-            cJSON_AddNumberToObject(j, "payload_bytes", (double)m->payload_bytes);
-        }
-        cJSON_AddNumberToObject(doc, "dls_unowned_bytes", (double)r->memory->dls_unowned_bytes);
-    } else {
-        cJSON_AddNullToObject(doc, "objects");
-        cJSON_AddNullToObject(doc, "light_sets");
-        cJSON_AddStringToObject(doc, "objects_error", r->memory_error ? r->memory_error : "");
-    }
-    if (r->budget) {
-        cJSON *bj = cJSON_AddObjectToObject(doc, "budget");
-        cJSON_AddStringToObject(bj, "name", r->budget->name);
-        cJSON_AddNumberToObject(bj, "checked", (double)r->budget_result->checked);
-        cJSON_AddBoolToObject(bj, "within", r->budget_result->violation_count == 0);
-        cJSON *vs = cJSON_AddArrayToObject(bj, "violations");
-        for (size_t i = 0; vs && i < r->budget_result->violation_count; i++) {
-            const tl_budget_violation *v = &r->budget_result->violations[i];
-            cJSON *j = cJSON_CreateObject();
-            if (!j || !cJSON_AddItemToArray(vs, j)) {
-                cJSON_Delete(j);
-                break;
-            }
-            cJSON_AddStringToObject(j, "kind", tl_budget_kind_name(v->kind));
-            cJSON_AddStringToObject(j, "name", v->name);
-            cJSON_AddNumberToObject(j, "bytes", (double)v->bytes);
-            cJSON_AddNumberToObject(j, "limit", (double)v->limit);
-        }
-    } else {
-        cJSON_AddNullToObject(doc, "budget");
-    }
-    char *text = cJSON_Print(doc);
-    cJSON_Delete(doc);
+    char *text = tl_inspect_json(r);
     if (!text) return 0;
     puts(text);
-    cJSON_free(text);
+    free(text);
     return 1;
 }
 
@@ -370,39 +188,8 @@ int lbk_cmd_inspect(int argc, char **argv)
         return LBK_EXIT_INPUT;
     }
 
-    static report r; /* large (64 rows); one per process */
-    memset(&r, 0, sizeof r);
-    r.path = path;
-    r.h = lbk_reader_header(reader);
-    r.count = lbk_reader_section_count(reader);
-    r.header_bytes = LBK_HEADER_SIZE;
-    r.table_bytes = (uint64_t)LBK_SECTION_ENTRY_SIZE * r.count;
-    uint64_t sections_disk = 0, prev_end = r.header_bytes + r.table_bytes;
-    for (uint32_t i = 0; i < r.count; i++) {
-        section_row *s = &r.rows[i];
-        lbk_reader_section_get(reader, i, &s->info);
-        lbk_fourcc_string(s->info.type, s->type);
-        inspect_describe_fn fn = inspect_describer(s->info.type);
-        s->known = fn != NULL;
-        const void *data;
-        size_t size;
-        s->error = lbk_reader_section_data(reader, i, &data, &size);
-        s->readable = s->error == LBK_OK;
-        if (s->readable && fn) fn(data, size, &s->st);
-        if (!s->readable) r.any_unreadable = 1;
-        sections_disk += s->info.stored_size;
-        /* the gaps the alignment rule left, measured (not derived from the file size) */
-        if (s->info.offset > prev_end) r.padding_bytes += s->info.offset - prev_end;
-        prev_end = s->info.offset + s->info.stored_size;
-        r.decoded_total += s->info.decoded_size;
-        r.gpu_total += s->st.gpu_bytes;
-        if (is_dynamic(s->info.type)) r.memory_with_dls += s->st.gpu_bytes;
-        else r.memory_without_dls += s->st.gpu_bytes;
-        add_stats(&r.level, &s->st);
-    }
-    r.memory_with_dls += r.memory_without_dls;
-    if (r.h->file_size > prev_end) r.padding_bytes += r.h->file_size - prev_end;
-    r.disk_total = r.header_bytes + r.table_bytes + sections_disk + r.padding_bytes;
+    static tl_inspect_report r; /* large (64 rows); one per process */
+    tl_inspect_scan(reader, path, &r);
 
     /* per object and light set: needs the views, so a file that validates */
     tl_bake bake;

@@ -8,11 +8,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include "cli/cli.h"
 #include "cli/options.h"
+#include "tools/inspect/report.h"
 #include "tools/view/view.h"
 
 #define DEFAULT_PORT 8765
@@ -44,50 +44,6 @@ static void usage(FILE *f)
             "            4 the input is not a valid container or SCENE is not the scene it was baked from,\n"
             "            5 internal error\n",
             DEFAULT_PORT);
-}
-
-/* `lbk inspect --json LEVEL` of this same binary (/proc/self/exe), for the page's panel: its
- * numbers exactly, without a second copy of inspect's logic. NULL when it cannot run or fails
- * (the page then shows its own reader's section sizes); at most 32 MiB of output. */
-static char *inspect_json(const char *level)
-{
-    if (level[0] == '-') return NULL; /* would read as an option; such a name gets no inspect panel */
-    int fd[2];
-    if (pipe(fd)) return NULL;
-    const pid_t pid = fork();
-    if (pid < 0) {
-        close(fd[0]), close(fd[1]);
-        return NULL;
-    }
-    if (pid == 0) {
-        dup2(fd[1], 1);
-        close(fd[0]), close(fd[1]);
-        const int devnull = open("/dev/null", O_WRONLY);
-        if (devnull >= 0) dup2(devnull, 2);
-        execl("/proc/self/exe", "lbk", "inspect", "--json", level, (char *)NULL);
-        _exit(127);
-    }
-    close(fd[1]);
-    size_t cap = 1 << 16, n = 0;
-    char *buf = malloc(cap);
-    ssize_t r = 0;
-    while (buf && (r = read(fd[0], buf + n, cap - 1 - n)) > 0) {
-        n += (size_t)r;
-        if (n + 1 == cap) {
-            char *b = cap < (16u << 20) ? realloc(buf, cap *= 2) : NULL;
-            if (!b) free(buf);
-            buf = b;
-        }
-    }
-    close(fd[0]);
-    int st = 0;
-    while (waitpid(pid, &st, 0) < 0 && errno == EINTR) {}
-    if (!buf || r < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
-        free(buf);
-        return NULL;
-    }
-    buf[n] = 0;
-    return buf;
 }
 
 static volatile int stop_flag;
@@ -190,7 +146,8 @@ int lbk_cmd_view(int argc, char **argv)
     }
     char err[TL_ERR_LEN];
     tl_view_stats s;
-    char *inspect = inspect_json(o.container);
+    char *inspect = NULL; /* the page then shows its own reader's section sizes */
+    if (tl_inspect_file_json(o.container, 0, &inspect)) inspect = NULL;
     o.inspect_json = inspect;
     int rc = tl_view_write(&o, &s, err);
     free(inspect);

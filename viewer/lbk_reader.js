@@ -373,11 +373,31 @@
     if (!p) return null;
     const dv = view(p); need(p, 16, 'OCTP');
     const n = dv.getUint32(0, true), scale = checkScale(dv.getFloat32(4, true), 'OCTP');
-    checkZero(p, 8, 16, 'OCTP');
-    if (16 + 1024 * n !== p.length) fail('OCTP: size does not match probe_count');
+    /* level_count 0: a list of probes (1.0-1.2); 1-3: a probe volume (1.3, §14.1) */
+    const L = dv.getUint32(8, true);
+    if (L > 3) fail('OCTP: level_count ' + L + ' (at most 3)');
+    checkZero(p, 12, 16, 'OCTP');
+    const base = 16 + 48 * L;
+    if (base + 1024 * n !== p.length) fail('OCTP: size does not match probe_count');
+    const levels = [];
+    let first = 0;
+    for (let l = 0; l < L; l++) {
+      const o = 16 + 48 * l;
+      const lv = { origin: [dv.getFloat32(o, true), dv.getFloat32(o + 4, true), dv.getFloat32(o + 8, true)],
+                   spacing: dv.getFloat32(o + 12, true),
+                   dims: [dv.getUint32(o + 16, true), dv.getUint32(o + 20, true), dv.getUint32(o + 24, true)],
+                   first_probe: dv.getUint32(o + 28, true), miss_distance: dv.getFloat32(o + 32, true) };
+      checkZero(p, o + 36, o + 48, 'OCTP level ' + l);
+      if (!(lv.spacing > 0) || (l > 0 && !(lv.spacing > levels[l - 1].spacing))) fail('OCTP level ' + l + ': spacing');
+      if (lv.dims.some((d) => d < 2 || d > 256)) fail('OCTP level ' + l + ': dims');
+      if (lv.first_probe !== first) fail('OCTP level ' + l + ': first_probe');
+      first += lv.dims[0] * lv.dims[1] * lv.dims[2];
+      levels.push(lv);
+    }
+    if (L && first !== n) fail('OCTP: probe_count is not the levels\' probes');
     const probes = [];
     for (let i = 0; i < n; i++) {
-      const o = 16 + 1024 * i;
+      const o = base + 1024 * i;
       /* the 4×4 interior, row-major (j·4 + i), physical */
       const irr = new Float32Array(48);
       for (let j = 0; j < 4; j++)
@@ -394,10 +414,22 @@
       for (let j = 0; j < 12; j++)
         for (let x = 0; x < 12; x++)
           for (let m = 0; m < 2; m++) depth[2 * (j * 12 + x) + m] = half(dv.getUint16(o + 144 + 4 * ((j + 1) * 14 + x + 1) + 2 * m, true));
-      probes.push({ position: [dv.getFloat32(o + 928, true), dv.getFloat32(o + 932, true), dv.getFloat32(o + 936, true)], irradiance: irr,
-                    irradiance_full: full, depth });
+      const probe = { position: [dv.getFloat32(o + 928, true), dv.getFloat32(o + 932, true), dv.getFloat32(o + 936, true)], irradiance: irr,
+                      irradiance_full: full, depth };
+      if (L) {
+        probe.offset = [dv.getFloat32(o + 940, true), dv.getFloat32(o + 944, true), dv.getFloat32(o + 948, true)];
+        probe.state = dv.getUint32(o + 952, true); /* 0 active, 1 inside geometry (not light), 2 no nearby geometry */
+        if (probe.state > 2) fail('OCTP probe ' + i + ': state ' + probe.state);
+        probe.rays = dv.getUint32(o + 956, true);
+        probe.backface = dv.getFloat32(o + 960, true);
+        probe.nearest = dv.getFloat32(o + 964, true);
+        checkZero(p, o + 968, o + 1024, 'OCTP probe ' + i);
+      } else {
+        checkZero(p, o + 940, o + 1024, 'OCTP probe ' + i);
+      }
+      probes.push(probe);
     }
-    return { scale, probes };
+    return { scale, levels, probes };
   }
 
 

@@ -431,7 +431,9 @@
         });
         groups.llg = glyphGroup(pos, (q, n) => shIrradiance(at[q][0].sh, 27 * at[q][1], n));
       }
-      if (octp) groups.octp = glyphGroup(octp.probes.map((p) => p.position), (i, n) => octIrradiance(octp.probes[i], n));
+      /* a volume's probes inside geometry (state 1) hold no light (§14.2): no glyph */
+      const lit = octp ? octp.probes.filter((p) => p.state !== 1) : [];
+      if (octp) groups.octp = glyphGroup(lit.map((p) => p.position), (i, n) => octIrradiance(lit[i], n));
       for (const [k, id] of [['glg', 'probes'], ['llg', 'probes-llg'], ['octp', 'probes-octp']]) if (groups[k]) groups[k].visible = $(id).checked;
     };
     buildGlyphs();

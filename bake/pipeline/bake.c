@@ -507,6 +507,18 @@ static lbk_result build_cell_sizes(bk_pipeline *b)
     return LBK_OK;
 }
 
+/* A distributed run that failed: the recorder's or player's own message (bk_dist_error), or, for
+ * a replay the transport refused (LBK_ERR_BAD_INPUT: numbers no run makes), that a part is
+ * corrupt or forged. LBK_OK: not the parts' fault. */
+static lbk_result replay_failure(bk_pipeline *b, lbk_result r)
+{
+    if (bk_dist_error(b->dist)[0]) return bk_pipeline_fail(b, r, "%s", bk_dist_error(b->dist));
+    if (r == LBK_ERR_BAD_INPUT)
+        return bk_pipeline_fail(b, r, "the parts hold numbers no bake makes (sample counts, weights, accumulators or "
+                                      "outputs negative, huge or not finite): a part is corrupt or forged");
+    return LBK_OK;
+}
+
 static lbk_result do_transport(bk_pipeline *b)
 {
     lbk_result r = phase(b, LBK_BAKE_PHASE_LIGHT);
@@ -552,7 +564,10 @@ static lbk_result do_transport(bk_pipeline *b)
     free(irradiance);
     b->octa_rel_rmse = b->stats.octa_rel_rmse;
     b->octa_rays = b->stats.octa_rays;
-    if (r && b->dist && bk_dist_error(b->dist)[0]) return bk_pipeline_fail(b, r, "%s", bk_dist_error(b->dist));
+    if (r && b->dist) {
+        lbk_result d = replay_failure(b, r);
+        if (d) return d;
+    }
     if (r) return bk_pipeline_failed(b, r, "light transport");
     if (b->stats.nonfinite)
         bk_events_say(&b->events, LBK_BAKE_SEVERITY_WARNING, "%llu non-finite samples were dropped",
@@ -633,7 +648,13 @@ static lbk_result run(bk_pipeline *b, const char *path, const lbk_bake_scene *de
     if (!r) r = do_layout(b);
     if (!r) r = bk_set_bakes_prepare(&b->sets, &b->scene, &b->events, b->err, sizeof b->err);
     if (!r) r = do_transport(b);
-    if (!r && b->sets.set_count) r = do_sets(b);
+    if (!r && b->sets.set_count) {
+        r = do_sets(b);
+        if (r && b->dist) {
+            lbk_result d = replay_failure(b, r);
+            if (d) r = d;
+        }
+    }
     if (!r && b->dist && bk_dist_error(b->dist)[0]) r = bk_pipeline_fail(b, LBK_ERR_BAD_INPUT, "%s", bk_dist_error(b->dist));
     if (b->dist && !r) {
         /* a unit ends with its part; the merge checks it replayed every run of the parts */

@@ -694,7 +694,8 @@ static lbk_result failure(run_ctx *rc, lbk_result r, const char *fmt, const char
 {
     if (r == LBK_ERR_CANCELLED) return r;
     snprintf(rc->err, rc->err_len, fmt, name, lbk_result_message(r));
-    return r == LBK_ERR_OUT_OF_MEMORY ? r : LBK_ERR_INTERNAL;
+    /* bad input stays bad input: a merge's replay refusing a part (the exit code says whose fault) */
+    return r == LBK_ERR_OUT_OF_MEMORY || r == LBK_ERR_BAD_INPUT ? r : LBK_ERR_INTERNAL;
 }
 
 /* A scene without the triangles of one or two doors (arrays are shared with `s` except the triangle

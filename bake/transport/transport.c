@@ -1866,6 +1866,42 @@ static void totals_of(const tp_ctx *c, int passes, const tp_chain_result chain[2
 
 /* The merge: every pass's estimate and report from the units' accumulators, then their outputs,
  * then the stats, as the run over all receivers computed them. */
+/* What a replay is handed comes from part files, which may be corrupt or forged past their
+ * checksums: numbers no run makes are refused before anything casts or indexes with them. */
+static int replay_count_ok(double x) { return isfinite(x) && x >= 0 && x <= 0x1p50; }
+
+static int replay_totals_ok(const bk_transport_totals *t)
+{
+    return t->passes >= 1 && t->passes <= BK_TRANSPORT_MAX_PASSES && t->stop >= BK_STOP_TARGET && t->stop <= BK_STOP_BUDGET &&
+           (t->nee == 0 || t->nee == 1) && t->bounces >= 0 && t->bounces <= 1 << 16 && isfinite(t->q) && t->q >= 0 &&
+           t->q <= 1 && replay_count_ok(t->tail_fraction);
+}
+
+static int replay_pass_ok(const bk_transport_pass_record *pr, size_t n)
+{
+    if (pr->bounces < 0 || pr->bounces > 1 << 16 || !replay_count_ok(pr->samples_per_receiver)) return 0;
+    for (int k = 0; k < BK_RECEIVER_CLASSES; k++)
+        if (!replay_count_ok(pr->weight_sum[k]) || !replay_count_ok(pr->class_samples[k])) return 0;
+    for (int h = 0; h < 2; h++)
+        for (size_t i = 0; i < n; i++)
+            if (!isfinite(pr->x_acc[h][i]) || !isfinite(pr->b_acc[h][i])) return 0;
+    return 1;
+}
+
+static int finite_floats(const float *a, size_t n)
+{
+    for (size_t i = 0; a && i < n; i++)
+        if (!isfinite(a[i])) return 0;
+    return 1;
+}
+
+/* The transport never writes a non-finite output (such samples are counted and dropped). */
+static int replay_outputs_ok(const bk_transport_output *o, size_t n)
+{
+    return finite_floats((const float *)o->radiance, 27 * n) && finite_floats((const float *)o->direct, 27 * n) &&
+           finite_floats(o->irradiance, 3 * n) && finite_floats(o->variance, n);
+}
+
 static lbk_result replay_run(tp_ctx *c, bk_transport_stats *stats)
 {
     const bk_transport_options *opt = c->opt;
@@ -1875,6 +1911,7 @@ static lbk_result replay_run(tp_ctx *c, bk_transport_stats *stats)
     memset(&t, 0, sizeof t);
     lbk_result res = sp->replay_totals(sp->user, c->recv_count, &t);
     if (res) return res;
+    if (!replay_totals_ok(&t)) return LBK_ERR_BAD_INPUT;
     bk_transport_pass_record pr;
     memset(&pr, 0, sizeof pr);
     const size_t n = c->recv_count ? c->recv_count : 1;
@@ -1888,6 +1925,7 @@ static lbk_result replay_run(tp_ctx *c, bk_transport_stats *stats)
     for (int pass = 0; !res && pass < t.passes; pass++) {
         pr.pass = pass;
         res = sp->replay_pass(sp->user, &pr);
+        if (!res && !replay_pass_ok(&pr, c->recv_count)) res = LBK_ERR_BAD_INPUT;
         if (res) break;
         for (int k = 0; k < c->ncls; k++) c->cls[k].weight_sum = pr.weight_sum[k], c->cls[k].spp = pr.class_samples[k];
         estimate_error_of(c->cls, c->ncls, pr.x_acc, pr.b_acc, &err, &bias, &ce);
@@ -1901,6 +1939,7 @@ static lbk_result replay_run(tp_ctx *c, bk_transport_stats *stats)
     }
     for (int h = 0; h < 2; h++) free(pr.x_acc[h]), free(pr.b_acc[h]);
     if (!res) res = sp->replay_outputs(sp->user, c->out);
+    if (!res && !replay_outputs_ok(c->out, c->recv_count)) res = LBK_ERR_BAD_INPUT;
     if (res || !stats) return res;
     for (int k = 0; k < BK_RECEIVER_CLASSES; k++) stats->class_rel_rmse[k] = ce.cls[k];
     stats->probe_rel_rmse = ce.probe;

@@ -18,12 +18,16 @@ def lum(rgb):
 
 
 class Receivers:
-    """texel_dump's TSV: header keys, objects, materials and one row per receiver."""
+    """texel_dump's TSV: header keys, objects, materials and one row per receiver. Footprint rows
+    (P, texel_dump --footprint K) are not receivers: every row is a Cycles sensor, in file order,
+    and footprint[i] lists the sensors of receiver i's footprint points (empty: its own point)."""
 
     def __init__(self, path):
         self.meta, self.objects, self.materials = {}, {}, {}
         self.kind, self.obj, self.mat, self.pos, self.nrm, self.size, self.rgb = [], [], [], [], [], [], []
         self.flags = []
+        self.sensor, self.footprint = [], []  # per receiver: its own sensor, its footprint's sensors
+        self.sensors = 0
         with open(path) as f:
             for line in f:
                 if line.startswith("#"):
@@ -40,6 +44,12 @@ class Receivers:
                 c = line.rstrip("\n").split("\t")
                 if len(c) < 16:
                     continue
+                self.sensors += 1
+                if c[0] == "P":  # a footprint point of the receiver whose T row came last
+                    self.footprint[-1].append(self.sensors - 1)
+                    continue
+                self.sensor.append(self.sensors - 1)
+                self.footprint.append([])
                 self.kind.append(c[0])
                 self.obj.append(int(c[1]))
                 self.mat.append(int(c[2]))
@@ -51,6 +61,24 @@ class Receivers:
 
     def __len__(self):
         return len(self.pos)
+
+    def per_receiver(self, values):
+        """Sensor values (one per row of the file) -> one per receiver: the mean over its footprint
+        points where it has them (the texel's footprint average, as lbk bakes it), else its own."""
+        if len(values) != self.sensors:
+            raise SystemExit("bench-cycles: %d sensor values for %d sensors" % (len(values), self.sensors))
+        out = []
+        for own, fp in zip(self.sensor, self.footprint):
+            out.append(sum(values[k] for k in fp) / len(fp) if fp else values[own])
+        return out
+
+
+def write_point_sensors(src, dst):
+    """texel_dump's TSV without its footprint rows (P): one sensor per receiver, at its point."""
+    with open(src) as f, open(dst, "w") as g:
+        for line in f:
+            if not line.startswith("P\t"):
+                g.write(line)
 
 
 def write_receivers(path, pos, nrm, rgb, kind="A", header=None):

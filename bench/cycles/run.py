@@ -89,7 +89,8 @@ def bake_lbk(sc, work, opt, seed, alt=False):
            "--threads", str(opt.threads)] + sc["lbk"]
     wall, cpu = common.run_timed(cmd, out + ".log")
     tsv = out + ".tsv"
-    common.run_timed([opt.alt_dump if alt else opt.dump, sc["path"], out, tsv] + density_args(sc["lbk"]), tsv + ".log")
+    common.run_timed([opt.alt_dump if alt else opt.dump, sc["path"], out, tsv] + density_args(sc["lbk"]) +
+                     ["--footprint", str(opt.footprint)], tsv + ".log")
     return common.Receivers(tsv), wall, cpu, json.load(open(rep))
 
 
@@ -116,29 +117,43 @@ def run_scene(sc, work, opt, out):
         alt_txt = "; alt = %s: %.1f s wall, %.1f s CPU (%s spp, estimated error %.1f %%)" % (
             opt.alt_name, alt_wall, alt_cpu, reca.meta.get("spp", "?"), 100 * float(reca.meta.get("est_rel_rmse", "nan")))
     target = lbk_cpu if opt.clock == "cpu" else lbk_wall
-    ref_spp = max(64, sc["ref_spp"] // (8 if opt.quick else 1))
+    # The reference is each texel's defined value (TRANSPORT.md, Footprint): the mean over its
+    # footprint's K x K points (README "Footprint sensors"), each point at half the reference's
+    # samples (with K = 2: twice the cost of one point at the full count). Cycles at equal time
+    # bakes one point per texel, as a Cycles lightmap bake samples a texel (at one position).
+    fp_points = max(1.0, rec.sensors / len(rec))
+    ref_spp = max(64, int(sc["ref_spp"] * (0.5 if fp_points > 1 else 1)) // (8 if opt.quick else 1))
+    tsv = os.path.join(work, "%s.seed1.lbk.tsv" % sc["name"])
+    points_tsv = tsv + ".points"
+    common.write_point_sensors(tsv, points_tsv)
     cdir = os.path.join(work, sc["name"] + ".cycles")
-    runs = common.run_cycles(sc["path"], os.path.join(work, "%s.seed1.lbk.tsv" % sc["name"]), cdir,
-                             [(s, 11 + i) for i, s in enumerate(sc["calib"])], sky=sc["sky"], threads=opt.threads,
-                             equal_time=target, clock=opt.clock, refs=[(ref_spp, 1), (ref_spp, 2)])
+    runs = common.run_cycles(sc["path"], points_tsv, cdir, [(s, 11 + i) for i, s in enumerate(sc["calib"])],
+                             sky=sc["sky"], threads=opt.threads, equal_time=target, clock=opt.clock)
+    rdir = os.path.join(work, sc["name"] + ".cycles-ref")
+    refs_run = common.run_cycles(sc["path"], tsv, rdir, [], sky=sc["sky"], threads=opt.threads,
+                                 refs=[(ref_spp, 1), (ref_spp, 2)])
     by_role = {}
-    for r in runs:
-        by_role.setdefault(r["role"], []).append(r)
+    for d, rs in ((cdir, runs), (rdir, refs_run)):
+        for r in rs:
+            r["dir"] = d
+            by_role.setdefault(r["role"], []).append(r)
     eq = by_role["equal_time"][0]
     refs = by_role["reference"]
     lum = [common.lum(x) for x in rec.rgb]
     lum2 = [common.lum(x) for x in rec2.rgb]
-    load = lambda r: [common.lum(x) for x in common.read_f32_rgb(os.path.join(cdir, r["file"]))]
+    def load(r):
+        v = [common.lum(x) for x in common.read_f32_rgb(os.path.join(r["dir"], r["file"]))]
+        return rec.per_receiver(v) if r["dir"] == rdir else v
     r1, r2, ceq = load(refs[0]), load(refs[1]), load(eq)
     calib = [(r, load(r)) for r in by_role["calibration"]]
     est = float(rec.meta.get("est_rel_rmse", "nan"))
     ref_cpu = sum(r["cpu_s"] for r in refs)
     out("")
     out("== %s: lbk %.1f s wall, %.1f s CPU (%s spp, %s; estimated error %.1f %%); Cycles at equal %s time: "
-        "%d spp, %.1f s CPU, %.1f s wall; reference 2 x %d spp (%.0f s CPU)" % (
+        "%d spp, %.1f s CPU, %.1f s wall; reference 2 x %d spp%s (%.0f s CPU)" % (
             sc["name"], lbk_wall, lbk_cpu, rec.meta.get("spp", "?"), rec.meta.get("status", "?"), 100 * est,
             opt.clock.upper() if opt.clock == "cpu" else opt.clock, eq["spp"], eq["cpu_s"], eq["wall_s"], ref_spp,
-            ref_cpu) + alt_txt)
+            " per point at %.1f footprint points per texel" % fp_points if fp_points > 1 else "", ref_cpu) + alt_txt)
     alt_head = "" if not opt.alt else " %9s %9s %8s" % ("alt err", "alt bias", "alt/Cyc")
     out("  %-22s %-8s %6s %9s %9s %9s %9s %9s %10s %6s %9s%s" % (
         "object", "rep", "n", "lbk err", "lbk bias", "lbk noise", "lbk est", "Cyc err", "lbk/Cyc", "goal", "ref noise",
@@ -228,6 +243,8 @@ def main():
     ap.add_argument("--only", default=env("BENCH_CYCLES_SCENES", ""))
     ap.add_argument("--quick", action="store_true", default=env("LBK_BENCH_QUICK", "0") not in ("", "0"))
     ap.add_argument("--no-analytic", action="store_true")
+    # K x K sensors over each texel's footprint (0: one sensor at the texel's sample point)
+    ap.add_argument("--footprint", type=int, default=int(env("BENCH_CYCLES_FOOTPRINT", "2")))
     # a second baker measured against the same references (seed 1 only); it must share the layout
     ap.add_argument("--alt", default=env("LBK_ALT", ""))
     ap.add_argument("--alt-dump", default=env("LBK_ALT_DUMP", ""))

@@ -1,7 +1,7 @@
 /* texel_dump: every receiver of an lbk bake that a Cycles "sensor" can measure, as text.
  *
  *   texel_dump SCENE.gltf BAKE.lbk OUT.tsv [--preset fast|high] [--texel-density D]
- *                                          [--llg-vertices N]
+ *                                          [--llg-vertices N] [--footprint K]
  *
  * The .lbk holds lighting per texel but not where a texel is in the world. This program
  * rebuilds the baker's layout (import → classify → atlas → texels → push-out, the same calls
@@ -22,7 +22,8 @@
  *   # material IDX NAME
  *   kind obj mat page x y  px py pz  nx ny nz  size  Er Eg Eb  flags
  * kind: T texel (page/x/y its texel; size = metres per texel; flags = enum bk_texel_flag),
- * V LLG vertex (x = vertex index in its grid; size = 0; flags 0 or HIDDEN). Rows come in the order the
+ * V LLG vertex (x = vertex index in its grid; size = 0; flags 0 or HIDDEN), P footprint
+ * point of the T row before it (--footprint K, see write_footprint). Rows come in the order the
  * baker stores them (page-major, row-major; then LLG objects in scene order): deterministic.
  *
  * Edge texels (BK_TEXEL_EDGE: the centre lies outside every triangle, so the baker samples the
@@ -384,8 +385,64 @@ static int enclosed(const bk_tracer *tr, const double p[3], const float n[3], do
     return back >= 8;
 }
 
-static int write_texels(const dump *d, FILE *f)
+/* The world point and shading normal of texel-local (s, t) on the footprint triangle that covers
+ * it (the transport's footprint_origin, bake/transport/transport.c); 0 where none does. */
+static int footprint_point(const dump *d, const bk_texel *t, double s, double tt, double p[3], double n[3])
 {
+    const bk_scene *sc = &d->scene;
+    for (uint32_t k = 0; k < t->footprint_count; k++) {
+        const bk_footprint_tri *fp = &d->texels.footprint[t->footprint_first + k];
+        double u = fp->uv[0][0] + fp->uv[0][1] * s + fp->uv[0][2] * tt;
+        double v = fp->uv[1][0] + fp->uv[1][1] * s + fp->uv[1][2] * tt;
+        if (!(u >= 0 && v >= 0 && u + v <= 1)) continue;
+        const uint32_t *ix = sc->tris + 3 * (size_t)fp->tri;
+        double w[3] = {1 - u - v, u, v};
+        for (int a = 0; a < 3; a++) p[a] = n[a] = 0;
+        for (int i = 0; i < 3; i++)
+            for (int a = 0; a < 3; a++) {
+                p[a] += w[i] * sc->positions[3 * (size_t)ix[i] + a];
+                n[a] += w[i] * (sc->normals ? sc->normals[3 * (size_t)ix[i] + a] : t->normal[a]);
+            }
+        double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (!(l > 0) || !isfinite(l)) return 0;
+        for (int a = 0; a < 3; a++) n[a] /= l;
+        return 1;
+    }
+    return 0;
+}
+
+/* Footprint sensors (--footprint K): the texel's value is its irradiance averaged over the part of
+ * its square its chart covers, so a point sensor at its sample point measures something else
+ * wherever the light changes within a texel (a ceiling texel over the Cornell light's 1 cm gap).
+ * K × K stratum centres of the footprint box, each where a footprint triangle covers it, become
+ * rows "P obj mat PARENT i j  p n  size  rgb  flags" (PARENT: the data row index of the texel's
+ * T row; rgb: the texel's own value; flags HIDDEN where the point is enclosed). run.py averages
+ * their Cycles values into the texel's. Returns the rows written. */
+static size_t write_footprint(const dump *d, FILE *f, const bk_texel *t, size_t parent, int k, const float rgb[3])
+{
+    if (k <= 0 || !t->footprint_count || (t->flags & (BK_TEXEL_EDGE | BK_TEXEL_RING))) return 0;
+    const float *bx = t->footprint_box;
+    const int box = bx[2] > 0 && bx[3] > 0;
+    size_t rows = 0;
+    uint32_t mat = d->scene.tri_material ? d->scene.tri_material[t->tri] : 0;
+    for (int j = 0; j < k; j++)
+        for (int i = 0; i < k; i++) {
+            double s = (i + 0.5) / k, tt = (j + 0.5) / k, p[3], n[3];
+            if (box) s = bx[0] + s * bx[2], tt = bx[1] + tt * bx[3];
+            if (!footprint_point(d, t, s, tt, p, n)) continue;
+            float nf[3] = {(float)n[0], (float)n[1], (float)n[2]};
+            uint32_t flags = enclosed(d->tracer, p, nf, sensor_offset(&d->scene)) ? DUMP_HIDDEN : 0;
+            fprintf(f, "P\t%u\t%u\t%zu\t%d\t%d\t%.9g\t%.9g\t%.9g\t%.7g\t%.7g\t%.7g\t%.6g\t%.7g\t%.7g\t%.7g\t%u\n",
+                    t->object, mat, parent, i, j, p[0] + d->scene.origin[0], p[1] + d->scene.origin[1],
+                    p[2] + d->scene.origin[2], nf[0], nf[1], nf[2], t->texel_size, rgb[0], rgb[1], rgb[2], flags);
+            rows++;
+        }
+    return rows;
+}
+
+static int write_texels(const dump *d, FILE *f, int footprint)
+{
+    size_t row = 0;
     for (size_t i = 0; i < d->texels.count; i++) {
         const bk_texel *t = &d->texels.receivers[i];
         if (!(t->flags & BK_TEXEL_VALID)) continue;
@@ -403,6 +460,7 @@ static int write_texels(const dump *d, FILE *f)
                 mat, t->page, t->x, t->y, p[0] + d->scene.origin[0], p[1] + d->scene.origin[1],
                 p[2] + d->scene.origin[2], t->normal[0], t->normal[1], t->normal[2], t->texel_size,
                 rgb[0], rgb[1], rgb[2], flags);
+        row += 1 + write_footprint(d, f, t, row, footprint, rgb);
     }
     return 0;
 }
@@ -462,16 +520,18 @@ int main(int argc, char **argv)
 {
     if (argc < 4) {
         fprintf(stderr, "usage: texel_dump SCENE.gltf BAKE.lbk OUT.tsv [--preset fast|high] [--texel-density D] "
-                        "[--llg-vertices N]\n");
+                        "[--llg-vertices N] [--footprint K]\n");
         return 2;
     }
     const char *preset = "fast";
     float density = 0;
     uint32_t llg_vertices = 256;
+    int footprint = 0;
     for (int i = 4; i + 1 < argc; i += 2) {
         if (!strcmp(argv[i], "--preset")) preset = argv[i + 1];
         else if (!strcmp(argv[i], "--texel-density")) density = strtof(argv[i + 1], NULL);
         else if (!strcmp(argv[i], "--llg-vertices")) llg_vertices = (uint32_t)strtoul(argv[i + 1], NULL, 10);
+        else if (!strcmp(argv[i], "--footprint")) footprint = atoi(argv[i + 1]);
         else return die("unknown option", argv[i]);
     }
     dump d;
@@ -483,7 +543,8 @@ int main(int argc, char **argv)
     if (!rc && !f) rc = die("cannot write", argv[3]);
     if (!rc) {
         write_header(&d, f, argv[1], argv[2]);
-        if (d.have_lmap) rc = write_texels(&d, f);
+        if (footprint < 0 || footprint > 8) rc = die("--footprint K: 0 (point sensors) to 8", NULL);
+        if (!rc && d.have_lmap) rc = write_texels(&d, f, footprint);
         if (!rc) rc = write_llg_vertices(&d, f, llg_vertices);
         if (fclose(f)) rc = die("write failed", argv[3]);
     }

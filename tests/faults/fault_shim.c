@@ -77,17 +77,25 @@ __attribute__((destructor)) static void write_counts(void)
     if (!real_##name) real_##name = (__typeof__(&name))dlsym(RTLD_NEXT, #name)
 
 static int writes_file(int flags) { return (flags & (O_WRONLY | O_RDWR | O_CREAT | O_TRUNC | O_APPEND)) != 0; }
+static int fopen_writes(const char *mode) { return mode && (strchr(mode, 'w') || strchr(mode, 'a') || strchr(mode, '+')); }
+
+/* open's third argument exists only with O_CREAT or O_TMPFILE (a macro: va_start must run in the
+ * variadic function itself) */
+#define OPEN_MODE(flags, mode)                                                                     \
+    do {                                                                                           \
+        if ((flags) & (O_CREAT | O_TMPFILE)) {                                                     \
+            va_list ap;                                                                            \
+            va_start(ap, flags);                                                                   \
+            (mode) = (mode_t)va_arg(ap, int);                                                      \
+            va_end(ap);                                                                            \
+        }                                                                                          \
+    } while (0)
 
 int open(const char *path, int flags, ...)
 {
     REAL(open);
     mode_t mode = 0;
-    if (flags & (O_CREAT | O_TMPFILE)) {
-        va_list ap;
-        va_start(ap, flags);
-        mode = (mode_t)va_arg(ap, int);
-        va_end(ap);
-    }
+    OPEN_MODE(flags, mode);
     if (writes_file(flags) && hit(OP_OPEN)) return -1;
     return real_open(path, flags, mode);
 }
@@ -96,12 +104,7 @@ int open64(const char *path, int flags, ...)
 {
     REAL(open64);
     mode_t mode = 0;
-    if (flags & (O_CREAT | O_TMPFILE)) {
-        va_list ap;
-        va_start(ap, flags);
-        mode = (mode_t)va_arg(ap, int);
-        va_end(ap);
-    }
+    OPEN_MODE(flags, mode);
     if (writes_file(flags) && hit(OP_OPEN)) return -1;
     return real_open64(path, flags, mode);
 }
@@ -110,12 +113,7 @@ int openat(int dir, const char *path, int flags, ...)
 {
     REAL(openat);
     mode_t mode = 0;
-    if (flags & (O_CREAT | O_TMPFILE)) {
-        va_list ap;
-        va_start(ap, flags);
-        mode = (mode_t)va_arg(ap, int);
-        va_end(ap);
-    }
+    OPEN_MODE(flags, mode);
     if (writes_file(flags) && hit(OP_OPEN)) return -1;
     return real_openat(dir, path, flags, mode);
 }
@@ -130,14 +128,14 @@ int mkstemp(char *tmpl)
 FILE *fopen(const char *path, const char *mode)
 {
     REAL(fopen);
-    if (mode && (strchr(mode, 'w') || strchr(mode, 'a') || strchr(mode, '+')) && hit(OP_OPEN)) return NULL;
+    if (fopen_writes(mode) && hit(OP_OPEN)) return NULL;
     return real_fopen(path, mode);
 }
 
 FILE *fopen64(const char *path, const char *mode)
 {
     REAL(fopen64);
-    if (mode && (strchr(mode, 'w') || strchr(mode, 'a') || strchr(mode, '+')) && hit(OP_OPEN)) return NULL;
+    if (fopen_writes(mode) && hit(OP_OPEN)) return NULL;
     return real_fopen64(path, mode);
 }
 

@@ -109,6 +109,26 @@ static int build_octp(void **out, size_t *size)
     return lbk_octp_build(&(lbk_octp_build_desc){.probes = p, .probe_count = 2, .scale = 0.5f}, NULL, out, size) != LBK_OK;
 }
 
+/* The volume form (1.3): one 2 x 2 x 2 level, probes of every state, relocated ones among them. */
+static int build_octp_volume(void **out, size_t *size)
+{
+    static lbk_octp_probe_desc p[8];
+    static lbk_octp_probe_info info[8];
+    const uint32_t states[8] = {LBK_OCTP_ACTIVE, LBK_OCTP_ACTIVE, LBK_OCTP_INSIDE, LBK_OCTP_NO_NEARBY,
+                                LBK_OCTP_ACTIVE, LBK_OCTP_ACTIVE, LBK_OCTP_ACTIVE, LBK_OCTP_NO_NEARBY};
+    for (int k = 0; k < 8; k++) {
+        for (int i = 0; i < 16; i++)
+            for (int c = 0; c < 3; c++) p[k].irradiance[i][c] = 0.25f + 0.05f * (float)i + 0.1f * (float)c + 0.5f * (float)k;
+        for (int i = 0; i < 144; i++) p[k].depth[i][0] = 0.5f + 0.01f * (float)i, p[k].depth[i][1] = p[k].depth[i][0] * p[k].depth[i][0] + 0.05f;
+        info[k] = (lbk_octp_probe_info){.offset = {k == 1 ? 0.25f : 0.0f, 0.0f, k == 5 ? -0.125f : 0.0f}, .state = states[k],
+                                        .rays = 64, .backface = k == 2 ? 0.75f : 0.0f, .nearest = 0.5f + 0.125f * (float)k};
+    }
+    const lbk_octp_level level = {.origin = {0.5f, 0.25f, 0.5f}, .spacing = 1.0f, .dims = {2, 2, 2}, .miss_distance = 8.0f};
+    lbk_octp_build_desc d = LBK_OCTP_BUILD_DESC_INIT;
+    d.probes = p, d.probe_count = 8, d.scale = 0.5f, d.levels = &level, d.level_count = 1, d.info = info;
+    return lbk_octp_build(&d, NULL, out, size) != LBK_OK;
+}
+
 /* DLS over 48 texels (the LMAP), 8 GLG and 8 LLG probes: two light sets, a door's open and
  * closed sets and one combination (A with the door open); the DOOR section names them. */
 enum { TEXELS = 48, GLG_PROBES = 8, LLG_PROBES = 8 };
@@ -284,6 +304,13 @@ int main(void)
              write_container("tests/fuzz/corpus/every_raw.lbk", s, 9, 0) ||
              write_container("tests/fuzz/corpus/every_zstd.lbk", s, 9, 1);
     for (int i = 0; i < 9; i++) lbk_free(NULL, s[i].data);
+    section vol[2] = {{LBK_SECTION_META, 0, 0}, {LBK_SECTION_OCTP, 0, 0}};
+    if (!rc && (lbk_meta_build(meta, 2, NULL, &vol[0].data, &vol[0].size) || build_octp_volume(&vol[1].data, &vol[1].size))) {
+        fprintf(stderr, "make_corpus: the OCTP volume failed to build\n");
+        rc = 1;
+    }
+    if (!rc) rc = write_container("tests/fuzz/corpus/octp_volume.lbk", vol, 2, 1);
+    for (int i = 0; i < 2; i++) lbk_free(NULL, vol[i].data);
     if (rc) fprintf(stderr, "make_corpus: a container failed to build or validate\n");
     return rc || write_dls();
 }

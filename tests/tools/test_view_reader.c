@@ -34,7 +34,8 @@
 #define OUT_DIR "build/tests/view_reader"
 
 static const char *files[] = {"bake_cornell.lbk", "bake_sets.lbk", "every_raw.lbk", "every_zstd.lbk",
-                              "dls.lbk",          "lmuv_raw.lbk",  "objects_zstd.lbk", "lmap_block.lbk"};
+                              "dls.lbk",          "lmuv_raw.lbk",  "objects_zstd.lbk", "lmap_block.lbk",
+                              "octp_volume.lbk"};
 
 static int have_node(void) { return system("command -v node >/dev/null 2>&1") == 0; }
 
@@ -202,11 +203,23 @@ static void dump_probes(FILE *f, lbk_reader *r)
         lbk_octp_view v;
         assert_int_equal(lbk_octp_open(d, n, &v), LBK_OK);
         fprintf(f, "OCTP %u", (unsigned)v.probe_count), fx(f, v.scale), fputc('\n', f);
+        for (uint32_t l = 0; l < v.level_count; l++) {
+            const lbk_octp_level *lv = &v.levels[l];
+            fputs("OL", f), fxs(f, lv->origin, 3), fx(f, lv->spacing);
+            fprintf(f, " %u %u %u %u", (unsigned)lv->dims[0], (unsigned)lv->dims[1], (unsigned)lv->dims[2], (unsigned)lv->first_probe);
+            fx(f, lv->miss_distance), fputc('\n', f);
+        }
         for (uint32_t i = 0; i < v.probe_count; i++) {
             lbk_octp_probe_desc p;
             assert_int_equal(lbk_octp_probe_get(&v, i, &p), LBK_OK);
             fputs("O", f), fxs(f, p.position, 3), fxs(f, &p.irradiance[0][0], 48), fxs(f, &p.depth[0][0], 288);
             fputc('\n', f);
+            lbk_octp_probe_info pi;
+            if (v.level_count && lbk_octp_probe_info_get(&v, i, &pi) == LBK_OK) {
+                fputs("OI", f), fxs(f, pi.offset, 3);
+                fprintf(f, " %u %u", (unsigned)pi.state, (unsigned)pi.rays);
+                fx(f, pi.backface), fx(f, pi.nearest), fputc('\n', f);
+            }
         }
     }
 }

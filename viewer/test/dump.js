@@ -89,7 +89,12 @@ async function main() {
   const oct = await lbk.octp();
   if (oct) {
     out.push('OCTP ' + oct.probes.length + ' ' + fx(oct.scale));
-    for (const p of oct.probes) out.push('O ' + fl(p.position) + ' ' + fl(p.irradiance) + ' ' + fl(p.depth));
+    for (const l of oct.levels)
+      out.push('OL ' + fl(l.origin) + ' ' + fx(l.spacing) + ' ' + l.dims.join(' ') + ' ' + l.first_probe + ' ' + fx(l.miss_distance));
+    for (const p of oct.probes) {
+      out.push('O ' + fl(p.position) + ' ' + fl(p.irradiance) + ' ' + fl(p.depth));
+      if (p.state !== undefined) out.push('OI ' + fl(p.offset) + ' ' + p.state + ' ' + p.rays + ' ' + fx(p.backface) + ' ' + fx(p.nearest));
+    }
   }
   if (applyFlag === '--apply') await dumpApply(lbk, lm, glg, llg, setArg, doorArg, out);
   fs.writeFileSync(outPath, out.join('\n') + '\n');

@@ -1,0 +1,132 @@
+/* libFuzzer harness for part files (spec/part.md) and the merge that replays them
+ * (bake/dist/dist.c, bake/pipeline/bake.c). A part comes from another machine, so the merge must
+ * treat it as hostile: every input is checked as it is, then once more with its checksums and
+ * identity fields repaired (the plan and options hashes, unit 0 of 1, the receiver range its count
+ * gives) so that mutations reach the run records and the values the merge replays into the
+ * pipeline (NaN, Inf, huge or negative radiance, foreign masks, pass counts). Such a part is then
+ * merged over tests/fuzz/part_scene.gltf. A crash or sanitizer report is a finding; a refusal is
+ * an answer; a merge that succeeds must give a container the library's validator accepts.
+ * Run from the repository root (the scene's path is relative; LBK_FUZZ_PART_SCENE overrides). */
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define XXH_INLINE_ALL
+#include <xxhash.h>
+
+#include "lbk/bake.h"
+#include "lbk/bake_dist.h"
+#include "lbk/lbk.h"
+#include "lbk/validate.h"
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+enum { HEADER = 96 };
+static const uint64_t plan_hash = 0x6c626b2d66757a7aull; /* any non-zero value: the harness is the plan */
+
+typedef struct harness {
+    int ready;
+    const char *scene;
+    lbk_bake_desc desc;
+    uint64_t options_hash; /* what the unit stamped (offset 80): the merge's own options */
+} harness;
+
+static harness H; /* libFuzzer's interface has no user pointer: the harness's one setting lives here */
+
+/* The options every part was baked with and every merge uses: small, one thread, a fixed
+ * schedule (what a distributed bake needs). */
+static void set_desc(lbk_bake_desc *d)
+{
+    memset(d, 0, sizeof *d);
+    d->size = sizeof *d;
+    d->threads = 1;
+    d->target_error = -1;
+    d->max_samples = 4;
+    d->texel_density = 2;
+    d->glg_spacing = 8;
+}
+
+static void put64(uint8_t *p, uint64_t v)
+{
+    for (int k = 0; k < 8; k++) p[k] = (uint8_t)(v >> (8 * k));
+}
+static void put32(uint8_t *p, uint32_t v)
+{
+    for (int k = 0; k < 4; k++) p[k] = (uint8_t)(v >> (8 * k));
+}
+static uint64_t get64(const uint8_t *p)
+{
+    uint64_t v = 0;
+    for (int k = 0; k < 8; k++) v |= (uint64_t)p[k] << (8 * k);
+    return v;
+}
+
+/* Bakes the scene's one unit once, to learn the options hash the merge will expect. */
+static void setup(void)
+{
+    H.scene = getenv("LBK_FUZZ_PART_SCENE");
+    if (!H.scene) H.scene = "tests/fuzz/part_scene.gltf";
+    set_desc(&H.desc);
+    void *part = NULL;
+    size_t n = 0;
+    if (lbk_bake_unit_from_file(H.scene, &H.desc, plan_hash, 1, 0, &part, &n) || n < HEADER) {
+        fprintf(stderr, "fuzz_part: cannot bake %s (run from the repository root)\n", H.scene);
+        abort();
+    }
+    H.options_hash = get64((const uint8_t *)part + 80);
+    lbk_bake_part_free(part);
+    H.ready = 1;
+}
+
+/* A copy of the input that passes every identity and checksum test the fuzzer cannot forge. */
+static uint8_t *repaired(const uint8_t *data, size_t size)
+{
+    uint8_t *p = malloc(size);
+    if (!p) abort();
+    memcpy(p, data, size);
+    uint64_t receivers = get64(p + 32) & (((uint64_t)1 << 40) - 1);
+    put64(p + 16, plan_hash);
+    put32(p + 24, 1);
+    put32(p + 28, 0);
+    put64(p + 32, receivers);
+    put64(p + 40, 0);
+    put64(p + 48, receivers);
+    put64(p + 64, size - HEADER);
+    put64(p + 72, XXH64(p + HEADER, size - HEADER, 0));
+    put64(p + 80, H.options_hash);
+    put64(p + 88, XXH64(p, 88, 0));
+    return p;
+}
+
+static void merge(const uint8_t *part, size_t size)
+{
+    const void *parts[1] = {part};
+    size_t sizes[1] = {size};
+    lbk_bake_output *out = NULL;
+    if (lbk_bake_merge_from_file(H.scene, &H.desc, plan_hash, 1, parts, sizes, 1, &out)) return;
+    void *bytes = NULL;
+    size_t n = 0;
+    if (lbk_bake_output_container(out, &bytes, &n)) abort();
+    lbk_validate_summary s;
+    if (lbk_validate_memory(bytes, n, NULL, NULL, NULL, &s) || s.fatal || s.errors) {
+        fprintf(stderr, "fuzz_part: a merged container does not validate (%u fatal, %u errors)\n", s.fatal, s.errors);
+        abort();
+    }
+    lbk_free(NULL, bytes);
+    lbk_bake_output_free(out);
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    if (!H.ready) setup();
+    lbk_bake_part_info info;
+    char err[256];
+    (void)lbk_bake_part_check(data, size, 0, 0, &info, err, sizeof err);
+    if (size < HEADER) return 0;
+    uint8_t *p = repaired(data, size);
+    if (lbk_bake_part_check(p, size, plan_hash, 1, &info, err, sizeof err) == LBK_OK) merge(p, size);
+    free(p);
+    return 0;
+}
