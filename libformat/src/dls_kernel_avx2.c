@@ -15,7 +15,7 @@
  * byte code (derived at texel_encode_fast), and keeps a byte only when
  * its value lies farther than NEAR_MARGIN from a rounding boundary; a group of 8 with a lane
  * nearer than that goes through the operation-by-operation encoder (texel_encode). So the bytes
- * are the definition's, and the slow encoder runs for about 1 group in 200 on the benchmark level. */
+ * are the definition's, and the slow encoder runs for about 1 group in 150 on the benchmark level. */
 #include "dls_kernel.h"
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
