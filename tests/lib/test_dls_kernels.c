@@ -313,6 +313,23 @@ static void test_encode_at_boundaries(void **state)
             boundaries(x, comp, lo, hi, 96, &pl);
         }
     }
+    /* the encoder's special directions: s = 0 (no gradient), s.z exactly 0, s.z ∓ a denormal,
+     * s below 1e-30, cancelling channels (the float sums' error bound fails) */
+    static const float gz[] = {0.0f, 1e-45f, -1e-45f, 1e-38f, -1e-38f, 1e-31f, -1e-31f, 1e-3f, -1e-3f};
+    for (int trial = 0; trial < 64; trial++) {
+        lbk_ahd_linear x;
+        const float e0 = ldexpf(1.0f, trial % 16 - 8) * (1.0f + dlsfx_uniform(&rng));
+        const float gx = trial & 1 ? 0.0f : e0 * (dlsfx_uniform(&rng) - 0.5f);
+        for (size_t q = 0; q < sizeof gz / sizeof gz[0]; q++) {
+            for (int c = 0; c < 3; c++) {
+                x.c[c][0] = e0;
+                x.c[c][1] = c == 0 || !(trial & 2) ? gx : -gx * LBK_LUM_R / LBK_LUM_G; /* 2: R and G cancel */
+                x.c[c][2] = trial & 4 ? gx : 0.0f;
+                x.c[c][3] = gz[q];
+            }
+            push(&pl, &x);
+        }
+    }
     uint32_t *z[2] = {malloc(pl.n * 4), malloc(pl.n * 4)}, *rgba[2] = {malloc(pl.n * 4), malloc(pl.n * 4)};
     dls_kernels_scalar()->texel_encode(pl.v, (uint32_t)pl.n, z[0], rgba[0]);
     v->texel_encode(pl.v, (uint32_t)pl.n, z[1], rgba[1]);
