@@ -45,6 +45,11 @@ static void help(FILE *f)
           "  --dls-threshold X       light sets and doors store a texel/probe only where their light\n"
           "                          exceeds X times the mean indirect light of the texels they light\n"
           "                          directly (default 0.01; 0 keeps every lit receiver)\n"
+          "  --light-culling auto|on|off\n"
+          "                          stochastic light culling of punctual lights (bake/transport/SLC.md;\n"
+          "                          auto, the default: on with more than 32 positional lights)\n"
+          "  --light-culling-delta X culling's delta relative to the mean punctual irradiance\n"
+          "                          (default 0.1; smaller: more lights per texel, less noise)\n"
           "  --door-method difference|guided\n"
           "                          how the light through an open door is baked: differences of\n"
           "                          full runs (default) or the seed's guided estimator (bake/sets/SETS.md)\n"
@@ -422,6 +427,18 @@ int cli_bake_parse(int argc, char **argv, bake_args *out, int *quiet_out)
         } else if (!strcmp(a, "--dls-threshold")) {
             NEED_NUMBER(0, 1);
             o.d.dls_threshold = d > 0 ? d : -1;
+        } else if (!strcmp(a, "--light-culling")) {
+            NEED_VALUE;
+            if (!strcmp(v, "auto")) o.d.light_culling = 0;
+            else if (!strcmp(v, "on")) o.d.light_culling = 1;
+            else if (!strcmp(v, "off")) o.d.light_culling = -1;
+            else {
+                fprintf(stderr, "lbk bake: --light-culling: '%s' is not auto, on or off\n", v);
+                return LBK_EXIT_USAGE;
+            }
+        } else if (!strcmp(a, "--light-culling-delta")) {
+            NEED_NUMBER(1e-9, 1e6);
+            o.d.light_culling_delta = d;
         } else if (!strcmp(a, "--door-method")) {
             NEED_VALUE;
             if (!strcmp(v, "difference")) o.d.door_method = LBK_BAKE_DOOR_DIFFERENCE;

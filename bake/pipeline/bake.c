@@ -490,6 +490,8 @@ static void transport_options(const bk_pipeline *b, bk_transport_options *to)
     to->class_end[BK_CLASS_LLG] = b->receiver_count;
     to->split = b->dist ? bk_dist_split(b->dist) : NULL;
     to->checkpoint = b->ckpt && !b->dist ? bk_ckpt_transport(b->ckpt) : NULL;
+    to->slc = opt->light_culling;
+    to->slc_delta = opt->light_culling_delta;
 }
 
 void bk_pipeline_set_inputs(const bk_pipeline *b, bk_set_inputs *in)
@@ -761,6 +763,9 @@ static lbk_result check_desc(bk_pipeline *b)
     if (!finite_nonneg(d->texel_density)) BAD("lbk_bake_desc.texel_density: %g is not a finite number >= 0", d->texel_density);
     if (!finite_nonneg(d->glg_spacing)) BAD("lbk_bake_desc.glg_spacing: %g is not a finite number >= 0", d->glg_spacing);
     if (!isfinite(d->dls_threshold)) BAD("lbk_bake_desc.dls_threshold is not finite");
+    if (d->light_culling < -1 || d->light_culling > 1) BAD("lbk_bake_desc.light_culling: %d is not -1, 0 or 1", d->light_culling);
+    if (!finite_nonneg(d->light_culling_delta) || d->light_culling_delta > 1e6)
+        BAD("lbk_bake_desc.light_culling_delta: %g is not a finite number in [0, 1e6]", d->light_culling_delta);
     if (d->sky_override && !d->sky_exr)
         for (int k = 0; k < 3; k++)
             if (!finite_nonneg(d->sky[k]) || !(d->sky[k] < 1e30f)) BAD("lbk_bake_desc.sky: radiance must be finite and >= 0");
@@ -960,6 +965,10 @@ static uint64_t options_hash(const lbk_bake_desc *options, int budgets)
     hash_str(st, d.sky_exr);
     hash_str(st, d.revision);
     hash_str(st, d.allow_outside);
+    if (d.light_culling || d.light_culling_delta > 0) { /* (absent from older hashes: same values) */
+        const double lc[2] = {(double)d.light_culling, d.light_culling_delta};
+        XXH64_update(st, lc, sizeof lc);
+    }
     uint64_t h = XXH64_digest(st);
     XXH64_freeState(st);
     return h;

@@ -306,6 +306,11 @@ lbk_result bk_provenance_meta(const bk_pipeline *b, void **data, size_t *size)
     p[n++] = (lbk_meta_pair){"bake.no_glg", o->no_glg ? "1" : "0"};
     p[n++] = (lbk_meta_pair){"bake.octahedral", o->octahedral_probes ? "1" : "0"};
     if (o->block_align) p[n++] = (lbk_meta_pair){"bake.block_align", "1"}; /* absent: 0 (older bakes) */
+    char culling_delta[32];
+    snprintf(culling_delta, sizeof culling_delta, "%g", o->light_culling_delta);
+    /* absent: auto and the default δ (so bakes that leave them alone keep their bytes) */
+    if (o->light_culling) p[n++] = (lbk_meta_pair){"bake.light_culling", o->light_culling > 0 ? "on" : "off"};
+    if (o->light_culling_delta > 0) p[n++] = (lbk_meta_pair){"bake.light_culling_delta", culling_delta};
     p[n++] = (lbk_meta_pair){"bake.dls_threshold", threshold};
     p[n++] = (lbk_meta_pair){"bake.door_method", o->door_method == LBK_BAKE_DOOR_GUIDED ? "guided" : "difference"};
     if (o->revision) p[n++] = (lbk_meta_pair){LBK_META_REVISION, o->revision};

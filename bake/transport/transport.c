@@ -3,6 +3,7 @@
 
 #include "bake/util/parallel.h"
 #include "bake/transport/shading.h"
+#include "bake/transport/slc.h"
 #include "bake/transport/solid.h"
 #include "lbk/octa.h"
 
@@ -31,7 +32,7 @@ static uint64_t mix64(uint64_t z)
 typedef struct { uint64_t s; } tp_rng;
 
 enum { DOM_CELL = 1, DOM_RECV = 2, DOM_CELL_NEE = 3, DOM_RECV_NEE = 4, DOM_RECV_NEAR = 5, DOM_RECV_POS = 6,
-       DOM_RECV_PROBE = 7, DOM_CELL_NEAR = 8 };
+       DOM_RECV_PROBE = 7, DOM_CELL_NEAR = 8, DOM_SLC_RECV = 9, DOM_SLC_CELL = 10 };
 
 /* Keyed by everything that identifies one item's samples: never by thread or time. */
 static tp_rng rng_make(uint64_t seed, uint64_t domain, uint64_t half, uint64_t pass, uint64_t bounce, uint64_t item)
@@ -179,6 +180,19 @@ typedef struct tp_ctx {
     size_t light_count;
     int use_sky;
     float scene_scale;
+    /* stochastic light culling (slc.h, SLC.md): the receivers' and the cells' tiles, the
+     * draws of the current pass (receivers: one per half; cells: the current chain's), δ of
+     * pass 0 in irradiance units (each pass p uses δ/2^p), and per thread room for two tile
+     * lists */
+    int slc;
+    double slc_delta;
+    bk_slc *slc_recv, *slc_cell;
+    bk_slc_draw *draw_recv[2], *draw_cell;
+    uint32_t *slc_ids;
+    uint64_t *thread_slc_tested;
+    double *slc_cdf;           /* positional lights by intensity, for continued points */
+    uint32_t *slc_pick_ids;
+    size_t slc_pick_count;
     /* per chain (half) state; [h] */
     float *l_prev[2], *l_cur[2], *l_sum[2];
     float *l_prev2[2];     /* bounce k−2 (what a near hit in bounce k continues into) */
@@ -477,6 +491,36 @@ static int nee_sample(const tp_ctx *c, const float o[3], const double n[3], int 
 /* Per-thread counters of one parallel step. */
 typedef struct tp_count { uint64_t rays, shadow, bad; } tp_count;
 
+/* The tile lists of a thread: for each half the list of the tile it last cut (tile). */
+typedef struct tp_slc_lists {
+    uint32_t *ids[2];
+    size_t n[2], tile[2];
+} tp_slc_lists;
+
+static void slc_lists_init(const tp_ctx *c, int thread, tp_slc_lists *t)
+{
+    for (int h = 0; h < 2; h++) {
+        t->ids[h] = c->slc_ids ? c->slc_ids + (2 * (size_t)thread + (size_t)h) * c->light_count : NULL;
+        t->n[h] = 0;
+        t->tile[h] = SIZE_MAX;
+    }
+}
+
+/* A culling draw over `slc` for (half, pass): one ξ per light from its own stream. */
+static lbk_result slc_draw(const tp_ctx *c, int dom, int h, int pass, const bk_slc *slc, bk_slc_draw **out)
+{
+    double *xi = malloc((c->light_count ? c->light_count : 1) * sizeof *xi);
+    if (!xi) return LBK_ERR_OUT_OF_MEMORY;
+    for (size_t li = 0; li < c->light_count; li++) {
+        tp_rng r = rng_make(c->seed, (uint64_t)dom, (uint64_t)h, (uint64_t)pass, 0, li);
+        xi[li] = rng_next(&r);
+    }
+    lbk_result res = bk_slc_draw_create(slc, xi, ldexp(c->slc_delta, -(pass < 60 ? pass : 60)), c->threads, out);
+    free(xi);
+    return res;
+}
+
+
 /* ---- near-field continuation -------------------------------------------------------------- */
 
 /* A cell holds one radiance for its whole area; read from closer than a few cell sizes (a
@@ -486,7 +530,7 @@ typedef struct tp_count { uint64_t rays, shadow, bad; } tp_count;
  * hit is near too) plus one punctual light picked uniformly. An unbiased estimate of the
  * reflected radiance at the point given the cache beyond it (TRANSPORT.md §Bias). */
 #define TP_NEAR_CELLS 1.5   /* continue when the hit is closer than this many cell sizes */
-#define TP_NEAR_DEPTH 3     /* continuations in a row before the cache is read anyway */
+#define TP_NEAR_DEPTH 24    /* continuations in a row before the cache is read anyway (TRANSPORT.md: 3 left the Cornell light gap 15-25 % dark) */
 
 static int near_hit(const tp_ctx *c, const bk_hit *h, long hc, const uint8_t *rough)
 {
@@ -559,6 +603,33 @@ static void mark_rough(tp_ctx *c)
  * k−1 at its near hit: the sources for k = 2, bounce k−2's cells beyond. */
 typedef struct tp_near_mode { const float *read; const uint8_t *rough; int sources, max_depth; } tp_near_mode;
 
+/* Light li at the continued point x (normal n, ray origin o), weighted `scale`, into e. */
+static void near_light(const tp_ctx *c, size_t li, const double x[3], const double n[3], const float o[3], double scale,
+                       double e[3], tp_count *cnt)
+{
+    double val[3], ld[3], dist;
+    if (!bk_light_eval(c->lights[li], x, val, ld, &dist)) return;
+    double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
+    if (cs <= 0) return;
+    cnt->shadow++;
+    if (bk_light_visible(c->tracer, o, ld, dist))
+        for (int a = 0; a < 3; a++) e[a] += scale * val[a] * cs;
+}
+
+/* A positional light for u ∈ [0, 1) in proportion to its intensity (slc_cdf); *scale gets 1/P. */
+static size_t slc_pick(const tp_ctx *c, double u, double *scale)
+{
+    size_t lo = 0, hi = c->slc_pick_count - 1;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (c->slc_cdf[mid] > u) hi = mid;
+        else lo = mid + 1;
+    }
+    double p = c->slc_cdf[lo] - (lo ? c->slc_cdf[lo - 1] : 0);
+    *scale = p > 0 ? 1 / p : 0;
+    return c->slc_pick_ids[lo];
+}
+
 static void near_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, long hc, int depth, tp_rng *rng,
                           tp_count *cnt, double out[3])
 {
@@ -609,17 +680,19 @@ static void near_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, 
             for (int a = 0; a < 3; a++) e[a] += val[a] * cq;
     }
     if (md->sources && c->light_count) {
-        size_t li = (size_t)(rng_next(rng) * (double)c->light_count);
-        if (li >= c->light_count) li = c->light_count - 1;
-        double val[3], ld[3], dist;
-        if (bk_light_eval(c->lights[li], x, val, ld, &dist)) {
-            double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
-            if (cs > 0) {
-                cnt->shadow++;
-                if (bk_light_visible(c->tracer, o, ld, dist))
-                    for (int a = 0; a < 3; a++) e[a] += (double)c->light_count * val[a] * cs;
-            }
+        /* one light: uniformly; with culling (many lights) a positional one in proportion to its
+         * intensity (a uniform pick among thousands almost never finds the lamp that matters)
+         * and every directional one */
+        double u = rng_next(rng), scale = (double)c->light_count;
+        size_t li = (size_t)(u * (double)c->light_count);
+        if (c->slc) {
+            li = slc_pick(c, u, &scale);
+            const uint32_t *always;
+            size_t na = bk_slc_always(c->slc_recv, &always);
+            for (size_t k = 0; k < na; k++) near_light(c, always[k], x, n, o, 1, e, cnt);
         }
+        if (li >= c->light_count) li = c->light_count - 1;
+        near_light(c, li, x, n, o, scale, e, cnt);
     }
     for (int a = 0; a < 3; a++) out[a] = cell->albedo[a] / TP_PI * e[a];
 }
@@ -633,7 +706,24 @@ static void near_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, 
 typedef struct tp_cell_sums {
     double e[3], en[3], ep[3];
     int valid, lit_points;
+    const uint32_t *ids; /* with culling: the cell's tile list of this chain's draw */
+    size_t nids;
 } tp_cell_sums;
+
+/* One punctual light at cell point p (offset origin o), weighted by the draw d (NULL: 1). */
+static void cell_light(const tp_ctx *c, size_t li, const double p[3], const float o[3], const double n[3],
+                       const bk_slc_draw *d, double delta, tp_cell_sums *cs, tp_count *cnt)
+{
+    double val[3], ld[3], dist;
+    if (!bk_light_eval(c->lights[li], p, val, ld, &dist)) return;
+    double w = d ? bk_slc_weight(bk_lum(val), delta, bk_slc_draw_xi(d, (uint32_t)li)) : 1.0;
+    if (w == 0) return;
+    double cq = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
+    if (cq <= 0) return;
+    cnt->shadow++;
+    if (!bk_light_visible(c->tracer, o, ld, dist)) return;
+    for (int a = 0; a < 3; a++) cs->ep[a] += val[a] * w * cq;
+}
 
 /* Shades sample j of a cell (point p, offset origin o, cosine direction d, hit) into the sums. */
 static void cell_sample(tp_ctx *c, const double n[3], int j, const double p[3],
@@ -682,21 +772,21 @@ static void cell_sample(tp_ctx *c, const double n[3], int j, const double p[3],
     /* punctual lights at the first TP_LIGHT_POINTS visible points */
     if (c->light_count && cs->lit_points < TP_LIGHT_POINTS) {
         cs->lit_points++;
-        for (size_t li = 0; li < c->light_count; li++) {
-            double val[3], ld[3], dist;
-            if (!bk_light_eval(c->lights[li], p, val, ld, &dist)) continue;
-            double cq = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
-            if (cq <= 0) continue;
-            cnt->shadow++;
-            if (!bk_light_visible(c->tracer, o, ld, dist)) continue;
-            for (int a = 0; a < 3; a++) cs->ep[a] += val[a] * cq;
+        if (!c->slc) {
+            for (size_t li = 0; li < c->light_count; li++) cell_light(c, li, p, o, n, NULL, 1, cs, cnt);
+            return;
         }
+        const double delta = ldexp(c->slc_delta, -(c->pass < 60 ? c->pass : 60));
+        const uint32_t *always;
+        size_t na = bk_slc_always(c->slc_cell, &always);
+        for (size_t q = 0; q < na; q++) cell_light(c, always[q], p, o, n, NULL, 1, cs, cnt);
+        for (size_t q = 0; q < cs->nids; q++) cell_light(c, cs->ids[q], p, o, n, c->draw_cell, delta, cs, cnt);
     }
 }
 
 /* Bounce k at one cell: R points uniform over the cell, cosine directions from the shifted
  * lattice, traced 64 at a time; returns the reflected radiance albedo/π × irradiance. */
-static void cell_bounce(tp_ctx *c, size_t ci, tp_count *cnt, double out[3])
+static void cell_bounce(tp_ctx *c, size_t ci, tp_slc_lists *lists, tp_count *cnt, double out[3])
 {
     const int h = c->half, k = c->bounce, R = c->rays;
     const tp_cell *cell = &c->cells[ci];
@@ -715,6 +805,14 @@ static void cell_bounce(tp_ctx *c, size_t ci, tp_count *cnt, double out[3])
     tp_shift shift = lattice_shift(s1, s2);
     tp_cell_geom geom;
     cell_geom(c, cell, &geom);
+    if (k == 1 && c->slc) { /* the cell's tile list, cut once per tile (lists->*[0]) */
+        if (lists->tile[0] != ci / BK_SLC_TILE) {
+            lists->n[0] = bk_slc_tile_lights(c->draw_cell, ci, lists->ids[0]);
+            lists->tile[0] = ci / BK_SLC_TILE;
+        }
+        cs.ids = lists->ids[0];
+        cs.nids = lists->n[0];
+    }
     double nee_t[2] = {0, 0}; /* the light samples' own lattice shift */
     if (k == 1 && c->nee) {
         tp_rng nr = rng_make(c->seed, DOM_CELL_NEE, (uint64_t)h, (uint64_t)c->pass, 0, ci);
@@ -757,9 +855,11 @@ static void cache_bounce(tp_ctx *c, size_t begin, size_t end, int thread)
 {
     float *cur = c->l_cur[c->half];
     tp_count cnt = {0, 0, 0};
+    tp_slc_lists lists;
+    slc_lists_init(c, thread, &lists);
     for (size_t ci = begin; ci < end; ci++) {
         double v[3];
-        cell_bounce(c, ci, &cnt, v);
+        cell_bounce(c, ci, &lists, &cnt, v);
         for (int a = 0; a < 3; a++) {
             if (!isfinite(v[a]) || v[a] < 0) { cnt.bad++; v[a] = 0; }
             cur[3 * ci + a] = (float)v[a];
@@ -799,7 +899,13 @@ static tp_chain_result run_chain(tp_ctx *c, int h, int pass, int rays, double to
     int k;
     for (k = 1; k <= max_bounces; k++) {
         c->bounce = k;
+        if (k == 1 && c->slc && slc_draw(c, DOM_SLC_CELL, h, pass, c->slc_cell, &c->draw_cell) != LBK_OK) {
+            res.bounces = -1;
+            return res;
+        }
         parallel_for(c, n, 64, cache_bounce);
+        bk_slc_draw_destroy(c->draw_cell);
+        c->draw_cell = NULL;
         double p = cell_power(c, c->l_cur[h]);
         for (size_t i = 0; i < 3 * n; i++) sum[i] += c->l_cur[h][i];
         indirect += p;
@@ -925,44 +1031,69 @@ static void footprint_sample(const tp_ctx *c, const bk_receiver *r, tp_rng *pos,
     }
 }
 
-/* Punctual light at one point: irradiance (sphere: fluence) and the SH of its incident radiance. */
-static uint64_t punctual_at(const tp_ctx *c, const tp_origin *g, double e[3], double sh[3][9])
+/* One punctual light at one point, weighted w (1, or 1/p of an accepted culling draw):
+ * irradiance (sphere: fluence) and the SH of its incident radiance. Returns the shadow rays. */
+static uint64_t punctual_one(const tp_ctx *c, const tp_origin *g, size_t li, const bk_slc_draw *d, double delta,
+                             double e[3], double sh[3][9])
+{
+    double val[3], ld[3], dist;
+    if (!bk_light_eval(c->lights[li], g->p, val, ld, &dist)) return 0;
+    double w = d ? bk_slc_weight(bk_lum(val), delta, bk_slc_draw_xi(d, (uint32_t)li)) : 1.0;
+    if (w == 0) return 0;
+    double cs = ld[0] * g->n[0] + ld[1] * g->n[1] + ld[2] * g->n[2];
+    if (!g->sphere && cs <= 0) return 0;
+    if (!bk_light_visible(c->tracer, g->o, ld, dist)) return 1;
+    double y[9];
+    bk_sh9_basis_d(ld, y);
+    for (int a = 0; a < 3; a++) {
+        double v = val[a] * w;
+        e[a] += g->sphere ? v : v * cs;
+        for (int kk = 0; kk < 9; kk++) sh[a][kk] += v * y[kk];
+    }
+    return 1;
+}
+
+/* Punctual light at one point. d NULL: every light, exactly. Else a culling draw: the lights
+ * that are never culled plus those of ids (the point's tile list), each by the draw's ξ. */
+static uint64_t punctual_at(const tp_ctx *c, const tp_origin *g, const bk_slc_draw *d, const uint32_t *ids, size_t n,
+                            double delta, double e[3], double sh[3][9])
 {
     uint64_t rays = 0;
-    for (size_t li = 0; li < c->light_count; li++) {
-        double val[3], ld[3], dist;
-        if (!bk_light_eval(c->lights[li], g->p, val, ld, &dist)) continue;
-        double cs = ld[0] * g->n[0] + ld[1] * g->n[1] + ld[2] * g->n[2];
-        if (!g->sphere && cs <= 0) continue;
-        rays++;
-        if (!bk_light_visible(c->tracer, g->o, ld, dist)) continue;
-        double y[9];
-        bk_sh9_basis_d(ld, y);
-        for (int a = 0; a < 3; a++) {
-            e[a] += g->sphere ? val[a] : val[a] * cs;
-            for (int kk = 0; kk < 9; kk++) sh[a][kk] += val[a] * y[kk];
-        }
+    if (!d) {
+        for (size_t li = 0; li < c->light_count; li++) rays += punctual_one(c, g, li, NULL, 1, e, sh);
+        return rays;
     }
+    const uint32_t *always;
+    size_t na = bk_slc_always(c->slc_recv, &always);
+    for (size_t k = 0; k < na; k++) rays += punctual_one(c, g, always[k], NULL, 1, e, sh);
+    for (size_t k = 0; k < n; k++) rays += punctual_one(c, g, ids[k], d, delta, e, sh);
     return rays;
+}
+
+/* The points at which a receiver's punctual light is evaluated: a texel with a footprint
+ * averages its four quarter centres (hard shadow edges resolve to a quarter of a texel). */
+static int punctual_points(const tp_ctx *c, const bk_receiver *r, tp_origin g[4])
+{
+    if (!r->footprint_count) {
+        recv_origin(c, r, &g[0]);
+        return 1;
+    }
+    for (int q = 0; q < 4; q++) footprint_origin(c, r, 0.25 + 0.5 * (q & 1), 0.25 + 0.5 * (q >> 1), &g[q]);
+    return 4;
 }
 
 static void recv_punctual(tp_ctx *c, size_t begin, size_t end, int thread)
 {
-    /* Punctual light is noise-free: computed once, then into the outputs / error scalars. A
-     * texel with a footprint averages its four quarter centres (hard shadow edges resolve to
-     * a quarter of a texel). */
+    /* Without culling, punctual light is noise-free: computed once, then into the outputs /
+     * error scalars. */
     uint64_t rays = 0;
     for (size_t i = begin; i < end; i++) {
         const bk_receiver *r = &c->recv[i];
         double e[3] = {0, 0, 0}, sh[3][9];
         memset(sh, 0, sizeof sh);
-        const int points = r->footprint_count ? 4 : 1;
-        for (int q = 0; q < points; q++) {
-            tp_origin g;
-            if (r->footprint_count) footprint_origin(c, r, 0.25 + 0.5 * (q & 1), 0.25 + 0.5 * (q >> 1), &g);
-            else recv_origin(c, r, &g);
-            rays += punctual_at(c, &g, e, sh);
-        }
+        tp_origin g[4];
+        const int points = punctual_points(c, r, g);
+        for (int q = 0; q < points; q++) rays += punctual_at(c, &g[q], NULL, NULL, 0, 1, e, sh);
         for (int a = 0; a < 3; a++) {
             e[a] /= points;
             for (int kk = 0; kk < 9; kk++) sh[a][kk] /= points;
@@ -1141,26 +1272,59 @@ static void recv_half(tp_ctx *c, const bk_receiver *r, size_t i, int h, int S, c
     }
 }
 
+/* The culled punctual light of receiver i in half h of this pass: one draw (the half's ξ, δ of
+ * the pass) at the receiver's punctual points; an unbiased estimate of what recv_punctual
+ * computes. */
+static uint64_t recv_slc(tp_ctx *c, const bk_receiver *r, size_t i, int h, tp_slc_lists *t, double e[3],
+                         double sh[3][9], uint64_t *tested)
+{
+    const bk_slc_draw *d = c->draw_recv[h];
+    if (t->tile[h] != i / BK_SLC_TILE) {
+        t->n[h] = bk_slc_tile_lights(d, i, t->ids[h]);
+        t->tile[h] = i / BK_SLC_TILE;
+    }
+    const double delta = ldexp(c->slc_delta, -(c->pass < 60 ? c->pass : 60));
+    tp_origin g[4];
+    const int points = punctual_points(c, r, g);
+    uint64_t rays = 0;
+    for (int q = 0; q < points; q++) rays += punctual_at(c, &g[q], d, t->ids[h], t->n[h], delta, e, sh);
+    *tested += (uint64_t)points * t->n[h];
+    for (int a = 0; a < 3; a++) {
+        e[a] /= points;
+        for (int kk = 0; kk < 9; kk++) sh[a][kk] /= points;
+    }
+    return rays;
+}
+
 static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
 {
     const int S = c->rays;
     const double w = c->pass_weight;
     const bk_transport_output *out = c->out;
     tp_count cnt = {0, 0, 0};
+    tp_slc_lists lists;
+    slc_lists_init(c, thread, &lists);
+    uint64_t tested = 0;
     for (size_t i = begin; i < end; i++) {
         const bk_receiver *r = &c->recv[i];
         const int sphere = !(r->normal[0] != 0 || r->normal[1] != 0 || r->normal[2] != 0);
         const double solid = sphere ? 4 * TP_PI : 2 * TP_PI;
         tp_recv_sums tot;
         memset(&tot, 0, sizeof tot);
+        double psh_tot[3][9];
+        memset(psh_tot, 0, sizeof psh_tot);
         for (int h = 0; h < 2; h++) {
             tp_recv_sums rs;
             memset(&rs, 0, sizeof rs);
             recv_half(c, r, i, h, S, &c->lat, &rs, NULL, &cnt);
+            double pe[3] = {0, 0, 0}, psh[3][9];
+            memset(psh, 0, sizeof psh);
+            if (c->slc) cnt.shadow += recv_slc(c, r, i, h, &lists, pe, psh, &tested);
             double e[3], eb[3];
             for (int a = 0; a < 3; a++) {
-                e[a] = rs.e[a] * solid / S;
+                e[a] = rs.e[a] * solid / S + pe[a];
                 eb[a] = rs.eb[a] * solid / S;
+                for (int kk = 0; kk < 9; kk++) psh_tot[a][kk] += psh[a][kk];
             }
             /* error scalar: irradiance for texels, fluence/4 for probes (equal under uniform
              * radiance, so texels and probes weigh alike in the relative RMSE) */
@@ -1183,7 +1347,15 @@ static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
             }
             if (out->irradiance) out->irradiance[3 * i + a] += (float)(tot.e[a] * w * 0.5);
         }
+        if (c->slc) /* culled punctual light: both halves' draws, weight w */
+            for (int a = 0; a < 3; a++) {
+                for (int kk = 0; kk < 9; kk++) {
+                    out->radiance[i].c[a][kk] += (float)(psh_tot[a][kk] * w * 0.5);
+                    if (out->direct) out->direct[i].c[a][kk] += (float)(psh_tot[a][kk] * w * 0.5);
+                }
+            } /* (the irradiance has it already: e above, in tot.e) */
     }
+    c->thread_slc_tested[thread] += tested;
     c->thread_rays[thread] += cnt.rays + cnt.shadow;
     c->thread_shadow[thread] += cnt.shadow;
     c->thread_nonfinite[thread] += cnt.bad;
@@ -1288,6 +1460,14 @@ static void free_ctx(tp_ctx *c)
     lattice_free(&c->oct_lat);
     free(c->oct_acc[0]);
     free(c->oct_acc[1]);
+    for (int h = 0; h < 2; h++) bk_slc_draw_destroy(c->draw_recv[h]);
+    bk_slc_draw_destroy(c->draw_cell);
+    bk_slc_destroy(c->slc_recv);
+    bk_slc_destroy(c->slc_cell);
+    free(c->slc_ids);
+    free(c->thread_slc_tested);
+    free(c->slc_cdf);
+    free(c->slc_pick_ids);
 }
 
 /* Longest edge of triangle i. */
@@ -1538,6 +1718,144 @@ static lbk_result check_inputs(const bk_scene *scene, const bk_tracer *tracer, c
     return footprints_valid(scene, opt, receivers, count) ? LBK_OK : LBK_ERR_INVALID_ARGUMENT;
 }
 
+/* ---- stochastic light culling: setup ------------------------------------------------------ */
+
+/* The float box holding the double box [lo, hi] (rounded outwards). */
+static void box_out(const double lo[3], const double hi[3], float *b)
+{
+    for (int a = 0; a < 3; a++) {
+        b[a] = nextafterf((float)lo[a], -INFINITY);
+        b[3 + a] = nextafterf((float)hi[a], INFINITY);
+    }
+}
+
+static void box_grow(double lo[3], double hi[3], const double p[3])
+{
+    for (int a = 0; a < 3; a++) {
+        if (p[a] < lo[a]) lo[a] = p[a];
+        if (p[a] > hi[a]) hi[a] = p[a];
+    }
+}
+
+/* The mean punctual irradiance of the positional lights (shadowed and cosine-weighted as
+ * received: the error scalar X of TRANSPORT.md, fluence/4 at probes) over `k` receivers spread
+ * evenly over [begin, end), or cell centres when there are no receivers. */
+static double slc_class_mean(const tp_ctx *c, size_t begin, size_t end, size_t k)
+{
+    const size_t n = end - begin;
+    if (k > n) k = n;
+    double sum = 0, sh[3][9] = {{0}};
+    for (size_t q = 0; q < k; q++) {
+        size_t i = begin + q * n / k;
+        tp_origin g;
+        if (c->recv_count) {
+            recv_origin(c, &c->recv[i], &g);
+        } else {
+            tp_cell_geom cg;
+            double p[3];
+            cell_geom(c, &c->cells[i], &cg);
+            cell_point_at(&cg, 0.5, 0.5, p, NULL, NULL);
+            float pf[3] = {(float)p[0], (float)p[1], (float)p[2]};
+            origin_from(c, pf, c->cells[i].n, &g);
+        }
+        double e[3] = {0, 0, 0};
+        for (size_t li = 0; li < c->light_count; li++)
+            if (c->lights[li]->type != BK_LIGHT_DIRECTIONAL) punctual_one(c, &g, li, NULL, 1, e, sh);
+        sum += bk_lum(e) * (g.sphere ? 0.25 : 1.0);
+    }
+    return k ? sum / (double)k : 0;
+}
+
+/* What δ is relative to: the smallest positive class mean of slc_class_mean, each class
+ * sampled at up to 256 receivers (fewer when the lights are many: at most 2^22 shadow rays in
+ * all, at least 16 receivers). Then one draw's relative RMSE over any class is at most √(δ/2)
+ * (SLC.md): a class of dim receivers (texels beside bright probes) gets the δ it needs. */
+static double slc_mean_irradiance(const tp_ctx *c)
+{
+    size_t k = c->light_count ? ((size_t)1 << 22) / (c->light_count * (size_t)c->ncls) : 256;
+    k = k < 16 ? 16 : k > 256 ? 256 : k;
+    if (!c->recv_count) return slc_class_mean(c, 0, c->cell_count, k);
+    double best = 0;
+    for (int q = 0; q < c->ncls; q++) {
+        double m = slc_class_mean(c, c->cls[q].begin, c->cls[q].end, k);
+        if (m > 0 && (best == 0 || m < best)) best = m;
+    }
+    return best;
+}
+
+/* Boxes of the points whose punctual light is culled: every receiver's punctual points, and
+ * every cell's sub-triangle (padded by its edge band: cell points are clamped into it). */
+static lbk_result slc_build(tp_ctx *c)
+{
+    const size_t nr = c->recv_count, nc = c->cell_count;
+    float *boxes = malloc(6 * (nr > nc ? nr : nc ? nc : 1) * sizeof(float));
+    if (!boxes) return LBK_ERR_OUT_OF_MEMORY;
+    for (size_t i = 0; i < nr; i++) {
+        tp_origin g[4];
+        int points = punctual_points(c, &c->recv[i], g);
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (int q = 0; q < points; q++) box_grow(lo, hi, g[q].p);
+        box_out(lo, hi, boxes + 6 * i);
+    }
+    lbk_result res = bk_slc_create(c->lights, c->light_count, boxes, nr, &c->slc_recv);
+    for (size_t ci = 0; ci < nc && res == LBK_OK; ci++) {
+        tp_cell_geom g;
+        cell_geom(c, &c->cells[ci], &g);
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, tl[3], th[3];
+        for (int a = 0; a < 3; a++) tl[a] = INFINITY, th[a] = -INFINITY;
+        for (int v = 0; v < 3; v++) {
+            double p[3];
+            for (int a = 0; a < 3; a++)
+                p[a] = (1 - g.b[v][0] - g.b[v][1]) * g.v[0][a] + g.b[v][0] * g.v[1][a] + g.b[v][1] * g.v[2][a];
+            box_grow(lo, hi, p);
+            box_grow(tl, th, g.v[v]);
+        }
+        for (int a = 0; a < 3; a++) {
+            double pad = 4 * g.eps * (th[a] - tl[a]);
+            lo[a] -= pad, hi[a] += pad;
+        }
+        box_out(lo, hi, boxes + 6 * ci);
+    }
+    if (res == LBK_OK) res = bk_slc_create(c->lights, c->light_count, boxes, nc, &c->slc_cell);
+    free(boxes);
+    if (res != LBK_OK) return res;
+    c->slc_ids = malloc(2 * (size_t)c->threads * (c->light_count ? c->light_count : 1) * sizeof(uint32_t));
+    c->slc_cdf = malloc((c->light_count ? c->light_count : 1) * sizeof(double));
+    c->slc_pick_ids = malloc((c->light_count ? c->light_count : 1) * sizeof(uint32_t));
+    if (!c->slc_ids || !c->slc_cdf || !c->slc_pick_ids) return LBK_ERR_OUT_OF_MEMORY;
+    double tot = 0;
+    for (size_t li = 0; li < c->light_count; li++) {
+        const float *col = c->lights[li]->color;
+        double v[3] = {isfinite(col[0]) && col[0] > 0 ? col[0] : 0, isfinite(col[1]) && col[1] > 0 ? col[1] : 0,
+                       isfinite(col[2]) && col[2] > 0 ? col[2] : 0};
+        if (c->lights[li]->type == BK_LIGHT_DIRECTIONAL || !(bk_lum(v) > 0)) continue;
+        tot += bk_lum(v);
+        c->slc_cdf[c->slc_pick_count] = tot;
+        c->slc_pick_ids[c->slc_pick_count++] = (uint32_t)li;
+    }
+    if (!c->slc_pick_count || !(tot > 0) || !isfinite(tot)) return LBK_ERR_UNSUPPORTED_FEATURE; /* (culling off) */
+    for (size_t k = 0; k < c->slc_pick_count; k++) c->slc_cdf[k] /= tot;
+    c->slc_cdf[c->slc_pick_count - 1] = 1;
+    return LBK_OK;
+}
+
+/* Whether this run culls (options.slc; auto: more than BK_SLC_AUTO_LIGHTS positional lights),
+ * and its δ in irradiance units. */
+static lbk_result slc_init(tp_ctx *c)
+{
+    const bk_transport_options *opt = c->opt;
+    size_t positional = 0;
+    for (size_t li = 0; li < c->light_count; li++) positional += c->lights[li]->type != BK_LIGHT_DIRECTIONAL;
+    const int want = opt->slc > 0 ? 1 : opt->slc < 0 ? 0 : positional > BK_SLC_AUTO_LIGHTS;
+    if (!want || !positional) return LBK_OK;
+    const double mean = slc_mean_irradiance(c);
+    if (!(mean > 0) || !isfinite(mean)) return LBK_OK; /* nothing measurable to be relative to */
+    c->slc_delta = (opt->slc_delta > 0 && isfinite(opt->slc_delta) ? opt->slc_delta : BK_SLC_DEFAULT_DELTA) * mean;
+    lbk_result res = slc_build(c);
+    c->slc = res == LBK_OK;
+    return res == LBK_ERR_UNSUPPORTED_FEATURE ? LBK_OK : res; /* no positional light with power: exact */
+}
+
 /* Everything a run needs before its first pass: counters, the light selection, cells,
  * emitters, the per-half radiance arrays and the receivers' accumulators. */
 static lbk_result ctx_init(tp_ctx *c)
@@ -1547,7 +1865,8 @@ static lbk_result ctx_init(tp_ctx *c)
     c->thread_rays = calloc((size_t)c->threads, sizeof(uint64_t));
     c->thread_nonfinite = calloc((size_t)c->threads, sizeof(uint64_t));
     c->thread_shadow = calloc((size_t)c->threads, sizeof(uint64_t));
-    if (!c->thread_rays || !c->thread_nonfinite || !c->thread_shadow) return LBK_ERR_OUT_OF_MEMORY;
+    c->thread_slc_tested = calloc((size_t)c->threads, sizeof(uint64_t));
+    if (!c->thread_rays || !c->thread_nonfinite || !c->thread_shadow || !c->thread_slc_tested) return LBK_ERR_OUT_OF_MEMORY;
     /* scale of the coordinates: offsets for receivers, which carry no triangle */
     for (size_t i = 0; i < scene->tri_count; i++) {
         float sc = bk_tracer_tri_scale(c->tracer, (uint32_t)i);
@@ -1563,6 +1882,7 @@ static lbk_result ctx_init(tp_ctx *c)
     }
     lbk_result res = build_cells(c);
     if (res == LBK_OK) res = build_emitters(c);
+    if (res == LBK_OK) res = slc_init(c);
     if (res != LBK_OK) return res;
     size_t nc = c->cell_count ? c->cell_count : 1, n = c->recv_count ? c->recv_count : 1;
     for (int h = 0; h < 2; h++) {
@@ -1645,6 +1965,8 @@ static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
     c->rays = c->s0 << (pass < 20 ? pass : 20);
     if (lattice_init(&c->lat, (uint32_t)c->rays) != LBK_OK) return LBK_ERR_OUT_OF_MEMORY;
     c->pass_weight = ldexp(1.0, pass);
+    for (int h = 0; h < 2 && c->slc; h++)
+        if (slc_draw(c, DOM_SLC_RECV, h, pass, c->slc_recv, &c->draw_recv[h]) != LBK_OK) return LBK_ERR_OUT_OF_MEMORY;
     size_t block = active / 8 + 1, done = 0;
     for (int k = 0; k < c->ncls; k++) {
         if (!c->cls[k].active) continue;
@@ -1658,6 +1980,10 @@ static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
             if (report_progress(c, "gather", c->spp + 2.0 * c->rays * (double)done / (double)(active ? active : 1)))
                 return LBK_ERR_CANCELLED;
         }
+    }
+    for (int h = 0; h < 2; h++) {
+        bk_slc_draw_destroy(c->draw_recv[h]);
+        c->draw_recv[h] = NULL;
     }
     if (c->oct_count) {
         const int f = c->opt->octa_ray_factor > 0 ? c->opt->octa_ray_factor : 4;
@@ -1771,7 +2097,7 @@ static void finish_outputs(tp_ctx *c)
             double w = recv_weight(c, i), a = w > 0 ? c->x_acc[0][i] / w : 0, b = w > 0 ? c->x_acc[1][i] / w : 0;
             output->variance[i] = (float)(0.25 * (a - b) * (a - b));
         }
-    if (c->light_count) {
+    if (c->light_count && !c->slc) { /* (culled light is in the passes' sums already) */
         float *pl = c->punct_lum;
         c->punct_lum = NULL; /* recv_punctual now writes into the outputs */
         parallel_range(c, c->g_begin, c->g_end, 64, recv_punctual);
@@ -1829,6 +2155,13 @@ static void fill_stats(const tp_ctx *c, int passes, double err, double bias, con
     }
     stats->stop = lead->stop;
     stats->nee = c->nee;
+    stats->slc = c->slc;
+    stats->slc_delta = c->slc_delta;
+    uint64_t tested = 0;
+    for (int t = 0; t < c->threads; t++) tested += c->thread_slc_tested[t];
+    double recv_spp = 0; /* receiver-draws: each receiver draws twice (halves) per pass it sampled */
+    for (int k = 0; k < c->ncls; k++) recv_spp += (double)(c->cls[k].end - c->cls[k].begin);
+    stats->slc_lights_tested = recv_spp > 0 ? (double)tested / recv_spp : 0;
 }
 
 /* ---- distributed runs (bk_transport_split) ------------------------------------------------ */
@@ -2118,9 +2451,9 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
         schedule_only(&c, stats);
         goto done;
     }
+    init_classes(&c); /* (before ctx_init: culling's δ is measured per class) */
     res = ctx_init(&c);
     if (res != LBK_OK) goto done;
-    init_classes(&c);
 
     for (size_t i = 0; i < count; i++) {
         memset(&output->radiance[i], 0, sizeof output->radiance[i]);
@@ -2128,7 +2461,8 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
         if (output->irradiance) output->irradiance[3 * i] = output->irradiance[3 * i + 1] = output->irradiance[3 * i + 2] = 0;
     }
     if (c.oct_count) memset(output->octa_irradiance, 0, c.oct_count * 48 * sizeof(float));
-    if (c.light_count) parallel_range(&c, c.g_begin, c.g_end, 64, recv_punctual); /* luminance only, for the error */
+    if (c.light_count && !c.slc) /* luminance only, for the error */
+        parallel_range(&c, c.g_begin, c.g_end, 64, recv_punctual);
 
     double err = 0, bias = 0;
     tp_errors ce = {{0}, 0};

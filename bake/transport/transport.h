@@ -219,7 +219,22 @@ typedef struct bk_transport_options {
     const bk_transport_split *split;
     /* NULL: none; else checkpoints after every pass and resumption (above). Not with split. */
     const bk_transport_checkpoint *checkpoint;
+    /* Stochastic light culling of punctual lights (bake/transport/SLC.md): 0 auto = on with more
+     * than BK_SLC_AUTO_LIGHTS positional lights, 1 on, -1 off. On, punctual light at receivers
+     * and in the cache's first bounce is one culling draw per half and pass (unbiased, in the
+     * error estimate) instead of every light with a shadow ray. */
+    int slc;
+    /* δ relative to the mean punctual irradiance of the positional lights at the receivers
+     * (shadowed, as received): a light is accepted for certain where its irradiance exceeds
+     * δ × that mean (pass p: δ/2^p), and one draw's level-wide relative RMSE is ≤ √(δ/2);
+     * 0: BK_SLC_DEFAULT_DELTA. Smaller: more lights per receiver, less noise. */
+    double slc_delta;
 } bk_transport_options;
+
+/* The light count above which culling is on by default, and the default δ (SLC.md, measured by
+ * bench_slc). */
+#define BK_SLC_AUTO_LIGHTS 32
+#define BK_SLC_DEFAULT_DELTA 0.1
 
 /* Caller-owned output arrays, `count` entries each; NULL pointers are skipped. */
 typedef struct bk_transport_output {
@@ -267,6 +282,9 @@ typedef struct bk_transport_stats {
     double octa_rel_rmse;    /* estimated relative RMSE of the octahedral texels (the two halves,
                                 over every texel; TRANSPORT.md's estimate) */
     double octa_rays;        /* gather rays per octahedral probe, both halves, all passes */
+    int slc;                 /* 1 when punctual lights were culled (options.slc) */
+    double slc_delta;        /* the δ of pass 0 in irradiance units (0 without culling) */
+    double slc_lights_tested;/* per receiver over the run: lights its tiles' lists gave it to test */
 } bk_transport_stats;
 
 /* Computes radiance at `count` receivers. The tracer must have been built from `scene`.

@@ -1,13 +1,17 @@
 /* The per-target arithmetic of lbk_dls_apply (spec/container.md §12.8), behind one table of
  * functions so that the scalar definition and the SIMD paths are interchangeable. Private.
  *
- * Every path computes, per target, exactly the operations of the definition — decode base and
- * entries with lbk_ahd_to_linear / lbk_sh9_unpack, acc = base; acc += w_j·S_j for the active
- * entries in ascending set order (a multiply, then an add: never fused), encode once with
- * lbk_ahd_from_linear / lbk_sh9_pack — in the same order and precision, so every path gives the
- * same bytes as the scalar one (tests/lib/test_dls_kernels.c checks it lane by lane). The
- * files that implement a path are compiled without contraction into fused multiply-adds
- * (-ffp-contract=off and the pragma below). */
+ * The definition, per target: decode base and entries with lbk_ahd_to_linear / lbk_sh9_unpack,
+ * acc = base; acc += w_j·S_j for the active entries in ascending set order (a multiply, then an
+ * add: never fused), encode once with lbk_ahd_from_linear / lbk_sh9_pack. Every path gives the
+ * bytes of the scalar one (tests/lib/test_dls_kernels.c checks it lane by lane): the sums are the
+ * same operations in the same order and precision; a path may compute a value of the codecs
+ * another way only where it is provably the same value (AVX2: a correctly rounded quotient by
+ * Markstein's correction instead of a division instruction) or the same byte (AVX2: the
+ * encoder's direction and ratio bytes from float approximations with a derived error bound,
+ * falling back to the operation-by-operation encoder near a rounding boundary). The files that
+ * implement a path are compiled without contraction into fused multiply-adds (-ffp-contract=off
+ * and the pragma below); the only FMAs are explicit ones that compute exact residuals. */
 #ifndef LBK_DLS_KERNEL_H
 #define LBK_DLS_KERNEL_H
 
@@ -42,18 +46,26 @@ typedef struct dls_var_batch {
     uint8_t *out0, *out1;
 } dls_var_batch;
 
+typedef struct lbk_ahd_linear lbk_ahd_linear;
+typedef struct lbk_sh9_rgb lbk_sh9_rgb;
+
 typedef struct dls_kernels {
     const char *name;
     void (*texels)(const dls_batch *b);
     void (*probes)(const dls_batch *b);
     void (*texels_var)(const dls_var_batch *b);
     void (*probes_var)(const dls_var_batch *b);
+    /* The codecs the kernels are made of, on `count` targets, for the tests: lbk_ahd_to_linear of
+     * the plane words z[t], rgba[t]; lbk_ahd_from_linear into them; lbk_sh9_unpack of 28-byte probes. */
+    void (*texel_decode)(const uint32_t *z, const uint32_t *rgba, uint32_t count, lbk_ahd_linear *out);
+    void (*texel_encode)(const lbk_ahd_linear *in, uint32_t count, uint32_t *z, uint32_t *rgba);
+    void (*probe_decode)(const uint8_t *probes, uint32_t count, lbk_sh9_rgb *out);
 } dls_kernels;
 
 /* The definition, one target at a time; always available. */
 const dls_kernels *dls_kernels_scalar(void);
-/* 8 targets per step with AVX2 (x86-64, chosen at run time); NULL where the compiler or the CPU
- * lacks it. */
+/* 8 targets per step with AVX2 and FMA (x86-64, chosen at run time); NULL where the compiler or
+ * the CPU lacks either. */
 const dls_kernels *dls_kernels_avx2(void);
 
 #endif

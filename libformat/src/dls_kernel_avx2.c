@@ -1,9 +1,21 @@
-/* The DLS arithmetic on 8 targets at a time with AVX2: the operations of dls_kernel_scalar.c
- * (lbk_ahd_to_linear / _from_linear, lbk_sh9_unpack / _pack and pixel.c's codecs) lane for lane,
- * in the same order and precision — float where they use float, double where they use double,
- * divisions and square roots as true IEEE operations, every rounding to nearest-even by an
- * instruction that ignores the rounding mode where the scalar code does so too — so the bytes
- * are the scalar ones. No FMA: the target is plain AVX2 and contraction is off. */
+/* The DLS arithmetic on 8 targets at a time with AVX2 and FMA: the bytes of dls_kernel_scalar.c
+ * (lbk_ahd_to_linear / _from_linear, lbk_sh9_unpack / _pack and pixel.c's codecs), lane for lane.
+ *
+ * Decoding follows the scalar operations in the same order and precision — float where they use
+ * float, double where they use double, every rounding to nearest-even by an instruction that
+ * ignores the rounding mode where the scalar code does so too — with one substitution: a float
+ * division a / b is computed as Markstein's correctly rounded quotient from y = RN(1/b)
+ * (q = RN(a·y); r = a − b·q, exact in one fused multiply-add; RN(q + r·y) = RN(a/b) when no
+ * step overflows or underflows, which holds for every decode here), so one true division serves
+ * three quotients. The FMAs are only those of that correction: the definition's own products and
+ * sums stay unfused (contraction is off).
+ *
+ * Encoding (texel_encode_fast) computes the bytes that need the encoder's double sums, division
+ * and square roots (the direction and the ambient ratio) in float, with an error below 3e-4 of a
+ * byte code (derived at texel_encode_fast), and keeps a byte only when
+ * its value lies farther than NEAR_MARGIN from a rounding boundary; a group of 8 with a lane
+ * nearer than that goes through the operation-by-operation encoder (texel_encode). So the bytes
+ * are the definition's, and the slow encoder runs for about 1 group in 150 on the benchmark level. */
 #include "dls_kernel.h"
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -19,12 +31,13 @@ const dls_kernels *dls_kernels_avx2(void) { return 0; }
 #include "internal.h"
 #include "lbk/ahd.h"
 #include "lbk/pixel.h"
+#include "lbk/sh.h"
 
 #if defined(__clang__)
-#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
+#pragma clang attribute push(__attribute__((target("avx2,fma"))), apply_to = function)
 #else
 #pragma GCC push_options
-#pragma GCC target("avx2")
+#pragma GCC target("avx2,fma")
 #endif
 #include <immintrin.h>
 
@@ -44,33 +57,19 @@ INL vf dvd(vf a, vf b) { return _mm256_div_ps(a, b); }
 INL vf sel(vf mask, vf yes, vf no) { return _mm256_blendv_ps(no, yes, mask); }
 INL vf gt(vf a, vf b) { return _mm256_cmp_ps(a, b, _CMP_GT_OQ); }
 
-/* fl32(n / d) for small integers n and an odd d, without a division or a gather: n · fl64(1/d)
- * is within 2^-52 (relative) of n/d, and n/d is either a float (only when d divides n: the callers
- * blend those cases in, so the rounding mode cannot matter) or at least 2^-32 (relative) away from
- * every float and from every point halfway between two (d odd divides n·2^k only if it divides n),
- * so the one rounding to float gives the correctly rounded quotient, as the scalar division does. */
-INL vf ratio(vi n, double recip)
+/* RN(a / b) from y = RN(1 / b), by Markstein's correction (see the top of the file). */
+INL vf quot(vf a, vf b, vf y)
 {
-    const vd r = _mm256_set1_pd(recip);
-    const vd lo = _mm256_mul_pd(_mm256_cvtepi32_pd(_mm256_castsi256_si128(n)), r);
-    const vd hi = _mm256_mul_pd(_mm256_cvtepi32_pd(_mm256_extracti128_si256(n, 1)), r);
-    return _mm256_set_m128(_mm256_cvtpd_ps(hi), _mm256_cvtpd_ps(lo));
+    const vf q = mul(a, y);
+    return _mm256_fmadd_ps(_mm256_fnmadd_ps(q, b, a), y, q);
 }
-INL vf when(vi n, int v, float x, vf q) { return sel(_mm256_castsi256_ps(_mm256_cmpeq_epi32(n, iset(v))), fset(x), q); }
+INL vf quot_by(vi n, float b) { return quot(_mm256_cvtepi32_ps(n), fset(b), fset(1.0f / b)); }
 /* lbk_unorm8_to_float: c/255 */
-INL vf unorm_f(vi c) { return when(c, 255, 1.0f, ratio(c, 1.0 / 255.0)); }
+INL vf unorm_f(vi c) { return quot_by(c, 255.0f); }
 /* decode_direction's x and y: 2c/255 − 1 */
-INL vf dir_f(vi c)
-{
-    const vi c2 = _mm256_add_epi32(c, c);
-    return sub(when(c2, 510, 2.0f, ratio(c2, 1.0 / 255.0)), fset(1.0f));
-}
+INL vf dir_f(vi c) { return sub(quot_by(_mm256_add_epi32(c, c), 255.0f), fset(1.0f)); }
 /* lbk_snorm8_to_float: max(q/127, −1) for the signed byte q */
-INL vf snorm_f(vi q)
-{
-    const vf v = when(q, 127, 1.0f, when(q, -127, -1.0f, ratio(q, 1.0 / 127.0)));
-    return _mm256_max_ps(v, fset(-1.0f));
-}
+INL vf snorm_f(vi q) { return _mm256_max_ps(quot_by(q, 127.0f), fset(-1.0f)); }
 INL vi byte_at(vi w, int i) { return _mm256_and_si256(_mm256_srli_epi32(w, 8 * i), iset(0xff)); }
 
 /* The two halves of 8 floats as doubles, and 8 doubles back to floats (rounded as (float)x). */
@@ -142,9 +141,10 @@ INL void direction(vi rgba, vf d[3], vf *k)
     const vf z = unorm_f(_mm256_srli_epi32(rgba, 24));
     const vf len = _mm256_sqrt_ps(add(add(mul(x, x), mul(y, y)), mul(z, z)));
     const vf shortv = _mm256_cmp_ps(len, fset(0.5f), _CMP_LT_OQ);
-    d[0] = sel(shortv, _mm256_setzero_ps(), dvd(x, len));
-    d[1] = sel(shortv, _mm256_setzero_ps(), dvd(y, len));
-    d[2] = sel(shortv, fset(1.0f), dvd(z, len));
+    const vf inv = dvd(fset(1.0f), len); /* len ≥ 1/255: x, y are odd multiples of 1/255 */
+    d[0] = sel(shortv, _mm256_setzero_ps(), quot(x, len, inv));
+    d[1] = sel(shortv, _mm256_setzero_ps(), quot(y, len, inv));
+    d[2] = sel(shortv, fset(1.0f), quot(z, len, inv));
     *k = add(fset(0.25f), mul(fset(0.5f), d[2]));
 }
 
@@ -158,9 +158,10 @@ INL void texel_decode(vi z, vi rgba, lin8 *out)
     const vf e[3] = {uf_decode(_mm256_and_si256(z, iset(0x7ff)), 6),
                      uf_decode(_mm256_and_si256(_mm256_srli_epi32(z, 11), iset(0x7ff)), 6),
                      uf_decode(_mm256_srli_epi32(z, 22), 5)};
+    const vf inv_k = dvd(fset(1.0f), k); /* k ∈ [1/4, 3/4] */
     for (int c = 0; c < 3; c++) {
         const vf amb = mul(r, e[c]);
-        const vf inten = dvd(mul(one_r, e[c]), k);
+        const vf inten = quot(mul(one_r, e[c]), k, inv_k);
         out->c[c][0] = add(amb, mul(fset(0.25f), inten));
         const vf h = mul(fset(0.5f), inten);
         for (int i = 0; i < 3; i++) out->c[c][1 + i] = mul(h, d[i]);
@@ -257,6 +258,105 @@ INL void texel_encode(const lin8 *lin, vi *z_out, vi *rgba_out)
                              _mm256_or_si256(_mm256_slli_epi32(uf_encode(ez[1], 6), 11), _mm256_slli_epi32(uf_encode(ez[2], 5), 22)));
 }
 
+/* Byte codes from values v within 3e-4 of the exact ones: rne(v) clamped to [0, 255]; a lane whose
+ * v lies within NEAR_MARGIN of a half-integer (or is NaN) is marked in *near. */
+#define NEAR_MARGIN 0x1p-11f
+INL vi byte_of(vf v, vf *near)
+{
+    const vf r = _mm256_round_ps(v, RNE);
+    const vf dist = _mm256_andnot_ps(fset(-0.0f), sub(v, r));
+    *near = _mm256_or_ps(*near, _mm256_cmp_ps(dist, fset(0.5f - NEAR_MARGIN), _CMP_NLE_UQ));
+    return _mm256_cvtps_epi32(_mm256_min_ps(_mm256_max_ps(r, _mm256_setzero_ps()), fset(255.0f)));
+}
+
+INL vf fabs8(vf x) { return _mm256_andnot_ps(fset(-0.0f), x); }
+
+/* lbk_ahd_from_linear for inputs that need no sanitising, in float, returning the lanes whose
+ * bytes must come from texel_encode instead (bit i: lane i). Only the direction and ratio bytes
+ * are approximations; d, k, the Ez words and the ambient terms are the definition's own float
+ * operations on the direction bytes.
+ *
+ * The bounds (u = 2^−24). Direction: the exact code forms s = Σ_c lum_c g_c in double (error
+ * ~2^−52 of A = Σ_i Σ_c |lum_c g_ci|), divides by |s| (or |s_xy| when s.z < 0), rounds (dir + 1)/2
+ * to float (2^−25) and codes rne(255·x); z: rne(255·fl32(dir.z)). Here s is summed in float
+ * (|error| ≤ γ3·A), and a lane goes on only if A ≤ 2·|s|, so the float s is within 6u·|s| of the
+ * true one and its direction within 12u; |s|² in float, its square root, the reciprocal and the
+ * product add 4.5u. So v = fl(fl(d + 1)·127.5) is within 127.5·(12u + 4.5u + u) + 2^−17 < 1.5e-4
+ * of 127.5·(1 + s/|s|) and the exact code's value within 255·2^−25 of that: < 1.6e-4 apart; z
+ * (255·d.z): < 255·16.5u + 2^−17 + 255·2^−25 < 2.7e-4. The sign of s.z decides the branch: a lane
+ * with |s.z| ≤ 4u·A_z is left to texel_encode. s = 0 exactly (A = 0, or every product below
+ * 2^−149: then |s| < 1e-30 too) is the exact (0, 0, 1). Ratio: a and e are sums of non-negative
+ * terms, each within γ3 relative in float; with the division (u) and the product by 255 (2^−17)
+ * and the exact code's float rounding (255·2^−25): < 255·7u + 2^−17 + 255·2^−25 < 1.2e-4 (a lane
+ * with e < 2^−100 is left to texel_encode, so float underflow of a is negligible). All are below
+ * NEAR_MARGIN = 2^−11 = 4.9e-4, so a value farther than that from a half-integer gives the byte
+ * of the exact code. */
+INL uint32_t texel_encode_fast(const lin8 *lin, vi *z_out, vi *rgba_out)
+{
+    const vf *g[3] = {&lin->c[0][1], &lin->c[1][1], &lin->c[2][1]};
+    const vf lw[3] = {fset(LBK_LUM_R), fset(LBK_LUM_G), fset(LBK_LUM_B)};
+    vf sv[3], A[3];
+    for (int i = 0; i < 3; i++) {
+        sv[i] = add(add(mul(lw[0], g[0][i]), mul(lw[1], g[1][i])), mul(lw[2], g[2][i]));
+        A[i] = add(add(mul(lw[0], fabs8(g[0][i])), mul(lw[1], fabs8(g[1][i]))), mul(lw[2], fabs8(g[2][i])));
+    }
+    const vf zero = _mm256_setzero_ps(), all = add(add(A[0], A[1]), A[2]);
+    const vf up = _mm256_cmp_ps(sv[2], zero, _CMP_GE_OQ);
+    const vf xy = add(mul(sv[0], sv[0]), mul(sv[1], sv[1]));
+    const vf den2 = sel(up, add(xy, mul(sv[2], sv[2])), xy);
+    const vf den = _mm256_sqrt_ps(den2);
+    const vf none = _mm256_cmp_ps(all, zero, _CMP_EQ_OQ); /* s = 0: the exact (0, 0, 1) */
+    vf near = _mm256_cmp_ps(all, mul(den, fset(2.0f)), _CMP_NLE_UQ);
+    near = _mm256_or_ps(near, _mm256_cmp_ps(den2, fset(0x1p-120f), _CMP_NGE_UQ));
+    near = _mm256_or_ps(near, _mm256_cmp_ps(den2, fset(0x1p120f), _CMP_NLE_UQ));
+    near = _mm256_or_ps(near, _mm256_cmp_ps(fabs8(sv[2]), mul(A[2], fset(0x1p-22f)), _CMP_LE_OQ));
+    const vf inv = dvd(fset(1.0f), den);
+    const vi q0 = byte_of(mul(add(mul(sv[0], inv), fset(1.0f)), fset(127.5f)), &near);
+    const vi q1 = byte_of(mul(add(mul(sv[1], inv), fset(1.0f)), fset(127.5f)), &near);
+    vf near_z = zero;
+    const vi q2 = _mm256_and_si256(byte_of(mul(mul(sv[2], inv), fset(255.0f)), &near_z), _mm256_castps_si256(up));
+    near = _mm256_andnot_ps(none, _mm256_or_ps(near, _mm256_and_ps(near_z, up)));
+    vi rgba = _mm256_or_si256(_mm256_slli_epi32(q0, 8), _mm256_or_si256(_mm256_slli_epi32(q1, 16), _mm256_slli_epi32(q2, 24)));
+    rgba = _mm256_castps_si256(sel(none, _mm256_castsi256_ps(iset((int)0xFF808000u)), _mm256_castsi256_ps(rgba)));
+    vf d[3], k;
+    direction(rgba, d, &k);
+    vf a[3], ez[3];
+    for (int c = 0; c < 3; c++) {
+        const vf gd = add(add(mul(g[c][0], d[0]), mul(g[c][1], d[1])), mul(g[c][2], d[2]));
+        const vf inten = _mm256_and_ps(gt(gd, zero), mul(fset(2.0f), gd));
+        const vf amb = sub(lin->c[c][0], mul(fset(0.25f), inten));
+        a[c] = _mm256_and_ps(gt(amb, zero), amb);
+        ez[c] = add(a[c], mul(inten, k));
+    }
+    const vf la = add(add(mul(lw[0], a[0]), mul(lw[1], a[1])), mul(lw[2], a[2]));
+    const vf le = add(add(mul(lw[0], ez[0]), mul(lw[1], ez[1])), mul(lw[2], ez[2]));
+    /* the exact code's e > 0 (double, exact products): some ez_c > 0 */
+    const vf lit = _mm256_cmp_ps(_mm256_max_ps(_mm256_max_ps(ez[0], ez[1]), ez[2]), zero, _CMP_GT_OQ);
+    vf near_r = _mm256_cmp_ps(le, fset(0x1p-100f), _CMP_LT_OQ);
+    const vi ratio = byte_of(mul(dvd(la, le), fset(255.0f)), &near_r);
+    near = _mm256_or_ps(near, _mm256_and_ps(near_r, lit));
+    const vi r = _mm256_castps_si256(sel(lit, _mm256_castsi256_ps(ratio), _mm256_castsi256_ps(iset(255))));
+    *rgba_out = _mm256_or_si256(rgba, r);
+    *z_out = _mm256_or_si256(uf_encode(ez[0], 6),
+                             _mm256_or_si256(_mm256_slli_epi32(uf_encode(ez[1], 6), 11), _mm256_slli_epi32(uf_encode(ez[2], 5), 22)));
+    return (uint32_t)_mm256_movemask_ps(near);
+}
+
+/* Components at most 1e30 in magnitude and no NaN: what lbk_ahd_from_linear's sanitize leaves as it is. */
+INL int texel_clean(const lin8 *lin)
+{
+    vi big = _mm256_setzero_si256();
+    for (int c = 0; c < 3; c++)
+        for (int i = 0; i < 4; i++) big = _mm256_max_epu32(big, _mm256_and_si256(_mm256_castps_si256(lin->c[c][i]), iset(0x7fffffff)));
+    return _mm256_testz_si256(_mm256_cmpgt_epi32(big, iset(0x7149F2CA)), iset(-1)); /* bits of 1e30f */
+}
+
+/* lbk_ahd_from_linear of 8 lanes: the fast encoder, the exact one where it cannot decide. */
+INL void texel_encode8(const lin8 *lin, vi *z, vi *rgba)
+{
+    if (!texel_clean(lin) || texel_encode_fast(lin, z, rgba)) texel_encode(lin, z, rgba);
+}
+
 /* ---- the texel kernels ------------------------------------------------------------------- */
 
 INL vi load8(const uint8_t *p) { return _mm256_loadu_si256((const __m256i *)(const void *)p); }
@@ -269,6 +369,15 @@ INL void texel_entries(const uint8_t *first, vi index, vi *z, vi *rgba)
     *rgba = _mm256_i32gather_epi32((const int *)(const void *)(first + 4), index, 4);
 }
 
+/* The entries of 8 consecutive targets with one entry each: 64 contiguous bytes, split into the
+ * Ez and RGBA words by shuffles instead of two gathers. */
+INL void texel_entries_packed(const uint8_t *first, vi *z, vi *rgba)
+{
+    const vf a = _mm256_castsi256_ps(load8(first)), b = _mm256_castsi256_ps(load8(first + 32));
+    *z = _mm256_permute4x64_epi64(_mm256_castps_si256(_mm256_shuffle_ps(a, b, _MM_SHUFFLE(2, 0, 2, 0))), _MM_SHUFFLE(3, 1, 2, 0));
+    *rgba = _mm256_permute4x64_epi64(_mm256_castps_si256(_mm256_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1))), _MM_SHUFFLE(3, 1, 2, 0));
+}
+
 /* Eight targets from SoA buffers; n ≤ 8 valid lanes (the others compute on copies). */
 INL void texel8(const uint8_t *bz, const uint8_t *brgba, uint8_t *oz, uint8_t *orgba,
                 const uint8_t *entries, vi index, uint32_t stride, uint32_t m, const uint32_t *idx, const float *w)
@@ -277,15 +386,15 @@ INL void texel8(const uint8_t *bz, const uint8_t *brgba, uint8_t *oz, uint8_t *o
     texel_decode(load8(bz), load8(brgba), &acc);
     for (uint32_t j = 0; j < m; j++) {
         vi ez, erg;
-        texel_entries(entries + (size_t)idx[j] * LBK_DLS_TEXEL_PAYLOAD, index, &ez, &erg);
+        if (stride == 1) texel_entries_packed(entries, &ez, &erg); /* then m = 1 and idx[0] = 0 */
+        else texel_entries(entries + (size_t)idx[j] * LBK_DLS_TEXEL_PAYLOAD, index, &ez, &erg);
         texel_decode(ez, erg, &l);
         texel_accumulate(&acc, &l, fset(w[j]));
     }
     vi z, rgba;
-    texel_encode(&acc, &z, &rgba);
+    texel_encode8(&acc, &z, &rgba);
     store8(oz, z);
     store8(orgba, rgba);
-    (void)stride;
 }
 
 static void texels(const dls_batch *b)
@@ -308,7 +417,7 @@ static void texels(const dls_batch *b)
     }
     const vi tail_index = _mm256_mullo_epi32(_mm256_min_epi32(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), iset((int)n - 1)),
                                              iset((int)words));
-    texel8(bz, brgba, oz, orgba, b->entries + (t / 8) * step, tail_index, b->stride, b->m, b->idx, b->w);
+    texel8(bz, brgba, oz, orgba, b->entries + (t / 8) * step, tail_index, 0, b->m, b->idx, b->w); /* 0: gather */
     memcpy(b->out0 + 4 * (size_t)t, oz, 4 * (size_t)n);
     memcpy(b->out1 + 4 * (size_t)t, orgba, 4 * (size_t)n);
 }
@@ -475,7 +584,7 @@ static void texels_var(const dls_var_batch *b)
             texel_accumulate(&acc, &l, _mm256_loadu_ps(wl));
         }
         vi z, rgba;
-        texel_encode(&acc, &z, &rgba);
+        texel_encode8(&acc, &z, &rgba);
         store8(oz, z);
         store8(orgba, rgba);
         for (uint32_t i = 0; i < n; i++) {
@@ -529,6 +638,56 @@ static void probes_var(const dls_var_batch *b)
     }
 }
 
+/* ---- the codecs alone (tests) -------------------------------------------------------------- */
+
+static void texel_decode_n(const uint32_t *z, const uint32_t *rgba, uint32_t count, lbk_ahd_linear *out)
+{
+    for (uint32_t t = 0; t < count; t += 8) {
+        const uint32_t n = count - t < 8 ? count - t : 8;
+        uint32_t bz[8], brgba[8];
+        float lanes[12][8];
+        for (uint32_t i = 0; i < 8; i++) bz[i] = z[t + (i < n ? i : n - 1)], brgba[i] = rgba[t + (i < n ? i : n - 1)];
+        lin8 l;
+        texel_decode(load8((const uint8_t *)bz), load8((const uint8_t *)brgba), &l);
+        for (int c = 0; c < 12; c++) _mm256_storeu_ps(lanes[c], l.c[c / 4][c % 4]);
+        for (uint32_t i = 0; i < n; i++)
+            for (int c = 0; c < 12; c++) out[t + i].c[c / 4][c % 4] = lanes[c][i];
+    }
+}
+
+static void texel_encode_n(const lbk_ahd_linear *in, uint32_t count, uint32_t *z, uint32_t *rgba)
+{
+    for (uint32_t t = 0; t < count; t += 8) {
+        const uint32_t n = count - t < 8 ? count - t : 8;
+        float lanes[12][8];
+        for (uint32_t i = 0; i < 8; i++)
+            for (int c = 0; c < 12; c++) lanes[c][i] = in[t + (i < n ? i : n - 1)].c[c / 4][c % 4];
+        lin8 l;
+        for (int c = 0; c < 12; c++) l.c[c / 4][c % 4] = _mm256_loadu_ps(lanes[c]);
+        vi vz, vrgba;
+        uint32_t oz[8], orgba[8];
+        texel_encode8(&l, &vz, &vrgba);
+        store8((uint8_t *)oz, vz), store8((uint8_t *)orgba, vrgba);
+        memcpy(z + t, oz, 4 * (size_t)n), memcpy(rgba + t, orgba, 4 * (size_t)n);
+    }
+}
+
+static void probe_decode_n(const uint8_t *p, uint32_t count, lbk_sh9_rgb *out)
+{
+    const vi lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    for (uint32_t t = 0; t < count; t += 8) {
+        const uint32_t n = count - t < 8 ? count - t : 8;
+        vi w[7];
+        sh8 l;
+        float lanes[27][8];
+        probe_gather(p + LBK_DLS_PROBE_PAYLOAD * (size_t)t, _mm256_mullo_epi32(_mm256_min_epi32(lane, iset((int)n - 1)), iset(7)), w);
+        probe_decode(w, &l);
+        for (int c = 0; c < 27; c++) _mm256_storeu_ps(lanes[c], l.c[c / 9][c % 9]);
+        for (uint32_t i = 0; i < n; i++)
+            for (int c = 0; c < 27; c++) out[t + i].c[c / 9][c % 9] = lanes[c][i];
+    }
+}
+
 #if defined(__clang__)
 #pragma clang attribute pop
 #else
@@ -537,8 +696,8 @@ static void probes_var(const dls_var_batch *b)
 
 const dls_kernels *dls_kernels_avx2(void)
 {
-    static const dls_kernels k = {"avx2", texels, probes, texels_var, probes_var};
+    static const dls_kernels k = {"avx2", texels, probes, texels_var, probes_var, texel_decode_n, texel_encode_n, probe_decode_n};
     __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2") ? &k : 0;
+    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") ? &k : 0;
 }
 #endif

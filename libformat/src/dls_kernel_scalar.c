@@ -108,8 +108,32 @@ static void probes_var(const dls_var_batch *b)
     }
 }
 
+static void texel_decode(const uint32_t *z, const uint32_t *rgba, uint32_t count, lbk_ahd_linear *out)
+{
+    for (uint32_t t = 0; t < count; t++) {
+        lbk_ahd_texel x = {.irradiance_z = z[t]};
+        memcpy(x.rgba, &rgba[t], 4);
+        lbk_ahd_to_linear(&x, &out[t]);
+    }
+}
+
+static void texel_encode(const lbk_ahd_linear *in, uint32_t count, uint32_t *z, uint32_t *rgba)
+{
+    for (uint32_t t = 0; t < count; t++) {
+        lbk_ahd_texel x;
+        lbk_ahd_from_linear(&in[t], &x);
+        z[t] = x.irradiance_z;
+        memcpy(&rgba[t], x.rgba, 4);
+    }
+}
+
+static void probe_decode(const uint8_t *p, uint32_t count, lbk_sh9_rgb *out)
+{
+    for (uint32_t t = 0; t < count; t++) lbk_sh9_unpack(p + LBK_DLS_PROBE_PAYLOAD * (size_t)t, &out[t]);
+}
+
 const dls_kernels *dls_kernels_scalar(void)
 {
-    static const dls_kernels k = {"scalar", texels, probes, texels_var, probes_var};
+    static const dls_kernels k = {"scalar", texels, probes, texels_var, probes_var, texel_decode, texel_encode, probe_decode};
     return &k;
 }

@@ -198,6 +198,14 @@ static void test_desc_rules(void **state)
     d.sky[1] = -1;
     expect_fail(&l.scene, &d, &s, LBK_ERR_INVALID_ARGUMENT, "sky");
     d = quick(&s);
+    d.size = sizeof d; /* (size 0 is version 1, which has no culling fields) */
+    d.light_culling = 2;
+    expect_fail(&l.scene, &d, &s, LBK_ERR_INVALID_ARGUMENT, "light_culling: 2");
+    d = quick(&s);
+    d.size = sizeof d;
+    d.light_culling_delta = NAN;
+    expect_fail(&l.scene, &d, &s, LBK_ERR_INVALID_ARGUMENT, "light_culling_delta");
+    d = quick(&s);
     d.size = 2; /* not even its own size field: nothing in it can be read, no message */
     lbk_bake_output *out = NULL;
     assert_int_equal(lbk_bake_from_scene(&l.scene, &d, &out), LBK_ERR_INVALID_ARGUMENT);

@@ -3,7 +3,12 @@
  * exponent-31 code, short and zero directions, denormal R11G11B10F and RGB9E5 codes included), on
  * weights from 1e-30 to 3e38 of both signs (so sums overflow to ±Inf and NaN and take the
  * encoder's sanitising branches), on every count of targets modulo 8, for the fixed and the
- * variable (prefix form) batches, and on every (G, B) direction byte pair for every fourth A byte. */
+ * variable (prefix form) batches, and on every (G, B) direction byte pair for every fourth A byte.
+ * The codecs alone: the SIMD decode gives the scalar floats bit for bit on every (G, B, A) byte
+ * triple (with every R byte and R11G11B10F code along), and every probe byte value; the SIMD
+ * encode, whose fast path decides bytes from float approximations, gives the scalar bytes on
+ * inputs placed at the exact points where a byte of the scalar encoder changes (found by
+ * bisection), where an approximation that strayed past its bound would show. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -18,6 +23,7 @@
 
 #include "lbk/ahd.h"
 #include "lbk/dls.h"
+#include "lbk/sh.h"
 #include "libformat/src/dls_kernel.h"
 #include "support/dls_fixture.h"
 
@@ -177,12 +183,173 @@ static void test_every_direction_byte(void **state)
     free(b0), free(b1), free(entries), free(o0[0]), free(o0[1]), free(o1[0]), free(o1[1]);
 }
 
+/* Every (G, B, A) triple, R and each R11G11B10F channel's codes cycling along: the decoded floats. */
+static void test_decode_every_direction(void **state)
+{
+    (void)state;
+    const dls_kernels *v = simd();
+    const uint32_t chunk = 1u << 16;
+    uint32_t *z = malloc(chunk * 4), *rgba = malloc(chunk * 4);
+    lbk_ahd_linear *l[2] = {malloc(chunk * sizeof(lbk_ahd_linear)), malloc(chunk * sizeof(lbk_ahd_linear))};
+    for (uint32_t a = 0; a < 256; a++) {
+        for (uint32_t i = 0; i < chunk; i++) {
+            const uint32_t n = a * chunk + i;
+            rgba[i] = (n * 37u & 0xff) | (i << 8) | (a << 24);
+            z[i] = (n & 0x7ff) | ((n * 7u >> 3 & 0x7ff) << 11) | ((n * 13u >> 5 & 0x3ff) << 22);
+        }
+        dls_kernels_scalar()->texel_decode(z, rgba, chunk, l[0]);
+        v->texel_decode(z, rgba, chunk, l[1]);
+        if (memcmp(l[0], l[1], chunk * sizeof(lbk_ahd_linear))) {
+            for (uint32_t i = 0; i < chunk; i++)
+                if (memcmp(&l[0][i], &l[1][i], sizeof(lbk_ahd_linear)))
+                    fail_msg("z %08x rgba %08x: scalar c0 %a %a, %s %a %a", z[i], rgba[i], l[0][i].c[0][0], l[0][i].c[0][1],
+                             v->name, l[1][i].c[0][0], l[1][i].c[0][1]);
+        }
+    }
+    free(z), free(rgba), free(l[0]), free(l[1]);
+}
+
+/* Every byte value in every SH byte of a probe, RGB9E5 words random (every exponent). */
+static void test_probe_decode_every_byte(void **state)
+{
+    (void)state;
+    const dls_kernels *v = simd();
+    enum { N = 256 * 8 };
+    uint8_t *p = malloc(N * 28);
+    lbk_sh9_rgb *l[2] = {malloc(N * sizeof(lbk_sh9_rgb)), malloc(N * sizeof(lbk_sh9_rgb))};
+    uint64_t rng = 5;
+    for (uint32_t i = 0; i < N; i++) {
+        random_bytes(&rng, p + 28 * i, 4);
+        for (int b = 4; b < 28; b++) p[28 * i + b] = (uint8_t)(i / 8 + (uint32_t)b * (i % 8));
+    }
+    dls_kernels_scalar()->probe_decode(p, N, l[0]);
+    v->probe_decode(p, N, l[1]);
+    assert_memory_equal(l[0], l[1], N * sizeof(lbk_sh9_rgb));
+    free(p), free(l[0]), free(l[1]);
+}
+
+static uint64_t encode1(const lbk_ahd_linear *in)
+{
+    uint32_t z, rgba;
+    dls_kernels_scalar()->texel_encode(in, 1, &z, &rgba);
+    return (uint64_t)z | (uint64_t)rgba << 32;
+}
+
+/* Float x moved by `ulps` representable values (through zero, skipping −0). */
+static float step_float(float x, int ulps)
+{
+    int32_t i;
+    memcpy(&i, &x, 4);
+    int64_t o = i < 0 ? -(int64_t)(i & 0x7fffffff) : i; /* ordered */
+    o += ulps;
+    i = o < 0 ? (int32_t)(0x80000000u | (uint32_t)-o) : (int32_t)o;
+    memcpy(&x, &i, 4);
+    return x;
+}
+
+typedef struct probe_list {
+    lbk_ahd_linear *v;
+    size_t n, cap;
+} probe_list;
+
+static void push(probe_list *l, const lbk_ahd_linear *x)
+{
+    if (l->n == l->cap) {
+        l->cap = l->cap ? 2 * l->cap : 4096;
+        l->v = realloc(l->v, l->cap * sizeof *l->v);
+    }
+    l->v[l->n++] = *x;
+}
+
+/* Component `comp` (channel comp / 4, term comp % 4) of x swept over [lo, hi] on a grid; at each grid step where the scalar bytes
+ * change, the two adjacent floats where they change (bisection), and 3 floats either side. */
+static void boundaries(lbk_ahd_linear x, int comp, float lo, float hi, int grid, probe_list *out)
+{
+    float *p = &x.c[comp / 4][comp % 4];
+    float prev = lo;
+    *p = lo;
+    uint64_t eprev = encode1(&x);
+    for (int gi = 1; gi <= grid; gi++) {
+        float cur = lo + (hi - lo) * (float)gi / (float)grid;
+        *p = cur;
+        const uint64_t ecur = encode1(&x);
+        if (ecur != eprev) {
+            float a = prev, b = cur; /* encode(a) != encode(b) */
+            *p = a;
+            const uint64_t ea = encode1(&x);
+            for (int it = 0; it < 64 && step_float(a, 1) != b; it++) {
+                const float m = a + (b - a) * 0.5f;
+                if (m == a || m == b) break;
+                *p = m;
+                if (encode1(&x) == ea) a = m;
+                else b = m;
+            }
+            for (int d = -3; d <= 3; d++) {
+                *p = step_float(a, d);
+                push(out, &x);
+                *p = step_float(b, d);
+                push(out, &x);
+            }
+        }
+        prev = cur, eprev = ecur;
+    }
+}
+
+static void test_encode_at_boundaries(void **state)
+{
+    (void)state;
+    const dls_kernels *v = simd();
+    uint64_t rng = 21;
+    probe_list pl = {0};
+    for (int trial = 0; trial < 40; trial++) {
+        lbk_ahd_linear x;
+        const float scale = ldexpf(1.0f, (int)(dlsfx_rand(&rng) % 30) - 15);
+        for (int c = 0; c < 3; c++) {
+            x.c[c][0] = scale * (0.2f + dlsfx_uniform(&rng));
+            for (int i = 1; i < 4; i++) x.c[c][i] = scale * (dlsfx_uniform(&rng) - 0.5f) * 0.5f;
+        }
+        for (int comp = 0; comp < 12; comp++) { /* every component, every channel */
+            const float lo = comp % 4 ? -scale : 0.0f, hi = comp % 4 ? scale : 2.0f * scale;
+            boundaries(x, comp, lo, hi, 96, &pl);
+        }
+    }
+    /* the encoder's special directions: s = 0 (no gradient), s.z exactly 0, s.z ∓ a denormal,
+     * s below 1e-30, cancelling channels (the float sums' error bound fails) */
+    static const float gz[] = {0.0f, 1e-45f, -1e-45f, 1e-38f, -1e-38f, 1e-31f, -1e-31f, 1e-3f, -1e-3f};
+    for (int trial = 0; trial < 64; trial++) {
+        lbk_ahd_linear x;
+        const float e0 = ldexpf(1.0f, trial % 16 - 8) * (1.0f + dlsfx_uniform(&rng));
+        const float gx = trial & 1 ? 0.0f : e0 * (dlsfx_uniform(&rng) - 0.5f);
+        for (size_t q = 0; q < sizeof gz / sizeof gz[0]; q++) {
+            for (int c = 0; c < 3; c++) {
+                x.c[c][0] = e0;
+                x.c[c][1] = c == 0 || !(trial & 2) ? gx : -gx * LBK_LUM_R / LBK_LUM_G; /* 2: R and G cancel */
+                x.c[c][2] = trial & 4 ? gx : 0.0f;
+                x.c[c][3] = gz[q];
+            }
+            push(&pl, &x);
+        }
+    }
+    uint32_t *z[2] = {malloc(pl.n * 4), malloc(pl.n * 4)}, *rgba[2] = {malloc(pl.n * 4), malloc(pl.n * 4)};
+    dls_kernels_scalar()->texel_encode(pl.v, (uint32_t)pl.n, z[0], rgba[0]);
+    v->texel_encode(pl.v, (uint32_t)pl.n, z[1], rgba[1]);
+    print_message("%zu inputs at byte boundaries\n", pl.n);
+    assert_true(pl.n > 20000);
+    for (size_t i = 0; i < pl.n; i++)
+        if (z[0][i] != z[1][i] || rgba[0][i] != rgba[1][i])
+            fail_msg("input %zu: scalar %08x/%08x, %s %08x/%08x", i, z[0][i], rgba[0][i], v->name, z[1][i], rgba[1][i]);
+    free(pl.v), free(z[0]), free(z[1]), free(rgba[0]), free(rgba[1]);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_fixed_batches),
         cmocka_unit_test(test_variable_batches),
         cmocka_unit_test(test_every_direction_byte),
+        cmocka_unit_test(test_decode_every_direction),
+        cmocka_unit_test(test_probe_decode_every_byte),
+        cmocka_unit_test(test_encode_at_boundaries),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

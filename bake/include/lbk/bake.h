@@ -164,6 +164,12 @@ typedef struct lbk_bake_desc {
                                    target_error or a larger max_samples adds passes) [0: a fresh
                                    bake, checkpoints of an earlier one in the folder removed] */
     /* added in 1.3 */
+    int light_culling;          /* stochastic light culling of punctual lights
+                                   (bake/transport/SLC.md): 1 on, -1 off [0: auto, on with more
+                                   than 32 positional lights in a run] */
+    double light_culling_delta; /* culling's δ relative to the mean punctual irradiance at the
+                                   receivers (smaller: more lights per receiver, less noise)
+                                   [0: 0.1] */
     /* The files the bake must read, byte for byte (lbk_bake_inputs_from_file's list, e.g. from a
      * distributed bake's plan): a bake whose import reads other files, or one with other bytes,
      * fails with LBK_ERR_BAD_INPUT naming it, before any light is traced [NULL: no check] */

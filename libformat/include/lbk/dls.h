@@ -357,8 +357,8 @@ struct lbk_dls_stats {
 
 LBK_API lbk_result lbk_dls_stats_get(const lbk_dls_view *view, lbk_dls_stats *out);
 
-/* The path lbk_dls_apply computes with: "scalar" or "avx2" (chosen at open from the CPU and
- * LBK_DLS_RUNTIME_SCALAR; every path writes the same bytes). */
+/* The path lbk_dls_apply computes with: "scalar" or "avx2" (AVX2 with FMA; chosen at open from
+ * the CPU and LBK_DLS_RUNTIME_SCALAR; every path writes the same bytes). */
 LBK_API const char *lbk_dls_runtime_path(const lbk_dls_runtime *runtime);
 
 #ifdef __cplusplus
