@@ -530,6 +530,7 @@ static lbk_result slc_draw(const tp_ctx *c, int dom, int h, int pass, const bk_s
  * hit is near too) plus one punctual light picked uniformly. An unbiased estimate of the
  * reflected radiance at the point given the cache beyond it (TRANSPORT.md §Bias). */
 #define TP_NEAR_CELLS 1.5   /* continue when the hit is closer than this many cell sizes */
+#define TP_NEAR_INSET 1e-4  /* barycentric inset of a continuation's point from its triangle's edges */
 #define TP_NEAR_DEPTH 24    /* continuations in a row before the cache is read anyway (TRANSPORT.md: 3 left the Cornell light gap 15-25 % dark) */
 
 static int near_hit(const tp_ctx *c, const bk_hit *h, long hc, const uint8_t *rough)
@@ -636,7 +637,15 @@ static void near_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, 
     const tp_cell *cell = &c->cells[hc];
     double v[3][3], x[3];
     tri_vertices(c, hit->tri, v);
-    for (int a = 0; a < 3; a++) x[a] = (1.0 - hit->u - hit->v) * v[0][a] + hit->u * v[1][a] + hit->v * v[2][a];
+    /* the point a hair inside its triangle: a hit on an edge where another surface meets it (a
+     * box's corner) rounds to either side, and from the far side of that surface the
+     * continuation starts behind it (in a furnace box it then saw the walls' backs: black) */
+    double hu = fmax(hit->u, TP_NEAR_INSET), hv = fmax(hit->v, TP_NEAR_INSET);
+    if (hu + hv > 1 - TP_NEAR_INSET) {
+        double k = (1 - TP_NEAR_INSET) / (hu + hv);
+        hu *= k, hv *= k;
+    }
+    for (int a = 0; a < 3; a++) x[a] = (1.0 - hu - hv) * v[0][a] + hu * v[1][a] + hv * v[2][a];
     double n[3] = {cell->n[0], cell->n[1], cell->n[2]}, t[3], b[3];
     bk_onb(n, t, b);
     float xf[3] = {(float)x[0], (float)x[1], (float)x[2]}, nf[3] = {cell->n[0], cell->n[1], cell->n[2]}, o[3];
