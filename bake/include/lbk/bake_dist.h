@@ -34,6 +34,8 @@ LBK_BAKE_API lbk_result lbk_bake_inputs_from_file(const char *path, const lbk_ba
 LBK_BAKE_API void lbk_bake_inputs_free(lbk_bake_input *inputs);
 
 /* What a part says about itself (lbk_bake_part_check). */
+/* Filled by the library, so frozen from now on (lbk.h): this is the layout of 1.3 (units by whole
+ * transport runs); 1.2's, without the run fields, was never in a release. */
 typedef struct lbk_bake_part_info {
     uint64_t plan_hash;
     uint32_t units, unit;
