@@ -114,7 +114,8 @@ static uint8_t *repaired(const uint8_t *data, size_t size)
     if (!p) abort();
     memcpy(p, data, size);
     uint64_t receivers = get64(p + 32) & (((uint64_t)1 << 40) - 1);
-    uint32_t runs = get32(p + 40) % 65536 + 1;
+    uint32_t runs = get32(p + 40); /* the input's own total_runs, kept: the records must match it */
+    if (runs == 0 || runs > 65536) runs = 1;
     put64(p + 16, plan_hash);
     put32(p + 24, 1);
     put32(p + 28, 0);
