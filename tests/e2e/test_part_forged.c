@@ -19,6 +19,7 @@
 
 #include "lbk/bake.h"
 #include "lbk/bake_dist.h"
+#include "lbk/byteorder.h"
 
 #define SCENE "tests/fuzz/part_scene.gltf"
 #define PLAN_HASH 0x70617274666f7267ull
@@ -49,16 +50,11 @@ static lbk_bake_desc desc(void)
     return d;
 }
 
-static void put64(uint8_t *p, uint64_t v)
-{
-    for (int k = 0; k < 8; k++) p[k] = (uint8_t)(v >> (8 * k));
-}
-
 /* What a forger does after changing the payload: the checksums made right again. */
 static void reseal(uint8_t *p, size_t n)
 {
-    put64(p + 72, XXH64(p + HEADER, n - HEADER, 0));
-    put64(p + 88, XXH64(p, 88, 0));
+    lbk_wr64(p + 72, XXH64(p + HEADER, n - HEADER, 0));
+    lbk_wr64(p + 88, XXH64(p, 88, 0));
 }
 
 static lbk_result merge(const void *part, size_t n)
@@ -128,8 +124,7 @@ static void test_negative_sample_count_refused(void **state)
 {
     unit *u = *state;
     uint8_t *p = forged(u);
-    double neg = -2.2e295;
-    memcpy(p + HEADER + RUN_HEADER + 8, &neg, 8); /* run 0, pass 0: samples_per_receiver */
+    lbk_wrf64(p + HEADER + RUN_HEADER + 8, -2.2e295); /* run 0, pass 0: samples_per_receiver */
     expect_refused(p, u->n);
 }
 
@@ -137,8 +132,7 @@ static void test_nan_accumulator_refused(void **state)
 {
     unit *u = *state;
     uint8_t *p = forged(u);
-    double nan = NAN;
-    memcpy(p + HEADER + RUN_HEADER + 64 + 8, &nan, 8); /* run 0, pass 0, receiver 0: x_acc of half 1 */
+    lbk_wrf64(p + HEADER + RUN_HEADER + 64 + 8, NAN); /* run 0, pass 0, receiver 0: x_acc of half 1 */
     expect_refused(p, u->n);
 }
 
@@ -146,8 +140,7 @@ static void test_infinite_output_refused(void **state)
 {
     unit *u = *state;
     uint8_t *p = forged(u);
-    float inf = INFINITY;
-    memcpy(p + u->n - 4, &inf, 4); /* the last run's last output value */
+    lbk_wrf32(p + u->n - 4, INFINITY); /* the last run's last output value */
     expect_refused(p, u->n);
 }
 

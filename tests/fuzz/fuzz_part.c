@@ -18,6 +18,7 @@
 
 #include "lbk/bake.h"
 #include "lbk/bake_dist.h"
+#include "lbk/byteorder.h"
 #include "lbk/lbk.h"
 #include "lbk/validate.h"
 
@@ -48,21 +49,6 @@ static void set_desc(lbk_bake_desc *d)
     d->glg_spacing = 8;
 }
 
-static void put64(uint8_t *p, uint64_t v)
-{
-    for (int k = 0; k < 8; k++) p[k] = (uint8_t)(v >> (8 * k));
-}
-static void put32(uint8_t *p, uint32_t v)
-{
-    for (int k = 0; k < 4; k++) p[k] = (uint8_t)(v >> (8 * k));
-}
-static uint64_t get64(const uint8_t *p)
-{
-    uint64_t v = 0;
-    for (int k = 0; k < 8; k++) v |= (uint64_t)p[k] << (8 * k);
-    return v;
-}
-
 /* Bakes the scene's one unit once, to learn the options hash the merge will expect. */
 static void setup(void)
 {
@@ -75,16 +61,9 @@ static void setup(void)
         fprintf(stderr, "fuzz_part: cannot bake %s (run from the repository root)\n", H.scene);
         abort();
     }
-    H.options_hash = get64((const uint8_t *)part + 80);
+    H.options_hash = lbk_rd64((const uint8_t *)part + 80);
     lbk_bake_part_free(part);
     H.ready = 1;
-}
-
-static uint32_t get32(const uint8_t *p)
-{
-    uint32_t v = 0;
-    for (int k = 0; k < 4; k++) v |= (uint32_t)p[k] << (8 * k);
-    return v;
 }
 
 /* Every run record's receiver range set to [0, receivers) (unit 0 of 1 holds every run whole),
@@ -94,9 +73,9 @@ static void repair_ranges(uint8_t *p, size_t size, uint64_t receivers)
     static const int floats[4] = {27, 27, 3, 1};
     size_t at = HEADER;
     while (size - at >= RUN_HEADER) {
-        put64(p + at + 96, 0);
-        put64(p + at + 104, receivers);
-        const uint32_t passes = get32(p + at), mask = get32(p + at + 4);
+        lbk_wr64(p + at + 96, 0);
+        lbk_wr64(p + at + 104, receivers);
+        const uint32_t passes = lbk_rd32(p + at), mask = lbk_rd32(p + at + 4);
         if (passes == 0 || passes > 32 || mask > 15 || receivers > ((uint64_t)1 << 30)) return;
         uint64_t per = 32ull * passes;
         for (int k = 0; k < 4; k++)
@@ -113,23 +92,23 @@ static uint8_t *repaired(const uint8_t *data, size_t size)
     uint8_t *p = malloc(size);
     if (!p) abort();
     memcpy(p, data, size);
-    uint64_t receivers = get64(p + 32) & (((uint64_t)1 << 40) - 1);
-    uint32_t runs = get32(p + 40); /* the input's own total_runs, kept: the records must match it */
+    uint64_t receivers = lbk_rd64(p + 32) & (((uint64_t)1 << 40) - 1);
+    uint32_t runs = lbk_rd32(p + 40); /* the input's own total_runs, kept: the records must match it */
     if (runs == 0 || runs > 65536) runs = 1;
-    put64(p + 16, plan_hash);
-    put32(p + 24, 1);
-    put32(p + 28, 0);
-    put64(p + 32, receivers);
-    put32(p + 40, runs);      /* format 2: unit 0 of 1 holds runs [0, runs) */
-    put32(p + 44, 0);
-    put64(p + 48, 0);
-    put32(p + 56, runs);
-    put32(p + 60, 0);
+    lbk_wr64(p + 16, plan_hash);
+    lbk_wr32(p + 24, 1);
+    lbk_wr32(p + 28, 0);
+    lbk_wr64(p + 32, receivers);
+    lbk_wr32(p + 40, runs);      /* format 2: unit 0 of 1 holds runs [0, runs) */
+    lbk_wr32(p + 44, 0);
+    lbk_wr64(p + 48, 0);
+    lbk_wr32(p + 56, runs);
+    lbk_wr32(p + 60, 0);
     repair_ranges(p, size, receivers);
-    put64(p + 64, size - HEADER);
-    put64(p + 72, XXH64(p + HEADER, size - HEADER, 0));
-    put64(p + 80, H.options_hash);
-    put64(p + 88, XXH64(p, 88, 0));
+    lbk_wr64(p + 64, size - HEADER);
+    lbk_wr64(p + 72, XXH64(p + HEADER, size - HEADER, 0));
+    lbk_wr64(p + 80, H.options_hash);
+    lbk_wr64(p + 88, XXH64(p, 88, 0));
     return p;
 }
 
