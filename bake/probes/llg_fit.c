@@ -234,25 +234,6 @@ lbk_result bk_llg_fit(const bk_llg *l, const bk_scene *s, const uint32_t *target
     return LBK_OK;
 }
 
-static int inside_geometry(const bk_tracer *tr, const float p[3], const float n[3], double offset)
-{
-    float org[3], t[3], b[3];
-    for (int a = 0; a < 3; a++) org[a] = (float)(p[a] + offset * n[a]);
-    /* orthonormal basis (Duff et al. 2017) */
-    float sg = n[2] >= 0 ? 1.0f : -1.0f, q = -1.0f / (sg + n[2]), w = n[0] * n[1] * q;
-    t[0] = 1 + sg * n[0] * n[0] * q, t[1] = sg * w, t[2] = -sg * n[0];
-    b[0] = w, b[1] = sg + n[1] * n[1] * q, b[2] = -n[1];
-    int back = 0;
-    for (int i = 0; i < 16; i++) {
-        double z = 1 - (i + 0.5) / 16, r = sqrt(fmax(0, 1 - z * z)), ph = 2.399963229728653 * i;
-        float d[3];
-        for (int a = 0; a < 3; a++) d[a] = (float)(r * cos(ph) * t[a] + r * sin(ph) * b[a] + z * n[a]);
-        bk_hit h;
-        if (bk_tracer_intersect(tr, org, d, 0.0f, INFINITY, &h) && !h.front) back++;
-    }
-    return back >= 8;
-}
-
 /* The grid's vertices that are not inside geometry, ascending; returns how many. */
 static size_t usable_vertices(const bk_llg *l, const bk_scene *s, const bk_tracer *tr, uint32_t *out)
 {
@@ -263,7 +244,7 @@ static size_t usable_vertices(const bk_llg *l, const bk_scene *s, const bk_trace
         const size_t v = l->vertices[j];
         const float *p = s->positions + 3 * v, *nn = s->normals + 3 * v;
         if (!(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2] > 0.25f)) continue;
-        if (tr && inside_geometry(tr, p, nn, offset)) continue;
+        if (tr && bk_tracer_enclosed(tr, (const double[3]){p[0], p[1], p[2]}, nn, offset)) continue;
         out[n++] = (uint32_t)j;
     }
     return n;
