@@ -320,6 +320,21 @@ int bk_vpl_volume_meets_box(const bk_vpl_volume *vol, const float box[6])
         double h = sqrt(vol->ru * vol->ru * vol->u[a] * vol->u[a] + vol->rv * vol->rv * (1 - vol->u[a] * vol->u[a]));
         if (vol->c[a] + h < box[a] || vol->c[a] - h > box[3 + a]) return 0;
     }
+    /* Stretched, the box's centre m and a ball of radius Σ|S e_a|/2 around it hold the whole
+     * box: the centre inside the unit sphere meets it, the ball outside it misses it. Only what
+     * lies between needs the exact minimum. */
+    double m[3], sm[3], ball = 0;
+    for (int a = 0; a < 3; a++) m[a] = 0.5 * ((double)box[a] + box[3 + a]) - vol->c[a];
+    stretch(vol, m, sm);
+    const double dm = sqrt(dot3(sm, sm));
+    if (dm <= 1) return 1;
+    for (int a = 0; a < 3; a++) {
+        double e[3] = {0, 0, 0}, se[3];
+        e[a] = 0.5 * ((double)box[3 + a] - box[a]);
+        stretch(vol, e, se);
+        ball += sqrt(dot3(se, se));
+    }
+    if (dm > 1 + ball * INFLATE) return 0;
     return bk_vpl_box_dist(vol, box) <= 1 + 1e-9;
 }
 
