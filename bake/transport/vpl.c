@@ -440,8 +440,7 @@ typedef struct gather_job {
     const bk_vpl_point *pts;
     size_t n;
     double *irr;
-    uint64_t (*st)[3]; /* per tile: listed, accepted, rays */
-    int failed;
+    uint64_t (*st)[3]; /* per tile: listed (UINT64_MAX: out of memory), accepted, rays */
 } gather_job;
 
 /* VPL v at point q with weight 1/p (0: rejected). */
@@ -479,7 +478,7 @@ static void gather_tiles(void *user, size_t begin, size_t end, int thread)
     gather_job *j = (gather_job *)user;
     uint32_t *ids = j->d ? malloc((j->count ? j->count : 1) * sizeof *ids) : NULL;
     if (j->d && !ids) {
-        j->failed = 1; /* a benign race: every writer stores 1 */
+        for (size_t t = begin; t < end; t++) j->st[t][0] = UINT64_MAX; /* out of memory, seen after */
         return;
     }
     for (size_t t = begin; t < end; t++) {
@@ -509,13 +508,14 @@ lbk_result bk_vpl_gather(const bk_vpl *vpls, size_t count, const bk_vpl_draw *d,
     if ((count && !vpls) || !tracer || (n && (!pts || !irr))) return LBK_ERR_INVALID_ARGUMENT;
     if (d && (d->vpls != vpls || d->count != count || n > bk_slc_item_count(d->tiles))) return LBK_ERR_INVALID_ARGUMENT;
     const size_t tiles = (n + BK_SLC_TILE - 1) / BK_SLC_TILE;
-    gather_job j = {vpls, count, d, tracer, pts, n, irr, calloc(tiles ? tiles : 1, sizeof *j.st), 0};
+    gather_job j = {vpls, count, d, tracer, pts, n, irr, calloc(tiles ? tiles : 1, sizeof *j.st)};
     if (!j.st) return LBK_ERR_OUT_OF_MEMORY;
     bk_parallel_chunks(0, tiles, 4, bk_thread_count(threads), gather_tiles, &j);
-    if (j.failed) {
-        free(j.st);
-        return LBK_ERR_OUT_OF_MEMORY;
-    }
+    for (size_t t = 0; t < tiles; t++)
+        if (j.st[t][0] == UINT64_MAX) {
+            free(j.st);
+            return LBK_ERR_OUT_OF_MEMORY;
+        }
     if (stats)
         for (size_t t = 0; t < tiles; t++) {
             stats->listed += j.st[t][0];

@@ -72,7 +72,8 @@ typedef struct bk_vpl_shoot_desc {
     int threads;                       /* 0: every core */
 } bk_vpl_shoot_desc;
 
-#define BK_VPL_MAX_PHOTONS ((size_t)1 << 26)
+/* Shooting holds 2 VPL slots (136 bytes each) per photon: 2^22 photons take 1.1 GB at most. */
+#define BK_VPL_MAX_PHOTONS ((size_t)1 << 22)
 
 /* Photons from `light` (a point light over the sphere, a spot light uniformly over its outer
  * cone), each carrying Φ = I(ω)·Ω/N (I with the light's cone and range window, Ω the sampled

@@ -518,6 +518,59 @@ static void test_threads_identical(void **state)
     room_free(&R);
 }
 
+/* Bad arguments are refused with the documented results; no photons is no VPLs. */
+static void test_arguments(void **state)
+{
+    (void)state;
+    room R;
+    room_make(&R, 0.1, 0);
+    bk_vpl_shoot_desc d = {&R.s, R.t, R.mats, 1, 0, 1};
+    bk_vpl *v = NULL;
+    size_t nv = 7;
+    assert_int_equal(bk_vpl_shoot(&d, &R.s.lights[0], &v, &nv), LBK_OK);
+    assert_true(nv == 0 && v != NULL);
+    free(v);
+    d.photons = BK_VPL_MAX_PHOTONS + 1;
+    assert_int_equal(bk_vpl_shoot(&d, &R.s.lights[0], &v, &nv), LBK_ERR_INVALID_ARGUMENT);
+    assert_null(v);
+    d.photons = 10;
+    bk_light sun = R.s.lights[0];
+    sun.type = BK_LIGHT_DIRECTIONAL;
+    assert_int_equal(bk_vpl_shoot(&d, &sun, &v, &nv), LBK_ERR_UNSUPPORTED_FEATURE);
+    d.materials = NULL;
+    assert_int_equal(bk_vpl_shoot(&d, &R.s.lights[0], &v, &nv), LBK_ERR_INVALID_ARGUMENT);
+    d.materials = R.mats;
+    v = room_vpls(&R, 100, 1, 1, &nv);
+    assert_true(nv > 50);
+    float box[6] = {0, 0, 0, 1, 1, 1};
+    bk_slc *tiles = NULL;
+    assert_int_equal(bk_slc_create(NULL, 0, box, 1, &tiles), LBK_OK);
+    double *xi = calloc(nv, sizeof *xi);
+    bk_vpl_draw *dr = NULL;
+    assert_int_equal(bk_vpl_draw_create(v, nv, xi, 0, BK_VPL_BOUND_ELLIPSOID, tiles, 1, &dr), LBK_ERR_INVALID_ARGUMENT);
+    assert_int_equal(bk_vpl_draw_create(v, nv, xi, NAN, BK_VPL_BOUND_ELLIPSOID, tiles, 1, &dr), LBK_ERR_INVALID_ARGUMENT);
+    assert_int_equal(bk_vpl_draw_create(v, nv, xi, 1, 9, tiles, 1, &dr), LBK_ERR_INVALID_ARGUMENT);
+    assert_int_equal(bk_vpl_draw_create(v, nv, xi, 1, BK_VPL_BOUND_ELLIPSOID, NULL, 1, &dr), LBK_ERR_INVALID_ARGUMENT);
+    assert_null(dr);
+    assert_int_equal(bk_vpl_draw_create(v, nv, xi, 1, BK_VPL_BOUND_ELLIPSOID, tiles, 1, &dr), LBK_OK);
+    bk_vpl_point q;
+    memset(&q, 0, sizeof q);
+    double irr[6];
+    assert_int_equal(bk_vpl_gather(v, nv - 1, dr, R.t, &q, 1, 1, irr, NULL), LBK_ERR_INVALID_ARGUMENT);
+    bk_vpl_point two[2];
+    memset(two, 0, sizeof two);
+    assert_int_equal(bk_vpl_gather(v, nv, dr, R.t, two, 2, 1, irr, NULL), LBK_ERR_INVALID_ARGUMENT); /* > items */
+    /* ξ = 0 (and out-of-range ξ, read as 0) never culls: the tile lists every VPL */
+    uint32_t *ids = malloc(nv * sizeof *ids);
+    assert_int_equal(bk_vpl_tile_list(dr, 0, ids), nv);
+    free(ids);
+    bk_vpl_draw_destroy(dr);
+    free(xi);
+    bk_slc_destroy(tiles);
+    free(v);
+    room_free(&R);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -528,6 +581,7 @@ int main(void)
         cmocka_unit_test(test_tiles_conservative),
         cmocka_unit_test(test_unbiased_against_every_vpl),
         cmocka_unit_test(test_threads_identical),
+        cmocka_unit_test(test_arguments),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
