@@ -1,5 +1,5 @@
 /* VPLs with stochastic light culling (bake/transport/vpl.h, VPL.md): the photons carry the
- * light's flux; the seed's bounding volumes enclose the range isosurface and the spheroid is
+ * light's flux and their gather converges to the floor's single-bounce integral; the seed's bounding volumes enclose the range isosurface and the spheroid is
  * tight; the box test is the exact minimum; tiles never lose an accepted VPL (brute force over
  * every pair); the gather matches the analytic one-VPL answer, is unbiased against the gather
  * of every VPL (and an injected bias fails the same test), the same for every bound, and
@@ -571,6 +571,81 @@ static void test_arguments(void **state)
     room_free(&R);
 }
 
+/* The whole chain against an independent answer: a spot light over an open GGX floor (α 0.3,
+ * F0 0.9) and receivers above it. The single-bounce irradiance at y is the floor integral
+ * ∫ E_light(x)·f(ω_i, ω_o)·cos θ_o·cos θ_y/l² dA (midpoint rule, 5 mm cells over the cone's
+ * footprint); the mean of M photon sets' brute-force gathers must match it within 4 standard
+ * errors of the sets' spread and 3 %. */
+static void test_gather_matches_the_floor_integral(void **state)
+{
+    (void)state;
+    bk_scene s;
+    tsc_init(&s);
+    uint32_t m = tsc_material(&s, 1, 1, 1, 0, 0, 0);
+    float p0[3] = {-3, -3, 0}, p1[3] = {3, -3, 0}, p2[3] = {3, 3, 0}, p3[3] = {-3, 3, 0};
+    tsc_quad(&s, p0, p1, p2, p3, 2, m);
+    float lp[3] = {0, 0, 2}, ld[3] = {0, 0, -1};
+    tsc_spot_light(&s, lp, ld, 40, 0.4f, 0.6f);
+    tsc_update_bounds(&s);
+    bk_tracer *t = NULL;
+    assert_int_equal(bk_tracer_create(&s, 1, &t), LBK_OK);
+    bk_vpl_material mat;
+    memset(&mat, 0, sizeof mat);
+    mat.f0[0] = mat.f0[1] = mat.f0[2] = 0.9f;
+    mat.alpha = 0.3f;
+    enum { NQ = 6, M = 8 };
+    bk_vpl_point q[NQ];
+    memset(q, 0, sizeof q);
+    const double xs[NQ] = {-1, 0, 0.5, 1, 1.5, 2.5};
+    for (int i = 0; i < NQ; i++) {
+        q[i].p[0] = xs[i], q[i].p[1] = 0.2 * i, q[i].p[2] = i == NQ - 1 ? 1.0 : 1.5;
+        if (i == NQ - 1) q[i].n[0] = -1; /* a wall-like receiver facing the light's side */
+        else q[i].n[2] = -1;
+        for (int k = 0; k < 3; k++) q[i].org[k] = (float)q[i].p[k];
+    }
+    double ref[NQ] = {0};
+    const double h = 0.005, R = 2 * tan(0.6) + 0.01;
+    for (double x = -R + h / 2; x < R; x += h)
+        for (double y = -R + h / 2; y < R; y += h) {
+            double pt[3] = {x, y, 0}, val[3], wi[3], dist;
+            if (!bk_light_eval(&s.lights[0], pt, val, wi, &dist)) continue;
+            const double e = val[1] * wi[2]; /* the floor's irradiance, green */
+            for (int i = 0; i < NQ; i++) {
+                double wo[3] = {q[i].p[0] - x, q[i].p[1] - y, q[i].p[2]};
+                double l2 = wo[0] * wo[0] + wo[1] * wo[1] + wo[2] * wo[2], l = sqrt(l2);
+                for (int k = 0; k < 3; k++) wo[k] /= l;
+                double hv[3] = {wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]}, hl = sqrt(hv[0] * hv[0] + hv[1] * hv[1] + hv[2] * hv[2]);
+                const double f = bk_ggx_fresnel(0.9f, (hv[0] * wi[0] + hv[1] * wi[1] + hv[2] * wi[2]) / hl) * bk_ggx_spec(0.3f, wo, wi);
+                const double cy = -(wo[0] * q[i].n[0] + wo[1] * q[i].n[1] + wo[2] * q[i].n[2]);
+                if (cy > 0) ref[i] += e * f * wo[2] * cy / l2 * h * h;
+            }
+        }
+    double mean[NQ] = {0}, sq[NQ] = {0};
+    for (int k = 0; k < M; k++) {
+        bk_vpl_shoot_desc d = {&s, t, &mat, 50 + (uint64_t)k, 20000, 2};
+        bk_vpl *v = NULL;
+        size_t nv = 0;
+        assert_int_equal(bk_vpl_shoot(&d, &s.lights[0], &v, &nv), LBK_OK);
+        double irr[3 * NQ];
+        assert_int_equal(bk_vpl_gather(v, nv, NULL, t, q, NQ, 2, irr, NULL), LBK_OK);
+        for (int i = 0; i < NQ; i++) {
+            mean[i] += irr[3 * i + 1] / M;
+            sq[i] += irr[3 * i + 1] * irr[3 * i + 1] / M;
+        }
+        free(v);
+    }
+    for (int i = 0; i < NQ; i++) {
+        const double se = sqrt(fmax(0.0, sq[i] - mean[i] * mean[i]) / (M - 1));
+        print_message("receiver %d: integral %.6f, VPL mean %.6f (se %.6f, %.2f %%)\n", i, ref[i], mean[i], se,
+                      100 * (mean[i] / ref[i] - 1));
+        assert_true(ref[i] > 0);
+        assert_true(fabs(mean[i] - ref[i]) < 4 * se + 1e-3 * ref[i]);
+        assert_true(fabs(mean[i] - ref[i]) < 0.03 * ref[i]);
+    }
+    bk_tracer_destroy(t);
+    tsc_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -578,6 +653,7 @@ int main(void)
         cmocka_unit_test(test_box_dist_is_the_minimum),
         cmocka_unit_test(test_gather_one_vpl),
         cmocka_unit_test(test_shoot_flux),
+        cmocka_unit_test(test_gather_matches_the_floor_integral),
         cmocka_unit_test(test_tiles_conservative),
         cmocka_unit_test(test_unbiased_against_every_vpl),
         cmocka_unit_test(test_threads_identical),
