@@ -183,7 +183,7 @@ static void run(room *R, const bk_slc *tiles, double delta_rel, double *bf, doub
            NVPL, NRECV, R->s.tri_count, delta_rel, DRAWS);
     for (int a = 0; a < 4; a++) {
         R->mats[0].alpha = (float)alphas[a];
-        bk_vpl_shoot_desc sd = {&R->s, R->t, R->mats, 1, NVPL, 1};
+        bk_vpl_shoot_desc sd = {&R->s, R->t, R->mats, 1, NVPL, 1, 0};
         bk_vpl *v = NULL;
         size_t nv = 0;
         if (bk_vpl_shoot(&sd, &R->s.lights[0], &v, &nv) != LBK_OK) abort();

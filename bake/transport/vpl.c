@@ -53,7 +53,7 @@ static void make_vpl(bk_vpl *v, const double pos[3], const double n[3], const do
 static int shoot_one(const shoot_job *j, size_t i, bk_vpl out[2])
 {
     const bk_vpl_shoot_desc *d = j->desc;
-    bk_rng r = bk_rng_stream(d->seed, VPL_SALT, 0, i);
+    bk_rng r = bk_rng_stream(d->seed, VPL_SALT, d->key, i);
     double ct = 1 - bk_rng_next(&r) * (1 - j->cos_max), phi = 2 * BK_PI * bk_rng_next(&r);
     double st = sqrt(fmax(0.0, 1 - ct * ct)), dir[3];
     for (int k = 0; k < 3; k++) dir[k] = st * cos(phi) * j->t[k] + st * sin(phi) * j->b[k] + ct * j->axis[k];
@@ -184,7 +184,7 @@ void bk_vpl_volume_of(const bk_vpl *v, double xi, double delta, int bound, bk_vp
         out->ru = out->rv = pow(4.0 / 27, 0.25) * R * INFLATE;
         return;
     }
-    const double ci = fmax(dot3(v->wi, v->n), 0.0), a = v->alpha;
+    const double ci = fmax(dot3(v->wi, v->n), 0.0), a = clamp_alpha(v->alpha); /* as ggx.c's lobe */
     double pf = 0; /* Σ lum_c Φ_c F_max,c */
     for (int k = 0; k < 3; k++) pf += LUM[k] * v->flux[k] * fresnel_max(v->refl[k], ci);
     /* Eq. 12: r = √(Φ F_max G1/(4πδξ cos θ_i)) */

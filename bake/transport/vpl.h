@@ -70,6 +70,8 @@ typedef struct bk_vpl_shoot_desc {
     uint64_t seed;
     size_t photons;                    /* from the light (at most BK_VPL_MAX_PHOTONS) */
     int threads;                       /* 0: every core */
+    uint64_t key;                      /* names the photons' stream with the seed: give each
+                                          light (and pass) its own, or their photons correlate */
 } bk_vpl_shoot_desc;
 
 /* Shooting holds 2 VPL slots (136 bytes each) per photon: 2^22 photons take 1.1 GB at most. */
