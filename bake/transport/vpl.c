@@ -177,9 +177,14 @@ void bk_vpl_volume_of(const bk_vpl *v, double xi, double delta, int bound, bk_vp
         return;
     }
     if (v->kind == BK_VPL_DIFFUSE) {
-        /* seed §6: l_max = R√cos θ_o lies in the sphere of radius (4/27)^¼R at q + 3^-¾R·n */
+        /* l_max = R√cos θ_o. Seed §6: it lies in the sphere of radius (4/27)^¼R at q + 3^-¾R·n;
+         * the sphere at the VPL bounds it by the intensity's maximum, radius R. */
         const double R = sqrt(dot3(LUM, (double[3]){v->flux[0] * v->refl[0], v->flux[1] * v->refl[1],
                                                    v->flux[2] * v->refl[2]}) / (BK_PI * delta * xi));
+        if (bound == BK_VPL_BOUND_SPHERE_AT_VPL) {
+            out->ru = out->rv = R * INFLATE;
+            return;
+        }
         for (int k = 0; k < 3; k++) out->c[k] = v->pos[k] + pow(1.0 / 3, 0.75) * R * v->n[k];
         out->ru = out->rv = pow(4.0 / 27, 0.25) * R * INFLATE;
         return;

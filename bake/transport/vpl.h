@@ -11,7 +11,8 @@
  *    p, so the gather is unbiased for any δ > 0. Accepted points lie inside l < √(I(ω_o)/(δξ)),
  *    which is bounded by one of three volumes (enum bk_vpl_bound): for glossy VPLs the sphere at
  *    the VPL of radius r/α, the sphere around the seed's spheroid (§4), or the spheroid itself;
- *    diffuse VPLs always use the seed's §6 sphere. Every bound is conservative, so the three give
+ *    diffuse VPLs the sphere at the VPL of radius R or the seed's §6 sphere (both other modes).
+ *    Every bound is conservative, so the three give
  *    the same gather (tested); they differ only in how many VPLs a tile has to test.
  * 3. The culling reuses bk_slc's receiver tiles (16 items) and blocks (1024 items) and their
  *    boxes: every VPL's volume against every block box, then a tile's list cut from its block's.
@@ -35,11 +36,14 @@
 
 enum bk_vpl_kind { BK_VPL_DIFFUSE = 0, BK_VPL_GLOSSY = 1 };
 
-/* How a glossy VPL's range is bounded (diffuse VPLs: the §6 sphere in every mode). */
+/* How a VPL's range is bounded. */
 enum bk_vpl_bound {
-    BK_VPL_BOUND_ELLIPSOID = 0,  /* the seed's spheroid (§4, Eq. 13–15): the default */
-    BK_VPL_BOUND_SPHERE_AT_VPL,  /* centre q, radius r/α (the NDF's maximum; seed §7 (a)) */
-    BK_VPL_BOUND_SPHERE_AROUND,  /* centre c, radius r_u: the sphere around the spheroid (b) */
+    BK_VPL_BOUND_ELLIPSOID = 0,  /* glossy: the seed's spheroid (§4, Eq. 13–15), diffuse: the §6
+                                    sphere; the default */
+    BK_VPL_BOUND_SPHERE_AT_VPL,  /* centre q, radius from the intensity's maximum: r/α (the NDF's
+                                    maximum; seed §7 (a)), diffuse √(Φk/(πδξ)) */
+    BK_VPL_BOUND_SPHERE_AROUND,  /* centre c, radius r_u: the sphere around the spheroid (b);
+                                    diffuse: the §6 sphere */
     BK_VPL_BOUND_NONE            /* no culling: every VPL listed for every tile (tests) */
 };
 
