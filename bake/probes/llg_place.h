@@ -26,6 +26,9 @@ typedef struct bk_llg_options {   /* zero-initialised = defaults */
     float min_half_extent;        /* floor for flat/line objects; 0: 5% of the largest
                                      half-extent (1 mm for a point-like object) */
     int visibility_rays;          /* cosine-distributed rays per vertex; 0: 64, at most 4096 */
+    int min_dim;                  /* probes per axis at least (2..64); 0: 2. The baker asks 3:
+                                     fitted to the vertices, 3 × 3 × 3 resolves what 2 × 2 × 2
+                                     cannot (PROBES.md §LLG fit) */
 } bk_llg_options;
 
 typedef struct bk_llg {
