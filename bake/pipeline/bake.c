@@ -439,13 +439,14 @@ static lbk_result build_receivers(bk_pipeline *b)
     size_t n = 0;
     for (size_t i = 0; i < b->texels.count; i++) n += (b->texels.receivers[i].flags & BK_TEXEL_VALID) != 0;
     b->texel_receivers = n;
+    /* the LLG fit's vertex targets: surface receivers sampled and estimated with the texels */
+    if (bk_llg_fit_plan_build(b->llgs, b->llg_count, &b->scene, b->tracer, n, &b->llg_fit))
+        return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
+    n += b->llg_fit.count;
     b->glg_first = n;
     if (b->have_glg) n += b->glg.probe_count;
     b->llg_first = n;
     for (size_t g = 0; g < b->llg_count; g++) n += bk_llg_probe_count(&b->llgs[g]);
-    if (bk_llg_fit_plan_build(b->llgs, b->llg_count, &b->scene, b->tracer, n, &b->llg_fit))
-        return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
-    n += b->llg_fit.count;
     b->receiver_count = n;
     b->receivers = calloc(n ? n : 1, sizeof *b->receivers);
     b->texel_of_receiver = calloc(b->texel_receivers ? b->texel_receivers : 1, sizeof *b->texel_of_receiver);
@@ -464,6 +465,8 @@ static lbk_result build_receivers(bk_pipeline *b)
         memcpy(b->receivers[k].footprint_box, t->footprint_box, sizeof t->footprint_box);
         b->texel_of_receiver[k++] = (uint32_t)i;
     }
+    for (size_t t = 0; t < b->llg_fit.count; t++, k++)
+        bk_llg_fit_receiver(&b->llg_fit, b->llgs, &b->scene, t, b->receivers[k].position, b->receivers[k].normal);
     if (b->have_glg)
         for (size_t p = 0; p < b->glg.probe_count; p++, k++) memcpy(b->receivers[k].position, &b->glg.positions[3 * p], 12);
     for (size_t g = 0; g < b->llg_count; g++) {
@@ -472,8 +475,6 @@ static lbk_result build_receivers(bk_pipeline *b)
             for (uint32_t y = 0; y < l->dims[1]; y++)
                 for (uint32_t x = 0; x < l->dims[0]; x++, k++) bk_llg_probe_position(l, x, y, z, b->receivers[k].position);
     }
-    for (size_t t = 0; t < b->llg_fit.count; t++, k++)
-        bk_llg_fit_receiver(&b->llg_fit, b->llgs, &b->scene, t, b->receivers[k].position, b->receivers[k].normal);
     return LBK_OK;
 }
 
@@ -491,7 +492,7 @@ static void transport_options(const bk_pipeline *b, bk_transport_options *to)
     to->cell_size = b->cell_size;
     to->footprint = b->texels.footprint;
     to->footprint_count = b->texels.footprint_count;
-    to->class_end[BK_CLASS_TEXEL] = b->texel_receivers;
+    to->class_end[BK_CLASS_TEXEL] = b->glg_first; /* texels and the LLG fit's targets */
     to->class_end[BK_CLASS_GLG] = b->llg_first;
     to->class_end[BK_CLASS_LLG] = b->receiver_count;
     to->split = b->dist ? bk_dist_split(b->dist) : NULL;
@@ -511,7 +512,7 @@ void bk_pipeline_set_inputs(const bk_pipeline *b, bk_set_inputs *in)
     in->glg_first = b->glg_first;
     in->glg_count = b->llg_first - b->glg_first;
     in->llg_first = b->llg_first;
-    in->llg_count = b->llg_fit.first - b->llg_first;
+    in->llg_count = b->receiver_count - b->llg_first;
     in->llg_fit = &b->llg_fit;
     in->llgs = b->llgs;
     in->llg_grids = b->llg_count;
@@ -551,18 +552,21 @@ static lbk_result build_cell_sizes(bk_pipeline *b)
 /* The LLG class's estimate gains the fit's residual at its targets (bake/probes/PROBES.md §LLG
  * fit): the halves' difference sees the noise of the probes, not what the lattice cannot
  * represent, and that is what LLG objects get at run time. The residual also holds the targets'
- * own noise, so the figure errs high. */
+ * own noise; its expected share is taken off where the transport measured it. */
 static void llg_fit_error(bk_pipeline *b)
 {
     const bk_llg_fit_stats *f = &b->llg_fit_stats;
     if (!f->targets || !(f->target_sum > 0)) return;
     const double n = (double)f->targets, mean = f->target_sum / n;
-    const double fitted = sqrt(f->fitted_sq / n) / mean, traced = sqrt(f->traced_sq / n) / mean;
+    /* without the targets' own noise where the transport measured it (b->variance: denoised bakes) */
+    const double noise_sq = b->variance ? bk_llg_fit_noise(&b->llg_fit, b->llgs, b->variance) : 0;
+    const double fitted = sqrt(fmax(0, f->fitted_sq - noise_sq) / n) / mean, traced = sqrt(f->traced_sq / n) / mean;
     double *e = &b->stats.class_rel_rmse[BK_CLASS_LLG];
     const double noise = *e;
     *e = sqrt(noise * noise + fitted * fitted);
     bk_events_say(&b->events, LBK_BAKE_SEVERITY_INFO,
-                  "LLG fit: %zu vertex targets, residual %.1f%% (traced probes %.1f%%); LLG error %.1f%% (noise %.1f%%)",
+                  "LLG fit: %zu vertex targets, residual %.1f%% without their noise (traced probes %.1f%%); LLG error "
+                  "%.1f%% (noise %.1f%%)",
                   f->targets, 100 * fitted, 100 * traced, 100 * *e, 100 * noise);
 }
 

@@ -59,8 +59,8 @@ typedef struct bk_pipeline {
     bk_llg *llgs;
     size_t llg_count;
     int32_t *object_llg;            /* per scene object: LLG index or -1 */
-    /* receivers handed to transport: valid texels, then GLG probes, then LLG probes, then the
-     * LLG fit's vertex targets (bake/probes/llg_fit.h; from llg_fit.first) */
+    /* receivers handed to transport: valid texels, the LLG fit's vertex targets (from
+     * llg_fit.first = texel_receivers; bake/probes/llg_fit.h), then GLG probes, then LLG probes */
     bk_receiver *receivers;
     size_t receiver_count, texel_receivers, glg_first, llg_first;
     bk_llg_fit_plan llg_fit;

@@ -342,3 +342,19 @@ lbk_result bk_llg_fit_run(const bk_llg_fit_plan *plan, const bk_llg *llgs, const
     }
     return LBK_OK;
 }
+
+double bk_llg_fit_noise(const bk_llg_fit_plan *plan, const bk_llg *llgs, const float *variance)
+{
+    double sum = 0;
+    for (size_t g = 0; g < plan->grids; g++) {
+        const size_t b = plan->begin[g], n = plan->begin[g + 1] - b;
+        if (!n) continue;
+        const double keep = 1.0 - 9.0 * (double)probe_count(&llgs[g]) / (double)n;
+        if (!(keep > 0)) continue;
+        for (size_t t = 0; t < n; t++) {
+            const float v = variance[plan->first + b + t];
+            if (isfinite(v) && v > 0) sum += keep * v;
+        }
+    }
+    return sum;
+}

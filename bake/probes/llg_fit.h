@@ -64,6 +64,10 @@ void bk_llg_fit_plan_free(bk_llg_fit_plan *plan);
 /* The target receiver k's position and normal (the vertex's, in the scene frame). */
 void bk_llg_fit_receiver(const bk_llg_fit_plan *plan, const bk_llg *llgs, const bk_scene *scene, size_t k,
                          float position[3], float normal[3]);
+/* The part of the fit's residual Σ (model − target)² that the targets' own noise makes:
+ * Σ_t σ_t² (1 − unknowns/targets) per grid (least squares absorbs a share unknowns/targets of
+ * it), σ_t² the transport's variance of target t's luminance (variance per receiver). */
+double bk_llg_fit_noise(const bk_llg_fit_plan *plan, const bk_llg *llgs, const float *variance);
 /* Fits every grid of one run: irradiance (3 per receiver) and radiance (per receiver) are the
  * run's outputs, the LLG probes of grid after grid from receiver llg_first. */
 lbk_result bk_llg_fit_run(const bk_llg_fit_plan *plan, const bk_llg *llgs, const bk_scene *scene,

@@ -35,12 +35,13 @@ typedef struct bk_set_bakes {
 typedef struct bk_set_inputs {
     const bk_scene *scene;
     const bk_tracer *tracer;          /* over the whole scene, doors closed */
-    const bk_receiver *receivers;     /* valid texels, then GLG probes, then LLG probes */
+    const bk_receiver *receivers;     /* valid texels, LLG fit targets, GLG probes, LLG probes */
     size_t receiver_count;
     size_t texel_receivers;           /* receivers [0, texel_receivers) are texels */
     size_t glg_first, glg_count;      /* receivers [glg_first, glg_first+glg_count) are GLG probes */
     size_t llg_first, llg_count;      /* then LLG probes, in LLG section order */
-    const bk_llg_fit_plan *llg_fit;   /* then the LLG fit's vertex targets; every run is fitted */
+    const bk_llg_fit_plan *llg_fit;   /* the LLG fit's vertex targets (receivers after the texels,
+                                         before the GLG probes); every run is fitted */
     const bk_llg *llgs;               /* the LLGs those probes belong to (their objects) */
     size_t llg_grids;
     const uint32_t *texel_of_receiver;/* receiver → index in texels->receivers */
