@@ -19,6 +19,7 @@
 #include "tools/inspect/diff.h"
 #include "lbk/lightmap.h"
 #include "lbk/octa.h"
+#include "lbk/validate.h"
 #include "support/tools_fixtures.h"
 
 static char tmpdir[64];
@@ -446,10 +447,21 @@ static tf_options octp_options(uint32_t dims)
     return o;
 }
 
-/* Decoded probes of a fixture's OCTP, for the direct computation the diff is checked against. */
+static int print_issue(void *user, const lbk_issue *issue)
+{
+    (void)user;
+    fprintf(stderr, "fixture issue: %s\n", issue->message);
+    return 0;
+}
+
+/* Decoded probes of a fixture's OCTP, for the direct computation the diff is checked against; the
+ * fixture must be a valid container (depth moments m2 ≥ m1², states, offsets). */
 static void octp_decode(const tf_options *o, lbk_octp_probe_desc *out, uint32_t n)
 {
     tf_blob b = tf_build_scene(TF_SCENE_FULL, o);
+    lbk_validate_summary vs;
+    assert_int_equal(lbk_validate_memory(b.data, b.size, NULL, print_issue, NULL, &vs), LBK_OK);
+    assert_int_equal(vs.fatal + vs.errors, 0);
     tl_bake bk;
     open_blob(&b, &bk);
     assert_true(bk.has_octp);
