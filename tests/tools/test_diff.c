@@ -20,6 +20,7 @@
 #include "lbk/lightmap.h"
 #include "lbk/octa.h"
 #include "lbk/validate.h"
+#include "support/bake_file.h"
 #include "support/tools_fixtures.h"
 
 static char tmpdir[64];
@@ -693,6 +694,88 @@ static void test_octp_noise_mode(void **state)
     }
 }
 
+/* Real bakes: cornell_box with --octahedral at seeds 1 and 2 (16 samples). The volumes have the
+ * same layout; the diff's irradiance and depth statistics are the direct computation over the
+ * decoded probes active on both sides, and the state counts are the files'. A bake against
+ * itself is zero. */
+static void octp_bake(const char *gltf, uint64_t seed, const char *out, tl_bake *b)
+{
+    tb_job job = {gltf, out, NULL, {0}};
+    job.d.seed = seed;
+    job.d.max_samples = 16;
+    job.d.octahedral_probes = 1;
+    char err[1024];
+    assert_int_equal(tb_bake(&job, NULL, err, sizeof err), LBK_OK);
+    if (tl_bake_open_file(out, b, err) != TL_OPEN_OK) fail_msg("%s", err);
+}
+
+static void test_octp_real_bakes(void **state)
+{
+    (void)state;
+    const char *scenes = getenv("LBK_SCENES");
+    char gltf[1024], pa[128], pb[128];
+    snprintf(gltf, sizeof gltf, "%s/cornell_box/CornellBox-Original.gltf", scenes && *scenes ? scenes : "../shared/scenes");
+    if (access(gltf, R_OK)) {
+        printf("[  SKIP    ] %s is missing (set LBK_SCENES)\n", gltf);
+        return;
+    }
+    snprintf(pa, sizeof pa, "%s/octp1.lbk", tmpdir);
+    snprintf(pb, sizeof pb, "%s/octp2.lbk", tmpdir);
+    tl_bake a, b;
+    octp_bake(gltf, 1, pa, &a);
+    octp_bake(gltf, 2, pb, &b);
+    assert_true(a.has_octp && b.has_octp);
+    const uint32_t n = a.octp.probe_count;
+    double sqd = 0, sqr = 0, max = 0, dmax = 0;
+    uint64_t compared = 0;
+    uint32_t changes = 0, inside_b = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        lbk_octp_probe_info ia, ib;
+        assert_int_equal(lbk_octp_probe_info_get(&a.octp, i, &ia), LBK_OK);
+        assert_int_equal(lbk_octp_probe_info_get(&b.octp, i, &ib), LBK_OK);
+        changes += ia.state != ib.state;
+        inside_b += ib.state == LBK_OCTP_INSIDE;
+        if (ia.state == LBK_OCTP_INSIDE || ib.state == LBK_OCTP_INSIDE) continue;
+        lbk_octp_probe_desc da, db;
+        assert_int_equal(lbk_octp_probe_get(&a.octp, i, &da), LBK_OK);
+        assert_int_equal(lbk_octp_probe_get(&b.octp, i, &db), LBK_OK);
+        compared++;
+        for (int t = 0; t < 16; t++)
+            for (int c = 0; c < 3; c++) {
+                const double d = (double)db.irradiance[t][c] - da.irradiance[t][c];
+                sqd += d * d;
+                sqr += (double)da.irradiance[t][c] * da.irradiance[t][c];
+                max = fmax(max, fabs(d));
+            }
+        for (int t = 0; t < 144; t++)
+            for (int m = 0; m < 2; m++) dmax = fmax(dmax, fabs((double)db.depth[t][m] - da.depth[t][m]));
+    }
+    tl_diff_options o = {.mode = TL_DIFF_MODE_TOLERANCE};
+    tl_diff_result r;
+    char err[TL_ERR_LEN];
+    assert_int_equal(tl_diff_run(&a, &b, &o, &r, err), 0);
+    assert_int_equal(r.octp.comparable, 1);
+    assert_int_equal(r.octp.count_a, n);
+    assert_int_equal(r.octp.lighting.count, compared);
+    assert_true(compared > 0);
+    assert_true(r.octp.lighting.max_abs == max);
+    assert_true(max > 0); /* another seed: other noise */
+    assert_float_equal(tl_err_rel_rmse(&r.octp.lighting), sqrt(sqd / sqr), 1e-9);
+    assert_true(r.octp.depth.max_abs == dmax);
+    assert_int_equal(r.octp.state_changes, changes);
+    assert_int_equal(r.octp.states_b[LBK_OCTP_INSIDE], inside_b);
+    printf("cornell_box seeds 1/2: %u probes, %llu compared, irradiance rel-RMSE %.4f max %.4g, depth max %.4g, "
+           "%u state changes\n", n, (unsigned long long)compared, tl_err_rel_rmse(&r.octp.lighting), max, dmax, changes);
+    tl_diff_free(&r);
+    assert_int_equal(tl_diff_run(&a, &a, &o, &r, err), 0);
+    assert_int_equal(r.octp.status, TL_DIFF_SAME);
+    assert_true(r.octp.lighting.max_abs == 0.0 && r.octp.depth.max_abs == 0.0);
+    assert_int_equal(r.differ, 0);
+    tl_diff_free(&r);
+    tl_bake_close(&a);
+    tl_bake_close(&b);
+}
+
 static int run_cli(int n, const char **args)
 {
     char *argv[16];
@@ -761,6 +844,7 @@ int main(void)
         cmocka_unit_test(test_octp_state_change),
         cmocka_unit_test(test_octp_layout_and_presence),
         cmocka_unit_test(test_octp_noise_mode),
+        cmocka_unit_test(test_octp_real_bakes),
     };
     return cmocka_run_group_tests(tests, setup_dir, teardown_dir);
 }
