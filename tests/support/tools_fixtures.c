@@ -12,6 +12,7 @@
 #include "lbk/lightmap.h"
 #include "lbk/meta.h"
 #include "lbk/objects.h"
+#include "lbk/octa.h"
 #include "lbk/pixel.h"
 #include "lbk/report.h"
 
@@ -49,6 +50,51 @@ void tf_probe_sh(uint32_t probe, lbk_sh9_rgb *out)
         out->c[c][3] = -0.05f * out->c[c][0];
         out->c[c][6] = 0.02f * out->c[c][0];
     }
+}
+
+float tf_octp_irradiance(uint32_t p, uint32_t t, int c)
+{
+    return (0.5f + 0.125f * (float)(p % 5) + 0.0625f * (float)t) * (1.0f - 0.25f * (float)c);
+}
+
+static void add_octp(lbk_writer *w, const tf_options *opt)
+{
+    const uint32_t n = opt->octp_dims * 4;
+    lbk_octp_probe_desc *pr = calloc(n, sizeof *pr);
+    lbk_octp_probe_info *info = calloc(n, sizeof *info);
+    if (!pr || !info) abort();
+    for (uint32_t p = 0; p < n; p++) {
+        const float f = p == opt->octp_probe && opt->octp_factor != 0.0f ? opt->octp_factor : 1.0f;
+        for (uint32_t t = 0; t < 16; t++)
+            for (int c = 0; c < 3; c++) pr[p].irradiance[t][c] = f * tf_octp_irradiance(p, t, c);
+        for (uint32_t t = 0; t < 144; t++) {
+            const float m = 1.0f + (float)(t % 64) / 256.0f + (p == opt->octp_probe ? opt->octp_depth_delta : 0.0f);
+            pr[p].depth[t][0] = m;
+            pr[p].depth[t][1] = m * m;
+        }
+        info[p].state = opt->octp_inside == p + 1 ? LBK_OCTP_INSIDE : LBK_OCTP_ACTIVE;
+        info[p].rays = 64;
+        info[p].nearest = 1.0f;
+    }
+    lbk_octp_level lv;
+    memset(&lv, 0, sizeof lv);
+    lv.spacing = 1.0f;
+    lv.dims[0] = opt->octp_dims, lv.dims[1] = 2, lv.dims[2] = 2;
+    lv.miss_distance = 10.0f;
+    lbk_octp_build_desc d = LBK_OCTP_BUILD_DESC_INIT;
+    d.probes = pr;
+    d.probe_count = n;
+    d.levels = &lv;
+    d.level_count = 1;
+    d.info = info;
+    void *data;
+    size_t size;
+    CHECK(lbk_octp_build(&d, NULL, &data, &size));
+    lbk_section_options so = {0};
+    CHECK(lbk_writer_section_add(w, LBK_SECTION_OCTP, data, size, &so));
+    lbk_free(NULL, data);
+    free(pr);
+    free(info);
 }
 
 void tf_blob_free(tf_blob *b)
@@ -223,6 +269,7 @@ tf_blob tf_build_scene(int kind, const tf_options *opt_in)
         free(targets);
         free(payload);
     }
+    if (opt.octp_dims) add_octp(w, &opt);
     free(tex[0]);
     free(tex[1]);
 

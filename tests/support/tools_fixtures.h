@@ -9,7 +9,10 @@
  *   LMAP   page 0 64×32, page 1 16×16; texel lighting tf_texel_linear()
  *   GLG    8 probes on the corners of the box [0,4]×[0,2]×[0,3], 5 tetras; probe SH tf_probe_sh()
  *   DLS    set "lamp" (lights "lamp.bulb"): entries on the texels of the crate and on GLG probes
- *          0 and 7 */
+ *          0 and 7
+ *   OCTP   only when opt->octp_dims: a one-level volume octp_dims × 2 × 2, origin 0, spacing 1,
+ *          every probe active; irradiance tf_octp_irradiance(), depth mean m = 1 + (t mod 64)/256,
+ *          mean² m² */
 #ifndef LBK_TESTS_TOOLS_FIXTURES_H
 #define LBK_TESTS_TOOLS_FIXTURES_H
 
@@ -36,6 +39,11 @@ typedef struct tf_options {
     uint32_t page0_width;      /* 0: 64 */
     int scale_log2;            /* LMAP and GLG scale 2^scale_log2 (spec §5.7), DLS payloads stored in
                                   it: the same physical lighting in other stored units */
+    uint32_t octp_dims;        /* OCTP volume octp_dims × 2 × 2 when != 0 (2 … 256) */
+    float octp_factor;         /* multiply OCTP probe octp_probe's irradiance by this when != 0 */
+    uint32_t octp_probe;
+    float octp_depth_delta;    /* add to probe octp_probe's depth mean (mean² stays its square) */
+    uint32_t octp_inside;      /* 1 + index of an OCTP probe marked inside geometry; 0: none */
 } tf_options;
 
 typedef struct tf_blob {
@@ -50,5 +58,7 @@ void tf_blob_free(tf_blob *blob);
 void tf_texel_linear(uint32_t page, uint32_t x, uint32_t y, lbk_ahd_linear *out);
 void tf_probe_sh(uint32_t probe, lbk_sh9_rgb *out);
 extern const float tf_probe_positions[8][3];
+/* OCTP interior texel t (0 … 15) of probe p, channel c. */
+float tf_octp_irradiance(uint32_t p, uint32_t t, int c);
 
 #endif

@@ -18,6 +18,9 @@
 #include "tools/common/file_util.h"
 #include "tools/inspect/diff.h"
 #include "lbk/lightmap.h"
+#include "lbk/octa.h"
+#include "lbk/validate.h"
+#include "support/bake_file.h"
 #include "support/tools_fixtures.h"
 
 static char tmpdir[64];
@@ -361,7 +364,7 @@ static void test_json_schema(void **state)
     assert_string_equal(cJSON_GetObjectItem(j, "schema")->valuestring, "lbk-diff");
     assert_int_equal(cJSON_GetObjectItem(j, "schema_version")->valueint, 2);
     const char *top[] = {"a", "b", "tolerance", "equal", "mode", "mode_reason", "noise_model", "inputs", "summary",
-                         "sections", "params", "objects", "pages", "glg", "light_sets", "doors"};
+                         "sections", "params", "objects", "pages", "glg", "octp", "light_sets", "doors"};
     for (size_t i = 0; i < sizeof top / sizeof top[0]; i++) require_key(j, top[i]);
     assert_true(cJSON_IsFalse(cJSON_GetObjectItem(j, "equal")));
     assert_string_equal(cJSON_GetObjectItem(j, "mode")->valuestring, "tolerance");
@@ -435,6 +438,344 @@ static void test_heatmap_png(void **state)
     assert_int_equal(access(path, R_OK), 0);
 }
 
+/* ---- OCTP ------------------------------------------------------------------------------------ */
+
+static tf_options octp_options(uint32_t dims)
+{
+    tf_options o;
+    memset(&o, 0, sizeof o);
+    o.octp_dims = dims;
+    return o;
+}
+
+static int print_issue(void *user, const lbk_issue *issue)
+{
+    (void)user;
+    fprintf(stderr, "fixture issue: %s\n", issue->message);
+    return 0;
+}
+
+/* Decoded probes of a fixture's OCTP, for the direct computation the diff is checked against; the
+ * fixture must be a valid container (depth moments m2 ≥ m1², states, offsets). */
+static void octp_decode(const tf_options *o, lbk_octp_probe_desc *out, uint32_t n)
+{
+    tf_blob b = tf_build_scene(TF_SCENE_FULL, o);
+    lbk_validate_summary vs;
+    assert_int_equal(lbk_validate_memory(b.data, b.size, NULL, print_issue, NULL, &vs), LBK_OK);
+    assert_int_equal(vs.fatal + vs.errors, 0);
+    tl_bake bk;
+    open_blob(&b, &bk);
+    assert_true(bk.has_octp);
+    assert_int_equal(bk.octp.probe_count, n);
+    for (uint32_t i = 0; i < n; i++) assert_int_equal(lbk_octp_probe_get(&bk.octp, i, &out[i]), LBK_OK);
+    tl_bake_close(&bk);
+    tf_blob_free(&b);
+}
+
+static char *diff_text(const tl_diff_result *r)
+{
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    assert_non_null(f);
+    tl_diff_print(f, r, 1);
+    fclose(f);
+    return buf;
+}
+
+static void test_octp_self_is_equal(void **state)
+{
+    (void)state;
+    tf_options o = octp_options(3);
+    tl_diff_result r;
+    run_diff(&o, &o, 0, 0, 0, &r);
+    assert_int_equal(r.differ, 0);
+    assert_int_equal(r.octp.status, TL_DIFF_SAME);
+    assert_int_equal(r.octp.comparable, 1);
+    assert_int_equal(r.octp.count_a, 12);
+    assert_int_equal(r.octp.levels_a, 1);
+    assert_int_equal(r.octp.lighting.count, 12);
+    assert_int_equal(r.octp.depth.count, 12);
+    assert_true(r.octp.lighting.max_abs == 0.0 && tl_err_rel_rmse(&r.octp.lighting) == 0.0);
+    assert_true(r.octp.depth.max_abs == 0.0);
+    assert_int_equal(r.octp.state_changes, 0);
+    assert_int_equal(r.octp.moved, 0);
+    assert_int_equal(r.octp.states_a[LBK_OCTP_ACTIVE], 12);
+    tl_diff_free(&r);
+    /* a bake without OCTP on either side: absent, and not in the text */
+    run_diff(NULL, NULL, 0, 0, 0, &r);
+    assert_int_equal(r.octp.status, -1);
+    char *text = diff_text(&r);
+    assert_null(strstr(text, "octp"));
+    free(text);
+    tl_diff_free(&r);
+}
+
+/* Probe 5's irradiance doubled: the diff's numbers are the direct computation over A's decoded
+ * texels (B = 2A exactly, a power of two): max |B − A| = max A of probe 5, rel-RMSE =
+ * √(Σ_probe5 A² / Σ_all A²). */
+static void test_octp_irradiance_change(void **state)
+{
+    (void)state;
+    tf_options oa = octp_options(3), ob = octp_options(3);
+    ob.octp_factor = 2.0f, ob.octp_probe = 5;
+    lbk_octp_probe_desc pa[12];
+    octp_decode(&oa, pa, 12);
+    double max5 = 0, sq5 = 0, sq = 0;
+    for (uint32_t p = 0; p < 12; p++)
+        for (int t = 0; t < 16; t++)
+            for (int c = 0; c < 3; c++) {
+                const double v = pa[p].irradiance[t][c];
+                sq += v * v;
+                if (p != 5) continue;
+                sq5 += v * v;
+                if (v > max5) max5 = v;
+            }
+    tl_diff_result r;
+    run_diff(&oa, &ob, 0, 0, 0, &r);
+    assert_int_equal(r.octp.status, TL_DIFF_CHANGED);
+    assert_int_equal(r.differ, 1);
+    assert_int_equal(r.octp.lighting.count, 12);
+    assert_int_equal(r.octp.lighting.over, 1);
+    assert_int_equal(r.octp.lighting.max_x, 5);
+    assert_int_equal(r.octp.lighting.x0, 5);
+    assert_int_equal(r.octp.lighting.x1, 5);
+    assert_true(r.octp.lighting.max_abs == max5);
+    assert_float_equal(tl_err_rel_rmse(&r.octp.lighting), sqrt(sq5 / sq), 1e-12);
+    assert_true(max5 > 1.0 && sqrt(sq5 / sq) > 0.2 && sqrt(sq5 / sq) < 0.5); /* the fixture's values: not trivial */
+    assert_int_equal(r.probes_over, 1); /* GLG unchanged */
+    assert_true(r.octp.depth.max_abs == 0.0);
+    assert_int_equal(r.octp.state_changes, 0);
+    tl_diff_free(&r);
+    /* a tolerance of 1 × A accepts a doubling; 0.99 × A does not */
+    run_diff(&oa, &ob, 0, 1.0, 0, &r);
+    assert_int_equal(r.octp.status, TL_DIFF_SAME);
+    assert_int_equal(r.differ, 0);
+    tl_diff_free(&r);
+    run_diff(&oa, &ob, 0, 0.99, 0, &r);
+    assert_int_equal(r.octp.status, TL_DIFF_CHANGED);
+    tl_diff_free(&r);
+}
+
+/* Probe 2's depth mean + 0.5 m (exact in half: means in [1, 1.25)), mean² its square: the diff's
+ * depth statistics are the direct computation over the decoded moments; irradiance 0. */
+static void test_octp_depth_change(void **state)
+{
+    (void)state;
+    tf_options oa = octp_options(3), ob = octp_options(3);
+    ob.octp_depth_delta = 0.5f, ob.octp_probe = 2;
+    lbk_octp_probe_desc pa[12], pb[12];
+    octp_decode(&oa, pa, 12);
+    octp_decode(&ob, pb, 12);
+    double max = 0, sqd = 0, sqr = 0;
+    for (uint32_t p = 0; p < 12; p++)
+        for (int t = 0; t < 144; t++)
+            for (int m = 0; m < 2; m++) {
+                const double d = (double)pb[p].depth[t][m] - pa[p].depth[t][m];
+                max = fmax(max, fabs(d));
+                sqd += d * d;
+                sqr += (double)pa[p].depth[t][m] * pa[p].depth[t][m];
+            }
+    assert_true(max > 0.5 && max < 2.0); /* mean + 0.5 exactly, mean² by (m + 0.5)² − m² = m + 0.25 */
+    tl_diff_result r;
+    run_diff(&oa, &ob, 0, 0, 0, &r);
+    assert_int_equal(r.octp.status, TL_DIFF_CHANGED);
+    assert_true(r.octp.lighting.max_abs == 0.0);
+    assert_true(r.octp.depth.max_abs == max);
+    assert_int_equal(r.octp.depth.max_x, 2);
+    assert_int_equal(r.octp.depth.over, 1);
+    assert_float_equal(tl_err_rel_rmse(&r.octp.depth), sqrt(sqd / sqr), 1e-12);
+    char *text = diff_text(&r);
+    assert_non_null(strstr(text, "octp changed 12 -> 12 probes, 1 -> 1 levels"));
+    assert_non_null(strstr(text, "depth moments: max "));
+    assert_non_null(strstr(text, "over 1/12"));
+    free(text);
+    tl_diff_free(&r);
+}
+
+/* Probe 3 marked inside geometry in B: one state change, counts 12/0 -> 11/1, and the probe's
+ * texels are not compared (a sampler skips it). */
+static void test_octp_state_change(void **state)
+{
+    (void)state;
+    tf_options oa = octp_options(3), ob = octp_options(3);
+    ob.octp_inside = 4;
+    tl_diff_result r;
+    run_diff(&oa, &ob, 0, 0, 0, &r);
+    assert_int_equal(r.octp.status, TL_DIFF_CHANGED);
+    assert_int_equal(r.differ, 1);
+    assert_int_equal(r.octp.state_changes, 1);
+    assert_int_equal(r.octp.states_a[LBK_OCTP_ACTIVE], 12);
+    assert_int_equal(r.octp.states_a[LBK_OCTP_INSIDE], 0);
+    assert_int_equal(r.octp.states_b[LBK_OCTP_ACTIVE], 11);
+    assert_int_equal(r.octp.states_b[LBK_OCTP_INSIDE], 1);
+    assert_int_equal(r.octp.lighting.count, 11);
+    assert_true(r.octp.lighting.max_abs == 0.0);
+    char *json = tl_diff_json(&r, "a", "b");
+    cJSON *j = cJSON_Parse(json);
+    free(json);
+    const cJSON *oc = cJSON_GetObjectItem(j, "octp");
+    assert_non_null(oc);
+    assert_string_equal(cJSON_GetObjectItem(oc, "status")->valuestring, "changed");
+    assert_true(cJSON_IsTrue(cJSON_GetObjectItem(oc, "comparable")));
+    assert_int_equal(cJSON_GetObjectItem(oc, "state_changes")->valueint, 1);
+    assert_int_equal(cJSON_GetObjectItem(cJSON_GetObjectItem(oc, "states_b"), "inside")->valueint, 1);
+    assert_int_equal(cJSON_GetObjectItem(cJSON_GetObjectItem(oc, "lighting"), "count")->valueint, 11);
+    assert_true(cJSON_GetObjectItem(cJSON_GetObjectItem(oc, "depth"), "max_abs")->valuedouble == 0.0);
+    cJSON_Delete(j);
+    tl_diff_free(&r);
+}
+
+/* Other grid dims: not comparable, said so; OCTP on one side only: removed / added. */
+static void test_octp_layout_and_presence(void **state)
+{
+    (void)state;
+    tf_options oa = octp_options(3), ob = octp_options(4);
+    tl_diff_result r;
+    run_diff(&oa, &ob, 0, 0, 0, &r);
+    assert_int_equal(r.octp.status, TL_DIFF_CHANGED);
+    assert_int_equal(r.octp.comparable, 0);
+    assert_int_equal(r.octp.count_b, 16);
+    assert_int_equal(r.octp.lighting.count, 0);
+    assert_int_equal(r.differ, 1);
+    char *text = diff_text(&r);
+    assert_non_null(strstr(text, "octp changed 12 -> 16 probes"));
+    assert_non_null(strstr(text, "not comparable (volume layout changed"));
+    free(text);
+    char *json = tl_diff_json(&r, "a", "b");
+    cJSON *j = cJSON_Parse(json);
+    free(json);
+    const cJSON *oc = cJSON_GetObjectItem(j, "octp");
+    assert_true(cJSON_IsFalse(cJSON_GetObjectItem(oc, "comparable")));
+    assert_true(cJSON_IsNull(cJSON_GetObjectItem(oc, "lighting")));
+    cJSON_Delete(j);
+    tl_diff_free(&r);
+
+    run_diff(&oa, NULL, 0, 0, 0, &r);
+    assert_int_equal(r.octp.status, TL_DIFF_REMOVED);
+    assert_int_equal(r.differ, 1);
+    text = diff_text(&r);
+    assert_non_null(strstr(text, "octp removed 12 -> 0 probes, 1 -> 0 levels (only in A)"));
+    free(text);
+    tl_diff_free(&r);
+    run_diff(NULL, &oa, 0, 0, 0, &r);
+    assert_int_equal(r.octp.status, TL_DIFF_ADDED);
+    assert_int_equal(r.differ, 1);
+    tl_diff_free(&r);
+}
+
+/* Noise mode (both fixtures carry REPT): identical volumes are within noise; one probe at 100×
+ * is beyond it. */
+static void test_octp_noise_mode(void **state)
+{
+    (void)state;
+    tf_options oa = octp_options(3), ob = octp_options(3);
+    ob.octp_factor = 100.0f, ob.octp_probe = 7;
+    tl_diff_result r;
+    for (int k = 0; k < 2; k++) {
+        tf_blob a = tf_build_scene(TF_SCENE_FULL, &oa), b = tf_build_scene(TF_SCENE_FULL, k ? &ob : &oa);
+        tl_bake ba, bb;
+        open_blob(&a, &ba);
+        open_blob(&b, &bb);
+        tl_diff_options o = {.mode = TL_DIFF_MODE_NOISE};
+        char err[TL_ERR_LEN];
+        assert_int_equal(tl_diff_run(&ba, &bb, &o, &r, err), 0);
+        assert_int_equal(r.mode, TL_DIFF_MODE_NOISE);
+        assert_int_equal(r.octp.noise.evaluated, 1);
+        assert_int_equal(r.octp.noise.count, 12);
+        assert_int_equal(r.octp.noise.within_noise, !k);
+        assert_int_equal(r.octp.status, k ? TL_DIFF_CHANGED : TL_DIFF_SAME);
+        assert_int_equal(r.items_beyond_noise, (uint32_t)k);
+        tl_diff_free(&r);
+        tl_bake_close(&ba);
+        tl_bake_close(&bb);
+        tf_blob_free(&a);
+        tf_blob_free(&b);
+    }
+}
+
+/* Real bakes: cornell_box with --octahedral at seeds 1 and 2 (16 samples). The volumes have the
+ * same layout; the diff's irradiance and depth statistics are the direct computation over the
+ * decoded probes active on both sides, and the state counts are the files'. A bake against
+ * itself is zero. */
+static void octp_bake(const char *gltf, uint64_t seed, const char *out, tl_bake *b)
+{
+    tb_job job = {gltf, out, NULL, {0}};
+    job.d.seed = seed;
+    job.d.max_samples = 16;
+    job.d.octahedral_probes = 1;
+    char err[1024];
+    assert_int_equal(tb_bake(&job, NULL, err, sizeof err), LBK_OK);
+    if (tl_bake_open_file(out, b, err) != TL_OPEN_OK) fail_msg("%s", err);
+}
+
+static void test_octp_real_bakes(void **state)
+{
+    (void)state;
+    const char *scenes = getenv("LBK_SCENES");
+    char gltf[1024], pa[128], pb[128];
+    snprintf(gltf, sizeof gltf, "%s/cornell_box/CornellBox-Original.gltf", scenes && *scenes ? scenes : "../shared/scenes");
+    if (access(gltf, R_OK)) {
+        printf("[  SKIP    ] %s is missing (set LBK_SCENES)\n", gltf);
+        return;
+    }
+    snprintf(pa, sizeof pa, "%s/octp1.lbk", tmpdir);
+    snprintf(pb, sizeof pb, "%s/octp2.lbk", tmpdir);
+    tl_bake a, b;
+    octp_bake(gltf, 1, pa, &a);
+    octp_bake(gltf, 2, pb, &b);
+    assert_true(a.has_octp && b.has_octp);
+    const uint32_t n = a.octp.probe_count;
+    double sqd = 0, sqr = 0, max = 0, dmax = 0;
+    uint64_t compared = 0;
+    uint32_t changes = 0, inside_b = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        lbk_octp_probe_info ia, ib;
+        assert_int_equal(lbk_octp_probe_info_get(&a.octp, i, &ia), LBK_OK);
+        assert_int_equal(lbk_octp_probe_info_get(&b.octp, i, &ib), LBK_OK);
+        changes += ia.state != ib.state;
+        inside_b += ib.state == LBK_OCTP_INSIDE;
+        if (ia.state == LBK_OCTP_INSIDE || ib.state == LBK_OCTP_INSIDE) continue;
+        lbk_octp_probe_desc da, db;
+        assert_int_equal(lbk_octp_probe_get(&a.octp, i, &da), LBK_OK);
+        assert_int_equal(lbk_octp_probe_get(&b.octp, i, &db), LBK_OK);
+        compared++;
+        for (int t = 0; t < 16; t++)
+            for (int c = 0; c < 3; c++) {
+                const double d = (double)db.irradiance[t][c] - da.irradiance[t][c];
+                sqd += d * d;
+                sqr += (double)da.irradiance[t][c] * da.irradiance[t][c];
+                max = fmax(max, fabs(d));
+            }
+        for (int t = 0; t < 144; t++)
+            for (int m = 0; m < 2; m++) dmax = fmax(dmax, fabs((double)db.depth[t][m] - da.depth[t][m]));
+    }
+    tl_diff_options o = {.mode = TL_DIFF_MODE_TOLERANCE};
+    tl_diff_result r;
+    char err[TL_ERR_LEN];
+    assert_int_equal(tl_diff_run(&a, &b, &o, &r, err), 0);
+    assert_int_equal(r.octp.comparable, 1);
+    assert_int_equal(r.octp.count_a, n);
+    assert_int_equal(r.octp.lighting.count, compared);
+    assert_true(compared > 0);
+    assert_true(r.octp.lighting.max_abs == max);
+    assert_true(max > 0); /* another seed: other noise */
+    assert_float_equal(tl_err_rel_rmse(&r.octp.lighting), sqrt(sqd / sqr), 1e-9);
+    assert_true(r.octp.depth.max_abs == dmax);
+    assert_int_equal(r.octp.state_changes, changes);
+    assert_int_equal(r.octp.states_b[LBK_OCTP_INSIDE], inside_b);
+    printf("cornell_box seeds 1/2: %u probes, %llu compared, irradiance rel-RMSE %.4f max %.4g, depth max %.4g, "
+           "%u state changes\n", n, (unsigned long long)compared, tl_err_rel_rmse(&r.octp.lighting), max, dmax, changes);
+    tl_diff_free(&r);
+    assert_int_equal(tl_diff_run(&a, &a, &o, &r, err), 0);
+    assert_int_equal(r.octp.status, TL_DIFF_SAME);
+    assert_true(r.octp.lighting.max_abs == 0.0 && r.octp.depth.max_abs == 0.0);
+    assert_int_equal(r.differ, 0);
+    tl_diff_free(&r);
+    tl_bake_close(&a);
+    tl_bake_close(&b);
+}
+
 static int run_cli(int n, const char **args)
 {
     char *argv[16];
@@ -497,6 +838,13 @@ int main(void)
         cmocka_unit_test(test_json_schema),
         cmocka_unit_test(test_heatmap_png),
         cmocka_unit_test(test_cli_exit_codes),
+        cmocka_unit_test(test_octp_self_is_equal),
+        cmocka_unit_test(test_octp_irradiance_change),
+        cmocka_unit_test(test_octp_depth_change),
+        cmocka_unit_test(test_octp_state_change),
+        cmocka_unit_test(test_octp_layout_and_presence),
+        cmocka_unit_test(test_octp_noise_mode),
+        cmocka_unit_test(test_octp_real_bakes),
     };
     return cmocka_run_group_tests(tests, setup_dir, teardown_dir);
 }

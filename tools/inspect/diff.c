@@ -36,13 +36,12 @@ typedef struct tol {
     const tl_noise_model *noise; /* NULL: tolerance mode */
 } tol;
 
-/* a and b: n normals × 3 channels. Returns 1 when over tolerance. NaN in B counts as over. */
-static int add_sample(tl_err_stats *s, const float *a, const float *b, int n, const tol *t, uint32_t x, uint32_t y,
-                      float *err_out)
+int tl_err_add(tl_err_stats *s, const float *a, const float *b, size_t values, double abs_tol, double rel_tol,
+               uint32_t x, uint32_t y, float *err_out)
 {
     double err = 0, ref = 0, sqd = 0, sqr = 0;
     int nan = 0;
-    for (int i = 0; i < 3 * n; i++) {
+    for (size_t i = 0; i < values; i++) {
         double d = (double)b[i] - (double)a[i];
         if (isnan(d)) nan = 1;
         double ad = fabs(d);
@@ -62,7 +61,7 @@ static int add_sample(tl_err_stats *s, const float *a, const float *b, int n, co
         s->max_y = y;
     }
     if (err_out) *err_out = (float)err;
-    if (!(err > t->abs_tol + t->rel_tol * ref)) return 0;
+    if (!(err > abs_tol + rel_tol * ref)) return 0;
     s->over++;
     if (!s->has_region) {
         s->has_region = 1;
@@ -75,6 +74,13 @@ static int add_sample(tl_err_stats *s, const float *a, const float *b, int n, co
         if (y > s->y1) s->y1 = y;
     }
     return 1;
+}
+
+/* a and b: n normals × 3 channels. Returns 1 when over tolerance. */
+static int add_sample(tl_err_stats *s, const float *a, const float *b, int n, const tol *t, uint32_t x, uint32_t y,
+                      float *err_out)
+{
+    return tl_err_add(s, a, b, 3 * (size_t)n, t->abs_tol, t->rel_tol, x, y, err_out);
 }
 
 /* ---- texel access ------------------------------------------------------------------------- */
@@ -923,6 +929,7 @@ int tl_diff_run(const tl_bake *a, const tl_bake *b, const tl_diff_options *o, tl
         return -1;
     }
     diff_glg(a, b, &t, r);
+    tl_diff_octp_run(a, b, o->abs_tol, o->rel_tol, t.noise, r);
     for (size_t i = 0; i < r->object_count; i++) {
         const tl_diff_object *d = &r->objects[i];
         if (d->repr_a == LBK_REPRESENTATION_LLG && d->compared) r->probes_over += d->lighting.over;
@@ -939,7 +946,8 @@ int tl_diff_run(const tl_bake *a, const tl_bake *b, const tl_diff_options *o, tl
     const int samples_over = r->mode == TL_DIFF_MODE_NOISE ? 0 : r->texels_over || r->probes_over;
     r->differ = structural_sections || r->objects_added || r->objects_removed || r->objects_changed ||
                 r->pages_changed || r->sets_changed || r->doors_changed || samples_over ||
-                r->glg.status == TL_DIFF_CHANGED || r->glg.status == TL_DIFF_ADDED || r->glg.status == TL_DIFF_REMOVED;
+                r->glg.status == TL_DIFF_CHANGED || r->glg.status == TL_DIFF_ADDED || r->glg.status == TL_DIFF_REMOVED ||
+                r->octp.status == TL_DIFF_CHANGED || r->octp.status == TL_DIFF_ADDED || r->octp.status == TL_DIFF_REMOVED;
     return 0;
 }
 

@@ -37,6 +37,10 @@ typedef struct tl_err_stats {
 } tl_err_stats;
 
 double tl_err_mean(const tl_err_stats *s);
+/* One sample of `values` numbers (A and B): its error is the largest |B − A|; over the tolerance
+ * when error > abs_tol + rel_tol × max |A|; NaN in B counts as over. Returns 1 when over. */
+int tl_err_add(tl_err_stats *s, const float *a, const float *b, size_t values, double abs_tol, double rel_tol,
+               uint32_t x, uint32_t y, float *err_out);
 /* sqrt(sum_sq_diff / sum_sq_ref); 0 when both are 0; +Inf when only A is all zero. */
 double tl_err_rel_rmse(const tl_err_stats *s);
 
@@ -126,6 +130,24 @@ typedef struct tl_diff_probes {
     tl_noise_stats noise;
 } tl_diff_probes;
 
+/* The OCTP octahedral probes (spec/container.md §14), compared probe by probe when both have the
+ * same layout: the same form, levels (origin, spacing, dims) or, for the list form, the same
+ * probe positions. Irradiance: a sample is a probe, its values the 4×4 interior texels × RGB
+ * (physical; the border only repeats them); depth: the 12×12 interior texels × (mean, mean²), in
+ * metres, as stored. */
+typedef struct tl_diff_octp {
+    int status;               /* same/changed/added/removed; -1 when in neither */
+    uint32_t count_a, count_b;
+    uint32_t levels_a, levels_b; /* 0: list form */
+    int comparable;           /* same layout: the probes were compared */
+    uint32_t moved;           /* comparable volume: probes whose relocation offset differs */
+    tl_err_stats lighting;    /* irradiance, decides with the tolerance or the noise */
+    tl_err_stats depth;       /* depth moments; decides in tolerance mode only (no noise estimate) */
+    tl_noise_stats noise;
+    uint32_t states_a[3], states_b[3]; /* volume form: probes per LBK_OCTP_ACTIVE, _INSIDE, _NO_NEARBY */
+    uint32_t state_changes;   /* comparable: probes whose state differs; decides in tolerance mode */
+} tl_diff_octp;
+
 typedef struct tl_diff_set {
     char name[128];
     int status;
@@ -152,19 +174,24 @@ typedef struct tl_diff_result {
     tl_diff_object *objects; size_t object_count;
     tl_diff_page *pages; size_t page_count;
     tl_diff_probes glg;
+    tl_diff_octp octp;
     tl_diff_set *sets; size_t set_count;
     tl_diff_door *doors; size_t door_count;
     /* summary */
     uint32_t objects_added, objects_removed, objects_changed;
     uint32_t pages_changed, sets_changed, doors_changed, sections_changed, params_changed;
     uint64_t texels_over, probes_over;
-    uint32_t items_beyond_noise; /* noise mode: objects, the GLG and light-set spaces whose change exceeds the noise */
+    uint32_t items_beyond_noise; /* noise mode: objects, the GLG, OCTP and light-set spaces whose change exceeds the noise */
     int differ; /* the exit-code decision: lighting or structure differs (not META/REPT alone) */
 } tl_diff_result;
 
 /* The inputs and options that differ (META provenance) into result->changes, and each matched
  * object's inputs_changed (diff_provenance.c). Returns 0, or -1 when out of memory. */
 int tl_diff_provenance(const tl_bake *a, const tl_bake *b, tl_diff_result *result);
+
+/* OCTP part of tl_diff_run (diff_octp.c): fills result->octp, adds to probes_over and items_beyond_noise. */
+void tl_diff_octp_run(const tl_bake *a, const tl_bake *b, double abs_tol, double rel_tol, const tl_noise_model *noise,
+                      tl_diff_result *result);
 
 /* Compares two opened bakes. Returns 0, or -1 (out of memory; err says so). */
 int tl_diff_run(const tl_bake *a, const tl_bake *b, const tl_diff_options *options, tl_diff_result *out,

@@ -101,6 +101,42 @@ static cJSON *side_json(uint32_t repr, uint32_t index, const uint32_t rect[4], u
 
 static const char *space_name(uint32_t sp) { return sp == LBK_DLS_SPACE_TEXEL ? "texels" : sp == LBK_DLS_SPACE_GLG ? "glg" : "llg"; }
 
+static cJSON *states_json(const uint32_t n[3])
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddNumberToObject(o, "active", n[LBK_OCTP_ACTIVE]);
+    cJSON_AddNumberToObject(o, "inside", n[LBK_OCTP_INSIDE]);
+    cJSON_AddNumberToObject(o, "no_nearby", n[LBK_OCTP_NO_NEARBY]);
+    return o;
+}
+
+static cJSON *octp_json(const tl_diff_octp *d)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "status", tl_diff_status_name(d->status));
+    cJSON_AddNumberToObject(o, "a_probes", d->count_a);
+    cJSON_AddNumberToObject(o, "b_probes", d->count_b);
+    cJSON_AddNumberToObject(o, "a_levels", d->levels_a);
+    cJSON_AddNumberToObject(o, "b_levels", d->levels_b);
+    const int both = d->status == TL_DIFF_SAME || d->status == TL_DIFF_CHANGED;
+    cJSON_AddBoolToObject(o, "comparable", both && d->comparable);
+    cJSON_AddItemToObject(o, "states_a", d->levels_a ? states_json(d->states_a) : cJSON_CreateNull());
+    cJSON_AddItemToObject(o, "states_b", d->levels_b ? states_json(d->states_b) : cJSON_CreateNull());
+    if (both && d->comparable) {
+        cJSON_AddNumberToObject(o, "state_changes", d->state_changes);
+        cJSON_AddNumberToObject(o, "moved", d->moved);
+        cJSON_AddItemToObject(o, "lighting", stats_json(&d->lighting, 0));
+        cJSON_AddItemToObject(o, "depth", stats_json(&d->depth, 0));
+    } else {
+        cJSON_AddNullToObject(o, "state_changes");
+        cJSON_AddNullToObject(o, "moved");
+        cJSON_AddNullToObject(o, "lighting");
+        cJSON_AddNullToObject(o, "depth");
+    }
+    cJSON_AddItemToObject(o, "noise", noise_json(&d->noise));
+    return o;
+}
+
 char *tl_diff_json(const tl_diff_result *r, const char *path_a, const char *path_b)
 {
     cJSON *root = cJSON_CreateObject();
@@ -237,6 +273,7 @@ char *tl_diff_json(const tl_diff_result *r, const char *path_a, const char *path
     if (r->glg.status == TL_DIFF_SAME || r->glg.status == TL_DIFF_CHANGED) cJSON_AddItemToObject(glg, "lighting", stats_json(&r->glg.lighting, 0));
     else cJSON_AddNullToObject(glg, "lighting");
     cJSON_AddItemToObject(glg, "noise", noise_json(&r->glg.noise));
+    cJSON_AddItemToObject(root, "octp", octp_json(&r->octp));
     cJSON *sets = cJSON_AddArrayToObject(root, "light_sets");
     for (size_t i = 0; i < r->set_count; i++) {
         const tl_diff_set *d = &r->sets[i];
@@ -286,6 +323,31 @@ static void print_stats(FILE *f, const tl_err_stats *s, int texels)
     }
 }
 
+static void print_octp(FILE *f, const tl_diff_octp *d, int verbose)
+{
+    if (d->status < 0 || (d->status == TL_DIFF_SAME && !verbose)) return;
+    fprintf(f, "octp %s %u -> %u probes, %u -> %u levels", tl_diff_status_name(d->status), d->count_a, d->count_b,
+            d->levels_a, d->levels_b);
+    if (d->status != TL_DIFF_SAME && d->status != TL_DIFF_CHANGED) {
+        fprintf(f, " (%s)\n", d->status == TL_DIFF_ADDED ? "only in B" : "only in A");
+        return;
+    }
+    if (!d->comparable) {
+        fprintf(f, "\n    not comparable (volume layout changed: form, levels, grid dims, origins or probe positions)\n");
+        return;
+    }
+    fprintf(f, "\n    irradiance: ");
+    print_stats(f, &d->lighting, 0);
+    print_noise(f, &d->noise);
+    fprintf(f, "\n    depth moments: ");
+    print_stats(f, &d->depth, 0);
+    fprintf(f, "\n    states: %u changed, %u moved", d->state_changes, d->moved);
+    if (d->levels_a)
+        fprintf(f, "; active %u -> %u, inside %u -> %u, no nearby geometry %u -> %u", d->states_a[0], d->states_b[0],
+                d->states_a[1], d->states_b[1], d->states_a[2], d->states_b[2]);
+    fprintf(f, "\n");
+}
+
 void tl_diff_print(FILE *f, const tl_diff_result *r, int verbose)
 {
     if (r->mode == TL_DIFF_MODE_NOISE)
@@ -302,7 +364,7 @@ void tl_diff_print(FILE *f, const tl_diff_result *r, int verbose)
     fprintf(f, "objects: %u added, %u removed, %u changed; pages changed %u; light sets changed %u; doors changed %u\n",
             r->objects_added, r->objects_removed, r->objects_changed, r->pages_changed, r->sets_changed, r->doors_changed);
     if (r->mode == TL_DIFF_MODE_NOISE)
-        fprintf(f, "items beyond noise %u (objects, the GLG, light-set spaces)\n", r->items_beyond_noise);
+        fprintf(f, "items beyond noise %u (objects, the GLG, OCTP, light-set spaces)\n", r->items_beyond_noise);
     else
         fprintf(f, "texels over tolerance %llu, probes over tolerance %llu\n", (unsigned long long)r->texels_over,
                 (unsigned long long)r->probes_over);
@@ -361,6 +423,7 @@ void tl_diff_print(FILE *f, const tl_diff_result *r, int verbose)
         }
         fprintf(f, "\n");
     }
+    print_octp(f, &r->octp, verbose);
     for (size_t i = 0; i < r->set_count; i++) {
         const tl_diff_set *d = &r->sets[i];
         if (d->status == TL_DIFF_SAME && !verbose) continue;
