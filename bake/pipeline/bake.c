@@ -220,6 +220,11 @@ static void recentre(bk_pipeline *b)
         for (int k = 0; k < 3; k++) s->positions[3 * v + k] = (float)((double)s->positions[3 * v + k] - c[k]);
     for (size_t i = 0; i < s->light_count; i++)
         for (int k = 0; k < 3; k++) s->lights[i].position[k] = (float)((double)s->lights[i].position[k] - c[k]);
+    for (size_t i = 0; i < s->playable_count; i++)
+        for (int k = 0; k < 3; k++) {
+            s->playable[i].min[k] = (float)((double)s->playable[i].min[k] - c[k]);
+            s->playable[i].max[k] = (float)((double)s->playable[i].max[k] - c[k]);
+        }
     for (int k = 0; k < 3; k++) {
         s->bounds_min[k] = (float)((double)s->bounds_min[k] - c[k]);
         s->bounds_max[k] = (float)((double)s->bounds_max[k] - c[k]);
