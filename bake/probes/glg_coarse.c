@@ -24,7 +24,8 @@ lbk_result bk_glg_coarse_lighting(void *user, const float *points, size_t n, flo
     to.threads = g->threads;
     to.max_samples = g->samples > 0 ? g->samples : 256;
     to.target_error = -1;                        /* a fixed schedule: same work on every level */
-    to.max_cells = g->max_cells > 0 ? g->max_cells : 8192;
+    to.max_cells = g->max_cells > 0 ? g->max_cells : 4096;
+    to.max_bounces = g->max_bounces > 0 ? g->max_bounces : 4;
     bk_transport_output o;
     memset(&o, 0, sizeof o);
     o.radiance = sh;

@@ -18,7 +18,8 @@ typedef struct bk_glg_coarse {    /* zero-initialised = defaults, except scene a
     uint64_t seed;                /* the bake's seed (the pass has its own stream: seed ^ a constant) */
     int threads;                  /* 0: all cores; the result does not depend on it */
     int samples;                  /* gather rays per point, both halves; 0: 256 */
-    int max_cells;                /* radiosity cache cells; 0: 8192 (a coarse cache is enough) */
+    int max_cells;                /* radiosity cache cells; 0: 4096 (a coarse cache is enough) */
+    int max_bounces;              /* explicit bounces before the transport's analytic tail; 0: 4 */
     /* filled by the pass: rays traced, seconds */
     uint64_t rays;
     double seconds;

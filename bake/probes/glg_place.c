@@ -165,21 +165,24 @@ static size_t cell_id(const int64_t dims[3], int64_t x, int64_t y, int64_t z)
     return (size_t)((z * dims[1] + y) * dims[0] + x);
 }
 
-/* The estimated interpolation error at a point of the coarse lattice, for a grid of `step`
- * lattice spacings: a linear interpolation between the points `step` away on either side along an
- * axis misses this one by |f(−) + f(+) − 2 f(c)| / 2, and the midpoints of such a grid, where
- * linear interpolation errs most, by about half of that. The largest over the three axes and the
- * six irradiance directions; 0 without free points on both sides along any axis (next to walls
+/* The estimated relative interpolation error at a point of the coarse lattice, for a grid of
+ * `step` lattice spacings: a linear interpolation between the points `step` away on either side
+ * along an axis misses this one by |f(−) + f(+) − 2 f(c)| / 2, and the midpoints of such a grid,
+ * where linear interpolation errs most, by about half of that. The largest over the three axes
+ * and the six irradiance directions, relative to the point's own level (the mean of its six
+ * values) plus `floor` (a share of the level's mean, so dark corners do not ask for probes for
+ * differences nobody sees); 0 without free points on both sides along any axis (next to walls
  * the near-geometry refinement decides). The coarse pass's noise is taken off first: a second
- * difference is only counted beyond 2 standard deviations of its own noise (the three points'
+ * difference only counts beyond 2 standard deviations of its own noise (the three points'
  * variances, the centre's four times), so few samples do not refine a smooth level. */
 static double lattice_error(const int64_t dims[3], const int64_t *slot, const float *val, int64_t x, int64_t y,
-                            int64_t z, int64_t step)
+                            int64_t z, int64_t step, double floor)
 {
     int64_t me = slot[cell_id(dims, x, y, z)];
     if (me < 0) return 0.0;
     int64_t at[3] = {x, y, z};
-    double e = 0.0;
+    double e = 0.0, level = floor;
+    for (int d = 0; d < 6; d++) level += val[7 * me + d] / 6.0;
     for (int a = 0; a < 3; a++) {
         if (at[a] < step || at[a] + step >= dims[a]) continue;
         int64_t m[3] = {x, y, z}, p[3] = {x, y, z};
@@ -193,7 +196,7 @@ static double lattice_error(const int64_t dims[3], const int64_t *slot, const fl
             e = fmax(e, 0.25 * (fabs(d2) - noise));
         }
     }
-    return e;
+    return level > 0.0 ? e / level : 0.0;
 }
 
 /* The lighting rule. The coarse pass lights a lattice twice as fine as the top grid (the centres
@@ -240,13 +243,13 @@ static lbk_result lighting_depths(place_ctx *c, const double lo[3], const double
     }
     mean /= (double)(6 * nv);
     if (!(mean > 0.0)) goto done;   /* a dark level: nothing to follow */
-    const double bar = c->lighting_threshold * mean;
+    const double bar = c->lighting_threshold, floor = 0.05 * mean;
     for (int64_t z = 0; z < top[2]; z++) for (int64_t y = 0; y < top[1]; y++) for (int64_t x = 0; x < top[0]; x++) {
         double e_top = 0.0, e_half = 0.0;
         for (int o = 0; o < 8; o++) {
             int64_t lx = 2 * x + (o & 1), ly = 2 * y + ((o >> 1) & 1), lz = 2 * z + ((o >> 2) & 1);
-            e_top = fmax(e_top, lattice_error(dims, slot, val, lx, ly, lz, 2));
-            e_half = fmax(e_half, lattice_error(dims, slot, val, lx, ly, lz, 1));
+            e_top = fmax(e_top, lattice_error(dims, slot, val, lx, ly, lz, 2, floor));
+            e_half = fmax(e_half, lattice_error(dims, slot, val, lx, ly, lz, 1, floor));
         }
         int k = e_half > 2.0 * bar ? 3 : e_half > bar ? 2 : e_top > bar ? 1 : 0;
         if (k > c->lighting_levels) k = c->lighting_levels;
@@ -436,7 +439,7 @@ lbk_result bk_glg_place(const bk_scene *scene, const bk_tracer *tracer,
     c.lighting = o.lighting;
     c.lighting_user = o.lighting_user;
     c.lighting_levels = !o.lighting ? 0 : o.lighting_levels <= 0 ? 2 : o.lighting_levels > 3 ? 3 : o.lighting_levels;
-    c.lighting_threshold = o.lighting_threshold > 0 && isfinite(o.lighting_threshold) ? o.lighting_threshold : 0.05f;
+    c.lighting_threshold = o.lighting_threshold > 0 && isfinite(o.lighting_threshold) ? o.lighting_threshold : 0.4f;
     c.adaptive = c.playable_levels > 0 || c.lighting;
     const int max_depth = c.playable_levels > c.lighting_levels ? c.playable_levels : c.lighting_levels;
     if (c.adaptive) spacing *= 2.0;

@@ -36,7 +36,7 @@ typedef struct bk_glg_options {   /* zero-initialised = defaults */
     bk_glg_lighting_fn lighting;  /* NULL: no lighting rule */
     void *lighting_user;
     float lighting_threshold;     /* relative interpolation error (of the mean irradiance) that
-                                     asks for a finer grid (PROBES.md); 0: 0.05 */
+                                     asks for a finer grid (PROBES.md); 0: 0.4 (bench_glg) */
     int lighting_levels;          /* most depth the lighting rule gives; 0: 2; at most 3 */
 } bk_glg_options;
 
