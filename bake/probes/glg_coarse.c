@@ -24,6 +24,7 @@ lbk_result bk_glg_coarse_lighting(void *user, const float *points, size_t n, flo
     to.threads = g->threads;
     to.max_samples = g->samples > 0 ? g->samples : 256;
     to.target_error = -1;                        /* a fixed schedule: same work on every level */
+    to.first_pass_samples = (to.max_samples + 1) / 2; /* one pass (two halves): one cache build */
     to.max_cells = g->max_cells > 0 ? g->max_cells : 4096;
     to.max_bounces = g->max_bounces > 0 ? g->max_bounces : 4;
     bk_transport_output o;
