@@ -39,8 +39,7 @@ static uint8_t *buf_grow(buf *b, size_t more)
 
 static const int out_floats[4] = {27, 27, 3, 1}; /* radiance, direct, irradiance, variance */
 
-/* Bytes of a run record of n receivers; 0 on overflow. */
-static size_t run_size(uint64_t n, uint32_t passes, uint32_t mask)
+size_t bk_part_run_size(uint64_t n, uint32_t passes, uint32_t mask)
 {
     if (n > (SIZE_MAX >> 12)) return 0;
     size_t per = (size_t)passes * 32;
@@ -133,7 +132,7 @@ lbk_result bk_part_parse(const void *bytes, size_t size, bk_part_view *v, char *
         uint64_t b, e;
         bk_dist_range(v->receiver_count, v->total_runs, v->units, v->unit, v->first_run + r, &b, &e);
         if (lbk_rd64(p + at + 96) != b || lbk_rd64(p + at + 104) != e) goto bad;
-        size_t n = run_size(e - b, passes, mask);
+        size_t n = bk_part_run_size(e - b, passes, mask);
         if (!n || n > size - at) goto bad;
         v->runs[r] = p + at;
         at += n;
@@ -289,7 +288,7 @@ static lbk_result rec_done(void *user, const bk_transport_output *o, const bk_tr
     const size_t n = (size_t)(d->end - d->begin);
     const uint32_t mask = mask_of(o);
     if ((uint32_t)t->passes != d->run_passes || d->run_count >= BK_PART_MAX_RUNS) return LBK_ERR_INTERNAL;
-    size_t total = run_size(n, d->run_passes, mask);
+    size_t total = bk_part_run_size(n, d->run_passes, mask);
     uint8_t *w = total ? buf_grow(&d->out, total) : NULL;
     if (!w || d->passes.failed) return LBK_ERR_OUT_OF_MEMORY;
     put_totals(w, d->run_passes, mask, t);

@@ -23,6 +23,10 @@
 #define BK_PART_MAX_RUNS 65536u
 #define BK_PART_MAX_PASSES 32u
 
+/* Bytes of a run record of n receivers with `passes` pass headers and the output planes of
+ * `mask` (spec/part.md); 0 on overflow. */
+size_t bk_part_run_size(uint64_t n, uint32_t passes, uint32_t mask);
+
 /* Output arrays a run record holds (bk_transport_output's non-NULL members). */
 enum { BK_PART_RADIANCE = 1, BK_PART_DIRECT = 2, BK_PART_IRRADIANCE = 4, BK_PART_VARIANCE = 8 };
 

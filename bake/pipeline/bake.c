@@ -462,6 +462,9 @@ static lbk_result build_receivers(bk_pipeline *b)
     if (b->have_glg) n += b->glg.probe_count;
     b->llg_first = n;
     for (size_t g = 0; g < b->llg_count; g++) n += bk_llg_probe_count(&b->llgs[g]);
+    if (bk_llg_fit_plan_build(b->llgs, b->llg_count, &b->scene, b->tracer, n, &b->llg_fit))
+        return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
+    n += b->llg_fit.count;
     b->receiver_count = n;
     b->receivers = calloc(n ? n : 1, sizeof *b->receivers);
     b->texel_of_receiver = calloc(b->texel_receivers ? b->texel_receivers : 1, sizeof *b->texel_of_receiver);
@@ -488,6 +491,8 @@ static lbk_result build_receivers(bk_pipeline *b)
             for (uint32_t y = 0; y < l->dims[1]; y++)
                 for (uint32_t x = 0; x < l->dims[0]; x++, k++) bk_llg_probe_position(l, x, y, z, b->receivers[k].position);
     }
+    for (size_t t = 0; t < b->llg_fit.count; t++, k++)
+        bk_llg_fit_receiver(&b->llg_fit, b->llgs, &b->scene, t, b->receivers[k].position, b->receivers[k].normal);
     return LBK_OK;
 }
 
@@ -525,7 +530,8 @@ void bk_pipeline_set_inputs(const bk_pipeline *b, bk_set_inputs *in)
     in->glg_first = b->glg_first;
     in->glg_count = b->llg_first - b->glg_first;
     in->llg_first = b->llg_first;
-    in->llg_count = b->receiver_count - b->llg_first;
+    in->llg_count = b->llg_fit.first - b->llg_first;
+    in->llg_fit = &b->llg_fit;
     in->llgs = b->llgs;
     in->llg_grids = b->llg_count;
     in->texel_of_receiver = b->texel_of_receiver;
@@ -559,6 +565,24 @@ static lbk_result build_cell_sizes(bk_pipeline *b)
         if (density > 0 && isfinite(density)) b->cell_size[t] = 1.0f / density;
     }
     return LBK_OK;
+}
+
+/* The LLG class's estimate gains the fit's residual at its targets (bake/probes/PROBES.md §LLG
+ * fit): the halves' difference sees the noise of the probes, not what the lattice cannot
+ * represent, and that is what LLG objects get at run time. The residual also holds the targets'
+ * own noise, so the figure errs high. */
+static void llg_fit_error(bk_pipeline *b)
+{
+    const bk_llg_fit_stats *f = &b->llg_fit_stats;
+    if (!f->targets || !(f->target_sum > 0)) return;
+    const double n = (double)f->targets, mean = f->target_sum / n;
+    const double fitted = sqrt(f->fitted_sq / n) / mean, traced = sqrt(f->traced_sq / n) / mean;
+    double *e = &b->stats.class_rel_rmse[BK_CLASS_LLG];
+    const double noise = *e;
+    *e = sqrt(noise * noise + fitted * fitted);
+    bk_events_say(&b->events, LBK_BAKE_SEVERITY_INFO,
+                  "LLG fit: %zu vertex targets, residual %.1f%% (traced probes %.1f%%); LLG error %.1f%% (noise %.1f%%)",
+                  f->targets, 100 * fitted, 100 * traced, 100 * *e, 100 * noise);
 }
 
 /* A distributed run that failed: the recorder's or player's own message (bk_dist_error), or, for
@@ -620,6 +644,7 @@ static lbk_result do_transport(bk_pipeline *b)
     }
     r = bk_transport_run(&b->scene, b->tracer, b->receivers, b->receiver_count, &to, &out, &b->stats);
     if (!r) bk_texels_match_irradiance(&b->texels, b->texel_of_receiver, b->texel_receivers, b->radiance, irradiance);
+    if (!r) r = bk_llg_fit_run(&b->llg_fit, b->llgs, &b->scene, irradiance, b->radiance, b->llg_first, &b->llg_fit_stats);
     free(irradiance);
     b->octa_rel_rmse = b->stats.octa_rel_rmse;
     b->octa_rays = b->stats.octa_rays;
@@ -628,6 +653,7 @@ static lbk_result do_transport(bk_pipeline *b)
         if (d) return d;
     }
     if (r) return bk_pipeline_failed(b, r, "light transport");
+    llg_fit_error(b);
     if (b->stats.nonfinite)
         bk_events_say(&b->events, LBK_BAKE_SEVERITY_WARNING, "%llu non-finite samples were dropped",
                       (unsigned long long)b->stats.nonfinite);
@@ -838,6 +864,7 @@ static void pipeline_free(bk_pipeline *b)
     free(b->texel_of_receiver);
     free(b->receivers);
     free(b->cell_size);
+    bk_llg_fit_plan_free(&b->llg_fit);
     for (size_t i = 0; i < b->llg_count; i++) bk_llg_free(&b->llgs[i]);
     free(b->llgs);
     free(b->object_llg);

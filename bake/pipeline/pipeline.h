@@ -13,6 +13,7 @@
 #include "bake/layout/texels.h"
 #include "bake/probes/glg_place.h"
 #include "bake/probes/octa_bake.h"
+#include "bake/probes/llg_fit.h"
 #include "bake/probes/llg_place.h"
 #include "bake/scene/scene.h"
 #include "bake/sets/bake_sets.h"
@@ -58,9 +59,12 @@ typedef struct bk_pipeline {
     bk_llg *llgs;
     size_t llg_count;
     int32_t *object_llg;            /* per scene object: LLG index or -1 */
-    /* receivers handed to transport: valid texels, then GLG probes, then LLG probes */
+    /* receivers handed to transport: valid texels, then GLG probes, then LLG probes, then the
+     * LLG fit's vertex targets (bake/probes/llg_fit.h; from llg_fit.first) */
     bk_receiver *receivers;
     size_t receiver_count, texel_receivers, glg_first, llg_first;
+    bk_llg_fit_plan llg_fit;
+    bk_llg_fit_stats llg_fit_stats; /* the base run's fit */
     uint32_t *texel_of_receiver;    /* receiver → index in texels.receivers */
     lbk_sh9_rgb *radiance;
     float *cell_size;               /* per scene triangle: the radiosity cache's cell size (texel size) */

@@ -42,7 +42,7 @@ static void fill_counts(const bk_pipeline *b, lbk_bake_counts *c)
     c->pages = b->atlas.page_count;
     c->glg_probes = b->have_glg ? b->glg.probe_count : 0;
     c->llgs = b->llg_count;
-    c->llg_probes = b->receiver_count - b->llg_first;
+    c->llg_probes = b->llg_fit.first - b->llg_first;
     c->light_sets = b->sets.set_count;
     c->doors = b->sets.door_count;
     c->file_bytes = b->container_bytes;

@@ -195,7 +195,7 @@ static lbk_result build_llg(bk_pipeline *b, section_list *sl)
     size_t size;
     double set_max[3];
     bk_set_bakes_max(&b->sets, set_max);
-    b->scale[2] = bk_scale_for(fmax(bk_probe_max(&b->radiance[b->llg_first], b->receiver_count - b->llg_first), set_max[2]));
+    b->scale[2] = bk_scale_for(fmax(bk_probe_max(&b->radiance[b->llg_first], b->llg_fit.first - b->llg_first), set_max[2]));
     r = lbk_llg_build(&(lbk_llg_build_desc){.grids = g, .grid_count = (uint32_t)b->llg_count, .scale = b->scale[2]}, NULL, &data, &size);
     r = sections_add(sl, LBK_SECTION_LLG, r, data, size);
 done:

@@ -8,6 +8,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "bake/probes/llg_fit.h"
 #include "bake/probes/llg_place.h"
 #include "bake/scene/scene.h"
 #include "bake/layout/seams.h"
@@ -39,6 +40,7 @@ typedef struct bk_set_inputs {
     size_t texel_receivers;           /* receivers [0, texel_receivers) are texels */
     size_t glg_first, glg_count;      /* receivers [glg_first, glg_first+glg_count) are GLG probes */
     size_t llg_first, llg_count;      /* then LLG probes, in LLG section order */
+    const bk_llg_fit_plan *llg_fit;   /* then the LLG fit's vertex targets; every run is fitted */
     const bk_llg *llgs;               /* the LLGs those probes belong to (their objects) */
     size_t llg_grids;
     const uint32_t *texel_of_receiver;/* receiver → index in texels->receivers */

@@ -988,32 +988,10 @@ static void recv_origin(const tp_ctx *c, const bk_receiver *r, tp_origin *g)
  * else the receiver's own point (returns 0). */
 static int footprint_origin(const tp_ctx *c, const bk_receiver *r, double s, double t, tp_origin *g)
 {
-    const bk_scene *fs = c->fscene;
-    for (uint32_t k = 0; k < r->footprint_count; k++) {
-        const bk_footprint_tri *f = &c->opt->footprint[r->footprint_first + k];
-        double u = f->uv[0][0] + f->uv[0][1] * s + f->uv[0][2] * t;
-        double v = f->uv[1][0] + f->uv[1][1] * s + f->uv[1][2] * t;
-        if (!(u >= 0 && v >= 0 && u + v <= 1)) continue;
-        const uint32_t *ix = fs->tris + 3 * (size_t)f->tri;
-        double w[3] = {1 - u - v, u, v}, p[3] = {0, 0, 0}, n[3] = {0, 0, 0}, q[3][3];
-        for (int i = 0; i < 3; i++)
-            for (int a = 0; a < 3; a++) {
-                q[i][a] = fs->positions[3 * (size_t)ix[i] + a];
-                p[a] += w[i] * q[i][a];
-                if (fs->normals) n[a] += w[i] * fs->normals[3 * (size_t)ix[i] + a];
-            }
-        double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-        if (!(l > 0) || !isfinite(l)) { /* no shading normal: the geometric one */
-            double e1[3], e2[3];
-            for (int a = 0; a < 3; a++) { e1[a] = q[1][a] - q[0][a]; e2[a] = q[2][a] - q[0][a]; }
-            n[0] = e1[1] * e2[2] - e1[2] * e2[1];
-            n[1] = e1[2] * e2[0] - e1[0] * e2[2];
-            n[2] = e1[0] * e2[1] - e1[1] * e2[0];
-            l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-            if (!(l > 0) || !isfinite(l)) break;
-        }
-        float pf[3] = {(float)p[0], (float)p[1], (float)p[2]}, nf[3];
-        for (int a = 0; a < 3; a++) nf[a] = (float)(n[a] / l);
+    double p[3], n[3];
+    if (r->footprint_count &&
+        bk_footprint_point(c->fscene, c->opt->footprint + r->footprint_first, r->footprint_count, s, t, p, n)) {
+        float pf[3] = {(float)p[0], (float)p[1], (float)p[2]}, nf[3] = {(float)n[0], (float)n[1], (float)n[2]};
         origin_from(c, pf, nf, g);
         return 1;
     }

@@ -61,6 +61,12 @@ typedef struct bk_footprint_tri {
     float uv[2][3];
 } bk_footprint_tri;
 
+/* The world point p and unit shading normal n (the geometric normal where the mesh has none) of
+ * texel-local (s, t) on the first of a texel's `count` footprint triangles that covers it.
+ * Returns 0 where none covers it or the covering triangle is degenerate. */
+int bk_footprint_point(const bk_scene *scene, const bk_footprint_tri *tris, uint32_t count, double s, double t,
+                       double p[3], double n[3]);
+
 /* One point of the error-against-time record, written after every pass. */
 /* Receiver classes, in the order the pipeline lists receivers (bk_transport_options.class_end). */
 enum { BK_CLASS_TEXEL, BK_CLASS_GLG, BK_CLASS_LLG, BK_RECEIVER_CLASSES };

@@ -385,32 +385,6 @@ static int enclosed(const bk_tracer *tr, const double p[3], const float n[3], do
     return back >= 8;
 }
 
-/* The world point and shading normal of texel-local (s, t) on the footprint triangle that covers
- * it (the transport's footprint_origin, bake/transport/transport.c); 0 where none does. */
-static int footprint_point(const dump *d, const bk_texel *t, double s, double tt, double p[3], double n[3])
-{
-    const bk_scene *sc = &d->scene;
-    for (uint32_t k = 0; k < t->footprint_count; k++) {
-        const bk_footprint_tri *fp = &d->texels.footprint[t->footprint_first + k];
-        double u = fp->uv[0][0] + fp->uv[0][1] * s + fp->uv[0][2] * tt;
-        double v = fp->uv[1][0] + fp->uv[1][1] * s + fp->uv[1][2] * tt;
-        if (!(u >= 0 && v >= 0 && u + v <= 1)) continue;
-        const uint32_t *ix = sc->tris + 3 * (size_t)fp->tri;
-        double w[3] = {1 - u - v, u, v};
-        for (int a = 0; a < 3; a++) p[a] = n[a] = 0;
-        for (int i = 0; i < 3; i++)
-            for (int a = 0; a < 3; a++) {
-                p[a] += w[i] * sc->positions[3 * (size_t)ix[i] + a];
-                n[a] += w[i] * (sc->normals ? sc->normals[3 * (size_t)ix[i] + a] : t->normal[a]);
-            }
-        double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-        if (!(l > 0) || !isfinite(l)) return 0;
-        for (int a = 0; a < 3; a++) n[a] /= l;
-        return 1;
-    }
-    return 0;
-}
-
 /* Footprint sensors (--footprint K): the texel's value is its irradiance averaged over the part of
  * its square its chart covers, so a point sensor at its sample point measures something else
  * wherever the light changes within a texel (a ceiling texel over the Cornell light's 1 cm gap).
@@ -429,7 +403,9 @@ static size_t write_footprint(const dump *d, FILE *f, const bk_texel *t, size_t 
         for (int i = 0; i < k; i++) {
             double s = (i + 0.5) / k, tt = (j + 0.5) / k, p[3], n[3];
             if (box) s = bx[0] + s * bx[2], tt = bx[1] + tt * bx[3];
-            if (!footprint_point(d, t, s, tt, p, n)) continue;
+            if (!bk_footprint_point(&d->scene, d->texels.footprint + t->footprint_first, t->footprint_count, s, tt, p,
+                                    n))
+                continue;
             float nf[3] = {(float)n[0], (float)n[1], (float)n[2]};
             uint32_t flags = enclosed(d->tracer, p, nf, sensor_offset(&d->scene)) ? DUMP_HIDDEN : 0;
             fprintf(f, "P\t%u\t%u\t%zu\t%d\t%d\t%.9g\t%.9g\t%.9g\t%.7g\t%.7g\t%.7g\t%.6g\t%.7g\t%.7g\t%.7g\t%u\n",

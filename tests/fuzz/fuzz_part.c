@@ -16,6 +16,7 @@
 #define XXH_INLINE_ALL
 #include <xxhash.h>
 
+#include "bake/dist/dist.h"
 #include "lbk/bake.h"
 #include "lbk/bake_dist.h"
 #include "lbk/byteorder.h"
@@ -24,7 +25,7 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-enum { HEADER = 96, RUN_HEADER = 112 };
+enum { HEADER = 96 };
 static const uint64_t plan_hash = 0x6c626b2d66757a7aull; /* any non-zero value: the harness is the plan */
 
 typedef struct harness {
@@ -70,19 +71,15 @@ static void setup(void)
  * walking the records as far as their passes and masks give sizes. */
 static void repair_ranges(uint8_t *p, size_t size, uint64_t receivers)
 {
-    static const int floats[4] = {27, 27, 3, 1};
     size_t at = HEADER;
-    while (size - at >= RUN_HEADER) {
+    while (size - at >= BK_PART_RUN_HEADER_SIZE) {
         lbk_wr64(p + at + 96, 0);
         lbk_wr64(p + at + 104, receivers);
         const uint32_t passes = lbk_rd32(p + at), mask = lbk_rd32(p + at + 4);
         if (passes == 0 || passes > 32 || mask > 15 || receivers > ((uint64_t)1 << 30)) return;
-        uint64_t per = 32ull * passes;
-        for (int k = 0; k < 4; k++)
-            if (mask & (1u << k)) per += 4ull * (uint64_t)floats[k];
-        const uint64_t n = RUN_HEADER + 64ull * passes + receivers * per;
-        if (n > size - at) return;
-        at += (size_t)n;
+        const size_t n = bk_part_run_size(receivers, passes, mask);
+        if (n == 0 || n > size - at) return;
+        at += n;
     }
 }
 
