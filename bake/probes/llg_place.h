@@ -70,7 +70,8 @@ void bk_llg_vertex_records(const bk_llg *llg, lbk_llg_vertex *out);
 /* The seed's connected-objects heuristic (PROBES.md): of the objects with candidate[i] != 0,
  * out[i] = 1 when the world-space bounding box of another candidate lies within `gap` of its
  * own (touching or overlapping) and neither box contains the other (a prop standing inside
- * another's box is not a joint); else 0. gap <= 0: 1 cm. O(n log n + touching pairs). */
+ * another's box is not a joint); else 0. candidate and out: scene->object_count entries.
+ * gap <= 0: 1 cm. O(n log n + touching pairs). */
 lbk_result bk_llg_connections(const bk_scene *scene, const uint8_t *candidate, float gap, uint8_t *out);
 
 /* OBB only (area-weighted PCA), exposed for tests: centre, axes, half extents (tight). */
