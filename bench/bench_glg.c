@@ -324,7 +324,11 @@ int main(void)
     char err[512];
     bk_import_options io = {0};
     io.recentre = 1;
-    if (bk_import_gltf("../shared/scenes/room_with_doors/room.glb", &io, &room, err, sizeof err)) {
+    /* LBK_SCENES overrides ../shared/scenes, as in bench_atlas */
+    const char *dir = getenv("LBK_SCENES");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/room_with_doors/room.glb", dir && *dir ? dir : "../shared/scenes");
+    if (bk_import_gltf(path, &io, &room, err, sizeof err)) {
         printf("room_with_doors: %s (skipped)\n", err);
     } else {
         room.sky[0] = room.sky[1] = room.sky[2] = 1.0f;
