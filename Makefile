@@ -184,6 +184,7 @@ $(BUILD)/liblbk.so: $(LIB_PIC)
 	$(CC) -shared -Wl,-soname,liblbk.so.1 -o $@ $^ $(LIB_LIBS)
 # The library's version, from LBK_LIBRARY_VERSION_{MAJOR,MINOR,PATCH} in lbk.h (never the format's).
 LIB_VERSION := $(shell for k in MAJOR MINOR PATCH; do sed -n "s/^\#define LBK_LIBRARY_VERSION_$$k  *\([0-9][0-9]*\).*/\1/p" libformat/include/lbk/lbk.h; done | paste -sd. -)
+BAKE_VERSION := $(shell for k in MAJOR MINOR PATCH; do sed -n "s/^\#define LBK_BAKE_LIBRARY_VERSION_$$k  *\([0-9][0-9]*\).*/\1/p" bake/include/lbk/bake.h; done | paste -sd. -)
 $(BUILD)/lbk.pc: Makefile libformat/include/lbk/lbk.h
 	@mkdir -p $(@D)
 	@printf 'prefix=%s\nincludedir=$${prefix}/include\nlibdir=$${prefix}/lib\n\nName: lbk\nDescription: light bake kit container library\nVersion: %s\nRequires.private: libzstd libxxhash\nCflags: -I$${includedir}\nLibs: -L$${libdir} -llbk\nLibs.private: -lm\n' '$(PREFIX)' '$(LIB_VERSION)' > $@
@@ -196,9 +197,9 @@ $(BUILD)/liblbkbake.a: $(BAKE_OBJ)
 $(BUILD)/liblbkbake.so: $(BAKE_PIC) $(BUILD)/liblbk.so
 	$(CXX) -shared -Wl,-soname,liblbkbake.so.1 -Wl,--no-undefined -Wl,-rpath,'$$ORIGIN' -o $@ $(BAKE_PIC) \
 	    -L$(BUILD) -llbk $(BAKE_LIBS)
-$(BUILD)/lbk-bake.pc: Makefile
+$(BUILD)/lbk-bake.pc: Makefile bake/include/lbk/bake.h
 	@mkdir -p $(@D)
-	@printf 'prefix=%s\nincludedir=$${prefix}/include\nlibdir=$${prefix}/lib\n\nName: lbk-bake\nDescription: light bake kit baker library\nVersion: 1.0.0\nRequires: lbk\nCflags: -I$${includedir}\nLibs: -L$${libdir} -llbkbake\nLibs.private: %s -lstdc++\n' '$(PREFIX)' '$(BAKE_LIBS)' > $@
+	@printf 'prefix=%s\nincludedir=$${prefix}/include\nlibdir=$${prefix}/lib\n\nName: lbk-bake\nDescription: light bake kit baker library\nVersion: %s\nRequires: lbk\nCflags: -I$${includedir}\nLibs: -L$${libdir} -llbkbake\nLibs.private: %s -lstdc++\n' '$(PREFIX)' '$(BAKE_VERSION)' '$(BAKE_LIBS)' > $@
 bake-lib: $(BUILD)/liblbkbake.a $(BUILD)/liblbkbake.so $(BUILD)/lbk-bake.pc
 
 # ---- the viewer's page as C arrays (tools/view/view.h tl_view_assets) ------------------------
@@ -277,9 +278,11 @@ install-check: all
 	$(CC) $(CSTD) $(WARN) tests/install/install_check.c -o $(BUILD)/tests/install_check_static \
 	    $$($(INST_PC) --cflags lbk) $(INST)/lib/liblbk.a \
 	    $$($(INST_PC) --static --libs-only-other --libs-only-l lbk | sed 's/-llbk//') -lcmocka
-	$(CC) $(CSTD) $(WARN) -DLBK_CLI='"$(INST)/bin/lbk"' tests/install/bake_check.c -o $(BUILD)/tests/bake_check_shared \
+	$(CC) $(CSTD) $(WARN) -DLBK_CLI='"$(INST)/bin/lbk"' -DLBK_BAKE_PC_VERSION="\"$$($(INST_PC) --modversion lbk-bake)\"" \
+	    tests/install/bake_check.c -o $(BUILD)/tests/bake_check_shared \
 	    $$($(INST_PC) --cflags --libs lbk-bake) -Wl,-rpath,$(INST)/lib -lcmocka
-	$(CC) $(CSTD) $(WARN) -DLBK_CLI='"$(INST)/bin/lbk"' tests/install/bake_check.c -o $(BUILD)/tests/bake_check_static \
+	$(CC) $(CSTD) $(WARN) -DLBK_CLI='"$(INST)/bin/lbk"' -DLBK_BAKE_PC_VERSION="\"$$($(INST_PC) --modversion lbk-bake)\"" \
+	    tests/install/bake_check.c -o $(BUILD)/tests/bake_check_static \
 	    $$($(INST_PC) --cflags lbk-bake) $(INST)/lib/liblbkbake.a $(INST)/lib/liblbk.a \
 	    $$($(INST_PC) --static --libs-only-other --libs-only-l lbk-bake | sed 's/-llbkbake//; s/-llbk\b//') -lcmocka
 

@@ -408,6 +408,7 @@ static lbk_result layout_llgs(bk_pipeline *b, size_t n_llg)
     bk_llg_options lo;
     memset(&lo, 0, sizeof lo);
     lo.visibility_rays = b->pre->llg_visibility_rays;
+    lo.min_dim = 3; /* bake/probes/PROBES.md §LLG fit */
     for (size_t i = 0; i < s->object_count; i++) {
         if (b->classes[i].rep != BK_REP_LLG) continue;
         lbk_result r = bk_llg_place(s, (uint32_t)i, &lo, b->opt->threads, &b->llgs[b->llg_count]);

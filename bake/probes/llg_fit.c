@@ -11,6 +11,9 @@
  * small enough that the targets decide wherever they constrain a probe, large enough that an
  * unconstrained direction (a probe no vertex reads, a band no normal sees) keeps its traced value. */
 #define FIT_REGULARISATION 1e-2
+/* Smoothness between lattice neighbours, relative to the same diagonal: what fills the probes no
+ * target reads and whose traced value is no prior (inside the object: black). */
+#define FIT_SMOOTHNESS 1e-3
 
 static const double band_a[9] = {LBK_SH_A0, LBK_SH_A1, LBK_SH_A1, LBK_SH_A1, LBK_SH_A2,
                                  LBK_SH_A2, LBK_SH_A2, LBK_SH_A2, LBK_SH_A2};
@@ -24,9 +27,9 @@ size_t bk_llg_fit_target_count(const bk_llg *l, const bk_scene *s, size_t usable
 {
     const size_t p = probe_count(l);
     if (!s->normals || p > BK_LLG_FIT_MAX_PROBES) return 0;
-    /* four equations per unknown (9 per probe): the prototype's held-out error was within 4 % of
-     * the fitted one at that ratio */
-    size_t want = 36 * p > 256 ? 36 * p : 256;
+    /* two equations per unknown (9 per probe): on room_with_doors' spheres four gave the same
+     * error against Cycles (PROBES.md §LLG fit) at twice the receivers */
+    size_t want = 18 * p > 256 ? 18 * p : 256;
     return want < usable ? want : usable;
 }
 
@@ -145,8 +148,31 @@ static void cholesky_solve(const double *l, size_t n, double *x)
     }
 }
 
+/* μ Σ_edges ‖x_i − x_j‖² over the lattice's axis neighbours, into the normal equations. */
+static void add_smoothness(const bk_llg *l, double mu, double *m, size_t u)
+{
+    const uint32_t *d = l->dims;
+    for (uint32_t z = 0; z < d[2]; z++)
+        for (uint32_t y = 0; y < d[1]; y++)
+            for (uint32_t x = 0; x < d[0]; x++) {
+                const size_t i = x + (size_t)d[0] * (y + (size_t)d[1] * z);
+                const size_t nb[3] = {x + 1 < d[0] ? i + 1 : i, y + 1 < d[1] ? i + d[0] : i,
+                                      z + 1 < d[2] ? i + (size_t)d[0] * d[1] : i};
+                for (int a = 0; a < 3; a++) {
+                    const size_t j = nb[a];
+                    if (j == i) continue;
+                    for (size_t k = 0; k < 9; k++) {
+                        m[(9 * i + k) * u + 9 * i + k] += mu;
+                        m[(9 * j + k) * u + 9 * j + k] += mu;
+                        m[(9 * i + k) * u + 9 * j + k] -= mu;
+                        m[(9 * j + k) * u + 9 * i + k] -= mu;
+                    }
+                }
+            }
+}
+
 lbk_result bk_llg_fit(const bk_llg *l, const bk_scene *s, const uint32_t *targets, size_t target_count,
-                      const float *irradiance, lbk_sh9_rgb *probes, bk_llg_fit_stats *stats)
+                      const float *irradiance, const uint8_t *inside, lbk_sh9_rgb *probes, bk_llg_fit_stats *stats)
 {
     const size_t p = probe_count(l), u = 9 * p;
     if (!target_count || p > BK_LLG_FIT_MAX_PROBES) return LBK_OK;
@@ -174,9 +200,11 @@ lbk_result bk_llg_fit(const bk_llg *l, const bk_scene *s, const uint32_t *target
     for (size_t i = 0; i < u; i++) trace += m[i * u + i];
     const double lambda = FIT_REGULARISATION * trace / (double)u;
     for (size_t i = 0; i < u; i++) {
+        if (inside && inside[i / 9]) continue;
         m[i * u + i] += lambda;
         for (int ch = 0; ch < 3; ch++) rhs[ch * u + i] += lambda * probes[i / 9].c[ch][i % 9];
     }
+    add_smoothness(l, FIT_SMOOTHNESS * trace / (double)u, m, u);
     double traced_sq = 0, fitted_sq = 0, sum = 0;
     for (size_t t = 0; t < target_count; t++) {
         double y[9], e[3], tg[3] = {irradiance[3 * t], irradiance[3 * t + 1], irradiance[3 * t + 2]};
@@ -206,25 +234,6 @@ lbk_result bk_llg_fit(const bk_llg *l, const bk_scene *s, const uint32_t *target
     return LBK_OK;
 }
 
-static int inside_geometry(const bk_tracer *tr, const float p[3], const float n[3], double offset)
-{
-    float org[3], t[3], b[3];
-    for (int a = 0; a < 3; a++) org[a] = (float)(p[a] + offset * n[a]);
-    /* orthonormal basis (Duff et al. 2017) */
-    float sg = n[2] >= 0 ? 1.0f : -1.0f, q = -1.0f / (sg + n[2]), w = n[0] * n[1] * q;
-    t[0] = 1 + sg * n[0] * n[0] * q, t[1] = sg * w, t[2] = -sg * n[0];
-    b[0] = w, b[1] = sg + n[1] * n[1] * q, b[2] = -n[1];
-    int back = 0;
-    for (int i = 0; i < 16; i++) {
-        double z = 1 - (i + 0.5) / 16, r = sqrt(fmax(0, 1 - z * z)), ph = 2.399963229728653 * i;
-        float d[3];
-        for (int a = 0; a < 3; a++) d[a] = (float)(r * cos(ph) * t[a] + r * sin(ph) * b[a] + z * n[a]);
-        bk_hit h;
-        if (bk_tracer_intersect(tr, org, d, 0.0f, INFINITY, &h) && !h.front) back++;
-    }
-    return back >= 8;
-}
-
 /* The grid's vertices that are not inside geometry, ascending; returns how many. */
 static size_t usable_vertices(const bk_llg *l, const bk_scene *s, const bk_tracer *tr, uint32_t *out)
 {
@@ -235,10 +244,34 @@ static size_t usable_vertices(const bk_llg *l, const bk_scene *s, const bk_trace
         const size_t v = l->vertices[j];
         const float *p = s->positions + 3 * v, *nn = s->normals + 3 * v;
         if (!(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2] > 0.25f)) continue;
-        if (tr && inside_geometry(tr, p, nn, offset)) continue;
+        if (tr && bk_tracer_enclosed(tr, (const double[3]){p[0], p[1], p[2]}, nn, offset)) continue;
         out[n++] = (uint32_t)j;
     }
     return n;
+}
+
+/* A probe is inside geometry when at least half of 32 rays over the sphere end on back faces
+ * (the transport bakes it black, bake/transport/solid.h). */
+static void mark_inside_probes(const bk_llg *llgs, size_t grids, const bk_tracer *tr, uint8_t *inside)
+{
+    size_t k = 0;
+    for (size_t g = 0; g < grids; g++) {
+        const bk_llg *l = &llgs[g];
+        for (uint32_t z = 0; z < l->dims[2]; z++)
+            for (uint32_t y = 0; y < l->dims[1]; y++)
+                for (uint32_t x = 0; x < l->dims[0]; x++, k++) {
+                    float p[3];
+                    bk_llg_probe_position(l, x, y, z, p);
+                    int back = 0;
+                    for (int i = 0; i < 32; i++) {
+                        double cz = 1 - (i + 0.5) / 16, r = sqrt(fmax(0, 1 - cz * cz)), ph = 2.399963229728653 * i;
+                        float d[3] = {(float)(r * cos(ph)), (float)(r * sin(ph)), (float)cz};
+                        bk_hit h;
+                        if (bk_tracer_intersect(tr, p, d, 0.0f, INFINITY, &h) && !h.front) back++;
+                    }
+                    inside[k] = back >= 16;
+                }
+    }
 }
 
 lbk_result bk_llg_fit_plan_build(const bk_llg *llgs, size_t grids, const bk_scene *s, const bk_tracer *tracer,
@@ -251,7 +284,10 @@ lbk_result bk_llg_fit_plan_build(const bk_llg *llgs, size_t grids, const bk_scen
     size_t cap = 0;
     for (size_t g = 0; g < grids; g++) cap += bk_llg_fit_target_count(&llgs[g], s, llgs[g].vertex_count);
     out->vertex = malloc((cap ? cap : 1) * sizeof *out->vertex);
-    if (!out->begin || !out->vertex) {
+    size_t probes = 0;
+    for (size_t g = 0; g < grids; g++) probes += probe_count(&llgs[g]);
+    out->inside = calloc(probes ? probes : 1, 1);
+    if (!out->begin || !out->vertex || !out->inside) {
         bk_llg_fit_plan_free(out);
         return LBK_ERR_OUT_OF_MEMORY;
     }
@@ -271,6 +307,7 @@ lbk_result bk_llg_fit_plan_build(const bk_llg *llgs, size_t grids, const bk_scen
         out->begin[g + 1] = out->begin[g] + got;
     }
     out->count = out->begin[grids];
+    if (tracer) mark_inside_probes(llgs, grids, tracer, out->inside);
     return LBK_OK;
 }
 
@@ -278,6 +315,7 @@ void bk_llg_fit_plan_free(bk_llg_fit_plan *plan)
 {
     free(plan->vertex);
     free(plan->begin);
+    free(plan->inside);
     memset(plan, 0, sizeof *plan);
 }
 
@@ -297,8 +335,8 @@ lbk_result bk_llg_fit_run(const bk_llg_fit_plan *plan, const bk_llg *llgs, const
     size_t probe = llg_first;
     for (size_t g = 0; g < plan->grids; g++) {
         const size_t b = plan->begin[g], n = plan->begin[g + 1] - b;
-        lbk_result r = bk_llg_fit(&llgs[g], s, plan->vertex + b, n, irradiance + 3 * (plan->first + b), radiance + probe,
-                                  stats);
+        lbk_result r = bk_llg_fit(&llgs[g], s, plan->vertex + b, n, irradiance + 3 * (plan->first + b),
+                                  plan->inside ? plan->inside + (probe - llg_first) : NULL, radiance + probe, stats);
         if (r) return r;
         probe += probe_count(&llgs[g]);
     }

@@ -39,10 +39,12 @@ typedef struct bk_llg_fit_stats {
 } bk_llg_fit_stats;
 
 /* Replaces the probes of `llg` (lattice order, dims product entries) by the fit to the targets'
- * irradiance (rgb, 3 per target; targets as bk_llg_fit_targets gave them). stats may be NULL (else
- * added to). Deterministic. LBK_ERR_OUT_OF_MEMORY; a singular system keeps the traced probes. */
+ * irradiance (rgb, 3 per target; targets as bk_llg_fit_targets gave them). inside (per probe, or
+ * NULL: none) marks probes inside geometry, whose traced value (black) is no prior: they take
+ * their neighbours' through the smoothness term. stats may be NULL (else added to).
+ * Deterministic. LBK_ERR_OUT_OF_MEMORY; a singular system keeps the traced probes. */
 lbk_result bk_llg_fit(const bk_llg *llg, const bk_scene *scene, const uint32_t *targets, size_t target_count,
-                      const float *irradiance, lbk_sh9_rgb *probes, bk_llg_fit_stats *stats);
+                      const float *irradiance, const uint8_t *inside, lbk_sh9_rgb *probes, bk_llg_fit_stats *stats);
 
 /* Every grid's targets as receivers: targets of grid g are receivers [first + begin[g],
  * first + begin[g + 1]), vertex[k] the index into llgs[g].vertices of target k. */
@@ -50,6 +52,7 @@ typedef struct bk_llg_fit_plan {
     size_t first, count, grids;
     uint32_t *vertex;
     size_t *begin;
+    uint8_t *inside; /* per LLG probe, grid after grid: 1 inside geometry */
 } bk_llg_fit_plan;
 
 /* Vertices inside other geometry (at least half of 16 hemisphere rays from just above them end

@@ -191,14 +191,16 @@ static void lattice_dims(const bk_object *obj, const bk_llg_options *o, bk_llg *
         double k = o->connected_scale > 0 && o->connected_scale <= 1 ? o->connected_scale : 0.5;
         spacing *= k;
     }
+    const double min_dim = o->min_dim >= 2 && o->min_dim <= (int)BK_LLG_MAX_DIM ? o->min_dim : 2;
     size_t cap = o->max_probes ? o->max_probes : 512;
     if (cap < 8) cap = 8;
+    if (cap < (size_t)(min_dim * min_dim * min_dim)) cap = (size_t)(min_dim * min_dim * min_dim);
     for (;;) {
         size_t total = 1;
         int too_long = 0;
         for (int a = 0; a < 3; a++) {
             double d = ceil(2.0 * out->half_extents[a] / spacing - 1e-9) + 1.0;
-            if (d < 2.0) d = 2.0;
+            if (d < min_dim) d = min_dim;
             if (d > 65535.0) d = 65535.0;
             out->dims[a] = (uint32_t)d;
             too_long |= out->dims[a] > BK_LLG_MAX_DIM;

@@ -31,6 +31,9 @@ typedef struct bk_llg_options {   /* zero-initialised = defaults */
      * (seed 001 §2.2 "extra probes for objects that can be connected"); the cap still applies */
     int connected;
     float connected_scale;        /* 0: 0.5 (twice the probes per axis) */
+    int min_dim;                  /* probes per axis at least (2..64); 0: 2. The baker asks 3:
+                                     fitted to the vertices, 3 × 3 × 3 resolves what 2 × 2 × 2
+                                     cannot (PROBES.md §LLG fit) */
 } bk_llg_options;
 
 typedef struct bk_llg {

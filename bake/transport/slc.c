@@ -127,6 +127,11 @@ size_t bk_slc_always(const bk_slc *s, const uint32_t **ids)
 }
 
 size_t bk_slc_light_count(const bk_slc *s) { return s->count; }
+size_t bk_slc_item_count(const bk_slc *s) { return s->items; }
+size_t bk_slc_tile_count(const bk_slc *s) { return (s->items + BK_SLC_TILE - 1) / BK_SLC_TILE; }
+size_t bk_slc_block_count(const bk_slc *s) { return s->blocks; }
+const float *bk_slc_tile_box(const bk_slc *s, size_t tile) { return s->tile_box + 6 * tile; }
+const float *bk_slc_block_box(const bk_slc *s, size_t block) { return s->block_box + 6 * block; }
 
 double bk_slc_draw_xi(const bk_slc_draw *d, uint32_t light) { return d->xi[light]; }
 

@@ -45,6 +45,14 @@ void bk_slc_draw_destroy(bk_slc_draw *d);
  * their count. */
 size_t bk_slc_tile_lights(const bk_slc_draw *d, size_t item, uint32_t *ids);
 size_t bk_slc_light_count(const bk_slc *s);
+/* The tiles and blocks themselves, for other culled sources over the same items (the VPLs of
+ * bake/transport/vpl.c): item i lies in tile i / BK_SLC_TILE and block i / BK_SLC_BLOCK; a box
+ * is 6 floats (min xyz, max xyz), min > max when empty. */
+size_t bk_slc_item_count(const bk_slc *s);
+size_t bk_slc_tile_count(const bk_slc *s);
+size_t bk_slc_block_count(const bk_slc *s);
+const float *bk_slc_tile_box(const bk_slc *s, size_t tile);
+const float *bk_slc_block_box(const bk_slc *s, size_t block);
 double bk_slc_draw_xi(const bk_slc_draw *d, uint32_t light);
 
 /* The weight of a light whose irradiance luminance at the point is `lum`: 1/p when accepted

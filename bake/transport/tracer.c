@@ -311,3 +311,22 @@ void bk_offset_ray_origin(const float p[3], const float n[3], float out[3])
 {
     bk_offset_ray_origin_scaled(p, n, 1.0f, out);
 }
+
+int bk_tracer_enclosed(const bk_tracer *tr, const double p[3], const float n[3], double offset)
+{
+    float org[3], t[3], b[3];
+    for (int a = 0; a < 3; a++) org[a] = (float)(p[a] + offset * n[a]);
+    /* orthonormal basis (Duff et al. 2017) */
+    float sg = n[2] >= 0 ? 1.0f : -1.0f, q = -1.0f / (sg + n[2]), w = n[0] * n[1] * q;
+    t[0] = 1 + sg * n[0] * n[0] * q, t[1] = sg * w, t[2] = -sg * n[0];
+    b[0] = w, b[1] = sg + n[1] * n[1] * q, b[2] = -n[1];
+    int back = 0;
+    for (int i = 0; i < 16; i++) {
+        double z = 1 - (i + 0.5) / 16, r = sqrt(fmax(0, 1 - z * z)), ph = 2.399963229728653 * i;
+        float d[3];
+        for (int a = 0; a < 3; a++) d[a] = (float)(r * cos(ph) * t[a] + r * sin(ph) * b[a] + z * n[a]);
+        bk_hit h;
+        if (bk_tracer_intersect(tr, org, d, 0.0f, INFINITY, &h) && !h.front) back++;
+    }
+    return back >= 8;
+}

@@ -84,6 +84,12 @@ size_t bk_tracer_tri_count(const bk_tracer *tracer);
 void bk_offset_ray_origin(const float p[3], const float n[3], float out[3]);
 void bk_offset_ray_origin_scaled(const float p[3], const float n[3], float scale, float out[3]);
 
+/* Whether a surface point is enclosed by geometry: at least half of 16 rays over the hemisphere
+ * of unit n (golden spiral), from `offset` above p, end on back faces (the pole of a sphere that
+ * dips into the next, a face sealed in a wall). lbk's rule for points no one sees: the LLG fit
+ * leaves such vertices out, the Cycles bench such sensors. */
+int bk_tracer_enclosed(const bk_tracer *tracer, const double p[3], const float n[3], double offset);
+
 #ifdef __cplusplus
 }
 #endif

@@ -207,6 +207,19 @@ def run_scene(sc, work, opt, out):
             100 * est, 100 * g.lbk_rms, est / g.lbk_rms if g.lbk_rms else float("nan"),
             "within 2x" if within else "NOT within 2x", 100 * g.lbk_noise_rms,
             est / g.lbk_noise_rms if g.lbk_noise_rms else float("nan")))
+    # LLG objects: the report's LLG class estimate (noise and the fit's residual at its vertex
+    # targets, bake/probes/PROBES.md) against the error measured at their vertices
+    llg_within = None
+    verts = [i for i in visible if rec.kind[i] == "V"]
+    llg_est = (report.get("errors") or {}).get("llg")
+    if verts and llg_est is not None:
+        gv = Group(verts, lum, lum2, r1, r2, ceq)
+        llg_within = 0.5 <= llg_est / gv.lbk_rms <= 2 if gv.lbk_rms > 0 else gv.unresolved
+        out("  LLG estimate vs measured (all LLG vertices, RMSE/RMS): estimated %.2f %%, measured error %.2f %% (%s; "
+            "reference noise %.2f %%)" % (100 * llg_est, 100 * gv.lbk_rms,
+                                          "est/measured %.2f: %s" % (llg_est / gv.lbk_rms, "within 2x" if llg_within
+                                                                     else "NOT within 2x") if gv.lbk_rms > 0
+                                          else "not resolved from the reference's noise", 100 * gv.ref_noise))
     # what equal wall time would have given (modelled: Cycles' error ~ 1/sqrt(spp), time linear in spp)
     cal = by_role["calibration"]
     if len(cal) >= 2 and eq["spp"] > 0 and g.cyc > 0:
@@ -228,6 +241,7 @@ def run_scene(sc, work, opt, out):
                   "ref_spp": ref_spp, "all_texels": {"lbk_err": g.lbk, "lbk_bias": g.lbk_bias, "cycles_err": g.cyc,
                                                      "lbk_err_rms": g.lbk_rms, "lbk_noise_rms": g.lbk_noise_rms,
                                                      "ref_noise": g.ref_noise}, "est_within_2x": within,
+                  "llg_est_within_2x": llg_within,
                   "alt_all_texels": {"err": ga.lbk, "bias": ga.lbk_bias} if ga else None}
 
 

@@ -366,25 +366,6 @@ static int off_plane(const bk_scene *s, const bk_texel *t)
     return fabs(dist) > 0.01 * t->texel_size;
 }
 
-/* See HIDDEN above: 16 directions over the hemisphere around n (equal solid angle bands). */
-static int enclosed(const bk_tracer *tr, const double p[3], const float n[3], double offset)
-{
-    float org[3], t[3], b[3];
-    for (int a = 0; a < 3; a++) org[a] = (float)(p[a] + offset * n[a]);
-    float sg = n[2] >= 0 ? 1.0f : -1.0f, q = -1.0f / (sg + n[2]), w = n[0] * n[1] * q;
-    t[0] = 1 + sg * n[0] * n[0] * q, t[1] = sg * w, t[2] = -sg * n[0];
-    b[0] = w, b[1] = sg + n[1] * n[1] * q, b[2] = -n[1];
-    int back = 0;
-    for (int i = 0; i < 16; i++) {
-        double z = 1 - (i + 0.5) / 16, r = sqrt(fmax(0, 1 - z * z)), ph = 2.399963229728653 * i;
-        float d[3];
-        for (int a = 0; a < 3; a++) d[a] = (float)(r * cos(ph) * t[a] + r * sin(ph) * b[a] + z * n[a]);
-        bk_hit h;
-        if (bk_tracer_intersect(tr, org, d, 0.0f, INFINITY, &h) && !h.front) back++;
-    }
-    return back >= 8;
-}
-
 /* Footprint sensors (--footprint K): the texel's value is its irradiance averaged over the part of
  * its square its chart covers, so a point sensor at its sample point measures something else
  * wherever the light changes within a texel (a ceiling texel over the Cornell light's 1 cm gap).
@@ -407,7 +388,7 @@ static size_t write_footprint(const dump *d, FILE *f, const bk_texel *t, size_t 
                                     n))
                 continue;
             float nf[3] = {(float)n[0], (float)n[1], (float)n[2]};
-            uint32_t flags = enclosed(d->tracer, p, nf, sensor_offset(&d->scene)) ? DUMP_HIDDEN : 0;
+            uint32_t flags = bk_tracer_enclosed(d->tracer, p, nf, sensor_offset(&d->scene)) ? DUMP_HIDDEN : 0;
             fprintf(f, "P\t%u\t%u\t%zu\t%d\t%d\t%.9g\t%.9g\t%.9g\t%.7g\t%.7g\t%.7g\t%.6g\t%.7g\t%.7g\t%.7g\t%u\n",
                     t->object, mat, parent, i, j, p[0] + d->scene.origin[0], p[1] + d->scene.origin[1],
                     p[2] + d->scene.origin[2], nf[0], nf[1], nf[2], t->texel_size, rgb[0], rgb[1], rgb[2], flags);
@@ -430,7 +411,8 @@ static int write_texels(const dump *d, FILE *f, int footprint)
         uint32_t mat = d->scene.tri_material ? d->scene.tri_material[t->tri] : 0;
         double p[3] = {t->position[0], t->position[1], t->position[2]};
         if (t->flags & BK_TEXEL_EDGE) inside_triangle(&d->scene, t, p);
-        uint32_t flags = t->flags | (enclosed(d->tracer, p, t->normal, sensor_offset(&d->scene)) ? DUMP_HIDDEN : 0) |
+        const int hidden = bk_tracer_enclosed(d->tracer, p, t->normal, sensor_offset(&d->scene));
+        uint32_t flags = t->flags | (hidden ? DUMP_HIDDEN : 0) |
                          (off_plane(&d->scene, t) ? DUMP_OFFPLANE : 0);
         fprintf(f, "T\t%u\t%u\t%u\t%u\t%u\t%.9g\t%.9g\t%.9g\t%.7g\t%.7g\t%.7g\t%.6g\t%.7g\t%.7g\t%.7g\t%u\n", t->object,
                 mat, t->page, t->x, t->y, p[0] + d->scene.origin[0], p[1] + d->scene.origin[1],
@@ -482,7 +464,7 @@ static int write_llg_vertices(const dump *d, FILE *f, uint32_t max_per_object)
             /* the material of the first triangle using the vertex is not needed: one per object */
             uint32_t mat = s->tri_material ? s->tri_material[ob->first_tri] : 0;
             const double pd[3] = {p[0], p[1], p[2]};
-            uint32_t flags = enclosed(d->tracer, pd, nn, sensor_offset(s)) ? DUMP_HIDDEN : 0;
+            uint32_t flags = bk_tracer_enclosed(d->tracer, pd, nn, sensor_offset(s)) ? DUMP_HIDDEN : 0;
             fprintf(f, "V\t%u\t%u\t%u\t%zu\t0\t%.9g\t%.9g\t%.9g\t%.7g\t%.7g\t%.7g\t0\t%.7g\t%.7g\t%.7g\t%u\n", i, mat,
                     o.index, k, pw[0], pw[1], pw[2], nn[0], nn[1], nn[2],
                     rgb[0], rgb[1], rgb[2], flags);

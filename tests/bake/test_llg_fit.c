@@ -193,12 +193,79 @@ static void test_vertices_inside_other_geometry_are_no_targets(void **state)
     teardown(&f);
 }
 
+/* A probe inside the object (the centre of a 3 × 3 × 3 lattice in a box whose only vertices are
+ * its corners) is traced black; the targets weight it by 0.09³, so without the smoothness term a
+ * renderer sampling the grid inside the box (per pixel, between vertices) would see it
+ * (test_render's furnace did: 12.5 %). In a uniform field it must come out like its neighbours. */
+static void test_inside_probe_takes_its_neighbours(void **state)
+{
+    (void)state;
+    bk_scene s;
+    psc_init(&s);
+    uint32_t obj = psc_object(&s, "prop", BK_LIGHTING_LLG);
+    const float lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1};
+    psc_box(&s, lo, hi, 1, 0);
+    psc_update_bounds(&s);
+    bk_tracer *tr = NULL;
+    assert_int_equal(bk_tracer_create(&s, 1, &tr), LBK_OK);
+    bk_llg_options o = {0};
+    o.spacing = 4;
+    o.min_dim = 3;
+    bk_llg l;
+    assert_int_equal(bk_llg_place(&s, obj, &o, 1, &l), LBK_OK);
+    bk_llg_fit_plan plan;
+    assert_int_equal(bk_llg_fit_plan_build(&l, 1, &s, tr, 0, &plan), LBK_OK);
+    assert_int_equal(bk_llg_probe_count(&l), 27);
+    for (size_t i = 0; i < 27; i++) assert_int_equal(plan.inside[i], i == 13); /* the centre only */
+    /* uniform radiance L = 1: DC = 1 / Y00, irradiance π at every target */
+    lbk_sh9_rgb probes[27];
+    memset(probes, 0, sizeof probes);
+    for (size_t i = 0; i < 27; i++)
+        for (int ch = 0; ch < 3; ch++) probes[i].c[ch][0] = i == 13 ? 0.0f : 1.0f / LBK_SH_Y00;
+    float *e = malloc(3 * plan.count * sizeof *e);
+    assert_non_null(e);
+    for (size_t t = 0; t < 3 * plan.count; t++) e[t] = (float)M_PI;
+    assert_int_equal(bk_llg_fit_run(&plan, &l, &s, e, probes, 0, NULL), LBK_OK);
+    for (int ch = 0; ch < 3; ch++) assert_float_equal(probes[13].c[ch][0] * LBK_SH_Y00, 1.0, 0.02);
+    free(e);
+    bk_llg_fit_plan_free(&plan);
+    bk_llg_free(&l);
+    bk_tracer_destroy(tr);
+    psc_free(&s);
+}
+
+/* The baker's lattices have at least 3 probes per axis (a 2 × 2 × 2 lattice has no probe inside
+ * the object to fit); the option's default stays 2. */
+static void test_min_dim(void **state)
+{
+    (void)state;
+    bk_scene s;
+    psc_init(&s);
+    uint32_t obj = psc_object(&s, "small", BK_LIGHTING_LLG);
+    const float c[3] = {0, 0, 0};
+    psc_sphere(&s, c, 0.5f, 8, 12);
+    psc_update_bounds(&s);
+    bk_llg_options o = {0};
+    bk_llg l;
+    assert_int_equal(bk_llg_place(&s, obj, &o, 1, &l), LBK_OK);
+    for (int a = 0; a < 3; a++) assert_int_equal(l.dims[a], 2);
+    bk_llg_free(&l);
+    o.min_dim = 3;
+    o.max_probes = 8; /* raised to 27 by the minimum */
+    assert_int_equal(bk_llg_place(&s, obj, &o, 1, &l), LBK_OK);
+    for (int a = 0; a < 3; a++) assert_int_equal(l.dims[a], 3);
+    bk_llg_free(&l);
+    psc_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_fit_reproduces_the_runtime),
         cmocka_unit_test(test_fit_is_linear),
         cmocka_unit_test(test_vertices_inside_other_geometry_are_no_targets),
+        cmocka_unit_test(test_min_dim),
+        cmocka_unit_test(test_inside_probe_takes_its_neighbours),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -32,6 +32,9 @@
 #ifndef LBK_CLI
 #define LBK_CLI "lbk"
 #endif
+#ifndef LBK_BAKE_PC_VERSION
+#define LBK_BAKE_PC_VERSION "" /* the Makefile passes pkg-config --modversion lbk-bake */
+#endif
 
 /* ---- the level, as plain data ------------------------------------------------------------- */
 
@@ -472,9 +475,21 @@ static void test_bad_description_is_refused(void **state)
     assert_int_equal(w.errors, 1);
 }
 
+/* lbk-bake.pc states the version the installed header declares (it said 1.0.0 while the
+ * header's structs had grown three minor versions). */
+static void test_pc_version_is_the_header_version(void **state)
+{
+    (void)state;
+    char want[32];
+    snprintf(want, sizeof want, "%d.%d.%d", LBK_BAKE_LIBRARY_VERSION_MAJOR, LBK_BAKE_LIBRARY_VERSION_MINOR,
+             LBK_BAKE_LIBRARY_VERSION_PATCH);
+    assert_string_equal(LBK_BAKE_PC_VERSION, want);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_pc_version_is_the_header_version),
         cmocka_unit_test(test_in_memory_bake_with_progress),
         cmocka_unit_test(test_cancel_from_callback),
         cmocka_unit_test(test_same_bytes_as_lbk_bake),

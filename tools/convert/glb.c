@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "lbk/byteorder.h"
 #include "tools/common/error_util.h"
 #include "tools/common/file_util.h"
 
@@ -59,11 +60,6 @@ static size_t bin_append(tl_glb *g, const void *data, size_t n)
     return at;
 }
 
-static void wr32(uint8_t *p, uint32_t v)
-{
-    p[0] = (uint8_t)v, p[1] = (uint8_t)(v >> 8), p[2] = (uint8_t)(v >> 16), p[3] = (uint8_t)(v >> 24);
-}
-
 /* A bufferView over little-endian copies of 32-bit words, or plain bytes (word_size 1). */
 static int add_view(tl_glb *g, const void *data, size_t count, size_t word_size, int target)
 {
@@ -75,7 +71,7 @@ static int add_view(tl_glb *g, const void *data, size_t count, size_t word_size,
         le = malloc(n ? n : 1);
         if (!le) return g->failed = 1, -1;
         const uint32_t *w = data;
-        for (size_t i = 0; i < count; i++) wr32(le + 4 * i, w[i]);
+        for (size_t i = 0; i < count; i++) lbk_wr32(le + 4 * i, w[i]);
         src = le;
     }
     const size_t at = bin_append(g, src, n);
@@ -164,18 +160,18 @@ int tl_glb_write(tl_glb *g, const char *path, char err[TL_ERR_LEN])
         free(json);
         return tl_fail(err, -1, total > UINT32_MAX ? "the glTF exceeds the 4 GiB GLB limit" : "out of memory");
     }
-    wr32(f, 0x46546C67u); /* "glTF" */
-    wr32(f + 4, 2);
-    wr32(f + 8, (uint32_t)total);
-    wr32(f + 12, (uint32_t)jpad);
-    wr32(f + 16, 0x4E4F534Au); /* "JSON" */
+    lbk_wr32(f, 0x46546C67u); /* "glTF" */
+    lbk_wr32(f + 4, 2);
+    lbk_wr32(f + 8, (uint32_t)total);
+    lbk_wr32(f + 12, (uint32_t)jpad);
+    lbk_wr32(f + 16, 0x4E4F534Au); /* "JSON" */
     memcpy(f + 20, json, jn);
     memset(f + 20 + jn, ' ', jpad - jn);
     free(json);
     if (g->bin_size) {
         uint8_t *c = f + 20 + jpad;
-        wr32(c, (uint32_t)bpad);
-        wr32(c + 4, 0x004E4942u); /* "BIN\0" */
+        lbk_wr32(c, (uint32_t)bpad);
+        lbk_wr32(c + 4, 0x004E4942u); /* "BIN\0" */
         memcpy(c + 8, g->bin, g->bin_size);
     }
     int rc = tl_write_file_atomic(path, f, total, err);

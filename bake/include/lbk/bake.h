@@ -52,6 +52,12 @@ extern "C" {
 #define LBK_BAKE_API
 #endif
 
+/* The baker library's version (lbk-bake.pc): the minor grows with every addition to the
+ * size-tagged structs below ("added in 1.x"). */
+#define LBK_BAKE_LIBRARY_VERSION_MAJOR 1
+#define LBK_BAKE_LIBRARY_VERSION_MINOR 3
+#define LBK_BAKE_LIBRARY_VERSION_PATCH 0
+
 /* ---- options ----------------------------------------------------------------------------- */
 
 /* Quality presets (README "Presets"); every value can be overridden in lbk_bake_desc. */
