@@ -39,6 +39,8 @@ static void help(FILE *f)
           "  --glg-spacing M         global light grid spacing in metres\n"
           "  --sky R,G,B | FILE.exr  sky radiance (overrides the scene's lbk_sky)\n"
           "  --no-glg                leave out the global light grid\n"
+          "  --glg-lighting          global light grid denser where the lighting varies, coarser where it\n"
+          "                          is smooth (a coarse probe pass first; bake/probes/PROBES.md)\n"
           "  --octahedral            also write a GIBS-style octahedral probe volume (OCTP, format 1.3)\n"
           "  --block-align           charts on 4-texel boundaries, so no 4x4 block of a block-compressed pack\n"
           "                          (lbk convert --profile console-current, handheld) holds two charts\n"
@@ -306,7 +308,7 @@ static int bake(bake_args *o, int quiet)
 
 int cli_bake_flag(const char *a)
 {
-    return !strcmp(a, "--no-glg") || !strcmp(a, "--octahedral") || !strcmp(a, "--block-align") || !strcmp(a, "--timestamp") ||
+    return !strcmp(a, "--no-glg") || !strcmp(a, "--octahedral") || !strcmp(a, "--glg-lighting") || !strcmp(a, "--block-align") || !strcmp(a, "--timestamp") ||
            !strcmp(a, "-q") || !strcmp(a, "--quiet") || !strcmp(a, "-h") || !strcmp(a, "--help");
 }
 
@@ -422,6 +424,8 @@ int cli_bake_parse(int argc, char **argv, bake_args *out, int *quiet_out)
             o.d.no_glg = 1;
         } else if (!strcmp(a, "--octahedral")) {
             o.d.octahedral_probes = 1;
+        } else if (!strcmp(a, "--glg-lighting")) {
+            o.d.glg_lighting = 1;
         } else if (!strcmp(a, "--block-align")) {
             o.d.block_align = 1;
         } else if (!strcmp(a, "--dls-threshold")) {

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bake/probes/glg_coarse.h"
 #include "bake/dist/checkpoint.h"
 #include "bake/dist/dist.h"
 #include "bake/pipeline/encode.h"
@@ -220,6 +221,11 @@ static void recentre(bk_pipeline *b)
         for (int k = 0; k < 3; k++) s->positions[3 * v + k] = (float)((double)s->positions[3 * v + k] - c[k]);
     for (size_t i = 0; i < s->light_count; i++)
         for (int k = 0; k < 3; k++) s->lights[i].position[k] = (float)((double)s->lights[i].position[k] - c[k]);
+    for (size_t i = 0; i < s->playable_count; i++)
+        for (int k = 0; k < 3; k++) {
+            s->playable[i].min[k] = (float)((double)s->playable[i].min[k] - c[k]);
+            s->playable[i].max[k] = (float)((double)s->playable[i].max[k] - c[k]);
+        }
     for (int k = 0; k < 3; k++) {
         s->bounds_min[k] = (float)((double)s->bounds_min[k] - c[k]);
         s->bounds_max[k] = (float)((double)s->bounds_max[k] - c[k]);
@@ -352,8 +358,22 @@ static lbk_result layout_glg(bk_pipeline *b)
     bk_glg_options go;
     memset(&go, 0, sizeof go);
     go.spacing = b->opt->glg_spacing > 0 ? b->opt->glg_spacing : b->pre->glg_spacing;
+    bk_glg_coarse coarse;
+    memset(&coarse, 0, sizeof coarse);
+    if (b->opt->glg_lighting) {   /* the density rule's coarse pass (bake/probes/glg_coarse.h) */
+        coarse.scene = &b->scene;
+        coarse.tracer = b->tracer;
+        coarse.seed = b->opt->seed;
+        coarse.threads = b->opt->threads;
+        go.lighting = bk_glg_coarse_lighting;
+        go.lighting_user = &coarse;
+        go.lighting_threshold = b->opt->glg_lighting_threshold;
+    }
     lbk_result r = bk_glg_build(&b->scene, b->tracer, &go, b->opt->threads, &b->glg);
     if (r) return bk_pipeline_failed(b, r, "global light grid");
+    if (b->opt->glg_lighting)
+        bk_events_say(&b->events, LBK_BAKE_SEVERITY_INFO, "global light grid by lighting: coarse pass %.1f Mrays, %.2f s",
+                      (double)coarse.rays * 1e-6, coarse.seconds);
     b->have_glg = b->glg.status == BK_GLG_OK && b->glg.probe_count >= 4 && b->glg.tet_count > 0;
     if (!b->have_glg) {
         static const char *why[] = {"ok", "the scene has no geometry", "there is no free space for 4 probes",
@@ -793,6 +813,8 @@ static lbk_result check_desc(bk_pipeline *b)
     if (d->max_samples < 0 || d->max_bounces < 0) BAD("lbk_bake_desc: max_samples and max_bounces must be >= 0");
     if (!finite_nonneg(d->texel_density)) BAD("lbk_bake_desc.texel_density: %g is not a finite number >= 0", d->texel_density);
     if (!finite_nonneg(d->glg_spacing)) BAD("lbk_bake_desc.glg_spacing: %g is not a finite number >= 0", d->glg_spacing);
+    if (!finite_nonneg(d->glg_lighting_threshold))
+        BAD("lbk_bake_desc.glg_lighting_threshold: %g is not a finite number >= 0", d->glg_lighting_threshold);
     if (!isfinite(d->dls_threshold)) BAD("lbk_bake_desc.dls_threshold is not finite");
     if (d->light_culling < -1 || d->light_culling > 1) BAD("lbk_bake_desc.light_culling: %d is not -1, 0 or 1", d->light_culling);
     if (!finite_nonneg(d->light_culling_delta) || d->light_culling_delta > 1e6)
@@ -997,6 +1019,10 @@ static uint64_t options_hash(const lbk_bake_desc *options, int budgets)
     hash_str(st, d.sky_exr);
     hash_str(st, d.revision);
     hash_str(st, d.allow_outside);
+    if (d.glg_lighting || d.glg_lighting_threshold > 0) { /* (absent from older hashes: same values) */
+        const double gl[2] = {(double)d.glg_lighting, (double)d.glg_lighting_threshold};
+        XXH64_update(st, gl, sizeof gl);
+    }
     if (d.light_culling || d.light_culling_delta > 0) { /* (absent from older hashes: same values) */
         const double lc[2] = {(double)d.light_culling, d.light_culling_delta};
         XXH64_update(st, lc, sizeof lc);

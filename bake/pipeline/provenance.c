@@ -311,6 +311,10 @@ lbk_result bk_provenance_meta(const bk_pipeline *b, void **data, size_t *size)
     /* absent: auto and the default δ (so bakes that leave them alone keep their bytes) */
     if (o->light_culling) p[n++] = (lbk_meta_pair){"bake.light_culling", o->light_culling > 0 ? "on" : "off"};
     if (o->light_culling_delta > 0) p[n++] = (lbk_meta_pair){"bake.light_culling_delta", culling_delta};
+    char glg_light[32];
+    snprintf(glg_light, sizeof glg_light, "%g", o->glg_lighting_threshold > 0 ? o->glg_lighting_threshold : 0.4);
+    /* absent: off (older bakes) */
+    if (o->glg_lighting) p[n++] = (lbk_meta_pair){"bake.glg_lighting", glg_light};
     p[n++] = (lbk_meta_pair){"bake.dls_threshold", threshold};
     p[n++] = (lbk_meta_pair){"bake.door_method", o->door_method == LBK_BAKE_DOOR_GUIDED ? "guided" : "difference"};
     if (o->revision) p[n++] = (lbk_meta_pair){LBK_META_REVISION, o->revision};

@@ -35,7 +35,15 @@ typedef struct place_ctx {
     const bk_tracer *tracer;
     const uint32_t *tris;      /* usable (finite, non-degenerate) triangle ids */
     size_t tri_count;
-    int levels;
+    int levels;                /* deepest refinement (scratch, clearance): geo_levels + max depth */
+    int geo_levels;            /* near-geometry halvings below a cell's adaptive depth */
+    /* adaptive density (bk_glg_options): 0 = off, the top grid at the spacing, no depths */
+    int adaptive;
+    int playable_levels, lighting_levels;
+    float lighting_threshold;
+    bk_glg_lighting_fn lighting;
+    void *lighting_user;
+    size_t coarse_points, cells_by_depth[4];
     double pad;                /* cells are grown by this before the overlap test */
     size_t max_candidates;     /* stop refining past this (the cap will coarsen anyway) */
     /* per-candidate test */
@@ -56,16 +64,18 @@ static int tri_hits_box(const place_ctx *c, uint32_t t, const double centre[3], 
     return bk_tri_box_overlap(centre, h, P + 3 * (size_t)v[0], P + 3 * (size_t)v[1], P + 3 * (size_t)v[2]);
 }
 
-/* Emits the centre of the cell, or of its octants where the cell holds geometry. list holds the
+/* Emits the centre of the cell, or of its octants: split while level < force (the adaptive
+ * depth of its top cell), and while level < geo_end where the cell holds geometry. list holds the
  * triangles overlapping the parent; scratch has room for level-many filtered lists. */
 static void refine(const place_ctx *c, candidates *out, const double centre[3], const double half[3],
-                   const uint32_t *list, size_t n, int level, uint32_t *scratch)
+                   const uint32_t *list, size_t n, int level, int force, int geo_end, uint32_t *scratch)
 {
     size_t m = 0;
-    if (level < c->levels && out->n < c->max_candidates)
+    int room = out->n < c->max_candidates;
+    if (level < geo_end && room)
         for (size_t i = 0; i < n; i++)
             if (tri_hits_box(c, list[i], centre, half)) scratch[m++] = list[i];
-    if (m == 0) {
+    if (m == 0 && !(level < force && room)) {
         cand_push(out, centre[0], centre[1], centre[2]);
         return;
     }
@@ -73,7 +83,7 @@ static void refine(const place_ctx *c, candidates *out, const double centre[3], 
     for (int o = 0; o < 8; o++) {
         double cc[3] = {centre[0] + ((o & 1) ? h[0] : -h[0]), centre[1] + ((o & 2) ? h[1] : -h[1]),
                         centre[2] + ((o & 4) ? h[2] : -h[2])};
-        refine(c, out, cc, h, scratch, m, level + 1, scratch + m);
+        refine(c, out, cc, h, scratch, m, level + 1, force, geo_end, scratch + m);
     }
 }
 
@@ -141,6 +151,139 @@ void bk_glg_probes_free(bk_glg_probes *p)
     memset(p, 0, sizeof *p);
 }
 
+/* ---- adaptive density (PROBES.md §Density by playable space and lighting) ------------------ */
+
+static int box_overlaps(const double lo[3], const double hi[3], const bk_box *b)
+{
+    for (int k = 0; k < 3; k++)
+        if (!(hi[k] > b->min[k] && lo[k] < b->max[k])) return 0;
+    return 1;
+}
+
+static size_t cell_id(const int64_t dims[3], int64_t x, int64_t y, int64_t z)
+{
+    return (size_t)((z * dims[1] + y) * dims[0] + x);
+}
+
+/* The estimated relative interpolation error at a point of the coarse lattice, for a grid of
+ * `step` lattice spacings: a linear interpolation between the points `step` away on either side
+ * along an axis misses this one by |f(−) + f(+) − 2 f(c)| / 2, and the midpoints of such a grid,
+ * where linear interpolation errs most, by about half of that. The largest over the three axes
+ * and the six irradiance directions, relative to the point's own level (the mean of its six
+ * values) plus `floor` (a share of the level's mean, so dark corners do not ask for probes for
+ * differences nobody sees); 0 without free points on both sides along any axis (next to walls
+ * the near-geometry refinement decides). The coarse pass's noise is taken off first: a second
+ * difference only counts beyond 2 standard deviations of its own noise (the three points'
+ * variances, the centre's four times), so few samples do not refine a smooth level. */
+static double lattice_error(const int64_t dims[3], const int64_t *slot, const float *val, int64_t x, int64_t y,
+                            int64_t z, int64_t step, double floor)
+{
+    int64_t me = slot[cell_id(dims, x, y, z)];
+    if (me < 0) return 0.0;
+    int64_t at[3] = {x, y, z};
+    double e = 0.0, level = floor;
+    for (int d = 0; d < 6; d++) level += val[7 * me + d] / 6.0;
+    for (int a = 0; a < 3; a++) {
+        if (at[a] < step || at[a] + step >= dims[a]) continue;
+        int64_t m[3] = {x, y, z}, p[3] = {x, y, z};
+        m[a] -= step; p[a] += step;
+        int64_t sm = slot[cell_id(dims, m[0], m[1], m[2])], sp = slot[cell_id(dims, p[0], p[1], p[2])];
+        if (sm < 0 || sp < 0) continue;
+        double var = (double)val[7 * sm + 6] + val[7 * sp + 6] + 4.0 * val[7 * me + 6];
+        double noise = 2.0 * sqrt(var > 0.0 ? var : 0.0);
+        for (int d = 0; d < 6; d++) {
+            double d2 = (double)val[7 * sm + d] + val[7 * sp + d] - 2.0 * val[7 * me + d];
+            e = fmax(e, 0.25 * (fabs(d2) - noise));
+        }
+    }
+    return level > 0.0 ? e / level : 0.0;
+}
+
+/* The lighting rule. The coarse pass lights a lattice twice as fine as the top grid (the centres
+ * of the top cells' octants, solid-tested and pushed out like candidates). A top cell gets depth 1
+ * where a grid of its own spacing (lattice step 2) would err by more than threshold × the mean
+ * irradiance at one of its octant centres, depth 2 where a grid of half its spacing (step 1)
+ * would, depth 3 where that one errs by more than 2 × the bar (a step's error only halves with
+ * the spacing). */
+static lbk_result lighting_depths(place_ctx *c, const double lo[3], const double cell[3], const int64_t top[3],
+                                  int threads, uint8_t *depth)
+{
+    const int64_t dims[3] = {2 * top[0], 2 * top[1], 2 * top[2]};
+    size_t ncell = (size_t)(dims[0] * dims[1] * dims[2]);
+    lbk_result res = LBK_OK;
+    float *pts = malloc(ncell * 3 * sizeof *pts), *moved = malloc(ncell * 3 * sizeof *moved), *val = NULL;
+    uint8_t *verdict = malloc(ncell);
+    int64_t *slot = malloc(ncell * sizeof *slot);
+    if (!pts || !moved || !verdict || !slot) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
+    for (int64_t z = 0; z < dims[2]; z++) for (int64_t y = 0; y < dims[1]; y++) for (int64_t x = 0; x < dims[0]; x++) {
+        float *p = pts + 3 * cell_id(dims, x, y, z);
+        p[0] = (float)(lo[0] + (x + 0.5) * 0.5 * cell[0]); p[1] = (float)(lo[1] + (y + 0.5) * 0.5 * cell[1]);
+        p[2] = (float)(lo[2] + (z + 0.5) * 0.5 * cell[2]);
+    }
+    c->cand = pts; c->out = moved; c->verdict = verdict;
+    if (c->tracer) bk_parallel_chunks(0, ncell, 16, bk_thread_count(threads), test_candidates, c);
+    else { memcpy(moved, pts, ncell * 3 * sizeof *pts); memset(verdict, 0, ncell); }
+    c->cand = NULL; c->out = NULL; c->verdict = NULL;
+    size_t nv = 0;
+    for (size_t i = 0; i < ncell; i++) {
+        if (verdict[i] & 3) { slot[i] = -1; continue; }
+        memmove(moved + 3 * nv, moved + 3 * i, 3 * sizeof *moved);   /* compact: nv <= i */
+        slot[i] = (int64_t)nv++;
+    }
+    c->coarse_points = nv;
+    if (nv == 0) goto done;
+    val = malloc(nv * 7 * sizeof *val);
+    if (!val) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
+    res = c->lighting(c->lighting_user, moved, nv, val);
+    if (res != LBK_OK) goto done;
+    double mean = 0.0;
+    for (size_t i = 0; i < 7 * nv; i++) {
+        if (!isfinite(val[i]) || val[i] < 0.0f) val[i] = 0.0f;   /* a caller's NaN refines nothing */
+        if (i % 7 != 6) mean += val[i];
+    }
+    mean /= (double)(6 * nv);
+    if (!(mean > 0.0)) goto done;   /* a dark level: nothing to follow */
+    const double bar = c->lighting_threshold, floor = 0.05 * mean;
+    for (int64_t z = 0; z < top[2]; z++) for (int64_t y = 0; y < top[1]; y++) for (int64_t x = 0; x < top[0]; x++) {
+        double e_top = 0.0, e_half = 0.0;
+        for (int o = 0; o < 8; o++) {
+            int64_t lx = 2 * x + (o & 1), ly = 2 * y + ((o >> 1) & 1), lz = 2 * z + ((o >> 2) & 1);
+            e_top = fmax(e_top, lattice_error(dims, slot, val, lx, ly, lz, 2, floor));
+            e_half = fmax(e_half, lattice_error(dims, slot, val, lx, ly, lz, 1, floor));
+        }
+        int k = e_half > 2.0 * bar ? 3 : e_half > bar ? 2 : e_top > bar ? 1 : 0;
+        if (k > c->lighting_levels) k = c->lighting_levels;
+        uint8_t *d = &depth[cell_id(top, x, y, z)];
+        *d = (uint8_t)((*d & 0xF0) | k);
+    }
+done:
+    free(pts); free(moved); free(verdict); free(slot); free(val);
+    return res;
+}
+
+/* Per top cell, how many times it is split before the near-geometry rule: the playable rule's
+ * depth in the high nibble, the lighting rule's in the low one. */
+static lbk_result adaptive_depths(place_ctx *c, const double lo[3], const double cell[3], const int64_t dims[3],
+                                  int threads, uint8_t *depth)
+{
+    const bk_scene *s = c->scene;
+    if (c->playable_levels > 0)
+        for (int64_t z = 0; z < dims[2]; z++) for (int64_t y = 0; y < dims[1]; y++) for (int64_t x = 0; x < dims[0]; x++) {
+            double a[3] = {lo[0] + x * cell[0], lo[1] + y * cell[1], lo[2] + z * cell[2]};
+            double b[3] = {a[0] + cell[0], a[1] + cell[1], a[2] + cell[2]};
+            for (size_t i = 0; i < s->playable_count; i++)
+                if (box_overlaps(a, b, &s->playable[i])) { depth[cell_id(dims, x, y, z)] = (uint8_t)(c->playable_levels << 4); break; }
+        }
+    lbk_result res = c->lighting ? lighting_depths(c, lo, cell, dims, threads, depth) : LBK_OK;
+    size_t ncell = (size_t)(dims[0] * dims[1] * dims[2]);
+    memset(c->cells_by_depth, 0, sizeof c->cells_by_depth);
+    for (size_t i = 0; i < ncell; i++) {
+        int pf = depth[i] >> 4, lf = depth[i] & 15, d = pf > lf ? pf : lf;
+        c->cells_by_depth[d < 3 ? d : 3]++;
+    }
+    return res;
+}
+
 /* One placement attempt at a given spacing and refinement. */
 static lbk_result place_once(place_ctx *c, const double lo[3], const double ext[3], double spacing,
                              int threads, bk_glg_probes *out)
@@ -165,6 +308,7 @@ static lbk_result place_once(place_ctx *c, const double lo[3], const double ext[
     /* bin usable triangles into top cells (CSR) by their padded bounding boxes */
     size_t *start = calloc(ncell + 1, sizeof *start);
     uint32_t *bins = NULL, *scratch = NULL;
+    uint8_t *depth = NULL;
     candidates cand = {0};
     if (!start) return LBK_ERR_OUT_OF_MEMORY;
     for (int pass = 0; pass < 2; pass++) {
@@ -198,6 +342,12 @@ static lbk_result place_once(place_ctx *c, const double lo[3], const double ext[
             start[0] = 0;
         }
     }
+    if (c->adaptive) {
+        depth = calloc(ncell, 1);
+        if (!depth) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
+        res = adaptive_depths(c, lo, cell, dims, threads, depth);
+        if (res != LBK_OK) goto done;
+    }
     size_t maxbin = 0;
     for (size_t i = 0; i < ncell; i++) if (start[i + 1] - start[i] > maxbin) maxbin = start[i + 1] - start[i];
     scratch = malloc(((size_t)(c->levels + 1) * maxbin + 1) * sizeof *scratch);
@@ -206,7 +356,11 @@ static lbk_result place_once(place_ctx *c, const double lo[3], const double ext[
         size_t id = (size_t)((z * dims[1] + y) * dims[0] + x);
         double centre[3] = {lo[0] + (x + 0.5) * cell[0], lo[1] + (y + 0.5) * cell[1], lo[2] + (z + 0.5) * cell[2]};
         double half[3] = {0.5 * cell[0], 0.5 * cell[1], 0.5 * cell[2]};
-        refine(c, &cand, centre, half, bins + start[id], start[id + 1] - start[id], 0, scratch);
+        /* playable cells keep the near-geometry refinement below their depth (inside, the density
+         * of the non-adaptive placement); lit cells get it only beyond their depth */
+        int pf = depth ? depth[id] >> 4 : 0, lf = depth ? depth[id] & 15 : 0, force = pf > lf ? pf : lf;
+        int geo_end = pf + c->geo_levels > force ? pf + c->geo_levels : force;
+        refine(c, &cand, centre, half, bins + start[id], start[id + 1] - start[id], 0, force, geo_end, scratch);
     }
     if (cand.oom) { res = LBK_ERR_OUT_OF_MEMORY; goto done; }
 
@@ -230,7 +384,7 @@ static lbk_result place_once(place_ctx *c, const double lo[3], const double ext[
     out->count = n;
 done:
     free(c->verdict); c->verdict = NULL;
-    free(cand.p); free(scratch); free(bins); free(start);
+    free(cand.p); free(scratch); free(bins); free(start); free(depth);
     return res;
 }
 
@@ -279,9 +433,20 @@ lbk_result bk_glg_place(const bk_scene *scene, const bk_tracer *tracer,
 
     place_ctx c = {0};
     c.scene = scene; c.tracer = tracer; c.tris = tris; c.tri_count = nt; c.rays = rays;
+    /* adaptive: a top grid twice as coarse, split where playable or where the lighting varies */
+    c.playable_levels = o.playable_levels < 0 || !scene->playable_count || !scene->playable ? 0
+                      : o.playable_levels == 0 ? 1 : o.playable_levels > 2 ? 2 : o.playable_levels;
+    c.lighting = o.lighting;
+    c.lighting_user = o.lighting_user;
+    c.lighting_levels = !o.lighting ? 0 : o.lighting_levels <= 0 ? 2 : o.lighting_levels > 3 ? 3 : o.lighting_levels;
+    c.lighting_threshold = o.lighting_threshold > 0 && isfinite(o.lighting_threshold) ? o.lighting_threshold : 0.4f;
+    c.adaptive = c.playable_levels > 0 || c.lighting;
+    const int max_depth = c.playable_levels > c.lighting_levels ? c.playable_levels : c.lighting_levels;
+    if (c.adaptive) spacing *= 2.0;
     lbk_result res = LBK_OK;
     for (int attempt = 0; attempt < 200; attempt++) {
-        c.levels = levels;
+        c.geo_levels = levels;
+        c.levels = levels + max_depth;
         c.user_min_distance = o.min_distance > 0 && isfinite(o.min_distance) ? o.min_distance : 0.0f;
         c.max_candidates = 8 * cap;
         bk_glg_probes_free(out);
@@ -289,6 +454,8 @@ lbk_result bk_glg_place(const bk_scene *scene, const bk_tracer *tracer,
         if (res != LBK_OK) break;
         out->spacing = (float)spacing;
         out->refine_levels = levels;
+        out->coarse_points = c.coarse_points;
+        memcpy(out->cells_by_depth, c.cells_by_depth, sizeof out->cells_by_depth);
         if (out->count <= cap) break;
         if (levels > 0) levels--;            /* coarsen near surfaces first */
         else spacing *= 1.25;                 /* then everywhere */

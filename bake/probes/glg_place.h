@@ -11,6 +11,12 @@
 #include "bake/transport/tracer.h"
 #include "lbk/lbk.h"
 
+/* Lighting at n points for the GLG's density rule: 7 floats per point, the luminance of the
+ * irradiance towards +x, −x, +y, −y, +z, −z, then the variance of the estimate's noise (one
+ * number for the six; 0 when exact or unknown). Must be deterministic (same points, same numbers).
+ * bk_glg_coarse_lighting (bake/probes/glg_coarse.h) is the transport's. */
+typedef lbk_result (*bk_glg_lighting_fn)(void *user, const float *points, size_t n, float *out);
+
 typedef struct bk_glg_options {   /* zero-initialised = defaults */
     float spacing;                /* largest probe spacing, metres; 0: 1.0 */
     int refine_levels;            /* halvings of the spacing in cells that hold geometry;
@@ -21,6 +27,17 @@ typedef struct bk_glg_options {   /* zero-initialised = defaults */
     int solid_rays;               /* rays of the inside-solid / distance test; 0: 32 */
     int face_visibility_level;    /* each face is split into 4^level triangles, one ray to the
                                      centroid of each; 0: 1 (4 rays per face), at most 4 */
+    /* Adaptive density (PROBES.md §Density by playable space and lighting). With playable boxes
+     * in the scene or a lighting function, the top grid is 2 × spacing (coarser) and a top cell is
+     * split unconditionally `depth` times before the near-geometry refinement, depth the larger
+     * of the playable and the lighting rule's. Neither: the placement above, unchanged. */
+    int playable_levels;          /* depth of a top cell overlapping a playable box; 0: 1;
+                                     -1: ignore the scene's playable boxes; at most 2 */
+    bk_glg_lighting_fn lighting;  /* NULL: no lighting rule */
+    void *lighting_user;
+    float lighting_threshold;     /* relative interpolation error (of the mean irradiance) that
+                                     asks for a finer grid (PROBES.md); 0: 0.4 (bench_glg) */
+    int lighting_levels;          /* most depth the lighting rule gives; 0: 2; at most 3 */
 } bk_glg_options;
 
 /* Why a scene gets no GLG (bk_glg.status). */
@@ -41,6 +58,8 @@ typedef struct bk_glg_probes {    /* placement only */
     size_t rejected_solid;        /* inside closed geometry (more back- than front-face hits) */
     size_t rejected_close;        /* still within min_distance after push-out */
     size_t pushed;                /* moved away from a surface */
+    size_t coarse_points;         /* lighting rule: top-cell centres whose lighting was evaluated */
+    size_t cells_by_depth[4];     /* adaptive: top cells given depth 0..3 */
 } bk_glg_probes;
 
 typedef struct bk_glg {

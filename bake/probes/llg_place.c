@@ -187,6 +187,10 @@ static void lattice_dims(const bk_object *obj, const bk_llg_options *o, bk_llg *
     double spacing = o->spacing > 0 && isfinite(o->spacing) ? o->spacing : 1.5;
     if (obj->lighting == BK_LIGHTING_LLG && obj->texel_density > 0 && isfinite(obj->texel_density))
         spacing = 1.0 / obj->texel_density;
+    if (o->connected) {
+        double k = o->connected_scale > 0 && o->connected_scale <= 1 ? o->connected_scale : 0.5;
+        spacing *= k;
+    }
     const double min_dim = o->min_dim >= 2 && o->min_dim <= (int)BK_LLG_MAX_DIM ? o->min_dim : 2;
     size_t cap = o->max_probes ? o->max_probes : 512;
     if (cap < 8) cap = 8;
@@ -352,4 +356,61 @@ void bk_llg_vertex_records(const bk_llg *l, lbk_llg_vertex *out)
         for (int a = 0; a < 3; a++) out[v].bent_normal[a] = len > 0.0f ? g[a] / len : (a == 2 ? 1.0f : 0.0f);
         out[v].visibility = l->visibility[v];
     }
+}
+
+/* ---- connected objects ----------------------------------------------------------------------- */
+
+typedef struct obj_box { double lo[3], hi[3]; uint32_t id; int ok; } obj_box;
+
+static int box_by_lo_x(const void *pa, const void *pb)
+{
+    const obj_box *a = pa, *b = pb;
+    if (a->lo[0] != b->lo[0]) return a->lo[0] < b->lo[0] ? -1 : 1;
+    return (a->id > b->id) - (a->id < b->id);
+}
+
+static int box_contains(const obj_box *a, const obj_box *b)
+{
+    for (int k = 0; k < 3; k++)
+        if (b->lo[k] < a->lo[k] || b->hi[k] > a->hi[k]) return 0;
+    return 1;
+}
+
+lbk_result bk_llg_connections(const bk_scene *scene, const uint8_t *candidate, float gap, uint8_t *out)
+{
+    if (!scene || !candidate || !out) return LBK_ERR_INVALID_ARGUMENT;
+    size_t n = scene->object_count;
+    memset(out, 0, n);
+    double g = gap > 0 && isfinite(gap) ? gap : 0.01;
+    obj_box *b = malloc((n ? n : 1) * sizeof *b);
+    if (!b) return LBK_ERR_OUT_OF_MEMORY;
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (!candidate[i]) continue;
+        const bk_object *o = &scene->objects[i];
+        obj_box x = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}, (uint32_t)i, 0};
+        for (size_t t = o->first_tri; t < (size_t)o->first_tri + o->tri_count && t < scene->tri_count; t++)
+            for (int c = 0; c < 3; c++) {
+                uint32_t v = scene->tris[3 * t + (size_t)c];
+                if (v >= scene->vertex_count) continue;
+                for (int k = 0; k < 3; k++) {
+                    double p = scene->positions[3 * (size_t)v + (size_t)k];
+                    if (!isfinite(p)) continue;
+                    x.lo[k] = fmin(x.lo[k], p); x.hi[k] = fmax(x.hi[k], p);
+                    x.ok = 1;
+                }
+            }
+        if (x.ok) b[m++] = x;
+    }
+    qsort(b, m, sizeof *b, box_by_lo_x);
+    for (size_t i = 0; i < m; i++)
+        for (size_t j = i + 1; j < m && b[j].lo[0] <= b[i].hi[0] + g; j++) {
+            int near = 1;
+            for (int k = 0; k < 3 && near; k++) near = b[j].lo[k] <= b[i].hi[k] + g && b[i].lo[k] <= b[j].hi[k] + g;
+            if (!near || box_contains(&b[i], &b[j]) || box_contains(&b[j], &b[i])) continue;
+            out[b[i].id] = 1;
+            out[b[j].id] = 1;
+        }
+    free(b);
+    return LBK_OK;
 }

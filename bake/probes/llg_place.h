@@ -26,6 +26,11 @@ typedef struct bk_llg_options {   /* zero-initialised = defaults */
     float min_half_extent;        /* floor for flat/line objects; 0: 5% of the largest
                                      half-extent (1 mm for a point-like object) */
     int visibility_rays;          /* cosine-distributed rays per vertex; 0: 64, at most 4096 */
+    /* 1: the object connects to another (bk_llg_connections): its spacing is multiplied by
+     * connected_scale, so the lighting gradient across the joint is sampled on both sides
+     * (seed 001 §2.2 "extra probes for objects that can be connected"); the cap still applies */
+    int connected;
+    float connected_scale;        /* 0: 0.5 (twice the probes per axis) */
     int min_dim;                  /* probes per axis at least (2..64); 0: 2. The baker asks 3:
                                      fitted to the vertices, 3 × 3 × 3 resolves what 2 × 2 × 2
                                      cannot (PROBES.md §LLG fit) */
@@ -64,6 +69,13 @@ size_t bk_llg_probe_count(const bk_llg *llg);
 /* The per-vertex records of the LLG section (lbk/llg.h): visibility and the bent normal in the
  * grid frame (components along axes[0..2]), in the order of llg->vertices. out: vertex_count. */
 void bk_llg_vertex_records(const bk_llg *llg, lbk_llg_vertex *out);
+
+/* The seed's connected-objects heuristic (PROBES.md): of the objects with candidate[i] != 0,
+ * out[i] = 1 when the world-space bounding box of another candidate lies within `gap` of its
+ * own (touching or overlapping) and neither box contains the other (a prop standing inside
+ * another's box is not a joint); else 0. candidate and out: scene->object_count entries.
+ * gap <= 0: 1 cm. O(n log n + touching pairs). */
+lbk_result bk_llg_connections(const bk_scene *scene, const uint8_t *candidate, float gap, uint8_t *out);
 
 /* OBB only (area-weighted PCA), exposed for tests: centre, axes, half extents (tight). */
 lbk_result bk_obb_from_triangles(const bk_scene *scene, uint32_t first_tri, uint32_t tri_count,

@@ -571,6 +571,10 @@ struct Instance {
     float texel_density = 0;
 };
 
+struct PlayableBox {  // world space, double (the origin is chosen later)
+    double min[3], max[3];
+};
+
 struct LightInstance {
     int node, light;
     Mat4 world;
@@ -610,6 +614,7 @@ private:
     std::vector<MeshData> meshes_;
     std::vector<Instance> instances_;
     std::vector<LightInstance> light_insts_;
+    std::vector<PlayableBox> playable_;
     std::vector<char> visited_;
 
     void warn(const char *fmt, ...) __attribute__((format(printf, 2, 3)));
@@ -639,6 +644,8 @@ private:
     void emit_lights();
     void read_sky();
     void read_combinations();
+    void read_playable(int n, const Mat4 &world, const tinygltf::Value &v);
+    void emit_playable();
     void record_inputs();
     std::vector<float> downsample(const float *rgba, int w, int h, int max_side, int *ow, int *oh);
 };
@@ -1019,6 +1026,7 @@ void Importer::visit(int n, const Mat4 &parent, const std::string &inh_set, cons
                 fail("%s: %s: extras key %s must be a string of 1 to 63 printable bytes", file, lbl.c_str(), key);
             (strcmp(key, "lbk_door") == 0 ? inst.door : inst.light_set) = v.Get<std::string>();
         }
+        if (ex.Has("lbk_playable")) read_playable(n, world, ex.Get("lbk_playable"));
     }
     if (nd.mesh >= 0) {
         if ((size_t)nd.mesh >= m_.meshes.size()) fail("%s: %s: mesh %d out of range", file, lbl.c_str(), nd.mesh);
@@ -1638,6 +1646,67 @@ void Importer::read_sky()
     for (int k = 0; k < 3; k++) s_->sky[k] = im.mean[k];
 }
 
+// Node extras lbk_playable (spec/authoring.md): true = the node-local box [-1, 1]³ (a Blender cube
+// empty of size 1, scaled by the node), {"min": [x, y, z], "max": [x, y, z]} = that node-local box,
+// false = nothing. The scene keeps the world-space bounding box of the transformed box.
+void Importer::read_playable(int n, const Mat4 &world, const tinygltf::Value &v)
+{
+    const char *file = path_.c_str();
+    std::string lbl = node_label(n);
+    double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1};
+    if (v.IsBool()) {
+        if (!v.Get<bool>()) return;
+    } else if (v.IsObject()) {
+        const char *keys[2] = {"min", "max"};
+        double *dst[2] = {lo, hi};
+        for (int i = 0; i < 2; i++) {
+            bool ok = v.Has(keys[i]) && v.Get(keys[i]).IsArray() && v.Get(keys[i]).ArrayLen() == 3;
+            for (int k = 0; ok && k < 3; k++) {
+                const tinygltf::Value &e = v.Get(keys[i]).Get(k);
+                ok = e.IsNumber() && std::isfinite(e.GetNumberAsDouble());
+                if (ok) dst[i][k] = e.GetNumberAsDouble();
+            }
+            if (!ok)
+                fail("%s: %s: extras key lbk_playable: \"%s\" must be an array of 3 finite numbers", file, lbl.c_str(),
+                     keys[i]);
+        }
+        for (int k = 0; k < 3; k++)
+            if (!(lo[k] < hi[k]))
+                fail("%s: %s: extras key lbk_playable: min must be below max on every axis", file, lbl.c_str());
+    } else {
+        fail("%s: %s: extras key lbk_playable must be true, false or {\"min\": [x, y, z], \"max\": [x, y, z]}", file,
+             lbl.c_str());
+    }
+    if (playable_.size() >= BK_MAX_PLAYABLE)
+        fail("%s: %s: more than %d nodes with lbk_playable (the cap)", file, lbl.c_str(), BK_MAX_PLAYABLE);
+    PlayableBox b;
+    for (int k = 0; k < 3; k++) { b.min[k] = INFINITY; b.max[k] = -INFINITY; }
+    for (int c = 0; c < 8; c++) {
+        double p[3] = {(c & 1) ? hi[0] : lo[0], (c & 2) ? hi[1] : lo[1], (c & 4) ? hi[2] : lo[2]}, w[3];
+        xform_point(world, p, w);
+        for (int k = 0; k < 3; k++) { b.min[k] = std::min(b.min[k], w[k]); b.max[k] = std::max(b.max[k], w[k]); }
+    }
+    for (int k = 0; k < 3; k++)
+        if (!std::isfinite(b.min[k]) || !std::isfinite(b.max[k]) || !(b.min[k] < b.max[k]) ||
+            std::fabs(b.min[k]) > 1e7 || std::fabs(b.max[k]) > 1e7)
+            fail("%s: %s: extras key lbk_playable: the box is empty or out of range after the node's transform", file,
+                 lbl.c_str());
+    playable_.push_back(b);
+}
+
+// Playable boxes into the scene, relative to the origin chosen for the geometry.
+void Importer::emit_playable()
+{
+    s_->playable = alloc_array<bk_box>(playable_.empty() ? 1 : playable_.size(), 1);
+    for (size_t i = 0; i < playable_.size(); i++)
+        for (int k = 0; k < 3; k++) {
+            s_->playable[i].min[k] = (float)(playable_[i].min[k] - s_->origin[k]);
+            s_->playable[i].max[k] = (float)(playable_[i].max[k] - s_->origin[k]);
+            if (!(s_->playable[i].min[k] < s_->playable[i].max[k])) s_->playable[i].max[k] = nextafterf(s_->playable[i].min[k], INFINITY);
+        }
+    s_->playable_count = playable_.size();
+}
+
 // Scene extras lbk_combinations: [[name, name], ...], looked up like lbk_sky (spec/authoring.md).
 void Importer::read_combinations()
 {
@@ -1716,6 +1785,7 @@ void Importer::run()
     emit_lights();
     read_sky();
     read_combinations();
+    emit_playable();
     // Tables move into the C struct last, so a failure above frees them with the vectors.
     s_->materials = alloc_array<bk_material>(materials_.size(), 1);
     if (!materials_.empty()) memcpy(s_->materials, materials_.data(), materials_.size() * sizeof(bk_material));

@@ -27,6 +27,7 @@ void bk_scene_free(bk_scene *scene)
     for (size_t i = 0; i < scene->image_count; i++) free(scene->images[i].rgba);
     free(scene->images);
     free(scene->combinations);
+    free(scene->playable);
     free(scene->inputs);
     memset(scene, 0, sizeof *scene);
     scene->sky_image = -1;

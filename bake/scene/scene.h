@@ -78,6 +78,14 @@ typedef struct bk_combination {
     char members[2][64];           /* lbk_door or lbk_light_set names, as authored */
 } bk_combination;
 
+/* A box of playable space (node extras lbk_playable, spec/authoring.md): axis-aligned, in the
+ * scene's frame (relative to bk_scene.origin), min < max on every axis. The GLG is denser inside
+ * and coarser outside (bake/probes/PROBES.md). */
+typedef struct bk_box {
+    float min[3], max[3];
+} bk_box;
+#define BK_MAX_PLAYABLE 4096       /* import refuses more lbk_playable nodes than this */
+
 /* A file the scene was read from (provenance: META input.files, spec/container.md §6.2). */
 typedef struct bk_input_file {
     char path[256];                /* relative to the scene file's folder; the scene file by name */
@@ -126,6 +134,9 @@ typedef struct bk_scene {
      * bakes (bake/sets/bake_sets.c), not by import */
     size_t combination_count;
     bk_combination *combinations;
+    /* playable space (node extras lbk_playable); none: the GLG is placed as before */
+    size_t playable_count;
+    bk_box *playable;
 } bk_scene;
 
 /* Frees every array and image (all malloc'ed) and leaves an empty scene (all zero, sky_image

@@ -548,6 +548,77 @@ static void test_extras(void **state)
     }
 }
 
+/* lbk_playable: true = the node-local [-1, 1]³ box, the object form a node-local box; the scene
+ * keeps the world AABB of the transformed corners (a 90° turn about z swaps x and y extents). */
+static void test_playable(void **state)
+{
+    (void)state;
+    write_quad_bin();
+    write_quad_gltf("playable.gltf",
+                    "{\"name\":\"floor\",\"mesh\":0},"
+                    "{\"name\":\"hall\",\"translation\":[10,2,0],\"scale\":[4,1,2],\"extras\":{\"lbk_playable\":true}},"
+                    "{\"name\":\"nook\",\"translation\":[0,0,5],\"rotation\":[0,0,0.70710678,0.70710678],"
+                    "\"extras\":{\"lbk_playable\":{\"min\":[0,0,0],\"max\":[3,1,2]}}},"
+                    "{\"name\":\"off\",\"extras\":{\"lbk_playable\":false}}",
+                    "0,1,2,3", NULL);
+    bk_scene s;
+    char err[1024];
+    int rc = import_tmp("playable.gltf", &s, NULL, err, sizeof err);
+    if (rc) printf("%s\n", err);
+    assert_int_equal(rc, 0);
+    assert_int_equal(s.playable_count, 2);
+    const float want[2][6] = {{6, 1, -2, 14, 3, 2}, {-1, 0, 5, 0, 3, 7}};
+    for (int b = 0; b < 2; b++)
+        for (int k = 0; k < 3; k++) {
+            assert_float_equal(s.playable[b].min[k], want[b][k], 1e-5);
+            assert_float_equal(s.playable[b].max[k], want[b][3 + k], 1e-5);
+        }
+    assert_int_equal(s.object_count, 1); /* playable nodes without a mesh add no geometry */
+    bk_scene_free(&s);
+
+    static const struct { const char *file, *extras; } bad[] = {
+        {"pl_str.gltf", "{\"lbk_playable\":\"yes\"}"},
+        {"pl_num.gltf", "{\"lbk_playable\":1}"},
+        {"pl_nomax.gltf", "{\"lbk_playable\":{\"min\":[0,0,0]}}"},
+        {"pl_short.gltf", "{\"lbk_playable\":{\"min\":[0,0],\"max\":[1,1,1]}}"},
+        {"pl_strnum.gltf", "{\"lbk_playable\":{\"min\":[0,\"0\",0],\"max\":[1,1,1]}}"},
+        {"pl_order.gltf", "{\"lbk_playable\":{\"min\":[0,0,0],\"max\":[1,0,1]}}"},
+        {"pl_huge.gltf", "{\"lbk_playable\":{\"min\":[0,0,0],\"max\":[1e300,1,1]}}"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        char nodes[512];
+        snprintf(nodes, sizeof nodes, "{\"mesh\":0},{\"name\":\"Zone\",\"extras\":%s}", bad[i].extras);
+        write_quad_gltf(bad[i].file, nodes, "0,1", NULL);
+        expect_error(bad[i].file, "lbk_playable", "node 1 \"Zone\"");
+    }
+    /* a zero scale collapses the box */
+    write_quad_gltf("pl_flat.gltf", "{\"mesh\":0},{\"name\":\"Zone\",\"scale\":[1,0,1],\"extras\":{\"lbk_playable\":true}}",
+                    "0,1", NULL);
+    expect_error("pl_flat.gltf", "lbk_playable", "node 1 \"Zone\"");
+    /* the cap: BK_MAX_PLAYABLE + 1 boxes */
+    size_t cap = 64 + (BK_MAX_PLAYABLE + 1) * 48;
+    char *nodes = malloc(cap), *roots = malloc(8 * (BK_MAX_PLAYABLE + 2));
+    assert_non_null(nodes); assert_non_null(roots);
+    size_t o = (size_t)snprintf(nodes, cap, "{\"mesh\":0}"), ro = (size_t)snprintf(roots, 8, "0");
+    for (int i = 1; i <= BK_MAX_PLAYABLE + 1; i++) {
+        o += (size_t)snprintf(nodes + o, cap - o, ",{\"extras\":{\"lbk_playable\":true}}");
+        ro += (size_t)snprintf(roots + ro, 8, ",%d", i);
+    }
+    size_t jl = o + ro + 4096;
+    char *json = malloc(jl);
+    assert_non_null(json);
+    snprintf(json, jl,
+             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"uri\":\"quad.bin\",\"byteLength\":108}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":12}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
+             "{\"bufferView\":1,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
+             "\"nodes\":[%s],\"scenes\":[{\"nodes\":[%s]}],\"scene\":0}", nodes, roots);
+    write_text("pl_cap.gltf", json);
+    expect_error("pl_cap.gltf", "lbk_playable", "the cap");
+    free(json); free(nodes); free(roots);
+}
+
 static void test_sky_extras(void **state)
 {
     (void)state;
@@ -1462,6 +1533,7 @@ int main(void)
         cmocka_unit_test(test_malformed_glb),
         cmocka_unit_test(test_draco_corrupt),
         cmocka_unit_test(test_scene_utilities),
+        cmocka_unit_test(test_playable),
     };
     return cmocka_run_group_tests(tests, setup_tmp, teardown_tmp);
 }

@@ -7,6 +7,7 @@
 
 #include <float.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -546,6 +547,62 @@ static void test_llg_self_visibility(void **state)
     psc_free(&s);
 }
 
+/* Connected objects (the seed's extra LLG probes): two 1 × 0.2 × 0.2 m bars end to end at x = 1
+ * touch, a third 3 m away and a small box inside the first bar's box do not count; a connected
+ * bar gets half the spacing (3 probes along it instead of 2). */
+static void test_llg_connected(void **state)
+{
+    (void)state;
+    bk_scene s;
+    psc_init(&s);
+    const float boxes[4][6] = {{0, 0, 0, 1, 0.2f, 0.2f}, {1, 0, 0, 2, 0.2f, 0.2f}, {5, 0, 0, 6, 0.2f, 0.2f},
+                               {0.4f, 0.05f, 0.05f, 0.6f, 0.15f, 0.15f}};
+    uint32_t id[4];
+    for (int i = 0; i < 4; i++) {
+        char name[16];
+        snprintf(name, sizeof name, "bar%d", i);
+        id[i] = psc_object(&s, name, BK_LIGHTING_LLG);
+        psc_box(&s, boxes[i], boxes[i] + 3, 1, 0);
+    }
+    assert_true(s.object_count <= 8);
+    uint8_t cand[8] = {0}, out[8];
+    for (int i = 0; i < 4; i++) cand[id[i]] = 1;
+    assert_int_equal(bk_llg_connections(&s, cand, 0, out), LBK_OK);
+    assert_int_equal(out[id[0]], 1);
+    assert_int_equal(out[id[1]], 1);
+    assert_int_equal(out[id[2]], 0);
+    assert_int_equal(out[id[3]], 0);   /* inside bar 0's box: not a joint */
+    /* only candidates count: without bar 1, bar 0 has no partner */
+    cand[id[1]] = 0;
+    assert_int_equal(bk_llg_connections(&s, cand, 0, out), LBK_OK);
+    assert_int_equal(out[id[0]], 0);
+    assert_int_equal(out[id[1]], 0);
+    /* bars 1 and 2 are 3 m apart: a gap of 3.1 m joins them, 2.9 m does not */
+    uint8_t c12[8] = {0};
+    c12[id[1]] = c12[id[2]] = 1;
+    assert_int_equal(bk_llg_connections(&s, c12, 3.1f, out), LBK_OK);
+    assert_true(out[id[1]] && out[id[2]]);
+    assert_int_equal(bk_llg_connections(&s, c12, 2.9f, out), LBK_OK);
+    assert_true(!out[id[1]] && !out[id[2]]);
+    bk_llg_options o = {0};
+    o.visibility_rays = 4;
+    bk_llg l;
+    assert_int_equal(bk_llg_place(&s, id[0], &o, 1, &l), LBK_OK);
+    assert_int_equal(l.dims[0], 2);   /* 2 × 0.55 m / 1.5 m -> 1 step */
+    bk_llg_free(&l);
+    o.connected = 1;
+    assert_int_equal(bk_llg_place(&s, id[0], &o, 1, &l), LBK_OK);
+    assert_float_equal(l.spacing, 0.75f, 1e-6);
+    assert_int_equal(l.dims[0], 3);   /* 1.1 m / 0.75 m -> 2 steps */
+    bk_llg_free(&l);
+    /* the cap still wins: 8 probes at most keeps 2 per axis */
+    o.max_probes = 8;
+    assert_int_equal(bk_llg_place(&s, id[0], &o, 1, &l), LBK_OK);
+    assert_true(bk_llg_probe_count(&l) <= 8);
+    bk_llg_free(&l);
+    psc_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -557,6 +614,7 @@ int main(void)
         cmocka_unit_test(test_llg_obb_rotated_box),
         cmocka_unit_test(test_llg_flat_object),
         cmocka_unit_test(test_llg_self_visibility),
+        cmocka_unit_test(test_llg_connected),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

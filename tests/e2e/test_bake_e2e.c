@@ -22,6 +22,7 @@
 #include "cli/cli.h"
 #include "lbk/container.h"
 #include "lbk/lightmap.h"
+#include "lbk/meta.h"
 #include "lbk/objects.h"
 #include "lbk/octa.h"
 #include "lbk/report.h"
@@ -401,6 +402,36 @@ static void test_octahedral_probes(void **state)
     lbk_reader_close(r);
 }
 
+/* --glg-lighting: the coarse pass runs, the bake keeps a valid GLG, META says so, and the probes
+ * differ from the geometry-only placement (a twice as coarse top grid, refined where lit). */
+static void test_glg_lighting(void **state)
+{
+    (void)state;
+    char out[512], err[512];
+    snprintf(out, sizeof out, "%s/glg_lighting.lbk", tmpdir);
+    tb_job o;
+    test_options(&o, "scenes/cornell_box/CornellBox-Original.gltf", out);
+    lbk_bake_report plain, lit;
+    assert_int_equal(bake_quiet(&o, &plain, err, sizeof err), 0);
+    o.d.glg_lighting = 1;
+    assert_int_equal(bake_quiet(&o, &lit, err, sizeof err), 0);
+    assert_valid(out);
+    assert_true(plain.counts.glg_probes > 0 && lit.counts.glg_probes > 0);
+    assert_true(lit.counts.glg_probes != plain.counts.glg_probes);
+    lbk_reader *r;
+    assert_int_equal(lbk_reader_open_file(out, NULL, &r), LBK_OK);
+    const void *data;
+    size_t size;
+    assert_int_equal(lbk_reader_section_by_type(r, LBK_SECTION_META, &data, &size), LBK_OK);
+    lbk_meta_view mv;
+    assert_int_equal(lbk_meta_open(data, size, &mv), LBK_OK);
+    lbk_string v;
+    assert_int_equal(lbk_meta_find(&mv, "bake.glg_lighting", &v), LBK_OK);
+    assert_int_equal(v.size, 3);
+    assert_memory_equal(v.data, "0.4", 3);
+    lbk_reader_close(r);
+}
+
 /* Issue 6 on real baker output: every shipped convert profile makes a pack that validates and
  * diffs equal to its source; export → convert --from-exr gives back the same lighting. On a
  * level with lightmaps, LLGs, GLG and OCTP, and on one with light sets and a door (DLS, DOOR). */
@@ -649,6 +680,7 @@ int main(void)
         cmocka_unit_test(test_target_error_and_reports),
         cmocka_unit_test(test_time_limit),
         cmocka_unit_test(test_octahedral_probes),
+        cmocka_unit_test(test_glg_lighting),
         cmocka_unit_test(test_tools_on_baker_output),
         cmocka_unit_test(test_duplicate_names_made_unique),
         cmocka_unit_test(test_cli_exit_codes),

@@ -55,7 +55,7 @@ extern "C" {
 /* The baker library's version (lbk-bake.pc): the minor grows with every addition to the
  * size-tagged structs below ("added in 1.x"). */
 #define LBK_BAKE_LIBRARY_VERSION_MAJOR 1
-#define LBK_BAKE_LIBRARY_VERSION_MINOR 3
+#define LBK_BAKE_LIBRARY_VERSION_MINOR 4
 #define LBK_BAKE_LIBRARY_VERSION_PATCH 0
 
 /* ---- options ----------------------------------------------------------------------------- */
@@ -181,6 +181,14 @@ typedef struct lbk_bake_desc {
      * fails with LBK_ERR_BAD_INPUT naming it, before any light is traced [NULL: no check] */
     const struct lbk_bake_input *expect_inputs;
     size_t expect_input_count;
+    /* added in 1.4 */
+    int glg_lighting;           /* 1: the global light grid's density follows the lighting: a
+                                   coarse probe pass first, probes added where the lighting
+                                   varies and a twice as coarse grid where it is smooth
+                                   (bake/probes/PROBES.md) [0: placed by geometry and the
+                                   scene's lbk_playable boxes only] */
+    float glg_lighting_threshold; /* the relative interpolation error that asks for more probes
+                                   [0: 0.4, measured by bench_glg] */
 } lbk_bake_desc;
 
 /* A file a bake read (the glTF, its buffers and images, a sky EXR), as META input.files
