@@ -382,7 +382,7 @@
       const mat = new THREE.ShaderMaterial({
         vertexShader: VERT, fragmentShader: FRAG, side: THREE.DoubleSide,
         uniforms: { plane0: { value: page ? page.t0 : dummyTex() }, plane1: { value: page ? page.t1 : dummyTex1() },
-                    footprint: { value: page ? page.t2 : dummyTex2() }, errmap: { value: page ? page.te : dummyTex2() },
+                    footprint: { value: page ? page.t2 : dummyTex2() }, errmap: { value: page && page.te ? page.te : dummyTex2() },
                     block0: { value: page && page.block ? page.b0 : dummyF() }, block1: { value: page && page.block ? page.b1 : dummyF() },
                     blockPage: { value: page && page.block ? 1 : 0 }, hasErr: { value: page && page.te ? 1 : 0 },
                     pageSize: { value: src ? src.size.clone() : new THREE.Vector2(1, 1) }, scale: { value: lmap ? lmap.scale : 1 },
