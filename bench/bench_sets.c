@@ -259,8 +259,8 @@ static int time_budget(const char *dir)
     return 0;
 }
 
-/* The texel luminance each light set adds (base + set at weight 1, doors closed, minus the
- * base) as liblbk's apply gives it, for every kind-0 set of a baked container. */
+/* The texel luminance each light set adds (a black base + the set at weight 1, doors closed)
+ * as liblbk's apply gives it, for every kind-0 set of a baked container. */
 typedef struct set_lum {
     char name[64];
     double *lum;
@@ -284,37 +284,44 @@ static int set_contributions(const void *bytes, size_t size, set_lum *sets, int 
     uint8_t *rgba = malloc(nt * 4 + 4), *orgba = malloc(nt * 4 + 4);
     const uint64_t ng = bad ? 0 : lbk_dls_target_count(dv, LBK_DLS_SPACE_GLG), nl = bad ? 0 : lbk_dls_target_count(dv, LBK_DLS_SPACE_LLG);
     uint8_t *bg = calloc(ng + 1, 28), *og = calloc(ng + 1, 28), *bl = calloc(nl + 1, 28), *ol = calloc(nl + 1, 28);
-    for (uint64_t i = 0; i < nt; i++) {
-        lbk_ahd_texel t;
-        lbk_lmap_texel_get(&lm, i, &t, NULL);
-        z[i] = t.irradiance_z;
-        memcpy(&rgba[4 * i], t.rgba, 4);
-    }
+    /* a black base: the output is the set's contribution alone, encoded once (on the lit base
+     * its encoding step would be a share of the base, not of the set) */
+    memset(z, 0, nt * 4);
+    memset(rgba, 0, nt * 4);
+    (void)lm;
     *nsets = 0;
     *ntex = nt;
     const uint32_t count = bad ? 0 : lbk_dls_set_count(dv);
     float *w = calloc(count + 1, sizeof *w);
-    for (uint32_t j = 0; j < count && *nsets < max_sets; j++) {
+    /* with the doors closed their closed-state sets (weight 1 − ω) are on: the output with
+     * every light set off is what each set's output is measured from */
+    double *closed = calloc(nt + 1, sizeof *closed);
+    for (uint32_t k = 0; k <= count && *nsets < max_sets; k++) {
+        const uint32_t j = k == 0 ? count : k - 1; /* the all-off output first */
         lbk_dls_set_info si;
-        if (lbk_dls_set_get(dv, j, &si) || si.kind != LBK_DLS_KIND_LIGHTS) continue;
+        if (j < count && (lbk_dls_set_get(dv, j, &si) || si.kind != LBK_DLS_KIND_LIGHTS)) continue;
         lbk_dls_runtime_desc rd2;
         memset(&rd2, 0, sizeof rd2);
         rd2.dls = dv, rd2.doors = door, rd2.base_irradiance_z = z, rd2.base_rgba = rgba;
         rd2.base_glg = bg, rd2.base_llg = bl, rd2.out_irradiance_z = oz, rd2.out_rgba = orgba, rd2.out_glg = og, rd2.out_llg = ol;
         lbk_dls_runtime *rt;
         memset(w, 0, (count + 1) * sizeof *w);
-        w[j] = 1;
+        w[j] = j < count; /* j == count: every light set off */
         if (lbk_dls_runtime_open(&rd2, &rt) || lbk_dls_apply(rt, w, NULL, NULL)) {
             bad = 1;
             break;
         }
         lbk_dls_runtime_close(rt);
+        if (j == count) {
+            for (uint64_t i = 0; i < nt; i++) closed[i] = texel_lum(oz[i], &orgba[4 * i]);
+            continue;
+        }
         set_lum *sl = &sets[(*nsets)++];
         snprintf(sl->name, sizeof sl->name, "%.*s", (int)si.name_length, si.name);
         sl->lum = malloc(nt * sizeof *sl->lum + 8);
-        for (uint64_t i = 0; i < nt; i++) sl->lum[i] = texel_lum(oz[i], &orgba[4 * i]) - texel_lum(z[i], &rgba[4 * i]);
+        for (uint64_t i = 0; i < nt; i++) sl->lum[i] = texel_lum(oz[i], &orgba[4 * i]) - closed[i];
     }
-    free(w), free(z), free(oz), free(rgba), free(orgba), free(bg), free(og), free(bl), free(ol);
+    free(closed), free(w), free(z), free(oz), free(rgba), free(orgba), free(bg), free(og), free(bl), free(ol);
     if (door) lbk_door_close(door);
     if (dv) lbk_dls_close(dv);
     lbk_reader_close(rd);
@@ -346,6 +353,7 @@ static int set_estimates(const char *dir)
         d.seed = 1 + (uint64_t)k;
         d.threads = 2;
         d.denoise = LBK_BAKE_DENOISE_OFF;
+        d.dls_threshold = getenv("BENCH_SETS_KEEP_ALL") ? -1 : 0;
         lbk_bake_output *bo;
         void *bytes = NULL;
         size_t size = 0;
