@@ -358,7 +358,7 @@ int main(int argc, char **argv)
                 o.footprint_count = tx.footprint_count;
             }
 #endif
-            bk_transport_output out = {rad, NULL, rep ? irr2 : irr, NULL, NULL};
+            bk_transport_output out = {rad, NULL, rep ? irr2 : irr, NULL, NULL, NULL};
             bk_transport_stats st1;
             double c0 = cpu_s();
             bk_transport_run(&s, t, r, nr, &o, &out, rep ? &st1 : &st);

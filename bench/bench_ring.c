@@ -103,7 +103,7 @@ int main(int argc, char **argv)
     o.cell_size = cell;
     o.footprint = tx.footprint;
     o.footprint_count = tx.footprint_count;
-    bk_transport_output out = {rad, NULL, irr, NULL, NULL};
+    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL};
     bk_transport_stats st;
     if (bk_transport_run(&s, t, r, tx.count, &o, &out, &st) != LBK_OK) { fprintf(stderr, "transport failed\n"); return 1; }
     /* per page: luminance planes for both candidates */

@@ -633,8 +633,10 @@ static lbk_result do_transport(bk_pipeline *b)
     out.radiance = b->radiance;
     if (b->opt->denoise != LBK_BAKE_DENOISE_OFF || b->opt->error_map) {
         b->variance = calloc(b->receiver_count ? b->receiver_count : 1, sizeof *b->variance);
-        if (!b->variance) return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
+        b->halves = calloc(b->receiver_count ? 2 * b->receiver_count : 1, sizeof *b->halves);
+        if (!b->variance || !b->halves) return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
         out.variance = b->variance;
+        out.halves = b->halves;
     }
     float *irradiance = malloc((b->receiver_count ? b->receiver_count : 1) * 3 * sizeof *irradiance);
     if (!irradiance) return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
@@ -681,6 +683,31 @@ static lbk_result do_sets(bk_pipeline *b)
     return bk_set_bakes_run(&b->sets, &in, b->err, sizeof b->err);
 }
 
+/* What the denoised base delivers: the two halves through the same weights (bk_denoiser_error).
+ * The LLG class is not filtered and keeps the base estimate with its fit residual. */
+static lbk_result denoised_error(bk_pipeline *b)
+{
+    bk_transport_options to;
+    transport_options(b, &to);
+    bk_denoise_error e;
+    lbk_result r = bk_denoiser_error(b->denoiser, b->halves, to.class_end, &e);
+    if (r) return r;
+    lbk_bake_denoised *d = &b->denoised;
+    d->errors.texels = e.rel_rmse[BK_CLASS_TEXEL];
+    d->errors.glg = e.rel_rmse[BK_CLASS_GLG];
+    d->errors.llg = b->stats.class_rel_rmse[BK_CLASS_LLG];
+    d->errors.probes = e.probe_rel_rmse;
+    d->texel_noise = e.noise[BK_CLASS_TEXEL], d->texel_bias = e.bias[BK_CLASS_TEXEL];
+    d->glg_noise = e.noise[BK_CLASS_GLG], d->glg_bias = e.bias[BK_CLASS_GLG];
+    d->seconds = e.seconds;
+    b->have_denoised = 1;
+    bk_events_say(&b->events, LBK_BAKE_SEVERITY_INFO,
+                  "denoised: texels %.2f%% (noise %.2f%%, bias %.2f%%; before %.2f%%), GLG probes %.2f%% (before %.2f%%)",
+                  100 * d->errors.texels, 100 * d->texel_noise, 100 * d->texel_bias, 100 * b->stats.class_rel_rmse[BK_CLASS_TEXEL],
+                  100 * d->errors.glg, 100 * b->stats.class_rel_rmse[BK_CLASS_GLG]);
+    return LBK_OK;
+}
+
 /* The denoising weights (texels and GLG probes) from the base + every light set and door (the
  * guide), applied to the base here and to every set by bk_set_bakes_emit with the same weights
  * (bake/transport/DENOISE.md). */
@@ -725,6 +752,7 @@ static lbk_result do_denoise(bk_pipeline *b)
     lbk_result r = bk_denoiser_create(&in, &o, &b->denoiser);
     free(guide), free(guide_var);
     if (!r) r = bk_denoiser_apply(b->denoiser, b->radiance);
+    if (!r) r = denoised_error(b);
     if (r) return bk_pipeline_failed(b, r, "denoising");
     return LBK_OK;
 }
@@ -871,6 +899,7 @@ static void pipeline_free(bk_pipeline *b)
     bk_set_bakes_free(&b->sets);
     bk_denoiser_destroy(b->denoiser);
     free(b->variance);
+    free(b->halves);
     free(b->texel_rel_error);
     free(b->samples);
     free(b->radiance);

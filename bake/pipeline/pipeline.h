@@ -69,8 +69,11 @@ typedef struct bk_pipeline {
     lbk_sh9_rgb *radiance;
     float *cell_size;               /* per scene triangle: the radiosity cache's cell size (texel size) */
     float *variance;                /* per receiver, from the transport: the denoiser's input */
+    float *halves;                  /* 2 per receiver, the transport's two halves' X (denoised bakes) */
     float *texel_rel_error;         /* per texel receiver with error_map: the TERR input (error_map.h) */
     struct bk_denoiser *denoiser;   /* weights of the base + every set (do_denoise), for all of them */
+    lbk_bake_denoised denoised;     /* the estimate of the denoised base (report, REPT's last record) */
+    int have_denoised;
     bk_transport_stats stats;
     bk_transport_sample *samples;
     size_t sample_count, sample_cap;

@@ -96,6 +96,7 @@ lbk_result bk_pipeline_report(const bk_pipeline *b, lbk_bake_output *out)
     }
     r->set_runs = out->set_runs;
     r->set_run_count = nrun;
+    if (b->have_denoised) r->denoised = b->denoised;
     fill_transport(b, &r->transport);
     fill_counts(b, &r->counts);
     r->scales.lmap = r->counts.texels ? b->scale[0] : 0;
@@ -215,6 +216,15 @@ static cJSON *json_report(const lbk_bake_report *r, const char *container_path)
         cJSON_AddNumberToObject(o, "relocated", r->octp.relocated);
         cJSON_AddNumberToObject(o, "rel_rmse", r->octp.rel_rmse);
         cJSON_AddNumberToObject(o, "rays_per_probe", r->octp.rays);
+    }
+    if (r->size >= offsetof(lbk_bake_report, denoised) + sizeof r->denoised && r->denoised.errors.texels + r->denoised.errors.glg > 0) {
+        cJSON *o = cJSON_AddObjectToObject(root, "denoised");
+        json_classes(o, &r->denoised.errors);
+        cJSON_AddNumberToObject(o, "texel_noise", r->denoised.texel_noise);
+        cJSON_AddNumberToObject(o, "texel_bias", r->denoised.texel_bias);
+        cJSON_AddNumberToObject(o, "glg_noise", r->denoised.glg_noise);
+        cJSON_AddNumberToObject(o, "glg_bias", r->denoised.glg_bias);
+        cJSON_AddNumberToObject(o, "seconds", r->denoised.seconds);
     }
     cJSON *ph = cJSON_AddArrayToObject(root, "phases");
     for (size_t i = 0; i < r->phase_count; i++) {

@@ -296,7 +296,10 @@ static lbk_result build_meta(bk_pipeline *b, section_list *sl)
 
 static lbk_result build_report(bk_pipeline *b, section_list *sl)
 {
-    size_t n = b->sample_count ? b->sample_count : 1;
+    /* a denoised bake ends with one more record: the same work, the estimate of what the
+     * denoiser delivers (spec §7.1, DENOISE.md) */
+    const size_t extra = b->have_denoised && b->sample_count ? 1 : 0;
+    size_t n = b->sample_count ? b->sample_count + extra : 1;
     lbk_report_record *rec = calloc(n, sizeof *rec);
     if (!rec) return LBK_ERR_OUT_OF_MEMORY;
     int has_probes = b->receiver_count > b->texel_receivers;
@@ -315,6 +318,11 @@ static lbk_result build_report(bk_pipeline *b, section_list *sl)
         if (i > 0 && rec[i].rays_traced < rec[i - 1].rays_traced) rec[i].rays_traced = rec[i - 1].rays_traced;
     }
     if (b->sample_count) rec[b->sample_count - 1].rays_traced = b->stats.rays;
+    if (extra) {
+        rec[n - 1] = rec[n - 2];
+        rec[n - 1].texel_rel_rmse = b->texel_receivers ? (float)b->denoised.errors.texels : 0;
+        rec[n - 1].probe_rel_rmse = has_probes ? (float)b->denoised.errors.probes : 0;
+    }
     lbk_report rp;
     memset(&rp, 0, sizeof rp);
     rp.status = bk_pipeline_status(b);

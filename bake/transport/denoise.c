@@ -476,6 +476,61 @@ lbk_result bk_denoiser_apply(const bk_denoiser *d, lbk_sh9_rgb *radiance)
     return r;
 }
 
+/* Per-class sums of bk_denoiser_error: noise², the bias term and the denoised values². */
+typedef struct dn_error_sums {
+    double noise, bias, den;
+} dn_error_sums;
+
+lbk_result bk_denoiser_error(const bk_denoiser *d, const float *halves, const size_t class_end[BK_RECEIVER_CLASSES],
+                             bk_denoise_error *out)
+{
+    if (!d || !out || !class_end || (!halves && d->receiver_count)) return LBK_ERR_INVALID_ARGUMENT;
+    for (int k = 0; k < BK_RECEIVER_CLASSES; k++)
+        if (class_end[k] > d->receiver_count || (k && class_end[k] < class_end[k - 1])) return LBK_ERR_INVALID_ARGUMENT;
+    const double t0 = bk_now();
+    memset(out, 0, sizeof *out);
+    const size_t n = d->receiver_count;
+    /* X and δ ride through the filter as two SH coefficients: the filter is linear and the same
+     * for every coefficient, so this is D applied to each */
+    lbk_sh9_rgb *f = calloc(n ? n : 1, sizeof *f);
+    if (!f) return LBK_ERR_OUT_OF_MEMORY;
+    for (size_t i = 0; i < n; i++) {
+        f[i].c[0][0] = 0.5f * (halves[2 * i] + halves[2 * i + 1]);
+        f[i].c[0][1] = 0.5f * (halves[2 * i] - halves[2 * i + 1]);
+    }
+    lbk_result r = bk_denoiser_apply(d, f);
+    if (r) {
+        free(f);
+        return r;
+    }
+    dn_error_sums sum[BK_RECEIVER_CLASSES];
+    memset(sum, 0, sizeof sum);
+    size_t i = 0;
+    for (int k = 0; k < BK_RECEIVER_CLASSES; k++)
+        for (; i < class_end[k]; i++) {
+            /* the same floats the filter started from, so that an unfiltered receiver adds no bias */
+            const double x = 0.5f * (halves[2 * i] + halves[2 * i + 1]);
+            const double dl = 0.5f * (halves[2 * i] - halves[2 * i + 1]);
+            const double fx = f[i].c[0][0], fd = f[i].c[0][1];
+            sum[k].noise += fd * fd;
+            sum[k].bias += (fx - x) * (fx - x) - (fd - dl) * (fd - dl);
+            sum[k].den += fx * fx;
+        }
+    free(f);
+    for (int k = 0; k < BK_RECEIVER_CLASSES; k++) {
+        if (!(sum[k].den > 0)) continue;
+        const double b2 = sum[k].bias > 0 ? sum[k].bias : 0;
+        out->noise[k] = sqrt(sum[k].noise / sum[k].den);
+        out->bias[k] = sqrt(b2 / sum[k].den);
+        out->rel_rmse[k] = sqrt((sum[k].noise + b2) / sum[k].den);
+    }
+    const double pn = sum[BK_CLASS_GLG].noise + sum[BK_CLASS_LLG].noise, pd = sum[BK_CLASS_GLG].den + sum[BK_CLASS_LLG].den;
+    const double pb = sum[BK_CLASS_GLG].bias > 0 ? sum[BK_CLASS_GLG].bias : 0; /* LLG: not filtered */
+    out->probe_rel_rmse = pd > 0 ? sqrt((pn + pb) / pd) : 0;
+    out->seconds = bk_now() - t0;
+    return LBK_OK;
+}
+
 void bk_denoiser_stats(const bk_denoiser *d, bk_denoise_stats *stats)
 {
     if (!stats) return;

@@ -36,6 +36,7 @@
 #include "bake/probes/glg_place.h"
 #include "bake/scene/scene.h"
 #include "bake/transport/tracer.h"
+#include "bake/transport/transport.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -99,6 +100,30 @@ lbk_result bk_denoiser_create(const bk_denoise_inputs *in, const bk_denoise_opti
 /* Filters `radiance` (receiver_count entries, numbered like the inputs) in place with the
  * stored weights: texel and GLG receivers change, every other receiver is left as it is. */
 lbk_result bk_denoiser_apply(const bk_denoiser *d, lbk_sh9_rgb *radiance);
+
+/* The estimated error of the denoised result per receiver class, relative to the RMS of the
+ * denoised values as the transport's estimate is (TRANSPORT.md §Error estimate; DENOISE.md
+ * §What the report says). With A, B the two halves' X per receiver, X = (A + B)/2,
+ * δ = (A − B)/2 and D the filter (these weights and clamp):
+ *   noise² = Σ (Dδ)²                      — the noise the filter leaves, with its correlation
+ *                                           between receivers (the cache's), which Σ w²σ² misses;
+ *   bias²  = max(0, Σ ((D − I)X)² − Σ ((D − I)δ)²) — what the filter moved beyond its noise;
+ * both unbiased for fixed weights (δ has X's variance and no mean). Receivers the filter does
+ * not touch contribute δ² (the transport's own estimate); with D = I every class gets exactly
+ * the transport's estimate. */
+typedef struct bk_denoise_error {
+    double rel_rmse[BK_RECEIVER_CLASSES]; /* √(noise² + bias²) / RMS of the denoised X */
+    double noise[BK_RECEIVER_CLASSES];    /* √noise² / RMS, and the bias part alone */
+    double bias[BK_RECEIVER_CLASSES];
+    double probe_rel_rmse;                /* GLG and LLG probes together (REPT's probe figure) */
+    double seconds;
+} bk_denoise_error;
+
+/* halves: 2 per receiver (bk_transport_output.halves, A then B); class_end as the transport's
+ * (bk_transport_options.class_end: the end of the texel, GLG and LLG classes). Errors:
+ * LBK_ERR_INVALID_ARGUMENT, LBK_ERR_OUT_OF_MEMORY. */
+lbk_result bk_denoiser_error(const bk_denoiser *d, const float *halves, const size_t class_end[BK_RECEIVER_CLASSES],
+                             bk_denoise_error *out);
 
 void bk_denoiser_stats(const bk_denoiser *d, bk_denoise_stats *stats);
 void bk_denoiser_destroy(bk_denoiser *d);

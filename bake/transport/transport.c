@@ -2063,6 +2063,16 @@ static double recv_weight(const tp_ctx *c, size_t i)
     return 0;
 }
 
+/* Each receiver's X of the two halves, normalised by its class's pass weights. */
+static void write_halves(const tp_ctx *c, double *const x_acc[2], float *halves)
+{
+    for (size_t i = 0; i < c->recv_count; i++) {
+        double w = recv_weight(c, i);
+        halves[2 * i] = (float)(w > 0 ? x_acc[0][i] / w : 0);
+        halves[2 * i + 1] = (float)(w > 0 ? x_acc[1][i] / w : 0);
+    }
+}
+
 /* Normalises the pass-weighted sums, then adds the noise-free punctual light. */
 static void finish_outputs(tp_ctx *c)
 {
@@ -2084,6 +2094,7 @@ static void finish_outputs(tp_ctx *c)
             double w = recv_weight(c, i), a = w > 0 ? c->x_acc[0][i] / w : 0, b = w > 0 ? c->x_acc[1][i] / w : 0;
             output->variance[i] = (float)(0.25 * (a - b) * (a - b));
         }
+    if (output->halves) write_halves(c, c->x_acc, output->halves);
     if (c->light_count && !c->slc) { /* (culled light is in the passes' sums already) */
         float *pl = c->punct_lum;
         c->punct_lum = NULL; /* recv_punctual now writes into the outputs */
@@ -2219,7 +2230,7 @@ static int finite_floats(const float *a, size_t n)
 static int replay_outputs_ok(const bk_transport_output *o, size_t n)
 {
     return finite_floats((const float *)o->radiance, 27 * n) && finite_floats((const float *)o->direct, 27 * n) &&
-           finite_floats(o->irradiance, 3 * n) && finite_floats(o->variance, n);
+           finite_floats(o->irradiance, 3 * n) && finite_floats(o->variance, n) && finite_floats(o->halves, 2 * n);
 }
 
 static lbk_result replay_run(tp_ctx *c, bk_transport_stats *stats)
@@ -2257,6 +2268,8 @@ static lbk_result replay_run(tp_ctx *c, bk_transport_stats *stats)
         }
         if (opt->progress && opt->progress(opt->user, "gather", (double)(pass + 1) / t.passes)) res = LBK_ERR_CANCELLED;
     }
+    /* the parts carry the accumulators of every pass, so the halves come from the last one */
+    if (!res && c->out->halves) write_halves(c, pr.x_acc, c->out->halves);
     for (int h = 0; h < 2; h++) free(pr.x_acc[h]), free(pr.b_acc[h]);
     if (!res) res = sp->replay_outputs(sp->user, c->out);
     if (!res && !replay_outputs_ok(c->out, c->recv_count)) res = LBK_ERR_BAD_INPUT;
@@ -2302,6 +2315,7 @@ static void schedule_only(tp_ctx *c, bk_transport_stats *stats)
     if (o->direct) memset(o->direct, 0, c->recv_count * sizeof *o->direct);
     if (o->irradiance) memset(o->irradiance, 0, c->recv_count * 3 * sizeof *o->irradiance);
     if (o->variance) memset(o->variance, 0, c->recv_count * sizeof *o->variance);
+    if (o->halves) memset(o->halves, 0, c->recv_count * 2 * sizeof *o->halves);
     if (!stats) return;
     const tp_class *lead = lead_class(c);
     stats->passes = pass + 1;

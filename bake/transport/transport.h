@@ -257,6 +257,10 @@ typedef struct bk_transport_output {
     /* octa_count × 16 × 3 (options.octa_points): irradiance E(n_t) = ∫ L·max(0, n_t·ω) dω for the
      * 16 directions n_t = lbk_oct_texel_direction(4, t % 4, t / 4), punctual light included */
     float *octa_irradiance;
+    /* 2 per receiver: X of the two halves, A then B (what `variance` is made of, with its
+     * sign): a linear filter applied to A − B shows how much of the noise it leaves, including
+     * the part correlated between receivers (bk_denoiser_error). */
+    float *halves;
 } bk_transport_output;
 
 enum bk_transport_stop { BK_STOP_TARGET = 0, BK_STOP_TIME, BK_STOP_BUDGET };

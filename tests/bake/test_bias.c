@@ -107,7 +107,7 @@ static void test_inside_solid_is_black(void **state)
     assert_int_equal(bk_tracer_create(&s, 0, &t), LBK_OK);
     lbk_sh9_rgb rad[4];
     float irr[12];
-    bk_transport_output out = {rad, NULL, irr, NULL, NULL};
+    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL};
     bk_transport_options o;
     memset(&o, 0, sizeof o);
     o.threads = 2;
@@ -245,7 +245,7 @@ static float *room_bake(const room *rm, int passes, bk_transport_stats *st)
     o.cell_size = rm->cell_size;
     o.footprint = rm->tx.footprint;
     o.footprint_count = rm->tx.footprint_count;
-    bk_transport_output out = {rad, NULL, irr, NULL, NULL};
+    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL};
     assert_int_equal(bk_transport_run(&rm->s, rm->tracer, rm->recv, rm->n, &o, &out, st), LBK_OK);
     assert_int_equal(st->nonfinite, 0);
     free(rad);
@@ -370,7 +370,7 @@ static void test_emitter_gap_unbiased(void **state)
     for (size_t i = 0; i < s.tri_count; i++) cell[i] = 0.1f;
     lbk_sh9_rgb rad[N];
     float irr[3 * N];
-    bk_transport_output out = {rad, NULL, irr, NULL, NULL};
+    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL};
     bk_transport_options o;
     memset(&o, 0, sizeof o);
     o.seed = 3;

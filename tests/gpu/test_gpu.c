@@ -19,6 +19,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "lbk/ahd.h"
@@ -158,7 +159,49 @@ static lbk_dls_runtime *cpu_runtime(level *lv)
     return r;
 }
 
-/* The GPU's output LMAP bytes: its page planes must be the CPU's output planes. */
+/* Texels and probes whose GPU bytes are not the CPU's, over a test (GPU.md, "Exactness"). */
+static uint64_t texels_compared, texels_differing;
+
+/* A texel the GPU rounded differently: its decoded irradiance along the six axes within 2^-5 of
+ * the texel's largest (one R11G11B10F step is 2^-6 relative, one direction or ratio code
+ * 1/255 of the directional part; a direction whose summed vector is near zero may flip, which
+ * moves almost nothing). */
+static void check_texel_close(uint32_t za, const uint8_t *ra, uint32_t zb, const uint8_t *rb)
+{
+    lbk_ahd_texel a = {.irradiance_z = za}, b = {.irradiance_z = zb};
+    memcpy(a.rgba, ra, 4), memcpy(b.rgba, rb, 4);
+    static const float axes[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    float ea[6][3], eb[6][3], top = 0;
+    for (int k = 0; k < 6; k++) {
+        lbk_ahd_irradiance(&a, axes[k], ea[k]);
+        lbk_ahd_irradiance(&b, axes[k], eb[k]);
+        for (int c = 0; c < 3; c++) top = fmaxf(top, fmaxf(fabsf(ea[k][c]), fabsf(eb[k][c])));
+    }
+    for (int k = 0; k < 6; k++)
+        for (int c = 0; c < 3; c++)
+            if (!(fabsf(ea[k][c] - eb[k][c]) <= ldexpf(top, -5)))
+                fail_msg("texel off by more than its rounding: %g vs %g (largest %g)", (double)eb[k][c], (double)ea[k][c], (double)top);
+}
+
+/* A probe the GPU rounded differently: every decoded coefficient within 2^-4 of the probe's
+ * largest (one snorm8 code is 1/127 of the band scale; near zero a code may move by a few). */
+static void check_probe_close(const uint8_t *a, const uint8_t *b)
+{
+    lbk_sh9_rgb sa, sb;
+    lbk_sh9_unpack(a, &sa), lbk_sh9_unpack(b, &sb);
+    float top = 0;
+    for (int c = 0; c < 3; c++)
+        for (int k = 0; k < 9; k++) top = fmaxf(top, fmaxf(fabsf(sa.c[c][k]), fabsf(sb.c[c][k])));
+    for (int c = 0; c < 3; c++)
+        for (int k = 0; k < 9; k++)
+            if (!(fabsf(sa.c[c][k] - sb.c[c][k]) <= ldexpf(top, -4)))
+                fail_msg("probe coefficient off by more than its rounding: %g vs %g (largest %g)", (double)sb.c[c][k],
+                         (double)sa.c[c][k], (double)top);
+}
+
+/* The GPU's output LMAP bytes against the CPU's output planes: identical, except texels a
+ * driver rounds differently (GPU.md: lavapipe on an AVX2-only host), each within its rounding;
+ * probes likewise. */
 static void check_outputs(const level *lv, const gpu_dls *g)
 {
     const uint8_t *out = gpu_dls_lmap(g);
@@ -167,11 +210,25 @@ static void check_outputs(const level *lv, const gpu_dls *g)
     for (uint32_t p = 0; p < PAGES; p++) {
         lbk_lmap_page pg;
         assert_int_equal(lbk_lmap_page_get(&lm, p, &pg), LBK_OK);
-        assert_memory_equal(pg.irradiance, lv->out_plane[p][0], 4 * W * H);
-        assert_memory_equal(pg.rgba, lv->out_plane[p][1], 4 * W * H);
+        const uint8_t *gz = pg.irradiance, *gr = pg.rgba, *cz = lv->out_plane[p][0], *cr = lv->out_plane[p][1];
+        for (uint32_t t = 0; t < W * H; t++) {
+            texels_compared++;
+            if (!memcmp(gz + 4 * t, cz + 4 * t, 4) && !memcmp(gr + 4 * t, cr + 4 * t, 4)) continue;
+            texels_differing++;
+            uint32_t za, zb;
+            memcpy(&za, cz + 4 * t, 4), memcpy(&zb, gz + 4 * t, 4);
+            check_texel_close(za, cr + 4 * t, zb, gr + 4 * t);
+        }
     }
-    for (uint32_t s = 1; s <= 2; s++)
-        assert_memory_equal(gpu_dls_probes(g, s), lv->out_probe[s - 1], 28 * lv->fx.desc.target_count[s]);
+    for (uint32_t s = 1; s <= 2; s++) {
+        const uint8_t *gp = gpu_dls_probes(g, s), *cp = lv->out_probe[s - 1];
+        for (uint64_t t = 0; t < lv->fx.desc.target_count[s]; t++) {
+            texels_compared++;
+            if (!memcmp(gp + 28 * t, cp + 28 * t, 28)) continue;
+            texels_differing++;
+            check_probe_close(cp + 28 * t, gp + 28 * t);
+        }
+    }
 }
 
 static void test_gpu_apply_matches_cpu(void **state)
@@ -228,6 +285,11 @@ static void test_gpu_apply_matches_cpu(void **state)
     print_message("naive gather: %u dispatches, %.2f MB moved; idle lanes of the entry loop (waves of 32): clustered "
                   "%.1f%%, naive %.1f%%\n", ns.dispatches, ns.bytes_moved / 1e6, 100 * dc, 100 * dn);
     assert_true(dn > dc);
+    /* bit-exact on most drivers; where one rounds differently, a few texels within their
+     * rounding (GPU.md, "Exactness") — never many */
+    print_message("texels and probes: %llu compared, %llu with other bytes than the CPU's (each within its rounding)\n",
+                  (unsigned long long)texels_compared, (unsigned long long)texels_differing);
+    assert_true(texels_differing * 50 <= texels_compared); /* measured 0.96 % on lavapipe, AMD EPYC (GPU.md) */
     lbk_dls_runtime_close(r);
     gpu_dls_close(g);
     level_free(&lv);
@@ -483,15 +545,21 @@ static void test_gpu_apply_tool(void **state)
     char log[600];
     snprintf(log, sizeof log, "%s.log", path);
     FILE *f = fopen(log, "r");
-    int identical = 0;
+    int identical = 0, differ = 0;
     for (char line[512]; f && fgets(line, sizeof line, f);) {
         identical += strstr(line, "identical to lbk_dls_apply") != NULL;
+        differ += strstr(line, "bytes differ from lbk_dls_apply") != NULL;
         print_message("  %s", line);
     }
     if (f) fclose(f);
     unlink(log), unlink(path);
-    assert_int_equal(rc, 0);
-    assert_int_equal(identical, 4); /* the default sequence: 4 applies */
+    if (texels_differing == 0) { /* an exact driver (test_gpu_apply_matches_cpu ran first) */
+        assert_int_equal(rc, 0);
+        assert_int_equal(identical, 4); /* the default sequence: 4 applies */
+    } else { /* a driver that rounds some texels differently: the tool must say so, exit 1 */
+        assert_true(WIFEXITED(rc) && WEXITSTATUS(rc) == 1);
+        assert_true(differ >= 1);
+    }
     free(glg), free(llg), free(probes);
     level_free(&lv);
 }

@@ -185,6 +185,16 @@ static tl_open_status open_views(tl_bake *b, uint64_t max_decoded_bytes, char er
     VIEW(LBK_SECTION_TERR, b->has_terr, lbk_terr_open(d, n, &b->terr));
     if (b->has_rept && lbk_report_record_get(&b->rept, b->rept.header.record_count - 1, &b->rept_last) != LBK_OK)
         b->has_rept = 0;
+    /* the last record that added work: a trailing step that only revises the estimate (a
+     * denoised bake's, spec §7.2) is skipped */
+    b->rept_sampled = b->rept_last;
+    for (uint32_t i = b->has_rept ? b->rept.header.record_count - 1 : 0; i > 0; i--) {
+        lbk_report_record prev;
+        if (lbk_report_record_get(&b->rept, i - 1, &prev) != LBK_OK || prev.rays_traced != b->rept_sampled.rays_traced ||
+            prev.samples_per_texel != b->rept_sampled.samples_per_texel)
+            break;
+        b->rept_sampled = prev;
+    }
     VIEW(LBK_SECTION_DLS, dls, lbk_dls_open(d, n, NULL, &b->dls));
     VIEW(LBK_SECTION_DOOR, door, lbk_door_open(d, n, NULL, &b->door));
 #undef VIEW

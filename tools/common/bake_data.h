@@ -43,6 +43,8 @@ typedef struct tl_bake {
     lbk_report_view rept;
     lbk_terr_view terr; /* the per-texel error map (format 1.4), when has_terr */
     lbk_report_record rept_last; /* the final estimate, when has_rept */
+    lbk_report_record rept_sampled; /* the last sampling pass's (rept_last without a denoised
+                                       bake's revised-estimate record), when has_rept */
     lbk_dls_view *dls;   /* NULL when absent */
     lbk_door_view *door; /* NULL when absent */
     /* per LMAP page: its texels decoded when the page is block-encoded (spec §9.2), else NULL */

@@ -908,8 +908,11 @@ static void choose_mode(const tl_bake *a, const tl_bake *b, const tl_diff_option
         r->mode = TL_DIFF_MODE_NOISE;
         r->mode_reason = o->mode == TL_DIFF_MODE_NOISE ? "asked for" : "both bakes carry REPT";
     }
-    const double ra[2] = {a->has_rept ? a->rept_last.texel_rel_rmse : 0, a->has_rept ? a->rept_last.probe_rel_rmse : 0};
-    const double rb[2] = {b->has_rept ? b->rept_last.texel_rel_rmse : 0, b->has_rept ? b->rept_last.probe_rel_rmse : 0};
+    /* the transport's estimate of the last sampling pass, on which the noise model (and its
+     * per-texel floor for denoised bakes) was calibrated; a denoised bake's revised estimate
+     * (REPT's last record) is of its whole error, bias included, not of how two seeds differ */
+    const double ra[2] = {a->has_rept ? a->rept_sampled.texel_rel_rmse : 0, a->has_rept ? a->rept_sampled.probe_rel_rmse : 0};
+    const double rb[2] = {b->has_rept ? b->rept_sampled.texel_rel_rmse : 0, b->has_rept ? b->rept_sampled.probe_rel_rmse : 0};
     tl_noise_model_init(model, o->false_alarm > 0 ? o->false_alarm : TL_NOISE_DEFAULT_FALSE_ALARM, ra, rb);
     model->denoised[0] = bake_denoised(a);
     model->denoised[1] = bake_denoised(b);

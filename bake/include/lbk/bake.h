@@ -362,6 +362,18 @@ typedef struct lbk_bake_octp {
     double rays;         /* gather rays per probe (both halves, all passes) */
 } lbk_bake_octp;
 
+/* The estimate of what a denoised bake delivers (lbk_bake_report.denoised; all 0 when the bake
+ * was not denoised): the transport's two halves passed through the denoiser's own weights, so
+ * it holds the noise the filter leaves (also the part correlated between receivers) and the
+ * bias it adds (bake/transport/DENOISE.md §What the report says). LLG probes are not filtered:
+ * errors.llg is the base estimate's. */
+typedef struct lbk_bake_denoised {
+    lbk_bake_class_errors errors;   /* √(noise² + bias²) per class, relative as REPT's */
+    double texel_noise, texel_bias; /* the two parts of errors.texels */
+    double glg_noise, glg_bias;     /* the two parts of errors.glg */
+    double seconds;                 /* estimating it (one more pass of the filter) */
+} lbk_bake_denoised;
+
 /* One transport run of the light sets and doors (a light set, a door open or closed, a
  * combination, the doors-closed reference), with its own final estimate. A door state's or a
  * combination's stored contribution is a difference of such runs: its error is larger. */
@@ -396,6 +408,8 @@ typedef struct lbk_bake_report {
     size_t set_run_count;
     /* appended with the OCTP probe volume: read only when size covers them */
     lbk_bake_octp octp;
+    /* appended in 1.5 (the denoised bake's own estimate): read only when size covers it */
+    lbk_bake_denoised denoised;
 } lbk_bake_report;
 
 /* Owned by the output, valid until lbk_bake_output_free. */
