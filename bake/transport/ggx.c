@@ -100,7 +100,15 @@ double bk_ggx_pdf(double alpha, const double v[3], const double l[3])
 
 /* ---- the albedo table and the coupled BSDF (ggx.h) ------------------------------------------- */
 
-#define TABLE_N 48 /* TABLE_N² stratified visible-normal samples per table entry */
+/* stratified visible-normal samples per table entry: TABLE_NU in u1 (the radius on the
+ * projected hemisphere, whose rim holds the directions lost below the horizon: it needs the
+ * finer grid) × TABLE_NP in u2 */
+#ifndef TABLE_NU
+#define TABLE_NU 256
+#endif
+#ifndef TABLE_NP
+#define TABLE_NP 8
+#endif
 
 static double clamp01(double x) { return x > 0 ? (x < 1 ? x : 1) : 0; }
 
@@ -110,10 +118,10 @@ static void table_entry(double alpha, double mu, double *a, double *b)
     const double v[3] = {sqrt(fmax(0.0, 1 - mu * mu)), 0, mu};
     const double g1 = bk_ggx_g1(alpha, mu);
     double sa = 0, sb = 0;
-    for (int i = 0; i < TABLE_N; i++)
-        for (int j = 0; j < TABLE_N; j++) {
+    for (int i = 0; i < TABLE_NU; i++)
+        for (int j = 0; j < TABLE_NP; j++) {
             double l[3];
-            if (!(bk_ggx_sample(alpha, v, (i + 0.5) / TABLE_N, (j + 0.5) / TABLE_N, l) > 0)) continue;
+            if (!(bk_ggx_sample(alpha, v, (i + 0.5) / TABLE_NU, (j + 0.5) / TABLE_NP, l) > 0)) continue;
             double h[3] = {v[0] + l[0], v[1] + l[1], v[2] + l[2]};
             double hn = sqrt(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
             double vh = hn > 0 ? (v[0] * h[0] + v[1] * h[1] + v[2] * h[2]) / hn : 0;
@@ -122,8 +130,8 @@ static void table_entry(double alpha, double mu, double *a, double *b)
             sa += (1 - m5) * w;
             sb += m5 * w;
         }
-    *a = sa / (TABLE_N * TABLE_N);
-    *b = sb / (TABLE_N * TABLE_N);
+    *a = sa / (TABLE_NU * TABLE_NP);
+    *b = sb / (TABLE_NU * TABLE_NP);
 }
 
 void bk_ggx_table_init(bk_ggx_table *t)
