@@ -435,6 +435,8 @@ fuzz-corpus: $(BUILD)/liblbk.a $(BUILD)/lbk
 	    --texel-density 2 --samples 8 --glg-spacing 3
 	$(BUILD)/lbk bake scenes/cornell_box/CornellBox-Original.gltf -o tests/fuzz/corpus/bake_cornell.lbk -q --threads 2 \
 	    --texel-density 2 --samples 8 --glg-spacing 2.5
+	$(BUILD)/lbk bake scenes/cornell_box/CornellBox-Original.gltf -o tests/fuzz/corpus/bake_cornell_terr.lbk -q --threads 2 \
+	    --texel-density 2 --samples 8 --glg-spacing 2.5 --error-map
 	@d=$$(mktemp -d) && for n in 1 2; do \
 	  $(BUILD)/lbk plan tests/fuzz/part_scene.gltf -o $$d/o.lbk --plan $$d/p$$n.json --units $$n --samples 4 --target-error none \
 	    --texel-density 2 --glg-spacing 8 -q && \

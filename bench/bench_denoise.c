@@ -12,19 +12,13 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench/bench_util.h"
 #include "bake/transport/denoise.h"
 #include "bake/transport/transport.h"
 #include "lbk/sh.h"
 #include "tests/support/scene_append.c"
 #include "tests/support/transport_scenes.c"
 #include "tests/support/lightmap_fixture.c"
-
-static double cpu_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-}
 
 typedef struct method {
     const char *name;
@@ -102,9 +96,9 @@ static double bake(const bk_scene *s, const lmf *f, int samples, uint64_t seed, 
     out.variance = var;
     out.irradiance = irr;
     bk_transport_stats st;
-    double t0 = cpu_now();
+    double t0 = bench_process_cpu();
     if (bk_transport_run(s, f->tracer, f->receivers, f->count, &o, &out, &st)) abort();
-    double dt = cpu_now() - t0;
+    double dt = bench_process_cpu() - t0;
     irradiance_as_sh(f->count, irr, irr_sh);
     free(irr);
     return dt;
@@ -125,10 +119,10 @@ static double denoise(const bk_scene *s, const lmf *f, const method *m, const lb
     in.receiver_count = f->count;
     in.radiance = base;
     in.variance = var;
-    double t0 = cpu_now();
+    double t0 = bench_process_cpu();
     bk_denoiser *d;
     if (bk_denoiser_create(&in, &m->o, &d) || bk_denoiser_apply(d, out)) abort();
-    double dt = cpu_now() - t0;
+    double dt = bench_process_cpu() - t0;
     bk_denoiser_destroy(d);
     return dt;
 }

@@ -9,6 +9,11 @@
  * each entry it blends read — against memcpy moving the same traffic (a copy of half as many
  * bytes, reading and writing each) on as many threads. Also the same on the door/light-set
  * levels of the room_with_doors scene (tests/support/door_scenes.h) as lbk bake writes them.
+ * Both modes of the runtime: bytes (AHD / packed SH9 outputs, the bytes of the scalar
+ * definition) and linear (LBK_DLS_RUNTIME_LINEAR: float outputs from prepared floats, whose
+ * traffic is 48 bytes per texel and 108 per probe for each base, entry and output; memcpy is
+ * measured on that traffic), with the linear mode's prepared memory. Threads run the jobs of
+ * lbk_dls_apply_begin (bk_parallel_chunks), memcpy on as many threads over 16 slices.
  * `bench_dls --quick` skips the baked levels. */
 #define LBK_STATIC_LINKING_ONLY /* lbk_dls_stats, lbk_dls_runtime_path: experimental (lbk/dls.h) */
 #include <math.h>
@@ -116,8 +121,9 @@ static lbk_result apply_threads(lbk_dls_runtime *rt, const float *w, const float
 }
 
 /* The bytes an apply of these weights moves: per cluster with a changed set, its targets' base
- * and output, and every entry it blends (all of them: every set is on in these scenarios). */
-static uint64_t traffic(const lbk_dls_view *v, const float *w_old, const float *w_new)
+ * and output, and every entry it blends (all of them: every set is on in these scenarios) — as
+ * stored (8 / 28 bytes) in the byte mode, as prepared floats (48 / 108 bytes) in the linear one. */
+static uint64_t traffic(const lbk_dls_view *v, const float *w_old, const float *w_new, bool linear)
 {
     uint64_t bytes = 0;
     for (uint32_t c = 0; c < lbk_dls_cluster_count(v); c++) {
@@ -129,7 +135,7 @@ static uint64_t traffic(const lbk_dls_view *v, const float *w_old, const float *
             lbk_dls_cluster_set_get(v, c, j, &s);
             changed = w_old[s] != w_new[s];
         }
-        const uint64_t psize = ci.space == LBK_DLS_SPACE_TEXEL ? 8 : 28;
+        const uint64_t psize = ci.space == LBK_DLS_SPACE_TEXEL ? (linear ? 48 : 8) : (linear ? 108 : 28);
         if (changed) bytes += psize * (2 * (uint64_t)ci.target_count + ci.entry_count);
     }
     return bytes;
@@ -144,6 +150,7 @@ typedef struct scenario_result {
 static int measure(lbk_dls_runtime *rt, const lbk_dls_view *v, uint32_t nsets, const float *dw, int one, int threads,
                    int reps, scenario_result *out)
 {
+    const bool linear = lbk_dls_runtime_linear_bytes(rt) > 0;
     float w0[256], w1[256];
     out->apply = (clocks){1e9, 1e9};
     for (int i = 0; i < reps; i++) {
@@ -156,7 +163,7 @@ static int measure(lbk_dls_runtime *rt, const lbk_dls_view *v, uint32_t nsets, c
         const clocks t0 = clocks_now();
         if (apply_threads(rt, w1, dw, threads) != LBK_OK) return 1;
         clocks_best(&out->apply, t0, threads);
-        out->bytes = traffic(v, w0, w1);
+        out->bytes = traffic(v, w0, w1, linear);
     }
     out->copy = memcpy_time(out->bytes, threads, reps + 2);
     return 0;
@@ -189,32 +196,47 @@ static int estate(void)
     for (uint64_t t = 0; t < G; t++) dlsfx_random_probe(&rng, 2.0f, bg + 28 * t);
     for (uint64_t t = 0; t < L; t++) dlsfx_random_probe(&rng, 2.0f, bl + 28 * t);
     lbk_dls_page pages[PAGES];
+    lbk_dls_linear_page lpages[PAGES];
+    float *lin = malloc((size_t)T * 48), *lg = malloc((size_t)G * 108), *ll = malloc((size_t)L * 108);
     for (uint32_t p = 0; p < PAGES; p++) {
         const uint64_t f = estate_page_first(p);
         pages[p] = (lbk_dls_page){.width = estate_page_w[p], .height = estate_page_h[p], .base_irradiance = base0 + 4 * f,
                                   .base_rgba = base1 + 4 * f, .out_irradiance = out0 + 4 * f, .out_rgba = out1 + 4 * f};
+        for (int c = 0; c < 3; c++) lpages[p].out[c] = lin + (size_t)T * 4 * c + 4 * f, lpages[p].out_pitch[c] = 0;
     }
+    /* paths: the byte mode (SIMD, scalar), then the linear mode (SIMD, scalar) */
+    static const uint32_t flags[4] = {0, LBK_DLS_RUNTIME_SCALAR, LBK_DLS_RUNTIME_LINEAR,
+                                      LBK_DLS_RUNTIME_LINEAR | LBK_DLS_RUNTIME_SCALAR};
     int bad = 0;
-    for (int path = 0; path < 2 && !bad; path++) {
+    for (int path = 0; path < 4 && !bad; path++) {
+        const bool linear = flags[path] & LBK_DLS_RUNTIME_LINEAR, scalar = flags[path] & LBK_DLS_RUNTIME_SCALAR;
         lbk_dls_runtime_desc d = {.size = sizeof d, .dls = lv.view, .base_glg = bg, .base_llg = bl, .out_glg = og,
-                                  .out_llg = ol, .page_count = PAGES, .pages = pages,
-                                  .flags = path ? LBK_DLS_RUNTIME_SCALAR : 0};
+                                  .out_llg = ol, .page_count = PAGES, .pages = pages, .flags = flags[path],
+                                  .linear_pages = lpages, .out_linear_glg = lg, .out_linear_llg = ll};
         lbk_dls_runtime *rt;
+        const double t0 = bk_now();
         if (lbk_dls_runtime_open(&d, &rt) != LBK_OK) return 1;
-        printf(" path %s:\n", lbk_dls_runtime_path(rt));
+        const double open_s = bk_now() - t0;
+        printf(" %s mode, path %s:", linear ? "linear" : "byte", lbk_dls_runtime_path(rt));
+        if (linear)
+            printf(" prepared %.1f MB (%.2f x the %.1f MB DLS section; outputs %.1f MB), open %.0f ms", lbk_dls_runtime_linear_bytes(rt) / 1e6,
+                   lbk_dls_runtime_linear_bytes(rt) / (double)lv.st.section_bytes, lv.st.section_bytes / 1e6,
+                   (48.0 * T + 108.0 * (G + L)) / 1e6, open_s * 1e3);
+        printf("\n");
         scenario_result r;
-        for (int threads = 1; threads <= (path ? 1 : 2) && !bad; threads++) {
-            bad |= measure(rt, lv.view, NSETS, NULL, -1, threads, path ? 1 : 4, &r);
+        for (int threads = 1; threads <= (scalar ? 1 : 2) && !bad; threads++) {
+            bad |= measure(rt, lv.view, NSETS, NULL, -1, threads, scalar ? 1 : 4, &r);
             report("every set changes", threads, &r);
-            if (path) break;
+            if (scalar) break;
             bad |= measure(rt, lv.view, NSETS, NULL, 5, threads, 8, &r);
             report("one set changes", threads, &r);
         }
         uint32_t nranges = lbk_dls_dirty_range_count(rt, 0), nrects = 0;
         for (uint32_t p = 0; p < PAGES; p++) nrects += lbk_dls_dirty_rect_count(rt, p);
-        if (!path) printf("  after the last apply: %u dirty texel ranges, %u rectangles over %d pages\n", nranges, nrects, PAGES);
+        if (!scalar) printf("  after the last apply: %u dirty texel ranges, %u rectangles over %d pages\n", nranges, nrects, PAGES);
         lbk_dls_runtime_close(rt);
     }
+    free(lin), free(lg), free(ll);
     free(base0), free(base1), free(out0), free(out1), free(bg), free(og), free(bl), free(ol);
     estate_free(&lv);
     return bad;

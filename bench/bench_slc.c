@@ -18,6 +18,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench/bench_util.h"
 #include "bake/transport/shading.h"
 #include "bake/transport/slc.h"
 #include "bake/transport/transport.h"
@@ -26,26 +27,6 @@
 
 #define PATCHES 256
 #define NRECV (PATCHES * 16)
-
-static double cpu_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
-static uint64_t mix(uint64_t z)
-{
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-typedef struct { uint64_t s; } rng;
-static double next(rng *r)
-{
-    r->s += 0x9E3779B97F4A7C15ull;
-    return (double)(mix(r->s) >> 11) * (1.0 / 9007199254740992.0);
-}
 
 typedef struct level {
     bk_scene s;
@@ -76,11 +57,11 @@ static void build(level *L, int nx, int ny)
         float mn[3] = {1, 16.0f * y + 10, 0}, mx[3] = {(float)sx * 0.6f, 16.0f * y + 10.3f, 1.2f};
         tsc_box(s, mn, mx, 1, 0, m);
     }
-    rng r = {42};
+    bench_rng r = {42};
     for (int y = 0; y < ny; y++)
         for (int x = 0; x < nx; x++) {
             float pos[3] = {4.0f * x + 2, 4.0f * y + 2, 3};
-            float I = (float)(10 * pow(10.0, 2 * next(&r)));
+            float I = (float)(10 * pow(10.0, 2 * bench_next(&r)));
             tsc_point_light(s, pos, I, 0.9f * I, 0.7f * I, 0);
         }
     tsc_update_bounds(s);
@@ -93,7 +74,7 @@ static void build(level *L, int nx, int ny)
             px |= ((k >> (2 * b)) & 1) << b;
             py |= ((k >> (2 * b + 1)) & 1) << b;
         }
-        double cx = (px + 0.1 + 0.8 * next(&r)) * cx_cell - 0.5, cy = (py + 0.1 + 0.8 * next(&r)) * cy_cell - 0.5;
+        double cx = (px + 0.1 + 0.8 * bench_next(&r)) * cx_cell - 0.5, cy = (py + 0.1 + 0.8 * bench_next(&r)) * cy_cell - 0.5;
         for (int j = 0; j < 16; j++) {
             double *p = L->pts[16 * k + j];
             p[0] = cx + 0.25 * (j % 4) + 0.125;
@@ -137,13 +118,13 @@ static double rel_rmse(const double *x, const double *ref)
 static result brute(const level *L, double *out)
 {
     uint64_t rays = 0;
-    double t0 = cpu_now();
+    double t0 = bench_thread_cpu();
     for (int i = 0; i < NRECV; i++) {
         double e = 0;
         for (size_t li = 0; li < L->s.light_count; li++) e += shade(L, li, i, 1, &rays);
         out[i] = e;
     }
-    result r = {cpu_now() - t0, (double)L->s.light_count, (double)rays / NRECV, 0};
+    result r = {bench_thread_cpu() - t0, (double)L->s.light_count, (double)rays / NRECV, 0};
     return r;
 }
 
@@ -153,12 +134,12 @@ static result sampled(const level *L, const double *cdf, int K, uint64_t seed, c
     const size_t n = L->s.light_count;
     double *x = malloc(NRECV * sizeof *x);
     uint64_t rays = 0;
-    double t0 = cpu_now();
+    double t0 = bench_thread_cpu();
     for (int i = 0; i < NRECV; i++) {
-        rng r = {mix(seed * 1000003u + (uint64_t)i)};
+        bench_rng r = {bench_mix(seed * 1000003u + (uint64_t)i)};
         double e = 0;
         for (int k = 0; k < K; k++) {
-            double u = next(&r);
+            double u = bench_next(&r);
             size_t li;
             double p;
             if (!cdf) {
@@ -178,7 +159,7 @@ static result sampled(const level *L, const double *cdf, int K, uint64_t seed, c
         }
         x[i] = e;
     }
-    result res = {cpu_now() - t0, K, (double)rays / NRECV, rel_rmse(x, ref)};
+    result res = {bench_thread_cpu() - t0, K, (double)rays / NRECV, rel_rmse(x, ref)};
     free(x);
     return res;
 }
@@ -191,9 +172,9 @@ static result slc(const level *L, bk_slc *sl, double delta, uint64_t seed, const
     double *x = malloc(NRECV * sizeof *x), *xi = malloc(n * sizeof *xi);
     uint32_t *ids = malloc(n * sizeof *ids);
     uint64_t rays = 0, tested = 0;
-    double t0 = cpu_now();
-    rng r = {mix(seed)};
-    for (size_t li = 0; li < n; li++) xi[li] = next(&r);
+    double t0 = bench_thread_cpu();
+    bench_rng r = {bench_mix(seed)};
+    for (size_t li = 0; li < n; li++) xi[li] = bench_next(&r);
     bk_slc_draw *d = NULL;
     if (bk_slc_draw_create(sl, xi, delta, 1, &d) != LBK_OK) abort();
     size_t cnt = 0;
@@ -211,7 +192,7 @@ static result slc(const level *L, bk_slc *sl, double delta, uint64_t seed, const
         x[i] = e;
     }
     bk_slc_draw_destroy(d);
-    result res = {cpu_now() - t0, (double)tested / NRECV, (double)rays / NRECV, rel_rmse(x, ref)};
+    result res = {bench_thread_cpu() - t0, (double)tested / NRECV, (double)rays / NRECV, rel_rmse(x, ref)};
     free(x);
     free(xi);
     free(ids);

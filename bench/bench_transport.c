@@ -11,19 +11,13 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench/bench_util.h"
 #include "bake/transport/transport.h"
 #include "tests/support/scene_append.c"     /* what the scene builders below build on */
 #include "tests/support/transport_scenes.c" /* the C scene builders the tests use */
 
 /* CPU time of the calling thread: the rays/s comparison runs both sides on this one thread,
  * and on a shared machine wall time would mostly measure the other tenants. */
-static double cpu_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
 static void build_room(bk_scene *s)
 {
     tsc_init(s);
@@ -107,7 +101,7 @@ static double raw_embree_rays_per_second(const bk_scene *s, size_t nrays)
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     size_t hits = 0;
-    double t0 = cpu_now();
+    double t0 = bench_thread_cpu();
     for (size_t i = 0; i < nrays; i++) {
         struct RTCRayHit rh;
         rh.ray.org_x = rays[6 * i]; rh.ray.org_y = rays[6 * i + 1]; rh.ray.org_z = rays[6 * i + 2];
@@ -117,7 +111,7 @@ static double raw_embree_rays_per_second(const bk_scene *s, size_t nrays)
         rtcIntersect1(sc, &ctx, &rh);
         hits += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
     }
-    double dt = cpu_now() - t0;
+    double dt = bench_thread_cpu() - t0;
     if (hits == 0) printf("  (raw loop hit nothing?)\n");
     free(rays);
     rtcReleaseScene(sc);
@@ -165,9 +159,9 @@ int main(int argc, char **argv)
     bk_transport_stats st;
     /* gather rays only (no light sampling): the same kind of rays as the raw loop */
     o.nee = -1;
-    double c0 = cpu_now();
+    double c0 = bench_thread_cpu();
     bk_transport_run(&s, t, r, n, &o, &out, &st);
-    double cpu = cpu_now() - c0;
+    double cpu = bench_thread_cpu() - c0;
     double baker = (double)st.rays / cpu;
     double raw = raw_embree_rays_per_second(&s, st.rays < 4000000 ? (size_t)st.rays : 4000000);
     printf("rays/s per CPU second, 1 thread, NEE off: baker %.3g (all transport work included, %llu rays of which "
@@ -176,9 +170,9 @@ int main(int argc, char **argv)
     /* the default (NEE on here): shadow rays to sampled emitter points are cheaper than
      * closest-hit rays, so this ratio flatters; shown for completeness */
     o.nee = 0;
-    c0 = cpu_now();
+    c0 = bench_thread_cpu();
     bk_transport_run(&s, t, r, n, &o, &out, &st);
-    cpu = cpu_now() - c0;
+    cpu = bench_thread_cpu() - c0;
     printf("rays/s per CPU second, 1 thread, NEE on:  baker %.3g (%llu rays, %llu shadow, %.2f s CPU): ratio %.0f %% of raw "
            "closest-hit\n",
            (double)st.rays / cpu, (unsigned long long)st.rays, (unsigned long long)st.shadow_rays, cpu,

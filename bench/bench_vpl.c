@@ -23,6 +23,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench/bench_util.h"
 #include "bake/transport/shading.h"
 #include "bake/transport/vpl.h"
 #include "tests/support/scene_append.c"
@@ -32,26 +33,6 @@
 #define PATCHES 160
 #define NRECV (PATCHES * 16)
 #define DRAWS 4 /* SLC draws per roughness (the error is their RMS; the counts their mean) */
-
-static double cpu_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
-static uint64_t mix(uint64_t z)
-{
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-typedef struct { uint64_t s; } rng;
-static double next(rng *r)
-{
-    r->s += 0x9E3779B97F4A7C15ull;
-    return (double)(mix(r->s) >> 11) * (1.0 / 9007199254740992.0);
-}
 
 typedef struct room {
     bk_scene s;
@@ -84,14 +65,14 @@ static void build(room *R)
     memset(R->mats, 0, sizeof R->mats);
     for (int k = 0; k < 3; k++) R->mats[fm].f0[k] = 0.95f, R->mats[wm].kd[k] = 0.6f;
     /* patches: 1 × 1 m at random places, on each face in proportion to its area */
-    rng r = {7};
+    bench_rng r = {7};
     const double area[6] = {100, 100, 40, 40, 40, 40};
     for (int k = 0; k < PATCHES; k++) {
-        double u = next(&r) * 360, a = 0;
+        double u = bench_next(&r) * 360, a = 0;
         int f = 0;
         while (f < 5 && u > a + area[f]) a += area[f++];
-        double o[3] = {0}, ax[3] = {0}, ay[3] = {0}, n[3] = {0}, p = 0.05 + 8.9 * next(&r), q = 0.05 + 8.9 * next(&r),
-               h = 0.05 + 2.9 * next(&r);
+        double o[3] = {0}, ax[3] = {0}, ay[3] = {0}, n[3] = {0}, p = 0.05 + 8.9 * bench_next(&r), q = 0.05 + 8.9 * bench_next(&r),
+               h = 0.05 + 2.9 * bench_next(&r);
         switch (f) {
         case 0: o[0] = p, o[1] = q, o[2] = 0; ax[0] = 1, ay[1] = 1, n[2] = 1; break;
         case 1: o[0] = p, o[1] = q, o[2] = Z; ax[0] = 1, ay[1] = 1, n[2] = -1; break;
@@ -135,15 +116,15 @@ static row slc_rows(const room *R, const bk_vpl *v, size_t nv, const bk_slc *til
     row out = {0, 0, 0, 0};
     double *xi = malloc(nv * sizeof *xi);
     for (int k = 0; k < DRAWS; k++) {
-        rng r = {1000 + (uint64_t)k};
-        for (size_t i = 0; i < nv; i++) xi[i] = next(&r);
-        double t0 = cpu_now();
+        bench_rng r = {1000 + (uint64_t)k};
+        for (size_t i = 0; i < nv; i++) xi[i] = bench_next(&r);
+        double t0 = bench_thread_cpu();
         bk_vpl_draw *d = NULL;
         bk_vpl_stats st;
         if (bk_vpl_draw_create(v, nv, xi, delta, bound, tiles, 1, &d) != LBK_OK ||
             bk_vpl_gather(v, nv, d, R->t, R->pts, NRECV, 1, irr, &st) != LBK_OK)
             abort();
-        out.seconds += (cpu_now() - t0) / DRAWS;
+        out.seconds += (bench_thread_cpu() - t0) / DRAWS;
         bk_vpl_draw_destroy(d);
         out.listed += (double)st.listed / NRECV / DRAWS;
         out.fp += (double)(st.listed - st.accepted) / NRECV / DRAWS;
@@ -161,9 +142,9 @@ static double subset_err(const room *R, const bk_vpl *v, size_t nv, size_t K, co
     double e2 = 0;
     bk_vpl *sub = malloc(K * sizeof *sub);
     for (int k = 0; k < DRAWS; k++) {
-        rng r = {77 + (uint64_t)k};
+        bench_rng r = {77 + (uint64_t)k};
         for (size_t i = 0; i < K; i++) {
-            sub[i] = v[(size_t)(next(&r) * nv) % nv];
+            sub[i] = v[(size_t)(bench_next(&r) * nv) % nv];
             for (int c = 0; c < 3; c++) sub[i].flux[c] *= (double)nv / K;
         }
         if (bk_vpl_gather(sub, K, NULL, R->t, R->pts, NRECV, 1, irr, NULL) != LBK_OK) abort();
@@ -184,9 +165,9 @@ static void diffuse(room *R, const bk_slc *tiles, double delta_rel, double *bf, 
     if (bk_vpl_shoot(&sd, &R->s.lights[1], &v, &nv) != LBK_OK) abort();
     size_t glossy = 0;
     for (size_t i = 0; i < nv; i++) glossy += v[i].kind == BK_VPL_GLOSSY;
-    double t0 = cpu_now();
+    double t0 = bench_thread_cpu();
     if (bk_vpl_gather(v, nv, NULL, R->t, R->pts, NRECV, 1, bf, NULL) != LBK_OK) abort();
-    const double bft = cpu_now() - t0;
+    const double bft = bench_thread_cpu() - t0;
     double mean = 0;
     for (int i = 0; i < NRECV; i++) mean += lum3(&bf[3 * i]) / NRECV;
     row a = slc_rows(R, v, nv, tiles, delta_rel * mean, BK_VPL_BOUND_SPHERE_AT_VPL, bf, irr);
@@ -221,9 +202,9 @@ static void run(room *R, const bk_slc *tiles, double delta_rel, double *bf, doub
         bk_vpl *v = NULL;
         size_t nv = 0;
         if (bk_vpl_shoot(&sd, &R->s.lights[0], &v, &nv) != LBK_OK) abort();
-        double t0 = cpu_now();
+        double t0 = bench_thread_cpu();
         if (bk_vpl_gather(v, nv, NULL, R->t, R->pts, NRECV, 1, bf, NULL) != LBK_OK) abort();
-        bft[a] = cpu_now() - t0;
+        bft[a] = bench_thread_cpu() - t0;
         double mean = 0;
         for (int i = 0; i < NRECV; i++) mean += lum3(&bf[3 * i]) / NRECV;
         for (int b = 0; b < 3; b++) fig[a][b] = slc_rows(R, v, nv, tiles, delta_rel * mean, bounds[b], bf, irr);

@@ -42,6 +42,9 @@ static void help(FILE *f)
           "  --glg-lighting          global light grid denser where the lighting varies, coarser where it\n"
           "                          is smooth (a coarse probe pass first; bake/probes/PROBES.md)\n"
           "  --octahedral            also write a GIBS-style octahedral probe volume (OCTP, format 1.3)\n"
+          "  --error-map             also write the per-texel error map (TERR, format 1.4): each lightmap\n"
+          "                          texel's estimated relative standard error (lbk view's error mode,\n"
+          "                          lbk export, lbk inspect); before denoising when denoised\n"
           "  --block-align           charts on 4-texel boundaries, so no 4x4 block of a block-compressed pack\n"
           "                          (lbk convert --profile console-current, handheld) holds two charts\n"
           "  --dls-threshold X       light sets and doors store a texel/probe only where their light\n"
@@ -308,7 +311,7 @@ static int bake(bake_args *o, int quiet)
 
 int cli_bake_flag(const char *a)
 {
-    return !strcmp(a, "--no-glg") || !strcmp(a, "--octahedral") || !strcmp(a, "--glg-lighting") || !strcmp(a, "--block-align") || !strcmp(a, "--timestamp") ||
+    return !strcmp(a, "--no-glg") || !strcmp(a, "--octahedral") || !strcmp(a, "--glg-lighting") || !strcmp(a, "--error-map") || !strcmp(a, "--block-align") || !strcmp(a, "--timestamp") ||
            !strcmp(a, "-q") || !strcmp(a, "--quiet") || !strcmp(a, "-h") || !strcmp(a, "--help");
 }
 
@@ -428,6 +431,8 @@ int cli_bake_parse(int argc, char **argv, bake_args *out, int *quiet_out)
             o.d.glg_lighting = 1;
         } else if (!strcmp(a, "--block-align")) {
             o.d.block_align = 1;
+        } else if (!strcmp(a, "--error-map")) {
+            o.d.error_map = 1;
         } else if (!strcmp(a, "--dls-threshold")) {
             NEED_NUMBER(0, 1);
             o.d.dls_threshold = d > 0 ? d : -1;

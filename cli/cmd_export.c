@@ -23,6 +23,8 @@ static void usage(FILE *f)
             "                                         direction (the brightest the texel gets)\n"
             "                   page_NNN.ahd.exr      the raw AHD planes: plane0.R/G/B (R11G11B10F, exact) and\n"
             "                                         plane1.R/G/B/A (ratio, direction x, y, z bytes / 255)\n"
+            "                   page_NNN.error.exr    Y = the per-texel error map's relative error (-1: no estimate),\n"
+            "                                         only for a bake with --error-map (TERR; .error.png with --png)\n"
             "  --png DIR      page_NNN.png tone-mapped previews of page_NNN.exr: one exposure for all pages,\n"
             "                 1 / (99th percentile of Rec.709 luminance over all texels), then sRGB, 8 bits\n"
             "  --per-object   also DIR/objects/III_name.exr (and .png): each lightmapped object's rectangle cut out\n"

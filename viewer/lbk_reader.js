@@ -184,7 +184,7 @@
     }
     if (anyZstd !== !!(req & FEATURE_ZSTD)) fail('the ZSTD feature bit does not match the sections');
     for (const s of sections)
-      if (KNOWN.indexOf(s.type) < 0 && s.type !== 'LMUV' && s.required) fail('unknown required section ' + s.type);
+      if (KNOWN.indexOf(s.type) < 0 && s.type !== 'LMUV' && s.type !== 'TERR' && s.required) fail('unknown required section ' + s.type);
 
     let charged = 0;
     const cache = new Map();
@@ -215,6 +215,7 @@
              glg: async () => parseGlg(await payload('GLG ')),
              llg: async () => parseLlg(await payload('LLG ')),
              octp: async () => parseOctp(await payload('OCTP')),
+             errorMap: async () => parseErrorMap(await payload('TERR')),
              dls: async () => parseDls(await payload('DLS ')),
              doors: async () => parseDoor(await payload('DOOR')) };
   }
@@ -308,19 +309,193 @@
     if (u64(dv, 8) !== first) fail('LMAP: texel_count');
     return { scale, texel_count: first, pages };
   }
-  /* Page i's texels as linear forms (12 floats each, physical units: × scale), 1.0 encoding only
-   * (block pages are decoded by the GPU in the viewer; this reader does not decode them on the CPU). */
+  /* Page i's texels as linear forms (12 floats each, physical units: × scale): 1.0 pages by
+   * §5.6 from the stored words, block pages (BC6H, BC5 + BC4; §9.2) through the float texel form
+   * as liblbk's lbk_lmap_planes_texel_unpack. ASTC pages: an error (no ASTC decoder here). */
   function pageLinear(lmap, i) {
     const pg = lmap.pages[i];
-    if (pg.format0 || pg.format1) fail('LMAP page ' + i + ': block-encoded planes are not decoded on the CPU by this reader');
     const n = pg.width * pg.height, out = new Float32Array(12 * n);
-    const d0 = view(pg.plane0);
+    if (pg.format0 || pg.format1) {
+      const tf = pageTexelsF(pg);
+      for (let t = 0; t < n; t++) texelFToLinear(tf, 7 * t, out, 12 * t);
+    } else {
+      const d0 = view(pg.plane0);
+      for (let t = 0; t < n; t++) ahdToLinear(d0.getUint32(4 * t, true), pg.plane1.subarray(4 * t, 4 * t + 4), out, 12 * t);
+    }
+    for (let k = 0; k < 12 * n; k++) out[k] = f32(out[k] * lmap.scale);
+    return out;
+  }
+
+  /* ---- block-encoded LMAP planes (§9.2): BC6H_UF16, BC4, BC5 ---------------------------------- */
+  /* BC6H unsigned (the D3D11 decoding, all 14 modes). A mode's fields are (endpoint component,
+   * first bit, bit count, reversed) in the order the block stores them, LSB first; components
+   * 0–11 are w, x, y, z of R, G, B (w/x region 0, y/z region 1), 12 the partition. */
+  const [RW, GW, BW, RX, GX, BX, RY, GY, BY, RZ, GZ, BZ, D] = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12];
+  const F = (w, a, n) => [w, a, n, 0], RV = (w, a, n) => [w, a, n, 1];
+  /* [code, code bits, regions, transformed, w, dr, dg, db, fields] */
+  const BC6H_MODES = [
+    [0x00, 2, 2, 1, 10, 5, 5, 5, [F(GY, 4, 1), F(BY, 4, 1), F(BZ, 4, 1), F(RW, 0, 10), F(GW, 0, 10), F(BW, 0, 10), F(RX, 0, 5), F(GZ, 4, 1),
+      F(GY, 0, 4), F(GX, 0, 5), F(BZ, 0, 1), F(GZ, 0, 4), F(BX, 0, 5), F(BZ, 1, 1), F(BY, 0, 4), F(RY, 0, 5),
+      F(BZ, 2, 1), F(RZ, 0, 5), F(BZ, 3, 1), F(D, 0, 5)]],
+    [0x01, 2, 2, 1, 7, 6, 6, 6, [F(GY, 5, 1), F(GZ, 4, 1), F(GZ, 5, 1), F(RW, 0, 7), F(BZ, 0, 1), F(BZ, 1, 1), F(BY, 4, 1), F(GW, 0, 7),
+      F(BY, 5, 1), F(BZ, 2, 1), F(GY, 4, 1), F(BW, 0, 7), F(BZ, 3, 1), F(BZ, 5, 1), F(BZ, 4, 1), F(RX, 0, 6),
+      F(GY, 0, 4), F(GX, 0, 6), F(GZ, 0, 4), F(BX, 0, 6), F(BY, 0, 4), F(RY, 0, 6), F(RZ, 0, 6), F(D, 0, 5)]],
+    [0x02, 5, 2, 1, 11, 5, 4, 4, [F(RW, 0, 10), F(GW, 0, 10), F(BW, 0, 10), F(RX, 0, 5), F(RW, 10, 1), F(GY, 0, 4), F(GX, 0, 4), F(GW, 10, 1),
+      F(BZ, 0, 1), F(GZ, 0, 4), F(BX, 0, 4), F(BW, 10, 1), F(BZ, 1, 1), F(BY, 0, 4), F(RY, 0, 5), F(BZ, 2, 1),
+      F(RZ, 0, 5), F(BZ, 3, 1), F(D, 0, 5)]],
+    [0x06, 5, 2, 1, 11, 4, 5, 4, [F(RW, 0, 10), F(GW, 0, 10), F(BW, 0, 10), F(RX, 0, 4), F(RW, 10, 1), F(GZ, 4, 1), F(GY, 0, 4), F(GX, 0, 5),
+      F(GW, 10, 1), F(GZ, 0, 4), F(BX, 0, 4), F(BW, 10, 1), F(BZ, 1, 1), F(BY, 0, 4), F(RY, 0, 4), F(BZ, 0, 1),
+      F(BZ, 2, 1), F(RZ, 0, 4), F(GY, 4, 1), F(BZ, 3, 1), F(D, 0, 5)]],
+    [0x0a, 5, 2, 1, 11, 4, 4, 5, [F(RW, 0, 10), F(GW, 0, 10), F(BW, 0, 10), F(RX, 0, 4), F(RW, 10, 1), F(BY, 4, 1), F(GY, 0, 4), F(GX, 0, 4),
+      F(GW, 10, 1), F(BZ, 0, 1), F(GZ, 0, 4), F(BX, 0, 5), F(BW, 10, 1), F(BY, 0, 4), F(RY, 0, 4), F(BZ, 1, 1),
+      F(BZ, 2, 1), F(RZ, 0, 4), F(BZ, 4, 1), F(BZ, 3, 1), F(D, 0, 5)]],
+    [0x0e, 5, 2, 1, 9, 5, 5, 5, [F(RW, 0, 9), F(BY, 4, 1), F(GW, 0, 9), F(GY, 4, 1), F(BW, 0, 9), F(BZ, 4, 1), F(RX, 0, 5), F(GZ, 4, 1),
+      F(GY, 0, 4), F(GX, 0, 5), F(BZ, 0, 1), F(GZ, 0, 4), F(BX, 0, 5), F(BZ, 1, 1), F(BY, 0, 4), F(RY, 0, 5),
+      F(BZ, 2, 1), F(RZ, 0, 5), F(BZ, 3, 1), F(D, 0, 5)]],
+    [0x12, 5, 2, 1, 8, 6, 5, 5, [F(RW, 0, 8), F(GZ, 4, 1), F(BY, 4, 1), F(GW, 0, 8), F(BZ, 2, 1), F(GY, 4, 1), F(BW, 0, 8), F(BZ, 3, 1),
+      F(BZ, 4, 1), F(RX, 0, 6), F(GY, 0, 4), F(GX, 0, 5), F(BZ, 0, 1), F(GZ, 0, 4), F(BX, 0, 5), F(BZ, 1, 1),
+      F(BY, 0, 4), F(RY, 0, 6), F(RZ, 0, 6), F(D, 0, 5)]],
+    [0x16, 5, 2, 1, 8, 5, 6, 5, [F(RW, 0, 8), F(BZ, 0, 1), F(BY, 4, 1), F(GW, 0, 8), F(GY, 5, 1), F(GY, 4, 1), F(BW, 0, 8), F(GZ, 5, 1),
+      F(BZ, 4, 1), F(RX, 0, 5), F(GZ, 4, 1), F(GY, 0, 4), F(GX, 0, 6), F(GZ, 0, 4), F(BX, 0, 5), F(BZ, 1, 1),
+      F(BY, 0, 4), F(RY, 0, 5), F(BZ, 2, 1), F(RZ, 0, 5), F(BZ, 3, 1), F(D, 0, 5)]],
+    [0x1a, 5, 2, 1, 8, 5, 5, 6, [F(RW, 0, 8), F(BZ, 1, 1), F(BY, 4, 1), F(GW, 0, 8), F(BY, 5, 1), F(GY, 4, 1), F(BW, 0, 8), F(BZ, 5, 1),
+      F(BZ, 4, 1), F(RX, 0, 5), F(GZ, 4, 1), F(GY, 0, 4), F(GX, 0, 5), F(BZ, 0, 1), F(GZ, 0, 4), F(BX, 0, 6),
+      F(BY, 0, 4), F(RY, 0, 5), F(BZ, 2, 1), F(RZ, 0, 5), F(BZ, 3, 1), F(D, 0, 5)]],
+    [0x1e, 5, 2, 0, 6, 6, 6, 6, [F(RW, 0, 6), F(GZ, 4, 1), F(BZ, 0, 1), F(BZ, 1, 1), F(BY, 4, 1), F(GW, 0, 6), F(GY, 5, 1), F(BY, 5, 1),
+      F(BZ, 2, 1), F(GY, 4, 1), F(BW, 0, 6), F(GZ, 5, 1), F(BZ, 3, 1), F(BZ, 5, 1), F(BZ, 4, 1), F(RX, 0, 6),
+      F(GY, 0, 4), F(GX, 0, 6), F(GZ, 0, 4), F(BX, 0, 6), F(BY, 0, 4), F(RY, 0, 6), F(RZ, 0, 6), F(D, 0, 5)]],
+    [0x03, 5, 1, 0, 10, 10, 10, 10, [F(RW, 0, 10), F(GW, 0, 10), F(BW, 0, 10), F(RX, 0, 10), F(GX, 0, 10), F(BX, 0, 10)]],
+    [0x07, 5, 1, 1, 11, 9, 9, 9, [F(RW, 0, 10), F(GW, 0, 10), F(BW, 0, 10), F(RX, 0, 9), F(RW, 10, 1), F(GX, 0, 9), F(GW, 10, 1), F(BX, 0, 9),
+      F(BW, 10, 1)]],
+    [0x0b, 5, 1, 1, 12, 8, 8, 8, [F(RW, 0, 10), F(GW, 0, 10), F(BW, 0, 10), F(RX, 0, 8), RV(RW, 10, 2), F(GX, 0, 8), RV(GW, 10, 2), F(BX, 0, 8),
+      RV(BW, 10, 2)]],
+    [0x0f, 5, 1, 1, 16, 4, 4, 4, [F(RW, 0, 10), F(GW, 0, 10), F(BW, 0, 10), F(RX, 0, 4), RV(RW, 10, 6), F(GX, 0, 4), RV(GW, 10, 6), F(BX, 0, 4),
+      RV(BW, 10, 6)]],
+  ];
+  /* two-region shapes: bit t set = texel t in region 1; the anchor texel of region 1 */
+  const BC6H_SHAPES = [0xcccc, 0x8888, 0xeeee, 0xecc8, 0xc880, 0xfeec, 0xfec8, 0xec80, 0xc800, 0xffec, 0xfe80,
+    0xe800, 0xffe8, 0xff00, 0xfff0, 0xf000, 0xf710, 0x008e, 0x7100, 0x08ce, 0x008c, 0x7310,
+    0x3100, 0x8cce, 0x088c, 0x3110, 0x6666, 0x366c, 0x17e8, 0x0ff0, 0x718e, 0x399c];
+  const BC6H_ANCHOR = [15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15,
+    15, 2, 8, 2, 2, 8, 8, 15, 2, 8, 2, 2, 8, 8, 2, 2];
+  const W3 = [0, 9, 18, 27, 37, 46, 55, 64], W4 = [0, 4, 9, 13, 17, 21, 26, 30, 34, 38, 43, 47, 51, 55, 60, 64];
+
+  function bc6hUnquantize(v, bits) {
+    if (bits >= 15 || v === 0) return v;
+    if (v === (1 << bits) - 1) return 0xffff;
+    return ((v << 16) + 0x8000) >>> bits;
+  }
+  /* 16 texels × RGB binary16 codes of the block at u8[o..o+16); reserved modes decode as 0 */
+  function bc6hUnpack(u8, o, out) {
+    let pos = 0;
+    const take = (n) => { let v = 0; for (let i = 0; i < n; i++, pos++) v |= ((u8[o + (pos >> 3)] >> (pos & 7)) & 1) << i; return v; };
+    let mode = -1;
+    if ((u8[o] & 3) < 2) { mode = u8[o] & 3; pos = 2; }
+    else { const five = u8[o] & 31; for (let m = 2; m < 14; m++) if (BC6H_MODES[m][0] === five) { mode = m; pos = 5; } }
+    if (mode < 0) { out.fill(0); return false; }
+    const [, , regions, transformed, wb, dr, dg, db, fields] = BC6H_MODES[mode];
+    const comp = new Array(13).fill(0);
+    for (const [what, first, count, rev] of fields) {
+      const v = take(count);
+      for (let i = 0; i < count; i++) comp[what] |= ((v >> i) & 1) << (rev ? first + count - 1 - i : first + i);
+    }
+    const nep = 2 * regions, dbits = [dr, dg, db], e = [[0, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0, 0]];
+    for (let c = 0; c < 3; c++) {
+      e[0][c] = comp[RW + c];
+      for (let k = 1; k < nep; k++) {
+        const raw = comp[RW + 3 * k + c];
+        if (transformed) {
+          const sh = 32 - dbits[c], d = (raw << sh) >> sh;
+          e[k][c] = (e[0][c] + d) & ((1 << wb) - 1);
+        } else e[k][c] = raw;
+      }
+      for (let k = 0; k < nep; k++) e[k][c] = bc6hUnquantize(e[k][c], wb);
+    }
+    const shape = regions === 2 ? BC6H_SHAPES[comp[D]] : 0, anchor = regions === 2 ? BC6H_ANCHOR[comp[D]] : 16;
+    const ib = regions === 2 ? 3 : 4, wt = regions === 2 ? W3 : W4;
+    for (let t = 0; t < 16; t++) {
+      const reg = (shape >> t) & 1, idx = take(t === 0 || t === anchor ? ib - 1 : ib);
+      for (let c = 0; c < 3; c++) {
+        const a = e[2 * reg][c], z = e[2 * reg + 1][c];
+        const v = (a * (64 - wt[idx]) + z * wt[idx] + 32) >> 6;
+        out[3 * t + c] = (v * 31) >> 6;
+      }
+    }
+    return true;
+  }
+  /* BC4_UNORM block at u8[o..o+8) → 16 binary32 values */
+  function bc4Unpack(u8, o, out) {
+    const a = u8[o], b = u8[o + 1], pal = [f32(a / 255), f32(b / 255)];
+    if (a > b) for (let i = 1; i < 7; i++) pal.push(f32(((7 - i) * a + i * b) / 1785));
+    else { for (let i = 1; i < 5; i++) pal.push(f32(((5 - i) * a + i * b) / 1275)); pal.push(0, 1); }
+    for (let t = 0; t < 16; t++) {
+      const bit = 3 * t, byte = o + 2 + (bit >> 3), sh = bit & 7;
+      const v = (u8[byte] | ((byte + 1 < o + 8 ? u8[byte + 1] : 0) << 8)) >> sh;
+      out[t] = pal[v & 7];
+    }
+  }
+  /* A page's texels in the float texel form of liblbk (lbk_ahd_texel_f: Ez RGB, then r, X, Y, Z
+   * of plane 1 as channel values), 7 floats each, stored units; any encoding but ASTC. */
+  function pageTexelsF(pg) {
+    if (pg.format0 === 2 || pg.format1 === 2) fail('ASTC 4x4 pages are not decoded by this reader (no ASTC decoder in JS)');
+    const w = pg.width, n = w * pg.height, out = new Float32Array(7 * n);
+    const bx = w / 4, nb = bx * (pg.height / 4);
+    const d0 = view(pg.plane0), h = new Array(48), dir0 = new Float32Array(16), dir1 = new Float32Array(16), rat = new Float32Array(16);
     for (let t = 0; t < n; t++) {
-      ahdToLinear(d0.getUint32(4 * t, true), pg.plane1.subarray(4 * t, 4 * t + 4), out, 12 * t);
-      for (let k = 0; k < 12; k++) out[12 * t + k] = f32(out[12 * t + k] * lmap.scale);
+      if (pg.format0 === 0) {
+        const ez = r11g11b10f(d0.getUint32(4 * t, true));
+        for (let c = 0; c < 3; c++) { let e = ez[c]; if (e !== e) e = 0; if (e > UF11_MAX) e = UF11_MAX; out[7 * t + c] = e; }
+      }
+      if (pg.format1 === 0) for (let k = 0; k < 4; k++) out[7 * t + 3 + k] = unorm8(pg.plane1[4 * t + k]);
+    }
+    const bo = align16(16 * nb);
+    for (let b = 0; b < (pg.format0 || pg.format1 ? nb : 0); b++) {
+      const x0 = 4 * (b % bx), y0 = 4 * Math.floor(b / bx);
+      if (pg.format0 === 1) bc6hUnpack(pg.plane0, 16 * b, h);
+      if (pg.format1 === 1) { bc4Unpack(pg.plane1, 16 * b, dir0); bc4Unpack(pg.plane1, 16 * b + 8, dir1); bc4Unpack(pg.plane1, bo + 8 * b, rat); }
+      for (let i = 0; i < 16; i++) {
+        const o = 7 * ((y0 + (i >> 2)) * w + x0 + (i & 3));
+        if (pg.format0 === 1) for (let c = 0; c < 3; c++) out[o + c] = half(h[3 * i + c]);
+        if (pg.format1 === 1) {
+          const dx = f32(f32(2 * dir0[i]) - 1), dy = f32(f32(2 * dir1[i]) - 1), zz = f32(f32(1 - f32(dx * dx)) - f32(dy * dy));
+          out[o + 3] = rat[i]; out[o + 4] = dir0[i]; out[o + 5] = dir1[i]; out[o + 6] = zz > 0 ? f32(Math.sqrt(zz)) : 0;
+        }
+      }
     }
     return out;
   }
+  /* lbk_ahd_texel_f_to_linear: 7 floats at t[o] → 12 floats at out[q] */
+  function texelFToLinear(t, o, out, q) {
+    const x = f32(f32(2 * t[o + 4]) - 1), y = f32(f32(2 * t[o + 5]) - 1), z = t[o + 6];
+    const len = f32(Math.sqrt(f32(f32(f32(x * x) + f32(y * y)) + f32(z * z))));
+    const d = len >= 0.5 ? [f32(x / len), f32(y / len), f32(z / len)] : [0, 0, 1];
+    let r = t[o + 3];
+    if (!(r >= 0)) r = 0;
+    if (r > 1) r = 1;
+    const k = f32(0.25 + f32(0.5 * d[2]));
+    for (let c = 0; c < 3; c++) {
+      let e = t[o + c];
+      if (!(e >= 0)) e = 0;
+      if (e > 65504) e = 65504;
+      const amb = f32(r * e), inten = f32(f32(f32(1 - r) * e) / k);
+      out[q + c * 4] = f32(amb + f32(0.25 * inten));
+      for (let i = 0; i < 3; i++) out[q + c * 4 + 1 + i] = f32(f32(0.5 * inten) * d[i]);
+    }
+  }
+
+  /* ---- TERR (§18, format 1.4): the per-texel error map ------------------------------------- */
+  const TERR_CODE_ONE = 161, TERR_STEPS = 16, TERR_DENOISED = 1;
+  function parseErrorMap(p) {
+    if (!p) return null;
+    const dv = view(p); need(p, 16, 'TERR');
+    const enc = dv.getUint32(0, true), flags = dv.getUint32(4, true), n = u64(dv, 8);
+    if (enc !== 0) fail('TERR: encoding ' + enc + ' is not defined');
+    if (flags & ~TERR_DENOISED) fail('TERR: unknown flag bits');
+    if (n < 1 || 16 + n !== p.length) fail('TERR: size does not match texel_count');
+    return { texel_count: n, denoised: !!(flags & TERR_DENOISED), codes: p.subarray(16, 16 + n) };
+  }
+  /* relative standard error of a code (§18.2); -1: no estimate (code 0) */
+  function errorOfCode(c) { return c === 0 ? -1 : Math.pow(2, (c - TERR_CODE_ONE) / TERR_STEPS); }
 
   /* ---- GLG (§10), LLG (§11), OCTP (§14) ------------------------------------------------------ */
   function parseGlg(p) {
@@ -701,5 +876,5 @@
     return out;
   }
 
-  return { open, LbkError, pageLinear, parseDls, parseDoor, dlsApply, effectiveWeights, ahdFromLinear, sh9Pack, r11g11b10fPack, rgb9e5Pack, linearEval, sh9Unpack, r11g11b10f, rgb9e5, half, unorm8, snorm8, ahdToLinear };
+  return { open, LbkError, errorOfCode, pageLinear, pageTexelsF, texelFToLinear, bc6hUnpack, bc4Unpack, parseDls, parseDoor, dlsApply, effectiveWeights, ahdFromLinear, sh9Pack, r11g11b10fPack, rgb9e5Pack, linearEval, sh9Unpack, r11g11b10f, rgb9e5, half, unorm8, snorm8, ahdToLinear };
 }));

@@ -5,7 +5,10 @@
  * container is read by lbk_reader.js (the page's own reader of spec/container.md).
  *
  * Lightmapped surfaces: the two LMAP planes are uploaded as stored (R32UI R11G11B10F words, RGBA8UI
- * bytes) and the fragment shader does what tools/render/shade.c does per pixel: bilinear over the
+ * bytes); a block-encoded page (BC6H, BC5 + BC4; spec §9.2) is decoded by lbk_reader.js to liblbk's
+ * float texel form (Ez RGB, r, X, Y, Z; two RGBA32F textures), as lbk render's loader does; ASTC
+ * pages are not decoded (the page says so; their objects are lit from the GLG instead). The
+ * fragment shader does what tools/render/shade.c does per pixel: bilinear over the
  * four texels around (X − ½, Y − ½) (clamped to the page), each decoded by spec §5.6 to the linear
  * form and blended there, evaluated along the shading normal (+Z of the tangent frame, no normal
  * maps), × the section's scale. Radiance = albedo · E / π. LLG objects: V · E_sh(bent normal) of
@@ -55,9 +58,15 @@
   const FRAG = `
     precision highp float;
     precision highp usampler2D;
+    precision highp sampler2D;
     uniform usampler2D plane0;
     uniform usampler2D plane1;
     uniform usampler2D footprint;
+    uniform usampler2D errmap;
+    uniform sampler2D block0;
+    uniform sampler2D block1;
+    uniform int blockPage;
+    uniform int hasErr;
     uniform vec2 pageSize;
     uniform float scale;
     uniform vec3 albedo;
@@ -75,7 +84,19 @@
       return (1.0 + float(m) / float(1u << mbits)) * exp2(float(e) - 15.0);
     }
     /* e0 + g.z per channel: the linear form along +Z (the shading normal) */
+    vec3 blockTexelE(ivec2 t) { /* lbk_ahd_texel_f_to_linear along +Z */
+      vec4 a = texelFetch(block0, t, 0), b = texelFetch(block1, t, 0);
+      vec3 d = vec3(2.0 * b.x - 1.0, 2.0 * b.y - 1.0, b.z);
+      float len = length(d);
+      d = len >= 0.5 ? d / len : vec3(0.0, 0.0, 1.0);
+      float r = clamp(a.a, 0.0, 1.0);
+      vec3 ez = clamp(a.rgb, 0.0, 65504.0);
+      float k = 0.25 + 0.5 * d.z;
+      vec3 amb = r * ez, inten = (1.0 - r) * ez / k;
+      return amb + 0.25 * inten + 0.5 * inten * d.z;
+    }
     vec3 texelE(ivec2 t) {
+      if (blockPage == 1) return blockTexelE(t);
       uint w = texelFetch(plane0, t, 0).r;
       uvec4 b = texelFetch(plane1, t, 0);
       vec3 ez = vec3(small(w & 2047u, 6u), small((w >> 11) & 2047u, 6u), small(w >> 22, 5u));
@@ -99,9 +120,28 @@
       }
       return max(e * scale, 0.0);
     }
+    /* the error map's colour scale (tools/convert/export.c error_colour): log10 of the relative
+     * error from 0.1 % to 100 %; display values (no sRGB encoding) */
+    vec3 errColour(float rel) {
+      vec3 s0 = vec3(0.05, 0.15, 0.6), s1 = vec3(0.0, 0.55, 0.9), s2 = vec3(0.1, 0.8, 0.3), s3 = vec3(0.95, 0.85, 0.1), s4 = vec3(0.85, 0.1, 0.1);
+      float t = clamp((log(max(rel, 1e-12)) / log(10.0) + 3.0) / 3.0, 0.0, 1.0) * 4.0;
+      if (t < 1.0) return mix(s0, s1, t);
+      if (t < 2.0) return mix(s1, s2, t - 1.0);
+      if (t < 3.0) return mix(s2, s3, t - 2.0);
+      return mix(s3, s4, t - 3.0);
+    }
     float srgb(float x) { x = clamp(x, 0.0, 1.0); return x <= 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1.0 / 2.4) - 0.055; }
     void main() {
       if (!gl_FrontFacing && lightmapped == 1) { gl_FragColor = vec4(0.0, 0.0, 0.0, 1.0); return; }
+      if (mode == 5) { /* per-texel error (TERR, spec §18): texels of lightmapped surfaces only */
+        vec3 g = vec3(0.25);
+        if (lightmapped == 1 && hasErr == 1) {
+          uint code = texelFetch(errmap, ivec2(clamp(floor(vCoord), vec2(0.0), pageSize - 1.0)), 0).r;
+          if (code != 0u) g = errColour(exp2((float(code) - 161.0) / 16.0));
+        } else if (lightmapped == 0) g = albedo * 0.2;
+        gl_FragColor = vec4(g, 1.0);
+        return;
+      }
       vec3 E = lightmapped == 1 ? lightmapE() : vColor;
       vec3 c;
       if (mode == 1) c = E * exposure;
@@ -257,8 +297,8 @@
     if (!data) throw new Error('data.js did not load (open the folder that lbk view wrote)');
     const deps = { decompress: (u8) => fzstd.decompress(u8), xxh3: (u8) => hashwasm.xxhash3(u8) };
     const lbk = await LbkReader.open(b64(data.lbk), deps);
-    const [meta, rept, objs, lmap, glg, llg, dls, doors, octp] = await Promise.all([lbk.meta(), lbk.report(), lbk.objects(), lbk.lightmap(),
-      lbk.glg(), lbk.llg(), lbk.dls(), lbk.doors(), lbk.octp()]);
+    const [meta, rept, objs, lmap, glg, llg, dls, doors, octp, emap] = await Promise.all([lbk.meta(), lbk.report(), lbk.objects(), lbk.lightmap(),
+      lbk.glg(), lbk.llg(), lbk.dls(), lbk.doors(), lbk.octp(), lbk.errorMap()]);
     const base = await dlsBase(lbk, lmap, glg, llg);
     panel(data, lbk, meta, rept, objs, lmap, glg);
 
@@ -277,19 +317,37 @@
     const scene = new THREE.Scene();
     scene.background = new THREE.Color(0, 0, 0);
 
-    /* pages: planes as stored */
-    const pages = (lmap ? lmap.pages : []).map((pg) => {
-      if (pg.format0 || pg.format1) return null; /* block pages: not decoded by this viewer yet */
-      const t0 = new THREE.DataTexture(new Uint32Array(pg.width * pg.height), pg.width, pg.height,
-                                       THREE.RedIntegerFormat, THREE.UnsignedIntType);
-      t0.internalFormat = 'R32UI';
-      const t1 = new THREE.DataTexture(new Uint8Array(pg.plane1), pg.width, pg.height, THREE.RGBAIntegerFormat, THREE.UnsignedByteType);
-      t1.internalFormat = 'RGBA8UI';
-      const t2 = new THREE.DataTexture(new Uint8Array(pg.width * pg.height), pg.width, pg.height, THREE.RedIntegerFormat, THREE.UnsignedByteType);
-      t2.internalFormat = 'R8UI'; /* the light-set footprint: 1 where the chosen set has an entry */
-      for (const t of [t0, t1, t2]) { t.magFilter = t.minFilter = THREE.NearestFilter; t.generateMipmaps = false; t.flipY = false; t.needsUpdate = true; }
-      return { t0, t1, t2, first: pg.first_texel, n: pg.width * pg.height, size: new THREE.Vector2(pg.width, pg.height) };
+    /* pages: 1.0 planes as stored; block pages (BC6H, BC5 + BC4) decoded to the float texel form;
+     * ASTC pages not drawn (no ASTC decoder in the page): null, their objects lit from the GLG */
+    const tex = (data, w, h, format, type, internal) => {
+      const t = new THREE.DataTexture(data, w, h, format, type);
+      t.internalFormat = internal;
+      t.magFilter = t.minFilter = THREE.NearestFilter; t.generateMipmaps = false; t.flipY = false; t.needsUpdate = true;
+      return t;
+    };
+    const astcPages = [];
+    const pages = (lmap ? lmap.pages : []).map((pg, i) => {
+      if (pg.format0 === 2 || pg.format1 === 2) { astcPages.push(i); return null; }
+      const n = pg.width * pg.height, block = !!(pg.format0 || pg.format1);
+      const t0 = tex(new Uint32Array(block ? 1 : n), block ? 1 : pg.width, block ? 1 : pg.height, THREE.RedIntegerFormat, THREE.UnsignedIntType, 'R32UI');
+      const t1 = tex(block ? new Uint8Array(4) : new Uint8Array(pg.plane1), block ? 1 : pg.width, block ? 1 : pg.height, THREE.RGBAIntegerFormat, THREE.UnsignedByteType, 'RGBA8UI');
+      /* the light-set footprint: 1 where the chosen set has an entry */
+      const t2 = tex(new Uint8Array(n), pg.width, pg.height, THREE.RedIntegerFormat, THREE.UnsignedByteType, 'R8UI');
+      let b0 = null, b1 = null;
+      if (block) {
+        const tf = LbkReader.pageTexelsF(pg), a = new Float32Array(4 * n), b = new Float32Array(4 * n);
+        for (let t = 0; t < n; t++) { a.set(tf.subarray(7 * t, 7 * t + 4), 4 * t); b.set(tf.subarray(7 * t + 4, 7 * t + 7), 4 * t); }
+        b0 = tex(a, pg.width, pg.height, THREE.RGBAFormat, THREE.FloatType, 'RGBA32F');
+        b1 = tex(b, pg.width, pg.height, THREE.RGBAFormat, THREE.FloatType, 'RGBA32F');
+      }
+      /* the per-texel error map's codes (TERR, §18), R8UI; none without the section */
+      const te = emap ? tex(new Uint8Array(emap.codes.subarray(pg.first_texel, pg.first_texel + n)), pg.width, pg.height,
+                            THREE.RedIntegerFormat, THREE.UnsignedByteType, 'R8UI') : null;
+      return { t0, t1, t2, te, b0, b1, block, first: pg.first_texel, n, size: new THREE.Vector2(pg.width, pg.height) };
     });
+    if (astcPages.length)
+      $('note').textContent = 'ASTC pages cannot be shown: this page has no ASTC decoder (page' + (astcPages.length > 1 ? 's ' : ' ') +
+        astcPages.join(', ') + '; their objects are lit from the GLG instead). Open the bake before lbk convert, or a BC/1.0 conversion of it.';
 
     const blank = 'data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAQAAAC1HAwCAAAAC0lEQVR42mNkYAAAAAYAAjCB0C8AAAAASUVORK5CYII=';
     const manager = new THREE.LoadingManager();
@@ -301,6 +359,7 @@
     const dummyTex = () => { const t = new THREE.DataTexture(new Uint32Array(1), 1, 1, THREE.RedIntegerFormat, THREE.UnsignedIntType); t.internalFormat = 'R32UI'; t.needsUpdate = true; return t; };
     const dummyTex1 = () => { const t = new THREE.DataTexture(new Uint8Array(4), 1, 1, THREE.RGBAIntegerFormat, THREE.UnsignedByteType); t.internalFormat = 'RGBA8UI'; t.needsUpdate = true; return t; };
     const dummyTex2 = () => { const t = new THREE.DataTexture(new Uint8Array(1), 1, 1, THREE.RedIntegerFormat, THREE.UnsignedByteType); t.internalFormat = 'R8UI'; t.needsUpdate = true; return t; };
+    const dummyF = () => tex(new Float32Array(4), 1, 1, THREE.RGBAFormat, THREE.FloatType, 'RGBA32F');
     const probeLit = []; /* meshes lit per vertex from the probes: recomputed when the sets change */
     const meshes = [];
     gltf.scene.traverse((m) => { if (m.isMesh) meshes.push(m); });
@@ -323,7 +382,9 @@
       const mat = new THREE.ShaderMaterial({
         vertexShader: VERT, fragmentShader: FRAG, side: THREE.DoubleSide,
         uniforms: { plane0: { value: page ? page.t0 : dummyTex() }, plane1: { value: page ? page.t1 : dummyTex1() },
-                    footprint: { value: page ? page.t2 : dummyTex2() },
+                    footprint: { value: page ? page.t2 : dummyTex2() }, errmap: { value: page && page.te ? page.te : dummyTex2() },
+                    block0: { value: page && page.block ? page.b0 : dummyF() }, block1: { value: page && page.block ? page.b1 : dummyF() },
+                    blockPage: { value: page && page.block ? 1 : 0 }, hasErr: { value: page && page.te ? 1 : 0 },
                     pageSize: { value: src ? src.size.clone() : new THREE.Vector2(1, 1) }, scale: { value: lmap ? lmap.scale : 1 },
                     albedo: { value: albedo }, emission: { value: emission }, lightmapped: { value: page ? 1 : 0 },
                     exposure: uniformsCommon.exposure, mode: uniformsCommon.mode } });
@@ -360,7 +421,7 @@
       let out = base;
       if (dls) out = LbkReader.dlsApply(dls, doors, base, controls0.setWeights(), controls0.doorWeights());
       pages.forEach((pg) => {
-        if (!pg) return;
+        if (!pg || pg.block) return; /* block pages: the stored base (DLS entries are applied to 1.0 pages only) */
         pg.t0.image.data.set(out.z.subarray(pg.first, pg.first + pg.n)); pg.t0.needsUpdate = true;
         pg.t1.image.data.set(out.rgba.subarray(4 * pg.first, 4 * (pg.first + pg.n))); pg.t1.needsUpdate = true;
       });
@@ -394,7 +455,8 @@
      * its normal (GLG, LLG lattice: SH9 of §5.5; OCTP: the octahedral map, bilinear with its border) */
     const diag = box.getSize(new THREE.Vector3()).length();
     const glyphMaterial = (mode) => new THREE.ShaderMaterial({ vertexShader: VERT, fragmentShader: FRAG,
-      uniforms: { plane0: { value: dummyTex() }, plane1: { value: dummyTex1() }, footprint: { value: dummyTex2() },
+      uniforms: { plane0: { value: dummyTex() }, plane1: { value: dummyTex1() }, footprint: { value: dummyTex2() }, errmap: { value: dummyTex2() },
+                  block0: { value: dummyF() }, block1: { value: dummyF() }, blockPage: { value: 0 }, hasErr: { value: 0 },
                   pageSize: { value: new THREE.Vector2(1, 1) }, scale: { value: 1 }, albedo: { value: new THREE.Vector3(1, 1, 1) },
                   emission: { value: new THREE.Vector3() }, lightmapped: { value: 0 }, exposure: uniformsCommon.exposure, mode } });
     const glyphMode = { value: 1 }; /* glyphs show irradiance ×(exposure); in radiance mode × 1/π */
@@ -484,6 +546,15 @@
         const l = (0.2126 * (lin[0] + lin[3]) + 0.7152 * (lin[4] + lin[7]) + 0.0722 * (lin[8] + lin[11])) * lmap.scale;
         if (l > 0) vals.push(l / Math.PI);
       }
+      /* block pages: their decoded linear forms (physical units already) */
+      (lmap ? lmap.pages : []).forEach((pg, i) => {
+        if (!pages[i] || !pages[i].block) return;
+        const L = LbkReader.pageLinear(lmap, i);
+        for (let t = 0; t < pg.width * pg.height; t++) {
+          const l = 0.2126 * (L[12 * t] + L[12 * t + 3]) + 0.7152 * (L[12 * t + 4] + L[12 * t + 7]) + 0.0722 * (L[12 * t + 8] + L[12 * t + 11]);
+          if (l > 0) vals.push(l / Math.PI);
+        }
+      });
       vals.sort((x, y) => x - y);
       if (vals.length) defaultStops = -Math.log2(vals[Math.floor(0.99 * (vals.length - 1))]);
     }
@@ -499,11 +570,25 @@
       uniformsCommon.exposure.value = Math.pow(2, Number($('exposure').value));
       $('exposure-v').textContent = Number($('exposure').value).toFixed(1);
       uniformsCommon.mode.value = Number($('mode').value);
+      legend(Number($('mode').value) === 5);
       for (const [k, id] of [['glg', 'probes'], ['llg', 'probes-llg'], ['octp', 'probes-octp']]) if (groups[k]) groups[k].visible = $(id).checked;
       placeSphere();
       draw();
     };
     const draw = () => renderer.render(scene, camera);
+    /* the error mode's legend (a colour bar in %), or why there is nothing to show */
+    const legend = (on) => {
+      const el = $('legend');
+      el.style.display = on ? 'block' : 'none';
+      if (!on) return;
+      if (!emap) { el.innerHTML = '<b>no per-texel error map in this file</b>: bake with --error-map (lbk bake … --error-map)'; return; }
+      let est = 0; for (let i = 0; i < emap.codes.length; i++) est += emap.codes[i] !== 0;
+      const stops = ['rgb(13,38,153)', 'rgb(0,140,230)', 'rgb(26,204,77)', 'rgb(242,217,26)', 'rgb(217,26,26)'];
+      el.innerHTML = 'relative standard error of the irradiance, per texel' + (emap.denoised ? ' (before denoising)' : '') +
+        `<div class="bar" style="background:linear-gradient(to right,${stops.join(',')})"></div>` +
+        '<div class="ticks"><span>0.1 %</span><span>1 %</span><span>10 %</span><span>≥ 100 %</span></div>' +
+        `grey: no estimate; ${est.toLocaleString('en-US')} of ${emap.texel_count.toLocaleString('en-US')} texels estimated`;
+    };
     for (const id of ['exposure', 'mode', 'probes', 'probes-llg', 'probes-octp', 'sphere', 'sx', 'sy', 'sz']) $(id).addEventListener('input', apply);
     $('sets').addEventListener('input', () => { applySets(); buildGlyphs(); placeSphere(); draw(); });
     $('footprint-set').addEventListener('input', () => { footprint(); draw(); });

@@ -15,6 +15,7 @@
 #include "bake/dist/dist.h"
 #include "bake/pipeline/encode.h"
 #include "bake/pipeline/pipeline.h"
+#include "bake/pipeline/error_map.h"
 #include "bake/pipeline/provenance.h"
 #include "bake/scene/exr_read.h"
 #include "bake/scene/import.h"
@@ -579,7 +580,8 @@ static void llg_fit_error(bk_pipeline *b)
     if (!f->targets || !(f->target_sum > 0)) return;
     const double n = (double)f->targets, mean = f->target_sum / n;
     /* without the targets' own noise where the transport measured it (b->variance: denoised bakes) */
-    const double noise_sq = b->variance ? bk_llg_fit_noise(&b->llg_fit, b->llgs, b->variance) : 0;
+    const double noise_sq = b->variance && b->opt->denoise != LBK_BAKE_DENOISE_OFF /* (not for --error-map alone: same bytes) */
+                                ? bk_llg_fit_noise(&b->llg_fit, b->llgs, b->variance) : 0;
     const double fitted = sqrt(fmax(0, f->fitted_sq - noise_sq) / n) / mean, traced = sqrt(f->traced_sq / n) / mean;
     double *e = &b->stats.class_rel_rmse[BK_CLASS_LLG];
     const double noise = *e;
@@ -629,7 +631,7 @@ static lbk_result do_transport(bk_pipeline *b)
     bk_transport_output out;
     memset(&out, 0, sizeof out);
     out.radiance = b->radiance;
-    if (b->opt->denoise != LBK_BAKE_DENOISE_OFF) {
+    if (b->opt->denoise != LBK_BAKE_DENOISE_OFF || b->opt->error_map) {
         b->variance = calloc(b->receiver_count ? b->receiver_count : 1, sizeof *b->variance);
         if (!b->variance) return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
         out.variance = b->variance;
@@ -650,6 +652,11 @@ static lbk_result do_transport(bk_pipeline *b)
     r = bk_transport_run(&b->scene, b->tracer, b->receivers, b->receiver_count, &to, &out, &b->stats);
     if (!r) bk_texels_match_irradiance(&b->texels, b->texel_of_receiver, b->texel_receivers, b->radiance, irradiance);
     if (!r) r = bk_llg_fit_run(&b->llg_fit, b->llgs, &b->scene, irradiance, b->radiance, b->llg_first, &b->llg_fit_stats);
+    if (!r && b->opt->error_map) { /* before denoising: the transport's own estimate (error_map.h) */
+        b->texel_rel_error = malloc((b->texel_receivers ? b->texel_receivers : 1) * sizeof *b->texel_rel_error);
+        if (!b->texel_rel_error) r = LBK_ERR_OUT_OF_MEMORY;
+        else bk_error_map_from_transport(b->variance, irradiance, b->texel_receivers, b->texel_rel_error);
+    }
     free(irradiance);
     b->octa_rel_rmse = b->stats.octa_rel_rmse;
     b->octa_rays = b->stats.octa_rays;
@@ -864,6 +871,7 @@ static void pipeline_free(bk_pipeline *b)
     bk_set_bakes_free(&b->sets);
     bk_denoiser_destroy(b->denoiser);
     free(b->variance);
+    free(b->texel_rel_error);
     free(b->samples);
     free(b->radiance);
     free(b->texel_of_receiver);
@@ -1026,6 +1034,10 @@ static uint64_t options_hash(const lbk_bake_desc *options, int budgets)
     if (d.light_culling || d.light_culling_delta > 0) { /* (absent from older hashes: same values) */
         const double lc[2] = {(double)d.light_culling, d.light_culling_delta};
         XXH64_update(st, lc, sizeof lc);
+    }
+    if (d.error_map) { /* units must record the variance the merge's map needs */
+        const int64_t em = d.error_map;
+        XXH64_update(st, &em, sizeof em);
     }
     uint64_t h = XXH64_digest(st);
     XXH64_freeState(st);

@@ -69,6 +69,7 @@ typedef struct bk_pipeline {
     lbk_sh9_rgb *radiance;
     float *cell_size;               /* per scene triangle: the radiosity cache's cell size (texel size) */
     float *variance;                /* per receiver, from the transport: the denoiser's input */
+    float *texel_rel_error;         /* per texel receiver with error_map: the TERR input (error_map.h) */
     struct bk_denoiser *denoiser;   /* weights of the base + every set (do_denoise), for all of them */
     bk_transport_stats stats;
     bk_transport_sample *samples;

@@ -332,6 +332,7 @@ lbk_result bk_provenance_meta(const bk_pipeline *b, void **data, size_t *size)
     snprintf(glg_light, sizeof glg_light, "%g", o->glg_lighting_threshold > 0 ? o->glg_lighting_threshold : 0.4);
     /* absent: off (older bakes) */
     if (o->glg_lighting) p[n++] = (lbk_meta_pair){"bake.glg_lighting", glg_light};
+    if (o->error_map) p[n++] = (lbk_meta_pair){"bake.error_map", "1"}; /* absent: off (older bakes) */
     p[n++] = (lbk_meta_pair){"bake.dls_threshold", threshold};
     p[n++] = (lbk_meta_pair){"bake.door_method", o->door_method == LBK_BAKE_DOOR_GUIDED ? "guided" : "difference"};
     if (o->revision) p[n++] = (lbk_meta_pair){LBK_META_REVISION, o->revision};

@@ -8,6 +8,8 @@
 #include <string.h>
 #include <time.h>
 
+#include "bake/pipeline/error_map.h"
+#include "lbk/error_map.h"
 #include "bake/pipeline/encode.h"
 #include "bake/pipeline/pipeline.h"
 #include "bake/pipeline/provenance.h"
@@ -358,6 +360,14 @@ static lbk_result build_sections(bk_pipeline *b, section_list *sl)
         if (!r && uv) r = sections_add(sl, LBK_SECTION_LMUV, r, uv, uv_size);
     }
     if (!r && b->texels.page_count && b->texel_receivers) r = build_lmap(b, sl);
+    if (!r && b->texels.page_count && b->texel_receivers && b->texel_rel_error) { /* --error-map (spec §18) */
+        void *terr = NULL;
+        size_t terr_size = 0;
+        const uint32_t flags = b->opt->denoise != LBK_BAKE_DENOISE_OFF ? LBK_TERR_DENOISED : 0;
+        r = bk_error_map_section(&b->texels, b->texel_of_receiver, b->texel_receivers, b->texel_rel_error, flags, &terr,
+                                 &terr_size);
+        r = sections_add(sl, LBK_SECTION_TERR, r, terr, terr_size);
+    }
     if (!r && b->have_glg) r = build_glg(b, sl);
     if (!r && b->llg_count) r = build_llg(b, sl);
     if (!r && b->octa.count && b->octa_irradiance) r = build_octp(b, sl);

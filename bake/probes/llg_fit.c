@@ -56,16 +56,8 @@ static void row_of(const bk_llg *l, const bk_scene *s, size_t j, fit_row *r)
 {
     lbk_llg_vertex rec, q;
     uint8_t packed[4];
-    /* bk_llg_vertex_records for one vertex, then through the file's bytes */
-    const float *bn = l->bent_normals + 3 * j;
-    float g[3], len = 0.0f;
-    for (int a = 0; a < 3; a++) {
-        g[a] = bn[0] * l->axes[a][0] + bn[1] * l->axes[a][1] + bn[2] * l->axes[a][2];
-        len += g[a] * g[a];
-    }
-    len = sqrtf(len);
-    for (int a = 0; a < 3; a++) rec.bent_normal[a] = len > 0.0f ? g[a] / len : (a == 2 ? 1.0f : 0.0f);
-    rec.visibility = l->visibility[j];
+    /* the record as stored, then through the file's bytes */
+    bk_llg_vertex_record(l, j, &rec);
     lbk_llg_vertex_pack(&rec, packed);
     lbk_llg_vertex_unpack(packed, &q);
     r->v = q.visibility;

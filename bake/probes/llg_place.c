@@ -343,19 +343,22 @@ lbk_result bk_llg_place(const bk_scene *scene, uint32_t object, const bk_llg_opt
     return res;
 }
 
+void bk_llg_vertex_record(const bk_llg *l, size_t v, lbk_llg_vertex *out)
+{
+    const float *b = l->bent_normals + 3 * v;
+    float g[3], len = 0.0f;
+    for (int a = 0; a < 3; a++) {
+        g[a] = b[0] * l->axes[a][0] + b[1] * l->axes[a][1] + b[2] * l->axes[a][2];
+        len += g[a] * g[a];
+    }
+    len = sqrtf(len);
+    for (int a = 0; a < 3; a++) out->bent_normal[a] = len > 0.0f ? g[a] / len : (a == 2 ? 1.0f : 0.0f);
+    out->visibility = l->visibility[v];
+}
+
 void bk_llg_vertex_records(const bk_llg *l, lbk_llg_vertex *out)
 {
-    for (size_t v = 0; v < l->vertex_count; v++) {
-        const float *b = l->bent_normals + 3 * v;
-        float g[3], len = 0.0f;
-        for (int a = 0; a < 3; a++) {
-            g[a] = b[0] * l->axes[a][0] + b[1] * l->axes[a][1] + b[2] * l->axes[a][2];
-            len += g[a] * g[a];
-        }
-        len = sqrtf(len);
-        for (int a = 0; a < 3; a++) out[v].bent_normal[a] = len > 0.0f ? g[a] / len : (a == 2 ? 1.0f : 0.0f);
-        out[v].visibility = l->visibility[v];
-    }
+    for (size_t v = 0; v < l->vertex_count; v++) bk_llg_vertex_record(l, v, &out[v]);
 }
 
 /* ---- connected objects ----------------------------------------------------------------------- */

@@ -69,6 +69,8 @@ size_t bk_llg_probe_count(const bk_llg *llg);
 /* The per-vertex records of the LLG section (lbk/llg.h): visibility and the bent normal in the
  * grid frame (components along axes[0..2]), in the order of llg->vertices. out: vertex_count. */
 void bk_llg_vertex_records(const bk_llg *llg, lbk_llg_vertex *out);
+/* The record of vertex v alone (what bk_llg_vertex_records writes at out[v]). */
+void bk_llg_vertex_record(const bk_llg *llg, size_t v, lbk_llg_vertex *out);
 
 /* The seed's connected-objects heuristic (PROBES.md): of the objects with candidate[i] != 0,
  * out[i] = 1 when the world-space bounding box of another candidate lies within `gap` of its

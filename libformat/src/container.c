@@ -13,6 +13,7 @@
 #include <zstd_errors.h>
 
 #include "framing.h"
+#include "lbk/error_map.h"
 #include "lbk/lightmap.h"
 
 #define LBK_DEFAULT_ZSTD_LEVEL 19
@@ -343,6 +344,7 @@ lbk_result lbk_writer_section_add(lbk_writer *w, uint32_t type, const void *data
     s->features = type == LBK_SECTION_LMAP ? lbk_lmap_required_features(data, size) : 0;
     /* an OCTP probe volume (level_count ≠ 0 at byte 8) is 1.3 content, §14 */
     s->minor = type == LBK_SECTION_OCTP && size >= 12 && lbk_rd32((const uint8_t *)data + 8) != 0 ? 3 : 0;
+    if (type == LBK_SECTION_TERR) s->minor = 4; /* the per-texel error map is 1.4 content, §18 */
     s->stored = stored;
     s->stored_size = stored_size;
     s->decoded_size = size;

@@ -31,6 +31,7 @@ void lbk_dls_runtime_close(lbk_dls_runtime *r)
     for (int s = 0; s < LBK_DLS_SPACE_COUNT_; s++) lbk_dealloc(a, r->ranges[s]);
     lbk_dealloc(a, r->nrects);
     lbk_dealloc(a, r->rects);
+    lbk_dealloc(a, r->lin_block);
     lbk_dealloc(a, r);
 }
 
@@ -44,6 +45,7 @@ static void load_cluster(const lbk_dls_raw *raw, uint32_t i, rt_cluster *c)
     c->set_first = lbk_rd32(cr + DLS_C_SET_FIRST);
     c->run_count = lbk_rd32(cr + DLS_C_RUN_COUNT);
     c->target_count = lbk_rd32(cr + DLS_C_TARGET_COUNT);
+    c->entry_count = lbk_rd32(cr + DLS_C_ENTRY_COUNT);
     c->sets = raw->d + raw->offset[DLS_A_CLUSTER_SETS] + 4ull * c->set_first;
     c->runs = raw->d + raw->offset[DLS_A_RUNS] + (uint64_t)DLS_RUN_SIZE * lbk_rd32(cr + DLS_C_RUN_FIRST);
     c->payload = raw->d + raw->offset[c->space == LBK_DLS_SPACE_TEXEL ? DLS_A_TEXEL_ENTRIES : DLS_A_PROBE_ENTRIES] +
@@ -95,15 +97,23 @@ static lbk_result check_spaces(lbk_dls_runtime *r)
     const lbk_dls_runtime_desc *d = &r->desc;
     r->probe_base[LBK_DLS_SPACE_GLG] = d->base_glg, r->probe_out[LBK_DLS_SPACE_GLG] = d->out_glg;
     r->probe_base[LBK_DLS_SPACE_LLG] = d->base_llg, r->probe_out[LBK_DLS_SPACE_LLG] = d->out_llg;
+    if (r->linear) {
+        r->probe_lin[LBK_DLS_SPACE_GLG] = d->out_linear_glg, r->probe_lin[LBK_DLS_SPACE_LLG] = d->out_linear_llg;
+        r->probe_out[LBK_DLS_SPACE_GLG] = r->probe_out[LBK_DLS_SPACE_LLG] = NULL; /* not written */
+    }
     for (uint32_t s = 0; s < LBK_DLS_SPACE_COUNT_; s++) {
         bool have, partial;
         if (s == LBK_DLS_SPACE_TEXEL) {
-            const bool arrays = d->base_irradiance_z && d->base_rgba && d->out_irradiance_z && d->out_rgba;
-            have = d->page_count ? true : arrays;
-            partial = d->page_count ? false : (d->base_irradiance_z || d->base_rgba || d->out_irradiance_z || d->out_rgba);
+            const bool outs = r->linear ? d->out_linear_texel[0] && d->out_linear_texel[1] && d->out_linear_texel[2]
+                                        : d->out_irradiance_z && d->out_rgba;
+            const bool some = r->linear ? d->out_linear_texel[0] || d->out_linear_texel[1] || d->out_linear_texel[2]
+                                        : d->out_irradiance_z || d->out_rgba;
+            have = d->page_count ? true : d->base_irradiance_z && d->base_rgba && outs;
+            partial = d->page_count ? false : (d->base_irradiance_z || d->base_rgba || some);
         } else {
-            have = r->probe_base[s] && r->probe_out[s];
-            partial = r->probe_base[s] || r->probe_out[s];
+            const bool out = r->linear ? r->probe_lin[s] != NULL : r->probe_out[s] != NULL;
+            have = r->probe_base[s] && out;
+            partial = r->probe_base[s] || out;
         }
         bool needed = false;
         for (uint32_t i = 0; i < r->ncl; i++) needed |= r->cl[i].space == s;
@@ -120,7 +130,7 @@ lbk_result lbk_dls_runtime_open(const lbk_dls_runtime_desc *caller_desc, lbk_dls
     lbk_dls_runtime_desc in;
     lbk_result rc = LBK_SIZED_IN(&in, caller_desc, lbk_dls_runtime_desc, allocator);
     if (rc != LBK_OK) return rc;
-    if (!in.dls || (in.flags & ~LBK_DLS_RUNTIME_SCALAR)) return LBK_ERR_INVALID_ARGUMENT;
+    if (!in.dls || (in.flags & ~(LBK_DLS_RUNTIME_SCALAR | LBK_DLS_RUNTIME_LINEAR))) return LBK_ERR_INVALID_ARGUMENT;
     if (in.doors) {
         lbk_result cr = lbk_door_check_dls(in.doors, in.dls);
         if (cr != LBK_OK) return cr;
@@ -130,6 +140,7 @@ lbk_result lbk_dls_runtime_open(const lbk_dls_runtime_desc *caller_desc, lbk_dls
     if (in.allocator) r->alloc_copy = *in.allocator;
     r->alloc = in.allocator ? &r->alloc_copy : NULL;
     r->desc = in;
+    r->linear = (in.flags & LBK_DLS_RUNTIME_LINEAR) != 0;
     lbk_dls_view_raw(in.dls, &r->raw);
     r->nsets = lbk_dls_set_count(in.dls);
     r->ndoors = in.doors ? lbk_door_count(in.doors) : 0;
@@ -151,6 +162,7 @@ lbk_result lbk_dls_runtime_open(const lbk_dls_runtime_desc *caller_desc, lbk_dls
     if (res == LBK_OK) res = check_spaces(r);
     if (res == LBK_OK) res = rt_planes_make(r);
     if (res == LBK_OK) res = rt_chunks_make(r);
+    if (res == LBK_OK && r->linear) res = rt_linear_prepare(r);
     if (res == LBK_OK) {
         r->jobs = lbk_alloc(a, (r->nchunks ? r->nchunks : 1) * sizeof *r->jobs);
         if (!r->jobs) res = LBK_ERR_OUT_OF_MEMORY;
@@ -168,6 +180,8 @@ void lbk_dls_runtime_invalidate(lbk_dls_runtime *runtime)
 {
     if (runtime) runtime->valid = 0;
 }
+
+uint64_t lbk_dls_runtime_linear_bytes(const lbk_dls_runtime *runtime) { return runtime ? runtime->lin_bytes : 0; }
 
 const char *lbk_dls_runtime_path(const lbk_dls_runtime *runtime) { return runtime ? runtime->kern->name : ""; }
 

@@ -15,6 +15,7 @@
 #ifndef LBK_DLS_KERNEL_H
 #define LBK_DLS_KERNEL_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #if defined(__clang__)
@@ -60,6 +61,15 @@ typedef struct dls_kernels {
     void (*texel_decode)(const uint32_t *z, const uint32_t *rgba, uint32_t count, lbk_ahd_linear *out);
     void (*texel_encode)(const lbk_ahd_linear *in, uint32_t count, uint32_t *z, uint32_t *rgba);
     void (*probe_decode)(const uint8_t *probes, uint32_t count, lbk_sh9_rgb *out);
+    /* The linear mode (LBK_DLS_RUNTIME_LINEAR) on prepared floats, element by element:
+     * out[i] = base[i] + w[0]·src[0][i] + … + w[m−1]·src[m−1][i], summed left to right, each
+     * term a multiply then an add (the byte kernels' accumulation, applied to n floats). */
+    void (*lin_sum)(const float *base, const float *const *src, const float *w, uint32_t m, size_t n, float *out);
+    /* Variable entries: `count` targets of f floats each, target t with n[t] entries (f floats
+     * each, consecutive from `entries`) and their weights (consecutive from `we`); entries of
+     * weight 0 are left out, as in the byte kernels. */
+    void (*lin_var)(const float *base, const float *entries, const float *we, const uint32_t *n, uint32_t count,
+                    uint32_t f, float *out);
 } dls_kernels;
 
 /* The definition, one target at a time; always available. */

@@ -688,6 +688,82 @@ static void probe_decode_n(const uint8_t *p, uint32_t count, lbk_sh9_rgb *out)
     }
 }
 
+/* ---- the linear mode: the scalar lin_sum / lin_var element by element, 8 (or 4) lanes wide;
+ * the same multiplies and adds in the same order, so the same floats. -------------------------- */
+
+#define LIN_MAX_SRC 8 /* fixed forms: dedicated clusters have ≤ 8 sets, packed ones ≤ 4 */
+
+static void lin_sum_wide(const float *base, const float *const *src, const float *w, uint32_t m, size_t n, float *out)
+{
+    vf wv[LIN_MAX_SRC];
+    for (uint32_t j = 0; j < m; j++) wv[j] = fset(w[j]);
+    size_t i = 0;
+    for (; i + 32 <= n; i += 32) { /* four independent accumulators per step */
+        vf a0 = _mm256_loadu_ps(base + i), a1 = _mm256_loadu_ps(base + i + 8);
+        vf a2 = _mm256_loadu_ps(base + i + 16), a3 = _mm256_loadu_ps(base + i + 24);
+        for (uint32_t j = 0; j < m; j++) {
+            const float *s = src[j] + i;
+            a0 = add(a0, mul(wv[j], _mm256_loadu_ps(s)));
+            a1 = add(a1, mul(wv[j], _mm256_loadu_ps(s + 8)));
+            a2 = add(a2, mul(wv[j], _mm256_loadu_ps(s + 16)));
+            a3 = add(a3, mul(wv[j], _mm256_loadu_ps(s + 24)));
+        }
+        _mm256_storeu_ps(out + i, a0), _mm256_storeu_ps(out + i + 8, a1);
+        _mm256_storeu_ps(out + i + 16, a2), _mm256_storeu_ps(out + i + 24, a3);
+    }
+    for (; i + 8 <= n; i += 8) {
+        vf a = _mm256_loadu_ps(base + i);
+        for (uint32_t j = 0; j < m; j++) a = add(a, mul(wv[j], _mm256_loadu_ps(src[j] + i)));
+        _mm256_storeu_ps(out + i, a);
+    }
+    for (; i < n; i++) {
+        float acc = base[i];
+        for (uint32_t j = 0; j < m; j++) acc += w[j] * src[j][i];
+        out[i] = acc;
+    }
+}
+
+static void lin_sum(const float *base, const float *const *src, const float *w, uint32_t m, size_t n, float *out)
+{
+    if (m > LIN_MAX_SRC) { /* not reached by the runtime; the definition, in groups of 8 lanes */
+        for (size_t i = 0; i < n; i++) {
+            float acc = base[i];
+            for (uint32_t j = 0; j < m; j++) acc += w[j] * src[j][i];
+            out[i] = acc;
+        }
+        return;
+    }
+    lin_sum_wide(base, src, w, m, n, out);
+}
+
+static void lin_var(const float *base, const float *entries, const float *we, const uint32_t *n, uint32_t count, uint32_t f,
+                    float *out)
+{
+    for (uint32_t t = 0; t < count; t++) {
+        uint32_t i = 0;
+        for (; i + 8 <= f; i += 8) {
+            vf a = _mm256_loadu_ps(base + i);
+            for (uint32_t e = 0; e < n[t]; e++)
+                if (we[e] != 0.0f) a = add(a, mul(fset(we[e]), _mm256_loadu_ps(entries + (size_t)e * f + i)));
+            _mm256_storeu_ps(out + i, a);
+        }
+        for (; i + 4 <= f; i += 4) {
+            __m128 a = _mm_loadu_ps(base + i);
+            for (uint32_t e = 0; e < n[t]; e++)
+                if (we[e] != 0.0f) a = _mm_add_ps(a, _mm_mul_ps(_mm_set1_ps(we[e]), _mm_loadu_ps(entries + (size_t)e * f + i)));
+            _mm_storeu_ps(out + i, a);
+        }
+        for (; i < f; i++) {
+            float acc = base[i];
+            for (uint32_t e = 0; e < n[t]; e++)
+                if (we[e] != 0.0f) acc += we[e] * entries[(size_t)e * f + i];
+            out[i] = acc;
+        }
+        base += f, out += f;
+        entries += (size_t)n[t] * f, we += n[t];
+    }
+}
+
 #if defined(__clang__)
 #pragma clang attribute pop
 #else
@@ -696,7 +772,8 @@ static void probe_decode_n(const uint8_t *p, uint32_t count, lbk_sh9_rgb *out)
 
 const dls_kernels *dls_kernels_avx2(void)
 {
-    static const dls_kernels k = {"avx2", texels, probes, texels_var, probes_var, texel_decode_n, texel_encode_n, probe_decode_n};
+    static const dls_kernels k = {"avx2", texels, probes, texels_var, probes_var, texel_decode_n, texel_encode_n, probe_decode_n,
+                                  lin_sum, lin_var};
     __builtin_cpu_init();
     return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") ? &k : 0;
 }

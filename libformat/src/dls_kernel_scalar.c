@@ -132,8 +132,35 @@ static void probe_decode(const uint8_t *p, uint32_t count, lbk_sh9_rgb *out)
     for (uint32_t t = 0; t < count; t++) lbk_sh9_unpack(p + LBK_DLS_PROBE_PAYLOAD * (size_t)t, &out[t]);
 }
 
+/* ---- the linear mode ---------------------------------------------------------------------- */
+
+static void lin_sum(const float *base, const float *const *src, const float *w, uint32_t m, size_t n, float *out)
+{
+    for (size_t i = 0; i < n; i++) {
+        float acc = base[i];
+        for (uint32_t j = 0; j < m; j++) acc += w[j] * src[j][i];
+        out[i] = acc;
+    }
+}
+
+static void lin_var(const float *base, const float *entries, const float *we, const uint32_t *n, uint32_t count, uint32_t f,
+                    float *out)
+{
+    for (uint32_t t = 0; t < count; t++) {
+        for (uint32_t i = 0; i < f; i++) {
+            float acc = base[i];
+            for (uint32_t e = 0; e < n[t]; e++)
+                if (we[e] != 0.0f) acc += we[e] * entries[(size_t)e * f + i];
+            out[i] = acc;
+        }
+        base += f, out += f;
+        entries += (size_t)n[t] * f, we += n[t];
+    }
+}
+
 const dls_kernels *dls_kernels_scalar(void)
 {
-    static const dls_kernels k = {"scalar", texels, probes, texels_var, probes_var, texel_decode, texel_encode, probe_decode};
+    static const dls_kernels k = {"scalar", texels, probes, texels_var, probes_var, texel_decode, texel_encode, probe_decode,
+                                  lin_sum, lin_var};
     return &k;
 }

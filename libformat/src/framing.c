@@ -11,6 +11,7 @@
 #include <zstd_errors.h>
 
 #include "framing.h"
+#include "lbk/error_map.h"
 
 const uint8_t lbk_magic[8] = {0x89, 'L', 'B', 'K', 0x0d, 0x0a, 0x1a, 0x0a};
 
@@ -28,7 +29,10 @@ int lbk_section_rank(uint32_t type)
 
 /* Types added by a minor version have no rank: they sort after the 1.0 types by ascending code,
  * exactly where a 1.0 reader expects a type it does not know (§3.2), so it accepts the order. */
-int lbk_section_known(uint32_t type) { return lbk_section_rank(type) != 0 || type == LBK_SECTION_LMUV; }
+int lbk_section_known(uint32_t type)
+{
+    return lbk_section_rank(type) != 0 || type == LBK_SECTION_LMUV || type == LBK_SECTION_TERR;
+}
 
 uint64_t lbk_default_decode_cap(uint64_t file_size)
 {

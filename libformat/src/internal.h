@@ -59,7 +59,7 @@ lbk_result lbk_sized_in(void *dst, size_t dst_size, const void *src, size_t v1_s
 
 /* ---- validation context ---------------------------------------------------------------------
  * validate.c walks the sections in dependency order (META, REPT, LMAP, GLG, LLG, OCTP, OBJS, LMUV,
- * DLS, DOOR) and hands each section validator this context. A validator reports through lbk_vreport,
+ * DLS, DOOR, TERR) and hands each section validator this context. A validator reports through lbk_vreport,
  * and fills in the facts later sections cross-check against. A fact stays zero when its section is
  * absent or unusable; *_ok flags say whether the section parsed. */
 typedef struct lbk_vctx {
@@ -149,5 +149,6 @@ void lbk_validate_objs(lbk_vctx *ctx, const uint8_t *data, size_t size);
 void lbk_validate_lmuv(lbk_vctx *ctx, const uint8_t *data, size_t size);
 void lbk_validate_dls(lbk_vctx *ctx, const uint8_t *data, size_t size);
 void lbk_validate_door(lbk_vctx *ctx, const uint8_t *data, size_t size);
+void lbk_validate_terr(lbk_vctx *ctx, const uint8_t *data, size_t size);
 
 #endif

@@ -7,6 +7,7 @@
  *     WARNING = the file is valid but something is unusual.
  *   - `section` is the fourcc the issue belongs to (0 for header and section-table issues).
  *   - The message is the generic text; the issue a validator reports carries the values. */
+#include "lbk/error_map.h"
 #include "internal.h"
 
 #define FATAL LBK_SEVERITY_FATAL
@@ -246,6 +247,14 @@ static const issue_row registry[] = {
     {1117, WARNING, LBK_SECTION_LMUV, "LMUV vertex used by no triangle"},
     {1118, WARNING, LBK_SECTION_LMUV, "LMUV lightmapped object has no record (an engine cannot map it)"},
     {1119, ERROR, LBK_SECTION_LMUV, "LMUV is present but there is no OBJS section"},
+
+    /* ---- 1200–1299 TERR (format 1.4) ----------------------------------------------------- */
+    {1200, ERROR, LBK_SECTION_TERR, "TERR shorter than its 16-byte header"},
+    {1201, ERROR, LBK_SECTION_TERR, "TERR encoding is not defined"},
+    {1202, ERROR, LBK_SECTION_TERR, "TERR unknown flag bits"},
+    {1203, ERROR, LBK_SECTION_TERR, "TERR texel_count is 0 or the size differs from 16 + texel_count"},
+    {1204, ERROR, LBK_SECTION_TERR, "TERR is present but there is no LMAP section"},
+    {1205, ERROR, LBK_SECTION_TERR, "TERR texel_count differs from LMAP's texel_count"},
 };
 
 const char *lbk_issue_template(uint32_t id, lbk_severity *severity)

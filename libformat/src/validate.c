@@ -4,6 +4,7 @@
 #include <stdio.h>
 
 #include "framing.h"
+#include "lbk/error_map.h"
 
 static void emit(lbk_vctx *ctx, uint32_t id, uint32_t section_type, uint64_t offset, const char *fmt, va_list ap)
 {
@@ -75,7 +76,7 @@ static const struct {
     {LBK_SECTION_META, lbk_validate_meta}, {LBK_SECTION_REPT, lbk_validate_rept}, {LBK_SECTION_LMAP, lbk_validate_lmap},
     {LBK_SECTION_GLG, lbk_validate_glg},   {LBK_SECTION_LLG, lbk_validate_llg},   {LBK_SECTION_OCTP, lbk_validate_octp},
     {LBK_SECTION_OBJS, lbk_validate_objs}, {LBK_SECTION_LMUV, lbk_validate_lmuv}, {LBK_SECTION_DLS, lbk_validate_dls},
-    {LBK_SECTION_DOOR, lbk_validate_door},
+    {LBK_SECTION_DOOR, lbk_validate_door}, {LBK_SECTION_TERR, lbk_validate_terr},
 };
 
 static const char *load_message(uint32_t id)

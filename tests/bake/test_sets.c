@@ -9,7 +9,8 @@
  *   R3 : no door panel, no A/B, another seed: S applied with A = B = 0 and the door open
  *        (base + S_O) must equal it (light through the opening).
  * Tolerances come from the bakes' own noise: the same comparison between two independent full
- * bakes (R1 with seeds 1 and 2) measures it in the same run. */
+ * bakes (R1 with seeds 1 and 2) measures it in the same run. The runtime's linear mode gives the
+ * byte mode's accumulators bit for bit on S (support/dls_linear_check.h). */
 #define LBK_STATIC_LINKING_ONLY /* lbk_dls_stats: experimental (lbk/dls.h) */
 #include <stdarg.h>
 #include <stddef.h>
@@ -33,6 +34,7 @@
 #include "lbk/lightmap.h"
 #include "lbk/objects.h"
 #include "lbk/validate.h"
+#include "support/dls_linear_check.h"
 #include "support/door_scenes.h"
 #include "support/room_compare.h"
 
@@ -385,6 +387,29 @@ static void test_door_opening(void **state)
     applied_free(&open), applied_free(&closed);
 }
 
+/* The linear mode on the baked sets and door: every target's floats are the byte mode's
+ * accumulator (re-encoded: its bytes), for door openings and set weights in turn. */
+static void test_linear_mode(void **state)
+{
+    (void)state;
+    dlslin d;
+    assert_int_equal(dlslin_open(&d, S.dls, S.door, S.base_z, S.base_rgba, S.base_glg, S.base_llg), 0);
+    const uint32_t ns = lbk_dls_set_count(S.dls);
+    float w[8] = {0};
+    static const float steps[5][4] = {{1, 1, 1, 0}, {0.5f, 0, 1, 0.25f}, {0.3f, 0.7f, 0, 1}, {0, 0, 0, 0.6f}, {2, 0.1f, 1, 0}};
+    uint64_t weighted = 0;
+    for (int i = 0; i < 5; i++) {
+        for (uint32_t s = 0; s < ns && s < 3; s++) w[s] = steps[i][s];
+        const float dw = steps[i][3];
+        dlslin_counts n;
+        assert_int_equal(dlslin_apply_check(&d, w, &dw, &n), 0);
+        assert_int_equal(n.mismatches, 0);
+        weighted += n.weighted;
+    }
+    assert_true(weighted > 0);
+    dlslin_close(&d);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -394,6 +419,7 @@ int main(void)
         cmocka_unit_test(test_zero_set_no_data),
         cmocka_unit_test(test_linearity),
         cmocka_unit_test(test_door_opening),
+        cmocka_unit_test(test_linear_mode),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -26,6 +26,7 @@
 #include "lbk/door.h"
 #include "lbk/glg.h"
 #include "lbk/lightmap.h"
+#include "lbk/error_map.h"
 #include "lbk/lightmap_uv.h"
 #include "lbk/llg.h"
 #include "lbk/meta.h"
@@ -376,6 +377,16 @@ static void exercise_sets(lbk_reader *r, const uint8_t *file, size_t file_n, int
     if (doors) lbk_door_close(doors);
 }
 
+/* TERR: whatever lbk_terr_open accepts, every code it promises is readable and decodes. */
+static void read_terr(const void *d, size_t n)
+{
+    lbk_terr_view v;
+    if (lbk_terr_open(d, n, &v) != LBK_OK) return;
+    uint8_t c;
+    if (lbk_terr_code_get(&v, v.texel_count - 1, &c) != LBK_OK || lbk_terr_code_get(&v, v.texel_count, &c) == LBK_OK) abort();
+    if (lbk_terr_decode(v.codes[0]) != lbk_terr_decode(v.codes[0])) abort(); /* never NaN */
+}
+
 /* LMUV: whatever lbk_lmuv_open accepts, every element it promises is readable and in range. */
 static void read_lmuv(const void *d, size_t n)
 {
@@ -436,7 +447,7 @@ static int known_type(uint32_t t)
     static const uint32_t known[] = {LBK_SECTION_META, LBK_SECTION_REPT, LBK_SECTION_OBJS,
                                      LBK_SECTION_LMAP, LBK_SECTION_GLG,  LBK_SECTION_LLG,
                                      LBK_SECTION_DLS,  LBK_SECTION_DOOR, LBK_SECTION_OCTP,
-                                     LBK_SECTION_LMUV};
+                                     LBK_SECTION_LMUV, LBK_SECTION_TERR};
     for (size_t i = 0; i < sizeof known / sizeof known[0]; i++)
         if (known[i] == t) return 1;
     return 0;
@@ -480,6 +491,7 @@ static void exercise(const uint8_t *data, size_t size)
         case LBK_SECTION_LLG: opened = sample_llg(d, n, valid); break;
         case LBK_SECTION_OCTP: opened = sample_octp(d, n, valid); break;
         case LBK_SECTION_LMUV: read_lmuv(d, n); break;
+        case LBK_SECTION_TERR: read_terr(d, n); break;
         default: read_meta_objs_rept(si.type, d, n); break;
         }
         if (opened != LBK_OK && valid) abort();

@@ -3,7 +3,9 @@
  * that skip unchanged clusters give the bytes of a full apply; all-zero weights give exactly the
  * base; a set without entries adds no data; door weights drive kinds 1–3; pages with padded
  * pitches, the scalar path, jobs in any order and on two threads all give the same bytes; the
- * dirty regions cover every target an apply writes. */
+ * dirty regions cover every target an apply writes. The linear mode (LBK_DLS_RUNTIME_LINEAR) writes
+ * the byte mode's accumulators bit for bit (support/dls_linear_check.h) on every path, split
+ * and page layout. */
 #define LBK_STATIC_LINKING_ONLY /* lbk_dls_stats: experimental (lbk/dls.h) */
 #include <stdarg.h>
 #include <stddef.h>
@@ -24,6 +26,7 @@
 #include "lbk/door.h"
 #include "lbk/sh.h"
 #include "support/dls_fixture.h"
+#include "support/dls_linear_check.h"
 
 typedef struct scene {
     dlsfx fx;
@@ -786,6 +789,171 @@ static void test_dirty_regions_cover_writes(void **state)
     scene_free(&sc);
 }
 
+/* ---- the linear mode ------------------------------------------------------------------------ */
+
+static void linear_rounds(scene *sc, const lbk_door_view *doors, uint64_t seed, uint32_t nsets, const float *door_w)
+{
+    dlslin d;
+    assert_int_equal(dlslin_open(&d, sc->view, doors, sc->base_z, sc->base_rgba, sc->base_probe[0], sc->base_probe[1]), 0);
+    uint64_t rng = seed;
+    float w[32];
+    dlslin_counts n;
+    for (int round = 0; round < 4; round++) { /* later rounds are incremental; the last one all 0 */
+        if (round < 3) random_weights(&rng, w, nsets);
+        else memset(w, 0, sizeof w);
+        if (round == 2) w[1] = w[2] = 0.0f; /* zero weights inside clusters that still apply */
+        assert_int_equal(dlslin_apply_check(&d, w, door_w, &n), 0);
+        assert_int_equal(n.mismatches, 0);
+        const uint64_t all = sc->fx.desc.target_count[0] + sc->fx.desc.target_count[1] + sc->fx.desc.target_count[2];
+        assert_int_equal(n.targets, all);
+        if (round < 3) assert_true(n.weighted > 0 && n.weighted < all);
+        else if (!doors) assert_int_equal(n.weighted, 0); /* with a door the closed set stays lit */
+    }
+    /* the re-encoded decoded base is not always the base bytes: the rule for unweighted targets
+     * (decoded base, not "encode = bytes") is needed */
+    assert_true(n.reencode_differs > 0);
+    dlslin_close(&d);
+}
+
+/* Random sets of every form and door-driven sets: linear outputs are the byte mode's
+ * accumulators bit for bit, on the SIMD and the scalar path. */
+static void test_linear_equals_byte_accumulators(void **state)
+{
+    (void)state;
+    for (uint64_t seed = 1; seed <= 2; seed++) {
+        scene sc;
+        memset(&sc, 0, sizeof sc);
+        random_sets(&sc.fx, seed, 22);
+        scene_build(&sc, seed);
+        linear_rounds(&sc, NULL, seed * 11, 22, NULL);
+        scene_free(&sc);
+    }
+    scene sc;
+    memset(&sc, 0, sizeof sc);
+    random_sets(&sc.fx, 21, 5);
+    sc.fx.sets[1].kind = LBK_DLS_KIND_DOOR_OPEN;
+    sc.fx.sets[2].kind = LBK_DLS_KIND_DOOR_CLOSED;
+    uint32_t mem[2] = {1, 0};
+    dlsfx_combination(&sc.fx, 3, 2, mem);
+    scene_build(&sc, 21);
+    lbk_door_desc door = {.name = "d", .axes = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, .half_extents = {1, 1, 1},
+                          .open_set = 1, .closed_set = 2};
+    lbk_door_build_desc dd = {.door_count = 1, .doors = &door};
+    void *db;
+    size_t dsize;
+    assert_int_equal(lbk_door_build(&dd, NULL, &db, &dsize), LBK_OK);
+    lbk_door_view *dv;
+    assert_int_equal(lbk_door_open(db, dsize, NULL, &dv), LBK_OK);
+    const float omega = 0.375f;
+    linear_rounds(&sc, dv, 5, 5, &omega);
+    linear_rounds(&sc, dv, 6, 5, NULL); /* closed: the bounce set at weight 1 */
+    lbk_door_close(dv);
+    free(db);
+    scene_free(&sc);
+}
+
+/* Linear pages with padded pitches, jobs in reverse order and on two threads: the floats of the
+ * array form; padding untouched; the dirty rectangles of the byte mode on the same pages. */
+static void test_linear_pages_and_jobs(void **state)
+{
+    (void)state;
+    scene sc;
+    memset(&sc, 0, sizeof sc);
+    random_sets(&sc.fx, 7, 22);
+    scene_build(&sc, 7);
+    const uint64_t nt = sc.fx.desc.target_count[0], np[2] = {sc.fx.desc.target_count[1], sc.fx.desc.target_count[2]};
+    float *ref[3], *refp[2];
+    for (int c = 0; c < 3; c++) ref[c] = calloc(nt, 16);
+    for (int p = 0; p < 2; p++) refp[p] = calloc(np[p], 108);
+    lbk_dls_runtime_desc ad = {.size = sizeof ad, .dls = sc.view, .base_irradiance_z = sc.base_z, .base_rgba = sc.base_rgba,
+                               .base_glg = sc.base_probe[0], .base_llg = sc.base_probe[1], .flags = LBK_DLS_RUNTIME_LINEAR,
+                               .out_linear_texel = {ref[0], ref[1], ref[2]}, .out_linear_glg = refp[0], .out_linear_llg = refp[1]};
+    lbk_dls_runtime *ra;
+    assert_int_equal(lbk_dls_runtime_open(&ad, &ra), LBK_OK);
+    /* the prepared data: 12 floats per clustered texel and texel entry, 27 per probe ones */
+    lbk_dls_stats st;
+    lbk_dls_stats_get(sc.view, &st);
+    const uint64_t floats = 12 * (st.touched[0] + st.entries[0]) + 27 * (st.touched[1] + st.entries[1] + st.touched[2] + st.entries[2]);
+    const uint64_t arrays = 4 * (uint64_t)st.cluster_count * 32; /* ≤ 3 planes × (1 + 8 slots) per cluster */
+    assert_true(lbk_dls_runtime_linear_bytes(ra) >= 4 * floats && lbk_dls_runtime_linear_bytes(ra) <= 4 * floats + 64 * arrays + 64);
+    const size_t lpitch = 16 * PAGE_W + 32, lplane = lpitch * PAGE_H;
+    float *lin = malloc(3 * PAGES * lplane);
+    float *linp[2] = {calloc(np[0], 108), calloc(np[1], 108)};
+    uint8_t *bz = malloc(PAGES * (4 * PAGE_W + PAD) * PAGE_H), *brgba = malloc(PAGES * (4 * PAGE_W + PAD) * PAGE_H);
+    lbk_dls_page pages[PAGES];
+    lbk_dls_linear_page lpages[PAGES];
+    for (uint32_t p = 0; p < PAGES; p++) {
+        pages[p] = (lbk_dls_page){.width = PAGE_W, .height = PAGE_H, .base_irradiance = (const uint8_t *)(sc.base_z + p * PAGE_W * PAGE_H),
+                                  .base_rgba = sc.base_rgba + 4 * p * PAGE_W * PAGE_H};
+        for (int c = 0; c < 3; c++) {
+            lpages[p].out[c] = (float *)((uint8_t *)lin + (3 * p + c) * lplane);
+            lpages[p].out_pitch[c] = lpitch;
+        }
+    }
+    memset(lin, 0x5A, 3 * PAGES * lplane);
+    lbk_dls_runtime_desc pd = {.size = sizeof pd, .dls = sc.view, .base_glg = sc.base_probe[0], .base_llg = sc.base_probe[1],
+                               .page_count = PAGES, .pages = pages, .flags = LBK_DLS_RUNTIME_LINEAR, .job_targets = 50,
+                               .linear_pages = lpages, .out_linear_glg = linp[0], .out_linear_llg = linp[1]};
+    lbk_dls_runtime *rp;
+    assert_int_equal(lbk_dls_runtime_open(&pd, &rp), LBK_OK);
+    /* the byte mode on the same pages, for its rectangles */
+    paged pg;
+    paged_init(&pg, &sc);
+    lbk_dls_runtime *rb = paged_runtime(&sc, &pg, 0, 50);
+    uint64_t rng = 17;
+    float w[22];
+    for (int a = 0; a < 3; a++) {
+        random_weights(&rng, w, 22);
+        assert_int_equal(lbk_dls_apply(ra, w, NULL, NULL), LBK_OK);
+        assert_int_equal(lbk_dls_apply(rb, w, NULL, NULL), LBK_OK);
+        uint32_t n;
+        assert_int_equal(lbk_dls_apply_begin(rp, w, NULL, &n), LBK_OK);
+        if (a == 1) {
+            job_pool pool = {.r = rp, .n = n};
+            atomic_init(&pool.next, 0);
+            pthread_t th[2];
+            for (int i = 0; i < 2; i++) assert_int_equal(pthread_create(&th[i], NULL, job_worker, &pool), 0);
+            for (int i = 0; i < 2; i++) pthread_join(th[i], NULL);
+        } else {
+            for (uint32_t j = n; j-- > 0;) lbk_dls_apply_job(rp, j);
+        }
+        assert_int_equal(lbk_dls_apply_end(rp, NULL), LBK_OK);
+        for (uint32_t p = 0; p < PAGES; p++)
+            for (int c = 0; c < 3; c++)
+                for (uint32_t y = 0; y < PAGE_H; y++) {
+                    const uint8_t *row = (const uint8_t *)lpages[p].out[c] + y * lpitch;
+                    assert_memory_equal(row, ref[c] + 4 * ((size_t)p * PAGE_W * PAGE_H + y * PAGE_W), 16 * PAGE_W);
+                    for (uint32_t b = 16 * PAGE_W; b < lpitch; b++) assert_int_equal(row[b], 0x5A);
+                }
+        for (int p = 0; p < 2; p++) assert_memory_equal(linp[p], refp[p], np[p] * 108);
+        for (uint32_t p = 0; p < PAGES; p++) {
+            assert_int_equal(lbk_dls_dirty_rect_count(rp, p), lbk_dls_dirty_rect_count(rb, p));
+            for (uint32_t i = 0; i < lbk_dls_dirty_rect_count(rp, p); i++) {
+                lbk_dls_rect x, y;
+                lbk_dls_dirty_rect_get(rp, p, i, &x), lbk_dls_dirty_rect_get(rb, p, i, &y);
+                assert_memory_equal(&x, &y, sizeof x);
+            }
+        }
+    }
+    /* linear outputs are required; pitches hold a row of float4 */
+    lbk_dls_runtime *bad;
+    pd.linear_pages = NULL;
+    assert_int_equal(lbk_dls_runtime_open(&pd, &bad), LBK_ERR_INVALID_ARGUMENT);
+    pd.linear_pages = lpages;
+    lpages[1].out_pitch[2] = 16 * PAGE_W - 4;
+    assert_int_equal(lbk_dls_runtime_open(&pd, &bad), LBK_ERR_INVALID_ARGUMENT);
+    lpages[1].out_pitch[2] = lpitch;
+    pd.out_linear_llg = NULL;
+    assert_int_equal(lbk_dls_runtime_open(&pd, &bad), LBK_ERR_INVALID_ARGUMENT);
+    ad.out_linear_texel[1] = NULL;
+    assert_int_equal(lbk_dls_runtime_open(&ad, &bad), LBK_ERR_INVALID_ARGUMENT);
+    lbk_dls_runtime_close(ra), lbk_dls_runtime_close(rp), lbk_dls_runtime_close(rb);
+    for (int c = 0; c < 3; c++) free(ref[c]);
+    for (int p = 0; p < 2; p++) free(refp[p]), free(linp[p]);
+    free(lin), free(bz), free(brgba), free(pg.z), free(pg.rgba);
+    scene_free(&sc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -798,6 +966,8 @@ int main(void)
         cmocka_unit_test(test_apply_in_another_scale),
         cmocka_unit_test(test_paths_pages_and_jobs_agree),
         cmocka_unit_test(test_dirty_regions_cover_writes),
+        cmocka_unit_test(test_linear_equals_byte_accumulators),
+        cmocka_unit_test(test_linear_pages_and_jobs),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -283,12 +283,11 @@ static int on_edge(const uint8_t *img, int x, int y)
  * error of a triangle edge, silhouettes — may differ more: they must lie on an edge of the reference
  * (on_edge) and be at most 1 % of the pixels. Measured (cornell bake, 160 × 120): 95.4 % of the
  * pixels identical, 4.5 % one code apart, 25 pixels (0.13 %) more, all on silhouettes. */
-static void test_view_screenshot_matches_lbk_render(void **state)
+static void screenshot_matches_lbk_render(const char *level)
 {
-    (void)state;
-    if (!have_chromium()) skip();
-    assert_int_equal(write_page(), TL_VIEW_OK);
     char url[2048], cmd[4096], err[TL_ERR_LEN];
+    tl_view_options vo = {.container = level, .scene = SCENE, .out_dir = OUT};
+    assert_int_equal(tl_view_write(&vo, NULL, err), TL_VIEW_OK);
     page_url(url, sizeof url);
     unlink("build/tests/view_shot.png");
     /* headless Chromium keeps a minimum window size: the canvas is the top-left W × H of a larger shot */
@@ -311,7 +310,7 @@ static void test_view_screenshot_matches_lbk_render(void **state)
     o.camera.yfov = FOV_DEG * 3.14159265358979f / 180.0f;
     o.sky_override = 1; /* the page's background is black */
     tl_image img;
-    assert_int_equal(tl_render(SCENE, LEVEL, &o, &img, err), TL_RENDER_OK);
+    assert_int_equal(tl_render(SCENE, level, &o, &img, err), TL_RENDER_OK);
     const float k = powf(2.0f, (float)STOPS);
     int over = 0, interior = 0, max_diff = 0, lit = 0;
     double sum = 0;
@@ -332,15 +331,149 @@ static void test_view_screenshot_matches_lbk_render(void **state)
         }
         if (d > max_diff) max_diff = d;
     }
-    print_message("page vs lbk render %dx%d: %d pixels over 1 code (%.2f %%, %d not on an edge), max %d, mean %.3f codes, "
+    print_message("%s: page vs lbk render %dx%d: %d pixels over 1 code (%.2f %%, %d not on an edge), max %d, mean %.3f codes, "
                   "%d lit channels\n",
-                  W, H, over, 100.0 * over / (W * H), interior, max_diff, sum / (W * H), lit);
+                  level, W, H, over, 100.0 * over / (W * H), interior, max_diff, sum / (W * H), lit);
     tl_png_write_rgb8("build/tests/view_ref.png", W, H, ref8, err); /* to look at when it fails */
     tl_image_free(&img);
     free(shot);
     assert_true(lit > W * H); /* the view shows the lit level, not a black frame */
     assert_true(over <= W * H / 100);
     assert_int_equal(interior, 0);
+}
+
+static void test_view_screenshot_matches_lbk_render(void **state)
+{
+    (void)state;
+    if (!have_chromium()) skip();
+    screenshot_matches_lbk_render(LEVEL);
+}
+
+/* ---- block-compressed packs, the error view ------------------------------------------------- */
+
+/* The cornell bake converted by `lbk convert` ($LBK, else build/lbk-asan) with a profile. */
+static void convert_level(const char *profile, const char *out)
+{
+    const char *lbk = getenv("LBK") ? getenv("LBK") : "build/lbk-asan";
+    if (access(lbk, X_OK)) skip();
+    char cmd[1024];
+    snprintf(cmd, sizeof cmd, "%s convert " LEVEL " -o %s --profile %s >/dev/null", lbk, out, profile);
+    assert_int_equal(system(cmd), 0);
+}
+
+/* BC6H + BC5/BC4 pages (console-current): the page decodes them in JS (bit-exact with liblbk:
+ * test_view_reader) and blends the float texels as the 1.0 ones. lbk render does not draw block
+ * packs, so the reference is lbk render of the uncompressed bake, and the bound is the pack's own
+ * error: bench_packs measures the cornell pack's irradiance against the bake at a mean 1.9 % and
+ * p99 13.2 % in luminance (tools/convert/profiles/README.md). A relative error e moves an sRGB
+ * code by at most about 255·e/2.4 (d log srgb / d log x ≤ 1/2.4 above the linear toe), i.e. a mean
+ * ≤ 2 and a p99 ≤ 14 codes, + 1 for the 8-bit rounding on each side: mean ≤ 4, 99th percentile of
+ * the pixels off silhouettes ≤ 16 codes. The pixels must be lit (the page draws the block pages). */
+static void test_view_bc_pages_match_lbk_render(void **state)
+{
+    (void)state;
+    if (!have_chromium()) skip();
+    convert_level("console-current", "build/tests/view_bc.lbk");
+    char url[2048], cmd[4096], err[TL_ERR_LEN];
+    tl_view_options vo = {.container = "build/tests/view_bc.lbk", .scene = SCENE, .out_dir = OUT};
+    assert_int_equal(tl_view_write(&vo, NULL, err), TL_VIEW_OK);
+    page_url(url, sizeof url);
+    unlink("build/tests/view_bc_shot.png");
+    snprintf(cmd, sizeof cmd, CHROMIUM " --window-size=%d,%d --screenshot=build/tests/view_bc_shot.png '%s' >/dev/null 2>&1",
+             3 * W, 3 * H, url);
+    assert_int_equal(system(cmd), 0);
+    int w, h;
+    uint8_t *shot;
+    assert_int_equal(tl_png_read_rgb8("build/tests/view_bc_shot.png", &w, &h, &shot, err), 0);
+    assert_int_equal(w, 3 * W);
+    for (int y = 0; y < H; y++) memmove(shot + 3 * W * y, shot + 3 * w * y, 3 * W);
+    tl_render_options o;
+    memset(&o, 0, sizeof o);
+    o.width = W, o.height = H, o.samples = 1, o.threads = 1;
+    memcpy(o.camera.from, cam_from, sizeof cam_from);
+    memcpy(o.camera.at, cam_at, sizeof cam_at);
+    memcpy(o.camera.up, cam_up, sizeof cam_up);
+    o.camera.yfov = FOV_DEG * 3.14159265358979f / 180.0f;
+    o.sky_override = 1;
+    tl_image img;
+    assert_int_equal(tl_render(SCENE, LEVEL, &o, &img, err), TL_RENDER_OK);
+    const float k = powf(2.0f, (float)STOPS);
+    static uint8_t ref8[W * H * 3];
+    for (int i = 0; i < 3 * W * H; i++) ref8[i] = (uint8_t)lrintf(srgb(img.rgb[i] * k) * 255.0f);
+    tl_image_free(&img);
+    int hist[256] = {0}, n = 0, lit = 0;
+    double sum = 0;
+    for (int i = 0; i < W * H; i++) {
+        int d = 0;
+        for (int c = 0; c < 3; c++) {
+            const int e = abs(ref8[3 * i + c] - shot[3 * i + c]);
+            d = e > d ? e : d;
+            lit += shot[3 * i + c] > 8;
+        }
+        sum += d;
+        if (!on_edge(ref8, i % W, i / W)) hist[d]++, n++;
+    }
+    int p99 = 0;
+    for (int run = 0; p99 < 255 && (run += hist[p99]) < n * 99 / 100; p99++) {}
+    print_message("BC pack page vs lbk render of the bake: mean %.3f codes, p99 off edges %d codes, %d lit channels\n",
+                  sum / (W * H), p99, lit);
+    free(shot);
+    assert_true(lit > W * H);
+    assert_true(sum / (W * H) <= 4.0);
+    assert_true(p99 <= 16);
+}
+
+/* The page's DOM after it loaded with these hash parameters (malloc'ed, NUL-terminated). */
+static char *page_dom(const char *level, const char *hash)
+{
+    char err[TL_ERR_LEN], cwd[1024], cmd[4096];
+    tl_view_options vo = {.container = level, .scene = SCENE, .out_dir = "build/tests/view_dom_out"};
+    assert_int_equal(tl_view_write(&vo, NULL, err), TL_VIEW_OK);
+    assert_non_null(getcwd(cwd, sizeof cwd));
+    snprintf(cmd, sizeof cmd, CHROMIUM " --dump-dom 'file://%s/build/tests/view_dom_out/index.html#%s' > build/tests/view_dom2.html 2>/dev/null",
+             cwd, hash);
+    assert_int_equal(system(cmd), 0);
+    void *dom;
+    size_t n;
+    assert_int_equal(tl_read_file("build/tests/view_dom2.html", &dom, &n, err), 0);
+    char *s = realloc(dom, n + 1);
+    assert_non_null(s);
+    s[n] = 0;
+    return s;
+}
+
+/* ASTC pages (handheld): not decoded in the page; it says so, loads without an error. */
+static void test_view_astc_pages_say_they_cannot_be_shown(void **state)
+{
+    (void)state;
+    if (!have_chromium()) skip();
+    convert_level("handheld", "build/tests/view_astc.lbk");
+    char *dom = page_dom("build/tests/view_astc.lbk", "stops=4");
+    assert_non_null(strstr(dom, "<title>lbk view: ready, 0 errors</title>"));
+    assert_non_null(strstr(dom, "ASTC pages cannot be shown"));
+    free(dom);
+    dom = page_dom(LEVEL, "stops=4"); /* not on a 1.0 file */
+    assert_null(strstr(dom, "ASTC pages cannot be shown"));
+    free(dom);
+}
+
+/* The error view (mode 5): a file without TERR says how to get one; a bake with --error-map (the
+ * corpus's bake_cornell_terr.lbk) shows the legend in % and how many texels carry an estimate. */
+static void test_view_error_mode(void **state)
+{
+    (void)state;
+    if (!have_chromium()) skip();
+    char *dom = page_dom(LEVEL, "mode=5");
+    assert_non_null(strstr(dom, "<title>lbk view: ready, 0 errors</title>"));
+    assert_non_null(strstr(dom, "no per-texel error map in this file</b>: bake with --error-map"));
+    free(dom);
+    dom = page_dom("tests/fuzz/corpus/bake_cornell_terr.lbk", "mode=5");
+    assert_non_null(strstr(dom, "<title>lbk view: ready, 0 errors</title>"));
+    assert_null(strstr(dom, "no per-texel error map"));
+    assert_non_null(strstr(dom, "relative standard error of the irradiance, per texel"));
+    assert_non_null(strstr(dom, "0.1 %"));
+    assert_non_null(strstr(dom, "texels estimated"));
+    free(dom);
 }
 
 /* ---- light-set slider: the page changes the pixels lbk render --set changes ------------------ */
@@ -484,6 +617,9 @@ int main(void)
         cmocka_unit_test(test_view_page_loads_without_errors),
         cmocka_unit_test(test_view_screenshot_matches_lbk_render),
         cmocka_unit_test(test_view_set_slider_changes_what_lbk_render_changes),
+        cmocka_unit_test(test_view_bc_pages_match_lbk_render),
+        cmocka_unit_test(test_view_astc_pages_say_they_cannot_be_shown),
+        cmocka_unit_test(test_view_error_mode),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

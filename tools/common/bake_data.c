@@ -182,6 +182,7 @@ static tl_open_status open_views(tl_bake *b, uint64_t max_decoded_bytes, char er
     VIEW(LBK_SECTION_OCTP, b->has_octp, lbk_octp_open(d, n, &b->octp));
     VIEW(LBK_SECTION_LMUV, b->has_lmuv, lbk_lmuv_open(d, n, &b->lmuv));
     VIEW(LBK_SECTION_REPT, b->has_rept, lbk_report_open(d, n, &b->rept));
+    VIEW(LBK_SECTION_TERR, b->has_terr, lbk_terr_open(d, n, &b->terr));
     if (b->has_rept && lbk_report_record_get(&b->rept, b->rept.header.record_count - 1, &b->rept_last) != LBK_OK)
         b->has_rept = 0;
     VIEW(LBK_SECTION_DLS, dls, lbk_dls_open(d, n, NULL, &b->dls));

@@ -7,6 +7,7 @@
 #include <stdint.h>
 
 #include "tools/common/image_io.h"
+#include "lbk/error_map.h"
 #include "lbk/ahd.h"
 #include "lbk/container.h"
 #include "lbk/dls.h"
@@ -31,7 +32,7 @@ typedef struct tl_bake {
     void *bytes; /* owned file bytes */
     size_t size;
     lbk_reader *reader;
-    int has_meta, has_objs, has_lmap, has_glg, has_llg, has_octp, has_lmuv, has_rept;
+    int has_meta, has_objs, has_lmap, has_glg, has_llg, has_octp, has_lmuv, has_rept, has_terr;
     lbk_meta_view meta;
     lbk_objects_view objs;
     lbk_lmap_view lmap;
@@ -40,6 +41,7 @@ typedef struct tl_bake {
     lbk_octp_view octp;
     lbk_lmuv_view lmuv;
     lbk_report_view rept;
+    lbk_terr_view terr; /* the per-texel error map (format 1.4), when has_terr */
     lbk_report_record rept_last; /* the final estimate, when has_rept */
     lbk_dls_view *dls;   /* NULL when absent */
     lbk_door_view *door; /* NULL when absent */

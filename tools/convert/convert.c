@@ -2,6 +2,7 @@
  * sections are decoded, optionally rewritten, and handed to the library writer, which lays them out
  * in canonical order; zstd at a fixed level is deterministic, so converting twice gives the same
  * bytes, and converting a pack again with the same profile reproduces it. */
+#include "lbk/error_map.h"
 #include "tools/convert/convert.h"
 
 #include <stdio.h>
@@ -49,6 +50,29 @@ static int validate_bytes(const void *data, size_t size, lbk_reader *reader, con
         return -1;
     }
     return 0;
+}
+
+/* The per-texel error map (spec §18) follows LMAP's texels when pages are widened: each code
+ * moves with its texel, the new padding texels get 0 (no estimate). */
+static int terr_remap_texels(const void *data, size_t size, const tl_texel_remap *remap, void **out, size_t *out_size,
+                             char err[TL_ERR_LEN])
+{
+    lbk_terr_view v;
+    if (lbk_terr_open(data, size, &v) != LBK_OK || v.texel_count != remap->old_total)
+        return tl_fail(err, TL_CONVERT_BAD_INPUT, "TERR does not match the lightmap's texels");
+    uint8_t *codes = calloc((size_t)remap->new_total + 1, 1);
+    if (!codes) return tl_fail(err, TL_CONVERT_INTERNAL, "out of memory");
+    for (uint64_t i = 0; i < v.texel_count; i++) {
+        uint64_t j;
+        if (v.codes[i] && tl_texel_remap_apply(remap, i, &j) == 0 && j < remap->new_total) codes[j] = v.codes[i];
+    }
+    void *built = NULL;
+    lbk_result r = lbk_terr_build(v.flags, codes, remap->new_total, NULL, &built, out_size);
+    free(codes);
+    if (r != LBK_OK) return tl_fail(err, TL_CONVERT_INTERNAL, "TERR: %s", lbk_result_message(r));
+    /* the caller frees with free(): lbk_terr_build used the default allocator (malloc) */
+    *out = built;
+    return TL_CONVERT_OK;
 }
 
 /* META of a pack that keeps it: the input's keys plus convert.profile and convert.profile_hash
@@ -161,6 +185,8 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
             have_remap = ls == TL_CONVERT_OK;
         } else if (si.type == LBK_SECTION_DLS && have_remap && !remap.identity) {
             ls = tl_dls_remap_texels(data, size, &remap, &rewritten, &rewritten_size, err);
+        } else if (si.type == LBK_SECTION_TERR && have_remap && !remap.identity) {
+            ls = terr_remap_texels(data, size, &remap, &rewritten, &rewritten_size, err);
         } else if (si.type == LBK_SECTION_META) {
             ls = meta_with_profile(data, size, p, &rewritten, &rewritten_size, err);
         }

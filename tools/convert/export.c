@@ -296,6 +296,61 @@ static int write_glg_plot(const char *dir, const tl_bake *b, const probe_row *ro
     return rc;
 }
 
+/* ---- the per-texel error map (TERR, spec/container.md §18) ---------------------------------- */
+
+/* The colour scale of lbk view's error mode (viewer/viewer.js errColour): log10 of the relative
+ * error from 0.1 % (0) to 100 % (1), dark blue, blue, green, yellow, red; grey: no estimate. */
+static void error_colour(double rel, uint8_t out[3])
+{
+    static const float stops[5][3] = {{0.05f, 0.15f, 0.6f}, {0.0f, 0.55f, 0.9f}, {0.1f, 0.8f, 0.3f},
+                                      {0.95f, 0.85f, 0.1f}, {0.85f, 0.1f, 0.1f}};
+    if (rel < 0) {
+        out[0] = out[1] = out[2] = 64;
+        return;
+    }
+    double t = (log10(rel > 1e-12 ? rel : 1e-12) + 3.0) / 3.0;
+    t = t < 0 ? 0 : t > 1 ? 1 : t;
+    const int i = t >= 1 ? 3 : (int)(t * 4);
+    const double f = t * 4 - i;
+    for (int c = 0; c < 3; c++) out[c] = (uint8_t)lrint(255.0 * ((1 - f) * stops[i][c] + f * stops[i + 1][c]));
+}
+
+/* Page p's error map: PAGE.error.exr (channel Y: the relative error, -1 where there is no
+ * estimate) and PAGE.error.png (the colour scale above). */
+static int write_error_map(const tl_bake *b, const tl_export_options *o, uint32_t p, tl_export_stats *st,
+                           char err[TL_ERR_LEN])
+{
+    lbk_lmap_planes pg;
+    tl_bake_planes(b, p, &pg);
+    const size_t n = (size_t)pg.width * pg.height;
+    float *rel = malloc(n * sizeof *rel + 1);
+    uint8_t *rgb = malloc(3 * n + 1);
+    if (!rel || !rgb) {
+        free(rel), free(rgb);
+        return tl_fail(err, -1, "out of memory");
+    }
+    for (size_t i = 0; i < n; i++) {
+        const double e = lbk_terr_decode(b->terr.codes[pg.first_texel + i]);
+        rel[i] = (float)e;
+        error_colour(e, rgb + 3 * i);
+    }
+    static const char *const Y[1] = {"Y"};
+    char path[4096];
+    int rc = 0;
+    if (o->exr_dir) {
+        tl_page_exr_path(path, sizeof path, o->exr_dir, p, ".error.exr");
+        rc = tl_exr_write(path, (int)pg.width, (int)pg.height, 1, Y, rel, err);
+        if (!rc) st->exr_files++;
+    }
+    if (!rc && o->png_dir) {
+        tl_page_exr_path(path, sizeof path, o->png_dir, p, ".error.png");
+        rc = tl_png_write_rgb8(path, (int)pg.width, (int)pg.height, rgb, err);
+        if (!rc) st->png_files++;
+    }
+    free(rel), free(rgb);
+    return rc;
+}
+
 /* ---- driver -------------------------------------------------------------------------------- */
 
 static int export_run(const tl_bake *b, const tl_export_options *o, tl_export_stats *st, char err[TL_ERR_LEN])
@@ -339,6 +394,7 @@ static int export_run(const tl_bake *b, const tl_export_options *o, tl_export_st
             break;
         }
         if (o->exr_dir) rc = write_page_exrs(o->exr_dir, p, &im, st, err);
+        if (!rc && b->has_terr) rc = write_error_map(b, o, p, st, err);
         if (!rc && o->png_dir) {
             char path[4096];
             tl_page_exr_path(path, sizeof path, o->png_dir, p, ".png");

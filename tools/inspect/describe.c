@@ -2,6 +2,7 @@
 #include <math.h>
 
 #include "tools/inspect/describe.h"
+#include "lbk/error_map.h"
 #include "lbk/lbk.h"
 
 inspect_describe_fn inspect_describer(uint32_t type)
@@ -17,6 +18,7 @@ inspect_describe_fn inspect_describer(uint32_t type)
     case LBK_SECTION_DLS: return inspect_describe_dls;
     case LBK_SECTION_DOOR: return inspect_describe_door;
     case LBK_SECTION_LMUV: return inspect_describe_lmuv;
+    case LBK_SECTION_TERR: return inspect_describe_terr;
     default: return NULL;
     }
 }

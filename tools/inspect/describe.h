@@ -18,6 +18,11 @@ typedef struct inspect_stats {
     uint64_t objects;
     uint64_t dls_light_sets, dls_sets, dls_clusters, dls_payload_bytes, dls_ancillary_bytes;
     uint64_t doors, door_states;
+    /* TERR (format 1.4): texels, those with an estimate, the median and 90th percentile of the
+     * relative error over those (0 without) */
+    int terr_present, terr_denoised;
+    uint64_t terr_texels, terr_estimated;
+    double terr_median, terr_p90;
     char detail[200];   /* one line of section-specific numbers for the text report */
 } inspect_stats;
 
@@ -33,6 +38,7 @@ void inspect_describe_octp(const uint8_t *data, size_t size, inspect_stats *out)
 void inspect_describe_dls(const uint8_t *data, size_t size, inspect_stats *out);
 void inspect_describe_door(const uint8_t *data, size_t size, inspect_stats *out);
 void inspect_describe_lmuv(const uint8_t *data, size_t size, inspect_stats *out);
+void inspect_describe_terr(const uint8_t *data, size_t size, inspect_stats *out);
 
 /* log2 of a lighting section's scale (a power of two, spec/container.md §5.7). */
 int inspect_scale_log2(float scale);

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "lbk/error_map.h"
 #include "lbk/pixel.h"
 
 const char *tl_diff_status_name(int s)
@@ -935,11 +936,12 @@ int tl_diff_run(const tl_bake *a, const tl_bake *b, const tl_diff_options *o, tl
         if (d->repr_a == LBK_REPRESENTATION_LLG && d->compared) r->probes_over += d->lighting.over;
         if (d->compared && d->noise.evaluated && !d->noise.within_noise) r->items_beyond_noise++;
     }
-    /* the exit decision: lighting and structure; META and REPT are provenance only */
+    /* the exit decision: lighting and structure; META and REPT are provenance only, TERR (the
+     * per-texel error map, a bake option) a diagnostic: present on one side only, it is reported */
     int structural_sections = 0;
     for (size_t i = 0; i < r->section_count; i++) {
         const tl_diff_section *s = &r->sections[i];
-        if (s->type == LBK_SECTION_META || s->type == LBK_SECTION_REPT) continue;
+        if (s->type == LBK_SECTION_META || s->type == LBK_SECTION_REPT || s->type == LBK_SECTION_TERR) continue;
         if (s->status == TL_DIFF_ADDED || s->status == TL_DIFF_REMOVED) structural_sections = 1;
     }
     /* noise mode: samples over the (zero) tolerance are expected; the items' verdicts decide */

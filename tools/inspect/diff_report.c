@@ -6,6 +6,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "lbk/error_map.h"
 #include "tools/inspect/diff.h"
 
 static void hex64(uint64_t v, char out[17]) { snprintf(out, 17, "%016llx", (unsigned long long)v); }
@@ -373,8 +374,12 @@ void tl_diff_print(FILE *f, const tl_diff_result *r, int verbose)
         if (s->status == TL_DIFF_SAME && !verbose) continue;
         char t[5];
         lbk_fourcc_string(s->type, t);
-        fprintf(f, "section %-4s %-8s %llu -> %llu decoded bytes\n", t, tl_diff_status_name(s->status),
+        fprintf(f, "section %-4s %-8s %llu -> %llu decoded bytes", t, tl_diff_status_name(s->status),
                 (unsigned long long)s->a_decoded, (unsigned long long)s->b_decoded);
+        if (s->type == LBK_SECTION_TERR && (s->status == TL_DIFF_ADDED || s->status == TL_DIFF_REMOVED))
+            fprintf(f, " (the per-texel error map is present in %s only: a diagnostic, not compared)",
+                    s->status == TL_DIFF_ADDED ? "B" : "A");
+        fputc('\n', f);
     }
     for (size_t i = 0; i < r->param_count; i++) {
         const tl_diff_param *p = &r->params[i];

@@ -26,6 +26,11 @@ static void add_stats(inspect_stats *sum, const inspect_stats *s)
     sum->dls_ancillary_bytes += s->dls_ancillary_bytes;
     sum->doors += s->doors;
     sum->door_states += s->door_states;
+    if (s->terr_present) {
+        sum->terr_present = 1, sum->terr_denoised = s->terr_denoised;
+        sum->terr_texels = s->terr_texels, sum->terr_estimated = s->terr_estimated;
+        sum->terr_median = s->terr_median, sum->terr_p90 = s->terr_p90;
+    }
 }
 
 static int is_dynamic(uint32_t type) { return type == LBK_SECTION_DLS || type == LBK_SECTION_DOOR; }
@@ -136,6 +141,18 @@ char *tl_inspect_json(const tl_inspect_report *r)
         cJSON_AddNumberToObject(lv, "door_states", (double)l->door_states);
         cJSON_AddNumberToObject(lv, "memory_without_dls_bytes", (double)r->memory_without_dls);
         cJSON_AddNumberToObject(lv, "memory_with_dls_bytes", (double)r->memory_with_dls);
+        /* the per-texel error map (TERR, format 1.4): null without one (added within lbk-inspect/1) */
+        if (!l->terr_present) cJSON_AddNullToObject(lv, "error_map");
+        else {
+            cJSON *em = cJSON_AddObjectToObject(lv, "error_map");
+            if (em) {
+                cJSON_AddNumberToObject(em, "texels", (double)l->terr_texels);
+                cJSON_AddNumberToObject(em, "texels_with_estimate", (double)l->terr_estimated);
+                cJSON_AddNumberToObject(em, "median_rel_error", l->terr_median);
+                cJSON_AddNumberToObject(em, "p90_rel_error", l->terr_p90);
+                cJSON_AddBoolToObject(em, "before_denoising", l->terr_denoised);
+            }
+        }
     }
     if (r->memory) {
         cJSON *objs = cJSON_AddArrayToObject(doc, "objects");

@@ -64,10 +64,15 @@ async function main() {
     out.push('LMAP ' + fx(lm.scale) + ' ' + lm.pages.length + ' ' + lm.texel_count);
     lm.pages.forEach((pg, i) => {
       out.push('PAGE ' + i + ' ' + pg.width + ' ' + pg.height + ' ' + pg.format0 + ' ' + pg.format1 + ' ' + pg.first_texel);
-      if (pg.format0 || pg.format1) return;
+      if (pg.format0 === 2 || pg.format1 === 2) { out.push('ASTC'); return; } /* no ASTC decoder in JS */
       const lin = R.pageLinear(lm, i);
       for (let t = 0; t < pg.width * pg.height; t++) out.push('T ' + fl(lin.subarray(12 * t, 12 * t + 12)));
     });
+  }
+  const em = await lbk.errorMap();
+  if (em) {
+    out.push('TERR ' + em.texel_count + ' ' + (em.denoised ? 1 : 0));
+    for (let o = 0; o < em.texel_count; o += 4096) out.push('E ' + Buffer.from(em.codes.subarray(o, o + 4096)).toString('hex'));
   }
   const glg = await lbk.glg();
   if (glg) {

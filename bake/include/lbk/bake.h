@@ -55,7 +55,7 @@ extern "C" {
 /* The baker library's version (lbk-bake.pc): the minor grows with every addition to the
  * size-tagged structs below ("added in 1.x"). */
 #define LBK_BAKE_LIBRARY_VERSION_MAJOR 1
-#define LBK_BAKE_LIBRARY_VERSION_MINOR 4
+#define LBK_BAKE_LIBRARY_VERSION_MINOR 5
 #define LBK_BAKE_LIBRARY_VERSION_PATCH 0
 
 /* ---- options ----------------------------------------------------------------------------- */
@@ -189,6 +189,12 @@ typedef struct lbk_bake_desc {
                                    scene's lbk_playable boxes only] */
     float glg_lighting_threshold; /* the relative interpolation error that asks for more probes
                                    [0: 0.4, measured by bench_glg] */
+    /* added in 1.5 */
+    int error_map;              /* 1: the container gets a TERR section (spec/container.md §18,
+                                   format 1.4): per lightmap texel the estimated relative standard
+                                   error of its irradiance, from the transport's two half
+                                   estimates (before denoising, when denoised) [0: none; the
+                                   file keeps the bytes it had without the field] */
 } lbk_bake_desc;
 
 /* A file a bake read (the glTF, its buffers and images, a sky EXR), as META input.files

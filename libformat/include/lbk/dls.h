@@ -210,8 +210,37 @@ typedef struct lbk_dls_page {
     size_t base_irradiance_pitch, base_rgba_pitch, out_irradiance_pitch, out_rgba_pitch;
 } lbk_dls_page;
 
+/* The linear outputs of one LMAP page (an array element: frozen), for LBK_DLS_RUNTIME_LINEAR:
+ * three RGBA32F planes, plane c holding lbk_ahd_linear.c[c] = (e0, g.x, g.y, g.z) of colour
+ * channel c (R, G, B) as 4 host-order floats per texel, so that E_c(n) = dot(plane_c, (1, n))
+ * (lbk/ahd.h) — three float4 images a shader samples and blends as it likes. Pitches are bytes
+ * from one row to the next (0: 16·width; otherwise ≥ 16·width and a multiple of 4). */
+typedef struct lbk_dls_linear_page {
+    float *out[3];
+    size_t out_pitch[3];
+} lbk_dls_linear_page;
+
 /* lbk_dls_runtime_desc.flags */
 #define LBK_DLS_RUNTIME_SCALAR 0x1u /* use the scalar path even where a SIMD one exists (same bytes) */
+/* Linear mode: apply writes L = L_B + Σ_j w_j S_j as floats — the sums the byte mode encodes —
+ * into linear outputs instead of AHD / packed SH9 bytes. Open decodes the base of every clustered
+ * target and every entry once into the additive forms and keeps them, laid out for streaming
+ * (per cluster: the base, then each set slot's entries, struct-of-arrays per plane, 64-byte
+ * aligned), so that an apply is multiplies and adds on floats, near memory bandwidth (bench_dls).
+ * Memory: 4·(12·(T_c + E_t) + 27·(P_c + E_p)) bytes plus at most 64 bytes per cluster array,
+ * where T_c / P_c are the texels / probes that some cluster has (lbk_dls_stats.touched) and E_t /
+ * E_p the texel / probe entries (lbk_dls_stats.entries); lbk_dls_runtime_linear_bytes says it.
+ * On the ESTATE-sized level of bench_dls: 336 MB, 7.7× its 43 MB DLS section (open ~2 s). Outputs: per page
+ * the three planes of `linear_pages` (or, in the array form, out_linear_texel), probes as
+ * lbk_sh9_rgb (27 floats each, the order of lbk_sh9_rgb.c) in out_linear_glg / out_linear_llg;
+ * the byte outputs (out_irradiance_z, out_rgba, out_glg, out_llg, lbk_dls_page.out_*) are
+ * neither needed nor written. Exactness: each target's linear output is bit for bit the
+ * accumulator the byte mode encodes (decode with lbk_ahd_to_linear / lbk_sh9_unpack, acc = base,
+ * acc += w_j·S_j over the entries of non-zero weight in ascending set order, a multiply then an
+ * add), whatever path or split; so lbk_ahd_from_linear / lbk_sh9_pack of it are the byte mode's
+ * bytes for every target with an entry of non-zero weight; a target without one gets its decoded
+ * base (where the byte mode copies the base bytes: their re-encoding need not be those bytes). */
+#define LBK_DLS_RUNTIME_LINEAR 0x2u
 
 /* Texels come either as pages (page_count ≥ 1, in LMAP page order, Σ width·height = the texel
  * count; the four texel arrays are then NULL) or as the four arrays over the global texel index:
@@ -237,6 +266,11 @@ typedef struct lbk_dls_runtime_desc {
     const lbk_dls_page *pages;
     uint32_t flags;               /* LBK_DLS_RUNTIME_* */
     uint32_t job_targets;         /* targets per job of lbk_dls_apply_begin; 0: 4096 */
+    /* appended for the linear mode (LBK_DLS_RUNTIME_LINEAR; ignored without it) */
+    const lbk_dls_linear_page *linear_pages; /* with pages: page_count of them, in page order */
+    float *out_linear_texel[3];   /* the array form: plane c, 4 floats per texel (as a page's) */
+    float *out_linear_glg;        /* 27 floats (lbk_sh9_rgb) × GLG probes */
+    float *out_linear_llg;        /* 27 floats × LLG probes */
 } lbk_dls_runtime_desc;
 #define LBK_DLS_RUNTIME_DESC_INIT LBK_SIZED_INIT(lbk_dls_runtime_desc)
 
@@ -250,9 +284,11 @@ typedef struct lbk_dls_apply_stats {
 
 /* Checks that the views agree (door sets exist and have the right kinds), that every needed
  * buffer is present and that the pages cover the texels. The views and buffers must outlive the
- * runtime. */
+ * runtime. With LBK_DLS_RUNTIME_LINEAR it also decodes the prepared data (above). */
 LBK_API lbk_result lbk_dls_runtime_open(const lbk_dls_runtime_desc *desc, lbk_dls_runtime **out);
 LBK_API void lbk_dls_runtime_close(lbk_dls_runtime *runtime);
+/* The bytes the runtime holds for the linear mode's prepared data (0 without LBK_DLS_RUNTIME_LINEAR). */
+LBK_API uint64_t lbk_dls_runtime_linear_bytes(const lbk_dls_runtime *runtime);
 /* The next apply rewrites every target. */
 LBK_API void lbk_dls_runtime_invalidate(lbk_dls_runtime *runtime);
 
@@ -269,7 +305,9 @@ LBK_API void lbk_dls_runtime_invalidate(lbk_dls_runtime *runtime);
  * base bytes. Later calls skip each cluster none of whose sets' effective weights changed; a
  * cluster whose weights are all 0 gets exactly the base bytes. The bytes are those of the
  * scalar definition whichever path (scalar, AVX2) runs and however the work is split.
- * stats may be NULL. */
+ * In linear mode the same, with floats for bytes: untouched targets and all-zero clusters get
+ * the decoded base, the others the weighted sums (LBK_DLS_RUNTIME_LINEAR); the stats count the
+ * same clusters and targets. stats may be NULL. */
 LBK_API lbk_result lbk_dls_apply(lbk_dls_runtime *runtime, const float *set_weights, const float *door_weights,
                                  lbk_dls_apply_stats *stats);
 /* The effective weights apply would use (lbk_dls_set_count floats). */

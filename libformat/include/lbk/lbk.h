@@ -75,9 +75,9 @@ extern "C" {
 #define LBK_FORMAT_VERSION_MAJOR 1
 /* The newest container minor version this library reads and writes. A writer stamps each file
  * with the lowest minor version that defines everything in it (spec §1.3): 2 when an LMAP page is
- * block-encoded, 1 when it holds LMUV, else 0, so a file without newer content keeps the bytes an
+ * block-encoded, 1 when it holds LMUV, else 0 (3: an OCTP probe volume, 4: a TERR error map), so a file without newer content keeps the bytes an
  * older writer gave it. */
-#define LBK_FORMAT_VERSION_MINOR 3
+#define LBK_FORMAT_VERSION_MINOR 4
 
 /* This library's version (semantic versioning of the API and ABI). */
 #define LBK_LIBRARY_VERSION_MAJOR 1
