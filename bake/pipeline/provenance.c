@@ -125,7 +125,19 @@ static uint64_t material_hash(const bk_scene *s, const bk_material *m)
     key.double_sided = m->double_sided;
     key.albedo_tex = image_hash(s, m->albedo_tex);
     key.emission_tex = image_hash(s, m->emission_tex);
-    return XXH3_64bits(&key, sizeof key);
+    if (!bk_material_glossy(m)) return XXH3_64bits(&key, sizeof key); /* Lambertian: as before 13.2 */
+    /* a glossy material (GGX.md) also bakes by its metallic, roughness and their texture */
+    struct {
+        uint64_t lambert;
+        float metallic, roughness;
+        uint64_t metal_rough_tex;
+    } gk;
+    memset(&gk, 0, sizeof gk);
+    gk.lambert = XXH3_64bits(&key, sizeof key);
+    gk.metallic = m->metallic;
+    gk.roughness = m->roughness;
+    gk.metal_rough_tex = image_hash(s, m->metal_rough_tex1 - 1);
+    return XXH3_64bits(&gk, sizeof gk);
 }
 
 /* geometry: world positions, normals, uv0 and (when it has them) uv1 of every triangle corner;
@@ -195,6 +207,11 @@ static void materials(const bk_scene *s, const uint64_t *mat_hash, text *t)
         put(t, " emission_tex=");
         if (m->emission_tex >= 0) put(t, "%016llx", (unsigned long long)image_hash(s, m->emission_tex));
         else put(t, "-");
+        if (bk_material_glossy(m)) { /* only where not Lambertian: Lambertian scenes' META as before */
+            put(t, " metallic=%.9g roughness=%.9g metal_rough_tex=", (double)m->metallic, (double)m->roughness);
+            if (m->metal_rough_tex1 > 0) put(t, "%016llx", (unsigned long long)image_hash(s, m->metal_rough_tex1 - 1));
+            else put(t, "-");
+        }
         put(t, "\n");
     }
 }

@@ -397,7 +397,7 @@ Prepass prepass(const char *json_begin, size_t json_len, const std::string &file
         }
     }
 
-    // Textures that matter to the baker: base colour and emissive.
+    // Textures that matter to the baker: base colour, metallic-roughness and emissive.
     {
         const nlohmann::json *images = jarr(doc, "images");
         const nlohmann::json *textures = jarr(doc, "textures");
@@ -416,6 +416,8 @@ Prepass prepass(const char *json_begin, size_t json_len, const std::string &file
                 auto pbr = m.find("pbrMetallicRoughness");
                 if (pbr != m.end() && pbr->is_object() && pbr->contains("baseColorTexture"))
                     need((*pbr)["baseColorTexture"]);
+                if (pbr != m.end() && pbr->is_object() && pbr->contains("metallicRoughnessTexture"))
+                    need((*pbr)["metallicRoughnessTexture"]);
                 if (m.contains("emissiveTexture")) need(m["emissiveTexture"]);
             }
     }
@@ -929,6 +931,16 @@ void Importer::build_materials()
         bm.albedo_tex = texture_image(gm.pbrMetallicRoughness.baseColorTexture, "baseColor", mi, gm.name);
         bm.emission_tex = texture_image(gm.emissiveTexture, "emissive", mi, gm.name);
         bm.double_sided = gm.doubleSided ? 1 : 0;
+        // glTF's defaults (1, 1: a rough metal) when pbrMetallicRoughness leaves them out, as
+        // tinygltf fills them; our own Lambertian scenes say metallicFactor 0 (GGX.md)
+        const double mf = gm.pbrMetallicRoughness.metallicFactor, rf = gm.pbrMetallicRoughness.roughnessFactor;
+        if (!(mf >= 0 && mf <= 1)) fail("%s: material %d %s: metallicFactor must lie in [0, 1]", file, mi, mq.c_str());
+        if (!(rf >= 0 && rf <= 1)) fail("%s: material %d %s: roughnessFactor must lie in [0, 1]", file, mi, mq.c_str());
+        bm.metallic = (float)mf;
+        bm.roughness = (float)rf;
+        // after the emissive texture: the images of materials without it keep their indices
+        bm.metal_rough_tex1 =
+            1 + texture_image(gm.pbrMetallicRoughness.metallicRoughnessTexture, "metallicRoughness", mi, gm.name);
         materials_.push_back(bm);
     }
 }
@@ -1216,6 +1228,7 @@ void Importer::prepare_prim(int mi, int pi, Prim &p, bool *is_triangles)
             snprintf(d.name, sizeof d.name, "default");
             d.albedo[0] = d.albedo[1] = d.albedo[2] = 1.0f;
             d.albedo_tex = d.emission_tex = -1;
+            d.metallic = d.roughness = 1.0f;  // the spec's default material: a rough metal
             materials_.push_back(d);
             default_material_ = (int)materials_.size() - 1;
         }

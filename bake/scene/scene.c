@@ -138,6 +138,10 @@ int bk_scene_check(const bk_scene *s, char *err, size_t err_len)
         if ((m->albedo_tex >= 0 && (size_t)m->albedo_tex >= s->image_count) ||
             (m->emission_tex >= 0 && (size_t)m->emission_tex >= s->image_count))
             FAIL("material %zu (%s): texture index out of range", i, m->name);
+        if (!(m->metallic >= 0 && m->metallic <= 1) || !(m->roughness >= 0 && m->roughness <= 1))
+            FAIL("material %zu (%s): metallic and roughness must lie in [0, 1]", i, m->name);
+        if (m->metal_rough_tex1 < 0 || (m->metal_rough_tex1 > 0 && (size_t)m->metal_rough_tex1 > s->image_count))
+            FAIL("material %zu (%s): metallicRoughness texture index out of range", i, m->name);
     }
     for (size_t i = 0; i < s->light_count; i++) {
         const bk_light *l = &s->lights[i];

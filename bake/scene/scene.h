@@ -27,7 +27,21 @@ typedef struct bk_material {
     int albedo_tex;                /* index into scene images, -1 none (sampled with uv0) */
     int emission_tex;              /* index into scene images, -1 none (sampled with uv0) */
     int double_sided;
+    /* glTF metallic-roughness (bake/transport/GGX.md); zero is a Lambertian material, as before */
+    float metallic;                /* metallicFactor in [0, 1] (import: the glTF default 1) */
+    float roughness;               /* roughnessFactor in [0, 1] (import: the glTF default 1) */
+    int metal_rough_tex1;          /* 1 + index into scene images of the metallicRoughnessTexture
+                                      (B = metallic, G = roughness, multiplied by the factors;
+                                      sampled with uv0); 0 none, so a zeroed material has none */
 } bk_material;
+
+/* A material the transport treats as glossy (coupled diffuse + GGX, GGX.md): metallic > 0 or a
+ * metallicRoughness texture. Every other material takes the Lambertian path of albedo
+ * baseColor (the dielectric's 4 % specular ignored), so Lambertian scenes bake as before. */
+static inline int bk_material_glossy(const bk_material *m)
+{
+    return m->metallic > 0 || m->metal_rough_tex1 > 0;
+}
 
 enum bk_lighting { BK_LIGHTING_AUTO = 0, BK_LIGHTING_LIGHTMAP, BK_LIGHTING_LLG, BK_LIGHTING_NONE };
 

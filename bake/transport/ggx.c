@@ -97,3 +97,169 @@ double bk_ggx_pdf(double alpha, const double v[3], const double l[3])
     if (!(v[2] > 0) || !(l[2] > 0) || !half_vector(v, l, h)) return 0;
     return bk_ggx_g1(alpha, v[2]) * bk_ggx_d(alpha, h[2]) / (4 * v[2]);
 }
+
+/* ---- the albedo table and the coupled BSDF (ggx.h) ------------------------------------------- */
+
+/* stratified visible-normal samples per table entry: TABLE_NU in u1 (the radius on the
+ * projected hemisphere, whose rim holds the directions lost below the horizon: it needs the
+ * finer grid) × TABLE_NP in u2 */
+#ifndef TABLE_NU
+#define TABLE_NU 256
+#endif
+#ifndef TABLE_NP
+#define TABLE_NP 8
+#endif
+
+static double clamp01(double x) { return x > 0 ? (x < 1 ? x : 1) : 0; }
+
+/* A and B at (α, μ) by the visible-normal estimator: E = E_vndf[F·G2/G1(v)]. */
+static void table_entry(double alpha, double mu, double *a, double *b)
+{
+    const double v[3] = {sqrt(fmax(0.0, 1 - mu * mu)), 0, mu};
+    const double g1 = bk_ggx_g1(alpha, mu);
+    double sa = 0, sb = 0;
+    for (int i = 0; i < TABLE_NU; i++)
+        for (int j = 0; j < TABLE_NP; j++) {
+            double l[3];
+            if (!(bk_ggx_sample(alpha, v, (i + 0.5) / TABLE_NU, (j + 0.5) / TABLE_NP, l) > 0)) continue;
+            double h[3] = {v[0] + l[0], v[1] + l[1], v[2] + l[2]};
+            double hn = sqrt(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
+            double vh = hn > 0 ? (v[0] * h[0] + v[1] * h[1] + v[2] * h[2]) / hn : 0;
+            double w = bk_ggx_g2(alpha, mu, l[2]) / g1;
+            double m = 1 - clamp01(vh), m5 = m * m * m * m * m;
+            sa += (1 - m5) * w;
+            sb += m5 * w;
+        }
+    *a = sa / (TABLE_NU * TABLE_NP);
+    *b = sb / (TABLE_NU * TABLE_NP);
+}
+
+void bk_ggx_table_init(bk_ggx_table *t)
+{
+    const double h = 1.0 / (BK_GGX_TABLE_MU - 1);
+    for (int i = 0; i < BK_GGX_TABLE_R; i++) {
+        double r = (double)i / (BK_GGX_TABLE_R - 1);
+        for (int j = 0; j < BK_GGX_TABLE_MU; j++) {
+            double mu = j ? j * h : 1e-4, a, b;
+            table_entry(r * r, mu, &a, &b);
+            t->a[i][j] = (float)a;
+            t->b[i][j] = (float)b;
+        }
+        /* 2∫X(μ)μ dμ of the piecewise-linear interpolant (as evaluated: the float nodes) */
+        double sa = 0, sb = 0;
+        for (int j = 0; j + 1 < BK_GGX_TABLE_MU; j++) {
+            double m0 = j * h, m1 = (j + 1) * h;
+            sa += h * (t->a[i][j] * (2 * m0 + m1) + t->a[i][j + 1] * (m0 + 2 * m1)) / 6;
+            sb += h * (t->b[i][j] * (2 * m0 + m1) + t->b[i][j + 1] * (m0 + 2 * m1)) / 6;
+        }
+        t->abar[i] = 2 * sa;
+        t->bbar[i] = 2 * sb;
+    }
+}
+
+static void cell_of(double x, int n, int *i, double *f)
+{
+    double s = clamp01(x) * (n - 1);
+    int k = (int)s;
+    if (k > n - 2) k = n - 2;
+    *i = k;
+    *f = s - k;
+}
+
+void bk_ggx_table_eval(const bk_ggx_table *t, double roughness, double mu, double *a, double *b)
+{
+    int i, j;
+    double fr, fm;
+    cell_of(roughness, BK_GGX_TABLE_R, &i, &fr);
+    cell_of(mu, BK_GGX_TABLE_MU, &j, &fm);
+    double w00 = (1 - fr) * (1 - fm), w01 = (1 - fr) * fm, w10 = fr * (1 - fm), w11 = fr * fm;
+    *a = w00 * t->a[i][j] + w01 * t->a[i][j + 1] + w10 * t->a[i + 1][j] + w11 * t->a[i + 1][j + 1];
+    *b = w00 * t->b[i][j] + w01 * t->b[i][j + 1] + w10 * t->b[i + 1][j] + w11 * t->b[i + 1][j + 1];
+}
+
+void bk_ggx_table_mean(const bk_ggx_table *t, double roughness, double *abar, double *bbar)
+{
+    int i;
+    double fr;
+    cell_of(roughness, BK_GGX_TABLE_R, &i, &fr);
+    *abar = (1 - fr) * t->abar[i] + fr * t->abar[i + 1];
+    *bbar = (1 - fr) * t->bbar[i] + fr * t->bbar[i + 1];
+}
+
+static double lum3(const double c[3]) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
+
+int bk_mr_lobe_init(bk_mr_lobe *lb, const bk_ggx_table *t, const double base[3], double metallic, double roughness,
+                    const double v[3])
+{
+    if (!(v[2] > 0)) return 0;
+    metallic = clamp01(metallic);
+    roughness = clamp01(roughness);
+    lb->t = t;
+    lb->roughness = roughness;
+    lb->alpha = roughness * roughness;
+    for (int k = 0; k < 3; k++) lb->v[k] = v[k];
+    double a, b, abar, bbar, es[3], cd[3];
+    bk_ggx_table_eval(t, roughness, v[2], &a, &b);
+    bk_ggx_table_mean(t, roughness, &abar, &bbar);
+    for (int k = 0; k < 3; k++) {
+        double bc = clamp01(base[k]);
+        lb->f0[k] = 0.04 + (bc - 0.04) * metallic;
+        es[k] = fmin(1.0, lb->f0[k] * a + b);
+        double ebar = fmin(1.0, lb->f0[k] * abar + bbar);
+        double c_diff = (1 - metallic) * bc;
+        cd[k] = c_diff * (1 - es[k]);
+        lb->kd[k] = ebar < 1 ? cd[k] / (GGX_PI * (1 - ebar)) : 0;
+    }
+    /* pick a lobe in proportion to what it reflects towards v (any split is unbiased) */
+    double ws = lum3(es), wd = lum3(cd);
+    lb->p_spec = ws + wd > 0 ? ws / (ws + wd) : 1;
+    if (wd <= 0) lb->p_spec = 1;
+    return 1;
+}
+
+void bk_mr_lobe_eval(const bk_mr_lobe *lb, const double l[3], double f[3])
+{
+    f[0] = f[1] = f[2] = 0;
+    double h[3];
+    if (!(l[2] > 0) || !half_vector(lb->v, l, h)) return;
+    double spec = bk_ggx_spec(lb->alpha, lb->v, l);
+    double vh = lb->v[0] * h[0] + lb->v[1] * h[1] + lb->v[2] * h[2];
+    double a, b, es_l;
+    bk_ggx_table_eval(lb->t, lb->roughness, l[2], &a, &b);
+    for (int k = 0; k < 3; k++) {
+        es_l = fmin(1.0, lb->f0[k] * a + b);
+        f[k] = bk_ggx_fresnel(lb->f0[k], vh) * spec + lb->kd[k] * (1 - es_l);
+    }
+}
+
+double bk_mr_lobe_pdf(const bk_mr_lobe *lb, const double l[3])
+{
+    if (!(l[2] > 0)) return 0;
+    double ps = lb->p_spec;
+    return ps * bk_ggx_pdf(lb->alpha, lb->v, l) + (1 - ps) * l[2] / GGX_PI;
+}
+
+double bk_mr_lobe_sample(const bk_mr_lobe *lb, double u0, double u1, double u2, double l[3])
+{
+    if (u0 < lb->p_spec) {
+        bk_ggx_sample(lb->alpha, lb->v, u1, u2, l);
+    } else {
+        double r = sqrt(u1), ph = 2 * GGX_PI * u2;
+        l[0] = r * cos(ph), l[1] = r * sin(ph), l[2] = sqrt(fmax(0.0, 1 - u1));
+    }
+    return bk_mr_lobe_pdf(lb, l);
+}
+
+void bk_mr_albedo_mean(const bk_ggx_table *t, const double base[3], double metallic, double roughness, double out[3])
+{
+    double abar, bbar;
+    metallic = clamp01(metallic);
+    bk_ggx_table_mean(t, clamp01(roughness), &abar, &bbar);
+    for (int k = 0; k < 3; k++) {
+        double bc = clamp01(base[k]);
+        double f0 = 0.04 + (bc - 0.04) * metallic;
+        double ebar = fmin(1.0, f0 * abar + bbar);
+        /* mean over v of E_s(v) + c_diff(1 − E_s(v)): the mean of a linear function of E_s */
+        out[k] = ebar + (1 - metallic) * bc * (1 - ebar);
+    }
+}

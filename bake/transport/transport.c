@@ -2,6 +2,7 @@
 #include "bake/transport/transport.h"
 
 #include "bake/util/parallel.h"
+#include "bake/transport/ggx.h"
 #include "bake/transport/shading.h"
 #include "bake/transport/slc.h"
 #include "bake/transport/solid.h"
@@ -138,6 +139,13 @@ typedef struct tp_cell {
                           sides alike), 0 when next-event estimation never picks it */
 } tp_cell;
 
+/* The glossy part of a cell (GGX.md): base colour (after the albedo hook), metallic and
+ * roughness at its centroid; `on` = 0 for cells of Lambertian materials (and black ones). */
+typedef struct tp_gloss {
+    float base[3], metallic, roughness;
+    uint8_t on;
+} tp_gloss;
+
 /* A sub-triangle of an emissive triangle that light samples pick (one per (tri, sub), shared
  * by both sides of a double-sided emitter). */
 typedef struct tp_emitter {
@@ -170,6 +178,10 @@ typedef struct tp_ctx {
     float *tri_cell_h;     /* size of the triangle's cells (metres): what "near" is measured in */
     float *tri_le;         /* 3 per triangle: emission factor after the light-set filter */
     int32_t *tri_le_tex;   /* emission texture per triangle, -1 none */
+    /* glossy materials (GGX.md): per cell, NULL when the scene has none (then every path is
+     * the Lambertian one, bytes as before), and the coupling's albedo table */
+    tp_gloss *gloss;
+    bk_ggx_table *ggx;
     /* next-event estimation: emitter sub-triangles picked by power through a CDF */
     int nee;
     size_t em_count;
@@ -446,8 +458,31 @@ static size_t em_pick(const tp_ctx *c, double u, double *rem)
  * [0,1)²: picks an emitter sub-triangle by power, a uniform point on it, and traces a shadow
  * ray. Returns 1 and fills the unit direction d, cos_p = d·n and val = Le·w_L/p_L (radiance
  * over its solid-angle pdf, MIS-weighted) when the sample carries light. */
+/* A glossy point's BSDF in its frame (t, b, n): what light samples there are weighed against. */
+typedef struct tp_lobe {
+    bk_mr_lobe lb;
+    double t[3], b[3], n[3];
+} tp_lobe;
+
+static void to_local(const tp_lobe *lf, const double d[3], double l[3])
+{
+    l[0] = d[0] * lf->t[0] + d[1] * lf->t[1] + d[2] * lf->t[2];
+    l[1] = d[0] * lf->b[0] + d[1] * lf->b[1] + d[2] * lf->b[2];
+    l[2] = d[0] * lf->n[0] + d[1] * lf->n[1] + d[2] * lf->n[2];
+}
+
+static int nee_sample_lobe(const tp_ctx *c, const float o[3], const double n[3], int kind, const tp_lobe *lf,
+                           double u0, double u1, double d[3], double *cos_p, double val[3], uint64_t *shadow);
+
 static int nee_sample(const tp_ctx *c, const float o[3], const double n[3], int kind, double u0, double u1,
                       double d[3], double *cos_p, double val[3], uint64_t *shadow)
+{
+    return nee_sample_lobe(c, o, n, kind, NULL, u0, u1, d, cos_p, val, shadow);
+}
+
+/* nee_sample weighed against the lobe lf's density instead of the gather pdf (lf NULL: that). */
+static int nee_sample_lobe(const tp_ctx *c, const float o[3], const double n[3], int kind, const tp_lobe *lf,
+                           double u0, double u1, double d[3], double *cos_p, double val[3], uint64_t *shadow)
 {
     double rem;
     const tp_emitter *em = &c->em[em_pick(c, u0, &rem)];
@@ -475,7 +510,15 @@ static int nee_sample(const tp_ctx *c, const float o[3], const double n[3], int 
     if (le[0] <= 0 && le[1] <= 0 && le[2] <= 0) return 0;
     double pl = cell->nee_parea * dist2 / cl;
     if (!(pl > 0) || !isfinite(pl)) return 0;
-    double w = mis_power(pl, gather_pdf(kind, cp));
+    double pg;
+    if (lf) {
+        double l[3];
+        to_local(lf, d, l);
+        pg = bk_mr_lobe_pdf(&lf->lb, l);
+    } else {
+        pg = gather_pdf(kind, cp);
+    }
+    double w = mis_power(pl, pg);
     /* shadow ray to the point moved off the emitter toward the origin, stopped just short */
     float xf[3] = {(float)x[0], (float)x[1], (float)x[2]}, xo[3];
     float ns[3] = {side ? -ng[0] : ng[0], side ? -ng[1] : ng[1], side ? -ng[2] : ng[2]};
@@ -535,7 +578,8 @@ static lbk_result slc_draw(const tp_ctx *c, int dom, int h, int pass, const bk_s
 
 static int near_hit(const tp_ctx *c, const bk_hit *h, long hc, const uint8_t *rough)
 {
-    return hc >= 0 && (h->t < TP_NEAR_CELLS * c->tri_cell_h[h->tri] || (rough && rough[hc]));
+    return hc >= 0 && (h->t < TP_NEAR_CELLS * c->tri_cell_h[h->tri] || (rough && rough[hc]) ||
+                       (c->gloss && c->gloss[hc].on));
 }
 
 /* ---- rough cells ---------------------------------------------------------------------------- */
@@ -604,16 +648,27 @@ static void mark_rough(tp_ctx *c)
  * k−1 at its near hit: the sources for k = 2, bounce k−2's cells beyond. */
 typedef struct tp_near_mode { const float *read; const uint8_t *rough; int sources, max_depth; } tp_near_mode;
 
-/* Light li at the continued point x (normal n, ray origin o), weighted `scale`, into e. */
+/* Light li at the continued point x (normal n, ray origin o), weighted `scale`, into e (through
+ * the BSDF lf at a glossy point; NULL: irradiance). */
 static void near_light(const tp_ctx *c, size_t li, const double x[3], const double n[3], const float o[3], double scale,
-                       double e[3], tp_count *cnt)
+                       const tp_lobe *lf, double e[3], tp_count *cnt)
 {
     double val[3], ld[3], dist;
     if (!bk_light_eval(c->lights[li], x, val, ld, &dist)) return;
     double cs = ld[0] * n[0] + ld[1] * n[1] + ld[2] * n[2];
     if (cs <= 0) return;
+    double f[3] = {1, 1, 1};
+    if (lf) { /* a glossy point: through its BSDF */
+        double l[3];
+        to_local(lf, ld, l);
+        bk_mr_lobe_eval(&lf->lb, l, f);
+        if (f[0] <= 0 && f[1] <= 0 && f[2] <= 0) return;
+    }
     cnt->shadow++;
-    if (bk_light_visible(c->tracer, o, ld, dist))
+    if (!bk_light_visible(c->tracer, o, ld, dist)) return;
+    if (lf)
+        for (int a = 0; a < 3; a++) e[a] += scale * val[a] * cs * f[a];
+    else
         for (int a = 0; a < 3; a++) e[a] += scale * val[a] * cs;
 }
 
@@ -631,11 +686,13 @@ static size_t slc_pick(const tp_ctx *c, double u, double *scale)
     return c->slc_pick_ids[lo];
 }
 
-static void near_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, long hc, int depth, tp_rng *rng,
-                          tp_count *cnt, double out[3])
+static void near_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, long hc, const double din[3],
+                          int depth, tp_rng *rng, tp_count *cnt, double out[3]);
+
+/* The continued point of `hit` (on cell's side) and its offset ray origin o. */
+static void cont_point(const tp_ctx *c, const bk_hit *hit, const tp_cell *cell, double x[3], float o[3])
 {
-    const tp_cell *cell = &c->cells[hc];
-    double v[3][3], x[3];
+    double v[3][3];
     tri_vertices(c, hit->tri, v);
     /* the point a hair inside its triangle: a hit on an edge where another surface meets it (a
      * box's corner) rounds to either side, and from the far side of that surface the
@@ -646,38 +703,106 @@ static void near_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, 
         hu *= k, hv *= k;
     }
     for (int a = 0; a < 3; a++) x[a] = (1.0 - hu - hv) * v[0][a] + hu * v[1][a] + hv * v[2][a];
-    double n[3] = {cell->n[0], cell->n[1], cell->n[2]}, t[3], b[3];
-    bk_onb(n, t, b);
-    float xf[3] = {(float)x[0], (float)x[1], (float)x[2]}, nf[3] = {cell->n[0], cell->n[1], cell->n[2]}, o[3];
+    float xf[3] = {(float)x[0], (float)x[1], (float)x[2]}, nf[3] = {cell->n[0], cell->n[1], cell->n[2]};
     bk_offset_ray_origin_scaled(xf, nf, bk_tracer_tri_scale(c->tracer, hit->tri), o);
-    double u1 = rng_next(rng), ph = 2 * TP_PI * rng_next(rng), rr = sqrt(u1), lz = sqrt(fmax(0.0, 1 - u1));
-    double d[3];
-    for (int a = 0; a < 3; a++) d[a] = rr * cos(ph) * t[a] + rr * sin(ph) * b[a] + lz * n[a];
+}
+
+/* What a continuation ray from o along unit d brings back: sky, emission (MIS-weighted against
+ * the light samples with the continuation's own density pg) and the cache — or the exact
+ * radiance where that hit is near, rough or glossy too (up to md->max_depth in a row). */
+static void cont_trace(tp_ctx *c, const tp_near_mode *md, const float o[3], const double d[3], double pg, int depth,
+                       tp_rng *rng, tp_count *cnt, double L[3])
+{
     float df[3] = {(float)d[0], (float)d[1], (float)d[2]};
-    double L[3] = {0, 0, 0};
+    L[0] = L[1] = L[2] = 0;
     bk_hit h2;
     cnt->rays++;
     if (!bk_tracer_intersect(c->tracer, o, df, 0.0f, INFINITY, &h2)) {
         if (md->sources) sky_radiance(c, d, L);
-    } else {
-        long h2c = hit_cell(c, &h2);
-        if (h2c >= 0) {
-            if (md->sources) {
-                emission_at(c, h2.tri, h2.u, h2.v, L);
-                if (L[0] > 0 || L[1] > 0 || L[2] > 0) {
-                    double w = mis_gather(c, &h2, h2c, d, lz / TP_PI);
-                    for (int a = 0; a < 3; a++) L[a] *= w;
-                }
-            }
-            double r2[3] = {0, 0, 0};
-            if (md->read && depth + 1 < md->max_depth && near_hit(c, &h2, h2c, md->rough)) {
-                near_radiance(c, md, &h2, h2c, depth + 1, rng, cnt, r2);
-            } else if (md->read) {
-                for (int a = 0; a < 3; a++) r2[a] = md->read[3 * h2c + a];
-            }
-            for (int a = 0; a < 3; a++) L[a] += r2[a];
+        return;
+    }
+    long h2c = hit_cell(c, &h2);
+    if (h2c < 0) return;
+    if (md->sources) {
+        emission_at(c, h2.tri, h2.u, h2.v, L);
+        if (L[0] > 0 || L[1] > 0 || L[2] > 0) {
+            double w = mis_gather(c, &h2, h2c, d, pg);
+            for (int a = 0; a < 3; a++) L[a] *= w;
         }
     }
+    double r2[3] = {0, 0, 0};
+    if (md->read && depth + 1 < md->max_depth && near_hit(c, &h2, h2c, md->rough)) {
+        near_radiance(c, md, &h2, h2c, d, depth + 1, rng, cnt, r2);
+    } else if (md->read) {
+        for (int a = 0; a < 3; a++) r2[a] = md->read[3 * h2c + a];
+    }
+    for (int a = 0; a < 3; a++) L[a] += r2[a];
+}
+
+/* One punctual light (picked as near_radiance picks it) at a continued point x, into e:
+ * E·(Lambertian: nothing more; glossy lf: × f(v, l) per channel). */
+static void cont_punctual(const tp_ctx *c, const double x[3], const double n[3], const float o[3], const tp_lobe *lf,
+                          tp_rng *rng, double e[3], tp_count *cnt);
+
+/* Reflected radiance (all bounces, emission excluded) at a glossy hit towards -din: one sample
+ * of the coupled BSDF (GGX.md) traced like a Lambertian continuation, one light sample weighed
+ * against the BSDF's density (MIS), one punctual light through the BSDF. */
+static void gloss_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, long hc, const double din[3],
+                           int depth, tp_rng *rng, tp_count *cnt, double out[3])
+{
+    const tp_cell *cell = &c->cells[hc];
+    const tp_gloss *g = &c->gloss[hc];
+    double x[3];
+    float o[3];
+    cont_point(c, hit, cell, x, o);
+    tp_lobe lf;
+    for (int a = 0; a < 3; a++) lf.n[a] = cell->n[a];
+    bk_onb(lf.n, lf.t, lf.b);
+    double vw[3] = {-din[0], -din[1], -din[2]}, v[3];
+    to_local(&lf, vw, v);
+    out[0] = out[1] = out[2] = 0;
+    const double base[3] = {g->base[0], g->base[1], g->base[2]};
+    if (!bk_mr_lobe_init(&lf.lb, c->ggx, base, g->metallic, g->roughness, v)) return;
+    double u0 = rng_next(rng), u1 = rng_next(rng), u2 = rng_next(rng), l[3];
+    double pdf = bk_mr_lobe_sample(&lf.lb, u0, u1, u2, l);
+    if (pdf > 0 && l[2] > 0) {
+        double d[3], f[3], L[3];
+        for (int a = 0; a < 3; a++) d[a] = l[0] * lf.t[a] + l[1] * lf.b[a] + l[2] * lf.n[a];
+        bk_mr_lobe_eval(&lf.lb, l, f);
+        cont_trace(c, md, o, d, pdf, depth, rng, cnt, L);
+        for (int a = 0; a < 3; a++) out[a] += f[a] * l[2] / pdf * L[a];
+    }
+    if (md->sources && c->nee) {
+        double ld[3], cq, val[3];
+        double a0 = rng_next(rng), a1 = rng_next(rng);
+        if (nee_sample_lobe(c, o, lf.n, PG_COSINE, &lf, a0, a1, ld, &cq, val, &cnt->shadow) && bk_finite3(val)) {
+            double ll[3], f[3];
+            to_local(&lf, ld, ll);
+            bk_mr_lobe_eval(&lf.lb, ll, f);
+            for (int a = 0; a < 3; a++) out[a] += val[a] * f[a] * cq;
+        }
+    }
+    if (md->sources && c->light_count) cont_punctual(c, x, lf.n, o, &lf, rng, out, cnt);
+}
+
+static void near_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, long hc, const double din[3],
+                          int depth, tp_rng *rng, tp_count *cnt, double out[3])
+{
+    if (c->gloss && c->gloss[hc].on) {
+        gloss_radiance(c, md, hit, hc, din, depth, rng, cnt, out);
+        return;
+    }
+    const tp_cell *cell = &c->cells[hc];
+    double x[3];
+    float o[3];
+    cont_point(c, hit, cell, x, o);
+    double n[3] = {cell->n[0], cell->n[1], cell->n[2]}, t[3], b[3];
+    bk_onb(n, t, b);
+    double u1 = rng_next(rng), ph = 2 * TP_PI * rng_next(rng), rr = sqrt(u1), lz = sqrt(fmax(0.0, 1 - u1));
+    double d[3];
+    for (int a = 0; a < 3; a++) d[a] = rr * cos(ph) * t[a] + rr * sin(ph) * b[a] + lz * n[a];
+    double L[3];
+    cont_trace(c, md, o, d, lz / TP_PI, depth, rng, cnt, L);
     double e[3] = {TP_PI * L[0], TP_PI * L[1], TP_PI * L[2]};
     if (md->sources && c->nee) {
         /* the light sample that pairs with the gather above (MIS): a point next to an emitter
@@ -688,22 +813,26 @@ static void near_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, 
         if (nee_sample(c, o, n, PG_COSINE, u0, u1n, ld, &cq, val, &cnt->shadow) && bk_finite3(val))
             for (int a = 0; a < 3; a++) e[a] += val[a] * cq;
     }
-    if (md->sources && c->light_count) {
-        /* one light: uniformly; with culling (many lights) a positional one in proportion to its
-         * intensity (a uniform pick among thousands almost never finds the lamp that matters)
-         * and every directional one */
-        double u = rng_next(rng), scale = (double)c->light_count;
-        size_t li = (size_t)(u * (double)c->light_count);
-        if (c->slc) {
-            li = slc_pick(c, u, &scale);
-            const uint32_t *always;
-            size_t na = bk_slc_always(c->slc_recv, &always);
-            for (size_t k = 0; k < na; k++) near_light(c, always[k], x, n, o, 1, e, cnt);
-        }
-        if (li >= c->light_count) li = c->light_count - 1;
-        near_light(c, li, x, n, o, scale, e, cnt);
-    }
+    if (md->sources && c->light_count) cont_punctual(c, x, n, o, NULL, rng, e, cnt);
     for (int a = 0; a < 3; a++) out[a] = cell->albedo[a] / TP_PI * e[a];
+}
+
+static void cont_punctual(const tp_ctx *c, const double x[3], const double n[3], const float o[3], const tp_lobe *lf,
+                          tp_rng *rng, double e[3], tp_count *cnt)
+{
+    /* one light: uniformly; with culling (many lights) a positional one in proportion to its
+     * intensity (a uniform pick among thousands almost never finds the lamp that matters)
+     * and every directional one */
+    double u = rng_next(rng), scale = (double)c->light_count;
+    size_t li = (size_t)(u * (double)c->light_count);
+    if (c->slc) {
+        li = slc_pick(c, u, &scale);
+        const uint32_t *always;
+        size_t na = bk_slc_always(c->slc_recv, &always);
+        for (size_t k = 0; k < na; k++) near_light(c, always[k], x, n, o, 1, lf, e, cnt);
+    }
+    if (li >= c->light_count) li = c->light_count - 1;
+    near_light(c, li, x, n, o, scale, lf, e, cnt);
 }
 
 /* ---- cache: one bounce for a range of cells ------------------------------------------------ */
@@ -756,7 +885,7 @@ static void cell_sample(tp_ctx *c, const double n[3], int j, const double p[3],
             } else if (near_hit(c, hit, hc, c->rough)) {
                 /* bounce k−1 at the exact point (see near_radiance) */
                 const tp_near_mode md = {k == 2 ? NULL : c->l_prev2[h], NULL, k == 2, 1};
-                near_radiance(c, &md, hit, hc, 0, near_rng, cnt, L);
+                near_radiance(c, &md, hit, hc, d, 0, near_rng, cnt, L);
             } else {
                 for (int a = 0; a < 3; a++) L[a] = prev[3 * hc + a];
             }
@@ -1155,7 +1284,7 @@ static long gather_hit(tp_ctx *c, const float *sum, const uint8_t *rough, const 
     int near = near_hit(c, hit, hc, rough);
     if (near) {
         const tp_near_mode md = {sum, rough, 1, TP_NEAR_DEPTH};
-        near_radiance(c, &md, hit, hc, 0, cont, cnt, r);
+        near_radiance(c, &md, hit, hc, d, 0, cont, cnt, r);
     } else {
         for (int a = 0; a < 3; a++) r[a] = sum[3 * hc + a];
     }
@@ -1237,7 +1366,7 @@ static void recv_half(tp_ctx *c, const bk_receiver *r, size_t i, int h, int S, c
             if (hc >= 0 && (j0 + jj) % TP_PROBE_EVERY == 0) {
                 double q[3];
                 const tp_near_mode md = {sum, c->rough, 1, TP_NEAR_DEPTH};
-                near_radiance(c, &md, &hits[jj], hc, 0, &probe, cnt, q);
+                near_radiance(c, &md, &hits[jj], hc, dd[jj], 0, &probe, cnt, q);
                 double cs = (sphere ? 1 : zz[jj]) * TP_PROBE_EVERY;
                 if (bk_finite3(q))
                     for (int a = 0; a < 3; a++) rs->eb[a] += (q[a] - sum[3 * hc + a]) * cs;
@@ -1434,6 +1563,7 @@ static void free_ctx(tp_ctx *c)
 {
     free(c->cells); free(c->tri_first); free(c->tri_m); free(c->tri_sides); free(c->tri_closed); free(c->tri_cell_h); free(c->tri_edge_eps);
     free(c->tri_le); free(c->tri_le_tex); free(c->em); free(c->em_cdf);
+    free(c->gloss); free(c->ggx);
     free(c->thread_shadow);
     free(c->lights);
     for (int h = 0; h < 2; h++) {
@@ -1518,6 +1648,46 @@ static lbk_result size_cells(tp_ctx *c, size_t *count_out)
     }
 }
 
+/* The glossy cells' storage and the coupling's table, only when a triangle's material is glossy
+ * (a scene without one runs exactly the Lambertian code). */
+static lbk_result gloss_init(tp_ctx *c)
+{
+    const bk_scene *s = c->scene;
+    int any = 0;
+    for (size_t i = 0; i < s->tri_count && !any; i++) {
+        uint32_t mi = s->tri_material ? s->tri_material[i] : 0;
+        any = mi < s->material_count && bk_material_glossy(&s->materials[mi]);
+    }
+    if (!any) return LBK_OK;
+    c->gloss = calloc(c->cell_count ? c->cell_count : 1, sizeof *c->gloss);
+    c->ggx = malloc(sizeof *c->ggx);
+    if (!c->gloss || !c->ggx) return LBK_ERR_OUT_OF_MEMORY;
+    bk_ggx_table_init(c->ggx);
+    return LBK_OK;
+}
+
+/* A glossy material's cell at uv: base colour = the (hooked) albedo, metallic and roughness =
+ * factor × texture (B, G); the cell's Lambertian albedo (what a read of its cache reflects,
+ * where a chain of continuations ends on it) becomes the coupled BSDF's mean albedo. A cell the
+ * hook made black (a closed door in a set run) stays black and Lambertian. */
+static void cell_gloss(const tp_ctx *c, const bk_material *mat, const double uv[2], float albedo[3], tp_gloss *gl)
+{
+    if (albedo[0] <= 0 && albedo[1] <= 0 && albedo[2] <= 0) return;
+    double mr[3] = {1, 1, 1};
+    if (mat->metal_rough_tex1 > 0)
+        bk_sample_image(bk_scene_image(c->scene, mat->metal_rough_tex1 - 1), uv[0], uv[1], mr);
+    double metal = mat->metallic * mr[2], rough = mat->roughness * mr[1];
+    gl->metallic = (float)(isfinite(metal) ? fmin(fmax(metal, 0), 1) : 0);
+    gl->roughness = (float)(isfinite(rough) ? fmin(fmax(rough, 0), 1) : 1);
+    double base[3] = {albedo[0], albedo[1], albedo[2]}, mean[3];
+    bk_mr_albedo_mean(c->ggx, base, gl->metallic, gl->roughness, mean);
+    for (int k = 0; k < 3; k++) {
+        gl->base[k] = albedo[k];
+        albedo[k] = (float)fmin(fmax(mean[k], 0), 0.999);
+    }
+    gl->on = 1;
+}
+
 static lbk_result build_cells(tp_ctx *c)
 {
     const bk_scene *s = c->scene;
@@ -1553,6 +1723,8 @@ static lbk_result build_cells(tp_ctx *c)
     c->cell_count = count;
     c->cells = calloc(count ? count : 1, sizeof *c->cells);
     if (!c->cells) return LBK_ERR_OUT_OF_MEMORY;
+    r = gloss_init(c);
+    if (r != LBK_OK) return r;
     for (size_t i = 0; i < nt; i++) {
         uint32_t mi = s->tri_material ? s->tri_material[i] : 0;
         const bk_material *mat = mi < s->material_count ? &s->materials[mi] : NULL;
@@ -1595,7 +1767,11 @@ static lbk_result build_cells(tp_ctx *c)
                 for (int k = 0; k < 3; k++)
                     albedo[k] = isfinite(albedo[k]) ? (albedo[k] < 0 ? 0 : albedo[k] > 0.999f ? 0.999f : albedo[k]) : 0;
             }
+            tp_gloss gl;
+            memset(&gl, 0, sizeof gl);
+            if (c->gloss && mat && bk_material_glossy(mat)) cell_gloss(c, mat, uv, albedo, &gl);
             for (int side = 0; side < c->tri_sides[i]; side++) {
+                if (gl.on) c->gloss[c->tri_first[i] + (size_t)side * m * m + sub] = gl;
                 tp_cell *cell = &c->cells[c->tri_first[i] + (size_t)side * m * m + sub];
                 cell->tri = (uint32_t)i;
                 cell->sub = (uint32_t)sub;

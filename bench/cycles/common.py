@@ -101,11 +101,46 @@ def blender():
     return os.environ.get("BLENDER", "blender")
 
 
+def _file_hash(path):
+    import hashlib
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def _sensor_hash(path):
+    """What Cycles reads of a sensor file (cycles_bake.read_sensors): the points and normals and
+    the offset, not lbk's values in the same rows (a new lbk build keeps the reference)."""
+    import hashlib
+    h = hashlib.sha256()
+    with open(path) as f:
+        for line in f:
+            if line.startswith("# sensor_offset"):
+                h.update(line.encode())
+            elif not line.startswith("#"):
+                h.update("\t".join(line.rstrip("\n").split("\t")[:12]).encode() + b"\n")
+    return h.hexdigest()
+
+
 def run_cycles(scene, sensors, out, runs, sky=(0, 0, 0), threads=0, log=None, equal_time=0.0, clock="cpu",
-               refs=()):
+               refs=(), keep=False):
     """Bakes the sensors in one Blender session: each (spp, seed) of runs, then (equal_time > 0)
     one run at the sample count that takes equal_time on `clock`, then the refs. Returns the
-    runs.json entries of this session, in order."""
+    runs.json entries of this session, in order. keep: when `out` holds a finished session of
+    the same inputs (key.json: scene and sensor file hashes, runs, sky, threads, the harness's
+    own scripts), return it instead of baking again (BENCH_CYCLES_KEEP_REFS, for references)."""
+    key = {"scene": _file_hash(scene) if scene else "", "sensors": _sensor_hash(sensors), "runs": list(map(list, runs)),
+           "refs": list(map(list, refs)), "sky": list(sky), "threads": threads, "equal_time": equal_time,
+           "harness": [_file_hash(os.path.join(HERE, f)) for f in ("cycles_bake.py", "gltf_scene.py")]}
+    key_path = os.path.join(out, "key.json")
+    if keep and os.path.exists(key_path) and os.path.exists(os.path.join(out, "runs.json")):
+        with open(key_path) as f:
+            if json.load(f) == key:
+                return json.load(open(os.path.join(out, "runs.json")))
+    if os.path.exists(key_path):
+        os.remove(key_path)
     cmd = [blender(), "-b", "--factory-startup", "--python", os.path.join(HERE, "cycles_bake.py"), "--",
            "--sensors", sensors, "--out", out, "--sky", ",".join("%g" % x for x in sky),
            "--threads", str(threads), "--runs", ",".join("%d:%d" % r for r in runs),
@@ -119,6 +154,8 @@ def run_cycles(scene, sensors, out, runs, sky=(0, 0, 0), threads=0, log=None, eq
         p = subprocess.run(cmd, stdout=lf, stderr=subprocess.STDOUT)
     if p.returncode != 0:
         sys.exit("bench-cycles: Blender failed (%d); see %s" % (p.returncode, log or os.path.join(out, "blender.log")))
+    with open(key_path, "w") as f:
+        json.dump(key, f)
     return json.load(open(os.path.join(out, "runs.json")))
 
 

@@ -141,11 +141,15 @@ def setup_cycles(scene, threads, bounces):
     c.use_denoising = False
     c.max_bounces = bounces
     c.diffuse_bounces = bounces
-    c.glossy_bounces = 0
+    # glossy materials (Principled, gltf_scene.is_glossy): the sensors' diffuse rays must see
+    # the light a metal reflects, i.e. diffuse -> glossy paths (Cycles' "reflective caustics")
+    glossy = bool(scene.get("lbk_glossy", 0))
+    c.glossy_bounces = bounces if glossy else 0
     c.transmission_bounces = 0
     c.volume_bounces = 0
     c.transparent_max_bounces = 8
-    c.caustics_reflective = False
+    c.caustics_reflective = glossy
+    c.blur_glossy = 0.0
     c.caustics_refractive = False
     c.sample_clamp_direct = 0.0
     c.sample_clamp_indirect = 0.0

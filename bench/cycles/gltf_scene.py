@@ -12,10 +12,14 @@ positions of texel_dump are in the same frame), and:
             shader of colour C and strength S emits radiance C*S, checked by analytic.py).
             A material that is not doubleSided is black and non-emitting on its back side
             (as lbk: the back of a one-sided surface carries no radiance; it still occludes).
+            Glossy materials (lbk's rule, bake/transport/GGX.md: metallicFactor > 0, glTF's
+            default being 1, or a metallicRoughnessTexture) become a Principled BSDF instead:
+            base colour as above, metallic and roughness = factor x texture (B, G; Non-Color),
+            GGX (single scattering, as lbk), specular 0.5 (F0 = 0.04 for the dielectric part).
   lights    KHR_lights_punctual, converted by LIGHT_UNITS below (proved by analytic.py).
   sky       a uniform world colour of radiance `sky` (Background strength 1 = radiance 1).
 
-Metallic, roughness, normal maps, transmission and alpha are ignored, as lbk ignores them.
+Normal maps, transmission and alpha are ignored, as lbk ignores them.
 """
 import array
 import base64
@@ -139,9 +143,10 @@ def world_nodes(g):
 
 # ---- materials --------------------------------------------------------------------------
 
-def _image(g, tex_index, cache):
-    if tex_index in cache:
-        return cache[tex_index]
+def _image(g, tex_index, cache, colorspace="sRGB"):
+    key = (tex_index, colorspace)  # one Blender image per colour space (metallicRoughness: Non-Color)
+    if key in cache:
+        return cache[key]
     tex = g.json["textures"][tex_index]
     src = tex.get("source")
     img = None
@@ -162,8 +167,8 @@ def _image(g, tex_index, cache):
             img = bpy.data.images.load(tmp)
             img.pack()
             os.unlink(tmp)
-        img.colorspace_settings.name = "sRGB"
-    cache[tex_index] = img
+        img.colorspace_settings.name = colorspace
+    cache[key] = img
     return img
 
 
@@ -182,6 +187,54 @@ def _texture_times(nodes, links, img, factor, uv_node):
     return mul.outputs["Color"]
 
 
+def is_glossy(gm):
+    """lbk's rule (bake/transport/GGX.md): not Lambertian when metallicFactor (default 1) > 0 or
+    a metallicRoughnessTexture is given; a material without pbrMetallicRoughness is the default
+    (metallic 1, roughness 1)."""
+    pbr = gm.get("pbrMetallicRoughness", {})
+    return pbr.get("metallicFactor", 1.0) > 0 or "metallicRoughnessTexture" in pbr
+
+
+def _principled(g, nodes, links, pbr, uv, cache):
+    p = nodes.new("ShaderNodeBsdfPrincipled")
+    p.distribution = "GGX"
+    p.inputs["Specular"].default_value = 0.5
+    p.inputs["Specular Tint"].default_value = 0.0
+    p.inputs["Sheen"].default_value = 0.0
+    p.inputs["Clearcoat"].default_value = 0.0
+    p.inputs["Subsurface"].default_value = 0.0
+    metal, rough = pbr.get("metallicFactor", 1.0), pbr.get("roughnessFactor", 1.0)
+    p.inputs["Metallic"].default_value = metal
+    p.inputs["Roughness"].default_value = rough
+    mr = pbr.get("metallicRoughnessTexture")
+    if mr is not None and mr.get("texCoord", 0) == 0:
+        img = _image(g, mr["index"], cache, "Non-Color")
+        if img is not None:
+            t = nodes.new("ShaderNodeTexImage")
+            t.image = img
+            t.interpolation = "Closest"
+            t.extension = "REPEAT"
+            links.new(uv.outputs["UV"], t.inputs["Vector"])
+            sep = nodes.new("ShaderNodeSeparateRGB")
+            links.new(t.outputs["Color"], sep.inputs["Image"])
+            for ch, factor, socket in (("B", metal, "Metallic"), ("G", rough, "Roughness")):
+                m = nodes.new("ShaderNodeMath")
+                m.operation = "MULTIPLY"
+                m.inputs[1].default_value = factor
+                links.new(sep.outputs[ch], m.inputs[0])
+                links.new(m.outputs["Value"], p.inputs[socket])
+    return p
+
+
+def scene_is_glossy(g):
+    """Whether any material Cycles builds for the glTF is glossy (a primitive without material
+    gets the default one, which is)."""
+    mats = g.json.get("materials", [])
+    if any(is_glossy(m) for m in mats):
+        return True
+    return any("material" not in p for m in g.json.get("meshes", []) for p in m.get("primitives", []))
+
+
 def lambert_material(g, mi, cache):
     """Blender material for glTF material mi (None: the glTF default material)."""
     gm = g.json["materials"][mi] if mi is not None else {}
@@ -197,13 +250,16 @@ def lambert_material(g, mi, cache):
     uv.uv_map = "UVMap"
     pbr = gm.get("pbrMetallicRoughness", {})
     base = pbr.get("baseColorFactor", [1, 1, 1, 1])
-    diff = nodes.new("ShaderNodeBsdfDiffuse")
-    diff.inputs["Roughness"].default_value = 0.0
-    diff.inputs["Color"].default_value = (base[0], base[1], base[2], 1.0)
+    if is_glossy(gm):
+        diff = _principled(g, nodes, links, pbr, uv, cache)
+    else:
+        diff = nodes.new("ShaderNodeBsdfDiffuse")
+        diff.inputs["Roughness"].default_value = 0.0
+    diff.inputs["Base Color" if is_glossy(gm) else "Color"].default_value = (base[0], base[1], base[2], 1.0)
     if "baseColorTexture" in pbr and pbr["baseColorTexture"].get("texCoord", 0) == 0:
         img = _image(g, pbr["baseColorTexture"]["index"], cache)
         if img is not None:
-            links.new(_texture_times(nodes, links, img, base, uv), diff.inputs["Color"])
+            links.new(_texture_times(nodes, links, img, base, uv), diff.inputs["Base Color" if is_glossy(gm) else "Color"])
     front = diff.outputs["BSDF"]
     ef = gm.get("emissiveFactor", [0, 0, 0])
     strength = gm.get("extensions", {}).get("KHR_materials_emissive_strength", {}).get("emissiveStrength", 1.0)
@@ -405,4 +461,5 @@ def load(path, scene, sky=(0.0, 0.0, 0.0)):
         if li is not None:
             add_light(lights[li], m, col, lights[li].get("name") or "light%d" % li)
     set_sky(scene, sky)
+    scene["lbk_glossy"] = 1 if scene_is_glossy(g) else 0
     return objects

@@ -1,6 +1,6 @@
 """A minimal glTF 2.0 writer (plain Python 3, also usable inside Blender) for the bench's own
 scenes: triangle meshes with POSITION, NORMAL, optional TEXCOORD_0/TEXCOORD_1, Lambert-style
-materials (base colour, emission, emissive strength, doubleSided), KHR_lights_punctual lights
+materials (base colour, metallic/roughness factors, emission, emissive strength, doubleSided), KHR_lights_punctual lights
 and node extras. One embedded base64 buffer, so a scene is one self-contained .gltf file."""
 import base64
 import json
@@ -39,9 +39,12 @@ class Writer:
                                      "count": len(idx), "type": "SCALAR"})
         return len(self.js["accessors"]) - 1
 
-    def material(self, name, base=(0.8, 0.8, 0.8), emission=(0, 0, 0), strength=1.0, double_sided=False):
+    def material(self, name, base=(0.8, 0.8, 0.8), emission=(0, 0, 0), strength=1.0, double_sided=False,
+                 metallic=0.0, roughness=1.0):
+        """metallic 0 (written explicitly: glTF's default is 1) is a Lambertian surface to lbk."""
         m = {"name": name, "pbrMetallicRoughness": {"baseColorFactor": [base[0], base[1], base[2], 1.0],
-                                                    "metallicFactor": 0.0, "roughnessFactor": 1.0},
+                                                    "metallicFactor": float(metallic),
+                                                    "roughnessFactor": float(roughness)},
              "emissiveFactor": list(emission), "doubleSided": bool(double_sided)}
         if strength != 1.0:
             m["extensions"] = {"KHR_materials_emissive_strength": {"emissiveStrength": strength}}

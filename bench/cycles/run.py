@@ -39,7 +39,14 @@ SCENES = [
      "sky": (1, 1, 1), "ref_spp": 512, "calib": (4, 16)},
     {"name": "furnished_room", "gltf": "{work}/furnished_room.gltf", "lbk": ["--sky", "1,1,1"], "sky": (1, 1, 1),
      "ref_spp": 2048, "calib": (8, 32), "make": "make_furnished_room.py"},
-]
+    # issue 13: a metal floor (metallic 1, roughness r) under a spot light; bake/transport/GGX.md.
+    # Written by plain Python (make_python); the other roughnesses only on request
+    # (BENCH_CYCLES_SCENES=metal_room_r0.05,...)
+    {"name": "metal_room_r0.1", "gltf": "{work}/metal_room_r0.1.gltf", "lbk": [], "sky": (0, 0, 0),
+     "ref_spp": 4096, "calib": (16, 64), "make": "make_metal_room.py", "make_python": True, "make_args": ["0.1"]},
+] + [{"name": "metal_room_r%g" % r, "gltf": "{work}/metal_room_r%g.gltf" % r, "lbk": [], "sky": (0, 0, 0),
+      "ref_spp": 4096, "calib": (16, 64), "make": "make_metal_room.py", "make_python": True,
+      "make_args": ["%g" % r], "on_request": True} for r in (0.05, 0.2, 0.4)]
 
 
 def density_args(lbk_args):
@@ -100,8 +107,11 @@ def run_scene(sc, work, opt, out):
     sc["path"] = sc["gltf"].format(scenes=opt.scenes, work=work)
     gen = os.path.join(common.HERE, sc.get("make", ""))
     if sc.get("make") and (not os.path.exists(sc["path"]) or os.path.getmtime(gen) > os.path.getmtime(sc["path"])):
-        common.run_timed([common.blender(), "-b", "--factory-startup", "--python",
-                          gen, "--", sc["path"]], sc["path"] + ".log")
+        if sc.get("make_python"):
+            common.run_timed([sys.executable, gen, sc["path"]] + sc.get("make_args", []), sc["path"] + ".log")
+        else:
+            common.run_timed([common.blender(), "-b", "--factory-startup", "--python",
+                              gen, "--", sc["path"]], sc["path"] + ".log")
     rec, lbk_wall, lbk_cpu, report = bake_lbk(sc, work, opt, 1)
     rec2, _, _, _ = bake_lbk(sc, work, opt, 2)
     if rec2.pos != rec.pos:
@@ -131,7 +141,7 @@ def run_scene(sc, work, opt, out):
                              sky=sc["sky"], threads=opt.threads, equal_time=target, clock=opt.clock)
     rdir = os.path.join(work, sc["name"] + ".cycles-ref")
     refs_run = common.run_cycles(sc["path"], tsv, rdir, [], sky=sc["sky"], threads=opt.threads,
-                                 refs=[(ref_spp, 1), (ref_spp, 2)])
+                                 refs=[(ref_spp, 1), (ref_spp, 2)], keep=opt.keep_refs)
     by_role = {}
     for d, rs in ((cdir, runs), (rdir, refs_run)):
         for r in rs:
@@ -263,6 +273,9 @@ def main():
     ap.add_argument("--alt", default=env("LBK_ALT", ""))
     ap.add_argument("--alt-dump", default=env("LBK_ALT_DUMP", ""))
     ap.add_argument("--alt-name", default=env("LBK_ALT_NAME", "alt"))
+    # reuse a reference whose inputs (scene and sensor files, sample counts, harness) are unchanged
+    ap.add_argument("--keep-refs", action="store_true",
+                    default=env("BENCH_CYCLES_KEEP_REFS", "0") not in ("", "0"))
     opt = ap.parse_args()
     opt.alt_dump = opt.alt_dump or opt.dump
     os.makedirs(opt.work, exist_ok=True)
@@ -284,7 +297,7 @@ def main():
     only = [s for s in opt.only.split(",") if s]
     rows, scenes = [], []
     for sc in SCENES:
-        if only and sc["name"] not in only:
+        if (only and sc["name"] not in only) or (not only and sc.get("on_request")):
             continue
         r, s = run_scene(sc, opt.work, opt, out)
         rows += r

@@ -1509,6 +1509,73 @@ static void test_exr_unused_channel(void **state)
     }
 }
 
+/* metallicFactor / roughnessFactor (glTF defaults 1, 1), the metallicRoughness texture (decoded
+ * after the other textures), the default material of a primitive without one (a rough metal),
+ * which materials are glossy, and factors outside [0, 1] refused. */
+static void test_metallic_roughness(void **state)
+{
+    (void)state;
+    write_quad_bin();
+    write_png("mr.png", 2, 2);
+    write_png("base.png", 4, 2);
+    const char *head =
+        "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"uri\":\"quad.bin\",\"byteLength\":108}],"
+        "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":12}],"
+        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
+        "{\"bufferView\":1,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],"
+        "\"images\":[{\"uri\":\"mr.png\"},{\"uri\":\"base.png\"}],\"textures\":[{\"source\":0},{\"source\":1}],";
+    char json[8192];
+    snprintf(json, sizeof json,
+             "%s\"materials\":[{\"name\":\"defaults\"},"
+             "{\"name\":\"lambert\",\"pbrMetallicRoughness\":{\"metallicFactor\":0,\"roughnessFactor\":0.3}},"
+             "{\"name\":\"textured\",\"pbrMetallicRoughness\":{\"metallicFactor\":0.25,\"roughnessFactor\":0.5,"
+             "\"metallicRoughnessTexture\":{\"index\":0},\"baseColorTexture\":{\"index\":1}}}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":0},"
+             "{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":1},"
+             "{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":2},"
+             "{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
+             "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]}", head);
+    write_text("mr.gltf", json);
+    bk_scene s;
+    char err[1024];
+    int rc = import_tmp("mr.gltf", &s, NULL, err, sizeof err);
+    if (rc) printf("%s\n", err);
+    assert_int_equal(rc, 0);
+    assert_valid(&s);
+    assert_int_equal(s.material_count, 4);
+    const bk_material *m = s.materials;
+    assert_float_equal(m[0].metallic, 1.0f, 0.0f);
+    assert_float_equal(m[0].roughness, 1.0f, 0.0f);
+    assert_int_equal(m[0].metal_rough_tex1, 0);
+    assert_true(bk_material_glossy(&m[0]));
+    assert_float_equal(m[1].metallic, 0.0f, 0.0f);
+    assert_float_equal(m[1].roughness, 0.3f, 1e-7);
+    assert_false(bk_material_glossy(&m[1]));
+    assert_float_equal(m[2].metallic, 0.25f, 0.0f);
+    assert_float_equal(m[2].roughness, 0.5f, 0.0f);
+    assert_true(bk_material_glossy(&m[2]));
+    /* base colour first (image 0 of the scene), the metallicRoughness texture after it */
+    assert_int_equal(m[2].albedo_tex, 0);
+    assert_int_equal(m[2].metal_rough_tex1, 2);
+    assert_int_equal(s.images[m[2].metal_rough_tex1 - 1].width, 2);
+    /* the primitive without a material: the spec's default material, white rough metal */
+    assert_string_equal(m[3].name, "default");
+    assert_float_equal(m[3].metallic, 1.0f, 0.0f);
+    assert_float_equal(m[3].roughness, 1.0f, 0.0f);
+    assert_float_equal(m[3].albedo[0], 1.0f, 0.0f);
+    bk_scene_free(&s);
+    /* out of [0, 1]: refused, with the material named */
+    snprintf(json, sizeof json,
+             "%s\"materials\":[{\"name\":\"bad\",\"pbrMetallicRoughness\":{\"metallicFactor\":1.5}}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":0}]}],"
+             "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]}", head);
+    write_text("mr_bad.gltf", json);
+    rc = import_tmp("mr_bad.gltf", &s, NULL, err, sizeof err);
+    assert_int_not_equal(rc, 0);
+    assert_non_null(strstr(err, "metallicFactor"));
+    assert_non_null(strstr(err, "bad"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1524,6 +1591,7 @@ int main(void)
         cmocka_unit_test(test_sky_exr),
         cmocka_unit_test(test_exr_unused_channel),
         cmocka_unit_test(test_textures),
+        cmocka_unit_test(test_metallic_roughness),
         cmocka_unit_test(test_glb_embedded_texture),
         cmocka_unit_test(test_required_extension),
         cmocka_unit_test(test_malformed_accessors),

@@ -151,6 +151,7 @@ int lmuv_scene_write(const char *path)
     cJSON *mat = cJSON_CreateObject(), *pbr = cJSON_AddObjectToObject(mat, "pbrMetallicRoughness");
     const float grey[4] = {0.5f, 0.5f, 0.5f, 1};
     cJSON_AddItemToObject(pbr, "baseColorFactor", cJSON_CreateFloatArray(grey, 4));
+    cJSON_AddNumberToObject(pbr, "metallicFactor", 0); /* Lambertian (glTF's default is a metal) */
     cJSON_AddBoolToObject(mat, "doubleSided", 1);
     cJSON_AddItemToArray(cJSON_AddArrayToObject(root, "materials"), mat);
     cJSON *sc = cJSON_CreateObject(), *sn = cJSON_AddArrayToObject(sc, "nodes");
