@@ -633,9 +633,12 @@ static lbk_result do_transport(bk_pipeline *b)
     out.radiance = b->radiance;
     if (b->opt->denoise != LBK_BAKE_DENOISE_OFF || b->opt->error_map) {
         b->variance = calloc(b->receiver_count ? b->receiver_count : 1, sizeof *b->variance);
-        b->halves = calloc(b->receiver_count ? 2 * b->receiver_count : 1, sizeof *b->halves);
-        if (!b->variance || !b->halves) return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
+        if (!b->variance) return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
         out.variance = b->variance;
+    }
+    if (b->opt->denoise != LBK_BAKE_DENOISE_OFF) { /* only the denoised estimate reads them */
+        b->halves = calloc(b->receiver_count ? 2 * b->receiver_count : 1, sizeof *b->halves);
+        if (!b->halves) return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
         out.halves = b->halves;
     }
     float *irradiance = malloc((b->receiver_count ? b->receiver_count : 1) * 3 * sizeof *irradiance);
