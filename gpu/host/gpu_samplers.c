@@ -8,6 +8,7 @@
 #include "lbk/llg.h"
 
 #include "ahd_irradiance.spv.h"
+#include "codec_pack.spv.h"
 #include "glg_sample.spv.h"
 #include "llg_sample.spv.h"
 #include "sh9_irradiance.spv.h"
@@ -48,6 +49,20 @@ int gpu_sh9_irradiance(gpu_ctx *c, const uint8_t *probes, const float *normals, 
 {
     return run3(c, sh9_irradiance_spv, sizeof sh9_irradiance_spv, probes, 28 * (size_t)n, normals, 12 * (size_t)n, rgb,
                 12 * (size_t)n, &n, 4, n);
+}
+
+int gpu_sh9_pack(gpu_ctx *c, const float *sh, uint32_t n, uint8_t *probes)
+{
+    const uint32_t push[2] = {n, 0};
+    return run3(c, codec_pack_spv, sizeof codec_pack_spv, sh, 108 * (size_t)n, NULL, 16, probes, 28 * (size_t)n, push,
+                sizeof push, n);
+}
+
+int gpu_ahd_from_linear(gpu_ctx *c, const float *lin, uint32_t n, uint32_t *texels)
+{
+    const uint32_t push[2] = {n, 1};
+    return run3(c, codec_pack_spv, sizeof codec_pack_spv, lin, 48 * (size_t)n, NULL, 16, texels, 8 * (size_t)n, push,
+                sizeof push, n);
 }
 
 static uint32_t word_of(const void *base, const void *p) { return (uint32_t)(((const uint8_t *)p - (const uint8_t *)base) / 4); }

@@ -19,5 +19,10 @@ int gpu_glg_sample(gpu_ctx *c, const void *glg, size_t size, const float *points
  * a vertex of it; out 27 SH floats and 3 irradiance floats. */
 int gpu_llg_sample(gpu_ctx *c, const void *llg, size_t size, const float *points, const uint32_t *grids,
                    const uint32_t *vertices, uint32_t n, float *sh, float *rgb);
+/* The encoders alone (codec_pack.comp): lbk_sh9_pack of 27 floats (channel-major) per probe into
+ * 28 bytes, and lbk_ahd_from_linear of 12 floats ({e0, gx, gy, gz} per channel) per texel into
+ * (Ez word, RGBA word). */
+int gpu_sh9_pack(gpu_ctx *c, const float *sh, uint32_t n, uint8_t *probes);
+int gpu_ahd_from_linear(gpu_ctx *c, const float *lin, uint32_t n, uint32_t *texels);
 
 #endif

@@ -9,7 +9,8 @@
 //     the IEEE result the CPU computes — on every device with shaderFloat64;
 //   - the CPU's double steps are double here;
 //   - NaN and sign tests look at bits, so no optimiser can fold them away;
-//   - constants are given as bit patterns (a decimal literal would be rounded twice).
+//   - constants are given as bit patterns (a decimal literal would be rounded twice);
+//   - rounding to an integer is rne_d (integer truncation and an exact remainder), never roundEven.
 // Needs shaderFloat64. Assumes round-to-nearest-even (every Vulkan desktop driver and lavapipe) and
 // no float denormal flushing on the (rare) paths where a float denormal can arise: weights below
 // about 2^-100 or SH coefficients of that size.
@@ -42,6 +43,21 @@ float fsqrt(float x)
 {
     precise double r = sqrt(double(x));
     return float(r);
+}
+
+// Round to nearest, ties to even, of a double |t| < 2^31 (pixel.c's rne), from integer truncation
+// and an exact remainder instead of roundEven: llvmpipe without AVX-512 rounds a double vector
+// of 512 bits (8 lanes) by adding ±nextafter(0.5, 0) and truncating, so every tie goes toward
+// zero (GPU.md, "Exactness": half of 66,713 ties off). Truncation and a − trunc(a) are exact on
+// every IEEE device, so this is too.
+int rne_d(double t)
+{
+    bool neg = t < 0.0lf;
+    precise double a = neg ? -t : t;
+    int i = int(a);                  // truncation toward zero (OpConvertFToS): exact
+    precise double d = a - double(i); // the fraction of a: exact (Sterbenz)
+    if (d > 0.5lf || (d == 0.5lf && (i & 1) != 0)) i++;
+    return neg ? -i : i;
 }
 
 bool is_nan(float x) { return (floatBitsToUint(x) & 0x7fffffffu) > 0x7f800000u; }
@@ -105,7 +121,7 @@ uint unorm8_encode(float x)
     if (!(x > 0.0)) return 0u;
     if (x >= 1.0) return 255u;
     precise double t = double(x) * 255.0lf;
-    return uint(roundEven(t));
+    return uint(rne_d(t));
 }
 
 float snorm8_decode(uint c)
@@ -121,7 +137,7 @@ uint snorm8_encode(float x)
     if (x >= 1.0) return 127u;
     if (x <= -1.0) return uint(-127) & 0xffu;
     precise double t = double(x) * 127.0lf;
-    return uint(int(roundEven(t))) & 0xffu;
+    return uint(rne_d(t)) & 0xffu;
 }
 
 // lbk_rgb9e5_pack in double, as pixel.c.
@@ -136,10 +152,10 @@ uint rgb9e5_pack(vec3 rgb)
         int e2;
         frexp(maxc, e2);
         exp_shared = (e2 - 1 < -16 ? -16 : e2 - 1) + 16;
-        if (roundEven(ldexp(maxc, 24 - exp_shared)) >= 512.0lf) exp_shared++;
+        if (rne_d(ldexp(maxc, 24 - exp_shared)) >= 512) exp_shared++;
     }
     uint outw = uint(exp_shared) << 27;
-    for (int i = 0; i < 3; i++) outw |= uint(roundEven(ldexp(c[i], 24 - exp_shared))) << (9 * i);
+    for (int i = 0; i < 3; i++) outw |= uint(rne_d(ldexp(c[i], 24 - exp_shared))) << (9 * i);
     return outw;
 }
 
