@@ -284,9 +284,9 @@ static void check_probe_close(const uint8_t *a, const uint8_t *b)
                          (double)sa.c[c][k], (double)top);
 }
 
-/* The GPU's output LMAP bytes against the CPU's output planes: identical, except texels a
- * driver rounds differently (GPU.md: lavapipe on an AVX2-only host), each within its rounding;
- * probes likewise. */
+/* The GPU's output LMAP bytes against the CPU's output planes: identical, except texels a GPU
+ * may round differently (its double division and square root need not be exact: GPU.md), each
+ * within its rounding; probes likewise. The caller decides how many may differ (none on lavapipe). */
 static void check_outputs(const level *lv, const gpu_dls *g)
 {
     const uint8_t *out = gpu_dls_lmap(g);
