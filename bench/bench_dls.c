@@ -14,7 +14,9 @@
  * traffic is 48 bytes per texel and 108 per probe for each base, entry and output; memcpy is
  * measured on that traffic), with the linear mode's prepared memory. Threads run the jobs of
  * lbk_dls_apply_begin (bk_parallel_chunks), memcpy on as many threads over 16 slices.
- * `bench_dls --quick` skips the baked levels. */
+ * `bench_dls --quick` skips the baked levels; `--linear` also runs only the linear mode's SIMD path.
+ * Each scenario alternates apply and memcpy (9 or 8 times) and reports the medians of the
+ * per-repetition ratios, with the load average before and after. */
 #define LBK_STATIC_LINKING_ONLY /* lbk_dls_stats, lbk_dls_runtime_path: experimental (lbk/dls.h) */
 #include <math.h>
 #include <stdbool.h>
@@ -86,22 +88,27 @@ static void memcpy_chunk(void *user, size_t begin, size_t end, int thread)
     (void)thread;
 }
 
-/* Best of `reps` memcpys moving `traffic` bytes (a copy of traffic / 2) on `threads` threads. */
-static clocks memcpy_time(uint64_t traffic, int threads, int reps)
+/* One memcpy moving the traffic of a `n`-byte copy on `threads` threads (16 slices). */
+static clocks memcpy_once(memcpy_job *m, int threads)
 {
-    const size_t n = (size_t)(traffic / 2) + 64;
-    uint8_t *src = malloc(n), *dst = malloc(n);
-    memset(src, 1, n), memset(dst, 2, n);
-    memcpy_job m = {dst, src, n};
-    clocks best = {1e9, 1e9};
-    for (int i = 0; i < reps; i++) {
-        const clocks t0 = clocks_now();
-        if (threads == 1) memcpy(dst, src, n);
-        else bk_parallel_chunks(0, 16, 1, threads, memcpy_chunk, &m);
-        clocks_best(&best, t0, threads);
-    }
-    free(src), free(dst);
-    return best;
+    clocks t = {1e9, 1e9};
+    const clocks t0 = clocks_now();
+    if (threads == 1) memcpy(m->dst, m->src, m->n);
+    else bk_parallel_chunks(0, 16, 1, threads, memcpy_chunk, m);
+    clocks_best(&t, t0, threads);
+    return t;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 static void job_chunk(void *user, size_t begin, size_t end, int thread)
@@ -141,46 +148,69 @@ static uint64_t traffic(const lbk_dls_view *v, const float *w_old, const float *
     return bytes;
 }
 
+#define MAX_REPS 64
 typedef struct scenario_result {
-    clocks apply, copy;
+    clocks apply, copy;         /* medians */
+    double ratio_wall, ratio_cpu; /* medians of the per-repetition ratios memcpy / apply */
     uint64_t bytes;
+    int reps;
 } scenario_result;
 
-/* Every set's weight changes between applies (on, 0.5…0.6), or only set `one` (≥ 0). */
+/* Every set's weight changes between applies (on, 0.5…0.6), or only set `one` (≥ 0). Each
+ * repetition times one apply and then one memcpy of the same traffic, back to back, so both see
+ * the same load from the other processes; the ratios are per repetition, reported as medians. */
 static int measure(lbk_dls_runtime *rt, const lbk_dls_view *v, uint32_t nsets, const float *dw, int one, int threads,
                    int reps, scenario_result *out)
 {
     const bool linear = lbk_dls_runtime_linear_bytes(rt) > 0;
     float w0[256], w1[256];
-    out->apply = (clocks){1e9, 1e9};
+    double aw[MAX_REPS], ac[MAX_REPS], cw[MAX_REPS], cc[MAX_REPS], rw[MAX_REPS], rc[MAX_REPS];
+    if (reps > MAX_REPS) reps = MAX_REPS;
+    memcpy_job m = {NULL, NULL, 0};
     for (int i = 0; i < reps; i++) {
         for (uint32_t s = 0; s < nsets; s++) w0[s] = 0.5f + 0.01f * (float)(i % 7), w1[s] = w0[s] + 0.005f;
         if (one >= 0) {
             memcpy(w1, w0, nsets * sizeof *w0);
             w1[one] = 0.25f;
         }
+        if (i == 0) { /* the traffic is the same every repetition (the same sets change) */
+            out->bytes = traffic(v, w0, w1, linear);
+            m.n = (size_t)(out->bytes / 2) + 64;
+            uint8_t *src = malloc(m.n), *dst = malloc(m.n);
+            if (!src || !dst) return 1;
+            memset(src, 1, m.n), memset(dst, 2, m.n);
+            m.src = src, m.dst = dst;
+            (void)memcpy_once(&m, threads); /* warm */
+        }
         if (apply_threads(rt, w0, dw, threads) != LBK_OK) return 1; /* the previous frame */
+        clocks a = {1e9, 1e9};
         const clocks t0 = clocks_now();
         if (apply_threads(rt, w1, dw, threads) != LBK_OK) return 1;
-        clocks_best(&out->apply, t0, threads);
-        out->bytes = traffic(v, w0, w1, linear);
+        clocks_best(&a, t0, threads);
+        const clocks c = memcpy_once(&m, threads);
+        aw[i] = a.wall, ac[i] = a.cpu, cw[i] = c.wall, cc[i] = c.cpu;
+        rw[i] = c.wall / a.wall, rc[i] = c.cpu / a.cpu;
     }
-    out->copy = memcpy_time(out->bytes, threads, reps + 2);
+    free((void *)m.src), free(m.dst);
+    out->reps = reps;
+    out->apply = (clocks){median(aw, reps), median(ac, reps)};
+    out->copy = (clocks){median(cw, reps), median(cc, reps)};
+    out->ratio_wall = median(rw, reps), out->ratio_cpu = median(rc, reps);
     return 0;
 }
 
-/* Ratios to memcpy by wall time and by CPU time per thread. */
+/* Ratios to memcpy by wall time and by CPU time per thread: medians over the repetitions. */
 static void report(const char *what, int threads, const scenario_result *r)
 {
     printf("  %-18s %d thread%s: %7.2f MB moved in %8.3f ms wall (%5.2f GB/s), %8.3f ms CPU/thread; memcpy of that "
-           "traffic %7.3f ms wall, %7.3f ms CPU: %.3f of memcpy (wall), %.3f (CPU)\n",
+           "traffic %7.3f ms wall, %7.3f ms CPU: %.3f of memcpy (wall), %.3f (CPU), medians of %d alternations\n",
            what, threads, threads > 1 ? "s" : " ", r->bytes / 1e6, r->apply.wall * 1e3, r->bytes / r->apply.wall / 1e9,
-           r->apply.cpu * 1e3, r->copy.wall * 1e3, r->copy.cpu * 1e3, r->copy.wall / r->apply.wall, r->copy.cpu / r->apply.cpu);
+           r->apply.cpu * 1e3, r->copy.wall * 1e3, r->copy.cpu * 1e3, r->ratio_wall, r->ratio_cpu, r->reps);
 }
 
 /* ---- the synthetic level's applies --------------------------------------------------------- */
 
-static int estate(void)
+static int estate(int only_linear)
 {
     estate_level lv;
     if (estate_build(&lv)) return 1;
@@ -208,7 +238,7 @@ static int estate(void)
     static const uint32_t flags[4] = {0, LBK_DLS_RUNTIME_SCALAR, LBK_DLS_RUNTIME_LINEAR,
                                       LBK_DLS_RUNTIME_LINEAR | LBK_DLS_RUNTIME_SCALAR};
     int bad = 0;
-    for (int path = 0; path < 4 && !bad; path++) {
+    for (int path = only_linear ? 2 : 0; path < (only_linear ? 3 : 4) && !bad; path++) {
         const bool linear = flags[path] & LBK_DLS_RUNTIME_LINEAR, scalar = flags[path] & LBK_DLS_RUNTIME_SCALAR;
         lbk_dls_runtime_desc d = {.size = sizeof d, .dls = lv.view, .base_glg = bg, .base_llg = bl, .out_glg = og,
                                   .out_llg = ol, .page_count = PAGES, .pages = pages, .flags = flags[path],
@@ -225,7 +255,7 @@ static int estate(void)
         printf("\n");
         scenario_result r;
         for (int threads = 1; threads <= (scalar ? 1 : 2) && !bad; threads++) {
-            bad |= measure(rt, lv.view, NSETS, NULL, -1, threads, scalar ? 1 : 4, &r);
+            bad |= measure(rt, lv.view, NSETS, NULL, -1, threads, scalar ? 1 : 9, &r);
             report("every set changes", threads, &r);
             if (scalar) break;
             bad |= measure(rt, lv.view, NSETS, NULL, 5, threads, 8, &r);
@@ -315,10 +345,23 @@ static int baked(const char *dir, const char *name, const ds_options *o)
     return bad;
 }
 
+/* The machine's load (Linux /proc/loadavg): ratios on a shared machine mean little without it. */
+static void print_load(const char *when)
+{
+    FILE *f = fopen("/proc/loadavg", "r");
+    char line[128] = "";
+    if (f && fgets(line, sizeof line, f)) printf("load average %s: %s", when, line);
+    if (f) fclose(f);
+    printf("online CPUs: %ld\n", sysconf(_SC_NPROCESSORS_ONLN));
+}
+
 int main(int argc, char **argv)
 {
-    const int quick = argc > 1 && !strcmp(argv[1], "--quick");
-    int bad = estate();
+    const int linear = argc > 1 && !strcmp(argv[1], "--linear");
+    const int quick = linear || (argc > 1 && !strcmp(argv[1], "--quick"));
+    print_load("before");
+    int bad = estate(linear);
+    print_load("after the ESTATE-sized level");
     if (!quick && !bad) {
         char dir[] = "/tmp/lbk_bench_dls_XXXXXX";
         if (!mkdtemp(dir)) return 1;

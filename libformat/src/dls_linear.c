@@ -5,6 +5,9 @@
  * kernels' (acc = base, += w·S for the non-zero weights in ascending set order, unfused), so each
  * output is the float the byte mode encodes. */
 #include <stdint.h>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 #include "dls_runtime.h"
 #include "lbk/ahd.h"
@@ -80,6 +83,24 @@ static int prep_target(void *user, uint32_t target, uint32_t count, const uint32
     return 0;
 }
 
+/* Blocks of HUGE_MIN bytes or more start on a 2 MiB boundary and ask the kernel for huge pages
+ * (Linux, where transparent huge pages are often "madvise" only): an apply streams 3·(1 + m)
+ * arrays of a cluster at once while its outputs jump from chart row to chart row, and with 4 KiB
+ * pages the inputs alone cross a page every 1024 floats. Measured on the ESTATE-sized level
+ * (bench_dls, one thread, alternating builds on a loaded machine): 0.35–0.47 of memcpy → 0.42–0.47 at
+ * the same load. Advice only: the bytes are the same with or without it, and an allocator whose
+ * memory refuses it (or another OS) just keeps small pages. */
+#define HUGE_PAGE ((size_t)2 << 20)
+#define HUGE_MIN ((uint64_t)64 << 20)
+static void advise_huge(void *p, size_t bytes)
+{
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    (void)madvise(p, bytes / HUGE_PAGE * HUGE_PAGE, MADV_HUGEPAGE);
+#else
+    (void)p, (void)bytes;
+#endif
+}
+
 lbk_result rt_linear_prepare(lbk_dls_runtime *r)
 {
     uint64_t total = 0;
@@ -89,11 +110,14 @@ lbk_result rt_linear_prepare(lbk_dls_runtime *r)
         if (n > (UINT64_MAX - total) / 8) return LBK_ERR_LIMIT;
         total += n;
     }
-    if (total > (SIZE_MAX - 64) / sizeof(float)) return LBK_ERR_LIMIT;
-    r->lin_bytes = total * sizeof(float) + 64;
+    if (total > (SIZE_MAX - HUGE_PAGE) / sizeof(float)) return LBK_ERR_LIMIT;
+    const bool huge = total * sizeof(float) >= HUGE_MIN;
+    const size_t align = huge ? HUGE_PAGE : 64;
+    r->lin_bytes = total * sizeof(float) + align;
     r->lin_block = lbk_alloc(r->alloc, (size_t)r->lin_bytes);
     if (!r->lin_block) return LBK_ERR_OUT_OF_MEMORY;
-    float *at = (float *)(void *)((uint8_t *)r->lin_block + (64 - (uintptr_t)r->lin_block % 64) % 64);
+    float *at = (float *)(void *)((uint8_t *)r->lin_block + (align - (uintptr_t)r->lin_block % align) % align);
+    if (huge) advise_huge(at, total * sizeof(float));
     for (uint32_t i = 0; i < r->ncl; i++) {
         rt_cluster *c = &r->cl[i];
         if (!r->space_on[c->space]) continue;

@@ -85,18 +85,34 @@ static void scene_free(scene *sc)
     dlsfx_free(&sc->fx);
 }
 
+/* the paged cases */
+#define PAGE_W 40u
+#define PAGE_H 25u
+#define PAGES 3u /* 3 × 40 × 25 = the 3000 texels of random_sets */
+
+/* The desc of a runtime over the scene's bases, shared by the byte and the linear cases: texels
+ * as the four arrays (pages NULL) or as PAGES pages; with flags LBK_DLS_RUNTIME_LINEAR no byte
+ * outputs (the caller adds the linear ones), else the scene's probe outputs, and in the array
+ * form its texel outputs. */
+static lbk_dls_runtime_desc scene_desc(scene *sc, uint32_t flags, const lbk_dls_page *pages)
+{
+    const bool linear = flags & LBK_DLS_RUNTIME_LINEAR;
+    lbk_dls_runtime_desc d = {.size = sizeof d, .dls = sc->view, .base_glg = sc->base_probe[0], .base_llg = sc->base_probe[1],
+                              .flags = flags};
+    if (pages) {
+        d.page_count = PAGES, d.pages = pages;
+    } else {
+        d.base_irradiance_z = sc->base_z, d.base_rgba = sc->base_rgba;
+        if (!linear) d.out_irradiance_z = sc->out_z, d.out_rgba = sc->out_rgba;
+    }
+    if (!linear) d.out_glg = sc->out_probe[0], d.out_llg = sc->out_probe[1];
+    return d;
+}
+
 static lbk_dls_runtime *runtime(scene *sc, const lbk_door_view *doors)
 {
-    lbk_dls_runtime_desc d = {.dls = sc->view,
-                              .doors = doors,
-                              .base_irradiance_z = sc->base_z,
-                              .base_rgba = sc->base_rgba,
-                              .base_glg = sc->base_probe[0],
-                              .base_llg = sc->base_probe[1],
-                              .out_irradiance_z = sc->out_z,
-                              .out_rgba = sc->out_rgba,
-                              .out_glg = sc->out_probe[0],
-                              .out_llg = sc->out_probe[1]};
+    lbk_dls_runtime_desc d = scene_desc(sc, 0, NULL);
+    d.doors = doors;
     lbk_dls_runtime *r;
     assert_int_equal(lbk_dls_runtime_open(&d, &r), LBK_OK);
     return r;
@@ -549,9 +565,6 @@ static void test_apply_in_another_scale(void **state)
 
 /* ---- pages, paths, jobs, dirty regions ------------------------------------------------------ */
 
-#define PAGE_W 40u
-#define PAGE_H 25u
-#define PAGES 3u /* 3 × 40 × 25 = the 3000 texels of random_sets */
 #define PAD 12u  /* bytes after each output row */
 
 typedef struct paged {
@@ -587,9 +600,8 @@ static void paged_check(const paged *pg, const scene *sc)
 
 static lbk_dls_runtime *paged_runtime(scene *sc, paged *pg, uint32_t flags, uint32_t job_targets)
 {
-    lbk_dls_runtime_desc d = {.size = sizeof d, .dls = sc->view, .base_glg = sc->base_probe[0], .base_llg = sc->base_probe[1],
-                              .out_glg = sc->out_probe[0], .out_llg = sc->out_probe[1], .page_count = PAGES,
-                              .pages = pg->pages, .flags = flags, .job_targets = job_targets};
+    lbk_dls_runtime_desc d = scene_desc(sc, flags, pg->pages);
+    d.job_targets = job_targets;
     lbk_dls_runtime *r;
     assert_int_equal(lbk_dls_runtime_open(&d, &r), LBK_OK);
     return r;
@@ -673,8 +685,8 @@ static void test_paths_pages_and_jobs_agree(void **state)
     /* pages must cover the texels exactly and pitches hold a row */
     paged pg;
     paged_init(&pg, &sc);
-    lbk_dls_runtime_desc d = {.size = sizeof d, .dls = sc.view, .base_glg = sc.base_probe[0], .base_llg = sc.base_probe[1],
-                              .out_glg = sc.out_probe[0], .out_llg = sc.out_probe[1], .page_count = PAGES - 1, .pages = pg.pages};
+    lbk_dls_runtime_desc d = scene_desc(&sc, 0, pg.pages);
+    d.page_count = PAGES - 1;
     lbk_dls_runtime *bad;
     assert_int_equal(lbk_dls_runtime_open(&d, &bad), LBK_ERR_INVALID_ARGUMENT);
     d.page_count = PAGES;
@@ -865,9 +877,9 @@ static void test_linear_pages_and_jobs(void **state)
     float *ref[3], *refp[2];
     for (int c = 0; c < 3; c++) ref[c] = calloc(nt, 16);
     for (int p = 0; p < 2; p++) refp[p] = calloc(np[p], 108);
-    lbk_dls_runtime_desc ad = {.size = sizeof ad, .dls = sc.view, .base_irradiance_z = sc.base_z, .base_rgba = sc.base_rgba,
-                               .base_glg = sc.base_probe[0], .base_llg = sc.base_probe[1], .flags = LBK_DLS_RUNTIME_LINEAR,
-                               .out_linear_texel = {ref[0], ref[1], ref[2]}, .out_linear_glg = refp[0], .out_linear_llg = refp[1]};
+    lbk_dls_runtime_desc ad = scene_desc(&sc, LBK_DLS_RUNTIME_LINEAR, NULL);
+    for (int c = 0; c < 3; c++) ad.out_linear_texel[c] = ref[c];
+    ad.out_linear_glg = refp[0], ad.out_linear_llg = refp[1];
     lbk_dls_runtime *ra;
     assert_int_equal(lbk_dls_runtime_open(&ad, &ra), LBK_OK);
     /* the prepared data: 12 floats per clustered texel and texel entry, 27 per probe ones */
@@ -891,9 +903,8 @@ static void test_linear_pages_and_jobs(void **state)
         }
     }
     memset(lin, 0x5A, 3 * PAGES * lplane);
-    lbk_dls_runtime_desc pd = {.size = sizeof pd, .dls = sc.view, .base_glg = sc.base_probe[0], .base_llg = sc.base_probe[1],
-                               .page_count = PAGES, .pages = pages, .flags = LBK_DLS_RUNTIME_LINEAR, .job_targets = 50,
-                               .linear_pages = lpages, .out_linear_glg = linp[0], .out_linear_llg = linp[1]};
+    lbk_dls_runtime_desc pd = scene_desc(&sc, LBK_DLS_RUNTIME_LINEAR, pages);
+    pd.job_targets = 50, pd.linear_pages = lpages, pd.out_linear_glg = linp[0], pd.out_linear_llg = linp[1];
     lbk_dls_runtime *rp;
     assert_int_equal(lbk_dls_runtime_open(&pd, &rp), LBK_OK);
     /* the byte mode on the same pages, for its rectangles */
