@@ -87,8 +87,8 @@ static int prep_target(void *user, uint32_t target, uint32_t count, const uint32
  * (Linux, where transparent huge pages are often "madvise" only): an apply streams 3·(1 + m)
  * arrays of a cluster at once while its outputs jump from chart row to chart row, and with 4 KiB
  * pages the inputs alone cross a page every 1024 floats. Measured on the ESTATE-sized level
- * (bench_dls, one thread, alternating builds on a loaded machine): 0.35–0.47 of memcpy → 0.42–0.47 at
- * the same load. Advice only: the bytes are the same with or without it, and an allocator whose
+ * (bench_dls, alternating builds, machine idle): one thread 0.37–0.40 of memcpy → 0.43–0.46, two
+ * threads 0.45–0.53 → 0.48–0.56. Advice only: the bytes are the same with or without it, and an allocator whose
  * memory refuses it (or another OS) just keeps small pages. */
 #define HUGE_PAGE ((size_t)2 << 20)
 #define HUGE_MIN ((uint64_t)64 << 20)

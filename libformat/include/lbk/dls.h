@@ -229,8 +229,9 @@ typedef struct lbk_dls_linear_page {
  * aligned), so that an apply is multiplies and adds on floats, near memory bandwidth (bench_dls).
  * Memory: 4·(12·(T_c + E_t) + 27·(P_c + E_p)) bytes plus at most 64 bytes per cluster array,
  * where T_c / P_c are the texels / probes that some cluster has (lbk_dls_stats.touched) and E_t /
- * E_p the texel / probe entries (lbk_dls_stats.entries); lbk_dls_runtime_linear_bytes says it.
- * On the ESTATE-sized level of bench_dls: 336 MB, 7.7× its 43 MB DLS section (open ~2 s). Outputs: per page
+ * E_p the texel / probe entries (lbk_dls_stats.entries), and 2 MiB of alignment for blocks of
+ * 64 MiB or more (those ask Linux for huge pages); lbk_dls_runtime_linear_bytes says it.
+ * On the ESTATE-sized level of bench_dls: 338 MB, 7.8× its 43 MB DLS section (open 1–2 s). Outputs: per page
  * the three planes of `linear_pages` (or, in the array form, out_linear_texel), probes as
  * lbk_sh9_rgb (27 floats each, the order of lbk_sh9_rgb.c) in out_linear_glg / out_linear_llg;
  * the byte outputs (out_irradiance_z, out_rgba, out_glg, out_llg, lbk_dls_page.out_*) are
