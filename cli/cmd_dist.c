@@ -204,8 +204,8 @@ static void plan_help(FILE *f)
           "units. Run every unit (lbk bake-unit PLAN K, anywhere the scene files are), then lbk merge:\n"
           "the container is byte-identical to `lbk bake` with the same options. --makefile writes a\n"
           "Makefile for make -j; --sbatch a script that submits a Slurm job array and the merge.\n"
-          "With an error target (the default) at most one unit per transport run (the base, each\n"
-          "light set and door state); with --samples N --target-error none any number. No --time-limit.\n"
+          "Any N, with the default error target or a fixed schedule (--samples N --target-error none)\n"
+          "and either door method. No --time-limit.\n"
           "See bake/dist/DIST.md (xargs -P, Kubernetes).\n",
           f);
 }
