@@ -4,8 +4,9 @@
  * every unit repeats (the slowest unit's time against local/N); bytes moved per unit (its part)
  * against its compute time; and a projection to 64 machines. Two scenes: the Cornell box (only
  * the base transport run: units cut its receivers, and every unit repeats its caches) and a scene
- * of light sets, a door and a combination (8 runs: units take whole runs). Every merge is
- * checked byte-identical to the local bake.
+ * of light sets, a door and a combination (8 runs: units take whole runs); then the Cornell box
+ * with the default preset's error target and the light-set scene with guided doors. Every merge
+ * is checked byte-identical to the local bake.
  * Usage: bench_dist [lbk [scene "options"]]. Wall seconds (the machine is shared: run it alone). */
 #include <stdio.h>
 #include <stdlib.h>
@@ -98,6 +99,11 @@ int main(int argc, char **argv)
     if (argc > 3) return bench(lbk, argv[2], argv[3]);
     int r = bench(lbk, "scenes/cornell_box/CornellBox-Original.gltf", "--samples 992 --target-error none --texel-density 8 --seed 1");
     r |= bench(lbk, "tests/fuzz/sets_scene.gltf", "--samples 480 --target-error none --texel-density 4 --seed 1");
+    /* the default preset's error target on the one-run Cornell box (every unit shares the run and
+     * gathers its stop receivers: all of them here, so "repeated s" is the run's whole cost per
+     * further unit), and guided doors (the merge makes their estimates: the merge column) */
+    r |= bench(lbk, "scenes/cornell_box/CornellBox-Original.gltf", "--texel-density 8 --seed 1");
+    r |= bench(lbk, "tests/fuzz/sets_scene.gltf", "--samples 64 --target-error none --texel-density 2 --door-method guided --seed 1");
     printf("\nESTATE-sized level (seed 001 Table 1: 133 min on 18 cores, up to 132 light sets, so 133+ transport runs):\n"
            "with units of whole runs (N <= runs) each unit bakes its runs alone and repeats only import and layout, so 64\n"
            "units approach runs/64 of the work each (bounded by the slowest run); a level with only its base run is cut by\n"

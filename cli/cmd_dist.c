@@ -139,10 +139,6 @@ int cli_plan_write(const bake_args *o, int argc, char **argv, const char *cmd)
                         "the units would not bake the same passes\n", cmd);
         return LBK_EXIT_USAGE;
     }
-    if (o->d.door_method == LBK_BAKE_DOOR_GUIDED) {
-        fprintf(stderr, "lbk %s: --door-method guided cannot be distributed yet (use difference)\n", cmd);
-        return LBK_EXIT_USAGE;
-    }
     tl_plan p;
     memset(&p, 0, sizeof p);
     char scene[PATH_MAX], output[PATH_MAX], plan[PATH_MAX], err[TL_ERR_LEN];
@@ -164,13 +160,6 @@ int cli_plan_write(const bake_args *o, int argc, char **argv, const char *cmd)
     uint32_t runs = 0;
     int rc = plan_inputs(cmd, scene, &o->d, &p, &runs);
     if (rc >= 0) return rc;
-    if (!(o->d.target_error < 0) && o->units > runs) {
-        fprintf(stderr, "lbk %s: with an error target each transport run stops on its own estimate over all its receivers, "
-                        "so units take whole runs: this bake makes %u (the base, light sets, door states), so --units %u or "
-                        "fewer, or a fixed schedule (--samples N --target-error none) for any number\n", cmd, runs, runs);
-        free(p.inputs);
-        return LBK_EXIT_USAGE;
-    }
     int seen_input = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -215,8 +204,8 @@ static void plan_help(FILE *f)
           "units. Run every unit (lbk bake-unit PLAN K, anywhere the scene files are), then lbk merge:\n"
           "the container is byte-identical to `lbk bake` with the same options. --makefile writes a\n"
           "Makefile for make -j; --sbatch a script that submits a Slurm job array and the merge.\n"
-          "With an error target (the default) at most one unit per transport run (the base, each\n"
-          "light set and door state); with --samples N --target-error none any number. No --time-limit.\n"
+          "Any N, with the default error target or a fixed schedule (--samples N --target-error none)\n"
+          "and either door method. No --time-limit.\n"
           "See bake/dist/DIST.md (xargs -P, Kubernetes).\n",
           f);
 }

@@ -188,12 +188,12 @@ static lbk_result rec_range(void *user, size_t count, int *own, size_t *begin, s
     if (d->run >= d->total_runs)
         return fail(d, LBK_ERR_INTERNAL, "the bake makes more than the %u transport runs it counted", d->total_runs);
     *own = d->run >= d->first_run && d->run < d->end_run;
-    /* the base, whole and unrecorded: an error target's stop decides the budget of this unit's
-     * door runs */
+    /* the base, unrecorded, gathering only the receivers its stop rule reads: where an error
+     * target stops it decides the budget of this unit's door runs */
     if (!*own && d->run == 0 && d->targeted && d->end_run > d->base_dependent) {
         *own = 2;
         *begin = 0;
-        *end = count;
+        *end = 0;
     }
     if (*own == 1) {
         bk_dist_range(d->count, d->total_runs, d->units, d->unit, d->run, &d->begin, &d->end);
@@ -440,11 +440,6 @@ lbk_result bk_dist_set_cut(bk_dist *d, uint64_t count, uint32_t runs, uint32_t b
 {
     if (count >= ((uint64_t)1 << 40)) return say(err, err_len, "too many receivers for a distributed bake");
     if (runs == 0 || runs > BK_PART_MAX_RUNS) return say(err, err_len, "too many transport runs for a distributed bake");
-    if (targeted && d->units > runs)
-        return say(err, err_len, "with an error target every transport run stops on its own estimate over all its receivers, "
-                   "so a run cannot be shared: this bake makes %u runs (the base, light sets, door states), the plan has %u "
-                   "units (use --units %u or fewer, or --samples N --target-error none)", runs, d->units, runs),
-               LBK_ERR_INVALID_ARGUMENT;
     d->count = count;
     d->total_runs = runs;
     d->base_dependent = base_dependent;

@@ -63,10 +63,11 @@ lbk_result bk_dist_create(int replay, uint64_t plan_hash, uint64_t options_hash,
 void bk_dist_destroy(bk_dist *d);
 /* The bake's receiver count and its transport runs, once known: fixes the unit's cut (record) or
  * checks the parts against them (replay). Runs from base_dependent on take the base's final
- * sample count as their budget (door states). targeted: the runs stop on an error target, so a
- * run cannot be shared (units <= runs), and a unit with any of those runs but not the base bakes
- * the base too, unrecorded, to learn its sample count. LBK_ERR_BAD_INPUT with a message when
- * they disagree or the cut is impossible. */
+ * sample count as their budget (door states). targeted: the runs stop on an error target (each
+ * unit of a shared run evaluates the stop on the run's stop receivers, which it gathers too:
+ * bk_transport_options.stop_receivers), and a unit with any door run but not the base bakes the
+ * base's stop receivers too, unrecorded, to learn its sample count. LBK_ERR_BAD_INPUT with a
+ * message when they disagree or the cut is impossible. */
 lbk_result bk_dist_set_cut(bk_dist *d, uint64_t count, uint32_t runs, uint32_t base_dependent, int targeted, char *err,
                            size_t err_len);
 /* What every transport run is handed (bk_transport_options.split). */

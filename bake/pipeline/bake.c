@@ -548,6 +548,7 @@ void bk_pipeline_set_inputs(const bk_pipeline *b, bk_set_inputs *in)
     in->threshold = b->opt->dls_threshold;
     in->events = &b->events;
     in->door_method = (int)b->opt->door_method;
+    in->skip_guided = b->dist && !bk_dist_split(b->dist)->replay; /* the merge makes them */
     in->denoiser = b->denoiser;
     in->deadline = b->opt->time_limit > 0 ? b->start + b->opt->time_limit : 0;
     memcpy(in->origin, b->origin, sizeof in->origin);
@@ -611,7 +612,7 @@ static lbk_result do_transport(bk_pipeline *b)
     if (!r) r = build_cell_sizes(b);
     if (!r && b->dist) {
         int ls = 0;
-        const int runs = 1 + bk_set_bakes_transport_runs(&b->sets, &ls);
+        const int runs = 1 + bk_set_bakes_transport_runs(&b->sets, (int)b->opt->door_method, &ls);
         r = bk_dist_set_cut(b->dist, b->receiver_count, (uint32_t)runs, (uint32_t)(1 + ls), !(b->opt->target_error < 0), b->err,
                             sizeof b->err);
     }
@@ -782,7 +783,7 @@ static lbk_result list_inputs(bk_pipeline *b)
         b->inputs[i].xxh3 = s->inputs[i].hash;
     }
     b->input_count = s->input_count;
-    b->transport_runs = (uint32_t)(1 + bk_set_bakes_transport_runs(&b->sets, NULL));
+    b->transport_runs = (uint32_t)(1 + bk_set_bakes_transport_runs(&b->sets, (int)b->opt->door_method, NULL));
     return LBK_OK;
 }
 
@@ -934,10 +935,6 @@ static lbk_result check_dist(bk_pipeline *b)
         return bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT,
                                 "a distributed bake cannot have a time limit: the passes it allows depend on the machine, "
                                 "so the units would not agree");
-    if (d->door_method == LBK_BAKE_DOOR_GUIDED)
-        return bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT,
-                                "a distributed bake needs the difference door method (the guided estimator is not cut by "
-                                "receivers yet)");
     return LBK_OK;
 }
 

@@ -862,6 +862,12 @@ static lbk_result guided_open(run_ctx *rc, const bs_door *d, const float *texel_
                               lbk_sh9_rgb *rad, lbk_sh9_rgb *dir)
 {
     const bk_set_inputs *in = rc->in;
+    if (in->skip_guided) { /* a unit: the merge makes it (the unit's base radiance is partial) */
+        memset(rad, 0, in->receiver_count * sizeof *rad);
+        memset(dir, 0, in->receiver_count * sizeof *dir);
+        rc->run++;
+        return LBK_OK;
+    }
     filtered_scene fs;
     bk_tracer *tr = NULL;
     lbk_result r = open_without(rc, d->name, NULL, &fs, &tr);
@@ -1116,7 +1122,15 @@ int bk_set_bakes_planned_runs(const bk_set_bakes *sets)
     return runs;
 }
 
-int bk_set_bakes_transport_runs(const bk_set_bakes *sets, int *light_set_runs)
+/* Whether a door pair before combination c has door p (guided: its open run is kept). */
+static int door_in_pair_before(const bs_impl *im, size_t c, int p)
+{
+    for (size_t e = 0; e < c; e++)
+        if (im->combos[e].door[1] >= 0 && (im->combos[e].door[0] == p || im->combos[e].door[1] == p)) return 1;
+    return 0;
+}
+
+int bk_set_bakes_transport_runs(const bk_set_bakes *sets, int method, int *light_set_runs)
 {
     const bs_impl *im = sets ? sets->impl : NULL;
     if (light_set_runs) *light_set_runs = 0;
@@ -1125,11 +1139,17 @@ int bk_set_bakes_transport_runs(const bk_set_bakes *sets, int *light_set_runs)
     for (size_t j = 0; j < im->light_set_count; j++) runs += !im->sets[j].zero;
     if (light_set_runs) *light_set_runs = runs;
     if (!im->door_count) return runs;
-    runs += 1 + 2 * (int)im->door_count; /* the reference, then each door open and closed */
+    const int guided = method == BK_DOOR_GUIDED;
+    runs += 1 + (guided ? 1 : 2) * (int)im->door_count; /* the reference, then each door (open and) closed */
     for (size_t c = 0; c < im->combo_count; c++) {
         const bs_combo *co = &im->combos[c];
-        if (co->door[1] >= 0) runs += 1;                  /* both open (bake_door kept each open run) */
-        else runs += im->sets[co->light_set].zero ? 0 : 2; /* the set with the door open and closed */
+        if (co->door[1] < 0) {
+            runs += im->sets[co->light_set].zero ? 0 : 2; /* the set with the door open and closed */
+            continue;
+        }
+        runs += 1; /* both open (difference: bake_door kept each open run) */
+        for (int m = 0; m < 2 && guided; m++) /* a door's first pair makes its open run */
+            runs += !door_in_pair_before(im, c, co->door[m]);
     }
     return runs;
 }

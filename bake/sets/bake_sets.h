@@ -56,6 +56,10 @@ typedef struct bk_set_inputs {
                                          < 0: store every receiver with a non-zero contribution */
     const bk_events *events;          /* messages, progress over all set runs, cancellation */
     int door_method;                  /* enum bk_door_method */
+    int skip_guided;                  /* a distributed bake's unit: the guided estimates (S_O,
+                                         which read the base's final radiance at every receiver)
+                                         are left zero; the merge, which has that radiance, makes
+                                         them (bake/dist/DIST.md) */
     const bk_denoiser *denoiser;      /* bk_set_bakes_emit: the denoiser built from the base + the
                                          guide (bk_set_bakes_guide), applied to every set with the
                                          same weights; NULL: not denoised */
@@ -92,12 +96,13 @@ void bk_set_bakes_guide(const bk_set_bakes *sets, const lbk_sh9_rgb **sum, const
 
 /* How many transport runs bk_set_bakes_run will make (for the time budget's shares). */
 int bk_set_bakes_planned_runs(const bk_set_bakes *sets);
-/* Exactly how many bk_transport_run calls bk_set_bakes_run makes with the difference door
- * method (a distributed bake's cut, bake/dist/DIST.md): a door pair reuses its doors' open runs
- * and a combination with a black light set makes none. The first *light_set_runs (may be NULL)
- * are the light sets' own; every later one (door states, combinations) has the base's final
- * sample count as its budget. */
-int bk_set_bakes_transport_runs(const bk_set_bakes *sets, int *light_set_runs);
+/* Exactly how many bk_transport_run calls bk_set_bakes_run makes with door method `method`
+ * (enum bk_door_method; a distributed bake's cut, bake/dist/DIST.md): a door pair reuses its
+ * doors' open runs (guided: the first pair a door is in makes its open run) and a combination
+ * with a black light set makes none; a guided estimate is no transport run. The first
+ * *light_set_runs (may be NULL) are the light sets' own; every later one (door states,
+ * combinations) has the base's final sample count as its budget. */
+int bk_set_bakes_transport_runs(const bk_set_bakes *sets, int method, int *light_set_runs);
 
 /* One transport run of bk_set_bakes_run (a light set, a door state, a reference): its label as in
  * the bake's messages and its final estimated error, pooled and per receiver class. */

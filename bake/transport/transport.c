@@ -244,6 +244,15 @@ typedef struct tp_ctx {
      * the caches alone traced (a distributed run's global part) */
     size_t g_begin, g_end;
     uint64_t cache_rays, cache_shadow, cache_nonfinite;
+    /* the stop rule's receivers (stop_init): stop_sub[k] = 1 when class k stops on the subset
+     * stop_idx[stop_first[k], stop_first[k + 1]) rather than on all its receivers; extra: the
+     * receivers the rule reads outside [g_begin, g_end) (a distributed run's unit gathers them
+     * too, unrecorded), class k's at [extra_first[k], extra_first[k + 1]); what they traced is
+     * left out of the unit's receiver counts */
+    size_t *stop_idx, *extra;
+    size_t stop_first[BK_RECEIVER_CLASSES + 1], extra_first[BK_RECEIVER_CLASSES + 1];
+    int stop_sub[BK_RECEIVER_CLASSES];
+    uint64_t extra_rays, extra_shadow, extra_nonfinite;
     bk_transport_sample samples[BK_TRANSPORT_MAX_PASSES]; /* what each pass reported (checkpoints) */
 } tp_ctx;
 
@@ -1572,6 +1581,8 @@ static void free_ctx(tp_ctx *c)
     }
     free(c->rough); free(c->cell_lum); free(c->cell_var);
     free(c->punct_lum);
+    free(c->stop_idx);
+    free(c->extra);
     free(c->thread_rays); free(c->thread_nonfinite);
     lattice_free(&c->lat);
     lattice_free(&c->oct_lat);
@@ -2095,6 +2106,75 @@ static int pass_cache_rays(const tp_ctx *c, int pass, size_t active)
     return (int)fmax(lo, fmin(cap, want));
 }
 
+/* ---- the stop rule's receivers (TRANSPORT.md §Stop subset) -------------------------------- */
+
+/* Class k's stop subset when it has more than `cap` receivers: one receiver per stratum of
+ * n/cap consecutive ones, at an offset hashed from (class, stratum) (no seed: the subset is
+ * the layout's, not the noise's). Receivers lie in atlas / probe order, so strata spread the
+ * subset over the whole level and the hash keeps it off any row pattern. n > cap. */
+static size_t stop_pick(size_t begin, size_t n, size_t cap, int k, size_t j)
+{
+    const size_t q = n / cap, r = n % cap; /* strata of q + 1 receivers first, then of q */
+    const size_t lo = begin + j * q + (j < r ? j : r), len = q + (j < r);
+    return lo + (size_t)(mix64(0x5707A11D00000000ull ^ ((uint64_t)k << 40) ^ (uint64_t)j) % len);
+}
+
+/* The subsets, and the receivers the rule reads outside [g_begin, g_end) (those of every class
+ * only when the run has a target and is cut). */
+static lbk_result stop_init(tp_ctx *c)
+{
+    const size_t cap = c->opt->stop_receivers > 0 ? c->opt->stop_receivers : BK_TRANSPORT_STOP_RECEIVERS;
+    const int cut = c->target > 0 && (c->g_begin != 0 || c->g_end != c->recv_count);
+    size_t subs = 0, extras = 0;
+    for (int k = 0; k < c->ncls; k++) {
+        size_t n = c->cls[k].end - c->cls[k].begin;
+        c->stop_sub[k] = n > cap;
+        subs += n > cap ? cap : 0;
+        extras += n > cap ? cap : n;
+    }
+    c->stop_idx = malloc((subs ? subs : 1) * sizeof *c->stop_idx);
+    c->extra = malloc((cut && extras ? extras : 1) * sizeof *c->extra);
+    if (!c->stop_idx || !c->extra) return LBK_ERR_OUT_OF_MEMORY;
+    size_t ns = 0, ne = 0;
+    for (int k = 0; k < c->ncls; k++) {
+        const size_t b = c->cls[k].begin, n = c->cls[k].end - b;
+        c->stop_first[k] = ns, c->extra_first[k] = ne;
+        for (size_t j = 0; j < (c->stop_sub[k] ? cap : n); j++) {
+            size_t i = c->stop_sub[k] ? stop_pick(b, n, cap, k, j) : b + j;
+            if (c->stop_sub[k]) c->stop_idx[ns++] = i;
+            if (cut && (i < c->g_begin || i >= c->g_end)) c->extra[ne++] = i;
+        }
+    }
+    for (int k = c->ncls; k <= BK_RECEIVER_CLASSES; k++) c->stop_first[k] = ns, c->extra_first[k] = ne;
+    return LBK_OK;
+}
+
+static void extra_gather(tp_ctx *c, size_t begin, size_t end, int thread)
+{
+    for (size_t p = begin; p < end; p++) recv_gather(c, c->extra[p], c->extra[p] + 1, thread);
+}
+
+static void extra_punctual(tp_ctx *c, size_t begin, size_t end, int thread)
+{
+    for (size_t p = begin; p < end; p++) recv_punctual(c, c->extra[p], c->extra[p] + 1, thread);
+}
+
+static void count_totals(const tp_ctx *c, uint64_t t[3]);
+
+/* fn over class k's extra receivers; what they trace goes to the extra counters. */
+static void extra_run(tp_ctx *c, int k, tp_fn fn)
+{
+    const size_t b = c->extra_first[k], e = c->extra_first[k + 1];
+    if (b == e) return;
+    uint64_t before[3], after[3];
+    count_totals(c, before);
+    parallel_range(c, b, e, 16, fn);
+    count_totals(c, after);
+    c->extra_rays += after[0] - before[0];
+    c->extra_shadow += after[1] - before[1];
+    c->extra_nonfinite += after[2] - before[2];
+}
+
 /* One pass: both halves' caches, then the final gather at the receivers (in blocks, so
  * progress can be reported). */
 static void count_totals(const tp_ctx *c, uint64_t t[3])
@@ -2144,6 +2224,8 @@ static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
                 return LBK_ERR_CANCELLED;
         }
     }
+    for (int k = 0; k < c->ncls; k++)
+        if (c->cls[k].active) extra_run(c, k, extra_gather);
     for (int h = 0; h < 2; h++) {
         bk_slc_draw_destroy(c->draw_recv[h]);
         c->draw_recv[h] = NULL;
@@ -2204,6 +2286,25 @@ static void estimate_error_of(const tp_class *cls, int ncls, double *const x_acc
 static void estimate_error(const tp_ctx *c, double *noise, double *bias, tp_errors *ce)
 {
     estimate_error_of(c->cls, c->ncls, c->x_acc, c->b_acc, noise, bias, ce);
+}
+
+/* The estimate the stop rule reads: the class's own (ce) where it stops on all its receivers,
+ * else the same sums over its subset. */
+static void stop_errors(const tp_ctx *c, const tp_errors *ce, tp_errors *sce)
+{
+    *sce = *ce;
+    for (int k = 0; k < c->ncls; k++) {
+        if (!c->stop_sub[k] || !(c->cls[k].weight_sum > 0)) continue;
+        const double inv = 1 / c->cls[k].weight_sum;
+        double num = 0, den = 0;
+        for (size_t p = c->stop_first[k]; p < c->stop_first[k + 1]; p++) {
+            const size_t i = c->stop_idx[p];
+            double a = c->x_acc[0][i] * inv, b = c->x_acc[1][i] * inv, m = 0.5 * (a + b);
+            num += 0.25 * (a - b) * (a - b);
+            den += m * m;
+        }
+        sce->cls[k] = den > 0 ? sqrt(num / den) : 0;
+    }
 }
 
 /* Which classes stop after this pass: a class whose estimate reached the target, or whose next
@@ -2367,8 +2468,8 @@ static void totals_of(const tp_ctx *c, int passes, const tp_chain_result chain[2
     t->tail_fraction = tot > 0 ? (chain[0].tail_energy + chain[1].tail_energy) / tot : 0;
     t->cells = c->cell_count;
     t->cache_rays = c->cache_rays, t->cache_shadow = c->cache_shadow, t->cache_nonfinite = c->cache_nonfinite;
-    t->recv_rays = all[0] - c->cache_rays, t->recv_shadow = all[1] - c->cache_shadow;
-    t->recv_nonfinite = all[2] - c->cache_nonfinite;
+    t->recv_rays = all[0] - c->cache_rays - c->extra_rays, t->recv_shadow = all[1] - c->cache_shadow - c->extra_shadow;
+    t->recv_nonfinite = all[2] - c->cache_nonfinite - c->extra_nonfinite;
 }
 
 /* The merge: every pass's estimate and report from the units' accumulators, then their outputs,
@@ -2595,8 +2696,6 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
         res = split->run_range(split->user, count, &own, &g_begin, &g_end);
         if (res != LBK_OK) return res;
         if (own && (g_begin > g_end || g_end > count)) return LBK_ERR_INVALID_ARGUMENT;
-        /* a stop on the error estimate needs every receiver of the run */
-        if (own && !(opt->target_error < 0) && (g_begin != 0 || g_end != count)) return LBK_ERR_INVALID_ARGUMENT;
     }
     const int rec = split && !split->replay && own == 1; /* own == 2: baked whole, not recorded */
 
@@ -2630,6 +2729,7 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
     }
     init_classes(&c); /* (before ctx_init: culling's δ is measured per class) */
     res = ctx_init(&c);
+    if (res == LBK_OK) res = stop_init(&c);
     if (res != LBK_OK) goto done;
 
     for (size_t i = 0; i < count; i++) {
@@ -2638,11 +2738,13 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
         if (output->irradiance) output->irradiance[3 * i] = output->irradiance[3 * i + 1] = output->irradiance[3 * i + 2] = 0;
     }
     if (c.oct_count) memset(output->octa_irradiance, 0, c.oct_count * 48 * sizeof(float));
-    if (c.light_count && !c.slc) /* luminance only, for the error */
+    if (c.light_count && !c.slc) { /* luminance only, for the error */
         parallel_range(&c, c.g_begin, c.g_end, 64, recv_punctual);
+        for (int k = 0; k < c.ncls; k++) extra_run(&c, k, extra_punctual);
+    }
 
     double err = 0, bias = 0;
-    tp_errors ce = {{0}, 0};
+    tp_errors ce = {{0}, 0}, sce;
     int pass = 0;
     tp_chain_result chain[2] = {{0, 0, 0, 0}, {0, 0, 0, 0}};
     if (opt->checkpoint && !split) {
@@ -2654,8 +2756,9 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
             if (opt->report)
                 for (int p = 0; p < done_passes; p++) opt->report(opt->user, &c.samples[p]);
             estimate_error(&c, &err, &bias, &ce);
+            stop_errors(&c, &ce, &sce);
             pass = done_passes - 1;
-            if (stop_after(&c, pass, &ce, 0)) goto finished;
+            if (stop_after(&c, pass, &sce, 0)) goto finished;
             pass = done_passes;
         }
     }
@@ -2672,7 +2775,8 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
         if (pass < BK_TRANSPORT_MAX_PASSES) c.samples[pass] = smp;
         if (opt->report) opt->report(opt->user, &smp);
         if (opt->checkpoint && !split && (res = save_state(&c, pass, chain)) != LBK_OK) goto done;
-        if (stop_after(&c, pass, &ce, now_seconds() - pass_start)) break;
+        stop_errors(&c, &ce, &sce);
+        if (stop_after(&c, pass, &sce, now_seconds() - pass_start)) break;
     }
 finished:
     finish_outputs(&c);

@@ -88,8 +88,10 @@ typedef struct bk_transport_sample {
  * A run cut by receivers: a unit gathers only receivers [begin, end) and hands what it computed
  * to `record_*`; the merge replays every unit's record instead of tracing (`replay_*`), so the
  * error estimates, the report and the stats are computed from the same numbers in the same
- * order as a run over all receivers (byte-identical). Only runs whose stop does not depend on
- * the estimate can be cut: target_error < 0 and no time_limit (else LBK_ERR_INVALID_ARGUMENT). */
+ * order as a run over all receivers (byte-identical). A run with an error target can be cut:
+ * its stop reads only the stop receivers (options.stop_receivers), which every unit gathers too,
+ * unrecorded. No time_limit (LBK_ERR_INVALID_ARGUMENT): the passes it allows depend on the
+ * machine. */
 
 /* One finished pass. x_acc/b_acc: per receiver, per half, the pass-weighted accumulators of the
  * error scalar and the bias probe (indexed by receiver; a unit's are valid in [begin, end)). */
@@ -149,8 +151,10 @@ typedef struct bk_transport_split {
     int replay;            /* 0: record (a unit), 1: replay (the merge) */
     void *user;
     /* record: called once at the start of every run, in run order: *own = 1 and the receivers
-     * [*begin, *end) this unit gathers (and records) in this run (all of them when the run has
-     * an error target); *own = 2: the whole run, not recorded (a later run needs its stats); or
+     * [*begin, *end) this unit gathers (and records) in this run; with an error target it also
+     * gathers, unrecorded, the receivers its stop rule reads (options.stop_receivers), so every
+     * unit of a run stops where the whole run does; *own = 2: the receivers [*begin, *end) (all,
+     * or none: the stop rule's receivers only), not recorded (a later run needs its stats); or
      * *own = 0: the unit has no share of the run, which then traces nothing, leaves its outputs 0
      * and reports only its sample schedule (stats passes and samples: a fixed schedule does not
      * depend on tracing; with an error target they are meaningless) */
@@ -235,7 +239,15 @@ typedef struct bk_transport_options {
      * δ × that mean (pass p: δ/2^p), and one draw's level-wide relative RMSE is ≤ √(δ/2);
      * 0: BK_SLC_DEFAULT_DELTA. Smaller: more lights per receiver, less noise. */
     double slc_delta;
+    /* The stop rule's receivers per class (TRANSPORT.md §Stop subset): a class of more than
+     * this many stops on the estimate over a hash-stratified subset of this many of its
+     * receivers (the reported estimate stays over all of them), so a unit of a distributed run
+     * can evaluate the stop alone by also gathering that subset; a smaller class stops on all
+     * its receivers. 0: BK_TRANSPORT_STOP_RECEIVERS. */
+    size_t stop_receivers;
 } bk_transport_options;
+
+#define BK_TRANSPORT_STOP_RECEIVERS ((size_t)65536)
 
 /* The light count above which culling is on by default, and the default δ (SLC.md, measured by
  * bench_slc). */

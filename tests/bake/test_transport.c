@@ -757,6 +757,134 @@ static void test_classes_sample_to_their_own_target(void **state)
     tsc_free(&s);
 }
 
+/* A run cut by receivers with an error target (bk_transport_split, DIST.md): each unit gathers
+ * its range plus the stop receivers (stop_receivers 24: the texel and probe classes stop on
+ * hashed subsets of 24 of their 48 and 32), so every unit stops where the whole run stops —
+ * the texels before the probes, after which the caches follow the probes alone — and its
+ * recorded passes, accumulators and outputs are the whole run's, bit for bit; the units'
+ * receiver rays add up to the whole run's (what the stop receivers cost is left out). */
+typedef struct cut_rec {
+    size_t begin, end, n;
+    int passes;
+    double weight_sum[32][BK_RECEIVER_CLASSES];
+    double *x[32];
+    bk_transport_totals t;
+} cut_rec;
+
+static lbk_result cut_range(void *user, size_t count, int *own, size_t *begin, size_t *end)
+{
+    cut_rec *c = user;
+    c->n = count;
+    *own = 1, *begin = c->begin, *end = c->end;
+    return LBK_OK;
+}
+
+static lbk_result cut_pass(void *user, const bk_transport_pass_record *pr)
+{
+    cut_rec *c = user;
+    assert_true(c->passes < 32 && pr->pass == c->passes);
+    memcpy(c->weight_sum[c->passes], pr->weight_sum, sizeof pr->weight_sum);
+    c->x[c->passes] = malloc(2 * c->n * sizeof(double));
+    memcpy(c->x[c->passes], pr->x_acc[0], c->n * sizeof(double));
+    memcpy(c->x[c->passes] + c->n, pr->x_acc[1], c->n * sizeof(double));
+    c->passes++;
+    return LBK_OK;
+}
+
+static lbk_result cut_done(void *user, const struct bk_transport_output *out, const bk_transport_totals *t)
+{
+    (void)out;
+    ((cut_rec *)user)->t = *t;
+    return LBK_OK;
+}
+
+/* One run through a recording split of receivers [begin, end). */
+static run_out cut_run(const bk_scene *s, const bk_receiver *r, size_t n, const bk_transport_options *o, size_t begin,
+                       size_t end, cut_rec *c)
+{
+    memset(c, 0, sizeof *c);
+    c->begin = begin, c->end = end;
+    bk_transport_split sp;
+    memset(&sp, 0, sizeof sp);
+    sp.user = c;
+    sp.run_range = cut_range;
+    sp.record_pass = cut_pass;
+    sp.record_done = cut_done;
+    bk_transport_options ou = *o;
+    ou.split = &sp;
+    ou.report = NULL;
+    return run(s, r, n, &ou);
+}
+
+static void cut_free(cut_rec *c)
+{
+    for (int p = 0; p < c->passes; p++) free(c->x[p]);
+}
+
+static void test_cut_run_with_target(void **state)
+{
+    (void)state;
+    bk_scene s;
+    nee_room(&s);
+    enum { ALL = 256, NT = 48, NP = 32, N = NT + NP };
+    bk_receiver all[ALL], r[N];
+    nee_receivers(all, ALL);
+    size_t nt = 0, np = 0;
+    for (size_t i = 0; i < ALL; i++) {
+        int probe = all[i].normal[0] == 0 && all[i].normal[1] == 0 && all[i].normal[2] == 0;
+        if (!probe && nt < NT) r[nt++] = all[i];
+        else if (probe && np < NP) r[NT + np++] = all[i];
+    }
+    assert_int_equal(nt, NT);
+    assert_int_equal(np, NP);
+    bk_transport_options o = fixed_opt(10);
+    o.target_error = 0.04;
+    o.class_end[BK_CLASS_TEXEL] = NT;
+    o.class_end[BK_CLASS_GLG] = N;
+    o.class_end[BK_CLASS_LLG] = N;
+    o.stop_receivers = 24;
+    run_out whole = run(&s, r, N, &o);
+    assert_int_equal(whole.st.stop, BK_STOP_TARGET);
+    /* the case is one where the cut matters: the texels stopped passes before the probes */
+    assert_true(whole.st.class_samples[BK_CLASS_GLG] > whole.st.class_samples[BK_CLASS_TEXEL]);
+    print_message("whole run: %d passes, texels %.0f samples (%.2f %%), probes %.0f (%.2f %%)\n", whole.st.passes,
+                  whole.st.class_samples[BK_CLASS_TEXEL], 100 * whole.st.class_rel_rmse[BK_CLASS_TEXEL],
+                  whole.st.class_samples[BK_CLASS_GLG], 100 * whole.st.class_rel_rmse[BK_CLASS_GLG]);
+    /* the whole run recorded: the reference for every unit's records */
+    cut_rec ref;
+    run_out w = cut_run(&s, r, N, &o, 0, N, &ref);
+    assert_int_equal(ref.passes, whole.st.passes);
+    assert_memory_equal(w.rad, whole.rad, N * sizeof *whole.rad);
+    assert_true(ref.t.cache_rays + ref.t.recv_rays == w.st.rays);
+    const size_t cuts[4] = {0, 27, 54, N};
+    uint64_t recv_rays = 0;
+    for (int u = 0; u < 3; u++) {
+        cut_rec c;
+        run_out part = cut_run(&s, r, N, &o, cuts[u], cuts[u + 1], &c);
+        const size_t b = c.begin, m = c.end - c.begin;
+        assert_int_equal(c.passes, ref.passes);
+        assert_int_equal(c.t.stop, ref.t.stop);
+        assert_true(c.t.cache_rays == ref.t.cache_rays); /* the caches followed the same classes */
+        for (int p = 0; p < c.passes; p++) {
+            assert_memory_equal(c.weight_sum[p], ref.weight_sum[p], sizeof ref.weight_sum[p]);
+            assert_memory_equal(c.x[p] + b, ref.x[p] + b, m * sizeof(double));
+            assert_memory_equal(c.x[p] + N + b, ref.x[p] + N + b, m * sizeof(double));
+        }
+        assert_memory_equal(part.rad + b, whole.rad + b, m * sizeof *whole.rad);
+        assert_memory_equal(part.irr + 3 * b, whole.irr + 3 * b, 3 * m * sizeof *whole.irr);
+        /* it traced the stop receivers outside its range too, and left them out of its count */
+        assert_true(c.t.cache_rays + c.t.recv_rays < part.st.rays);
+        recv_rays += c.t.recv_rays;
+        cut_free(&c);
+        run_free(&part);
+    }
+    assert_true(recv_rays == ref.t.recv_rays);
+    cut_free(&ref);
+    run_free(&w);
+    run_free(&whole);
+    tsc_free(&s);
+}
+
 static void test_stream_equals_single(void **state)
 {
     (void)state;
@@ -835,6 +963,7 @@ int main(void)
         cmocka_unit_test(test_light_sets),
         cmocka_unit_test(test_nee_unbiased_and_quieter),
         cmocka_unit_test(test_classes_sample_to_their_own_target),
+        cmocka_unit_test(test_cut_run_with_target),
         cmocka_unit_test(test_stream_equals_single),
         cmocka_unit_test(test_intensity_extremes),
         cmocka_unit_test(test_scale_and_offset_extremes),

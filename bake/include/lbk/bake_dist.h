@@ -3,11 +3,11 @@
  * (spec/part.md); the merge of all parts is byte-identical to lbk_bake_from_file with the same
  * scene, options and seed, at any number of units.
  *
- * A run that stops on an error target (desc->target_error >= 0) needs its estimate over all its
- * receivers, so with one only units <= runs can be cut (each run whole in one unit); with
- * target_error < 0 (stop at max_samples) any number. No time_limit, and the difference door
- * method (the guided estimator is not a transport run). Anything else: LBK_ERR_INVALID_ARGUMENT
- * with the reason sent as the ERROR message. */
+ * An error target (desc->target_error >= 0) cuts at any number too: a run's stop reads only its
+ * stop receivers, which every unit sharing the run also gathers (DIST.md §Error targets). Guided
+ * doors (LBK_BAKE_DOOR_GUIDED): the merge makes their estimates. No time_limit (the passes it
+ * allows depend on the machine): LBK_ERR_INVALID_ARGUMENT with the reason sent as the ERROR
+ * message. */
 #ifndef LBK_BAKE_DIST_H
 #define LBK_BAKE_DIST_H
 
