@@ -385,17 +385,31 @@ static lbk_result layout_glg(bk_pipeline *b)
     return LBK_OK;
 }
 
-/* OCTP: a probe volume over the level at the GLG's spacing, or finer in a small level
- * (bake/probes/octa_bake.h). */
+/* OCTP: clip levels around the playable space's centre (the level's when it has none), the
+ * finest at the GLG's spacing, or finer in a small level (bake/probes/octa_bake.h). */
 static lbk_result layout_octa(bk_pipeline *b)
 {
     bk_octa_options oo;
     memset(&oo, 0, sizeof oo);
-    oo.spacing = b->opt->glg_spacing > 0 ? b->opt->glg_spacing : b->pre->glg_spacing;
+    const lbk_bake_desc *d = b->opt;
+    oo.spacing = d->glg_spacing > 0 ? d->glg_spacing : b->pre->glg_spacing;
     /* at least 8 probes along the level's longest side: a small room gets a usable volume */
     float ext = 0;
     for (int a = 0; a < 3; a++) ext = fmaxf(ext, b->scene.bounds_max[a] - b->scene.bounds_min[a]);
     if (ext > 0 && ext / 8 < oo.spacing) oo.spacing = ext / 8;
+    if (d->octp_spacing > 0) oo.spacing = d->octp_spacing;
+    oo.levels = d->octp_levels > 0 ? (uint32_t)d->octp_levels : 0;
+    oo.clip = d->octp_clip > 0 ? (uint32_t)d->octp_clip : 0;
+    if (b->scene.playable_count) { /* the centre of the playable boxes' union */
+        float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (size_t i = 0; i < b->scene.playable_count; i++)
+            for (int a = 0; a < 3; a++) {
+                lo[a] = fminf(lo[a], b->scene.playable[i].min[a]);
+                hi[a] = fmaxf(hi[a], b->scene.playable[i].max[a]);
+            }
+        oo.has_centre = 1;
+        for (int a = 0; a < 3; a++) oo.centre[a] = 0.5f * (lo[a] + hi[a]);
+    }
     lbk_result r = bk_octa_place(&b->scene, b->tracer, b->scene.bounds_min, b->scene.bounds_max, &oo, &b->octa);
     return r ? bk_pipeline_failed(b, r, "octahedral probe volume") : LBK_OK;
 }
