@@ -50,6 +50,9 @@ static void help(FILE *f)
           "  --octp-spacing M        the finest level's probe spacing in metres (default the GLG's, or\n"
           "                          the longest extent / 8 when finer)\n"
           "  --octp-clip N           probes per axis of a clip level, 2-32 (default 32)\n"
+          "  --gather-limit M        final-gather rays from surfaces end after M metres and read the\n"
+          "                          global light grid (baked first) where they hit nothing; off by\n"
+          "                          default (bake/transport/TRANSPORT.md, measured)\n"
           "  --error-map             also write the per-texel error map (TERR, format 1.4): each lightmap\n"
           "                          texel's estimated relative standard error (lbk view's error mode,\n"
           "                          lbk export, lbk inspect); before denoising when denoised\n"
@@ -435,6 +438,9 @@ int cli_bake_parse(int argc, char **argv, bake_args *out, int *quiet_out)
             o.d.no_glg = 1;
         } else if (!strcmp(a, "--octahedral")) {
             o.d.octahedral_probes = 1;
+        } else if (!strcmp(a, "--gather-limit")) {
+            NEED_NUMBER(1e-4, 1e6);
+            o.d.gather_limit = (float)d;
         } else if (!strcmp(a, "--octp-levels")) {
             NEED_UINT(1, 3);
             o.d.octp_levels = (int)u;

@@ -14,6 +14,7 @@
 #include "bake/dist/checkpoint.h"
 #include "bake/dist/dist.h"
 #include "bake/pipeline/encode.h"
+#include "bake/pipeline/gather_limit.h"
 #include "bake/pipeline/pipeline.h"
 #include "bake/pipeline/error_map.h"
 #include "bake/pipeline/provenance.h"
@@ -668,7 +669,24 @@ static lbk_result do_transport(bk_pipeline *b)
         to.octa_count = b->octa.count;
         out.octa_irradiance = b->octa_irradiance;
     }
+    bk_far_probes far;
+    memset(&far, 0, sizeof far);
+    if (b->opt->gather_limit > 0) { /* the GLG first, read by the base run's long rays (gather_limit.h) */
+        r = bk_far_probes_bake(b, &to, &far);
+        if (r) {
+            free(irradiance);
+            return bk_pipeline_failed(b, r, "light transport (the probes for --gather-limit)");
+        }
+        if (far.bytes) {
+            to.gather_limit = b->opt->gather_limit;
+            to.far_radiance = bk_far_probes_radiance;
+            to.far_user = &far;
+        } else {
+            bk_events_say(&b->events, LBK_BAKE_SEVERITY_WARNING, "--gather-limit needs a global light grid to fall back on; gathering in full");
+        }
+    }
     r = bk_transport_run(&b->scene, b->tracer, b->receivers, b->receiver_count, &to, &out, &b->stats);
+    bk_far_probes_free(&far);
     if (!r) bk_texels_match_irradiance(&b->texels, b->texel_of_receiver, b->texel_receivers, b->radiance, irradiance);
     if (!r) r = bk_llg_fit_run(&b->llg_fit, b->llgs, &b->scene, irradiance, b->radiance, b->llg_first, &b->llg_fit_stats);
     if (!r && b->opt->error_map) { /* before denoising: the transport's own estimate (error_map.h) */
@@ -983,6 +1001,9 @@ static lbk_result bake(const char *path, const lbk_bake_scene *desc, const lbk_b
     }
     if (!r && !path && !desc) r = bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT, "no scene");
     /* the octahedral volume's accumulators are neither in parts nor in checkpoints yet */
+    if (!r && b->desc.gather_limit > 0 && (dist || b->desc.checkpoint_dir))
+        r = bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT,
+                             "a ray-length limit (--gather-limit) cannot be baked distributed or with checkpoints yet");
     if (!r && b->desc.octahedral_probes && (dist || b->desc.checkpoint_dir))
         r = bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT,
                              "octahedral probes (--octahedral) cannot be baked distributed or with checkpoints yet");

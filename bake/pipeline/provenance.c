@@ -341,6 +341,9 @@ lbk_result bk_provenance_meta(const bk_pipeline *b, void **data, size_t *size)
     if (o->octahedral_probes && o->octp_levels > 0) p[n++] = (lbk_meta_pair){"bake.octp_levels", octp_levels};
     if (o->octahedral_probes && o->octp_spacing > 0) p[n++] = (lbk_meta_pair){"bake.octp_spacing", octp_spacing};
     if (o->octahedral_probes && o->octp_clip > 0) p[n++] = (lbk_meta_pair){"bake.octp_clip", octp_clip};
+    char glimit[32];
+    snprintf(glimit, sizeof glimit, "%g", o->gather_limit);
+    if (o->gather_limit > 0) p[n++] = (lbk_meta_pair){"bake.gather_limit", glimit}; /* absent: off */
     p[n++] = (lbk_meta_pair){"bake.dls_threshold", threshold};
     p[n++] = (lbk_meta_pair){"bake.door_method", o->door_method == LBK_BAKE_DOOR_GUIDED ? "guided" : "difference"};
     if (o->revision) p[n++] = (lbk_meta_pair){LBK_META_REVISION, o->revision};

@@ -472,17 +472,21 @@ static void to_local(const tp_lobe *lf, const double d[3], double l[3])
 }
 
 static int nee_sample_lobe(const tp_ctx *c, const float o[3], const double n[3], int kind, const tp_lobe *lf,
-                           double u0, double u1, double d[3], double *cos_p, double val[3], uint64_t *shadow);
+                           double u0, double u1, double max_dist, double d[3], double *cos_p, double val[3],
+                           uint64_t *shadow);
 
 static int nee_sample(const tp_ctx *c, const float o[3], const double n[3], int kind, double u0, double u1,
                       double d[3], double *cos_p, double val[3], uint64_t *shadow)
 {
-    return nee_sample_lobe(c, o, n, kind, NULL, u0, u1, d, cos_p, val, shadow);
+    return nee_sample_lobe(c, o, n, kind, NULL, u0, u1, INFINITY, d, cos_p, val, shadow);
 }
 
-/* nee_sample weighed against the lobe lf's density instead of the gather pdf (lf NULL: that). */
+/* nee_sample weighed against the lobe lf's density instead of the gather pdf (lf NULL: that);
+ * emitter points farther than max_dist give no sample (the gather's ray-length limit: a gather
+ * ray that far reads the probes, which hold that emitter's light). */
 static int nee_sample_lobe(const tp_ctx *c, const float o[3], const double n[3], int kind, const tp_lobe *lf,
-                           double u0, double u1, double d[3], double *cos_p, double val[3], uint64_t *shadow)
+                           double u0, double u1, double max_dist, double d[3], double *cos_p, double val[3],
+                           uint64_t *shadow)
 {
     double rem;
     const tp_emitter *em = &c->em[em_pick(c, u0, &rem)];
@@ -495,6 +499,7 @@ static int nee_sample_lobe(const tp_ctx *c, const float o[3], const double n[3],
     double dist2 = dv[0] * dv[0] + dv[1] * dv[1] + dv[2] * dv[2];
     if (!(dist2 > 0) || !isfinite(dist2)) return 0;
     double dist = sqrt(dist2);
+    if (dist > max_dist) return 0;
     for (int a = 0; a < 3; a++) d[a] = dv[a] / dist;
     double cp = kind == PG_SPHERE ? 1 : d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
     if (!(cp > 0)) return 0;
@@ -775,7 +780,7 @@ static void gloss_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit,
     if (md->sources && c->nee) {
         double ld[3], cq, val[3];
         double a0 = rng_next(rng), a1 = rng_next(rng);
-        if (nee_sample_lobe(c, o, lf.n, PG_COSINE, &lf, a0, a1, ld, &cq, val, &cnt->shadow) && bk_finite3(val)) {
+        if (nee_sample_lobe(c, o, lf.n, PG_COSINE, &lf, a0, a1, INFINITY, ld, &cq, val, &cnt->shadow) && bk_finite3(val)) {
             double ll[3], f[3];
             to_local(&lf, ld, ll);
             bk_mr_lobe_eval(&lf.lb, ll, f);
@@ -1329,6 +1334,13 @@ static void recv_half(tp_ctx *c, const bk_receiver *r, size_t i, int h, int S, c
     }
     double t0[3], b0[3];
     bk_onb(g0.n, t0, b0);
+    /* the ray-length limit (options.gather_limit): surface receivers' rays end at lim and read
+     * the probes there */
+    const bk_transport_options *o = c->opt;
+    const double lim = !sphere && o->gather_limit > 0 && o->far_radiance ? o->gather_limit : INFINITY;
+    uint32_t far_hint = 0;
+    float tmax[TP_BATCH];
+    for (int jj = 0; jj < TP_BATCH; jj++) tmax[jj] = (float)lim;
     for (int j0 = 0; j0 < S; j0 += TP_BATCH) {
         const int m = S - j0 < TP_BATCH ? S - j0 : TP_BATCH;
         float org[3 * TP_BATCH], dir[3 * TP_BATCH];
@@ -1353,11 +1365,19 @@ static void recv_half(tp_ctx *c, const bk_receiver *r, size_t i, int h, int S, c
                 nn[jj][a] = g.n[a];
             }
         }
-        bk_tracer_intersect_n(c->tracer, (size_t)m, org, dir, 0.0f, NULL, hits);
+        bk_tracer_intersect_n(c->tracer, (size_t)m, org, dir, 0.0f, isfinite(lim) ? tmax : NULL, hits);
         cnt->rays += (uint64_t)m;
         for (int jj = 0; jj < m; jj++) {
             double L[3], Ld[3];
-            long hc = gather_hit(c, sum, c->rough, &hits[jj], dd[jj], solid, &cont, cnt, L, Ld);
+            long hc = -1;
+            if (isfinite(lim) && hits[jj].tri == UINT32_MAX) { /* no hit within lim: the probes */
+                const double x[3] = {org[3 * jj] + lim * dd[jj][0], org[3 * jj + 1] + lim * dd[jj][1],
+                                     org[3 * jj + 2] + lim * dd[jj][2]};
+                o->far_radiance(o->far_user, x, dd[jj], &far_hint, L);
+                Ld[0] = Ld[1] = Ld[2] = 0; /* the probes' light counts as indirect */
+            } else {
+                hc = gather_hit(c, sum, c->rough, &hits[jj], dd[jj], solid, &cont, cnt, L, Ld);
+            }
             if (!bk_finite3(L) || !bk_finite3(Ld)) cnt->bad++;
             else {
                 accumulate(dd[jj], sphere ? 1 : zz[jj], L, Ld, rs->e, rs->sh_t, rs->sh_d);
@@ -1376,7 +1396,7 @@ static void recv_half(tp_ctx *c, const bk_receiver *r, size_t i, int h, int S, c
              * units (radiance, later × solid/S) by 1/solid */
             double u0, uu1, ld[3], cl, val[3];
             lattice_uv(lat, (uint32_t)(j0 + jj), t1, t2, &u0, &uu1);
-            if (nee_sample(c, org + 3 * jj, nn[jj], pg_kind, u0, uu1, ld, &cl, val, &cnt->shadow)) {
+            if (nee_sample_lobe(c, org + 3 * jj, nn[jj], pg_kind, NULL, u0, uu1, lim, ld, &cl, val, &cnt->shadow)) {
                 for (int a = 0; a < 3; a++) val[a] /= solid;
                 if (!bk_finite3(val)) cnt->bad++;
                 else {

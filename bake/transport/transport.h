@@ -235,6 +235,19 @@ typedef struct bk_transport_options {
      * δ × that mean (pass p: δ/2^p), and one draw's level-wide relative RMSE is ≤ √(δ/2);
      * 0: BK_SLC_DEFAULT_DELTA. Smaller: more lights per receiver, less noise. */
     double slc_delta;
+    /* Ray-length limit with probe fallback (seed 003's "sample probes when coverage is low";
+     * TRANSPORT.md §Ray-length limit): > 0 and far_radiance set, every final-gather ray of a
+     * surface receiver (a texel, an LLG fit target: receivers with a normal) ends at this many
+     * metres; one that hits nothing within it takes far_radiance at its end point x for its
+     * direction d (the incident radiance at x arriving from d, e.g. a probe volume's SH9), as
+     * indirect light, and light samples of emitters farther than it are dropped (the gather
+     * ray there reads the probes, which hold that emitter). Sphere receivers (probes) and the
+     * cache trace in full. far_radiance must be deterministic and thread-safe; *hint starts at 0
+     * for each receiver and half and is the callee's to keep (a tetrahedron to start from).
+     * 0: off (default), every bake unchanged. */
+    double gather_limit;
+    void (*far_radiance)(void *user, const double x[3], const double d[3], uint32_t *hint, double L[3]);
+    void *far_user;
 } bk_transport_options;
 
 /* The light count above which culling is on by default, and the default δ (SLC.md, measured by

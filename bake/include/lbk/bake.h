@@ -204,6 +204,11 @@ typedef struct lbk_bake_desc {
     float octp_spacing;         /* the finest level's probe spacing in metres, each coarser level
                                    doubling it [0: min(GLG spacing, longest extent / 8)] */
     int octp_clip;              /* probes per axis of a clip level, 2 … 32 [0: 32, seed 003] */
+    float gather_limit;         /* metres: the base run's final-gather rays from surfaces end here
+                                   and read the global light grid (gathered first) where they hit
+                                   nothing (bake/transport/TRANSPORT.md §Ray-length limit;
+                                   light sets and doors gather in full) [0: off, measured not to
+                                   pay] */
 } lbk_bake_desc;
 
 /* A file a bake read (the glTF, its buffers and images, a sky EXR), as META input.files
