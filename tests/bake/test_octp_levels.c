@@ -11,7 +11,9 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "bake/probes/octa_bake.h"
 #include "lbk/bake.h"
@@ -19,6 +21,9 @@
 #include "lbk/octa.h"
 #include "lbk/validate.h"
 #include "support/transport_scenes.h"
+#include "tools/common/bake_data.h"
+#include "tools/common/image_io.h"
+#include "tools/convert/export.h"
 
 static void assert_level(const lbk_octp_level *l, float spacing, uint32_t dx, uint32_t dy, uint32_t dz, float ox,
                          float oy, float oz, uint32_t first)
@@ -113,6 +118,47 @@ static float blend_delta(const lbk_octp_view *v, uint32_t l, const float p[3], c
         d = fminf(d, fminf(g, (float)(lv->dims[a] - 1) - g));
     }
     return d;
+}
+
+/* lbk export's atlases of every level (tools/convert/export_octp.c): each probe's tile holds its
+ * interior texels exactly (EXR float), at tile (x, y + dims_y·z) of its level's image. */
+static void export_levels(const void *bytes, size_t size, const lbk_octp_view *ov)
+{
+    tl_bake tb;
+    char err[TL_ERR_LEN], dir[] = "/tmp/test_octp_levels_XXXXXX";
+    assert_int_equal(tl_bake_open_memory(bytes, size, &tb, err), TL_OPEN_OK);
+    assert_non_null(mkdtemp(dir));
+    tl_export_stats st;
+    memset(&st, 0, sizeof st);
+    assert_int_equal(tl_export_octp(&tb, dir, &st, err), 0);
+    assert_int_equal(st.exr_files, 2 * ov->level_count);
+    static const char *const RGB[3] = {"R", "G", "B"}, *const M[2] = {"m1", "m2"};
+    for (uint32_t l = 0; l < ov->level_count; l++) {
+        const lbk_octp_level *lv = &ov->levels[l];
+        char path[256];
+        int w, h, wd, hd;
+        float *irr, *dep;
+        snprintf(path, sizeof path, "%s/octp_level_%u.exr", dir, l);
+        assert_int_equal(tl_exr_read(path, 3, RGB, &w, &h, &irr, err), 0);
+        remove(path);
+        snprintf(path, sizeof path, "%s/octp_level_%u.depth.exr", dir, l);
+        assert_int_equal(tl_exr_read(path, 2, M, &wd, &hd, &dep, err), 0);
+        remove(path);
+        assert_int_equal(w, 4 * (int)lv->dims[0]);
+        assert_int_equal(h, 4 * (int)(lv->dims[1] * lv->dims[2]));
+        assert_int_equal(wd, 12 * (int)lv->dims[0]);
+        /* the last probe of the level: tile (dims0 − 1, dims1·dims2 − 1); texel (i, j) = (3, 1) */
+        lbk_octp_probe_desc pd;
+        const uint32_t k = lv->dims[0] * lv->dims[1] * lv->dims[2] - 1;
+        assert_int_equal(lbk_octp_probe_get(ov, lv->first_probe + k, &pd), LBK_OK);
+        const int x0 = 4 * ((int)lv->dims[0] - 1), y0 = h - 4;
+        for (int c = 0; c < 3; c++) assert_float_equal(irr[3 * ((y0 + 1) * w + x0 + 3) + c], pd.irradiance[1 * 4 + 3][c], 0);
+        const int xd = 12 * ((int)lv->dims[0] - 1), yd = hd - 12;
+        for (int c = 0; c < 2; c++) assert_float_equal(dep[2 * ((yd + 5) * wd + xd + 7) + c], pd.depth[5 * 12 + 7][c], 0);
+        free(irr), free(dep);
+    }
+    rmdir(dir);
+    tl_bake_close(&tb);
 }
 
 /* A closed 6 × 3 × 2.5 m room (grey, faces inward), a 20 cd lamp off-centre, baked through the
@@ -227,6 +273,7 @@ static void blend_on_baked_volume(void **state)
     sample(&ov, pe, nx, 0, e);
     sample(&v1, pe, nx, 0, e1);
     for (int k = 0; k < 3; k++) assert_float_equal(e[k], e1[k], 1e-3 * e1[k]);
+    export_levels(bytes, size, &ov);
     lbk_reader_close(rd);
     lbk_free(NULL, bytes);
     lbk_bake_output_free(out);
