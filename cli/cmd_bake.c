@@ -53,6 +53,8 @@ static void help(FILE *f)
           "  --gather-limit M        final-gather rays from surfaces end after M metres and read the\n"
           "                          global light grid (baked first) where they hit nothing; off by\n"
           "                          default (bake/transport/TRANSPORT.md, measured)\n"
+          "  --llg-connected         LLG props that meet end to end (touching bounding boxes, neither\n"
+          "                          inside the other) get twice the probes per axis (seed 001)\n"
           "  --error-map             also write the per-texel error map (TERR, format 1.4): each lightmap\n"
           "                          texel's estimated relative standard error (lbk view's error mode,\n"
           "                          lbk export, lbk inspect); before denoising when denoised\n"
@@ -322,7 +324,7 @@ static int bake(bake_args *o, int quiet)
 
 int cli_bake_flag(const char *a)
 {
-    return !strcmp(a, "--no-glg") || !strcmp(a, "--octahedral") || !strcmp(a, "--glg-lighting") || !strcmp(a, "--error-map") || !strcmp(a, "--block-align") || !strcmp(a, "--timestamp") ||
+    return !strcmp(a, "--no-glg") || !strcmp(a, "--octahedral") || !strcmp(a, "--glg-lighting") || !strcmp(a, "--llg-connected") || !strcmp(a, "--error-map") || !strcmp(a, "--block-align") || !strcmp(a, "--timestamp") ||
            !strcmp(a, "-q") || !strcmp(a, "--quiet") || !strcmp(a, "-h") || !strcmp(a, "--help");
 }
 
@@ -450,6 +452,8 @@ int cli_bake_parse(int argc, char **argv, bake_args *out, int *quiet_out)
         } else if (!strcmp(a, "--octp-clip")) {
             NEED_UINT(2, 32);
             o.d.octp_clip = (int)u;
+        } else if (!strcmp(a, "--llg-connected")) {
+            o.d.llg_connected = 1;
         } else if (!strcmp(a, "--glg-lighting")) {
             o.d.glg_lighting = 1;
         } else if (!strcmp(a, "--block-align")) {

@@ -425,8 +425,27 @@ static lbk_result layout_llgs(bk_pipeline *b, size_t n_llg)
     memset(&lo, 0, sizeof lo);
     lo.visibility_rays = b->pre->llg_visibility_rays;
     lo.min_dim = 3; /* bake/probes/PROBES.md §LLG fit */
+    /* --llg-connected: twice the probes per axis for LLG objects that meet end to end */
+    uint8_t *cand = NULL, *conn = NULL;
+    if (b->opt->llg_connected) {
+        cand = calloc(s->object_count ? s->object_count : 1, 1);
+        conn = calloc(s->object_count ? s->object_count : 1, 1);
+        if (!cand || !conn) {
+            free(cand), free(conn);
+            return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
+        }
+        for (size_t i = 0; i < s->object_count; i++) cand[i] = b->classes[i].rep == BK_REP_LLG;
+        lbk_result r = bk_llg_connections(s, cand, 0, conn);
+        if (r) {
+            free(cand), free(conn);
+            return bk_pipeline_failed(b, r, "connected LLG objects");
+        }
+    }
+    size_t n_conn = 0;
     for (size_t i = 0; i < s->object_count; i++) {
         if (b->classes[i].rep != BK_REP_LLG) continue;
+        lo.connected = conn ? conn[i] : 0;
+        n_conn += lo.connected != 0;
         lbk_result r = bk_llg_place(s, (uint32_t)i, &lo, b->opt->threads, &b->llgs[b->llg_count]);
         if (r) {
             bk_events_say(&b->events, LBK_BAKE_SEVERITY_WARNING, "object '%s': no local light grid (%s)", s->objects[i].name,
@@ -436,6 +455,8 @@ static lbk_result layout_llgs(bk_pipeline *b, size_t n_llg)
         }
         b->object_llg[i] = (int32_t)b->llg_count++;
     }
+    if (conn) bk_events_say(&b->events, LBK_BAKE_SEVERITY_NOTE, "%zu LLG objects connect to another: finer grids", n_conn);
+    free(cand), free(conn);
     return LBK_OK;
 }
 

@@ -344,6 +344,7 @@ lbk_result bk_provenance_meta(const bk_pipeline *b, void **data, size_t *size)
     char glimit[32];
     snprintf(glimit, sizeof glimit, "%g", o->gather_limit);
     if (o->gather_limit > 0) p[n++] = (lbk_meta_pair){"bake.gather_limit", glimit}; /* absent: off */
+    if (o->llg_connected) p[n++] = (lbk_meta_pair){"bake.llg_connected", "1"}; /* absent: off */
     p[n++] = (lbk_meta_pair){"bake.dls_threshold", threshold};
     p[n++] = (lbk_meta_pair){"bake.door_method", o->door_method == LBK_BAKE_DOOR_GUIDED ? "guided" : "difference"};
     if (o->revision) p[n++] = (lbk_meta_pair){LBK_META_REVISION, o->revision};

@@ -209,6 +209,10 @@ typedef struct lbk_bake_desc {
                                    nothing (bake/transport/TRANSPORT.md §Ray-length limit;
                                    light sets and doors gather in full) [0: off, measured not to
                                    pay] */
+    int llg_connected;          /* 1: LLG objects whose bounding boxes touch another's end to end
+                                   (pipes, rails, stacked props; neither box inside the other) get
+                                   half the probe spacing (seed 001's extra probes for connected
+                                   objects; bake/probes/PROBES.md) [0: off] */
 } lbk_bake_desc;
 
 /* A file a bake read (the glTF, its buffers and images, a sky EXR), as META input.files
