@@ -18,6 +18,9 @@ lbk_result bk_far_probes_bake(const bk_pipeline *b, const bk_transport_options *
     to.octa_points = NULL, to.octa_count = 0;
     to.gather_limit = 0, to.far_radiance = NULL;
     to.report = NULL; /* the bake's pass log and report are the base run's */
+    /* a cache of the default budget instead of one as fine as the lightmap: the probes are read
+     * as a smooth field, and a texel-fine cache is most of a run's cost */
+    to.cell_size = NULL;
     lbk_sh9_rgb *sh = calloc(n, sizeof *sh);
     uint8_t(*vis)[4] = calloc(b->glg.tet_count ? b->glg.tet_count : 1, sizeof *vis);
     lbk_result r = sh && vis ? LBK_OK : LBK_ERR_OUT_OF_MEMORY;
@@ -49,14 +52,17 @@ lbk_result bk_far_probes_bake(const bk_pipeline *b, const bk_transport_options *
     return r;
 }
 
-void bk_far_probes_radiance(void *user, const double x[3], const double d[3], uint32_t *hint, double L[3])
+int bk_far_probes_radiance(void *user, const double x[3], const double d[3], uint32_t *hint, double L[3])
 {
     const bk_far_probes *f = user;
     const float p[3] = {(float)x[0], (float)x[1], (float)x[2]}, df[3] = {(float)d[0], (float)d[1], (float)d[2]};
     lbk_sh9_rgb sh;
+    lbk_glg_sample_info info;
     float rgb[3] = {0, 0, 0};
-    if (lbk_glg_sample(&f->view, p, hint, &sh, NULL) == LBK_OK) lbk_sh9_eval(&sh, df, rgb);
+    if (lbk_glg_sample(&f->view, p, hint, &sh, &info) != LBK_OK || !info.location.inside) return 0;
+    lbk_sh9_eval(&sh, df, rgb);
     for (int a = 0; a < 3; a++) L[a] = rgb[a] > 0 && isfinite(rgb[a]) ? rgb[a] : 0;
+    return 1;
 }
 
 void bk_far_probes_free(bk_far_probes *f)

@@ -17,12 +17,15 @@ typedef struct bk_far_probes {
 } bk_far_probes;
 
 /* Gathers the pipeline's GLG probes (receivers [glg_first, llg_first)) with `base`'s options (one
- * receiver class, no octahedral points, no limit) and builds the section. LBK_OK with
+ * receiver class, no octahedral points, no limit, the radiosity cache at its default budget of
+ * cells rather than lightmap-fine) and builds the section. LBK_OK with
  * out->bytes NULL when the bake has no GLG. */
 lbk_result bk_far_probes_bake(const bk_pipeline *b, const bk_transport_options *base, bk_far_probes *out);
-/* bk_transport_options.far_radiance over a bk_far_probes (user): the SH9 at x evaluated towards d,
- * clamped at 0 (SH9 rings below zero near bright sources). */
-void bk_far_probes_radiance(void *user, const double x[3], const double d[3], uint32_t *hint, double L[3]);
+/* bk_transport_options.far_radiance over a bk_far_probes (user): inside the GLG's hull the SH9 at
+ * x evaluated towards d, clamped at 0 (SH9 rings below zero near bright sources), and 1; outside
+ * it 0 (the GLG covers the level's free space only: a ray from an outer wall into the open sky
+ * would read the clamped inside probes). */
+int bk_far_probes_radiance(void *user, const double x[3], const double d[3], uint32_t *hint, double L[3]);
 void bk_far_probes_free(bk_far_probes *f);
 
 #endif

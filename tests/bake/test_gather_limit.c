@@ -1,7 +1,7 @@
 /* The final gather's ray-length limit with probe fallback (bk_transport_options.gather_limit;
  * TRANSPORT.md §Ray-length limit): surface rays that hit nothing within L take far_radiance at
  * their end point, rays that hit within L are untouched, sphere receivers (probes) trace in
- * full. Checked on an open floor under a uniform sky with a short wall beside the receivers,
+ * full, and rays whose end the probes do not cover are traced on. Checked on an open floor under a uniform sky with a short wall beside the receivers,
  * against the same run without the limit: the estimates are linear in what the rays bring back,
  * so a fallback that returns the sky gives the same irradiance to float rounding, and one that
  * returns twice the sky adds exactly the sky's share once more. */
@@ -20,6 +20,7 @@
 
 typedef struct far_check {
     float value;       /* radiance returned */
+    int uncovered;     /* 1: the probes cover nothing (return 0: the ray is traced on) */
     double limit;
     const bk_receiver *r;
     size_t n;
@@ -27,7 +28,7 @@ typedef struct far_check {
     unsigned long calls;
 } far_check;
 
-static void far_const(void *user, const double x[3], const double d[3], uint32_t *hint, double L[3])
+static int far_const(void *user, const double x[3], const double d[3], uint32_t *hint, double L[3])
 {
     far_check *f = user;
     (void)hint;
@@ -46,6 +47,7 @@ static void far_const(void *user, const double x[3], const double d[3], uint32_t
     f->worst = fmax(f->worst, best);
     f->calls++;
     L[0] = L[1] = L[2] = f->value;
+    return !f->uncovered;
 }
 
 static bk_transport_options opts(void)
@@ -99,7 +101,7 @@ static void limit_and_fallback(void **state)
     float base[3 * (N + 1)], same[3 * (N + 1)], twice[3 * (N + 1)], open[3 * (N + 1)];
     bk_transport_options o = opts();
     run(&s, t, r, N + 1, &o, base);
-    far_check fc = {1.0f, 4.0, r, N, 0, 0};
+    far_check fc = {1.0f, 0, 4.0, r, N, 0, 0};
     o.gather_limit = 4.0;
     o.far_radiance = far_const;
     o.far_user = &fc;
@@ -143,6 +145,12 @@ static void limit_and_fallback(void **state)
     for (int i = 0; i < N; i++)
         for (int c = 0; c < 3; c++) assert_float_equal(cut[3 * i + c], 0, 0);
     for (int c = 0; c < 3; c++) assert_float_equal(cut[3 * N + c], base[3 * N + c], 0);
+    /* probes that cover nothing: every cut ray is traced on from its end and finds what the full
+     * ray found (the sky, the wall: the same cells, the hit point to float rounding) */
+    fc.uncovered = 1;
+    float on[3 * (N + 1)];
+    run(&s, t, r, N + 1, &o, on);
+    for (int i = 0; i < 3 * (N + 1); i++) assert_float_equal(on[i], base[i], 1e-3 * base[i]);
     bk_tracer_destroy(t2);
     tsc_free(&s2);
     bk_tracer_destroy(t);
