@@ -50,6 +50,14 @@ static int far_const(void *user, const double x[3], const double d[3], uint32_t 
     return !f->uncovered;
 }
 
+/* Thread-safe fallback for the determinism check: twice the sky where z > 0.3, else uncovered. */
+static int far_half(void *user, const double x[3], const double d[3], uint32_t *hint, double L[3])
+{
+    (void)user, (void)d, (void)hint;
+    L[0] = L[1] = L[2] = 2;
+    return x[2] > 0.3;
+}
+
 static bk_transport_options opts(void)
 {
     bk_transport_options o;
@@ -151,6 +159,15 @@ static void limit_and_fallback(void **state)
     float on[3 * (N + 1)];
     run(&s, t, r, N + 1, &o, on);
     for (int i = 0; i < 3 * (N + 1); i++) assert_float_equal(on[i], base[i], 1e-3 * base[i]);
+    /* byte-identical at 1 and 3 threads (the hint is per receiver and half) */
+    float t1[3 * (N + 1)], t3[3 * (N + 1)];
+    o.far_radiance = far_half;
+    o.far_user = NULL;
+    o.gather_limit = 1.5;
+    run(&s, t, r, N + 1, &o, t1);
+    o.threads = 3;
+    run(&s, t, r, N + 1, &o, t3);
+    assert_memory_equal(t1, t3, sizeof t1);
     bk_tracer_destroy(t2);
     tsc_free(&s2);
     bk_tracer_destroy(t);
