@@ -41,7 +41,20 @@ static void help(FILE *f)
           "  --no-glg                leave out the global light grid\n"
           "  --glg-lighting          global light grid denser where the lighting varies, coarser where it\n"
           "                          is smooth (a coarse probe pass first; bake/probes/PROBES.md)\n"
-          "  --octahedral            also write a GIBS-style octahedral probe volume (OCTP, format 1.3)\n"
+          "  --octahedral            also write a GIBS-style octahedral probe volume (OCTP, format 1.3):\n"
+          "                          clip levels of 32^3 probes around the playable space (the level's\n"
+          "                          centre without lbk_playable), each coarser level doubling the\n"
+          "                          spacing, until one holds the whole level (bake/probes/PROBES.md)\n"
+          "  --octp-levels N         at most N clip levels, 1-3 (default 3; 1: one level over the whole\n"
+          "                          level, its spacing growing until it fits)\n"
+          "  --octp-spacing M        the finest level's probe spacing in metres (default the GLG's, or\n"
+          "                          the longest extent / 8 when finer)\n"
+          "  --octp-clip N           probes per axis of a clip level, 2-32 (default 32)\n"
+          "  --gather-limit M        final-gather rays from surfaces end after M metres and read the\n"
+          "                          global light grid (baked first) where they hit nothing; off by\n"
+          "                          default (bake/transport/TRANSPORT.md, measured)\n"
+          "  --llg-connected         LLG props that meet end to end (touching bounding boxes, neither\n"
+          "                          inside the other) get twice the probes per axis (seed 001)\n"
           "  --error-map             also write the per-texel error map (TERR, format 1.4): each lightmap\n"
           "                          texel's estimated relative standard error (lbk view's error mode,\n"
           "                          lbk export, lbk inspect); before denoising when denoised\n"
@@ -311,7 +324,7 @@ static int bake(bake_args *o, int quiet)
 
 int cli_bake_flag(const char *a)
 {
-    return !strcmp(a, "--no-glg") || !strcmp(a, "--octahedral") || !strcmp(a, "--glg-lighting") || !strcmp(a, "--error-map") || !strcmp(a, "--block-align") || !strcmp(a, "--timestamp") ||
+    return !strcmp(a, "--no-glg") || !strcmp(a, "--octahedral") || !strcmp(a, "--glg-lighting") || !strcmp(a, "--llg-connected") || !strcmp(a, "--error-map") || !strcmp(a, "--block-align") || !strcmp(a, "--timestamp") ||
            !strcmp(a, "-q") || !strcmp(a, "--quiet") || !strcmp(a, "-h") || !strcmp(a, "--help");
 }
 
@@ -427,6 +440,20 @@ int cli_bake_parse(int argc, char **argv, bake_args *out, int *quiet_out)
             o.d.no_glg = 1;
         } else if (!strcmp(a, "--octahedral")) {
             o.d.octahedral_probes = 1;
+        } else if (!strcmp(a, "--gather-limit")) {
+            NEED_NUMBER(1e-4, 1e6);
+            o.d.gather_limit = (float)d;
+        } else if (!strcmp(a, "--octp-levels")) {
+            NEED_UINT(1, 3);
+            o.d.octp_levels = (int)u;
+        } else if (!strcmp(a, "--octp-spacing")) {
+            NEED_NUMBER(1e-4, 1e4);
+            o.d.octp_spacing = (float)d;
+        } else if (!strcmp(a, "--octp-clip")) {
+            NEED_UINT(2, 32);
+            o.d.octp_clip = (int)u;
+        } else if (!strcmp(a, "--llg-connected")) {
+            o.d.llg_connected = 1;
         } else if (!strcmp(a, "--glg-lighting")) {
             o.d.glg_lighting = 1;
         } else if (!strcmp(a, "--block-align")) {
@@ -516,6 +543,10 @@ int lbk_cmd_bake(int argc, char **argv)
     }
     if (o.continued && !(o.d.target_error > 0) && o.d.max_samples <= 0) {
         fprintf(stderr, "lbk bake: --continue needs the new stop: a lower --target-error and/or a larger --samples\n");
+        return LBK_EXIT_USAGE;
+    }
+    if (!o.d.octahedral_probes && (o.d.octp_levels || o.d.octp_spacing > 0 || o.d.octp_clip)) {
+        fprintf(stderr, "lbk bake: --octp-levels/--octp-spacing/--octp-clip shape the octahedral probe volume: add --octahedral\n");
         return LBK_EXIT_USAGE;
     }
     if (!o.input || !o.output) {

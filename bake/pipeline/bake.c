@@ -14,6 +14,7 @@
 #include "bake/dist/checkpoint.h"
 #include "bake/dist/dist.h"
 #include "bake/pipeline/encode.h"
+#include "bake/pipeline/gather_limit.h"
 #include "bake/pipeline/pipeline.h"
 #include "bake/pipeline/error_map.h"
 #include "bake/pipeline/provenance.h"
@@ -385,17 +386,31 @@ static lbk_result layout_glg(bk_pipeline *b)
     return LBK_OK;
 }
 
-/* OCTP: a probe volume over the level at the GLG's spacing, or finer in a small level
- * (bake/probes/octa_bake.h). */
+/* OCTP: clip levels around the playable space's centre (the level's when it has none), the
+ * finest at the GLG's spacing, or finer in a small level (bake/probes/octa_bake.h). */
 static lbk_result layout_octa(bk_pipeline *b)
 {
     bk_octa_options oo;
     memset(&oo, 0, sizeof oo);
-    oo.spacing = b->opt->glg_spacing > 0 ? b->opt->glg_spacing : b->pre->glg_spacing;
+    const lbk_bake_desc *d = b->opt;
+    oo.spacing = d->glg_spacing > 0 ? d->glg_spacing : b->pre->glg_spacing;
     /* at least 8 probes along the level's longest side: a small room gets a usable volume */
     float ext = 0;
     for (int a = 0; a < 3; a++) ext = fmaxf(ext, b->scene.bounds_max[a] - b->scene.bounds_min[a]);
     if (ext > 0 && ext / 8 < oo.spacing) oo.spacing = ext / 8;
+    if (d->octp_spacing > 0) oo.spacing = d->octp_spacing;
+    oo.levels = d->octp_levels > 0 ? (uint32_t)d->octp_levels : 0;
+    oo.clip = d->octp_clip > 0 ? (uint32_t)d->octp_clip : 0;
+    if (b->scene.playable_count) { /* the centre of the playable boxes' union */
+        float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (size_t i = 0; i < b->scene.playable_count; i++)
+            for (int a = 0; a < 3; a++) {
+                lo[a] = fminf(lo[a], b->scene.playable[i].min[a]);
+                hi[a] = fmaxf(hi[a], b->scene.playable[i].max[a]);
+            }
+        oo.has_centre = 1;
+        for (int a = 0; a < 3; a++) oo.centre[a] = 0.5f * (lo[a] + hi[a]);
+    }
     lbk_result r = bk_octa_place(&b->scene, b->tracer, b->scene.bounds_min, b->scene.bounds_max, &oo, &b->octa);
     return r ? bk_pipeline_failed(b, r, "octahedral probe volume") : LBK_OK;
 }
@@ -410,8 +425,27 @@ static lbk_result layout_llgs(bk_pipeline *b, size_t n_llg)
     memset(&lo, 0, sizeof lo);
     lo.visibility_rays = b->pre->llg_visibility_rays;
     lo.min_dim = 3; /* bake/probes/PROBES.md §LLG fit */
+    /* --llg-connected: twice the probes per axis for LLG objects that meet end to end */
+    uint8_t *cand = NULL, *conn = NULL;
+    if (b->opt->llg_connected) {
+        cand = calloc(s->object_count ? s->object_count : 1, 1);
+        conn = calloc(s->object_count ? s->object_count : 1, 1);
+        if (!cand || !conn) {
+            free(cand), free(conn);
+            return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
+        }
+        for (size_t i = 0; i < s->object_count; i++) cand[i] = b->classes[i].rep == BK_REP_LLG;
+        lbk_result r = bk_llg_connections(s, cand, 0, conn);
+        if (r) {
+            free(cand), free(conn);
+            return bk_pipeline_failed(b, r, "connected LLG objects");
+        }
+    }
+    size_t n_conn = 0;
     for (size_t i = 0; i < s->object_count; i++) {
         if (b->classes[i].rep != BK_REP_LLG) continue;
+        lo.connected = conn ? conn[i] : 0;
+        n_conn += lo.connected != 0;
         lbk_result r = bk_llg_place(s, (uint32_t)i, &lo, b->opt->threads, &b->llgs[b->llg_count]);
         if (r) {
             bk_events_say(&b->events, LBK_BAKE_SEVERITY_WARNING, "object '%s': no local light grid (%s)", s->objects[i].name,
@@ -421,6 +455,8 @@ static lbk_result layout_llgs(bk_pipeline *b, size_t n_llg)
         }
         b->object_llg[i] = (int32_t)b->llg_count++;
     }
+    if (conn) bk_events_say(&b->events, LBK_BAKE_SEVERITY_NOTE, "%zu LLG objects connect to another: finer grids", n_conn);
+    free(cand), free(conn);
     return LBK_OK;
 }
 
@@ -655,7 +691,24 @@ static lbk_result do_transport(bk_pipeline *b)
         to.octa_count = b->octa.count;
         out.octa_irradiance = b->octa_irradiance;
     }
+    bk_far_probes far;
+    memset(&far, 0, sizeof far);
+    if (b->opt->gather_limit > 0) { /* the GLG first, read by the base run's long rays (gather_limit.h) */
+        r = bk_far_probes_bake(b, &to, &far);
+        if (r) {
+            free(irradiance);
+            return bk_pipeline_failed(b, r, "light transport (the probes for --gather-limit)");
+        }
+        if (far.bytes) {
+            to.gather_limit = b->opt->gather_limit;
+            to.far_radiance = bk_far_probes_radiance;
+            to.far_user = &far;
+        } else {
+            bk_events_say(&b->events, LBK_BAKE_SEVERITY_WARNING, "--gather-limit needs a global light grid to fall back on; gathering in full");
+        }
+    }
     r = bk_transport_run(&b->scene, b->tracer, b->receivers, b->receiver_count, &to, &out, &b->stats);
+    bk_far_probes_free(&far);
     if (!r) bk_texels_match_irradiance(&b->texels, b->texel_of_receiver, b->texel_receivers, b->radiance, irradiance);
     if (!r) r = bk_llg_fit_run(&b->llg_fit, b->llgs, &b->scene, irradiance, b->radiance, b->llg_first, &b->llg_fit_stats);
     if (!r && b->opt->error_map) { /* before denoising: the transport's own estimate (error_map.h) */
@@ -966,6 +1019,9 @@ static lbk_result bake(const char *path, const lbk_bake_scene *desc, const lbk_b
     }
     if (!r && !path && !desc) r = bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT, "no scene");
     /* the octahedral volume's accumulators are neither in parts nor in checkpoints yet */
+    if (!r && b->desc.gather_limit > 0 && (dist || b->desc.checkpoint_dir))
+        r = bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT,
+                             "a ray-length limit (--gather-limit) cannot be baked distributed or with checkpoints yet");
     if (!r && b->desc.octahedral_probes && (dist || b->desc.checkpoint_dir))
         r = bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT,
                              "octahedral probes (--octahedral) cannot be baked distributed or with checkpoints yet");

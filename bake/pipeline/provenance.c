@@ -259,7 +259,7 @@ static void sky(const bk_scene *s, text *t)
 
 /* ---- META ------------------------------------------------------------------------------------- */
 
-enum { MAX_PAIRS = 32 };
+enum { MAX_PAIRS = 40 };
 
 lbk_result bk_provenance_meta(const bk_pipeline *b, void **data, size_t *size)
 {
@@ -333,6 +333,18 @@ lbk_result bk_provenance_meta(const bk_pipeline *b, void **data, size_t *size)
     /* absent: off (older bakes) */
     if (o->glg_lighting) p[n++] = (lbk_meta_pair){"bake.glg_lighting", glg_light};
     if (o->error_map) p[n++] = (lbk_meta_pair){"bake.error_map", "1"}; /* absent: off (older bakes) */
+    char octp_levels[16], octp_spacing[32], octp_clip[16];
+    snprintf(octp_levels, sizeof octp_levels, "%d", o->octp_levels);
+    snprintf(octp_spacing, sizeof octp_spacing, "%g", o->octp_spacing);
+    snprintf(octp_clip, sizeof octp_clip, "%d", o->octp_clip);
+    /* absent: the defaults (older bakes) */
+    if (o->octahedral_probes && o->octp_levels > 0) p[n++] = (lbk_meta_pair){"bake.octp_levels", octp_levels};
+    if (o->octahedral_probes && o->octp_spacing > 0) p[n++] = (lbk_meta_pair){"bake.octp_spacing", octp_spacing};
+    if (o->octahedral_probes && o->octp_clip > 0) p[n++] = (lbk_meta_pair){"bake.octp_clip", octp_clip};
+    char glimit[32];
+    snprintf(glimit, sizeof glimit, "%g", o->gather_limit);
+    if (o->gather_limit > 0) p[n++] = (lbk_meta_pair){"bake.gather_limit", glimit}; /* absent: off */
+    if (o->llg_connected) p[n++] = (lbk_meta_pair){"bake.llg_connected", "1"}; /* absent: off */
     p[n++] = (lbk_meta_pair){"bake.dls_threshold", threshold};
     p[n++] = (lbk_meta_pair){"bake.door_method", o->door_method == LBK_BAKE_DOOR_GUIDED ? "guided" : "difference"};
     if (o->revision) p[n++] = (lbk_meta_pair){LBK_META_REVISION, o->revision};

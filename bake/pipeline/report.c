@@ -113,6 +113,7 @@ lbk_result bk_pipeline_report(const bk_pipeline *b, lbk_bake_output *out)
         }
         r->octp.rel_rmse = b->octa_rel_rmse;
         r->octp.rays = b->octa_rays;
+        r->octp_levels = b->octa.level_count;
     }
     for (int i = 0; i < b->phase_count; i++) out->phases[i] = (lbk_bake_phase_time){b->phases[i], b->phase_seconds[i]};
     r->phases = out->phases;
@@ -216,6 +217,8 @@ static cJSON *json_report(const lbk_bake_report *r, const char *container_path)
         cJSON_AddNumberToObject(o, "relocated", r->octp.relocated);
         cJSON_AddNumberToObject(o, "rel_rmse", r->octp.rel_rmse);
         cJSON_AddNumberToObject(o, "rays_per_probe", r->octp.rays);
+        if (r->size >= offsetof(lbk_bake_report, octp_levels) + sizeof r->octp_levels && r->octp_levels)
+            cJSON_AddNumberToObject(o, "levels", r->octp_levels);
     }
     if (r->size >= offsetof(lbk_bake_report, denoised) + sizeof r->denoised && r->denoised.errors.texels + r->denoised.errors.glg > 0) {
         cJSON *o = cJSON_AddObjectToObject(root, "denoised");

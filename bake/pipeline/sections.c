@@ -152,7 +152,7 @@ static lbk_result build_octp(bk_pipeline *b, section_list *sl)
         info[i] = v->info[i];
         info[i].rays = b->octa_rays < 4e9 ? (uint32_t)b->octa_rays : UINT32_MAX;
         if (info[i].state == LBK_OCTP_INSIDE) continue;
-        bk_octa_depth(b->tracer, &v->positions[3 * i], v->level.miss_distance, p[i].depth);
+        bk_octa_depth(b->tracer, &v->positions[3 * i], v->levels[bk_octa_probe_level(v, i)].miss_distance, p[i].depth);
         for (int t = 0; t < 16; t++)
             for (int c = 0; c < 3; c++) {
                 const float e = b->octa_irradiance[((size_t)i * 16 + (size_t)t) * 3 + (size_t)c];
@@ -160,13 +160,16 @@ static lbk_result build_octp(bk_pipeline *b, section_list *sl)
                 if (p[i].irradiance[t][c] > m) m = p[i].irradiance[t][c];
             }
     }
-    lbk_octp_level level = v->level;
-    bk_pipeline_to_world(b, v->level.origin, level.origin);
+    lbk_octp_level levels[LBK_OCTP_MAX_LEVELS];
+    for (uint32_t l = 0; l < v->level_count; l++) {
+        levels[l] = v->levels[l];
+        bk_pipeline_to_world(b, v->levels[l].origin, levels[l].origin);
+    }
     b->octp_scale = bk_scale_for(m);
     void *data;
     size_t size;
     lbk_result r = lbk_octp_build(&(lbk_octp_build_desc){.size = sizeof(lbk_octp_build_desc), .probes = p, .probe_count = v->count, .scale = b->octp_scale,
-                                                          .levels = &level, .level_count = 1, .info = info},
+                                                          .levels = levels, .level_count = v->level_count, .info = info},
                                   NULL, &data, &size);
     free(p), free(info);
     return sections_add(sl, LBK_SECTION_OCTP, r, data, size);

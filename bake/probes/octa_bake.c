@@ -7,7 +7,6 @@
 #include <string.h>
 
 #define OCTA_PI 3.14159265358979323846
-#define OCTA_MAX_DIM 32u /* per axis, seed 003's 32³ clip */
 #define OCTA_MOVES 3
 
 static int double_sided(const bk_scene *s, uint32_t tri)
@@ -97,33 +96,81 @@ static void place_probe(const bk_scene *s, const bk_tracer *t, const float g[3],
     for (int a = 0; a < 3; a++) pos[a] = g[a] + off[a];
 }
 
-lbk_result bk_octa_place(const bk_scene *scene, const bk_tracer *tracer, const float bmin[3], const float bmax[3],
-                         const bk_octa_options *options, bk_octa_volume *out)
+/* Dims per axis over a box of extent e at spacing s: max(2, ceil(e/s)), clip + 1 when it does
+ * not fit in clip; the probe count (or UINT64_MAX when an axis does not fit). */
+static uint64_t grid_dims(const float e[3], float s, uint32_t clip, uint32_t dims[3])
 {
-    memset(out, 0, sizeof *out);
-    float s = options && options->spacing > 0 ? options->spacing : 1.0f;
-    const uint32_t cap = options && options->max_probes ? options->max_probes : 32768u;
-    lbk_octp_level *l = &out->level;
-    for (;;) {
-        uint64_t n = 1;
-        for (int a = 0; a < 3; a++) {
-            const float e = bmax[a] - bmin[a];
-            double d = ceil((double)e / s); /* outermost probes half a spacing inside */
-            if (!(d >= 2)) d = 2;
-            l->dims[a] = d > OCTA_MAX_DIM ? OCTA_MAX_DIM + 1 : (uint32_t)d;
-            n *= l->dims[a];
-        }
-        if (n <= cap && l->dims[0] <= OCTA_MAX_DIM && l->dims[1] <= OCTA_MAX_DIM && l->dims[2] <= OCTA_MAX_DIM) break;
-        s *= 1.25f;
+    uint64_t n = 1;
+    for (int a = 0; a < 3; a++) {
+        double d = ceil((double)e[a] / s); /* outermost probes half a spacing inside */
+        if (!(d >= 2)) d = 2;
+        dims[a] = d > clip ? clip + 1 : (uint32_t)d;
+        n *= dims[a];
     }
+    return dims[0] > clip || dims[1] > clip || dims[2] > clip ? UINT64_MAX : n;
+}
+
+/* The grid of one level centred in [lo, hi] at spacing s, miss distance from its diagonal. */
+static void level_grid(lbk_octp_level *l, const float lo[3], const float hi[3], float s)
+{
     double diag = 0;
     for (int a = 0; a < 3; a++) {
-        l->origin[a] = 0.5f * (bmin[a] + bmax[a]) - 0.5f * s * (float)(l->dims[a] - 1);
+        l->origin[a] = 0.5f * (lo[a] + hi[a]) - 0.5f * s * (float)(l->dims[a] - 1);
         diag += (double)(s * (float)(l->dims[a] - 1)) * (s * (float)(l->dims[a] - 1));
     }
     l->spacing = s;
     l->miss_distance = (float)fmin(sqrt(diag), LBK_OCTP_MAX_MISS);
-    out->count = l->dims[0] * l->dims[1] * l->dims[2];
+}
+
+/* The clip levels (bk_octa_place's rule), first_probe set; returns the level count. */
+static uint32_t plan_levels(const float bmin[3], const float bmax[3], const bk_octa_options *o, lbk_octp_level *lv)
+{
+    const float s0 = o && o->spacing > 0 ? o->spacing : 1.0f;
+    const uint32_t cap = o && o->max_probes ? o->max_probes : 32768u;
+    const uint32_t maxl = o && o->levels >= 1 && o->levels <= LBK_OCTP_MAX_LEVELS ? o->levels : LBK_OCTP_MAX_LEVELS;
+    const uint32_t clip = o && o->clip >= 2 && o->clip <= BK_OCTA_CLIP ? o->clip : BK_OCTA_CLIP;
+    float c[3], ext[3];
+    for (int a = 0; a < 3; a++) {
+        c[a] = 0.5f * (bmin[a] + bmax[a]);
+        if (o && o->has_centre && isfinite(o->centre[a])) c[a] = fminf(fmaxf(o->centre[a], bmin[a]), bmax[a]);
+        ext[a] = bmax[a] - bmin[a];
+    }
+    uint32_t L = 0, first = 0;
+    float s = s0;
+    for (; L + 1 < maxl; L++, s *= 2) {
+        lbk_octp_level *l = &lv[L];
+        memset(l, 0, sizeof *l);
+        const uint64_t whole = grid_dims(ext, s, clip, l->dims);
+        if (whole <= cap) break; /* this level holds the whole bounds: the last one */
+        float lo[3], hi[3], e[3];
+        for (int a = 0; a < 3; a++) {
+            const float half = 0.5f * s * (float)clip;
+            lo[a] = fmaxf(bmin[a], c[a] - half);
+            hi[a] = fminf(bmax[a], c[a] + half);
+            e[a] = hi[a] - lo[a];
+        }
+        grid_dims(e, s, clip, l->dims);
+        for (int a = 0; a < 3; a++)
+            if (l->dims[a] > clip) l->dims[a] = clip; /* rounding of c ± half */
+        level_grid(l, lo, hi, s);
+        l->first_probe = first;
+        first += l->dims[0] * l->dims[1] * l->dims[2];
+    }
+    lbk_octp_level *l = &lv[L];
+    memset(l, 0, sizeof *l);
+    while (grid_dims(ext, s, clip, l->dims) > cap) s *= 1.25f;
+    level_grid(l, bmin, bmax, s);
+    l->first_probe = first;
+    return L + 1;
+}
+
+lbk_result bk_octa_place(const bk_scene *scene, const bk_tracer *tracer, const float bmin[3], const float bmax[3],
+                         const bk_octa_options *options, bk_octa_volume *out)
+{
+    memset(out, 0, sizeof *out);
+    out->level_count = plan_levels(bmin, bmax, options, out->levels);
+    const lbk_octp_level *last = &out->levels[out->level_count - 1];
+    out->count = last->first_probe + last->dims[0] * last->dims[1] * last->dims[2];
     out->positions = malloc((size_t)out->count * 3 * sizeof(float));
     out->info = calloc(out->count, sizeof *out->info);
     if (!out->positions || !out->info) {
@@ -131,12 +178,21 @@ lbk_result bk_octa_place(const bk_scene *scene, const bk_tracer *tracer, const f
         return LBK_ERR_OUT_OF_MEMORY;
     }
     for (uint32_t i = 0; i < out->count; i++) {
-        const uint32_t c[3] = {i % l->dims[0], i / l->dims[0] % l->dims[1], i / l->dims[0] / l->dims[1]};
+        const lbk_octp_level *l = &out->levels[bk_octa_probe_level(out, i)];
+        const uint32_t k = i - l->first_probe;
+        const uint32_t c[3] = {k % l->dims[0], k / l->dims[0] % l->dims[1], k / l->dims[0] / l->dims[1]};
         float g[3];
-        for (int a = 0; a < 3; a++) g[a] = l->origin[a] + s * (float)c[a];
-        place_probe(scene, tracer, g, s, l->miss_distance, &out->positions[3 * i], &out->info[i]);
+        for (int a = 0; a < 3; a++) g[a] = l->origin[a] + l->spacing * (float)c[a];
+        place_probe(scene, tracer, g, l->spacing, l->miss_distance, &out->positions[3 * i], &out->info[i]);
     }
     return LBK_OK;
+}
+
+uint32_t bk_octa_probe_level(const bk_octa_volume *v, uint32_t i)
+{
+    uint32_t l = 0;
+    while (l + 1 < v->level_count && i >= v->levels[l + 1].first_probe) l++;
+    return l;
 }
 
 void bk_octa_volume_free(bk_octa_volume *v)

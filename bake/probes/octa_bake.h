@@ -18,22 +18,35 @@
 #define BK_OCTA_CLASSIFY_RAYS 128
 /* More than this fraction of back-face hits: the probe is inside closed geometry. */
 #define BK_OCTA_INSIDE_FRACTION 0.25f
+/* Probes per axis of a clip level (seed 003: 32³) and the most levels. */
+#define BK_OCTA_CLIP 32u
 
 typedef struct bk_octa_options {
-    float spacing;      /* metres; 0: 1 (the baker passes min(GLG spacing, largest extent / 8)) */
-    uint32_t max_probes; /* 0: 32768; the spacing grows by 1.25 until the grid fits */
+    float spacing;      /* the finest level's, metres; 0: 1 (the baker passes min(GLG spacing,
+                           largest extent / 8)) */
+    uint32_t max_probes; /* per level; 0: 32768; the last level's spacing grows by 1.25 until it fits */
+    uint32_t levels;    /* at most this many clip levels, 1 … 3; 0: 3 */
+    uint32_t clip;      /* probes per axis of a level, 2 … 32; 0: 32 (seed 003's 32³ clip) */
+    int has_centre;     /* 1: the clip levels are centred on `centre` (clamped into the bounds),
+                           else on the bounds' centre */
+    float centre[3];
 } bk_octa_options;
 
 typedef struct bk_octa_volume {
-    lbk_octp_level level;        /* one level (first_probe 0), in the scene's frame */
-    uint32_t count;              /* probes: dims product */
+    lbk_octp_level levels[LBK_OCTP_MAX_LEVELS]; /* finest first, first_probe set, scene frame */
+    uint32_t level_count;
+    uint32_t count;              /* probes: Σ of the levels' dims products */
     float *positions;            /* 3 per probe: grid point + offset */
     lbk_octp_probe_info *info;   /* offset, state, back-face fraction, nearest hit */
 } bk_octa_volume;
 
-/* Grid over [bmin, bmax]: max(2, ceil(extent/spacing)) probes per axis, centred (so the outermost
- * probes stand half a spacing inside a box that is a whole number of spacings), spacing as above,
- * miss distance min(255, grid diagonal);
+/* Clip levels over [bmin, bmax] (PROBES.md §OCTP): level l has spacing s·2^l (s = options'
+ * spacing) and covers the bounds clipped to a box of `clip` spacings per axis around the centre,
+ * max(2, ceil(extent/spacing)) probes per axis, centred in that box (so the outermost probes
+ * stand half a spacing inside it). The first level that holds the whole bounds within `clip`
+ * probes per axis is the last: a level smaller than clip × s gets one level, as before. The
+ * last allowed level (options.levels) always covers the whole bounds, its spacing growing by
+ * 1.25 until it fits. Miss distance per level min(255, its grid diagonal);
  * then per probe: classification rays from the grid point; inside (back-face fraction >
  * BK_OCTA_INSIDE_FRACTION) → moved through the nearest back face to 0.1·spacing beyond it,
  * too close to a front face (< 0.1·spacing) → moved away from it; offsets bounded by 0.45 ×
@@ -42,6 +55,8 @@ typedef struct bk_octa_volume {
 lbk_result bk_octa_place(const bk_scene *scene, const bk_tracer *tracer, const float bmin[3], const float bmax[3],
                          const bk_octa_options *options, bk_octa_volume *out);
 void bk_octa_volume_free(bk_octa_volume *v);
+/* The level of probe i (levels are stored finest first, each a contiguous run of probes). */
+uint32_t bk_octa_probe_level(const bk_octa_volume *v, uint32_t i);
 
 /* 12×12 interior depth moments (mean, mean² of min(hit distance, miss)) from p, 16 rays per
  * texel (BK_OCTA_DEPTH_SIDE²). */

@@ -481,17 +481,20 @@ static void to_local(const tp_lobe *lf, const double d[3], double l[3])
 }
 
 static int nee_sample_lobe(const tp_ctx *c, const float o[3], const double n[3], int kind, const tp_lobe *lf,
-                           double u0, double u1, double d[3], double *cos_p, double val[3], uint64_t *shadow);
+                           double u0, double u1, double *dist_out, double d[3], double *cos_p, double val[3],
+                           uint64_t *shadow);
 
 static int nee_sample(const tp_ctx *c, const float o[3], const double n[3], int kind, double u0, double u1,
                       double d[3], double *cos_p, double val[3], uint64_t *shadow)
 {
-    return nee_sample_lobe(c, o, n, kind, NULL, u0, u1, d, cos_p, val, shadow);
+    return nee_sample_lobe(c, o, n, kind, NULL, u0, u1, NULL, d, cos_p, val, shadow);
 }
 
-/* nee_sample weighed against the lobe lf's density instead of the gather pdf (lf NULL: that). */
+/* nee_sample weighed against the lobe lf's density instead of the gather pdf (lf NULL: that);
+ * dist_out (or NULL): the distance to the emitter point of a sample it returns. */
 static int nee_sample_lobe(const tp_ctx *c, const float o[3], const double n[3], int kind, const tp_lobe *lf,
-                           double u0, double u1, double d[3], double *cos_p, double val[3], uint64_t *shadow)
+                           double u0, double u1, double *dist_out, double d[3], double *cos_p, double val[3],
+                           uint64_t *shadow)
 {
     double rem;
     const tp_emitter *em = &c->em[em_pick(c, u0, &rem)];
@@ -504,6 +507,7 @@ static int nee_sample_lobe(const tp_ctx *c, const float o[3], const double n[3],
     double dist2 = dv[0] * dv[0] + dv[1] * dv[1] + dv[2] * dv[2];
     if (!(dist2 > 0) || !isfinite(dist2)) return 0;
     double dist = sqrt(dist2);
+    if (dist_out) *dist_out = dist;
     for (int a = 0; a < 3; a++) d[a] = dv[a] / dist;
     double cp = kind == PG_SPHERE ? 1 : d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
     if (!(cp > 0)) return 0;
@@ -784,7 +788,7 @@ static void gloss_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit,
     if (md->sources && c->nee) {
         double ld[3], cq, val[3];
         double a0 = rng_next(rng), a1 = rng_next(rng);
-        if (nee_sample_lobe(c, o, lf.n, PG_COSINE, &lf, a0, a1, ld, &cq, val, &cnt->shadow) && bk_finite3(val)) {
+        if (nee_sample_lobe(c, o, lf.n, PG_COSINE, &lf, a0, a1, NULL, ld, &cq, val, &cnt->shadow) && bk_finite3(val)) {
             double ll[3], f[3];
             to_local(&lf, ld, ll);
             bk_mr_lobe_eval(&lf.lb, ll, f);
@@ -1314,6 +1318,25 @@ static void oct_add(const tp_ctx *c, double (*oct)[3], const double d[3], const 
     }
 }
 
+/* The ray-length limit (options.gather_limit): the probes' radiance at o + lim·d towards d; 0
+ * where they do not cover that point (outside the probe volume: the ray goes on). */
+static int far_lookup(const tp_ctx *c, const float o[3], const double d[3], double lim, uint32_t *hint, double L[3])
+{
+    const double x[3] = {o[0] + lim * d[0], o[1] + lim * d[1], o[2] + lim * d[2]};
+    return c->opt->far_radiance(c->opt->far_user, x, d, hint, L);
+}
+
+/* A limited ray whose end the probes do not cover: traced on from there; *hit gets the result
+ * with its distance from the original origin. */
+static void far_continue(const tp_ctx *c, const float o[3], const double d[3], double lim, bk_hit *hit, tp_count *cnt)
+{
+    const float x[3] = {(float)(o[0] + lim * d[0]), (float)(o[1] + lim * d[1]), (float)(o[2] + lim * d[2])};
+    const float df[3] = {(float)d[0], (float)d[1], (float)d[2]};
+    cnt->rays++;
+    if (bk_tracer_intersect(c->tracer, x, df, 0.0f, INFINITY, hit)) hit->t += (float)lim;
+    else hit->tri = UINT32_MAX;
+}
+
 /* oct: NULL, or the 16 octahedral texels' Σ L·max(0, cos) (an octahedral probe). */
 static void recv_half(tp_ctx *c, const bk_receiver *r, size_t i, int h, int S, const tp_lattice *lat,
                       tp_recv_sums *rs, double (*oct)[3], tp_count *cnt)
@@ -1338,6 +1361,13 @@ static void recv_half(tp_ctx *c, const bk_receiver *r, size_t i, int h, int S, c
     }
     double t0[3], b0[3];
     bk_onb(g0.n, t0, b0);
+    /* the ray-length limit (options.gather_limit): surface receivers' rays end at lim and read
+     * the probes there */
+    const bk_transport_options *o = c->opt;
+    const double lim = !sphere && o->gather_limit > 0 && o->far_radiance ? o->gather_limit : INFINITY;
+    uint32_t far_hint = 0;
+    float tmax[TP_BATCH];
+    for (int jj = 0; jj < TP_BATCH; jj++) tmax[jj] = (float)lim;
     for (int j0 = 0; j0 < S; j0 += TP_BATCH) {
         const int m = S - j0 < TP_BATCH ? S - j0 : TP_BATCH;
         float org[3 * TP_BATCH], dir[3 * TP_BATCH];
@@ -1362,11 +1392,17 @@ static void recv_half(tp_ctx *c, const bk_receiver *r, size_t i, int h, int S, c
                 nn[jj][a] = g.n[a];
             }
         }
-        bk_tracer_intersect_n(c->tracer, (size_t)m, org, dir, 0.0f, NULL, hits);
+        bk_tracer_intersect_n(c->tracer, (size_t)m, org, dir, 0.0f, isfinite(lim) ? tmax : NULL, hits);
         cnt->rays += (uint64_t)m;
         for (int jj = 0; jj < m; jj++) {
             double L[3], Ld[3];
-            long hc = gather_hit(c, sum, c->rough, &hits[jj], dd[jj], solid, &cont, cnt, L, Ld);
+            long hc = -1;
+            if (isfinite(lim) && hits[jj].tri == UINT32_MAX && far_lookup(c, org + 3 * jj, dd[jj], lim, &far_hint, L)) {
+                Ld[0] = Ld[1] = Ld[2] = 0; /* no hit within lim: the probes' light, as indirect */
+            } else {
+                if (isfinite(lim) && hits[jj].tri == UINT32_MAX) far_continue(c, org + 3 * jj, dd[jj], lim, &hits[jj], cnt);
+                hc = gather_hit(c, sum, c->rough, &hits[jj], dd[jj], solid, &cont, cnt, L, Ld);
+            }
             if (!bk_finite3(L) || !bk_finite3(Ld)) cnt->bad++;
             else {
                 accumulate(dd[jj], sphere ? 1 : zz[jj], L, Ld, rs->e, rs->sh_t, rs->sh_d);
@@ -1385,7 +1421,9 @@ static void recv_half(tp_ctx *c, const bk_receiver *r, size_t i, int h, int S, c
              * units (radiance, later × solid/S) by 1/solid */
             double u0, uu1, ld[3], cl, val[3];
             lattice_uv(lat, (uint32_t)(j0 + jj), t1, t2, &u0, &uu1);
-            if (nee_sample(c, org + 3 * jj, nn[jj], pg_kind, u0, uu1, ld, &cl, val, &cnt->shadow)) {
+            double ndist = 0, skip[3];
+            if (nee_sample_lobe(c, org + 3 * jj, nn[jj], pg_kind, NULL, u0, uu1, &ndist, ld, &cl, val, &cnt->shadow) &&
+                !(ndist > lim && far_lookup(c, org + 3 * jj, ld, lim, &far_hint, skip))) {
                 for (int a = 0; a < 3; a++) val[a] /= solid;
                 if (!bk_finite3(val)) cnt->bad++;
                 else {

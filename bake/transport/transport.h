@@ -245,6 +245,21 @@ typedef struct bk_transport_options {
      * can evaluate the stop alone by also gathering that subset; a smaller class stops on all
      * its receivers. 0: BK_TRANSPORT_STOP_RECEIVERS. */
     size_t stop_receivers;
+    /* Ray-length limit with probe fallback (seed 003's "sample probes when coverage is low";
+     * TRANSPORT.md §Ray-length limit): > 0 and far_radiance set, every final-gather ray of a
+     * surface receiver (a texel, an LLG fit target: receivers with a normal) ends at this many
+     * metres; one that hits nothing within it asks far_radiance at its end point x for its
+     * direction d: where it returns 1 (the probes cover x) L is the ray's radiance (the incident
+     * radiance at x arriving from d, e.g. a probe volume's SH9), counted as indirect light;
+     * where it returns 0 the ray is traced on from x. A light sample of an emitter farther than
+     * the limit is dropped where the probes cover the point at the limit on its way (the
+     * gather ray there reads them, and they hold that emitter). Sphere receivers (probes) and
+     * the cache trace in full. far_radiance must be deterministic and thread-safe; *hint starts
+     * at 0 for each receiver and half and is the callee's to keep (where its last lookup was).
+     * 0: off (default), every bake unchanged. */
+    double gather_limit;
+    int (*far_radiance)(void *user, const double x[3], const double d[3], uint32_t *hint, double L[3]);
+    void *far_user;
 } bk_transport_options;
 
 #define BK_TRANSPORT_STOP_RECEIVERS ((size_t)65536)

@@ -122,10 +122,11 @@ static void classify_and_relocate(void **state)
     /* a grid of spacing 0.5 over [-3.25, 3.25]³: 13³ probes at multiples of 0.5 */
     const float bmin[3] = {-3.25f, -3.25f, -3.25f}, bmax[3] = {3.25f, 3.25f, 3.25f};
     bk_octa_volume v;
-    bk_octa_options oo = {0.5f, 0};
+    bk_octa_options oo = {.spacing = 0.5f};
     assert_int_equal(bk_octa_place(&s, t, bmin, bmax, &oo, &v), LBK_OK);
     assert_int_equal(v.count, 13 * 13 * 13);
-    assert_float_equal(v.level.spacing, 0.5f, 0);
+    assert_int_equal(v.level_count, 1);
+    assert_float_equal(v.levels[0].spacing, 0.5f, 0);
     uint32_t inside = 0, moved = 0;
     for (uint32_t i = 0; i < v.count; i++) {
         const lbk_octp_probe_info *in = &v.info[i];
@@ -156,7 +157,7 @@ static void classify_and_relocate(void **state)
     /* depth moments from a probe at (2, 0, 0) towards −x: the face at x = 1.1 is 0.9 away */
     float depth[144][2];
     const float p[3] = {2, 0, 0};
-    bk_octa_depth(t, p, v.level.miss_distance, depth);
+    bk_octa_depth(t, p, v.levels[0].miss_distance, depth);
     float dir[3] = {-1, 0, 0}, uv[2];
     lbk_oct_encode(dir, uv);
     int i = (int)((uv[0] + 1) * 0.5f * 12), j = (int)((uv[1] + 1) * 0.5f * 12);

@@ -602,7 +602,9 @@ static void test_cli_careless_use(void **state)
     assert_int_equal(run_cli("bake %s -o %s -q --samples 32 --json-report %s", in, out, in), LBK_EXIT_USAGE);
     assert_int_equal(file_size(in), before);
     const char *bad[] = {"--threads 1.5", "--threads -2", "--seed -1", "--seed 1e3", "--samples 0x20",
-                         "--samples ' 32'", "--max-bounces 2.0"};
+                         "--samples ' 32'", "--max-bounces 2.0", "--octp-levels 2" /* without --octahedral */,
+                         "--octahedral --octp-levels 4", "--octahedral --octp-clip 1", "--octahedral --octp-spacing 0",
+                         "--gather-limit 0", "--gather-limit -1"};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)
         assert_int_equal(run_cli("bake %s -o %s -q %s", in, out, bad[i]), LBK_EXIT_USAGE);
     assert_int_equal(run_cli("bake %s -o %s -q --samples 32 --json-report %s/no/such/dir/r.json", in, out, tmpdir),

@@ -438,6 +438,7 @@ static int export_run(const tl_bake *b, const tl_export_options *o, tl_export_st
         if (!rc) rc = write_glg_plot(dirs[d], b, rows, nrows, st, err);
     }
     free(rows);
+    if (!rc && o->exr_dir) rc = tl_export_octp(b, o->exr_dir, st, err);
     return rc;
 }
 

@@ -19,6 +19,10 @@ typedef struct tl_export_stats {
 /* Returns 0, or -1 with err (an I/O error: a file could not be written). */
 int tl_export(const tl_bake *bake, const tl_export_options *options, tl_export_stats *stats, char err[TL_ERR_LEN]);
 
+/* The OCTP probe volume's atlases (octp_level_L.exr, octp_level_L.depth.exr per clip level) into
+ * dir; 0 without a volume (a list-form OCTP has no grid to lay out). Returns 0 or -1 with err. */
+int tl_export_octp(const tl_bake *bake, const char *dir, tl_export_stats *stats, char err[TL_ERR_LEN]);
+
 /* Object → file name stem "NNN_name": NNN is the object's index in OBJS (3+ digits, so stems
  * never clash), name with bytes outside [A-Za-z0-9._-] replaced by '_', cut at 64 bytes. */
 void tl_export_object_stem(const char *name, uint32_t index, char *out, size_t size);

@@ -55,7 +55,7 @@ extern "C" {
 /* The baker library's version (lbk-bake.pc): the minor grows with every addition to the
  * size-tagged structs below ("added in 1.x"). */
 #define LBK_BAKE_LIBRARY_VERSION_MAJOR 1
-#define LBK_BAKE_LIBRARY_VERSION_MINOR 5
+#define LBK_BAKE_LIBRARY_VERSION_MINOR 6
 #define LBK_BAKE_LIBRARY_VERSION_PATCH 0
 
 /* ---- options ----------------------------------------------------------------------------- */
@@ -140,7 +140,8 @@ typedef struct lbk_bake_desc {
     float sky[3];               /* uniform sky radiance, nits */
     const char *sky_exr;        /* with sky_override: an equirectangular EXR instead of `sky` */
     int no_glg;                 /* 1: leave out the global light grid */
-    int octahedral_probes;      /* 1: also write OCTP, a probe volume at the GLG spacing (spec §14) */
+    int octahedral_probes;      /* 1: also write OCTP, a probe volume in up to 3 clip levels
+                                   (spec §14; octp_* below) */
     int no_seam_stitch;         /* 1: leave lightmap seams unstitched (for comparisons, bench_atlas) [0] */
     double dls_threshold;       /* light sets and doors store a receiver where their light exceeds
                                    this fraction of the mean indirect light of the texels they
@@ -195,6 +196,23 @@ typedef struct lbk_bake_desc {
                                    error of its irradiance, from the transport's two half
                                    estimates (before denoising, when denoised) [0: none; the
                                    file keeps the bytes it had without the field] */
+    /* added in 1.6: the OCTP probe volume's clip levels (with octahedral_probes;
+       bake/probes/PROBES.md §OCTP) */
+    int octp_levels;            /* at most this many clip levels, 1 … 3; a level that holds the
+                                   whole scene is the last [0: 3, so a level up to 32 spacings
+                                   across gets one] */
+    float octp_spacing;         /* the finest level's probe spacing in metres, each coarser level
+                                   doubling it [0: min(GLG spacing, longest extent / 8)] */
+    int octp_clip;              /* probes per axis of a clip level, 2 … 32 [0: 32, seed 003] */
+    float gather_limit;         /* metres: the base run's final-gather rays from surfaces end here
+                                   and read the global light grid (gathered first) where they hit
+                                   nothing (bake/transport/TRANSPORT.md §Ray-length limit;
+                                   light sets and doors gather in full) [0: off, measured not to
+                                   pay] */
+    int llg_connected;          /* 1: LLG objects whose bounding boxes touch another's end to end
+                                   (pipes, rails, stacked props; neither box inside the other) get
+                                   half the probe spacing (seed 001's extra probes for connected
+                                   objects; bake/probes/PROBES.md) [0: off] */
 } lbk_bake_desc;
 
 /* A file a bake read (the glTF, its buffers and images, a sky EXR), as META input.files
@@ -410,6 +428,8 @@ typedef struct lbk_bake_report {
     lbk_bake_octp octp;
     /* appended in 1.5 (the denoised bake's own estimate): read only when size covers it */
     lbk_bake_denoised denoised;
+    /* appended in 1.6: read only when size covers it */
+    uint32_t octp_levels;        /* clip levels of the OCTP volume (0: none written) */
 } lbk_bake_report;
 
 /* Owned by the output, valid until lbk_bake_output_free. */
