@@ -55,7 +55,7 @@ extern "C" {
 /* The baker library's version (lbk-bake.pc): the minor grows with every addition to the
  * size-tagged structs below ("added in 1.x"). */
 #define LBK_BAKE_LIBRARY_VERSION_MAJOR 1
-#define LBK_BAKE_LIBRARY_VERSION_MINOR 5
+#define LBK_BAKE_LIBRARY_VERSION_MINOR 6
 #define LBK_BAKE_LIBRARY_VERSION_PATCH 0
 
 /* ---- options ----------------------------------------------------------------------------- */
@@ -384,6 +384,20 @@ typedef struct lbk_bake_set_run {
     double seconds;
 } lbk_bake_set_run;
 
+/* A stored light set, door state or combination and the estimated error of its contribution
+ * as stored (appended in 1.6; bake/sets/SETS.md, "Error of each stored set"): its two halves —
+ * for a door state or combination, the same difference of the runs' halves as of their
+ * results — through the base's denoising weights, or unfiltered. Relative to the RMS of the
+ * contribution itself, so a door's difference, small where the door changes little, reads
+ * large where the run estimates read small. The guided door estimator's open sets have none. */
+typedef struct lbk_bake_set_estimate {
+    const char *name;            /* the set's name in the DLS section */
+    uint32_t set;                /* its index in the DLS section's set table */
+    uint32_t kind;               /* lbk_dls_set_kind (lbk/dls.h) */
+    int denoised;                /* 1: through the denoiser's weights (then bias may be > 0) */
+    lbk_bake_denoised error;     /* as the base's denoised estimate; seconds: its share of the pass */
+} lbk_bake_set_estimate;
+
 /* What lbk_bake_report_write_json writes (spec/bake-report-json.md), as data. */
 typedef struct lbk_bake_report {
     size_t size;                 /* sizeof(lbk_bake_report) of the library that filled it */
@@ -410,6 +424,9 @@ typedef struct lbk_bake_report {
     lbk_bake_octp octp;
     /* appended in 1.5 (the denoised bake's own estimate): read only when size covers it */
     lbk_bake_denoised denoised;
+    /* appended in 1.6 (each stored set's estimate): read only when size covers them */
+    const lbk_bake_set_estimate *set_estimates; /* in DLS set order; sets without one are left out */
+    size_t set_estimate_count;
 } lbk_bake_report;
 
 /* Owned by the output, valid until lbk_bake_output_free. */
