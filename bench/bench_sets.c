@@ -258,15 +258,39 @@ static const char *const set_kind_label[4] = {"light set", "door open", "door cl
  * bias part is printed beside). The sparse threshold's dropped texels are in the measure (both
  * seeds drop them), not in the estimate (BENCH_SETS_KEEP_ALL=1 keeps every texel). Goal: within
  * 2×. */
-/* One bake of the estimate level; its stored sets' texel luminance and estimates. */
+/* One bake of the estimate level: its stored sets' texel luminance and estimates, and the
+ * base (the LMAP as stored, every set off) as entry 0 of the same arrays' parallel `base`. */
 typedef struct est_bake {
     tl_set_texels sets[8];
     int ns;
     uint64_t nt;
     double noise[8], bias[8];
+    int filtered[8];              /* texels stored filtered */
+    double *base;                 /* per texel */
+    double base_noise, base_bias; /* the report's: transport's, or denoised */
+    int base_filtered;
 } est_bake;
 
-static int est_bake_run(const char *gltf, uint64_t seed, int denoise, int samples, est_bake *out)
+static double *stored_base(const void *bytes, size_t size, uint64_t nt)
+{
+    lbk_reader *rd;
+    const void *d;
+    size_t n;
+    lbk_lmap_view lm;
+    double *out = NULL;
+    if (lbk_reader_open_memory(bytes, size, NULL, &rd)) return NULL;
+    if (!lbk_reader_section_by_type(rd, LBK_SECTION_LMAP, &d, &n) && !lbk_lmap_open(d, n, &lm) && lm.texel_count == nt &&
+        (out = malloc((nt + 1) * sizeof *out)))
+        for (uint64_t i = 0; i < nt; i++) {
+            lbk_ahd_texel t;
+            lbk_lmap_texel_get(&lm, i, &t, NULL);
+            out[i] = tl_texel_lum(t.irradiance_z, t.rgba);
+        }
+    lbk_reader_close(rd);
+    return out;
+}
+
+static int est_bake_run(const char *gltf, uint64_t seed, lbk_bake_denoise denoise, int samples, est_bake *out)
 {
     memset(out, 0, sizeof *out);
     lbk_bake_desc d;
@@ -275,7 +299,7 @@ static int est_bake_run(const char *gltf, uint64_t seed, int denoise, int sample
     d.preset = LBK_BAKE_PRESET_FAST;
     d.seed = seed;
     d.threads = 2;
-    d.denoise = denoise ? LBK_BAKE_DENOISE_AUTO : LBK_BAKE_DENOISE_OFF;
+    d.denoise = denoise;
     d.dls_threshold = getenv("BENCH_SETS_KEEP_ALL") ? -1 : 0;
     if (samples) d.max_samples = samples, d.target_error = 1e-9;
     lbk_bake_output *bo;
@@ -288,13 +312,20 @@ static int est_bake_run(const char *gltf, uint64_t seed, int denoise, int sample
         return 1;
     }
     int bad = tl_set_texels_decode(bytes, size, out->sets, 8, &out->ns, &out->nt) != 0;
+    if (!bad) bad = !(out->base = stored_base(bytes, size, out->nt));
     const lbk_bake_report *rep = lbk_bake_output_report(bo);
     for (int j = 0; j < out->ns; j++) {
         out->noise[j] = -1;
         for (size_t i = 0; i < rep->set_estimate_count; i++)
-            if (rep->set_estimates[i].set == out->sets[j].set)
-                out->noise[j] = rep->set_estimates[i].error.texel_noise, out->bias[j] = rep->set_estimates[i].error.texel_bias;
+            if (rep->set_estimates[i].set == out->sets[j].set) {
+                const lbk_bake_denoised *e = &rep->set_estimates[i].error;
+                out->noise[j] = e->texel_noise, out->bias[j] = e->texel_bias, out->filtered[j] = e->texels_filtered;
+            }
     }
+    const int den = denoise != LBK_BAKE_DENOISE_OFF;
+    out->base_noise = den ? rep->denoised.texel_noise : rep->errors.texels;
+    out->base_bias = den ? rep->denoised.texel_bias : 0;
+    out->base_filtered = den && rep->denoised.texels_filtered;
     lbk_free(NULL, bytes);
     lbk_bake_output_free(bo);
     return bad;
@@ -303,6 +334,7 @@ static int est_bake_run(const char *gltf, uint64_t seed, int denoise, int sample
 static void est_bake_free(est_bake *b)
 {
     tl_set_texels_free(b->sets, b->ns);
+    free(b->base);
 }
 
 /* √(Σ (a − b)² / Σ b²) over the texels */
@@ -313,45 +345,49 @@ static double rel_diff(const double *a, const double *b, uint64_t n)
     return den > 0 ? sqrt(num / den) : 0;
 }
 
-/* Is each stored set's reported error what its stored contribution has? The sets level baked
- * twice (seeds 1, 2; fast preset) with the denoiser off and on, and once (seed 3, denoiser off,
- * REF_FACTOR × the preset's samples) as the reference; each stored set's texel contribution
- * decoded through lbk_dls_apply. Measured noise √(Σ (S₁ − S₂)²/2 / Σ ((S₁ + S₂)/2)²) against the
- * noise part of the report's set_estimates (two seeds see no bias), and the error against the
- * reference (its own noise, 1/REF_FACTOR of the off bakes' variance, taken off) against the
- * estimate's noise and bias together: what denoising does to each set. The sparse threshold's
- * dropped texels are in the measures, not in the estimate (BENCH_SETS_KEEP_ALL=1 keeps every
- * texel). Goal: within 2×. */
-#define REF_FACTOR 4
-static int set_estimates_mode(const est_bake *ref, const est_bake *b, const char *what)
+/* One line: a stored contribution x of seeds 1 and 2 against the other seed and the reference. */
+static void est_line(const char *kind, const char *name, const double *x0, const double *x1, const double *ref, uint64_t nt,
+                     double ref_noise, double noise, double bias, int filtered)
 {
-    printf("stored-set estimates (sets A+B + door level, fast preset, %s, seeds 1 and 2; texels; reference seed 3 at "
-           "%d x the samples, denoise off):\n", what, REF_FACTOR);
-    for (int j = 0; j < b[0].ns && j < b[1].ns && j < ref->ns && b[0].nt == b[1].nt && b[0].nt == ref->nt; j++) {
-        const uint64_t nt = b[0].nt;
-        double num = 0, den = 0;
-        for (uint64_t i = 0; i < nt; i++) {
-            const double x = b[0].sets[j].lum[i], y = b[1].sets[j].lum[i];
-            num += 0.5 * (x - y) * (x - y), den += 0.25 * (x + y) * (x + y);
-        }
+    double num = 0, den = 0;
+    for (uint64_t i = 0; i < nt; i++) num += 0.5 * (x0[i] - x1[i]) * (x0[i] - x1[i]), den += 0.25 * (x0[i] + x1[i]) * (x0[i] + x1[i]);
+    const double m = den > 0 ? sqrt(num / den) : 0, ratio = m > 0 ? noise / m : 0;
+    /* against the reference: the mean square of both seeds' errors, less the reference's noise */
+    const double e0 = rel_diff(x0, ref, nt), e1 = rel_diff(x1, ref, nt);
+    const double err = sqrt(fmax(0, 0.5 * (e0 * e0 + e1 * e1) - ref_noise * ref_noise)), tot = sqrt(noise * noise + bias * bias);
+    printf("  %-11s %-20s %-10s est. noise %5.2f%% / between seeds %5.2f%% (%.2f%s); error vs reference %5.2f%%, "
+           "estimated %5.2f%% (bias %.2f%%) (%.2f%s)\n",
+           kind, name, filtered ? "filtered" : "unfiltered", 100 * noise, 100 * m, ratio,
+           ratio >= 0.5 && ratio <= 2 ? "" : " NOT within 2x", 100 * err, 100 * tot, 100 * bias, err > 0 ? tot / err : 0,
+           err > 0 && tot / err >= 0.5 && tot / err <= 2 ? "" : " NOT within 2x");
+}
+
+/* Is each stored set's reported error what its stored contribution has, and does --denoise auto
+ * keep the better of filtered and unfiltered? The sets level baked at seeds 1 and 2 (fast
+ * preset) with --denoise off, on and auto, and once (seed 3, off, REF_FACTOR × the preset's
+ * samples) as the reference; each stored set's texel contribution decoded through lbk_dls_apply
+ * (tools/common/set_decode.h), the base as stored. Per set: the estimate's noise against the
+ * noise between the two seeds (which sees no bias), and noise + bias against the error against
+ * the reference (its own noise, 1/REF_FACTOR of the off bakes' variance, taken off). The sparse
+ * threshold's dropped texels are in the measures, not in the estimate (BENCH_SETS_KEEP_ALL=1
+ * keeps every texel). Goal: within 2×; auto's errors the lower of off's and on's. */
+#define REF_FACTOR 4
+static void set_estimates_mode(const est_bake *ref, const est_bake *b, const char *what)
+{
+    printf("stored-set estimates (sets A+B + door level, fast preset, --denoise %s, seeds 1 and 2; texels; reference "
+           "seed 3 at %d x the samples, denoise off):\n", what, REF_FACTOR);
+    if (b[0].nt != b[1].nt || b[0].nt != ref->nt) return;
+    est_line("base", "", b[0].base, b[1].base, ref->base, ref->nt, ref->base_noise, 0.5 * (b[0].base_noise + b[1].base_noise),
+             0.5 * (b[0].base_bias + b[1].base_bias), b[0].base_filtered);
+    for (int j = 0; j < b[0].ns && j < b[1].ns && j < ref->ns; j++) {
         const char *kind = b[0].sets[j].kind < 4 ? set_kind_label[b[0].sets[j].kind] : "set";
         if (b[0].noise[j] < 0 || b[1].noise[j] < 0) {
-            printf("  %-11s '%s': no estimate (not a transport run)\n", kind, b[0].sets[j].name);
+            printf("  %-11s %-20s no estimate (not a transport run)\n", kind, b[0].sets[j].name);
             continue;
         }
-        const double m = den > 0 ? sqrt(num / den) : 0, e = 0.5 * (b[0].noise[j] + b[1].noise[j]), ratio = m > 0 ? e / m : 0;
-        const double bias = 0.5 * (b[0].bias[j] + b[1].bias[j]);
-        /* against the reference: the mean square of both seeds' errors, less the reference's noise */
-        const double e0 = rel_diff(b[0].sets[j].lum, ref->sets[j].lum, nt), e1 = rel_diff(b[1].sets[j].lum, ref->sets[j].lum, nt);
-        const double ref_noise2 = ref->noise[j] >= 0 ? ref->noise[j] * ref->noise[j] : 0;
-        const double err = sqrt(fmax(0, 0.5 * (e0 * e0 + e1 * e1) - ref_noise2)), tot = sqrt(e * e + bias * bias);
-        printf("  %-11s '%s': estimated noise %.2f%%, measured noise %.2f%%, ratio %.2f%s; error vs reference %.2f%%, "
-               "estimated %.2f%% (bias %.2f%%), ratio %.2f%s\n",
-               kind, b[0].sets[j].name, 100 * e, 100 * m, ratio, ratio >= 0.5 && ratio <= 2 ? "" : " NOT within 2x",
-               100 * err, 100 * tot, 100 * bias, err > 0 ? tot / err : 0,
-               err > 0 && tot / err >= 0.5 && tot / err <= 2 ? "" : " NOT within 2x");
+        est_line(kind, b[0].sets[j].name, b[0].sets[j].lum, b[1].sets[j].lum, ref->sets[j].lum, ref->nt, ref->noise[j],
+                 0.5 * (b[0].noise[j] + b[1].noise[j]), 0.5 * (b[0].bias[j] + b[1].bias[j]), b[0].filtered[j]);
     }
-    return 0;
 }
 
 static int set_estimates(const char *dir)
@@ -360,17 +396,20 @@ static int set_estimates(const char *dir)
     char gltf[256], err[512];
     snprintf(gltf, sizeof gltf, "%s/estimate.gltf", dir);
     if (ds_write_room_scene(DS_ROOM_GLB, gltf, &o, err, sizeof err)) return fprintf(stderr, "estimate: %s\n", err), 1;
-    est_bake ref, off[2], on[2];
-    memset(off, 0, sizeof off), memset(on, 0, sizeof on);
-    int bad = est_bake_run(gltf, 3, 0, REF_FACTOR * 992, &ref);
-    for (int k = 0; k < 2 && !bad; k++) bad = est_bake_run(gltf, 1 + (uint64_t)k, 0, 0, &off[k]);
-    for (int k = 0; k < 2 && !bad; k++) bad = est_bake_run(gltf, 1 + (uint64_t)k, 1, 0, &on[k]);
+    static const lbk_bake_denoise modes[3] = {LBK_BAKE_DENOISE_OFF, LBK_BAKE_DENOISE_ON, LBK_BAKE_DENOISE_AUTO};
+    static const char *const names[3] = {"off", "on", "auto"};
+    est_bake ref, b[3][2];
+    memset(b, 0, sizeof b);
+    int bad = est_bake_run(gltf, 3, LBK_BAKE_DENOISE_OFF, REF_FACTOR * 992, &ref);
+    for (int m = 0; m < 3 && !bad; m++)
+        for (int k = 0; k < 2 && !bad; k++) bad = est_bake_run(gltf, 1 + (uint64_t)k, modes[m], 0, &b[m][k]);
     /* the reference's own noise: the off bakes' estimate over REF_FACTOR */
-    for (int j = 0; j < ref.ns && !bad; j++) ref.noise[j] = off[0].noise[j] >= 0 ? off[0].noise[j] / sqrt(REF_FACTOR) : -1;
-    if (!bad) set_estimates_mode(&ref, off, "denoise off");
-    if (!bad) set_estimates_mode(&ref, on, "denoise on");
+    ref.base_noise = bad ? 0 : b[0][0].base_noise / sqrt(REF_FACTOR);
+    for (int j = 0; j < ref.ns && !bad; j++) ref.noise[j] = b[0][0].noise[j] >= 0 ? b[0][0].noise[j] / sqrt(REF_FACTOR) : -1;
+    for (int m = 0; m < 3 && !bad; m++) set_estimates_mode(&ref, b[m], names[m]);
     est_bake_free(&ref);
-    for (int k = 0; k < 2; k++) est_bake_free(&off[k]), est_bake_free(&on[k]);
+    for (int m = 0; m < 3; m++)
+        for (int k = 0; k < 2; k++) est_bake_free(&b[m][k]);
     unlink(gltf);
     return bad;
 }

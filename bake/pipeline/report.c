@@ -62,10 +62,12 @@ static int fill_set_estimates(const bk_pipeline *b, lbk_bake_output *out, lbk_ba
         char *name = out->set_names + i * sizeof e->name;
         memcpy(name, e[i].name, sizeof e->name);
         const bk_denoise_error *x = &e[i].error;
+        const int ft = e[i].filtered[BK_CLASS_TEXEL], fg = e[i].filtered[BK_CLASS_GLG];
         out->set_estimates[i] = (lbk_bake_set_estimate){
-            name, e[i].set, e[i].kind, e[i].denoised,
+            name, e[i].set, e[i].kind, ft || fg,
             {{x->rel_rmse[BK_CLASS_TEXEL], x->rel_rmse[BK_CLASS_GLG], x->rel_rmse[BK_CLASS_LLG], x->probe_rel_rmse},
-             x->noise[BK_CLASS_TEXEL], x->bias[BK_CLASS_TEXEL], x->noise[BK_CLASS_GLG], x->bias[BK_CLASS_GLG], x->seconds}};
+             x->noise[BK_CLASS_TEXEL], x->bias[BK_CLASS_TEXEL], x->noise[BK_CLASS_GLG], x->bias[BK_CLASS_GLG], x->seconds,
+             ft, fg}};
     }
     r->set_estimates = out->set_estimates;
     r->set_estimate_count = n;
@@ -207,6 +209,8 @@ static void json_set_estimates(cJSON *root, const lbk_bake_report *r)
         cJSON_AddNumberToObject(o, "set", e->set);
         cJSON_AddStringToObject(o, "kind", e->kind < LBK_DLS_KIND_COUNT_ ? set_kind_names[e->kind] : "unknown");
         cJSON_AddBoolToObject(o, "denoised", e->denoised);
+        cJSON_AddBoolToObject(o, "texels_filtered", e->error.texels_filtered);
+        cJSON_AddBoolToObject(o, "glg_filtered", e->error.glg_filtered);
         json_classes(o, &e->error.errors);
         cJSON_AddNumberToObject(o, "texel_noise", e->error.texel_noise);
         cJSON_AddNumberToObject(o, "texel_bias", e->error.texel_bias);
@@ -273,6 +277,8 @@ static cJSON *json_report(const lbk_bake_report *r, const char *container_path)
         cJSON_AddNumberToObject(o, "glg_noise", r->denoised.glg_noise);
         cJSON_AddNumberToObject(o, "glg_bias", r->denoised.glg_bias);
         cJSON_AddNumberToObject(o, "seconds", r->denoised.seconds);
+        cJSON_AddBoolToObject(o, "texels_filtered", r->denoised.texels_filtered);
+        cJSON_AddBoolToObject(o, "glg_filtered", r->denoised.glg_filtered);
     }
     cJSON *ph = cJSON_AddArrayToObject(root, "phases");
     for (size_t i = 0; i < r->phase_count; i++) {

@@ -643,34 +643,74 @@ void bk_set_bakes_guide(const bk_set_bakes *sets, const lbk_sh9_rgb **sum, const
     *variance = im ? im->guide_var : NULL;
 }
 
-/* What each stored set's contribution delivers as stored: its two halves through the base's
- * denoising weights (or unfiltered), bk_denoiser_errors; one filter pass per 13 sets. */
+/* One class of a set's estimate: the filtered one where it is kept, else the unfiltered. */
+static void choose_class(bk_set_estimate *o, const bk_denoise_error *f, const bk_denoise_error *u, int k, int have_filter,
+                         int always)
+{
+    o->filtered[k] = have_filter && (always || f->rel_rmse[k] < u->rel_rmse[k]);
+    const bk_denoise_error *x = o->filtered[k] ? f : u;
+    o->error.rel_rmse[k] = x->rel_rmse[k], o->error.noise[k] = x->noise[k], o->error.bias[k] = x->bias[k];
+}
+
+/* What each stored set's contribution delivers as stored (bk_denoiser_errors: one filter pass
+ * per 13 sets): its two halves through the base's denoising weights and unfiltered; with
+ * --denoise auto each class (texels, GLG probes) is kept filtered only where that estimate is
+ * the lower (bk_set_bakes_emit then stores it so). */
 static lbk_result estimate_sets(bs_impl *im, const bk_set_inputs *in)
 {
-    const float **h = malloc((im->set_count ? im->set_count : 1) * sizeof *h);
-    bk_denoise_error *e = malloc((im->set_count ? im->set_count : 1) * sizeof *e);
-    im->estimates = calloc(im->set_count ? im->set_count : 1, sizeof *im->estimates);
-    lbk_result r = h && e && im->estimates ? LBK_OK : LBK_ERR_OUT_OF_MEMORY;
+    const size_t cap = im->set_count ? im->set_count : 1;
+    const float **h = malloc(cap * sizeof *h);
+    bk_denoise_error *e = malloc(cap * sizeof *e), *u = malloc(cap * sizeof *u);
+    im->estimates = calloc(cap, sizeof *im->estimates);
+    lbk_result r = h && e && u && im->estimates ? LBK_OK : LBK_ERR_OUT_OF_MEMORY;
     size_t m = 0;
     for (size_t j = 0; j < im->set_count && !r; j++)
         if (im->sets[j].stash && im->sets[j].stash_halves) h[m++] = im->sets[j].stash_halves;
-    if (!r) r = bk_denoiser_errors(in->denoiser, h, m, in->transport.class_end, e);
-    for (size_t j = 0, k = 0; j < im->set_count && !r; j++) {
+    if (!r) r = bk_denoiser_errors(NULL, h, m, in->transport.class_end, u);
+    if (!r && in->denoiser) r = bk_denoiser_errors(in->denoiser, h, m, in->transport.class_end, e);
+    for (size_t j = 0, next = 0; j < im->set_count && !r; j++) {
         const bs_set *st = &im->sets[j];
         if (!st->stash || !st->stash_halves) continue;
+        const size_t k = next++; /* its place in h, e and u */
         bk_set_estimate *o = &im->estimates[im->estimate_count++];
         snprintf(o->name, sizeof o->name, "%s", st->name);
         o->set = (uint32_t)j;
         o->kind = st->kind;
-        o->denoised = in->denoiser != NULL;
-        o->error = e[k++];
+        o->error = u[k]; /* the LLG class is never filtered */
+        const bk_denoise_error *f = in->denoiser ? &e[k] : &u[k];
+        choose_class(o, f, &u[k], BK_CLASS_TEXEL, in->denoiser != NULL, in->denoise_always);
+        choose_class(o, f, &u[k], BK_CLASS_GLG, in->denoiser != NULL, in->denoise_always);
+        o->error.probe_rel_rmse = o->filtered[BK_CLASS_GLG] ? f->probe_rel_rmse : u[k].probe_rel_rmse;
+        o->error.seconds = f->seconds + (in->denoiser ? u[k].seconds : 0);
         static const char *const kinds[LBK_DLS_KIND_COUNT_] = {"light set", "door open", "door closed", "combination"};
-        bk_events_say(in->events, LBK_BAKE_SEVERITY_INFO, "%-11s %-22s as stored%s: texels %.2f%% (bias %.2f%%), GLG %.2f%%",
-                      o->kind < LBK_DLS_KIND_COUNT_ ? kinds[o->kind] : "set", o->name, o->denoised ? " (denoised)" : "",
+        bk_events_say(in->events, LBK_BAKE_SEVERITY_INFO,
+                      "%-11s %-22s as stored: texels %.2f%% (bias %.2f%%%s), GLG %.2f%%%s",
+                      o->kind < LBK_DLS_KIND_COUNT_ ? kinds[o->kind] : "set", o->name,
                       100 * o->error.rel_rmse[BK_CLASS_TEXEL], 100 * o->error.bias[BK_CLASS_TEXEL],
-                      100 * o->error.rel_rmse[BK_CLASS_GLG]);
+                      o->filtered[BK_CLASS_TEXEL] ? ", denoised" : "", 100 * o->error.rel_rmse[BK_CLASS_GLG],
+                      o->filtered[BK_CLASS_GLG] ? " (denoised)" : "");
     }
-    free(h), free(e);
+    free(h), free(e), free(u);
+    return r;
+}
+
+/* Filters a kept contribution with the base's weights, then gives the classes its estimate
+ * keeps unfiltered (est NULL: none known, every class filtered) their unfiltered receivers. */
+static lbk_result filter_set(const bk_set_inputs *in, bs_set *st, const bk_set_estimate *est)
+{
+    const size_t *ce = in->transport.class_end;
+    const int keep_t = est && !est->filtered[BK_CLASS_TEXEL], keep_g = est && !est->filtered[BK_CLASS_GLG];
+    lbk_sh9_rgb *raw = NULL;
+    if (keep_t || keep_g) {
+        raw = malloc((in->receiver_count ? in->receiver_count : 1) * sizeof *raw);
+        if (!raw) return LBK_ERR_OUT_OF_MEMORY;
+        memcpy(raw, st->stash, in->receiver_count * sizeof *raw);
+    }
+    lbk_result r = bk_denoiser_apply(in->denoiser, st->stash);
+    if (!r && keep_t) memcpy(st->stash, raw, ce[BK_CLASS_TEXEL] * sizeof *raw);
+    if (!r && keep_g)
+        memcpy(st->stash + ce[BK_CLASS_TEXEL], raw + ce[BK_CLASS_TEXEL], (ce[BK_CLASS_GLG] - ce[BK_CLASS_TEXEL]) * sizeof *raw);
+    free(raw);
     return r;
 }
 
@@ -691,7 +731,10 @@ lbk_result bk_set_bakes_emit(bk_set_bakes *sets, const bk_set_inputs *in, char *
         if (!st->stash) continue;
         /* every set with the same weights, so sets toggled at run time add up to what a
          * denoised bake of the sum would be */
-        if (in->denoiser) r = bk_denoiser_apply(in->denoiser, st->stash);
+        const bk_set_estimate *est = NULL;
+        for (size_t i = 0; i < im->estimate_count; i++)
+            if (im->estimates[i].set == j) est = &im->estimates[i];
+        if (in->denoiser) r = filter_set(in, st, est);
         if (!r) r = emit_set(in, st, st->stash, st->stash_direct, st->stash_fraction, st->stash_skip_doors);
         free(st->stash), free(st->stash_direct), free(st->stash_halves);
         st->stash = NULL, st->stash_direct = NULL, st->stash_halves = NULL;

@@ -56,6 +56,8 @@ typedef struct bk_set_inputs {
                                          < 0: store every receiver with a non-zero contribution */
     const bk_events *events;          /* messages, progress over all set runs, cancellation */
     int door_method;                  /* enum bk_door_method */
+    int denoise_always;               /* 1: every set filtered (--denoise on); 0: per set and class
+                                         only where it lowers the estimate (auto) */
     const bk_denoiser *denoiser;      /* bk_set_bakes_emit: the denoiser built from the base + the
                                          guide (bk_set_bakes_guide), applied to every set with the
                                          same weights; NULL: not denoised */
@@ -120,8 +122,8 @@ typedef struct bk_set_estimate {
     char name[144];
     uint32_t set;          /* index in the DLS section's set table */
     uint32_t kind;         /* lbk_dls_set_kind */
-    int denoised;
-    bk_denoise_error error; /* relative to the RMS of the contribution itself */
+    int filtered[BK_RECEIVER_CLASSES]; /* 1: the class is stored filtered (texels, GLG) */
+    bk_denoise_error error; /* of what is stored, relative to the RMS of the contribution itself */
 } bk_set_estimate;
 
 /* The stored sets' estimates, in set order (owned by sets; after bk_set_bakes_emit). */

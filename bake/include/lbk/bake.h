@@ -76,8 +76,11 @@ typedef enum lbk_bake_door_method {
 
 /* Denoising of the baked texels and probes (bake/transport/DENOISE.md). */
 typedef enum lbk_bake_denoise {
-    LBK_BAKE_DENOISE_AUTO = 0, /* on: edge-aware, guided by the transport's own noise estimate */
+    LBK_BAKE_DENOISE_AUTO = 0, /* edge-aware, guided by the transport's own noise estimate, kept per
+                                  class (texels, GLG probes) of the base and of each stored set
+                                  only where it lowers the estimated error (noise + bias) */
     LBK_BAKE_DENOISE_OFF = 1,  /* the transport's estimate as it is */
+    LBK_BAKE_DENOISE_ON = 2,   /* (1.6) the filter everywhere, whatever the estimate says */
     LBK_BAKE_DENOISE_COUNT_
 } lbk_bake_denoise;
 
@@ -146,8 +149,8 @@ typedef struct lbk_bake_desc {
                                    this fraction of the mean indirect light of the texels they
                                    light directly [0: 0.01]; < 0: every non-zero receiver */
     lbk_bake_door_method door_method; /* [difference] */
-    lbk_bake_denoise denoise;   /* [auto: lightmap texels and GLG probes denoised, both presets;
-                                   bake/transport/DENOISE.md] */
+    lbk_bake_denoise denoise;   /* [auto: lightmap texels and GLG probes denoised where that lowers
+                                   the estimated error, both presets; bake/transport/DENOISE.md] */
     const char *revision;       /* stored in META [NULL: none] */
     int timestamp;              /* 1: store the bake time in META (no longer byte-identical) */
     const char *allow_outside;  /* files a glTF names (buffers, images, its lbk_sky EXR) must lie in
@@ -372,6 +375,9 @@ typedef struct lbk_bake_denoised {
     double texel_noise, texel_bias; /* the two parts of errors.texels */
     double glg_noise, glg_bias;     /* the two parts of errors.glg */
     double seconds;                 /* estimating it (one more pass of the filter) */
+    /* (1.6) which classes are stored filtered: --denoise auto keeps the unfiltered result of a
+     * class (then its error is the transport's, bias 0) where filtering would not lower it */
+    int texels_filtered, glg_filtered;
 } lbk_bake_denoised;
 
 /* One transport run of the light sets and doors (a light set, a door open or closed, a
