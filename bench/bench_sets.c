@@ -18,6 +18,7 @@
 #include "lbk/dls.h"
 #include "lbk/door.h"
 #include "lbk/lightmap.h"
+#include "tools/common/set_decode.h"
 #include "tests/support/bake_file.c"
 /* The generator lives with the tests; benches link the tools only, so take its source. */
 #include "tests/support/door_scenes.c"
@@ -88,17 +89,6 @@ typedef struct lit {
     double seconds;
 } lit;
 
-static double texel_lum(uint32_t z, const uint8_t *rgba)
-{
-    lbk_ahd_texel t;
-    t.irradiance_z = z;
-    memcpy(t.rgba, rgba, 4);
-    const float nz[3] = {0, 0, 1};
-    float e[3];
-    lbk_ahd_irradiance(&t, nz, e);
-    return LBK_LUM_R * e[0] + LBK_LUM_G * e[1] + LBK_LUM_B * e[2];
-}
-
 /* Bakes the level and returns its texels with every door open (base + S_O via lbk_dls_apply;
  * the plain bake of a level without door sets as it is). */
 static int bake_open(const char *dir, const char *name, const ds_options *o, int samples, int method, uint64_t seed,
@@ -162,7 +152,7 @@ static int bake_open(const char *dir, const char *name, const ds_options *o, int
         }
         free(bg), free(og), free(bl), free(ol);
     }
-    for (uint64_t i = 0; i < out->n; i++) out->lum[i] = texel_lum(z[i], &rgba[4 * i]);
+    for (uint64_t i = 0; i < out->n; i++) out->lum[i] = tl_texel_lum(z[i], &rgba[4 * i]);
     if (door) lbk_door_close(door);
     if (dv) lbk_dls_close(dv);
     lbk_reader_close(rd);
@@ -259,136 +249,168 @@ static int time_budget(const char *dir)
     return 0;
 }
 
-/* The texel luminance each light set adds (a black base + the set at weight 1, doors closed)
- * as liblbk's apply gives it, for every kind-0 set of a baked container. */
-typedef struct set_lum {
-    char name[64];
-    double *lum;
-} set_lum;
+static const char *const set_kind_label[4] = {"light set", "door open", "door closed", "combination"};
 
-static int set_contributions(const void *bytes, size_t size, set_lum *sets, int max_sets, int *nsets, uint64_t *ntex)
+/* Is each stored set's reported error what its stored contribution has? The sets level baked
+ * twice (seeds 1, 2; fast preset) with the denoiser off and on; each stored set's texel
+ * contribution decoded through lbk_dls_apply; measured noise √(Σ (S₁ − S₂)²/2 / Σ ((S₁ + S₂)/2)²)
+ * against the noise part of the report's set_estimates (two seeds see no bias; the estimate's
+ * bias part is printed beside). The sparse threshold's dropped texels are in the measure (both
+ * seeds drop them), not in the estimate (BENCH_SETS_KEEP_ALL=1 keeps every texel). Goal: within
+ * 2×. */
+/* One bake of the estimate level: its stored sets' texel luminance and estimates, and the
+ * base (the LMAP as stored, every set off) as entry 0 of the same arrays' parallel `base`. */
+typedef struct est_bake {
+    tl_set_texels sets[8];
+    int ns;
+    uint64_t nt;
+    double noise[8], bias[8];
+    int filtered[8];              /* texels stored filtered */
+    double *base;                 /* per texel */
+    double base_noise, base_bias; /* the report's: transport's, or denoised */
+    int base_filtered;
+} est_bake;
+
+static double *stored_base(const void *bytes, size_t size, uint64_t nt)
 {
     lbk_reader *rd;
-    const void *d, *dd, *doord;
-    size_t n, dn, doorn;
+    const void *d;
+    size_t n;
     lbk_lmap_view lm;
-    lbk_dls_view *dv = NULL;
-    lbk_door_view *door = NULL;
-    if (lbk_reader_open_memory(bytes, size, NULL, &rd)) return 1;
-    int bad = lbk_reader_section_by_type(rd, LBK_SECTION_LMAP, &d, &n) || lbk_lmap_open(d, n, &lm) ||
-              lbk_reader_section_by_type(rd, LBK_SECTION_DLS, &dd, &dn) || lbk_dls_open(dd, dn, NULL, &dv);
-    if (!bad && lbk_reader_section_by_type(rd, LBK_SECTION_DOOR, &doord, &doorn) == LBK_OK)
-        bad = lbk_door_open(doord, doorn, NULL, &door) != LBK_OK;
-    const uint64_t nt = bad ? 0 : lm.texel_count;
-    uint32_t *z = malloc(nt * 4 + 4), *oz = malloc(nt * 4 + 4);
-    uint8_t *rgba = malloc(nt * 4 + 4), *orgba = malloc(nt * 4 + 4);
-    const uint64_t ng = bad ? 0 : lbk_dls_target_count(dv, LBK_DLS_SPACE_GLG), nl = bad ? 0 : lbk_dls_target_count(dv, LBK_DLS_SPACE_LLG);
-    uint8_t *bg = calloc(ng + 1, 28), *og = calloc(ng + 1, 28), *bl = calloc(nl + 1, 28), *ol = calloc(nl + 1, 28);
-    /* a black base: the output is the set's contribution alone, encoded once (on the lit base
-     * its encoding step would be a share of the base, not of the set) */
-    memset(z, 0, nt * 4);
-    memset(rgba, 0, nt * 4);
-    (void)lm;
-    *nsets = 0;
-    *ntex = nt;
-    const uint32_t count = bad ? 0 : lbk_dls_set_count(dv);
-    float *w = calloc(count + 1, sizeof *w);
-    /* with the doors closed their closed-state sets (weight 1 − ω) are on: the output with
-     * every light set off is what each set's output is measured from */
-    double *closed = calloc(nt + 1, sizeof *closed);
-    for (uint32_t k = 0; k <= count && *nsets < max_sets; k++) {
-        const uint32_t j = k == 0 ? count : k - 1; /* the all-off output first */
-        lbk_dls_set_info si;
-        if (j < count && (lbk_dls_set_get(dv, j, &si) || si.kind != LBK_DLS_KIND_LIGHTS)) continue;
-        lbk_dls_runtime_desc rd2;
-        memset(&rd2, 0, sizeof rd2);
-        rd2.dls = dv, rd2.doors = door, rd2.base_irradiance_z = z, rd2.base_rgba = rgba;
-        rd2.base_glg = bg, rd2.base_llg = bl, rd2.out_irradiance_z = oz, rd2.out_rgba = orgba, rd2.out_glg = og, rd2.out_llg = ol;
-        lbk_dls_runtime *rt;
-        memset(w, 0, (count + 1) * sizeof *w);
-        w[j] = j < count; /* j == count: every light set off */
-        if (lbk_dls_runtime_open(&rd2, &rt) || lbk_dls_apply(rt, w, NULL, NULL)) {
-            bad = 1;
-            break;
+    double *out = NULL;
+    if (lbk_reader_open_memory(bytes, size, NULL, &rd)) return NULL;
+    if (!lbk_reader_section_by_type(rd, LBK_SECTION_LMAP, &d, &n) && !lbk_lmap_open(d, n, &lm) && lm.texel_count == nt &&
+        (out = malloc((nt + 1) * sizeof *out)))
+        for (uint64_t i = 0; i < nt; i++) {
+            lbk_ahd_texel t;
+            lbk_lmap_texel_get(&lm, i, &t, NULL);
+            out[i] = tl_texel_lum(t.irradiance_z, t.rgba);
         }
-        lbk_dls_runtime_close(rt);
-        if (j == count) {
-            for (uint64_t i = 0; i < nt; i++) closed[i] = texel_lum(oz[i], &orgba[4 * i]);
-            continue;
-        }
-        set_lum *sl = &sets[(*nsets)++];
-        snprintf(sl->name, sizeof sl->name, "%.*s", (int)si.name_length, si.name);
-        sl->lum = malloc(nt * sizeof *sl->lum + 8);
-        for (uint64_t i = 0; i < nt; i++) sl->lum[i] = texel_lum(oz[i], &orgba[4 * i]) - closed[i];
-    }
-    free(closed), free(w), free(z), free(oz), free(rgba), free(orgba), free(bg), free(og), free(bl), free(ol);
-    if (door) lbk_door_close(door);
-    if (dv) lbk_dls_close(dv);
     lbk_reader_close(rd);
+    return out;
+}
+
+static int est_bake_run(const char *gltf, uint64_t seed, lbk_bake_denoise denoise, int samples, est_bake *out)
+{
+    memset(out, 0, sizeof *out);
+    lbk_bake_desc d;
+    memset(&d, 0, sizeof d);
+    d.size = sizeof d;
+    d.preset = LBK_BAKE_PRESET_FAST;
+    d.seed = seed;
+    d.threads = 2;
+    d.denoise = denoise;
+    d.dls_threshold = getenv("BENCH_SETS_KEEP_ALL") ? -1 : 0;
+    if (samples) d.max_samples = samples, d.target_error = 1e-9;
+    lbk_bake_output *bo;
+    void *bytes = NULL;
+    size_t size = 0;
+    lbk_result r = lbk_bake_from_file(gltf, &d, &bo);
+    if (!r) r = lbk_bake_output_container(bo, &bytes, &size);
+    if (r) {
+        fprintf(stderr, "estimate: %s\n", lbk_result_message(r));
+        return 1;
+    }
+    int bad = tl_set_texels_decode(bytes, size, out->sets, 8, &out->ns, &out->nt) != 0;
+    if (!bad) bad = !(out->base = stored_base(bytes, size, out->nt));
+    const lbk_bake_report *rep = lbk_bake_output_report(bo);
+    for (int j = 0; j < out->ns; j++) {
+        out->noise[j] = -1;
+        for (size_t i = 0; i < rep->set_estimate_count; i++)
+            if (rep->set_estimates[i].set == out->sets[j].set) {
+                const lbk_bake_denoised *e = &rep->set_estimates[i].error;
+                out->noise[j] = e->texel_noise, out->bias[j] = e->texel_bias, out->filtered[j] = e->texels_filtered;
+            }
+    }
+    const int den = denoise != LBK_BAKE_DENOISE_OFF;
+    out->base_noise = den ? rep->denoised.texel_noise : rep->errors.texels;
+    out->base_bias = den ? rep->denoised.texel_bias : 0;
+    out->base_filtered = den && rep->denoised.texels_filtered;
+    lbk_free(NULL, bytes);
+    lbk_bake_output_free(bo);
     return bad;
 }
 
-/* Is each light set's reported error what its stored contribution has? The sets level baked
- * twice (seeds 1, 2; fast preset, denoiser off so the run's own estimate is the whole noise),
- * each set's texel contribution decoded through lbk_dls_apply; measured noise
- * √(Σ (S₁ − S₂)²/2 / Σ ((S₁ + S₂)/2)²) against the run's texel estimate (set_runs), as
- * bench_estimate does for the base. The sparse threshold's dropped texels are in the measure
- * (both seeds drop them), not in the estimate. Goal: within 2×. */
+static void est_bake_free(est_bake *b)
+{
+    tl_set_texels_free(b->sets, b->ns);
+    free(b->base);
+}
+
+/* √(Σ (a − b)² / Σ b²) over the texels */
+static double rel_diff(const double *a, const double *b, uint64_t n)
+{
+    double num = 0, den = 0;
+    for (uint64_t i = 0; i < n; i++) num += (a[i] - b[i]) * (a[i] - b[i]), den += b[i] * b[i];
+    return den > 0 ? sqrt(num / den) : 0;
+}
+
+/* One line: a stored contribution x of seeds 1 and 2 against the other seed and the reference. */
+static void est_line(const char *kind, const char *name, const double *x0, const double *x1, const double *ref, uint64_t nt,
+                     double ref_noise, double noise, double bias, int filtered)
+{
+    double num = 0, den = 0;
+    for (uint64_t i = 0; i < nt; i++) num += 0.5 * (x0[i] - x1[i]) * (x0[i] - x1[i]), den += 0.25 * (x0[i] + x1[i]) * (x0[i] + x1[i]);
+    const double m = den > 0 ? sqrt(num / den) : 0, ratio = m > 0 ? noise / m : 0;
+    /* against the reference: the mean square of both seeds' errors, less the reference's noise */
+    const double e0 = rel_diff(x0, ref, nt), e1 = rel_diff(x1, ref, nt);
+    const double err = sqrt(fmax(0, 0.5 * (e0 * e0 + e1 * e1) - ref_noise * ref_noise)), tot = sqrt(noise * noise + bias * bias);
+    printf("  %-11s %-20s %-10s est. noise %5.2f%% / between seeds %5.2f%% (%.2f%s); error vs reference %5.2f%%, "
+           "estimated %5.2f%% (bias %.2f%%) (%.2f%s)\n",
+           kind, name, filtered ? "filtered" : "unfiltered", 100 * noise, 100 * m, ratio,
+           ratio >= 0.5 && ratio <= 2 ? "" : " NOT within 2x", 100 * err, 100 * tot, 100 * bias, err > 0 ? tot / err : 0,
+           err > 0 && tot / err >= 0.5 && tot / err <= 2 ? "" : " NOT within 2x");
+}
+
+/* Is each stored set's reported error what its stored contribution has, and does --denoise auto
+ * keep the better of filtered and unfiltered? The sets level baked at seeds 1 and 2 (fast
+ * preset) with --denoise off, on and auto, and once (seed 3, off, REF_FACTOR × the preset's
+ * samples) as the reference; each stored set's texel contribution decoded through lbk_dls_apply
+ * (tools/common/set_decode.h), the base as stored. Per set: the estimate's noise against the
+ * noise between the two seeds (which sees no bias), and noise + bias against the error against
+ * the reference (its own noise, 1/REF_FACTOR of the off bakes' variance, taken off). The sparse
+ * threshold's dropped texels are in the measures, not in the estimate (BENCH_SETS_KEEP_ALL=1
+ * keeps every texel). Goal: within 2×; auto's errors the lower of off's and on's. */
+#define REF_FACTOR 4
+static void set_estimates_mode(const est_bake *ref, const est_bake *b, const char *what)
+{
+    printf("stored-set estimates (sets A+B + door level, fast preset, --denoise %s, seeds 1 and 2; texels; reference "
+           "seed 3 at %d x the samples, denoise off):\n", what, REF_FACTOR);
+    if (b[0].nt != b[1].nt || b[0].nt != ref->nt) return;
+    est_line("base", "", b[0].base, b[1].base, ref->base, ref->nt, ref->base_noise, 0.5 * (b[0].base_noise + b[1].base_noise),
+             0.5 * (b[0].base_bias + b[1].base_bias), b[0].base_filtered);
+    for (int j = 0; j < b[0].ns && j < b[1].ns && j < ref->ns; j++) {
+        const char *kind = b[0].sets[j].kind < 4 ? set_kind_label[b[0].sets[j].kind] : "set";
+        if (b[0].noise[j] < 0 || b[1].noise[j] < 0) {
+            printf("  %-11s %-20s no estimate (not a transport run)\n", kind, b[0].sets[j].name);
+            continue;
+        }
+        est_line(kind, b[0].sets[j].name, b[0].sets[j].lum, b[1].sets[j].lum, ref->sets[j].lum, ref->nt, ref->noise[j],
+                 0.5 * (b[0].noise[j] + b[1].noise[j]), 0.5 * (b[0].bias[j] + b[1].bias[j]), b[0].filtered[j]);
+    }
+}
+
 static int set_estimates(const char *dir)
 {
     const ds_options o = {DS_DOOR_TAGGED, DS_INSIDE_SETS, 0, 1, 0.5f, 4, 0, 0, 0};
     char gltf[256], err[512];
     snprintf(gltf, sizeof gltf, "%s/estimate.gltf", dir);
     if (ds_write_room_scene(DS_ROOM_GLB, gltf, &o, err, sizeof err)) return fprintf(stderr, "estimate: %s\n", err), 1;
-    enum { MAXS = 8 };
-    set_lum sets[2][MAXS];
-    int ns[2] = {0, 0}, bad = 0;
-    uint64_t nt[2] = {0, 0};
-    double est[2][MAXS] = {{0}};
-    for (int k = 0; k < 2 && !bad; k++) {
-        lbk_bake_desc d;
-        memset(&d, 0, sizeof d);
-        d.size = sizeof d;
-        d.preset = LBK_BAKE_PRESET_FAST;
-        d.seed = 1 + (uint64_t)k;
-        d.threads = 2;
-        d.denoise = LBK_BAKE_DENOISE_OFF;
-        d.dls_threshold = getenv("BENCH_SETS_KEEP_ALL") ? -1 : 0;
-        lbk_bake_output *bo;
-        void *bytes = NULL;
-        size_t size = 0;
-        lbk_result r = lbk_bake_from_file(gltf, &d, &bo);
-        if (!r) r = lbk_bake_output_container(bo, &bytes, &size);
-        if (r) {
-            fprintf(stderr, "estimate: %s\n", lbk_result_message(r));
-            bad = 1;
-            break;
-        }
-        bad = set_contributions(bytes, size, sets[k], MAXS, &ns[k], &nt[k]);
-        const lbk_bake_report *rep = lbk_bake_output_report(bo);
-        for (int j = 0; j < ns[k]; j++) {
-            char label[96];
-            snprintf(label, sizeof label, "light set '%.63s'", sets[k][j].name);
-            for (size_t i = 0; i < rep->set_run_count; i++)
-                if (rep->set_runs[i].label && !strcmp(rep->set_runs[i].label, label)) est[k][j] = rep->set_runs[i].classes.texels;
-        }
-        lbk_free(NULL, bytes);
-        lbk_bake_output_free(bo);
-    }
+    static const lbk_bake_denoise modes[3] = {LBK_BAKE_DENOISE_OFF, LBK_BAKE_DENOISE_ON, LBK_BAKE_DENOISE_AUTO};
+    static const char *const names[3] = {"off", "on", "auto"};
+    est_bake ref, b[3][2];
+    memset(b, 0, sizeof b);
+    int bad = est_bake_run(gltf, 3, LBK_BAKE_DENOISE_OFF, REF_FACTOR * 992, &ref);
+    for (int m = 0; m < 3 && !bad; m++)
+        for (int k = 0; k < 2 && !bad; k++) bad = est_bake_run(gltf, 1 + (uint64_t)k, modes[m], 0, &b[m][k]);
+    /* the reference's own noise: the off bakes' estimate over REF_FACTOR */
+    ref.base_noise = bad ? 0 : b[0][0].base_noise / sqrt(REF_FACTOR);
+    for (int j = 0; j < ref.ns && !bad; j++) ref.noise[j] = b[0][0].noise[j] >= 0 ? b[0][0].noise[j] / sqrt(REF_FACTOR) : -1;
+    for (int m = 0; m < 3 && !bad; m++) set_estimates_mode(&ref, b[m], names[m]);
+    est_bake_free(&ref);
+    for (int m = 0; m < 3; m++)
+        for (int k = 0; k < 2; k++) est_bake_free(&b[m][k]);
     unlink(gltf);
-    printf("light-set estimates (sets A+B + door level, fast preset, denoise off, seeds 1 and 2; texels):\n");
-    for (int j = 0; !bad && j < ns[0] && j < ns[1] && nt[0] == nt[1]; j++) {
-        double num = 0, den = 0;
-        for (uint64_t i = 0; i < nt[0]; i++) {
-            const double a = sets[0][j].lum[i], b = sets[1][j].lum[i];
-            num += 0.5 * (a - b) * (a - b), den += 0.25 * (a + b) * (a + b);
-        }
-        const double m = den > 0 ? sqrt(num / den) : 0, e = 0.5 * (est[0][j] + est[1][j]), ratio = m > 0 ? e / m : 0;
-        printf("  light set '%s': estimated %.2f%%, measured %.2f%%, ratio %.2f%s\n", sets[0][j].name, 100 * e, 100 * m,
-               ratio, ratio >= 0.5 && ratio <= 2 ? "" : "  NOT within 2x");
-    }
-    for (int k = 0; k < 2; k++)
-        for (int j = 0; j < ns[k]; j++) free(sets[k][j].lum);
     return bad;
 }
 

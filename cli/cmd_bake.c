@@ -71,9 +71,11 @@ static void help(FILE *f)
           "  --door-method difference|guided\n"
           "                          how the light through an open door is baked: differences of\n"
           "                          full runs (default) or the seed's guided estimator (bake/sets/SETS.md)\n"
-          "  --denoise auto|off      edge-aware denoising of lightmap texels and GLG probes, guided\n"
-          "                          by the transport's own noise estimate (default auto: on in both\n"
-          "                          presets; bake/transport/DENOISE.md)\n"
+          "  --denoise auto|on|off   edge-aware denoising of lightmap texels and GLG probes, guided\n"
+          "                          by the transport's own noise estimate; auto (the default, both\n"
+          "                          presets) keeps it per class of the base and of each light set or\n"
+          "                          door state only where it lowers the estimated error; on: always\n"
+          "                          (bake/transport/DENOISE.md)\n"
           "  --threads N             worker threads (default: all cores)\n"
           "  --seed N                random seed (default 1)\n"
           "  --json-report FILE      write the error-against-time report as JSON\n"
@@ -487,8 +489,9 @@ int cli_bake_parse(int argc, char **argv, bake_args *out, int *quiet_out)
             NEED_VALUE;
             if (!strcmp(v, "auto")) o.d.denoise = LBK_BAKE_DENOISE_AUTO;
             else if (!strcmp(v, "off")) o.d.denoise = LBK_BAKE_DENOISE_OFF;
+            else if (!strcmp(v, "on")) o.d.denoise = LBK_BAKE_DENOISE_ON;
             else {
-                fprintf(stderr, "lbk bake: unknown denoise mode '%s' (auto, off)\n", v);
+                fprintf(stderr, "lbk bake: unknown denoise mode '%s' (auto, on, off)\n", v);
                 return LBK_EXIT_USAGE;
             }
         } else if (!strcmp(a, "--threads")) {

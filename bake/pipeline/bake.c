@@ -586,6 +586,7 @@ void bk_pipeline_set_inputs(const bk_pipeline *b, bk_set_inputs *in)
     in->door_method = (int)b->opt->door_method;
     in->skip_guided = b->dist && !bk_dist_split(b->dist)->replay; /* the merge makes them */
     in->denoiser = b->denoiser;
+    in->denoise_always = b->opt->denoise == LBK_BAKE_DENOISE_ON;
     in->deadline = b->opt->time_limit > 0 ? b->start + b->opt->time_limit : 0;
     memcpy(in->origin, b->origin, sizeof in->origin);
 }
@@ -741,8 +742,11 @@ static lbk_result do_sets(bk_pipeline *b)
 }
 
 /* What the denoised base delivers: the two halves through the same weights (bk_denoiser_error).
- * The LLG class is not filtered and keeps the base estimate with its fit residual. */
-static lbk_result denoised_error(bk_pipeline *b)
+ * The LLG class is not filtered and keeps the base estimate with its fit residual. With
+ * --denoise auto a class whose filtered estimate is not below its unfiltered one (the
+ * transport's) gets its unfiltered receivers back from `raw` (NULL: keep every class filtered),
+ * and its error is the transport's. */
+static lbk_result denoised_error(bk_pipeline *b, const lbk_sh9_rgb *raw)
 {
     bk_transport_options to;
     transport_options(b, &to);
@@ -750,6 +754,19 @@ static lbk_result denoised_error(bk_pipeline *b)
     lbk_result r = bk_denoiser_error(b->denoiser, b->halves, to.class_end, &e);
     if (r) return r;
     lbk_bake_denoised *d = &b->denoised;
+    const double raw_t = b->stats.class_rel_rmse[BK_CLASS_TEXEL], raw_g = b->stats.class_rel_rmse[BK_CLASS_GLG];
+    d->texels_filtered = !raw || e.rel_rmse[BK_CLASS_TEXEL] < raw_t;
+    d->glg_filtered = !raw || e.rel_rmse[BK_CLASS_GLG] < raw_g;
+    if (!d->texels_filtered) {
+        memcpy(b->radiance, raw, to.class_end[BK_CLASS_TEXEL] * sizeof *raw);
+        e.rel_rmse[BK_CLASS_TEXEL] = e.noise[BK_CLASS_TEXEL] = raw_t, e.bias[BK_CLASS_TEXEL] = 0;
+    }
+    if (!d->glg_filtered) {
+        const size_t g0 = to.class_end[BK_CLASS_TEXEL];
+        memcpy(b->radiance + g0, raw + g0, (to.class_end[BK_CLASS_GLG] - g0) * sizeof *raw);
+        e.rel_rmse[BK_CLASS_GLG] = e.noise[BK_CLASS_GLG] = raw_g, e.bias[BK_CLASS_GLG] = 0;
+        e.probe_rel_rmse = b->stats.probe_rel_rmse;
+    }
     d->errors.texels = e.rel_rmse[BK_CLASS_TEXEL];
     d->errors.glg = e.rel_rmse[BK_CLASS_GLG];
     d->errors.llg = b->stats.class_rel_rmse[BK_CLASS_LLG];
@@ -759,9 +776,10 @@ static lbk_result denoised_error(bk_pipeline *b)
     d->seconds = e.seconds;
     b->have_denoised = 1;
     bk_events_say(&b->events, LBK_BAKE_SEVERITY_INFO,
-                  "denoised: texels %.2f%% (noise %.2f%%, bias %.2f%%; before %.2f%%), GLG probes %.2f%% (before %.2f%%)",
-                  100 * d->errors.texels, 100 * d->texel_noise, 100 * d->texel_bias, 100 * b->stats.class_rel_rmse[BK_CLASS_TEXEL],
-                  100 * d->errors.glg, 100 * b->stats.class_rel_rmse[BK_CLASS_GLG]);
+                  "denoised: texels %.2f%% (noise %.2f%%, bias %.2f%%; before %.2f%%%s), GLG probes %.2f%% (before %.2f%%%s)",
+                  100 * d->errors.texels, 100 * d->texel_noise, 100 * d->texel_bias, 100 * raw_t,
+                  d->texels_filtered ? "" : ": kept unfiltered", 100 * d->errors.glg, 100 * raw_g,
+                  d->glg_filtered ? "" : ": kept unfiltered");
     return LBK_OK;
 }
 
@@ -808,8 +826,16 @@ static lbk_result do_denoise(bk_pipeline *b)
     o.threads = b->opt->threads;
     lbk_result r = bk_denoiser_create(&in, &o, &b->denoiser);
     free(guide), free(guide_var);
+    /* auto: what the filter replaces, in case the estimate says it does not pay */
+    lbk_sh9_rgb *raw = NULL;
+    if (!r && b->opt->denoise == LBK_BAKE_DENOISE_AUTO) {
+        raw = malloc((b->receiver_count ? b->receiver_count : 1) * sizeof *raw);
+        if (!raw) r = LBK_ERR_OUT_OF_MEMORY;
+        else memcpy(raw, b->radiance, b->receiver_count * sizeof *raw);
+    }
     if (!r) r = bk_denoiser_apply(b->denoiser, b->radiance);
-    if (!r) r = denoised_error(b);
+    if (!r) r = denoised_error(b, raw);
+    free(raw);
     if (r) return bk_pipeline_failed(b, r, "denoising");
     return LBK_OK;
 }

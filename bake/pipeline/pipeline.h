@@ -109,6 +109,8 @@ struct lbk_bake_output {
     lbk_bake_class_errors *pass_errors;
     lbk_bake_set_run *set_runs;
     char *set_labels;               /* the set runs' labels, 64 bytes each */
+    lbk_bake_set_estimate *set_estimates;
+    char *set_names;                /* their names, 144 bytes each */
     lbk_bake_phase_time phases[BK_MAX_PHASES];
     char *input;
 };

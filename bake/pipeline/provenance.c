@@ -318,7 +318,8 @@ lbk_result bk_provenance_meta(const bk_pipeline *b, void **data, size_t *size)
     p[n++] = (lbk_meta_pair){"bake.target_error", target};
     p[n++] = (lbk_meta_pair){"bake.max_bounces", bounces};
     p[n++] = (lbk_meta_pair){"bake.time_limit", tlimit};
-    p[n++] = (lbk_meta_pair){"bake.denoise", o->denoise == LBK_BAKE_DENOISE_OFF ? "off" : "auto"};
+    p[n++] = (lbk_meta_pair){"bake.denoise", o->denoise == LBK_BAKE_DENOISE_OFF ? "off"
+                                             : o->denoise == LBK_BAKE_DENOISE_ON ? "on" : "auto"};
     p[n++] = (lbk_meta_pair){"bake.sky", skyv.p};
     p[n++] = (lbk_meta_pair){"bake.no_glg", o->no_glg ? "1" : "0"};
     p[n++] = (lbk_meta_pair){"bake.octahedral", o->octahedral_probes ? "1" : "0"};

@@ -9,6 +9,7 @@
 
 #include "bake/pipeline/pipeline.h"
 #include "bake/util/clock.h"
+#include "lbk/dls.h"
 
 static const char *const phase_names[LBK_BAKE_PHASE_COUNT_] = {
     [LBK_BAKE_PHASE_IMPORT] = "import", [LBK_BAKE_PHASE_LAYOUT] = "layout", [LBK_BAKE_PHASE_LIGHT] = "light",
@@ -46,6 +47,31 @@ static void fill_counts(const bk_pipeline *b, lbk_bake_counts *c)
     c->light_sets = b->sets.set_count;
     c->doors = b->sets.door_count;
     c->file_bytes = b->container_bytes;
+}
+
+/* Each stored set's estimate (bk_set_bakes_estimates) as lbk_bake_set_estimate. */
+static int fill_set_estimates(const bk_pipeline *b, lbk_bake_output *out, lbk_bake_report *r)
+{
+    size_t n;
+    const bk_set_estimate *e = bk_set_bakes_estimates(&b->sets, &n);
+    if (!n) return 0;
+    out->set_estimates = bk_output_alloc(out, n * sizeof *out->set_estimates);
+    out->set_names = bk_output_alloc(out, n * sizeof e->name);
+    if (!out->set_estimates || !out->set_names) return 1;
+    for (size_t i = 0; i < n; i++) {
+        char *name = out->set_names + i * sizeof e->name;
+        memcpy(name, e[i].name, sizeof e->name);
+        const bk_denoise_error *x = &e[i].error;
+        const int ft = e[i].filtered[BK_CLASS_TEXEL], fg = e[i].filtered[BK_CLASS_GLG];
+        out->set_estimates[i] = (lbk_bake_set_estimate){
+            name, e[i].set, e[i].kind, ft || fg,
+            {{x->rel_rmse[BK_CLASS_TEXEL], x->rel_rmse[BK_CLASS_GLG], x->rel_rmse[BK_CLASS_LLG], x->probe_rel_rmse},
+             x->noise[BK_CLASS_TEXEL], x->bias[BK_CLASS_TEXEL], x->noise[BK_CLASS_GLG], x->bias[BK_CLASS_GLG], x->seconds,
+             ft, fg}};
+    }
+    r->set_estimates = out->set_estimates;
+    r->set_estimate_count = n;
+    return 0;
 }
 
 lbk_result bk_pipeline_report(const bk_pipeline *b, lbk_bake_output *out)
@@ -97,6 +123,7 @@ lbk_result bk_pipeline_report(const bk_pipeline *b, lbk_bake_output *out)
     r->set_runs = out->set_runs;
     r->set_run_count = nrun;
     if (b->have_denoised) r->denoised = b->denoised;
+    if (fill_set_estimates(b, out, r)) return LBK_ERR_OUT_OF_MEMORY;
     fill_transport(b, &r->transport);
     fill_counts(b, &r->counts);
     r->scales.lmap = r->counts.texels ? b->scale[0] : 0;
@@ -171,6 +198,29 @@ static void json_classes(cJSON *parent, const lbk_bake_class_errors *e)
     cJSON_AddNumberToObject(o, "probes", e->probes);
 }
 
+static const char *const set_kind_names[LBK_DLS_KIND_COUNT_] = {"lights", "door_open", "door_closed", "combination"};
+
+static void json_set_estimates(cJSON *root, const lbk_bake_report *r)
+{
+    cJSON *arr = cJSON_AddArrayToObject(root, "set_estimates");
+    for (size_t i = 0; i < r->set_estimate_count; i++) {
+        const lbk_bake_set_estimate *e = &r->set_estimates[i];
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "name", e->name ? e->name : "");
+        cJSON_AddNumberToObject(o, "set", e->set);
+        cJSON_AddStringToObject(o, "kind", e->kind < LBK_DLS_KIND_COUNT_ ? set_kind_names[e->kind] : "unknown");
+        cJSON_AddBoolToObject(o, "denoised", e->denoised);
+        cJSON_AddBoolToObject(o, "texels_filtered", e->error.texels_filtered);
+        cJSON_AddBoolToObject(o, "glg_filtered", e->error.glg_filtered);
+        json_classes(o, &e->error.errors);
+        cJSON_AddNumberToObject(o, "texel_noise", e->error.texel_noise);
+        cJSON_AddNumberToObject(o, "texel_bias", e->error.texel_bias);
+        cJSON_AddNumberToObject(o, "glg_noise", e->error.glg_noise);
+        cJSON_AddNumberToObject(o, "glg_bias", e->error.glg_bias);
+        cJSON_AddItemToArray(arr, o);
+    }
+}
+
 static cJSON *json_report(const lbk_bake_report *r, const char *container_path)
 {
     /* a report struct from before the per-class fields were appended has none of them */
@@ -220,6 +270,8 @@ static cJSON *json_report(const lbk_bake_report *r, const char *container_path)
         if (r->size >= offsetof(lbk_bake_report, octp_levels) + sizeof r->octp_levels && r->octp_levels)
             cJSON_AddNumberToObject(o, "levels", r->octp_levels);
     }
+    if (r->size >= offsetof(lbk_bake_report, set_estimate_count) + sizeof r->set_estimate_count && r->set_estimate_count)
+        json_set_estimates(root, r);
     if (r->size >= offsetof(lbk_bake_report, denoised) + sizeof r->denoised && r->denoised.errors.texels + r->denoised.errors.glg > 0) {
         cJSON *o = cJSON_AddObjectToObject(root, "denoised");
         json_classes(o, &r->denoised.errors);
@@ -228,6 +280,8 @@ static cJSON *json_report(const lbk_bake_report *r, const char *container_path)
         cJSON_AddNumberToObject(o, "glg_noise", r->denoised.glg_noise);
         cJSON_AddNumberToObject(o, "glg_bias", r->denoised.glg_bias);
         cJSON_AddNumberToObject(o, "seconds", r->denoised.seconds);
+        cJSON_AddBoolToObject(o, "texels_filtered", r->denoised.texels_filtered);
+        cJSON_AddBoolToObject(o, "glg_filtered", r->denoised.glg_filtered);
     }
     cJSON *ph = cJSON_AddArrayToObject(root, "phases");
     for (size_t i = 0; i < r->phase_count; i++) {
@@ -278,3 +332,4 @@ lbk_result lbk_bake_report_write_json(const lbk_bake_report *report, const char 
     free(text);
     return ok ? LBK_OK : LBK_ERR_IO;
 }
+

@@ -374,7 +374,7 @@ static lbk_result build_sections(bk_pipeline *b, section_list *sl)
     if (!r && b->texels.page_count && b->texel_receivers && b->texel_rel_error) { /* --error-map (spec §18) */
         void *terr = NULL;
         size_t terr_size = 0;
-        const uint32_t flags = b->opt->denoise != LBK_BAKE_DENOISE_OFF ? LBK_TERR_DENOISED : 0;
+        const uint32_t flags = b->have_denoised && b->denoised.texels_filtered ? LBK_TERR_DENOISED : 0;
         r = bk_error_map_section(&b->texels, b->texel_of_receiver, b->texel_receivers, b->texel_rel_error, flags, &terr,
                                  &terr_size);
         r = sections_add(sl, LBK_SECTION_TERR, r, terr, terr_size);

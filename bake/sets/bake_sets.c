@@ -47,6 +47,7 @@ typedef struct bs_set {
      * every set first): radiance per receiver, direct luminance per texel receiver */
     lbk_sh9_rgb *stash;
     double *stash_direct;
+    float *stash_halves;           /* its two half estimates, 2 per receiver (NULL: none known) */
     double stash_fraction;
     int stash_skip_doors;
 } bs_set;
@@ -78,6 +79,8 @@ typedef struct bs_impl {
     float *guide_var;
     bk_set_run_error *run_errors; /* every transport run's estimate, in order */
     size_t run_error_count;
+    bk_set_estimate *estimates;   /* every stored set's, by bk_set_bakes_emit */
+    size_t estimate_count;
 } bs_impl;
 
 /* ---- prepare --------------------------------------------------------------------------- */
@@ -599,14 +602,17 @@ static lbk_result emit_set(const bk_set_inputs *in, bs_set *st, const lbk_sh9_rg
  * (combination sets are corrections of their members: not in the guide). `variance` is the
  * run's own (light sets) or NULL (differences of correlated runs: unknown). */
 static lbk_result stash_set(const bk_set_inputs *in, bs_impl *im, bs_set *st, const lbk_sh9_rgb *contrib,
-                            const lbk_sh9_rgb *direct, const float *variance, double fraction, int skip_doors)
+                            const lbk_sh9_rgb *direct, const float *halves, const float *variance, double fraction,
+                            int skip_doors)
 {
     size_t n = in->receiver_count, nt = in->texel_receivers;
-    free(st->stash), free(st->stash_direct);
+    free(st->stash), free(st->stash_direct), free(st->stash_halves);
     st->stash = malloc((n ? n : 1) * sizeof *st->stash);
     st->stash_direct = malloc((nt ? nt : 1) * sizeof *st->stash_direct);
-    if (!st->stash || !st->stash_direct) return LBK_ERR_OUT_OF_MEMORY;
+    st->stash_halves = halves ? malloc((n ? n : 1) * 2 * sizeof *st->stash_halves) : NULL;
+    if (!st->stash || !st->stash_direct || (halves && !st->stash_halves)) return LBK_ERR_OUT_OF_MEMORY;
     memcpy(st->stash, contrib, n * sizeof *st->stash);
+    if (halves) memcpy(st->stash_halves, halves, n * 2 * sizeof *st->stash_halves);
     for (size_t k = 0; k < nt; k++) {
         lbk_ahd_linear dlin;
         float ez[3];
@@ -637,20 +643,101 @@ void bk_set_bakes_guide(const bk_set_bakes *sets, const lbk_sh9_rgb **sum, const
     *variance = im ? im->guide_var : NULL;
 }
 
+/* One class of a set's estimate: the filtered one where it is kept, else the unfiltered. */
+static void choose_class(bk_set_estimate *o, const bk_denoise_error *f, const bk_denoise_error *u, int k, int have_filter,
+                         int always)
+{
+    o->filtered[k] = have_filter && (always || f->rel_rmse[k] < u->rel_rmse[k]);
+    const bk_denoise_error *x = o->filtered[k] ? f : u;
+    o->error.rel_rmse[k] = x->rel_rmse[k], o->error.noise[k] = x->noise[k], o->error.bias[k] = x->bias[k];
+}
+
+/* What each stored set's contribution delivers as stored (bk_denoiser_errors: one filter pass
+ * per 13 sets): its two halves through the base's denoising weights and unfiltered; with
+ * --denoise auto each class (texels, GLG probes) is kept filtered only where that estimate is
+ * the lower (bk_set_bakes_emit then stores it so). */
+static lbk_result estimate_sets(bs_impl *im, const bk_set_inputs *in)
+{
+    const size_t cap = im->set_count ? im->set_count : 1;
+    const float **h = malloc(cap * sizeof *h);
+    bk_denoise_error *e = malloc(cap * sizeof *e), *u = malloc(cap * sizeof *u);
+    im->estimates = calloc(cap, sizeof *im->estimates);
+    lbk_result r = h && e && u && im->estimates ? LBK_OK : LBK_ERR_OUT_OF_MEMORY;
+    size_t m = 0;
+    for (size_t j = 0; j < im->set_count && !r; j++)
+        if (im->sets[j].stash && im->sets[j].stash_halves) h[m++] = im->sets[j].stash_halves;
+    if (!r) r = bk_denoiser_errors(NULL, h, m, in->transport.class_end, u);
+    if (!r && in->denoiser) r = bk_denoiser_errors(in->denoiser, h, m, in->transport.class_end, e);
+    for (size_t j = 0, next = 0; j < im->set_count && !r; j++) {
+        const bs_set *st = &im->sets[j];
+        if (!st->stash || !st->stash_halves) continue;
+        const size_t k = next++; /* its place in h, e and u */
+        bk_set_estimate *o = &im->estimates[im->estimate_count++];
+        snprintf(o->name, sizeof o->name, "%s", st->name);
+        o->set = (uint32_t)j;
+        o->kind = st->kind;
+        o->error = u[k]; /* the LLG class is never filtered */
+        const bk_denoise_error *f = in->denoiser ? &e[k] : &u[k];
+        choose_class(o, f, &u[k], BK_CLASS_TEXEL, in->denoiser != NULL, in->denoise_always);
+        choose_class(o, f, &u[k], BK_CLASS_GLG, in->denoiser != NULL, in->denoise_always);
+        o->error.probe_rel_rmse = o->filtered[BK_CLASS_GLG] ? f->probe_rel_rmse : u[k].probe_rel_rmse;
+        o->error.seconds = f->seconds + (in->denoiser ? u[k].seconds : 0);
+        static const char *const kinds[LBK_DLS_KIND_COUNT_] = {"light set", "door open", "door closed", "combination"};
+        bk_events_say(in->events, LBK_BAKE_SEVERITY_INFO,
+                      "%-11s %-22s as stored: texels %.2f%% (bias %.2f%%%s), GLG %.2f%%%s",
+                      o->kind < LBK_DLS_KIND_COUNT_ ? kinds[o->kind] : "set", o->name,
+                      100 * o->error.rel_rmse[BK_CLASS_TEXEL], 100 * o->error.bias[BK_CLASS_TEXEL],
+                      o->filtered[BK_CLASS_TEXEL] ? ", denoised" : "", 100 * o->error.rel_rmse[BK_CLASS_GLG],
+                      o->filtered[BK_CLASS_GLG] ? " (denoised)" : "");
+    }
+    free(h), free(e), free(u);
+    return r;
+}
+
+/* Filters a kept contribution with the base's weights, then gives the classes its estimate
+ * keeps unfiltered (est NULL: none known, every class filtered) their unfiltered receivers. */
+static lbk_result filter_set(const bk_set_inputs *in, bs_set *st, const bk_set_estimate *est)
+{
+    const size_t *ce = in->transport.class_end;
+    const int keep_t = est && !est->filtered[BK_CLASS_TEXEL], keep_g = est && !est->filtered[BK_CLASS_GLG];
+    lbk_sh9_rgb *raw = NULL;
+    if (keep_t || keep_g) {
+        raw = malloc((in->receiver_count ? in->receiver_count : 1) * sizeof *raw);
+        if (!raw) return LBK_ERR_OUT_OF_MEMORY;
+        memcpy(raw, st->stash, in->receiver_count * sizeof *raw);
+    }
+    lbk_result r = bk_denoiser_apply(in->denoiser, st->stash);
+    if (!r && keep_t) memcpy(st->stash, raw, ce[BK_CLASS_TEXEL] * sizeof *raw);
+    if (!r && keep_g)
+        memcpy(st->stash + ce[BK_CLASS_TEXEL], raw + ce[BK_CLASS_TEXEL], (ce[BK_CLASS_GLG] - ce[BK_CLASS_TEXEL]) * sizeof *raw);
+    free(raw);
+    return r;
+}
+
+const bk_set_estimate *bk_set_bakes_estimates(const bk_set_bakes *sets, size_t *count)
+{
+    const bs_impl *im = sets ? sets->impl : NULL;
+    *count = im ? im->estimate_count : 0;
+    return im ? im->estimates : NULL;
+}
+
 lbk_result bk_set_bakes_emit(bk_set_bakes *sets, const bk_set_inputs *in, char *err, size_t err_len)
 {
     bs_impl *im = sets->impl;
     if (!im) return LBK_OK;
-    lbk_result r = LBK_OK;
+    lbk_result r = estimate_sets(im, in);
     for (size_t j = 0; j < im->set_count && !r; j++) {
         bs_set *st = &im->sets[j];
         if (!st->stash) continue;
         /* every set with the same weights, so sets toggled at run time add up to what a
          * denoised bake of the sum would be */
-        if (in->denoiser) r = bk_denoiser_apply(in->denoiser, st->stash);
+        const bk_set_estimate *est = NULL;
+        for (size_t i = 0; i < im->estimate_count; i++)
+            if (im->estimates[i].set == j) est = &im->estimates[i];
+        if (in->denoiser) r = filter_set(in, st, est);
         if (!r) r = emit_set(in, st, st->stash, st->stash_direct, st->stash_fraction, st->stash_skip_doors);
-        free(st->stash), free(st->stash_direct);
-        st->stash = NULL, st->stash_direct = NULL;
+        free(st->stash), free(st->stash_direct), free(st->stash_halves);
+        st->stash = NULL, st->stash_direct = NULL, st->stash_halves = NULL;
     }
     free(im->guide), free(im->guide_var);
     im->guide = NULL, im->guide_var = NULL;
@@ -769,7 +856,7 @@ const bk_set_run_error *bk_set_bakes_run_errors(const bk_set_bakes *sets, size_t
 
 /* One transport run at the base receivers. */
 static lbk_result run_one(run_ctx *rc, const bk_scene *scene, const bk_tracer *tracer, const bk_transport_options *base,
-                          lbk_sh9_rgb *radiance, lbk_sh9_rgb *direct, const char *what)
+                          lbk_sh9_rgb *radiance, lbk_sh9_rgb *direct, float *halves, const char *what)
 {
     const bk_set_inputs *in = rc->in;
     bk_transport_options opt = *base;
@@ -791,6 +878,7 @@ static lbk_result run_one(run_ctx *rc, const bk_scene *scene, const bk_tracer *t
     memset(&out, 0, sizeof out);
     out.radiance = radiance;
     out.direct = direct;
+    out.halves = halves;
     out.variance = rc->variance;
     bk_transport_stats st;
     /* every run stores the direct irradiance estimate along texel normals like the base
@@ -843,7 +931,7 @@ static lbk_result open_without(run_ctx *rc, const char *door, const char *door2,
 
 /* A run over the scene with one or two doors removed (its own tracer). */
 static lbk_result run_without(run_ctx *rc, const char *door, const char *door2, const bk_transport_options *opt,
-                              lbk_sh9_rgb *rad, lbk_sh9_rgb *dir, const char *what)
+                              lbk_sh9_rgb *rad, lbk_sh9_rgb *dir, float *halves, const char *what)
 {
     filtered_scene fs;
     bk_tracer *tr = NULL;
@@ -851,7 +939,7 @@ static lbk_result run_without(run_ctx *rc, const char *door, const char *door2, 
     if (r) return r;
     bk_transport_options o = *opt;
     o.cell_size = fs.cell_size;
-    r = run_one(rc, &fs.scene, tr, &o, rad, dir, what);
+    r = run_one(rc, &fs.scene, tr, &o, rad, dir, halves, what);
     bk_tracer_destroy(tr);
     filtered_free(&fs);
     return r;
@@ -917,12 +1005,16 @@ typedef struct set_run {
     double fraction;                /* sparse storage threshold (emit_set) */
     bk_transport_options fixed;     /* the door runs' fixed budget */
     lbk_sh9_rgb *rad, *dir;         /* the current run */
+    float *halves;                  /* its two half estimates (2 per receiver; differences alike) */
     float *var;                     /* its variance (light-set runs: the denoiser's guide) */
     lbk_sh9_rgb *ref, *ref_dir;     /* every door closed and black */
+    float *ref_halves;
     lbk_sh9_rgb **keep, **keep_dir; /* open runs of doors in door–door combinations */
+    float **keep_halves;
     float *texel_size;              /* guided: per texel receiver */
     uint8_t *door_texel;
     lbk_sh9_rgb *ls_closed, *ls_closed_dir; /* door–light set combinations: the set, doors closed */
+    float *ls_closed_halves;
     char what[256];
 } set_run;
 
@@ -932,10 +1024,24 @@ static lbk_result out_of_memory(set_run *s)
     return LBK_ERR_OUT_OF_MEMORY;
 }
 
-/* Keeps the current run's contribution for bk_set_bakes_emit (stash_set). */
-static lbk_result emit(set_run *s, bs_set *st, const float *variance, int skip_doors)
+/* Keeps the current run's contribution for bk_set_bakes_emit (stash_set); halves: 1 when
+ * s->halves holds the contribution's half estimates (0: the guided estimator's, none). */
+static lbk_result emit(set_run *s, bs_set *st, const float *variance, int skip_doors, int halves)
 {
-    return stash_set(s->in, s->im, st, s->rad, s->dir, variance, s->fraction, skip_doors) ? out_of_memory(s) : LBK_OK;
+    return stash_set(s->in, s->im, st, s->rad, s->dir, halves ? s->halves : NULL, variance, s->fraction, skip_doors)
+               ? out_of_memory(s)
+               : LBK_OK;
+}
+
+/* dst −= b (or += b), two half estimates per receiver */
+static void halves_sub(float *dst, const float *b, size_t n)
+{
+    for (size_t i = 0; i < 2 * n; i++) dst[i] -= b[i];
+}
+
+static void halves_add(float *dst, const float *b, size_t n)
+{
+    for (size_t i = 0; i < 2 * n; i++) dst[i] += b[i];
 }
 
 /* Light sets: their lights alone (transport leaves out the sky and every other emitter); doors
@@ -951,10 +1057,10 @@ static lbk_result bake_light_sets(set_run *s)
         s->rc.black_doors = 0;
         snprintf(s->what, sizeof s->what, "light set '%s'", st->name);
         s->rc.variance = s->var;
-        lbk_result r = run_one(&s->rc, s->in->scene, s->in->tracer, &opt, s->rad, s->dir, s->what);
+        lbk_result r = run_one(&s->rc, s->in->scene, s->in->tracer, &opt, s->rad, s->dir, s->halves, s->what);
         s->rc.variance = NULL;
         if (r) return r;
-        r = emit(s, st, s->var, 0);
+        r = emit(s, st, s->var, 0, 1);
         if (r) return r;
     }
     return LBK_OK;
@@ -973,9 +1079,11 @@ static lbk_result bake_door_reference(set_run *s, int guided)
     s->fixed.time_limit = 0;
     if (in->base_samples_per_receiver > 0) s->fixed.max_samples = (int)fmin(in->base_samples_per_receiver, 1 << 24);
     s->ref = malloc(s->n * sizeof *s->ref), s->ref_dir = malloc(s->n * sizeof *s->ref_dir);
+    s->ref_halves = malloc(s->n * 2 * sizeof *s->ref_halves);
     s->keep = calloc(s->im->door_count, sizeof *s->keep);
     s->keep_dir = calloc(s->im->door_count, sizeof *s->keep_dir);
-    if (!s->ref || !s->ref_dir || !s->keep || !s->keep_dir) return out_of_memory(s);
+    s->keep_halves = calloc(s->im->door_count, sizeof *s->keep_halves);
+    if (!s->ref || !s->ref_dir || !s->ref_halves || !s->keep || !s->keep_dir || !s->keep_halves) return out_of_memory(s);
     if (guided) {
         s->texel_size = calloc(in->texel_receivers ? in->texel_receivers : 1, sizeof *s->texel_size);
         s->door_texel = calloc(in->texel_receivers ? in->texel_receivers : 1, 1);
@@ -987,7 +1095,8 @@ static lbk_result bake_door_reference(set_run *s, int guided)
     }
     s->rc.black_doors = 1;
     s->rc.keep = NULL;
-    return run_one(&s->rc, in->scene, in->tracer, &s->fixed, s->ref, s->ref_dir, "doors closed, black (reference)");
+    return run_one(&s->rc, in->scene, in->tracer, &s->fixed, s->ref, s->ref_dir, s->ref_halves,
+                   "doors closed, black (reference)");
 }
 
 /* Door p's two sets: S_O (open: the light through the opening) and S_C (closed: its bounce). */
@@ -1008,28 +1117,32 @@ static lbk_result bake_door(set_run *s, size_t p, int guided)
         /* S_O = L(door p removed, others closed and black) − reference */
         s->rc.keep = NULL;
         snprintf(s->what, sizeof s->what, "door '%s' open", d->name);
-        r = run_without(&s->rc, d->name, NULL, &s->fixed, s->rad, s->dir, s->what);
+        r = run_without(&s->rc, d->name, NULL, &s->fixed, s->rad, s->dir, s->halves, s->what);
         if (r) return r;
         if (keep_it) {
             s->keep[p] = malloc(s->n * sizeof **s->keep), s->keep_dir[p] = malloc(s->n * sizeof **s->keep_dir);
-            if (!s->keep[p] || !s->keep_dir[p]) return out_of_memory(s);
+            s->keep_halves[p] = malloc(s->n * 2 * sizeof **s->keep_halves);
+            if (!s->keep[p] || !s->keep_dir[p] || !s->keep_halves[p]) return out_of_memory(s);
             memcpy(s->keep[p], s->rad, s->n * sizeof *s->rad);
             memcpy(s->keep_dir[p], s->dir, s->n * sizeof *s->dir);
+            memcpy(s->keep_halves[p], s->halves, s->n * 2 * sizeof *s->halves);
         }
         sh_sub(s->rad, s->ref, count);
         sh_sub(s->dir, s->ref_dir, count);
+        halves_sub(s->halves, s->ref_halves, count);
     }
-    r = emit(s, &s->im->sets[d->open_set], NULL, 1);
+    r = emit(s, &s->im->sets[d->open_set], NULL, 1, !guided);
     if (r) return r;
 
     /* S_C = L(door p closed with its albedo, others black) − reference */
     s->rc.keep = d->name;
     snprintf(s->what, sizeof s->what, "door '%s' closed (bounce)", d->name);
-    r = run_one(&s->rc, s->in->scene, s->in->tracer, &s->fixed, s->rad, s->dir, s->what);
+    r = run_one(&s->rc, s->in->scene, s->in->tracer, &s->fixed, s->rad, s->dir, s->halves, s->what);
     if (r) return r;
     sh_sub(s->rad, s->ref, count);
     sh_sub(s->dir, s->ref_dir, count);
-    return emit(s, &s->im->sets[d->closed_set], NULL, 1);
+    halves_sub(s->halves, s->ref_halves, count);
+    return emit(s, &s->im->sets[d->closed_set], NULL, 1, 1);
 }
 
 /* Doors A, B: S_AB = L(A, B open) − L(A open) − L(B open) + L(ref), into rad/dir. */
@@ -1044,17 +1157,22 @@ static lbk_result bake_door_pair(set_run *s, const bs_combo *co)
         if (s->keep[p]) continue;
         /* guided mode has no open run yet: the combination needs a correlated one */
         s->keep[p] = malloc(s->n * sizeof **s->keep), s->keep_dir[p] = malloc(s->n * sizeof **s->keep_dir);
-        if (!s->keep[p] || !s->keep_dir[p]) return out_of_memory(s);
+        s->keep_halves[p] = malloc(s->n * 2 * sizeof **s->keep_halves);
+        if (!s->keep[p] || !s->keep_dir[p] || !s->keep_halves[p]) return out_of_memory(s);
         snprintf(s->what, sizeof s->what, "door '%s' open (for a combination)", s->im->doors[p].name);
-        lbk_result r = run_without(&s->rc, s->im->doors[p].name, NULL, &s->fixed, s->keep[p], s->keep_dir[p], s->what);
+        lbk_result r = run_without(&s->rc, s->im->doors[p].name, NULL, &s->fixed, s->keep[p], s->keep_dir[p],
+                                   s->keep_halves[p], s->what);
         if (r) return r;
     }
     snprintf(s->what, sizeof s->what, "doors '%s' and '%s' open", da->name, db->name);
-    lbk_result r = run_without(&s->rc, da->name, db->name, &s->fixed, s->rad, s->dir, s->what);
+    lbk_result r = run_without(&s->rc, da->name, db->name, &s->fixed, s->rad, s->dir, s->halves, s->what);
     if (r) return r;
     sh_sub(s->rad, s->keep[co->door[0]], count);
     sh_sub(s->rad, s->keep[co->door[1]], count);
     sh_add(s->rad, s->ref, count);
+    halves_sub(s->halves, s->keep_halves[co->door[0]], count);
+    halves_sub(s->halves, s->keep_halves[co->door[1]], count);
+    halves_add(s->halves, s->ref_halves, count);
     sh_sub(s->dir, s->keep_dir[co->door[0]], count);
     sh_sub(s->dir, s->keep_dir[co->door[1]], count);
     sh_add(s->dir, s->ref_dir, count);
@@ -1071,15 +1189,19 @@ static lbk_result bake_door_light_set(set_run *s, const bs_combo *co)
     opt.light_set = ls->name;
     s->rc.black_doors = 0;
     snprintf(s->what, sizeof s->what, "light set '%s', door '%s' open", ls->name, da->name);
-    lbk_result r = run_without(&s->rc, da->name, NULL, &opt, s->rad, s->dir, s->what);
+    lbk_result r = run_without(&s->rc, da->name, NULL, &opt, s->rad, s->dir, s->halves, s->what);
     if (r) return r;
     snprintf(s->what, sizeof s->what, "light set '%s' (fixed budget)", ls->name);
-    if (!s->ls_closed) s->ls_closed = malloc(s->n * sizeof *s->ls_closed), s->ls_closed_dir = malloc(s->n * sizeof *s->ls_closed_dir);
-    if (!s->ls_closed || !s->ls_closed_dir) return out_of_memory(s);
-    r = run_one(&s->rc, s->in->scene, s->in->tracer, &opt, s->ls_closed, s->ls_closed_dir, s->what);
+    if (!s->ls_closed) {
+        s->ls_closed = malloc(s->n * sizeof *s->ls_closed), s->ls_closed_dir = malloc(s->n * sizeof *s->ls_closed_dir);
+        s->ls_closed_halves = malloc(s->n * 2 * sizeof *s->ls_closed_halves);
+    }
+    if (!s->ls_closed || !s->ls_closed_dir || !s->ls_closed_halves) return out_of_memory(s);
+    r = run_one(&s->rc, s->in->scene, s->in->tracer, &opt, s->ls_closed, s->ls_closed_dir, s->ls_closed_halves, s->what);
     if (r) return r;
     sh_sub(s->rad, s->ls_closed, s->in->receiver_count);
     sh_sub(s->dir, s->ls_closed_dir, s->in->receiver_count);
+    halves_sub(s->halves, s->ls_closed_halves, s->in->receiver_count);
     return LBK_OK;
 }
 
@@ -1097,7 +1219,7 @@ static lbk_result bake_combinations(set_run *s)
             if (s->im->sets[co->light_set].zero) continue; /* a black set: nothing to combine, no entries */
             r = bake_door_light_set(s, co);
         }
-        if (!r) r = emit(s, &s->im->sets[co->set], NULL, 1);
+        if (!r) r = emit(s, &s->im->sets[co->set], NULL, 1, 1);
         if (r) return r;
     }
     return LBK_OK;
@@ -1107,8 +1229,11 @@ static void set_run_free(set_run *s)
 {
     if (s->keep)
         for (size_t p = 0; p < s->im->door_count; p++) free(s->keep[p]), free(s->keep_dir[p]);
-    free(s->keep), free(s->keep_dir), free(s->texel_size), free(s->door_texel), free(s->ls_closed), free(s->ls_closed_dir);
-    free(s->rad), free(s->dir), free(s->ref), free(s->ref_dir), free(s->var);
+    if (s->keep_halves)
+        for (size_t p = 0; p < s->im->door_count; p++) free(s->keep_halves[p]);
+    free(s->keep), free(s->keep_dir), free(s->keep_halves), free(s->texel_size), free(s->door_texel), free(s->ls_closed),
+        free(s->ls_closed_dir), free(s->ls_closed_halves);
+    free(s->rad), free(s->dir), free(s->halves), free(s->ref), free(s->ref_dir), free(s->ref_halves), free(s->var);
 }
 
 int bk_set_bakes_planned_runs(const bk_set_bakes *sets)
@@ -1172,7 +1297,8 @@ lbk_result bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *e
     s.rc.t_start = bk_now();
     const int guided = in->door_method == BK_DOOR_GUIDED;
     s.rad = malloc(s.n * sizeof *s.rad), s.dir = malloc(s.n * sizeof *s.dir), s.var = malloc(s.n * sizeof *s.var);
-    lbk_result r = s.rad && s.dir && s.var ? LBK_OK : out_of_memory(&s);
+    s.halves = malloc(s.n * 2 * sizeof *s.halves);
+    lbk_result r = s.rad && s.dir && s.var && s.halves ? LBK_OK : out_of_memory(&s);
     if (!r) r = bake_light_sets(&s);
     if (!r && im->door_count) {
         r = bake_door_reference(&s, guided);
@@ -1331,10 +1457,10 @@ void bk_set_bakes_free(bk_set_bakes *sets)
     if (im) {
         for (size_t j = 0; j < im->set_count; j++) {
             free(im->sets[j].light_names);
-            free(im->sets[j].stash), free(im->sets[j].stash_direct);
+            free(im->sets[j].stash), free(im->sets[j].stash_direct), free(im->sets[j].stash_halves);
             for (int s = 0; s < LBK_DLS_SPACE_COUNT_; s++) free(im->sets[j].targets[s]), free(im->sets[j].values[s]);
         }
-        free(im->sets), free(im->doors), free(im->combos), free(im->guide), free(im->guide_var), free(im->run_errors), free(im);
+        free(im->sets), free(im->doors), free(im->combos), free(im->guide), free(im->guide_var), free(im->run_errors), free(im->estimates), free(im);
     }
     memset(sets, 0, sizeof *sets);
 }

@@ -60,6 +60,8 @@ typedef struct bk_set_inputs {
                                          which read the base's final radiance at every receiver)
                                          are left zero; the merge, which has that radiance, makes
                                          them (bake/dist/DIST.md) */
+    int denoise_always;               /* 1: every set filtered (--denoise on); 0: per set and class
+                                         only where it lowers the estimate (auto) */
     const bk_denoiser *denoiser;      /* bk_set_bakes_emit: the denoiser built from the base + the
                                          guide (bk_set_bakes_guide), applied to every set with the
                                          same weights; NULL: not denoised */
@@ -116,6 +118,21 @@ typedef struct bk_set_run_error {
 
 /* The runs so far, in the order they ran (owned by sets). */
 const bk_set_run_error *bk_set_bakes_run_errors(const bk_set_bakes *sets, size_t *count);
+/* What a stored set's contribution delivers (bk_set_bakes_emit): its two half estimates — the
+ * run's, or for a door state or combination the same difference of the runs' halves as of
+ * their results (the runs share a seed, so the correlation that makes a difference quiet is in
+ * it) — through the base's denoising weights (denoised) or unfiltered. None for the guided
+ * estimator's open sets (not a transport run). */
+typedef struct bk_set_estimate {
+    char name[144];
+    uint32_t set;          /* index in the DLS section's set table */
+    uint32_t kind;         /* lbk_dls_set_kind */
+    int filtered[BK_RECEIVER_CLASSES]; /* 1: the class is stored filtered (texels, GLG) */
+    bk_denoise_error error; /* of what is stored, relative to the RMS of the contribution itself */
+} bk_set_estimate;
+
+/* The stored sets' estimates, in set order (owned by sets; after bk_set_bakes_emit). */
+const bk_set_estimate *bk_set_bakes_estimates(const bk_set_bakes *sets, size_t *count);
 /* Denoises every kept contribution with in->denoiser (NULL: none) and chooses its sparse
  * entries (threshold, dilation); frees what bk_set_bakes_run kept. LBK_OK or an error with a
  * message in err. */

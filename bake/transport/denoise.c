@@ -11,7 +11,7 @@
 #include "bake/util/clock.h"
 #include "bake/util/parallel.h"
 
-#define SH_N 27 /* floats per lbk_sh9_rgb */
+#define SH_N DN_MAX_CH /* floats per lbk_sh9_rgb */
 
 /* ---- the texel guide: geometry, charts, the base's luminance and variance ------------------ */
 
@@ -255,8 +255,9 @@ static void level_taps(const dn_texels *g, int level, int *r, int *step)
 typedef struct level_job {
     const dn_texels *g;
     int level;
-    const float *in;          /* SH_N floats per receiver (apply), or NULL (build) */
+    const float *in;          /* ch floats per receiver (apply), or NULL (build) */
     float *out;
+    int ch;
     float *lum_next, *var_next; /* build: the base's luminance and variance after this level */
 } level_job;
 
@@ -278,8 +279,8 @@ static void level_run(void *user, size_t begin, size_t end, int thread)
                 if (!(w > 0)) continue;
                 W += w;
                 if (j->in) {
-                    const float *v = j->in + (size_t)q * SH_N;
-                    for (int k = 0; k < SH_N; k++) acc[k] += w * (double)v[k];
+                    const float *v = j->in + (size_t)q * j->ch;
+                    for (int k = 0; k < j->ch; k++) acc[k] += w * (double)v[k];
                 } else {
                     wl += w * (double)lum[q];
                     wv += (double)w * w * var[q];
@@ -287,8 +288,8 @@ static void level_run(void *user, size_t begin, size_t end, int thread)
             }
         /* the centre always has a weight, so W > 0 */
         if (j->in) {
-            float *o = j->out + p * SH_N;
-            for (int k = 0; k < SH_N; k++) o[k] = (float)(acc[k] / W);
+            float *o = j->out + p * j->ch;
+            for (int k = 0; k < j->ch; k++) o[k] = (float)(acc[k] / W);
         } else {
             j->lum_next[p] = (float)(wl / W);
             j->var_next[p] = (float)(wv / (W * W));
@@ -360,7 +361,7 @@ static lbk_result texels_build(bk_denoiser *d, const bk_denoise_inputs *in)
     free(raw);
     for (size_t p = 0; p < n; p++) g->sigma[p] = sqrtf(g->var[p]);
     for (int l = 0; l < L; l++) {
-        level_job j = {g, l, NULL, NULL, g->lum + (size_t)(l + 1) * n, g->var + (size_t)(l + 1) * n};
+        level_job j = {g, l, NULL, NULL, 0, g->lum + (size_t)(l + 1) * n, g->var + (size_t)(l + 1) * n};
         run_chunks(d, n, level_run, &j);
     }
     /* clamp: the filtered base luminance may move at most clamp·σ from the input */
@@ -378,30 +379,33 @@ static lbk_result texels_build(bk_denoiser *d, const bk_denoise_inputs *in)
     return LBK_OK;
 }
 
-/* Filters texel receivers [0, n) of `radiance` in place. */
-static lbk_result texels_apply(const bk_denoiser *d, lbk_sh9_rgb *radiance)
+/* Filters texel receivers [0, n) of `vals` (ch ≤ SH_N floats each) in place. Every channel is
+ * filtered on its own with the same weights, so a channel's result does not depend on which
+ * others ride along: the error estimates filter many two-channel inputs in one pass (the
+ * weights, not the channels, are most of a pass's cost). */
+static lbk_result texels_apply(const bk_denoiser *d, float *vals, int ch)
 {
     const dn_texels *g = &d->tex;
     size_t n = g->n;
-    float *a = malloc(n * SH_N * sizeof *a), *b = malloc(n * SH_N * sizeof *b);
+    float *a = malloc((n ? n : 1) * ch * sizeof *a), *b = malloc((n ? n : 1) * ch * sizeof *b);
     if (!a || !b) {
         free(a), free(b);
         return LBK_ERR_OUT_OF_MEMORY;
     }
-    for (size_t p = 0; p < n; p++) memcpy(a + p * SH_N, radiance[p].c, sizeof radiance[p].c);
+    memcpy(a, vals, n * ch * sizeof *a);
     for (int l = 0; l < g->levels; l++) {
-        level_job j = {g, l, a, b, NULL, NULL};
+        level_job j = {g, l, a, b, ch, NULL, NULL};
         run_chunks(d, n, level_run, &j);
         float *t = a;
         a = b, b = t;
     }
     for (size_t p = 0; p < n; p++) {
-        float *o = &radiance[p].c[0][0];
-        const float *f = a + p * SH_N;
+        float *o = vals + p * ch;
+        const float *f = a + p * ch;
         float al = g->alpha[p];
-        if (al == 1) memcpy(o, f, SH_N * sizeof *o);
+        if (al == 1) memcpy(o, f, ch * sizeof *o);
         else if (al > 0)
-            for (int k = 0; k < SH_N; k++) o[k] += al * (f[k] - o[k]);
+            for (int k = 0; k < ch; k++) o[k] += al * (f[k] - o[k]);
     }
     free(a), free(b);
     return LBK_OK;
@@ -471,8 +475,8 @@ lbk_result bk_denoiser_apply(const bk_denoiser *d, lbk_sh9_rgb *radiance)
 {
     if (!d || (!radiance && d->receiver_count)) return LBK_ERR_INVALID_ARGUMENT;
     lbk_result r = LBK_OK;
-    if (d->have_tex) r = texels_apply(d, radiance);
-    if (!r && d->have_probes) r = dn_probes_apply(&d->probes, radiance);
+    if (d->have_tex) r = texels_apply(d, (float *)radiance, SH_N);
+    if (!r && d->have_probes) r = dn_probes_apply(&d->probes, (float *)radiance, SH_N);
     return r;
 }
 
@@ -481,28 +485,10 @@ typedef struct dn_error_sums {
     double noise, bias, den;
 } dn_error_sums;
 
-lbk_result bk_denoiser_error(const bk_denoiser *d, const float *halves, const size_t class_end[BK_RECEIVER_CLASSES],
-                             bk_denoise_error *out)
+/* The estimate of one input from its filtered channels f (X then δ per receiver). */
+static void error_from_filtered(const float *halves, const float *f, size_t stride, const size_t class_end[BK_RECEIVER_CLASSES],
+                                bk_denoise_error *out)
 {
-    if (!d || !out || !class_end || (!halves && d->receiver_count)) return LBK_ERR_INVALID_ARGUMENT;
-    for (int k = 0; k < BK_RECEIVER_CLASSES; k++)
-        if (class_end[k] > d->receiver_count || (k && class_end[k] < class_end[k - 1])) return LBK_ERR_INVALID_ARGUMENT;
-    const double t0 = bk_now();
-    memset(out, 0, sizeof *out);
-    const size_t n = d->receiver_count;
-    /* X and δ ride through the filter as two SH coefficients: the filter is linear and the same
-     * for every coefficient, so this is D applied to each */
-    lbk_sh9_rgb *f = calloc(n ? n : 1, sizeof *f);
-    if (!f) return LBK_ERR_OUT_OF_MEMORY;
-    for (size_t i = 0; i < n; i++) {
-        f[i].c[0][0] = 0.5f * (halves[2 * i] + halves[2 * i + 1]);
-        f[i].c[0][1] = 0.5f * (halves[2 * i] - halves[2 * i + 1]);
-    }
-    lbk_result r = bk_denoiser_apply(d, f);
-    if (r) {
-        free(f);
-        return r;
-    }
     dn_error_sums sum[BK_RECEIVER_CLASSES];
     memset(sum, 0, sizeof sum);
     size_t i = 0;
@@ -511,12 +497,11 @@ lbk_result bk_denoiser_error(const bk_denoiser *d, const float *halves, const si
             /* the same floats the filter started from, so that an unfiltered receiver adds no bias */
             const double x = 0.5f * (halves[2 * i] + halves[2 * i + 1]);
             const double dl = 0.5f * (halves[2 * i] - halves[2 * i + 1]);
-            const double fx = f[i].c[0][0], fd = f[i].c[0][1];
+            const double fx = f[i * stride], fd = f[i * stride + 1];
             sum[k].noise += fd * fd;
             sum[k].bias += (fx - x) * (fx - x) - (fd - dl) * (fd - dl);
             sum[k].den += fx * fx;
         }
-    free(f);
     for (int k = 0; k < BK_RECEIVER_CLASSES; k++) {
         if (!(sum[k].den > 0)) continue;
         const double b2 = sum[k].bias > 0 ? sum[k].bias : 0;
@@ -527,8 +512,49 @@ lbk_result bk_denoiser_error(const bk_denoiser *d, const float *halves, const si
     const double pn = sum[BK_CLASS_GLG].noise + sum[BK_CLASS_LLG].noise, pd = sum[BK_CLASS_GLG].den + sum[BK_CLASS_LLG].den;
     const double pb = sum[BK_CLASS_GLG].bias > 0 ? sum[BK_CLASS_GLG].bias : 0; /* LLG: not filtered */
     out->probe_rel_rmse = pd > 0 ? sqrt((pn + pb) / pd) : 0;
-    out->seconds = bk_now() - t0;
-    return LBK_OK;
+}
+
+/* Inputs per filter pass: X and δ of each ride as two channels, the filter being linear and the
+ * same for every channel, so this is D applied to each. */
+#define DN_ERROR_GROUP (DN_MAX_CH / 2)
+
+lbk_result bk_denoiser_errors(const bk_denoiser *d, const float *const *halves, size_t count,
+                              const size_t class_end[BK_RECEIVER_CLASSES], bk_denoise_error *out)
+{
+    if (!out || !class_end || (count && !halves)) return LBK_ERR_INVALID_ARGUMENT;
+    const size_t n = d ? d->receiver_count : class_end[BK_RECEIVER_CLASSES - 1];
+    for (size_t j = 0; j < count; j++)
+        if (!halves[j] && n) return LBK_ERR_INVALID_ARGUMENT;
+    for (int k = 0; k < BK_RECEIVER_CLASSES; k++)
+        if (class_end[k] > n || (k && class_end[k] < class_end[k - 1])) return LBK_ERR_INVALID_ARGUMENT;
+    const double t0 = bk_now();
+    memset(out, 0, count * sizeof *out);
+    float *f = malloc((n ? n : 1) * 2 * DN_ERROR_GROUP * sizeof *f);
+    if (!f) return LBK_ERR_OUT_OF_MEMORY;
+    lbk_result r = LBK_OK;
+    for (size_t j0 = 0; j0 < count && !r; j0 += DN_ERROR_GROUP) {
+        const size_t m = count - j0 < DN_ERROR_GROUP ? count - j0 : DN_ERROR_GROUP;
+        const int ch = (int)(2 * m);
+        for (size_t i = 0; i < n; i++)
+            for (size_t j = 0; j < m; j++) {
+                const float *h = halves[j0 + j];
+                f[i * ch + 2 * j] = 0.5f * (h[2 * i] + h[2 * i + 1]);
+                f[i * ch + 2 * j + 1] = 0.5f * (h[2 * i] - h[2 * i + 1]);
+            }
+        if (d && d->have_tex) r = texels_apply(d, f, ch);
+        if (!r && d && d->have_probes) r = dn_probes_apply(&d->probes, f, ch);
+        for (size_t j = 0; j < m && !r; j++) error_from_filtered(halves[j0 + j], f + 2 * j, (size_t)ch, class_end, &out[j0 + j]);
+    }
+    free(f);
+    const double secs = (bk_now() - t0) / (count ? (double)count : 1);
+    for (size_t j = 0; j < count; j++) out[j].seconds = secs;
+    return r;
+}
+
+lbk_result bk_denoiser_error(const bk_denoiser *d, const float *halves, const size_t class_end[BK_RECEIVER_CLASSES],
+                             bk_denoise_error *out)
+{
+    return bk_denoiser_errors(d, &halves, 1, class_end, out);
 }
 
 void bk_denoiser_stats(const bk_denoiser *d, bk_denoise_stats *stats)

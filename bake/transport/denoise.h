@@ -120,10 +120,16 @@ typedef struct bk_denoise_error {
 } bk_denoise_error;
 
 /* halves: 2 per receiver (bk_transport_output.halves, A then B); class_end as the transport's
- * (bk_transport_options.class_end: the end of the texel, GLG and LLG classes). Errors:
- * LBK_ERR_INVALID_ARGUMENT, LBK_ERR_OUT_OF_MEMORY. */
+ * (bk_transport_options.class_end: the end of the texel, GLG and LLG classes). d NULL: the
+ * identity filter (the transport's own two-halves estimate, bias 0), over class_end's last
+ * receivers, for contributions that were not denoised. Errors: LBK_ERR_INVALID_ARGUMENT,
+ * LBK_ERR_OUT_OF_MEMORY. */
 lbk_result bk_denoiser_error(const bk_denoiser *d, const float *halves, const size_t class_end[BK_RECEIVER_CLASSES],
                              bk_denoise_error *out);
+/* The same for `count` inputs (halves[j], each as above) into out[j], in one filter pass per 13
+ * inputs; out[j].seconds is the pass time shared equally. */
+lbk_result bk_denoiser_errors(const bk_denoiser *d, const float *const *halves, size_t count,
+                              const size_t class_end[BK_RECEIVER_CLASSES], bk_denoise_error *out);
 
 void bk_denoiser_stats(const bk_denoiser *d, bk_denoise_stats *stats);
 void bk_denoiser_destroy(bk_denoiser *d);

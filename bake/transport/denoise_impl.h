@@ -12,6 +12,9 @@
 #define DN_LG 0.7152f
 #define DN_LB 0.0722f
 
+/* Floats per lbk_sh9_rgb: the most channels one filter pass carries. */
+#define DN_MAX_CH 27
+
 /* Probe filter: weights built from the base probes, applied to any probe SH. */
 typedef struct dn_probes {
     size_t count;              /* GLG probes */
@@ -25,7 +28,9 @@ typedef struct dn_probes {
 } dn_probes;
 
 lbk_result dn_probes_build(const bk_denoise_inputs *in, const bk_denoise_options *opt, int threads, dn_probes *out);
-lbk_result dn_probes_apply(const dn_probes *p, lbk_sh9_rgb *radiance);
+/* Filters the GLG probes' receivers of `vals` (ch ≤ DN_MAX_CH floats per receiver, each
+ * channel on its own with the same weights) in place. */
+lbk_result dn_probes_apply(const dn_probes *p, float *vals, int ch);
 void dn_probes_free(dn_probes *p);
 
 /* Fluence/4 luminance of a probe's SH (the transport's probe error scalar: π·L00·Y00·4/4). */

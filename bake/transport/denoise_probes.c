@@ -162,23 +162,23 @@ lbk_result dn_probes_build(const bk_denoise_inputs *in, const bk_denoise_options
     return LBK_OK;
 }
 
-lbk_result dn_probes_apply(const dn_probes *p, lbk_sh9_rgb *radiance)
+lbk_result dn_probes_apply(const dn_probes *p, float *vals, int ch)
 {
-    lbk_sh9_rgb *x = radiance + p->first;
-    lbk_sh9_rgb *copy = malloc((p->count ? p->count : 1) * sizeof *copy);
+    float *x = vals + p->first * ch;
+    float *copy = malloc((p->count ? p->count : 1) * ch * sizeof *copy);
     if (!copy) return LBK_ERR_OUT_OF_MEMORY;
-    memcpy(copy, x, p->count * sizeof *copy);
+    memcpy(copy, x, p->count * ch * sizeof *copy);
     for (size_t i = 0; i < p->count; i++) {
         if (!(p->alpha[i] > 0)) continue;
-        double acc[SH_N];
-        const float *s = &copy[i].c[0][0];
-        for (int k = 0; k < SH_N; k++) acc[k] = s[k];
+        double acc[DN_MAX_CH];
+        const float *s = copy + i * ch;
+        for (int k = 0; k < ch; k++) acc[k] = s[k];
         for (uint32_t e = p->adj_first[i]; e < p->adj_first[i + 1]; e++) {
-            const float *v = &copy[p->adj[e]].c[0][0];
-            for (int k = 0; k < SH_N; k++) acc[k] += p->w[e] * (double)v[k];
+            const float *v = copy + (size_t)p->adj[e] * ch;
+            for (int k = 0; k < ch; k++) acc[k] += p->w[e] * (double)v[k];
         }
-        float *o = &x[i].c[0][0];
-        for (int k = 0; k < SH_N; k++) o[k] = s[k] + p->alpha[i] * ((float)(acc[k] / p->w_sum[i]) - s[k]);
+        float *o = x + i * ch;
+        for (int k = 0; k < ch; k++) o[k] = s[k] + p->alpha[i] * ((float)(acc[k] / p->w_sum[i]) - s[k]);
     }
     free(copy);
     return LBK_OK;

@@ -34,6 +34,7 @@
 #include "lbk/validate.h"
 #include "support/door_scenes.h"
 #include "support/room_compare.h"
+#include "tools/common/set_decode.h"
 
 #define SAMPLES 96
 #define DENSITY 2.0f
@@ -467,6 +468,161 @@ static void *read_all(const char *path, size_t *size)
     return d;
 }
 
+/* ---- each stored set's estimate (bake/sets/SETS.md "Error of each stored set") -------------- */
+
+typedef struct est_run {
+    tl_set_texels sets[8];
+    int ns;
+    uint64_t nt;
+    double est[8];     /* report.set_estimates texels (-1: none) */
+    double run_est[8]; /* the light set's own run (set_runs), -1 for other kinds */
+    int filtered[8];   /* texels stored filtered */
+    double base_est;   /* the base's texels: denoised.errors (or errors with --denoise off) */
+    int base_filtered;
+} est_run;
+
+static void est_bake(const ds_options *o, uint64_t seed, lbk_bake_denoise denoise, est_run *out)
+{
+    char gltf[256], err[512];
+    snprintf(gltf, sizeof gltf, "%s/estimate%llu.gltf", tmpdir, (unsigned long long)seed);
+    assert_int_equal(ds_write_room_scene(DS_ROOM_GLB, gltf, o, err, sizeof err), 0);
+    lbk_bake_desc d;
+    memset(&d, 0, sizeof d);
+    d.size = sizeof d;
+    d.seed = seed;
+    d.threads = 2;
+    d.target_error = 1e-6;
+    d.max_samples = SAMPLES;
+    d.glg_spacing = 2.5f;
+    d.denoise = denoise;
+    d.dls_threshold = -1; /* every texel: the measure then holds what the estimate covers */
+    lbk_bake_output *bo;
+    assert_int_equal(lbk_bake_from_file(gltf, &d, &bo), LBK_OK);
+    unlink(gltf);
+    void *bytes;
+    size_t size;
+    assert_int_equal(lbk_bake_output_container(bo, &bytes, &size), LBK_OK);
+    memset(out, 0, sizeof *out);
+    assert_int_equal(tl_set_texels_decode(bytes, size, out->sets, 8, &out->ns, &out->nt), 0);
+    const lbk_bake_report *r = lbk_bake_output_report(bo);
+    assert_true(r->size >= offsetof(lbk_bake_report, set_estimate_count) + sizeof r->set_estimate_count);
+    assert_int_equal(r->set_estimate_count, (size_t)out->ns); /* every stored set is a transport run's */
+    for (int j = 0; j < out->ns; j++) {
+        out->est[j] = out->run_est[j] = -1;
+        for (size_t i = 0; i < r->set_estimate_count; i++) {
+            const lbk_bake_set_estimate *e = &r->set_estimates[i];
+            if (e->set != out->sets[j].set) continue;
+            assert_string_equal(e->name, out->sets[j].name);
+            assert_int_equal(e->kind, out->sets[j].kind);
+            if (denoise == LBK_BAKE_DENOISE_OFF) assert_true(!e->denoised && e->error.texel_bias == 0);
+            if (denoise == LBK_BAKE_DENOISE_ON) assert_true(e->error.texels_filtered && e->error.glg_filtered);
+            out->est[j] = e->error.errors.texels;
+            out->filtered[j] = e->error.texels_filtered;
+        }
+        char label[96];
+        snprintf(label, sizeof label, "light set '%.63s'", out->sets[j].name);
+        for (size_t i = 0; i < r->set_run_count; i++)
+            if (out->sets[j].kind == LBK_DLS_KIND_LIGHTS && !strcmp(r->set_runs[i].label, label))
+                out->run_est[j] = r->set_runs[i].classes.texels;
+    }
+    const int den = denoise != LBK_BAKE_DENOISE_OFF;
+    out->base_est = den ? r->denoised.errors.texels : r->errors.texels;
+    out->base_filtered = den && r->denoised.texels_filtered;
+    lbk_free(NULL, bytes);
+    lbk_bake_output_free(bo);
+}
+
+static const ds_options est_level = {DS_DOOR_TAGGED, DS_INSIDE_SETS, 0, 1, 0.5f, DENSITY, 0, 0, 0};
+static est_run est_off1; /* seed 1, --denoise off: both cases read it */
+
+/* Light sets A, B and the north door, denoiser off, two seeds: every stored set has an
+ * estimate; a light set's is its own run's (the same halves, unfiltered; float rounding only);
+ * and each set's estimate — the door states' from the differences of their runs' halves — is
+ * within 2× of the noise between the two seeds' stored contributions, decoded through
+ * lbk_dls_apply. (A door state's error relative to its own, small, contribution is far above
+ * either run's: at 96 samples the closed door's bounce reads 15 % estimated, 22 % between seeds, where
+ * the light sets read 3.4 %.) */
+static void test_stored_set_estimates(void **state)
+{
+    (void)state;
+    est_run b;
+    est_bake(&est_level, 1, LBK_BAKE_DENOISE_OFF, &est_off1);
+    est_bake(&est_level, 2, LBK_BAKE_DENOISE_OFF, &b);
+    const est_run *a = &est_off1;
+    assert_int_equal(a->ns, 4); /* A, B, door open, door closed */
+    assert_int_equal(b.ns, a->ns);
+    assert_true(a->nt == b.nt && a->nt > 0);
+    int kinds[4] = {0};
+    for (int j = 0; j < a->ns; j++) {
+        kinds[a->sets[j].kind]++;
+        assert_true(a->est[j] > 0 && b.est[j] > 0);
+        if (a->sets[j].kind == LBK_DLS_KIND_LIGHTS) {
+            assert_true(fabs(a->est[j] - a->run_est[j]) <= 1e-4 * a->run_est[j]);
+            assert_true(fabs(b.est[j] - b.run_est[j]) <= 1e-4 * b.run_est[j]);
+        }
+        double num = 0, den = 0;
+        for (uint64_t i = 0; i < a->nt; i++) {
+            const double x = a->sets[j].lum[i], y = b.sets[j].lum[i];
+            num += 0.5 * (x - y) * (x - y), den += 0.25 * (x + y) * (x + y);
+        }
+        const double measured = sqrt(num / den), est = 0.5 * (a->est[j] + b.est[j]);
+        printf("  %s (kind %u): estimated %.2f%%, measured between seeds %.2f%%, ratio %.2f\n", a->sets[j].name,
+               a->sets[j].kind, 100 * est, 100 * measured, est / measured);
+        assert_true(est >= 0.5 * measured && est <= 2 * measured);
+    }
+    assert_int_equal(kinds[LBK_DLS_KIND_LIGHTS], 2);
+    assert_int_equal(kinds[LBK_DLS_KIND_DOOR_OPEN], 1);
+    assert_int_equal(kinds[LBK_DLS_KIND_DOOR_CLOSED], 1);
+    tl_set_texels_free(b.sets, b.ns);
+}
+
+/* RMS of (x − y) over the RMS of y */
+static double rel_rms(const double *x, const double *y, uint64_t n)
+{
+    double num = 0, den = 0;
+    for (uint64_t i = 0; i < n; i++) num += (x[i] - y[i]) * (x[i] - y[i]), den += y[i] * y[i];
+    return den > 0 ? sqrt(num / den) : 0;
+}
+
+/* --denoise auto keeps, per stored set and for the base, the filtered texels exactly where their
+ * estimate is below the unfiltered one: the same seed baked off, on and auto (same runs, same
+ * weights, so the same estimates to the bit), auto's choice and estimate equal the lower of the
+ * two, and its stored contribution is the chosen bake's (up to the DLS encoding, whose scale
+ * follows the base), far from the other's. Both choices occur on this level. */
+static void test_denoise_auto_keeps_the_better(void **state)
+{
+    (void)state;
+    if (!est_off1.ns) est_bake(&est_level, 1, LBK_BAKE_DENOISE_OFF, &est_off1);
+    est_run on, au;
+    est_bake(&est_level, 1, LBK_BAKE_DENOISE_ON, &on);
+    est_bake(&est_level, 1, LBK_BAKE_DENOISE_AUTO, &au);
+    const est_run *off = &est_off1;
+    assert_int_equal(au.ns, off->ns);
+    assert_int_equal(on.ns, off->ns);
+    int chose[2] = {0, 0};
+    for (int j = 0; j < au.ns; j++) {
+        const int better = on.est[j] < off->est[j];
+        chose[better]++;
+        printf("  %s: filtered %.2f%%, unfiltered %.2f%%: auto %s\n", au.sets[j].name, 100 * on.est[j], 100 * off->est[j],
+               au.filtered[j] ? "filtered" : "unfiltered");
+        assert_int_equal(au.filtered[j], better);
+        assert_true(au.est[j] == (better ? on.est[j] : off->est[j]));
+        const double d_kept = rel_rms(au.sets[j].lum, (better ? &on : off)->sets[j].lum, au.nt);
+        const double d_other = rel_rms(au.sets[j].lum, (better ? off : &on)->sets[j].lum, au.nt);
+        printf("    stored: %.3f%% from the chosen bake's, %.3f%% from the other's\n", 100 * d_kept, 100 * d_other);
+        assert_true(d_kept < 0.25 * d_other);
+    }
+    const int base_better = on.base_est < off->base_est;
+    printf("  base: filtered %.2f%%, unfiltered %.2f%%: auto %s\n", 100 * on.base_est, 100 * off->base_est,
+           au.base_filtered ? "filtered" : "unfiltered");
+    assert_int_equal(au.base_filtered, base_better);
+    assert_true(au.base_est == (base_better ? on.base_est : off->base_est));
+    tl_set_texels_free(on.sets, on.ns);
+    tl_set_texels_free(au.sets, au.ns);
+    tl_set_texels_free(est_off1.sets, est_off1.ns);
+    memset(&est_off1, 0, sizeof est_off1);
+}
+
 /* Light sets and a guided door: the same bytes at 1 and 3 threads (the guided estimator and
  * every set's transport run in parallel; `make tsan` runs this case, hence the small budget). */
 static void test_same_bytes_at_any_thread_count(void **state)
@@ -518,6 +674,8 @@ int main(void)
         cmocka_unit_test(test_combination_two_doors),
         cmocka_unit_test(test_combination_unknown_name),
         cmocka_unit_test(test_same_bytes_at_any_thread_count),
+        cmocka_unit_test(test_stored_set_estimates),
+        cmocka_unit_test(test_denoise_auto_keeps_the_better),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -41,19 +41,6 @@ static void receiver(bk_receiver *r, float x, float y, float z, float nz)
     r->normal[2] = nz;
 }
 
-static bk_transport_options opts(int passes)
-{
-    bk_transport_options o;
-    memset(&o, 0, sizeof o);
-    o.seed = 5;
-    o.threads = 2;
-    o.target_error = -1;
-    o.first_pass_samples = 16;
-    o.max_samples = 2 * 16 * ((1 << passes) - 1);
-    o.max_cells = 512;
-    return o;
-}
-
 static float *irradiance(const bk_scene *s, const bk_receiver *r, size_t n, const bk_transport_options *o)
 {
     bk_tracer *t = NULL;
@@ -115,7 +102,7 @@ static void test_metal_plane_sky(void **state)
     enum { N = 32 };
     bk_receiver r[N];
     for (int i = 0; i < N; i++) receiver(&r[i], (float)(i % 8) - 4, (float)(i / 8) - 2, 1, i < N / 2 ? -1.0f : 1.0f);
-    bk_transport_options o = opts(6);
+    bk_transport_options o = tsc_fixed_passes(6, 5);
     float *irr = irradiance(&s, r, N, &o);
     const double expect_down = PI * 2 * spec_albedo_mean((double)rough * rough, base), expect_up = PI * 2;
     double mean_down = 0, mean_up = 0, worst = 0;
@@ -161,7 +148,7 @@ static void test_glossy_furnace(void **state)
         receiver(&r[i], p[0], p[1], p[2], 0);
         r[i].normal[i % 3] = (i / 3) % 2 ? 1.0f : -1.0f;
     }
-    bk_transport_options o = opts(5);
+    bk_transport_options o = tsc_fixed_passes(5, 5);
     float *irr = irradiance(&s, r, N, &o);
     const double f0 = 0.04 + (base - 0.04) * metallic, c_diff = (1 - metallic) * base;
     double emin = 1, emax = 0;
@@ -228,7 +215,7 @@ static void test_reflected_lobe(void **state)
     tsc_point_light(&s, lp, I, I, I, 0);
     bk_receiver r[ROW];
     for (int i = 0; i < ROW; i++) receiver(&r[i], -1.5f + 3.0f * (float)i / (ROW - 1), 0, 2, -1);
-    bk_transport_options o = opts(8);
+    bk_transport_options o = tsc_fixed_passes(8, 5);
     float *irr = irradiance(&s, r, ROW, &o);
     bk_ggx_table *t = malloc(sizeof *t);
     assert_non_null(t);
@@ -281,7 +268,7 @@ static void test_lambertian_unchanged(void **state)
         s.sky[0] = s.sky[1] = s.sky[2] = 1;
         bk_receiver r[8];
         for (int i = 0; i < 8; i++) receiver(&r[i], -2 + 0.5f * (float)i, 0.3f, 0.01f, 1);
-        bk_transport_options o = opts(3);
+        bk_transport_options o = tsc_fixed_passes(3, 5);
         res[k] = irradiance(&s, r, 8, &o);
         tsc_free(&s);
     }

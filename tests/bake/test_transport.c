@@ -30,19 +30,6 @@ static void texel(bk_receiver *r, float x, float y, float z)
     r->normal[2] = 1;
 }
 
-static bk_transport_options fixed_opt(int passes)
-{
-    bk_transport_options o;
-    memset(&o, 0, sizeof o);
-    o.seed = 3;
-    o.threads = 2;
-    o.target_error = -1;
-    o.first_pass_samples = 16;
-    o.max_samples = 2 * 16 * ((1 << passes) - 1);
-    o.max_cells = 512;
-    return o;
-}
-
 typedef struct run_out {
     lbk_sh9_rgb *rad, *dir;
     float *irr;
@@ -88,7 +75,7 @@ static void test_point_light_plane(void **state)
     const float xs[6] = {0.05f, 0.5f, 1, 2, 5, 9.3f};
     bk_receiver r[6];
     for (int i = 0; i < 6; i++) texel(&r[i], xs[i], 0, 0);
-    bk_transport_options o = fixed_opt(1);
+    bk_transport_options o = tsc_fixed_passes(1, 3);
     run_out ro = run(&s, r, 6, &o);
     for (int i = 0; i < 6; i++) {
         double d = sqrt(xs[i] * xs[i] + 4.0), cs = 2 / d;
@@ -123,7 +110,7 @@ static void test_spot_cone(void **state)
     const double th[5] = {0, 0.1, 0.3, 0.39, 0.5};
     bk_receiver r[5];
     for (int i = 0; i < 5; i++) texel(&r[i], (float)(3 * tan(th[i])), 0, 0);
-    bk_transport_options o = fixed_opt(1);
+    bk_transport_options o = tsc_fixed_passes(1, 3);
     run_out ro = run(&s, r, 5, &o);
     for (int i = 0; i < 5; i++) {
         double x = r[i].position[0], d = sqrt(x * x + 9), cs = 3 / d;
@@ -155,7 +142,7 @@ static void test_directional_and_shadow(void **state)
     texel(&r[0], 5, 5, 0);      /* lit */
     texel(&r[1], 0.75f, 0, 0); /* in the blocker's shadow (light travels +x: shifted by +0.75) */
     texel(&r[2], -0.6f, 0, 0); /* beside it: lit */
-    bk_transport_options o = fixed_opt(1);
+    bk_transport_options o = tsc_fixed_passes(1, 3);
     run_out ro = run(&s, r, 3, &o);
     assert_true(rel(ro.irr[0], 800) < 1e-5);
     assert_true(ro.irr[3] == 0);
@@ -186,7 +173,7 @@ static void test_sky_open_plane(void **state)
     enum { N = 64 };
     bk_receiver r[N];
     for (int i = 0; i < N; i++) texel(&r[i], (float)(i % 8) - 4, (float)(i / 8) - 4, 0);
-    bk_transport_options o = fixed_opt(5);
+    bk_transport_options o = tsc_fixed_passes(5, 3);
     run_out ro = run(&s, r, N, &o);
     double num = 0, den = 0, maxe = 0;
     for (int i = 0; i < N; i++) {
@@ -237,7 +224,7 @@ static void closed_box_case(double scale, const double offset[3])
         else { p[0] = 0.2 + 1.6 * a; p[1] = 0.2 + 2.6 * b; p[2] = 1.25; }
         for (int k = 0; k < 3; k++) r[i].position[k] = (float)(p[k] * scale + offset[k]);
     }
-    bk_transport_options o = fixed_opt(2);
+    bk_transport_options o = tsc_fixed_passes(2, 3);
     run_out ro = run(&s, r, N, &o);
     for (int i = 0; i < N; i++)
         for (int c = 0; c < 3; c++) {
@@ -280,7 +267,7 @@ static void test_light_sets(void **state)
     bk_receiver r[2];
     texel(&r[0], 0, 0, 0);
     texel(&r[1], 5, 0, 0);
-    bk_transport_options o = fixed_opt(2);
+    bk_transport_options o = tsc_fixed_passes(2, 3);
     run_out base = run(&s, r, 2, &o);
     o.light_set = "A";
     run_out a = run(&s, r, 2, &o);
@@ -357,7 +344,7 @@ static run_out room_run(double intensity, double scale, const double offset[3], 
     room(&s, intensity, scale, offset);
     bk_receiver r[ROOM_N];
     room_receivers(r, scale, offset);
-    bk_transport_options o = fixed_opt(2);
+    bk_transport_options o = tsc_fixed_passes(2, 3);
     o.threads = threads;
     o.seed = seed;
     run_out ro = run(&s, r, ROOM_N, &o);
@@ -421,7 +408,7 @@ static void test_degenerate_triangles_and_duplicate_vertices(void **state)
     room(&s, 1, 1, ORIGIN);
     bk_receiver r[ROOM_N];
     room_receivers(r, 1, ORIGIN);
-    bk_transport_options o = fixed_opt(2);
+    bk_transport_options o = tsc_fixed_passes(2, 3);
     run_out ref = run(&s, r, ROOM_N, &o);
 
     /* duplicate vertices merged: the same geometry through shared indices */
@@ -520,7 +507,7 @@ static void test_stop_rules_and_report(void **state)
     room_receivers(r, 1, ORIGIN);
     rec rp;
     memset(&rp, 0, sizeof rp);
-    bk_transport_options o = fixed_opt(4);
+    bk_transport_options o = tsc_fixed_passes(4, 3);
     o.report = on_report;
     o.progress = on_progress;
     o.user = &rp;
@@ -538,14 +525,14 @@ static void test_stop_rules_and_report(void **state)
     assert_true(rp.s[3].est_rel_rmse < 0.7 * rp.s[0].est_rel_rmse);
     run_free(&a);
     /* a target the first pass meets stops there */
-    o = fixed_opt(4);
+    o = tsc_fixed_passes(4, 3);
     o.target_error = 0.9;
     run_out b = run(&s, r, ROOM_N, &o);
     assert_int_equal(b.st.stop, BK_STOP_TARGET);
     assert_int_equal(b.st.passes, 1);
     run_free(&b);
     /* an impossible time limit still completes one pass */
-    o = fixed_opt(4);
+    o = tsc_fixed_passes(4, 3);
     o.time_limit = 1e-9;
     run_out c = run(&s, r, ROOM_N, &o);
     assert_int_equal(c.st.stop, BK_STOP_TIME);
@@ -553,7 +540,7 @@ static void test_stop_rules_and_report(void **state)
     run_free(&c);
     /* a progress callback that says stop: the run returns at that checkpoint, before any pass
      * completes (the third checkpoint is inside pass 0's gather) */
-    o = fixed_opt(4);
+    o = tsc_fixed_passes(4, 3);
     cancel_at ca = {0, 3, {0}};
     o.progress = cancel_progress;
     o.report = cancel_report;
@@ -651,7 +638,7 @@ static void test_nee_unbiased_and_quieter(void **state)
     enum { N = 160 };
     bk_receiver r[N];
     nee_receivers(r, N);
-    bk_transport_options o = fixed_opt(4);
+    bk_transport_options o = tsc_fixed_passes(4, 3);
     o.max_cells = 1024;
     o.nee = -1;
     run_out off = run(&s, r, N, &o);
@@ -693,7 +680,7 @@ static void test_nee_unbiased_and_quieter(void **state)
 static void class_run(const bk_scene *s, const bk_receiver *r, size_t nt, size_t n, uint64_t seed, rec *rp,
                       run_out *ro)
 {
-    bk_transport_options o = fixed_opt(10);
+    bk_transport_options o = tsc_fixed_passes(10, 3);
     o.seed = seed;
     o.target_error = 0.04;
     o.class_end[BK_CLASS_TEXEL] = nt;

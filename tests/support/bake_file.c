@@ -43,6 +43,7 @@ lbk_result tb_bake(const tb_job *job, lbk_bake_report *report, char *err, size_t
         report->phases = NULL; /* phase_count stays */
         report->pass_errors = NULL;
         report->set_runs = NULL; /* set_run_count stays: how many runs there were */
+        report->set_estimates = NULL; /* set_estimate_count stays */
     }
     if (r && !e.text[0]) snprintf(e.text, e.len, "%s", lbk_result_message(r));
     lbk_bake_output_free(o);

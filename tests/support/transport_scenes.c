@@ -177,3 +177,16 @@ void tsc_rotate(bk_scene *s, double ax, double ay, double az)
     }
     tsc_update_bounds(s);
 }
+
+bk_transport_options tsc_fixed_passes(int passes, uint64_t seed)
+{
+    bk_transport_options o;
+    memset(&o, 0, sizeof o);
+    o.seed = seed;
+    o.threads = 2;
+    o.target_error = -1;
+    o.first_pass_samples = 16;
+    o.max_samples = 2 * 16 * ((1 << passes) - 1);
+    o.max_cells = 512;
+    return o;
+}

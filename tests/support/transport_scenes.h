@@ -7,6 +7,7 @@
 #include <stdint.h>
 
 #include "bake/scene/scene.h"
+#include "bake/transport/transport.h"
 
 void tsc_init(bk_scene *s);                /* empty scene, sky 0, one object "tsc" */
 void tsc_free(bk_scene *s);
@@ -31,5 +32,9 @@ void tsc_update_bounds(bk_scene *s);
 /* Rotates vertices, vertex normals and light positions/directions about the origin by the
  * Euler angles (radians, x then y then z). */
 void tsc_rotate(bk_scene *s, double ax, double ay, double az);
+
+/* Transport options of a fixed schedule: exactly `passes` passes (16 samples in the first, each
+ * doubling; no error target), 2 threads, a 512-cell cache, the given seed. */
+bk_transport_options tsc_fixed_passes(int passes, uint64_t seed);
 
 #endif

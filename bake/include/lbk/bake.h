@@ -76,8 +76,11 @@ typedef enum lbk_bake_door_method {
 
 /* Denoising of the baked texels and probes (bake/transport/DENOISE.md). */
 typedef enum lbk_bake_denoise {
-    LBK_BAKE_DENOISE_AUTO = 0, /* on: edge-aware, guided by the transport's own noise estimate */
+    LBK_BAKE_DENOISE_AUTO = 0, /* edge-aware, guided by the transport's own noise estimate, kept per
+                                  class (texels, GLG probes) of the base and of each stored set
+                                  only where it lowers the estimated error (noise + bias) */
     LBK_BAKE_DENOISE_OFF = 1,  /* the transport's estimate as it is */
+    LBK_BAKE_DENOISE_ON = 2,   /* (1.6) the filter everywhere, whatever the estimate says */
     LBK_BAKE_DENOISE_COUNT_
 } lbk_bake_denoise;
 
@@ -147,8 +150,8 @@ typedef struct lbk_bake_desc {
                                    this fraction of the mean indirect light of the texels they
                                    light directly [0: 0.01]; < 0: every non-zero receiver */
     lbk_bake_door_method door_method; /* [difference] */
-    lbk_bake_denoise denoise;   /* [auto: lightmap texels and GLG probes denoised, both presets;
-                                   bake/transport/DENOISE.md] */
+    lbk_bake_denoise denoise;   /* [auto: lightmap texels and GLG probes denoised where that lowers
+                                   the estimated error, both presets; bake/transport/DENOISE.md] */
     const char *revision;       /* stored in META [NULL: none] */
     int timestamp;              /* 1: store the bake time in META (no longer byte-identical) */
     const char *allow_outside;  /* files a glTF names (buffers, images, its lbk_sky EXR) must lie in
@@ -390,6 +393,9 @@ typedef struct lbk_bake_denoised {
     double texel_noise, texel_bias; /* the two parts of errors.texels */
     double glg_noise, glg_bias;     /* the two parts of errors.glg */
     double seconds;                 /* estimating it (one more pass of the filter) */
+    /* (1.6) which classes are stored filtered: --denoise auto keeps the unfiltered result of a
+     * class (then its error is the transport's, bias 0) where filtering would not lower it */
+    int texels_filtered, glg_filtered;
 } lbk_bake_denoised;
 
 /* One transport run of the light sets and doors (a light set, a door open or closed, a
@@ -401,6 +407,20 @@ typedef struct lbk_bake_set_run {
     lbk_bake_class_errors classes;
     double seconds;
 } lbk_bake_set_run;
+
+/* A stored light set, door state or combination and the estimated error of its contribution
+ * as stored (appended in 1.6; bake/sets/SETS.md, "Error of each stored set"): its two halves —
+ * for a door state or combination, the same difference of the runs' halves as of their
+ * results — through the base's denoising weights, or unfiltered. Relative to the RMS of the
+ * contribution itself, so a door's difference, small where the door changes little, reads
+ * large where the run estimates read small. The guided door estimator's open sets have none. */
+typedef struct lbk_bake_set_estimate {
+    const char *name;            /* the set's name in the DLS section */
+    uint32_t set;                /* its index in the DLS section's set table */
+    uint32_t kind;               /* lbk_dls_set_kind (lbk/dls.h) */
+    int denoised;                /* 1: through the denoiser's weights (then bias may be > 0) */
+    lbk_bake_denoised error;     /* as the base's denoised estimate; seconds: its share of the pass */
+} lbk_bake_set_estimate;
 
 /* What lbk_bake_report_write_json writes (spec/bake-report-json.md), as data. */
 typedef struct lbk_bake_report {
@@ -430,6 +450,9 @@ typedef struct lbk_bake_report {
     lbk_bake_denoised denoised;
     /* appended in 1.6: read only when size covers it */
     uint32_t octp_levels;        /* clip levels of the OCTP volume (0: none written) */
+    /* appended in 1.6 (each stored set's estimate): read only when size covers them */
+    const lbk_bake_set_estimate *set_estimates; /* in DLS set order; sets without one are left out */
+    size_t set_estimate_count;
 } lbk_bake_report;
 
 /* Owned by the output, valid until lbk_bake_output_free. */
