@@ -824,7 +824,7 @@ static void test_cut_run_with_target(void **state)
     }
     assert_int_equal(nt, NT);
     assert_int_equal(np, NP);
-    bk_transport_options o = fixed_opt(10);
+    bk_transport_options o = tsc_fixed_passes(10, 3);
     o.target_error = 0.04;
     o.class_end[BK_CLASS_TEXEL] = NT;
     o.class_end[BK_CLASS_GLG] = N;
