@@ -741,12 +741,12 @@ static lbk_result do_sets(bk_pipeline *b)
     return bk_set_bakes_run(&b->sets, &in, b->err, sizeof b->err);
 }
 
-/* What the denoised base delivers: the two halves through the same weights (bk_denoiser_error).
- * The LLG class is not filtered and keeps the base estimate with its fit residual. With
- * --denoise auto a class whose filtered estimate is not below its unfiltered one (the
- * transport's) gets its unfiltered receivers back from `raw` (NULL: keep every class filtered),
- * and its error is the transport's. */
-static lbk_result denoised_error(bk_pipeline *b, const lbk_sh9_rgb *raw)
+/* What the denoised base delivers: the two halves through the same weights (bk_denoiser_error;
+ * it reads the halves only, so it runs before the filter). The LLG class is not filtered and
+ * keeps the base estimate with its fit residual. With --denoise auto (choose) a class whose
+ * filtered estimate is not below its unfiltered one (the transport's) stays unfiltered and its
+ * error is the transport's; do_denoise then filters the classes marked filtered. */
+static lbk_result denoised_error(bk_pipeline *b, int choose)
 {
     bk_transport_options to;
     transport_options(b, &to);
@@ -755,15 +755,10 @@ static lbk_result denoised_error(bk_pipeline *b, const lbk_sh9_rgb *raw)
     if (r) return r;
     lbk_bake_denoised *d = &b->denoised;
     const double raw_t = b->stats.class_rel_rmse[BK_CLASS_TEXEL], raw_g = b->stats.class_rel_rmse[BK_CLASS_GLG];
-    d->texels_filtered = !raw || e.rel_rmse[BK_CLASS_TEXEL] < raw_t;
-    d->glg_filtered = !raw || e.rel_rmse[BK_CLASS_GLG] < raw_g;
-    if (!d->texels_filtered) {
-        memcpy(b->radiance, raw, to.class_end[BK_CLASS_TEXEL] * sizeof *raw);
-        e.rel_rmse[BK_CLASS_TEXEL] = e.noise[BK_CLASS_TEXEL] = raw_t, e.bias[BK_CLASS_TEXEL] = 0;
-    }
+    d->texels_filtered = !choose || e.rel_rmse[BK_CLASS_TEXEL] < raw_t;
+    d->glg_filtered = !choose || e.rel_rmse[BK_CLASS_GLG] < raw_g;
+    if (!d->texels_filtered) e.rel_rmse[BK_CLASS_TEXEL] = e.noise[BK_CLASS_TEXEL] = raw_t, e.bias[BK_CLASS_TEXEL] = 0;
     if (!d->glg_filtered) {
-        const size_t g0 = to.class_end[BK_CLASS_TEXEL];
-        memcpy(b->radiance + g0, raw + g0, (to.class_end[BK_CLASS_GLG] - g0) * sizeof *raw);
         e.rel_rmse[BK_CLASS_GLG] = e.noise[BK_CLASS_GLG] = raw_g, e.bias[BK_CLASS_GLG] = 0;
         e.probe_rel_rmse = b->stats.probe_rel_rmse;
     }
@@ -826,16 +821,9 @@ static lbk_result do_denoise(bk_pipeline *b)
     o.threads = b->opt->threads;
     lbk_result r = bk_denoiser_create(&in, &o, &b->denoiser);
     free(guide), free(guide_var);
-    /* auto: what the filter replaces, in case the estimate says it does not pay */
-    lbk_sh9_rgb *raw = NULL;
-    if (!r && b->opt->denoise == LBK_BAKE_DENOISE_AUTO) {
-        raw = malloc((b->receiver_count ? b->receiver_count : 1) * sizeof *raw);
-        if (!raw) r = LBK_ERR_OUT_OF_MEMORY;
-        else memcpy(raw, b->radiance, b->receiver_count * sizeof *raw);
-    }
-    if (!r) r = bk_denoiser_apply(b->denoiser, b->radiance);
-    if (!r) r = denoised_error(b, raw);
-    free(raw);
+    if (!r) r = denoised_error(b, b->opt->denoise == LBK_BAKE_DENOISE_AUTO);
+    const int filter[BK_RECEIVER_CLASSES] = {b->denoised.texels_filtered, b->denoised.glg_filtered, 0};
+    if (!r) r = bk_denoiser_apply_classes(b->denoiser, b->radiance, filter);
     if (r) return bk_pipeline_failed(b, r, "denoising");
     return LBK_OK;
 }

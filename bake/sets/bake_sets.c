@@ -694,24 +694,12 @@ static lbk_result estimate_sets(bs_impl *im, const bk_set_inputs *in)
     return r;
 }
 
-/* Filters a kept contribution with the base's weights, then gives the classes its estimate
- * keeps unfiltered (est NULL: none known, every class filtered) their unfiltered receivers. */
+/* Filters a kept contribution with the base's weights in the classes its estimate keeps
+ * filtered (est NULL: none known, every class filtered). */
 static lbk_result filter_set(const bk_set_inputs *in, bs_set *st, const bk_set_estimate *est)
 {
-    const size_t *ce = in->transport.class_end;
-    const int keep_t = est && !est->filtered[BK_CLASS_TEXEL], keep_g = est && !est->filtered[BK_CLASS_GLG];
-    lbk_sh9_rgb *raw = NULL;
-    if (keep_t || keep_g) {
-        raw = malloc((in->receiver_count ? in->receiver_count : 1) * sizeof *raw);
-        if (!raw) return LBK_ERR_OUT_OF_MEMORY;
-        memcpy(raw, st->stash, in->receiver_count * sizeof *raw);
-    }
-    lbk_result r = bk_denoiser_apply(in->denoiser, st->stash);
-    if (!r && keep_t) memcpy(st->stash, raw, ce[BK_CLASS_TEXEL] * sizeof *raw);
-    if (!r && keep_g)
-        memcpy(st->stash + ce[BK_CLASS_TEXEL], raw + ce[BK_CLASS_TEXEL], (ce[BK_CLASS_GLG] - ce[BK_CLASS_TEXEL]) * sizeof *raw);
-    free(raw);
-    return r;
+    static const int all[BK_RECEIVER_CLASSES] = {1, 1, 1};
+    return bk_denoiser_apply_classes(in->denoiser, st->stash, est ? est->filtered : all);
 }
 
 const bk_set_estimate *bk_set_bakes_estimates(const bk_set_bakes *sets, size_t *count)

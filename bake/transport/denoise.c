@@ -471,13 +471,19 @@ lbk_result bk_denoiser_create(const bk_denoise_inputs *in, const bk_denoise_opti
     return LBK_OK;
 }
 
+lbk_result bk_denoiser_apply_classes(const bk_denoiser *d, lbk_sh9_rgb *radiance, const int filter[BK_RECEIVER_CLASSES])
+{
+    if (!d || !filter || (!radiance && d->receiver_count)) return LBK_ERR_INVALID_ARGUMENT;
+    lbk_result r = LBK_OK;
+    if (d->have_tex && filter[BK_CLASS_TEXEL]) r = texels_apply(d, (float *)radiance, SH_N);
+    if (!r && d->have_probes && filter[BK_CLASS_GLG]) r = dn_probes_apply(&d->probes, (float *)radiance, SH_N);
+    return r;
+}
+
 lbk_result bk_denoiser_apply(const bk_denoiser *d, lbk_sh9_rgb *radiance)
 {
-    if (!d || (!radiance && d->receiver_count)) return LBK_ERR_INVALID_ARGUMENT;
-    lbk_result r = LBK_OK;
-    if (d->have_tex) r = texels_apply(d, (float *)radiance, SH_N);
-    if (!r && d->have_probes) r = dn_probes_apply(&d->probes, (float *)radiance, SH_N);
-    return r;
+    static const int all[BK_RECEIVER_CLASSES] = {1, 1, 1};
+    return bk_denoiser_apply_classes(d, radiance, all);
 }
 
 /* Per-class sums of bk_denoiser_error: noise², the bias term and the denoised values². */

@@ -100,6 +100,10 @@ lbk_result bk_denoiser_create(const bk_denoise_inputs *in, const bk_denoise_opti
 /* Filters `radiance` (receiver_count entries, numbered like the inputs) in place with the
  * stored weights: texel and GLG receivers change, every other receiver is left as it is. */
 lbk_result bk_denoiser_apply(const bk_denoiser *d, lbk_sh9_rgb *radiance);
+/* The same for the classes with filter[k] set only (BK_CLASS_TEXEL: the texel receivers,
+ * BK_CLASS_GLG: the GLG probes; the two filters are independent, so a class left out keeps its
+ * input exactly and the other gets what bk_denoiser_apply gives it). */
+lbk_result bk_denoiser_apply_classes(const bk_denoiser *d, lbk_sh9_rgb *radiance, const int filter[BK_RECEIVER_CLASSES]);
 
 /* The estimated error of the denoised result per receiver class, relative to the RMS of the
  * denoised values as the transport's estimate is (TRANSPORT.md §Error estimate; DENOISE.md
