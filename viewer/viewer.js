@@ -349,10 +349,12 @@
       $('note').textContent = 'ASTC pages cannot be shown: this page has no ASTC decoder (page' + (astcPages.length > 1 ? 's ' : ' ') +
         astcPages.join(', ') + '; their objects are lit from the GLG instead). Open the bake before lbk convert, or a BC/1.0 conversion of it.';
 
-    const blank = 'data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAQAAAC1HAwCAAAAC0lEQVR42mNkYAAAAAYAAjCB0C8AAAAASUVORK5CYII=';
-    const manager = new THREE.LoadingManager();
-    manager.setURLModifier((url) => (/^data:/.test(url) ? url : blank)); /* the preview PNGs are not needed */
-    const gltf = await new Promise((res, rej) => new THREE.GLTFLoader(manager).parse(b64(data.glb).buffer, '', res, rej));
+    /* The glTF's textures (lbk export's lightmap previews) are never drawn here, so none is loaded:
+     * an image decodes off the main thread, which headless Chromium's virtual time does not wait
+     * for, and a test's page could be read before it was ready. */
+    const loader = new THREE.GLTFLoader();
+    loader.register(() => ({ name: 'lbk_no_textures', loadTexture: () => Promise.resolve(null) }));
+    const gltf = await new Promise((res, rej) => loader.parse(b64(data.glb).buffer, '', res, rej));
     const uniformsCommon = { exposure: { value: 1 }, mode: { value: 0 } };
     const box = new THREE.Box3();
     const dummy = pages.find((p) => p) || null;
