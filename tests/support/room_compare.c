@@ -9,17 +9,7 @@
 #include <string.h>
 
 #include "lbk/ahd.h"
-
-double rc_texel_lum(uint32_t z, const uint8_t *rgba)
-{
-    lbk_ahd_texel t;
-    t.irradiance_z = z;
-    memcpy(t.rgba, rgba, 4);
-    const float n[3] = {0, 0, 1};
-    float e[3];
-    lbk_ahd_irradiance(&t, n, e);
-    return LBK_LUM_R * e[0] + LBK_LUM_G * e[1] + LBK_LUM_B * e[2];
-}
+#include "tools/common/set_decode.h"
 
 rc_result rc_compare_room(rc_side a, rc_side b)
 {
@@ -33,8 +23,8 @@ rc_result rc_compare_room(rc_side a, rc_side b)
             uint64_t ia = pa.first_texel + (uint64_t)(a.rect[2] + y) * pa.width + a.rect[1] + x;
             uint64_t ib = pb.first_texel + (uint64_t)(b.rect[2] + y) * pb.width + b.rect[1] + x;
             /* physical: stored × each file's LMAP scale (spec §5.7) */
-            double va = rc_texel_lum(a.z[ia], &a.rgba[4 * ia]) * pa.scale;
-            double vb = rc_texel_lum(b.z[ib], &b.rgba[4 * ib]) * pb.scale;
+            double va = tl_texel_lum(a.z[ia], &a.rgba[4 * ia]) * pa.scale;
+            double vb = tl_texel_lum(b.z[ib], &b.rgba[4 * ib]) * pb.scale;
             diff += fabs(va - vb), sa += va, sb += vb;
         }
     rc_result r = {sb > 0 ? diff / sb : 0, sb > 0 ? sa / sb : 0, sa, sb};

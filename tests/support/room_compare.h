@@ -20,8 +20,6 @@ typedef struct rc_result {
     double sum_a, sum_b;
 } rc_result;
 
-/* Luminance of a texel's irradiance along its normal, in stored units. */
-double rc_texel_lum(uint32_t z, const uint8_t *rgba);
 /* Asserts (cmocka) that both rectangles have the same size and their pages exist. */
 rc_result rc_compare_room(rc_side a, rc_side b);
 
