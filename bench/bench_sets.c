@@ -337,14 +337,6 @@ static void est_bake_free(est_bake *b)
     free(b->base);
 }
 
-/* √(Σ (a − b)² / Σ b²) over the texels */
-static double rel_diff(const double *a, const double *b, uint64_t n)
-{
-    double num = 0, den = 0;
-    for (uint64_t i = 0; i < n; i++) num += (a[i] - b[i]) * (a[i] - b[i]), den += b[i] * b[i];
-    return den > 0 ? sqrt(num / den) : 0;
-}
-
 /* One line: a stored contribution x of seeds 1 and 2 against the other seed and the reference. */
 static void est_line(const char *kind, const char *name, const double *x0, const double *x1, const double *ref, uint64_t nt,
                      double ref_noise, double noise, double bias, int filtered)
@@ -353,7 +345,7 @@ static void est_line(const char *kind, const char *name, const double *x0, const
     for (uint64_t i = 0; i < nt; i++) num += 0.5 * (x0[i] - x1[i]) * (x0[i] - x1[i]), den += 0.25 * (x0[i] + x1[i]) * (x0[i] + x1[i]);
     const double m = den > 0 ? sqrt(num / den) : 0, ratio = m > 0 ? noise / m : 0;
     /* against the reference: the mean square of both seeds' errors, less the reference's noise */
-    const double e0 = rel_diff(x0, ref, nt), e1 = rel_diff(x1, ref, nt);
+    const double e0 = tl_rel_rms(x0, ref, nt), e1 = tl_rel_rms(x1, ref, nt);
     const double err = sqrt(fmax(0, 0.5 * (e0 * e0 + e1 * e1) - ref_noise * ref_noise)), tot = sqrt(noise * noise + bias * bias);
     printf("  %-11s %-20s %-10s est. noise %5.2f%% / between seeds %5.2f%% (%.2f%s); error vs reference %5.2f%%, "
            "estimated %5.2f%% (bias %.2f%%) (%.2f%s)\n",

@@ -576,14 +576,6 @@ static void test_stored_set_estimates(void **state)
     tl_set_texels_free(b.sets, b.ns);
 }
 
-/* RMS of (x − y) over the RMS of y */
-static double rel_rms(const double *x, const double *y, uint64_t n)
-{
-    double num = 0, den = 0;
-    for (uint64_t i = 0; i < n; i++) num += (x[i] - y[i]) * (x[i] - y[i]), den += y[i] * y[i];
-    return den > 0 ? sqrt(num / den) : 0;
-}
-
 /* --denoise auto keeps, per stored set and for the base, the filtered texels exactly where their
  * estimate is below the unfiltered one: the same seed baked off, on and auto (same runs, same
  * weights, so the same estimates to the bit), auto's choice and estimate equal the lower of the
@@ -607,8 +599,8 @@ static void test_denoise_auto_keeps_the_better(void **state)
                au.filtered[j] ? "filtered" : "unfiltered");
         assert_int_equal(au.filtered[j], better);
         assert_true(au.est[j] == (better ? on.est[j] : off->est[j]));
-        const double d_kept = rel_rms(au.sets[j].lum, (better ? &on : off)->sets[j].lum, au.nt);
-        const double d_other = rel_rms(au.sets[j].lum, (better ? off : &on)->sets[j].lum, au.nt);
+        const double d_kept = tl_rel_rms(au.sets[j].lum, (better ? &on : off)->sets[j].lum, au.nt);
+        const double d_other = tl_rel_rms(au.sets[j].lum, (better ? off : &on)->sets[j].lum, au.nt);
         printf("    stored: %.3f%% from the chosen bake's, %.3f%% from the other's\n", 100 * d_kept, 100 * d_other);
         assert_true(d_kept < 0.25 * d_other);
     }

@@ -1,5 +1,6 @@
 #include "tools/common/set_decode.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -19,6 +20,13 @@ double tl_texel_lum(uint32_t irradiance_z, const uint8_t rgba[4])
     float e[3];
     lbk_ahd_irradiance(&t, nz, e);
     return LBK_LUM_R * e[0] + LBK_LUM_G * e[1] + LBK_LUM_B * e[2];
+}
+
+double tl_rel_rms(const double *x, const double *y, uint64_t n)
+{
+    double num = 0, den = 0;
+    for (uint64_t i = 0; i < n; i++) num += (x[i] - y[i]) * (x[i] - y[i]), den += y[i] * y[i];
+    return den > 0 ? sqrt(num / den) : 0;
 }
 
 typedef struct set_decoder {

@@ -24,4 +24,7 @@ void tl_set_texels_free(tl_set_texels *sets, int nsets);
 /* Luminance of one AHD texel's irradiance along its normal (lux). */
 double tl_texel_lum(uint32_t irradiance_z, const uint8_t rgba[4]);
 
+/* √(Σ (x − y)² / Σ y²) over n values: the relative RMS difference of two decoded sets; 0 when y is 0. */
+double tl_rel_rms(const double *x, const double *y, uint64_t n);
+
 #endif
