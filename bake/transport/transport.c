@@ -2262,6 +2262,34 @@ static void vpl_pass_end(tp_ctx *c)
     }
 }
 
+/* What the VPLs' δ is relative to: the mean irradiance that pass 0's VPLs (half 0, as vpl_sharp_
+ * share leaves them) give the surface receivers, by brute force at up to 256 of them spread
+ * evenly by index (their points, as the gather takes them). Then one draw's relative RMSE of the
+ * VPL light over the receivers is at most √δ_rel (VPL.md), whatever the direct light. */
+static double vpl_mean_irradiance(tp_ctx *c)
+{
+    enum { K = 256 };
+    const size_t n = c->recv_count, k = n < K ? n : K;
+    bk_vpl_point *pts = malloc(4 * K * sizeof *pts);
+    double *irr = malloc(3 * 4 * K * sizeof *irr);
+    size_t np = 0;
+    for (size_t q = 0; q < k && pts && irr; q++) {
+        const bk_receiver *r = &c->recv[q * n / k];
+        if (!(r->normal[0] != 0 || r->normal[1] != 0 || r->normal[2] != 0)) continue;
+        tp_origin g[4];
+        const int points = punctual_points(c, r, g);
+        for (int j = 0; j < points; j++, np++)
+            for (int a = 0; a < 3; a++) pts[np].p[a] = g[j].p[a], pts[np].n[a] = g[j].n[a], pts[np].org[a] = g[j].o[a];
+    }
+    double sum = 0;
+    int ok = pts && irr && np &&
+             bk_vpl_gather(c->vpls[0], c->vpl_n[0], NULL, c->tracer, pts, np, c->threads, irr, NULL) == LBK_OK;
+    for (size_t j = 0; ok && j < np; j++) sum += bk_lum(irr + 3 * j); /* (a texel's 4 points: its mean, × 4) */
+    free(pts);
+    free(irr);
+    return ok ? sum / (double)np : 0;
+}
+
 /* What auto measures: the share of the shooting lights' flux (its upper bound lum(I)·Ω) that
  * pass 0's photons (half 0) put into sharp glossy VPLs (α ≤ BK_VPL_AUTO_ROUGHNESS², weighted by
  * lum(Φ·F0): what they reflect specularly). */
@@ -2282,7 +2310,6 @@ static double vpl_sharp_share(tp_ctx *c)
         const double outer = l->type == BK_LIGHT_SPOT && l->outer_cone > 0 && l->outer_cone < TP_PI ? l->outer_cone : TP_PI;
         emitted += bk_lum(col) * 2 * TP_PI * (1 - cos(outer));
     }
-    vpl_pass_end(c);
     return emitted > 0 ? sharp / emitted : 0;
 }
 
@@ -2313,9 +2340,9 @@ static lbk_result vpl_init(tp_ctx *c)
     if (!shooters) return LBK_OK;
     c->vpl_photons = opt->glossy_vpl_photons > 0 ? opt->glossy_vpl_photons : BK_VPL_DEFAULT_PHOTONS;
     c->vpl_share = vpl_sharp_share(c);
-    if (opt->glossy_vpl == 0 && !(c->vpl_share >= BK_VPL_AUTO_SHARE)) return LBK_OK;
-    const double mean = slc_mean_irradiance(c);
-    if (!(mean > 0) || !isfinite(mean)) return LBK_OK; /* nothing measurable to be relative to */
+    const double mean = opt->glossy_vpl > 0 || c->vpl_share >= BK_VPL_AUTO_SHARE ? vpl_mean_irradiance(c) : 0;
+    vpl_pass_end(c);
+    if (!(mean > 0) || !isfinite(mean)) return LBK_OK; /* off, or no VPL light reaches a receiver */
     c->vpl_delta = (opt->glossy_vpl_delta > 0 && isfinite(opt->glossy_vpl_delta) ? opt->glossy_vpl_delta
                                                                                   : BK_VPL_DEFAULT_DELTA) * mean;
     float *boxes = malloc(6 * c->recv_count * sizeof(float));

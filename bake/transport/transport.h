@@ -249,8 +249,8 @@ typedef struct bk_transport_options {
      * glossy surfaces of roughness ≤ BK_VPL_AUTO_ROUGHNESS; 1 on; -1 off. */
     int glossy_vpl;
     size_t glossy_vpl_photons; /* per light and half in pass 0 (pass p: × 2^p); 0: BK_VPL_DEFAULT_PHOTONS */
-    double glossy_vpl_delta;   /* δ relative to the smallest class mean of the punctual irradiance
-                                  (pass p: δ/2^p); 0: BK_VPL_DEFAULT_DELTA */
+    double glossy_vpl_delta;   /* δ relative to the mean irradiance the VPLs give the surface
+                                  receivers (pass p: δ/2^p); 0: BK_VPL_DEFAULT_DELTA */
     /* The stop rule's receivers per class (TRANSPORT.md §Stop subset): a class of more than
      * this many stops on the estimate over a hash-stratified subset of this many of its
      * receivers (the reported estimate stays over all of them), so a unit of a distributed run
