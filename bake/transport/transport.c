@@ -2301,7 +2301,7 @@ static double vpl_sharp_share(tp_ctx *c)
     for (size_t k = 0; k < c->vpl_n[0]; k++) {
         const bk_vpl *v = &c->vpls[0][k];
         double pf[3] = {v->flux[0] * v->refl[0], v->flux[1] * v->refl[1], v->flux[2] * v->refl[2]};
-        if (v->alpha <= amax * (1 + 1e-9)) sharp += bk_lum(pf);
+        if (v->alpha <= amax * (1 + 1e-5)) sharp += bk_lum(pf); /* (float roughness 0.3f counts as 0.3) */
     }
     for (size_t li = 0; li < c->light_count; li++) {
         if (!c->light_vpl[li]) continue;
