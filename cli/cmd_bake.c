@@ -76,7 +76,7 @@ static void help(FILE *f)
           "                          of roughness <= 0.3\n"
           "  --glossy-vpl-photons N  photons per light and half in the first pass, doubling per pass\n"
           "                          (default 1024)\n"
-          "  --glossy-vpl-delta X    the VPLs' culling delta relative to the mean punctual irradiance\n"
+          "  --glossy-vpl-delta X    the VPLs' culling delta relative to their mean irradiance at the texels\n"
           "                          (default 0.1; smaller: more VPLs per texel, less noise)\n"
           "  --door-method difference|guided\n"
           "                          how the light through an open door is baked: differences of\n"

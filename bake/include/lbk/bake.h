@@ -224,8 +224,8 @@ typedef struct lbk_bake_desc {
                                    <= 0.3] */
     int glossy_vpl_photons;     /* photons per light and half in the first pass, doubling with
                                    every pass [0: 1024] */
-    double glossy_vpl_delta;    /* the VPLs' culling δ relative to the mean punctual irradiance
-                                   at the receivers [0: 0.1] */
+    double glossy_vpl_delta;    /* the VPLs' culling δ relative to the mean irradiance they give
+                                   the texels (smaller: more VPLs per texel, less noise) [0: 0.1] */
 } lbk_bake_desc;
 
 /* A file a bake read (the glTF, its buffers and images, a sky EXR), as META input.files
