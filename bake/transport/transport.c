@@ -2192,16 +2192,23 @@ static int vpl_material(void *user, const bk_hit *hit, const double x[3], bk_vpl
     return 1;
 }
 
-/* Half h's photons of `pass` from every light that shoots: c->vpls[h] (N·2^pass per light). */
+/* Half h's photons of `pass` from every light that shoots: c->vpls[h] (N·2^pass per light, at
+ * most TP_VPL_PHOTON_CAP over all the lights, ~140 MB of VPLs per half: a level of many lamps
+ * must not shoot N per lamp into gigabytes; each lamp then gets fewer photons, at least 16). */
+#define TP_VPL_PHOTON_CAP ((size_t)1 << 20)
 static lbk_result vpl_shoot_all(tp_ctx *c, int h, int pass)
 {
     free(c->vpls[h]);
     c->vpls[h] = NULL;
     c->vpl_n[h] = 0;
-    const size_t n = c->vpl_photons << (pass < 12 ? pass : 12);
+    size_t shooters = 0;
+    for (size_t li = 0; li < c->light_count; li++) shooters += c->light_vpl[li];
+    size_t n = c->vpl_photons << (pass < 12 ? pass : 12);
+    const size_t cap = TP_VPL_PHOTON_CAP / (shooters ? shooters : 1);
+    if (n > cap) n = cap > 16 ? cap : 16;
     for (size_t li = 0; li < c->light_count; li++) {
         if (!c->light_vpl[li]) continue;
-        bk_vpl_shoot_desc sd = {c->scene, c->tracer, NULL, c->seed, n < BK_VPL_MAX_PHOTONS ? n : BK_VPL_MAX_PHOTONS,
+        bk_vpl_shoot_desc sd = {c->scene, c->tracer, NULL, c->seed, n,
                                 c->threads, mix64(((uint64_t)DOM_VPL_SHOOT << 56) ^ ((uint64_t)h << 48) ^
                                                   ((uint64_t)pass << 32) ^ (uint64_t)li),
                                 vpl_material, c};
