@@ -35,7 +35,7 @@ typedef struct { uint64_t s; } tp_rng;
 
 enum { DOM_CELL = 1, DOM_RECV = 2, DOM_CELL_NEE = 3, DOM_RECV_NEE = 4, DOM_RECV_NEAR = 5, DOM_RECV_POS = 6,
        DOM_RECV_PROBE = 7, DOM_CELL_NEAR = 8, DOM_SLC_RECV = 9, DOM_SLC_CELL = 10,
-       DOM_VPL_SHOOT = 11, DOM_VPL_XI = 12 };
+       DOM_VPL_SHOOT = 11, DOM_VPL_XI = 12, DOM_VPL_POINT = 13 };
 
 /* Keyed by everything that identifies one item's samples: never by thread or time. */
 static tp_rng rng_make(uint64_t seed, uint64_t domain, uint64_t half, uint64_t pass, uint64_t bounce, uint64_t item)
@@ -1494,10 +1494,12 @@ static void vpl_lists_init(const tp_ctx *c, int thread, tp_vpl_lists *t)
     }
 }
 
-/* The glossy VPLs of half h at surface receiver i: the half's draw at the receiver's punctual
- * points (averaged, as recv_punctual does), irradiance into e and the SH of the incident
- * radiance into sh (indirect light: not in `direct`). An unbiased estimate of the light that
- * punctual lights send to the receiver over one specular bounce (VPL.md). Returns shadow rays. */
+/* The glossy VPLs of half h at surface receiver i: the half's draw at one of the receiver's
+ * punctual points (a texel with a footprint: one of its four quarter centres, uniformly at random
+ * per half and pass, an unbiased estimate of their average at a quarter of the work; the VPLs
+ * were most of the gather's CPU at four), irradiance into e and the SH of the incident radiance
+ * into sh (indirect light: not in `direct`). An unbiased estimate of the light that punctual
+ * lights send to the receiver over one specular bounce (VPL.md). Returns shadow rays. */
 static uint64_t recv_vpl(tp_ctx *c, const bk_receiver *r, size_t i, int h, tp_vpl_lists *t, double e[3],
                          double sh[3][9], uint64_t *tested)
 {
@@ -1510,8 +1512,10 @@ static uint64_t recv_vpl(tp_ctx *c, const bk_receiver *r, size_t i, int h, tp_vp
     const double delta = bk_vpl_draw_delta(d);
     tp_origin g[4];
     const int points = punctual_points(c, r, g);
+    tp_rng pr = rng_make(c->seed, DOM_VPL_POINT, (uint64_t)h, (uint64_t)c->pass, 0, i);
+    const int q0 = points > 1 ? (int)(rng_next(&pr) * points) % points : 0;
     uint64_t rays = 0;
-    for (int q = 0; q < points; q++) {
+    for (int q = q0; q < q0 + 1; q++) {
         bk_vpl_point pt;
         for (int a = 0; a < 3; a++) pt.p[a] = g[q].p[a], pt.n[a] = g[q].n[a], pt.org[a] = g[q].o[a];
         for (size_t k = 0; k < t->n[h]; k++) {
@@ -1531,11 +1535,7 @@ static uint64_t recv_vpl(tp_ctx *c, const bk_receiver *r, size_t i, int h, tp_vp
             }
         }
     }
-    *tested += (uint64_t)points * t->n[h];
-    for (int a = 0; a < 3; a++) {
-        e[a] /= points;
-        for (int kk = 0; kk < 9; kk++) sh[a][kk] /= points;
-    }
+    *tested += t->n[h];
     return rays;
 }
 

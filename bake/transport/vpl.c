@@ -431,14 +431,33 @@ void bk_vpl_draw_destroy(bk_vpl_draw *d)
     free(d);
 }
 
+/* 1 when the whole box lies strictly behind v's surface plane ((x − q)·n < 0 everywhere, with a
+ * margin for rounding): v's intensity is exactly 0 there (bk_vpl_intensity: ω_o·n ≤ 0), so the
+ * tile needs no test of it. The spheroid itself reaches behind the plane near q, so without this
+ * every receiver tile on the VPLs' own floor listed them (the transport's metal room: most of the
+ * gather's work). */
+static int box_behind(const bk_vpl *v, const float box[6])
+{
+    double m = 0, mag = 0;
+    for (int k = 0; k < 3; k++) {
+        const double a = v->n[k] * ((double)box[k] - v->pos[k]), b = v->n[k] * ((double)box[3 + k] - v->pos[k]);
+        m += a > b ? a : b;
+        mag += fabs(v->pos[k]) + fabs((double)box[3 + k]) + fabs((double)box[k]);
+    }
+    return m < -1e-9 * (mag + 1);
+}
+
 size_t bk_vpl_tile_list(const bk_vpl_draw *d, size_t item, uint32_t *ids)
 {
     if (item >= bk_slc_item_count(d->tiles)) return 0;
     const size_t k = item / BK_SLC_BLOCK;
     const float *box = bk_slc_tile_box(d->tiles, item / BK_SLC_TILE);
+    if (!(box[0] <= box[3] && box[1] <= box[4] && box[2] <= box[5])) return 0; /* an empty tile */
     size_t n = 0;
-    for (uint32_t j = 0; j < d->list_n[k]; j++)
-        if (bk_vpl_volume_meets_box(&d->vol[d->list[k][j]], box)) ids[n++] = d->list[k][j];
+    for (uint32_t j = 0; j < d->list_n[k]; j++) {
+        const uint32_t vi = d->list[k][j];
+        if (!box_behind(&d->vpls[vi], box) && bk_vpl_volume_meets_box(&d->vol[vi], box)) ids[n++] = vi;
+    }
     return n;
 }
 
