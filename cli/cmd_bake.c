@@ -68,6 +68,16 @@ static void help(FILE *f)
           "                          auto, the default: on with more than 32 positional lights)\n"
           "  --light-culling-delta X culling's delta relative to the mean punctual irradiance\n"
           "                          (default 0.1; smaller: more lights per texel, less noise)\n"
+          "  --glossy-vpl auto|on|off\n"
+          "                          glossy-to-diffuse light (caustics of metal floors) through VPLs:\n"
+          "                          photons from point and spot lights, culled stochastically and\n"
+          "                          gathered at the texels (bake/transport/VPL.md); auto, the default:\n"
+          "                          on where the lights put >= 5 % of their flux into glossy surfaces\n"
+          "                          of roughness <= 0.3\n"
+          "  --glossy-vpl-photons N  photons per light and half in the first pass, doubling per pass\n"
+          "                          (default 1024)\n"
+          "  --glossy-vpl-delta X    the VPLs' culling delta relative to their mean irradiance at the texels\n"
+          "                          (default 0.1; smaller: more VPLs per texel, less noise)\n"
           "  --door-method difference|guided\n"
           "                          how the light through an open door is baked: differences of\n"
           "                          full runs (default) or the seed's guided estimator (bake/sets/SETS.md)\n"
@@ -477,6 +487,21 @@ int cli_bake_parse(int argc, char **argv, bake_args *out, int *quiet_out)
         } else if (!strcmp(a, "--light-culling-delta")) {
             NEED_NUMBER(1e-9, 1e6);
             o.d.light_culling_delta = d;
+        } else if (!strcmp(a, "--glossy-vpl")) {
+            NEED_VALUE;
+            if (!strcmp(v, "auto")) o.d.glossy_vpl = 0;
+            else if (!strcmp(v, "on")) o.d.glossy_vpl = 1;
+            else if (!strcmp(v, "off")) o.d.glossy_vpl = -1;
+            else {
+                fprintf(stderr, "lbk bake: --glossy-vpl: '%s' is not auto, on or off\n", v);
+                return LBK_EXIT_USAGE;
+            }
+        } else if (!strcmp(a, "--glossy-vpl-photons")) {
+            NEED_UINT(1, 1 << 20);
+            o.d.glossy_vpl_photons = (int)u;
+        } else if (!strcmp(a, "--glossy-vpl-delta")) {
+            NEED_NUMBER(1e-9, 1e6);
+            o.d.glossy_vpl_delta = d;
         } else if (!strcmp(a, "--door-method")) {
             NEED_VALUE;
             if (!strcmp(v, "difference")) o.d.door_method = LBK_BAKE_DOOR_DIFFERENCE;

@@ -556,6 +556,9 @@ static void transport_options(const bk_pipeline *b, bk_transport_options *to)
     to->checkpoint = b->ckpt && !b->dist ? bk_ckpt_transport(b->ckpt) : NULL;
     to->slc = opt->light_culling;
     to->slc_delta = opt->light_culling_delta;
+    to->glossy_vpl = opt->glossy_vpl;
+    to->glossy_vpl_photons = opt->glossy_vpl_photons > 0 ? (size_t)opt->glossy_vpl_photons : 0;
+    to->glossy_vpl_delta = opt->glossy_vpl_delta;
 }
 
 void bk_pipeline_set_inputs(const bk_pipeline *b, bk_set_inputs *in)
@@ -726,6 +729,12 @@ static lbk_result do_transport(bk_pipeline *b)
     }
     if (r) return bk_pipeline_failed(b, r, "light transport");
     llg_fit_error(b);
+    if (b->stats.vpl_share > 0 || b->stats.vpl) /* (a scene with glossy cells and a point or spot light) */
+        bk_events_say(&b->events, LBK_BAKE_SEVERITY_INFO,
+                      "glossy VPLs %s: the lights put %.1f %% of their flux into glossy surfaces of roughness <= %.1f "
+                      "(auto: on from %.0f %%); %llu VPLs, %.1f tested per receiver",
+                      b->stats.vpl ? "on" : "off", 100 * b->stats.vpl_share, BK_VPL_AUTO_ROUGHNESS,
+                      100 * BK_VPL_AUTO_SHARE, (unsigned long long)b->stats.vpl_made, b->stats.vpl_tested);
     if (b->stats.nonfinite)
         bk_events_say(&b->events, LBK_BAKE_SEVERITY_WARNING, "%llu non-finite samples were dropped",
                       (unsigned long long)b->stats.nonfinite);
@@ -925,6 +934,11 @@ static lbk_result check_desc(bk_pipeline *b)
     if (d->light_culling < -1 || d->light_culling > 1) BAD("lbk_bake_desc.light_culling: %d is not -1, 0 or 1", d->light_culling);
     if (!finite_nonneg(d->light_culling_delta) || d->light_culling_delta > 1e6)
         BAD("lbk_bake_desc.light_culling_delta: %g is not a finite number in [0, 1e6]", d->light_culling_delta);
+    if (d->glossy_vpl < -1 || d->glossy_vpl > 1) BAD("lbk_bake_desc.glossy_vpl: %d is not -1, 0 or 1", d->glossy_vpl);
+    if (d->glossy_vpl_photons < 0 || d->glossy_vpl_photons > (1 << 20))
+        BAD("lbk_bake_desc.glossy_vpl_photons: %d is not in [0, 2^20]", d->glossy_vpl_photons);
+    if (!finite_nonneg(d->glossy_vpl_delta) || d->glossy_vpl_delta > 1e6)
+        BAD("lbk_bake_desc.glossy_vpl_delta: %g is not a finite number in [0, 1e6]", d->glossy_vpl_delta);
     if (d->sky_override && !d->sky_exr)
         for (int k = 0; k < 3; k++)
             if (!finite_nonneg(d->sky[k]) || !(d->sky[k] < 1e30f)) BAD("lbk_bake_desc.sky: radiance must be finite and >= 0");
@@ -1133,6 +1147,10 @@ static uint64_t options_hash(const lbk_bake_desc *options, int budgets)
     if (d.light_culling || d.light_culling_delta > 0) { /* (absent from older hashes: same values) */
         const double lc[2] = {(double)d.light_culling, d.light_culling_delta};
         XXH64_update(st, lc, sizeof lc);
+    }
+    if (d.glossy_vpl || d.glossy_vpl_photons || d.glossy_vpl_delta > 0) { /* (absent from older hashes) */
+        const double gv[3] = {(double)d.glossy_vpl, (double)d.glossy_vpl_photons, d.glossy_vpl_delta};
+        XXH64_update(st, gv, sizeof gv);
     }
     if (d.error_map) { /* units must record the variance the merge's map needs */
         const int64_t em = d.error_map;

@@ -346,6 +346,13 @@ lbk_result bk_provenance_meta(const bk_pipeline *b, void **data, size_t *size)
     snprintf(glimit, sizeof glimit, "%g", o->gather_limit);
     if (o->gather_limit > 0) p[n++] = (lbk_meta_pair){"bake.gather_limit", glimit}; /* absent: off */
     if (o->llg_connected) p[n++] = (lbk_meta_pair){"bake.llg_connected", "1"}; /* absent: off */
+    char vpl_photons[16], vpl_delta[32];
+    snprintf(vpl_photons, sizeof vpl_photons, "%d", o->glossy_vpl_photons);
+    snprintf(vpl_delta, sizeof vpl_delta, "%g", o->glossy_vpl_delta);
+    /* absent: auto and the defaults (so bakes that leave them alone keep their bytes) */
+    if (o->glossy_vpl) p[n++] = (lbk_meta_pair){"bake.glossy_vpl", o->glossy_vpl > 0 ? "on" : "off"};
+    if (o->glossy_vpl_photons > 0) p[n++] = (lbk_meta_pair){"bake.glossy_vpl_photons", vpl_photons};
+    if (o->glossy_vpl_delta > 0) p[n++] = (lbk_meta_pair){"bake.glossy_vpl_delta", vpl_delta};
     p[n++] = (lbk_meta_pair){"bake.dls_threshold", threshold};
     p[n++] = (lbk_meta_pair){"bake.door_method", o->door_method == LBK_BAKE_DOOR_GUIDED ? "guided" : "difference"};
     if (o->revision) p[n++] = (lbk_meta_pair){LBK_META_REVISION, o->revision};

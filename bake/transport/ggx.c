@@ -232,6 +232,15 @@ void bk_mr_lobe_eval(const bk_mr_lobe *lb, const double l[3], double f[3])
     }
 }
 
+void bk_mr_lobe_eval_diffuse(const bk_mr_lobe *lb, const double l[3], double f[3])
+{
+    f[0] = f[1] = f[2] = 0;
+    if (!(l[2] > 0)) return;
+    double a, b;
+    bk_ggx_table_eval(lb->t, lb->roughness, l[2], &a, &b);
+    for (int k = 0; k < 3; k++) f[k] = lb->kd[k] * (1 - fmin(1.0, lb->f0[k] * a + b));
+}
+
 double bk_mr_lobe_pdf(const bk_mr_lobe *lb, const double l[3])
 {
     if (!(l[2] > 0)) return 0;

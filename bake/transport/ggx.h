@@ -81,6 +81,10 @@ int bk_mr_lobe_init(bk_mr_lobe *lb, const bk_ggx_table *t, const double base[3],
                     const double v[3]);
 /* f(v, l) per channel (without the cosine); 0 below the horizon. */
 void bk_mr_lobe_eval(const bk_mr_lobe *lb, const double l[3], double f[3]);
+/* The coupled diffuse part alone, c_diff/π·(1 − E_s(v))(1 − E_s(l))/(1 − Ē_s) (eval minus the
+ * specular lobe F·D·G2/(4|n·v||n·l|)): what the transport evaluates at a glossy point for the
+ * lights whose specular bounce glossy VPLs carry (VPL.md). */
+void bk_mr_lobe_eval_diffuse(const bk_mr_lobe *lb, const double l[3], double f[3]);
 /* The density (solid angle) sampling draws l with. */
 double bk_mr_lobe_pdf(const bk_mr_lobe *lb, const double l[3]);
 /* A direction from (u0, u1, u2) ∈ [0,1)³ (u0 picks the lobe); returns its density (0: lost). */

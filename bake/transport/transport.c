@@ -6,6 +6,7 @@
 #include "bake/transport/shading.h"
 #include "bake/transport/slc.h"
 #include "bake/transport/solid.h"
+#include "bake/transport/vpl.h"
 #include "lbk/octa.h"
 
 #include <math.h>
@@ -33,7 +34,8 @@ static uint64_t mix64(uint64_t z)
 typedef struct { uint64_t s; } tp_rng;
 
 enum { DOM_CELL = 1, DOM_RECV = 2, DOM_CELL_NEE = 3, DOM_RECV_NEE = 4, DOM_RECV_NEAR = 5, DOM_RECV_POS = 6,
-       DOM_RECV_PROBE = 7, DOM_CELL_NEAR = 8, DOM_SLC_RECV = 9, DOM_SLC_CELL = 10 };
+       DOM_RECV_PROBE = 7, DOM_CELL_NEAR = 8, DOM_SLC_RECV = 9, DOM_SLC_CELL = 10,
+       DOM_VPL_SHOOT = 11, DOM_VPL_XI = 12, DOM_VPL_POINT = 13 };
 
 /* Keyed by everything that identifies one item's samples: never by thread or time. */
 static tp_rng rng_make(uint64_t seed, uint64_t domain, uint64_t half, uint64_t pass, uint64_t bounce, uint64_t item)
@@ -205,6 +207,21 @@ typedef struct tp_ctx {
     double *slc_cdf;           /* positional lights by intensity, for continued points */
     uint32_t *slc_pick_ids;
     size_t slc_pick_count;
+    /* glossy VPLs (vpl.h; VPL.md "In the transport"): on; δ of pass 0 in irradiance units (pass
+     * p: δ/2^p); photons per light and half in pass 0 (pass p: × 2^p); per light whether it
+     * shoots (its light → glossy → receiver path is then the VPLs', and the receivers' glossy
+     * continuations see it through the diffuse part only); the receivers' tiles; this pass's
+     * VPLs and draws per half; per thread room for two tile lists; what auto measured */
+    int vpl;
+    double vpl_delta, vpl_share;
+    size_t vpl_photons;
+    uint8_t *light_vpl;
+    bk_slc *vpl_tiles;
+    bk_vpl *vpls[2];
+    size_t vpl_n[2], vpl_cap;
+    bk_vpl_draw *vpl_draw[2];
+    uint32_t *vpl_ids;
+    uint64_t *thread_vpl_tested, vpl_made;
     /* per chain (half) state; [h] */
     float *l_prev[2], *l_cur[2], *l_sum[2];
     float *l_prev2[2];     /* bounce k−2 (what a near hit in bounce k continues into) */
@@ -659,12 +676,14 @@ static void mark_rough(tp_ctx *c)
  * the light sources count (sky, emission, one punctual light). The final gather continues with
  * everything (read = the cache's sum); bounce k of the cache continues with the exact bounce
  * k−1 at its near hit: the sources for k = 2, bounce k−2's cells beyond. */
-typedef struct tp_near_mode { const float *read; const uint8_t *rough; int sources, max_depth; } tp_near_mode;
+/* vpl: a receiver's gather with glossy VPLs on: at its first hit (depth 0) a glossy point takes
+ * the lights that shoot photons through its diffuse part only (VPL.md: counted once). */
+typedef struct tp_near_mode { const float *read; const uint8_t *rough; int sources, max_depth, vpl; } tp_near_mode;
 
 /* Light li at the continued point x (normal n, ray origin o), weighted `scale`, into e (through
  * the BSDF lf at a glossy point; NULL: irradiance). */
 static void near_light(const tp_ctx *c, size_t li, const double x[3], const double n[3], const float o[3], double scale,
-                       const tp_lobe *lf, double e[3], tp_count *cnt)
+                       const tp_lobe *lf, int split, double e[3], tp_count *cnt)
 {
     double val[3], ld[3], dist;
     if (!bk_light_eval(c->lights[li], x, val, ld, &dist)) return;
@@ -674,7 +693,8 @@ static void near_light(const tp_ctx *c, size_t li, const double x[3], const doub
     if (lf) { /* a glossy point: through its BSDF */
         double l[3];
         to_local(lf, ld, l);
-        bk_mr_lobe_eval(&lf->lb, l, f);
+        if (split && c->light_vpl[li]) bk_mr_lobe_eval_diffuse(&lf->lb, l, f); /* the VPLs carry the rest */
+        else bk_mr_lobe_eval(&lf->lb, l, f);
         if (f[0] <= 0 && f[1] <= 0 && f[2] <= 0) return;
     }
     cnt->shadow++;
@@ -755,7 +775,7 @@ static void cont_trace(tp_ctx *c, const tp_near_mode *md, const float o[3], cons
 /* One punctual light (picked as near_radiance picks it) at a continued point x, into e:
  * E·(Lambertian: nothing more; glossy lf: × f(v, l) per channel). */
 static void cont_punctual(const tp_ctx *c, const double x[3], const double n[3], const float o[3], const tp_lobe *lf,
-                          tp_rng *rng, double e[3], tp_count *cnt);
+                          int split, tp_rng *rng, double e[3], tp_count *cnt);
 
 /* Reflected radiance (all bounces, emission excluded) at a glossy hit towards -din: one sample
  * of the coupled BSDF (GGX.md) traced like a Lambertian continuation, one light sample weighed
@@ -795,7 +815,7 @@ static void gloss_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit,
             for (int a = 0; a < 3; a++) out[a] += val[a] * f[a] * cq;
         }
     }
-    if (md->sources && c->light_count) cont_punctual(c, x, lf.n, o, &lf, rng, out, cnt);
+    if (md->sources && c->light_count) cont_punctual(c, x, lf.n, o, &lf, md->vpl && depth == 0, rng, out, cnt);
 }
 
 static void near_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, long hc, const double din[3],
@@ -826,12 +846,12 @@ static void near_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, 
         if (nee_sample(c, o, n, PG_COSINE, u0, u1n, ld, &cq, val, &cnt->shadow) && bk_finite3(val))
             for (int a = 0; a < 3; a++) e[a] += val[a] * cq;
     }
-    if (md->sources && c->light_count) cont_punctual(c, x, n, o, NULL, rng, e, cnt);
+    if (md->sources && c->light_count) cont_punctual(c, x, n, o, NULL, 0, rng, e, cnt);
     for (int a = 0; a < 3; a++) out[a] = cell->albedo[a] / TP_PI * e[a];
 }
 
 static void cont_punctual(const tp_ctx *c, const double x[3], const double n[3], const float o[3], const tp_lobe *lf,
-                          tp_rng *rng, double e[3], tp_count *cnt)
+                          int split, tp_rng *rng, double e[3], tp_count *cnt)
 {
     /* one light: uniformly; with culling (many lights) a positional one in proportion to its
      * intensity (a uniform pick among thousands almost never finds the lamp that matters)
@@ -842,10 +862,10 @@ static void cont_punctual(const tp_ctx *c, const double x[3], const double n[3],
         li = slc_pick(c, u, &scale);
         const uint32_t *always;
         size_t na = bk_slc_always(c->slc_recv, &always);
-        for (size_t k = 0; k < na; k++) near_light(c, always[k], x, n, o, 1, lf, e, cnt);
+        for (size_t k = 0; k < na; k++) near_light(c, always[k], x, n, o, 1, lf, split, e, cnt);
     }
     if (li >= c->light_count) li = c->light_count - 1;
-    near_light(c, li, x, n, o, scale, lf, e, cnt);
+    near_light(c, li, x, n, o, scale, lf, split, e, cnt);
 }
 
 /* ---- cache: one bounce for a range of cells ------------------------------------------------ */
@@ -897,7 +917,7 @@ static void cell_sample(tp_ctx *c, const double n[3], int j, const double p[3],
                 }
             } else if (near_hit(c, hit, hc, c->rough)) {
                 /* bounce k−1 at the exact point (see near_radiance) */
-                const tp_near_mode md = {k == 2 ? NULL : c->l_prev2[h], NULL, k == 2, 1};
+                const tp_near_mode md = {k == 2 ? NULL : c->l_prev2[h], NULL, k == 2, 1, 0};
                 near_radiance(c, &md, hit, hc, d, 0, near_rng, cnt, L);
             } else {
                 for (int a = 0; a < 3; a++) L[a] = prev[3 * hc + a];
@@ -1278,7 +1298,7 @@ typedef struct tp_recv_sums {
 /* Radiance L (direct part Ld) that gather ray d (pdf 1/solid) brings back from `hit`. Returns
  * the cell it read (a far hit), else -1. */
 static long gather_hit(tp_ctx *c, const float *sum, const uint8_t *rough, const bk_hit *hit, const double d[3],
-                       double solid, tp_rng *cont, tp_count *cnt, double L[3], double Ld[3])
+                       double solid, int vpl, tp_rng *cont, tp_count *cnt, double L[3], double Ld[3])
 {
     for (int a = 0; a < 3; a++) L[a] = Ld[a] = 0;
     if (hit->tri == UINT32_MAX) {
@@ -1296,7 +1316,7 @@ static long gather_hit(tp_ctx *c, const float *sum, const uint8_t *rough, const 
     double r[3];
     int near = near_hit(c, hit, hc, rough);
     if (near) {
-        const tp_near_mode md = {sum, rough, 1, TP_NEAR_DEPTH};
+        const tp_near_mode md = {sum, rough, 1, TP_NEAR_DEPTH, vpl};
         near_radiance(c, &md, hit, hc, d, 0, cont, cnt, r);
     } else {
         for (int a = 0; a < 3; a++) r[a] = sum[3 * hc + a];
@@ -1401,7 +1421,7 @@ static void recv_half(tp_ctx *c, const bk_receiver *r, size_t i, int h, int S, c
                 Ld[0] = Ld[1] = Ld[2] = 0; /* no hit within lim: the probes' light, as indirect */
             } else {
                 if (isfinite(lim) && hits[jj].tri == UINT32_MAX) far_continue(c, org + 3 * jj, dd[jj], lim, &hits[jj], cnt);
-                hc = gather_hit(c, sum, c->rough, &hits[jj], dd[jj], solid, &cont, cnt, L, Ld);
+                hc = gather_hit(c, sum, c->rough, &hits[jj], dd[jj], solid, c->vpl && !sphere, &cont, cnt, L, Ld);
             }
             if (!bk_finite3(L) || !bk_finite3(Ld)) cnt->bad++;
             else {
@@ -1410,7 +1430,7 @@ static void recv_half(tp_ctx *c, const bk_receiver *r, size_t i, int h, int S, c
             }
             if (hc >= 0 && (j0 + jj) % TP_PROBE_EVERY == 0) {
                 double q[3];
-                const tp_near_mode md = {sum, c->rough, 1, TP_NEAR_DEPTH};
+                const tp_near_mode md = {sum, c->rough, 1, TP_NEAR_DEPTH, c->vpl && !sphere};
                 near_radiance(c, &md, &hits[jj], hc, dd[jj], 0, &probe, cnt, q);
                 double cs = (sphere ? 1 : zz[jj]) * TP_PROBE_EVERY;
                 if (bk_finite3(q))
@@ -1459,6 +1479,66 @@ static uint64_t recv_slc(tp_ctx *c, const bk_receiver *r, size_t i, int h, tp_sl
     return rays;
 }
 
+/* The tile lists of a thread for the VPL draws: per half the list of the tile it last cut. */
+typedef struct tp_vpl_lists {
+    uint32_t *ids[2];
+    size_t n[2], tile[2];
+} tp_vpl_lists;
+
+static void vpl_lists_init(const tp_ctx *c, int thread, tp_vpl_lists *t)
+{
+    for (int h = 0; h < 2; h++) {
+        t->ids[h] = c->vpl_ids ? c->vpl_ids + (2 * (size_t)thread + (size_t)h) * c->vpl_cap : NULL;
+        t->n[h] = 0;
+        t->tile[h] = SIZE_MAX;
+    }
+}
+
+/* The glossy VPLs of half h at surface receiver i: the half's draw at one of the receiver's
+ * punctual points (a texel with a footprint: one of its four quarter centres, uniformly at random
+ * per half and pass, an unbiased estimate of their average at a quarter of the work; the VPLs
+ * were most of the gather's CPU at four), irradiance into e and the SH of the incident radiance
+ * into sh (indirect light: not in `direct`). An unbiased estimate of the light that punctual
+ * lights send to the receiver over one specular bounce (VPL.md). Returns shadow rays. */
+static uint64_t recv_vpl(tp_ctx *c, const bk_receiver *r, size_t i, int h, tp_vpl_lists *t, double e[3],
+                         double sh[3][9], uint64_t *tested)
+{
+    const bk_vpl_draw *d = c->vpl_draw[h];
+    if (!d) return 0;
+    if (t->tile[h] != i / BK_SLC_TILE) {
+        t->n[h] = bk_vpl_tile_list(d, i, t->ids[h]);
+        t->tile[h] = i / BK_SLC_TILE;
+    }
+    const double delta = bk_vpl_draw_delta(d);
+    tp_origin g[4];
+    const int points = punctual_points(c, r, g);
+    tp_rng pr = rng_make(c->seed, DOM_VPL_POINT, (uint64_t)h, (uint64_t)c->pass, 0, i);
+    const int q0 = points > 1 ? (int)(rng_next(&pr) * points) % points : 0;
+    uint64_t rays = 0;
+    for (int q = q0; q < q0 + 1; q++) {
+        bk_vpl_point pt;
+        for (int a = 0; a < 3; a++) pt.p[a] = g[q].p[a], pt.n[a] = g[q].n[a], pt.org[a] = g[q].o[a];
+        for (size_t k = 0; k < t->n[h]; k++) {
+            const uint32_t vi = t->ids[h][k];
+            double rgb[3], to[3];
+            int acc, ray;
+            const int hit = bk_vpl_eval(&c->vpls[h][vi], bk_vpl_draw_xi(d, vi), delta, c->tracer, &pt, rgb, to, &acc, &ray);
+            rays += (uint64_t)ray;
+            if (!hit || !bk_finite3(rgb)) continue;
+            const double cs = to[0] * g[q].n[0] + to[1] * g[q].n[1] + to[2] * g[q].n[2];
+            if (!(cs > 0)) continue;
+            double y[9];
+            bk_sh9_basis_d(to, y);
+            for (int a = 0; a < 3; a++) {
+                e[a] += rgb[a] * cs;
+                for (int kk = 0; kk < 9; kk++) sh[a][kk] += rgb[a] * y[kk];
+            }
+        }
+    }
+    *tested += t->n[h];
+    return rays;
+}
+
 static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
 {
     const int S = c->rays;
@@ -1467,15 +1547,18 @@ static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
     tp_count cnt = {0, 0, 0};
     tp_slc_lists lists;
     slc_lists_init(c, thread, &lists);
-    uint64_t tested = 0;
+    tp_vpl_lists vlists;
+    vpl_lists_init(c, thread, &vlists);
+    uint64_t tested = 0, vtested = 0;
     for (size_t i = begin; i < end; i++) {
         const bk_receiver *r = &c->recv[i];
         const int sphere = !(r->normal[0] != 0 || r->normal[1] != 0 || r->normal[2] != 0);
         const double solid = sphere ? 4 * TP_PI : 2 * TP_PI;
         tp_recv_sums tot;
         memset(&tot, 0, sizeof tot);
-        double psh_tot[3][9];
+        double psh_tot[3][9], vsh_tot[3][9];
         memset(psh_tot, 0, sizeof psh_tot);
+        memset(vsh_tot, 0, sizeof vsh_tot);
         for (int h = 0; h < 2; h++) {
             tp_recv_sums rs;
             memset(&rs, 0, sizeof rs);
@@ -1483,11 +1566,14 @@ static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
             double pe[3] = {0, 0, 0}, psh[3][9];
             memset(psh, 0, sizeof psh);
             if (c->slc) cnt.shadow += recv_slc(c, r, i, h, &lists, pe, psh, &tested);
+            double ve[3] = {0, 0, 0}, vsh[3][9];
+            memset(vsh, 0, sizeof vsh);
+            if (c->vpl && !sphere) cnt.shadow += recv_vpl(c, r, i, h, &vlists, ve, vsh, &vtested);
             double e[3], eb[3];
             for (int a = 0; a < 3; a++) {
-                e[a] = rs.e[a] * solid / S + pe[a];
+                e[a] = rs.e[a] * solid / S + pe[a] + ve[a];
                 eb[a] = rs.eb[a] * solid / S;
-                for (int kk = 0; kk < 9; kk++) psh_tot[a][kk] += psh[a][kk];
+                for (int kk = 0; kk < 9; kk++) psh_tot[a][kk] += psh[a][kk], vsh_tot[a][kk] += vsh[a][kk];
             }
             /* error scalar: irradiance for texels, fluence/4 for probes (equal under uniform
              * radiance, so texels and probes weigh alike in the relative RMSE) */
@@ -1517,8 +1603,12 @@ static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
                     if (out->direct) out->direct[i].c[a][kk] += (float)(psh_tot[a][kk] * w * 0.5);
                 }
             } /* (the irradiance has it already: e above, in tot.e) */
+        if (c->vpl && !sphere) /* glossy VPLs: both halves' draws, weight w; indirect light */
+            for (int a = 0; a < 3; a++)
+                for (int kk = 0; kk < 9; kk++) out->radiance[i].c[a][kk] += (float)(vsh_tot[a][kk] * w * 0.5);
     }
     c->thread_slc_tested[thread] += tested;
+    c->thread_vpl_tested[thread] += vtested;
     c->thread_rays[thread] += cnt.rays + cnt.shadow;
     c->thread_shadow[thread] += cnt.shadow;
     c->thread_nonfinite[thread] += cnt.bad;
@@ -1606,6 +1696,8 @@ static double now_seconds(void)
     return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
+static void vpl_pass_end(tp_ctx *c);
+
 static void free_ctx(tp_ctx *c)
 {
     free(c->cells); free(c->tri_first); free(c->tri_m); free(c->tri_sides); free(c->tri_closed); free(c->tri_cell_h); free(c->tri_edge_eps);
@@ -1634,6 +1726,11 @@ static void free_ctx(tp_ctx *c)
     free(c->thread_slc_tested);
     free(c->slc_cdf);
     free(c->slc_pick_ids);
+    vpl_pass_end(c);
+    bk_slc_destroy(c->vpl_tiles);
+    free(c->vpl_ids);
+    free(c->light_vpl);
+    free(c->thread_vpl_tested);
 }
 
 /* Longest edge of triangle i. */
@@ -1997,18 +2094,23 @@ static double slc_mean_irradiance(const tp_ctx *c)
 
 /* Boxes of the points whose punctual light is culled: every receiver's punctual points, and
  * every cell's sub-triangle (padded by its edge band: cell points are clamped into it). */
-static lbk_result slc_build(tp_ctx *c)
+static void recv_boxes(const tp_ctx *c, float *boxes)
 {
-    const size_t nr = c->recv_count, nc = c->cell_count;
-    float *boxes = malloc(6 * (nr > nc ? nr : nc ? nc : 1) * sizeof(float));
-    if (!boxes) return LBK_ERR_OUT_OF_MEMORY;
-    for (size_t i = 0; i < nr; i++) {
+    for (size_t i = 0; i < c->recv_count; i++) {
         tp_origin g[4];
         int points = punctual_points(c, &c->recv[i], g);
         double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (int q = 0; q < points; q++) box_grow(lo, hi, g[q].p);
         box_out(lo, hi, boxes + 6 * i);
     }
+}
+
+static lbk_result slc_build(tp_ctx *c)
+{
+    const size_t nr = c->recv_count, nc = c->cell_count;
+    float *boxes = malloc(6 * (nr > nc ? nr : nc ? nc : 1) * sizeof(float));
+    if (!boxes) return LBK_ERR_OUT_OF_MEMORY;
+    recv_boxes(c, boxes);
     lbk_result res = bk_slc_create(c->lights, c->light_count, boxes, nr, &c->slc_recv);
     for (size_t ci = 0; ci < nc && res == LBK_OK; ci++) {
         tp_cell_geom g;
@@ -2068,6 +2170,198 @@ static lbk_result slc_init(tp_ctx *c)
     return res == LBK_ERR_UNSUPPORTED_FEATURE ? LBK_OK : res; /* no positional light with power: exact */
 }
 
+/* ---- glossy VPLs (VPL.md "In the transport") ------------------------------------------------ */
+
+/* The surface a photon lands on, as the transport sees it: the hit's cell; glossy cells give
+ * their specular lobe only (F0 = lerp(0.04, base, metallic), α = roughness²: bk_mr_lobe's),
+ * everything else (Lambertian, black, the inside of a solid) makes no VPL: diffuse bounces are
+ * the cache's. */
+static int vpl_material(void *user, const bk_hit *hit, const double x[3], bk_vpl_material *m)
+{
+    (void)x;
+    const tp_ctx *c = (const tp_ctx *)user;
+    const long hc = hit_cell(c, hit);
+    if (hc < 0 || !c->gloss[hc].on) return 0;
+    const tp_gloss *g = &c->gloss[hc];
+    memset(m, 0, sizeof *m);
+    for (int k = 0; k < 3; k++) {
+        const double bc = fmin(fmax(g->base[k], 0.0), 1.0);
+        m->f0[k] = (float)(0.04 + (bc - 0.04) * g->metallic);
+    }
+    m->alpha = g->roughness * g->roughness;
+    return 1;
+}
+
+/* Half h's photons of `pass` from every light that shoots: c->vpls[h] (N·2^pass per light, at
+ * most TP_VPL_PHOTON_CAP over all the lights, ~140 MB of VPLs per half: a level of many lamps
+ * must not shoot N per lamp into gigabytes; each lamp then gets fewer photons, at least 16). */
+#define TP_VPL_PHOTON_CAP ((size_t)1 << 20)
+static lbk_result vpl_shoot_all(tp_ctx *c, int h, int pass)
+{
+    free(c->vpls[h]);
+    c->vpls[h] = NULL;
+    c->vpl_n[h] = 0;
+    size_t shooters = 0;
+    for (size_t li = 0; li < c->light_count; li++) shooters += c->light_vpl[li];
+    size_t n = c->vpl_photons << (pass < 12 ? pass : 12);
+    const size_t cap = TP_VPL_PHOTON_CAP / (shooters ? shooters : 1);
+    if (n > cap) n = cap > 16 ? cap : 16;
+    for (size_t li = 0; li < c->light_count; li++) {
+        if (!c->light_vpl[li]) continue;
+        bk_vpl_shoot_desc sd = {c->scene, c->tracer, NULL, c->seed, n,
+                                c->threads, mix64(((uint64_t)DOM_VPL_SHOOT << 56) ^ ((uint64_t)h << 48) ^
+                                                  ((uint64_t)pass << 32) ^ (uint64_t)li),
+                                vpl_material, c};
+        bk_vpl *v;
+        size_t cnt;
+        lbk_result res = bk_vpl_shoot(&sd, c->lights[li], &v, &cnt);
+        if (res != LBK_OK) return res;
+        bk_vpl *all = realloc(c->vpls[h], (c->vpl_n[h] + cnt + 1) * sizeof *all);
+        if (!all) {
+            free(v);
+            return LBK_ERR_OUT_OF_MEMORY;
+        }
+        memcpy(all + c->vpl_n[h], v, cnt * sizeof *v);
+        c->vpls[h] = all;
+        c->vpl_n[h] += cnt;
+        free(v);
+    }
+    return LBK_OK;
+}
+
+/* This pass's VPLs and draws (one per half; ξ per VPL from the stream (seed, DOM_VPL_XI, half,
+ * pass, the VPL's index: lights in order, photons in order), δ/2^pass) and the threads' room for tile lists. */
+static lbk_result vpl_pass(tp_ctx *c, int pass)
+{
+    for (int h = 0; h < 2; h++) {
+        lbk_result res = vpl_shoot_all(c, h, pass);
+        if (res != LBK_OK) return res;
+        c->vpl_made += c->vpl_n[h];
+        double *xi = malloc((c->vpl_n[h] ? c->vpl_n[h] : 1) * sizeof *xi);
+        if (!xi) return LBK_ERR_OUT_OF_MEMORY;
+        for (size_t k = 0; k < c->vpl_n[h]; k++) {
+            tp_rng r = rng_make(c->seed, DOM_VPL_XI, (uint64_t)h, (uint64_t)pass, 0, k);
+            xi[k] = rng_next(&r);
+        }
+        res = bk_vpl_draw_create(c->vpls[h], c->vpl_n[h], xi, ldexp(c->vpl_delta, -(pass < 60 ? pass : 60)),
+                                 BK_VPL_BOUND_ELLIPSOID, c->vpl_tiles, c->threads, &c->vpl_draw[h]);
+        free(xi);
+        if (res != LBK_OK) return res;
+    }
+    const size_t cap = c->vpl_n[0] > c->vpl_n[1] ? c->vpl_n[0] : c->vpl_n[1];
+    if (cap > c->vpl_cap || !c->vpl_ids) {
+        free(c->vpl_ids);
+        c->vpl_cap = cap ? cap : 1;
+        c->vpl_ids = malloc(2 * (size_t)c->threads * c->vpl_cap * sizeof(uint32_t));
+        if (!c->vpl_ids) return LBK_ERR_OUT_OF_MEMORY;
+    }
+    return LBK_OK;
+}
+
+static void vpl_pass_end(tp_ctx *c)
+{
+    for (int h = 0; h < 2; h++) {
+        bk_vpl_draw_destroy(c->vpl_draw[h]);
+        c->vpl_draw[h] = NULL;
+        free(c->vpls[h]);
+        c->vpls[h] = NULL;
+        c->vpl_n[h] = 0;
+    }
+}
+
+/* What the VPLs' δ is relative to: the mean irradiance that pass 0's VPLs (half 0, as vpl_sharp_
+ * share leaves them) give the surface receivers, by brute force at up to 256 of them spread
+ * evenly by index (their points, as the gather takes them). Then one draw's relative RMSE of the
+ * VPL light over the receivers is at most √δ_rel (VPL.md), whatever the direct light. */
+static double vpl_mean_irradiance(tp_ctx *c)
+{
+    enum { K = 256 };
+    const size_t n = c->recv_count, k = n < K ? n : K;
+    bk_vpl_point *pts = malloc(4 * K * sizeof *pts);
+    double *irr = malloc(3 * 4 * K * sizeof *irr);
+    size_t np = 0;
+    for (size_t q = 0; q < k && pts && irr; q++) {
+        const bk_receiver *r = &c->recv[q * n / k];
+        if (!(r->normal[0] != 0 || r->normal[1] != 0 || r->normal[2] != 0)) continue;
+        tp_origin g[4];
+        const int points = punctual_points(c, r, g);
+        for (int j = 0; j < points; j++, np++)
+            for (int a = 0; a < 3; a++) pts[np].p[a] = g[j].p[a], pts[np].n[a] = g[j].n[a], pts[np].org[a] = g[j].o[a];
+    }
+    double sum = 0;
+    int ok = pts && irr && np &&
+             bk_vpl_gather(c->vpls[0], c->vpl_n[0], NULL, c->tracer, pts, np, c->threads, irr, NULL) == LBK_OK;
+    for (size_t j = 0; ok && j < np; j++) sum += bk_lum(irr + 3 * j); /* (a texel's 4 points: its mean, × 4) */
+    free(pts);
+    free(irr);
+    return ok ? sum / (double)np : 0;
+}
+
+/* What auto measures: the share of the shooting lights' flux (its upper bound lum(I)·Ω) that
+ * pass 0's photons (half 0) put into sharp glossy VPLs (α ≤ BK_VPL_AUTO_ROUGHNESS², weighted by
+ * lum(Φ·F0): what they reflect specularly). */
+static double vpl_sharp_share(tp_ctx *c)
+{
+    if (vpl_shoot_all(c, 0, 0) != LBK_OK) return 0;
+    double sharp = 0, emitted = 0;
+    const double amax = BK_VPL_AUTO_ROUGHNESS * BK_VPL_AUTO_ROUGHNESS;
+    for (size_t k = 0; k < c->vpl_n[0]; k++) {
+        const bk_vpl *v = &c->vpls[0][k];
+        double pf[3] = {v->flux[0] * v->refl[0], v->flux[1] * v->refl[1], v->flux[2] * v->refl[2]};
+        if (v->alpha <= amax * (1 + 1e-5)) sharp += bk_lum(pf); /* (float roughness 0.3f counts as 0.3) */
+    }
+    for (size_t li = 0; li < c->light_count; li++) {
+        if (!c->light_vpl[li]) continue;
+        const bk_light *l = c->lights[li];
+        double col[3] = {l->color[0], l->color[1], l->color[2]};
+        const double outer = l->type == BK_LIGHT_SPOT && l->outer_cone > 0 && l->outer_cone < TP_PI ? l->outer_cone : TP_PI;
+        emitted += bk_lum(col) * 2 * TP_PI * (1 - cos(outer));
+    }
+    return emitted > 0 ? sharp / emitted : 0;
+}
+
+/* Whether this run adds glossy VPLs (options.glossy_vpl; auto: vpl_sharp_share ≥
+ * BK_VPL_AUTO_SHARE), which lights shoot (positional ones with power), the receivers' tiles and
+ * δ (relative to the smallest class mean of the punctual irradiance, as SLC's). Needs a glossy
+ * cell, a light that shoots and a surface receiver; else off and nothing else changes. */
+static lbk_result vpl_init(tp_ctx *c)
+{
+    const bk_transport_options *opt = c->opt;
+    if (opt->glossy_vpl < 0 || !c->gloss || !c->light_count || !c->recv_count) return LBK_OK;
+    int surface = 0;
+    for (size_t i = 0; i < c->recv_count && !surface; i++) {
+        const float *n = c->recv[i].normal;
+        surface = n[0] != 0 || n[1] != 0 || n[2] != 0;
+    }
+    if (!surface) return LBK_OK;
+    c->light_vpl = calloc(c->light_count, 1);
+    if (!c->light_vpl) return LBK_ERR_OUT_OF_MEMORY;
+    int shooters = 0;
+    for (size_t li = 0; li < c->light_count; li++) {
+        const float *col = c->lights[li]->color;
+        double v[3] = {isfinite(col[0]) && col[0] > 0 ? col[0] : 0, isfinite(col[1]) && col[1] > 0 ? col[1] : 0,
+                       isfinite(col[2]) && col[2] > 0 ? col[2] : 0};
+        c->light_vpl[li] = c->lights[li]->type != BK_LIGHT_DIRECTIONAL && bk_lum(v) > 0;
+        shooters += c->light_vpl[li];
+    }
+    if (!shooters) return LBK_OK;
+    c->vpl_photons = opt->glossy_vpl_photons > 0 ? opt->glossy_vpl_photons : BK_VPL_DEFAULT_PHOTONS;
+    c->vpl_share = vpl_sharp_share(c);
+    const double mean = opt->glossy_vpl > 0 || c->vpl_share >= BK_VPL_AUTO_SHARE ? vpl_mean_irradiance(c) : 0;
+    vpl_pass_end(c);
+    if (!(mean > 0) || !isfinite(mean)) return LBK_OK; /* off, or no VPL light reaches a receiver */
+    c->vpl_delta = (opt->glossy_vpl_delta > 0 && isfinite(opt->glossy_vpl_delta) ? opt->glossy_vpl_delta
+                                                                                  : BK_VPL_DEFAULT_DELTA) * mean;
+    float *boxes = malloc(6 * c->recv_count * sizeof(float));
+    if (!boxes) return LBK_ERR_OUT_OF_MEMORY;
+    recv_boxes(c, boxes);
+    lbk_result res = bk_slc_create(NULL, 0, boxes, c->recv_count, &c->vpl_tiles);
+    free(boxes);
+    if (res != LBK_OK) return res;
+    c->vpl = 1;
+    return LBK_OK;
+}
+
 /* Everything a run needs before its first pass: counters, the light selection, cells,
  * emitters, the per-half radiance arrays and the receivers' accumulators. */
 static lbk_result ctx_init(tp_ctx *c)
@@ -2078,7 +2372,9 @@ static lbk_result ctx_init(tp_ctx *c)
     c->thread_nonfinite = calloc((size_t)c->threads, sizeof(uint64_t));
     c->thread_shadow = calloc((size_t)c->threads, sizeof(uint64_t));
     c->thread_slc_tested = calloc((size_t)c->threads, sizeof(uint64_t));
-    if (!c->thread_rays || !c->thread_nonfinite || !c->thread_shadow || !c->thread_slc_tested) return LBK_ERR_OUT_OF_MEMORY;
+    c->thread_vpl_tested = calloc((size_t)c->threads, sizeof(uint64_t));
+    if (!c->thread_rays || !c->thread_nonfinite || !c->thread_shadow || !c->thread_slc_tested || !c->thread_vpl_tested)
+        return LBK_ERR_OUT_OF_MEMORY;
     /* scale of the coordinates: offsets for receivers, which carry no triangle */
     for (size_t i = 0; i < scene->tri_count; i++) {
         float sc = bk_tracer_tri_scale(c->tracer, (uint32_t)i);
@@ -2095,6 +2391,7 @@ static lbk_result ctx_init(tp_ctx *c)
     lbk_result res = build_cells(c);
     if (res == LBK_OK) res = build_emitters(c);
     if (res == LBK_OK) res = slc_init(c);
+    if (res == LBK_OK) res = vpl_init(c);
     if (res != LBK_OK) return res;
     size_t nc = c->cell_count ? c->cell_count : 1, n = c->recv_count ? c->recv_count : 1;
     for (int h = 0; h < 2; h++) {
@@ -2248,6 +2545,10 @@ static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
     c->pass_weight = ldexp(1.0, pass);
     for (int h = 0; h < 2 && c->slc; h++)
         if (slc_draw(c, DOM_SLC_RECV, h, pass, c->slc_recv, &c->draw_recv[h]) != LBK_OK) return LBK_ERR_OUT_OF_MEMORY;
+    if (c->vpl) {
+        lbk_result res = vpl_pass(c, pass);
+        if (res != LBK_OK) return res;
+    }
     size_t block = active / 8 + 1, done = 0;
     for (int k = 0; k < c->ncls; k++) {
         if (!c->cls[k].active) continue;
@@ -2268,6 +2569,7 @@ static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
         bk_slc_draw_destroy(c->draw_recv[h]);
         c->draw_recv[h] = NULL;
     }
+    vpl_pass_end(c);
     if (c->oct_count) {
         const int f = c->opt->octa_ray_factor > 0 ? c->opt->octa_ray_factor : 4;
         c->oct_rays = c->rays * (f > 64 ? 64 : f);
@@ -2475,6 +2777,13 @@ static void fill_stats(const tp_ctx *c, int passes, double err, double bias, con
     double recv_spp = 0; /* receiver-draws: each receiver draws twice (halves) per pass it sampled */
     for (int k = 0; k < c->ncls; k++) recv_spp += (double)(c->cls[k].end - c->cls[k].begin);
     stats->slc_lights_tested = recv_spp > 0 ? (double)tested / recv_spp : 0;
+    stats->vpl = c->vpl;
+    stats->vpl_delta = c->vpl_delta;
+    stats->vpl_share = c->vpl_share;
+    stats->vpl_made = c->vpl_made;
+    uint64_t vt = 0;
+    for (int t = 0; t < c->threads; t++) vt += c->thread_vpl_tested[t];
+    stats->vpl_tested = recv_spp > 0 ? (double)vt / recv_spp : 0;
 }
 
 /* ---- distributed runs (bk_transport_split) ------------------------------------------------ */

@@ -239,6 +239,18 @@ typedef struct bk_transport_options {
      * δ × that mean (pass p: δ/2^p), and one draw's level-wide relative RMSE is ≤ √(δ/2);
      * 0: BK_SLC_DEFAULT_DELTA. Smaller: more lights per receiver, less noise. */
     double slc_delta;
+    /* Glossy VPLs (seed 002; bake/transport/VPL.md "In the transport"): photons from every
+     * point and spot light make a VPL where they land on a glossy cell (its specular lobe),
+     * culled stochastically against the receivers' tiles (the seed's spheroids) and gathered
+     * at every surface receiver with shadow rays, per half and pass (unbiased, in the error
+     * estimate); the receivers' gather then takes those lights at its first glossy hit through
+     * the diffuse part only, so the light → glossy → receiver path is counted once.
+     * 0 auto = on where the lights' photons put at least BK_VPL_AUTO_SHARE of their flux into
+     * glossy surfaces of roughness ≤ BK_VPL_AUTO_ROUGHNESS; 1 on; -1 off. */
+    int glossy_vpl;
+    size_t glossy_vpl_photons; /* per light and half in pass 0 (pass p: × 2^p); 0: BK_VPL_DEFAULT_PHOTONS */
+    double glossy_vpl_delta;   /* δ relative to the mean irradiance the VPLs give the surface
+                                  receivers (pass p: δ/2^p); 0: BK_VPL_DEFAULT_DELTA */
     /* The stop rule's receivers per class (TRANSPORT.md §Stop subset): a class of more than
      * this many stops on the estimate over a hash-stratified subset of this many of its
      * receivers (the reported estimate stays over all of them), so a unit of a distributed run
@@ -268,6 +280,12 @@ typedef struct bk_transport_options {
  * bench_slc). */
 #define BK_SLC_AUTO_LIGHTS 32
 #define BK_SLC_DEFAULT_DELTA 0.1
+
+/* Glossy VPLs' defaults and auto rule (VPL.md "In the transport", measured by bench_vpl_bake). */
+#define BK_VPL_DEFAULT_PHOTONS 1024
+#define BK_VPL_DEFAULT_DELTA 0.1
+#define BK_VPL_AUTO_ROUGHNESS 0.3
+#define BK_VPL_AUTO_SHARE 0.05
 
 /* Caller-owned output arrays, `count` entries each; NULL pointers are skipped. */
 typedef struct bk_transport_output {
@@ -322,6 +340,12 @@ typedef struct bk_transport_stats {
     int slc;                 /* 1 when punctual lights were culled (options.slc) */
     double slc_delta;        /* the δ of pass 0 in irradiance units (0 without culling) */
     double slc_lights_tested;/* per receiver over the run: lights its tiles' lists gave it to test */
+    int vpl;                 /* 1 when glossy VPLs were gathered (options.glossy_vpl) */
+    double vpl_delta;        /* their δ of pass 0 in irradiance units (0 without) */
+    double vpl_share;        /* what auto measured: the shooting lights' flux share in sharp glossy
+                                VPLs (0 when not measured: no glossy cell or no shooting light) */
+    uint64_t vpl_made;       /* VPLs made over the run (both halves, all passes) */
+    double vpl_tested;       /* per receiver over the run: VPLs its tiles' lists gave it to test */
 } bk_transport_stats;
 
 /* Computes radiance at `count` receivers. The tracer must have been built from `scene`.

@@ -71,9 +71,15 @@ static int shoot_one(const shoot_job *j, size_t i, bk_vpl out[2])
         wi[k] = ld[k];
     }
     if (dot3(wi, n) <= 0) return 0; /* a grazing hit rounded to the back: no lobe faces the light */
-    const uint32_t m = d->scene->tri_material[h.tri];
-    if (m >= d->scene->material_count) return 0;
-    const bk_vpl_material *mat = &d->materials[m];
+    bk_vpl_material own;
+    const bk_vpl_material *mat = &own;
+    if (d->material_at) {
+        if (!d->material_at(d->user, &h, x, &own)) return 0;
+    } else {
+        const uint32_t m = d->scene->tri_material[h.tri];
+        if (m >= d->scene->material_count) return 0;
+        mat = &d->materials[m];
+    }
     float xf[3] = {(float)x[0], (float)x[1], (float)x[2]}, nf[3] = {(float)n[0], (float)n[1], (float)n[2]}, of[3];
     bk_offset_ray_origin_scaled(xf, nf, bk_tracer_tri_scale(d->tracer, h.tri), of);
     double pos[3] = {of[0], of[1], of[2]};
@@ -96,7 +102,8 @@ lbk_result bk_vpl_shoot(const bk_vpl_shoot_desc *desc, const bk_light *light, bk
     if (!out || !count) return LBK_ERR_INVALID_ARGUMENT;
     *out = NULL;
     *count = 0;
-    if (!desc || !light || !desc->scene || !desc->tracer || (desc->scene->material_count && !desc->materials) ||
+    if (!desc || !light || !desc->scene || !desc->tracer ||
+        (desc->scene->material_count && !desc->materials && !desc->material_at) ||
         desc->photons > BK_VPL_MAX_PHOTONS)
         return LBK_ERR_INVALID_ARGUMENT;
     if (light->type == BK_LIGHT_DIRECTIONAL) return LBK_ERR_UNSUPPORTED_FEATURE;
@@ -424,14 +431,33 @@ void bk_vpl_draw_destroy(bk_vpl_draw *d)
     free(d);
 }
 
+/* 1 when the whole box lies strictly behind v's surface plane ((x − q)·n < 0 everywhere, with a
+ * margin for rounding): v's intensity is exactly 0 there (bk_vpl_intensity: ω_o·n ≤ 0), so the
+ * tile needs no test of it. The spheroid itself reaches behind the plane near q, so without this
+ * every receiver tile on the VPLs' own floor listed them (the transport's metal room: most of the
+ * gather's work). */
+static int box_behind(const bk_vpl *v, const float box[6])
+{
+    double m = 0, mag = 0;
+    for (int k = 0; k < 3; k++) {
+        const double a = v->n[k] * ((double)box[k] - v->pos[k]), b = v->n[k] * ((double)box[3 + k] - v->pos[k]);
+        m += a > b ? a : b;
+        mag += fabs(v->pos[k]) + fabs((double)box[3 + k]) + fabs((double)box[k]);
+    }
+    return m < -1e-9 * (mag + 1);
+}
+
 size_t bk_vpl_tile_list(const bk_vpl_draw *d, size_t item, uint32_t *ids)
 {
     if (item >= bk_slc_item_count(d->tiles)) return 0;
     const size_t k = item / BK_SLC_BLOCK;
     const float *box = bk_slc_tile_box(d->tiles, item / BK_SLC_TILE);
+    if (!(box[0] <= box[3] && box[1] <= box[4] && box[2] <= box[5])) return 0; /* an empty tile */
     size_t n = 0;
-    for (uint32_t j = 0; j < d->list_n[k]; j++)
-        if (bk_vpl_volume_meets_box(&d->vol[d->list[k][j]], box)) ids[n++] = d->list[k][j];
+    for (uint32_t j = 0; j < d->list_n[k]; j++) {
+        const uint32_t vi = d->list[k][j];
+        if (!box_behind(&d->vpls[vi], box) && bk_vpl_volume_meets_box(&d->vol[vi], box)) ids[n++] = vi;
+    }
     return n;
 }
 
@@ -448,33 +474,54 @@ typedef struct gather_job {
     uint64_t (*st)[3]; /* per tile: listed (UINT64_MAX: out of memory), accepted, rays */
 } gather_job;
 
-/* VPL v at point q with weight 1/p (0: rejected). */
+double bk_vpl_draw_xi(const bk_vpl_draw *d, uint32_t vi) { return vi < d->count ? d->xi[vi] : 0; }
+double bk_vpl_draw_delta(const bk_vpl_draw *d) { return d->delta; }
+
+int bk_vpl_eval(const bk_vpl *v, double xi, double delta, const bk_tracer *tracer, const bk_vpl_point *q,
+                double rgb[3], double to[3], int *accepted, int *ray)
+{
+    *accepted = *ray = 0;
+    double wo[3] = {q->p[0] - v->pos[0], q->p[1] - v->pos[1], q->p[2] - v->pos[2]};
+    const double l2 = dot3(wo, wo), l = sqrt(l2);
+    if (!(l > 0)) return 0;
+    for (int k = 0; k < 3; k++) wo[k] /= l;
+    double in[3];
+    const double lum = bk_vpl_intensity(v, wo, in);
+    if (!(lum > 0)) return 0;
+    double w = 1;
+    if (delta > 0) {
+        w = bk_slc_weight(lum / l2, delta, xi);
+        if (w == 0) return 0;
+        *accepted = 1;
+    }
+    const int has_n = q->n[0] != 0 || q->n[1] != 0 || q->n[2] != 0;
+    if (has_n && !(dot3(wo, q->n) < 0)) return 0;
+    double t[3] = {v->pos[0] - q->org[0], v->pos[1] - q->org[1], v->pos[2] - q->org[2]};
+    const double tl = sqrt(dot3(t, t));
+    if (!(tl > 0)) return 0;
+    for (int k = 0; k < 3; k++) to[k] = t[k] / tl;
+    *ray = 1;
+    if (!bk_light_visible(tracer, q->org, to, tl)) return 0;
+    for (int k = 0; k < 3; k++) rgb[k] = in[k] / l2 * w;
+    return 1;
+}
+
+/* VPL v at point q with weight 1/p (0: rejected). The cosine is the receiver's, −ω_o·n. */
 static void gather_one(const gather_job *j, const bk_vpl *v, double xi, const bk_vpl_point *q, double acc[3],
                        uint64_t *accepted, uint64_t *rays)
 {
+    double rgb[3], to[3];
+    int acc_one, ray;
+    const int hit = bk_vpl_eval(v, xi, j->d ? j->d->delta : 0, j->tracer, q, rgb, to, &acc_one, &ray);
+    *accepted += (uint64_t)acc_one;
+    *rays += (uint64_t)ray;
+    if (!hit) return;
     double wo[3] = {q->p[0] - v->pos[0], q->p[1] - v->pos[1], q->p[2] - v->pos[2]};
-    const double l2 = dot3(wo, wo), l = sqrt(l2);
-    if (!(l > 0)) return;
+    const double l = sqrt(dot3(wo, wo));
     for (int k = 0; k < 3; k++) wo[k] /= l;
-    double rgb[3];
-    const double lum = bk_vpl_intensity(v, wo, rgb);
-    if (!(lum > 0)) return;
-    double w = 1;
-    if (j->d) {
-        w = bk_slc_weight(lum / l2, j->d->delta, xi);
-        if (w == 0) return;
-        (*accepted)++;
-    }
     const int has_n = q->n[0] != 0 || q->n[1] != 0 || q->n[2] != 0;
     const double cy = has_n ? -dot3(wo, q->n) : 1;
-    if (!(cy > 0)) return;
-    double to[3] = {v->pos[0] - q->org[0], v->pos[1] - q->org[1], v->pos[2] - q->org[2]};
-    const double tl = sqrt(dot3(to, to));
-    if (!(tl > 0)) return;
-    for (int k = 0; k < 3; k++) to[k] /= tl;
-    (*rays)++;
-    if (!bk_light_visible(j->tracer, q->org, to, tl)) return;
-    for (int k = 0; k < 3; k++) acc[k] += rgb[k] * cy / l2 * w;
+    for (int k = 0; k < 3; k++) acc[k] += rgb[k] * cy;
 }
 
 static void gather_tiles(void *user, size_t begin, size_t end, int thread)

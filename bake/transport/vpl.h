@@ -22,7 +22,8 @@
  * Determinism: photons and lists depend only on the seed, the ξ, δ and the boxes; every
  * receiver sums its VPLs in index order: byte-identical at any thread count (tested). Nothing
  * is clamped: a receiver very close to a VPL receives I/l² (the VPL singularity), unbiased,
- * with the variance that brings (VPL.md). Library only: `lbk bake` does not use VPLs yet. */
+ * with the variance that brings (VPL.md). `lbk bake` uses the glossy VPLs where they pay
+ * (bake/transport/transport.c, VPL.md "In the transport"). */
 #ifndef BK_VPL_H
 #define BK_VPL_H
 
@@ -76,6 +77,12 @@ typedef struct bk_vpl_shoot_desc {
     int threads;                       /* 0: every core */
     uint64_t key;                      /* names the photons' stream with the seed: give each
                                           light (and pass) its own, or their photons correlate */
+    /* NULL: `materials` by the hit triangle's material. Else the surface at each photon hit
+     * (the hit, and the hit point x): fills *m and returns 1, or returns 0 where the photon
+     * makes no VPL (a textured or per-cell material, a surface the caller treats as black).
+     * Must be deterministic and thread-safe. */
+    int (*material_at)(void *user, const bk_hit *hit, const double x[3], bk_vpl_material *m);
+    void *user;
 } bk_vpl_shoot_desc;
 
 /* Shooting holds 2 VPL slots (136 bytes each) per photon: 2^22 photons take 1.1 GB at most. */
@@ -128,6 +135,18 @@ typedef struct bk_vpl_stats {
     uint64_t accepted;  /* of those, accepted (ξ < p): the rest are the culling's false positives */
     uint64_t rays;      /* shadow rays */
 } bk_vpl_stats;
+
+/* ξ of VPL vi in the draw, and the draw's δ. */
+double bk_vpl_draw_xi(const bk_vpl_draw *d, uint32_t vi);
+double bk_vpl_draw_delta(const bk_vpl_draw *d);
+
+/* One VPL at one receiver, as bk_vpl_gather evaluates it: with culling (delta > 0) weight 1/p
+ * where ξ < p = min(lum(I(ω_o))/(δl²), 1), else 0; then a shadow ray. Returns 1 (and *ray = 1)
+ * when it contributes: rgb = weight·I(ω_o)/l² (the irradiance at normal incidence) arriving
+ * from unit direction `to` (receiver → VPL); the receiver's cosine is the caller's (rgb·(n·to)).
+ * *accepted = 1 when the draw accepted it (before the shadow ray). */
+int bk_vpl_eval(const bk_vpl *v, double xi, double delta, const bk_tracer *tracer, const bk_vpl_point *q,
+                double rgb[3], double to[3], int *accepted, int *ray);
 
 /* Irradiance (3 per point) at the n points, which are the items of d's tiles (n ≤ the bk_slc's
  * items); d NULL: brute force, every VPL with weight 1. stats may be NULL. */

@@ -206,6 +206,18 @@ static void test_desc_rules(void **state)
     d.light_culling_delta = NAN;
     expect_fail(&l.scene, &d, &s, LBK_ERR_INVALID_ARGUMENT, "light_culling_delta");
     d = quick(&s);
+    d.size = sizeof d; /* (the glossy VPL fields: added in 1.7) */
+    d.glossy_vpl = -2;
+    expect_fail(&l.scene, &d, &s, LBK_ERR_INVALID_ARGUMENT, "glossy_vpl: -2");
+    d = quick(&s);
+    d.size = sizeof d;
+    d.glossy_vpl_photons = -1;
+    expect_fail(&l.scene, &d, &s, LBK_ERR_INVALID_ARGUMENT, "glossy_vpl_photons");
+    d = quick(&s);
+    d.size = sizeof d;
+    d.glossy_vpl_delta = INFINITY;
+    expect_fail(&l.scene, &d, &s, LBK_ERR_INVALID_ARGUMENT, "glossy_vpl_delta");
+    d = quick(&s);
     d.size = 2; /* not even its own size field: nothing in it can be read, no message */
     lbk_bake_output *out = NULL;
     assert_int_equal(lbk_bake_from_scene(&l.scene, &d, &out), LBK_ERR_INVALID_ARGUMENT);

@@ -55,7 +55,7 @@ extern "C" {
 /* The baker library's version (lbk-bake.pc): the minor grows with every addition to the
  * size-tagged structs below ("added in 1.x"). */
 #define LBK_BAKE_LIBRARY_VERSION_MAJOR 1
-#define LBK_BAKE_LIBRARY_VERSION_MINOR 6
+#define LBK_BAKE_LIBRARY_VERSION_MINOR 7
 #define LBK_BAKE_LIBRARY_VERSION_PATCH 0
 
 /* ---- options ----------------------------------------------------------------------------- */
@@ -216,6 +216,16 @@ typedef struct lbk_bake_desc {
                                    (pipes, rails, stacked props; neither box inside the other) get
                                    half the probe spacing (seed 001's extra probes for connected
                                    objects; bake/probes/PROBES.md) [0: off] */
+    /* added in 1.7: glossy VPLs (seed 002; bake/transport/VPL.md "In the transport") */
+    int glossy_vpl;             /* photons from point and spot lights make VPLs on glossy
+                                   surfaces, gathered at the lightmap texels (glossy-to-diffuse
+                                   caustics): 1 on, -1 off [0: auto, on where the lights put at
+                                   least 5 % of their flux into glossy surfaces of roughness
+                                   <= 0.3] */
+    int glossy_vpl_photons;     /* photons per light and half in the first pass, doubling with
+                                   every pass [0: 1024] */
+    double glossy_vpl_delta;    /* the VPLs' culling δ relative to the mean irradiance they give
+                                   the texels (smaller: more VPLs per texel, less noise) [0: 0.1] */
 } lbk_bake_desc;
 
 /* A file a bake read (the glTF, its buffers and images, a sky EXR), as META input.files
