@@ -159,7 +159,7 @@ static double subset_err(const room *R, const bk_vpl *v, size_t nv, size_t K, co
  * (the intensity's maximum) against the seed's §6 sphere. */
 static void diffuse(room *R, const bk_slc *tiles, double delta_rel, double *bf, double *irr)
 {
-    bk_vpl_shoot_desc sd = {&R->s, R->t, R->mats, 1, NVPL, 1, 1};
+    bk_vpl_shoot_desc sd = {.scene = &R->s, .tracer = R->t, .materials = R->mats, .seed = 1, .photons = NVPL, .threads = 1, .key = 1};
     bk_vpl *v = NULL;
     size_t nv = 0;
     if (bk_vpl_shoot(&sd, &R->s.lights[1], &v, &nv) != LBK_OK) abort();
@@ -198,7 +198,7 @@ static void run(room *R, const bk_slc *tiles, double delta_rel, double *bf, doub
            NVPL, NRECV, R->s.tri_count, delta_rel, DRAWS);
     for (int a = 0; a < 4; a++) {
         R->mats[0].alpha = (float)alphas[a];
-        bk_vpl_shoot_desc sd = {&R->s, R->t, R->mats, 1, NVPL, 1, 0};
+        bk_vpl_shoot_desc sd = {.scene = &R->s, .tracer = R->t, .materials = R->mats, .seed = 1, .photons = NVPL, .threads = 1, .key = 0};
         bk_vpl *v = NULL;
         size_t nv = 0;
         if (bk_vpl_shoot(&sd, &R->s.lights[0], &v, &nv) != LBK_OK) abort();

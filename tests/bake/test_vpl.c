@@ -68,7 +68,7 @@ static void room_free(room *R)
 
 static bk_vpl *room_vpls(const room *R, size_t photons, uint64_t seed, int threads, size_t *count)
 {
-    bk_vpl_shoot_desc d = {&R->s, R->t, R->mats, seed, photons, threads, 0};
+    bk_vpl_shoot_desc d = {.scene = &R->s, .tracer = R->t, .materials = R->mats, .seed = seed, .photons = photons, .threads = threads, .key = 0};
     bk_vpl *v = NULL;
     assert_int_equal(bk_vpl_shoot(&d, &R->s.lights[0], &v, count), LBK_OK);
     return v;
@@ -487,7 +487,7 @@ static void test_threads_identical(void **state)
     assert_int_equal(n1, n3);
     assert_memory_equal(v1, v3, n1 * sizeof *v1);
     { /* another key, another stream */
-        bk_vpl_shoot_desc d = {&R.s, R.t, R.mats, 8, 3000, 1, 1};
+        bk_vpl_shoot_desc d = {.scene = &R.s, .tracer = R.t, .materials = R.mats, .seed = 8, .photons = 3000, .threads = 1, .key = 1};
         bk_vpl *vk = NULL;
         size_t nk = 0;
         assert_int_equal(bk_vpl_shoot(&d, &R.s.lights[0], &vk, &nk), LBK_OK);
@@ -532,7 +532,7 @@ static void test_arguments(void **state)
     (void)state;
     room R;
     room_make(&R, 0.1, 0);
-    bk_vpl_shoot_desc d = {&R.s, R.t, R.mats, 1, 0, 1, 0};
+    bk_vpl_shoot_desc d = {.scene = &R.s, .tracer = R.t, .materials = R.mats, .seed = 1, .photons = 0, .threads = 1, .key = 0};
     bk_vpl *v = NULL;
     size_t nv = 7;
     assert_int_equal(bk_vpl_shoot(&d, &R.s.lights[0], &v, &nv), LBK_OK);
@@ -630,7 +630,7 @@ static void test_gather_matches_the_floor_integral(void **state)
         }
     double mean[NQ] = {0}, sq[NQ] = {0};
     for (int k = 0; k < M; k++) {
-        bk_vpl_shoot_desc d = {&s, t, &mat, 50 + (uint64_t)k, 20000, 2, 0};
+        bk_vpl_shoot_desc d = {.scene = &s, .tracer = t, .materials = &mat, .seed = 50 + (uint64_t)k, .photons = 20000, .threads = 2, .key = 0};
         bk_vpl *v = NULL;
         size_t nv = 0;
         assert_int_equal(bk_vpl_shoot(&d, &s.lights[0], &v, &nv), LBK_OK);
