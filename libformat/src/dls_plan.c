@@ -156,6 +156,7 @@ static void prefetch_lines(const void *p, size_t bytes, int write)
 }
 static void prefetch_run(const lbk_dls_runtime *r, uint32_t space, uint64_t t, uint32_t len, uint32_t *hint)
 {
+    if (r->linear && r->kern->lin_streams) return; /* written without reads: lin_streams */
     if (space != LBK_DLS_SPACE_TEXEL && r->linear) { /* the prepared data streams; the outputs jump */
         if (r->probe_lin[space]) prefetch_lines(r->probe_lin[space] + 27 * t, 4 * 27 * (size_t)len, 1);
         return;
