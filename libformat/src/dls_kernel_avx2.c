@@ -701,6 +701,14 @@ INL float lin_one(const float *base, const float *const *src, const float *w, ui
     return acc;
 }
 
+/* Step of 4 floats (one texel's plane; the ends of a stretch), an ordinary store. */
+INL void lin_step4(const float *base, const float *const *src, const float *w, uint32_t m, size_t i, float *out)
+{
+    __m128 a = _mm_loadu_ps(base + i);
+    for (uint32_t j = 0; j < m; j++) a = _mm_add_ps(a, _mm_mul_ps(_mm_set1_ps(w[j]), _mm_loadu_ps(src[j] + i)));
+    _mm_storeu_ps(out + i, a);
+}
+
 /* Step of 16 floats (one 64-byte output line) with two accumulators. */
 INL void lin_step16(const float *base, const float *const *src, const vf *wv, uint32_t m, size_t i, float *out, int stream)
 {
@@ -727,7 +735,9 @@ static void lin_sum_wide(const float *base, const float *const *src, const float
     size_t i = 0;
     const uintptr_t mis = (uintptr_t)out % 64;
     if (mis % 4 == 0 && n >= 16) { /* up to the first line boundary, then whole lines streamed */
-        for (const size_t head = mis ? (64 - mis) / 4 : 0; i < head; i++) out[i] = lin_one(base, src, w, m, i);
+        const size_t head = mis ? (64 - mis) / 4 : 0;
+        for (; i + 4 <= head; i += 4) lin_step4(base, src, w, m, i, out);
+        for (; i < head; i++) out[i] = lin_one(base, src, w, m, i);
         for (; i + 16 <= n; i += 16) lin_step16(base, src, wv, m, i, out, 1);
     }
     for (; i + 16 <= n; i += 16) lin_step16(base, src, wv, m, i, out, 0);
@@ -736,6 +746,7 @@ static void lin_sum_wide(const float *base, const float *const *src, const float
         for (uint32_t j = 0; j < m; j++) a = add(a, mul(wv[j], _mm256_loadu_ps(src[j] + i)));
         _mm256_storeu_ps(out + i, a);
     }
+    if (i + 4 <= n) lin_step4(base, src, w, m, i, out), i += 4;
     for (; i < n; i++) out[i] = lin_one(base, src, w, m, i);
 }
 
