@@ -710,8 +710,17 @@ INL void lin_step4(const float *base, const float *const *src, const float *w, u
 }
 
 /* Step of 16 floats (one 64-byte output line) with two accumulators. */
+/* Inputs are fetched this many floats (1 KiB) ahead: a cluster's 3·(1 + m) input streams advance
+ * one chart row at a time, interleaved, and the hardware's stream prefetcher, which stops at each
+ * 4 KiB boundary, lags them. Measured on the ESTATE-sized level (bench_dls, one thread, four
+ * alternations, non-temporal outputs): 0.47 of memcpy without, 0.50 / 0.51 / 0.50 at 128 / 256 /
+ * 512 floats. A prefetch past an array's end is harmless (prefetches do not fault). */
+#define LIN_PREFETCH 256
+
 INL void lin_step16(const float *base, const float *const *src, const vf *wv, uint32_t m, size_t i, float *out, int stream)
 {
+    _mm_prefetch((const char *)(base + i + LIN_PREFETCH), _MM_HINT_T0);
+    for (uint32_t j = 0; j < m; j++) _mm_prefetch((const char *)(src[j] + i + LIN_PREFETCH), _MM_HINT_T0);
     vf a0 = _mm256_loadu_ps(base + i), a1 = _mm256_loadu_ps(base + i + 8);
     for (uint32_t j = 0; j < m; j++) {
         const float *s = src[j] + i;
