@@ -12,7 +12,7 @@
  * Both modes of the runtime: bytes (AHD / packed SH9 outputs, the bytes of the scalar
  * definition) and linear (LBK_DLS_RUNTIME_LINEAR: float outputs from prepared floats, whose
  * traffic is 48 bytes per texel and 108 per probe for each base, entry and output; memcpy is
- * measured on that traffic), with the linear mode's prepared memory. Threads run the jobs of
+ * measured on that traffic), with the linear mode's prepared memory (both modes on the baked levels too). Threads run the jobs of
  * lbk_dls_apply_begin (bk_parallel_chunks), memcpy on as many threads over 16 slices.
  * `bench_dls --quick` skips the baked levels; `--linear` also runs only the linear mode's SIMD path.
  * Each scenario alternates apply and memcpy (9 or 8 times) and reports the medians of the
@@ -320,24 +320,34 @@ static int baked(const char *dir, const char *name, const ds_options *o)
     }
     const uint64_t ng = lbk_dls_target_count(dv, 1), nl = lbk_dls_target_count(dv, 2);
     uint8_t *bg = calloc(ng + 1, 28), *og = calloc(ng + 1, 28), *bl = calloc(nl + 1, 28), *ol = calloc(nl + 1, 28);
-    lbk_dls_runtime_desc rdsc = {.size = sizeof rdsc, .dls = dv, .doors = door, .base_glg = bg, .base_llg = bl,
-                                 .out_glg = og, .out_llg = ol, .page_count = lm.page_count, .pages = pages};
-    lbk_dls_runtime *rt;
-    if (lbk_dls_runtime_open(&rdsc, &rt) != LBK_OK) return 1;
+    /* the linear mode's outputs: three RGBA32F planes per page, 27 floats per probe */
+    lbk_dls_linear_page *lpages = calloc(lm.page_count, sizeof *lpages);
+    float *lin = malloc(48 * (size_t)lm.texel_count + 16), *lg = malloc(108 * (ng + 1)), *ll = malloc(108 * (nl + 1));
+    for (uint64_t p = 0, first = 0; p < lm.page_count; first += (uint64_t)pages[p].width * pages[p].height, p++)
+        for (int c = 0; c < 3; c++) lpages[p].out[c] = lin + 4 * (lm.texel_count * (uint64_t)c + first);
     lbk_dls_stats st;
     lbk_dls_stats_get(dv, &st);
     printf(" %s: %llu texels, %llu GLG + %llu LLG probes, %u sets, %u clusters, %.1f KB DLS\n", name,
            (unsigned long long)lm.texel_count, (unsigned long long)ng, (unsigned long long)nl, st.set_count, st.cluster_count,
            st.section_bytes / 1e3);
-    const float dw[8] = {0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f};
-    scenario_result r;
-    bad |= measure(rt, dv, st.set_count, door ? dw : NULL, -1, 1, 50, &r);
-    report("every set changes", 1, &r);
-    bad |= measure(rt, dv, st.set_count, door ? dw : NULL, 0, 1, 50, &r);
-    report("one set changes", 1, &r);
-    lbk_dls_runtime_close(rt);
+    for (int linear = 0; linear < 2 && !bad; linear++) {
+        lbk_dls_runtime_desc rdsc = {.size = sizeof rdsc, .dls = dv, .doors = door, .base_glg = bg, .base_llg = bl,
+                                     .out_glg = og, .out_llg = ol, .page_count = lm.page_count, .pages = pages,
+                                     .flags = linear ? LBK_DLS_RUNTIME_LINEAR : 0, .linear_pages = lpages,
+                                     .out_linear_glg = lg, .out_linear_llg = ll};
+        lbk_dls_runtime *rt;
+        if (lbk_dls_runtime_open(&rdsc, &rt) != LBK_OK) return 1;
+        printf("  %s mode, path %s:\n", linear ? "linear" : "byte", lbk_dls_runtime_path(rt));
+        const float dw[8] = {0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f};
+        scenario_result r;
+        bad |= measure(rt, dv, st.set_count, door ? dw : NULL, -1, 1, 50, &r);
+        report("every set changes", 1, &r);
+        bad |= measure(rt, dv, st.set_count, door ? dw : NULL, 0, 1, 50, &r);
+        report("one set changes", 1, &r);
+        lbk_dls_runtime_close(rt);
+    }
     for (uint32_t p = 0; p < 2 * lm.page_count; p++) free(outs[p]);
-    free(outs), free(pages), free(bg), free(og), free(bl), free(ol);
+    free(outs), free(pages), free(lpages), free(lin), free(lg), free(ll), free(bg), free(og), free(bl), free(ol);
     if (door) lbk_door_close(door);
     lbk_dls_close(dv);
     lbk_reader_close(rd);
