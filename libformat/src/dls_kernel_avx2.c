@@ -709,7 +709,6 @@ INL void lin_step4(const float *base, const float *const *src, const float *w, u
     _mm_storeu_ps(out + i, a);
 }
 
-/* Step of 16 floats (one 64-byte output line) with two accumulators. */
 /* Inputs are fetched this many floats (1 KiB) ahead: a cluster's 3·(1 + m) input streams advance
  * one chart row at a time, interleaved, and the hardware's stream prefetcher, which stops at each
  * 4 KiB boundary, lags them. Measured on the ESTATE-sized level (bench_dls, one thread, four
@@ -717,6 +716,7 @@ INL void lin_step4(const float *base, const float *const *src, const float *w, u
  * 512 floats. A prefetch past an array's end is harmless (prefetches do not fault). */
 #define LIN_PREFETCH 256
 
+/* Step of 16 floats (one 64-byte output line) with two accumulators. */
 INL void lin_step16(const float *base, const float *const *src, const vf *wv, uint32_t m, size_t i, float *out, int stream)
 {
     _mm_prefetch((const char *)(base + i + LIN_PREFETCH), _MM_HINT_T0);
@@ -732,9 +732,9 @@ INL void lin_step16(const float *base, const float *const *src, const vf *wv, ui
 }
 
 /* The outputs' whole 64-byte lines are written with non-temporal stores: an apply writes every
- * output once and reads none, and an ordinary store first reads the line for ownership — a third
- * of the traffic of a full apply on one thread (its reads, the limit there, go from 287 MB of
- * inputs to 444 MB with the outputs' lines). The lines an output stretch only partly covers
+ * output once and reads none, and an ordinary store first reads the line for ownership: on the
+ * ESTATE-sized level that takes a full apply's reads (the limit on one thread) from the 287 MB of
+ * inputs to 444 MB with the outputs' lines. The lines an output stretch only partly covers
  * (chart rows start anywhere) keep ordinary stores: a partial non-temporal line costs a read at
  * the memory controller instead. The job ends with lin_end's store fence. */
 static void lin_sum_wide(const float *base, const float *const *src, const float *w, uint32_t m, size_t n, float *out)
