@@ -12,7 +12,7 @@
  * Both modes of the runtime: bytes (AHD / packed SH9 outputs, the bytes of the scalar
  * definition) and linear (LBK_DLS_RUNTIME_LINEAR: float outputs from prepared floats, whose
  * traffic is 48 bytes per texel and 108 per probe for each base, entry and output; memcpy is
- * measured on that traffic), with the linear mode's prepared memory. Threads run the jobs of
+ * measured on that traffic), with the linear mode's prepared memory (both modes on the baked levels too). Threads run the jobs of
  * lbk_dls_apply_begin (bk_parallel_chunks), memcpy on as many threads over 16 slices.
  * `bench_dls --quick` skips the baked levels; `--linear` also runs only the linear mode's SIMD path.
  * Each scenario alternates apply and memcpy (9 or 8 times) and reports the medians of the
@@ -208,6 +208,61 @@ static void report(const char *what, int threads, const scenario_result *r)
            r->apply.cpu * 1e3, r->copy.wall * 1e3, r->copy.cpu * 1e3, r->ratio_wall, r->ratio_cpu, r->reps);
 }
 
+/* ---- the bound: a contiguous kernel of the same traffic ------------------------------------- */
+
+#if defined(__x86_64__) || defined(__SSE2__)
+#include <immintrin.h>
+#define HAVE_STREAM 1
+#endif
+
+/* out = a + w·b over contiguous arrays, 4 floats a step (SSE, baseline on x86-64), ordinary or
+ * non-temporal stores: the linear apply's arithmetic with its read/write proportion and none of
+ * its access pattern (interleaved chart-row streams, outputs a page row apart). */
+static void triad(const float *a, const float *b, float *o, size_t n, int nt)
+{
+#if HAVE_STREAM
+    const __m128 w = _mm_set1_ps(0.5f);
+    for (size_t i = 0; i + 4 <= n; i += 4) {
+        const __m128 x = _mm_add_ps(_mm_loadu_ps(a + i), _mm_mul_ps(w, _mm_loadu_ps(b + i)));
+        if (nt) _mm_stream_ps(o + i, x);
+        else _mm_storeu_ps(o + i, x);
+    }
+    if (nt) _mm_sfence();
+#else
+    for (size_t i = 0; i < n; i++) o[i] = a[i] + 0.5f * b[i];
+    (void)nt;
+#endif
+}
+
+/* The ESTATE level's linear traffic (`bytes`) as that contiguous kernel, one thread, against
+ * memcpy of the same traffic, alternating: what the machine allows the apply's arithmetic. */
+static int triad_bound(uint64_t bytes)
+{
+    const size_t n = (size_t)(bytes / 12 + 15) / 16 * 16; /* floats per array: 2 read, 1 written */
+    float *a = aligned_alloc(64, 4 * n), *b = aligned_alloc(64, 4 * n), *o = aligned_alloc(64, 4 * n);
+    memcpy_job m = {NULL, NULL, 6 * n};
+    uint8_t *src = malloc(m.n), *dst = malloc(m.n);
+    if (!a || !b || !o || !src || !dst) return 1;
+    memset(a, 0, 4 * n), memset(b, 0, 4 * n), memset(o, 0, 4 * n), memset(src, 1, m.n), memset(dst, 2, m.n);
+    m.src = src, m.dst = dst;
+    double r[2][9];
+    for (int i = 0; i < 9; i++) {
+        const double c = memcpy_once(&m, 1).cpu;
+        for (int nt = 0; nt < 2; nt++) {
+            const clocks t0 = clocks_now();
+            triad(a, b, o, n, nt);
+            clocks t = {1e9, 1e9};
+            clocks_best(&t, t0, 1);
+            r[nt][i] = c / t.cpu;
+        }
+    }
+    printf("  the bound: out = a + w*b over contiguous arrays, %.1f MB of traffic, 1 thread: %.3f of memcpy with ordinary "
+           "stores, %.3f with non-temporal ones (CPU time, medians of 9 alternations)\n",
+           12.0 * (double)n / 1e6, median(r[0], 9), median(r[1], 9));
+    free(a), free(b), free(o), free(src), free(dst);
+    return 0;
+}
+
 /* ---- the synthetic level's applies --------------------------------------------------------- */
 
 static int estate(int only_linear)
@@ -257,6 +312,7 @@ static int estate(int only_linear)
         for (int threads = 1; threads <= (scalar ? 1 : 2) && !bad; threads++) {
             bad |= measure(rt, lv.view, NSETS, NULL, -1, threads, scalar ? 1 : 9, &r);
             report("every set changes", threads, &r);
+            if (linear && !scalar && threads == 1) bad |= triad_bound(r.bytes);
             if (scalar) break;
             bad |= measure(rt, lv.view, NSETS, NULL, 5, threads, 8, &r);
             report("one set changes", threads, &r);
@@ -320,24 +376,34 @@ static int baked(const char *dir, const char *name, const ds_options *o)
     }
     const uint64_t ng = lbk_dls_target_count(dv, 1), nl = lbk_dls_target_count(dv, 2);
     uint8_t *bg = calloc(ng + 1, 28), *og = calloc(ng + 1, 28), *bl = calloc(nl + 1, 28), *ol = calloc(nl + 1, 28);
-    lbk_dls_runtime_desc rdsc = {.size = sizeof rdsc, .dls = dv, .doors = door, .base_glg = bg, .base_llg = bl,
-                                 .out_glg = og, .out_llg = ol, .page_count = lm.page_count, .pages = pages};
-    lbk_dls_runtime *rt;
-    if (lbk_dls_runtime_open(&rdsc, &rt) != LBK_OK) return 1;
+    /* the linear mode's outputs: three RGBA32F planes per page, 27 floats per probe */
+    lbk_dls_linear_page *lpages = calloc(lm.page_count, sizeof *lpages);
+    float *lin = malloc(48 * (size_t)lm.texel_count + 16), *lg = malloc(108 * (ng + 1)), *ll = malloc(108 * (nl + 1));
+    for (uint64_t p = 0, first = 0; p < lm.page_count; first += (uint64_t)pages[p].width * pages[p].height, p++)
+        for (int c = 0; c < 3; c++) lpages[p].out[c] = lin + 4 * (lm.texel_count * (uint64_t)c + first);
     lbk_dls_stats st;
     lbk_dls_stats_get(dv, &st);
     printf(" %s: %llu texels, %llu GLG + %llu LLG probes, %u sets, %u clusters, %.1f KB DLS\n", name,
            (unsigned long long)lm.texel_count, (unsigned long long)ng, (unsigned long long)nl, st.set_count, st.cluster_count,
            st.section_bytes / 1e3);
-    const float dw[8] = {0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f};
-    scenario_result r;
-    bad |= measure(rt, dv, st.set_count, door ? dw : NULL, -1, 1, 50, &r);
-    report("every set changes", 1, &r);
-    bad |= measure(rt, dv, st.set_count, door ? dw : NULL, 0, 1, 50, &r);
-    report("one set changes", 1, &r);
-    lbk_dls_runtime_close(rt);
+    for (int linear = 0; linear < 2 && !bad; linear++) {
+        lbk_dls_runtime_desc rdsc = {.size = sizeof rdsc, .dls = dv, .doors = door, .base_glg = bg, .base_llg = bl,
+                                     .out_glg = og, .out_llg = ol, .page_count = lm.page_count, .pages = pages,
+                                     .flags = linear ? LBK_DLS_RUNTIME_LINEAR : 0, .linear_pages = lpages,
+                                     .out_linear_glg = lg, .out_linear_llg = ll};
+        lbk_dls_runtime *rt;
+        if (lbk_dls_runtime_open(&rdsc, &rt) != LBK_OK) return 1;
+        printf("  %s mode, path %s:\n", linear ? "linear" : "byte", lbk_dls_runtime_path(rt));
+        const float dw[8] = {0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f};
+        scenario_result r;
+        bad |= measure(rt, dv, st.set_count, door ? dw : NULL, -1, 1, 50, &r);
+        report("every set changes", 1, &r);
+        bad |= measure(rt, dv, st.set_count, door ? dw : NULL, 0, 1, 50, &r);
+        report("one set changes", 1, &r);
+        lbk_dls_runtime_close(rt);
+    }
     for (uint32_t p = 0; p < 2 * lm.page_count; p++) free(outs[p]);
-    free(outs), free(pages), free(bg), free(og), free(bl), free(ol);
+    free(outs), free(pages), free(lpages), free(lin), free(lg), free(ll), free(bg), free(og), free(bl), free(ol);
     if (door) lbk_door_close(door);
     lbk_dls_close(dv);
     lbk_reader_close(rd);

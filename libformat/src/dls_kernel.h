@@ -15,6 +15,7 @@
 #ifndef LBK_DLS_KERNEL_H
 #define LBK_DLS_KERNEL_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -70,6 +71,13 @@ typedef struct dls_kernels {
      * weight 0 are left out, as in the byte kernels. */
     void (*lin_var)(const float *base, const float *entries, const float *we, const uint32_t *n, uint32_t count,
                     uint32_t f, float *out);
+    /* NULL, or what a job of the linear mode calls last: a path whose lin_sum writes with
+     * non-temporal stores fences them here, so the job's outputs are ordered like ordinary
+     * stores before the job reports done. */
+    void (*lin_end)(void);
+    /* lin_sum writes its outputs' whole lines without reading them first (non-temporal): the
+     * runtime then does not prefetch the outputs of the linear mode, which would read them. */
+    bool lin_streams;
 } dls_kernels;
 
 /* The definition, one target at a time; always available. */

@@ -161,6 +161,6 @@ static void lin_var(const float *base, const float *entries, const float *we, co
 const dls_kernels *dls_kernels_scalar(void)
 {
     static const dls_kernels k = {"scalar", texels, probes, texels_var, probes_var, texel_decode, texel_encode, probe_decode,
-                                  lin_sum, lin_var};
+                                  lin_sum, lin_var, NULL, false};
     return &k;
 }

@@ -268,4 +268,5 @@ void rt_linear_chunk_run(const lbk_dls_runtime *r, const rt_chunk *ch)
         lw.pf = dls_prefix(c->form);
         rt_chunk_spans(r, ch, lin_span, &lw);
     }
+    if (r->kern->lin_end) r->kern->lin_end();
 }

@@ -139,7 +139,9 @@ static uint32_t subgroup_targets(const lbk_dls_runtime *r, const uint8_t *gr)
 #define PREFETCH_LINES 4
 /* The linear mode's outputs are 4× wider and its inputs stream: there the whole next run's
  * output lines (up to a 96-texel chart row), which measured 0.32–0.37 of memcpy instead of
- * 0.28–0.29 on one thread (bench_dls, alternate runs). */
+ * 0.28–0.29 on one thread (bench_dls, alternate runs) — with ordinary stores (the scalar path).
+ * A path that streams its outputs (dls_kernels.lin_streams: whole lines written without a read)
+ * gets no output prefetch: it would read the lines that path avoids reading. */
 #define PREFETCH_LINEAR_TEXELS 96
 static void prefetch_lines(const void *p, size_t bytes, int write)
 {
@@ -156,6 +158,7 @@ static void prefetch_lines(const void *p, size_t bytes, int write)
 }
 static void prefetch_run(const lbk_dls_runtime *r, uint32_t space, uint64_t t, uint32_t len, uint32_t *hint)
 {
+    if (r->linear && r->kern->lin_streams) return; /* written without reads: lin_streams */
     if (space != LBK_DLS_SPACE_TEXEL && r->linear) { /* the prepared data streams; the outputs jump */
         if (r->probe_lin[space]) prefetch_lines(r->probe_lin[space] + 27 * t, 4 * 27 * (size_t)len, 1);
         return;

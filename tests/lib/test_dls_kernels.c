@@ -341,6 +341,40 @@ static void test_encode_at_boundaries(void **state)
     free(pl.v), free(z[0]), free(z[1]), free(rgba[0]), free(rgba[1]);
 }
 
+/* The linear mode's lin_sum (AVX2: whole output lines non-temporal, the partial ones at either end
+ * ordinary stores): every output offset within a 64-byte line, lengths across the 16- and 8-float
+ * steps, 0 to 8 sources; the floats of the scalar definition bit for bit, and nothing written
+ * outside the stretch (the guard floats around it keep their bytes). */
+static void test_lin_sum_every_alignment(void **state)
+{
+    (void)state;
+    const dls_kernels *v = simd();
+    enum { MAXN = 200, GUARD = 36, SRC = 8 }; /* (MAXN + 2·GUARD)·4 bytes: whole 64-byte lines */
+    uint64_t rng = 41;
+    float *in = malloc((SRC + 1) * MAXN * sizeof(float)), *o[2];
+    for (int p = 0; p < 2; p++) o[p] = aligned_alloc(64, (MAXN + 2 * GUARD) * sizeof(float));
+    for (size_t i = 0; i < (SRC + 1) * (size_t)MAXN; i++) in[i] = random_weight(&rng) * (float)(i % 97 + 1);
+    const float *src[SRC];
+    float w[SRC];
+    for (uint32_t j = 0; j < SRC; j++) src[j] = in + (1 + j) * MAXN, w[j] = random_weight(&rng);
+    uint32_t cases = 0;
+    for (uint32_t m = 0; m <= SRC; m++)
+        for (uint32_t off = 0; off < 16; off++)
+            for (uint32_t n = 0; n <= 100; n += n < 40 ? 1 : 7) {
+                for (int p = 0; p < 2; p++) {
+                    memset(o[p], 0x5a, (MAXN + 2 * GUARD) * sizeof(float));
+                    (p ? v : dls_kernels_scalar())->lin_sum(in, src, w, m, n, o[p] + GUARD + off);
+                    if (p && v->lin_end) v->lin_end();
+                }
+                if (memcmp(o[0], o[1], (MAXN + 2 * GUARD) * sizeof(float)))
+                    fail_msg("lin_sum m %u, output offset %u floats, n %u: %s differs from scalar", m, off, n, v->name);
+                cases++;
+            }
+    print_message("%u lin_sum stretches\n", cases);
+    assert_true(v->lin_streams == (v->lin_end != NULL));
+    free(in), free(o[0]), free(o[1]);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -350,6 +384,7 @@ int main(void)
         cmocka_unit_test(test_decode_every_direction),
         cmocka_unit_test(test_probe_decode_every_byte),
         cmocka_unit_test(test_encode_at_boundaries),
+        cmocka_unit_test(test_lin_sum_every_alignment),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
