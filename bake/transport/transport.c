@@ -564,19 +564,25 @@ static int nee_sample_lobe(const tp_ctx *c, const float o[3], const double n[3],
 /* Per-thread counters of one parallel step. */
 typedef struct tp_count { uint64_t rays, shadow, bad; } tp_count;
 
-/* The tile lists of a thread: for each half the list of the tile it last cut (tile). */
-typedef struct tp_slc_lists {
+/* The tile lists of a thread (for the punctual lights' draws and for the VPLs' draws): for each
+ * half the list of the tile it last cut (tile), in the thread's two slots of `ids` (cap each). */
+typedef struct tp_tile_lists {
     uint32_t *ids[2];
     size_t n[2], tile[2];
-} tp_slc_lists;
+} tp_tile_lists;
 
-static void slc_lists_init(const tp_ctx *c, int thread, tp_slc_lists *t)
+static void tile_lists_init(uint32_t *ids, size_t cap, int thread, tp_tile_lists *t)
 {
     for (int h = 0; h < 2; h++) {
-        t->ids[h] = c->slc_ids ? c->slc_ids + (2 * (size_t)thread + (size_t)h) * c->light_count : NULL;
+        t->ids[h] = ids ? ids + (2 * (size_t)thread + (size_t)h) * cap : NULL;
         t->n[h] = 0;
         t->tile[h] = SIZE_MAX;
     }
+}
+
+static void slc_lists_init(const tp_ctx *c, int thread, tp_tile_lists *t)
+{
+    tile_lists_init(c->slc_ids, c->light_count, thread, t);
 }
 
 /* A culling draw over `slc` for (half, pass): one ξ per light from its own stream. */
@@ -957,7 +963,7 @@ static void cell_sample(tp_ctx *c, const double n[3], int j, const double p[3],
 
 /* Bounce k at one cell: R points uniform over the cell, cosine directions from the shifted
  * lattice, traced 64 at a time; returns the reflected radiance albedo/π × irradiance. */
-static void cell_bounce(tp_ctx *c, size_t ci, tp_slc_lists *lists, tp_count *cnt, double out[3])
+static void cell_bounce(tp_ctx *c, size_t ci, tp_tile_lists *lists, tp_count *cnt, double out[3])
 {
     const int h = c->half, k = c->bounce, R = c->rays;
     const tp_cell *cell = &c->cells[ci];
@@ -1026,7 +1032,7 @@ static void cache_bounce(tp_ctx *c, size_t begin, size_t end, int thread)
 {
     float *cur = c->l_cur[c->half];
     tp_count cnt = {0, 0, 0};
-    tp_slc_lists lists;
+    tp_tile_lists lists;
     slc_lists_init(c, thread, &lists);
     for (size_t ci = begin; ci < end; ci++) {
         double v[3];
@@ -1458,7 +1464,7 @@ static void recv_half(tp_ctx *c, const bk_receiver *r, size_t i, int h, int S, c
 /* The culled punctual light of receiver i in half h of this pass: one draw (the half's ξ, δ of
  * the pass) at the receiver's punctual points; an unbiased estimate of what recv_punctual
  * computes. */
-static uint64_t recv_slc(tp_ctx *c, const bk_receiver *r, size_t i, int h, tp_slc_lists *t, double e[3],
+static uint64_t recv_slc(tp_ctx *c, const bk_receiver *r, size_t i, int h, tp_tile_lists *t, double e[3],
                          double sh[3][9], uint64_t *tested)
 {
     const bk_slc_draw *d = c->draw_recv[h];
@@ -1479,19 +1485,9 @@ static uint64_t recv_slc(tp_ctx *c, const bk_receiver *r, size_t i, int h, tp_sl
     return rays;
 }
 
-/* The tile lists of a thread for the VPL draws: per half the list of the tile it last cut. */
-typedef struct tp_vpl_lists {
-    uint32_t *ids[2];
-    size_t n[2], tile[2];
-} tp_vpl_lists;
-
-static void vpl_lists_init(const tp_ctx *c, int thread, tp_vpl_lists *t)
+static void vpl_lists_init(const tp_ctx *c, int thread, tp_tile_lists *t)
 {
-    for (int h = 0; h < 2; h++) {
-        t->ids[h] = c->vpl_ids ? c->vpl_ids + (2 * (size_t)thread + (size_t)h) * c->vpl_cap : NULL;
-        t->n[h] = 0;
-        t->tile[h] = SIZE_MAX;
-    }
+    tile_lists_init(c->vpl_ids, c->vpl_cap, thread, t);
 }
 
 /* The glossy VPLs of half h at surface receiver i: the half's draw at one of the receiver's
@@ -1500,7 +1496,7 @@ static void vpl_lists_init(const tp_ctx *c, int thread, tp_vpl_lists *t)
  * were most of the gather's CPU at four), irradiance into e and the SH of the incident radiance
  * into sh (indirect light: not in `direct`). An unbiased estimate of the light that punctual
  * lights send to the receiver over one specular bounce (VPL.md). Returns shadow rays. */
-static uint64_t recv_vpl(tp_ctx *c, const bk_receiver *r, size_t i, int h, tp_vpl_lists *t, double e[3],
+static uint64_t recv_vpl(tp_ctx *c, const bk_receiver *r, size_t i, int h, tp_tile_lists *t, double e[3],
                          double sh[3][9], uint64_t *tested)
 {
     const bk_vpl_draw *d = c->vpl_draw[h];
@@ -1545,9 +1541,9 @@ static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
     const double w = c->pass_weight;
     const bk_transport_output *out = c->out;
     tp_count cnt = {0, 0, 0};
-    tp_slc_lists lists;
+    tp_tile_lists lists;
     slc_lists_init(c, thread, &lists);
-    tp_vpl_lists vlists;
+    tp_tile_lists vlists;
     vpl_lists_init(c, thread, &vlists);
     uint64_t tested = 0, vtested = 0;
     for (size_t i = begin; i < end; i++) {
