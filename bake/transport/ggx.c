@@ -112,6 +112,8 @@ double bk_ggx_pdf(double alpha, const double v[3], const double l[3])
 
 static double clamp01(double x) { return x > 0 ? (x < 1 ? x : 1) : 0; }
 
+double bk_mr_f0(double base, double metallic) { return 0.04 + (clamp01(base) - 0.04) * metallic; }
+
 /* A and B at (α, μ) by the visible-normal estimator: E = E_vndf[F·G2/G1(v)]. */
 static void table_entry(double alpha, double mu, double *a, double *b)
 {
@@ -203,7 +205,7 @@ int bk_mr_lobe_init(bk_mr_lobe *lb, const bk_ggx_table *t, const double base[3],
     bk_ggx_table_mean(t, roughness, &abar, &bbar);
     for (int k = 0; k < 3; k++) {
         double bc = clamp01(base[k]);
-        lb->f0[k] = 0.04 + (bc - 0.04) * metallic;
+        lb->f0[k] = bk_mr_f0(bc, metallic);
         es[k] = fmin(1.0, lb->f0[k] * a + b);
         double ebar = fmin(1.0, lb->f0[k] * abar + bbar);
         double c_diff = (1 - metallic) * bc;
@@ -266,7 +268,7 @@ void bk_mr_albedo_mean(const bk_ggx_table *t, const double base[3], double metal
     bk_ggx_table_mean(t, clamp01(roughness), &abar, &bbar);
     for (int k = 0; k < 3; k++) {
         double bc = clamp01(base[k]);
-        double f0 = 0.04 + (bc - 0.04) * metallic;
+        double f0 = bk_mr_f0(bc, metallic);
         double ebar = fmin(1.0, f0 * abar + bbar);
         /* mean over v of E_s(v) + c_diff(1 − E_s(v)): the mean of a linear function of E_s */
         out[k] = ebar + (1 - metallic) * bc * (1 - ebar);

@@ -75,6 +75,10 @@ typedef struct bk_mr_lobe {
     double v[3];
 } bk_mr_lobe;
 
+/* The specular reflectance at normal incidence of glTF's metallic-roughness model:
+ * lerp(0.04, base, metallic), base clamped to [0, 1]. */
+double bk_mr_f0(double base, double metallic);
+
 /* base colour (linear, ≤ 1), metallic and roughness in [0, 1]. Returns 0 when v is below the
  * horizon (nothing is reflected towards it). */
 int bk_mr_lobe_init(bk_mr_lobe *lb, const bk_ggx_table *t, const double base[3], double metallic, double roughness,

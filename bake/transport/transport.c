@@ -1509,26 +1509,24 @@ static uint64_t recv_vpl(tp_ctx *c, const bk_receiver *r, size_t i, int h, tp_ti
     tp_origin g[4];
     const int points = punctual_points(c, r, g);
     tp_rng pr = rng_make(c->seed, DOM_VPL_POINT, (uint64_t)h, (uint64_t)c->pass, 0, i);
-    const int q0 = points > 1 ? (int)(rng_next(&pr) * points) % points : 0;
+    const int q = points > 1 ? (int)(rng_next(&pr) * points) % points : 0;
+    bk_vpl_point pt;
+    for (int a = 0; a < 3; a++) pt.p[a] = g[q].p[a], pt.n[a] = g[q].n[a], pt.org[a] = g[q].o[a];
     uint64_t rays = 0;
-    for (int q = q0; q < q0 + 1; q++) {
-        bk_vpl_point pt;
-        for (int a = 0; a < 3; a++) pt.p[a] = g[q].p[a], pt.n[a] = g[q].n[a], pt.org[a] = g[q].o[a];
-        for (size_t k = 0; k < t->n[h]; k++) {
-            const uint32_t vi = t->ids[h][k];
-            double rgb[3], to[3];
-            int acc, ray;
-            const int hit = bk_vpl_eval(&c->vpls[h][vi], bk_vpl_draw_xi(d, vi), delta, c->tracer, &pt, rgb, to, &acc, &ray);
-            rays += (uint64_t)ray;
-            if (!hit || !bk_finite3(rgb)) continue;
-            const double cs = to[0] * g[q].n[0] + to[1] * g[q].n[1] + to[2] * g[q].n[2];
-            if (!(cs > 0)) continue;
-            double y[9];
-            bk_sh9_basis_d(to, y);
-            for (int a = 0; a < 3; a++) {
-                e[a] += rgb[a] * cs;
-                for (int kk = 0; kk < 9; kk++) sh[a][kk] += rgb[a] * y[kk];
-            }
+    for (size_t k = 0; k < t->n[h]; k++) {
+        const uint32_t vi = t->ids[h][k];
+        double rgb[3], to[3];
+        int acc, ray;
+        const int hit = bk_vpl_eval(&c->vpls[h][vi], bk_vpl_draw_xi(d, vi), delta, c->tracer, &pt, rgb, to, &acc, &ray);
+        rays += (uint64_t)ray;
+        if (!hit || !bk_finite3(rgb)) continue;
+        const double cs = to[0] * g[q].n[0] + to[1] * g[q].n[1] + to[2] * g[q].n[2];
+        if (!(cs > 0)) continue;
+        double y[9];
+        bk_sh9_basis_d(to, y);
+        for (int a = 0; a < 3; a++) {
+            e[a] += rgb[a] * cs;
+            for (int kk = 0; kk < 9; kk++) sh[a][kk] += rgb[a] * y[kk];
         }
     }
     *tested += t->n[h];
@@ -2180,10 +2178,7 @@ static int vpl_material(void *user, const bk_hit *hit, const double x[3], bk_vpl
     if (hc < 0 || !c->gloss[hc].on) return 0;
     const tp_gloss *g = &c->gloss[hc];
     memset(m, 0, sizeof *m);
-    for (int k = 0; k < 3; k++) {
-        const double bc = fmin(fmax(g->base[k], 0.0), 1.0);
-        m->f0[k] = (float)(0.04 + (bc - 0.04) * g->metallic);
-    }
+    for (int k = 0; k < 3; k++) m->f0[k] = (float)bk_mr_f0(g->base[k], g->metallic);
     m->alpha = g->roughness * g->roughness;
     return 1;
 }
@@ -2759,17 +2754,18 @@ static void fill_stats(const tp_ctx *c, int passes, double err, double bias, con
     double tot = chain[0].total_energy + chain[1].total_energy;
     stats->tail_fraction = tot > 0 ? (chain[0].tail_energy + chain[1].tail_energy) / tot : 0;
     stats->cells = c->cell_count;
+    uint64_t tested = 0, vt = 0;
     for (int t = 0; t < c->threads; t++) {
         stats->rays += c->thread_rays[t];
         stats->shadow_rays += c->thread_shadow[t];
         stats->nonfinite += c->thread_nonfinite[t];
+        tested += c->thread_slc_tested[t];
+        vt += c->thread_vpl_tested[t];
     }
     stats->stop = lead->stop;
     stats->nee = c->nee;
     stats->slc = c->slc;
     stats->slc_delta = c->slc_delta;
-    uint64_t tested = 0;
-    for (int t = 0; t < c->threads; t++) tested += c->thread_slc_tested[t];
     double recv_spp = 0; /* receiver-draws: each receiver draws twice (halves) per pass it sampled */
     for (int k = 0; k < c->ncls; k++) recv_spp += (double)(c->cls[k].end - c->cls[k].begin);
     stats->slc_lights_tested = recv_spp > 0 ? (double)tested / recv_spp : 0;
@@ -2777,8 +2773,6 @@ static void fill_stats(const tp_ctx *c, int passes, double err, double bias, con
     stats->vpl_delta = c->vpl_delta;
     stats->vpl_share = c->vpl_share;
     stats->vpl_made = c->vpl_made;
-    uint64_t vt = 0;
-    for (int t = 0; t < c->threads; t++) vt += c->thread_vpl_tested[t];
     stats->vpl_tested = recv_spp > 0 ? (double)vt / recv_spp : 0;
 }
 
