@@ -334,6 +334,19 @@ static int bake(bake_args *o, int quiet)
     return LBK_EXIT_OK;
 }
 
+/* auto | on | off as lbk_bake_desc's tri-state fields take it (0, 1, -1); 0 after saying why. */
+static int auto_on_off(const char *option, const char *v, int *out)
+{
+    if (!strcmp(v, "auto")) *out = 0;
+    else if (!strcmp(v, "on")) *out = 1;
+    else if (!strcmp(v, "off")) *out = -1;
+    else {
+        fprintf(stderr, "lbk bake: %s: '%s' is not auto, on or off\n", option, v);
+        return 0;
+    }
+    return 1;
+}
+
 int cli_bake_flag(const char *a)
 {
     return !strcmp(a, "--no-glg") || !strcmp(a, "--octahedral") || !strcmp(a, "--glg-lighting") || !strcmp(a, "--llg-connected") || !strcmp(a, "--error-map") || !strcmp(a, "--block-align") || !strcmp(a, "--timestamp") ||
@@ -477,25 +490,13 @@ int cli_bake_parse(int argc, char **argv, bake_args *out, int *quiet_out)
             o.d.dls_threshold = d > 0 ? d : -1;
         } else if (!strcmp(a, "--light-culling")) {
             NEED_VALUE;
-            if (!strcmp(v, "auto")) o.d.light_culling = 0;
-            else if (!strcmp(v, "on")) o.d.light_culling = 1;
-            else if (!strcmp(v, "off")) o.d.light_culling = -1;
-            else {
-                fprintf(stderr, "lbk bake: --light-culling: '%s' is not auto, on or off\n", v);
-                return LBK_EXIT_USAGE;
-            }
+            if (!auto_on_off(a, v, &o.d.light_culling)) return LBK_EXIT_USAGE;
         } else if (!strcmp(a, "--light-culling-delta")) {
             NEED_NUMBER(1e-9, 1e6);
             o.d.light_culling_delta = d;
         } else if (!strcmp(a, "--glossy-vpl")) {
             NEED_VALUE;
-            if (!strcmp(v, "auto")) o.d.glossy_vpl = 0;
-            else if (!strcmp(v, "on")) o.d.glossy_vpl = 1;
-            else if (!strcmp(v, "off")) o.d.glossy_vpl = -1;
-            else {
-                fprintf(stderr, "lbk bake: --glossy-vpl: '%s' is not auto, on or off\n", v);
-                return LBK_EXIT_USAGE;
-            }
+            if (!auto_on_off(a, v, &o.d.glossy_vpl)) return LBK_EXIT_USAGE;
         } else if (!strcmp(a, "--glossy-vpl-photons")) {
             NEED_UINT(1, 1 << 20);
             o.d.glossy_vpl_photons = (int)u;
