@@ -78,6 +78,9 @@ static void help(FILE *f)
           "                          (default 1024)\n"
           "  --glossy-vpl-delta X    the VPLs' culling delta relative to their mean irradiance at the texels\n"
           "                          (default 0.1; smaller: more VPLs per texel, less noise)\n"
+          "  --adaptive on|off       adaptive sampling (default on): blocks of 64 texels or probes whose\n"
+          "                          own estimate reached --target-error stop while the rest go on\n"
+          "                          (bake/transport/TRANSPORT.md)\n"
           "  --door-method difference|guided\n"
           "                          how the light through an open door is baked: differences of\n"
           "                          full runs (default) or the seed's guided estimator (bake/sets/SETS.md)\n"
@@ -503,6 +506,14 @@ int cli_bake_parse(int argc, char **argv, bake_args *out, int *quiet_out)
         } else if (!strcmp(a, "--glossy-vpl-delta")) {
             NEED_NUMBER(1e-9, 1e6);
             o.d.glossy_vpl_delta = d;
+        } else if (!strcmp(a, "--adaptive")) {
+            NEED_VALUE;
+            if (!strcmp(v, "on")) o.d.adaptive = 0;
+            else if (!strcmp(v, "off")) o.d.adaptive = -1;
+            else {
+                fprintf(stderr, "lbk bake: --adaptive: '%s' is not on or off\n", v);
+                return LBK_EXIT_USAGE;
+            }
         } else if (!strcmp(a, "--door-method")) {
             NEED_VALUE;
             if (!strcmp(v, "difference")) o.d.door_method = LBK_BAKE_DOOR_DIFFERENCE;

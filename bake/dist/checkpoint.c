@@ -16,9 +16,9 @@
 #include <xxhash.h>
 
 #define CK_MAGIC "LBKCKPT\0"
-#define CK_VERSION 2u /* 2: the rough marks of the cache cells */
+#define CK_VERSION 3u /* 2: the rough marks of the cache cells; 3: adaptive blocks' weights, mean samples */
 #define CK_HEADER 64u
-#define CK_SAMPLE 88u
+#define CK_SAMPLE 112u
 #define CK_SCALARS (8 * 6 + 4 * 6 + 4 * 2 + 8 * 6 + 8 * 6)
 
 struct bk_ckpt {
@@ -50,10 +50,10 @@ static uint32_t mask_of(const bk_transport_state *s)
     return 1u | (s->direct ? 2u : 0) | (s->irradiance ? 4u : 0);
 }
 
-static size_t payload_size(size_t n, int passes, uint32_t mask, size_t cells)
+static size_t payload_size(size_t n, int passes, uint32_t mask, size_t cells, size_t blocks)
 {
     size_t per = 4 * 8 + 27 * 4 + ((mask & 2) ? 27 * 4 : 0) + ((mask & 4) ? 3 * 4 : 0);
-    return CK_SCALARS + (size_t)passes * CK_SAMPLE + n * per + cells;
+    return CK_SCALARS + (size_t)passes * CK_SAMPLE + n * per + cells + 8 * blocks;
 }
 
 typedef struct cur {
@@ -71,7 +71,7 @@ static lbk_result ck_save(void *user, const bk_transport_state *s)
 {
     bk_ckpt *c = user;
     const uint32_t mask = mask_of(s);
-    const size_t n = s->count, pay = payload_size(n, s->passes, mask, s->cells);
+    const size_t n = s->count, pay = payload_size(n, s->passes, mask, s->cells, s->blocks);
     uint8_t *buf = malloc(CK_HEADER + pay);
     if (!buf) return LBK_ERR_OUT_OF_MEMORY;
     cur k = {buf + CK_HEADER};
@@ -84,12 +84,14 @@ static lbk_result ck_save(void *user, const bk_transport_state *s)
         w(&k, &sm->seconds, 8), w(&k, &sm->samples_per_receiver, 8), w(&k, &sm->est_rel_rmse, 8);
         int32_t ib[2] = {sm->bounces, sm->pass};
         w(&k, ib, 8), w(&k, sm->class_rel_rmse, 24), w(&k, &sm->probe_rel_rmse, 8), w(&k, sm->class_samples, 24);
+        w(&k, sm->class_mean_samples, 24);
     }
     for (int h = 0; h < 2; h++) w(&k, s->x_acc[h], 8 * n), w(&k, s->b_acc[h], 8 * n);
     w(&k, s->radiance, n * sizeof(lbk_sh9_rgb));
     if (mask & 2) w(&k, s->direct, n * sizeof(lbk_sh9_rgb));
     if (mask & 4) w(&k, s->irradiance, 12 * n);
     if (s->cells) w(&k, s->rough, s->cells);
+    if (s->blocks) w(&k, s->block_weight, 8 * s->blocks);
     memset(buf, 0, CK_HEADER);
     memcpy(buf, CK_MAGIC, 8);
     uint32_t u32[4] = {CK_VERSION, mask, (uint32_t)c->run, (uint32_t)s->passes};
@@ -138,7 +140,7 @@ static int ck_load(void *user, bk_transport_state *s)
                      "--resume, or with the options it was made with", path);
     }
     const int passes = (int)u32[3];
-    if (passes < 1 || passes > BK_TRANSPORT_MAX_PASSES || u64[2] != payload_size(s->count, passes, mask, s->cells)) {
+    if (passes < 1 || passes > BK_TRANSPORT_MAX_PASSES || u64[2] != payload_size(s->count, passes, mask, s->cells, s->blocks)) {
         fclose(f);
         return -fail(c, LBK_ERR_BAD_INPUT, "checkpoint %s: corrupt", path);
     }
@@ -163,6 +165,7 @@ static int ck_load(void *user, bk_transport_state *s)
         r(&k, &sm->seconds, 8), r(&k, &sm->samples_per_receiver, 8), r(&k, &sm->est_rel_rmse, 8);
         int32_t ib[2];
         r(&k, ib, 8), r(&k, sm->class_rel_rmse, 24), r(&k, &sm->probe_rel_rmse, 8), r(&k, sm->class_samples, 24);
+        r(&k, sm->class_mean_samples, 24);
         sm->bounces = ib[0], sm->pass = ib[1];
     }
     for (int hh2 = 0; hh2 < 2; hh2++) r(&k, s->x_acc[hh2], 8 * n), r(&k, s->b_acc[hh2], 8 * n);
@@ -170,6 +173,7 @@ static int ck_load(void *user, bk_transport_state *s)
     if (mask & 2) r(&k, s->direct, n * sizeof(lbk_sh9_rgb));
     if (mask & 4) r(&k, s->irradiance, 12 * n);
     if (s->cells) r(&k, s->rough, s->cells);
+    if (s->blocks) r(&k, s->block_weight, 8 * s->blocks);
     free(buf);
     c->resumed++;
     c->skipped += passes;

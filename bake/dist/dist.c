@@ -78,9 +78,10 @@ void bk_dist_range(uint64_t count, uint32_t runs, uint32_t units, uint32_t unit,
 {
     uint32_t u0, u1;
     bk_dist_run_units(runs, units, run, &u0, &u1);
-    const uint64_t m = u1 - u0, j = unit - u0;
-    *begin = count * j / m;
-    *end = count * (j + 1) / m;
+    /* whole blocks of adaptive sampling (BK_TRANSPORT_BLOCK): a block's stop reads all of it */
+    const uint64_t m = u1 - u0, j = unit - u0, B = BK_TRANSPORT_BLOCK, blocks = (count + B - 1) / B;
+    *begin = blocks * j / m * B < count ? blocks * j / m * B : count;
+    *end = blocks * (j + 1) / m * B < count ? blocks * (j + 1) / m * B : count;
 }
 
 static lbk_result say(char *err, size_t len, const char *fmt, ...) __attribute__((format(printf, 3, 4)));

@@ -15,7 +15,7 @@
 #include "lbk/lbk.h"
 
 #define BK_PART_MAGIC "LBKPART\0"
-#define BK_PART_VERSION 2u
+#define BK_PART_VERSION 3u /* 3: shared runs cut at multiples of 64 receivers */
 #define BK_PART_HEADER_SIZE 96u
 #define BK_PART_RUN_HEADER_SIZE 112u
 #define BK_PART_PASS_HEADER_SIZE 64u

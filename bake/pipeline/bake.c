@@ -125,15 +125,19 @@ static void transport_report(void *user, const bk_transport_sample *s)
         b->sample_cap = cap;
     }
     b->samples[b->sample_count++] = *s;
+    /* samples_per_receiver is the mean; where adaptive sampling gave some blocks more, the most */
+    char peak[32] = "";
+    const double most = s->class_samples[BK_CLASS_TEXEL];
+    if (most > s->class_mean_samples[BK_CLASS_TEXEL] + 0.5) snprintf(peak, sizeof peak, " (max %.0f)", most);
     if (b->llg_first > b->texel_receivers || b->receiver_count > b->llg_first)
         bk_events_say(&b->events, LBK_BAKE_SEVERITY_INFO,
-                      "pass %d: %7.0f samples/texel  est. error %6.2f%%, probes %6.2f%% at %.0f samples  %2d bounces  %7.1f s",
-                      s->pass, s->samples_per_receiver, 100 * s->class_rel_rmse[BK_CLASS_TEXEL], 100 * s->probe_rel_rmse,
+                      "pass %d: %7.0f samples/texel%s  est. error %6.2f%%, probes %6.2f%% at %.0f samples  %2d bounces  %7.1f s",
+                      s->pass, s->samples_per_receiver, peak, 100 * s->class_rel_rmse[BK_CLASS_TEXEL], 100 * s->probe_rel_rmse,
                       fmax(s->class_samples[BK_CLASS_GLG], s->class_samples[BK_CLASS_LLG]), s->bounces, s->seconds);
     else
         bk_events_say(&b->events, LBK_BAKE_SEVERITY_INFO,
-                      "pass %d: %7.0f samples/receiver  est. error %6.2f%%  %2d bounces  %7.1f s", s->pass,
-                      s->samples_per_receiver, 100 * s->est_rel_rmse, s->bounces, s->seconds);
+                      "pass %d: %7.0f samples/receiver%s  est. error %6.2f%%  %2d bounces  %7.1f s", s->pass,
+                      s->samples_per_receiver, peak, 100 * s->est_rel_rmse, s->bounces, s->seconds);
 }
 
 /* ---- import ---------------------------------------------------------------------------- */
@@ -559,6 +563,7 @@ static void transport_options(const bk_pipeline *b, bk_transport_options *to)
     to->glossy_vpl = opt->glossy_vpl;
     to->glossy_vpl_photons = opt->glossy_vpl_photons > 0 ? (size_t)opt->glossy_vpl_photons : 0;
     to->glossy_vpl_delta = opt->glossy_vpl_delta;
+    to->adaptive = opt->adaptive >= 0;
 }
 
 void bk_pipeline_set_inputs(const bk_pipeline *b, bk_set_inputs *in)
@@ -935,6 +940,7 @@ static lbk_result check_desc(bk_pipeline *b)
     if (!finite_nonneg(d->light_culling_delta) || d->light_culling_delta > 1e6)
         BAD("lbk_bake_desc.light_culling_delta: %g is not a finite number in [0, 1e6]", d->light_culling_delta);
     if (d->glossy_vpl < -1 || d->glossy_vpl > 1) BAD("lbk_bake_desc.glossy_vpl: %d is not -1, 0 or 1", d->glossy_vpl);
+    if (d->adaptive < -1 || d->adaptive > 0) BAD("lbk_bake_desc.adaptive: %d is not -1 or 0", d->adaptive);
     if (d->glossy_vpl_photons < 0 || d->glossy_vpl_photons > (1 << 20))
         BAD("lbk_bake_desc.glossy_vpl_photons: %d is not in [0, 2^20]", d->glossy_vpl_photons);
     if (!finite_nonneg(d->glossy_vpl_delta) || d->glossy_vpl_delta > 1e6)
@@ -1151,6 +1157,10 @@ static uint64_t options_hash(const lbk_bake_desc *options, int budgets)
     if (d.glossy_vpl || d.glossy_vpl_photons || d.glossy_vpl_delta > 0) { /* (absent from older hashes) */
         const double gv[3] = {(double)d.glossy_vpl, (double)d.glossy_vpl_photons, d.glossy_vpl_delta};
         XXH64_update(st, gv, sizeof gv);
+    }
+    if (d.adaptive) { /* (absent from older hashes: on) */
+        const int64_t ad = d.adaptive;
+        XXH64_update(st, &ad, sizeof ad);
     }
     if (d.error_map) { /* units must record the variance the merge's map needs */
         const int64_t em = d.error_map;

@@ -259,7 +259,7 @@ static void sky(const bk_scene *s, text *t)
 
 /* ---- META ------------------------------------------------------------------------------------- */
 
-enum { MAX_PAIRS = 40 };
+enum { MAX_PAIRS = 48 };
 
 lbk_result bk_provenance_meta(const bk_pipeline *b, void **data, size_t *size)
 {
@@ -353,6 +353,7 @@ lbk_result bk_provenance_meta(const bk_pipeline *b, void **data, size_t *size)
     if (o->glossy_vpl) p[n++] = (lbk_meta_pair){"bake.glossy_vpl", o->glossy_vpl > 0 ? "on" : "off"};
     if (o->glossy_vpl_photons > 0) p[n++] = (lbk_meta_pair){"bake.glossy_vpl_photons", vpl_photons};
     if (o->glossy_vpl_delta > 0) p[n++] = (lbk_meta_pair){"bake.glossy_vpl_delta", vpl_delta};
+    if (o->adaptive < 0) p[n++] = (lbk_meta_pair){"bake.adaptive", "off"}; /* absent: on */
     p[n++] = (lbk_meta_pair){"bake.dls_threshold", threshold};
     p[n++] = (lbk_meta_pair){"bake.door_method", o->door_method == LBK_BAKE_DOOR_GUIDED ? "guided" : "difference"};
     if (o->revision) p[n++] = (lbk_meta_pair){LBK_META_REVISION, o->revision};

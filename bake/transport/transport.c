@@ -270,6 +270,15 @@ typedef struct tp_ctx {
     size_t stop_first[BK_RECEIVER_CLASSES + 1], extra_first[BK_RECEIVER_CLASSES + 1];
     int stop_sub[BK_RECEIVER_CLASSES];
     uint64_t extra_rays, extra_shadow, extra_nonfinite;
+    /* adaptive sampling's blocks (TRANSPORT.md §Adaptive sampling), class k's
+     * [blk_first[k], blk_first[k + 1]): per block the sum of the weights of the passes it sampled
+     * in, whether it samples in this pass, and whether it would sample in the next (adapt_mark;
+     * applied where its class may adapt, stop_after). Without adapt every block of a class
+     * samples while the class does, so blk_w is the class's weight_sum. */
+    int adapt;
+    size_t blk_count, blk_first[BK_RECEIVER_CLASSES + 1];
+    double *blk_w;
+    uint8_t *blk_on, *blk_next;
     bk_transport_sample samples[BK_TRANSPORT_MAX_PASSES]; /* what each pass reported (checkpoints) */
 } tp_ctx;
 
@@ -292,6 +301,29 @@ static void parallel_range(tp_ctx *c, size_t begin, size_t end, size_t chunk, tp
 }
 
 static void parallel_for(tp_ctx *c, size_t n, size_t chunk, tp_fn fn) { parallel_range(c, 0, n, chunk, fn); }
+
+/* ---- adaptive sampling's blocks: receiver index / BK_TRANSPORT_BLOCK, cut at the class bounds */
+
+static int class_of(const tp_ctx *c, size_t i)
+{
+    int k = 0;
+    while (k + 1 < c->ncls && i >= c->cls[k].end) k++;
+    return k;
+}
+
+static size_t block_of(const tp_ctx *c, size_t i)
+{
+    const int k = class_of(c, i);
+    return c->blk_first[k] + i / BK_TRANSPORT_BLOCK - c->cls[k].begin / BK_TRANSPORT_BLOCK;
+}
+
+/* The receivers [*lo, *hi) of block b of class k. */
+static void block_range(const tp_ctx *c, int k, size_t b, size_t *lo, size_t *hi)
+{
+    const size_t chunk = c->cls[k].begin / BK_TRANSPORT_BLOCK + (b - c->blk_first[k]);
+    *lo = chunk * BK_TRANSPORT_BLOCK > c->cls[k].begin ? chunk * BK_TRANSPORT_BLOCK : c->cls[k].begin;
+    *hi = (chunk + 1) * BK_TRANSPORT_BLOCK < c->cls[k].end ? (chunk + 1) * BK_TRANSPORT_BLOCK : c->cls[k].end;
+}
 
 /* ---- scene lookups -------------------------------------------------------------------------- */
 
@@ -1545,6 +1577,7 @@ static void recv_gather(tp_ctx *c, size_t begin, size_t end, int thread)
     vpl_lists_init(c, thread, &vlists);
     uint64_t tested = 0, vtested = 0;
     for (size_t i = begin; i < end; i++) {
+        if (!c->blk_on[block_of(c, i)]) continue; /* converged (adaptive sampling) */
         const bk_receiver *r = &c->recv[i];
         const int sphere = !(r->normal[0] != 0 || r->normal[1] != 0 || r->normal[2] != 0);
         const double solid = sphere ? 4 * TP_PI : 2 * TP_PI;
@@ -1707,6 +1740,7 @@ static void free_ctx(tp_ctx *c)
     free(c->punct_lum);
     free(c->stop_idx);
     free(c->extra);
+    free(c->blk_w); free(c->blk_on); free(c->blk_next);
     free(c->thread_rays); free(c->thread_nonfinite);
     lattice_free(&c->lat);
     lattice_free(&c->oct_lat);
@@ -2434,14 +2468,16 @@ static int pass_cache_rays(const tp_ctx *c, int pass, size_t active)
 
 /* ---- the stop rule's receivers (TRANSPORT.md §Stop subset) -------------------------------- */
 
-/* Class k's stop subset when it has more than `cap` receivers: one receiver per stratum of
- * n/cap consecutive ones, at an offset hashed from (class, stratum) (no seed: the subset is
- * the layout's, not the noise's). Receivers lie in atlas / probe order, so strata spread the
- * subset over the whole level and the hash keeps it off any row pattern. n > cap. */
-static size_t stop_pick(size_t begin, size_t n, size_t cap, int k, size_t j)
+/* Class k's stop subset when it has more than `cap` blocks: one block per stratum of n/cap
+ * consecutive ones, at an offset hashed from (class, stratum) (no seed: the subset is the
+ * layout's, not the noise's). Receivers lie in atlas / probe order, so strata spread the subset
+ * over the whole level and the hash keeps it off any row pattern. Whole blocks, so that a unit
+ * of a distributed run that gathers them decides their adaptive stops as the whole run does.
+ * Returns the block's offset in the class; n > cap. */
+static size_t stop_pick(size_t n, size_t cap, int k, size_t j)
 {
-    const size_t q = n / cap, r = n % cap; /* strata of q + 1 receivers first, then of q */
-    const size_t lo = begin + j * q + (j < r ? j : r), len = q + (j < r);
+    const size_t q = n / cap, r = n % cap; /* strata of q + 1 blocks first, then of q */
+    const size_t lo = j * q + (j < r ? j : r), len = q + (j < r);
     return lo + (size_t)(mix64(0x5707A11D00000000ull ^ ((uint64_t)k << 40) ^ (uint64_t)j) % len);
 }
 
@@ -2450,29 +2486,79 @@ static size_t stop_pick(size_t begin, size_t n, size_t cap, int k, size_t j)
 static lbk_result stop_init(tp_ctx *c)
 {
     const size_t cap = c->opt->stop_receivers > 0 ? c->opt->stop_receivers : BK_TRANSPORT_STOP_RECEIVERS;
+    const size_t capb = cap / BK_TRANSPORT_BLOCK > 0 ? cap / BK_TRANSPORT_BLOCK : 1;
     const int cut = c->target > 0 && (c->g_begin != 0 || c->g_end != c->recv_count);
     size_t subs = 0, extras = 0;
     for (int k = 0; k < c->ncls; k++) {
-        size_t n = c->cls[k].end - c->cls[k].begin;
-        c->stop_sub[k] = n > cap;
-        subs += n > cap ? cap : 0;
-        extras += n > cap ? cap : n;
+        const size_t nb = c->blk_first[k + 1] - c->blk_first[k];
+        c->stop_sub[k] = nb > capb;
+        subs += nb > capb ? capb * BK_TRANSPORT_BLOCK : 0;
+        extras += nb > capb ? capb * BK_TRANSPORT_BLOCK : c->cls[k].end - c->cls[k].begin;
     }
     c->stop_idx = malloc((subs ? subs : 1) * sizeof *c->stop_idx);
     c->extra = malloc((cut && extras ? extras : 1) * sizeof *c->extra);
     if (!c->stop_idx || !c->extra) return LBK_ERR_OUT_OF_MEMORY;
     size_t ns = 0, ne = 0;
     for (int k = 0; k < c->ncls; k++) {
-        const size_t b = c->cls[k].begin, n = c->cls[k].end - b;
+        const size_t b0 = c->blk_first[k], nb = c->blk_first[k + 1] - b0;
         c->stop_first[k] = ns, c->extra_first[k] = ne;
-        for (size_t j = 0; j < (c->stop_sub[k] ? cap : n); j++) {
-            size_t i = c->stop_sub[k] ? stop_pick(b, n, cap, k, j) : b + j;
-            if (c->stop_sub[k]) c->stop_idx[ns++] = i;
-            if (cut && (i < c->g_begin || i >= c->g_end)) c->extra[ne++] = i;
+        for (size_t j = 0; j < (c->stop_sub[k] ? capb : nb); j++) {
+            size_t lo, hi;
+            block_range(c, k, b0 + (c->stop_sub[k] ? stop_pick(nb, capb, k, j) : j), &lo, &hi);
+            for (size_t i = lo; i < hi; i++) {
+                if (c->stop_sub[k]) c->stop_idx[ns++] = i;
+                if (cut && (i < c->g_begin || i >= c->g_end)) c->extra[ne++] = i;
+            }
         }
     }
     for (int k = c->ncls; k <= BK_RECEIVER_CLASSES; k++) c->stop_first[k] = ns, c->extra_first[k] = ne;
     return LBK_OK;
+}
+
+/* Class k's receivers that sample in this pass and, with adaptive sampling, their mean samples
+ * so far: over its stop subset where it has one (scaled to the class), so that every unit of a
+ * distributed run counts alike without the other units' blocks. */
+static size_t class_on(const tp_ctx *c, int k)
+{
+    const size_t n = c->cls[k].end - c->cls[k].begin;
+    if (c->stop_sub[k]) {
+        const size_t all = c->stop_first[k + 1] - c->stop_first[k];
+        size_t on = 0;
+        for (size_t p = c->stop_first[k]; p < c->stop_first[k + 1]; p++) on += c->blk_on[block_of(c, c->stop_idx[p])];
+        return all ? (size_t)((uint64_t)n * on / all) : n;
+    }
+    size_t on = 0;
+    for (size_t b = c->blk_first[k]; b < c->blk_first[k + 1]; b++) {
+        size_t lo, hi;
+        block_range(c, k, b, &lo, &hi);
+        if (c->blk_on[b]) on += hi - lo;
+    }
+    return on;
+}
+
+/* (the samples of pass p are 2^p those of pass 0, as its weight is) */
+static double mean_samples(const tp_ctx *c, int k)
+{
+    const tp_class *cl = &c->cls[k];
+    if (!c->adapt || k >= c->ncls || !(cl->weight_sum > 0)) return cl->spp;
+    double sum = 0, n = 0;
+    if (c->stop_sub[k])
+        for (size_t p = c->stop_first[k]; p < c->stop_first[k + 1]; p++) sum += c->blk_w[block_of(c, c->stop_idx[p])], n++;
+    else
+        for (size_t b = c->blk_first[k]; b < c->blk_first[k + 1]; b++) {
+            size_t lo, hi;
+            block_range(c, k, b, &lo, &hi);
+            sum += (double)(hi - lo) * c->blk_w[b], n += (double)(hi - lo);
+        }
+    return n > 0 ? cl->spp * sum / (n * cl->weight_sum) : cl->spp;
+}
+
+static size_t active_receivers(const tp_ctx *c)
+{
+    size_t active = 0;
+    for (int k = 0; k < c->ncls; k++)
+        if (c->cls[k].active) active += class_on(c, k);
+    return active;
 }
 
 static void extra_gather(tp_ctx *c, size_t begin, size_t end, int thread)
@@ -2513,11 +2599,17 @@ static void count_totals(const tp_ctx *c, uint64_t t[3])
     }
 }
 
+/* After a pass of weight w: the blocks that sampled in it, of the classes that did. */
+static void add_block_weights(tp_ctx *c, double w)
+{
+    for (int k = 0; k < c->ncls; k++)
+        for (size_t b = c->blk_first[k]; c->cls[k].active && b < c->blk_first[k + 1]; b++)
+            if (c->blk_on[b]) c->blk_w[b] += w;
+}
+
 static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
 {
-    size_t active = 0;
-    for (int k = 0; k < c->ncls; k++)
-        if (c->cls[k].active) active += c->cls[k].end - c->cls[k].begin;
+    const size_t active = active_receivers(c);
     int cache_rays = pass_cache_rays(c, pass, active);
     for (int h = 0; h < 2; h++) {
         uint64_t before[3], after[3];
@@ -2540,7 +2632,10 @@ static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
         lbk_result res = vpl_pass(c, pass);
         if (res != LBK_OK) return res;
     }
-    size_t block = active / 8 + 1, done = 0;
+    size_t all = 0, done = 0;
+    for (int k = 0; k < c->ncls; k++)
+        if (c->cls[k].active) all += c->cls[k].end - c->cls[k].begin;
+    const size_t block = all / 8 + 1;
     for (int k = 0; k < c->ncls; k++) {
         if (!c->cls[k].active) continue;
         for (size_t b = c->cls[k].begin; b < c->cls[k].end; b += block) {
@@ -2550,7 +2645,7 @@ static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
             size_t gb = b > c->g_begin ? b : c->g_begin, ge = e < c->g_end ? e : c->g_end;
             if (gb < ge) parallel_range(c, gb, ge, 16, recv_gather);
             done += e - b;
-            if (report_progress(c, "gather", c->spp + 2.0 * c->rays * (double)done / (double)(active ? active : 1)))
+            if (report_progress(c, "gather", c->spp + 2.0 * c->rays * (double)done / (double)(all ? all : 1)))
                 return LBK_ERR_CANCELLED;
         }
     }
@@ -2575,6 +2670,7 @@ static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
         c->cls[k].spp += 2.0 * c->rays;
         if (c->cls[k].spp > c->spp) c->spp = c->cls[k].spp;
     }
+    add_block_weights(c, c->pass_weight);
     mark_rough(c);
     return LBK_OK;
 }
@@ -2590,20 +2686,23 @@ typedef struct tp_errors {
  * product is an unbiased estimate of each receiver's squared bias. Relative to the RMS of the
  * receivers' values. */
 
-static void estimate_error_of(const tp_class *cls, int ncls, double *const x_acc[2], double *const b_acc[2], double *noise,
+static void estimate_error_of(const tp_ctx *c, double *const x_acc[2], double *const b_acc[2], double *noise,
                               double *bias, tp_errors *ce)
 {
     double num = 0, den = 0, bb = 0, cnum[BK_RECEIVER_CLASSES] = {0}, cden[BK_RECEIVER_CLASSES] = {0};
-    for (int k = 0; k < ncls; k++) {
-        const tp_class *cl = &cls[k];
-        if (!(cl->weight_sum > 0)) continue;
-        const double inv = 1 / cl->weight_sum;
-        for (size_t i = cl->begin; i < cl->end; i++) {
-            double a = x_acc[0][i] * inv, b = x_acc[1][i] * inv;
-            double m = 0.5 * (a + b), v = 0.25 * (a - b) * (a - b);
-            cnum[k] += v;
-            cden[k] += m * m;
-            bb += (b_acc[0][i] * inv) * (b_acc[1][i] * inv);
+    for (int k = 0; k < c->ncls; k++) {
+        for (size_t blk = c->blk_first[k]; blk < c->blk_first[k + 1]; blk++) {
+            if (!(c->blk_w[blk] > 0)) continue;
+            const double inv = 1 / c->blk_w[blk];
+            size_t lo, hi;
+            block_range(c, k, blk, &lo, &hi);
+            for (size_t i = lo; i < hi; i++) {
+                double a = x_acc[0][i] * inv, b = x_acc[1][i] * inv;
+                double m = 0.5 * (a + b), v = 0.25 * (a - b) * (a - b);
+                cnum[k] += v;
+                cden[k] += m * m;
+                bb += (b_acc[0][i] * inv) * (b_acc[1][i] * inv);
+            }
         }
         num += cnum[k];
         den += cden[k];
@@ -2616,7 +2715,7 @@ static void estimate_error_of(const tp_class *cls, int ncls, double *const x_acc
 
 static void estimate_error(const tp_ctx *c, double *noise, double *bias, tp_errors *ce)
 {
-    estimate_error_of(c->cls, c->ncls, c->x_acc, c->b_acc, noise, bias, ce);
+    estimate_error_of(c, c->x_acc, c->b_acc, noise, bias, ce);
 }
 
 /* The estimate the stop rule reads: the class's own (ce) where it stops on all its receivers,
@@ -2626,10 +2725,10 @@ static void stop_errors(const tp_ctx *c, const tp_errors *ce, tp_errors *sce)
     *sce = *ce;
     for (int k = 0; k < c->ncls; k++) {
         if (!c->stop_sub[k] || !(c->cls[k].weight_sum > 0)) continue;
-        const double inv = 1 / c->cls[k].weight_sum;
         double num = 0, den = 0;
         for (size_t p = c->stop_first[k]; p < c->stop_first[k + 1]; p++) {
             const size_t i = c->stop_idx[p];
+            const double w = c->blk_w[block_of(c, i)], inv = w > 0 ? 1 / w : 0;
             double a = c->x_acc[0][i] * inv, b = c->x_acc[1][i] * inv, m = 0.5 * (a + b);
             num += 0.25 * (a - b) * (a - b);
             den += m * m;
@@ -2638,12 +2737,85 @@ static void stop_errors(const tp_ctx *c, const tp_errors *ce, tp_errors *sce)
     }
 }
 
+/* The mean over class k's receivers (its stop subset where it has one) of m², m the mean of a
+ * receiver's two halves. */
+static double class_mean_square(const tp_ctx *c, int k, double *const x_acc[2])
+{
+    double den = 0, n = 0;
+    if (c->stop_sub[k])
+        for (size_t p = c->stop_first[k]; p < c->stop_first[k + 1]; p++) {
+            const size_t i = c->stop_idx[p];
+            const double w = c->blk_w[block_of(c, i)], m = w > 0 ? 0.5 * (x_acc[0][i] + x_acc[1][i]) / w : 0;
+            den += m * m, n++;
+        }
+    else
+        for (size_t b = c->blk_first[k]; b < c->blk_first[k + 1]; b++) {
+            const double inv = c->blk_w[b] > 0 ? 1 / c->blk_w[b] : 0;
+            size_t lo, hi;
+            block_range(c, k, b, &lo, &hi);
+            for (size_t i = lo; i < hi; i++) {
+                const double m = 0.5 * (x_acc[0][i] + x_acc[1][i]) * inv;
+                den += m * m, n++;
+            }
+        }
+    return n > 0 ? den / n : 0;
+}
+
+/* Adaptive sampling, after pass `pass`: which blocks sample in the next one. A block goes on
+ * while its noise per receiver (its halves' difference, v) exceeds what the target allows the
+ * class's mean receiver, target² · S with S the class's mean square: once every block is below,
+ * so is the class, and until then the samples go to the blocks that hold the error (in the
+ * class's own metric, so dark blocks stop first; TRANSPORT.md §Adaptive sampling has what was
+ * measured against a relative rule). A pure function of the accumulators, the weights and S
+ * (over the stop subset where the class has one), so a unit of a distributed run, the merge's
+ * replay and a resumed run decide alike; a block that falls behind as S changes comes back. A
+ * block without light (or outside a unit's receivers: never gathered there) stops. */
+static void adapt_mark(tp_ctx *c, int pass, double *const x_acc[2])
+{
+    if (!c->adapt) return;
+    for (int k = 0; k < c->ncls; k++) {
+        const size_t b0 = c->blk_first[k], nb = c->blk_first[k + 1] - b0;
+        if (pass < BK_TRANSPORT_ADAPT_PASS) {
+            memset(c->blk_next + b0, 1, nb);
+            continue;
+        }
+        const double allow = c->target * c->target * class_mean_square(c, k, x_acc);
+        for (size_t blk = b0; blk < b0 + nb; blk++) {
+            const double inv = c->blk_w[blk] > 0 ? 1 / c->blk_w[blk] : 0;
+            size_t lo, hi;
+            block_range(c, k, blk, &lo, &hi);
+            double num = 0;
+            for (size_t i = lo; i < hi; i++) {
+                const double d = (x_acc[0][i] - x_acc[1][i]) * inv;
+                num += 0.25 * d * d;
+            }
+            c->blk_next[blk] = num > allow * (double)(hi - lo);
+        }
+    }
+}
+
+/* Class k's blocks that sample in the next pass (its probes' only once the texels have stopped,
+ * as for the target below); 0 when none does: the class has reached its target. The merge's
+ * replay calls it with the classes that sampled in the next pass active, as stop_after left them. */
+static int adapt_apply(tp_ctx *c, int k)
+{
+    size_t on = 0;
+    for (size_t b = c->blk_first[k]; b < c->blk_first[k + 1]; b++) {
+        if (c->adapt && (k == 0 || !c->cls[0].active)) c->blk_on[b] = c->blk_next[b];
+        on += c->blk_on[b];
+    }
+    return on > 0;
+}
+
 /* Which classes stop after this pass: a class whose estimate reached the target, or whose next
  * pass would pass the sample budget; every class when the next pass (about twice the cost of
  * this one) could not finish within the time limit. Returns 1 when none samples any more.
  * Probes stop on their target only once the texels have stopped: the estimate measures their
  * fluence, not the directions of their SH (in a furnace it is exactly 0 at any count while 32
- * directions leave the SH's bands 1–2 visibly wrong), so they get at least the texels' samples. */
+ * directions leave the SH's bands 1–2 visibly wrong), so they get at least the texels' samples.
+ * With adaptive sampling the converged blocks stop first, the budget is of the class's mean
+ * samples per receiver (what the blocks that go on add to it), and a class none of whose blocks
+ * goes on has reached its target. */
 static int stop_after(tp_ctx *c, int pass, const tp_errors *ce, double pass_seconds)
 {
     const bk_transport_options *opt = c->opt;
@@ -2652,10 +2824,12 @@ static int stop_after(tp_ctx *c, int pass, const tp_errors *ce, double pass_seco
     for (int k = 0; k < c->ncls; k++) {
         tp_class *cl = &c->cls[k];
         if (!cl->active) continue;
-        double next_spp = cl->spp + 2.0 * (c->s0 << (pass + 1 < 20 ? pass + 1 : 20));
-        const int texels_sampling = k > 0 && c->cls[0].active;
-        if (c->target > 0 && ce->cls[k] <= c->target && !texels_sampling) cl->stop = BK_STOP_TARGET;
-        else if (next_spp > c->max_samples || pass >= 24) cl->stop = BK_STOP_BUDGET;
+        const double step = 2.0 * (c->s0 << (pass + 1 < 20 ? pass + 1 : 20));
+        const int texels_sampling = k > 0 && c->cls[0].active, going = adapt_apply(c, k);
+        const double next = c->adapt ? mean_samples(c, k) + step * (double)class_on(c, k) / (double)(cl->end - cl->begin)
+                                     : cl->spp + step;
+        if (!going || (c->target > 0 && ce->cls[k] <= c->target && !texels_sampling)) cl->stop = BK_STOP_TARGET;
+        else if (next > c->max_samples || pass >= 24) cl->stop = BK_STOP_BUDGET;
         else if (late) cl->stop = BK_STOP_TIME;
         else { left++; continue; }
         cl->active = 0;
@@ -2664,12 +2838,7 @@ static int stop_after(tp_ctx *c, int pass, const tp_errors *ce, double pass_seco
 }
 
 /* The weight sum of receiver i's passes. */
-static double recv_weight(const tp_ctx *c, size_t i)
-{
-    for (int k = 0; k < c->ncls; k++)
-        if (i < c->cls[k].end) return c->cls[k].weight_sum;
-    return 0;
-}
+static double recv_weight(const tp_ctx *c, size_t i) { return c->recv_count ? c->blk_w[block_of(c, i)] : 0; }
 
 /* Each receiver's X of the two halves, normalised by its class's pass weights. */
 static void write_halves(const tp_ctx *c, double *const x_acc[2], float *halves)
@@ -2711,18 +2880,32 @@ static void finish_outputs(tp_ctx *c)
     }
 }
 
-/* The classes from options.class_end (validated by check_inputs); without it one class. */
-static void init_classes(tp_ctx *c)
+/* The classes from options.class_end (validated by check_inputs; without it one class), and
+ * their blocks. */
+static lbk_result init_classes(tp_ctx *c)
 {
     const size_t *end = c->opt->class_end;
     c->ncls = end[BK_RECEIVER_CLASSES - 1] ? BK_RECEIVER_CLASSES : 1;
+    size_t nb = 0;
     for (int k = 0; k < c->ncls; k++) {
         tp_class *cl = &c->cls[k];
         cl->begin = k ? c->cls[k - 1].end : 0;
         cl->end = c->ncls == 1 ? c->recv_count : end[k];
         cl->active = cl->end > cl->begin;
         cl->stop = BK_STOP_BUDGET;
+        c->blk_first[k] = nb;
+        if (cl->active) nb += (cl->end - 1) / BK_TRANSPORT_BLOCK - cl->begin / BK_TRANSPORT_BLOCK + 1;
     }
+    for (int k = c->ncls; k <= BK_RECEIVER_CLASSES; k++) c->blk_first[k] = nb;
+    c->blk_count = nb;
+    c->adapt = c->opt->adaptive > 0 && c->target > 0;
+    c->blk_w = calloc(nb ? nb : 1, sizeof *c->blk_w);
+    c->blk_on = malloc(nb ? nb : 1);
+    c->blk_next = malloc(nb ? nb : 1);
+    if (!c->blk_w || !c->blk_on || !c->blk_next) return LBK_ERR_OUT_OF_MEMORY;
+    memset(c->blk_on, 1, nb);
+    memset(c->blk_next, 1, nb);
+    return LBK_OK;
 }
 
 /* What the run reports as its samples and its reason to stop: the texels' when there are any
@@ -2737,6 +2920,9 @@ static const tp_class *lead_class(const tp_ctx *c)
     return best;
 }
 
+/* The lead class's mean samples per receiver (its samples without adaptive sampling). */
+static double lead_samples(const tp_ctx *c) { return mean_samples(c, (int)(lead_class(c) - c->cls)); }
+
 static void fill_stats(const tp_ctx *c, int passes, double err, double bias, const tp_errors *ce,
                        const tp_chain_result chain[2], bk_transport_stats *stats)
 {
@@ -2745,8 +2931,8 @@ static void fill_stats(const tp_ctx *c, int passes, double err, double bias, con
     stats->probe_rel_rmse = ce->probe;
     stats->seconds = now_seconds() - c->t0;
     stats->passes = passes;
-    stats->samples_per_receiver = lead->spp;
-    for (int k = 0; k < c->ncls; k++) stats->class_samples[k] = c->cls[k].spp;
+    stats->samples_per_receiver = lead_samples(c);
+    for (int k = 0; k < c->ncls; k++) stats->class_samples[k] = c->cls[k].spp, stats->class_mean_samples[k] = mean_samples(c, k);
     stats->est_rel_rmse = err;
     stats->est_cache_bias = bias;
     stats->bounces = chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces;
@@ -2778,6 +2964,24 @@ static void fill_stats(const tp_ctx *c, int passes, double err, double bias, con
 
 /* ---- distributed runs (bk_transport_split) ------------------------------------------------ */
 
+/* What a pass reports. */
+static void sample_of(const tp_ctx *c, double spp, double err, int bounces, int pass, const tp_errors *ce,
+                      bk_transport_sample *smp)
+{
+    memset(smp, 0, sizeof *smp);
+    smp->seconds = now_seconds() - c->t0;
+    smp->samples_per_receiver = spp;
+    smp->est_rel_rmse = err;
+    smp->bounces = bounces;
+    smp->pass = pass;
+    for (int k = 0; k < BK_RECEIVER_CLASSES; k++) {
+        smp->class_rel_rmse[k] = ce->cls[k];
+        smp->class_samples[k] = c->cls[k].spp;
+        smp->class_mean_samples[k] = mean_samples(c, k);
+    }
+    smp->probe_rel_rmse = ce->probe;
+}
+
 static lbk_result record_pass(const tp_ctx *c, int pass, const tp_chain_result chain[2])
 {
     const bk_transport_split *sp = c->opt->split;
@@ -2785,7 +2989,7 @@ static lbk_result record_pass(const tp_ctx *c, int pass, const tp_chain_result c
     memset(&pr, 0, sizeof pr);
     pr.pass = pass;
     pr.bounces = chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces;
-    pr.samples_per_receiver = lead_class(c)->spp;
+    pr.samples_per_receiver = lead_samples(c);
     for (int k = 0; k < c->ncls; k++) pr.weight_sum[k] = c->cls[k].weight_sum, pr.class_samples[k] = c->cls[k].spp;
     for (int h = 0; h < 2; h++) pr.x_acc[h] = c->x_acc[h], pr.b_acc[h] = c->b_acc[h];
     return sp->record_pass(sp->user, &pr);
@@ -2851,10 +3055,12 @@ static lbk_result replay_run(tp_ctx *c, bk_transport_stats *stats)
 {
     const bk_transport_options *opt = c->opt;
     const bk_transport_split *sp = opt->split;
-    init_classes(c);
+    lbk_result res = init_classes(c);
+    if (res == LBK_OK) res = stop_init(c); /* (the subsets adaptive sampling reads) */
+    if (res) return res;
     bk_transport_totals t;
     memset(&t, 0, sizeof t);
-    lbk_result res = sp->replay_totals(sp->user, c->recv_count, &t);
+    res = sp->replay_totals(sp->user, c->recv_count, &t);
     if (res) return res;
     if (!replay_totals_ok(&t)) return LBK_ERR_BAD_INPUT;
     bk_transport_pass_record pr;
@@ -2872,12 +3078,20 @@ static lbk_result replay_run(tp_ctx *c, bk_transport_stats *stats)
         res = sp->replay_pass(sp->user, &pr);
         if (!res && !replay_pass_ok(&pr, c->recv_count)) res = LBK_ERR_BAD_INPUT;
         if (res) break;
-        for (int k = 0; k < c->ncls; k++) c->cls[k].weight_sum = pr.weight_sum[k], c->cls[k].spp = pr.class_samples[k];
-        estimate_error_of(c->cls, c->ncls, pr.x_acc, pr.b_acc, &err, &bias, &ce);
+        /* the classes that sampled in this pass are those whose weight grew; their marked
+         * blocks stopped before it, as stop_after stopped them in the run */
+        for (int k = 0; k < c->ncls; k++) {
+            c->cls[k].active = pr.weight_sum[k] > c->cls[k].weight_sum;
+            c->cls[k].weight_sum = pr.weight_sum[k], c->cls[k].spp = pr.class_samples[k];
+        }
+        for (int k = 0; k < c->ncls; k++)
+            if (c->cls[k].active) adapt_apply(c, k);
+        add_block_weights(c, ldexp(1.0, pass));
+        estimate_error_of(c, pr.x_acc, pr.b_acc, &err, &bias, &ce);
+        adapt_mark(c, pass, pr.x_acc);
         if (opt->report) {
-            bk_transport_sample smp = {now_seconds() - c->t0, pr.samples_per_receiver, err, pr.bounces, pass,
-                                       {ce.cls[0], ce.cls[1], ce.cls[2]}, ce.probe,
-                                       {c->cls[0].spp, c->cls[1].spp, c->cls[2].spp}};
+            bk_transport_sample smp;
+            sample_of(c, pr.samples_per_receiver, err, pr.bounces, pass, &ce, &smp);
             opt->report(opt->user, &smp);
         }
         if (opt->progress && opt->progress(opt->user, "gather", (double)(pass + 1) / t.passes)) res = LBK_ERR_CANCELLED;
@@ -2893,7 +3107,7 @@ static lbk_result replay_run(tp_ctx *c, bk_transport_stats *stats)
     stats->seconds = now_seconds() - c->t0;
     stats->passes = t.passes;
     stats->samples_per_receiver = pr.samples_per_receiver;
-    for (int k = 0; k < c->ncls; k++) stats->class_samples[k] = c->cls[k].spp;
+    for (int k = 0; k < c->ncls; k++) stats->class_samples[k] = c->cls[k].spp, stats->class_mean_samples[k] = mean_samples(c, k);
     stats->est_rel_rmse = err;
     stats->est_cache_bias = bias;
     stats->bounces = t.bounces;
@@ -2911,9 +3125,10 @@ static lbk_result replay_run(tp_ctx *c, bk_transport_stats *stats)
 /* A unit's run it has no share of (bk_transport_split.run_range): no cache, no gather; zero
  * outputs and the passes and samples the fixed schedule gives (run_pass, stop_after with no
  * target and no time limit), which later runs may depend on (door runs' budget). */
-static void schedule_only(tp_ctx *c, bk_transport_stats *stats)
+static lbk_result schedule_only(tp_ctx *c, bk_transport_stats *stats)
 {
-    init_classes(c);
+    lbk_result res = init_classes(c);
+    if (res) return res;
     const tp_errors none = {{0}, 0};
     int pass = 0;
     for (;; pass++) {
@@ -2930,13 +3145,14 @@ static void schedule_only(tp_ctx *c, bk_transport_stats *stats)
     if (o->irradiance) memset(o->irradiance, 0, c->recv_count * 3 * sizeof *o->irradiance);
     if (o->variance) memset(o->variance, 0, c->recv_count * sizeof *o->variance);
     if (o->halves) memset(o->halves, 0, c->recv_count * 2 * sizeof *o->halves);
-    if (!stats) return;
+    if (!stats) return LBK_OK;
     const tp_class *lead = lead_class(c);
     stats->passes = pass + 1;
     stats->samples_per_receiver = lead->spp;
-    for (int k = 0; k < c->ncls; k++) stats->class_samples[k] = c->cls[k].spp;
+    for (int k = 0; k < c->ncls; k++) stats->class_samples[k] = c->cls[k].spp, stats->class_mean_samples[k] = c->cls[k].spp;
     stats->stop = lead->stop;
     stats->seconds = now_seconds() - c->t0;
+    return LBK_OK;
 }
 
 /* ---- checkpoints (bk_transport_checkpoint) ------------------------------------------------ */
@@ -2950,6 +3166,8 @@ static void state_arrays(tp_ctx *c, bk_transport_state *st)
     st->irradiance = c->out->irradiance;
     st->cells = c->cell_count;
     st->rough = c->rough;
+    st->blocks = c->blk_count;
+    st->block_weight = c->blk_w;
 }
 
 static lbk_result save_state(tp_ctx *c, int pass, const tp_chain_result chain[2])
@@ -3061,11 +3279,11 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
         goto done;
     }
     if (!own) {
-        schedule_only(&c, stats);
+        res = schedule_only(&c, stats);
         goto done;
     }
-    init_classes(&c); /* (before ctx_init: culling's δ is measured per class) */
-    res = ctx_init(&c);
+    res = init_classes(&c); /* (before ctx_init: culling's δ is measured per class) */
+    if (res == LBK_OK) res = ctx_init(&c);
     if (res == LBK_OK) res = stop_init(&c);
     if (res != LBK_OK) goto done;
 
@@ -3095,6 +3313,7 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
             estimate_error(&c, &err, &bias, &ce);
             stop_errors(&c, &ce, &sce);
             pass = done_passes - 1;
+            adapt_mark(&c, pass, c.x_acc);
             if (stop_after(&c, pass, &sce, 0)) goto finished;
             pass = done_passes;
         }
@@ -3104,11 +3323,11 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
         res = run_pass(&c, pass, chain);
         if (res != LBK_OK) goto done;
         estimate_error(&c, &err, &bias, &ce);
+        adapt_mark(&c, pass, c.x_acc);
         if (rec && (res = record_pass(&c, pass, chain)) != LBK_OK) goto done;
-        bk_transport_sample smp = {now_seconds() - t0, lead_class(&c)->spp, err,
-                                   chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces, pass,
-                                   {ce.cls[0], ce.cls[1], ce.cls[2]}, ce.probe,
-                                   {c.cls[0].spp, c.cls[1].spp, c.cls[2].spp}};
+        bk_transport_sample smp;
+        sample_of(&c, lead_samples(&c), err, chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces,
+                  pass, &ce, &smp);
         if (pass < BK_TRANSPORT_MAX_PASSES) c.samples[pass] = smp;
         if (opt->report) opt->report(opt->user, &smp);
         if (opt->checkpoint && !split && (res = save_state(&c, pass, chain)) != LBK_OK) goto done;

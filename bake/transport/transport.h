@@ -73,7 +73,8 @@ enum { BK_CLASS_TEXEL, BK_CLASS_GLG, BK_CLASS_LLG, BK_RECEIVER_CLASSES };
 
 typedef struct bk_transport_sample {
     double seconds;               /* since bk_transport_run started */
-    double samples_per_receiver;  /* gather rays per receiver so far (both halves, all passes) */
+    double samples_per_receiver;  /* gather rays per receiver so far (both halves, all passes): the
+                                     lead class's mean (class_mean_samples) */
     double est_rel_rmse;          /* estimated relative RMSE of the result so far (TRANSPORT.md) */
     int bounces;                  /* bounces computed explicitly in the last pass (tail excluded) */
     int pass;
@@ -81,7 +82,12 @@ typedef struct bk_transport_sample {
      * GLG probes, LLG probes, and the probes together */
     double class_rel_rmse[BK_RECEIVER_CLASSES];
     double probe_rel_rmse;
-    double class_samples[BK_RECEIVER_CLASSES]; /* samples per receiver of each class so far */
+    double class_samples[BK_RECEIVER_CLASSES]; /* the samples so far of each class's receivers that
+                                                  sampled longest */
+    /* the mean over each class's receivers (over its stop subset where it has one) of their own
+     * samples: below class_samples where adaptive sampling (options.adaptive) let converged
+     * blocks stop while others went on */
+    double class_mean_samples[BK_RECEIVER_CLASSES];
 } bk_transport_sample;
 
 /* ---- distributed bakes (bake/dist/DIST.md) ----------------------------------------------
@@ -135,6 +141,10 @@ typedef struct bk_transport_state {
     /* per cache cell (cells): the rough marks the last pass left for the next (TRANSPORT.md) */
     size_t cells;
     uint8_t *rough;
+    /* per adaptive block (blocks; TRANSPORT.md §Adaptive sampling): the sum of the weights of
+     * the passes it sampled in */
+    size_t blocks;
+    double *block_weight;
 } bk_transport_state;
 
 typedef struct bk_transport_checkpoint {
@@ -252,8 +262,8 @@ typedef struct bk_transport_options {
     double glossy_vpl_delta;   /* δ relative to the mean irradiance the VPLs give the surface
                                   receivers (pass p: δ/2^p); 0: BK_VPL_DEFAULT_DELTA */
     /* The stop rule's receivers per class (TRANSPORT.md §Stop subset): a class of more than
-     * this many stops on the estimate over a hash-stratified subset of this many of its
-     * receivers (the reported estimate stays over all of them), so a unit of a distributed run
+     * this many stops on the estimate over a hash-stratified subset of about this many of its
+     * receivers, in whole adaptive blocks (the reported estimate stays over all of them), so a unit of a distributed run
      * can evaluate the stop alone by also gathering that subset; a smaller class stops on all
      * its receivers. 0: BK_TRANSPORT_STOP_RECEIVERS. */
     size_t stop_receivers;
@@ -272,9 +282,24 @@ typedef struct bk_transport_options {
     double gather_limit;
     int (*far_radiance)(void *user, const double x[3], const double d[3], uint32_t *hint, double L[3]);
     void *far_user;
+    /* Adaptive sampling (TRANSPORT.md §Adaptive sampling): 1: with a target, the receivers of a
+     * class are taken in blocks of BK_TRANSPORT_BLOCK (receiver index / BK_TRANSPORT_BLOCK, cut
+     * at the class bounds); after pass BK_TRANSPORT_ADAPT_PASS and each one after it, a block
+     * whose noise per receiver (its two halves' difference) is at most target² × the class's
+     * mean square sits the next pass out while the rest of its class goes on, and max_samples
+     * bounds the class's mean samples per receiver (bk_transport_sample.class_mean_samples).
+     * Probes' blocks adapt once the texels have stopped. 0: off (every receiver of a class
+     * samples while the class does). */
+    int adaptive;
 } bk_transport_options;
 
 #define BK_TRANSPORT_STOP_RECEIVERS ((size_t)65536)
+
+/* Adaptive sampling's blocks and the first pass after which one may stop (TRANSPORT.md
+ * §Adaptive sampling, measured by bench_estimate and bench-cycles). A distributed run's unit
+ * gathers whole blocks (spec/part.md §1.1). */
+#define BK_TRANSPORT_BLOCK 64
+#define BK_TRANSPORT_ADAPT_PASS 1
 
 /* The light count above which culling is on by default, and the default δ (SLC.md, measured by
  * bench_slc). */
@@ -325,6 +350,7 @@ typedef struct bk_transport_stats {
      * texels' (the first class with receivers when there are no texels: the one that sampled
      * longest) */
     double class_samples[BK_RECEIVER_CLASSES];
+    double class_mean_samples[BK_RECEIVER_CLASSES]; /* the mean over each class's receivers (adaptive) */
     int bounces;             /* explicit bounces of the last pass */
     double q;                /* per-bounce energy ratio used for the tail (last pass, mean of halves) */
     double tail_fraction;    /* share of the cache's indirect energy that came from the tail */

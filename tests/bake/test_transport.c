@@ -671,6 +671,102 @@ static void test_nee_unbiased_and_quieter(void **state)
     tsc_free(&s);
 }
 
+/* ---- adaptive sampling (TRANSPORT.md §Adaptive sampling) ----------------------------------- */
+
+/* nee_room with a spot light down onto the middle of the floor, and its surface texels in
+ * blocks of one surface each: the floor by distance from the spot's axis (the first block in
+ * its noise-free light: quiet), then the x = 4 wall and the ceiling (mostly indirect: noisy). */
+enum { AD_PER = 192, AD_N = 3 * AD_PER };
+static void adaptive_scene(bk_scene *s, bk_receiver *r)
+{
+    nee_room(s);
+    const float lp[3] = {2, 1.5f, 2.3f}, ld[3] = {0, 0, -1};
+    tsc_spot_light(s, lp, ld, 300, 0.5f, 0.6f);
+    bk_receiver all[4 * AD_PER];
+    nee_receivers(all, 4 * AD_PER);
+    for (int g = 0; g < 3; g++)
+        for (int j = 0; j < AD_PER; j++) r[g * AD_PER + j] = all[4 * j + g];
+    for (int i = 1; i < AD_PER; i++) /* insertion sort of the floor by distance from (2, 1.5) */
+        for (int j = i; j > 0; j--) {
+            bk_receiver *x = &r[j - 1], *y = &r[j];
+            const double dx = hypot(x->position[0] - 2, x->position[1] - 1.5), dy = hypot(y->position[0] - 2, y->position[1] - 1.5);
+            if (dx <= dy) break;
+            bk_receiver t = *x;
+            *x = *y, *y = t;
+        }
+}
+
+/* The per-surface relative RMS difference of a against b (the estimate's metric). */
+static double group_diff(const run_out *a, const run_out *b, const bk_receiver *r, int g)
+{
+    return rel_rms_diff(a->irr + 3 * g * AD_PER, b->irr + 3 * g * AD_PER, r + g * AD_PER, AD_PER);
+}
+
+/* Blocks whose noise is below what the target allows the class's mean receiver stop, the rest
+ * sample on past the class's mean: the floor's blocks in the spot's light stop first. Each block is normalised by its own
+ * passes, so against a long non-adaptive reference every surface is within 3x of the noise the
+ * two bakes estimate (a block divided by its class's weights instead of its own would be off by
+ * 2x or more); the class estimate stays within 2x of the measured error; it reaches the target
+ * with less work than sampling every block; and the bytes do not depend on the thread count. */
+static void test_adaptive_sampling(void **state)
+{
+    (void)state;
+    bk_scene s;
+    bk_receiver r[AD_N];
+    adaptive_scene(&s, r);
+    bk_transport_options o = tsc_fixed_passes(8, 3);
+    o.max_cells = 1024;
+    o.target_error = 0.01;
+    o.adaptive = 1;
+    rec rp;
+    memset(&rp, 0, sizeof rp);
+    o.report = on_report;
+    o.user = &rp;
+    run_out ad = run(&s, r, AD_N, &o);
+    o.report = NULL;
+    o.threads = 1;
+    run_out ad1 = run(&s, r, AD_N, &o);
+    o.threads = 2;
+    o.adaptive = 0;
+    run_out off = run(&s, r, AD_N, &o);
+    o.target_error = -1;
+    o.seed = 11;
+    o.max_samples = 2 * 16 * ((1 << 9) - 1); /* the reference: 9 passes, every receiver */
+    run_out ref = run(&s, r, AD_N, &o);
+    const bk_transport_stats *st = &ad.st;
+    print_message("adaptive: %.2f %% at mean %.0f / max %.0f samples, %d passes, %.3g rays; off: %.2f %% at %.0f, %.3g rays\n",
+                  100 * st->est_rel_rmse, st->class_mean_samples[0], st->class_samples[0], st->passes, (double)st->rays,
+                  100 * off.st.est_rel_rmse, off.st.class_samples[0], (double)off.st.rays);
+    assert_memory_equal(ad.irr, ad1.irr, 3 * AD_N * sizeof *ad.irr);
+    assert_memory_equal(ad.rad, ad1.rad, AD_N * sizeof *ad.rad);
+    /* some blocks stopped early, others sampled longer than the class's mean */
+    assert_true(st->class_mean_samples[0] < 0.9 * st->class_samples[0]);
+    assert_true(st->samples_per_receiver == st->class_mean_samples[0]);
+    assert_true(rp.n == st->passes && rp.s[rp.n - 1].class_mean_samples[0] == st->class_mean_samples[0]);
+    for (int i = 1; i < rp.n; i++) assert_true(rp.s[i].samples_per_receiver >= rp.s[i - 1].samples_per_receiver);
+    /* the mean stays within the budget the run was given */
+    assert_true(st->class_mean_samples[0] <= o.max_samples);
+    for (int g = 0; g < 3; g++) {
+        const double d = group_diff(&ad, &ref, r, g), d_off = group_diff(&off, &ref, r, g);
+        print_message("  surface %d: adaptive vs reference %.2f %%, off vs reference %.2f %%\n", g, 100 * d, 100 * d_off);
+        assert_true(d <= 3 * sqrt(st->est_rel_rmse * st->est_rel_rmse + 4 * ref.st.est_rel_rmse * ref.st.est_rel_rmse) + 0.01);
+    }
+    const double all = rel_rms_diff(ad.irr, ref.irr, r, AD_N);
+    const double measured = sqrt(fmax(all * all - ref.st.est_rel_rmse * ref.st.est_rel_rmse, 0));
+    print_message("  all: estimated %.2f %%, measured %.2f %% (reference %.2f %%)\n", 100 * st->est_rel_rmse, 100 * measured,
+                  100 * ref.st.est_rel_rmse);
+    assert_true(st->est_rel_rmse <= 2 * measured && st->est_rel_rmse >= 0.5 * measured);
+    /* both reach the target, the adaptive run with less work */
+    assert_int_equal(st->stop, BK_STOP_TARGET);
+    assert_int_equal(off.st.stop, BK_STOP_TARGET);
+    assert_true(st->rays < 0.95 * off.st.rays);
+    run_free(&ad);
+    run_free(&ad1);
+    run_free(&off);
+    run_free(&ref);
+    tsc_free(&s);
+}
+
 /* The stream path (rtcIntersect1M in chunks) returns exactly what single calls return. */
 /* Receiver classes sample to their own target: probes gather over the whole sphere and are
  * noisier than texels at equal samples, so when the texels reach the target the probes have
@@ -745,8 +841,9 @@ static void test_classes_sample_to_their_own_target(void **state)
 }
 
 /* A run cut by receivers with an error target (bk_transport_split, DIST.md): each unit gathers
- * its range plus the stop receivers (stop_receivers 24: the texel and probe classes stop on
- * hashed subsets of 24 of their 48 and 32), so every unit stops where the whole run stops —
+ * its range plus the stop receivers (stop_receivers 24: one block; the 48 texels, one block,
+ * stop on all of them, the 32 probes, in two blocks, on a hashed one), so every unit stops where
+ * the whole run stops —
  * the texels before the probes, after which the caches follow the probes alone — and its
  * recorded passes, accumulators and outputs are the whole run's, bit for bit; the units'
  * receiver rays add up to the whole run's (what the stop receivers cost is left out). */
@@ -808,6 +905,148 @@ static void cut_free(cut_rec *c)
     for (int p = 0; p < c->passes; p++) free(c->x[p]);
 }
 
+/* Checkpoints in memory: every pass's state saved; a load hands back the one of pass `at`. */
+typedef struct mem_ckpt {
+    int at, saved;
+    bk_transport_state st[32];
+    size_t n;
+} mem_ckpt;
+
+static void *dup_or_null(const void *p, size_t size)
+{
+    if (!p) return NULL;
+    void *q = malloc(size ? size : 1);
+    memcpy(q, p, size);
+    return q;
+}
+
+static lbk_result mem_save(void *user, const bk_transport_state *st)
+{
+    mem_ckpt *m = user;
+    assert_true(m->saved < 32 && st->passes == m->saved + 1);
+    bk_transport_state *d = &m->st[m->saved++];
+    *d = *st;
+    const size_t n = st->count;
+    for (int h = 0; h < 2; h++) d->x_acc[h] = dup_or_null(st->x_acc[h], 8 * n), d->b_acc[h] = dup_or_null(st->b_acc[h], 8 * n);
+    d->radiance = dup_or_null(st->radiance, n * sizeof(lbk_sh9_rgb));
+    d->direct = dup_or_null(st->direct, n * sizeof(lbk_sh9_rgb));
+    d->irradiance = dup_or_null(st->irradiance, 12 * n);
+    d->rough = dup_or_null(st->rough, st->cells);
+    d->block_weight = dup_or_null(st->block_weight, 8 * st->blocks);
+    return LBK_OK;
+}
+
+static int mem_load(void *user, bk_transport_state *st)
+{
+    mem_ckpt *m = user;
+    if (m->at < 0) return 0;
+    const bk_transport_state *sv = &m->st[m->at];
+    const size_t n = st->count;
+    assert_true(sv->count == n && sv->cells == st->cells && sv->blocks == st->blocks);
+    bk_transport_state keep = *st; /* the run's own arrays, which the load fills */
+    *st = *sv;
+    for (int h = 0; h < 2; h++) {
+        st->x_acc[h] = keep.x_acc[h], st->b_acc[h] = keep.b_acc[h];
+        memcpy(st->x_acc[h], sv->x_acc[h], 8 * n), memcpy(st->b_acc[h], sv->b_acc[h], 8 * n);
+    }
+    st->radiance = keep.radiance, st->direct = keep.direct, st->irradiance = keep.irradiance;
+    st->rough = keep.rough, st->block_weight = keep.block_weight;
+    memcpy(st->radiance, sv->radiance, n * sizeof(lbk_sh9_rgb));
+    if (st->direct) memcpy(st->direct, sv->direct, n * sizeof(lbk_sh9_rgb));
+    if (st->irradiance) memcpy(st->irradiance, sv->irradiance, 12 * n);
+    if (st->cells) memcpy(st->rough, sv->rough, st->cells);
+    if (st->blocks) memcpy(st->block_weight, sv->block_weight, 8 * st->blocks);
+    return 1;
+}
+
+static void mem_free(mem_ckpt *m)
+{
+    for (int p = 0; p < m->saved; p++) {
+        bk_transport_state *d = &m->st[p];
+        for (int h = 0; h < 2; h++) free(d->x_acc[h]), free(d->b_acc[h]);
+        free(d->radiance), free(d->direct), free(d->irradiance), free(d->rough), free(d->block_weight);
+    }
+}
+
+/* A run resumed from any of its passes' checkpoints ends with the uninterrupted run's bytes,
+ * also across adaptive stops: the blocks' weights are saved and which blocks sample next is
+ * recomputed from the saved sums. */
+static void test_resume_adaptive(void **state)
+{
+    (void)state;
+    bk_scene s;
+    bk_receiver r[AD_N];
+    adaptive_scene(&s, r);
+    bk_transport_options o = tsc_fixed_passes(8, 3);
+    o.max_cells = 1024;
+    o.target_error = 0.01;
+    o.adaptive = 1;
+    mem_ckpt m;
+    memset(&m, 0, sizeof m);
+    m.at = -1;
+    bk_transport_checkpoint ck = {&m, mem_save, mem_load};
+    o.checkpoint = &ck;
+    run_out whole = run(&s, r, AD_N, &o);
+    assert_true(whole.st.class_mean_samples[0] < whole.st.class_samples[0]);
+    assert_int_equal(m.saved, whole.st.passes);
+    for (int at = 0; at + 1 < whole.st.passes; at++) {
+        mem_ckpt from = m;
+        from.at = at;
+        from.saved = at + 1; /* it saves the passes after it */
+        bk_transport_checkpoint ck2 = {&from, mem_save, mem_load};
+        o.checkpoint = &ck2;
+        run_out res = run(&s, r, AD_N, &o);
+        assert_memory_equal(res.irr, whole.irr, 3 * AD_N * sizeof *whole.irr);
+        assert_memory_equal(res.rad, whole.rad, AD_N * sizeof *whole.rad);
+        assert_true(res.st.class_mean_samples[0] == whole.st.class_mean_samples[0] && res.st.rays == whole.st.rays);
+        for (int p = at + 1; p < from.saved; p++) { /* (free what the resumed run saved) */
+            bk_transport_state *d = &from.st[p];
+            for (int h = 0; h < 2; h++) free(d->x_acc[h]), free(d->b_acc[h]);
+            free(d->radiance), free(d->direct), free(d->irradiance), free(d->rough), free(d->block_weight);
+        }
+        run_free(&res);
+    }
+    mem_free(&m);
+    run_free(&whole);
+    tsc_free(&s);
+}
+
+/* The units [cuts[u], cuts[u + 1]) of a cut run each record the whole run's passes, class
+ * weights and accumulators over their range, and its outputs; their receiver rays add up. */
+static void check_cuts(const bk_scene *s, const bk_receiver *r, size_t n, const bk_transport_options *o,
+                       const run_out *whole, const size_t *cuts, int units)
+{
+    cut_rec ref;
+    run_out w = cut_run(s, r, n, o, 0, n, &ref);
+    assert_int_equal(ref.passes, whole->st.passes);
+    assert_memory_equal(w.rad, whole->rad, n * sizeof *whole->rad);
+    assert_true(ref.t.cache_rays + ref.t.recv_rays == w.st.rays);
+    uint64_t recv_rays = 0;
+    for (int u = 0; u < units; u++) {
+        cut_rec c;
+        run_out part = cut_run(s, r, n, o, cuts[u], cuts[u + 1], &c);
+        const size_t b = c.begin, m = c.end - c.begin;
+        assert_int_equal(c.passes, ref.passes);
+        assert_int_equal(c.t.stop, ref.t.stop);
+        assert_true(c.t.cache_rays == ref.t.cache_rays); /* the caches followed the same classes */
+        for (int p = 0; p < c.passes; p++) {
+            assert_memory_equal(c.weight_sum[p], ref.weight_sum[p], sizeof ref.weight_sum[p]);
+            assert_memory_equal(c.x[p] + b, ref.x[p] + b, m * sizeof(double));
+            assert_memory_equal(c.x[p] + n + b, ref.x[p] + n + b, m * sizeof(double));
+        }
+        assert_memory_equal(part.rad + b, whole->rad + b, m * sizeof *whole->rad);
+        assert_memory_equal(part.irr + 3 * b, whole->irr + 3 * b, 3 * m * sizeof *whole->irr);
+        /* it traced the stop receivers outside its range too, and left them out of its count */
+        assert_true(c.t.cache_rays + c.t.recv_rays < part.st.rays);
+        recv_rays += c.t.recv_rays;
+        cut_free(&c);
+        run_free(&part);
+    }
+    assert_true(recv_rays == ref.t.recv_rays);
+    cut_free(&ref);
+    run_free(&w);
+}
+
 static void test_cut_run_with_target(void **state)
 {
     (void)state;
@@ -837,37 +1076,49 @@ static void test_cut_run_with_target(void **state)
     print_message("whole run: %d passes, texels %.0f samples (%.2f %%), probes %.0f (%.2f %%)\n", whole.st.passes,
                   whole.st.class_samples[BK_CLASS_TEXEL], 100 * whole.st.class_rel_rmse[BK_CLASS_TEXEL],
                   whole.st.class_samples[BK_CLASS_GLG], 100 * whole.st.class_rel_rmse[BK_CLASS_GLG]);
-    /* the whole run recorded: the reference for every unit's records */
-    cut_rec ref;
-    run_out w = cut_run(&s, r, N, &o, 0, N, &ref);
-    assert_int_equal(ref.passes, whole.st.passes);
-    assert_memory_equal(w.rad, whole.rad, N * sizeof *whole.rad);
-    assert_true(ref.t.cache_rays + ref.t.recv_rays == w.st.rays);
     const size_t cuts[4] = {0, 27, 54, N};
-    uint64_t recv_rays = 0;
-    for (int u = 0; u < 3; u++) {
-        cut_rec c;
-        run_out part = cut_run(&s, r, N, &o, cuts[u], cuts[u + 1], &c);
-        const size_t b = c.begin, m = c.end - c.begin;
-        assert_int_equal(c.passes, ref.passes);
-        assert_int_equal(c.t.stop, ref.t.stop);
-        assert_true(c.t.cache_rays == ref.t.cache_rays); /* the caches followed the same classes */
-        for (int p = 0; p < c.passes; p++) {
-            assert_memory_equal(c.weight_sum[p], ref.weight_sum[p], sizeof ref.weight_sum[p]);
-            assert_memory_equal(c.x[p] + b, ref.x[p] + b, m * sizeof(double));
-            assert_memory_equal(c.x[p] + N + b, ref.x[p] + N + b, m * sizeof(double));
-        }
-        assert_memory_equal(part.rad + b, whole.rad + b, m * sizeof *whole.rad);
-        assert_memory_equal(part.irr + 3 * b, whole.irr + 3 * b, 3 * m * sizeof *whole.irr);
-        /* it traced the stop receivers outside its range too, and left them out of its count */
-        assert_true(c.t.cache_rays + c.t.recv_rays < part.st.rays);
-        recv_rays += c.t.recv_rays;
-        cut_free(&c);
-        run_free(&part);
-    }
-    assert_true(recv_rays == ref.t.recv_rays);
-    cut_free(&ref);
-    run_free(&w);
+    check_cuts(&s, r, N, &o, &whole, cuts, 3);
+    run_free(&whole);
+    tsc_free(&s);
+}
+
+/* The same with adaptive sampling, cut at whole blocks (spec/part.md §1.1): both classes stop
+ * on subsets of two of their blocks (6 and 3), so each unit decides the blocks it gathers and
+ * those of the subsets as the whole run does, and the second class adapts only once the first
+ * has stopped; then without subsets. */
+static void test_cut_run_adaptive(void **state)
+{
+    (void)state;
+    bk_scene s;
+    bk_receiver r[AD_N];
+    adaptive_scene(&s, r);
+    bk_transport_options o = tsc_fixed_passes(8, 3);
+    o.max_cells = 1024;
+    o.target_error = 0.01;
+    o.adaptive = 1;
+    o.class_end[BK_CLASS_TEXEL] = 2 * AD_PER;
+    o.class_end[BK_CLASS_GLG] = AD_N;
+    o.class_end[BK_CLASS_LLG] = AD_N;
+    o.stop_receivers = 2 * BK_TRANSPORT_BLOCK;
+    run_out whole = run(&s, r, AD_N, &o);
+    o.adaptive = 0;
+    run_out off = run(&s, r, AD_N, &o);
+    o.adaptive = 1;
+    print_message("whole run: %d passes, %.3g rays (%.3g without adaptive sampling); the subsets' mean samples: "
+                  "texels %.0f / max %.0f, class 1 %.0f / max %.0f\n", whole.st.passes, (double)whole.st.rays,
+                  (double)off.st.rays, whole.st.class_mean_samples[0], whole.st.class_samples[0],
+                  whole.st.class_mean_samples[1], whole.st.class_samples[1]);
+    /* blocks stopped early (the classes' means are their subsets', which need not show it) */
+    assert_true(whole.st.passes == off.st.passes && whole.st.rays < off.st.rays);
+    run_free(&off);
+    const size_t cuts[4] = {0, 3 * BK_TRANSPORT_BLOCK, 5 * BK_TRANSPORT_BLOCK, AD_N};
+    check_cuts(&s, r, AD_N, &o, &whole, cuts, 3);
+    run_free(&whole);
+    /* and without subsets (every unit gathers both classes whole), where the means show it */
+    o.stop_receivers = 0;
+    whole = run(&s, r, AD_N, &o);
+    assert_true(whole.st.class_mean_samples[0] < whole.st.class_samples[0]);
+    check_cuts(&s, r, AD_N, &o, &whole, cuts, 3);
     run_free(&whole);
     tsc_free(&s);
 }
@@ -951,6 +1202,9 @@ int main(void)
         cmocka_unit_test(test_nee_unbiased_and_quieter),
         cmocka_unit_test(test_classes_sample_to_their_own_target),
         cmocka_unit_test(test_cut_run_with_target),
+        cmocka_unit_test(test_adaptive_sampling),
+        cmocka_unit_test(test_cut_run_adaptive),
+        cmocka_unit_test(test_resume_adaptive),
         cmocka_unit_test(test_stream_equals_single),
         cmocka_unit_test(test_intensity_extremes),
         cmocka_unit_test(test_scale_and_offset_extremes),

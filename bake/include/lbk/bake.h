@@ -55,7 +55,7 @@ extern "C" {
 /* The baker library's version (lbk-bake.pc): the minor grows with every addition to the
  * size-tagged structs below ("added in 1.x"). */
 #define LBK_BAKE_LIBRARY_VERSION_MAJOR 1
-#define LBK_BAKE_LIBRARY_VERSION_MINOR 7
+#define LBK_BAKE_LIBRARY_VERSION_MINOR 8
 #define LBK_BAKE_LIBRARY_VERSION_PATCH 0
 
 /* ---- options ----------------------------------------------------------------------------- */
@@ -226,6 +226,11 @@ typedef struct lbk_bake_desc {
                                    every pass [0: 1024] */
     double glossy_vpl_delta;    /* the VPLs' culling δ relative to the mean irradiance they give
                                    the texels (smaller: more VPLs per texel, less noise) [0: 0.1] */
+    /* added in 1.8 */
+    int adaptive;               /* adaptive sampling (bake/transport/TRANSPORT.md §Adaptive
+                                   sampling): blocks of 64 receivers whose own estimate reached
+                                   the target stop sampling while the rest go on; -1 off [0: on;
+                                   no effect without a target] */
 } lbk_bake_desc;
 
 /* A file a bake read (the glTF, its buffers and images, a sky EXR), as META input.files
