@@ -268,6 +268,7 @@ typedef struct ckpt {
     lbk_sh9_rgb rad[NR], dir[NR];
     float irr[3 * NR];
     uint8_t *rough;
+    double *blocks;
 } ckpt;
 
 static lbk_result ck_save(void *user, const bk_transport_state *st)
@@ -287,6 +288,8 @@ static lbk_result ck_save(void *user, const bk_transport_state *st)
     memcpy(k->irr, st->irradiance, sizeof k->irr);
     k->rough = malloc(st->cells ? st->cells : 1);
     memcpy(k->rough, st->rough, st->cells);
+    k->blocks = malloc(st->blocks ? 8 * st->blocks : 1);
+    memcpy(k->blocks, st->block_weight, 8 * st->blocks);
     return LBK_OK;
 }
 
@@ -298,7 +301,8 @@ static int ck_load(void *user, bk_transport_state *st)
     *st = k->st; /* the saved numbers, with this run's arrays */
     for (int h = 0; h < 2; h++) st->x_acc[h] = mine.x_acc[h], st->b_acc[h] = mine.b_acc[h];
     st->radiance = mine.radiance, st->direct = mine.direct, st->irradiance = mine.irradiance, st->rough = mine.rough;
-    st->count = mine.count, st->cells = mine.cells;
+    st->block_weight = mine.block_weight;
+    st->count = mine.count, st->cells = mine.cells, st->blocks = mine.blocks;
     for (int h = 0; h < 2; h++) {
         memcpy(st->x_acc[h], k->acc[h], st->count * sizeof(double));
         memcpy(st->b_acc[h], k->acc[2 + h], st->count * sizeof(double));
@@ -307,6 +311,7 @@ static int ck_load(void *user, bk_transport_state *st)
     memcpy(st->direct, k->dir, sizeof k->dir);
     memcpy(st->irradiance, k->irr, sizeof k->irr);
     memcpy(st->rough, k->rough, st->cells);
+    memcpy(st->block_weight, k->blocks, 8 * st->blocks);
     return 1;
 }
 
@@ -353,6 +358,7 @@ static void test_resume_identical(void **state)
     assert_true(a->st.est_rel_rmse == b->st.est_rel_rmse);
     for (int q = 0; q < 4; q++) free(k->acc[q]);
     free(k->rough);
+    free(k->blocks);
     free(k);
     free(a);
     free(b);

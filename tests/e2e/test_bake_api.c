@@ -218,6 +218,10 @@ static void test_desc_rules(void **state)
     d.glossy_vpl_delta = INFINITY;
     expect_fail(&l.scene, &d, &s, LBK_ERR_INVALID_ARGUMENT, "glossy_vpl_delta");
     d = quick(&s);
+    d.size = sizeof d; /* (added in 1.8) */
+    d.adaptive = 1;
+    expect_fail(&l.scene, &d, &s, LBK_ERR_INVALID_ARGUMENT, "adaptive: 1");
+    d = quick(&s);
     d.size = 2; /* not even its own size field: nothing in it can be read, no message */
     lbk_bake_output *out = NULL;
     assert_int_equal(lbk_bake_from_scene(&l.scene, &d, &out), LBK_ERR_INVALID_ARGUMENT);

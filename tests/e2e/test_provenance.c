@@ -96,6 +96,7 @@ static void bake(const char *gltf, const char *sky, const char *out, tl_bake *b)
     job.d.octp_clip = 8;
     job.d.gather_limit = 3;
     job.d.llg_connected = 1;
+    job.d.adaptive = -1;
     char err[1024];
     assert_int_equal(tb_bake(&job, NULL, err, sizeof err), LBK_OK);
     if (tl_bake_open_file(out, b, err) != TL_OPEN_OK) fail_msg("%s", err);
@@ -159,7 +160,7 @@ static void test_every_input_and_option(void **state)
                                           {"bake.preset", "fast"}, {"bake.texel_density", "8"}, {"bake.glg_spacing", "2"},
                                           {"bake.target_error", "0.03"}, {"bake.max_bounces", "0"}, {"bake.time_limit", "0"},
                                           {"bake.octp_levels", "2"}, {"bake.octp_clip", "8"}, {"bake.gather_limit", "3"},
-                                          {"bake.llg_connected", "1"}};
+                                          {"bake.llg_connected", "1"}, {"bake.adaptive", "off"}};
     for (size_t i = 0; i < sizeof opts / sizeof opts[0]; i++) {
         char *v = meta(&b, opts[i][0]);
         if (strcmp(v, opts[i][1])) fail_msg("%s = %s, expected %s", opts[i][0], v, opts[i][1]);
