@@ -696,6 +696,16 @@ static void adaptive_scene(bk_scene *s, bk_receiver *r)
         }
 }
 
+/* Up to 8 passes, a 1 % target, adaptive sampling on. */
+static bk_transport_options adaptive_options(void)
+{
+    bk_transport_options o = tsc_fixed_passes(8, 3);
+    o.max_cells = 1024;
+    o.target_error = 0.01;
+    o.adaptive = 1;
+    return o;
+}
+
 /* The per-surface relative RMS difference of a against b (the estimate's metric). */
 static double group_diff(const run_out *a, const run_out *b, const bk_receiver *r, int g)
 {
@@ -714,10 +724,7 @@ static void test_adaptive_sampling(void **state)
     bk_scene s;
     bk_receiver r[AD_N];
     adaptive_scene(&s, r);
-    bk_transport_options o = tsc_fixed_passes(8, 3);
-    o.max_cells = 1024;
-    o.target_error = 0.01;
-    o.adaptive = 1;
+    bk_transport_options o = adaptive_options();
     rec rp;
     memset(&rp, 0, sizeof rp);
     o.report = on_report;
@@ -977,10 +984,7 @@ static void test_resume_adaptive(void **state)
     bk_scene s;
     bk_receiver r[AD_N];
     adaptive_scene(&s, r);
-    bk_transport_options o = tsc_fixed_passes(8, 3);
-    o.max_cells = 1024;
-    o.target_error = 0.01;
-    o.adaptive = 1;
+    bk_transport_options o = adaptive_options();
     mem_ckpt m;
     memset(&m, 0, sizeof m);
     m.at = -1;
@@ -1092,10 +1096,7 @@ static void test_cut_run_adaptive(void **state)
     bk_scene s;
     bk_receiver r[AD_N];
     adaptive_scene(&s, r);
-    bk_transport_options o = tsc_fixed_passes(8, 3);
-    o.max_cells = 1024;
-    o.target_error = 0.01;
-    o.adaptive = 1;
+    bk_transport_options o = adaptive_options();
     o.class_end[BK_CLASS_TEXEL] = 2 * AD_PER;
     o.class_end[BK_CLASS_GLG] = AD_N;
     o.class_end[BK_CLASS_LLG] = AD_N;
