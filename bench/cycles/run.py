@@ -14,8 +14,10 @@ built from the same tree), BLENDER, LBK_SCENES (../shared/scenes), CYCLES_CLOCK 
 clock "equal time" is measured on, default cpu), LBK_BENCH_QUICK=1 (references 8x shorter),
 BENCH_CYCLES_SCENES (comma-separated subset), BENCH_CYCLES_THREADS (default: all cores),
 LBK_ALT (a second lbk binary, e.g. an experiment, baked with seed 1 and measured against the same
-references: extra columns; it must give the same receivers), LBK_ALT_DUMP (its texel_dump, default
-LBK_TEXEL_DUMP), LBK_ALT_NAME (its column label, default "alt").
+references: extra columns; it must give the same receivers; default: LBK itself with
+--adaptive off, so every run shows what adaptive sampling buys; "none": no second baker),
+LBK_ALT_DUMP (its texel_dump, default LBK_TEXEL_DUMP), LBK_ALT_NAME (its column label, default
+"alt", or "adaptive off" for the default).
 """
 import argparse
 import json
@@ -272,13 +274,22 @@ def main():
     # a second baker measured against the same references (seed 1 only); it must share the layout
     ap.add_argument("--alt", default=env("LBK_ALT", ""))
     ap.add_argument("--alt-dump", default=env("LBK_ALT_DUMP", ""))
-    ap.add_argument("--alt-name", default=env("LBK_ALT_NAME", "alt"))
+    ap.add_argument("--alt-name", default=env("LBK_ALT_NAME", ""))
     # reuse a reference whose inputs (scene and sensor files, sample counts, harness) are unchanged
     ap.add_argument("--keep-refs", action="store_true",
                     default=env("BENCH_CYCLES_KEEP_REFS", "0") not in ("", "0"))
     opt = ap.parse_args()
     opt.alt_dump = opt.alt_dump or opt.dump
     os.makedirs(opt.work, exist_ok=True)
+    if not opt.alt:  # the default second baker: the same lbk without adaptive sampling
+        opt.alt = os.path.join(opt.work, "lbk-adaptive-off.sh")
+        with open(opt.alt, "w") as f:
+            f.write('#!/bin/sh\nexec "%s" "$@" --adaptive off\n' % os.path.abspath(opt.lbk).replace('"', '\\"'))
+        os.chmod(opt.alt, 0o755)
+        opt.alt_name = opt.alt_name or "adaptive off"
+    elif opt.alt == "none":
+        opt.alt = ""
+    opt.alt_name = opt.alt_name or "alt"
     t0 = time.perf_counter()
     lines = []
 
