@@ -2515,9 +2515,9 @@ static lbk_result stop_init(tp_ctx *c)
     return LBK_OK;
 }
 
-/* Class k's receivers that sample in this pass and, with adaptive sampling, their mean samples
- * so far: over its stop subset where it has one (scaled to the class), so that every unit of a
- * distributed run counts alike without the other units' blocks. */
+/* Class k's receivers that sample in this pass (class_on) and, with adaptive sampling, their
+ * mean samples so far (mean_samples): over its stop subset where it has one (scaled to the
+ * class), so that every unit of a distributed run counts alike without the other units' blocks. */
 static size_t class_on(const tp_ctx *c, int k)
 {
     const size_t n = c->cls[k].end - c->cls[k].begin;
@@ -2536,7 +2536,8 @@ static size_t class_on(const tp_ctx *c, int k)
     return on;
 }
 
-/* (the samples of pass p are 2^p those of pass 0, as its weight is) */
+/* (its spp scaled by its blocks' share of its weight: the samples of pass p are 2^p those of
+ * pass 0, as its weight is) */
 static double mean_samples(const tp_ctx *c, int k)
 {
     const tp_class *cl = &c->cls[k];
@@ -2840,7 +2841,7 @@ static int stop_after(tp_ctx *c, int pass, const tp_errors *ce, double pass_seco
 /* The weight sum of receiver i's passes. */
 static double recv_weight(const tp_ctx *c, size_t i) { return c->recv_count ? c->blk_w[block_of(c, i)] : 0; }
 
-/* Each receiver's X of the two halves, normalised by its class's pass weights. */
+/* Each receiver's X of the two halves, normalised by its block's pass weights. */
 static void write_halves(const tp_ctx *c, double *const x_acc[2], float *halves)
 {
     for (size_t i = 0; i < c->recv_count; i++) {
