@@ -15,6 +15,7 @@
 #include "bake/transport/shading.h"
 #include "bake/transport/slc.h"
 #include "bake/transport/transport.h"
+#include "support/mem_checkpoint.h"
 #include "support/transport_scenes.h"
 
 #define NL 300   /* lights of the test level */
@@ -260,61 +261,6 @@ static void test_threads_identical_and_auto(void **state)
     tsc_free(&s);
 }
 
-/* A checkpoint in memory: the state after pass `keep` (1-based count of passes). */
-typedef struct ckpt {
-    int keep, have;
-    bk_transport_state st;
-    double *acc[4];
-    lbk_sh9_rgb rad[NR], dir[NR];
-    float irr[3 * NR];
-    uint8_t *rough;
-    double *blocks;
-} ckpt;
-
-static lbk_result ck_save(void *user, const bk_transport_state *st)
-{
-    ckpt *k = user;
-    if (st->passes != k->keep) return LBK_OK;
-    k->have = 1;
-    k->st = *st;
-    for (int h = 0; h < 2; h++) {
-        k->acc[h] = malloc(st->count * sizeof(double));
-        k->acc[2 + h] = malloc(st->count * sizeof(double));
-        memcpy(k->acc[h], st->x_acc[h], st->count * sizeof(double));
-        memcpy(k->acc[2 + h], st->b_acc[h], st->count * sizeof(double));
-    }
-    memcpy(k->rad, st->radiance, sizeof k->rad);
-    memcpy(k->dir, st->direct, sizeof k->dir);
-    memcpy(k->irr, st->irradiance, sizeof k->irr);
-    k->rough = malloc(st->cells ? st->cells : 1);
-    memcpy(k->rough, st->rough, st->cells);
-    k->blocks = malloc(st->blocks ? 8 * st->blocks : 1);
-    memcpy(k->blocks, st->block_weight, 8 * st->blocks);
-    return LBK_OK;
-}
-
-static int ck_load(void *user, bk_transport_state *st)
-{
-    ckpt *k = user;
-    if (!k->have) return 0;
-    bk_transport_state mine = *st;
-    *st = k->st; /* the saved numbers, with this run's arrays */
-    for (int h = 0; h < 2; h++) st->x_acc[h] = mine.x_acc[h], st->b_acc[h] = mine.b_acc[h];
-    st->radiance = mine.radiance, st->direct = mine.direct, st->irradiance = mine.irradiance, st->rough = mine.rough;
-    st->block_weight = mine.block_weight;
-    st->count = mine.count, st->cells = mine.cells, st->blocks = mine.blocks;
-    for (int h = 0; h < 2; h++) {
-        memcpy(st->x_acc[h], k->acc[h], st->count * sizeof(double));
-        memcpy(st->b_acc[h], k->acc[2 + h], st->count * sizeof(double));
-    }
-    memcpy(st->radiance, k->rad, sizeof k->rad);
-    memcpy(st->direct, k->dir, sizeof k->dir);
-    memcpy(st->irradiance, k->irr, sizeof k->irr);
-    memcpy(st->rough, k->rough, st->cells);
-    memcpy(st->block_weight, k->blocks, 8 * st->blocks);
-    return 1;
-}
-
 static int count_chains(void *user, const char *phase, double f)
 {
     (void)f;
@@ -334,20 +280,21 @@ static void test_resume_identical(void **state)
     bk_tracer *t = NULL;
     assert_int_equal(bk_tracer_create(&s, 0, &t), LBK_OK);
     out *a = calloc(1, sizeof *a), *b = calloc(1, sizeof *b);
-    ckpt *k = calloc(1, sizeof *k);
-    k->keep = 2;
-    bk_transport_checkpoint cp = {k, ck_save, ck_load};
+    mem_ckpt *k = malloc(sizeof *k);
+    bk_transport_checkpoint cp;
+    mem_ckpt_init(k, &cp);
     bk_transport_options o = opts(1, 21, 2);
     o.max_samples = 2 * 8 * 7; /* three passes */
     o.checkpoint = &cp;
     int chains = 0;
     o.progress = count_chains;
     o.user = &chains;
-    run(&s, t, rc, &o, a); /* saves after pass 2 (and loads nothing: have = 0) */
-    assert_int_equal(k->have, 1);
+    run(&s, t, rc, &o, a); /* saves after every pass (and loads nothing: at = -1) */
+    assert_int_equal(k->saved, 3);
     assert_int_equal(a->st.passes, 3);
     assert_int_equal(chains, 6); /* two caches per pass */
-    k->keep = 0;           /* the resumed run saves nothing */
+    mem_ckpt_drop(k, 2);   /* resume after pass 2 (0-based 1) */
+    k->at = 1;
     chains = 0;
     run(&s, t, rc, &o, b); /* loads the state after pass 2, runs pass 3 only */
     assert_int_equal(chains, 2);
@@ -356,9 +303,7 @@ static void test_resume_identical(void **state)
     assert_memory_equal(a->rad, b->rad, sizeof a->rad);
     assert_memory_equal(a->dir, b->dir, sizeof a->dir);
     assert_true(a->st.est_rel_rmse == b->st.est_rel_rmse);
-    for (int q = 0; q < 4; q++) free(k->acc[q]);
-    free(k->rough);
-    free(k->blocks);
+    mem_ckpt_drop(k, 0);
     free(k);
     free(a);
     free(b);

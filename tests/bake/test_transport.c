@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "bake/transport/transport.h"
+#include "support/mem_checkpoint.h"
 #include "support/transport_scenes.h"
 
 #define Y00 0.282094791773878
@@ -912,69 +913,6 @@ static void cut_free(cut_rec *c)
     for (int p = 0; p < c->passes; p++) free(c->x[p]);
 }
 
-/* Checkpoints in memory: every pass's state saved; a load hands back the one of pass `at`. */
-typedef struct mem_ckpt {
-    int at, saved;
-    bk_transport_state st[32];
-    size_t n;
-} mem_ckpt;
-
-static void *dup_or_null(const void *p, size_t size)
-{
-    if (!p) return NULL;
-    void *q = malloc(size ? size : 1);
-    memcpy(q, p, size);
-    return q;
-}
-
-static lbk_result mem_save(void *user, const bk_transport_state *st)
-{
-    mem_ckpt *m = user;
-    assert_true(m->saved < 32 && st->passes == m->saved + 1);
-    bk_transport_state *d = &m->st[m->saved++];
-    *d = *st;
-    const size_t n = st->count;
-    for (int h = 0; h < 2; h++) d->x_acc[h] = dup_or_null(st->x_acc[h], 8 * n), d->b_acc[h] = dup_or_null(st->b_acc[h], 8 * n);
-    d->radiance = dup_or_null(st->radiance, n * sizeof(lbk_sh9_rgb));
-    d->direct = dup_or_null(st->direct, n * sizeof(lbk_sh9_rgb));
-    d->irradiance = dup_or_null(st->irradiance, 12 * n);
-    d->rough = dup_or_null(st->rough, st->cells);
-    d->block_weight = dup_or_null(st->block_weight, 8 * st->blocks);
-    return LBK_OK;
-}
-
-static int mem_load(void *user, bk_transport_state *st)
-{
-    mem_ckpt *m = user;
-    if (m->at < 0) return 0;
-    const bk_transport_state *sv = &m->st[m->at];
-    const size_t n = st->count;
-    assert_true(sv->count == n && sv->cells == st->cells && sv->blocks == st->blocks);
-    bk_transport_state keep = *st; /* the run's own arrays, which the load fills */
-    *st = *sv;
-    for (int h = 0; h < 2; h++) {
-        st->x_acc[h] = keep.x_acc[h], st->b_acc[h] = keep.b_acc[h];
-        memcpy(st->x_acc[h], sv->x_acc[h], 8 * n), memcpy(st->b_acc[h], sv->b_acc[h], 8 * n);
-    }
-    st->radiance = keep.radiance, st->direct = keep.direct, st->irradiance = keep.irradiance;
-    st->rough = keep.rough, st->block_weight = keep.block_weight;
-    memcpy(st->radiance, sv->radiance, n * sizeof(lbk_sh9_rgb));
-    if (st->direct) memcpy(st->direct, sv->direct, n * sizeof(lbk_sh9_rgb));
-    if (st->irradiance) memcpy(st->irradiance, sv->irradiance, 12 * n);
-    if (st->cells) memcpy(st->rough, sv->rough, st->cells);
-    if (st->blocks) memcpy(st->block_weight, sv->block_weight, 8 * st->blocks);
-    return 1;
-}
-
-static void mem_free(mem_ckpt *m)
-{
-    for (int p = 0; p < m->saved; p++) {
-        bk_transport_state *d = &m->st[p];
-        for (int h = 0; h < 2; h++) free(d->x_acc[h]), free(d->b_acc[h]);
-        free(d->radiance), free(d->direct), free(d->irradiance), free(d->rough), free(d->block_weight);
-    }
-}
-
 /* A run resumed from any of its passes' checkpoints ends with the uninterrupted run's bytes,
  * also across adaptive stops: the blocks' weights are saved and which blocks sample next is
  * recomputed from the saved sums. */
@@ -986,31 +924,24 @@ static void test_resume_adaptive(void **state)
     adaptive_scene(&s, r);
     bk_transport_options o = adaptive_options();
     mem_ckpt m;
-    memset(&m, 0, sizeof m);
-    m.at = -1;
-    bk_transport_checkpoint ck = {&m, mem_save, mem_load};
+    bk_transport_checkpoint ck;
+    mem_ckpt_init(&m, &ck);
     o.checkpoint = &ck;
     run_out whole = run(&s, r, AD_N, &o);
     assert_true(whole.st.class_mean_samples[0] < whole.st.class_samples[0]);
     assert_int_equal(m.saved, whole.st.passes);
-    for (int at = 0; at + 1 < whole.st.passes; at++) {
-        mem_ckpt from = m;
-        from.at = at;
-        from.saved = at + 1; /* it saves the passes after it */
-        bk_transport_checkpoint ck2 = {&from, mem_save, mem_load};
-        o.checkpoint = &ck2;
+    /* latest first: each resumed run saves the passes after `at` again */
+    for (int at = whole.st.passes - 2; at >= 0; at--) {
+        mem_ckpt_drop(&m, at + 1);
+        m.at = at;
         run_out res = run(&s, r, AD_N, &o);
+        assert_int_equal(m.saved, whole.st.passes);
         assert_memory_equal(res.irr, whole.irr, 3 * AD_N * sizeof *whole.irr);
         assert_memory_equal(res.rad, whole.rad, AD_N * sizeof *whole.rad);
         assert_true(res.st.class_mean_samples[0] == whole.st.class_mean_samples[0] && res.st.rays == whole.st.rays);
-        for (int p = at + 1; p < from.saved; p++) { /* (free what the resumed run saved) */
-            bk_transport_state *d = &from.st[p];
-            for (int h = 0; h < 2; h++) free(d->x_acc[h]), free(d->b_acc[h]);
-            free(d->radiance), free(d->direct), free(d->irradiance), free(d->rough), free(d->block_weight);
-        }
         run_free(&res);
     }
-    mem_free(&m);
+    mem_ckpt_drop(&m, 0);
     run_free(&whole);
     tsc_free(&s);
 }
