@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bake/layout/edge_inset.h"
 #include "bake/layout/uv_math.h"
 #include "bake/layout/uv_raster.h"
 #include "bake/util/parallel.h"
@@ -513,7 +514,9 @@ lbk_result bk_texels_build(const bk_scene *s, const bk_atlas *a, bk_texels *out)
     out->count = count;
     free(best);
     free(pairs);
-    return LBK_OK;
+    lbk_result res = bk_texels_inset_edges(out, s);
+    if (res != LBK_OK) bk_texels_free(out);
+    return res;
 }
 
 /* ---------------------------------------------------------------------------------------- */

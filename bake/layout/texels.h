@@ -44,6 +44,10 @@
  * 4): the border point extrapolates the chart's light to the ring's centre better than the
  * texels inside the chart do.
  *
+ * Edge inset (edge_inset.h): an edge texel's point (the closest point of its triangle, on the
+ * triangle's border) is moved 1 % of a texel inside the edges another surface may meet (a box
+ * side standing on a floor, a crease), so its gather rays do not start on two surfaces at once.
+ *
  * Push-out (bk_texels_push_out): the single sample point (which the transport still uses for
  * punctual lights where no footprint triangle covers a quarter centre, and for parts of the
  * square no triangle covers) is moved out from behind surfaces: from it, 8 rays along the
@@ -86,7 +90,8 @@ extern "C" {
 
 enum bk_texel_flag {
     BK_TEXEL_VALID = 1u,   /* light this sample */
-    BK_TEXEL_EDGE = 2u,    /* centre outside every triangle: sample at the nearest point */
+    BK_TEXEL_EDGE = 2u,    /* centre outside every triangle: sample at the nearest point,
+                              moved 1 % of a texel inside (Edge inset above) */
     BK_TEXEL_PUSHED = 4u,  /* moved out from behind a surface */
     BK_TEXEL_INSIDE = 8u,  /* its point is inside closed geometry (information; still valid) */
     BK_TEXEL_RING = 16u    /* read only by bilinear filtering (its chart does not cover its square):

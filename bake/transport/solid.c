@@ -1,5 +1,6 @@
 /* Closed solids by edge balance; see solid.h. */
 #include "bake/transport/solid.h"
+#include "bake/scene/weld.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -10,21 +11,6 @@ typedef struct sd_edge {
     uint32_t tri;
     int32_t dir;      /* +1: the triangle runs lo -> hi, -1: hi -> lo */
 } sd_edge;
-
-typedef struct sd_vert { float p[3]; uint32_t i, nonfinite; } sd_vert;
-
-static int cmp_pos(const void *a, const void *b)
-{
-    const sd_vert *u = a, *v = b;
-    /* non-finite positions last and never equal (NaN would break the ordering) */
-    if (u->nonfinite || v->nonfinite)
-        return u->nonfinite != v->nonfinite ? (u->nonfinite ? 1 : -1) : (u->i < v->i ? -1 : u->i > v->i);
-    for (int k = 0; k < 3; k++) {
-        if (u->p[k] < v->p[k]) return -1;
-        if (u->p[k] > v->p[k]) return 1;
-    }
-    return u->i < v->i ? -1 : u->i > v->i;
-}
 
 static int cmp_edge(const void *a, const void *b)
 {
@@ -56,35 +42,6 @@ static void unite(uint32_t *parent, uint32_t a, uint32_t b)
     else parent[a] = b;
 }
 
-/* Welded id per vertex: the smallest index among the vertices at exactly the same position
- * (non-finite positions keep their own id; their triangles are dropped anyway). */
-static uint32_t *weld(const bk_scene *s)
-{
-    size_t nv = s->vertex_count;
-    sd_vert *order = malloc((nv ? nv : 1) * sizeof *order);
-    uint32_t *id = malloc((nv ? nv : 1) * sizeof *id);
-    if (!order || !id) {
-        free(order);
-        free(id);
-        return NULL;
-    }
-    for (size_t i = 0; i < nv; i++) {
-        memcpy(order[i].p, s->positions + 3 * i, sizeof order[i].p);
-        order[i].i = (uint32_t)i;
-        order[i].nonfinite = !isfinite(order[i].p[0]) || !isfinite(order[i].p[1]) || !isfinite(order[i].p[2]);
-    }
-    qsort(order, nv, sizeof *order, cmp_pos);
-    for (size_t i = 0; i < nv;) {
-        size_t j = i + 1;
-        while (j < nv && !order[i].nonfinite && !order[j].nonfinite && order[j].p[0] == order[i].p[0] && order[j].p[1] == order[i].p[1] && order[j].p[2] == order[i].p[2])
-            j++;
-        for (size_t k = i; k < j; k++) id[order[k].i] = order[i].i;
-        i = j;
-    }
-    free(order);
-    return id;
-}
-
 static int usable(const bk_scene *s, const uint32_t *id, size_t t, uint32_t w[3])
 {
     double p[3][3];
@@ -111,7 +68,7 @@ lbk_result bk_closed_triangles(const bk_scene *s, uint8_t *closed)
     memset(closed, 0, nt);
     if (nt == 0) return LBK_OK;
     if (nt > UINT32_MAX / 3) return LBK_ERR_LIMIT;
-    uint32_t *id = weld(s);
+    uint32_t *id = bk_weld_vertices(s);
     sd_edge *e = malloc(3 * nt * sizeof *e);
     uint32_t *parent = malloc(nt * sizeof *parent);
     uint8_t *bad = calloc(nt, 1), *ok = calloc(nt, 1);

@@ -33,6 +33,8 @@
 #include "support/scene_append.h"
 #include "support/transport_scenes.h"
 
+#define TP_HALF_PI 1.57079632679489661923
+
 static double lum(const float *c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
 static double lumd(const double *c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
 
@@ -398,12 +400,123 @@ static void test_emitter_gap_unbiased(void **state)
     tsc_free(&s);
 }
 
+/* ---- edge texels where surfaces meet ---------------------------------------------------------- */
+
+/* An open box (four sides and a top, no bottom, like the Cornell box's blocks) standing on a black
+ * floor under a uniform sky of radiance 1 (a black slab further down hides the sky below the
+ * floor), axis-aligned and turned by 0.3 rad. Its side faces see the sky over the upper quarter
+ * of the sphere and the black floor below (the box is convex: its faces never see each other),
+ * so a side point at height h has E = π/2 plus the sky that grazes past the floor's edge R away:
+ * at most 2·atan(h/R) (the cosine-weighted band of elevations below the horizon that pass the
+ * floor). That must hold for every texel, including the ring texels on the floor contact and
+ * the top crease, whose nearest points are edge points shared with the floor or the top
+ * (bake/layout/edge_inset.h: a gather ray from such a point grazes the other surface at
+ * t ≈ 10⁻¹³; whether it hits depends on the origin's last bit — here the push-out happens to
+ * rescue the contact points, on the Cornell box it did not: bench-cycles measured it there —
+ * so test_texels checks the inset itself). */
+static void contact_box(bk_scene *s, double turn)
+{
+    tsc_init(s);
+    uint32_t black = tsc_material(s, 0, 0, 0, 0, 0, 0), grey = tsc_material(s, 0.8f, 0.8f, 0.8f, 0, 0, 0);
+    /* a floor height that floats do not hold exactly: interpolated edge points then round to
+     * either side of the floor, as on the (re-centred) Cornell box */
+    const float z0 = 0.3711f;
+    float g0[3] = {-20, -20, z0}, g1[3] = {20, -20, z0}, g2[3] = {20, 20, z0}, g3[3] = {-20, 20, z0};
+    tsc_quad(s, g0, g1, g2, g3, 4, black);
+    const float mn[3] = {-20, -20, z0 - 3}, mx[3] = {20, 20, z0 - 2.5f}; /* no sky below the floor */
+    tsc_box(s, mn, mx, 4, 0, black);
+    tsc_object(s, "box", NULL, NULL);
+    float c[4][3], t[4][3];
+    const double cs = cos(turn), sn = sin(turn);
+    for (int k = 0; k < 4; k++) {
+        double x = (k == 1 || k == 2) ? 0.5 : -0.5, y = k >= 2 ? 0.5 : -0.5;
+        c[k][0] = t[k][0] = (float)(cs * x - sn * y);
+        c[k][1] = t[k][1] = (float)(sn * x + cs * y);
+        c[k][2] = z0;
+        t[k][2] = z0 + 1.2f;
+    }
+    for (int k = 0; k < 4; k++) { /* outward sides: bottom edge k -> k+1, counter-clockwise from outside */
+        int j = (k + 1) % 4;
+        tsc_quad(s, c[k], c[j], t[j], t[k], 2, grey);
+    }
+    tsc_quad(s, t[0], t[1], t[2], t[3], 2, grey);
+    s->sky[0] = s->sky[1] = s->sky[2] = 1;
+    tsc_update_bounds(s);
+}
+
+static void test_edge_texels_at_contact(void **state)
+{
+    (void)state;
+    for (int turned = 0; turned < 2; turned++) {
+        bk_scene s;
+        contact_box(&s, turned ? 0.3 : 0.0);
+        bk_atlas_options ao;
+        memset(&ao, 0, sizeof ao);
+        ao.default_density = 5;
+        bk_atlas atlas;
+        bk_texels tx;
+        bk_tracer *tr = NULL;
+        assert_int_equal(bk_atlas_build(&s, NULL, &ao, &atlas), LBK_OK);
+        assert_int_equal(bk_tracer_create(&s, 0, &tr), LBK_OK);
+        assert_int_equal(bk_texels_build(&s, &atlas, &tx), LBK_OK);
+        bk_pushout_options po;
+        memset(&po, 0, sizeof po);
+        po.threads = 2;
+        assert_int_equal(bk_texels_push_out(&tx, &s, tr, &po, NULL), LBK_OK);
+        bk_receiver *r = calloc(tx.count, sizeof *r);
+        for (size_t i = 0; i < tx.count; i++) {
+            memcpy(r[i].position, tx.receivers[i].position, 12);
+            memcpy(r[i].normal, tx.receivers[i].normal, 12);
+            r[i].footprint_first = tx.receivers[i].footprint_first;
+            r[i].footprint_count = tx.receivers[i].footprint_count;
+            memcpy(r[i].footprint_box, tx.receivers[i].footprint_box, sizeof r[i].footprint_box);
+        }
+        float *irr = calloc(3 * tx.count, sizeof *irr);
+        lbk_sh9_rgb *rad = calloc(tx.count, sizeof *rad);
+        bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL};
+        bk_transport_options o = tsc_fixed_passes(4, 11);
+        o.footprint = tx.footprint;
+        o.footprint_count = tx.footprint_count;
+        bk_transport_stats st;
+        assert_int_equal(bk_transport_run(&s, tr, r, tx.count, &o, &out, &st), LBK_OK);
+        size_t sides = 0, contact = 0, crease = 0;
+        double worst = 0;
+        for (size_t i = 0; i < tx.count; i++) {
+            const bk_texel *x = &tx.receivers[i];
+            if (s.tri_object[x->tri] != 1 || fabsf(x->normal[2]) > 0.1f) continue;
+            const double h = x->position[2] - 0.3711f, e = lum(irr + 3 * i);
+            const double lo = TP_HALF_PI, hi = TP_HALF_PI + 2 * atan(h / 19.0);
+            /* 240 stratified directions per half: a few % of noise */
+            const double dev = e < lo ? (lo - e) / lo : e > hi ? (e - hi) / hi : 0;
+            if (dev > worst) worst = dev;
+            sides++;
+            if (x->flags & BK_TEXEL_RING) {
+                contact += h < 0.01;
+                crease += h > 1.19;
+            }
+        }
+        print_message("open box on a black floor (%s): %zu side texels (%zu ring texels on the floor contact, %zu on "
+                      "the top crease), worst deviation from [pi/2, pi/2 + 2 atan(h/R)] %.1f %%\n",
+                      turned ? "turned 0.3 rad" : "axis-aligned", sides, contact, crease, 100 * worst);
+        assert_true(contact >= 8 && crease >= 8);
+        assert_true(worst < 0.08);
+        free(irr);
+        free(rad);
+        free(r);
+        bk_texels_free(&tx);
+        bk_tracer_destroy(tr);
+        bk_atlas_free(&atlas);
+        tsc_free(&s);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_solid_topology),
         cmocka_unit_test(test_inside_solid_is_black),
         cmocka_unit_test(test_emitter_gap_unbiased),
+        cmocka_unit_test(test_edge_texels_at_contact),
         cmocka_unit_test(test_room_converges_unbiased),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
