@@ -465,6 +465,28 @@ int gpu_dls_apply(gpu_dls *g, const float *set_weights, const float *door_weight
     return 0;
 }
 
+int gpu_dls_copy_bases(gpu_dls *g, gpu_dls_stats *st)
+{
+    gpu_dls_stats s = {0};
+    const double t0 = now_ms();
+    gpu_ctx *c = g->c;
+    if (gpu_begin(c)) return -1;
+    gpu_timestamp(c, 0);
+    copy_buffer(c, &g->buf[B_LMAP], &g->buf[B_LMAP_OUT]);
+    copy_buffer(c, &g->buf[B_GLG], &g->buf[B_GLG_OUT]);
+    copy_buffer(c, &g->buf[B_LLG], &g->buf[B_LLG_OUT]);
+    s.copies = 3;
+    s.bytes_moved = 2 * (g->buf[B_LMAP].size + g->buf[B_GLG].size + g->buf[B_LLG].size);
+    gpu_timestamp(c, 1);
+    gpu_barrier(c);
+    if (gpu_submit(c)) return -1;
+    s.gpu_ms = gpu_elapsed_ms(c);
+    s.wall_ms = now_ms() - t0;
+    g->valid = 0; /* the outputs are the bases now, not the last weights' */
+    if (st) *st = s;
+    return 0;
+}
+
 int gpu_dls_apply_naive(gpu_dls *g, const float *set_weights, const float *door_weights, gpu_dls_stats *st)
 {
     gpu_dls_stats s = {0};

@@ -49,6 +49,11 @@ int gpu_dls_apply(gpu_dls *g, const float *set_weights, const float *door_weight
 /* Every target, gathered per target (needs level.naive). */
 int gpu_dls_apply_naive(gpu_dls *g, const float *set_weights, const float *door_weights, gpu_dls_stats *stats);
 
+/* The three base copies alone (base → output buffers, as the first apply starts): the device's
+ * copy speed over the same bytes, the reference an apply's time is measured against. The outputs
+ * are the bases afterwards; the next apply rewrites every target. */
+int gpu_dls_copy_bases(gpu_dls *g, gpu_dls_stats *stats);
+
 /* The outputs after the last apply (mapped device memory): the LMAP section's layout, and the
  * probe array of space 1 (GLG) or 2 (LLG). */
 const uint8_t *gpu_dls_lmap(const gpu_dls *g);

@@ -157,6 +157,7 @@ int gpu_buffer_create(gpu_ctx *c, VkDeviceSize size, const void *data, gpu_buffe
         return -1;
     }
     b->size = alloc;
+    c->buffers_device_local = (c->mem.memoryTypes[type].propertyFlags & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT) != 0;
     memset(b->map, 0, alloc);
     if (data && size) memcpy(b->map, data, size);
     return 0;

@@ -30,6 +30,7 @@ typedef struct gpu_ctx {
     uint32_t max_groups_x;
     char device_name[VK_MAX_PHYSICAL_DEVICE_NAME_SIZE];
     int cpu_device; /* VK_PHYSICAL_DEVICE_TYPE_CPU: lavapipe and the like */
+    int buffers_device_local; /* the last buffer created is in device-local memory (resizable BAR) */
 } gpu_ctx;
 
 /* 0: ready; 1: no usable device (Vulkan missing, no ICD, no shaderFloat64): a test skips;
