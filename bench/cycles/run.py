@@ -141,21 +141,36 @@ def run_scene(sc, work, opt, out):
     cdir = os.path.join(work, sc["name"] + ".cycles")
     runs = common.run_cycles(sc["path"], points_tsv, cdir, [(s, 11 + i) for i, s in enumerate(sc["calib"])],
                              sky=sc["sky"], threads=opt.threads, equal_time=target, clock=opt.clock)
-    rdir = os.path.join(work, sc["name"] + ".cycles-ref")
-    refs_run = common.run_cycles(sc["path"], tsv, rdir, [], sky=sc["sky"], threads=opt.threads,
-                                 refs=[(ref_spp, 1), (ref_spp, 2)], keep=opt.keep_refs)
+    # The two references: from the seed-1 bake's rows (footprint points at the stratum centres), or,
+    # BENCH_CYCLES_JITTER=1, with the points jittered in their strata, each reference from its own
+    # points (jitter seeds 1 and 2), so that their mean is the footprint mean and their
+    # difference, the reference noise, holds the quadrature's spread too (README, Footprint sensors).
     by_role = {}
-    for d, rs in ((cdir, runs), (rdir, refs_run)):
-        for r in rs:
-            r["dir"] = d
+    jittered = fp_points > 1 and opt.jitter
+    for rseeds in (((1,), (2,)) if jittered else ((1, 2),)):
+        rtsv = "%s.ref%d" % (tsv, rseeds[0]) if jittered else tsv
+        if jittered:
+            common.run_timed([opt.dump, sc["path"], os.path.join(work, "%s.seed1.lbk" % sc["name"]), rtsv] +
+                             density_args(sc["lbk"]) + ["--footprint", str(opt.footprint), "--jitter",
+                                                        str(rseeds[0])], rtsv + ".log")
+        rr = common.Receivers(rtsv)
+        if rr.pos != rec.pos:
+            sys.exit("bench-cycles: %s: the reference sensors %s have other receivers" % (sc["name"], rtsv))
+        rdir = os.path.join(work, sc["name"] + ".cycles-ref" + ("%d" % rseeds[0] if jittered else ""))
+        for r in common.run_cycles(sc["path"], rtsv, rdir, [], sky=sc["sky"], threads=opt.threads,
+                                   refs=[(ref_spp, k) for k in rseeds], keep=opt.keep_refs):
+            r["dir"], r["rec"] = rdir, rr
             by_role.setdefault(r["role"], []).append(r)
+    for r in runs:
+        r["dir"] = cdir
+        by_role.setdefault(r["role"], []).append(r)
     eq = by_role["equal_time"][0]
     refs = by_role["reference"]
     lum = [common.lum(x) for x in rec.rgb]
     lum2 = [common.lum(x) for x in rec2.rgb]
     def load(r):
         v = [common.lum(x) for x in common.read_f32_rgb(os.path.join(r["dir"], r["file"]))]
-        return rec.per_receiver(v) if r["dir"] == rdir else v
+        return r["rec"].per_receiver(v) if "rec" in r else v
     r1, r2, ceq = load(refs[0]), load(refs[1]), load(eq)
     calib = [(r, load(r)) for r in by_role["calibration"]]
     est = float(rec.meta.get("est_rel_rmse", "nan"))
@@ -165,7 +180,9 @@ def run_scene(sc, work, opt, out):
         "%d spp, %.1f s CPU, %.1f s wall; reference 2 x %d spp%s (%.0f s CPU)" % (
             sc["name"], lbk_wall, lbk_cpu, rec.meta.get("spp", "?"), rec.meta.get("status", "?"), 100 * est,
             opt.clock.upper() if opt.clock == "cpu" else opt.clock, eq["spp"], eq["cpu_s"], eq["wall_s"], ref_spp,
-            " per point at %.1f footprint points per texel" % fp_points if fp_points > 1 else "", ref_cpu) + alt_txt)
+            " per point at %.1f footprint points per texel%s" % (fp_points, " (jittered, own points per reference)"
+                                                             if opt.jitter else " (stratum centres)")
+            if fp_points > 1 else "", ref_cpu) + alt_txt)
     alt_head = "" if not opt.alt else " %9s %9s %8s" % ("alt err", "alt bias", "alt/Cyc")
     out("  %-22s %-8s %6s %9s %9s %9s %9s %9s %10s %6s %9s%s" % (
         "object", "rep", "n", "lbk err", "lbk bias", "lbk noise", "lbk est", "Cyc err", "lbk/Cyc", "goal", "ref noise",
@@ -271,6 +288,8 @@ def main():
     ap.add_argument("--no-analytic", action="store_true")
     # K x K sensors over each texel's footprint (0: one sensor at the texel's sample point)
     ap.add_argument("--footprint", type=int, default=int(env("BENCH_CYCLES_FOOTPRINT", "2")))
+    # footprint points uniform in their strata, a seed per reference (0: the strata's centres)
+    ap.add_argument("--jitter", type=int, default=int(env("BENCH_CYCLES_JITTER", "0")))
     # a second baker measured against the same references (seed 1 only); it must share the layout
     ap.add_argument("--alt", default=env("LBK_ALT", ""))
     ap.add_argument("--alt-dump", default=env("LBK_ALT_DUMP", ""))
