@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bake/layout/edge_key.h"
 #include "bake/layout/uv_math.h"
 #include "bake/scene/weld.h"
 
@@ -12,25 +13,14 @@
 #define EI_COPLANAR_COS 0.99996
 #define EI_MAX_EDGES 6 /* its own three, or two and its coplanar neighbours' outer ones */
 
-typedef struct ei_edge {
-    uint32_t lo, hi; /* welded vertex ids, lo < hi */
-    uint32_t tri;
-} ei_edge;
+typedef bk_edge_key ei_edge;
 
 typedef struct ei_table {
     const bk_scene *scene;
     uint32_t *id;    /* welded id per vertex */
-    ei_edge *edges;  /* sorted by (lo, hi, tri) */
+    ei_edge *edges;  /* sorted by (a, b, tri) */
     size_t count;
 } ei_table;
-
-static int cmp_edge(const void *a, const void *b)
-{
-    const ei_edge *e = a, *f = b;
-    if (e->lo != f->lo) return e->lo < f->lo ? -1 : 1;
-    if (e->hi != f->hi) return e->hi < f->hi ? -1 : 1;
-    return (e->tri > f->tri) - (e->tri < f->tri);
-}
 
 static lbk_result table_build(const bk_scene *s, ei_table *t)
 {
@@ -49,7 +39,7 @@ static lbk_result table_build(const bk_scene *s, ei_table *t)
             t->edges[t->count++] = (ei_edge){a < b ? a : b, a < b ? b : a, (uint32_t)i};
         }
     }
-    qsort(t->edges, t->count, sizeof *t->edges, cmp_edge);
+    qsort(t->edges, t->count, sizeof *t->edges, bk_edge_key_cmp);
     return LBK_OK;
 }
 
@@ -74,13 +64,13 @@ static int64_t coplanar_neighbour(const ei_table *t, uint32_t tri, uint32_t a, u
     const bk_scene *s = t->scene;
     ei_edge key = {a < b ? a : b, a < b ? b : a, 0};
     size_t lo = 0, hi = t->count;
-    while (lo < hi) { /* first entry >= (key.lo, key.hi, 0) */
+    while (lo < hi) { /* first entry >= (key.a, key.b, 0) */
         size_t mid = lo + (hi - lo) / 2;
-        if (cmp_edge(&t->edges[mid], &key) < 0) lo = mid + 1;
+        if (bk_edge_key_cmp(&t->edges[mid], &key) < 0) lo = mid + 1;
         else hi = mid;
     }
     uint32_t object = s->tri_object ? s->tri_object[tri] : 0;
-    for (size_t i = lo; i < t->count && t->edges[i].lo == key.lo && t->edges[i].hi == key.hi; i++) {
+    for (size_t i = lo; i < t->count && t->edges[i].a == key.a && t->edges[i].b == key.b; i++) {
         uint32_t o = t->edges[i].tri;
         if (o == tri || (s->tri_object && s->tri_object[o] != object)) continue;
         double q[3][3], m[3];

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bake/layout/edge_key.h"
 #include "bake/layout/uv_math.h"
 #include "bake/util/parallel.h"
 
@@ -50,9 +51,7 @@ typedef struct edge_key {
 static int cmp_edge(const void *pa, const void *pb)
 {
     const edge_key *x = pa, *y = pb;
-    if (x->a != y->a) return x->a < y->a ? -1 : 1;
-    if (x->b != y->b) return x->b < y->b ? -1 : 1;
-    return (x->tri > y->tri) - (x->tri < y->tri);
+    return bk_edge_order(x->a, x->b, x->tri, y->a, y->b, y->tri);
 }
 
 typedef struct seam_vec {

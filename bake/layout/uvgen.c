@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "bake/layout/chart_merge.h"
+#include "bake/layout/edge_key.h"
 #include "bake/layout/uv_math.h"
 #include "bake/layout/uv_raster.h"
 
@@ -102,17 +103,7 @@ static int cmp_weld(const void *a, const void *b)
     return (x->corner > y->corner) - (x->corner < y->corner);
 }
 
-typedef struct edge_key {
-    uint32_t a, b, tri;
-} edge_key;
-
-static int cmp_edge(const void *pa, const void *pb)
-{
-    const edge_key *x = pa, *y = pb;
-    if (x->a != y->a) return x->a < y->a ? -1 : 1;
-    if (x->b != y->b) return x->b < y->b ? -1 : 1;
-    return (x->tri > y->tri) - (x->tri < y->tri);
-}
+typedef bk_edge_key edge_key;
 
 static int cmp_u32(const void *a, const void *b)
 {
@@ -164,7 +155,7 @@ static lbk_result build_adjacency(gen_ctx *g)
             e++;
         }
     }
-    qsort(ek, e, sizeof *ek, cmp_edge);
+    qsort(ek, e, sizeof *ek, bk_edge_key_cmp);
     /* links: consecutive triangles of a group of equal edges (2 for a manifold edge) */
     g->adj_start = calloc((size_t)n + 1, sizeof *g->adj_start);
     uint32_t *pairs = malloc((e ? e : 1) * 2 * sizeof *pairs);
