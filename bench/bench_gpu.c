@@ -23,6 +23,13 @@
 #if LBK_HAVE_VULKAN
 #include "gpu/host/gpu_dls.h"
 
+/* The GPU's outputs equal the CPU runtime's, byte for byte. */
+static int outputs_match(const gpu_dls *g, const uint8_t *lmap, size_t lmap_size, const uint8_t *glg, const uint8_t *llg)
+{
+    return !memcmp(gpu_dls_lmap(g), lmap, lmap_size) && !memcmp(gpu_dls_probes(g, 1), glg, 28 * (size_t)ESTATE_GLG) &&
+           !memcmp(gpu_dls_probes(g, 2), llg, 28 * (size_t)ESTATE_LLG);
+}
+
 static void line(const char *what, const gpu_dls_stats *s)
 {
     printf("  %-34s %5u dispatches, %8llu invocations, %7.2f MB moved, %9.2f ms device, %9.2f ms wall\n", what, s->dispatches,
@@ -95,8 +102,7 @@ int main(void)
     for (int i = 0; i < ESTATE_SETS; i++) w[i] = 0.5f;
     gpu_dls_apply(g, w, NULL, &s);
     lbk_dls_apply(rt, w, NULL, NULL);
-    const int same = !memcmp(gpu_dls_lmap(g), cpu_lmap, lmap_size) && !memcmp(gpu_dls_probes(g, 1), cpu_glg, 28 * (size_t)ESTATE_GLG) &&
-                     !memcmp(gpu_dls_probes(g, 2), cpu_llg, 28 * (size_t)ESTATE_LLG);
+    const int same = outputs_match(g, cpu_lmap, lmap_size, cpu_glg, cpu_llg);
     printf("buffers in %s memory\n", ctx.buffers_device_local ? "device-local, host-visible (resizable BAR)" : "host-visible, not device-local");
     printf("clustered, the first apply (base copies + every cluster):\n");
     line("first apply", &s);
@@ -140,9 +146,7 @@ int main(void)
         if (t < cpu_all) cpu_all = t;
     }
     lbk_dls_apply(rt, w, NULL, NULL);
-    const int same_last = !memcmp(gpu_dls_lmap(g), cpu_lmap, lmap_size) &&
-                          !memcmp(gpu_dls_probes(g, 1), cpu_glg, 28 * (size_t)ESTATE_GLG) &&
-                          !memcmp(gpu_dls_probes(g, 2), cpu_llg, 28 * (size_t)ESTATE_LLG);
+    const int same_last = outputs_match(g, cpu_lmap, lmap_size, cpu_glg, cpu_llg);
     double dc, dn;
     gpu_dls_divergence(g, &dc, &dn);
     printf("clustered (dls_apply.comp) vs the naive gather (dls_naive.comp), best of the runs:\n");

@@ -153,7 +153,7 @@ def run_scene(sc, work, opt, out):
             common.run_timed([opt.dump, sc["path"], os.path.join(work, "%s.seed1.lbk" % sc["name"]), rtsv] +
                              density_args(sc["lbk"]) + ["--footprint", str(opt.footprint), "--jitter",
                                                         str(rseeds[0])], rtsv + ".log")
-        rr = common.Receivers(rtsv)
+        rr = common.Receivers(rtsv) if jittered else rec
         if rr.pos != rec.pos:
             sys.exit("bench-cycles: %s: the reference sensors %s have other receivers" % (sc["name"], rtsv))
         rdir = os.path.join(work, sc["name"] + ".cycles-ref" + ("%d" % rseeds[0] if jittered else ""))

@@ -67,6 +67,7 @@
 #include "bake/scene/import.h"
 #include "bake/scene/scene.h"
 #include "bake/transport/tracer.h"
+#include "bench/bench_util.h"
 #include "lbk/container.h"
 #include "lbk/lightmap.h"
 #include "lbk/lightmap_uv.h"
@@ -366,15 +367,12 @@ static int off_plane(const bk_scene *s, const bk_texel *t)
     return fabs(dist) > 0.01 * t->texel_size;
 }
 
-/* Uniform in [0, 1) from (seed, row, stratum, axis): SplitMix64's finaliser, the same numbers
- * on every machine. */
+/* Uniform in [0, 1) from (seed, row, stratum, axis): the benches' SplitMix64 finaliser, the same
+ * numbers on every machine. */
 static double jitter_u(uint32_t seed, size_t row, int i, int j, int axis)
 {
     uint64_t z = ((uint64_t)seed << 40) ^ ((uint64_t)row << 8) ^ ((uint64_t)(unsigned)i << 4) ^ (uint64_t)(unsigned)j;
-    z = z * 2 + (uint64_t)axis + 0x9E3779B97F4A7C15ull;
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return (double)((z ^ (z >> 31)) >> 11) * (1.0 / 9007199254740992.0);
+    return (double)(bench_mix(z * 2 + (uint64_t)axis + 0x9E3779B97F4A7C15ull) >> 11) * (1.0 / 9007199254740992.0);
 }
 
 /* Footprint sensors (--footprint K): the texel's value is its irradiance averaged over the part of

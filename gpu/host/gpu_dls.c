@@ -392,6 +392,16 @@ static void copy_buffer(gpu_ctx *c, const gpu_buffer *src, const gpu_buffer *dst
     vkCmdCopyBuffer(c->cmd, src->buf, dst->buf, 1, &r);
 }
 
+/* Records the three base → output copies (every target starts as its base) and counts them. */
+static void record_base_copies(gpu_dls *g, gpu_dls_stats *s)
+{
+    copy_buffer(g->c, &g->buf[B_LMAP], &g->buf[B_LMAP_OUT]);
+    copy_buffer(g->c, &g->buf[B_GLG], &g->buf[B_GLG_OUT]);
+    copy_buffer(g->c, &g->buf[B_LLG], &g->buf[B_LLG_OUT]);
+    s->copies = 3;
+    s->bytes_moved += 2 * (g->buf[B_LMAP].size + g->buf[B_GLG].size + g->buf[B_LLG].size);
+}
+
 int gpu_dls_apply(gpu_dls *g, const float *set_weights, const float *door_weights, gpu_dls_stats *st)
 {
     gpu_dls_stats s = {0};
@@ -403,11 +413,7 @@ int gpu_dls_apply(gpu_dls *g, const float *set_weights, const float *door_weight
     if (gpu_begin(c)) return -1;
     gpu_timestamp(c, 0);
     if (full) { /* every target starts as its base; then the clusters with a non-zero weight */
-        copy_buffer(c, &g->buf[B_LMAP], &g->buf[B_LMAP_OUT]);
-        copy_buffer(c, &g->buf[B_GLG], &g->buf[B_GLG_OUT]);
-        copy_buffer(c, &g->buf[B_LLG], &g->buf[B_LLG_OUT]);
-        s.copies = 3;
-        s.bytes_moved += 2 * (g->buf[B_LMAP].size + g->buf[B_GLG].size + g->buf[B_LLG].size);
+        record_base_copies(g, &s);
         gpu_barrier(c);
     }
     uint32_t *table = g->buf[B_TABLE].map, groups = 0;
@@ -472,11 +478,7 @@ int gpu_dls_copy_bases(gpu_dls *g, gpu_dls_stats *st)
     gpu_ctx *c = g->c;
     if (gpu_begin(c)) return -1;
     gpu_timestamp(c, 0);
-    copy_buffer(c, &g->buf[B_LMAP], &g->buf[B_LMAP_OUT]);
-    copy_buffer(c, &g->buf[B_GLG], &g->buf[B_GLG_OUT]);
-    copy_buffer(c, &g->buf[B_LLG], &g->buf[B_LLG_OUT]);
-    s.copies = 3;
-    s.bytes_moved = 2 * (g->buf[B_LMAP].size + g->buf[B_GLG].size + g->buf[B_LLG].size);
+    record_base_copies(g, &s);
     gpu_timestamp(c, 1);
     gpu_barrier(c);
     if (gpu_submit(c)) return -1;
