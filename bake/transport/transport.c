@@ -163,6 +163,9 @@ typedef struct tp_class {
     int active, stop;
 } tp_class;
 
+#define TP_NEAR_DEPTH 24    /* continuations in a row before the cache is read anyway (TRANSPORT.md: 3 left the Cornell light gap 15-25 % dark) */
+#define TP_CACHE_DEPTH 2    /* the same in the cache's bounces (TRANSPORT.md, gap cells; bench_gap) */
+
 typedef struct tp_ctx {
     const bk_scene *scene;
     const bk_tracer *tracer;
@@ -223,9 +226,14 @@ typedef struct tp_ctx {
     uint32_t *vpl_ids;
     uint64_t *thread_vpl_tested, vpl_made;
     /* per chain (half) state; [h] */
-    float *l_prev[2], *l_cur[2], *l_sum[2];
-    float *l_prev2[2];     /* bounce k−2 (what a near hit in bounce k continues into) */
-    uint8_t *rough;        /* cells whose radiance changes sharply, from the last pass (mark_rough) */
+    float *l_cur[2], *l_sum[2];
+    /* the last bounces' cells, newest first: l_hist[h][0] is bounce k−1 (what bounce k reads),
+     * l_hist[h][d] bounce k−1−d (what a near hit's d-th continuation in a row reads);
+     * cache_depth + 1 of them (cache_depth_for) */
+    float *l_hist[2][TP_CACHE_DEPTH + 1];
+    int cache_depth;
+    uint8_t *rough;        /* cells whose radiance changes sharply, from the last pass (mark_rough), and the gap cells */
+    uint8_t *gap;          /* cells facing a surface much closer than their size (mark_gaps): TP_GAP_* */
     float *cell_lum, *cell_var; /* scratch for mark_rough */
     /* current job */
     int half, pass, bounce, rays;
@@ -642,7 +650,6 @@ static lbk_result slc_draw(const tp_ctx *c, int dom, int h, int pass, const bk_s
  * reflected radiance at the point given the cache beyond it (TRANSPORT.md §Bias). */
 #define TP_NEAR_CELLS 1.5   /* continue when the hit is closer than this many cell sizes */
 #define TP_NEAR_INSET 1e-4  /* barycentric inset of a continuation's point from its triangle's edges */
-#define TP_NEAR_DEPTH 24    /* continuations in a row before the cache is read anyway (TRANSPORT.md: 3 left the Cornell light gap 15-25 % dark) */
 
 static int near_hit(const tp_ctx *c, const bk_hit *h, long hc, const uint8_t *rough)
 {
@@ -686,7 +693,7 @@ static void mark_rough(tp_ctx *c)
         double la = bk_lum(va), lb = bk_lum(vb);
         c->cell_lum[i] = (float)(0.5 * (la + lb));
         c->cell_var[i] = (float)(0.25 * (la - lb) * (la - lb));
-        c->rough[i] = 0;
+        c->rough[i] = c->gap[i] != 0;
         pa += c->cells[i].area * c->cell_lum[i];
         area += c->cells[i].area;
     }
@@ -708,6 +715,43 @@ static void mark_rough(tp_ctx *c)
     }
 }
 
+/* Gap cells: a cell that faces another surface much closer than its own size (the ceiling over
+ * a light hung 1 cm under it, the light's top) holds light that changes across it far faster
+ * than the cell resolves — bright deep in the gap, dim at its mouth — and the room sees only the
+ * mouth. Read as one constant it leaks its average out of the gap (+2–3 % on a whole room,
+ * bench_gap). Every hit on a gap cell is continued at the exact point, like a rough one, from
+ * pass 0 on. Of TP_GAP_PROBES rays along its normal, from points spread over it, those that meet
+ * a surface closer than TP_GAP_RATIO of its size say how much of it the gap covers: all (inside)
+ * or some (mouth; near_entry splits only hits inside). Geometry only: the same marks in every
+ * half, pass, unit and resumed run. */
+#define TP_GAP_RATIO 0.25
+#define TP_GAP_PROBES 4
+enum { TP_GAP_MOUTH = 1, TP_GAP_INSIDE = 2 }; /* some of the probes covered; all of them */
+
+static void mark_gaps(tp_ctx *c, size_t begin, size_t end, int thread)
+{
+    static const double probe[TP_GAP_PROBES][2] = {{0.2, 0.5}, {0.7, 0.15}, {0.7, 0.85}, {0.45, 0.5}};
+    (void)thread; /* uncounted: a fixed cost of the set-up, not of any pass */
+    for (size_t ci = begin; ci < end; ci++) {
+        const tp_cell *cell = &c->cells[ci];
+        float h = c->tri_cell_h[cell->tri];
+        if (!(h > 0) || (cell->n[0] == 0 && cell->n[1] == 0 && cell->n[2] == 0)) continue;
+        tp_cell_geom g;
+        cell_geom(c, cell, &g);
+        float scale = bk_tracer_tri_scale(c->tracer, cell->tri);
+        int covered = 0;
+        for (int k = 0; k < TP_GAP_PROBES; k++) {
+            double p[3];
+            cell_point_at(&g, probe[k][0], probe[k][1], p, NULL, NULL);
+            float pf[3] = {(float)p[0], (float)p[1], (float)p[2]}, o[3];
+            bk_offset_ray_origin_scaled(pf, cell->n, scale, o);
+            bk_hit hit;
+            covered += bk_tracer_intersect(c->tracer, o, cell->n, 0.0f, (float)(TP_GAP_RATIO * h), &hit) != 0;
+        }
+        c->gap[ci] = (uint8_t)(covered == TP_GAP_PROBES ? TP_GAP_INSIDE : covered ? TP_GAP_MOUTH : 0);
+    }
+}
+
 /* Reflected radiance (all bounces, emission excluded) at the point of `hit` (cell hc, reached
  * along unit d) from one continuation sample. */
 /* What a continuation sample gathers: the cells it reads at its hit (NULL: none) and whether
@@ -716,7 +760,27 @@ static void mark_rough(tp_ctx *c)
  * k−1 at its near hit: the sources for k = 2, bounce k−2's cells beyond. */
 /* vpl: a receiver's gather with glossy VPLs on: at its first hit (depth 0) a glossy point takes
  * the lights that shoot photons through its diffuse part only (VPL.md: counted once). */
-typedef struct tp_near_mode { const float *read; const uint8_t *rough; int sources, max_depth, vpl; } tp_near_mode;
+/* hist (the cache's bounce k, NULL in the final gather): the continuation at depth d evaluates
+ * bounce b = k − 1 − d at its point, so it takes the sources where b = 1 and reads bounce b − 1
+ * (hist[d + 1]) where b ≥ 2; read and sources are then per depth (mode_read, mode_sources). */
+typedef struct tp_near_mode {
+    const float *read;
+    const uint8_t *rough;
+    int sources, max_depth, vpl;
+    const float *const *hist;
+    int bounce;
+} tp_near_mode;
+
+static const float *mode_read(const tp_near_mode *md, int depth)
+{
+    if (!md->hist) return md->read;
+    return md->bounce - 1 - depth >= 2 ? md->hist[depth + 1] : NULL;
+}
+
+static int mode_sources(const tp_near_mode *md, int depth)
+{
+    return md->hist ? md->bounce - 1 - depth == 1 : md->sources;
+}
 
 /* Light li at the continued point x (normal n, ray origin o), weighted `scale`, into e (through
  * the BSDF lf at a glossy point; NULL: irradiance). */
@@ -788,13 +852,15 @@ static void cont_trace(tp_ctx *c, const tp_near_mode *md, const float o[3], cons
     L[0] = L[1] = L[2] = 0;
     bk_hit h2;
     cnt->rays++;
+    const int sources = mode_sources(md, depth);
+    const float *read = mode_read(md, depth);
     if (!bk_tracer_intersect(c->tracer, o, df, 0.0f, INFINITY, &h2)) {
-        if (md->sources) sky_radiance(c, d, L);
+        if (sources) sky_radiance(c, d, L);
         return;
     }
     long h2c = hit_cell(c, &h2);
     if (h2c < 0) return;
-    if (md->sources) {
+    if (sources) {
         emission_at(c, h2.tri, h2.u, h2.v, L);
         if (L[0] > 0 || L[1] > 0 || L[2] > 0) {
             double w = mis_gather(c, &h2, h2c, d, pg);
@@ -802,10 +868,10 @@ static void cont_trace(tp_ctx *c, const tp_near_mode *md, const float o[3], cons
         }
     }
     double r2[3] = {0, 0, 0};
-    if (md->read && depth + 1 < md->max_depth && near_hit(c, &h2, h2c, md->rough)) {
+    if (read && depth + 1 < md->max_depth && near_hit(c, &h2, h2c, md->rough)) {
         near_radiance(c, md, &h2, h2c, d, depth + 1, rng, cnt, r2);
-    } else if (md->read) {
-        for (int a = 0; a < 3; a++) r2[a] = md->read[3 * h2c + a];
+    } else if (read) {
+        for (int a = 0; a < 3; a++) r2[a] = read[3 * h2c + a];
     }
     for (int a = 0; a < 3; a++) L[a] += r2[a];
 }
@@ -843,7 +909,8 @@ static void gloss_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit,
         cont_trace(c, md, o, d, pdf, depth, rng, cnt, L);
         for (int a = 0; a < 3; a++) out[a] += f[a] * l[2] / pdf * L[a];
     }
-    if (md->sources && c->nee) {
+    const int sources = mode_sources(md, depth);
+    if (sources && c->nee) {
         double ld[3], cq, val[3];
         double a0 = rng_next(rng), a1 = rng_next(rng);
         if (nee_sample_lobe(c, o, lf.n, PG_COSINE, &lf, a0, a1, NULL, ld, &cq, val, &cnt->shadow) && bk_finite3(val)) {
@@ -853,7 +920,7 @@ static void gloss_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit,
             for (int a = 0; a < 3; a++) out[a] += val[a] * f[a] * cq;
         }
     }
-    if (md->sources && c->light_count) cont_punctual(c, x, lf.n, o, &lf, md->vpl && depth == 0, rng, out, cnt);
+    if (sources && c->light_count) cont_punctual(c, x, lf.n, o, &lf, md->vpl && depth == 0, rng, out, cnt);
 }
 
 static void near_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, long hc, const double din[3],
@@ -875,7 +942,8 @@ static void near_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, 
     double L[3];
     cont_trace(c, md, o, d, lz / TP_PI, depth, rng, cnt, L);
     double e[3] = {TP_PI * L[0], TP_PI * L[1], TP_PI * L[2]};
-    if (md->sources && c->nee) {
+    const int sources = mode_sources(md, depth);
+    if (sources && c->nee) {
         /* the light sample that pairs with the gather above (MIS): a point next to an emitter
          * (the ceiling by the Cornell light's 1 cm gap) sees it at grazing angles, which
          * gathering alone finds rarely and brightly */
@@ -884,8 +952,30 @@ static void near_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, 
         if (nee_sample(c, o, n, PG_COSINE, u0, u1n, ld, &cq, val, &cnt->shadow) && bk_finite3(val))
             for (int a = 0; a < 3; a++) e[a] += val[a] * cq;
     }
-    if (md->sources && c->light_count) cont_punctual(c, x, n, o, NULL, 0, rng, e, cnt);
+    if (sources && c->light_count) cont_punctual(c, x, n, o, NULL, 0, rng, e, cnt);
     for (int a = 0; a < 3; a++) out[a] = cell->albedo[a] / TP_PI * e[a];
+}
+
+/* A gather ray's near hit (depth 0): one continuation, or on a cell inside a gap the mean of
+ * TP_GAP_SPLIT. Seen from the room, such a cell is the gap's mouth, whose exact radiance one
+ * continuation estimates poorly (half its directions go deep into a gap ~25× brighter than the
+ * room); such hits are rare (a 1 cm slit subtends little), so splitting them costs few rays and
+ * brings the noise the cell's constant did not have back down (TRANSPORT.md, gap cells). A cell
+ * only partly covered (a floor cell by a sphere's contact) is hit from everywhere and its
+ * continuation starts outside the gap: split, it cost 22 % more time on room_with_doors. */
+#define TP_GAP_SPLIT 4
+static void near_entry(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, long hc, const double d[3], tp_rng *rng,
+                       tp_count *cnt, double out[3])
+{
+    const int n = c->gap[hc] == TP_GAP_INSIDE ? TP_GAP_SPLIT : 1;
+    near_radiance(c, md, hit, hc, d, 0, rng, cnt, out);
+    for (int k = 1; k < n; k++) {
+        double r[3];
+        near_radiance(c, md, hit, hc, d, 0, rng, cnt, r);
+        for (int a = 0; a < 3; a++) out[a] += r[a];
+    }
+    if (n > 1)
+        for (int a = 0; a < 3; a++) out[a] /= n;
 }
 
 static void cont_punctual(const tp_ctx *c, const double x[3], const double n[3], const float o[3], const tp_lobe *lf,
@@ -940,7 +1030,7 @@ static void cell_sample(tp_ctx *c, const double n[3], int j, const double p[3],
                         tp_rng *near_rng, tp_cell_sums *cs, tp_count *cnt)
 {
     const int k = c->bounce, h = c->half;
-    const float *prev = c->l_prev[h];
+    const float *prev = c->l_hist[h][0];
     double L[3] = {0, 0, 0};
     if (hit->tri != UINT32_MAX) {
         long hc = hit_cell(c, hit);
@@ -955,8 +1045,9 @@ static void cell_sample(tp_ctx *c, const double n[3], int j, const double p[3],
                 }
             } else if (near_hit(c, hit, hc, c->rough)) {
                 /* bounce k−1 at the exact point (see near_radiance) */
-                const tp_near_mode md = {k == 2 ? NULL : c->l_prev2[h], NULL, k == 2, 1, 0};
-                near_radiance(c, &md, hit, hc, d, 0, near_rng, cnt, L);
+                const tp_near_mode md = {NULL, NULL, 0, k - 1 < c->cache_depth ? k - 1 : c->cache_depth, 0,
+                                         (const float *const *)c->l_hist[h], k};
+                near_entry(c, &md, hit, hc, d, near_rng, cnt, L);
             } else {
                 for (int a = 0; a < 3; a++) L[a] = prev[3 * hc + a];
             }
@@ -1119,10 +1210,10 @@ static tp_chain_result run_chain(tp_ctx *c, int h, int pass, int rays, double to
         for (size_t i = 0; i < 3 * n; i++) sum[i] += c->l_cur[h][i];
         indirect += p;
         pw[0] = pw[1]; pw[1] = pw[2]; pw[2] = p;
-        /* rotate: k−2 <- k−1 <- k, the oldest buffer is overwritten next */
-        float *tmp = c->l_prev2[h];
-        c->l_prev2[h] = c->l_prev[h];
-        c->l_prev[h] = c->l_cur[h];
+        /* rotate: k−1−d <- k−d, the oldest buffer is overwritten next */
+        float *tmp = c->l_hist[h][c->cache_depth];
+        for (int d = c->cache_depth; d > 0; d--) c->l_hist[h][d] = c->l_hist[h][d - 1];
+        c->l_hist[h][0] = c->l_cur[h];
         c->l_cur[h] = tmp;
         if (k >= 2) q = pw[1] > 0 ? pw[2] / pw[1] : 0;
         if (!(p > 0) || p <= 1e-7 * indirect) break;
@@ -1142,7 +1233,7 @@ static tp_chain_result run_chain(tp_ctx *c, int h, int pass, int rays, double to
     if (!isfinite(q)) q = 0;
     /* tail of the Neumann series: L_K·(q + q² + ...) = L_K·q/(1−q), shaped like the last bounce */
     double f = q / (1 - q);
-    const float *last = c->l_prev[h];
+    const float *last = c->l_hist[h][0];
     for (size_t i = 0; i < 3 * n; i++) sum[i] += (float)(last[i] * f);
     res.bounces = k;
     res.q = q;
@@ -1354,8 +1445,8 @@ static long gather_hit(tp_ctx *c, const float *sum, const uint8_t *rough, const 
     double r[3];
     int near = near_hit(c, hit, hc, rough);
     if (near) {
-        const tp_near_mode md = {sum, rough, 1, TP_NEAR_DEPTH, vpl};
-        near_radiance(c, &md, hit, hc, d, 0, cont, cnt, r);
+        const tp_near_mode md = {sum, rough, 1, TP_NEAR_DEPTH, vpl, NULL, 0};
+        near_entry(c, &md, hit, hc, d, cont, cnt, r);
     } else {
         for (int a = 0; a < 3; a++) r[a] = sum[3 * hc + a];
     }
@@ -1468,7 +1559,7 @@ static void recv_half(tp_ctx *c, const bk_receiver *r, size_t i, int h, int S, c
             }
             if (hc >= 0 && (j0 + jj) % TP_PROBE_EVERY == 0) {
                 double q[3];
-                const tp_near_mode md = {sum, c->rough, 1, TP_NEAR_DEPTH, c->vpl && !sphere};
+                const tp_near_mode md = {sum, c->rough, 1, TP_NEAR_DEPTH, c->vpl && !sphere, NULL, 0};
                 near_radiance(c, &md, &hits[jj], hc, dd[jj], 0, &probe, cnt, q);
                 double cs = (sphere ? 1 : zz[jj]) * TP_PROBE_EVERY;
                 if (bk_finite3(q))
@@ -1733,10 +1824,11 @@ static void free_ctx(tp_ctx *c)
     free(c->thread_shadow);
     free(c->lights);
     for (int h = 0; h < 2; h++) {
-        free(c->l_prev[h]); free(c->l_prev2[h]); free(c->l_cur[h]); free(c->l_sum[h]); free(c->x_acc[h]);
+        for (int d = 0; d <= TP_CACHE_DEPTH; d++) free(c->l_hist[h][d]);
+        free(c->l_cur[h]); free(c->l_sum[h]); free(c->x_acc[h]);
         free(c->b_acc[h]);
     }
-    free(c->rough); free(c->cell_lum); free(c->cell_var);
+    free(c->rough); free(c->gap); free(c->cell_lum); free(c->cell_var);
     free(c->punct_lum);
     free(c->stop_idx);
     free(c->extra);
@@ -2389,6 +2481,19 @@ static lbk_result vpl_init(tp_ctx *c)
 
 /* Everything a run needs before its first pass: counters, the light selection, cells,
  * emitters, the per-half radiance arrays and the receivers' accumulators. */
+/* How many continuations in a row a near hit in the cache's bounces may take: TP_CACHE_DEPTH
+ * while the bounce history fits TP_CACHE_HIST_BYTES, fewer on caches of millions of cells (at
+ * least 1, as before gap cells: TRANSPORT.md). It depends on the cell count only, so every unit of a
+ * distributed bake and every resumed run picks the same. */
+#define TP_CACHE_HIST_BYTES ((size_t)256 << 20)
+static int cache_depth_for(size_t cells)
+{
+    size_t per = 2 * 3 * sizeof(float) * (cells ? cells : 1); /* one bounce, both halves */
+    size_t fit = TP_CACHE_HIST_BYTES / per;
+    if (fit < 2) return 1;
+    return fit - 1 > TP_CACHE_DEPTH ? TP_CACHE_DEPTH : (int)(fit - 1);
+}
+
 static lbk_result ctx_init(tp_ctx *c)
 {
     const bk_scene *scene = c->scene;
@@ -2419,20 +2524,24 @@ static lbk_result ctx_init(tp_ctx *c)
     if (res == LBK_OK) res = vpl_init(c);
     if (res != LBK_OK) return res;
     size_t nc = c->cell_count ? c->cell_count : 1, n = c->recv_count ? c->recv_count : 1;
+    c->cache_depth = cache_depth_for(nc);
     for (int h = 0; h < 2; h++) {
-        c->l_prev[h] = calloc(3 * nc, sizeof(float));
-        c->l_prev2[h] = calloc(3 * nc, sizeof(float));
+        for (int d = 0; d <= c->cache_depth; d++)
+            if (!(c->l_hist[h][d] = calloc(3 * nc, sizeof(float)))) return LBK_ERR_OUT_OF_MEMORY;
         c->l_cur[h] = calloc(3 * nc, sizeof(float));
         c->l_sum[h] = calloc(3 * nc, sizeof(float));
         c->x_acc[h] = calloc(n, sizeof(double));
         c->b_acc[h] = calloc(n, sizeof(double));
-        if (!c->l_prev[h] || !c->l_prev2[h] || !c->l_cur[h] || !c->l_sum[h] || !c->x_acc[h] || !c->b_acc[h])
+        if (!c->l_cur[h] || !c->l_sum[h] || !c->x_acc[h] || !c->b_acc[h])
             return LBK_ERR_OUT_OF_MEMORY;
     }
     c->rough = calloc(nc, 1);
+    c->gap = calloc(nc, 1);
     c->cell_lum = calloc(nc, sizeof(float));
     c->cell_var = calloc(nc, sizeof(float));
-    if (!c->rough || !c->cell_lum || !c->cell_var) return LBK_ERR_OUT_OF_MEMORY;
+    if (!c->rough || !c->gap || !c->cell_lum || !c->cell_var) return LBK_ERR_OUT_OF_MEMORY;
+    parallel_for(c, c->cell_count, 256, mark_gaps);
+    memcpy(c->rough, c->gap, c->cell_count);
     for (int h = 0; h < 2 && c->oct_count; h++)
         if (!(c->oct_acc[h] = calloc(16 * c->oct_count, sizeof(double)))) return LBK_ERR_OUT_OF_MEMORY;
     for (uint32_t t = 0; t < 16; t++) {

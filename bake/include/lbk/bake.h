@@ -56,7 +56,7 @@ extern "C" {
  * size-tagged structs below ("added in 1.x"). */
 #define LBK_BAKE_LIBRARY_VERSION_MAJOR 1
 #define LBK_BAKE_LIBRARY_VERSION_MINOR 8
-#define LBK_BAKE_LIBRARY_VERSION_PATCH 0
+#define LBK_BAKE_LIBRARY_VERSION_PATCH 1 /* 1.8.1: the same API, other bakes (gap cells, TRANSPORT.md) */
 
 /* ---- options ----------------------------------------------------------------------------- */
 
