@@ -1166,6 +1166,11 @@ static uint64_t options_hash(const lbk_bake_desc *options, int budgets)
         const int64_t em = d.error_map;
         XXH64_update(st, &em, sizeof em);
     }
+    /* the baker's version: another transport gives other values for the same options, so its
+     * parts and checkpoints are refused rather than mixed with this one's (absent before 1.8.1) */
+    const int64_t version[3] = {LBK_BAKE_LIBRARY_VERSION_MAJOR, LBK_BAKE_LIBRARY_VERSION_MINOR,
+                                LBK_BAKE_LIBRARY_VERSION_PATCH};
+    XXH64_update(st, version, sizeof version);
     uint64_t h = XXH64_digest(st);
     XXH64_freeState(st);
     return h;
