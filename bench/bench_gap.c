@@ -41,7 +41,7 @@ static double seconds(void)
 
 int main(int argc, char **argv)
 {
-    int samples = 2016, seeds = 3, ref_paths = 16384, threads = 0;
+    int samples = 2016, seeds = 4, ref_paths = 65536, threads = 0;
     for (int i = 1; i + 1 < argc; i += 2) {
         if (!strcmp(argv[i], "--samples")) samples = atoi(argv[i + 1]);
         else if (!strcmp(argv[i], "--seeds")) seeds = atoi(argv[i + 1]);
@@ -87,14 +87,9 @@ int main(int argc, char **argv)
         lbk_sh9_rgb rad[GSC_N];
         float irr[3 * GSC_N];
         bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL};
-        bk_transport_options o;
-        memset(&o, 0, sizeof o);
-        o.seed = (uint64_t)seed;
+        bk_transport_options o = tsc_fixed_passes(passes, (uint64_t)seed);
         o.threads = threads;
-        o.target_error = -1;
-        o.first_pass_samples = 16;
-        o.max_samples = 2 * 16 * ((1 << passes) - 1);
-        o.cell_size = cell;
+        o.cell_size = cell; /* every triangle sized: max_cells unused */
         bk_transport_stats st;
         t0 = seconds();
         if (bk_transport_run(&s, t, r, GSC_N, &o, &out, &st) != LBK_OK) { fprintf(stderr, "bench_gap: transport failed\n"); return 1; }

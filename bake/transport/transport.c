@@ -960,14 +960,16 @@ static void near_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, 
  * TP_GAP_SPLIT. Seen from the room, such a cell is the gap's mouth, whose exact radiance one
  * continuation estimates poorly (half its directions go deep into a gap ~25× brighter than the
  * room); such hits are rare (a 1 cm slit subtends little), so splitting them costs few rays and
- * brings the noise the cell's constant did not have back down (TRANSPORT.md, gap cells). A cell
- * only partly covered (a floor cell by a sphere's contact) is hit from everywhere and its
- * continuation starts outside the gap: split, it cost 22 % more time on room_with_doors. */
+ * brings the noise the cell's constant did not have back down (TRANSPORT.md, gap cells). Not
+ * split: a cell only partly covered (the gap's mouth: hit from everywhere, its continuation
+ * starts outside the gap), and hits from close by (the crevice where two of room_with_doors'
+ * spheres touch, gathered from their own vertices: a fifth more time, nothing gained). */
 #define TP_GAP_SPLIT 4
 static void near_entry(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, long hc, const double d[3], tp_rng *rng,
                        tp_count *cnt, double out[3])
 {
-    const int n = c->gap[hc] == TP_GAP_INSIDE ? TP_GAP_SPLIT : 1;
+    const int far = hit->t >= TP_NEAR_CELLS * c->tri_cell_h[hit->tri];
+    const int n = far && c->gap[hc] == TP_GAP_INSIDE ? TP_GAP_SPLIT : 1;
     near_radiance(c, md, hit, hc, d, 0, rng, cnt, out);
     for (int k = 1; k < n; k++) {
         double r[3];
@@ -3267,6 +3269,20 @@ static lbk_result schedule_only(tp_ctx *c, bk_transport_stats *stats)
 
 /* ---- checkpoints (bk_transport_checkpoint) ------------------------------------------------ */
 
+/* A saved state holds a class as stopped when it stopped before the last saved pass (the texels
+ * reach their target a pass before the probes). Such a class is put back to the stop rule with
+ * the others: under the same options it stops again for the same reason (its estimate, blocks
+ * and samples are what they were, and a later pass's step is larger), so a resumed bake is the
+ * uninterrupted one; with --continue's lower target or larger budget it samples on. A class
+ * stopped by the clock stays stopped: the rule's clock is not what it was. */
+static void reopen_classes(tp_ctx *c)
+{
+    for (int k = 0; k < c->ncls; k++)
+        if (!c->cls[k].active && c->cls[k].end > c->cls[k].begin &&
+            (c->cls[k].stop == BK_STOP_TARGET || c->cls[k].stop == BK_STOP_BUDGET))
+            c->cls[k].active = 1;
+}
+
 static void state_arrays(tp_ctx *c, bk_transport_state *st)
 {
     st->count = c->recv_count;
@@ -3424,6 +3440,7 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
             stop_errors(&c, &ce, &sce);
             pass = done_passes - 1;
             adapt_mark(&c, pass, c.x_acc);
+            reopen_classes(&c);
             if (stop_after(&c, pass, &sce, 0)) goto finished;
             pass = done_passes;
         }
