@@ -7,7 +7,7 @@
  * through the mouth at grazing angles. Cache cells of 0.125 m (the fast preset's texel), far
  * larger than the gap. Receivers: 16 on the floor, 16 on two walls, 16 on the ceiling beside the
  * slit (10–30 cm from its mouth). Reference: the brute-force path tracer
- * (tests/support/ref_path.h), 16,384 paths per point.
+ * (tests/support/ref_path.h), 65,536 paths per point by default.
  *
  * Prints the reference's noise per group, then per seed the transport's seconds and the signed
  * mean relative error Σ(lbk − ref)/Σref of each group and of all receivers; then the mean over
@@ -21,6 +21,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "bake/transport/shading.h"
 #include "bake/transport/transport.h"
 #include "tests/support/gap_scene.c"
 #include "tests/support/ref_path.c"
@@ -30,7 +31,6 @@
 static int group_of(int i) { return i / GSC_PER; }
 
 static double lum(const float *c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
-static double lumd(const double *c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
 
 static double seconds(void)
 {
@@ -65,7 +65,7 @@ int main(int argc, char **argv)
     double ref_s = seconds() - t0;
     double gref[GSC_GROUPS] = {0}, gvar[GSC_GROUPS] = {0};
     for (int i = 0; i < GSC_N; i++) {
-        gref[group_of(i)] += lumd(ref + 3 * i);
+        gref[group_of(i)] += bk_lum(ref + 3 * i);
         gvar[group_of(i)] += se[i] * se[i];
     }
     printf("bench_gap: 2 m room (albedo 0.725), 0.5 x 0.4 m emitter 1 cm under the ceiling, cells 0.125 m; "
@@ -96,7 +96,7 @@ int main(int argc, char **argv)
         double dt = seconds() - t0;
         double gsum[GSC_GROUPS] = {0};
         for (int i = 0; i < GSC_N; i++) {
-            gsum[group_of(i)] += lum(irr + 3 * i) - lumd(ref + 3 * i);
+            gsum[group_of(i)] += lum(irr + 3 * i) - bk_lum(ref + 3 * i);
             x_sum[i] += lum(irr + 3 * i);
             x_sq[i] += lum(irr + 3 * i) * lum(irr + 3 * i);
         }

@@ -2484,8 +2484,6 @@ static lbk_result vpl_init(tp_ctx *c)
     return LBK_OK;
 }
 
-/* Everything a run needs before its first pass: counters, the light selection, cells,
- * emitters, the per-half radiance arrays and the receivers' accumulators. */
 /* How many continuations in a row a near hit in the cache's bounces may take: TP_CACHE_DEPTH
  * while the bounce history fits TP_CACHE_HIST_BYTES, fewer on caches of millions of cells (at
  * least 1, as before gap cells: TRANSPORT.md). It depends on the cell count only, so every unit of a
@@ -2499,6 +2497,8 @@ static int cache_depth_for(size_t cells)
     return fit - 1 > TP_CACHE_DEPTH ? TP_CACHE_DEPTH : (int)(fit - 1);
 }
 
+/* Everything a run needs before its first pass: counters, the light selection, cells,
+ * emitters, the per-half radiance arrays and the receivers' accumulators. */
 static lbk_result ctx_init(tp_ctx *c)
 {
     const bk_scene *scene = c->scene;
@@ -2546,7 +2546,7 @@ static lbk_result ctx_init(tp_ctx *c)
     c->cell_var = calloc(nc, sizeof(float));
     if (!c->rough || !c->gap || !c->cell_lum || !c->cell_var) return LBK_ERR_OUT_OF_MEMORY;
     parallel_for(c, c->cell_count, 256, mark_gaps);
-    memcpy(c->rough, c->gap, c->cell_count);
+    for (size_t i = 0; i < c->cell_count; i++) c->rough[i] = c->gap[i] != 0; /* pass 0's marks, as mark_rough's */
     for (int h = 0; h < 2 && c->oct_count; h++)
         if (!(c->oct_acc[h] = calloc(16 * c->oct_count, sizeof(double)))) return LBK_ERR_OUT_OF_MEMORY;
     for (uint32_t t = 0; t < 16; t++) {
