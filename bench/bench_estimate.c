@@ -211,7 +211,7 @@ int main(int argc, char **argv)
 {
     const char *dir = argc > 1 ? argv[1] : getenv("LBK_SCENES") ? getenv("LBK_SCENES") : "../shared/scenes";
     static const float white[3] = {1, 1, 1};
-    /* the furnished room (many small authored charts, issue 11) is written by make bench-cycles
+    /* the furnished room (many small authored charts) is written by make bench-cycles
      * (bench/cycles/make_furnished_room.py, Blender): measured where that has run */
     const char *furnished = getenv("LBK_FURNISHED_ROOM") ? getenv("LBK_FURNISHED_ROOM")
                                                          : "build/bench-cycles/furnished_room.gltf";

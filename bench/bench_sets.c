@@ -206,7 +206,7 @@ static int door_methods(const char *dir)
     return bad;
 }
 
-/* One time budget (--time-limit T covers base, light sets and doors, issue 11 item 3): the
+/* One time budget (--time-limit T covers base, light sets and doors): the
  * sets + door level, 2 threads, high preset (which alone would run far past T), baked with T and
  * timed from outside; printed as wall / T, and the share each run got. Goal: wall ≤ T plus the
  * write phase; the transport always finishes one pass per run, so T below the sum of one pass

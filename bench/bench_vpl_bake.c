@@ -1,5 +1,5 @@
 /* Glossy VPLs in the whole transport (bake/transport/VPL.md "In the transport"; printed, not
- * asserted): issue 13's metal room (bench/cycles/make_metal_room.py: 6 × 5 × 3 m, metal floor of
+ * asserted): the glossy-bounce metal room (bench/cycles/make_metal_room.py: 6 × 5 × 3 m, metal floor of
  * base 0.9 and glTF roughness r, plaster walls 0.75, ceiling 0.8, a grey box 0.6, one 300 cd spot
  * light aimed down and across the room) at r = 0.05, 0.1, 0.2, 0.4. Receivers: 25 cm texels on
  * the floor, the ceiling and the four walls (2,016, in 1 × 1 m patches of 4 × 4: one culling tile
@@ -132,7 +132,7 @@ int main(void)
     const int P = 4;
     static room R;
     static result ref, on, off, off1, off2;
-    printf("bench_vpl_bake: metal room (issue 13), 2016 texel receivers, 2 threads, fixed passes; error = rel. RMSE\n"
+    printf("bench_vpl_bake: metal room, 2016 texel receivers, 2 threads, fixed passes; error = rel. RMSE\n"
            "of the irradiance against a VPL-on reference of 4064 samples (its own estimated noise removed over all)\n");
     printf("| roughness | run | samples | CPU s | VPLs | est. error | error all | floor | ceiling | walls | all at VPL-on's CPU |\n");
     printf("|---|---|---|---|---|---|---|---|---|---|---|\n");

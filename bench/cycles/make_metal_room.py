@@ -1,4 +1,4 @@
-"""The glossy-bounce scene of issue 13: a closed room with a metal floor lit by one spot light
+"""The glossy-bounce scene (bake/transport/GGX.md): a closed room with a metal floor lit by one spot light
 (plain Python 3; also runs inside Blender).
 
     python3 make_metal_room.py OUT.gltf [ROUGHNESS]     (default 0.1)

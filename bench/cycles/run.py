@@ -41,7 +41,7 @@ SCENES = [
      "sky": (1, 1, 1), "ref_spp": 512, "calib": (4, 16)},
     {"name": "furnished_room", "gltf": "{work}/furnished_room.gltf", "lbk": ["--sky", "1,1,1"], "sky": (1, 1, 1),
      "ref_spp": 2048, "calib": (8, 32), "make": "make_furnished_room.py"},
-    # issue 13: a metal floor (metallic 1, roughness r) under a spot light; bake/transport/GGX.md.
+    # the glossy-bounce scene: a metal floor (metallic 1, roughness r) under a spot light; bake/transport/GGX.md.
     # Written by plain Python (make_python); the other roughnesses only on request
     # (BENCH_CYCLES_SCENES=metal_room_r0.05,...)
     {"name": "metal_room_r0.1", "gltf": "{work}/metal_room_r0.1.gltf", "lbk": [], "sky": (0, 0, 0),
