@@ -1,5 +1,6 @@
 /* What `lbk bake`, `lbk plan`, `lbk bake-unit` and `lbk merge` share: the bake options parsed
- * from the command line (cmd_bake.c) and the bake's end (messages, the report, exit codes). */
+ * from the command line (bake_options.c: one table of them) and the bake's end (messages, the
+ * report, exit codes). */
 #ifndef LBK_CLI_BAKE_OPTIONS_H
 #define LBK_CLI_BAKE_OPTIONS_H
 
@@ -26,6 +27,9 @@ typedef struct bake_args {
 int cli_bake_parse(int argc, char **argv, bake_args *o, int *quiet);
 /* 1 for the options that take no value. */
 int cli_bake_flag(const char *arg);
+/* 1 for the options that change no byte of the container (output paths, threads, progress, the
+ * plan's own): a plan leaves them out. */
+int cli_bake_plan_neutral(const char *arg);
 /* Bakes o->input into o->output as `lbk bake` does; the exit code. */
 int cli_bake_run(bake_args *o, int quiet);
 /* Writes the plan (and the Makefile / sbatch script) of a distributed bake; the exit code.

@@ -15,17 +15,6 @@
 #include "tools/common/bake_plan.h"
 #include "tools/common/file_util.h"
 
-/* Options that do not change a byte of the container, so they stay out of the plan: where the
- * files go, threads, progress, the plan's own. */
-static int plan_neutral(const char *a)
-{
-    static const char *const skip[] = {"-o", "--output", "--plan", "--units", "--makefile", "--sbatch", "--threads",
-                                       "--json-report", "-q", "--quiet"};
-    for (size_t i = 0; i < sizeof skip / sizeof skip[0]; i++)
-        if (!strcmp(a, skip[i])) return 1;
-    return 0;
-}
-
 static int abs_path(const char *path, char *out, size_t size)
 {
     if (path[0] == '/') return snprintf(out, size, "%s", path) < (int)size;
@@ -167,7 +156,7 @@ int cli_plan_write(const bake_args *o, int argc, char **argv, const char *cmd)
         if (a[0] != '-' || !a[1]) {
             if (!seen_input++) continue; /* the scene */
         }
-        if (!plan_neutral(a)) {
+        if (!cli_bake_plan_neutral(a)) {
             if (p.option_count + 2 > TL_PLAN_MAX_OPTIONS) {
                 fprintf(stderr, "lbk %s: too many options for a plan\n", cmd);
                 return LBK_EXIT_USAGE;

@@ -931,7 +931,9 @@ static lbk_result check_desc(bk_pipeline *b)
     if (!isfinite(d->target_error)) BAD("lbk_bake_desc.target_error is not finite");
     if (!finite_nonneg(d->time_limit)) BAD("lbk_bake_desc.time_limit: %g is not a finite number >= 0", d->time_limit);
     if (d->max_samples < 0 || d->max_bounces < 0) BAD("lbk_bake_desc: max_samples and max_bounces must be >= 0");
-    if (!finite_nonneg(d->texel_density)) BAD("lbk_bake_desc.texel_density: %g is not a finite number >= 0", d->texel_density);
+    if (!(d->texel_density >= 0 && d->texel_density <= LBK_BAKE_TEXEL_DENSITY_MAX))
+        BAD("lbk_bake_desc.texel_density: %g is not a number in [0, %g] (0: the default)", d->texel_density,
+            LBK_BAKE_TEXEL_DENSITY_MAX);
     if (!finite_nonneg(d->glg_spacing)) BAD("lbk_bake_desc.glg_spacing: %g is not a finite number >= 0", d->glg_spacing);
     if (!finite_nonneg(d->glg_lighting_threshold))
         BAD("lbk_bake_desc.glg_lighting_threshold: %g is not a finite number >= 0", d->glg_lighting_threshold);

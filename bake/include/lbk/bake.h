@@ -119,6 +119,13 @@ typedef enum lbk_bake_severity {
 /* One line of text, no newline, no "lbk bake:" prefix; valid during the call only. */
 typedef void (*lbk_bake_message_fn)(void *user, lbk_bake_severity severity, const char *message);
 
+/* Texel densities, in texels per metre: lbk_bake_desc.texel_density, lbk_bake_object.texel_density,
+ * the glTF extras key lbk_texel_density and `lbk bake --texel-density` all take a density above
+ * LBK_BAKE_TEXEL_DENSITY_MIN (exclusive) up to LBK_BAKE_TEXEL_DENSITY_MAX; 0 in a desc or an
+ * object means the default (spec/authoring.md: (0, 10000]). */
+#define LBK_BAKE_TEXEL_DENSITY_MIN 0.0
+#define LBK_BAKE_TEXEL_DENSITY_MAX 10000.0
+
 /* Zero-initialised = defaults (given in brackets). */
 typedef struct lbk_bake_desc {
     size_t size;                /* sizeof(lbk_bake_desc) as the caller compiled it; 0: the size
@@ -136,7 +143,8 @@ typedef struct lbk_bake_desc {
                                    estimator and writing are not limited [0: none] */
     int max_samples;            /* gather samples per receiver, whole run [0: preset] */
     int max_bounces;            /* explicit bounces before the analytic tail [0: 64] */
-    float texel_density;        /* texels per metre for every object [0: the object's own
+    float texel_density;        /* texels per metre for every object, at most
+                                   LBK_BAKE_TEXEL_DENSITY_MAX [0: the object's own
                                    (lbk_texel_density, lbk_bake_object.texel_density), then preset] */
     float glg_spacing;          /* global light grid spacing in metres [0: preset] */
     int sky_override;           /* 1: `sky` (or `sky_exr`) replaces the scene's sky */
