@@ -209,7 +209,7 @@ static int denoised_rows(const char *name, const char *path, const float *sky, c
 
 int main(int argc, char **argv)
 {
-    const char *dir = argc > 1 ? argv[1] : getenv("LBK_SCENES") ? getenv("LBK_SCENES") : "../shared/scenes";
+    const char *dir = argc > 1 ? argv[1] : getenv("LBK_SCENES") ? getenv("LBK_SCENES") : "scenes";
     static const float white[3] = {1, 1, 1};
     /* the furnished room (many small authored charts) is written by make bench-cycles
      * (bench/cycles/make_furnished_room.py, Blender): measured where that has run */

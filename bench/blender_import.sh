@@ -5,7 +5,7 @@
 # usage: blender_import.sh LBK OUTDIR
 set -u
 LBK=$1; OUT=$2
-S=${LBK_SCENES:-../shared/scenes}
+S=${LBK_SCENES:-scenes}
 if ! command -v blender >/dev/null 2>&1; then
   echo "SKIPPED blender import (blender not installed: apt-get install blender python3-numpy)"; exit 0
 fi

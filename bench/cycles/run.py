@@ -10,7 +10,7 @@ RMSE = RMSE / mean over the receivers both cover, with the reference's own noise
 quadrature (sqrt(max(0, MSE - sigma_ref^2))). README.md describes it all and the units.
 
 Environment (or the options of the same name): LBK (lbk binary), LBK_TEXEL_DUMP (texel_dump
-built from the same tree), BLENDER, LBK_SCENES (../shared/scenes), CYCLES_CLOCK (cpu|wall: the
+built from the same tree), BLENDER, LBK_SCENES (scenes), CYCLES_CLOCK (cpu|wall: the
 clock "equal time" is measured on, default cpu), LBK_BENCH_QUICK=1 (references 8x shorter),
 BENCH_CYCLES_SCENES (comma-separated subset), BENCH_CYCLES_THREADS (default: all cores),
 LBK_ALT (a second lbk binary, e.g. an experiment, baked with seed 1 and measured against the same
@@ -287,7 +287,7 @@ def main():
     env = os.environ.get
     ap.add_argument("--lbk", default=env("LBK", "build/lbk"))
     ap.add_argument("--dump", default=env("LBK_TEXEL_DUMP", "build/bench/cycles/texel_dump"))
-    ap.add_argument("--scenes", default=env("LBK_SCENES", "../shared/scenes"))
+    ap.add_argument("--scenes", default=env("LBK_SCENES", "scenes"))
     ap.add_argument("--work", default=env("BENCH_CYCLES_WORK", "build/bench-cycles"))
     ap.add_argument("--clock", default=env("CYCLES_CLOCK", "cpu"), choices=("cpu", "wall"))
     ap.add_argument("--threads", type=int, default=int(env("BENCH_CYCLES_THREADS", "0")) or os.cpu_count())

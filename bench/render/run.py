@@ -191,7 +191,7 @@ def main():
     ap.add_argument("--out", default="build/bench-render")
     ap.add_argument("--harness", default=os.environ.get("LBK_CYCLES_HARNESS", os.path.join(HERE, "..", "cycles")))
     ap.add_argument("--blender", default=os.environ.get("BLENDER", "blender"))
-    ap.add_argument("--scenes", default=os.environ.get("LBK_SCENES", "../shared/scenes"))
+    ap.add_argument("--scenes", default=os.environ.get("LBK_SCENES", "scenes"))
     ap.add_argument("--ref-scale", type=float, default=float(os.environ.get("LBK_REF_SCALE", "1")),
                     help="multiplies each scene's reference sample count")
     ap.add_argument("--threads", type=int, default=2)

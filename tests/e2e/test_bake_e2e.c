@@ -29,12 +29,7 @@
 #include "lbk/validate.h"
 #include "support/door_scenes.h"
 #include "support/gltf_writer.h"
-
-static const char *scenes_dir(void)
-{
-    const char *d = getenv("LBK_SCENES");
-    return d && *d ? d : "../shared/scenes";
-}
+#include "support/scenes_dir.h"
 
 static char tmpdir[256];
 
@@ -123,11 +118,7 @@ typedef struct expect {
 static void bake_and_check(const expect *e)
 {
     char in[512], out[512], err[512] = "";
-    snprintf(in, sizeof in, "%s/%s", scenes_dir(), e->path);
-    if (access(in, R_OK) != 0) {
-        print_message("[  SKIP    ] %s missing (set LBK_SCENES)\n", in);
-        skip();
-    }
+    SD_REQUIRE(sd_path(in, sizeof in, e->path));
     snprintf(out, sizeof out, "%s/scene.lbk", tmpdir);
     tb_job o;
     test_options(&o, in, out);
@@ -191,8 +182,7 @@ static void test_water_bottle_draco(void **state)
     (void)state;
     /* one small object (0.11 × 0.26 m): the classifier picks its representation; it must bake */
     char in[512], out[512], err[512] = "";
-    snprintf(in, sizeof in, "%s/water_bottle_draco/WaterBottle.gltf", scenes_dir());
-    if (access(in, R_OK) != 0) skip();
+    SD_REQUIRE(sd_path(in, sizeof in, "water_bottle_draco/WaterBottle.gltf"));
     snprintf(out, sizeof out, "%s/bottle.lbk", tmpdir);
     tb_job o;
     test_options(&o, in, out);
@@ -237,8 +227,7 @@ static void test_no_light_is_refused(void **state)
 {
     (void)state;
     char in[512], out[512], err[512] = "";
-    snprintf(in, sizeof in, "%s/room_with_doors/room.glb", scenes_dir());
-    if (access(in, R_OK) != 0) skip();
+    SD_REQUIRE(sd_path(in, sizeof in, "room_with_doors/room.glb"));
     snprintf(out, sizeof out, "%s/nolight.lbk", tmpdir);
     tb_job o;
     test_options(&o, in, out);
@@ -531,8 +520,7 @@ static void test_tools_on_baker_output(void **state)
     char in[512], out[512], err[512];
     tb_job o;
     lbk_bake_report sum;
-    snprintf(in, sizeof in, "%s/cornell_box_bjs/cornellBox-2.80-Eevee-gltf.gltf", scenes_dir());
-    if (access(in, R_OK) != 0) skip();
+    SD_REQUIRE(sd_path(in, sizeof in, "cornell_box_bjs/cornellBox-2.80-Eevee-gltf.gltf"));
     snprintf(out, sizeof out, "%s/tools_bjs.lbk", tmpdir);
     test_options(&o, in, out);
     o.d.max_samples = 32;
@@ -566,8 +554,8 @@ static void test_cli_exit_codes(void **state)
     char out[512], in[512];
     snprintf(out, sizeof out, "%s/cli_fail.lbk", tmpdir);
     assert_int_equal(run_cli("bake /nonexistent/level.glb -o %s -q", out), LBK_EXIT_IO);
-    snprintf(in, sizeof in, "%s/room_with_doors/room.glb", scenes_dir());
-    if (access(in, R_OK) == 0) assert_int_equal(run_cli("bake %s -o %s -q --samples 32", in, out), LBK_EXIT_INPUT);
+    SD_REQUIRE(sd_path(in, sizeof in, "room_with_doors/room.glb"));
+    assert_int_equal(run_cli("bake %s -o %s -q --samples 32", in, out), LBK_EXIT_INPUT);
     assert_int_equal(run_cli("bake %s -o %s --samples zero", in, out), LBK_EXIT_USAGE);
     assert_int_not_equal(access(out, F_OK), 0);
     char cmd[1200];

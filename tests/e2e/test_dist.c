@@ -19,6 +19,7 @@
 #include "bake/dist/dist.h"
 #include "lbk/bake.h"
 #include "lbk/bake_dist.h"
+#include "support/scenes_dir.h"
 
 #define PLAN_HASH 0x1234abcd5678ef01ull
 
@@ -255,14 +256,8 @@ static void test_cut_tiles(void **state)
 static void test_merge_equals_local_room(void **state)
 {
     (void)state;
-    const char *dir = getenv("LBK_SCENES");
     char path[512];
-    snprintf(path, sizeof path, "%s/room_with_doors/room.glb", dir && *dir ? dir : "../shared/scenes");
-    struct stat st;
-    if (stat(path, &st) != 0) {
-        printf("SKIPPED: %s not found (LBK_SCENES)\n", path);
-        skip();
-    }
+    SD_REQUIRE(sd_path(path, sizeof path, "room_with_doors/room.glb"));
     lbk_bake_desc d = desc_of(32, 2, 7);
     d.sky_override = 1;
     d.sky[0] = d.sky[1] = d.sky[2] = 1;
@@ -474,11 +469,13 @@ static void test_changed_inputs_refused(void **state)
     if (!strstr(last_error, "sky 'sky.exr' is not among the 1 files the plan lists")) fail_msg("unexpected message '%s'", last_error);
     lbk_bake_inputs_free(in);
 
-    /* the CLI, with a scene of a .bin buffer and textures (the shared lamp), if present */
-    const char *lbk = getenv("LBK"), *scenes = getenv("LBK_SCENES");
-    char lamp[512];
-    snprintf(lamp, sizeof lamp, "%s/lights_punctual_lamp", scenes && *scenes ? scenes : "../shared/scenes");
-    if (lbk && *lbk && stat(lamp, &st) == 0) {
+    /* the CLI (when LBK is set), with a scene of a .bin buffer and textures (the shared lamp) */
+    const char *lbk = getenv("LBK");
+    char lamp[512], lamp_gltf[600];
+    sd_path(lamp, sizeof lamp, "lights_punctual_lamp");
+    if (lbk && *lbk) {
+        snprintf(lamp_gltf, sizeof lamp_gltf, "%s/LightsPunctualLamp.gltf", lamp);
+        SD_REQUIRE(lamp_gltf);
         const char *o = "--samples 16 --target-error none --texel-density 1";
         assert_int_equal(sh("cp -r %s %s/lamp && %s plan %s/lamp/LightsPunctualLamp.gltf -o %s/o.lbk --plan %s/p.json --units 2 "
                             "%s >/dev/null", lamp, dir, lbk, dir, dir, dir, o), 0);
@@ -494,7 +491,7 @@ static void test_changed_inputs_refused(void **state)
                             "%s bake-unit %s/p.json 1 -o %s/u.lbkpart -q 2>%s/err", dir, lbk, dir, dir, dir), 4);
         assert_int_equal(sh("grep -q \"buffer 'LightsPunctualLamp.data.bin' changed since the plan\" %s/err", dir), 0);
     } else {
-        printf("(the CLI part needs LBK and %s)\n", lamp);
+        printf("(the CLI part needs LBK)\n");
     }
     sh("rm -rf %s", dir);
 }

@@ -23,6 +23,7 @@
 
 #include "lbk/meta.h"
 #include "support/bake_file.h"
+#include "support/scenes_dir.h"
 #include "tools/common/file_util.h"
 #include "tools/common/image_io.h"
 #include "tools/inspect/diff.h"
@@ -30,18 +31,12 @@
 static char dir[64];
 static char scene_dir[1024];
 
-static const char *scenes_dir(void)
-{
-    const char *d = getenv("LBK_SCENES");
-    return d && *d ? d : "../shared/scenes";
-}
-
 static int setup(void **state)
 {
     (void)state;
     snprintf(dir, sizeof dir, "/tmp/lbk-prov-XXXXXX");
     if (!mkdtemp(dir)) return -1;
-    snprintf(scene_dir, sizeof scene_dir, "%s/cornell_box_bjs", scenes_dir());
+    sd_path(scene_dir, sizeof scene_dir, "cornell_box_bjs");
     return 0;
 }
 
@@ -53,12 +48,12 @@ static int teardown(void **state)
     return system(cmd) == 0 ? 0 : -1;
 }
 
-static int have_scene(void)
+/* The scene must be there (scenes/ or $LBK_SCENES): a missing file fails, naming it. */
+static void require_scene(void)
 {
-    struct stat st;
-    if (stat(scene_dir, &st) == 0) return 1;
-    printf("[  SKIP    ] %s is missing (set LBK_SCENES)\n", scene_dir);
-    return 0;
+    char gltf[1200];
+    snprintf(gltf, sizeof gltf, "%s/cornellBox-2.80-Eevee-gltf.gltf", scene_dir);
+    SD_REQUIRE(gltf);
 }
 
 static void file_hash(const char *path, uint64_t *hash, uint64_t *bytes)
@@ -122,7 +117,7 @@ static size_t lines(const char *s)
 static void test_every_input_and_option(void **state)
 {
     (void)state;
-    if (!have_scene()) skip();
+    require_scene();
     char gltf[1200], sky[128], out[128];
     snprintf(gltf, sizeof gltf, "%s/cornellBox-2.80-Eevee-gltf.gltf", scene_dir);
     snprintf(sky, sizeof sky, "%s/sky.exr", dir);
@@ -194,7 +189,7 @@ static void copy_with_new_texture(const char *to)
 static void test_diff_names_the_changed_texture(void **state)
 {
     (void)state;
-    if (!have_scene()) skip();
+    require_scene();
     char a_dir[128], b_dir[128], sky[128], ga[256], gb[256], oa[128], ob[128];
     snprintf(a_dir, sizeof a_dir, "%s/level_a", dir);
     snprintf(b_dir, sizeof b_dir, "%s/level_b", dir);

@@ -1,4 +1,5 @@
 #include "tests/support/door_scenes.h"
+#include "tests/support/scenes_dir.h"
 
 #include <stdint.h>
 #include <stdio.h>
@@ -149,8 +150,15 @@ static void door_box(float pos[24][3], float nrm[24][3], uint16_t idx[36])
 int ds_write_room_scene(const char *room_glb, const char *out_path, const ds_options *o, char *err, size_t err_len)
 {
     size_t size;
+    if (!sd_present(room_glb)) {
+        snprintf(err, err_len, "missing input %s", room_glb);
+        return 1;
+    }
     unsigned char *glb = read_file(room_glb, &size);
-    if (!glb) return fail(err, err_len, "cannot read room.glb");
+    if (!glb) {
+        snprintf(err, err_len, "cannot read %s", room_glb);
+        return 1;
+    }
     if (size < 28 || rd32(glb) != 0x46546C67u) {
         free(glb);
         return fail(err, err_len, "room.glb: not a GLB");
@@ -318,7 +326,5 @@ int ds_write_room_scene(const char *room_glb, const char *out_path, const ds_opt
 const char *ds_room_glb(void)
 {
     static char path[1024]; /* test support: one thread */
-    const char *d = getenv("LBK_SCENES");
-    snprintf(path, sizeof path, "%s/room_with_doors/room.glb", d && *d ? d : "../shared/scenes");
-    return path;
+    return sd_path(path, sizeof path, "room_with_doors/room.glb");
 }

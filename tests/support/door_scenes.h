@@ -1,5 +1,5 @@
 /* The light-set and door test level, generated from the shared room_with_doors scene
- * (/work/shared/scenes/room_with_doors/room.glb, MIT, Godot demo projects): the room mesh only
+ * (scenes/room_with_doors/room.glb, MIT, Godot demo projects): the room mesh only
  * (232 triangles, 10 × 5 × 10 m, a doorway in each wall; the 16 spheres are left out to keep
  * bakes fast), plus, by option:
  *   - a closed door panel (a thin box, grey 0.8 like the walls) in the north doorway (z = −5),
@@ -18,8 +18,8 @@
 
 #include <stddef.h>
 
-/* room_with_doors/room.glb under $LBK_SCENES, else ../shared/scenes (tests run from the repo
- * root, with shared/ beside the clone as in CI). */
+/* room_with_doors/room.glb in the scenes directory (tests/support/scenes_dir.h: scenes/ of the
+ * repository, or $LBK_SCENES). ds_write_room_scene fails naming the file when it is missing. */
 const char *ds_room_glb(void);
 #define DS_ROOM_GLB ds_room_glb()
 

@@ -21,6 +21,7 @@
 #include "lbk/octa.h"
 #include "lbk/validate.h"
 #include "support/bake_file.h"
+#include "support/scenes_dir.h"
 #include "support/tools_fixtures.h"
 
 static char tmpdir[64];
@@ -712,13 +713,8 @@ static void octp_bake(const char *gltf, uint64_t seed, const char *out, tl_bake 
 static void test_octp_real_bakes(void **state)
 {
     (void)state;
-    const char *scenes = getenv("LBK_SCENES");
     char gltf[1024], pa[128], pb[128];
-    snprintf(gltf, sizeof gltf, "%s/cornell_box/CornellBox-Original.gltf", scenes && *scenes ? scenes : "../shared/scenes");
-    if (access(gltf, R_OK)) {
-        printf("[  SKIP    ] %s is missing (set LBK_SCENES)\n", gltf);
-        return;
-    }
+    SD_REQUIRE(sd_path(gltf, sizeof gltf, "cornell_box/CornellBox-Original.gltf"));
     snprintf(pa, sizeof pa, "%s/octp1.lbk", tmpdir);
     snprintf(pb, sizeof pb, "%s/octp2.lbk", tmpdir);
     tl_bake a, b;
