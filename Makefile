@@ -54,9 +54,11 @@ TOOL_LIBS:= $(BAKE_LIBS) -lastcenc $(LIB_LIBS)
 TOOL_CXXINC := $(LIB_INC) -Ibake/include -I. -isystem /usr/include/draco -isystem /usr/include/stb
 
 LIB_SRC   := $(sort $(wildcard libformat/src/*.c))
-BAKE_CSRC := $(sort $(wildcard bake/*/*.c))
-BAKE_CXXSRC := $(sort $(wildcard bake/*/*.cc))
-TOOL_CSRC := $(sort $(wildcard cli/*.c bake/*/*.c tools/*/*.c))
+# liblbkbake holds the scene library (scene/: import, bk_scene, tracer, parallel-for, clock) and
+# the baker (bake/*/) above it.
+BAKE_CSRC := $(sort $(wildcard scene/*.c bake/*/*.c))
+BAKE_CXXSRC := $(sort $(wildcard scene/*.cc bake/*/*.cc))
+TOOL_CSRC := $(sort $(wildcard cli/*.c scene/*.c bake/*/*.c tools/*/*.c))
 TOOL_CXXSRC := $(BAKE_CXXSRC) $(sort $(wildcard tools/*/*.cc))
 TOOL_MAIN := cli/main.c
 # The page of `lbk view` (viewer/: the scripts, the vendored npm builds and their licences),
@@ -160,6 +162,12 @@ $(BUILD)/asan/libformat/%.o: libformat/%.c
 $(BUILD)/pic/bake/%.o: bake/%.c
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) $(OPT) $(WARN) -fPIC -fvisibility=hidden -DLBK_BAKE_BUILDING_SHARED $(TOOL_INC) -MMD -MP -c $< -o $@
+$(BUILD)/pic/scene/%.o: scene/%.c
+	@mkdir -p $(@D)
+	$(CC) $(CSTD) $(OPT) $(WARN) -fPIC -fvisibility=hidden -DLBK_BAKE_BUILDING_SHARED $(TOOL_INC) -MMD -MP -c $< -o $@
+$(BUILD)/pic/scene/%.o: scene/%.cc
+	@mkdir -p $(@D)
+	$(CXX) -std=c++17 $(OPT) -w -fPIC -fvisibility=hidden -DLBK_BAKE_BUILDING_SHARED $(TOOL_INC) -MMD -MP -c $< -o $@
 $(BUILD)/pic/bake/%.o: bake/%.cc
 	@mkdir -p $(@D)
 	$(CXX) -std=c++17 $(OPT) -w -fPIC -fvisibility=hidden -DLBK_BAKE_BUILDING_SHARED $(TOOL_INC) -MMD -MP -c $< -o $@
@@ -309,7 +317,7 @@ test: deps-test
 	@LBK=$(BUILD)/lbk-asan LBK_FAULT_SHIM=$(BUILD)/fault_shim.so BUILD=$(BUILD) FUZZ=$(BUILD)/fuzz_container TSAN_BIN=$(BUILD)/tsan/bin \
 	  FUZZ_MORE="$(foreach h,$(FUZZ_HARNESSES),$(h:fuzz_%=%)=$(BUILD)/$(h))" \
 	  GLTF_VALIDATOR=$$(test -f $(GLTF_VALIDATOR)/package.json && echo $(GLTF_VALIDATOR)) \
-	  sh tests/run.sh $(TESTS) install_check_shared install_check_static install_lib_check \
+	  sh tests/run.sh $(TESTS) $(STRUCTURE_CHECKS) install_check_shared install_check_static install_lib_check \
 	    bake_check_shared bake_check_static; \
 	st=$$?; n=$$(sed -n 's/^\[  SKIPPED \] \([0-9]*\) test(s).*/\1/p' $(BUILD)/tests/test_gpu.log 2>/dev/null); \
 	if [ "$${n:-0}" -gt 0 ]; then echo "tests: $$n GPU tests SKIPPED, not run: $$(grep -m1 -o 'SKIPPED: .*' $(BUILD)/tests/test_gpu.log)"; fi; \
@@ -347,12 +355,20 @@ tsan: deps-test
 	@$(MAKE) --no-print-directory $(TSAN_TESTS:%=$(BUILD)/tsan/bin/%)
 	@BUILD=$(BUILD) TSAN_BIN=$(BUILD)/tsan/bin sh tests/run.sh
 
+# The house rules (tests/structure/: includes by layer, file and function sizes), run by
+# tests/run.sh like the test binaries through a one-line wrapper.
+STRUCTURE_CHECKS := $(patsubst tests/structure/%.sh,%,$(sort $(wildcard tests/structure/*.sh)))
+$(STRUCTURE_CHECKS:%=$(BUILD)/tests/%): $(BUILD)/tests/%: tests/structure/%.sh
+	@mkdir -p $(@D)
+	@printf '#!/bin/sh\nexec sh "%s/$<" "$$@"\n' "$(CURDIR)" > $@ && chmod +x $@
+
 # What `make test` builds (after TSAN_TESTS is defined); make test builds it through a sub-make,
 # so that HAVE_VULKAN sees what deps-test installed.
 test-build: $(BUILD)/lbk $(BUILD)/lbk-asan $(TESTS:%=$(BUILD)/tests/%) $(BUILD)/fuzz_container $(BUILD)/fault_shim.so \
             $(FUZZ_HARNESSES:%=$(BUILD)/%) \
             install-check install-lib-check $(TSAN_TESTS:%=$(BUILD)/tsan/bin/%) \
-            $(if $(HAVE_VULKAN),$(BUILD)/lbk-gpu-apply)
+            $(if $(HAVE_VULKAN),$(BUILD)/lbk-gpu-apply) $(STRUCTURE_CHECKS:%=$(BUILD)/tests/%)
+
 
 # ---- liblbk alone: zstd, xxHash and a C compiler, nothing else -----------------------------
 # install-lib builds and installs only the container library (static, shared, headers, lbk.pc).
@@ -407,9 +423,9 @@ $(BUILD)/fuzz-obj/%.o: %.c
 $(BUILD)/fuzz-obj/%.o: %.cc
 	@mkdir -p $(@D)
 	$(CLANGXX) -std=c++17 $(FUZZ_OBJ_FLAGS) $(CXXWARN) $(TOOL_CXXINC) -MMD -MP -c $< -o $@
-FUZZ_GLTF_OBJ := $(addprefix $(BUILD)/fuzz-obj/,tests/fuzz/fuzz_gltf.o bake/scene/gltf_import.o bake/scene/scene.o \
-                   bake/scene/exr_read.o)
-FUZZ_EXR_OBJ := $(addprefix $(BUILD)/fuzz-obj/,tests/fuzz/fuzz_exr.o bake/scene/exr_read.o bake/scene/scene.o)
+FUZZ_GLTF_OBJ := $(addprefix $(BUILD)/fuzz-obj/,tests/fuzz/fuzz_gltf.o scene/gltf_import.o scene/scene.o \
+                   scene/exr_read.o)
+FUZZ_EXR_OBJ := $(addprefix $(BUILD)/fuzz-obj/,tests/fuzz/fuzz_exr.o scene/exr_read.o scene/scene.o)
 FUZZ_PROFILE_OBJ := $(addprefix $(BUILD)/fuzz-obj/,tests/fuzz/fuzz_profile.o tools/convert/profile.o \
                       tools/common/lmap_decode.o tools/common/error_util.o tools/common/astc_codec.o)
 # the part harness merges, so it links the whole baker
@@ -486,7 +502,7 @@ $(CYC_DUMP): bench/cycles/texel_dump.c FORCE
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) -O2 -g $(WARN) -I$(LBK_TREE)/libformat/include -I$(LBK_TREE)/bake/include -I$(LBK_TREE) \
 	    -I/usr/include/draco -I/usr/include/stb -c $< -o $@.o
-	$(CXX) -o $@ $@.o $$(ls $(LBK_TREE)/$(BUILD)/rel/bake/*/*.o | sort) $(LBK_TREE)/$(BUILD)/liblbk.a $(TOOL_LIBS)
+	$(CXX) -o $@ $@.o $$(ls $(LBK_TREE)/$(BUILD)/rel/scene/*.o $(LBK_TREE)/$(BUILD)/rel/bake/*/*.o | sort) $(LBK_TREE)/$(BUILD)/liblbk.a $(TOOL_LIBS)
 FORCE:
 else
 CYC_LBK  ?= $(BUILD)/lbk

@@ -20,7 +20,7 @@
 #include "bake/layout/seams.h"
 #include "bake/layout/texels.h"
 #include "lbk/bake.h"
-#include "bake/scene/import.h"
+#include "scene/import.h"
 #include "lbk/container.h"
 #include "lbk/lightmap.h"
 #include "lbk/pixel.h"

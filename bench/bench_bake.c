@@ -15,7 +15,7 @@
 #include <unistd.h>
 
 #include "lbk/bake.h"
-#include "bake/util/parallel.h"
+#include "scene/parallel.h"
 #include "lbk/container.h"
 #include "lbk/lightmap.h"
 #include "lbk/pixel.h"

@@ -20,7 +20,7 @@
 #include "lbk/report.h"
 #include "lbk/validate.h"
 
-#include "bake/util/clock.h"
+#include "scene/clock.h"
 
 static uint32_t rng_state = 12345;
 static uint32_t rnd(void)

@@ -1,4 +1,4 @@
-/* Denoiser measurements (printed, not asserted; bake/transport/DENOISE.md quotes them):
+/* Denoiser measurements (printed, not asserted; bake/denoise/DENOISE.md quotes them):
  *  contact  the contact-shadow scene (tests/support/lightmap_fixture.h) with albedo 0: the
  *           reference is the direct irradiance integrated independently (no baker code), so
  *           the error includes the denoiser's bias. Per method: relative RMSE over the floor,
@@ -13,7 +13,7 @@
 #include <time.h>
 
 #include "bench/bench_util.h"
-#include "bake/transport/denoise.h"
+#include "bake/denoise/denoise.h"
 #include "bake/transport/transport.h"
 #include "lbk/sh.h"
 #include "tests/support/scene_append.c"

@@ -26,8 +26,8 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "bake/util/clock.h"
-#include "bake/util/parallel.h"
+#include "scene/clock.h"
+#include "scene/parallel.h"
 #include "bake/util/rng.h"
 #include "lbk/ahd.h"
 #include "lbk/bake.h"

@@ -27,7 +27,7 @@
 #include "bake/probes/glg_coarse.h"
 #include "bake/probes/glg_place.h"
 #include "bake/probes/probe_math.h"
-#include "bake/scene/import.h"
+#include "scene/import.h"
 #include "bake/transport/transport.h"
 #include "tests/support/scene_append.c"
 #include "tests/support/transport_scenes.c"

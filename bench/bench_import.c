@@ -8,7 +8,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "bake/scene/import.h"
+#include "scene/import.h"
 
 static double now(void)
 {

@@ -19,7 +19,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "bake/util/clock.h"
+#include "scene/clock.h"
 #include "lbk/bake.h"
 #include "tools/common/bake_data.h"
 #include "tools/convert/convert.h"

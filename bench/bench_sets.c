@@ -11,7 +11,7 @@
 
 #include <math.h>
 
-#include "bake/util/clock.h"
+#include "scene/clock.h"
 #include "lbk/bake.h"
 #include "lbk/ahd.h"
 #include "lbk/container.h"

@@ -42,7 +42,7 @@
 #include <stdint.h>
 
 #include "lbk/lbk.h"
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 #include "bake/layout/uvgen.h"
 
 #ifdef __cplusplus

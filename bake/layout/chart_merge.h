@@ -24,7 +24,7 @@
 
 #include "lbk/lbk.h"
 #include "bake/layout/uvgen.h"
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 
 typedef struct bk_chart_graph {
     uint32_t first, n;               /* the object's triangle range */

@@ -7,7 +7,7 @@
 
 #include "bake/layout/edge_key.h"
 #include "bake/layout/uv_math.h"
-#include "bake/scene/weld.h"
+#include "scene/weld.h"
 
 /* Two triangles' normals within ~0.5°: one flat face (a quad's two halves). */
 #define EI_COPLANAR_COS 0.99996

@@ -22,7 +22,7 @@
 
 #include "lbk/lbk.h"
 #include "bake/layout/texels.h"
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 
 /* Moves the point of every BK_TEXEL_EDGE receiver of tx (see above); deterministic.
  * Errors: LBK_ERR_INVALID_ARGUMENT, LBK_ERR_OUT_OF_MEMORY, LBK_ERR_LIMIT (over 2^32/3 triangles). */

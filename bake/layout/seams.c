@@ -7,7 +7,7 @@
 
 #include "bake/layout/edge_key.h"
 #include "bake/layout/uv_math.h"
-#include "bake/util/parallel.h"
+#include "scene/parallel.h"
 
 #define SMOOTH_DOT 0.999
 #define UV_SAME_EPS 1e-3          /* texels: an edge mapped to the same place on both sides */

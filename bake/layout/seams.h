@@ -42,7 +42,7 @@
 
 #include "lbk/lbk.h"
 #include "bake/layout/atlas.h"
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 
 #ifdef __cplusplus
 extern "C" {

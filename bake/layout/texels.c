@@ -9,7 +9,7 @@
 #include "bake/layout/edge_inset.h"
 #include "bake/layout/uv_math.h"
 #include "bake/layout/uv_raster.h"
-#include "bake/util/parallel.h"
+#include "scene/parallel.h"
 
 /* ---------------------------------------------------------------------------------------- */
 /* Tangent frame                                                                            */

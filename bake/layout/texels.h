@@ -80,8 +80,8 @@
 
 #include "lbk/lbk.h"
 #include "bake/layout/atlas.h"
-#include "bake/scene/scene.h"
-#include "bake/transport/tracer.h"
+#include "scene/scene.h"
+#include "scene/tracer.h"
 #include "bake/transport/transport.h"
 
 #ifdef __cplusplus

@@ -8,7 +8,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 
 static inline void bkv_load(double out[3], const float *p)
 {

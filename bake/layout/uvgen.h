@@ -35,7 +35,7 @@
 #include <stdint.h>
 
 #include "lbk/lbk.h"
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 
 #ifdef __cplusplus
 extern "C" {

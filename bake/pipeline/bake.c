@@ -13,16 +13,16 @@
 #include "bake/probes/glg_coarse.h"
 #include "bake/dist/checkpoint.h"
 #include "bake/dist/dist.h"
-#include "bake/pipeline/encode.h"
+#include "bake/encode/encode.h"
 #include "bake/pipeline/gather_limit.h"
 #include "bake/pipeline/pipeline.h"
 #include "bake/pipeline/error_map.h"
 #include "bake/pipeline/provenance.h"
-#include "bake/scene/exr_read.h"
-#include "bake/scene/import.h"
-#include "bake/scene/scene_desc.h"
-#include "bake/transport/denoise.h"
-#include "bake/util/clock.h"
+#include "scene/exr_read.h"
+#include "scene/import.h"
+#include "bake/pipeline/scene_desc.h"
+#include "bake/denoise/denoise.h"
+#include "scene/clock.h"
 #include "lbk/bake_dist.h"
 
 #define XXH_INLINE_ALL /* as the rest of the baker: liblbkbake links no xxhash of its own */
@@ -794,7 +794,7 @@ static lbk_result denoised_error(bk_pipeline *b, int choose)
 
 /* The denoising weights (texels and GLG probes) from the base + every light set and door (the
  * guide), applied to the base here and to every set by bk_set_bakes_emit with the same weights
- * (bake/transport/DENOISE.md). */
+ * (bake/denoise/DENOISE.md). */
 static lbk_result do_denoise(bk_pipeline *b)
 {
     if (b->opt->denoise == LBK_BAKE_DENOISE_OFF) return LBK_OK;

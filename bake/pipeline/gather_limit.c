@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/pipeline/encode.h"
+#include "bake/encode/encode.h"
 #include "lbk/sh.h"
 
 lbk_result bk_far_probes_bake(const bk_pipeline *b, const bk_transport_options *base, bk_far_probes *out)

@@ -8,7 +8,7 @@
 #include <cjson/cJSON.h>
 
 #include "bake/pipeline/pipeline.h"
-#include "bake/util/clock.h"
+#include "scene/clock.h"
 #include "lbk/dls.h"
 
 static const char *const phase_names[LBK_BAKE_PHASE_COUNT_] = {

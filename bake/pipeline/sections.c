@@ -10,7 +10,7 @@
 
 #include "bake/pipeline/error_map.h"
 #include "lbk/error_map.h"
-#include "bake/pipeline/encode.h"
+#include "bake/encode/encode.h"
 #include "bake/pipeline/pipeline.h"
 #include "bake/pipeline/provenance.h"
 #include "bake/pipeline/uv_section.h"

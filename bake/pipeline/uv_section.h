@@ -10,7 +10,7 @@
 #include "lbk/lbk.h"
 #include "bake/layout/atlas.h"
 #include "bake/layout/classify.h"
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 
 #ifdef __cplusplus
 extern "C" {

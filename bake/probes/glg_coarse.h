@@ -8,8 +8,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "bake/scene/scene.h"
-#include "bake/transport/tracer.h"
+#include "scene/scene.h"
+#include "scene/tracer.h"
 #include "lbk/lbk.h"
 
 typedef struct bk_glg_coarse {    /* zero-initialised = defaults, except scene and tracer */

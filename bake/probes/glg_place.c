@@ -6,7 +6,7 @@
 
 #include "bake/probes/delaunay.h"
 #include "bake/probes/probe_math.h"
-#include "bake/util/parallel.h"
+#include "scene/parallel.h"
 
 #include <float.h>
 #include <math.h>

@@ -7,8 +7,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "bake/scene/scene.h"
-#include "bake/transport/tracer.h"
+#include "scene/scene.h"
+#include "scene/tracer.h"
 #include "lbk/lbk.h"
 
 /* Lighting at n points for the GLG's density rule: 7 floats per point, the luminance of the

@@ -16,8 +16,8 @@
 #include <stdint.h>
 
 #include "bake/probes/llg_place.h"
-#include "bake/scene/scene.h"
-#include "bake/transport/tracer.h"
+#include "scene/scene.h"
+#include "scene/tracer.h"
 #include "lbk/lbk.h"
 #include "lbk/sh.h"
 

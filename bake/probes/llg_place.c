@@ -3,8 +3,8 @@
 #include "bake/probes/llg_place.h"
 
 #include "bake/probes/probe_math.h"
-#include "bake/transport/tracer.h"
-#include "bake/util/parallel.h"
+#include "scene/tracer.h"
+#include "scene/parallel.h"
 
 #include <float.h>
 #include <math.h>

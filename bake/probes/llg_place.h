@@ -9,7 +9,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 #include "lbk/lbk.h"
 #include "lbk/llg.h"
 

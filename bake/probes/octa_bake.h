@@ -7,8 +7,8 @@
 
 #include <stddef.h>
 
-#include "bake/scene/scene.h"
-#include "bake/transport/tracer.h"
+#include "scene/scene.h"
+#include "scene/tracer.h"
 #include "lbk/octa.h"
 
 /* Depth rays per texel: a 4×4 stratified grid over the texel's square of the octahedral map

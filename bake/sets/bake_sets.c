@@ -17,8 +17,8 @@
 #include <string.h>
 
 #include "bake/sets/door_guided.h"
-#include "bake/util/clock.h"
-#include "bake/pipeline/encode.h"
+#include "scene/clock.h"
+#include "bake/encode/encode.h"
 #include "lbk/ahd.h"
 #include "lbk/container.h"
 #include "lbk/dls.h"
@@ -73,7 +73,7 @@ typedef struct bs_impl {
     size_t light_set_count;
     bs_combo *combos;
     size_t combo_count;
-    /* the denoiser's guide (bake/transport/DENOISE.md): Σ of the light sets' and doors'
+    /* the denoiser's guide (bake/denoise/DENOISE.md): Σ of the light sets' and doors'
      * contributions, and Σ of the light-set runs' variances (independent runs); NULL before any */
     lbk_sh9_rgb *guide;
     float *guide_var;

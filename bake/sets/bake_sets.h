@@ -10,12 +10,12 @@
 
 #include "bake/probes/llg_fit.h"
 #include "bake/probes/llg_place.h"
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 #include "bake/layout/seams.h"
 #include "bake/layout/texels.h"
-#include "bake/transport/denoise.h"
+#include "bake/denoise/denoise.h"
 #include "bake/util/events.h"
-#include "bake/transport/tracer.h"
+#include "scene/tracer.h"
 #include "bake/transport/transport.h"
 #include "lbk/sh.h"
 
@@ -92,7 +92,7 @@ void bk_set_bakes_base_albedo(const bk_set_bakes *sets, const bk_scene *scene, u
  * LBK_ERR_OUT_OF_MEMORY / LBK_ERR_INTERNAL with a message in err. */
 lbk_result bk_set_bakes_run(bk_set_bakes *sets, const bk_set_inputs *in, char *err, size_t err_len);
 /* After bk_set_bakes_run: the denoiser's guide, Σ of the light sets' and doors' contributions
- * per receiver and Σ of the light-set runs' variances (bake/transport/DENOISE.md); both NULL
+ * per receiver and Σ of the light-set runs' variances (bake/denoise/DENOISE.md); both NULL
  * without sets. Valid until bk_set_bakes_emit. */
 void bk_set_bakes_guide(const bk_set_bakes *sets, const lbk_sh9_rgb **sum, const float **variance);
 

@@ -1,8 +1,8 @@
 /* The guided door estimator; see door_guided.h and bake/sets/SETS.md. */
 #include "bake/sets/door_guided.h"
 
-#include "bake/util/clock.h"
-#include "bake/util/parallel.h"
+#include "scene/clock.h"
+#include "scene/parallel.h"
 #include "bake/transport/shading.h"
 
 #include <math.h>
@@ -449,7 +449,7 @@ static void stage_bounce(dg_ctx *c, size_t begin, size_t end, int thread)
     c->thread_rays[thread] += rays;
 }
 
-/* ---- parallel-for (bake/util/parallel.h: items independent, results independent of threads) ----- */
+/* ---- parallel-for (scene/parallel.h: items independent, results independent of threads) ----- */
 
 typedef void (*dg_fn)(dg_ctx *c, size_t begin, size_t end, int thread);
 typedef struct dg_call { dg_ctx *c; dg_fn fn; } dg_call;

@@ -11,8 +11,8 @@
 #include <stdint.h>
 
 #include "lbk/lbk.h"
-#include "bake/scene/scene.h"
-#include "bake/transport/tracer.h"
+#include "scene/scene.h"
+#include "scene/tracer.h"
 #include "bake/util/rng.h"
 
 #define BK_GUIDE_MAX_BOXES 12 /* the seed's count */

@@ -9,8 +9,8 @@
 #include <math.h>
 #include <stdint.h>
 
-#include "bake/scene/scene.h"
-#include "bake/transport/tracer.h"
+#include "scene/scene.h"
+#include "scene/tracer.h"
 
 #define BK_PI 3.14159265358979323846
 

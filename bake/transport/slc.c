@@ -1,7 +1,7 @@
 /* Stochastic light culling: ranges, block lists, tile lists; see slc.h and SLC.md. */
 #include "bake/transport/slc.h"
 
-#include "bake/util/parallel.h"
+#include "scene/parallel.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -19,7 +19,7 @@
 #include <stdint.h>
 
 #include "lbk/lbk.h"
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 
 #define BK_SLC_TILE 16
 #define BK_SLC_BLOCK 1024

@@ -1,6 +1,6 @@
 /* Closed solids by edge balance; see solid.h. */
 #include "bake/transport/solid.h"
-#include "bake/scene/weld.h"
+#include "scene/weld.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -18,7 +18,7 @@
 #include <stdint.h>
 
 #include "lbk/lbk.h"
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 
 /* closed[t] = 1 for every triangle of a closed component, else 0 (tri_count entries).
  * Errors: LBK_ERR_INVALID_ARGUMENT (NULL), LBK_ERR_OUT_OF_MEMORY. */

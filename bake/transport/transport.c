@@ -1,7 +1,7 @@
 /* Series-expansion light transport; see transport.h and TRANSPORT.md. */
 #include "bake/transport/transport.h"
 
-#include "bake/util/parallel.h"
+#include "scene/parallel.h"
 #include "bake/transport/ggx.h"
 #include "bake/transport/shading.h"
 #include "bake/transport/slc.h"

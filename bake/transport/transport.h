@@ -29,8 +29,8 @@
 
 #include "lbk/lbk.h"
 #include "lbk/sh.h"
-#include "bake/scene/scene.h"
-#include "bake/transport/tracer.h"
+#include "scene/scene.h"
+#include "scene/tracer.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -322,7 +322,7 @@ typedef struct bk_transport_output {
     /* 1 per receiver: the estimated variance of the result's error scalar X (luminance of the
      * irradiance, texels; fluence/4, probes; TRANSPORT.md §Error estimate), ((A − B)/2)² from the
      * two halves A, B: unbiased, one degree of freedom, 0 where only noise-free punctual light
-     * arrives. The denoiser's input (bake/transport/denoise.h). */
+     * arrives. The denoiser's input (bake/denoise/denoise.h). */
     float *variance;
     /* octa_count × 16 × 3 (options.octa_points): irradiance E(n_t) = ∫ L·max(0, n_t·ω) dω for the
      * 16 directions n_t = lbk_oct_texel_direction(4, t % 4, t / 4), punctual light included */

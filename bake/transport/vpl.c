@@ -4,7 +4,7 @@
 
 #include "bake/transport/ggx.h"
 #include "bake/transport/shading.h"
-#include "bake/util/parallel.h"
+#include "scene/parallel.h"
 #include "bake/util/rng.h"
 
 #include <math.h>

@@ -16,7 +16,7 @@
  *    the same gather (tested); they differ only in how many VPLs a tile has to test.
  * 3. The culling reuses bk_slc's receiver tiles (16 items) and blocks (1024 items) and their
  *    boxes: every VPL's volume against every block box, then a tile's list cut from its block's.
- * 4. bk_vpl_gather: irradiance at receivers, a shadow ray (bake/transport/tracer.h) per accepted
+ * 4. bk_vpl_gather: irradiance at receivers, a shadow ray (scene/tracer.h) per accepted
  *    VPL, contribution / p; or every VPL with weight 1 (brute force, the reference).
  *
  * Determinism: photons and lists depend only on the seed, the ξ, δ and the boxes; every
@@ -31,9 +31,9 @@
 #include <stdint.h>
 
 #include "lbk/lbk.h"
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 #include "bake/transport/slc.h"
-#include "bake/transport/tracer.h"
+#include "scene/tracer.h"
 
 enum bk_vpl_kind { BK_VPL_DIFFUSE = 0, BK_VPL_GLOSSY = 1 };
 

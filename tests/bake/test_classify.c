@@ -12,7 +12,7 @@
 #include <unistd.h>
 
 #include "bake/layout/classify.h"
-#include "bake/scene/import.h"
+#include "scene/import.h"
 #include "support/uv_scenes.h"
 
 /* A wall in the plane x = x0 (facing +x when dir = 1) from z0..z1, 0..h, with a doorway of

@@ -1,4 +1,4 @@
-/* The denoiser (bake/transport/denoise.h, DENOISE.md):
+/* The denoiser (bake/denoise/denoise.h, DENOISE.md):
  *  - furnace: a closed box of albedo 0.9 emitting Le baked through atlas, texels and the
  *    transport's fixed 6-pass schedule, then denoised: every texel still within the furnace
  *    bound of TRANSPORT.md (the weights are a normalised non-negative combination, so an output
@@ -30,7 +30,7 @@
 
 #include "bake/probes/delaunay.h"
 #include "bake/probes/glg_place.h"
-#include "bake/transport/denoise.h"
+#include "bake/denoise/denoise.h"
 #include "bake/transport/transport.h"
 #include "lbk/sh.h"
 #include "support/lightmap_fixture.h"

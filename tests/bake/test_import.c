@@ -15,9 +15,9 @@
 
 #include <spng.h>
 
-#include "bake/scene/exr_read.h"
-#include "bake/scene/import.h"
-#include "bake/scene/scene.h"
+#include "scene/exr_read.h"
+#include "scene/import.h"
+#include "scene/scene.h"
 #include "support/scene_builders.h"
 
 /* ---- helpers ----------------------------------------------------------------------------- */

@@ -14,7 +14,7 @@
 
 #include "bake/probes/llg_fit.h"
 #include "bake/probes/llg_place.h"
-#include "bake/transport/tracer.h"
+#include "scene/tracer.h"
 #include "lbk/llg.h"
 #include "tests/support/probe_scenes.h"
 

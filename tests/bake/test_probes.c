@@ -14,7 +14,7 @@
 #include "bake/probes/delaunay.h"
 #include "bake/probes/glg_place.h"
 #include "bake/probes/llg_place.h"
-#include "bake/transport/tracer.h"
+#include "scene/tracer.h"
 #include "lbk/container.h"
 #include "lbk/glg.h"
 #include "lbk/llg.h"

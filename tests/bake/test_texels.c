@@ -14,7 +14,7 @@
 #include "bake/layout/atlas.h"
 #include "bake/layout/seams.h"
 #include "bake/layout/texels.h"
-#include "bake/transport/tracer.h"
+#include "scene/tracer.h"
 #include "support/uv_scenes.h"
 
 static uint32_t quad_object(bk_scene *s, const char *name, const float p0[3], const float p1[3], const float p2[3],

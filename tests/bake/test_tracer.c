@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/transport/tracer.h"
+#include "scene/tracer.h"
 #include "support/transport_scenes.h"
 
 static void test_quad_hit_and_miss(void **state)

@@ -26,7 +26,7 @@
 #include "bake/layout/classify.h"
 #include "bake/layout/texels.h"
 #include "bake/pipeline/uv_section.h"
-#include "bake/scene/import.h"
+#include "scene/import.h"
 #include "lbk/ahd.h"
 #include "lbk/container.h"
 #include "lbk/lightmap_uv.h"

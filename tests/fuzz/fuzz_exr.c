@@ -1,4 +1,4 @@
-/* libFuzzer harness for the sky EXR reader (bake/scene/exr_read.c over OpenEXRCore): each input
+/* libFuzzer harness for the sky EXR reader (scene/exr_read.c over OpenEXRCore): each input
  * is written to a file of this process and read with a pixel cap. A crash or sanitizer report is
  * a finding; a refusal is an answer. A read that succeeds must keep the reader's contract
  * (exr_read.h): a non-empty image within the cap, every value finite and >= 0 (negative values
@@ -11,8 +11,8 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "bake/scene/exr_read.h"
-#include "bake/scene/scene.h"
+#include "scene/exr_read.h"
+#include "scene/scene.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 

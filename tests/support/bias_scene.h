@@ -12,7 +12,7 @@
 
 #include <stdint.h>
 
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 
 /* Surface groups for the per-surface numbers (bsc_group). */
 enum bsc_group {

@@ -10,7 +10,7 @@
 #ifndef GSC_GAP_SCENE_H
 #define GSC_GAP_SCENE_H
 
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 #include "bake/transport/transport.h"
 
 enum { GSC_PER = 16, GSC_GROUPS = 3, GSC_N = GSC_PER * GSC_GROUPS };

@@ -11,8 +11,8 @@
 
 #include "bake/layout/atlas.h"
 #include "bake/layout/texels.h"
-#include "bake/scene/scene.h"
-#include "bake/transport/tracer.h"
+#include "scene/scene.h"
+#include "scene/tracer.h"
 #include "bake/transport/transport.h"
 
 typedef struct lmf {

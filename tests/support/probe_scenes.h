@@ -5,7 +5,7 @@
 
 #include <stdint.h>
 
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 
 void psc_init(bk_scene *s);                 /* empty: one grey single-sided material */
 void psc_free(bk_scene *s);

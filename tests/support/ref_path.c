@@ -4,7 +4,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "bake/util/parallel.h"
+#include "scene/parallel.h"
 
 #define RP_PI 3.14159265358979323846
 

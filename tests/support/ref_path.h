@@ -19,8 +19,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "bake/scene/scene.h"
-#include "bake/transport/tracer.h"
+#include "scene/scene.h"
+#include "scene/tracer.h"
 #include "bake/transport/transport.h"
 
 /* 0 when the scene is within the model above, else 1 with a reason in err. */

@@ -8,7 +8,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 
 /* realloc to a power-of-two capacity >= count elements (at least 16); call before each append. */
 void *sa_grow(void *p, size_t count, size_t elem);

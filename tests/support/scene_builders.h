@@ -5,7 +5,7 @@
 #ifndef SB_SCENE_BUILDERS_H
 #define SB_SCENE_BUILDERS_H
 
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 
 /* Closed axis-aligned cube [-size/2, size/2]³, faces facing inward, each face split into n×n
  * quads (2·n² triangles), one material with the given albedo (grey) and emission (grey

@@ -6,7 +6,7 @@
 
 #include <stdint.h>
 
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 #include "bake/transport/transport.h"
 
 void tsc_init(bk_scene *s);                /* empty scene, sky 0, one object "tsc" */

@@ -5,7 +5,7 @@
 
 #include <stdint.h>
 
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 
 void uvs_init(bk_scene *s);                 /* empty scene, sky 0, one grey material (0) */
 void uvs_free(bk_scene *s);

@@ -21,7 +21,7 @@
 #include <cjson/cJSON.h>
 
 #include "support/bake_file.h"
-#include "bake/scene/import.h"
+#include "scene/import.h"
 #include "tools/common/bake_data.h"
 #include "tools/common/file_util.h"
 #include "tools/convert/gltf_export.h"

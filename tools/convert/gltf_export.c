@@ -13,7 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/scene/import.h"
+#include "scene/import.h"
 #include "tools/common/error_util.h"
 #include "tools/convert/glb.h"
 #include "lbk/pixel.h"

@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/scene/import.h"
+#include "scene/import.h"
 #include "tools/common/error_util.h"
 
 /* The scene primitives of object i: [*first, *first + *count) (they are in object order). */

@@ -6,8 +6,8 @@
 
 #include <stdint.h>
 
-#include "bake/scene/scene.h"
-#include "bake/transport/tracer.h"
+#include "scene/scene.h"
+#include "scene/tracer.h"
 #include "tools/common/bake_data.h"
 #include "tools/render/render.h"
 

@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/util/parallel.h"
+#include "scene/parallel.h"
 #include "tools/common/error_util.h"
 #include "tools/render/level.h"
 #include "tools/render/seams.h"

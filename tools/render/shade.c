@@ -35,7 +35,7 @@ void rl_sky(const rl_level *L, const float d[3], float rgb[3])
         memcpy(rgb, L->sky, 3 * sizeof(float));
         return;
     }
-    /* the equirectangular mapping of bake/scene/scene.h */
+    /* the equirectangular mapping of scene/scene.h */
     const float uv[2] = {0.5f + atan2f(d[0], -d[2]) / (2.0f * PI_F), acosf(fmaxf(-1.0f, fminf(1.0f, d[1]))) / PI_F};
     rgb[0] = rgb[1] = rgb[2] = 1.0f;
     texture(&L->scene, L->scene.sky_image, uv, rgb);

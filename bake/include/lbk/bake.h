@@ -74,7 +74,7 @@ typedef enum lbk_bake_door_method {
     LBK_BAKE_DOOR_METHOD_COUNT_
 } lbk_bake_door_method;
 
-/* Denoising of the baked texels and probes (bake/transport/DENOISE.md). */
+/* Denoising of the baked texels and probes (bake/denoise/DENOISE.md). */
 typedef enum lbk_bake_denoise {
     LBK_BAKE_DENOISE_AUTO = 0, /* edge-aware, guided by the transport's own noise estimate, kept per
                                   class (texels, GLG probes) of the base and of each stored set
@@ -159,7 +159,7 @@ typedef struct lbk_bake_desc {
                                    light directly [0: 0.01]; < 0: every non-zero receiver */
     lbk_bake_door_method door_method; /* [difference] */
     lbk_bake_denoise denoise;   /* [auto: lightmap texels and GLG probes denoised where that lowers
-                                   the estimated error, both presets; bake/transport/DENOISE.md] */
+                                   the estimated error, both presets; bake/denoise/DENOISE.md] */
     const char *revision;       /* stored in META [NULL: none] */
     int timestamp;              /* 1: store the bake time in META (no longer byte-identical) */
     const char *allow_outside;  /* files a glTF names (buffers, images, its lbk_sky EXR) must lie in
@@ -409,7 +409,7 @@ typedef struct lbk_bake_octp {
 /* The estimate of what a denoised bake delivers (lbk_bake_report.denoised; all 0 when the bake
  * was not denoised): the transport's two halves passed through the denoiser's own weights, so
  * it holds the noise the filter leaves (also the part correlated between receivers) and the
- * bias it adds (bake/transport/DENOISE.md §What the report says). LLG probes are not filtered:
+ * bias it adds (bake/denoise/DENOISE.md §What the report says). LLG probes are not filtered:
  * errors.llg is the base estimate's. */
 typedef struct lbk_bake_denoised {
     lbk_bake_class_errors errors;   /* √(noise² + bias²) per class, relative as REPT's */

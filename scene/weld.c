@@ -1,5 +1,5 @@
 /* Vertices welded by exact position; see weld.h. */
-#include "bake/scene/weld.h"
+#include "scene/weld.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -4,7 +4,7 @@
 
 #include <stddef.h>
 
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -1,4 +1,4 @@
-#include "bake/pipeline/encode.h"
+#include "bake/encode/encode.h"
 
 #include <math.h>
 #include <stdlib.h>

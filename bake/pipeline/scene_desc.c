@@ -2,7 +2,7 @@
  * description and a glTF file of the same scene give the same bk_scene up to the provenance
  * hash; where the importer works in double through a node transform, the identity transform's
  * arithmetic is reproduced (it turns -0 into +0). */
-#include "bake/scene/scene_desc.h"
+#include "bake/pipeline/scene_desc.h"
 
 #include <math.h>
 #include <stdarg.h>

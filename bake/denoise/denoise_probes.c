@@ -1,4 +1,4 @@
-/* Denoising of GLG probes along the edges of their tetrahedra (bake/transport/DENOISE.md):
+/* Denoising of GLG probes along the edges of their tetrahedra (bake/denoise/DENOISE.md):
  * a probe is averaged with the neighbours it shares a tetrahedron edge with and can see (the
  * segment between the two is unoccluded), each weighted by how far its value is from the
  * probe's in noise standard deviations. A probe behind a wall therefore never takes light from
@@ -7,8 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/transport/denoise_impl.h"
-#include "bake/util/parallel.h"
+#include "bake/denoise/denoise_impl.h"
+#include "scene/parallel.h"
 
 #define SH_N 27
 #define NEIGHBOUR_WEIGHT 0.5f /* a neighbour's weight at equal value; the probe's own is 1 */

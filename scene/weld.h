@@ -10,7 +10,7 @@
 
 #include <stdint.h>
 
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 
 /* A welded id per vertex (vertex_count entries, malloc'd; free() it): the smallest index among
  * the vertices at exactly the same position. Non-finite positions keep their own id. NULL when

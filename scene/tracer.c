@@ -1,5 +1,5 @@
 /* Embree 3 wrapper; see tracer.h. */
-#include "bake/transport/tracer.h"
+#include "scene/tracer.h"
 
 #include <embree3/rtcore.h>
 #include <math.h>

@@ -1,5 +1,5 @@
 /* EXR → linear float RGBA with the OpenEXRCore C API. */
-#include "bake/scene/exr_read.h"
+#include "scene/exr_read.h"
 
 #include <math.h>
 #include <stdint.h>

@@ -5,7 +5,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "bake/transport/denoise.h"
+#include "bake/denoise/denoise.h"
 
 /* Luminance weights (ITU-R BT.709, as bk_lum). */
 #define DN_LR 0.2126f

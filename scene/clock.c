@@ -1,4 +1,4 @@
-#include "bake/util/clock.h"
+#include "scene/clock.h"
 
 #include <time.h>
 

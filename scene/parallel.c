@@ -1,5 +1,5 @@
 /* Dynamic-chunk parallel-for; see parallel.h. */
-#include "bake/util/parallel.h"
+#include "scene/parallel.h"
 
 #include <pthread.h>
 #include <stdatomic.h>

@@ -48,8 +48,8 @@
 #include <string>
 #include <vector>
 
-#include "bake/scene/exr_read.h"
-#include "bake/scene/import.h"
+#include "scene/exr_read.h"
+#include "scene/import.h"
 
 namespace {
 

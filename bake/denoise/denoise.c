@@ -1,15 +1,15 @@
 /* Denoising of baked texels (lightmap space) and the API; probes are in denoise_probes.c.
- * Method and measurements: bake/transport/DENOISE.md. */
-#include "bake/transport/denoise.h"
+ * Method and measurements: bake/denoise/DENOISE.md. */
+#include "bake/denoise/denoise.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/transport/denoise_impl.h"
+#include "bake/denoise/denoise_impl.h"
 #include "bake/transport/shading.h"
-#include "bake/util/clock.h"
-#include "bake/util/parallel.h"
+#include "scene/clock.h"
+#include "scene/parallel.h"
 
 #define SH_N DN_MAX_CH /* floats per lbk_sh9_rgb */
 

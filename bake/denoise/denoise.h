@@ -1,6 +1,6 @@
 /* Denoising of the transport's result: lightmap texels in lightmap space, GLG probes along their
  * tetrahedral edges. Method, parameters, what was measured and the guarantees:
- * bake/transport/DENOISE.md.
+ * bake/denoise/DENOISE.md.
  *
  * The filter lives with the transport because it finishes the transport's estimate: it uses the
  * transport's own per-receiver variance (bk_transport_output.variance) to decide how far apart
@@ -34,8 +34,8 @@
 #include "bake/layout/atlas.h"
 #include "bake/layout/texels.h"
 #include "bake/probes/glg_place.h"
-#include "bake/scene/scene.h"
-#include "bake/transport/tracer.h"
+#include "scene/scene.h"
+#include "scene/tracer.h"
 #include "bake/transport/transport.h"
 
 #ifdef __cplusplus

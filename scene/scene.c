@@ -1,5 +1,5 @@
 /* Small utilities over bk_scene: freeing, bounds, hashing, the "is anything lit" test, a check. */
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 
 #include <math.h>
 #include <stdio.h>
