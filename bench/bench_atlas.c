@@ -7,7 +7,7 @@
  *    bake (--preset fast --samples 16, room_with_doors with --sky 1,1,1), whose LMAP pages
  *    are read back from the container. The atlas is rebuilt here exactly as the baker builds
  *    it (import, classify, fast-preset density) and checked against the container's pages.
- * LBK_SCENES overrides ../shared/scenes. */
+ * LBK_SCENES overrides scenes/. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -28,7 +28,7 @@
 static const char *scenes_dir(void)
 {
     const char *d = getenv("LBK_SCENES");
-    return d && *d ? d : "../shared/scenes";
+    return d && *d ? d : "scenes";
 }
 
 typedef struct scene_case {

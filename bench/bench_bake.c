@@ -7,7 +7,7 @@
  *     error includes it (and the ~0.5 % RMS rounding of R11G11B10F).
  *  b. wall time of room_with_doors at --preset fast (goal ≤ 60 s on the 2-core machine) and at
  *     --preset high, with the machine's core count.
- * LBK_SCENES overrides ../shared/scenes; LBK_BENCH_QUICK=1 shrinks the budgets (smoke run). */
+ * LBK_SCENES overrides scenes/; LBK_BENCH_QUICK=1 shrinks the budgets (smoke run). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -24,7 +24,7 @@
 static const char *scenes_dir(void)
 {
     const char *d = getenv("LBK_SCENES");
-    return d && *d ? d : "../shared/scenes";
+    return d && *d ? d : "scenes";
 }
 
 static int quick(void)

@@ -324,10 +324,10 @@ int main(void)
     char err[512];
     bk_import_options io = {0};
     io.recentre = 1;
-    /* LBK_SCENES overrides ../shared/scenes, as in bench_atlas */
+    /* LBK_SCENES overrides scenes/, as in bench_atlas */
     const char *dir = getenv("LBK_SCENES");
     char path[1024];
-    snprintf(path, sizeof path, "%s/room_with_doors/room.glb", dir && *dir ? dir : "../shared/scenes");
+    snprintf(path, sizeof path, "%s/room_with_doors/room.glb", dir && *dir ? dir : "scenes");
     if (bk_import_gltf(path, &io, &room, err, sizeof err)) {
         printf("room_with_doors: %s (skipped)\n", err);
     } else {

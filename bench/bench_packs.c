@@ -221,7 +221,7 @@ static int bake(const char *path, const char *scene, int block_align, void **byt
 static const char *scenes_dir(void)
 {
     const char *d = getenv("LBK_SCENES");
-    return d && *d ? d : "../shared/scenes";
+    return d && *d ? d : "scenes";
 }
 
 /* bench_packs [PROFILE...]: the shipped profiles, or the named ones / profile files (then without

@@ -13,6 +13,7 @@
 
 #include "bake/layout/classify.h"
 #include "scene/import.h"
+#include "support/scenes_dir.h"
 #include "support/uv_scenes.h"
 
 /* A wall in the plane x = x0 (facing +x when dir = 1) from z0..z1, 0..h, with a doorway of
@@ -98,12 +99,8 @@ static void test_room_with_spheres(void **state)
 static void test_room_with_doors_file(void **state)
 {
     (void)state;
-    const char *path = "../shared/scenes/room_with_doors/room.glb";
-    if (access(path, R_OK) != 0) path = "/work/shared/scenes/room_with_doors/room.glb";
-    if (access(path, R_OK) != 0) {
-        skip();
-        return;
-    }
+    char path[1024];
+    SD_REQUIRE(sd_path(path, sizeof path, "room_with_doors/room.glb"));
     bk_scene s;
     char err[512];
     bk_import_options io = {0};

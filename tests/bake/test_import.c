@@ -1,4 +1,4 @@
-/* glTF import: the shared scenes (counts from ../shared/scenes/SOURCES.md), transforms, extras,
+/* glTF import: the shared scenes (counts from scenes/SOURCES.md), transforms, extras,
  * lights, textures, the EXR sky, and malformed input (must fail with a message, never crash). */
 #include <stdarg.h>
 #include <stddef.h>
@@ -19,27 +19,16 @@
 #include "scene/import.h"
 #include "scene/scene.h"
 #include "support/scene_builders.h"
+#include "support/scenes_dir.h"
 
 /* ---- helpers ----------------------------------------------------------------------------- */
 
-static const char *scenes_dir(void)
-{
-    const char *d = getenv("LBK_SCENES");
-    return d && *d ? d : "../shared/scenes";
-}
-
-static int have_scenes(void)
-{
-    struct stat st;
-    if (stat(scenes_dir(), &st) == 0 && S_ISDIR(st.st_mode)) return 1;
-    printf("[  SKIP    ] shared scenes directory %s is missing (set LBK_SCENES)\n", scenes_dir());
-    return 0;
-}
-
+/* A scene of scenes/ (or $LBK_SCENES): a missing file fails the test, naming it. */
 static int import_shared(const char *rel, bk_scene *s, bk_import_options *opt)
 {
     char path[1024], err[1024];
-    snprintf(path, sizeof path, "%s/%s", scenes_dir(), rel);
+    sd_path(path, sizeof path, rel);
+    SD_REQUIRE(path);
     int rc = bk_import_gltf(path, opt, s, err, sizeof err);
     if (rc) printf("import %s: %s\n", path, err);
     return rc;
@@ -151,7 +140,6 @@ static int teardown_tmp(void **state)
 static void test_cornell_box(void **state)
 {
     (void)state;
-    if (!have_scenes()) { skip(); }
     bk_scene s;
     assert_int_equal(import_shared("cornell_box/CornellBox-Original.gltf", &s, NULL), 0);
     assert_valid(&s);
@@ -181,7 +169,6 @@ static void test_cornell_box(void **state)
 static void test_cornell_box_bjs(void **state)
 {
     (void)state;
-    if (!have_scenes()) { skip(); }
     bk_scene s;
     bk_import_report rep;
     bk_import_options opt = {0};
@@ -214,7 +201,6 @@ static void test_cornell_box_bjs(void **state)
 static void test_room_with_doors(void **state)
 {
     (void)state;
-    if (!have_scenes()) { skip(); }
     bk_scene s;
     assert_int_equal(import_shared("room_with_doors/room.glb", &s, NULL), 0);
     assert_valid(&s);
@@ -235,7 +221,6 @@ static void test_room_with_doors(void **state)
 static void test_lights_punctual_lamp(void **state)
 {
     (void)state;
-    if (!have_scenes()) { skip(); }
     bk_scene s;
     bk_import_report rep;
     bk_import_options opt = {0};
@@ -291,7 +276,6 @@ static void test_lights_punctual_lamp(void **state)
 static void test_water_bottle_draco(void **state)
 {
     (void)state;
-    if (!have_scenes()) { skip(); }
     bk_scene s;
     bk_import_report rep;
     bk_import_options opt = {0};
@@ -1316,9 +1300,8 @@ static void test_resource_policy(void **state)
 static void test_malformed_glb(void **state)
 {
     (void)state;
-    if (!have_scenes()) { skip(); }
     char path[1024];
-    snprintf(path, sizeof path, "%s/room_with_doors/room.glb", scenes_dir());
+    SD_REQUIRE(sd_path(path, sizeof path, "room_with_doors/room.glb"));
     FILE *f = fopen(path, "rb");
     assert_non_null(f);
     fseek(f, 0, SEEK_END);
@@ -1363,17 +1346,16 @@ static void test_malformed_glb(void **state)
 static void test_draco_corrupt(void **state)
 {
     (void)state;
-    if (!have_scenes()) { skip(); }
     /* Copy the Draco bottle with a damaged Draco stream and with bogus attribute ids. */
     char src[1024];
-    snprintf(src, sizeof src, "%s/water_bottle_draco/WaterBottle.bin", scenes_dir());
+    SD_REQUIRE(sd_path(src, sizeof src, "water_bottle_draco/WaterBottle.bin"));
     FILE *f = fopen(src, "rb");
     assert_non_null(f);
     static unsigned char bin[65536];
     size_t n = fread(bin, 1, sizeof bin, f);
     fclose(f);
     assert_int_equal(n, 49580);
-    snprintf(src, sizeof src, "%s/water_bottle_draco/WaterBottle.gltf", scenes_dir());
+    SD_REQUIRE(sd_path(src, sizeof src, "water_bottle_draco/WaterBottle.gltf"));
     f = fopen(src, "rb");
     assert_non_null(f);
     static char json[8192];

@@ -31,12 +31,7 @@
 #include "lbk/container.h"
 #include "lbk/lightmap_uv.h"
 #include "support/lmuv_scene.h"
-
-static const char *scenes_dir(void)
-{
-    const char *d = getenv("LBK_SCENES");
-    return d && *d ? d : "../shared/scenes";
-}
+#include "support/scenes_dir.h"
 
 /* Everything the rule check needs: the scene, the baker's layout, and the section. */
 typedef struct level {
@@ -275,11 +270,7 @@ static void shared_levels(void **state)
     } levels[] = {{"cornell_box_bjs/cornellBox-2.80-Eevee-gltf.gltf", 8, 1}, {"cornell_box/CornellBox-Original.gltf", 16, 0}};
     for (size_t i = 0; i < sizeof levels / sizeof levels[0]; i++) {
         char path[1024];
-        snprintf(path, sizeof path, "%s/%s", scenes_dir(), levels[i].file);
-        if (access(path, R_OK) != 0) {
-            print_message("[  SKIP    ] %s is missing (set LBK_SCENES)\n", path);
-            continue;
-        }
+        SD_REQUIRE(sd_path(path, sizeof path, levels[i].file));
         level l;
         assert_int_equal(level_open(path, levels[i].density, &l), 0);
         rule_stats st = check_rule(&l);
@@ -298,11 +289,7 @@ static void old_rule_measured(void **state)
 {
     (void)state;
     char path[1024];
-    snprintf(path, sizeof path, "%s/cornell_box_bjs/cornellBox-2.80-Eevee-gltf.gltf", scenes_dir());
-    if (access(path, R_OK) != 0) {
-        print_message("[  SKIP    ] %s is missing\n", path);
-        return;
-    }
+    SD_REQUIRE(sd_path(path, sizeof path, "cornell_box_bjs/cornellBox-2.80-Eevee-gltf.gltf"));
     level l;
     assert_int_equal(level_open(path, 8, &l), 0);
     double worst = 0;
@@ -350,8 +337,7 @@ static void tangent_frame_is_the_bakers(void **state)
 #undef RND
     /* and the receivers' tangents are what a renderer rebuilds from the stored coordinates */
     char path[1024];
-    snprintf(path, sizeof path, "%s/cornell_box/CornellBox-Original.gltf", scenes_dir());
-    if (access(path, R_OK) != 0) return;
+    SD_REQUIRE(sd_path(path, sizeof path, "cornell_box/CornellBox-Original.gltf"));
     level l;
     assert_int_equal(level_open(path, 16, &l), 0);
     double worst = 0;

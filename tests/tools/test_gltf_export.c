@@ -28,6 +28,7 @@
 #include "lbk/container.h"
 #include "support/bake_file.h"
 #include "support/lmuv_scene.h"
+#include "support/scenes_dir.h"
 
 static char tmpdir[64];
 
@@ -44,12 +45,6 @@ static int teardown(void **state)
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
     return system(cmd) == 0 ? 0 : -1;
-}
-
-static const char *scenes_dir(void)
-{
-    const char *d = getenv("LBK_SCENES");
-    return d && *d ? d : "../shared/scenes";
 }
 
 static void bake(const char *in, const char *out, float density)
@@ -231,11 +226,7 @@ static void cornell_box(void **state)
 {
     (void)state;
     char scene[1024];
-    snprintf(scene, sizeof scene, "%s/cornell_box/CornellBox-Original.gltf", scenes_dir());
-    if (access(scene, R_OK)) {
-        print_message("[  SKIP    ] %s is missing (set LBK_SCENES)\n", scene);
-        return;
-    }
+    SD_REQUIRE(sd_path(scene, sizeof scene, "cornell_box/CornellBox-Original.gltf"));
     export_and_reimport(scene, "cornell", 16);
 }
 
