@@ -317,7 +317,7 @@ static double lum_e(const lbk_sh9_rgb *y) { return 0.2126 * sh_e(y, 0) + 0.7152 
 /* bk_denoiser_error against the truth. The contact scene's floor (receivers reordered so that
  * the floor is the first class) has an analytic irradiance, so the error each denoised bake
  * really has is known: √(Σ (D − E)² / Σ D²) over the floor, normalised like the estimate. The
- * estimate must be within 2× of it (the issue's goal for every class), for the default filter,
+ * estimate must be within 2× of it (the goal for every class), for the default filter,
  * whose error is mostly the noise it leaves, and for the geometry-only blur, whose error is
  * mostly its bias across the shadow (the estimate without its bias term is ~0.1× the blur's
  * error here: this is what makes the case fail when the bias term is missing). With every

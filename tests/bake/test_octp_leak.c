@@ -1,4 +1,4 @@
-/* Light leaking through a thin wall (issue 14, seed 003's "variance depth attenuation"): two
+/* Light leaking through a thin wall (seed 003's "variance depth attenuation"): two
  * rooms 3 m × 3 m × 2.5 m separated by a wall 0.1 m or 0.02 m thick, a point light in one, the
  * other closed and dark (its true irradiance is exactly 0). A grid of points on the dark face of
  * the wall and 0.25 m into the dark room, normal into the dark room, sampled with

@@ -429,7 +429,7 @@ static void test_glg_lighting(void **state)
     lbk_reader_close(r);
 }
 
-/* Issue 6 on real baker output: every shipped convert profile makes a pack that validates and
+/* Console-ready packs from real baker output: every shipped convert profile makes a pack that validates and
  * diffs equal to its source; export → convert --from-exr gives back the same lighting. On a
  * level with lightmaps, LLGs, GLG and OCTP, and on one with light sets and a door (DLS, DOOR). */
 static int run_cli(const char *fmt, ...) __attribute__((format(printf, 1, 2)));

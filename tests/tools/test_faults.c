@@ -1,4 +1,4 @@
-/* Fault injection into the CLI's writers (issue 17, item 8): every file-writing call of
+/* Fault injection into the CLI's writers: every file-writing call of
  * `lbk bake` (with --json-report), `lbk convert` and `lbk export` — open, write, fsync, rename,
  * mkdir — is made to fail once in turn (ENOSPC, EIO or EXDEV: tests/faults/fault_shim.c, an
  * LD_PRELOAD library), and the process is killed (SIGKILL) at each of those points. After each:
