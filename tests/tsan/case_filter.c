@@ -1,6 +1,6 @@
 /* Linked into the ThreadSanitizer test binaries (`make tsan`) with
  * -Wl,--wrap=_cmocka_run_group_tests: runs only the cases whose name matches LBK_TEST_FILTER
- * (a cmocka glob), so tests/tsan/run.sh can pick the determinism cases listed in
+ * (a cmocka glob), so tests/run.sh can pick the determinism cases listed in
  * tests/tsan/determinism.list out of the ordinary test binaries without touching their mains. */
 #include <stdarg.h>
 #include <stddef.h>

@@ -1,6 +1,6 @@
 /* lbk export --gltf: the level as glTF 2.0 (GLB) with TEXCOORD_1 on every lightmapped primitive,
  * the lightmap pages as linear EXR and PNG previews beside it, and the GLG/LLG probes as data.
- * The container holds no geometry, so the scene it was baked from is read again (bake/scene's
+ * The container holds no geometry, so the scene it was baked from is read again (scene/'s
  * importer) and matched object by object (geometry hash, glTF node and primitives). Conventions:
  * tools/convert/README.md "glTF export". */
 #ifndef LBK_TOOLS_GLTF_EXPORT_H

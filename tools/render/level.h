@@ -12,7 +12,7 @@
 #include "tools/render/render.h"
 
 typedef struct rl_level {
-    bk_scene scene;          /* world space, as bake/scene's importer gives it */
+    bk_scene scene;          /* world space, as scene/'s importer gives it */
     tl_bake bake;            /* the container with a view on every section */
     bk_tracer *tracer;       /* Embree over the scene's triangles */
     lbk_object *objects;     /* the OBJS record of every scene object (same order) */

@@ -1,5 +1,5 @@
 /* lbk render: a reference renderer of a baked level, written to show an engine programmer how to
- * use the data. Geometry comes from the glTF the level was baked from (bake/scene's importer,
+ * use the data. Geometry comes from the glTF the level was baked from (scene/'s importer,
  * primary rays through Embree); every bit of lighting comes from the container through liblbk's
  * public runtime API only:
  *

@@ -1,7 +1,7 @@
 /* Block-compressed texture decoders for the LMAP plane encodings of format 1.2 (spec/container.md
  * §9.2): BC6H unsigned (plane 0, HDR irradiance) and BC4 / BC5 unsigned (plane 1, the ratio and
  * the direction). Bit-exact with the D3D11 functional specification and the Khronos Data Format
- * specification (checked against Mesa's decoders, bench/bench_bc.c); what a GPU's texture unit
+ * specification (checked against Mesa's decoders, bench/mesa_bc_check.c); what a GPU's texture unit
  * returns. They live in liblbk because readers other than a GPU need texel values — DLS apply on
  * the CPU, the validator, tools — and they are small and dependency-free. (The ASTC encodings are
  * decoded by the tools through astcenc: liblbk reports LBK_ERR_UNSUPPORTED_FEATURE for them.)
