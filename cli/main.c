@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "cli/cli.h"
+#include "lbk/bake.h"
 #include "lbk/lbk.h"
 
 static const struct {
@@ -42,8 +43,10 @@ int main(int argc, char **argv)
         return LBK_EXIT_OK;
     }
     if (!strcmp(argv[1], "--version")) {
-        printf("lbk %s (container format %d.%d)\n", lbk_version_string(), LBK_FORMAT_VERSION_MAJOR,
-               LBK_FORMAT_VERSION_MINOR);
+        /* liblbkbake is linked statically into lbk: its compile-time version is the one running. */
+        printf("lbk %s (liblbk %s, liblbkbake %d.%d.%d, container format %d.%d)\n", lbk_version_string(),
+               lbk_version_string(), LBK_BAKE_LIBRARY_VERSION_MAJOR, LBK_BAKE_LIBRARY_VERSION_MINOR,
+               LBK_BAKE_LIBRARY_VERSION_PATCH, LBK_FORMAT_VERSION_MAJOR, LBK_FORMAT_VERSION_MINOR);
         return LBK_EXIT_OK;
     }
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
