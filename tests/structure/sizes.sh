@@ -1,5 +1,5 @@
 #!/bin/sh
-# The house sizes (issue 38): no source file over 1,200 lines, no C/C++ function over 150.
+# The house sizes: no source file over 1,200 lines, no C/C++ function over 150.
 #   files:     *.c *.h *.cc *.hh *.js *.py *.sh under libformat/ scene/ bake/ tools/ cli/ gpu/
 #              tests/ bench/ viewer/, tracked or new (not ignored); not viewer/vendor/ and not a
 #              generated file (one that says "generated ... do not edit" in its first 5 lines)
