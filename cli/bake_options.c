@@ -350,15 +350,30 @@ static void store_number(const bake_option *opt, parse_state *s, double d, unsig
     }
 }
 
+/* The choice named v, or NULL after saying which there are. */
+static const opt_choice *find_choice(const bake_option *opt, const char *a, const char *v)
+{
+    for (const opt_choice *c = opt->choices; c->name; c++)
+        if (!strcmp(c->name, v)) return c;
+    char list[128];
+    if (opt->what) {
+        join_choices(opt->choices, ", ", ", ", list, sizeof list);
+        fprintf(stderr, "lbk bake: unknown %s '%s' (%s)\n", opt->what, v, list);
+    } else {
+        join_choices(opt->choices, ", ", " or ", list, sizeof list);
+        fprintf(stderr, "lbk bake: %s: '%s' is not %s\n", a, v, list);
+    }
+    return NULL;
+}
+
 /* One option and its value (NULL when the command line ended); 0 or the exit code. */
 static int apply(const bake_option *opt, const char *a, const char *v, parse_state *s)
 {
     double d = 0;
     unsigned long long u = 0;
-    switch (opt->kind) {
-    case OPT_HELP: return LBK_EXIT_OK; /* the caller prints the help */
-    case OPT_FLAG: *(int *)field_of(opt, s) = 1; return 0;
-    default: break;
+    if (opt->kind == OPT_FLAG) {
+        *(int *)field_of(opt, s) = 1;
+        return 0;
     }
     if (!v) {
         fprintf(stderr, "lbk bake: %s needs a value\n", a);
@@ -385,21 +400,9 @@ static int apply(const bake_option *opt, const char *a, const char *v, parse_sta
             }
         }
     } else if (opt->kind == OPT_ENUM) {
-        const opt_choice *c = opt->choices;
-        while (c->name && strcmp(c->name, v)) c++;
-        if (!c->name) {
-            char list[128];
-            if (opt->what) {
-                join_choices(opt->choices, ", ", ", ", list, sizeof list);
-                fprintf(stderr, "lbk bake: unknown %s '%s' (%s)\n", opt->what, v, list);
-            } else {
-                join_choices(opt->choices, ", ", " or ", list, sizeof list);
-                fprintf(stderr, "lbk bake: %s: '%s' is not %s\n", a, v, list);
-            }
-            return LBK_EXIT_USAGE;
-        }
+        const opt_choice *c = find_choice(opt, a, v);
+        if (!c) return LBK_EXIT_USAGE;
         d = c->value;
-        u = (unsigned long long)(long long)c->value;
     }
     if (opt->set) return opt->set(opt, a, v, d, s);
     if (opt->field == F_STR) *(const char **)field_of(opt, s) = v;
@@ -466,13 +469,13 @@ int cli_bake_parse(int argc, char **argv, bake_args *out, int *quiet_out)
         const char *a = argv[i];
         const bake_option *opt = find_option(a);
         if (opt) {
-            int takes_value = opt->kind != OPT_FLAG && opt->kind != OPT_HELP;
-            const char *v = takes_value && i + 1 < argc ? argv[i + 1] : NULL;
-            int rc = apply(opt, a, v, &s);
             if (opt->kind == OPT_HELP) {
                 help(stdout);
                 return LBK_EXIT_OK;
             }
+            int takes_value = opt->kind != OPT_FLAG;
+            const char *v = takes_value && i + 1 < argc ? argv[i + 1] : NULL;
+            int rc = apply(opt, a, v, &s);
             if (rc) return rc;
             if (takes_value) i++;
         } else if (a[0] == '-' && a[1]) {
