@@ -1,4 +1,4 @@
-/* Scene lookups shared by the light transport (transport.c) and the guided door estimator
+/* Scene lookups shared by the light transport (transport_impl.h) and the guided door estimator
  * (door_sampling.c, door_guided.c): one definition of how an image, a material, the sky and a
  * punctual light are evaluated, so the two estimators can never disagree on what a light is.
  * Doubles throughout (the bake accumulates in double; libformat's lbk_sh9_basis is the float

@@ -23,7 +23,7 @@
  * receiver sums its VPLs in index order: byte-identical at any thread count (tested). Nothing
  * is clamped: a receiver very close to a VPL receives I/l² (the VPL singularity), unbiased,
  * with the variance that brings (VPL.md). `lbk bake` uses the glossy VPLs where they pay
- * (bake/transport/transport.c, VPL.md "In the transport"). */
+ * (bake/transport/culling_glue.c and gather.c, VPL.md "In the transport"). */
 #ifndef BK_VPL_H
 #define BK_VPL_H
 
