@@ -9,6 +9,12 @@ set -eu
 lbk=${1:-build/lbk}
 out=${2:-docs/cli.md}
 [ -x "$lbk" ] || { echo "gen_cli_doc: $lbk is not an executable lbk (make first)" >&2; exit 2; }
+# Paths from where the script was called; the help itself from the repository root with no
+# profile path of the caller's (lbk convert --help lists the profiles it finds).
+case $lbk in /*) ;; *) lbk=$(pwd)/$lbk;; esac
+case $out in /*|-) ;; *) out=$(pwd)/$out;; esac
+cd "$(dirname "$0")/../.."
+unset LBK_PROFILE_PATH
 
 # The commands: the lines "  NAME  summary" between "commands:" and the next blank line.
 cmds=$("$lbk" --help | awk '/^commands:/ { on = 1; next } on && /^$/ { exit } on { print $1 }')
