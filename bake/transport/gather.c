@@ -323,7 +323,8 @@ static void recv_half(tp_ctx *c, const bk_receiver *r, size_t i, int h, int S, c
             double u0, uu1, ld[3], cl, val[3];
             bk_tr_lattice_uv(lat, (uint32_t)(j0 + jj), t1, t2, &u0, &uu1);
             double ndist = 0, skip[3];
-            if (bk_tr_nee_sample_lobe(c, org + 3 * jj, nn[jj], pg_kind, NULL, u0, uu1, &ndist, ld, &cl, val, &cnt->shadow) &&
+            if (bk_tr_nee_sample_lobe(c, org + 3 * jj, nn[jj], pg_kind, NULL, u0, uu1, &ndist, ld, &cl, val,
+                                      &cnt->shadow) &&
                 !(ndist > lim && far_lookup(c, org + 3 * jj, ld, lim, &far_hint, skip))) {
                 for (int a = 0; a < 3; a++) val[a] /= solid;
                 if (!bk_finite3(val)) cnt->bad++;

@@ -143,7 +143,8 @@ static void gloss_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit,
     if (sources && c->nee) {
         double ld[3], cq, val[3];
         double a0 = bk_rng_next(rng), a1 = bk_rng_next(rng);
-        if (bk_tr_nee_sample_lobe(c, o, lf.n, PG_COSINE, &lf, a0, a1, NULL, ld, &cq, val, &cnt->shadow) && bk_finite3(val)) {
+        if (bk_tr_nee_sample_lobe(c, o, lf.n, PG_COSINE, &lf, a0, a1, NULL, ld, &cq, val, &cnt->shadow) &&
+            bk_finite3(val)) {
             double ll[3], f[3];
             bk_tr_to_local(&lf, ld, ll);
             bk_mr_lobe_eval(&lf.lb, ll, f);

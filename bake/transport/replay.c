@@ -131,7 +131,8 @@ lbk_result bk_tr_replay_run(tp_ctx *c, bk_transport_stats *stats)
     stats->seconds = bk_now() - c->t0;
     stats->passes = t.passes;
     stats->samples_per_receiver = pr.samples_per_receiver;
-    for (int k = 0; k < c->ncls; k++) stats->class_samples[k] = c->cls[k].spp, stats->class_mean_samples[k] = bk_tr_mean_samples(c, k);
+    for (int k = 0; k < c->ncls; k++)
+        stats->class_samples[k] = c->cls[k].spp, stats->class_mean_samples[k] = bk_tr_mean_samples(c, k);
     stats->est_rel_rmse = err;
     stats->est_cache_bias = bias;
     stats->bounces = t.bounces;

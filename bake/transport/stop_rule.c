@@ -115,7 +115,8 @@ static size_t class_on(const tp_ctx *c, int k)
     if (c->stop_sub[k]) {
         const size_t all = c->stop_first[k + 1] - c->stop_first[k];
         size_t on = 0;
-        for (size_t p = c->stop_first[k]; p < c->stop_first[k + 1]; p++) on += c->blk_on[bk_tr_block_of(c, c->stop_idx[p])];
+        for (size_t p = c->stop_first[k]; p < c->stop_first[k + 1]; p++)
+            on += c->blk_on[bk_tr_block_of(c, c->stop_idx[p])];
         return all ? (size_t)((uint64_t)n * on / all) : n;
     }
     size_t on = 0;
@@ -135,7 +136,8 @@ double bk_tr_mean_samples(const tp_ctx *c, int k)
     if (!c->adapt || k >= c->ncls || !(cl->weight_sum > 0)) return cl->spp;
     double sum = 0, n = 0;
     if (c->stop_sub[k])
-        for (size_t p = c->stop_first[k]; p < c->stop_first[k + 1]; p++) sum += c->blk_w[bk_tr_block_of(c, c->stop_idx[p])], n++;
+        for (size_t p = c->stop_first[k]; p < c->stop_first[k + 1]; p++)
+            sum += c->blk_w[bk_tr_block_of(c, c->stop_idx[p])], n++;
     else
         for (size_t b = c->blk_first[k]; b < c->blk_first[k + 1]; b++) {
             size_t lo, hi;
@@ -306,7 +308,8 @@ int bk_tr_stop_after(tp_ctx *c, int pass, const tp_errors *ce, double pass_secon
         if (!cl->active) continue;
         const double step = 2.0 * (c->s0 << (pass + 1 < 20 ? pass + 1 : 20));
         const int texels_sampling = k > 0 && c->cls[0].active, going = bk_tr_adapt_apply(c, k);
-        const double next = c->adapt ? bk_tr_mean_samples(c, k) + step * (double)class_on(c, k) / (double)(cl->end - cl->begin)
+        const double next = c->adapt ? bk_tr_mean_samples(c, k) +
+                                           step * (double)class_on(c, k) / (double)(cl->end - cl->begin)
                                      : cl->spp + step;
         if (!going || (c->target > 0 && ce->cls[k] <= c->target && !texels_sampling)) cl->stop = BK_STOP_TARGET;
         else if (next > c->max_samples || pass >= 24) cl->stop = BK_STOP_BUDGET;

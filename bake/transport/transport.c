@@ -125,7 +125,8 @@ static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
     if (bk_tr_lattice_init(&c->lat, (uint32_t)c->rays) != LBK_OK) return LBK_ERR_OUT_OF_MEMORY;
     c->pass_weight = ldexp(1.0, pass);
     for (int h = 0; h < 2 && c->slc; h++)
-        if (bk_tr_slc_draw(c, DOM_SLC_RECV, h, pass, c->slc_recv, &c->draw_recv[h]) != LBK_OK) return LBK_ERR_OUT_OF_MEMORY;
+        if (bk_tr_slc_draw(c, DOM_SLC_RECV, h, pass, c->slc_recv, &c->draw_recv[h]) != LBK_OK)
+            return LBK_ERR_OUT_OF_MEMORY;
     if (c->vpl) {
         lbk_result res = bk_tr_vpl_pass(c, pass);
         if (res != LBK_OK) return res;
@@ -225,7 +226,8 @@ static void fill_stats(const tp_ctx *c, int passes, double err, double bias, con
     stats->seconds = bk_now() - c->t0;
     stats->passes = passes;
     stats->samples_per_receiver = bk_tr_lead_samples(c);
-    for (int k = 0; k < c->ncls; k++) stats->class_samples[k] = c->cls[k].spp, stats->class_mean_samples[k] = bk_tr_mean_samples(c, k);
+    for (int k = 0; k < c->ncls; k++)
+        stats->class_samples[k] = c->cls[k].spp, stats->class_mean_samples[k] = bk_tr_mean_samples(c, k);
     stats->est_rel_rmse = err;
     stats->est_cache_bias = bias;
     stats->bounces = chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces;
@@ -368,8 +370,8 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
         bk_tr_adapt_mark(&c, pass, c.x_acc);
         if (rec && (res = bk_tr_record_pass(&c, pass, chain)) != LBK_OK) goto done;
         bk_transport_sample smp;
-        bk_tr_sample_of(&c, bk_tr_lead_samples(&c), err, chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces,
-                  pass, &ce, &smp);
+        bk_tr_sample_of(&c, bk_tr_lead_samples(&c), err,
+                        chain[0].bounces > chain[1].bounces ? chain[0].bounces : chain[1].bounces, pass, &ce, &smp);
         if (pass < BK_TRANSPORT_MAX_PASSES) c.samples[pass] = smp;
         if (opt->report) opt->report(opt->user, &smp);
         if (opt->checkpoint && !split && (res = bk_tr_save_state(&c, pass, chain)) != LBK_OK) goto done;

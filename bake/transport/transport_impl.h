@@ -70,7 +70,8 @@ static inline tp_shift bk_tr_lattice_shift(double s1, double s2)
     return t;
 }
 
-static inline void bk_tr_lattice(const tp_lattice *l, uint32_t j, const tp_shift *sh, double *u1, double *cphi, double *sphi)
+static inline void bk_tr_lattice(const tp_lattice *l, uint32_t j, const tp_shift *sh, double *u1, double *cphi,
+                                 double *sphi)
 {
     double a = (double)j / l->S + sh->s1;
     *u1 = a - floor(a);
@@ -259,7 +260,10 @@ typedef void (*tp_fn)(tp_ctx *c, size_t begin, size_t end, int thread);
 
 void bk_tr_parallel_range(tp_ctx *c, size_t begin, size_t end, size_t chunk, tp_fn fn);
 
-static inline void bk_tr_parallel_for(tp_ctx *c, size_t n, size_t chunk, tp_fn fn) { bk_tr_parallel_range(c, 0, n, chunk, fn); }
+static inline void bk_tr_parallel_for(tp_ctx *c, size_t n, size_t chunk, tp_fn fn)
+{
+    bk_tr_parallel_range(c, 0, n, chunk, fn);
+}
 
 /* ---- adaptive sampling's blocks: receiver index / BK_TRANSPORT_BLOCK, cut at the class bounds */
 
