@@ -1,0 +1,48 @@
+# Benchmarks, printed as ratios against baselines measured in the same run: make bench (all of
+# them), bench-cycles and bench-render (lbk against Blender Cycles), mesa-bc-check.
+.PHONY: bench bench-cycles bench-render mesa-bc-check
+
+$(BUILD)/bench/%: bench/%.c $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a
+	@mkdir -p $(@D)
+	$(CC) $(CSTD) -O2 -g $(WARN) $(TOOL_INC) -c $< -o $@.o
+	$(CXX) -o $@ $@.o $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a $(BENCH_EXTRA) $(TOOL_LIBS)
+# The BC codecs against Mesa's (llvmpipe, surfaceless EGL): optional, needs libegl-dev libgl-dev.
+mesa-bc-check: $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a
+	@mkdir -p $(BUILD)/bench
+	$(CC) $(CSTD) -O2 -g $(WARN) $(TOOL_INC) -c bench/mesa_bc_check.c -o $(BUILD)/bench/mesa_bc_check.o
+	$(CXX) -o $(BUILD)/bench/mesa_bc_check $(BUILD)/bench/mesa_bc_check.o $(TOOL_OBJ) $(BUILD)/liblbkbake.a \
+	    $(BUILD)/liblbk.a $(TOOL_LIBS) -lEGL -lGL
+	$(BUILD)/bench/mesa_bc_check
+bench: deps-tools deps-bench
+	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BENCHES:%=$(BUILD)/bench/%)
+	@for b in $(BENCHES); do echo "== $$b"; $(BUILD)/bench/$$b || exit 1; done
+	@echo "== blender_import"; sh bench/blender_import.sh $(BUILD)/lbk $(BUILD)/bench-blender
+	@echo "== bench-cycles"; $(MAKE) --no-print-directory bench-cycles
+	@echo "== render (lbk render vs Blender Cycles)"; $(MAKE) --no-print-directory bench-render
+
+# lbk against Cycles (bench/cycles/README.md). LBK_TREE=/path/to/other/checkout compares that
+# tree's baker instead: its build/lbk (built there first) and texel_dump linked against its
+# baker objects, so the rebuilt layout is the one its lbk bakes.
+ifdef LBK_TREE
+CYC_LBK  := $(LBK_TREE)/$(BUILD)/lbk
+CYC_DUMP := $(BUILD)/bench/cycles/texel_dump-tree
+$(CYC_DUMP): bench/cycles/texel_dump.c FORCE
+	@$(MAKE) --no-print-directory -C $(LBK_TREE) $(BUILD)/lbk
+	@mkdir -p $(@D)
+	$(CC) $(CSTD) -O2 -g $(WARN) -I$(LBK_TREE)/libformat/include -I$(LBK_TREE)/bake/include -I$(LBK_TREE) \
+	    $(BAKE_CFLAGS) -c $< -o $@.o
+	$(CXX) -o $@ $@.o $$(ls $(LBK_TREE)/$(BUILD)/rel/scene/*.o $(LBK_TREE)/$(BUILD)/rel/bake/*/*.o | sort) $(LBK_TREE)/$(BUILD)/liblbk.a $(TOOL_LIBS)
+FORCE:
+else
+CYC_LBK  ?= $(BUILD)/lbk
+CYC_DUMP ?= $(BUILD)/bench/cycles/texel_dump
+endif
+bench-cycles: deps-tools deps-bench
+	@$(MAKE) --no-print-directory $(if $(LBK_TREE),,$(BUILD)/lbk) $(CYC_DUMP)
+	@LBK=$${LBK:-$(CYC_LBK)} LBK_TEXEL_DUMP=$${LBK_TEXEL_DUMP:-$(CYC_DUMP)} python3 bench/cycles/run.py
+
+# lbk render against converged Cycles renders (bench/render/README.md); the Cycles scene converter
+# comes from LBK_CYCLES_HARNESS (default bench/cycles).
+LBK_CYCLES_HARNESS ?= bench/cycles
+bench-render: $(BUILD)/lbk
+	@LBK_CYCLES_HARNESS=$(LBK_CYCLES_HARNESS) python3 bench/render/run.py --lbk $(BUILD)/lbk --out $(BUILD)/bench-render $(BENCH_RENDER_ARGS)
