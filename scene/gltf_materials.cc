@@ -1,0 +1,221 @@
+// The glTF importer's images and materials: tinygltf keeps the encoded bytes of the images the
+// baker needs (keep_encoded_image), and they are decoded here (stb_image, PNG/JPEG only, after a
+// header-only size check), linearised and box-filtered to the size cap; then the materials.
+
+#define STB_IMAGE_IMPLEMENTATION
+#define STB_IMAGE_STATIC
+#define STBI_NO_STDIO
+#define STBI_ONLY_PNG
+#define STBI_ONLY_JPEG
+#include <stb_image.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+
+#include "scene/gltf_internal.hh"
+
+namespace bk_gltf {
+
+bool keep_encoded_image(tinygltf::Image *image, const int idx, std::string *, std::string *, int, int,
+                        const unsigned char *bytes, int size, void *user)
+{
+    const ImageLoaderCtx *ctx = static_cast<const ImageLoaderCtx *>(user);
+    // bufferView images are read later from the validated view; tinygltf's pointer is not used.
+    if (ctx->skip || image->bufferView >= 0) return true;
+    if (idx < 0 || (size_t)idx >= ctx->needed->size() || !(*ctx->needed)[(size_t)idx]) return true;
+    if (bytes && size > 0) image->image.assign(bytes, bytes + size);
+    return true;
+}
+
+// Box filter to at most max_side on the longer side; partial edge blocks average what they cover.
+std::vector<float> Importer::downsample(const float *rgba, int w, int h, int max_side, int *ow, int *oh)
+{
+    int f = 1;
+    while ((w + f - 1) / f > max_side || (h + f - 1) / f > max_side) f++;
+    int nw = (w + f - 1) / f, nh = (h + f - 1) / f;
+    std::vector<float> out((size_t)nw * nh * 4);
+    for (int y = 0; y < nh; y++)
+        for (int x = 0; x < nw; x++) {
+            double acc[4] = {0, 0, 0, 0};
+            int n = 0;
+            for (int yy = y * f; yy < std::min(h, (y + 1) * f); yy++)
+                for (int xx = x * f; xx < std::min(w, (x + 1) * f); xx++, n++)
+                    for (int k = 0; k < 4; k++) acc[k] += rgba[4 * ((size_t)yy * w + xx) + k];
+            for (int k = 0; k < 4; k++) out[4 * ((size_t)y * nw + x) + k] = (float)(acc[k] / n);
+        }
+    *ow = nw;
+    *oh = nh;
+    return out;
+}
+
+int Importer::decode_image(int gi)
+{
+    if (image_map_[(size_t)gi] != -2) return image_map_[(size_t)gi];
+    const tinygltf::Image &im = m_.images[(size_t)gi];
+    std::string label = "image " + std::to_string(gi) + (im.uri.empty() || im.uri.rfind("data:", 0) == 0
+                                                             ? (im.name.empty() ? "" : " " + qstr(im.name))
+                                                             : " " + qstr(im.uri));
+    const unsigned char *bytes = nullptr;
+    size_t len = 0;
+    if (im.bufferView >= 0) {
+        if ((size_t)im.bufferView >= m_.bufferViews.size()) fail("%s: %s: bufferView out of range", path_.c_str(), label.c_str());
+        const tinygltf::BufferView &bv = m_.bufferViews[(size_t)im.bufferView];
+        if (bv.buffer < 0 || (size_t)bv.buffer >= m_.buffers.size()) fail("%s: %s: buffer out of range", path_.c_str(), label.c_str());
+        const tinygltf::Buffer &b = m_.buffers[(size_t)bv.buffer];
+        uint64_t end;
+        if (!add_ok(bv.byteOffset, bv.byteLength, &end) || end > b.data.size() || bv.byteLength == 0)
+            fail("%s: %s: bufferView %d lies outside its buffer", path_.c_str(), label.c_str(), im.bufferView);
+        bytes = b.data.data() + bv.byteOffset;
+        len = bv.byteLength;
+    } else {
+        bytes = im.image.data();
+        len = im.image.size();
+    }
+    if (!bytes || len == 0) fail("%s: %s: could not be read (missing file or empty data)", path_.c_str(), label.c_str());
+    if (len > (size_t)INT32_MAX) fail("%s: %s: encoded image larger than 2 GiB", path_.c_str(), label.c_str());
+    XXH3_64bits_update(&hash_, bytes, len);
+    int w = 0, h = 0, comp = 0;
+    if (!stbi_info_from_memory(bytes, (int)len, &w, &h, &comp)) {
+        if (o_.report) o_.report->ignored_textures++;
+        warn("%s: not a decodable PNG or JPEG (%s); texture ignored", label.c_str(), stbi_failure_reason());
+        image_map_[(size_t)gi] = -1;
+        return -1;
+    }
+    if (w <= 0 || h <= 0 || (uint64_t)w * (uint64_t)h > o_.max_image_pixels)
+        fail("%s: %s: %dx%d pixels exceeds the %zu-pixel cap", path_.c_str(), label.c_str(), w, h, o_.max_image_pixels);
+    int cw = 0, ch = 0;
+    unsigned char *px = stbi_load_from_memory(bytes, (int)len, &cw, &ch, &comp, 4);
+    if (!px || cw != w || ch != h) {
+        if (px) stbi_image_free(px);
+        fail("%s: %s: decoding failed (%s)", path_.c_str(), label.c_str(), stbi_failure_reason());
+    }
+    float lut[256];
+    for (int i = 0; i < 256; i++) {
+        double c = i / 255.0;
+        lut[i] = (float)(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
+    }
+    // Convert and filter in rows so a big texture never exists in float at full size.
+    int f = 1;
+    while ((w + f - 1) / f > o_.max_texture_size || (h + f - 1) / f > o_.max_texture_size) f++;
+    int nw = (w + f - 1) / f, nh = (h + f - 1) / f;
+    uint64_t bytes_out = (uint64_t)nw * nh * 16;
+    if (image_bytes_ + bytes_out > o_.max_image_bytes) {
+        stbi_image_free(px);
+        fail("%s: %s: textures exceed the %zu-byte image memory cap", path_.c_str(), label.c_str(), o_.max_image_bytes);
+    }
+    float *rgba = static_cast<float *>(malloc((size_t)bytes_out));
+    if (!rgba) {
+        stbi_image_free(px);
+        throw std::bad_alloc();
+    }
+    double sum[4] = {0, 0, 0, 0};
+    for (int y = 0; y < nh; y++)
+        for (int x = 0; x < nw; x++) {
+            double acc[4] = {0, 0, 0, 0};
+            int n = 0;
+            for (int yy = y * f; yy < std::min(h, (y + 1) * f); yy++)
+                for (int xx = x * f; xx < std::min(w, (x + 1) * f); xx++, n++) {
+                    const unsigned char *p = px + 4 * ((size_t)yy * w + xx);
+                    acc[0] += lut[p[0]]; acc[1] += lut[p[1]]; acc[2] += lut[p[2]]; acc[3] += p[3] / 255.0;
+                }
+            for (int k = 0; k < 4; k++) {
+                float v = (float)(acc[k] / n);
+                rgba[4 * ((size_t)y * nw + x) + k] = v;
+                sum[k] += v;
+            }
+        }
+    stbi_image_free(px);
+    if (f > 1 && o_.report) o_.report->downsampled_images++;
+    bk_image bi{};
+    bi.width = nw;
+    bi.height = nh;
+    bi.rgba = rgba;
+    for (int k = 0; k < 4; k++) bi.mean[k] = (float)(sum[k] / ((double)nw * nh));
+    images_.push_back(bi);
+    image_bytes_ += bytes_out;
+    image_map_[(size_t)gi] = (int)images_.size() - 1;
+    return image_map_[(size_t)gi];
+}
+
+void Importer::decode_images()
+{
+    image_map_.assign(m_.images.size(), -2);  // -2: not decoded yet
+}
+
+int Importer::texture_image(const tinygltf::TextureInfo &ti, const char *slot, int mi, const std::string &mname)
+{
+    if (ti.index < 0 || o_.skip_textures) return -1;
+    if ((size_t)ti.index >= m_.textures.size())
+        fail("%s: material %d %s: %s texture %d out of range", path_.c_str(), mi, qstr(mname).c_str(), slot, ti.index);
+    int src = m_.textures[(size_t)ti.index].source;
+    if (src < 0) {
+        // e.g. KHR_texture_basisu / EXT_texture_webp sources only
+        if (o_.report) o_.report->ignored_textures++;
+        warn("material %d %s: %s texture %d has no PNG/JPEG source; ignored", mi, qstr(mname).c_str(), slot, ti.index);
+        return -1;
+    }
+    if ((size_t)src >= m_.images.size())
+        fail("%s: material %d %s: %s texture %d: image %d out of range", path_.c_str(), mi, qstr(mname).c_str(),
+             slot, ti.index, src);
+    if (ti.texCoord != 0) {
+        if (o_.report) o_.report->ignored_textures++;
+        warn("material %d %s: %s texture uses TEXCOORD_%d (only TEXCOORD_0 is sampled); ignored", mi,
+             qstr(mname).c_str(), slot, ti.texCoord);
+        return -1;
+    }
+    if (ti.extensions.count("KHR_texture_transform"))
+        warn("material %d %s: KHR_texture_transform on the %s texture is ignored", mi, qstr(mname).c_str(), slot);
+    return decode_image(src);
+}
+
+void Importer::build_materials()
+{
+    for (size_t i = 0; i < m_.materials.size(); i++) {
+        const tinygltf::Material &gm = m_.materials[i];
+        int mi = (int)i;
+        const char *file = path_.c_str();
+        std::string mq = qstr(gm.name);
+        bk_material bm{};
+        snprintf(bm.name, sizeof bm.name, "%s", gm.name.empty() ? ("material" + std::to_string(i)).c_str() : gm.name.c_str());
+        const std::vector<double> &bc = gm.pbrMetallicRoughness.baseColorFactor;
+        if (bc.size() != 4) fail("%s: material %d %s: baseColorFactor must have 4 numbers", file, mi, mq.c_str());
+        for (int k = 0; k < 3; k++) {
+            if (!finite_nonneg(bc[k])) fail("%s: material %d %s: baseColorFactor must be finite and >= 0", file, mi, mq.c_str());
+            bm.albedo[k] = (float)std::min(bc[k], 1.0);
+        }
+        if (bc[0] > 1 || bc[1] > 1 || bc[2] > 1) warn("material %d %s: baseColorFactor above 1 clamped", mi, mq.c_str());
+        const std::vector<double> &ef = gm.emissiveFactor;
+        if (ef.size() != 3) fail("%s: material %d %s: emissiveFactor must have 3 numbers", file, mi, mq.c_str());
+        double strength = 1.0;
+        auto es = gm.extensions.find("KHR_materials_emissive_strength");
+        if (es != gm.extensions.end() && es->second.IsObject() && es->second.Has("emissiveStrength")) {
+            const tinygltf::Value &v = es->second.Get("emissiveStrength");
+            if (!v.IsNumber() || !finite_nonneg(v.GetNumberAsDouble()))
+                fail("%s: material %d %s: emissiveStrength must be a finite number >= 0", file, mi, mq.c_str());
+            strength = v.GetNumberAsDouble();
+        }
+        for (int k = 0; k < 3; k++) {
+            if (!finite_nonneg(ef[k])) fail("%s: material %d %s: emissiveFactor must be finite and >= 0", file, mi, mq.c_str());
+            double e = ef[k] * strength;
+            if (!std::isfinite((float)e)) fail("%s: material %d %s: emission overflows a float", file, mi, mq.c_str());
+            bm.emission[k] = (float)e;
+        }
+        bm.albedo_tex = texture_image(gm.pbrMetallicRoughness.baseColorTexture, "baseColor", mi, gm.name);
+        bm.emission_tex = texture_image(gm.emissiveTexture, "emissive", mi, gm.name);
+        bm.double_sided = gm.doubleSided ? 1 : 0;
+        // glTF's defaults (1, 1: a rough metal) when pbrMetallicRoughness leaves them out, as
+        // tinygltf fills them; our own Lambertian scenes say metallicFactor 0 (GGX.md)
+        const double mf = gm.pbrMetallicRoughness.metallicFactor, rf = gm.pbrMetallicRoughness.roughnessFactor;
+        if (!(mf >= 0 && mf <= 1)) fail("%s: material %d %s: metallicFactor must lie in [0, 1]", file, mi, mq.c_str());
+        if (!(rf >= 0 && rf <= 1)) fail("%s: material %d %s: roughnessFactor must lie in [0, 1]", file, mi, mq.c_str());
+        bm.metallic = (float)mf;
+        bm.roughness = (float)rf;
+        // after the emissive texture: the images of materials without it keep their indices
+        bm.metal_rough_tex1 =
+            1 + texture_image(gm.pbrMetallicRoughness.metallicRoughnessTexture, "metallicRoughness", mi, gm.name);
+        materials_.push_back(bm);
+    }
+}
+
+}  // namespace bk_gltf
