@@ -11,17 +11,11 @@
 
 #include "cli/bake_options.h"
 #include "cli/cli.h"
+#include "cli/options.h"
 #include "cli/progress.h"
 #include "lbk/bake.h"
 #include "lbk/bake_dist.h"
 #include "tools/common/file_util.h"
-
-/* True when both paths name one existing file (the same inode: hard links count). */
-static int same_file(const char *a, const char *b)
-{
-    struct stat sa, sb;
-    return a && b && stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
-}
 
 
 /* What the callbacks share: the bar, and the error text the CLI prints after the bake. */
@@ -256,18 +250,12 @@ int lbk_cmd_bake(int argc, char **argv)
         fprintf(stderr, "lbk bake: need a scene and -o OUT.lbk (lbk bake --help)\n");
         return LBK_EXIT_USAGE;
     }
-    /* An output must never replace an input (`-o scene.gltf` once destroyed the scene). */
-    const char *inputs[] = {o.input, o.d.sky_exr};
-    for (int k = 0; k < 2; k++) {
-        if (same_file(o.output, inputs[k]) || same_file(o.json_report, inputs[k])) {
-            fprintf(stderr, "lbk bake: refusing to overwrite the input %s with an output\n", inputs[k]);
-            return LBK_EXIT_USAGE;
-        }
-    }
-    if (o.json_report && (same_file(o.json_report, o.output) || !strcmp(o.json_report, o.output))) {
-        fprintf(stderr, "lbk bake: --json-report and -o name the same file %s\n", o.output);
-        return LBK_EXIT_USAGE;
-    }
+    /* An output must never replace an input (`-o scene.gltf` once destroyed the scene), a file
+     * the scene reads, or a device (output_guard.h). */
+    const char *extra[] = {"the sky", o.d.sky_exr, NULL, NULL};
+    const char *outs[] = {"-o", o.output, "--json-report", o.json_report, NULL, NULL};
+    int guarded = cli_check_scene_outputs("bake", o.input, o.d.allow_outside, extra, outs);
+    if (guarded) return guarded;
     return bake(&o, quiet);
 }
 

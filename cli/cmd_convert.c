@@ -10,6 +10,7 @@
 #include "tools/common/lmap_decode.h"
 #include "tools/convert/convert.h"
 #include "tools/common/file_util.h"
+#include "tools/common/output_guard.h"
 
 static void usage(FILE *f)
 {
@@ -91,6 +92,15 @@ int lbk_cmd_convert(int argc, char **argv)
         fprintf(stderr, "lbk convert: need IN.lbk, -o OUT.lbk and --profile (see lbk convert --help)\n");
         return LBK_EXIT_USAGE;
     }
+    tl_guard guard;
+    tl_guard_init(&guard, "convert");
+    const char *outs[] = {"-o", out, NULL, NULL};
+    int guarded = tl_guard_input(&guard, in, "the container") || tl_guard_input(&guard, profile_arg, "the profile") ||
+                          tl_guard_input_dir(&guard, exr_dir, "an EXR page of --from-exr")
+                      ? LBK_EXIT_INTERNAL
+                      : cli_check_outputs("convert", &guard, outs);
+    tl_guard_free(&guard);
+    if (guarded) return guarded;
     char err[TL_ERR_LEN];
     tl_profile profile;
     if (tl_profile_resolve(profile_arg, NULL, &profile, err)) {

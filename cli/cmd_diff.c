@@ -7,6 +7,7 @@
 
 #include "cli/cli.h"
 #include "cli/options.h"
+#include "tools/common/output_guard.h"
 #include "tools/inspect/diff.h"
 
 static void usage(FILE *f)
@@ -66,7 +67,7 @@ static int parse_tol(const char *flag, const char *v, double *out)
     return 0;
 }
 
-int lbk_cmd_diff(int argc, char **argv)
+static int diff_main(int argc, char **argv, tl_guard *guard)
 {
     const char *path[2] = {NULL, NULL}, *heat = NULL;
     int json = 0, verbose = 0, npath = 0;
@@ -130,6 +131,14 @@ int lbk_cmd_diff(int argc, char **argv)
     if (tol_given && !mode_given) o.mode = TL_DIFF_MODE_TOLERANCE;
     o.keep_error_maps = heat != NULL;
     char err[TL_ERR_LEN];
+    /* the heatmaps may replace neither container nor a device (output_guard.h) */
+    if (tl_guard_input(guard, path[0], "the container") || tl_guard_input(guard, path[1], "the container"))
+        return LBK_EXIT_INTERNAL;
+    if (heat && tl_guard_output_dir(guard, heat, NULL, "--heatmap", err)) {
+        fprintf(stderr, "lbk diff: %s\n", err);
+        return LBK_EXIT_USAGE;
+    }
+    tl_guard_activate(guard);
     tl_bake bake[2];
     for (int k = 0; k < 2; k++) {
         tl_open_status st = tl_bake_open_file_capped(path[k], max_memory, &bake[k], err);
@@ -166,4 +175,14 @@ int lbk_cmd_diff(int argc, char **argv)
     }
     tl_diff_free(&r);
     return exit_code;
+}
+
+int lbk_cmd_diff(int argc, char **argv)
+{
+    tl_guard guard;
+    tl_guard_init(&guard, "diff");
+    const int code = diff_main(argc, argv, &guard);
+    tl_guard_activate(NULL);
+    tl_guard_free(&guard);
+    return code;
 }

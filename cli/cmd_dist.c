@@ -11,6 +11,8 @@
 
 #include "cli/bake_options.h"
 #include "cli/cli.h"
+#include "cli/options.h"
+#include "tools/common/output_guard.h"
 #include "lbk/bake_dist.h"
 #include "tools/common/bake_plan.h"
 #include "tools/common/file_util.h"
@@ -146,8 +148,12 @@ int cli_plan_write(const bake_args *o, int argc, char **argv, const char *cmd)
         fprintf(stderr, "lbk %s: %s\n", cmd, err);
         return LBK_EXIT_IO;
     }
+    const char *plan_in[] = {"the sky", o->d.sky_exr, NULL, NULL};
+    const char *plan_out[] = {"--plan", o->plan, "--makefile", o->makefile, "--sbatch", o->sbatch, "-o", o->output, NULL, NULL};
+    int rc = cli_check_scene_outputs(cmd, scene, o->d.allow_outside, plan_in, plan_out);
+    if (rc) return rc;
     uint32_t runs = 0;
-    int rc = plan_inputs(cmd, scene, &o->d, &p, &runs);
+    rc = plan_inputs(cmd, scene, &o->d, &p, &runs);
     if (rc >= 0) return rc;
     int seen_input = 0;
     for (int i = 1; i < argc; i++) {
@@ -321,6 +327,13 @@ int lbk_cmd_bake_unit(int argc, char **argv)
         free((void *)o.d.expect_inputs);
         return LBK_EXIT_USAGE;
     }
+    const char *unit_in[] = {"the plan", plan, "the sky", o.d.sky_exr, NULL, NULL};
+    const char *unit_out[] = {"-o", out, NULL, NULL};
+    if ((rc = cli_check_scene_outputs("bake-unit", o.input, o.d.allow_outside, unit_in, unit_out))) {
+        tl_plan_free(&p);
+        free((void *)o.d.expect_inputs);
+        return rc;
+    }
     o.d.message = unit_message;
     o.d.user = &quiet;
     void *part = NULL;
@@ -410,9 +423,21 @@ int lbk_cmd_merge(int argc, char **argv)
             rc = LBK_EXIT_INPUT;
         }
     }
+    char output[PATH_MAX];
+    snprintf(output, sizeof output, "%s", out ? out : p.output);
     if (rc < 0) {
-        char output[PATH_MAX];
-        snprintf(output, sizeof output, "%s", out ? out : p.output);
+        /* the container and the report may replace no part, the plan, the scene or its files */
+        tl_guard g;
+        tl_guard_init(&g, "merge");
+        int bad = tl_guard_input(&g, plan, "the plan") || tl_guard_input(&g, o.d.sky_exr, "the sky") ||
+                  tl_guard_scene(&g, o.input, o.d.allow_outside);
+        for (size_t k = 0; !bad && k < n_files; k++) bad = tl_guard_input(&g, files[k], "the part");
+        const char *outs[] = {"-o", output, "--json-report", o.json_report, NULL, NULL};
+        rc = bad ? LBK_EXIT_INTERNAL : cli_check_outputs("merge", &g, outs);
+        tl_guard_free(&g);
+        if (!rc) rc = -1;
+    }
+    if (rc < 0) {
         o.output = output;
         o.merge = 1;
         o.plan_hash = p.hash;

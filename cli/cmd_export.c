@@ -4,6 +4,7 @@
 
 #include "cli/cli.h"
 #include "cli/options.h"
+#include "tools/common/output_guard.h"
 #include "tools/convert/export.h"
 #include "tools/convert/gltf_export.h"
 
@@ -55,7 +56,25 @@ static void usage(FILE *f)
             "            5 internal error\n");
 }
 
-int lbk_cmd_export(int argc, char **argv)
+/* The outputs may replace neither the container nor the scene or its files, nor a device; the
+ * guard stays active while the export writes its folders' files (output_guard.h). */
+static int check_outputs(tl_guard *guard, const char *in, const tl_export_options *o, const tl_gltf_options *g)
+{
+    if (tl_guard_input(guard, in, "the container") || (g->scene && tl_guard_scene(guard, g->scene, NULL)))
+        return LBK_EXIT_INTERNAL;
+    const char *outs[] = {"--gltf", g->output, NULL, NULL};
+    int rc = cli_check_outputs("export", guard, outs);
+    char err[TL_ERR_LEN];
+    if (!rc && ((o->exr_dir && tl_guard_output_dir(guard, o->exr_dir, NULL, "--exr", err)) ||
+                (o->png_dir && tl_guard_output_dir(guard, o->png_dir, NULL, "--png", err)))) {
+        fprintf(stderr, "lbk export: %s\n", err);
+        rc = LBK_EXIT_USAGE;
+    }
+    if (!rc) tl_guard_activate(guard);
+    return rc;
+}
+
+static int export_main(int argc, char **argv, tl_guard *guard)
 {
     const char *in = NULL;
     tl_export_options o = {NULL, NULL, 0};
@@ -114,6 +133,8 @@ int lbk_cmd_export(int argc, char **argv)
         fprintf(stderr, "lbk export: --gltf and --scene go together (the container holds no geometry)\n");
         return LBK_EXIT_USAGE;
     }
+    int guarded = check_outputs(guard, in, &o, &g);
+    if (guarded) return guarded;
     char err[TL_ERR_LEN];
     tl_bake b;
     tl_open_status st = tl_bake_open_file_capped(in, max_memory, &b, err);
@@ -150,4 +171,14 @@ int lbk_cmd_export(int argc, char **argv)
     }
     tl_bake_close(&b);
     return LBK_EXIT_OK;
+}
+
+int lbk_cmd_export(int argc, char **argv)
+{
+    tl_guard guard;
+    tl_guard_init(&guard, "export");
+    const int code = export_main(argc, argv, &guard);
+    tl_guard_activate(NULL);
+    tl_guard_free(&guard);
+    return code;
 }

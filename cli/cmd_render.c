@@ -7,6 +7,7 @@
 
 #include "cli/cli.h"
 #include "cli/options.h"
+#include "tools/common/output_guard.h"
 #include "tools/render/render.h"
 
 #define MAX_NAMED 64
@@ -92,6 +93,7 @@ static int parse_spheres(const char *s, tl_sphere *sp, size_t *n)
 
 typedef struct args {
     const char *scene, *level, *exr, *png, *seams;
+    tl_guard guard;
     int camera, have_from, have_at, quiet;
     float fov;
     tl_render_options o;
@@ -171,10 +173,23 @@ static int report(const char *err, int status)
          : status == TL_RENDER_INPUT ? LBK_EXIT_INPUT : LBK_EXIT_INTERNAL;
 }
 
+/* No output may replace the container, the scene or a file the scene reads, or a device; the
+ * guard stays active while the command writes (output_guard.h). */
+static int check_outputs(args *a)
+{
+    if (tl_guard_input(&a->guard, a->level, "the container") || tl_guard_scene(&a->guard, a->scene, NULL))
+        return LBK_EXIT_INTERNAL;
+    const char *outs[] = {"-o", a->exr, "--png", a->png, "--seams", a->seams, NULL, NULL};
+    int rc = cli_check_outputs("render", &a->guard, outs);
+    if (!rc) tl_guard_activate(&a->guard);
+    return rc;
+}
+
 static int run(int argc, char **argv, args *a)
 {
     int rc = parse(argc, argv, a);
     if (rc) return rc < 0 ? LBK_EXIT_OK : rc;
+    if ((rc = check_outputs(a))) return rc;
     char err[TL_ERR_LEN];
     if (a->have_from) {
         a->o.camera.yfov = a->fov * 3.14159265f / 180.0f;
@@ -198,7 +213,10 @@ int lbk_cmd_render(int argc, char **argv)
 {
     args *a = calloc(1, sizeof *a);
     if (!a) return LBK_EXIT_INTERNAL;
+    tl_guard_init(&a->guard, "render");
     const int code = run(argc, argv, a);
+    tl_guard_activate(NULL);
+    tl_guard_free(&a->guard);
     for (size_t i = 0; i < a->o.set_count; i++) free((void *)a->sets[i].name);
     for (size_t i = 0; i < a->o.door_count; i++) free((void *)a->doors[i].name);
     free(a);

@@ -12,6 +12,7 @@
 
 #include "cli/cli.h"
 #include "cli/options.h"
+#include "tools/common/output_guard.h"
 #include "tools/inspect/report.h"
 #include "tools/view/view.h"
 
@@ -85,7 +86,7 @@ static int serve(const char *dir, long port, int quiet)
     return rc ? LBK_EXIT_IO : LBK_EXIT_OK;
 }
 
-int lbk_cmd_view(int argc, char **argv)
+static int view_main(int argc, char **argv, tl_guard *guard)
 {
     tl_view_options o = {.container = NULL};
     long port = -1;
@@ -135,6 +136,20 @@ int lbk_cmd_view(int argc, char **argv)
         fprintf(stderr, "lbk view: need LEVEL.lbk and the SCENE it was baked from (see lbk view --help)\n");
         return LBK_EXIT_USAGE;
     }
+    /* the page's files may replace neither the level, the scene (a level.glb in --out), a file the
+     * scene reads, the report nor a device (output_guard.h) */
+    if (tl_guard_input(guard, o.container, "the container") || tl_guard_scene(guard, o.scene, NULL) ||
+        tl_guard_input(guard, o.report_path, "the report"))
+        return LBK_EXIT_INTERNAL;
+    if (o.out_dir) {
+        static const char *const page[] = {"index.html", "data.js", "level.glb", NULL};
+        char why[TL_ERR_LEN];
+        if (tl_guard_output_dir(guard, o.out_dir, page, "--out", why)) {
+            fprintf(stderr, "lbk view: %s\n", why);
+            return LBK_EXIT_USAGE;
+        }
+    }
+    tl_guard_activate(guard);
     char tmp[] = "/tmp/lbk-view-XXXXXX";
     if (!o.out_dir) {
         if (!mkdtemp(tmp)) {
@@ -162,4 +177,14 @@ int lbk_cmd_view(int argc, char **argv)
     }
     if (o.out_dir == tmp) nftw(tmp, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
     return rc;
+}
+
+int lbk_cmd_view(int argc, char **argv)
+{
+    tl_guard guard;
+    tl_guard_init(&guard, "view");
+    const int code = view_main(argc, argv, &guard);
+    tl_guard_activate(NULL);
+    tl_guard_free(&guard);
+    return code;
 }

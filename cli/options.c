@@ -5,6 +5,10 @@
 #include <stdio.h>
 #include <string.h>
 
+#include <sys/stat.h>
+
+#include "cli/cli.h"
+#include "tools/common/output_guard.h"
 #include "tools/inspect/budget.h"
 
 int cli_max_memory_option(const char *cmd, int argc, char **argv, int *i, uint64_t *out)
@@ -31,4 +35,44 @@ int cli_parse_uint(const char *s, unsigned long long lo, unsigned long long hi, 
     if (errno || *end || v < lo || v > hi) return 0;
     *out = v;
     return 1;
+}
+
+/* Two outputs naming one file (by name, or by inode when it exists) would overwrite each other. */
+static int same_output(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    if (!strcmp(a, b)) return 1;
+    return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
+
+int cli_check_outputs(const char *cmd, const struct tl_guard *g, const char *const *outputs)
+{
+    char err[TL_ERR_LEN];
+    for (size_t i = 0; outputs[i]; i += 2) {
+        const char *what = outputs[i], *path = outputs[i + 1];
+        if (!path) continue;
+        if (tl_guard_output(g, path, what, err) != 0) {
+            fprintf(stderr, "lbk %s: %s\n", cmd, err);
+            return LBK_EXIT_USAGE;
+        }
+        for (size_t j = 0; j < i; j += 2)
+            if (outputs[j + 1] && same_output(path, outputs[j + 1])) {
+                fprintf(stderr, "lbk %s: %s and %s name the same file %s\n", cmd, outputs[j], what, path);
+                return LBK_EXIT_USAGE;
+            }
+    }
+    return 0;
+}
+
+int cli_check_scene_outputs(const char *cmd, const char *scene, const char *allow_outside,
+                            const char *const *extra_inputs, const char *const *outputs)
+{
+    tl_guard g;
+    tl_guard_init(&g, cmd);
+    int rc = tl_guard_scene(&g, scene, allow_outside);
+    for (size_t i = 0; !rc && extra_inputs && extra_inputs[i]; i += 2)
+        rc = tl_guard_input(&g, extra_inputs[i + 1], extra_inputs[i]);
+    rc = rc ? LBK_EXIT_INTERNAL : cli_check_outputs(cmd, &g, outputs);
+    tl_guard_free(&g);
+    return rc;
 }

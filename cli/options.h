@@ -16,6 +16,19 @@ int cli_max_memory_option(const char *cmd, int argc, char **argv, int *i, uint64
  * (strtoull alone would turn "-1" into 2^64 - 1, atoi "1.5" into 1). 1 and *out set, or 0. */
 int cli_parse_uint(const char *s, unsigned long long lo, unsigned long long hi, unsigned long long *out);
 
+/* The output policy (tools/common/output_guard.h) at the command line: `outputs` holds pairs
+ * {what, path} ("-o", "a.exr"; a NULL path is skipped), ended by {NULL, NULL}. Refuses an output
+ * that is one of g's inputs, not a regular file, or the same file as another output, printing
+ * "lbk CMD: ..." and returning LBK_EXIT_USAGE; 0 when every output may be written. */
+struct tl_guard;
+int cli_check_outputs(const char *cmd, const struct tl_guard *g, const char *const *outputs);
+
+/* cli_check_outputs for a command that reads a glTF scene: the scene, every file it references
+ * (allow_outside as the bake resolves them) and `extra_inputs` (pairs {role, path}, ended by
+ * {NULL, NULL}; NULL paths skipped) are the inputs. */
+int cli_check_scene_outputs(const char *cmd, const char *scene, const char *allow_outside,
+                            const char *const *extra_inputs, const char *const *outputs);
+
 #define CLI_MAX_MEMORY_HELP                                                                          \
     "  --max-memory SIZE  refuse a file whose sections decode to more than SIZE (bytes, or kB, KiB, MB,\n" \
     "                     MiB, GB, GiB); default min(4 GiB, 1024 x file size + 64 MiB)\n"

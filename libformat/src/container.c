@@ -461,9 +461,17 @@ static int sync_parent_dir(const char *path, const lbk_allocator *alloc)
     return rc;
 }
 
+/* Only a regular file, a symlink (the rename replaces the link, never its target) or nothing may
+ * stand at the path: renaming over /dev/null as root would replace the device with a file. */
+static int replaceable(const char *path)
+{
+    struct stat st;
+    return lstat(path, &st) != 0 || S_ISREG(st.st_mode) || S_ISLNK(st.st_mode);
+}
+
 lbk_result lbk_writer_to_file(lbk_writer *w, const char *path)
 {
-    if (!w || !path || !*path) return LBK_ERR_INVALID_ARGUMENT;
+    if (!w || !path || !*path || !replaceable(path)) return LBK_ERR_INVALID_ARGUMENT;
     void *bytes;
     size_t size;
     lbk_result r = lbk_writer_to_memory(w, &bytes, &size);
@@ -487,7 +495,10 @@ lbk_result lbk_writer_to_file(lbk_writer *w, const char *path)
             ok = 0;
             saved = errno;
         }
-        if (ok && rename(tmp, path) == 0) {
+        if (ok && !replaceable(path)) {
+            unlink(tmp);
+            r = LBK_ERR_INVALID_ARGUMENT;
+        } else if (ok && rename(tmp, path) == 0) {
             r = sync_parent_dir(path, &w->alloc) == 0 ? LBK_OK : LBK_ERR_IO;
         } else {
             if (ok) saved = errno;

@@ -1,5 +1,6 @@
 /* Whole-file reading and atomic writing for the tools. */
 #include "tools/common/file_util.h"
+#include "tools/common/output_guard.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -60,6 +61,7 @@ int tl_read_file(const char *path, void **data, size_t *size, char err[TL_ERR_LE
 
 int tl_write_file_atomic(const char *path, const void *data, size_t size, char err[TL_ERR_LEN])
 {
+    if (tl_guard_replaceable(path, err) != 0 || tl_guard_check_active(path, err) != 0) return -1;
     tl_remove_stale_temps(path, 0, NULL, NULL); /* what a killed earlier write of it left */
     size_t plen = strlen(path);
     char *tmp = malloc(plen + 32);
@@ -89,6 +91,11 @@ int tl_write_file_atomic(const char *path, const void *data, size_t size, char e
     if (ok && fsync(fd) != 0) ok = 0;
     int saved = errno;
     if (close(fd) != 0 && ok) ok = 0, saved = errno;
+    if (ok && tl_guard_replaceable(path, err) != 0) { /* it became a device while we wrote */
+        unlink(tmp);
+        free(tmp);
+        return -1;
+    }
     if (ok && rename(tmp, path) != 0) ok = 0, saved = errno;
     if (!ok) {
         snprintf(err, TL_ERR_LEN, "cannot write %s: %s", path, strerror(saved));

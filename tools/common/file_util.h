@@ -9,7 +9,8 @@
 
 /* Reads a whole regular file into a malloc'ed buffer (at least 1 byte allocated). */
 int tl_read_file(const char *path, void **data, size_t *size, char err[TL_ERR_LEN]);
-/* Writes through a temp file beside path, fsync, rename: readers never see a partial file. */
+/* Writes through a temp file beside path, fsync, rename: readers never see a partial file. A
+ * device, FIFO, socket or directory at path is refused, never replaced (output_guard.h). */
 int tl_write_file_atomic(const char *path, const void *data, size_t size, char err[TL_ERR_LEN]);
 /* Removes the temporary files an interrupted write to `path` left beside it: `PATH.tmp-XXXXXX`
  * (liblbk's lbk_writer_to_file, six letters or digits) last modified before `before`, and

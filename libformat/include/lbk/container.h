@@ -128,7 +128,9 @@ LBK_API lbk_result lbk_writer_section_add(lbk_writer *writer, uint32_t type, con
                                           const lbk_section_options *options);
 /* Serialises into one buffer allocated with the writer's allocator; free it with lbk_free. */
 LBK_API lbk_result lbk_writer_to_memory(lbk_writer *writer, void **out, size_t *size);
-/* Writes atomically: a temp file beside path, fsync, rename, fsync of the directory. */
+/* Writes atomically: a temp file beside path, fsync, rename, fsync of the directory. Only a
+ * regular file, a symlink (the rename replaces the link, not its target) or nothing is ever
+ * replaced: a device, FIFO, socket or directory at path gives LBK_ERR_INVALID_ARGUMENT. */
 LBK_API lbk_result lbk_writer_to_file(lbk_writer *writer, const char *path);
 
 #ifdef __cplusplus
