@@ -312,17 +312,22 @@ private:
     {
         return o_.max_triangles > (UINT32_MAX - 1) / 3 ? (size_t)UINT32_MAX - 1 : o_.max_triangles * 3;
     }
+    // gltf_import.cc: loading, the node graph, the inputs record
     void load();
     void check_extensions();
-    void decode_images();
-    int decode_image(int gi);
-    void build_materials();
-    int texture_image(const tinygltf::TextureInfo &ti, const char *slot, int mi, const std::string &mname);
     void traverse();
     void visit(int n, const Mat4 &parent, const std::string &light_set, const std::string &door, int depth);
     std::string node_label(int n) const;
     std::string mesh_label(int mi, int pi) const;
     Mat4 local_matrix(int n) const;
+    void record_inputs();
+    // gltf_materials.cc
+    void decode_images();
+    int decode_image(int gi);
+    void build_materials();
+    int texture_image(const tinygltf::TextureInfo &ti, const char *slot, int mi, const std::string &mname);
+    std::vector<float> downsample(const float *rgba, int w, int h, int max_side, int *ow, int *oh);
+    // gltf_geometry.cc
     void prepare_mesh(int mi);
     void prepare_prim(int mi, int pi, Prim &p, bool *is_triangles);
     void read_accessor(int acc, int want_comps, bool index, std::vector<float> *f, std::vector<uint32_t> *u,
@@ -330,13 +335,12 @@ private:
     void decode_draco(int mi, int pi, const DracoInfo &di, Prim &p, std::vector<uint32_t> &idx, size_t *nverts);
     void emit_geometry();
     void choose_origin(const std::vector<Instance> &kept);
+    // gltf_extras.cc
     void emit_lights();
     void read_sky();
     void read_combinations();
     void read_playable(int n, const Mat4 &world, const tinygltf::Value &v);
     void emit_playable();
-    void record_inputs();
-    std::vector<float> downsample(const float *rgba, int w, int h, int max_side, int *ow, int *oh);
 };
 
 }  // namespace bk_gltf
