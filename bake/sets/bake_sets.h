@@ -28,7 +28,7 @@ enum bk_door_method {
 typedef struct bk_set_bakes {
     uint32_t set_count;   /* DLS sets written (light sets, door open/closed sets, combinations) */
     uint32_t door_count;
-    void *impl;           /* owned by bake_sets.c */
+    void *impl;           /* owned by bake/sets/ (sets_internal.h) */
 } bk_set_bakes;
 
 /* Everything the set bakes share with the base bake. */
