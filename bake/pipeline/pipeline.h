@@ -1,6 +1,8 @@
 /* The bake pipeline's shared state (internal to bake/pipeline/): one bk_pipeline per lbk_bake_*
- * call, filled phase by phase. bake.c runs the phases, sections.c encodes the container,
- * report.c fills the report and writes its JSON, output.c owns what the caller gets back. */
+ * call, filled phase by phase. bake.c runs the phases (phase_import.c, phase_layout.c,
+ * phase_light.c), bake_dist.c makes the distributed bakes' calls, sections.c encodes the
+ * container, report.c fills the report and writes its JSON, output.c owns what the caller gets
+ * back. */
 #ifndef BK_PIPELINE_H
 #define BK_PIPELINE_H
 
@@ -127,6 +129,30 @@ void bk_pipeline_to_world(const bk_pipeline *b, const float local[3], float worl
 uint32_t bk_pipeline_status(const bk_pipeline *b);
 /* What the set bakes share with the base bake. */
 void bk_pipeline_set_inputs(const bk_pipeline *b, bk_set_inputs *in);
+/* Starts a phase: closes the previous one's time, then a checkpoint at 0. */
+lbk_result bk_pipeline_phase(bk_pipeline *b, lbk_bake_phase ph);
+/* A checkpoint as a result: LBK_ERR_CANCELLED when the caller cancelled. */
+lbk_result bk_pipeline_checkpoint(bk_pipeline *b, double fraction);
+
+/* One bake from a file or a scene description (bake.c): a whole one into *out, a unit's part
+ * (dist a recorder: *part), a merge (dist a player), or only the inputs it reads (inputs). */
+lbk_result bk_pipeline_bake(const char *path, const lbk_bake_scene *desc, const lbk_bake_desc *options,
+                            lbk_bake_output **out, struct bk_dist *dist, void **part, size_t *part_size,
+                            lbk_bake_input **inputs, size_t *input_count, uint32_t *runs);
+/* The identity of the options that shape a bake's bytes; budgets 0 leaves out the budgets
+ * (target error, time limit, samples) (bake_dist.c). */
+uint64_t bk_pipeline_options_hash(const lbk_bake_desc *options, int budgets);
+/* A distributed run that failed: the parts' fault as an error, or LBK_OK (phase_light.c). */
+lbk_result bk_pipeline_replay_failure(bk_pipeline *b, lbk_result r);
+
+/* The phases, in order: import (phase_import.c), layout (phase_layout.c), the base transport,
+ * the sets' runs, denoising and the sets' entries (phase_light.c). */
+lbk_result bk_phase_import(bk_pipeline *b, const char *path, const lbk_bake_scene *desc);
+lbk_result bk_phase_layout(bk_pipeline *b);
+lbk_result bk_phase_transport(bk_pipeline *b);
+lbk_result bk_phase_sets(bk_pipeline *b);
+lbk_result bk_phase_denoise(bk_pipeline *b);
+lbk_result bk_phase_emit_sets(bk_pipeline *b);
 
 /* The write phase: every section into b->writer (sections.c). */
 lbk_result bk_pipeline_encode(bk_pipeline *b);

@@ -5,7 +5,7 @@
  *
  * The .lbk holds lighting per texel but not where a texel is in the world. This program
  * rebuilds the baker's layout (import → classify → atlas → texels → push-out, the same calls
- * and options as bake/pipeline/bake.c do_layout) to get each texel's world sample point and
+ * and options as bake/pipeline/phase_layout.c) to get each texel's world sample point and
  * normal, checks that the layout matches the file (pages, page sizes, every lightmapped
  * object's rectangle, and the LMUV section rebuilt from it equal to the file's byte for byte:
  * the page coordinate of every lightmapped vertex), and reads the lighting from the file with liblbk: the AHD texel decoded
@@ -50,7 +50,7 @@
  * The lighting comes through the public API only (liblbk's readers). The sample points do not:
  * where the baker put a texel's sample (the nearest point for edge and ring texels, the push-out
  * from behind walls) is in no section, so the layout is rebuilt with the current pipeline's
- * internals (bake/pipeline/bake.c do_layout: the same calls, options and preset table).
+ * internals (bake/pipeline/phase_layout.c bk_phase_layout: the same calls, options and preset table).
  * It links the baker's internals (like bench_transport.c) but writes nothing the baker reads;
  * the layout it rebuilds must come from the same source tree as the lbk that baked the file
  * (the checks above fail loudly otherwise). */

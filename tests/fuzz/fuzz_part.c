@@ -1,5 +1,5 @@
 /* libFuzzer harness for part files (spec/part.md) and the merge that replays them
- * (bake/dist/dist.c, bake/pipeline/bake.c). A part comes from another machine, so the merge must
+ * (bake/dist/dist.c, bake/pipeline/bake_dist.c). A part comes from another machine, so the merge must
  * treat it as hostile: every input is checked as it is, then once more with its checksums and
  * identity fields repaired (the plan and options hashes, unit 0 of 1, the receiver range its count
  * gives) so that mutations reach the run records and the values the merge replays into the
