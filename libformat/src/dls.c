@@ -386,11 +386,129 @@ static void check_prefix(dls_chk *c, uint64_t ci, const uint8_t *cr, uint32_t fo
     }
 }
 
-/* Form-specific (k, set count range, subgroup/prefix usage) of a cluster record. */
+/* The set list, overlaps field, runs and entries of cluster ci, whose first indices are the
+ * packed layout's (check_clusters); its runs go to runs[*nruns]. */
+static void check_cluster_contents(dls_chk *c, uint64_t ci, run_key *runs, uint64_t *nruns)
+{
+    const uint64_t nsets = c->L.count[DLS_A_SETS];
+    const uint8_t *cr = arr(c, DLS_A_CLUSTERS, ci, DLS_CLUSTER_SIZE);
+    uint64_t co = arr_off(c, DLS_A_CLUSTERS, ci, DLS_CLUSTER_SIZE);
+    uint32_t form = lbk_rd32(cr + DLS_C_FORM), space = lbk_rd32(cr + DLS_C_SPACE);
+    uint32_t k = lbk_rd32(cr + DLS_C_OVERLAPS);
+    uint32_t set_first = lbk_rd32(cr + DLS_C_SET_FIRST), set_count = lbk_rd32(cr + DLS_C_SET_COUNT);
+    uint32_t run_first = lbk_rd32(cr + DLS_C_RUN_FIRST), run_count = lbk_rd32(cr + DLS_C_RUN_COUNT);
+    uint32_t T = lbk_rd32(cr + DLS_C_TARGET_COUNT), E = lbk_rd32(cr + DLS_C_ENTRY_COUNT);
+
+    /* Set list. */
+    static const uint32_t min_sets[LBK_DLS_FORM_COUNT_] = {1, 1, 5, 9, 17};
+    uint32_t max_sets = form == LBK_DLS_FORM_DEDICATED ? LBK_DLS_MAX_DEDICATED_SETS : LBK_DLS_MAX_CLUSTER_SETS;
+    bool sets_ok = set_count >= min_sets[form] && set_count <= max_sets;
+    for (uint32_t j = 0; sets_ok && j < set_count; j++) {
+        uint32_t s = lbk_rd32(arr(c, DLS_A_CLUSTER_SETS, (uint64_t)set_first + j, 4));
+        if (s >= nsets || (j && s <= lbk_rd32(arr(c, DLS_A_CLUSTER_SETS, (uint64_t)set_first + j - 1, 4)))) sets_ok = false;
+    }
+    if (!sets_ok) {
+        rep(c, 824, co + DLS_C_SET_COUNT, "cluster %llu (form %u) lists %u sets: count outside %u..%u, a set out of range or not ascending",
+            (unsigned long long)ci, form, set_count, min_sets[form], max_sets);
+        return;
+    }
+    bool k_ok = form == LBK_DLS_FORM_DEDICATED ? k == set_count
+                : form == LBK_DLS_FORM_PACKED  ? (k >= 1 && k <= LBK_DLS_MAX_PACKED_SETS && k <= set_count)
+                                               : k == 0;
+    if (!k_ok) {
+        rep(c, 825, co + DLS_C_OVERLAPS, "cluster %llu (form %u, %u sets) has overlaps field %u", (unsigned long long)ci,
+            form, set_count, k);
+        return;
+    }
+
+    /* Runs and target count. */
+    if (run_count == 0 || T == 0) {
+        rep(c, 827, co + DLS_C_TARGET_COUNT, "cluster %llu has %u runs and %u targets", (unsigned long long)ci, run_count, T);
+        return;
+    }
+    uint64_t tsum = 0;
+    if (form == LBK_DLS_FORM_PACKED) {
+        for (uint32_t i = 0; i < run_count; i++) tsum += lbk_rd32(arr(c, DLS_A_RUNS, (uint64_t)run_first + i, DLS_RUN_SIZE) + 4);
+    } else {
+        tsum = check_runs(c, ci, space, run_first, run_count);
+        if (tsum == UINT64_MAX) return;
+    }
+    if (tsum != T) {
+        rep(c, 827, co + DLS_C_TARGET_COUNT, "cluster %llu target count %u differs from its runs' %llu",
+            (unsigned long long)ci, T, (unsigned long long)tsum);
+        return;
+    }
+    for (uint32_t i = 0; i < run_count; i++) {
+        const uint8_t *r = arr(c, DLS_A_RUNS, (uint64_t)run_first + i, DLS_RUN_SIZE);
+        runs[(*nruns)++] = (run_key){space, lbk_rd32(r), lbk_rd32(r + 4), (uint32_t)ci};
+    }
+
+    /* Entries. */
+    bool used[LBK_DLS_MAX_CLUSTER_SETS] = {0};
+    if (form == LBK_DLS_FORM_DEDICATED || form == LBK_DLS_FORM_PACKED) {
+        if ((uint64_t)T * k != E) {
+            rep(c, 828, co + DLS_C_ENTRY_COUNT, "cluster %llu has %u entries, %u targets × %u sets need %llu",
+                (unsigned long long)ci, E, T, k, (unsigned long long)T * k);
+            return;
+        }
+        if (form == LBK_DLS_FORM_PACKED) {
+            uint32_t before = c->errors;
+            check_subgroups(c, ci, cr, k, set_count, used);
+            if (c->errors != before) return;
+        }
+    } else {
+        uint32_t before = c->errors;
+        check_prefix(c, ci, cr, form, set_count, used);
+        if (c->errors != before) return;
+    }
+    if (form != LBK_DLS_FORM_DEDICATED)
+        for (uint32_t j = 0; j < set_count; j++)
+            if (!used[j]) {
+                rep(c, 832, co + DLS_C_SET_FIRST, "cluster %llu lists set %u but no target uses it", (unsigned long long)ci,
+                    lbk_rd32(arr(c, DLS_A_CLUSTER_SETS, (uint64_t)set_first + j, 4)));
+                break;
+            }
+}
+
+/* The header's array counts against what the clusters use (t). */
+static void check_cluster_totals(dls_chk *c, const dls_totals *t)
+{
+    const struct {
+        uint64_t have, want;
+        const char *what;
+    } tot[] = {{t->sets, c->L.count[DLS_A_CLUSTER_SETS], "cluster sets"},
+               {t->runs, c->L.count[DLS_A_RUNS], "runs"},
+               {t->subgroups, c->L.count[DLS_A_SUBGROUPS], "sub-groups"},
+               {t->words, c->L.count[DLS_A_PREFIX_WORDS], "prefix words"},
+               {t->base16, c->L.count[DLS_A_BASE16], "u16 bases"},
+               {t->base32, c->L.count[DLS_A_BASE32], "u32 bases"},
+               {t->slots, c->L.count[DLS_A_SLOTS], "slots"},
+               {t->entries[0], c->L.count[DLS_A_TEXEL_ENTRIES], "texel entries"},
+               {t->entries[1], c->L.count[DLS_A_PROBE_ENTRIES], "probe entries"}};
+    for (size_t i = 0; i < sizeof tot / sizeof tot[0]; i++)
+        if (tot[i].have != tot[i].want)
+            rep(c, 805, DLS_H_CLUSTER_SET_COUNT, "header declares %llu %s, the clusters use %llu",
+                (unsigned long long)tot[i].want, tot[i].what, (unsigned long long)tot[i].have);
+}
+
+/* Each target in at most one cluster: runs sorted, neighbours of a space must not overlap. */
+static void check_run_overlaps(dls_chk *c, run_key *runs, uint64_t nruns)
+{
+    qsort(runs, nruns, sizeof *runs, cmp_run);
+    for (uint64_t i = 1; i < nruns && !stopped(c); i++) {
+        const run_key *a = &runs[i - 1], *b = &runs[i];
+        if (a->space == b->space && (uint64_t)a->start + a->length > b->start)
+            rep(c, 829, arr_off(c, DLS_A_CLUSTERS, b->cluster, DLS_CLUSTER_SIZE),
+                "%s target %u is in cluster %u and cluster %u", space_name(a->space), b->start, a->cluster, b->cluster);
+    }
+}
+
+/* Every cluster record: form, space and order, first indices against the packed layout, ranges
+ * inside the arrays; then the form-specific checks (check_cluster_contents: k, set count range,
+ * subgroup/prefix usage), the header's totals and each target in at most one cluster. */
 static void check_clusters(dls_chk *c)
 {
     const uint64_t ncl = c->L.count[DLS_A_CLUSTERS];
-    const uint64_t nsets = c->L.count[DLS_A_SETS];
     dls_totals t = {0};
     uint32_t prev_key = 0;
     bool totals_ok = true;
@@ -404,7 +522,6 @@ static void check_clusters(dls_chk *c)
         const uint8_t *cr = arr(c, DLS_A_CLUSTERS, ci, DLS_CLUSTER_SIZE);
         uint64_t co = arr_off(c, DLS_A_CLUSTERS, ci, DLS_CLUSTER_SIZE);
         uint32_t form = lbk_rd32(cr + DLS_C_FORM), space = lbk_rd32(cr + DLS_C_SPACE);
-        uint32_t k = lbk_rd32(cr + DLS_C_OVERLAPS);
         uint32_t set_first = lbk_rd32(cr + DLS_C_SET_FIRST), set_count = lbk_rd32(cr + DLS_C_SET_COUNT);
         uint32_t run_first = lbk_rd32(cr + DLS_C_RUN_FIRST), run_count = lbk_rd32(cr + DLS_C_RUN_COUNT);
         uint32_t T = lbk_rd32(cr + DLS_C_TARGET_COUNT), E = lbk_rd32(cr + DLS_C_ENTRY_COUNT);
@@ -464,104 +581,10 @@ static void check_clusters(dls_chk *c)
             t.slots += E;
         }
         t.entries[stride] += E;
-        if (!canon) continue;
-
-        /* Set list. */
-        static const uint32_t min_sets[LBK_DLS_FORM_COUNT_] = {1, 1, 5, 9, 17};
-        uint32_t max_sets = form == LBK_DLS_FORM_DEDICATED ? LBK_DLS_MAX_DEDICATED_SETS : LBK_DLS_MAX_CLUSTER_SETS;
-        bool sets_ok = set_count >= min_sets[form] && set_count <= max_sets;
-        for (uint32_t j = 0; sets_ok && j < set_count; j++) {
-            uint32_t s = lbk_rd32(arr(c, DLS_A_CLUSTER_SETS, (uint64_t)set_first + j, 4));
-            if (s >= nsets || (j && s <= lbk_rd32(arr(c, DLS_A_CLUSTER_SETS, (uint64_t)set_first + j - 1, 4)))) sets_ok = false;
-        }
-        if (!sets_ok) {
-            rep(c, 824, co + DLS_C_SET_COUNT, "cluster %llu (form %u) lists %u sets: count outside %u..%u, a set out of range or not ascending",
-                (unsigned long long)ci, form, set_count, min_sets[form], max_sets);
-            continue;
-        }
-        bool k_ok = form == LBK_DLS_FORM_DEDICATED ? k == set_count
-                    : form == LBK_DLS_FORM_PACKED  ? (k >= 1 && k <= LBK_DLS_MAX_PACKED_SETS && k <= set_count)
-                                                   : k == 0;
-        if (!k_ok) {
-            rep(c, 825, co + DLS_C_OVERLAPS, "cluster %llu (form %u, %u sets) has overlaps field %u", (unsigned long long)ci,
-                form, set_count, k);
-            continue;
-        }
-
-        /* Runs and target count. */
-        if (run_count == 0 || T == 0) {
-            rep(c, 827, co + DLS_C_TARGET_COUNT, "cluster %llu has %u runs and %u targets", (unsigned long long)ci, run_count, T);
-            continue;
-        }
-        uint64_t tsum = 0;
-        if (form == LBK_DLS_FORM_PACKED) {
-            for (uint32_t i = 0; i < run_count; i++) tsum += lbk_rd32(arr(c, DLS_A_RUNS, (uint64_t)run_first + i, DLS_RUN_SIZE) + 4);
-        } else {
-            tsum = check_runs(c, ci, space, run_first, run_count);
-            if (tsum == UINT64_MAX) continue;
-        }
-        if (tsum != T) {
-            rep(c, 827, co + DLS_C_TARGET_COUNT, "cluster %llu target count %u differs from its runs' %llu",
-                (unsigned long long)ci, T, (unsigned long long)tsum);
-            continue;
-        }
-        for (uint32_t i = 0; i < run_count; i++) {
-            const uint8_t *r = arr(c, DLS_A_RUNS, (uint64_t)run_first + i, DLS_RUN_SIZE);
-            runs[nruns++] = (run_key){space, lbk_rd32(r), lbk_rd32(r + 4), (uint32_t)ci};
-        }
-
-        /* Entries. */
-        bool used[LBK_DLS_MAX_CLUSTER_SETS] = {0};
-        if (form == LBK_DLS_FORM_DEDICATED || form == LBK_DLS_FORM_PACKED) {
-            if ((uint64_t)T * k != E) {
-                rep(c, 828, co + DLS_C_ENTRY_COUNT, "cluster %llu has %u entries, %u targets × %u sets need %llu",
-                    (unsigned long long)ci, E, T, k, (unsigned long long)T * k);
-                continue;
-            }
-            if (form == LBK_DLS_FORM_PACKED) {
-                uint32_t before = c->errors;
-                check_subgroups(c, ci, cr, k, set_count, used);
-                if (c->errors != before) continue;
-            }
-        } else {
-            uint32_t before = c->errors;
-            check_prefix(c, ci, cr, form, set_count, used);
-            if (c->errors != before) continue;
-        }
-        if (form != LBK_DLS_FORM_DEDICATED)
-            for (uint32_t j = 0; j < set_count; j++)
-                if (!used[j]) {
-                    rep(c, 832, co + DLS_C_SET_FIRST, "cluster %llu lists set %u but no target uses it", (unsigned long long)ci,
-                        lbk_rd32(arr(c, DLS_A_CLUSTER_SETS, (uint64_t)set_first + j, 4)));
-                    break;
-                }
+        if (canon) check_cluster_contents(c, ci, runs, &nruns);
     }
-    if (totals_ok && !stopped(c)) {
-        const struct {
-            uint64_t have, want;
-            const char *what;
-        } tot[] = {{t.sets, c->L.count[DLS_A_CLUSTER_SETS], "cluster sets"},
-                   {t.runs, c->L.count[DLS_A_RUNS], "runs"},
-                   {t.subgroups, c->L.count[DLS_A_SUBGROUPS], "sub-groups"},
-                   {t.words, c->L.count[DLS_A_PREFIX_WORDS], "prefix words"},
-                   {t.base16, c->L.count[DLS_A_BASE16], "u16 bases"},
-                   {t.base32, c->L.count[DLS_A_BASE32], "u32 bases"},
-                   {t.slots, c->L.count[DLS_A_SLOTS], "slots"},
-                   {t.entries[0], c->L.count[DLS_A_TEXEL_ENTRIES], "texel entries"},
-                   {t.entries[1], c->L.count[DLS_A_PROBE_ENTRIES], "probe entries"}};
-        for (size_t i = 0; i < sizeof tot / sizeof tot[0]; i++)
-            if (tot[i].have != tot[i].want)
-                rep(c, 805, DLS_H_CLUSTER_SET_COUNT, "header declares %llu %s, the clusters use %llu",
-                    (unsigned long long)tot[i].want, tot[i].what, (unsigned long long)tot[i].have);
-    }
-    /* Each target in at most one cluster. */
-    qsort(runs, nruns, sizeof *runs, cmp_run);
-    for (uint64_t i = 1; i < nruns && !stopped(c); i++) {
-        const run_key *a = &runs[i - 1], *b = &runs[i];
-        if (a->space == b->space && (uint64_t)a->start + a->length > b->start)
-            rep(c, 829, arr_off(c, DLS_A_CLUSTERS, b->cluster, DLS_CLUSTER_SIZE),
-                "%s target %u is in cluster %u and cluster %u", space_name(a->space), b->start, a->cluster, b->cluster);
-    }
+    if (totals_ok && !stopped(c)) check_cluster_totals(c, &t);
+    check_run_overlaps(c, runs, nruns);
     lbk_dealloc(c->alloc, runs);
 }
 

@@ -702,6 +702,124 @@ static void put_array(uint8_t *out, const dls_layout *L, int a, const vec *v)
     if (v->len) memcpy(out + L->offset[a], v->p, v->len);
 }
 
+/* The set table's arrays: set records, light references, combination members, names. */
+typedef struct set_table {
+    vec sets, lrefs, members, strings;
+} set_table;
+
+/* Every target space's clusters (build_space) from the sets' entries of that space. */
+static lbk_result build_spaces(builder *b)
+{
+    const lbk_dls_build_desc *desc = b->desc;
+    const lbk_allocator *a = b->a;
+    lbk_result r = LBK_OK;
+    for (uint32_t sp = 0; sp < LBK_DLS_SPACE_COUNT_ && r == LBK_OK; sp++) {
+        b->space = sp;
+        uint64_t n = 0;
+        for (uint32_t s = 0; s < desc->set_count; s++) n += desc->sets[s].entries[sp].count;
+        if (n == 0) continue;
+        if (n > SIZE_MAX / sizeof(rec)) { r = LBK_ERR_LIMIT; break; }
+        b->recs = lbk_alloc(a, n * sizeof *b->recs);
+        if (!b->recs) { r = LBK_ERR_OUT_OF_MEMORY; break; }
+        uint32_t psize = dls_payload_size(sp);
+        b->nrecs = 0;
+        for (uint32_t s = 0; s < desc->set_count; s++) {
+            const lbk_dls_sparse *e = &desc->sets[s].entries[sp];
+            for (uint64_t q = 0; q < e->count; q++)
+                b->recs[b->nrecs++] = (rec){e->targets[q], s, (const uint8_t *)e->payloads + q * psize};
+        }
+        r = build_space(b);
+        lbk_dealloc(a, b->recs);
+        lbk_dealloc(a, b->groups);
+        lbk_dealloc(a, b->combos);
+        lbk_dealloc(a, b->combo_groups);
+        b->recs = NULL; b->groups = NULL; b->combos = NULL; b->combo_groups = NULL;
+    }
+    return r;
+}
+
+/* Set table and strings. */
+static lbk_result build_set_table(const lbk_dls_build_desc *desc, const lbk_allocator *a, set_table *t)
+{
+    for (uint32_t s = 0; s < desc->set_count; s++) {
+        const lbk_dls_set_desc *sd = &desc->sets[s];
+        uint8_t rec_[DLS_SET_SIZE] = {0};
+        size_t nl = strlen(sd->name);
+        lbk_wr32(rec_ + DLS_S_NAME_OFF, (uint32_t)t->strings.len);
+        lbk_wr32(rec_ + DLS_S_NAME_LEN, (uint32_t)nl);
+        vec_bytes(&t->strings, sd->name, nl);
+        lbk_wr32(rec_ + DLS_S_KIND, sd->kind);
+        lbk_wr32(rec_ + DLS_S_LIGHT_FIRST, (uint32_t)(t->lrefs.len / DLS_LIGHT_REF_SIZE));
+        lbk_wr32(rec_ + DLS_S_LIGHT_COUNT, sd->light_count);
+        lbk_wr32(rec_ + DLS_S_MEMBER_FIRST, (uint32_t)(t->members.len / 4));
+        lbk_wr32(rec_ + DLS_S_MEMBER_COUNT, sd->kind == LBK_DLS_KIND_COMBINATION ? sd->member_count : 0);
+        vec_bytes(&t->sets, rec_, sizeof rec_);
+        for (uint32_t l = 0; l < sd->light_count; l++) {
+            size_t ll = strlen(sd->light_names[l]);
+            vec_u32(&t->lrefs, (uint32_t)t->strings.len);
+            vec_u32(&t->lrefs, (uint32_t)ll);
+            vec_bytes(&t->strings, sd->light_names[l], ll);
+        }
+        if (sd->kind == LBK_DLS_KIND_COMBINATION) {
+            uint32_t sorted[LBK_DLS_MAX_OVERLAPS];
+            uint32_t *m = sd->member_count <= LBK_DLS_MAX_OVERLAPS ? sorted : lbk_alloc(a, sd->member_count * sizeof *m);
+            if (!m) return LBK_ERR_OUT_OF_MEMORY;
+            memcpy(m, sd->members, sd->member_count * sizeof *m);
+            qsort(m, sd->member_count, sizeof *m, cmp_u32);
+            for (uint32_t q = 0; q < sd->member_count; q++) vec_u32(&t->members, m[q]);
+            if (m != sorted) lbk_dealloc(a, m);
+        }
+    }
+    return LBK_OK;
+}
+
+/* The section's bytes: the layout of every array, the header, then the arrays in place. */
+static lbk_result assemble(const builder *b, const set_table *t, uint8_t **bytes, dls_layout *L)
+{
+    const lbk_dls_build_desc *desc = b->desc;
+    L->count[DLS_A_SETS] = desc->set_count;
+    L->count[DLS_A_LIGHT_REFS] = t->lrefs.len / DLS_LIGHT_REF_SIZE;
+    L->count[DLS_A_MEMBERS] = t->members.len / 4;
+    L->count[DLS_A_CLUSTERS] = b->clusters.len / DLS_CLUSTER_SIZE;
+    L->count[DLS_A_CLUSTER_SETS] = b->tot_sets;
+    L->count[DLS_A_RUNS] = b->tot_runs;
+    L->count[DLS_A_SUBGROUPS] = b->tot_subgroups;
+    L->count[DLS_A_PREFIX_WORDS] = b->tot_words;
+    L->count[DLS_A_BASE16] = b->tot_base16;
+    L->count[DLS_A_BASE32] = b->tot_base32;
+    L->count[DLS_A_SLOTS] = b->tot_slots;
+    L->count[DLS_A_TEXEL_ENTRIES] = b->tot_entries[0];
+    L->count[DLS_A_PROBE_ENTRIES] = b->tot_entries[1];
+    L->count[DLS_A_STRINGS] = t->strings.len;
+    if (!dls_layout_compute(L) || L->size > SIZE_MAX) return LBK_ERR_LIMIT;
+    uint8_t *out = *bytes = lbk_calloc(b->a, 1, (size_t)L->size);
+    if (!out) return LBK_ERR_OUT_OF_MEMORY;
+    static const int hdr_u32[] = {DLS_H_SET_COUNT, DLS_H_LIGHT_REF_COUNT, DLS_H_MEMBER_COUNT, DLS_H_CLUSTER_COUNT,
+                                  DLS_H_CLUSTER_SET_COUNT, DLS_H_RUN_COUNT, DLS_H_SUBGROUP_COUNT,
+                                  DLS_H_PREFIX_WORD_COUNT, DLS_H_BASE16_COUNT, DLS_H_BASE32_COUNT};
+    for (int i = 0; i < 10; i++) lbk_wr32(out + hdr_u32[i], (uint32_t)L->count[i]);
+    lbk_wr64(out + DLS_H_SLOT_COUNT, L->count[DLS_A_SLOTS]);
+    lbk_wr64(out + DLS_H_TEXEL_ENTRY_COUNT, L->count[DLS_A_TEXEL_ENTRIES]);
+    lbk_wr64(out + DLS_H_PROBE_ENTRY_COUNT, L->count[DLS_A_PROBE_ENTRIES]);
+    lbk_wr64(out + DLS_H_STRING_BYTES, L->count[DLS_A_STRINGS]);
+    for (int s = 0; s < LBK_DLS_SPACE_COUNT_; s++) lbk_wr64(out + DLS_H_TARGET_COUNT + 8 * s, desc->target_count[s]);
+    put_array(out, L, DLS_A_SETS, &t->sets);
+    put_array(out, L, DLS_A_LIGHT_REFS, &t->lrefs);
+    put_array(out, L, DLS_A_MEMBERS, &t->members);
+    put_array(out, L, DLS_A_CLUSTERS, &b->clusters);
+    put_array(out, L, DLS_A_CLUSTER_SETS, &b->cluster_sets);
+    put_array(out, L, DLS_A_RUNS, &b->runs);
+    put_array(out, L, DLS_A_SUBGROUPS, &b->subgroups);
+    put_array(out, L, DLS_A_PREFIX_WORDS, &b->words);
+    put_array(out, L, DLS_A_BASE16, &b->base16);
+    put_array(out, L, DLS_A_BASE32, &b->base32);
+    put_array(out, L, DLS_A_SLOTS, &b->slots);
+    put_array(out, L, DLS_A_TEXEL_ENTRIES, &b->texels);
+    put_array(out, L, DLS_A_PROBE_ENTRIES, &b->probes);
+    put_array(out, L, DLS_A_STRINGS, &t->strings);
+    return LBK_OK;
+}
+
 lbk_result lbk_dls_build(const lbk_dls_build_desc *caller_desc, const lbk_dls_build_options *caller_options,
                          void **out, size_t *out_size, lbk_dls_stats *stats)
 {
@@ -727,65 +845,14 @@ lbk_result lbk_dls_build(const lbk_dls_build_desc *caller_desc, const lbk_dls_bu
     b.packed_cap = tuning.packed_max_targets ? tuning.packed_max_targets : 4096;
     vec *vs[] = {&b.clusters, &b.cluster_sets, &b.runs, &b.subgroups, &b.words, &b.base16, &b.base32, &b.slots, &b.texels, &b.probes};
     for (size_t i = 0; i < sizeof vs / sizeof vs[0]; i++) vs[i]->a = a;
-    vec sets = {.a = a}, lrefs = {.a = a}, members = {.a = a}, strings = {.a = a};
+    set_table t = {.sets = {.a = a}, .lrefs = {.a = a}, .members = {.a = a}, .strings = {.a = a}};
 
-    for (uint32_t sp = 0; sp < LBK_DLS_SPACE_COUNT_ && r == LBK_OK; sp++) {
-        b.space = sp;
-        uint64_t n = 0;
-        for (uint32_t s = 0; s < desc->set_count; s++) n += desc->sets[s].entries[sp].count;
-        if (n == 0) continue;
-        if (n > SIZE_MAX / sizeof(rec)) { r = LBK_ERR_LIMIT; break; }
-        b.recs = lbk_alloc(a, n * sizeof *b.recs);
-        if (!b.recs) { r = LBK_ERR_OUT_OF_MEMORY; break; }
-        uint32_t psize = dls_payload_size(sp);
-        b.nrecs = 0;
-        for (uint32_t s = 0; s < desc->set_count; s++) {
-            const lbk_dls_sparse *e = &desc->sets[s].entries[sp];
-            for (uint64_t q = 0; q < e->count; q++)
-                b.recs[b.nrecs++] = (rec){e->targets[q], s, (const uint8_t *)e->payloads + q * psize};
-        }
-        r = build_space(&b);
-        lbk_dealloc(a, b.recs);
-        lbk_dealloc(a, b.groups);
-        lbk_dealloc(a, b.combos);
-        lbk_dealloc(a, b.combo_groups);
-        b.recs = NULL; b.groups = NULL; b.combos = NULL; b.combo_groups = NULL;
-    }
-
-    /* Set table and strings. */
-    for (uint32_t s = 0; s < desc->set_count && r == LBK_OK; s++) {
-        const lbk_dls_set_desc *sd = &desc->sets[s];
-        uint8_t rec_[DLS_SET_SIZE] = {0};
-        size_t nl = strlen(sd->name);
-        lbk_wr32(rec_ + DLS_S_NAME_OFF, (uint32_t)strings.len);
-        lbk_wr32(rec_ + DLS_S_NAME_LEN, (uint32_t)nl);
-        vec_bytes(&strings, sd->name, nl);
-        lbk_wr32(rec_ + DLS_S_KIND, sd->kind);
-        lbk_wr32(rec_ + DLS_S_LIGHT_FIRST, (uint32_t)(lrefs.len / DLS_LIGHT_REF_SIZE));
-        lbk_wr32(rec_ + DLS_S_LIGHT_COUNT, sd->light_count);
-        lbk_wr32(rec_ + DLS_S_MEMBER_FIRST, (uint32_t)(members.len / 4));
-        lbk_wr32(rec_ + DLS_S_MEMBER_COUNT, sd->kind == LBK_DLS_KIND_COMBINATION ? sd->member_count : 0);
-        vec_bytes(&sets, rec_, sizeof rec_);
-        for (uint32_t l = 0; l < sd->light_count; l++) {
-            size_t ll = strlen(sd->light_names[l]);
-            vec_u32(&lrefs, (uint32_t)strings.len);
-            vec_u32(&lrefs, (uint32_t)ll);
-            vec_bytes(&strings, sd->light_names[l], ll);
-        }
-        if (sd->kind == LBK_DLS_KIND_COMBINATION) {
-            uint32_t sorted[LBK_DLS_MAX_OVERLAPS];
-            uint32_t *m = sd->member_count <= LBK_DLS_MAX_OVERLAPS ? sorted : lbk_alloc(a, sd->member_count * sizeof *m);
-            if (!m) { r = LBK_ERR_OUT_OF_MEMORY; break; }
-            memcpy(m, sd->members, sd->member_count * sizeof *m);
-            qsort(m, sd->member_count, sizeof *m, cmp_u32);
-            for (uint32_t q = 0; q < sd->member_count; q++) vec_u32(&members, m[q]);
-            if (m != sorted) lbk_dealloc(a, m);
-        }
-    }
-    if (strings.len > UINT32_MAX) r = LBK_ERR_LIMIT;
+    r = build_spaces(&b);
+    if (r == LBK_OK) r = build_set_table(desc, a, &t);
+    if (t.strings.len > UINT32_MAX) r = LBK_ERR_LIMIT;
     for (size_t i = 0; i < sizeof vs / sizeof vs[0]; i++)
         if (vs[i]->oom) r = LBK_ERR_OUT_OF_MEMORY;
-    if (sets.oom || lrefs.oom || members.oom || strings.oom) r = LBK_ERR_OUT_OF_MEMORY;
+    if (t.sets.oom || t.lrefs.oom || t.members.oom || t.strings.oom) r = LBK_ERR_OUT_OF_MEMORY;
     if (r == LBK_OK && (b.tot_runs > UINT32_MAX || b.tot_sets > UINT32_MAX || b.tot_words > UINT32_MAX ||
                         b.tot_base16 > UINT32_MAX || b.tot_base32 > UINT32_MAX || b.tot_subgroups > UINT32_MAX ||
                         b.clusters.len / DLS_CLUSTER_SIZE > UINT32_MAX))
@@ -793,57 +860,12 @@ lbk_result lbk_dls_build(const lbk_dls_build_desc *caller_desc, const lbk_dls_bu
 
     uint8_t *bytes = NULL;
     dls_layout L;
-    if (r == LBK_OK) {
-        L.count[DLS_A_SETS] = desc->set_count;
-        L.count[DLS_A_LIGHT_REFS] = lrefs.len / DLS_LIGHT_REF_SIZE;
-        L.count[DLS_A_MEMBERS] = members.len / 4;
-        L.count[DLS_A_CLUSTERS] = b.clusters.len / DLS_CLUSTER_SIZE;
-        L.count[DLS_A_CLUSTER_SETS] = b.tot_sets;
-        L.count[DLS_A_RUNS] = b.tot_runs;
-        L.count[DLS_A_SUBGROUPS] = b.tot_subgroups;
-        L.count[DLS_A_PREFIX_WORDS] = b.tot_words;
-        L.count[DLS_A_BASE16] = b.tot_base16;
-        L.count[DLS_A_BASE32] = b.tot_base32;
-        L.count[DLS_A_SLOTS] = b.tot_slots;
-        L.count[DLS_A_TEXEL_ENTRIES] = b.tot_entries[0];
-        L.count[DLS_A_PROBE_ENTRIES] = b.tot_entries[1];
-        L.count[DLS_A_STRINGS] = strings.len;
-        if (!dls_layout_compute(&L) || L.size > SIZE_MAX) r = LBK_ERR_LIMIT;
-    }
-    if (r == LBK_OK) {
-        bytes = lbk_calloc(a, 1, (size_t)L.size);
-        if (!bytes) r = LBK_ERR_OUT_OF_MEMORY;
-    }
-    if (r == LBK_OK) {
-        static const int hdr_u32[] = {DLS_H_SET_COUNT, DLS_H_LIGHT_REF_COUNT, DLS_H_MEMBER_COUNT, DLS_H_CLUSTER_COUNT,
-                                      DLS_H_CLUSTER_SET_COUNT, DLS_H_RUN_COUNT, DLS_H_SUBGROUP_COUNT,
-                                      DLS_H_PREFIX_WORD_COUNT, DLS_H_BASE16_COUNT, DLS_H_BASE32_COUNT};
-        for (int i = 0; i < 10; i++) lbk_wr32(bytes + hdr_u32[i], (uint32_t)L.count[i]);
-        lbk_wr64(bytes + DLS_H_SLOT_COUNT, L.count[DLS_A_SLOTS]);
-        lbk_wr64(bytes + DLS_H_TEXEL_ENTRY_COUNT, L.count[DLS_A_TEXEL_ENTRIES]);
-        lbk_wr64(bytes + DLS_H_PROBE_ENTRY_COUNT, L.count[DLS_A_PROBE_ENTRIES]);
-        lbk_wr64(bytes + DLS_H_STRING_BYTES, L.count[DLS_A_STRINGS]);
-        for (int s = 0; s < LBK_DLS_SPACE_COUNT_; s++) lbk_wr64(bytes + DLS_H_TARGET_COUNT + 8 * s, desc->target_count[s]);
-        put_array(bytes, &L, DLS_A_SETS, &sets);
-        put_array(bytes, &L, DLS_A_LIGHT_REFS, &lrefs);
-        put_array(bytes, &L, DLS_A_MEMBERS, &members);
-        put_array(bytes, &L, DLS_A_CLUSTERS, &b.clusters);
-        put_array(bytes, &L, DLS_A_CLUSTER_SETS, &b.cluster_sets);
-        put_array(bytes, &L, DLS_A_RUNS, &b.runs);
-        put_array(bytes, &L, DLS_A_SUBGROUPS, &b.subgroups);
-        put_array(bytes, &L, DLS_A_PREFIX_WORDS, &b.words);
-        put_array(bytes, &L, DLS_A_BASE16, &b.base16);
-        put_array(bytes, &L, DLS_A_BASE32, &b.base32);
-        put_array(bytes, &L, DLS_A_SLOTS, &b.slots);
-        put_array(bytes, &L, DLS_A_TEXEL_ENTRIES, &b.texels);
-        put_array(bytes, &L, DLS_A_PROBE_ENTRIES, &b.probes);
-        put_array(bytes, &L, DLS_A_STRINGS, &strings);
-    }
+    if (r == LBK_OK) r = assemble(&b, &t, &bytes, &L);
     for (size_t i = 0; i < sizeof vs / sizeof vs[0]; i++) vec_free(vs[i]);
-    vec_free(&sets);
-    vec_free(&lrefs);
-    vec_free(&members);
-    vec_free(&strings);
+    vec_free(&t.sets);
+    vec_free(&t.lrefs);
+    vec_free(&t.members);
+    vec_free(&t.strings);
     if (r != LBK_OK) {
         lbk_dealloc(a, bytes);
         return r;
