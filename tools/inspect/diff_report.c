@@ -138,19 +138,8 @@ static cJSON *octp_json(const tl_diff_octp *d)
     return o;
 }
 
-char *tl_diff_json(const tl_diff_result *r, const char *path_a, const char *path_b)
+static void add_noise_model(cJSON *root, const tl_diff_result *r)
 {
-    cJSON *root = cJSON_CreateObject();
-    cJSON_AddStringToObject(root, "schema", "lbk-diff");
-    cJSON_AddNumberToObject(root, "schema_version", TL_DIFF_SCHEMA_VERSION);
-    cJSON_AddStringToObject(root, "a", path_a);
-    cJSON_AddStringToObject(root, "b", path_b);
-    cJSON *tol = cJSON_AddObjectToObject(root, "tolerance");
-    cJSON_AddNumberToObject(tol, "abs", r->abs_tol);
-    cJSON_AddNumberToObject(tol, "rel", r->rel_tol);
-    cJSON_AddBoolToObject(root, "equal", !r->differ);
-    cJSON_AddStringToObject(root, "mode", tl_diff_mode_name(r->mode));
-    cJSON_AddStringToObject(root, "mode_reason", r->mode_reason ? r->mode_reason : "");
     if (r->mode == TL_DIFF_MODE_NOISE) {
         cJSON *nm = cJSON_AddObjectToObject(root, "noise_model");
         cJSON_AddNumberToObject(nm, "false_alarm", r->noise.false_alarm);
@@ -167,7 +156,10 @@ char *tl_diff_json(const tl_diff_result *r, const char *path_a, const char *path
     } else {
         cJSON_AddNullToObject(root, "noise_model");
     }
+}
 
+static void add_summary(cJSON *root, const tl_diff_result *r)
+{
     cJSON *sum = cJSON_AddObjectToObject(root, "summary");
     cJSON_AddNumberToObject(sum, "objects_added", r->objects_added);
     cJSON_AddNumberToObject(sum, "objects_removed", r->objects_removed);
@@ -181,21 +173,101 @@ char *tl_diff_json(const tl_diff_result *r, const char *path_a, const char *path
     cJSON_AddNumberToObject(sum, "probes_over_tolerance", (double)r->probes_over);
     cJSON_AddNumberToObject(sum, "beyond_noise", r->items_beyond_noise);
     cJSON_AddNumberToObject(sum, "inputs_changed", (double)r->change_count);
+}
 
-    cJSON *inputs = cJSON_AddArrayToObject(root, "inputs");
-    for (size_t i = 0; i < r->change_count; i++) {
-        const tl_diff_change *c = &r->changes[i];
-        cJSON *o = cJSON_CreateObject();
-        cJSON_AddStringToObject(o, "kind", tl_change_kind_name(c->kind));
-        cJSON_AddStringToObject(o, "status", tl_diff_status_name(c->status));
-        cJSON_AddStringToObject(o, "name", c->name);
-        if (c->a) cJSON_AddStringToObject(o, "a", c->a);
-        else cJSON_AddNullToObject(o, "a");
-        if (c->b) cJSON_AddStringToObject(o, "b", c->b);
-        else cJSON_AddNullToObject(o, "b");
-        cJSON_AddStringToObject(o, "what", c->what);
-        cJSON_AddItemToArray(inputs, o);
+static cJSON *change_json(const tl_diff_change *c)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "kind", tl_change_kind_name(c->kind));
+    cJSON_AddStringToObject(o, "status", tl_diff_status_name(c->status));
+    cJSON_AddStringToObject(o, "name", c->name);
+    if (c->a) cJSON_AddStringToObject(o, "a", c->a);
+    else cJSON_AddNullToObject(o, "a");
+    if (c->b) cJSON_AddStringToObject(o, "b", c->b);
+    else cJSON_AddNullToObject(o, "b");
+    cJSON_AddStringToObject(o, "what", c->what);
+    return o;
+}
+
+static cJSON *object_json(const tl_diff_result *r, const tl_diff_object *d)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "name", d->name);
+    if (d->renamed) cJSON_AddStringToObject(o, "b_name", d->name_b);
+    else cJSON_AddNullToObject(o, "b_name");
+    cJSON_AddStringToObject(o, "status", tl_diff_status_name(d->status));
+    cJSON *flags = cJSON_AddArrayToObject(o, "changes");
+    if (d->renamed) cJSON_AddItemToArray(flags, cJSON_CreateString("renamed"));
+    if (d->geometry_changed) cJSON_AddItemToArray(flags, cJSON_CreateString("geometry"));
+    if (d->representation_changed) cJSON_AddItemToArray(flags, cJSON_CreateString("representation"));
+    if (d->rect_changed) cJSON_AddItemToArray(flags, cJSON_CreateString("placement"));
+    if (r->mode == TL_DIFF_MODE_NOISE ? (d->noise.evaluated && !d->noise.within_noise) : d->lighting.over > 0)
+        cJSON_AddItemToArray(flags, cJSON_CreateString("lighting"));
+    cJSON *in = cJSON_AddArrayToObject(o, "inputs_changed");
+    if (d->inputs_changed & TL_INPUT_GEOMETRY) cJSON_AddItemToArray(in, cJSON_CreateString("geometry"));
+    if (d->inputs_changed & TL_INPUT_MATERIAL) cJSON_AddItemToArray(in, cJSON_CreateString("material"));
+    if (d->inputs_changed & TL_INPUT_OPTIONS) cJSON_AddItemToArray(in, cJSON_CreateString("options"));
+    cJSON_AddItemToObject(o, "a", side_json(d->repr_a, d->page_a, d->rect_a, d->hash_a));
+    cJSON_AddItemToObject(o, "b", side_json(d->repr_b, d->page_b, d->rect_b, d->hash_b));
+    cJSON_AddBoolToObject(o, "resampled", d->resampled);
+    if (d->compared) cJSON_AddItemToObject(o, "lighting", stats_json(&d->lighting, d->repr_a == LBK_REPRESENTATION_LIGHTMAP));
+    else cJSON_AddNullToObject(o, "lighting");
+    cJSON_AddItemToObject(o, "noise", noise_json(&d->noise));
+    return o;
+}
+
+static cJSON *page_json(const tl_diff_page *p)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddNumberToObject(o, "index", p->index);
+    cJSON_AddStringToObject(o, "status", tl_diff_status_name(p->status));
+    cJSON *sa = cJSON_CreateArray(), *sb = cJSON_CreateArray();
+    cJSON_AddItemToArray(sa, cJSON_CreateNumber(p->wa));
+    cJSON_AddItemToArray(sa, cJSON_CreateNumber(p->ha));
+    cJSON_AddItemToArray(sb, cJSON_CreateNumber(p->wb));
+    cJSON_AddItemToArray(sb, cJSON_CreateNumber(p->hb));
+    cJSON_AddItemToObject(o, "a_size", sa);
+    cJSON_AddItemToObject(o, "b_size", sb);
+    cJSON_AddBoolToObject(o, "resized", p->resized);
+    if (p->status == TL_DIFF_SAME || p->status == TL_DIFF_CHANGED) cJSON_AddItemToObject(o, "lighting", stats_json(&p->lighting, 1));
+    else cJSON_AddNullToObject(o, "lighting");
+    return o;
+}
+
+static cJSON *set_json(const tl_diff_set *d)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "name", d->name);
+    cJSON_AddStringToObject(o, "status", tl_diff_status_name(d->status));
+    cJSON_AddBoolToObject(o, "definition_changed", d->meta_changed);
+    for (uint32_t sp = 0; sp < LBK_DLS_SPACE_COUNT_; sp++) {
+        if (d->compared[sp]) cJSON_AddItemToObject(o, space_name(sp), stats_json(&d->lighting[sp], sp == LBK_DLS_SPACE_TEXEL));
+        else if (d->not_comparable[sp]) cJSON_AddStringToObject(o, space_name(sp), "not comparable");
+        else cJSON_AddNullToObject(o, space_name(sp));
     }
+    cJSON *nz = cJSON_AddObjectToObject(o, "noise");
+    for (uint32_t sp = 0; sp < LBK_DLS_SPACE_COUNT_; sp++)
+        cJSON_AddItemToObject(nz, space_name(sp), noise_json(&d->noise[sp]));
+    return o;
+}
+
+char *tl_diff_json(const tl_diff_result *r, const char *path_a, const char *path_b)
+{
+    cJSON *root = cJSON_CreateObject();
+    cJSON_AddStringToObject(root, "schema", "lbk-diff");
+    cJSON_AddNumberToObject(root, "schema_version", TL_DIFF_SCHEMA_VERSION);
+    cJSON_AddStringToObject(root, "a", path_a);
+    cJSON_AddStringToObject(root, "b", path_b);
+    cJSON *tol = cJSON_AddObjectToObject(root, "tolerance");
+    cJSON_AddNumberToObject(tol, "abs", r->abs_tol);
+    cJSON_AddNumberToObject(tol, "rel", r->rel_tol);
+    cJSON_AddBoolToObject(root, "equal", !r->differ);
+    cJSON_AddStringToObject(root, "mode", tl_diff_mode_name(r->mode));
+    cJSON_AddStringToObject(root, "mode_reason", r->mode_reason ? r->mode_reason : "");
+    add_noise_model(root, r);
+    add_summary(root, r);
+    cJSON *inputs = cJSON_AddArrayToObject(root, "inputs");
+    for (size_t i = 0; i < r->change_count; i++) cJSON_AddItemToArray(inputs, change_json(&r->changes[i]));
 
     cJSON *secs = cJSON_AddArrayToObject(root, "sections");
     for (size_t i = 0; i < r->section_count; i++) {
@@ -222,50 +294,9 @@ char *tl_diff_json(const tl_diff_result *r, const char *path_a, const char *path
         cJSON_AddItemToArray(params, o);
     }
     cJSON *objs = cJSON_AddArrayToObject(root, "objects");
-    for (size_t i = 0; i < r->object_count; i++) {
-        const tl_diff_object *d = &r->objects[i];
-        cJSON *o = cJSON_CreateObject();
-        cJSON_AddStringToObject(o, "name", d->name);
-        if (d->renamed) cJSON_AddStringToObject(o, "b_name", d->name_b);
-        else cJSON_AddNullToObject(o, "b_name");
-        cJSON_AddStringToObject(o, "status", tl_diff_status_name(d->status));
-        cJSON *flags = cJSON_AddArrayToObject(o, "changes");
-        if (d->renamed) cJSON_AddItemToArray(flags, cJSON_CreateString("renamed"));
-        if (d->geometry_changed) cJSON_AddItemToArray(flags, cJSON_CreateString("geometry"));
-        if (d->representation_changed) cJSON_AddItemToArray(flags, cJSON_CreateString("representation"));
-        if (d->rect_changed) cJSON_AddItemToArray(flags, cJSON_CreateString("placement"));
-        if (r->mode == TL_DIFF_MODE_NOISE ? (d->noise.evaluated && !d->noise.within_noise) : d->lighting.over > 0)
-            cJSON_AddItemToArray(flags, cJSON_CreateString("lighting"));
-        cJSON *in = cJSON_AddArrayToObject(o, "inputs_changed");
-        if (d->inputs_changed & TL_INPUT_GEOMETRY) cJSON_AddItemToArray(in, cJSON_CreateString("geometry"));
-        if (d->inputs_changed & TL_INPUT_MATERIAL) cJSON_AddItemToArray(in, cJSON_CreateString("material"));
-        if (d->inputs_changed & TL_INPUT_OPTIONS) cJSON_AddItemToArray(in, cJSON_CreateString("options"));
-        cJSON_AddItemToObject(o, "a", side_json(d->repr_a, d->page_a, d->rect_a, d->hash_a));
-        cJSON_AddItemToObject(o, "b", side_json(d->repr_b, d->page_b, d->rect_b, d->hash_b));
-        cJSON_AddBoolToObject(o, "resampled", d->resampled);
-        if (d->compared) cJSON_AddItemToObject(o, "lighting", stats_json(&d->lighting, d->repr_a == LBK_REPRESENTATION_LIGHTMAP));
-        else cJSON_AddNullToObject(o, "lighting");
-        cJSON_AddItemToObject(o, "noise", noise_json(&d->noise));
-        cJSON_AddItemToArray(objs, o);
-    }
+    for (size_t i = 0; i < r->object_count; i++) cJSON_AddItemToArray(objs, object_json(r, &r->objects[i]));
     cJSON *pages = cJSON_AddArrayToObject(root, "pages");
-    for (size_t i = 0; i < r->page_count; i++) {
-        const tl_diff_page *p = &r->pages[i];
-        cJSON *o = cJSON_CreateObject();
-        cJSON_AddNumberToObject(o, "index", p->index);
-        cJSON_AddStringToObject(o, "status", tl_diff_status_name(p->status));
-        cJSON *sa = cJSON_CreateArray(), *sb = cJSON_CreateArray();
-        cJSON_AddItemToArray(sa, cJSON_CreateNumber(p->wa));
-        cJSON_AddItemToArray(sa, cJSON_CreateNumber(p->ha));
-        cJSON_AddItemToArray(sb, cJSON_CreateNumber(p->wb));
-        cJSON_AddItemToArray(sb, cJSON_CreateNumber(p->hb));
-        cJSON_AddItemToObject(o, "a_size", sa);
-        cJSON_AddItemToObject(o, "b_size", sb);
-        cJSON_AddBoolToObject(o, "resized", p->resized);
-        if (p->status == TL_DIFF_SAME || p->status == TL_DIFF_CHANGED) cJSON_AddItemToObject(o, "lighting", stats_json(&p->lighting, 1));
-        else cJSON_AddNullToObject(o, "lighting");
-        cJSON_AddItemToArray(pages, o);
-    }
+    for (size_t i = 0; i < r->page_count; i++) cJSON_AddItemToArray(pages, page_json(&r->pages[i]));
     cJSON *glg = cJSON_AddObjectToObject(root, "glg");
     cJSON_AddStringToObject(glg, "status", tl_diff_status_name(r->glg.status));
     cJSON_AddNumberToObject(glg, "a_probes", r->glg.count_a);
@@ -276,22 +307,7 @@ char *tl_diff_json(const tl_diff_result *r, const char *path_a, const char *path
     cJSON_AddItemToObject(glg, "noise", noise_json(&r->glg.noise));
     cJSON_AddItemToObject(root, "octp", octp_json(&r->octp));
     cJSON *sets = cJSON_AddArrayToObject(root, "light_sets");
-    for (size_t i = 0; i < r->set_count; i++) {
-        const tl_diff_set *d = &r->sets[i];
-        cJSON *o = cJSON_CreateObject();
-        cJSON_AddStringToObject(o, "name", d->name);
-        cJSON_AddStringToObject(o, "status", tl_diff_status_name(d->status));
-        cJSON_AddBoolToObject(o, "definition_changed", d->meta_changed);
-        for (uint32_t sp = 0; sp < LBK_DLS_SPACE_COUNT_; sp++) {
-            if (d->compared[sp]) cJSON_AddItemToObject(o, space_name(sp), stats_json(&d->lighting[sp], sp == LBK_DLS_SPACE_TEXEL));
-            else if (d->not_comparable[sp]) cJSON_AddStringToObject(o, space_name(sp), "not comparable");
-            else cJSON_AddNullToObject(o, space_name(sp));
-        }
-        cJSON *nz = cJSON_AddObjectToObject(o, "noise");
-        for (uint32_t sp = 0; sp < LBK_DLS_SPACE_COUNT_; sp++)
-            cJSON_AddItemToObject(nz, space_name(sp), noise_json(&d->noise[sp]));
-        cJSON_AddItemToArray(sets, o);
-    }
+    for (size_t i = 0; i < r->set_count; i++) cJSON_AddItemToArray(sets, set_json(&r->sets[i]));
     cJSON *doors = cJSON_AddArrayToObject(root, "doors");
     for (size_t i = 0; i < r->door_count; i++) {
         cJSON *o = cJSON_CreateObject();
