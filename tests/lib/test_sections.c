@@ -811,26 +811,23 @@ static void container_clean(void **state)
     for (int i = 0; i < 4; i++) lbk_free(NULL, s[i]);
 }
 
-/* The radiometric scale (spec §5.7): every section round-trips physical values exactly through a
- * scale ≠ 1 (stored bytes are those of value / scale), builders refuse and validators report a
- * scale that is not a positive finite power of two. */
-static void scaled_sections(void **state)
+/* LMAP at scale 2^-20: texels are stored units; the view and lbk_lmap_page_irradiance apply
+ * 2^-20. Its bytes go to *bytes (lbk_free). */
+static void scaled_lmap(void **bytes, size_t *size)
 {
-    (void)state;
-    /* LMAP: texels are stored units; the view and lbk_lmap_page_irradiance apply 2^-20 */
     lbk_ahd_texel t0[6], t1[20];
-    void *b1, *bs;
-    size_t n1, ns;
+    void *b1;
+    size_t n1;
     lmap_fixture(&b1, &n1, t0, t1);
     const lbk_lmap_page_desc pages[2] = {{3, 2, t0}, {5, 4, t1}};
     assert_int_equal(lbk_lmap_build(&(lbk_lmap_build_desc){.pages = pages, .page_count = 2,
-        .scale = 0x1p-20f}, NULL, &bs, &ns), LBK_OK);
-    assert_int_equal(ns, n1);
-    assert_memory_equal((uint8_t *)bs + 8, (uint8_t *)b1 + 8, n1 - 8); /* only the scale differs */
-    assert_true(lbk_rdf32((uint8_t *)bs + 4) == 0x1p-20f && lbk_rdf32((uint8_t *)b1 + 4) == 1.0f);
+        .scale = 0x1p-20f}, NULL, bytes, size), LBK_OK);
+    assert_int_equal(*size, n1);
+    assert_memory_equal((uint8_t *)*bytes + 8, (uint8_t *)b1 + 8, n1 - 8); /* only the scale differs */
+    assert_true(lbk_rdf32((uint8_t *)*bytes + 4) == 0x1p-20f && lbk_rdf32((uint8_t *)b1 + 4) == 1.0f);
     lbk_lmap_view lv;
     lbk_lmap_page pg;
-    assert_int_equal(lbk_lmap_open(bs, ns, &lv), LBK_OK);
+    assert_int_equal(lbk_lmap_open(*bytes, *size, &lv), LBK_OK);
     assert_true(lv.scale == 0x1p-20f);
     assert_int_equal(lbk_lmap_page_get(&lv, 0, &pg), LBK_OK);
     assert_true(pg.scale == 0x1p-20f);
@@ -842,16 +839,22 @@ static void scaled_sections(void **state)
         for (int c = 0; c < 3; c++) assert_true(e[c] == want[c] * 0x1p-20f && want[c] > 0);
     }
     issues is;
-    run(lbk_validate_lmap, bs, ns, &is, NULL);
+    run(lbk_validate_lmap, *bytes, *size, &is, NULL);
     assert_int_equal(is.n, 0);
     void *none;
     size_t none_n;
     assert_int_equal(lbk_lmap_build(&(lbk_lmap_build_desc){.pages = pages, .page_count = 2,
         .scale = 3.0f}, NULL, &none, &none_n), LBK_ERR_INVALID_ARGUMENT);
     lbk_free(NULL, b1);
+}
 
-    /* GLG: physical SH in, physical out; the stored probe is value / scale */
+/* GLG: physical SH in, physical out; the stored probe is value / scale. */
+static void scaled_glg(void)
+{
     lbk_sh9_rgb sh[8], got;
+    issues is;
+    void *none;
+    size_t none_n;
     memset(sh, 0, sizeof sh);
     for (int i = 0; i < 8; i++)
         for (int c = 0; c < 3; c++) {
@@ -888,21 +891,31 @@ static void scaled_sections(void **state)
     lbk_free(NULL, gb);
     d.scale = -2.0f;
     assert_int_equal(lbk_glg_build(&d, NULL, &none, &none_n), LBK_ERR_INVALID_ARGUMENT);
+}
 
-    /* LLG: a uniform field sampled and applied to a vertex, physical values at scale 2^-30 */
-    lbk_sh9_rgb lp[8];
-    memset(lp, 0, sizeof lp);
+/* A 2×2×2 LLG over the unit cube with a uniform field of 1e-7 (lp) and one vertex (vert). */
+static void uniform_llg(lbk_sh9_rgb lp[8], const lbk_llg_vertex *vert, lbk_llg_grid_desc *g)
+{
+    memset(lp, 0, 8 * sizeof *lp);
     for (int i = 0; i < 8; i++)
         for (int c = 0; c < 3; c++) lp[i].c[c][0] = 1e-7f;
+    memset(g, 0, sizeof *g);
+    g->axes[0][0] = g->axes[1][1] = g->axes[2][2] = 1.0f;
+    g->half_extents[0] = g->half_extents[1] = g->half_extents[2] = 1.0f;
+    g->dims[0] = g->dims[1] = g->dims[2] = 2;
+    g->probes = lp;
+    g->vertices = vert;
+    g->vertex_count = 1;
+}
+
+/* LLG: a uniform field sampled and applied to a vertex, physical values at scale 2^-30. */
+static void scaled_llg(void)
+{
+    lbk_sh9_rgb lp[8], got;
     const lbk_llg_vertex vert = {1.0f, {0, 0, 1}};
     lbk_llg_grid_desc g;
-    memset(&g, 0, sizeof g);
-    g.axes[0][0] = g.axes[1][1] = g.axes[2][2] = 1.0f;
-    g.half_extents[0] = g.half_extents[1] = g.half_extents[2] = 1.0f;
-    g.dims[0] = g.dims[1] = g.dims[2] = 2;
-    g.probes = lp;
-    g.vertices = &vert;
-    g.vertex_count = 1;
+    uniform_llg(lp, &vert, &g);
+    issues is;
     void *lb;
     size_t ln;
     assert_int_equal(lbk_llg_build(&(lbk_llg_build_desc){.grids = &g, .grid_count = 1,
@@ -920,20 +933,23 @@ static void scaled_sections(void **state)
     run(lbk_validate_llg, lb, ln, &is, NULL);
     assert_int_equal(is.n, 0);
     lbk_free(NULL, lb);
+}
 
-    /* OCTP: irradiance 2^20 × the fixture's exact values round-trips exactly at scale 2^20 */
-    lbk_octp_probe_desc pd[2], back;
-    void *ob;
-    size_t on;
-    octp_fixture(pd, &ob, &on);
-    lbk_free(NULL, ob);
+/* OCTP: irradiance 2^20 × the fixture's exact values (pd) round-trips exactly at scale 2^20; its
+ * bytes go to *bytes (lbk_free). */
+static void scaled_octp(lbk_octp_probe_desc pd[2], void **bytes, size_t *size)
+{
+    lbk_octp_probe_desc back;
+    issues is;
+    octp_fixture(pd, bytes, size);
+    lbk_free(NULL, *bytes);
     for (int p = 0; p < 2; p++)
         for (int i = 0; i < 16; i++)
             for (int k = 0; k < 3; k++) pd[p].irradiance[i][k] *= 0x1p20f;
     assert_int_equal(lbk_octp_build(&(lbk_octp_build_desc){.probes = pd, .probe_count = 2,
-        .scale = 0x1p20f}, NULL, &ob, &on), LBK_OK);
+        .scale = 0x1p20f}, NULL, bytes, size), LBK_OK);
     lbk_octp_view ov;
-    assert_int_equal(lbk_octp_open(ob, on, &ov), LBK_OK);
+    assert_int_equal(lbk_octp_open(*bytes, *size, &ov), LBK_OK);
     assert_true(ov.scale == 0x1p20f);
     assert_int_equal(lbk_octp_probe_get(&ov, 1, &back), LBK_OK);
     assert_memory_equal(back.irradiance, pd[1].irradiance, sizeof back.irradiance);
@@ -941,11 +957,25 @@ static void scaled_sections(void **state)
     lbk_oct_texel_direction(4, 2, 1, dir);
     assert_int_equal(lbk_octp_irradiance(&ov, 0, dir, rgb), LBK_OK);
     for (int k = 0; k < 3; k++) assert_true(fabsf(rgb[k] - pd[0].irradiance[1 * 4 + 2][k]) <= pd[0].irradiance[1 * 4 + 2][k] * 1e-6f);
-    run(lbk_validate_octp, ob, on, &is, NULL);
+    run(lbk_validate_octp, *bytes, *size, &is, NULL);
     assert_int_equal(is.n, 0);
+}
 
-    /* invalid scales: zero, NaN, +Inf, negative, not a power of two, denormal — each is exactly
-     * the section's scale issue, and the view refuses the bytes */
+/* Invalid scales: zero, NaN, +Inf, negative, not a power of two, denormal — each is exactly the
+ * section's scale issue, and the view refuses the bytes (bs: a scaled LMAP, ob: a scaled OCTP of
+ * pd). */
+static void bad_scales(const void *bs, size_t ns, const void *ob, size_t on, const lbk_octp_probe_desc pd[2])
+{
+    void *gb, *lb, *none;
+    size_t gn, ln, none_n;
+    lbk_lmap_view lv;
+    lbk_octp_view ov;
+    lbk_glg_view gv;
+    lbk_llg_view llv;
+    lbk_sh9_rgb lp[8];
+    const lbk_llg_vertex vert = {1.0f, {0, 0, 1}};
+    lbk_llg_grid_desc g;
+    uniform_llg(lp, &vert, &g);
     const uint32_t bad[6] = {0x00000000u, 0x7fc00000u, 0x7f800000u, 0xc0000000u, 0x40400000u /* 3 */, 0x00400000u};
     for (int k = 0; k < 6; k++) {
         uint8_t *c = dup_bytes(bs, ns);
@@ -975,7 +1005,24 @@ static void scaled_sections(void **state)
     }
     assert_int_equal(lbk_octp_build(&(lbk_octp_build_desc){.probes = pd, .probe_count = 2,
         .scale = NAN}, NULL, &none, &none_n), LBK_ERR_INVALID_ARGUMENT);
-    lbk_free(NULL, gb), lbk_free(NULL, lb), lbk_free(NULL, ob), lbk_free(NULL, bs);
+    lbk_free(NULL, gb), lbk_free(NULL, lb);
+}
+
+/* The radiometric scale (spec §5.7): every section round-trips physical values exactly through a
+ * scale ≠ 1 (stored bytes are those of value / scale), builders refuse and validators report a
+ * scale that is not a positive finite power of two. */
+static void scaled_sections(void **state)
+{
+    (void)state;
+    void *bs, *ob;
+    size_t ns, on;
+    lbk_octp_probe_desc pd[2];
+    scaled_lmap(&bs, &ns);
+    scaled_glg();
+    scaled_llg();
+    scaled_octp(pd, &ob, &on);
+    bad_scales(bs, ns, ob, on, pd);
+    lbk_free(NULL, ob), lbk_free(NULL, bs);
 }
 
 int main(void)
