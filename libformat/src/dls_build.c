@@ -860,6 +860,7 @@ lbk_result lbk_dls_build(const lbk_dls_build_desc *caller_desc, const lbk_dls_bu
 
     uint8_t *bytes = NULL;
     dls_layout L;
+    memset(&L, 0, sizeof L);
     if (r == LBK_OK) r = assemble(&b, &t, &bytes, &L);
     for (size_t i = 0; i < sizeof vs / sizeof vs[0]; i++) vec_free(vs[i]);
     vec_free(&t.sets);
