@@ -231,6 +231,78 @@ static int parse(int argc, char **argv, args *a)
     return 0;
 }
 
+/* The evaluation subset: up to `per` texels of each group, evenly spread over the group (the groups
+ * with a reference first, then every texel of the ones that must be 0). */
+static void pick_eval(const bk_texels *tx, const int *tgroup, const size_t *recv_of, int per, eval_set *e)
+{
+    size_t gcount[BSC_GROUPS] = {0};
+    for (size_t i = 0; i < tx->count; i++) gcount[tgroup[i]]++;
+    e->recv = calloc(tx->count, sizeof *e->recv);
+    e->group = calloc(tx->count, sizeof *e->group);
+    e->p = calloc(3 * tx->count, sizeof *e->p);
+    e->fp_first = calloc(tx->count, sizeof *e->fp_first);
+    e->fp_count = calloc(tx->count, sizeof *e->fp_count);
+    e->nrm = calloc(3 * tx->count, sizeof *e->nrm);
+    /* the groups with a reference first, then the ones that must be 0 (no reference needed) */
+    size_t seen[BSC_GROUPS] = {0}, took[BSC_GROUPS] = {0};
+    for (int phase = 0; phase < 2; phase++)
+        for (size_t i = 0; i < tx->count; i++) {
+            int g = tgroup[i], zero = g == BSC_SEALED || g == BSC_BURIED;
+            if (g == BSC_OUTSIDE || zero != phase) continue;
+            size_t want = zero ? gcount[g] : (size_t)per;
+            /* take texel i when the running quota crosses an integer */
+            size_t q = (seen[g] + 1) * want / gcount[g];
+            seen[g]++;
+            if (q <= took[g]) continue;
+            took[g]++;
+            const bk_texel *x = &tx->receivers[i];
+            e->recv[e->n] = recv_of[i];
+            e->group[e->n] = g;
+            memcpy(e->p + 3 * e->n, x->position, 12);
+            memcpy(e->nrm + 3 * e->n, x->normal, 12);
+#ifndef BENCH_BIAS_ORIG
+            e->fp_first[e->n] = x->footprint_first;
+            e->fp_count[e->n] = x->footprint_count;
+#endif
+            e->n++;
+        }
+}
+
+/* The transport options of run rep (0, or 1: the second seed of --noise) at a->passes[k]. */
+static void pass_options(const args *a, int k, int rep, float *cell_size, const bk_texels *tx, bk_transport_options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->seed = a->seed + 1000 * (uint64_t)rep;
+    o->threads = a->threads;
+    o->target_error = -1;
+    o->first_pass_samples = 16;
+    o->max_samples = 2 * 16 * ((1 << a->passes[k]) - 1);
+    o->max_cells = a->cells;
+#ifndef BENCH_BIAS_ORIG
+    if (cell_size) o->cell_size = cell_size;
+    if (a->footprint) {
+        o->footprint = tx->footprint;
+        o->footprint_count = tx->footprint_count;
+    }
+#endif
+}
+
+/* BENCH_BIAS_DEBUG: where each evaluated buried texel sits, before and after push-out. */
+static void print_buried(const bk_scene *s, const bk_texels *tx, const eval_set *e, const size_t *texel_of,
+                         const float *orig, const float *irr)
+{
+    for (size_t q = 0; q < e->n; q++)
+        if (e->group[q] == BSC_BURIED) {
+            if (e->recv[q] == SIZE_MAX) continue;
+            size_t ti = texel_of[e->recv[q]];
+            const bk_texel *x = &tx->receivers[ti];
+            printf("   buried %s: orig (%.3f %.3f %.3f) now (%.3f %.3f %.3f) n (%.2f %.2f %.2f) flags %u E %.4f\n",
+                   s->objects[s->tri_object[x->tri]].name, orig[3 * ti], orig[3 * ti + 1], orig[3 * ti + 2],
+                   x->position[0], x->position[1], x->position[2], x->normal[0], x->normal[1], x->normal[2],
+                   x->flags, lbk_at(irr, e->recv[q]));
+        }
+}
+
 int main(int argc, char **argv)
 {
     args a;
@@ -287,40 +359,9 @@ int main(int argc, char **argv)
            "inside; cavity texels %zu (%zu inside), buried texels %zu (%zu inside)\n",
            s.tri_count, tx.count, a.density, nr, ps.pushed, ps.inside, sealed_total, inside_sealed, buried_total,
            buried_inside);
-    /* evaluation subset: up to `per` texels of each group, evenly spread over the group */
-    size_t gcount[BSC_GROUPS] = {0};
-    for (size_t i = 0; i < tx.count; i++) gcount[tgroup[i]]++;
     eval_set e;
     memset(&e, 0, sizeof e);
-    e.recv = calloc(tx.count, sizeof *e.recv);
-    e.group = calloc(tx.count, sizeof *e.group);
-    e.p = calloc(3 * tx.count, sizeof *e.p);
-    e.fp_first = calloc(tx.count, sizeof *e.fp_first);
-    e.fp_count = calloc(tx.count, sizeof *e.fp_count);
-    e.nrm = calloc(3 * tx.count, sizeof *e.nrm);
-    /* the groups with a reference first, then the ones that must be 0 (no reference needed) */
-    size_t seen[BSC_GROUPS] = {0}, took[BSC_GROUPS] = {0};
-    for (int phase = 0; phase < 2; phase++)
-        for (size_t i = 0; i < tx.count; i++) {
-            int g = tgroup[i], zero = g == BSC_SEALED || g == BSC_BURIED;
-            if (g == BSC_OUTSIDE || zero != phase) continue;
-            size_t want = zero ? gcount[g] : (size_t)a.per;
-            /* take texel i when the running quota crosses an integer */
-            size_t q = (seen[g] + 1) * want / gcount[g];
-            seen[g]++;
-            if (q <= took[g]) continue;
-            took[g]++;
-            const bk_texel *x = &tx.receivers[i];
-            e.recv[e.n] = recv_of[i];
-            e.group[e.n] = g;
-            memcpy(e.p + 3 * e.n, x->position, 12);
-            memcpy(e.nrm + 3 * e.n, x->normal, 12);
-#ifndef BENCH_BIAS_ORIG
-            e.fp_first[e.n] = x->footprint_first;
-            e.fp_count[e.n] = x->footprint_count;
-#endif
-            e.n++;
-        }
+    pick_eval(&tx, tgroup, recv_of, a.per, &e);
     e.ref = calloc(3 * e.n, sizeof *e.ref);
     e.se = calloc(e.n, sizeof *e.se);
     /* the zero groups need no reference (and keep the cached one valid) */
@@ -344,20 +385,7 @@ int main(int argc, char **argv)
         double cpu = 0;
         for (int rep = 0; rep < (a.noise ? 2 : 1); rep++) {
             bk_transport_options o;
-            memset(&o, 0, sizeof o);
-            o.seed = a.seed + 1000 * (uint64_t)rep;
-            o.threads = a.threads;
-            o.target_error = -1;
-            o.first_pass_samples = 16;
-            o.max_samples = 2 * 16 * ((1 << a.passes[k]) - 1);
-            o.max_cells = a.cells;
-#ifndef BENCH_BIAS_ORIG
-            if (cell_size) o.cell_size = cell_size;
-            if (a.footprint) {
-                o.footprint = tx.footprint;
-                o.footprint_count = tx.footprint_count;
-            }
-#endif
+            pass_options(&a, k, rep, cell_size, &tx, &o);
             bk_transport_output out = {rad, NULL, rep ? irr2 : irr, NULL, NULL, NULL};
             bk_transport_stats st1;
             double c0 = cpu_s();
@@ -376,17 +404,7 @@ int main(int argc, char **argv)
                  a.passes[k], st.samples_per_receiver, st.seconds, cpu, st.cells, st.bounces, (double)st.rays,
                  100 * st.est_rel_rmse, 100 * est_bias);
         report(&e, irr, irr2, label);
-        if (getenv("BENCH_BIAS_DEBUG"))
-            for (size_t q = 0; q < e.n; q++)
-                if (e.group[q] == BSC_BURIED) {
-                    if (e.recv[q] == SIZE_MAX) continue;
-                    size_t ti = texel_of[e.recv[q]];
-                    const bk_texel *x = &tx.receivers[ti];
-                    printf("   buried %s: orig (%.3f %.3f %.3f) now (%.3f %.3f %.3f) n (%.2f %.2f %.2f) flags %u E %.4f\n",
-                           s.objects[s.tri_object[x->tri]].name, orig[3 * ti], orig[3 * ti + 1], orig[3 * ti + 2],
-                           x->position[0], x->position[1], x->position[2], x->normal[0], x->normal[1], x->normal[2],
-                           x->flags, lbk_at(irr, e.recv[q]));
-                }
+        if (getenv("BENCH_BIAS_DEBUG")) print_buried(&s, &tx, &e, texel_of, orig, irr);
         if (a.worst && irr2) print_worst(&e, irr, irr2, a.worst);
     }
     free(irr2);

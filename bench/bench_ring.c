@@ -48,6 +48,133 @@ static double filtered(const float *plane, int w, int h, double x, double y)
     return v;
 }
 
+/* Bakes every texel once (the ring texels as points, the others over their footprints) into
+ * irr (3 per texel); returns the transport's result. */
+static lbk_result bake_texels(const bk_scene *s, const bk_tracer *t, const bk_texels *tx, double density, int passes,
+                              int threads, float *irr, bk_transport_stats *st, size_t *rings)
+{
+    bk_receiver *r = calloc(tx->count, sizeof *r);
+    *rings = 0;
+    for (size_t i = 0; i < tx->count; i++) {
+        const bk_texel *x = &tx->receivers[i];
+        memcpy(r[i].position, x->position, 12);
+        memcpy(r[i].normal, x->normal, 12);
+        r[i].footprint_first = x->footprint_first;
+        r[i].footprint_count = x->footprint_count;
+        memcpy(r[i].footprint_box, x->footprint_box, sizeof x->footprint_box);
+        *rings += (x->flags & BK_TEXEL_RING) != 0;
+    }
+    float *cell = malloc(s->tri_count * sizeof *cell);
+    for (size_t i = 0; i < s->tri_count; i++) cell[i] = (float)(1.0 / density);
+    lbk_sh9_rgb *rad = calloc(tx->count, sizeof *rad);
+    bk_transport_options o;
+    memset(&o, 0, sizeof o);
+    o.seed = 3;
+    o.threads = threads;
+    o.target_error = -1;
+    o.first_pass_samples = 16;
+    o.max_samples = 2 * 16 * ((1 << passes) - 1);
+    o.cell_size = cell;
+    o.footprint = tx->footprint;
+    o.footprint_count = tx->footprint_count;
+    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL};
+    lbk_result res = bk_transport_run(s, t, r, tx->count, &o, &out, st);
+    free(rad), free(r), free(cell);
+    return res;
+}
+
+/* Per page, the luminance planes of both candidates: point (every texel as baked) and dilate
+ * (the ring left empty, filled by bk_dilate). */
+static void candidate_planes(const bk_texels *tx, const float *irr, int margin, float **pl_point, float **pl_dil)
+{
+    for (size_t p = 0; p < tx->page_count; p++) {
+        int w = tx->pages[p].width, h = tx->pages[p].height;
+        size_t n = (size_t)w * (size_t)h;
+        pl_point[p] = calloc(n, sizeof(float));
+        pl_dil[p] = calloc(n, sizeof(float));
+        uint8_t *mask = calloc(n, 1), *mask2 = calloc(n, 1);
+        for (size_t i = 0; i < n; i++) {
+            int32_t ri = tx->index[tx->page_offset[p] + i];
+            if (ri < 0) continue;
+            float v = (float)lum3f(irr + 3 * (size_t)ri);
+            pl_point[p][i] = v;
+            mask2[i] = 1;
+            if (!(tx->receivers[ri].flags & BK_TEXEL_RING)) { /* dilate: the ring left empty */
+                pl_dil[p][i] = v;
+                mask[i] = 1;
+            }
+        }
+        bk_dilate(pl_dil[p], 1, mask, w, h, margin + 2);
+        bk_dilate(pl_point[p], 1, mask2, w, h, margin + 2);
+        free(mask);
+        free(mask2);
+    }
+}
+
+/* The world point and normal of triangle tri at barycentrics (1 − a − b, a, b). */
+static void world_point(const bk_scene *s, uint32_t tri, double a, double b, float p[3], float n[3])
+{
+    const uint32_t *ix = s->tris + 3 * (size_t)tri;
+    double wb[3] = {1 - a - b, a, b}, nn = 0;
+    for (int d = 0; d < 3; d++) {
+        double pp = 0, nv = 0;
+        for (int m = 0; m < 3; m++) {
+            pp += wb[m] * s->positions[3 * (size_t)ix[m] + d];
+            nv += wb[m] * s->normals[3 * (size_t)ix[m] + d];
+        }
+        p[d] = (float)pp;
+        n[d] = (float)nv;
+        nn += nv * nv;
+    }
+    for (int d = 0; d < 3; d++) n[d] = (float)(n[d] / sqrt(nn));
+}
+
+/* Candidate points: uniform over the chart triangles (one per 0.25 texel² of uv area), those whose
+ * bilinear taps include a ring texel and that lie in the room's air; *count of them. */
+static ev_pt *ring_points(const bk_scene *s, const bk_atlas *at, const bk_texels *tx, size_t *count)
+{
+    size_t cap = 1024, n = 0;
+    ev_pt *ev = malloc(cap * sizeof *ev);
+    uint64_t rng = 0x9E3779B97F4A7C15ull;
+    for (size_t c = 0; c < at->chart_count; c++) {
+        const bk_atlas_chart *ch = &at->charts[c];
+        if (ch->page < 0) continue;
+        int w = tx->pages[ch->page].width, h = tx->pages[ch->page].height;
+        for (uint32_t e = ch->first; e < ch->first + ch->count; e++) {
+            const float *uv = at->tri_uv + 6 * (size_t)e;
+            double area = 0.5 * fabs((uv[2] - uv[0]) * (uv[5] - uv[1]) - (uv[4] - uv[0]) * (uv[3] - uv[1]));
+            int k = (int)ceil(area * 4);
+            for (int q = 0; q < k; q++) {
+                double a = rp_uniform(&rng), b = rp_uniform(&rng);
+                if (a + b > 1) { a = 1 - a; b = 1 - b; }
+                double x = uv[0] + a * (uv[2] - uv[0]) + b * (uv[4] - uv[0]);
+                double y = uv[1] + a * (uv[3] - uv[1]) + b * (uv[5] - uv[1]);
+                int32_t idx[4];
+                double wt[4];
+                bk_bilinear_taps(x, y, w, h, idx, wt);
+                int ring = 0;
+                for (int j = 0; j < 4; j++) {
+                    int32_t ri = tx->index[tx->page_offset[ch->page] + (size_t)idx[j]];
+                    if (wt[j] > 0 && ri >= 0 && (tx->receivers[ri].flags & BK_TEXEL_RING)) ring = 1;
+                }
+                if (!ring) continue;
+                ev_pt v;
+                v.page = (uint32_t)ch->page;
+                v.tri = at->tris[e];
+                v.x = x;
+                v.y = y;
+                world_point(s, v.tri, a, b, v.p, v.n);
+                int g = bsc_group(s, v.tri, v.p, v.n);
+                if (g == BSC_OUTSIDE || g == BSC_SEALED || bsc_solid_depth(v.p) > 0) continue;
+                if (n == cap) ev = realloc(ev, (cap *= 2) * sizeof *ev);
+                ev[n++] = v;
+            }
+        }
+    }
+    *count = n;
+    return ev;
+}
+
 int main(int argc, char **argv)
 {
     double density = 6;
@@ -77,110 +204,17 @@ int main(int argc, char **argv)
     memset(&po, 0, sizeof po);
     po.threads = threads;
     bk_texels_push_out(&tx, &s, t, &po, NULL);
-    /* every texel a receiver: the ring texels as points, the others over their footprints */
-    bk_receiver *r = calloc(tx.count, sizeof *r);
-    size_t rings = 0;
-    for (size_t i = 0; i < tx.count; i++) {
-        const bk_texel *x = &tx.receivers[i];
-        memcpy(r[i].position, x->position, 12);
-        memcpy(r[i].normal, x->normal, 12);
-        r[i].footprint_first = x->footprint_first;
-        r[i].footprint_count = x->footprint_count;
-        memcpy(r[i].footprint_box, x->footprint_box, sizeof x->footprint_box);
-        rings += (x->flags & BK_TEXEL_RING) != 0;
-    }
-    float *cell = malloc(s.tri_count * sizeof *cell);
-    for (size_t i = 0; i < s.tri_count; i++) cell[i] = (float)(1.0 / density);
     float *irr = calloc(3 * tx.count, sizeof *irr);
-    lbk_sh9_rgb *rad = calloc(tx.count, sizeof *rad);
-    bk_transport_options o;
-    memset(&o, 0, sizeof o);
-    o.seed = 3;
-    o.threads = threads;
-    o.target_error = -1;
-    o.first_pass_samples = 16;
-    o.max_samples = 2 * 16 * ((1 << passes) - 1);
-    o.cell_size = cell;
-    o.footprint = tx.footprint;
-    o.footprint_count = tx.footprint_count;
-    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL};
     bk_transport_stats st;
-    if (bk_transport_run(&s, t, r, tx.count, &o, &out, &st) != LBK_OK) { fprintf(stderr, "transport failed\n"); return 1; }
-    /* per page: luminance planes for both candidates */
+    size_t rings = 0;
+    if (bake_texels(&s, t, &tx, density, passes, threads, irr, &st, &rings) != LBK_OK) {
+        fprintf(stderr, "transport failed\n");
+        return 1;
+    }
     float **pl_point = calloc(tx.page_count, sizeof *pl_point), **pl_dil = calloc(tx.page_count, sizeof *pl_dil);
-    for (size_t p = 0; p < tx.page_count; p++) {
-        int w = tx.pages[p].width, h = tx.pages[p].height;
-        size_t n = (size_t)w * (size_t)h;
-        pl_point[p] = calloc(n, sizeof(float));
-        pl_dil[p] = calloc(n, sizeof(float));
-        uint8_t *mask = calloc(n, 1), *mask2 = calloc(n, 1);
-        for (size_t i = 0; i < n; i++) {
-            int32_t ri = tx.index[tx.page_offset[p] + i];
-            if (ri < 0) continue;
-            float v = (float)lum3f(irr + 3 * (size_t)ri);
-            pl_point[p][i] = v;
-            mask2[i] = 1;
-            if (!(tx.receivers[ri].flags & BK_TEXEL_RING)) { /* dilate: the ring left empty */
-                pl_dil[p][i] = v;
-                mask[i] = 1;
-            }
-        }
-        bk_dilate(pl_dil[p], 1, mask, w, h, at.margin + 2);
-        bk_dilate(pl_point[p], 1, mask2, w, h, at.margin + 2);
-        free(mask);
-        free(mask2);
-    }
-    /* candidate points: uniform over the chart triangles (one per 0.25 texel² of uv area) */
-    size_t cap = 1024, n = 0;
-    ev_pt *ev = malloc(cap * sizeof *ev);
-    uint64_t rng = 0x9E3779B97F4A7C15ull;
-    for (size_t c = 0; c < at.chart_count; c++) {
-        const bk_atlas_chart *ch = &at.charts[c];
-        if (ch->page < 0) continue;
-        int w = tx.pages[ch->page].width, h = tx.pages[ch->page].height;
-        for (uint32_t e = ch->first; e < ch->first + ch->count; e++) {
-            const float *uv = at.tri_uv + 6 * (size_t)e;
-            double area = 0.5 * fabs((uv[2] - uv[0]) * (uv[5] - uv[1]) - (uv[4] - uv[0]) * (uv[3] - uv[1]));
-            int k = (int)ceil(area * 4);
-            for (int q = 0; q < k; q++) {
-                double a = rp_uniform(&rng), b = rp_uniform(&rng);
-                if (a + b > 1) { a = 1 - a; b = 1 - b; }
-                double x = uv[0] + a * (uv[2] - uv[0]) + b * (uv[4] - uv[0]);
-                double y = uv[1] + a * (uv[3] - uv[1]) + b * (uv[5] - uv[1]);
-                int32_t idx[4];
-                double wt[4];
-                bk_bilinear_taps(x, y, w, h, idx, wt);
-                int ring = 0;
-                for (int j = 0; j < 4; j++) {
-                    int32_t ri = tx.index[tx.page_offset[ch->page] + (size_t)idx[j]];
-                    if (wt[j] > 0 && ri >= 0 && (tx.receivers[ri].flags & BK_TEXEL_RING)) ring = 1;
-                }
-                if (!ring) continue;
-                ev_pt v;
-                v.page = (uint32_t)ch->page;
-                v.tri = at.tris[e];
-                v.x = x;
-                v.y = y;
-                const uint32_t *ix = s.tris + 3 * (size_t)v.tri;
-                double wb[3] = {1 - a - b, a, b}, nn = 0;
-                for (int d = 0; d < 3; d++) {
-                    double pp = 0, nv = 0;
-                    for (int m = 0; m < 3; m++) {
-                        pp += wb[m] * s.positions[3 * (size_t)ix[m] + d];
-                        nv += wb[m] * s.normals[3 * (size_t)ix[m] + d];
-                    }
-                    v.p[d] = (float)pp;
-                    v.n[d] = (float)nv;
-                    nn += nv * nv;
-                }
-                for (int d = 0; d < 3; d++) v.n[d] = (float)(v.n[d] / sqrt(nn));
-                int g = bsc_group(&s, v.tri, v.p, v.n);
-                if (g == BSC_OUTSIDE || g == BSC_SEALED || bsc_solid_depth(v.p) > 0) continue;
-                if (n == cap) ev = realloc(ev, (cap *= 2) * sizeof *ev);
-                ev[n++] = v;
-            }
-        }
-    }
+    candidate_planes(&tx, irr, at.margin, pl_point, pl_dil);
+    size_t n = 0;
+    ev_pt *ev = ring_points(&s, &at, &tx, &n);
     /* an even subset of `want` points */
     size_t m = 0;
     for (size_t i = 0; i < n; i++)
@@ -215,7 +249,7 @@ int main(int argc, char **argv)
                100 * sg[k] / rs);
     for (size_t p = 0; p < tx.page_count; p++) free(pl_point[p]), free(pl_dil[p]);
     free(pl_point), free(pl_dil), free(ev), free(pp), free(nn), free(ref), free(se);
-    free(irr), free(rad), free(r), free(cell);
+    free(irr);
     bk_texels_free(&tx);
     bk_tracer_destroy(t);
     bk_atlas_free(&at);
