@@ -203,9 +203,9 @@ void Importer::visit(int n, const Mat4 &parent, const std::string &inh_set, cons
         if (ex.Has("lbk_texel_density")) {
             const tinygltf::Value &v = ex.Get("lbk_texel_density");
             double d = v.IsNumber() ? v.GetNumberAsDouble() : -1;
-            if (!v.IsNumber() || !std::isfinite(d) || d <= 0 || d > 10000)
-                fail("%s: %s: extras key lbk_texel_density must be a number of texels per metre in (0, 10000]",
-                     file, lbl.c_str());
+            if (!v.IsNumber() || !std::isfinite(d) || d <= 0 || d > BK_TEXEL_DENSITY_MAX)
+                fail("%s: %s: extras key lbk_texel_density must be a number of texels per metre in (0, %g]",
+                     file, lbl.c_str(), BK_TEXEL_DENSITY_MAX);
             inst.texel_density = (float)d;
         }
         for (const char *key : {"lbk_light_set", "lbk_door"}) {

@@ -9,6 +9,10 @@
 #include <stddef.h>
 #include <stdint.h>
 
+/* The highest texel density (texels per metre) anything accepts: lbk/bake.h's
+ * LBK_BAKE_TEXEL_DENSITY_MAX, which bake/pipeline asserts equal (this library sits below it). */
+#define BK_TEXEL_DENSITY_MAX 10000.0
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -50,7 +54,8 @@ typedef struct bk_object {         /* one glTF node that instantiates a mesh */
     uint64_t geometry_hash;        /* XXH3-64 of the object's local-space positions and indices */
     uint32_t first_tri, tri_count; /* range in bk_scene.tris */
     int lighting;                  /* enum bk_lighting, from extras lbk_lighting */
-    float texel_density;           /* texels per metre from extras lbk_texel_density; 0: default */
+    float texel_density;           /* texels per metre from extras lbk_texel_density, in
+                                      (0, BK_TEXEL_DENSITY_MAX]; 0: default */
     char light_set[64];            /* extras lbk_light_set ("" none): emissive triangles join that set */
     char door[64];                 /* extras lbk_door ("" none): the object is a door, closed state */
     int has_uv1;                   /* TEXCOORD_1 present on all its primitives */

@@ -13,6 +13,9 @@
 #define XXH_INLINE_ALL
 #include <xxhash.h>
 
+/* One range for the texel density: the scene library's importer checks the one lbk/bake.h states. */
+_Static_assert(BK_TEXEL_DENSITY_MAX == LBK_BAKE_TEXEL_DENSITY_MAX, "one texel density range");
+
 #define SD_MAX_TRIANGLES ((size_t)1 << 24) /* the importer's default cap */
 #define SD_PI 3.14159265358979323846
 
@@ -120,8 +123,9 @@ static lbk_result check_objects(sd_ctx *c)
             return sd_fail(c, LBK_ERR_BAD_INPUT, "object %zu: material %u out of range", i, o->material);
         if ((unsigned)o->lighting > LBK_BAKE_LIGHTING_NONE)
             return sd_fail(c, LBK_ERR_BAD_INPUT, "object %zu: unknown lighting %d", i, (int)o->lighting);
-        if (!(o->texel_density >= 0 && o->texel_density <= 10000))
-            return sd_fail(c, LBK_ERR_BAD_INPUT, "object %zu: texel density must be in [0, 10000] texels per metre", i);
+        if (!(o->texel_density >= 0 && o->texel_density <= LBK_BAKE_TEXEL_DENSITY_MAX))
+            return sd_fail(c, LBK_ERR_BAD_INPUT, "object %zu: texel density must be in [0, %g] texels per metre", i,
+                           LBK_BAKE_TEXEL_DENSITY_MAX);
         if ((o->light_set && o->light_set[0] && !valid_name(o->light_set)) || (o->door && o->door[0] && !valid_name(o->door)))
             return sd_fail(c, LBK_ERR_BAD_INPUT, "object %zu: a light set or door name must be 1 to 63 printable bytes", i);
     }
