@@ -1,5 +1,5 @@
 /* An in-memory scene description (lbk_bake_scene, lbk/bake.h) → bk_scene, by the glTF
- * importer's rules (scene/gltf_import.cc): flat shading where there are no normals, base
+ * importer's rules (scene/gltf_*.cc): flat shading where there are no normals, base
  * colours clamped to 1, lights as KHR_lights_punctual gives them, identity node frames. The
  * description is untrusted: every index, count and number is checked. */
 #ifndef BK_SCENE_DESC_H

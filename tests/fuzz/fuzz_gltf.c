@@ -1,4 +1,4 @@
-/* libFuzzer harness for the glTF importer (scene/gltf_import.cc: tinygltf, Draco, stb_image,
+/* libFuzzer harness for the glTF importer (scene/gltf_*.cc: tinygltf, Draco, stb_image,
  * our own JSON pre-pass and limits): each input is written to a file of this process
  * (`.glb` when it starts with the GLB magic, else `.gltf`) in a private folder and imported with
  * small caps, so that no input can make the harness allocate or run without bound. Any crash or
