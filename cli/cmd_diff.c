@@ -177,12 +177,4 @@ static int diff_main(int argc, char **argv, tl_guard *guard)
     return exit_code;
 }
 
-int lbk_cmd_diff(int argc, char **argv)
-{
-    tl_guard guard;
-    tl_guard_init(&guard, "diff");
-    const int code = diff_main(argc, argv, &guard);
-    tl_guard_activate(NULL);
-    tl_guard_free(&guard);
-    return code;
-}
+int lbk_cmd_diff(int argc, char **argv) { return cli_run_guarded("diff", diff_main, argc, argv); }

@@ -173,12 +173,4 @@ static int export_main(int argc, char **argv, tl_guard *guard)
     return LBK_EXIT_OK;
 }
 
-int lbk_cmd_export(int argc, char **argv)
-{
-    tl_guard guard;
-    tl_guard_init(&guard, "export");
-    const int code = export_main(argc, argv, &guard);
-    tl_guard_activate(NULL);
-    tl_guard_free(&guard);
-    return code;
-}
+int lbk_cmd_export(int argc, char **argv) { return cli_run_guarded("export", export_main, argc, argv); }

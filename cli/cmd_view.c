@@ -179,12 +179,4 @@ static int view_main(int argc, char **argv, tl_guard *guard)
     return rc;
 }
 
-int lbk_cmd_view(int argc, char **argv)
-{
-    tl_guard guard;
-    tl_guard_init(&guard, "view");
-    const int code = view_main(argc, argv, &guard);
-    tl_guard_activate(NULL);
-    tl_guard_free(&guard);
-    return code;
-}
+int lbk_cmd_view(int argc, char **argv) { return cli_run_guarded("view", view_main, argc, argv); }

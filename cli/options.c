@@ -76,3 +76,13 @@ int cli_check_scene_outputs(const char *cmd, const char *scene, const char *allo
     tl_guard_free(&g);
     return rc;
 }
+
+int cli_run_guarded(const char *cmd, int (*fn)(int argc, char **argv, struct tl_guard *guard), int argc, char **argv)
+{
+    tl_guard guard;
+    tl_guard_init(&guard, cmd);
+    const int code = fn(argc, argv, &guard);
+    tl_guard_activate(NULL);
+    tl_guard_free(&guard);
+    return code;
+}

@@ -23,6 +23,10 @@ int cli_parse_uint(const char *s, unsigned long long lo, unsigned long long hi, 
 struct tl_guard;
 int cli_check_outputs(const char *cmd, const struct tl_guard *g, const char *const *outputs);
 
+/* Runs fn with a fresh guard for `cmd` and deactivates and frees it afterwards, whatever fn
+ * returns: the commands that keep their guard active while they write use this. */
+int cli_run_guarded(const char *cmd, int (*fn)(int argc, char **argv, struct tl_guard *guard), int argc, char **argv);
+
 /* cli_check_outputs for a command that reads a glTF scene: the scene, every file it references
  * (allow_outside as the bake resolves them) and `extra_inputs` (pairs {role, path}, ended by
  * {NULL, NULL}; NULL paths skipped) are the inputs. */
