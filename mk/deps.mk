@@ -13,12 +13,13 @@ DEB_TEST_PKGS := $(DEB_TOOL_PKGS) libcmocka-dev clang libclang-rt-14-dev
 # lbk view's tests: node runs the page's container reader against liblbk, headless Chromium
 # (SwiftShader WebGL) loads the page; without them those cases are SKIPPED (counted so).
 VIEW_PKGS     := nodejs chromium
-# npm, for the glTF-Validator check (gltf-validator below)
+# npm, for the glTF-Validator check (gltf-validator below): installed only where no npm runs yet
+# (a nodejs that bundles its own npm conflicts with Debian's npm package)
 NPM_PKGS      := npm
 # A single-node Slurm cluster for the distributed-bake test (tests/e2e/slurm_dist.sh, which
 # also installs them itself when run as root).
 SLURM_PKGS    := munge slurmd slurmctld slurm-client
-DEB_PKGS      := $(DEB_TEST_PKGS) $(GPU_PKGS) $(VIEW_PKGS) $(NPM_PKGS) $(SLURM_PKGS)
+DEB_PKGS      := $(DEB_TEST_PKGS) $(GPU_PKGS) $(VIEW_PKGS) $(SLURM_PKGS)
 # What `make bench-cycles` needs besides the build: Blender (Cycles) and Python 3.
 BENCH_DEB_PKGS := blender python3
 
@@ -75,7 +76,7 @@ $(GLTF_VALIDATOR)/package.json:
 	@mkdir -p $(BUILD)/npm
 	npm install --prefix $(BUILD)/npm --no-audit --no-fund --loglevel=error gltf-validator@$(GLTF_VALIDATOR_VERSION)
 gltf-validator:
-	@($(call deps_sh,$(NPM_PKGS),$$([ "$$(id -u)" = 0 ] && echo 'running as root'),the glTF-Validator check will be SKIPPED)) || true
+	@command -v npm >/dev/null 2>&1 || ($(call deps_sh,$(NPM_PKGS),$$([ "$$(id -u)" = 0 ] && echo 'running as root'),the glTF-Validator check will be SKIPPED)) || true
 	@if command -v npm >/dev/null 2>&1 && command -v node >/dev/null 2>&1; then \
 	  $(MAKE) --no-print-directory $(GLTF_VALIDATOR)/package.json; \
 	else echo "lbk: npm/node not found: the glTF-Validator check will be SKIPPED (apt-get install npm)"; fi
