@@ -1,6 +1,6 @@
-# Fuzzing (clang libFuzzer; tests/fuzz/README.md): make fuzz, make fuzz-long, make fuzz-corpus.
+# Fuzzing (clang libFuzzer; tests/fuzz/README.md): make fuzz, make fuzz-long, make fuzz-corpus, make fuzz-cov.
 # make test builds every harness and runs each for a fixed number of inputs.
-.PHONY: fuzz fuzz-long fuzz-corpus
+.PHONY: fuzz fuzz-long fuzz-corpus fuzz-cov
 FUZZ_FLAGS := -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined -g -O1
 $(BUILD)/fuzz_container: tests/fuzz/fuzz_container.c $(LIB_SRC)
 	@mkdir -p $(@D)
@@ -38,8 +38,15 @@ $(BUILD)/fuzz_part: $(FUZZ_PART_OBJ) $(FUZZ_LIB_OBJ)
 	$(CLANGXX) -fsanitize=fuzzer,address,undefined -o $@ $^ $(BAKE_LIBS) $(LIB_LIBS)
 -include $(wildcard $(BUILD)/fuzz-obj/*/*.d $(BUILD)/fuzz-obj/*/*/*.d)
 
-# The seed corpus (tests/fuzz/README.md): the golden files, the containers make_corpus.c builds
-# (every section type) and two small real bakes. Regenerate by hand; the files are committed.
+# The seed corpora (tests/fuzz/README.md), regenerated from the current writers (deterministic:
+# the bakes are byte-reproducible, a fixed thread count): corpus/ the golden files, the containers
+# make_corpus.c builds (every section type) and small real bakes; corpus_part/ units of
+# part_scene.gltf and sets_scene.gltf (lbk plan + lbk bake-unit), the hand-made regression parts
+# given the current part format version (the harness repairs their checksums); corpus_profile/
+# the shipped profiles; corpus_gltf/ the shared scenes and a GLB lbk export wrote. corpus_exr/ is
+# Blender's and lbk export's EXRs, which carry no lbk format version: left as they are. Run it
+# when a writer's output or a format version changes and commit the result; make test's
+# fuzz_seeds check fails while a seed is older than its writer.
 fuzz-corpus: $(BUILD)/liblbk.a $(BUILD)/lbk
 	$(CC) $(CSTD) -O1 $(WARN) $(LIB_INC) tests/fuzz/make_corpus.c $(BUILD)/liblbk.a $(LIB_LIBS) -o $(BUILD)/make_corpus
 	cp tests/golden/*.lbk tests/fuzz/corpus/
@@ -53,7 +60,17 @@ fuzz-corpus: $(BUILD)/liblbk.a $(BUILD)/lbk
 	@d=$$(mktemp -d) && for n in 1 2; do \
 	  $(BUILD)/lbk plan tests/fuzz/part_scene.gltf -o $$d/o.lbk --plan $$d/p$$n.json --units $$n --samples 4 --target-error none \
 	    --texel-density 2 --glg-spacing 8 -q && \
-	  $(BUILD)/lbk bake-unit $$d/p$$n.json 0 -o tests/fuzz/corpus_part/unit0of$$n.lbkpart -q || exit 1; done; rm -rf $$d
+	  $(BUILD)/lbk bake-unit $$d/p$$n.json 0 -o tests/fuzz/corpus_part/unit0of$$n.lbkpart -q --threads 2 || exit 1; done && \
+	  $(BUILD)/lbk plan tests/fuzz/sets_scene.gltf -o $$d/o.lbk --plan $$d/s.json --units 16 --samples 4 --target-error none \
+	    --texel-density 1 --glg-spacing 8 -q && \
+	  $(BUILD)/lbk bake-unit $$d/s.json 15 -o tests/fuzz/corpus_part/sets_unit15of16.lbkpart -q --threads 2 || exit 1; rm -rf $$d
+	@v=$$(sed -n 's/^#define BK_PART_VERSION  *\([0-9]*\).*/\1/p' bake/dist/dist.h) && for f in tests/fuzz/corpus_part/regress_*.lbkpart; do \
+	  printf "\\$$(printf %o $$v)\\000\\000\\000" | dd of=$$f bs=1 seek=8 conv=notrunc status=none || exit 1; done
+	cp tools/convert/profiles/*.profile tests/fuzz/corpus_profile/
+	cp scenes/cornell_box/CornellBox-Original.gltf tests/fuzz/corpus_gltf/cornell.gltf
+	cp tests/fuzz/sets_scene.gltf tests/fuzz/corpus_gltf/sets_scene.gltf
+	@d=$$(mktemp -d) && $(BUILD)/lbk export tests/fuzz/corpus/bake_sets.lbk --gltf $$d/sets_export.glb --scene tests/fuzz/sets_scene.gltf -q && \
+	  cp $$d/sets_export.glb tests/fuzz/corpus_gltf/ && rm -rf $$d
 fuzz: deps-test
 	@$(MAKE) --no-print-directory $(BUILD)/fuzz_container
 	@mkdir -p $(BUILD)/fuzz-corpus
@@ -62,6 +79,16 @@ fuzz: deps-test
 	  $(BUILD)/$$h -max_total_time=$${FUZZ_SECONDS:-60} -max_len=65536 -rss_limit_mb=2048 -artifact_prefix=$(BUILD)/ \
 	    $(BUILD)/fuzz-corpus-$$n \
 	    tests/fuzz/corpus_$$n || exit 1; done
+	@$(MAKE) --no-print-directory fuzz-cov
+# Each harness's coverage from its committed seeds alone (libFuzzer's cov: at INITED, -runs=0;
+# a scratch folder first, so nothing is written into the seeds): a harness whose seeds its code
+# refuses (an old format) shows a few dozen instead of thousands.
+fuzz-cov: deps-test
+	@$(MAKE) --no-print-directory $(BUILD)/fuzz_container $(FUZZ_HARNESSES:%=$(BUILD)/%)
+	@printf '%-16s %6s %8s\n' harness seeds cov; \
+	for h in fuzz_container $(FUZZ_HARNESSES); do n=$${h#fuzz_}; c=tests/fuzz/corpus_$$n; [ $$h = fuzz_container ] && c=tests/fuzz/corpus; \
+	  d=$$(mktemp -d) && cov=$$($(BUILD)/$$h -runs=0 -max_len=65536 -rss_limit_mb=2048 $$d $$c 2>&1 | sed -n 's/.*INITED cov: \([0-9]*\).*/\1/p' | tail -n 1); \
+	  rm -rf $$d; printf '%-16s %6s %8s\n' $$h $$(ls $$c | wc -l) $${cov:-?}; done
 # Hours of fuzzing (FUZZ_HOURS, default 1, per harness, one after the other): a finding stops it
 # with the reproducer in build/ (crash-*, leak-*, timeout-*); what the runs found stays in
 # build/fuzz-corpus*.

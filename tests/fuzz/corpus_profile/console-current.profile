@@ -17,6 +17,8 @@ default = zstd:19
 # Provenance and the bake report are editor data; the runtime never reads them.
 META = drop
 REPT = drop
+# The per-texel error map (TERR, lbk bake --error-map) is a diagnostic for the editor and lbk view.
+TERR = drop
 # GPU-resident payloads: raw, so the hardware decompressor and zero-copy upload see them as is.
 LMAP = none
 GLG  = none

@@ -11,6 +11,8 @@ alignment   = 2048
 default = zstd:19
 META = drop
 REPT = drop
+# The per-texel error map (TERR, lbk bake --error-map) is a diagnostic for the editor and lbk view.
+TERR = drop
 
 [lmap]
 # GNM/D3D11.X linear texture rows: 256-byte pitch alignment.

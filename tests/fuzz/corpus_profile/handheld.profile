@@ -10,6 +10,8 @@ alignment   = 4096
 default = zstd:19
 META = drop
 REPT = drop
+# The per-texel error map (TERR, lbk bake --error-map) is a diagnostic for the editor and lbk view.
+TERR = drop
 
 [lmap]
 # Vulkan / NVN linear uploads: 256-byte rows keep a buffer-to-image copy aligned on every driver.

@@ -10,6 +10,8 @@ alignment   = 4096
 default = zstd:19
 META = drop
 REPT = drop
+# The per-texel error map (TERR, lbk bake --error-map) is a diagnostic for the editor and lbk view.
+TERR = drop
 
 [lmap]
 # D3D12 buffer-to-texture copies want a 256-byte row pitch (Vulkan is satisfied by it too).
