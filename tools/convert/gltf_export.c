@@ -15,6 +15,7 @@
 
 #include "scene/import.h"
 #include "tools/common/error_util.h"
+#include "tools/common/lmuv_match.h"
 #include "tools/convert/glb.h"
 #include "lbk/pixel.h"
 
@@ -110,30 +111,10 @@ static void object_primitives(const bk_scene *s, size_t i, size_t *first, size_t
     *count = p - *first;
 }
 
-/* A GENERATED record must describe exactly the scene's primitives of its object. */
+/* A record must describe exactly the scene object it names (the check lbk render makes too). */
 static int check_record(ex *e, size_t i, const lbk_lmuv_object *r)
 {
-    const bk_scene *s = e->s;
-    size_t pf, pn;
-    object_primitives(s, i, &pf, &pn);
-    if (r->source_node != (uint32_t)s->objects[i].node)
-        return tl_fail(e->err, TL_GLTF_INPUT, "object %zu: LMUV names glTF node %u, the scene node %d", i, r->source_node,
-                       s->objects[i].node);
-    if (r->kind != LBK_LMUV_GENERATED) return 0;
-    if (r->primitive_count != pn)
-        return tl_fail(e->err, TL_GLTF_INPUT, "object %zu: LMUV has %u primitives, the scene %zu", i, r->primitive_count, pn);
-    for (size_t k = 0; k < pn; k++) {
-        lbk_lmuv_primitive q;
-        lbk_lmuv_get_primitive(&e->b->lmuv, r->primitive_first + (uint32_t)k, &q);
-        const bk_primitive *p = &s->primitives[pf + k];
-        if (q.source_primitive != p->gltf_primitive || q.source_vertex_count != p->source_vertex_count ||
-            q.index_count != 3 * (uint64_t)p->tri_count)
-            return tl_fail(e->err, TL_GLTF_INPUT,
-                           "object %zu primitive %u: LMUV (%u vertices, %u indices) does not match the scene's (%u, %u)",
-                           i, q.source_primitive, q.source_vertex_count, q.index_count, p->source_vertex_count,
-                           3 * p->tri_count);
-    }
-    return 0;
+    return tl_lmuv_match_object(e->s, i, &e->b->lmuv, r, TL_GLTF_INPUT, e->err);
 }
 
 /* ---- primitives ------------------------------------------------------------------------------ */

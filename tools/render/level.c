@@ -7,6 +7,7 @@
 
 #include "scene/import.h"
 #include "tools/common/error_util.h"
+#include "tools/common/lmuv_match.h"
 
 /* The scene primitives of object i: [*first, *first + *count) (they are in object order). */
 static void object_primitives(const bk_scene *s, size_t i, size_t *first, size_t *count)
@@ -57,6 +58,8 @@ static int lightmap_coords(rl_level *L, size_t i, char err[TL_ERR_LEN])
         return tl_fail(err, TL_RENDER_INPUT, "object %zu ('%.60s') is lightmapped but has no LMUV record", i,
                        s->objects[i].name);
     const bk_object *o = &s->objects[i];
+    int rc = tl_lmuv_match_object(s, i, lv, &r, TL_RENDER_INPUT, err); /* what lbk export / view check */
+    if (rc) return rc;
     if (r.kind == LBK_LMUV_AUTHORED) {
         for (size_t k = 0; k < 3 * (size_t)o->tri_count; k++) {
             const size_t t = 3 * (size_t)o->first_tri + k;
@@ -66,7 +69,6 @@ static int lightmap_coords(rl_level *L, size_t i, char err[TL_ERR_LEN])
     }
     size_t pf, pn;
     object_primitives(s, i, &pf, &pn);
-    if (r.primitive_count != pn) return tl_fail(err, TL_RENDER_INPUT, "object %zu: LMUV and the scene disagree on its primitives", i);
     /* the importer swapped corners 1 and 2 of a mirrored node's triangles; LMUV keeps glTF's winding */
     static const uint32_t straight[3] = {0, 1, 2}, swapped[3] = {0, 2, 1};
     const uint32_t *order = o->mirrored ? swapped : straight;
@@ -74,8 +76,6 @@ static int lightmap_coords(rl_level *L, size_t i, char err[TL_ERR_LEN])
         const bk_primitive *p = &s->primitives[pf + k];
         lbk_lmuv_primitive q;
         lbk_lmuv_get_primitive(lv, r.primitive_first + (uint32_t)k, &q);
-        if (q.source_primitive != p->gltf_primitive || q.index_count != 3 * (uint64_t)p->tri_count)
-            return tl_fail(err, TL_RENDER_INPUT, "object %zu primitive %u: LMUV does not match the scene", i, p->gltf_primitive);
         for (uint32_t j = 0; j < p->tri_count; j++)
             for (uint32_t c = 0; c < 3; c++) {
                 uint32_t nv, src;
