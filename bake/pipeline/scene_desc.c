@@ -14,7 +14,8 @@
 #include <xxhash.h>
 
 /* One range for the texel density: the scene library's importer checks the one lbk/bake.h states. */
-_Static_assert(BK_TEXEL_DENSITY_MAX == LBK_BAKE_TEXEL_DENSITY_MAX, "one texel density range");
+/* (long): clang takes floating constants in a static assertion only as the operands of casts */
+_Static_assert((long)BK_TEXEL_DENSITY_MAX == (long)LBK_BAKE_TEXEL_DENSITY_MAX, "one texel density range");
 
 #define SD_MAX_TRIANGLES ((size_t)1 << 24) /* the importer's default cap */
 #define SD_PI 3.14159265358979323846
