@@ -316,6 +316,84 @@ void Importer::choose_origin(const std::vector<Instance> &kept)
     }
 }
 
+// What float rays can trace, checked once here over the world-space positions (double, after
+// every transform) before any of them becomes a float or reaches Embree (scene/tracer.h):
+//  * |coordinate| <= kMaxWorldCoord = 1e9 m in the glTF's world, before the origin is taken
+//    away: the origin is a double, 1.2e-7 m apart there, so a 1 mm object keeps its shape;
+//    1e9 m is 2.6 times the Moon's distance, a level beyond it is a unit error or hostile.
+//  * the level's extent (largest axis span) <= kMaxLevelExtent = 1e6 m: float positions of a
+//    recentred level reach E/2, 5e5 m, where floats are 3 cm apart and the tracer's ray offset
+//    (8 ulps) is 25 cm; 10 times the 1e5 m level the tests bake. Past it the baker's
+//    metre-sized grids run out of memory (from ~1e10 m) and past 1.8e18 Embree asserts
+//    (ray.valid(): |org|, |dir| <= FLT_LARGE).
+//  * M / f <= kMaxFeatureRatio = 2^20, M the largest |coordinate| the bake's tracer gets (after
+//    the origin choose_origin picks is taken away, also when this import does not recentre), f
+//    the smallest object's size (largest axis span of its bounds; objects of size 0 have no area
+//    to trace): floats have 24 bits, so at M they are <= M·2^-23 apart and an object of
+//    f = M·2^-20 spans 8 ulps, the tracer's ray offset: a ray leaving a smaller object starts
+//    beyond its far side.
+// The refusal names the node: for the extent the largest object if it alone is too large, else
+// the one farthest from the level's (lower) median object; for the ratio the smallest object.
+void Importer::check_extent(const std::vector<Instance> &kept)
+{
+    const double kMaxWorldCoord = 1e9, kMaxLevelExtent = 1e6, kMaxFeatureRatio = 1048576.0;
+    const char *file = path_.c_str();
+    size_t n = kept.size();
+    if (!n) return;
+    std::vector<double> bmin(n * 3, HUGE_VAL), bmax(n * 3, -HUGE_VAL);
+    for (size_t i = 0; i < n; i++) {
+        const Instance &in = kept[i];
+        for (const Prim &p : meshes_[(size_t)m_.nodes[(size_t)in.node].mesh].prims)
+            for (size_t v = 0; v < p.pos.size() / 3; v++) {
+                double lp[3] = {p.pos[v * 3], p.pos[v * 3 + 1], p.pos[v * 3 + 2]}, wp[3];
+                xform_point(in.world, lp, wp);
+                for (int k = 0; k < 3; k++) {
+                    if (!(std::fabs(wp[k]) <= kMaxWorldCoord))
+                        fail("%s: %s: world-space coordinate %.3g m lies beyond +-%.0e m, the importer's limit "
+                             "(spec/authoring.md: scene extent)", file, node_label(in.node).c_str(), wp[k], kMaxWorldCoord);
+                    bmin[i * 3 + k] = std::min(bmin[i * 3 + k], wp[k]);
+                    bmax[i * 3 + k] = std::max(bmax[i * 3 + k], wp[k]);
+                }
+            }
+    }
+    double mn[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, mx[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, med[3];
+    for (int k = 0; k < 3; k++) {
+        std::vector<double> c(n);
+        for (size_t i = 0; i < n; i++) {
+            mn[k] = std::min(mn[k], bmin[i * 3 + k]);
+            mx[k] = std::max(mx[k], bmax[i * 3 + k]);
+            c[i] = 0.5 * (bmin[i * 3 + k] + bmax[i * 3 + k]);
+        }
+        std::nth_element(c.begin(), c.begin() + (long)((n - 1) / 2), c.end());
+        med[k] = c[(n - 1) / 2];
+    }
+    double extent = 0, reach = 0, feature = HUGE_VAL, largest = -1, far_d = -1;
+    size_t far = 0, small = 0, big = 0;
+    for (int k = 0; k < 3; k++) extent = std::max(extent, mx[k] - mn[k]);
+    for (int k = 0; k < 3; k++) {  // the frame the bake traces in: choose_origin's rule, recentred or not
+        double mid = 0.5 * (mn[k] + mx[k]), o = std::fabs(mid) > 2 * extent ? std::nearbyint(mid) : 0;
+        reach = std::max(reach, std::max(std::fabs(mn[k] - o), std::fabs(mx[k] - o)));
+    }
+    for (size_t i = 0; i < n; i++) {
+        double size = 0, d = 0;
+        for (int k = 0; k < 3; k++) {
+            size = std::max(size, bmax[i * 3 + k] - bmin[i * 3 + k]);
+            d = std::max(d, std::max(std::fabs(bmin[i * 3 + k] - med[k]), std::fabs(bmax[i * 3 + k] - med[k])));
+        }
+        if (d > far_d) far_d = d, far = i;
+        if (size > largest) largest = size, big = i;
+        if (size > 0 && size < feature) feature = size, small = i;
+    }
+    if (largest > kMaxLevelExtent) far = big;  // one object too large by itself
+    if (!(extent <= kMaxLevelExtent))
+        fail("%s: %s: the level's extent reaches %.3g m, beyond the %.0e m float rays can trace "
+             "(spec/authoring.md: scene extent)", file, node_label(kept[far].node).c_str(), extent, kMaxLevelExtent);
+    if (feature < HUGE_VAL && !(reach <= kMaxFeatureRatio * feature))
+        fail("%s: %s: an object %.3g m across in a level whose coordinates reach %.3g m: a ratio of %.3g, beyond "
+             "the 2^20 float rays can resolve (spec/authoring.md: scene extent)", file,
+             node_label(kept[small].node).c_str(), feature, reach, reach / feature);
+}
+
 void Importer::emit_geometry()
 {
     const char *file = path_.c_str();
@@ -345,6 +423,7 @@ void Importer::emit_geometry()
         dets.push_back(det);
     }
     if (o_.recentre) choose_origin(kept);
+    check_extent(kept);
     s_->positions = alloc_array<float>(total_v, 3);
     s_->normals = alloc_array<float>(total_v, 3);
     s_->uv0 = alloc_array<float>(total_v, 2);

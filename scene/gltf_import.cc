@@ -109,6 +109,11 @@ void Importer::check_extensions()
     static const char *const supported[] = {"KHR_draco_mesh_compression", "KHR_lights_punctual",
                                             "KHR_materials_emissive_strength", "KHR_mesh_quantization"};
     for (const std::string &e : m_.extensionsRequired) {
+        bool used = false;
+        for (const std::string &u : m_.extensionsUsed) used = used || u == e;
+        if (!used)  // glTF 2.0 §3.12: extensionsRequired lists extensions that are also in extensionsUsed
+            fail("%s: extensionsRequired names %s, which extensionsUsed does not list", path_.c_str(),
+                 qstr(e).c_str());
         bool ok = false;
         for (const char *s : supported) ok = ok || e == s;
         if (!ok)

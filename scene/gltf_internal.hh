@@ -335,6 +335,7 @@ private:
     void decode_draco(int mi, int pi, const DracoInfo &di, Prim &p, std::vector<uint32_t> &idx, size_t *nverts);
     void emit_geometry();
     void choose_origin(const std::vector<Instance> &kept);
+    void check_extent(const std::vector<Instance> &kept);  // the limits float rays can trace
     // gltf_extras.cc
     void emit_lights();
     void read_sky();

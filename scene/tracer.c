@@ -154,9 +154,16 @@ lbk_result bk_tracer_create(const bk_scene *scene, int build_threads, bk_tracer 
     return LBK_OK;
 }
 
+/* Embree's ray.valid() (asserted in its intersectors) wants |org| and |dir| <= FLT_LARGE,
+ * 1.844e18; a ray beyond that is a miss here, like a non-finite one. The importer keeps levels
+ * far inside (spec/authoring.md, scene extent); this guards scenes made otherwise. */
+#define RAY_LARGE 1.844e18f
+
+static int small3(const float *v) { return fabsf(v[0]) <= RAY_LARGE && fabsf(v[1]) <= RAY_LARGE && fabsf(v[2]) <= RAY_LARGE; }
+
 static int ray_ok(const float org[3], const float dir[3], float tmin, float tmax)
 {
-    return finite3(org) && finite3(dir) && (dir[0] != 0 || dir[1] != 0 || dir[2] != 0) && tmin >= 0 &&
+    return small3(org) && small3(dir) && (dir[0] != 0 || dir[1] != 0 || dir[2] != 0) && tmin >= 0 &&
            !(tmax < tmin) && !isnan(tmax);
 }
 

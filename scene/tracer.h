@@ -43,7 +43,8 @@ lbk_result bk_tracer_create(const bk_scene *scene, int build_threads, bk_tracer 
 void bk_tracer_destroy(bk_tracer *tracer);
 
 /* Closest hit in [tmin, tmax] along org + t·dir (dir need not be unit). Returns 1 and fills
- * *hit on a hit, 0 on a miss (also for non-finite input rays). */
+ * *hit on a hit, 0 on a miss (also for non-finite input rays and for rays with a |org| or |dir|
+ * coordinate above 1.844e18, which Embree cannot take). */
 int bk_tracer_intersect(const bk_tracer *tracer, const float org[3], const float dir[3],
                         float tmin, float tmax, bk_hit *hit);
 /* 1 when anything blocks org + t·dir for t in [tmin, tmax], else 0 (non-finite ray: 0). */
