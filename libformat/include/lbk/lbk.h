@@ -79,9 +79,13 @@ extern "C" {
  * older writer gave it. */
 #define LBK_FORMAT_VERSION_MINOR 4
 
-/* This library's version (semantic versioning of the API and ABI). */
+/* This library's version (semantic versioning of the API and ABI): the minor grows with every
+ * release that adds API. 1.1: LMUV; 1.2: block-encoded LMAP pages (BC6H/BC4/BC5 decoding);
+ * 1.3: OCTP probe volumes and their sampler; 1.4: the TERR error map, the DLS linear apply and
+ * its caller-driven jobs. tests/structure/versions.sh keeps it in step with lbk --version, lbk.pc
+ * and the spec. */
 #define LBK_LIBRARY_VERSION_MAJOR 1
-#define LBK_LIBRARY_VERSION_MINOR 0
+#define LBK_LIBRARY_VERSION_MINOR 4
 #define LBK_LIBRARY_VERSION_PATCH 0
 #define LBK_LIBRARY_VERSION_NUMBER \
     (LBK_LIBRARY_VERSION_MAJOR * 10000 + LBK_LIBRARY_VERSION_MINOR * 100 + LBK_LIBRARY_VERSION_PATCH)
