@@ -19,18 +19,6 @@
 #include "scene/tracer.h"
 #include "support/import_fixtures.h"
 
-/* quad.bin with the quad's four positions replaced (indices and normals as imp_write_quad_bin) */
-static void write_quad_bin_at(const float pos[12])
-{
-    unsigned char buf[108];
-    uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
-    float nrm[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
-    memcpy(buf, pos, 48);
-    memcpy(buf + 48, idx, 12);
-    memcpy(buf + 60, nrm, 48);
-    imp_write_file("quad.bin", buf, sizeof buf);
-}
-
 static void expect_imports(const char *name)
 {
     bk_scene s;
@@ -74,10 +62,10 @@ static void test_extent_positions(void **state)
     (void)state;
     static const float far_x[12] = {3e38f, 0, 0, 3e38f, 1, 0, 3e38f, 1, 1, 3e38f, 0, 1};
     static const float wide[12] = {-3e38f, 0, 0, 3e38f, 0, 0, 3e38f, 1, 0, -3e38f, 1, 0};
-    write_quad_bin_at(far_x);
+    imp_write_quad_bin_at(far_x);
     imp_write_quad_gltf("pos3e38.gltf", "{\"name\":\"edge\",\"mesh\":0}", "0", NULL);
     imp_expect_error("pos3e38.gltf", "node 0 \"edge\"", "3e+38 m");
-    write_quad_bin_at(wide);
+    imp_write_quad_bin_at(wide);
     imp_write_quad_gltf("wide3e38.gltf", "{\"name\":\"span\",\"mesh\":0}", "0", NULL);
     imp_expect_error("wide3e38.gltf", "node 0 \"span\"", "beyond");
     imp_write_quad_bin();

@@ -130,8 +130,13 @@ int imp_teardown_tmp(void **state)
  * (0 1 2, 0 2 3), then 4 +Z normals. 48 + 12 + 48 = 108 bytes. */
 void imp_write_quad_bin(void)
 {
+    static const float pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+    imp_write_quad_bin_at(pos);
+}
+
+void imp_write_quad_bin_at(const float pos[12])
+{
     unsigned char buf[108];
-    float pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
     uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
     float nrm[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
     memcpy(buf, pos, 48);

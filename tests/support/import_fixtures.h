@@ -35,6 +35,8 @@ int imp_teardown_tmp(void **state);
 
 /* quad.bin: 4 positions of a unit quad in the XY plane (z = 0), 6 uint16 indices, 4 +Z normals. */
 void imp_write_quad_bin(void);
+/* The same with the quad's four positions replaced (indices and normals kept). */
+void imp_write_quad_bin_at(const float pos[12]);
 /* A glTF over quad.bin: mesh 0 the quad (indexed, normals, material "grey"), mesh 1 its first
  * three positions (material "lamp", emissive); `nodes`, `scene_nodes` and `top` spliced in as
  * JSON text. */
