@@ -4,6 +4,7 @@ materials (base colour, metallic/roughness factors, emission, emissive strength,
 and node extras. One embedded base64 buffer, so a scene is one self-contained .gltf file."""
 import base64
 import json
+import os
 import struct
 
 
@@ -92,13 +93,23 @@ class Writer:
         self.js["scenes"][0]["nodes"].append(i)
         return i
 
-    def save(self, path):
+    def save(self, path, external_bin=False, scene_extras=None):
+        """external_bin: the buffer goes to a .bin file beside PATH (same stem) instead of a base64
+        data URI. scene_extras: the default scene's extras (e.g. lbk_sky)."""
         js = dict(self.js)
+        if scene_extras:
+            js["scenes"] = [dict(self.js["scenes"][0], extras=scene_extras)]
         if self.lights:
             js["extensions"] = {"KHR_lights_punctual": {"lights": self.lights}}
-            js.setdefault("extensionsUsed", []).append("KHR_lights_punctual")
-        js["buffers"] = [{"byteLength": len(self.bin),
-                          "uri": "data:application/octet-stream;base64," + base64.b64encode(bytes(self.bin)).decode()}]
+            js["extensionsUsed"] = list(js.get("extensionsUsed", [])) + ["KHR_lights_punctual"]
+        if external_bin:
+            bin_path = os.path.splitext(path)[0] + ".bin"
+            with open(bin_path, "wb") as f:
+                f.write(bytes(self.bin))
+            uri = os.path.basename(bin_path)
+        else:
+            uri = "data:application/octet-stream;base64," + base64.b64encode(bytes(self.bin)).decode()
+        js["buffers"] = [{"byteLength": len(self.bin), "uri": uri}]
         with open(path, "w") as f:
             json.dump(js, f)
 
