@@ -52,6 +52,11 @@ STRUCTURE_CHECKS := $(patsubst tests/structure/%.sh,%,$(sort $(wildcard tests/st
 $(STRUCTURE_CHECKS:%=$(BUILD)/tests/%): $(BUILD)/tests/%: tests/structure/%.sh
 	@mkdir -p $(@D)
 	@printf '#!/bin/sh\nexec sh "%s/$<" "$$@"\n' "$(CURDIR)" > $@ && chmod +x $@
+# shell tests of other parts (tests/bench/*.sh: the hard-level suite's generator), the same wrapper
+SHELL_TESTS := $(patsubst tests/bench/%.sh,%,$(sort $(wildcard tests/bench/*.sh)))
+$(SHELL_TESTS:%=$(BUILD)/tests/%): $(BUILD)/tests/%: tests/bench/%.sh
+	@mkdir -p $(@D)
+	@printf '#!/bin/sh\nexec sh "%s/$<" "$$@"\n' "$(CURDIR)" > $@ && chmod +x $@
 
 # ---- make test ------------------------------------------------------------------------------
 # What it builds (test-build) is built through a sub-make, so that HAVE_VULKAN sees what
@@ -59,14 +64,15 @@ $(STRUCTURE_CHECKS:%=$(BUILD)/tests/%): $(BUILD)/tests/%: tests/structure/%.sh
 test-build: $(BUILD)/lbk $(BUILD)/lbk-asan $(TESTS:%=$(BUILD)/tests/%) $(BUILD)/fuzz_container $(BUILD)/fault_shim.so \
             $(FUZZ_HARNESSES:%=$(BUILD)/%) \
             install-check install-lib-check $(TSAN_TESTS:%=$(BUILD)/tsan/bin/%) \
-            $(if $(HAVE_VULKAN),$(BUILD)/lbk-gpu-apply) $(STRUCTURE_CHECKS:%=$(BUILD)/tests/%)
+            $(if $(HAVE_VULKAN),$(BUILD)/lbk-gpu-apply) $(STRUCTURE_CHECKS:%=$(BUILD)/tests/%) \
+            $(SHELL_TESTS:%=$(BUILD)/tests/%)
 test: deps-test
 	@$(MAKE) --no-print-directory test-build
 	@$(MAKE) --no-print-directory gltf-validator
 	@LBK=$(BUILD)/lbk-asan LBK_FAULT_SHIM=$(BUILD)/fault_shim.so BUILD=$(BUILD) FUZZ=$(BUILD)/fuzz_container TSAN_BIN=$(BUILD)/tsan/bin \
 	  FUZZ_MORE="$(foreach h,$(FUZZ_HARNESSES),$(h:fuzz_%=%)=$(BUILD)/$(h))" \
 	  GLTF_VALIDATOR=$$(test -f $(GLTF_VALIDATOR)/package.json && echo $(GLTF_VALIDATOR)) \
-	  sh tests/run.sh $(TESTS) $(STRUCTURE_CHECKS) install_check_shared install_check_static install_lib_check \
+	  sh tests/run.sh $(TESTS) $(STRUCTURE_CHECKS) $(SHELL_TESTS) install_check_shared install_check_static install_lib_check \
 	    bake_check_shared bake_check_static; \
 	st=$$?; n=$$(sed -n 's/^\[  SKIPPED \] \([0-9]*\) test(s).*/\1/p' $(BUILD)/tests/test_gpu.log 2>/dev/null); \
 	if [ "$${n:-0}" -gt 0 ]; then echo "tests: $$n GPU tests SKIPPED, not run: $$(grep -m1 -o 'SKIPPED: .*' $(BUILD)/tests/test_gpu.log)"; fi; \
