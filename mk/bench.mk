@@ -1,6 +1,7 @@
 # Benchmarks, printed as ratios against baselines measured in the same run: make bench (all of
-# them), bench-cycles and bench-render (lbk against Blender Cycles), mesa-bc-check.
-.PHONY: bench bench-cycles bench-render mesa-bc-check
+# them), bench-cycles and bench-render (lbk against Blender Cycles), bench-suite (lbk against
+# Cycles over the generated hard levels; make bench runs bench-suite-quick), mesa-bc-check.
+.PHONY: bench bench-cycles bench-render bench-suite bench-suite-quick mesa-bc-check
 
 $(BUILD)/bench/%: bench/%.c $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a
 	@mkdir -p $(@D)
@@ -18,6 +19,7 @@ bench: deps-tools deps-bench
 	@for b in $(BENCHES); do echo "== $$b"; $(BUILD)/bench/$$b || exit 1; done
 	@echo "== blender_import"; sh bench/blender_import.sh $(BUILD)/lbk $(BUILD)/bench-blender
 	@echo "== bench-cycles"; $(MAKE) --no-print-directory bench-cycles
+	@echo "== bench-suite-quick (hard levels: a few dev scenes)"; $(MAKE) --no-print-directory bench-suite-quick
 	@echo "== render (lbk render vs Blender Cycles)"; $(MAKE) --no-print-directory bench-render
 
 # lbk against Cycles (bench/cycles/README.md). LBK_TREE=/path/to/other/checkout compares that
@@ -46,3 +48,12 @@ bench-cycles: deps-tools deps-bench
 LBK_CYCLES_HARNESS ?= bench/cycles
 bench-render: $(BUILD)/lbk
 	@LBK_CYCLES_HARNESS=$(LBK_CYCLES_HARNESS) python3 bench/render/run.py --lbk $(BUILD)/lbk --out $(BUILD)/bench-render $(BENCH_RENDER_ARGS)
+
+# The hard-level suite against Cycles (bench/levels/README.md), on bench-cycles' harness: every
+# level of the dev and the validation set, reported apart (hours on 2 cores; LBK_BENCH_QUICK=1:
+# short references); bench-suite-quick is make bench's few dev scenes with short references.
+bench-suite bench-suite-quick: deps-tools deps-bench
+	@$(MAKE) --no-print-directory $(if $(LBK_TREE),,$(BUILD)/lbk) $(CYC_DUMP)
+	@LBK=$${LBK:-$(CYC_LBK)} LBK_TEXEL_DUMP=$${LBK_TEXEL_DUMP:-$(CYC_DUMP)} \
+	  BENCH_LEVELS_WORK=$${BENCH_LEVELS_WORK:-$(BUILD)/bench-levels} \
+	  python3 bench/levels/suite.py $(if $(filter bench-suite-quick,$@),--subset --quick)

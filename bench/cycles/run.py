@@ -17,7 +17,9 @@ LBK_ALT (a second lbk binary, e.g. an experiment, baked with seed 1 and measured
 references: extra columns; it must give the same receivers; default: LBK itself with
 --adaptive off, so every run shows what adaptive sampling buys; "none": no second baker),
 LBK_ALT_DUMP (its texel_dump, default LBK_TEXEL_DUMP), LBK_ALT_NAME (its column label, default
-"alt", or "adaptive off" for the default).
+"alt", or "adaptive off" for the default). BENCH_CYCLES_LEVELS / --levels MANIFEST: the scenes
+are those of a bench/levels manifest instead (its folder holds the glTFs; every row and scene
+header carries the level's set, family and layout; bench/levels/README.md).
 """
 import argparse
 import json
@@ -49,6 +51,21 @@ SCENES = [
 ] + [{"name": "metal_room_r%g" % r, "gltf": "{work}/metal_room_r%g.gltf" % r, "lbk": [], "sky": (0, 0, 0),
       "ref_spp": 4096, "calib": (16, 64), "make": "make_metal_room.py", "make_python": True,
       "make_args": ["%g" % r], "on_request": True} for r in (0.05, 0.2, 0.4)]
+
+
+def levels_scenes(manifest):
+    """The scenes of a bench/levels manifest (gen_levels.py), in its order, as SCENES entries."""
+    d = json.load(open(manifest))
+    base = os.path.dirname(os.path.abspath(manifest))
+    out = []
+    for e in d["scenes"]:
+        sc = {"name": e["name"], "gltf": os.path.join(base, e["gltf"]), "lbk": list(e["lbk_args"]),
+              "sky": tuple(e["sky"]), "ref_spp": e["cycles"]["ref_spp"], "calib": tuple(e["cycles"]["calib"]),
+              "ref_spp_quick": e["cycles"].get("ref_spp_quick")}
+        sc["tags"] = {k: e[k] for k in ("set", "level", "family", "layout", "lighting", "density",
+                                        "texel_density", "thin_m")}
+        out.append(sc)
+    return out
 
 
 def density_args(lbk_args):
@@ -143,6 +160,8 @@ def run_scene(sc, work, opt, out):
     # bakes one point per texel, as a Cycles lightmap bake samples a texel (at one position).
     fp_points = max(1.0, rec.sensors / len(rec))
     ref_spp = max(64, int(sc["ref_spp"] * (0.5 if fp_points > 1 else 1)) // (8 if opt.quick else 1))
+    if opt.quick and sc.get("ref_spp_quick"):  # a levels manifest's own quick count (bench/levels/README.md)
+        ref_spp = max(64, int(sc["ref_spp_quick"] * (0.5 if fp_points > 1 else 1)))
     tsv = os.path.join(work, "%s.seed1.lbk.tsv" % sc["name"])
     points_tsv = tsv + ".points"
     common.write_point_sensors(tsv, points_tsv)
@@ -183,7 +202,12 @@ def run_scene(sc, work, opt, out):
     calib = [(r, load(r)) for r in by_role["calibration"]]
     est = float(rec.meta.get("est_rel_rmse", "nan"))
     ref_cpu = sum(r["cpu_s"] for r in refs)
+    tags = sc.get("tags")
     out("")
+    if tags:
+        out("== %s [%s set] %s level %s, %s-lit, %s density (%g texels/m), %s charts" % (
+            sc["name"], tags["set"], tags["family"], tags["level"], tags["lighting"], tags["density"],
+            tags["texel_density"], tags["layout"]))
     out("== %s: lbk %.1f s wall, %.1f s CPU (%s spp, %s; estimated error %.1f %%); Cycles at equal %s time: "
         "%d spp, %.1f s CPU, %.1f s wall; reference 2 x %d spp%s (%.0f s CPU)" % (
             sc["name"], lbk_wall, lbk_cpu, rec.meta.get("spp", "?"), rec.meta.get("status", "?"), 100 * est,
@@ -222,7 +246,18 @@ def run_scene(sc, work, opt, out):
         g, ratio, ga = row(name, rep, idx)
         rows.append({"scene": sc["name"], "object": name, "rep": rep, "n": g.n, "lbk_err": g.lbk,
                      "lbk_bias": g.lbk_bias, "lbk_noise": g.lbk_noise, "lbk_est": est, "cycles_err": g.cyc,
-                     "ratio": ratio, "ref_noise": g.ref_noise, "mean_lux": g.mean, "unresolved": g.unresolved})
+                     "ratio": ratio, "ref_noise": g.ref_noise, "mean_lux": g.mean, "unresolved": g.unresolved,
+                     "lbk_err_rms": g.lbk_rms, "lbk_noise_rms": g.lbk_noise_rms})
+        if tags:
+            rows[-1].update({k: v for k, v in tags.items() if k != "thin_m"})
+            rows[-1]["thin_m"] = tags["thin_m"].get(name)
+            # bias of the receivers facing up and down (a slab lit from the wrong side: top too dark,
+            # underside too bright), each relative to its own mean reference
+            for side, sgn in (("up", 1), ("down", -1)):
+                sub = [i for i in idx if sgn * rec.nrm[i][1] > 0.7]
+                if len(sub) >= 4:
+                    gs = Group(sub, lum, lum2, r1, r2, ceq)
+                    rows[-1]["bias_" + side], rows[-1]["err_" + side] = gs.lbk_bias, gs.lbk
         if ga:
             rows[-1].update({"alt_err": ga.lbk, "alt_bias": ga.lbk_bias})
         mats = sorted(set(rec.mat[i] for i in idx))
@@ -273,7 +308,7 @@ def run_scene(sc, work, opt, out):
             sum(1 for f in rec.flags if f & common.OFFPLANE and not f & common.HIDDEN)))
     cal_txt = ", ".join("%d spp %.1f %%" % (r["spp"], 100 * Group(tex, lum, lum2, r1, r2, v).cyc) for r, v in calib)
     out("  Cycles calibration runs (all texels): %s; scene done in %.0f s" % (cal_txt, time.perf_counter() - t_scene))
-    return rows, {"scene": sc["name"], "lbk_wall_s": lbk_wall, "lbk_cpu_s": lbk_cpu, "lbk_est": est,
+    return rows, {"scene": sc["name"], "tags": tags, "lbk_wall_s": lbk_wall, "lbk_cpu_s": lbk_cpu, "lbk_est": est,
                   "cycles_equal_spp": eq["spp"], "cycles_equal_cpu_s": eq["cpu_s"], "cycles_equal_wall_s": eq["wall_s"],
                   "ref_spp": ref_spp, "all_texels": {"lbk_err": g.lbk, "lbk_bias": g.lbk_bias, "cycles_err": g.cyc,
                                                      "lbk_err_rms": g.lbk_rms, "lbk_noise_rms": g.lbk_noise_rms,
@@ -292,6 +327,9 @@ def main():
     ap.add_argument("--clock", default=env("CYCLES_CLOCK", "cpu"), choices=("cpu", "wall"))
     ap.add_argument("--threads", type=int, default=int(env("BENCH_CYCLES_THREADS", "0")) or os.cpu_count())
     ap.add_argument("--only", default=env("BENCH_CYCLES_SCENES", ""))
+    # the scenes of a bench/levels manifest instead of SCENES
+    ap.add_argument("--levels", default=env("BENCH_CYCLES_LEVELS", ""))
+    ap.add_argument("--results", default="", help="results JSON (default WORK/results.json)")
     ap.add_argument("--quick", action="store_true", default=env("LBK_BENCH_QUICK", "0") not in ("", "0"))
     ap.add_argument("--no-analytic", action="store_true")
     # K x K sensors over each texel's footprint (0: one sensor at the texel's sample point)
@@ -334,7 +372,7 @@ def main():
             out("  ANALYTIC CHECK FAILED: Cycles' units or the sensor orientation are wrong; the comparison is void")
     only = [s for s in opt.only.split(",") if s]
     rows, scenes = [], []
-    for sc in SCENES:
+    for sc in (levels_scenes(opt.levels) if opt.levels else SCENES):
         if (only and sc["name"] not in only) or (not only and sc.get("on_request")):
             continue
         r, s = run_scene(sc, opt.work, opt, out)
@@ -347,7 +385,7 @@ def main():
         "reference's noise exceeds lbk's or Cycles' error, n/r); estimate within 2x of the measured error on %d of %d scenes; "
         "bench took %.0f s" % (met, len(resolved), len(rows) - len(resolved), sum(s["est_within_2x"] for s in scenes),
                                len(scenes), time.perf_counter() - t0))
-    with open(os.path.join(opt.work, "results.json"), "w") as f:
+    with open(opt.results or os.path.join(opt.work, "results.json"), "w") as f:
         json.dump({"rows": rows, "scenes": scenes, "clock": opt.clock, "threads": opt.threads, "lbk": opt.lbk,
                    "blender": ver, "analytic_ok": ok}, f, indent=1)
     with open(os.path.join(opt.work, "report.txt"), "w") as f:

@@ -23,11 +23,14 @@ import geom  # noqa: E402
 import gltf_write  # noqa: E402
 
 LAYOUTS = ("generated", "authored")
-# Cycles reference samples per lighting (bench/cycles/run.py's ref_spp and calibration runs):
-# a lamp's and the sun's direct light need fewer than light reaching a room through a window
-# only after bounces, but the dark room of thin_wall and the shadows under slabs need many.
-CYCLES = {"sky": {"ref_spp": 1024, "calib": [4, 16]}, "lamp": {"ref_spp": 1024, "calib": [4, 16]},
-          "sun": {"ref_spp": 1024, "calib": [4, 16]}}
+
+
+# Cycles reference samples (bench/cycles/run.py: per footprint point half of ref_spp; LBK_BENCH_QUICK
+# uses ref_spp_quick): at 64 spp per point a sky-lit room's reference has 5-12 % noise per texel,
+# more than lbk's error, so every object came out "n/r" (measured 2026-12-06 on table_slab_00);
+# noise falls as 1/sqrt(spp). Fine density has 9x the texels, so half the samples.
+def cycles_spp(density):
+    return {"ref_spp": 8192 if density == "coarse" else 4096, "ref_spp_quick": 2048, "calib": [4, 16]}
 
 
 def all_levels(seed_base):
@@ -91,7 +94,7 @@ def main():
                            "lighting": lv.lighting, "density": p["density"], "texel_density": density,
                            "layout": layout, "gltf": stem + ".gltf", "sky": list(lv.sky),
                            "lbk_args": ["--sky", ",".join("%g" % x for x in lv.sky), "--texel-density", "%g" % density],
-                           "params": p, "objects": [o[0] for o in lv.objects], "thin_m": lv.thin, "cycles": CYCLES[lv.lighting]})
+                           "params": p, "objects": [o[0] for o in lv.objects], "thin_m": lv.thin, "cycles": cycles_spp(p["density"])})
     with open(os.path.join(opt.out, "manifest.json"), "w") as f:
         json.dump({"generator": "bench/levels/gen_levels.py", "seed_base": opt.seed_base, "set": opt.set,
                    "scenes": scenes}, f, indent=1, sort_keys=True)
