@@ -143,6 +143,29 @@ void Importer::decode_draco(int mi, int pi, const DracoInfo &di, Prim &p, std::v
     p.has_nrm = take("NORMAL", 3, p.nrm);
     take("TEXCOORD_0", 2, p.uv0);
     p.has_uv1 = take("TEXCOORD_1", 2, p.uv1);
+    check_draco_counts(mi, pi, di, np, idx.size());
+}
+
+// KHR_draco_mesh_compression: the accessors of the attributes in the stream, and the indices
+// accessor, describe the decoded data; a count that disagrees with it is refused.
+void Importer::check_draco_counts(int mi, int pi, const DracoInfo &di, size_t points, size_t indices)
+{
+    const char *file = path_.c_str();
+    std::string lbl = mesh_label(mi, pi) + ": KHR_draco_mesh_compression";
+    const tinygltf::Primitive &gp = m_.meshes[(size_t)mi].primitives[(size_t)pi];
+    auto check = [&](int acc, size_t decoded, const char *what) {
+        if (acc < 0) return;
+        if ((size_t)acc >= m_.accessors.size())
+            fail("%s: %s: %s accessor %d out of range (%zu accessors)", file, lbl.c_str(), what, acc, m_.accessors.size());
+        if (m_.accessors[(size_t)acc].count != decoded)
+            fail("%s: %s: %s accessor %d has count %zu, the decoded stream %zu", file, lbl.c_str(), what, acc,
+                 m_.accessors[(size_t)acc].count, decoded);
+    };
+    for (const auto &a : di.attributes) {
+        auto it = gp.attributes.find(a.first);
+        if (it != gp.attributes.end()) check(it->second, points, a.first.c_str());
+    }
+    check(di.indices, indices, "indices");
 }
 
 void Importer::prepare_prim(int mi, int pi, Prim &p, bool *is_triangles)

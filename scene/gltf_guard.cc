@@ -6,6 +6,7 @@
 
 #include <sys/stat.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -17,6 +18,12 @@ namespace bk_gltf {
 namespace {
 
 const int kMaxJsonDepth = 64;     // deeper JSON is refused (tinygltf converts extras recursively)
+
+const char *kind_of(mode_t m)
+{
+    return S_ISDIR(m) ? "a directory" : S_ISCHR(m) ? "a character device" : S_ISBLK(m) ? "a block device"
+         : S_ISFIFO(m) ? "a FIFO" : S_ISSOCK(m) ? "a socket" : "not a regular file";
+}
 
 }  // namespace
 
@@ -184,10 +191,255 @@ static int json_max_depth(const char *p, size_t n)
     return deepest;
 }
 
+// ---- the memory budget: what the JSON will cost before anything is built ------------------------
+//
+// tinygltf builds a DOM of the whole JSON and then a struct per node, mesh, primitive, accessor
+// and so on; an empty node `{}` is 3 bytes of JSON but several hundred bytes of tinygltf::Node
+// (2*10^7 of them, 57 MiB of JSON, took more than 12.8 GB). One SAX pass (nlohmann's parser
+// without a DOM: linear, nothing kept but counts) counts what each part will cost and refuses the
+// file when the estimate exceeds kBudgetBase + kBudgetPerByte * its JSON size, naming the counts,
+// before the pre-pass's own DOM or tinygltf allocate anything.
+
+const uint64_t kBudgetBase = (uint64_t)256 << 20;  // any file may take this much
+const uint64_t kBudgetPerByte = 16;                 // and this much more per byte of JSON
+
+enum Kind { K_NODES, K_MESHES, K_PRIMITIVES, K_ACCESSORS, K_BUFFER_VIEWS, K_MATERIALS, K_TEXTURES, K_IMAGES,
+            K_SAMPLERS, K_BUFFERS, K_SCENES, K_ANIMATIONS, K_SKINS, K_CAMERAS, K_KINDS };
+const char *const kKindName[K_KINDS] = {"nodes", "meshes", "primitives", "accessors", "bufferViews", "materials",
+                                        "textures", "images", "samplers", "buffers", "scenes", "animations",
+                                        "skins", "cameras"};
+// What tinygltf allocates for each element (its struct; vectors and strings inside are counted
+// as the JSON values they come from).
+const size_t kKindBytes[K_KINDS] = {
+    sizeof(tinygltf::Node), sizeof(tinygltf::Mesh), sizeof(tinygltf::Primitive), sizeof(tinygltf::Accessor),
+    sizeof(tinygltf::BufferView), sizeof(tinygltf::Material), sizeof(tinygltf::Texture), sizeof(tinygltf::Image),
+    sizeof(tinygltf::Sampler), sizeof(tinygltf::Buffer), sizeof(tinygltf::Scene), sizeof(tinygltf::Animation),
+    sizeof(tinygltf::Skin), sizeof(tinygltf::Camera)};
+const uint64_t kHeap = 16;  // malloc's overhead per block
+
+using json = nlohmann::json;
+
+struct Census {
+    uint64_t values = 0, objects = 0, arrays = 0, keys = 0, extras_values = 0;
+    uint64_t count[K_KINDS] = {};
+};
+
+// The SAX handler: a stack of open containers, each knowing what its elements are.
+class CensusSax : public nlohmann::json_sax<json> {
+public:
+    explicit CensusSax(Census *c) : c_(c) {}
+    std::string error;
+
+    bool null() override { return value(); }
+    bool boolean(bool) override { return value(); }
+    bool number_integer(number_integer_t) override { return value(); }
+    bool number_unsigned(number_unsigned_t) override { return value(); }
+    bool number_float(number_float_t, const string_t &) override { return value(); }
+    bool string(string_t &) override { return value(); }
+    bool binary(binary_t &) override { return value(); }
+    bool key(string_t &k) override
+    {
+        c_->keys++;
+        key_ = k;
+        return true;
+    }
+    bool start_object(std::size_t) override { return open(false); }
+    bool start_array(std::size_t) override { return open(true); }
+    bool end_object() override { return close(); }
+    bool end_array() override { return close(); }
+    bool parse_error(std::size_t, const std::string &, const nlohmann::detail::exception &e) override
+    {
+        error = e.what();
+        return false;
+    }
+
+private:
+    struct Frame {
+        bool array, root, mesh, extras;
+        int kind;  // an array whose elements are counted as this kind, or -1
+    };
+    Census *c_;
+    std::vector<Frame> stack_;
+    std::string key_;  // the current object's last key (read only while that object is on top)
+
+    bool in_object() const { return !stack_.empty() && !stack_.back().array; }
+    bool extras_key() const { return in_object() && (key_ == "extras" || key_ == "extensions"); }
+    bool value()
+    {
+        c_->values++;
+        if (!stack_.empty() && stack_.back().array && stack_.back().kind >= 0) c_->count[stack_.back().kind]++;
+        if ((!stack_.empty() && stack_.back().extras) || extras_key()) c_->extras_values++;
+        return true;
+    }
+    bool open(bool array)
+    {
+        Frame f{array, stack_.empty(), false, extras_key() || (!stack_.empty() && stack_.back().extras), -1};
+        if (array && in_object() && stack_.back().root) {
+            for (int k = 0; k < K_KINDS; k++)
+                if (k != K_PRIMITIVES && key_ == kKindName[k]) f.kind = k;
+        } else if (array && in_object() && stack_.back().mesh && key_ == "primitives") {
+            f.kind = K_PRIMITIVES;
+        } else if (!array && !stack_.empty() && stack_.back().array && stack_.back().kind == K_MESHES) {
+            f.mesh = true;
+        }
+        value();
+        (array ? c_->arrays : c_->objects)++;
+        stack_.push_back(f);
+        return true;
+    }
+    bool close()
+    {
+        if (!stack_.empty()) stack_.pop_back();
+        return true;
+    }
+};
+
+// Bytes the import is expected to hold at its peak (tinygltf's DOM and model together).
+uint64_t census_bytes(const Census &c, size_t json_len)
+{
+    uint64_t b = 4 * (uint64_t)json_len;  // the file, the rewritten JSON, GLB copies, strings
+    b += c.values * (2 * sizeof(json) + 8);  // a DOM slot (arrays grow by doubling) and the parsed number
+    b += c.objects * (sizeof(json::object_t) + kHeap) + c.arrays * (sizeof(json::array_t) + kHeap);
+    b += c.keys * (sizeof(std::pair<const std::string, json>) + 32 + kHeap);  // a map node
+    b += c.extras_values * (sizeof(tinygltf::Value) + sizeof(std::pair<const std::string, tinygltf::Value>) + 32);
+    for (int k = 0; k < K_KINDS; k++) b += c.count[k] * (kKindBytes[k] + kHeap);
+    return b;
+}
+
+void check_budget(const char *json_begin, size_t json_len, const std::string &file)
+{
+    Census c;
+    CensusSax sax(&c);
+    if (!json::sax_parse(json_begin, json_begin + json_len, &sax, nlohmann::json::input_format_t::json, true, false) &&
+        !sax.error.empty())
+        fail("%s: invalid JSON: %s", file.c_str(), sax.error.c_str());
+    const uint64_t need = census_bytes(c, json_len), allowed = kBudgetBase + kBudgetPerByte * json_len;
+    if (need <= allowed) return;
+    std::string counts;
+    for (int k = 0; k < K_KINDS; k++)
+        if (c.count[k]) counts += (counts.empty() ? "" : ", ") + std::to_string(c.count[k]) + " " + kKindName[k];
+    fail("%s: %s%s%llu JSON values would take about %llu MiB to import, more than the %llu MiB allowed for "
+         "%zu bytes of JSON (256 MiB + 16 per byte)", file.c_str(), counts.c_str(), counts.empty() ? "" : ", ",
+         (unsigned long long)c.values, (unsigned long long)(need >> 20), (unsigned long long)(allowed >> 20), json_len);
+}
+
+// The node graph's depth along `children` (first parent wins; a node with two parents or a cycle
+// is refused by the traversal when the scene reaches it), computed on parent indices: a 10^6-deep
+// chain is refused here, in milliseconds, before tinygltf builds its nodes.
+void check_node_depth(const nlohmann::json &doc, const std::string &file)
+{
+    const nlohmann::json *nodes = jarr(doc, "nodes");
+    if (!nodes) return;
+    const size_t n = nodes->size();
+    std::vector<int32_t> parent(n, -1), depth(n, -1);  // depth -2: on the walk being resolved
+    for (size_t i = 0; i < n; i++) {
+        const nlohmann::json *ch = jarr((*nodes)[i], "children");
+        if (!ch) continue;
+        for (const nlohmann::json &c : *ch)
+            if (c.is_number_integer() && c.get<long long>() >= 0 && (size_t)c.get<long long>() < n &&
+                (size_t)c.get<long long>() != i && parent[(size_t)c.get<long long>()] < 0)
+                parent[(size_t)c.get<long long>()] = (int32_t)i;
+    }
+    std::vector<int32_t> walk;
+    for (size_t i = 0; i < n; i++) {
+        walk.clear();
+        int32_t j = (int32_t)i;
+        while (j >= 0 && depth[(size_t)j] == -1) {
+            depth[(size_t)j] = -2;
+            walk.push_back(j);
+            j = parent[(size_t)j];
+        }
+        int32_t d = (j >= 0 && depth[(size_t)j] >= 0) ? depth[(size_t)j] : -1;  // a root, or a cycle
+        for (size_t k = walk.size(); k-- > 0;) {
+            depth[(size_t)walk[k]] = ++d;
+            if (d > kMaxNodeDepth) {
+                const nlohmann::json &nd = (*nodes)[(size_t)walk[k]];
+                std::string nm = nd.is_object() && nd.contains("name") && nd["name"].is_string()
+                                     ? " " + qstr(nd["name"].get<std::string>()) : "";
+                fail("%s: node %d%s: node hierarchy deeper than %d", file.c_str(), walk[k], nm.c_str(), kMaxNodeDepth);
+            }
+        }
+    }
+}
+
+// tinygltf percent-decodes file URIs (dlib::urldecode: %XX and '+' as a space) before it opens
+// them; the same decoding, so that what is checked is what is opened.
+std::string url_decode(const std::string &s)
+{
+    auto hex = [](char c) {  // as dlib's from_hex: anything else is 0 ("%zz" decodes to NUL)
+        return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : 0;
+    };
+    std::string out;
+    for (size_t i = 0; i < s.size(); i++) {
+        if (s[i] == '+') {
+            out += ' ';
+        } else if (s[i] == '%' && s.size() > i + 2) {
+            out += (char)(hex(s[i + 1]) * 16 + hex(s[i + 2]));
+            i += 2;
+        } else {
+            out += s[i];
+        }
+    }
+    return out;
+}
+
+// Bytes a base64 data: URI decodes to, as tinygltf's decoder counts them (it stops at '=' or at
+// the first character outside the alphabet); -1 when the URI is not base64.
+long long data_uri_bytes(const std::string &uri)
+{
+    size_t at = uri.find(";base64,");
+    if (at == std::string::npos) return -1;
+    long long k = 0;
+    for (size_t i = at + 8; i < uri.size() && (isalnum((unsigned char)uri[i]) || uri[i] == '+' || uri[i] == '/'); i++) k++;
+    return k / 4 * 3 + (k % 4 > 1 ? k % 4 - 1 : 0);
+}
+
+// The files buffers and images name, before tinygltf opens them: a FIFO, folder or device is
+// refused by name (tinygltf would say "File not found"), a buffer's file or data: URI must hold
+// byteLength bytes (tinygltf would say "File size mismatch" or "Failed to decode 'uri'").
+void check_uri_targets(const nlohmann::json &arr, const char *kind, const std::string &file, const ResourcePolicy &pol)
+{
+    const int klen = (int)strlen(kind) - 1;  // "buffers" -> "buffer"
+    const bool buffer = !strcmp(kind, "buffers");
+    for (size_t i = 0; i < arr.size(); i++) {
+        const nlohmann::json &e = arr[i];
+        if (!e.is_object() || !e.contains("uri") || !e["uri"].is_string()) continue;
+        const std::string uri = e["uri"].get<std::string>();
+        long long blen = -1;
+        if (buffer && !jint(e, "byteLength", &blen)) blen = -1;
+        if (uri.compare(0, 5, "data:") == 0) {
+            const long long have = data_uri_bytes(uri);
+            if (buffer && have >= 0 && blen >= 0 && have != blen)
+                fail("%s: buffer %zu: its data: URI holds %lld bytes, byteLength says %lld", file.c_str(), i, have, blen);
+            continue;
+        }
+        const std::string dec = url_decode(uri);
+        if (dec.find('\0') != std::string::npos)
+            fail("%s: %.*s %zu: uri %s holds a NUL byte (%%00): refused, it would name another file", file.c_str(),
+                 klen, kind, i, qstr(uri).c_str());
+        const std::string p = dir_of(file) + "/" + dec;
+        struct stat st;
+        if (stat(p.c_str(), &st) != 0) {
+            if (buffer)
+                fail("%s: buffer %zu: uri %s: %s (%s)", file.c_str(), i, qstr(uri).c_str(), strerror(errno), p.c_str());
+            continue;  // an image: a warning, or an error if the baker needs it (decode_image)
+        }
+        if (!S_ISREG(st.st_mode))
+            fail("%s: %.*s %zu: uri %s names %s, not a regular file", file.c_str(), klen, kind, i, qstr(uri).c_str(),
+                 kind_of(st.st_mode));
+        std::string why;
+        if (!resource_allowed(pol, p, &why))
+            fail("%s: %.*s %zu: uri %s %s", file.c_str(), klen, kind, i, qstr(uri).c_str(), why.c_str());
+        if (buffer && blen >= 0 && (long long)st.st_size != blen)
+            fail("%s: buffer %zu: %s is %lld bytes, byteLength says %lld", file.c_str(), i, qstr(uri).c_str(),
+                 (long long)st.st_size, blen);
+    }
+}
+
 // Buffers and images name files relative to the scene (or embed data: URIs). An absolute path
 // or another URI scheme (file://, http://) would reach outside it: refuse them up front, with the
 // entry named; `..` escapes and symlinks are caught when the file is opened (resource_allowed).
-void check_uris(const nlohmann::json &doc, const std::string &file)
+void check_uris(const nlohmann::json &doc, const std::string &file, const ResourcePolicy &pol)
 {
     for (const char *kind : {"buffers", "images"}) {
         const nlohmann::json *arr = jarr(doc, kind);
@@ -204,16 +456,18 @@ void check_uris(const nlohmann::json &doc, const std::string &file)
                      "URI schemes other than data: are refused)",
                      file.c_str(), (int)strlen(kind) - 1, kind, i, qstr(uri).c_str());
         }
+        check_uri_targets(*arr, kind, file, pol);
     }
 }
 
 }  // namespace
 
-Prepass prepass(const char *json_begin, size_t json_len, const std::string &file)
+Prepass prepass(const char *json_begin, size_t json_len, const std::string &file, const ResourcePolicy &pol)
 {
     Prepass pp;
     if (json_max_depth(json_begin, json_len) > kMaxJsonDepth)
         fail("%s: JSON nested deeper than %d levels", file.c_str(), kMaxJsonDepth);
+    check_budget(json_begin, json_len, file);
     nlohmann::json doc;
     try {
         doc = nlohmann::json::parse(json_begin, json_begin + json_len, nullptr, true);
@@ -221,7 +475,8 @@ Prepass prepass(const char *json_begin, size_t json_len, const std::string &file
         fail("%s: invalid JSON: %s", file.c_str(), e.what());
     }
     if (!doc.is_object()) fail("%s: the JSON root is not an object", file.c_str());
-    check_uris(doc, file);
+    check_uris(doc, file, pol);
+    check_node_depth(doc, file);
 
     // Image bufferViews: tinygltf forms a pointer into the buffer before we see it.
     const nlohmann::json *buffers = jarr(doc, "buffers");
@@ -295,6 +550,8 @@ Prepass prepass(const char *json_begin, size_t json_len, const std::string &file
                              file.c_str(), mi, pi, qstr(it.key()).c_str());
                     di.attributes[it.key()] = (int)it->get<long long>();
                 }
+                long long ia;
+                if (jint(prim, "indices", &ia) && ia >= 0 && ia <= INT32_MAX) di.indices = (int)ia;
                 pp.draco[{(int)mi, (int)pi}] = di;
                 prim.erase("indices");
             }

@@ -11,12 +11,6 @@
 
 namespace bk_gltf {
 
-namespace {
-
-const int kMaxNodeDepth = 256;    // node hierarchy depth cap (the traversal is recursive)
-
-}  // namespace
-
 void Importer::warn(const char *fmt, ...)
 {
     va_list ap;
@@ -61,7 +55,7 @@ void Importer::load()
     size_t json_len = glb ? g.json_len : bytes.size();
     if (json_len > o_.max_json_bytes)
         fail("%s: %zu bytes of JSON exceeds the %zu-byte JSON cap", file, json_len, o_.max_json_bytes);
-    pp_ = prepass(glb ? g.json : reinterpret_cast<const char *>(bytes.data()), json_len, path_);
+    pp_ = prepass(glb ? g.json : reinterpret_cast<const char *>(bytes.data()), json_len, path_, policy_);
 
     tinygltf::TinyGLTF loader;
     FsState fss{o_.max_file_bytes, &policy_, &reads_};

@@ -46,6 +46,8 @@
 
 namespace bk_gltf {
 
+const int kMaxNodeDepth = 256;  // node hierarchy depth cap (the traversal is recursive; the pre-pass checks it)
+
 struct ImportError {
     std::string msg;
 };
@@ -196,6 +198,7 @@ T *alloc_array(size_t n, size_t per)
 
 struct DracoInfo {
     int buffer_view = -1;
+    int indices = -1;  // the primitive's indices accessor (hidden from tinygltf), -1: none
     std::map<std::string, int> attributes;  // glTF semantic -> Draco unique id
 };
 
@@ -205,9 +208,11 @@ struct Prepass {
     std::string json;                                // rewritten JSON handed to tinygltf
 };
 
-// Caps the JSON's depth, refuses absolute and non-data: URIs, validates image bufferViews, notes
+// Caps the JSON's depth and what it may cost to import (a SAX census before any DOM), the node
+// hierarchy's depth, refuses absolute and non-data: URIs, URIs holding a NUL and files that are
+// not regular or not byteLength long (before tinygltf opens them), validates image bufferViews, notes
 // the images the baker needs and the Draco primitives, and rewrites the JSON for tinygltf.
-Prepass prepass(const char *json_begin, size_t json_len, const std::string &file);
+Prepass prepass(const char *json_begin, size_t json_len, const std::string &file, const ResourcePolicy &pol);
 
 // ---- GLB container (gltf_guard.cc) ------------------------------------------------------------
 
@@ -333,6 +338,7 @@ private:
     void read_accessor(int acc, int want_comps, bool index, std::vector<float> *f, std::vector<uint32_t> *u,
                        const std::string &what);
     void decode_draco(int mi, int pi, const DracoInfo &di, Prim &p, std::vector<uint32_t> &idx, size_t *nverts);
+    void check_draco_counts(int mi, int pi, const DracoInfo &di, size_t points, size_t indices);
     void emit_geometry();
     void choose_origin(const std::vector<Instance> &kept);
     void check_extent(const std::vector<Instance> &kept);  // the limits float rays can trace

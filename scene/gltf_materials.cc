@@ -75,6 +75,19 @@ int Importer::decode_image(int gi)
     if (!bytes || len == 0) fail("%s: %s: could not be read (missing file or empty data)", path_.c_str(), label.c_str());
     if (len > (size_t)INT32_MAX) fail("%s: %s: encoded image larger than 2 GiB", path_.c_str(), label.c_str());
     XXH3_64bits_update(&hash_, bytes, len);
+    // stb_image's header probe fails on a PNG past 2^30 bytes of pixels ("too large"), which would
+    // read as "not decodable" and be ignored: the IHDR's size is checked against the cap first,
+    // so a PNG is refused exactly like a JPEG of that size.
+    static const unsigned char png_sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    if (len >= 24 && !memcmp(bytes, png_sig, 8) && !memcmp(bytes + 12, "IHDR", 4)) {
+        auto be32 = [](const unsigned char *q) {
+            return (uint64_t)q[0] << 24 | (uint64_t)q[1] << 16 | (uint64_t)q[2] << 8 | (uint64_t)q[3];
+        };
+        const uint64_t pw = be32(bytes + 16), ph = be32(bytes + 20);
+        if (pw == 0 || ph == 0 || pw * ph > o_.max_image_pixels)
+            fail("%s: %s: %llux%llu pixels exceeds the %zu-pixel cap", path_.c_str(), label.c_str(),
+                 (unsigned long long)pw, (unsigned long long)ph, o_.max_image_pixels);
+    }
     int w = 0, h = 0, comp = 0;
     if (!stbi_info_from_memory(bytes, (int)len, &w, &h, &comp)) {
         if (o_.report) o_.report->ignored_textures++;
