@@ -23,11 +23,12 @@ class Level:
             self.thin[name] = round(thin, 4)
 
     def add_boxes(self, name, material, boxes, skip=()):
-        """boxes: (lo, hi); thin: the smallest extent of any of them."""
+        """boxes: (lo, hi) or (lo, hi, faces to skip on this box besides skip); thin: the smallest
+        extent of any of them."""
         polys = []
-        for lo, hi in boxes:
-            polys += geom.box(lo, hi, skip)
-        self.add(name, material, polys, min(min(hi[k] - lo[k] for k in range(3)) for lo, hi in boxes))
+        for b in boxes:
+            polys += geom.box(b[0], b[1], tuple(skip) + tuple(b[2] if len(b) > 2 else ()))
+        self.add(name, material, polys, min(min(b[1][k] - b[0][k] for k in range(3)) for b in boxes))
 
     def light(self, W, H, D, lamp_at=None):
         """The level's light: sky through its openings, a point lamp, or the sun plus a dim sky."""
@@ -122,7 +123,9 @@ def thin_wall(p, rng):
     for name, mat, polys in geom.room_shell(W, H, D, [win]):
         lv.add(name, mat, polys)
     a, b, door_z0, door_z1, door_h = xm - t / 2, xm + t / 2, 0.3, 1.1, 2.0
-    lv.add_boxes("partition", "plaster", [((a, 0.0, door_z1), (b, H, D)), ((a, 0.0, 0.0), (b, H, door_z0)),
+    # the end faces against the (zero-thickness) front and back walls would lie outside, in the sky
+    lv.add_boxes("partition", "plaster", [((a, 0.0, door_z1), (b, H, D), ("front",)),
+                                          ((a, 0.0, 0.0), (b, H, door_z0), ("back",)),
                                           ((a, door_h, door_z0), (b, H, door_z1))], skip=("bottom", "top"))
     lv.add_boxes("cabinet_dark", "white", [((b, 0.0, 2.0), (b + 0.45, 0.9, 3.0))], skip=("bottom",))
     lv.add_boxes("cabinet_lit", "white", [((a - 0.45, 0.0, 2.0), (a, 0.9, 3.0))], skip=("bottom",))
