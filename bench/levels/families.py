@@ -16,11 +16,23 @@ class Level:
         self.thin = {}
         self.lights = []
         self.sky = (0.0, 0.0, 0.0)
+        self.extras = {}
 
-    def add(self, name, material, polys, thin=None):
+    def add(self, name, material, polys, thin=None, extras=None):
         self.objects.append((name, material, polys))
         if thin is not None:
             self.thin[name] = round(thin, 4)
+        if extras:
+            self.extras[name] = extras
+
+    def shell(self, W, H, D, openings=(), skip=(), box_openings=()):
+        """The room (geom.room_shell) and its outside (geom.hull): a black, unlit closed box 40 cm
+        out, tunnels at the openings. box_openings: openings of walls the family builds of boxes
+        (wall, a0, a1, y0, y1, thickness)."""
+        for name, mat, polys in geom.room_shell(W, H, D, openings, skip):
+            self.add(name, mat, polys)
+        hull_openings = [tuple(o) + (0.0,) for o in openings] + list(box_openings)
+        self.add("exterior", "exterior", geom.hull(W, H, D, hull_openings), extras={"lbk_lighting": "none"})
 
     def add_boxes(self, name, material, boxes, skip=()):
         """boxes: (lo, hi) or (lo, hi, faces to skip on this box besides skip); thin: the smallest
@@ -57,8 +69,7 @@ def table_slab(p, rng):
     t, shape, lighting = p["thick"], p["shape"], p["lighting"]
     W, H, D = _room(rng)
     lv = Level(lighting)
-    for name, mat, polys in geom.room_shell(W, H, D, [_window(W, H, True)]):
-        lv.add(name, mat, polys)
+    lv.shell(W, H, D, [_window(W, H, True)])
     cx, cz = W / 2 + rng.randint(-30, 30) / 100.0, D / 2 + rng.randint(-30, 30) / 100.0
     top = 0.74
     if shape == "round":
@@ -87,8 +98,7 @@ def shelf_slab(p, rng):
     t, n, lighting = p["thick"], p["shelves"], p["lighting"]
     W, H, D = _room(rng)
     lv = Level(lighting)
-    for name, mat, polys in geom.room_shell(W, H, D, [_window(W, H, False)]):
-        lv.add(name, mat, polys)
+    lv.shell(W, H, D, [_window(W, H, False)])
     x0 = 0.6 + rng.randint(0, 40) / 100.0
     x1, z0, z1, sh = x0 + 1.6, 0.02, 0.4, 2.0
     boxes = [((x0, 0.0, z0), (x0 + 0.02, sh, z1)), ((x1 - 0.02, 0.0, z0), (x1, sh, z1)),
@@ -120,8 +130,7 @@ def thin_wall(p, rng):
     W, xm = 7.0, 3.5
     lv = Level(lighting)
     win = ("front", 0.8, 2.7, 0.9, 2.2)
-    for name, mat, polys in geom.room_shell(W, H, D, [win]):
-        lv.add(name, mat, polys)
+    lv.shell(W, H, D, [win])
     a, b, door_z0, door_z1, door_h = xm - t / 2, xm + t / 2, 0.3, 1.1, 2.0
     # the end faces against the (zero-thickness) front and back walls would lie outside, in the sky
     lv.add_boxes("partition", "plaster", [((a, 0.0, door_z1), (b, H, D), ("front",)),
@@ -140,10 +149,10 @@ def overlap(p, rng):
     lighting = p["lighting"]
     W, H, D = _room(rng)
     lv = Level(lighting)
-    for name, mat, polys in geom.room_shell(W, H, D, skip=("wall_front",)):
-        lv.add(name, mat, polys)
     wx0, wx1, wy0, wy1, th = W / 2 - 1.0, W / 2 + 0.9, 0.9, 2.2, 0.25
     o = 0.1 + rng.randint(0, 10) / 100.0  # how far the wall's boxes run into each other
+    # the side boxes reach o into the window: the clear opening is wx0 + o .. wx1 - o
+    lv.shell(W, H, D, skip=("wall_front",), box_openings=[("front", wx0 + o, wx1 - o, wy0, wy1, th)])
     lv.add_boxes("window_wall", "plaster", [((-0.05, -0.05, D), (wx0 + o, H + 0.05, D + th)),
                                             ((wx1 - o, -0.05, D), (W + 0.05, H + 0.05, D + th)),
                                             ((wx0 - o, -0.05, D - 0.001), (wx1 + o, wy0, D + th)),
@@ -169,8 +178,7 @@ def resting(p, rng):
     lighting, bottoms = p["lighting"], p["bottoms"]
     W, H, D = _room(rng)
     lv = Level(lighting)
-    for name, mat, polys in geom.room_shell(W, H, D, [_window(W, H, False)]):
-        lv.add(name, mat, polys)
+    lv.shell(W, H, D, [_window(W, H, False)])
     skip = () if bottoms else ("bottom",)
     for k in range(3):
         x, z, e = 0.6 + 1.1 * k + rng.randint(0, 20) / 100.0, 1.2 + rng.randint(0, 80) / 100.0, 0.3 + 0.1 * k
@@ -196,9 +204,8 @@ def sill_niche(p, rng):
     lighting, st = p["lighting"], p["sill"]
     W, H, D = _room(rng)
     lv = Level(lighting)
-    for name, mat, polys in geom.room_shell(W, H, D, skip=("wall_front", "wall_back")):
-        lv.add(name, mat, polys)
     win = (W / 2 - 0.9, W / 2 + 0.9, 0.9, 2.2)
+    lv.shell(W, H, D, skip=("wall_front", "wall_back"), box_openings=[("front",) + win + (0.3,)])
     lv.add_boxes("front_wall", "plaster", _wall_boxes(W, H, D, D + 0.3, [win]), skip=("bottom", "top"))
     lv.add_boxes("sill", "white", [((win[0] - 0.05, win[2] - st, D - 0.06), (win[1] + 0.05, win[2], D + 0.3))])
     nx = 0.8 + rng.randint(0, 60) / 100.0
@@ -219,8 +226,7 @@ def tiny(p, rng):
     lighting = p["lighting"]
     W, H, D = _room(rng)
     lv = Level(lighting)
-    for name, mat, polys in geom.room_shell(W, H, D, [_window(W, H, False)]):
-        lv.add(name, mat, polys)
+    lv.shell(W, H, D, [_window(W, H, False)])
     cx, cz, top = W / 2, D / 2, 0.74
     lv.add_boxes("table", "oak", [((cx - 0.6, top - 0.04, cz - 0.4), (cx + 0.6, top, cz + 0.4))] +
                  [((x - 0.025, 0.0, z - 0.025), (x + 0.025, top - 0.04, z + 0.025))
@@ -249,6 +255,7 @@ MATERIALS = {
     "oak": (0.55, 0.40, 0.25), "fabric": (0.25, 0.35, 0.5), "red": (0.6, 0.1, 0.08), "blue": (0.1, 0.15, 0.5),
     "paper": (0.8, 0.78, 0.7), "white": (0.85, 0.85, 0.82), "crate": (0.6, 0.5, 0.3), "fabric_red": (0.5, 0.12, 0.1),
     "stone": (0.5, 0.5, 0.48), "metal_dull": (0.6, 0.6, 0.6),
+    "exterior": (0.0, 0.0, 0.0),  # the hull: reflects nothing, so lbk and Cycles agree on it
 }
 
 S, L, U = "sky", "lamp", "sun"

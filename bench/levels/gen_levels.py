@@ -59,7 +59,7 @@ def write_level(lv, path, layout, density):
         if layout == "authored":
             uv = geom.lightmap_pack(polys, 1.5 / density)
             prim["uv1"] = [_r(c) for pi, vi in corner for c in uv[pi][vi]]
-        w.mesh(name, [prim])
+        w.mesh(name, [prim], extras=lv.extras.get(name))
     for name, kind, intensity, at, rot in lv.lights:
         w.light(name, kind, intensity, translation=[_r(x) for x in at] if at else None,
                 rotation=[_r(x) for x in rot] if rot else None)

@@ -121,6 +121,48 @@ def room_shell(W, H, D, openings=(), skip=()):
     return objs
 
 
+# wall name -> (axis of its plane, outward sign, the in-plane axis that an opening's a runs along)
+_WALLS = {"back": (2, -1, 0), "front": (2, 1, 0), "left": (0, -1, 2), "right": (0, 1, 2)}
+
+
+def _rect_axes(axis, c, ranges, facing):
+    """rect() with the two other axes' ranges given by axis number."""
+    a_ax, b_ax = [k for k in range(3) if k != axis]
+    return rect(axis, c, ranges[a_ax], ranges[b_ax], facing)
+
+
+def hull(W, H, D, openings, T=0.4):
+    """The outside of a room: a closed box T outside the room's planes whose faces point outwards
+    (seen from between it and the room, every face is a back face), holes at the openings and a
+    tunnel (four quads facing into the opening) from each opening's outer face to the hull.
+    openings: (wall, a0, a1, y0, y1, d) with d how far outside the wall's plane the opening's
+    outer face lies (0 for a one-sided room_shell wall, the thickness for a wall of boxes). Faces
+    against a one-sided wall or floor (a crate's bottom, a shelf flush with a wall) then lie in a
+    closed cavity, as in a level with thick walls, instead of in the open sky."""
+    lo, hi = (-T, -T, -T), (W + T, H + T, D + T)
+    planes = {"back": 0.0, "front": D, "left": 0.0, "right": W}
+    out = []
+    for axis, side, name in _BOX_FACES:
+        a_ax, b_ax = [k for k in range(3) if k != axis]
+        hs = []
+        for o in openings:
+            ax, sgn, o_ax = _WALLS[o[0]]
+            if ax == axis and (sgn > 0) == bool(side):
+                r = {o_ax: (o[1], o[2]), 1: (o[3], o[4])}
+                hs.append((r[a_ax][0], r[a_ax][1], r[b_ax][0], r[b_ax][1]))
+        out += wall(axis, hi[axis] if side else lo[axis], (lo[a_ax], hi[a_ax]), (lo[b_ax], hi[b_ax]),
+                    1 if side else -1, hs)
+    for o in openings:
+        ax, sgn, a_ax = _WALLS[o[0]]
+        c = planes[o[0]]
+        depth = tuple(sorted((c + sgn * o[5], c + sgn * T)))
+        # the tunnel's sides: planes at a0 and a1 facing inwards, then at y0 and y1
+        for k, ra, other, span in ((a_ax, (o[1], o[2]), 1, (o[3], o[4])), (1, (o[3], o[4]), a_ax, (o[1], o[2]))):
+            for val, f in ((ra[0], 1), (ra[1], -1)):
+                out.append(_rect_axes(k, val, {ax: depth, other: span}, f))
+    return out
+
+
 def triangulate(polys):
     """Flat-shaded triangle lists: (pos, nrm, idx, corner) with corner[i] = (polygon, vertex)."""
     pos, nrm, idx, corner = [], [], [], []
