@@ -6,6 +6,7 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cstdio>
@@ -167,13 +168,20 @@ const nlohmann::json *jarr(const nlohmann::json &o, const char *key)
     return (it != o.end() && it->is_array()) ? &*it : nullptr;
 }
 
-// Deepest nesting of arrays and objects in JSON text, in one linear scan (brackets inside
-// strings do not count). nlohmann's callback parser would check depth for us, but it re-scans
-// the open container each time an element closes, which made 80 k empty nodes take ~17 s and
-// 10^6 nodes effectively never finish; the plain parser after this scan is linear.
-static int json_max_depth(const char *p, size_t n)
+// The JSON text's shape in one linear scan (brackets and commas inside strings do not count):
+// its deepest nesting, and how many objects, arrays and commas it holds. nlohmann's callback
+// parser would check depth for us, but it re-scans the open container each time an element
+// closes, which made 80 k empty nodes take ~17 s and 10^6 nodes effectively never finish; the
+// parsers after this scan are linear.
+struct Shape {
+    int deepest = 0;
+    uint64_t objects = 0, arrays = 0, commas = 0;
+};
+
+Shape json_shape(const char *p, size_t n)
 {
-    int depth = 0, deepest = 0;
+    Shape s;
+    int depth = 0;
     bool in_string = false;
     for (size_t i = 0; i < n; i++) {
         const char c = p[i];
@@ -183,22 +191,26 @@ static int json_max_depth(const char *p, size_t n)
         } else if (c == '"') {
             in_string = true;
         } else if (c == '[' || c == '{') {
-            if (++depth > deepest) deepest = depth;
+            (c == '[' ? s.arrays : s.objects)++;
+            if (++depth > s.deepest) s.deepest = depth;
         } else if (c == ']' || c == '}') {
             depth--;
+        } else if (c == ',') {
+            s.commas++;
         }
     }
-    return deepest;
+    return s;
 }
 
 // ---- the memory budget: what the JSON will cost before anything is built ------------------------
 //
 // tinygltf builds a DOM of the whole JSON and then a struct per node, mesh, primitive, accessor
 // and so on; an empty node `{}` is 3 bytes of JSON but several hundred bytes of tinygltf::Node
-// (2*10^7 of them, 57 MiB of JSON, took more than 12.8 GB). One SAX pass (nlohmann's parser
-// without a DOM: linear, nothing kept but counts) counts what each part will cost and refuses the
-// file when the estimate exceeds kBudgetBase + kBudgetPerByte * its JSON size, naming the counts,
-// before the pre-pass's own DOM or tinygltf allocate anything.
+// (2*10^7 of them, 57 MiB of JSON, took more than 12.8 GB). The file is refused when what it
+// would cost exceeds kBudgetBase + kBudgetPerByte * its JSON size, before the pre-pass's own DOM
+// or tinygltf allocate anything: first a floor from the depth scan's counts (the DOM alone), then
+// one SAX pass (nlohmann's parser without a DOM: linear, nothing kept but counts) that counts the
+// elements of each kind and what tinygltf makes of them, naming the counts.
 
 const uint64_t kBudgetBase = (uint64_t)256 << 20;  // any file may take this much
 const uint64_t kBudgetPerByte = 16;                 // and this much more per byte of JSON
@@ -302,18 +314,30 @@ uint64_t census_bytes(const Census &c, size_t json_len)
     b += c.objects * (sizeof(json::object_t) + kHeap) + c.arrays * (sizeof(json::array_t) + kHeap);
     b += c.keys * (sizeof(std::pair<const std::string, json>) + 32 + kHeap);  // a map node
     b += c.extras_values * (sizeof(tinygltf::Value) + sizeof(std::pair<const std::string, tinygltf::Value>) + 32);
-    for (int k = 0; k < K_KINDS; k++) b += c.count[k] * (kKindBytes[k] + kHeap);
+    // tinygltf appends each element to a std::vector that grows by doubling: up to twice the size
+    for (int k = 0; k < K_KINDS; k++) b += c.count[k] * (2 * kKindBytes[k] + kHeap);
     return b;
 }
 
-void check_budget(const char *json_begin, size_t json_len, const std::string &file)
+void check_budget(const char *json_begin, size_t json_len, const Shape &shape, const std::string &file)
 {
+    const uint64_t allowed = kBudgetBase + kBudgetPerByte * json_len;
+    // A lower bound from the scan's counts first (the DOM alone, every comma a value), which
+    // refuses 2*10^7 empty nodes without the SAX pass.
+    uint64_t floor = 4 * (uint64_t)json_len + shape.objects * (sizeof(json::object_t) + kHeap) +
+                     shape.arrays * (sizeof(json::array_t) + kHeap) +
+                     std::max(shape.commas, shape.objects + shape.arrays) * (2 * sizeof(json) + 8);
+    if (floor > allowed)
+        fail("%s: %llu JSON objects, %llu arrays and %llu commas would take at least %llu MiB to import, more than "
+             "the %llu MiB allowed for %zu bytes of JSON (256 MiB + 16 per byte)", file.c_str(),
+             (unsigned long long)shape.objects, (unsigned long long)shape.arrays, (unsigned long long)shape.commas,
+             (unsigned long long)(floor >> 20), (unsigned long long)(allowed >> 20), json_len);
     Census c;
     CensusSax sax(&c);
     if (!json::sax_parse(json_begin, json_begin + json_len, &sax, nlohmann::json::input_format_t::json, true, false) &&
         !sax.error.empty())
         fail("%s: invalid JSON: %s", file.c_str(), sax.error.c_str());
-    const uint64_t need = census_bytes(c, json_len), allowed = kBudgetBase + kBudgetPerByte * json_len;
+    const uint64_t need = census_bytes(c, json_len);
     if (need <= allowed) return;
     std::string counts;
     for (int k = 0; k < K_KINDS; k++)
@@ -465,9 +489,10 @@ void check_uris(const nlohmann::json &doc, const std::string &file, const Resour
 Prepass prepass(const char *json_begin, size_t json_len, const std::string &file, const ResourcePolicy &pol)
 {
     Prepass pp;
-    if (json_max_depth(json_begin, json_len) > kMaxJsonDepth)
+    const Shape shape = json_shape(json_begin, json_len);
+    if (shape.deepest > kMaxJsonDepth)
         fail("%s: JSON nested deeper than %d levels", file.c_str(), kMaxJsonDepth);
-    check_budget(json_begin, json_len, file);
+    check_budget(json_begin, json_len, shape, file);
     nlohmann::json doc;
     try {
         doc = nlohmann::json::parse(json_begin, json_begin + json_len, nullptr, true);
