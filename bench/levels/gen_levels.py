@@ -28,9 +28,10 @@ LAYOUTS = ("generated", "authored")
 # Cycles reference samples (bench/cycles/run.py: per footprint point half of ref_spp; LBK_BENCH_QUICK
 # uses ref_spp_quick): at 64 spp per point a sky-lit room's reference has 5-12 % noise per texel,
 # more than lbk's error, so every object came out "n/r" (measured 2026-12-06 on table_slab_00);
-# noise falls as 1/sqrt(spp). Fine density has 9x the texels, so half the samples.
+# noise falls as 1/sqrt(spp). Fine density has 9x the texels (and sensors), so a quarter of the
+# samples: about 1.4 % reference noise per texel, as the quick setting at coarse density.
 def cycles_spp(density):
-    return {"ref_spp": 8192 if density == "coarse" else 4096, "ref_spp_quick": 2048, "calib": [4, 16]}
+    return {"ref_spp": 8192 if density == "coarse" else 2048, "ref_spp_quick": 2048, "calib": [4, 16]}
 
 
 def all_levels(seed_base):
