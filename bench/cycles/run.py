@@ -378,17 +378,24 @@ def main():
         r, s = run_scene(sc, opt.work, opt, out)
         rows += r
         scenes.append(s)
-    resolved = [r for r in rows if not r["unresolved"]]
-    met = sum(1 for r in resolved if r["ratio"] <= 0.5)
     out("")
-    out("goal lbk error <= 0.5 x Cycles' at equal time: met on %d of %d objects (%d more not resolved: the "
-        "reference's noise exceeds lbk's or Cycles' error, n/r); estimate within 2x of the measured error on %d of %d scenes; "
-        "bench took %.0f s" % (met, len(resolved), len(rows) - len(resolved), sum(s["est_within_2x"] for s in scenes),
-                               len(scenes), time.perf_counter() - t0))
+    # a levels run: one line per set (dev, validation), never pooled (bench/levels/README.md)
+    groups = [("", rows, scenes)] if not opt.levels else [
+        ("[%s set] " % k, [r for r in rows if r["set"] == k], [s for s in scenes if s["tags"]["set"] == k])
+        for k in ("dev", "validation") if any(s["tags"]["set"] == k for s in scenes)]
+    for label, grows, gscenes in groups:
+        resolved = [r for r in grows if not r["unresolved"]]
+        met = sum(1 for r in resolved if r["ratio"] <= 0.5)
+        out("%sgoal lbk error <= 0.5 x Cycles' at equal time: met on %d of %d objects (%d more not resolved: the "
+            "reference's noise exceeds lbk's or Cycles' error, n/r); estimate within 2x of the measured error on %d of "
+            "%d scenes" % (label, met, len(resolved), len(grows) - len(resolved),
+                           sum(s["est_within_2x"] for s in gscenes), len(gscenes)))
+    out("bench took %.0f s" % (time.perf_counter() - t0))
     with open(opt.results or os.path.join(opt.work, "results.json"), "w") as f:
         json.dump({"rows": rows, "scenes": scenes, "clock": opt.clock, "threads": opt.threads, "lbk": opt.lbk,
                    "blender": ver, "analytic_ok": ok}, f, indent=1)
-    with open(os.path.join(opt.work, "report.txt"), "w") as f:
+    with open(opt.results[:-len(".json")] + ".report.txt" if opt.results.endswith(".json")
+              else os.path.join(opt.work, "report.txt"), "w") as f:
         f.write("\n".join(lines) + "\n")
     return 0 if ok else 1
 
