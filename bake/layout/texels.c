@@ -162,9 +162,15 @@ static void rtri_weights(const bk_rtri *t, double px, double py, double w[3])
 }
 
 /* UV islands: entries of one chart joined by edges they share both in uv and in the world
- * (exact corner coordinates). An authored layout is one chart holding many islands, often
+ * (exact corner coordinates), where the surface is smooth: their face normals within
+ * ISLAND_CREASE_COS of each other. An authored layout is one chart holding many islands, often
  * closer than a texel or even touching; a texel's footprint stays on its own island, as a
- * renderer's bake stays on the texel's triangle. */
+ * renderer's bake stays on the texel's triangle. A generated chart may fold over a hard edge
+ * (chart_merge.c lays a table top's 7 cm rim strip beside its top): the footprint must not
+ * follow it, or the top's texels along the rim average in points of the rim, which see half
+ * the sky (measured: −18 % at 2 texels/m on a slab under a sky), and the underside's the
+ * rim's sky (TRANSPORT.md, Thin geometry). */
+#define ISLAND_CREASE_COS 0.7660444431 /* cos 40°: uvgen's chart cone (uvgen.h cone_degrees) */
 typedef struct fp_edge { uint32_t chart; float k[10]; uint32_t entry; } fp_edge; /* uv a, uv b, world a, b */
 
 static int cmp_edge(const void *p, const void *q)
@@ -191,6 +197,19 @@ static uint32_t uf_find(uint32_t *p, uint32_t x)
         x = p[x];
     }
     return x;
+}
+
+/* Whether entries i and j of the atlas meet at no crease (face normals within the island's
+ * crease angle); a degenerate triangle joins anything, as before. */
+static int smooth_join(const bk_scene *s, const bk_atlas *a, uint32_t i, uint32_t j)
+{
+    double p[3][3], ni[3], nj[3];
+    if (!bk_tri_positions(s, a->tris[i], p)) return 1;
+    bk_tri_cross(p, ni);
+    if (!bk_tri_positions(s, a->tris[j], p)) return 1;
+    bk_tri_cross(p, nj);
+    if (!(bkv_normalize(ni) > 0.0) || !(bkv_normalize(nj) > 0.0)) return 1;
+    return bkv_dot(ni, nj) >= ISLAND_CREASE_COS;
 }
 
 static uint32_t *uv_islands(const bk_scene *s, const bk_atlas *a)
@@ -235,7 +254,7 @@ static uint32_t *uv_islands(const bk_scene *s, const bk_atlas *a)
     qsort(e, m, sizeof *e, cmp_edge);
     for (size_t i = 1; i < m; i++) {
         const fp_edge *p = &e[i - 1], *q = &e[i];
-        if (!same_edge(p, q)) continue;
+        if (!same_edge(p, q) || !smooth_join(s, a, p->entry, q->entry)) continue;
         uint32_t r1 = uf_find(parent, p->entry), r2 = uf_find(parent, q->entry);
         if (r1 != r2) parent[r1 > r2 ? r1 : r2] = r1 > r2 ? r2 : r1;
     }

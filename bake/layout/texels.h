@@ -27,8 +27,10 @@
  *
  * Footprint: every triangle of the texel's own UV island that overlaps its square (exact
  * triangle/square overlap; an island: the chart's triangles joined to the texel's own by shared
- * UV edges — an authored layout is one chart of many islands, often less than a texel apart, and
- * a floor texel must not average in the island next to it, perhaps the floor's underside), as the affine map from texel-local (s, t) to the triangle's
+ * UV edges where the surface has no crease, face normals within 40° — an authored layout is one
+ * chart of many islands, often less than a texel apart, and a floor texel must not average in
+ * the island next to it, perhaps the floor's underside; a generated chart may fold a table top's
+ * thin rim beside the top, and the top's texels must not average in the rim), as the affine map from texel-local (s, t) to the triangle's
  * barycentrics (bk_footprint_tri). The light transport starts each gather ray from a random
  * point of the square that one of them covers, so a texel's value is the irradiance averaged
  * over the part of its square its chart covers, as a renderer's bake of the texel is (a chart
