@@ -563,6 +563,51 @@ lbk_result bk_denoiser_error(const bk_denoiser *d, const float *halves, const si
     return bk_denoiser_errors(d, &halves, 1, class_end, out);
 }
 
+lbk_result bk_denoiser_group_errors(const bk_denoiser *d, const float *halves, size_t count, const uint32_t *group,
+                                    size_t group_count, bk_denoise_group_error *out)
+{
+    if (!out || (count && (!halves || !group))) return LBK_ERR_INVALID_ARGUMENT;
+    if (d && count > d->receiver_count) return LBK_ERR_INVALID_ARGUMENT;
+    memset(out, 0, group_count * sizeof *out);
+    /* the filter runs over every receiver it was made for; the texels come first */
+    const size_t n = d ? d->receiver_count : count;
+    float *f = malloc((n ? n : 1) * 2 * sizeof *f);
+    dn_error_sums *sum = calloc(group_count ? group_count : 1, sizeof *sum);
+    lbk_result r = f && sum ? LBK_OK : LBK_ERR_OUT_OF_MEMORY;
+    if (!r) {
+        for (size_t i = 0; i < n; i++) {
+            const int mine = i < count;
+            f[2 * i] = mine ? 0.5f * (halves[2 * i] + halves[2 * i + 1]) : 0.0f;
+            f[2 * i + 1] = mine ? 0.5f * (halves[2 * i] - halves[2 * i + 1]) : 0.0f;
+        }
+        if (d && d->have_tex) r = texels_apply(d, f, 2);
+    }
+    for (size_t i = 0; i < count && !r; i++) {
+        if (group[i] >= group_count) continue;
+        const double x = 0.5f * (halves[2 * i] + halves[2 * i + 1]);
+        const double dl = 0.5f * (halves[2 * i] - halves[2 * i + 1]);
+        const double fx = f[2 * i], fd = f[2 * i + 1];
+        dn_error_sums *g = &sum[group[i]];
+        g->noise += fd * fd;
+        g->bias += (fx - x) * (fx - x) - (fd - dl) * (fd - dl);
+        g->den += fx * fx;
+        out[group[i]].receivers++;
+    }
+    for (size_t k = 0; k < group_count && !r; k++) {
+        const double b2 = sum[k].bias > 0 ? sum[k].bias : 0;
+        out[k].noise2 = sum[k].noise;
+        out[k].bias2 = b2;
+        out[k].value2 = sum[k].den;
+        if (!(sum[k].den > 0)) continue;
+        out[k].noise = sqrt(sum[k].noise / sum[k].den);
+        out[k].bias = sqrt(b2 / sum[k].den);
+        out[k].rel_rmse = sqrt((sum[k].noise + b2) / sum[k].den);
+    }
+    free(f);
+    free(sum);
+    return r;
+}
+
 void bk_denoiser_stats(const bk_denoiser *d, bk_denoise_stats *stats)
 {
     if (!stats) return;

@@ -135,6 +135,18 @@ lbk_result bk_denoiser_error(const bk_denoiser *d, const float *halves, const si
 lbk_result bk_denoiser_errors(const bk_denoiser *d, const float *const *halves, size_t count,
                               const size_t class_end[BK_RECEIVER_CLASSES], bk_denoise_error *out);
 
+/* The same estimate per group of texel receivers (a group: an object), over the first `count`
+ * receivers (the texels; group[i] its group, >= group_count for none), through the texel filter
+ * (d NULL: the identity, the transport's own estimate). Sums are kept so that groups pool to
+ * the class figure: noise2 + bias2 over value2 (the bias clamp is per group, so pooled groups
+ * can only add bias). Errors: LBK_ERR_INVALID_ARGUMENT, LBK_ERR_OUT_OF_MEMORY. */
+typedef struct bk_denoise_group_error {
+    size_t receivers;
+    double rel_rmse, noise, bias;  /* relative to the RMS of the group's (denoised) values */
+    double noise2, bias2, value2;  /* the sums they come from */
+} bk_denoise_group_error;
+lbk_result bk_denoiser_group_errors(const bk_denoiser *d, const float *halves, size_t count, const uint32_t *group,
+                                    size_t group_count, bk_denoise_group_error *out);
 void bk_denoiser_stats(const bk_denoiser *d, bk_denoise_stats *stats);
 void bk_denoiser_destroy(bk_denoiser *d);
 

@@ -133,6 +133,7 @@ static lbk_result run(bk_pipeline *b, const char *path, const lbk_bake_scene *de
         }
     }
     if (!r) r = bk_phase_denoise(b);
+    if (!r) r = bk_object_estimates(b);
     if (!r && b->sets.set_count) r = bk_phase_emit_sets(b);
     if (!r) r = bk_pipeline_phase(b, LBK_BAKE_PHASE_WRITE);
     if (!r) r = bk_pipeline_encode(b);
@@ -227,6 +228,7 @@ static void pipeline_free(bk_pipeline *b)
     bk_denoiser_destroy(b->denoiser);
     free(b->variance);
     free(b->halves);
+    free(b->object_est);
     free(b->texel_rel_error);
     free(b->samples);
     free(b->radiance);

@@ -244,7 +244,7 @@ lbk_result bk_phase_transport(bk_pipeline *b)
         if (!b->variance) return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
         out.variance = b->variance;
     }
-    if (b->opt->denoise != LBK_BAKE_DENOISE_OFF) { /* only the denoised estimate reads them */
+    { /* the denoised estimate and each object's estimate (object_errors.c) read them */
         b->halves = calloc(b->receiver_count ? 2 * b->receiver_count : 1, sizeof *b->halves);
         if (!b->halves) return bk_pipeline_fail(b, LBK_ERR_OUT_OF_MEMORY, "out of memory");
         out.halves = b->halves;

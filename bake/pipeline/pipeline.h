@@ -71,7 +71,8 @@ typedef struct bk_pipeline {
     lbk_sh9_rgb *radiance;
     float *cell_size;               /* per scene triangle: the radiosity cache's cell size (texel size) */
     float *variance;                /* per receiver, from the transport: the denoiser's input */
-    float *halves;                  /* 2 per receiver, the transport's two halves' X (denoised bakes) */
+    float *halves;                  /* 2 per receiver, the transport's two halves' X (local bakes) */
+    lbk_bake_object_estimate *object_est; /* per scene object (texels 0: none), object_errors.c */
     float *texel_rel_error;         /* per texel receiver with error_map: the TERR input (error_map.h) */
     struct bk_denoiser *denoiser;   /* weights of the base + every set (do_denoise), for all of them */
     lbk_bake_denoised denoised;     /* the estimate of the denoised base (report, REPT's last record) */
@@ -113,6 +114,8 @@ struct lbk_bake_output {
     char *set_labels;               /* the set runs' labels, 64 bytes each */
     lbk_bake_set_estimate *set_estimates;
     char *set_names;                /* their names, 144 bytes each */
+    lbk_bake_object_estimate *object_estimates; /* lightmapped objects, in scene order */
+    char *object_names;             /* their names, 128 bytes each */
     lbk_bake_phase_time phases[BK_MAX_PHASES];
     char *input;
 };
@@ -153,6 +156,8 @@ lbk_result bk_phase_transport(bk_pipeline *b);
 lbk_result bk_phase_sets(bk_pipeline *b);
 lbk_result bk_phase_denoise(bk_pipeline *b);
 lbk_result bk_phase_emit_sets(bk_pipeline *b);
+/* Each lightmapped object's estimate into b->object_est (object_errors.c); after the denoiser. */
+lbk_result bk_object_estimates(bk_pipeline *b);
 
 /* The write phase: every section into b->writer (sections.c). */
 lbk_result bk_pipeline_encode(bk_pipeline *b);

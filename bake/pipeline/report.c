@@ -74,6 +74,31 @@ static int fill_set_estimates(const bk_pipeline *b, lbk_bake_output *out, lbk_ba
     return 0;
 }
 
+/* Each lightmapped object's estimate (object_errors.c), copied into the output. */
+static int fill_object_estimates(const bk_pipeline *b, lbk_bake_output *out, lbk_bake_report *r)
+{
+    size_t n = 0;
+    for (size_t o = 0; b->object_est && o < b->scene.object_count; o++) n += b->object_est[o].texels > 0;
+    if (!n) return 0;
+    const size_t name_len = sizeof b->scene.objects[0].name;
+    out->object_estimates = bk_output_alloc(out, n * sizeof *out->object_estimates);
+    out->object_names = bk_output_alloc(out, n * name_len);
+    if (!out->object_estimates || !out->object_names) return 1;
+    size_t k = 0;
+    for (size_t o = 0; o < b->scene.object_count; o++) {
+        if (!b->object_est[o].texels) continue;
+        char *name = out->object_names + k * name_len;
+        memcpy(name, b->scene.objects[o].name, name_len);
+        name[name_len - 1] = 0;
+        out->object_estimates[k] = b->object_est[o];
+        out->object_estimates[k].name = name;
+        k++;
+    }
+    r->object_estimates = out->object_estimates;
+    r->object_estimate_count = n;
+    return 0;
+}
+
 lbk_result bk_pipeline_report(const bk_pipeline *b, lbk_bake_output *out)
 {
     lbk_bake_report *r = &out->report;
@@ -123,7 +148,7 @@ lbk_result bk_pipeline_report(const bk_pipeline *b, lbk_bake_output *out)
     r->set_runs = out->set_runs;
     r->set_run_count = nrun;
     if (b->have_denoised) r->denoised = b->denoised;
-    if (fill_set_estimates(b, out, r)) return LBK_ERR_OUT_OF_MEMORY;
+    if (fill_set_estimates(b, out, r) || fill_object_estimates(b, out, r)) return LBK_ERR_OUT_OF_MEMORY;
     fill_transport(b, &r->transport);
     fill_counts(b, &r->counts);
     r->scales.lmap = r->counts.texels ? b->scale[0] : 0;
@@ -221,6 +246,23 @@ static void json_set_estimates(cJSON *root, const lbk_bake_report *r)
     }
 }
 
+/* "objects": each lightmapped object's estimate as stored (lbk_bake_object_estimate). */
+static void json_object_estimates(cJSON *root, const lbk_bake_report *r)
+{
+    cJSON *arr = cJSON_AddArrayToObject(root, "objects");
+    for (size_t i = 0; i < r->object_estimate_count; i++) {
+        const lbk_bake_object_estimate *e = &r->object_estimates[i];
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "name", e->name ? e->name : "");
+        cJSON_AddNumberToObject(o, "object", e->object);
+        cJSON_AddNumberToObject(o, "texels", e->texels);
+        cJSON_AddNumberToObject(o, "est_rel_rmse", e->rel_rmse);
+        cJSON_AddNumberToObject(o, "noise", e->noise);
+        cJSON_AddNumberToObject(o, "bias", e->bias);
+        cJSON_AddItemToArray(arr, o);
+    }
+}
+
 static cJSON *json_report(const lbk_bake_report *r, const char *container_path)
 {
     /* a report struct from before the per-class fields were appended has none of them */
@@ -283,6 +325,9 @@ static cJSON *json_report(const lbk_bake_report *r, const char *container_path)
         cJSON_AddBoolToObject(o, "texels_filtered", r->denoised.texels_filtered);
         cJSON_AddBoolToObject(o, "glg_filtered", r->denoised.glg_filtered);
     }
+    if (r->size >= offsetof(lbk_bake_report, object_estimate_count) + sizeof r->object_estimate_count &&
+        r->object_estimate_count)
+        json_object_estimates(root, r);
     cJSON *ph = cJSON_AddArrayToObject(root, "phases");
     for (size_t i = 0; i < r->phase_count; i++) {
         cJSON *o = cJSON_CreateObject();

@@ -363,6 +363,51 @@ static void test_normals_and_one_object(void **state)
     lbk_bake_output_free(out);
 }
 
+/* Each lightmapped object's estimate (report.object_estimates, 1.9): one per object with texels,
+ * named as in the scene, and — unfiltered (--denoise off), where each is the texel class's sum
+ * taken over the object's texels alone — pooling them with their weights gives back the
+ * class's estimate exactly: Σ_o rel_o²·value2_o / Σ_o value2_o = errors.texels². Denoised, the
+ * noise parts pool to the denoised figure's noise part (the bias clamp is per object). */
+static void test_object_estimates(void **state)
+{
+    (void)state;
+    for (int denoise = 0; denoise < 2; denoise++) {
+        level l;
+        level_init(&l, 0);
+        seen s;
+        lbk_bake_desc d = quick(&s);
+        d.max_samples = 64;
+        d.denoise = denoise ? LBK_BAKE_DENOISE_ON : LBK_BAKE_DENOISE_OFF;
+        lbk_bake_output *out = NULL;
+        assert_int_equal(lbk_bake_from_scene(&l.scene, &d, &out), LBK_OK);
+        const lbk_bake_report *r = lbk_bake_output_report(out);
+        assert_int_equal(r->object_estimate_count, 2); /* room and block */
+        assert_string_equal(r->object_estimates[0].name, "room");
+        assert_string_equal(r->object_estimates[1].name, "block");
+        double num = 0, noise = 0, den = 0;
+        uint64_t texels = 0;
+        for (size_t k = 0; k < r->object_estimate_count; k++) {
+            const lbk_bake_object_estimate *e = &r->object_estimates[k];
+            assert_true(e->texels > 0 && e->rel_rmse > 0 && e->value2 > 0);
+            assert_true(fabs(e->rel_rmse * e->rel_rmse - e->noise * e->noise - e->bias * e->bias) <=
+                        1e-9 * e->rel_rmse * e->rel_rmse);
+            num += e->rel_rmse * e->rel_rmse * e->value2;
+            noise += e->noise * e->noise * e->value2;
+            den += e->value2;
+            texels += e->texels;
+        }
+        const double pooled = sqrt(num / den), pooled_noise = sqrt(noise / den);
+        const double want = denoise ? r->denoised.errors.texels : r->errors.texels;
+        print_message("  denoise %s: %zu objects, %llu texels; pooled %.5f, the bake's texel estimate %.5f "
+                      "(noise %.5f / %.5f)\n", denoise ? "on" : "off", r->object_estimate_count,
+                      (unsigned long long)texels, pooled, want, pooled_noise,
+                      denoise ? r->denoised.texel_noise : r->errors.texels);
+        if (!denoise) assert_true(fabs(pooled - want) <= 1e-5 * want);
+        else assert_true(fabs(pooled_noise - r->denoised.texel_noise) <= 1e-5 * r->denoised.texel_noise);
+        lbk_bake_output_free(out);
+    }
+}
+
 typedef struct counting {
     long live, calls;
 } counting;
@@ -418,6 +463,7 @@ int main(void)
         cmocka_unit_test(test_scene_rules),
         cmocka_unit_test(test_cancel_every_phase),
         cmocka_unit_test(test_normals_and_one_object),
+        cmocka_unit_test(test_object_estimates),
         cmocka_unit_test(test_allocator_sees_the_output),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -55,8 +55,9 @@ extern "C" {
 /* The baker library's version (lbk-bake.pc): the minor grows with every addition to the
  * size-tagged structs below ("added in 1.x"). */
 #define LBK_BAKE_LIBRARY_VERSION_MAJOR 1
-#define LBK_BAKE_LIBRARY_VERSION_MINOR 8
-#define LBK_BAKE_LIBRARY_VERSION_PATCH 1 /* 1.8.1: the same API, other bakes (gap cells, TRANSPORT.md) */
+#define LBK_BAKE_LIBRARY_VERSION_MINOR 9
+#define LBK_BAKE_LIBRARY_VERSION_PATCH 0 /* 1.9.0: each object's estimate in the report; footprints stay
+                                           on their smooth surface (other bakes) */
 
 /* ---- options ----------------------------------------------------------------------------- */
 
@@ -445,6 +446,20 @@ typedef struct lbk_bake_set_estimate {
     lbk_bake_denoised error;     /* as the base's denoised estimate; seconds: its share of the pass */
 } lbk_bake_set_estimate;
 
+/* A lightmapped object's estimated error as stored (appended in 1.9): the bake's texel estimate
+ * (REPT's, the denoised one where the texels were denoised) taken over the object's texels
+ * alone, relative to the RMS of their irradiance. The level's figure is dominated by its large
+ * bright surfaces; a small or dark object's own error can be many times larger. Pooled over
+ * all objects (weights value2) the noise parts give the level's figure. */
+typedef struct lbk_bake_object_estimate {
+    const char *name;            /* the scene object's name */
+    uint32_t object;             /* scene object index (OBJS order) */
+    uint32_t texels;             /* its texel receivers */
+    double rel_rmse;             /* √(noise² + bias²) */
+    double noise, bias;          /* bias: what the denoiser moved beyond noise (0 unfiltered) */
+    double value2;               /* Σ of its texels' squared irradiance luminance (pooling weight) */
+} lbk_bake_object_estimate;
+
 /* What lbk_bake_report_write_json writes (spec/bake-report-json.md), as data. */
 typedef struct lbk_bake_report {
     size_t size;                 /* sizeof(lbk_bake_report) of the library that filled it */
@@ -476,6 +491,9 @@ typedef struct lbk_bake_report {
     /* appended in 1.6 (each stored set's estimate): read only when size covers them */
     const lbk_bake_set_estimate *set_estimates; /* in DLS set order; sets without one are left out */
     size_t set_estimate_count;
+    /* appended in 1.9 (each lightmapped object's estimate): read only when size covers them */
+    const lbk_bake_object_estimate *object_estimates; /* in scene object order */
+    size_t object_estimate_count;
 } lbk_bake_report;
 
 /* Owned by the output, valid until lbk_bake_output_free. */
