@@ -5,7 +5,9 @@
 //
 // The input is untrusted. tinygltf 2.7.0 parses JSON, buffers (data URIs, .bin files, the GLB BIN
 // chunk) and materials/nodes/lights, but indexes several arrays without bounds checks, so:
-//  * a pre-pass over the JSON (nlohmann) caps nesting depth, validates image bufferViews before
+//  * a pre-pass over the JSON (nlohmann) caps nesting depth and, before any DOM, what the import
+//    may hold (a SAX census against 256 MiB + 16 x the JSON size), checks the node hierarchy's
+//    depth and the files URIs name (regular, byteLength long, no NUL), validates image bufferViews before
 //    tinygltf takes a pointer into them, and takes KHR_draco_mesh_compression away from tinygltf:
 //    its Draco path (TINYGLTF_ENABLE_DRACO) dereferences unchecked indices and a possibly null
 //    attribute and overruns a 4-element stack array, so we decode Draco here with checks;
