@@ -36,12 +36,20 @@ def likely_cause(r):
     thin, dens = r.get("thin_m"), r.get("texel_density")
     if thin is not None and dens and thin * dens < 1.0:
         why.append("thin: %.3g cm = %.2f texel" % (100 * thin, thin * dens))
+    err, bias, noise = r["lbk_err"], r["lbk_bias"], r["lbk_noise"]
     up, down = r.get("bias_up"), r.get("bias_down")
     if up is not None and down is not None and up < -0.05 and down > 0.05:
         why.append("lit from the wrong side: top %+.0f %%, underside %+.0f %%" % (100 * up, 100 * down))
-    elif up is not None and down is not None and max(abs(up), abs(down)) > 0.1:
-        why.append("top %+.0f %%, underside %+.0f %%" % (100 * up, 100 * down))
-    err, bias, noise = r["lbk_err"], r["lbk_bias"], r["lbk_noise"]
+    # where the error is: its top, its underside (bias_/err_up, _down: receivers facing up, down), or
+    # neither (then its sides: a slab's edges, a wall's faces)
+    faces = [(r["err_" + k], k, r["bias_" + k]) for k in ("up", "down") if r.get("err_" + k) is not None]
+    if faces and err > 0:
+        e, k, b = max(faces)
+        if e > 1.5 * err:
+            why.append("%s error %.0f %% (bias %+.0f %%)" % ("top" if k == "up" else "underside", 100 * e, 100 * b))
+        elif len(faces) == 2 and e < 0.5 * err:
+            why.append("the error is on its sides (top %.1f %%, underside %.1f %%)" % (
+                100 * r["err_up"], 100 * r["err_down"]))
     if err > 0 and abs(bias) >= 0.5 * err:
         why.append("bias %+.1f %% (%s)" % (100 * bias, "too bright: leak?" if bias > 0 else "too dark: occluded?"))
     if err > 0 and noise >= 0.5 * err:
