@@ -13,7 +13,7 @@ set -u
 cd "$(dirname "$0")/../.."
 : "${BUILD:=build}"
 lbk=${LBK_LEVELS_BAKER:-$BUILD/lbk}
-w=$BUILD/tests/bench_levels.d
+w=$BUILD/tests/bench_levels.work
 gen=bench/levels/gen_levels.py
 echo "[==========] Running 3 test(s)."
 if ! command -v python3 >/dev/null 2>&1; then
