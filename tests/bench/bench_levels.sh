@@ -4,7 +4,9 @@
 #                  exactly the files of --set all;
 #   split          at least 40 levels, each with both layouts, at least 10 in each set;
 #   imports        every level (both layouts) bakes in lbk (a minimal bake: 1 bounce, 1
-#                  sample pass, no GLG, no denoising) with every object of the manifest, and
+#                  sample pass, no GLG, no denoising, 4 texels/m: import, classification and
+#                  the authored layout's checks need no finer, and it halves the time) with
+#                  every object of the manifest, and
 #                  `lbk inspect` shows the layout it asks for: NAME.gltf all generated charts,
 #                  NAME_authored.gltf every lightmapped object on its authored TEXCOORD_1.
 # The baker is the release build ($BUILD/lbk; LBK_LEVELS_BAKER overrides): the ASan one would
@@ -56,7 +58,7 @@ st=0
 if [ ! -x "$lbk" ]; then echo "  no baker $lbk"; st=1; fi
 [ $st = 0 ] && cut -d" " -f1 "$w/scenes.txt" | xargs -P 2 -I{} sh -c '
     "$1" bake "$2/a/$3.gltf" -o "$2/$3.lbk" --samples 1 --max-bounces 1 --target-error none --no-glg \
-        --denoise off --threads 1 -q >"$2/$3.bake.log" 2>&1 && "$1" inspect "$2/$3.lbk" >"$2/$3.inspect" 2>&1 ||
+        --denoise off --threads 1 -q --texel-density 4 >"$2/$3.bake.log" 2>&1 && "$1" inspect "$2/$3.lbk" >"$2/$3.inspect" 2>&1 ||
         echo "  $3: lbk bake/inspect failed: $(tail -n 2 "$2/$3.bake.log")"' _ "$lbk" "$w" {} >"$w/bake_errors.txt"
 [ -s "$w/bake_errors.txt" ] && { cat "$w/bake_errors.txt"; st=1; }
 n=0
