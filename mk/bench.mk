@@ -21,6 +21,13 @@ bench: deps-tools deps-bench
 	@echo "== bench-cycles"; $(MAKE) --no-print-directory bench-cycles
 	@echo "== bench-suite-quick (hard levels: a few dev scenes)"; $(MAKE) --no-print-directory bench-suite-quick
 	@echo "== render (lbk render vs Blender Cycles)"; $(MAKE) --no-print-directory bench-render
+	@echo "== bench-diff (lbk diff: reseed study and power)"; $(MAKE) --no-print-directory bench-diff
+
+# lbk diff's calibration (bench/diff_reseed.py): every scene of scenes/ and every preset, 20 reseed
+# pairs each (the measured false-alarm rate per receiver class against the stated one), then the
+# power table. Hours at the high preset; BENCH_DIFF_ARGS narrows it (e.g. --presets fast --pairs 5).
+bench-diff: $(BUILD)/lbk
+	@python3 bench/diff_reseed.py --lbk $(BUILD)/lbk --out $(BUILD)/bench-diff --power $(BENCH_DIFF_ARGS)
 
 # lbk against Cycles (bench/cycles/README.md). LBK_TREE=/path/to/other/checkout compares that
 # tree's baker instead: its build/lbk (built there first) and texel_dump linked against its

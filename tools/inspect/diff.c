@@ -174,7 +174,8 @@ static double rect_noise(const pageref *pg, const uint32_t rect[4], double fallb
         }
     double s = -1;
     for (int k = 0; k < TL_TEXEL_NORMALS; k++) s = fmax(s, tl_noise_highpass(lum + k * (n + 1), ref, rect[2], rect[3]));
-    if (s < 0) s = fallback;
+    /* too few texels to measure: REPT's estimate, a bake-wide RMS, spread as for probes */
+    if (s < 0) s = TL_NOISE_REPT_SPREAD * fallback;
     s = fmax(s, floor_noise);
     if (local && (*local = malloc(sizeof **local * (n + 1)))) {
         tl_noise_highpass_tiles(lum, rect[2], rect[3], s, *local);
@@ -294,8 +295,11 @@ static void compare_object(const tl_bake *a, const tl_bake *b, const lbk_object 
         d->resampled = !same_size;
         float *local_a = NULL, *local_b = NULL;
         if (t->noise)
-            tl_noise_begin(&d->noise, t->noise, 0, rect_noise(&pa, d->rect_a, t->noise->rept[0][0], texel_floor(t->noise, 0), &local_a),
+            tl_noise_begin(&d->noise, t->noise, TL_NOISE_TEXELS, rect_noise(&pa, d->rect_a, t->noise->rept[0][0], texel_floor(t->noise, 0), &local_a),
                            rect_noise(&pb, d->rect_b, t->noise->rept[1][0], texel_floor(t->noise, 1), same_size ? &local_b : NULL));
+        /* no texel noise of its own (under 16 interior texels): no per-texel test either */
+        if (t->noise && (oa->rect_w < 5 || oa->rect_h < 5 || (uint64_t)(oa->rect_w - 4) * (oa->rect_h - 4) < 16))
+            d->noise.count_test = 0;
         for (uint32_t y = 0; y < oa->rect_h; y++)
             for (uint32_t x = 0; x < oa->rect_w; x++) {
                 float va[TL_TEXEL_NORMALS][3], vb[TL_TEXEL_NORMALS][3];
@@ -309,7 +313,7 @@ static void compare_object(const tl_bake *a, const tl_bake *b, const lbk_object 
                 add_sample(&d->lighting, &va[0][0], &vb[0][0], TL_TEXEL_NORMALS, t, x, y, NULL);
                 if (t->noise) {
                     const size_t i = (size_t)y * oa->rect_w + x;
-                    tl_noise_add(&d->noise, t->noise, 0, &va[0][0], &vb[0][0], TL_TEXEL_NORMALS,
+                    tl_noise_add(&d->noise, t->noise, &va[0][0], &vb[0][0], TL_TEXEL_NORMALS,
                                  local_a ? local_a[i] : d->noise.noise_a, local_b ? local_b[i] : d->noise.noise_b);
                 }
             }
@@ -326,7 +330,7 @@ static void compare_object(const tl_bake *a, const tl_bake *b, const lbk_object 
         d->compared = 1;
         const int same = ga.dims[0] == gb.dims[0] && ga.dims[1] == gb.dims[1] && ga.dims[2] == gb.dims[2];
         d->resampled = !same;
-        if (t->noise) tl_noise_begin(&d->noise, t->noise, 1, t->noise->rept[0][1], t->noise->rept[1][1]);
+        if (t->noise) tl_noise_begin(&d->noise, t->noise, TL_NOISE_LLG, t->noise->rept[0][1], t->noise->rept[1][1]);
         const uint64_t n = (uint64_t)ga.dims[0] * ga.dims[1] * ga.dims[2];
         for (uint64_t i = 0; i < n; i++) {
             lbk_sh9_rgb sa, sb;
@@ -345,8 +349,8 @@ static void compare_object(const tl_bake *a, const tl_bake *b, const lbk_object 
             tl_probe_eval(&sb, vb);
             add_sample(&d->lighting, &va[0][0], &vb[0][0], TL_PROBE_NORMALS, t, (uint32_t)i, 0, NULL);
             if (t->noise)
-                tl_noise_add(&d->noise, t->noise, 1, &va[0][0], &vb[0][0], TL_PROBE_NORMALS,
-                             TL_NOISE_PROBE_SPREAD * d->noise.noise_a, TL_NOISE_PROBE_SPREAD * d->noise.noise_b);
+                tl_noise_add(&d->noise, t->noise, &va[0][0], &vb[0][0], TL_PROBE_NORMALS, d->noise.noise_a,
+                             d->noise.noise_b);
         }
         if (t->noise) tl_noise_end(&d->noise, t->noise);
     }
@@ -497,7 +501,7 @@ static int diff_pages(const tl_bake *a, const tl_bake *b, const tol *t, int keep
                 texel_values(&rb, x, y, vb);
                 int over = add_sample(&d->lighting, &va[0][0], &vb[0][0], TL_TEXEL_NORMALS, t, x, y, &e);
                 if (owner)
-                    over = tl_noise_sample_significant(t->noise, 0, local_a[(size_t)y * pa.width + x],
+                    over = tl_noise_sample_significant(t->noise, TL_NOISE_TEXELS, local_a[(size_t)y * pa.width + x],
                                                        local_b[(size_t)y * pb.width + x], &va[0][0], &vb[0][0],
                                                        TL_TEXEL_NORMALS);
                 if (keep_maps) {
@@ -545,7 +549,7 @@ static void diff_glg(const tl_bake *a, const tl_bake *b, const tol *t, tl_diff_r
     }
     const int same = glg_same_layout(a, b);
     d->resampled = !same;
-    if (t->noise) tl_noise_begin(&d->noise, t->noise, 1, t->noise->rept[0][1], t->noise->rept[1][1]);
+    if (t->noise) tl_noise_begin(&d->noise, t->noise, TL_NOISE_GLG, t->noise->rept[0][1], t->noise->rept[1][1]);
     uint32_t hint = 0;
     for (uint32_t i = 0; i < a->glg.probe_count; i++) {
         float pos[3], pb[3];
@@ -558,8 +562,8 @@ static void diff_glg(const tl_bake *a, const tl_bake *b, const tol *t, tl_diff_r
         tl_probe_eval(&sb, vb);
         add_sample(&d->lighting, &va[0][0], &vb[0][0], TL_PROBE_NORMALS, t, i, 0, NULL);
         if (t->noise)
-            tl_noise_add(&d->noise, t->noise, 1, &va[0][0], &vb[0][0], TL_PROBE_NORMALS,
-                         TL_NOISE_PROBE_SPREAD * d->noise.noise_a, TL_NOISE_PROBE_SPREAD * d->noise.noise_b);
+            tl_noise_add(&d->noise, t->noise, &va[0][0], &vb[0][0], TL_PROBE_NORMALS, d->noise.noise_a,
+                         d->noise.noise_b);
     }
     r->probes_over += d->lighting.over;
     if (t->noise) {
@@ -705,7 +709,9 @@ static int compare_set_space(const tl_bake *a, uint32_t sa, const tl_bake *b, ui
                              tl_err_stats *st, tl_noise_stats *ns)
 {
     const int kind = space == LBK_DLS_SPACE_TEXEL ? 0 : 1;
-    if (t->noise) tl_noise_begin(ns, t->noise, kind, t->noise->rept[0][kind], t->noise->rept[1][kind]);
+    if (t->noise)
+        tl_noise_begin(ns, t->noise, kind ? TL_NOISE_SET_PROBES : TL_NOISE_SET_TEXELS, t->noise->rept[0][kind],
+                       t->noise->rept[1][kind]);
     set_entries ea, eb;
     keyed *ka = NULL, *kb = NULL;
     int rc = -1;
@@ -735,10 +741,7 @@ static int compare_set_space(const tl_bake *a, uint32_t sa, const tl_bake *b, ui
         uint32_t x = space == LBK_DLS_SPACE_TEXEL ? (uint32_t)(key & 0xFFFF) : (uint32_t)key;
         uint32_t y = space == LBK_DLS_SPACE_TEXEL ? (uint32_t)((key >> 16) & 0xFFFF) : 0;
         add_sample(st, va, vb, n, t, x, y, NULL);
-        if (t->noise) {
-            const double spread = kind ? TL_NOISE_PROBE_SPREAD : 1.0;
-            tl_noise_add(ns, t->noise, kind, va, vb, n, spread * ns->noise_a, spread * ns->noise_b);
-        }
+        if (t->noise) tl_noise_add(ns, t->noise, va, vb, n, ns->noise_a, ns->noise_b);
     }
     if (t->noise) tl_noise_end(ns, t->noise);
     rc = 0;
@@ -894,6 +897,63 @@ static int diff_doors(const tl_bake *a, const tl_bake *b, tl_diff_result *r)
 
 /* ---- driver -------------------------------------------------------------------------------- */
 
+static int cmp_dbl(const void *x, const void *y)
+{
+    const double a = *(const double *)x, b = *(const double *)y;
+    return (a > b) - (a < b);
+}
+
+/* The median of n levels (sorts them); 0 when none. */
+static double median_level(double *v, size_t n)
+{
+    if (!n) return 0;
+    qsort(v, n, sizeof *v, cmp_dbl);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/* The median level of a bake's lit receivers (luminance; texels at +Z, probes the mean over the
+ * six normals), [0] texels, [1] GLG and LLG probes: with REPT's relative estimate it gives the
+ * absolute noise of a typical receiver (tl_noise_model.level_ref); 0 when out of memory. */
+static void bake_levels(const tl_bake *b, double out[2])
+{
+    uint64_t texels = 0;
+    for (uint32_t p = 0; b->has_lmap && p < b->lmap.page_count; p++) {
+        pageref pg;
+        if (!pageref_get(b, p, &pg)) texels += (uint64_t)pg.pl.width * pg.pl.height;
+    }
+    const uint64_t glg = b->has_glg ? b->glg.probe_count : 0, llg = b->has_llg ? b->llg.probe_count : 0;
+    out[0] = out[1] = 0;
+    if (texels > SIZE_MAX / sizeof(double) - 1 || glg + llg > SIZE_MAX / sizeof(double) - 1) return;
+    double *v = malloc(sizeof *v * ((size_t)(texels > glg + llg ? texels : glg + llg) + 1));
+    if (!v) return;
+    size_t n = 0;
+    for (uint32_t p = 0; b->has_lmap && p < b->lmap.page_count; p++) {
+        pageref pg;
+        if (pageref_get(b, p, &pg)) continue;
+        for (uint32_t y = 0; y < pg.pl.height; y++)
+            for (uint32_t x = 0; x < pg.pl.width; x++) {
+                float t[TL_TEXEL_NORMALS][3];
+                texel_values(&pg, x, y, t);
+                const double l = LBK_LUM_R * t[0][0] + LBK_LUM_G * t[0][1] + LBK_LUM_B * t[0][2];
+                if (l > 0) v[n++] = l;
+            }
+    }
+    out[0] = median_level(v, n);
+    n = 0;
+    for (uint64_t i = 0; i < glg + llg; i++) {
+        float pos[3], e[TL_PROBE_NORMALS][3];
+        lbk_sh9_rgb sh;
+        if (i < glg) lbk_glg_probe_get(&b->glg, (uint32_t)i, pos, &sh);
+        else tl_probe_unpack(b->llg.probes + (i - glg) * LBK_SH9_PACKED_SIZE, b->llg.scale, &sh);
+        tl_probe_eval(&sh, e);
+        double l = 0;
+        for (int k = 0; k < TL_PROBE_NORMALS; k++) l += (LBK_LUM_R * e[k][0] + LBK_LUM_G * e[k][1] + LBK_LUM_B * e[k][2]) / TL_PROBE_NORMALS;
+        if (l > 0) v[n++] = l;
+    }
+    out[1] = median_level(v, n);
+    free(v);
+}
+
 static void choose_mode(const tl_bake *a, const tl_bake *b, const tl_diff_options *o, tl_diff_result *r,
                         tl_noise_model *model)
 {
@@ -916,6 +976,7 @@ static void choose_mode(const tl_bake *a, const tl_bake *b, const tl_diff_option
     tl_noise_model_init(model, o->false_alarm > 0 ? o->false_alarm : TL_NOISE_DEFAULT_FALSE_ALARM, ra, rb);
     model->denoised[0] = bake_denoised(a);
     model->denoised[1] = bake_denoised(b);
+    if (r->mode == TL_DIFF_MODE_NOISE) bake_levels(a, model->level_ref[0]), bake_levels(b, model->level_ref[1]);
 }
 
 int tl_diff_run(const tl_bake *a, const tl_bake *b, const tl_diff_options *o, tl_diff_result *r, char err[TL_ERR_LEN])

@@ -19,11 +19,40 @@ double tl_normal_quantile(double p)
     return 0.5 * (lo + hi);
 }
 
+/* The classes' factors, from the reseed study (bench/diff_reseed.py; docs/tools.md "Calibration"):
+ * on 6 scenes × 3 reseed pairs at the fast preset the RMS of the samples' normalised deviation was
+ * 0.70 (texels), 0.48 (GLG, ρ 2.5) and 0.81 (LLG, ρ 5; 2.45 at ρ 2), the share of samples beyond
+ * k_sample 0.0044, 0 and 0.0069 (p₀ 0.02 keeps a margin), the largest |z|/k_mean 0.51 and
+ * chroma_z/k_chroma 0.33. LLG probes are fitted together from the object's vertices, so their
+ * standard error counts N/9 independent samples (ν 9). OCTP and the light-set classes had no item
+ * in the shared scenes: they take the GLG's (probes) and the texels' (texel entries) factors.
+ * p_x: samples beyond 30σ at their darker side were 0 of every class but the LLG's (0.17 %: dark
+ * probes of leak_rooms), 1e-5 elsewhere lets one such sample in a small item decide.
+ * φ 0.1: a texel far darker than the bake's RMS level (a room lit only through a leak) has an
+ * absolute noise floor of 0.1·r·level_ref; without it leak_rooms' texels were beyond 3.29σ in
+ * 27 % of the samples and its dark LLG prop shifted by −88 %. */
+static const tl_noise_class_params classes[TL_NOISE_CLASS_COUNT_] = {
+    /* name          kind  κ    ρ    p₀    χ    χ_c  ν    φ    p_x */
+    {"texels",       0,   1.0, 1.0, 0.02, 2.0, 0.3, 4.0, 0.1, 1e-5},
+    {"glg",          1,   1.0, 3.0, 0.05, 2.0, 0.3, 4.0, 0.1, 1e-5},
+    {"llg",          1,   1.0, 6.0, 0.05, 2.0, 0.3, 9.0, 0.1, 0.005},
+    {"octp",         1,   1.0, 3.0, 0.05, 2.0, 0.3, 4.0, 0.1, 1e-5},
+    {"set_texels",   0,   1.0, 1.0, 0.02, 2.0, 0.3, 4.0, 0.1, 1e-5},
+    {"set_probes",   1,   1.0, 3.0, 0.05, 2.0, 0.3, 4.0, 0.1, 1e-5},
+};
+
+const tl_noise_class_params *tl_noise_class_get(int cls)
+{
+    return &classes[cls >= 0 && cls < TL_NOISE_CLASS_COUNT_ ? cls : 0];
+}
+
 void tl_noise_model_init(tl_noise_model *m, double false_alarm, const double rept_a[2], const double rept_b[2])
 {
     memset(m, 0, sizeof *m);
     m->false_alarm = false_alarm;
-    m->k_mean = m->k_sample = tl_normal_quantile(1 - false_alarm / 2);
+    m->k_mean = tl_normal_quantile(1 - false_alarm / 6);
+    m->k_chroma = tl_normal_quantile(1 - false_alarm / 18);
+    m->k_sample = TL_NOISE_K_SAMPLE;
     m->common = TL_NOISE_COMMON;
     for (int k = 0; k < 2; k++) {
         m->rept[0][k] = rept_a[k];
@@ -31,13 +60,18 @@ void tl_noise_model_init(tl_noise_model *m, double false_alarm, const double rep
     }
 }
 
-void tl_noise_begin(tl_noise_stats *s, const tl_noise_model *m, int kind, double s_a, double s_b)
+void tl_noise_begin(tl_noise_stats *s, const tl_noise_model *m, int cls, double s_a, double s_b)
 {
     memset(s, 0, sizeof *s);
     s->evaluated = 1;
+    s->count_test = 1;
+    s->cls = cls >= 0 && cls < TL_NOISE_CLASS_COUNT_ ? cls : 0;
     s->noise_a = s_a;
     s->noise_b = s_b;
-    s->noise_common = m->common * hypot(m->rept[0][kind], m->rept[1][kind]);
+    const tl_noise_class_params *c = tl_noise_class_get(s->cls);
+    s->noise_common = m->common * hypot(m->rept[0][c->kind], m->rept[1][c->kind]);
+    s->floor_a = c->floor_scale * m->rept[0][c->kind] * m->level_ref[0][c->kind];
+    s->floor_b = c->floor_scale * m->rept[1][c->kind] * m->level_ref[1][c->kind];
 }
 
 static double lum(const float *c) { return LBK_LUM_R * c[0] + LBK_LUM_G * c[1] + LBK_LUM_B * c[2]; }
@@ -50,31 +84,105 @@ static double level(const float *v, int kind, int n)
     return l;
 }
 
-int tl_noise_sample_significant(const tl_noise_model *m, int kind, double t_a, double t_b, const float *a,
-                                const float *b, int n)
+/* A sample's change over its noise, |b₀ − a₀| / σ (+∞ for NaN or a change without noise); and
+ * into *extreme the same with the relative noise of the darker side for both (a sample 100×
+ * brighter stays 100× beyond it, where σ relative to the brighter side caps u near 1/σ_B). */
+static double sample_deviation(const tl_noise_model *m, int cls, double t_a, double t_b, const float *a,
+                               const float *b, int n, double *extreme)
 {
-    const double ca = m->common * m->rept[0][kind], cb = m->common * m->rept[1][kind];
-    const double la = level(a, kind, n), lb = level(b, kind, n), d = lb - la;
-    const double sigma = sqrt((t_a * t_a + ca * ca) * la * la + (t_b * t_b + cb * cb) * lb * lb);
-    const double t = sigma > 0 ? fabs(d) / sigma : (d != 0 || isnan(d) ? INFINITY : 0);
-    return !(t <= m->k_sample); /* NaN counts as significant */
+    const tl_noise_class_params *c = tl_noise_class_get(cls);
+    const double ca = m->common * m->rept[0][c->kind], cb = m->common * m->rept[1][c->kind];
+    const double ta = c->sample_spread * t_a, tb = c->sample_spread * t_b;
+    const double la = level(a, c->kind, n), lb = level(b, c->kind, n), d = lb - la;
+    const double fa = c->floor_scale * m->rept[0][c->kind] * m->level_ref[0][c->kind];
+    const double fb = c->floor_scale * m->rept[1][c->kind] * m->level_ref[1][c->kind];
+    const double sa2 = ta * ta + ca * ca, sb2 = tb * tb + cb * cb, lo = fmin(la, lb);
+    const double sigma = sqrt(sa2 * la * la + sb2 * lb * lb + fa * fa + fb * fb);
+    const double sigma_lo = sqrt((sa2 + sb2) * lo * lo + fa * fa + fb * fb);
+    if (isnan(d)) {
+        if (extreme) *extreme = INFINITY;
+        return INFINITY;
+    }
+    if (extreme) *extreme = sigma_lo > 0 ? fabs(d) / sigma_lo : (d != 0 ? INFINITY : 0);
+    return sigma > 0 ? fabs(d) / sigma : (d != 0 ? INFINITY : 0);
 }
 
-void tl_noise_add(tl_noise_stats *s, const tl_noise_model *m, int kind, const float *a, const float *b, int n,
-                  double t_a, double t_b)
+int tl_noise_sample_significant(const tl_noise_model *m, int cls, double t_a, double t_b, const float *a,
+                                const float *b, int n)
 {
-    double la_sum = 0, lb_sum = 0;
+    return !(sample_deviation(m, cls, t_a, t_b, a, b, n, NULL) <= m->k_sample);
+}
+
+void tl_noise_add(tl_noise_stats *s, const tl_noise_model *m, const float *a, const float *b, int n, double t_a,
+                  double t_b)
+{
+    double la_sum = 0, lb_sum = 0, ca[3] = {0}, cb[3] = {0};
     for (int i = 0; i < n; i++) {
         const double la = lum(a + 3 * i), lb = lum(b + 3 * i), d = lb - la;
         la_sum += la;
         lb_sum += lb;
         s->sum_d2 += d * d / n;
+        for (int k = 0; k < 3; k++) ca[k] += a[3 * i + k], cb[k] += b[3 * i + k];
     }
     if (la_sum == 0 && lb_sum == 0) return; /* unlit on both sides: no evidence either way */
     s->count++;
-    s->sum_a += la_sum / n;
-    s->sum_d += (lb_sum - la_sum) / n;
-    s->significant += (uint64_t)tl_noise_sample_significant(m, kind, t_a, t_b, a, b, n);
+    const double la = la_sum / n, d = (lb_sum - la_sum) / n;
+    s->sum_a += la;
+    s->sum_d += d;
+    s->sum_dd += d * d, s->sum_da += d * la, s->sum_aa += la * la;
+    for (int k = 0; k < 3; k++) {
+        const double dc = (cb[k] - ca[k]) / n;
+        s->sum_ca[k] += ca[k] / n, s->sum_cb[k] += cb[k] / n;
+        s->sum_dcdc[k] += dc * dc, s->sum_dcdl[k] += dc * d;
+    }
+    double ux;
+    const double u = sample_deviation(m, s->cls, t_a, t_b, a, b, n, &ux);
+    s->significant += !(u <= m->k_sample);
+    s->extreme += !(ux <= TL_NOISE_K_EXTREME);
+    if (isfinite(u)) s->sum_u2 += u * u;
+}
+
+uint64_t tl_binomial_critical(uint64_t n, double p, double q)
+{
+    if (!(p > 0)) return 1;
+    if (p >= 1) return n + 1;
+    /* the upper tail summed downward from where the pmf is below 1e-300 of the whole (40 standard
+     * deviations above the mean); each term from lgamma keeps every term in range */
+    const double lp = log(p), lq = log1p(-p), dn = (double)n;
+    const double top = dn * p + 40 * sqrt(dn * p * (1 - p)) + 50;
+    double tail = 0;
+    for (uint64_t c = top < dn ? (uint64_t)top : n;; c--) {
+        const double dc = (double)c;
+        tail += exp(lgamma(dn + 1) - lgamma(dc + 1) - lgamma(dn - dc + 1) + dc * lp + (dn - dc) * lq);
+        if (tail > q) return c + 1;
+        if (c == 0) return 0;
+    }
+}
+
+/* The chromaticity test of tl_noise_end: g_C with its noise, the model's or the samples' own. */
+static void chroma_end(tl_noise_stats *s, const tl_noise_model *m, const tl_noise_class_params *c, double n)
+{
+    const double la = LBK_LUM_R * s->sum_ca[0] + LBK_LUM_G * s->sum_ca[1] + LBK_LUM_B * s->sum_ca[2];
+    const double lb = LBK_LUM_R * s->sum_cb[0] + LBK_LUM_G * s->sum_cb[1] + LBK_LUM_B * s->sum_cb[2];
+    const double model = c->chroma_scale * c->chroma_scale * (s->noise_a * s->noise_a + s->noise_b * s->noise_b) / n;
+    const double common = c->chroma_common * s->noise_common;
+    s->chroma_z = 0;
+    s->chroma_noise = sqrt(model + common * common);
+    for (int k = 0; k < 3; k++) {
+        s->chroma_shift[k] = 0;
+        if (!(la > 0) || !(lb > 0)) continue;
+        const double qa = s->sum_ca[k] / la, qb = s->sum_cb[k] / lb;
+        if (!(qa >= TL_NOISE_CHROMA_MIN_SHARE) || !(qb >= TL_NOISE_CHROMA_MIN_SHARE)) continue;
+        s->chroma_shift[k] = qb / qa - 1;
+        /* x = dC/ΣC_a − dL/ΣL_a per sample: Σx ≈ g_C, its standard error √(Σx² − (Σx)²/N) */
+        const double sc = s->sum_ca[k], sx = (s->sum_cb[k] - sc) / sc - (lb - la) / la;
+        const double sxx = s->sum_dcdc[k] / (sc * sc) - 2 * s->sum_dcdl[k] / (sc * la) + s->sum_dd / (la * la);
+        const double emp = c->empirical_scale * fmax(sxx - sx * sx / n, 0);
+        const double sigma = sqrt(fmax(model, emp) + common * common);
+        const double z = sigma > 0 ? fabs(s->chroma_shift[k]) / sigma : (s->chroma_shift[k] != 0 ? INFINITY : 0);
+        if (k == 0 || z > s->chroma_z) s->chroma_z = z, s->chroma_noise = sigma;
+    }
+    s->chroma_significant = !(s->chroma_z <= m->k_chroma);
 }
 
 void tl_noise_end(tl_noise_stats *s, const tl_noise_model *m)
@@ -83,16 +191,29 @@ void tl_noise_end(tl_noise_stats *s, const tl_noise_model *m)
         s->within_noise = 1;
         return;
     }
-    const double n = (double)s->count, alpha = m->false_alarm;
+    const tl_noise_class_params *c = tl_noise_class_get(s->cls);
+    const double n = (double)s->count, k2 = c->mean_scale * c->mean_scale;
     s->mean_shift = s->sum_a > 0 ? s->sum_d / s->sum_a : (s->sum_d != 0 ? INFINITY : 0);
     s->rmse = sqrt(s->sum_d2 / n);
-    s->noise_mean = sqrt((s->noise_a * s->noise_a + s->noise_b * s->noise_b) / n + s->noise_common * s->noise_common);
+    /* relative per-sample noise, and the absolute floor relative to the item's mean level */
+    const double level = s->sum_a / n, fl = level > 0 ? (s->floor_a * s->floor_a + s->floor_b * s->floor_b) / (level * level) : 0;
+    s->noise_model = sqrt((k2 * (s->noise_a * s->noise_a + s->noise_b * s->noise_b) + c->empirical_scale * fl) / n);
+    /* the ratio estimator's standard error: √Σ(d − m·a)² / Σa */
+    const double mm = isfinite(s->mean_shift) ? s->mean_shift : 0;
+    const double e2 = fmax(s->sum_dd - 2 * mm * s->sum_da + mm * mm * s->sum_aa, 0);
+    s->noise_empirical = s->sum_a > 0 ? sqrt(c->empirical_scale * e2) / s->sum_a : 0;
+    s->noise_mean = sqrt(fmax(s->noise_model, s->noise_empirical) * fmax(s->noise_model, s->noise_empirical) +
+                         s->noise_common * s->noise_common);
     s->z = s->noise_mean > 0 ? s->mean_shift / s->noise_mean : (s->mean_shift != 0 ? INFINITY : 0);
+    s->sample_rms = sqrt(s->sum_u2 / n);
     s->significant_share = (double)s->significant / n;
-    s->share_limit = fmax(TL_NOISE_SHARE_FACTOR * alpha, alpha + 4 * sqrt(alpha / n));
+    const uint64_t critical = tl_binomial_critical(s->count, c->sample_rate, m->false_alarm / 6);
+    const uint64_t critical_extreme = tl_binomial_critical(s->count, c->extreme_rate, m->false_alarm / 6);
+    s->share_limit = critical > 0 ? (double)(critical - 1) / n : 0;
     s->shift_significant = !(fabs(s->z) <= m->k_mean);
-    s->share_significant = s->significant_share > s->share_limit;
-    s->within_noise = !s->shift_significant && !s->share_significant;
+    s->share_significant = s->count_test && (s->significant >= critical || s->extreme >= critical_extreme);
+    chroma_end(s, m, c, n);
+    s->within_noise = !s->shift_significant && !s->share_significant && !s->chroma_significant;
 }
 
 static int cmp_double(const void *x, const void *y)

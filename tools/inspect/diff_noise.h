@@ -1,20 +1,28 @@
 /* The noise-aware verdict of lbk diff (spec/diff-json.md "Noise mode"): is the difference between
- * two bakes of an object larger than the Monte Carlo noise the two bakes carry? Each bake's noise
- * comes from two places: its own estimate (REPT, one number per bake) and the texels themselves
- * (a robust high-pass of the lightmap, per object and per 4×4 tile). The rule, per object, light
- * grid and light set, with α the false-alarm rate:
+ * two bakes of an item larger than the Monte Carlo noise the two bakes carry? Each bake's noise
+ * comes from two places: its own estimate (REPT: the transport's half estimates, one RMS for the
+ * texels and one for the probes) and the texels themselves (a robust high-pass of the lightmap, per
+ * object and per 4×4 tile). Each receiver class (tl_noise_class) scales them by its own factors,
+ * measured by the reseed study (bench/diff_reseed.sh). Per item, with α the false-alarm rate, three
+ * tests each at α/3 (so the item's false-alarm rate is at most α):
  *
- *   mean shift  m = Σ(b − a) / Σa over every sample and normal (luminance);
- *   its noise   σ_m² = (s_A² + s_B²)/N + c²·(r_A² + r_B²)
+ *   luminance mean shift  m = Σ(b − a) / Σa over every sample and normal;
+ *   its noise   σ_m² = κ²·(s_A² + s_B²)/N + c²·(r_A² + r_B²)
  *               s = relative per-sample noise (texels: high-pass of the object; probes: REPT),
- *               r = REPT's final estimate, c = TL_NOISE_COMMON (the common-mode share, measured);
- *   a sample is significant when |b₀ − a₀| > k_sample·σ, b₀, a₀ its level (texels: luminance at
- *               +Z; probes: the mean over the six axis normals), σ² = (σ_A·a₀)² + (σ_B·b₀)²,
- *               σ_X² = t_X² + c²·r_X², t = the local noise (texels: the high-pass of the sample's
- *               4×4 tile and its 2-texel surround; probes: TL_NOISE_PROBE_SPREAD × REPT);
- *   the item is within noise when |m| ≤ k_mean·σ_m and the share of significant samples is at most
- *               max(TL_NOISE_SHARE_FACTOR·α, α + 4·√(α/N)),
- * with k_mean = k_sample = Φ⁻¹(1 − α/2). */
+ *               r = REPT's estimate, c = TL_NOISE_COMMON, κ the class's mean_scale;
+ *               significant when |m| > k_mean·σ_m, k_mean = Φ⁻¹(1 − α/6);
+ *   chromaticity shift, per channel C of R, G, B: g_C = (ΣC_b/ΣL_b) / (ΣC_a/ΣL_a) − 1 (L the
+ *               luminance; a channel below TL_NOISE_CHROMA_MIN_SHARE of the luminance on either
+ *               side is not tested); its noise σ_g² = χ²·(s_A² + s_B²)/N + (χ_c·c)²·(r_A² + r_B²),
+ *               χ, χ_c the class's; significant when max |g_C|/σ_g > k_chroma = Φ⁻¹(1 − α/18);
+ *   significant samples: a sample is significant when |b₀ − a₀| > k_sample·σ (k_sample =
+ *               Φ⁻¹(1 − α/2)), b₀, a₀ its level (texels: luminance at +Z; probes: the mean over
+ *               the normals), σ² = (σ_A·a₀)² + (σ_B·b₀)², σ_X² = (ρ·t_X)² + c²·r_X², t the local noise
+ *               (texels: the high-pass of the sample's 4×4 tile and its 2-texel surround; probes:
+ *               REPT), ρ the class's sample_spread. Reseeds make a sample significant with the
+ *               class's rate p₀ (measured); the count is significant when a Binomial(N, p₀) count
+ *               reaches it with probability at most α/3.
+ * The item is within noise when none is significant. */
 #ifndef LBK_TOOLS_DIFF_NOISE_H
 #define LBK_TOOLS_DIFF_NOISE_H
 
@@ -26,20 +34,49 @@
  * object: the spread of object means over reseeds was 0.05–0.27 × REPT on two_rooms,
  * cornell_box and cornell_box_bjs (spec/diff-json.md). */
 #define TL_NOISE_COMMON 0.3
-/* Monte Carlo noise of a texel has heavier tails than a normal distribution and the high-pass
- * reads it 10–20 % low: over 58 reseed pairs of two_rooms, cornell_box and cornell_box_bjs the
- * share of texels beyond k_sample reached 16 α (α = 0.001). A share of significant samples counts
- * only above this many α. */
-#define TL_NOISE_SHARE_FACTOR 25.0
 #define TL_NOISE_DEFAULT_FALSE_ALARM 0.001
-/* Probes have no neighbourhood to measure their own noise in, and REPT's estimate is one RMS over
- * all of them: single probes were up to 1.85 × REPT over 8 reseeds of two_rooms. A probe's sample
- * test takes twice REPT's noise. */
-#define TL_NOISE_PROBE_SPREAD 2.0
+/* A lightmapped object too small for its own high-pass (under 16 usable texels) takes REPT's
+ * texel estimate × this, as probes do (lights_punctual_lamp's 6×5-texel object: 13 of 30 texels
+ * beyond 3.29σ at 1×). */
+#define TL_NOISE_REPT_SPREAD 3.0
+/* The sample test's threshold, Φ⁻¹(1 − 0.0005), whatever α: each class's rate p₀ is measured at it. */
+#define TL_NOISE_K_SAMPLE 3.2905267314918945
+/* A sample beyond this many σ, its relative noise taken at its darker side, is extreme (a probe
+ * 100× brighter): reseeds make one at the class's extreme_rate (bench/diff_reseed.py), and the
+ * count of extreme samples is a second binomial test; the two counts share the count test's α/3. */
+#define TL_NOISE_K_EXTREME 30.0
+/* A channel that carries less than this share of the luminance (C/L, both sides) has too few
+ * paths to compare its chromaticity. */
+#define TL_NOISE_CHROMA_MIN_SHARE 0.05
+
+/* Receiver classes: each has its own noise factors (diff_noise.c, measured by bench/diff_reseed.sh). */
+typedef enum tl_noise_class {
+    TL_NOISE_TEXELS = 0,    /* a lightmapped object */
+    TL_NOISE_GLG,           /* the global light grid */
+    TL_NOISE_LLG,           /* an LLG object */
+    TL_NOISE_OCTP,          /* the octahedral probes */
+    TL_NOISE_SET_TEXELS,    /* a light set or door state, texel entries */
+    TL_NOISE_SET_PROBES,    /* a light set or door state, GLG or LLG entries */
+    TL_NOISE_CLASS_COUNT_
+} tl_noise_class;
+
+typedef struct tl_noise_class_params {
+    const char *name;       /* "texels", "glg", "llg", "octp", "set_texels", "set_probes" */
+    int kind;               /* 0 texels (REPT's texel estimate, level at +Z), 1 probes */
+    double mean_scale;      /* κ */
+    double sample_spread;   /* ρ */
+    double sample_rate;     /* p₀ */
+    double chroma_scale;    /* χ */
+    double chroma_common;   /* χ_c */
+    double empirical_scale; /* ν: variance factor of the samples' own standard errors (correlated samples) */
+    double floor_scale;     /* φ: a sample's absolute noise is at least φ·r·level_ref */
+    double extreme_rate;    /* p_x: reseeds' rate of extreme samples (TL_NOISE_K_EXTREME) */
+} tl_noise_class_params;
+const tl_noise_class_params *tl_noise_class_get(int cls);
 
 typedef struct tl_noise_model {
     double false_alarm;     /* α */
-    double k_mean, k_sample;
+    double k_mean, k_sample, k_chroma;
     double common;          /* c */
     /* REPT's final estimates: [side][0 texels, 1 probes]; 0 when REPT is absent */
     double rept[2][2];
@@ -47,6 +84,10 @@ typedef struct tl_noise_model {
      * frequencies a texel's own high-pass measures, and what noise remains is smooth, so for a
      * denoised bake the texel noise is at least REPT's (the undenoised estimate, an upper side) */
     int denoised[2];
+    /* [side][kind]: the median level of the bake's lit texels / probes. r × level_ref is the
+     * absolute noise of a typical receiver: one far darker is lit by rare paths (a leak), whose
+     * noise is absolute, not relative to its own level. */
+    double level_ref[2][2];
 } tl_noise_model;
 
 /* α → the model's thresholds; rept from the two bakes. */
@@ -56,29 +97,48 @@ double tl_normal_quantile(double p);
 
 typedef struct tl_noise_stats {
     int evaluated;
+    int cls;                 /* tl_noise_class */
     uint64_t count;          /* samples with light on either side */
     double sum_a, sum_d, sum_d2;
+    /* the moments of the empirical standard errors: luminance d = b − a and a (means over the
+     * normals), and per channel its change dc */
+    double sum_dd, sum_da, sum_aa;
+    double sum_ca[3], sum_cb[3]; /* channel sums (mean over normals) */
+    double sum_dcdc[3], sum_dcdl[3];
     double mean_shift;       /* m */
     double rmse;             /* √(mean (b − a)²), luminance */
     double noise_a, noise_b; /* s_A, s_B */
     double noise_common;     /* c·√(r_A² + r_B²) */
+    double floor_a, floor_b; /* φ·r·level_ref per side: absolute */
+    double noise_model;      /* κ·√((s_A² + s_B²)/N): the model's independent noise of m */
+    double noise_empirical;  /* √ν × the ratio estimator's standard error of m from the samples */
     double noise_mean;       /* σ_m */
     double z;                /* m / σ_m */
     uint64_t significant;    /* samples over k_sample */
-    double significant_share, share_limit;
-    int shift_significant, share_significant;
+    uint64_t extreme;        /* samples over TL_NOISE_K_EXTREME (σ at the darker side) */
+    int count_test;          /* the count decides (begin sets 1; 0: no local noise to test samples against) */
+    double sample_rms;       /* √(mean u²) over the finite u: 1 when σ is the samples' noise */
+    double sum_u2;
+    double significant_share, share_limit; /* share_limit: the largest share within noise */
+    double chroma_shift[3];  /* g_C; 0 for a channel not tested */
+    double chroma_noise;     /* σ_g of the channel with the largest |g_C|/σ_g */
+    double chroma_z;         /* max |g_C| / σ_g over the channels tested */
+    int shift_significant, share_significant, chroma_significant;
     int within_noise;
 } tl_noise_stats;
 
-/* Starts an item: kind 0 texels, 1 probes; s_a, s_b its relative per-sample noise. */
-void tl_noise_begin(tl_noise_stats *s, const tl_noise_model *m, int kind, double s_a, double s_b);
-/* One sample: n normals × 3 channels of irradiance, A and B; t_a, t_b its local relative noise. */
-void tl_noise_add(tl_noise_stats *s, const tl_noise_model *m, int kind, const float *a, const float *b, int n,
-                  double t_a, double t_b);
+/* Starts an item of class cls (tl_noise_class); s_a, s_b its relative per-sample noise. */
+void tl_noise_begin(tl_noise_stats *s, const tl_noise_model *m, int cls, double s_a, double s_b);
+/* One sample: n normals × 3 channels of irradiance, A and B; t_a, t_b its local relative noise
+ * (before the class's sample_spread). */
+void tl_noise_add(tl_noise_stats *s, const tl_noise_model *m, const float *a, const float *b, int n, double t_a,
+                  double t_b);
 void tl_noise_end(tl_noise_stats *s, const tl_noise_model *m);
 /* The sample test alone (1: significant), for heatmaps. */
-int tl_noise_sample_significant(const tl_noise_model *m, int kind, double t_a, double t_b, const float *a,
+int tl_noise_sample_significant(const tl_noise_model *m, int cls, double t_a, double t_b, const float *a,
                                 const float *b, int n);
+/* The smallest count c with P(Binomial(n, p) ≥ c) ≤ q (n + 1 when none). */
+uint64_t tl_binomial_critical(uint64_t n, double p, double q);
 
 /* Relative noise of a lightmap from its own texels: the median absolute deviation of the
  * residual of each texel's value against the mean of its 4 neighbours, relative to the texel's

@@ -63,8 +63,8 @@ static void compare_probe(const lbk_octp_view *va, const lbk_octp_view *vb, uint
     tl_err_add(&d->depth, &pa.depth[0][0], &pb.depth[0][0], 2 * LBK_OCTP_DEPTH_N * LBK_OCTP_DEPTH_N, abs_tol, rel_tol,
                i, 0, NULL);
     if (noise)
-        tl_noise_add(&d->noise, noise, 1, &pa.irradiance[0][0], &pb.irradiance[0][0], (int)texels,
-                     TL_NOISE_PROBE_SPREAD * d->noise.noise_a, TL_NOISE_PROBE_SPREAD * d->noise.noise_b);
+        tl_noise_add(&d->noise, noise, &pa.irradiance[0][0], &pb.irradiance[0][0], (int)texels, d->noise.noise_a,
+                     d->noise.noise_b);
 }
 
 void tl_diff_octp_run(const tl_bake *a, const tl_bake *b, double abs_tol, double rel_tol, const tl_noise_model *noise,
@@ -87,7 +87,7 @@ void tl_diff_octp_run(const tl_bake *a, const tl_bake *b, double abs_tol, double
         d->status = TL_DIFF_CHANGED;
         return;
     }
-    if (noise) tl_noise_begin(&d->noise, noise, 1, noise->rept[0][1], noise->rept[1][1]);
+    if (noise) tl_noise_begin(&d->noise, noise, TL_NOISE_OCTP, noise->rept[0][1], noise->rept[1][1]);
     for (uint32_t i = 0; i < a->octp.probe_count; i++) compare_probe(&a->octp, &b->octp, i, abs_tol, rel_tol, noise, d);
     r->probes_over += d->lighting.over;
     int differs;

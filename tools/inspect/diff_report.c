@@ -56,6 +56,7 @@ static cJSON *noise_json(const tl_noise_stats *n)
 {
     if (!n->evaluated) return cJSON_CreateNull();
     cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "class", tl_noise_class_get(n->cls)->name);
     cJSON_AddNumberToObject(o, "count", (double)n->count);
     cJSON_AddItemToObject(o, "mean_shift", num_or_null(n->mean_shift));
     cJSON_AddItemToObject(o, "z", num_or_null(n->z));
@@ -65,11 +66,22 @@ static cJSON *noise_json(const tl_noise_stats *n)
     cJSON_AddNumberToObject(nz, "b", n->noise_b);
     cJSON_AddNumberToObject(nz, "common", n->noise_common);
     cJSON_AddNumberToObject(nz, "mean", n->noise_mean);
+    cJSON_AddNumberToObject(nz, "model", n->noise_model);
+    cJSON_AddNumberToObject(nz, "empirical", n->noise_empirical);
     cJSON_AddNumberToObject(o, "significant", (double)n->significant);
     cJSON_AddNumberToObject(o, "significant_share", n->significant_share);
+    cJSON_AddItemToObject(o, "sample_rms", num_or_null(n->sample_rms));
+    cJSON_AddNumberToObject(o, "extreme", (double)n->extreme);
+    cJSON_AddBoolToObject(o, "count_test", n->count_test);
     cJSON_AddNumberToObject(o, "share_limit", n->share_limit);
     cJSON_AddBoolToObject(o, "shift_significant", n->shift_significant);
     cJSON_AddBoolToObject(o, "share_significant", n->share_significant);
+    cJSON *ch = cJSON_AddObjectToObject(o, "chroma");
+    cJSON *shift = cJSON_AddArrayToObject(ch, "shift");
+    for (int k = 0; k < 3; k++) cJSON_AddItemToArray(shift, num_or_null(n->chroma_shift[k]));
+    cJSON_AddItemToObject(ch, "noise", num_or_null(n->chroma_noise));
+    cJSON_AddItemToObject(ch, "z", num_or_null(n->chroma_z));
+    cJSON_AddBoolToObject(o, "chroma_significant", n->chroma_significant);
     cJSON_AddBoolToObject(o, "within_noise", n->within_noise);
     return o;
 }
@@ -145,14 +157,34 @@ static void add_noise_model(cJSON *root, const tl_diff_result *r)
         cJSON_AddNumberToObject(nm, "false_alarm", r->noise.false_alarm);
         cJSON_AddNumberToObject(nm, "k_mean", r->noise.k_mean);
         cJSON_AddNumberToObject(nm, "k_sample", r->noise.k_sample);
-        cJSON_AddNumberToObject(nm, "probe_spread", TL_NOISE_PROBE_SPREAD);
+        cJSON_AddNumberToObject(nm, "k_chroma", r->noise.k_chroma);
+        /* schema 2's fields, kept: the GLG's sample spread, the texels' p₀ in units of α */
+        cJSON_AddNumberToObject(nm, "probe_spread", tl_noise_class_get(TL_NOISE_GLG)->sample_spread);
+        cJSON_AddNumberToObject(nm, "share_factor", tl_noise_class_get(TL_NOISE_TEXELS)->sample_rate / r->noise.false_alarm);
         cJSON_AddNumberToObject(nm, "common", r->noise.common);
-        cJSON_AddNumberToObject(nm, "share_factor", TL_NOISE_SHARE_FACTOR);
+        cJSON_AddNumberToObject(nm, "chroma_min_share", TL_NOISE_CHROMA_MIN_SHARE);
+        cJSON *cl = cJSON_AddObjectToObject(nm, "classes");
+        for (int k = 0; k < TL_NOISE_CLASS_COUNT_; k++) {
+            const tl_noise_class_params *c = tl_noise_class_get(k);
+            cJSON *co = cJSON_AddObjectToObject(cl, c->name);
+            cJSON_AddNumberToObject(co, "mean_scale", c->mean_scale);
+            cJSON_AddNumberToObject(co, "sample_spread", c->sample_spread);
+            cJSON_AddNumberToObject(co, "sample_rate", c->sample_rate);
+            cJSON_AddNumberToObject(co, "chroma_scale", c->chroma_scale);
+            cJSON_AddNumberToObject(co, "chroma_common", c->chroma_common);
+            cJSON_AddNumberToObject(co, "empirical_scale", c->empirical_scale);
+            cJSON_AddNumberToObject(co, "floor_scale", c->floor_scale);
+            cJSON_AddNumberToObject(co, "extreme_rate", c->extreme_rate);
+        }
         cJSON *ra = cJSON_AddObjectToObject(nm, "rept_a"), *rb = cJSON_AddObjectToObject(nm, "rept_b");
         cJSON_AddNumberToObject(ra, "texel_rel_rmse", r->noise.rept[0][0]);
         cJSON_AddNumberToObject(ra, "probe_rel_rmse", r->noise.rept[0][1]);
         cJSON_AddNumberToObject(rb, "texel_rel_rmse", r->noise.rept[1][0]);
         cJSON_AddNumberToObject(rb, "probe_rel_rmse", r->noise.rept[1][1]);
+        cJSON_AddNumberToObject(ra, "texel_level", r->noise.level_ref[0][0]);
+        cJSON_AddNumberToObject(ra, "probe_level", r->noise.level_ref[0][1]);
+        cJSON_AddNumberToObject(rb, "texel_level", r->noise.level_ref[1][0]);
+        cJSON_AddNumberToObject(rb, "probe_level", r->noise.level_ref[1][1]);
     } else {
         cJSON_AddNullToObject(root, "noise_model");
     }
@@ -327,6 +359,9 @@ static void print_noise(FILE *f, const tl_noise_stats *n)
             n->within_noise ? "within noise" : "BEYOND NOISE", n->mean_shift, n->z, n->noise_mean, n->rmse,
             (unsigned long long)n->significant, (unsigned long long)n->count, 100 * n->significant_share,
             100 * n->share_limit);
+    fprintf(f, "\n      chromaticity R %+.4f G %+.4f B %+.4f (z %.2f, noise %.4f)%s [%s]", n->chroma_shift[0],
+            n->chroma_shift[1], n->chroma_shift[2], n->chroma_z, n->chroma_noise,
+            n->chroma_significant ? " BEYOND NOISE" : "", tl_noise_class_get(n->cls)->name);
 }
 
 static void print_stats(FILE *f, const tl_err_stats *s, int texels)

@@ -1,0 +1,307 @@
+/* lbk diff's noise verdict, calibrated (tools/inspect/diff_noise.h):
+ *   - the binomial critical count against a direct sum of the pmf;
+ *   - synthetic items of Gaussian noise of known σ (texels and probes, per-channel noise): the
+ *     false-alarm rate over many trials is at most α (within its binomial spread), and a mean
+ *     shift, a chromaticity shift at equal luminance and a local change of a tenth of the samples
+ *     are each detected;
+ *   - real bakes of scenes/cornell_box (cheap: 256 samples): two reseeds are EQUAL, and the right
+ *     wall changed from green (0.14, 0.45, 0.091) to a cyan-blue of the same luminance (0.14, 0.40,
+ *     0.58) is DIFFERENT, through the chromaticity test (no item's luminance shift is significant). */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "lbk/ahd.h"
+#include "support/bake_file.h"
+#include "support/scenes_dir.h"
+#include "tools/inspect/diff.h"
+
+/* ---- the binomial tail ------------------------------------------------------------------------ */
+
+static void test_binomial_critical(void **state)
+{
+    (void)state;
+    const uint64_t ns[] = {1, 5, 27, 200};
+    const double ps[] = {0.02, 0.1, 0.5};
+    for (size_t i = 0; i < sizeof ns / sizeof *ns; i++)
+        for (size_t j = 0; j < sizeof ps / sizeof *ps; j++) {
+            const uint64_t n = ns[i];
+            const double p = ps[j], q = 0.001 / 3;
+            /* the smallest c with P(X ≥ c) ≤ q, by the pmf summed from the top */
+            double tail = 0;
+            uint64_t want = n + 1;
+            for (uint64_t c = n + 1; c-- > 0;) {
+                tail += exp(lgamma((double)n + 1) - lgamma((double)c + 1) - lgamma((double)(n - c) + 1) +
+                            (double)c * log(p) + (double)(n - c) * log1p(-p));
+                if (tail > q) break;
+                want = c;
+            }
+            assert_int_equal(tl_binomial_critical(n, p, q), want);
+        }
+    /* 27 LLG probes at p₀ 0.02: one or two significant probes are within noise */
+    assert_true(tl_binomial_critical(27, 0.02, 0.001 / 3) >= 4);
+}
+
+/* ---- synthetic items ------------------------------------------------------------------------- */
+
+static uint64_t rng = 0x9E3779B97F4A7C15ull;
+static double uniform(void)
+{
+    rng ^= rng << 13, rng ^= rng >> 7, rng ^= rng << 17;
+    return ((double)(rng >> 11) + 0.5) / 9007199254740992.0;
+}
+static double gauss(void) { return sqrt(-2 * log(uniform())) * cos(6.283185307179586 * uniform()); }
+
+enum { N = 256, NORMALS = 5 };
+
+typedef struct change {
+    double shift;           /* every sample × (1 + shift) in B */
+    double blue, red;       /* B's blue and red channels × (1 + x) with the green keeping the luminance */
+    double local;           /* the first N/10 samples × (1 + local) */
+} change;
+
+/* One item of N samples, grey level 1..2 at each normal, each channel of each side with its own
+ * relative Gaussian noise of σ; the model told σ exactly (s = t = σ, no REPT). Returns 1 when
+ * beyond noise. */
+static int trial(const tl_noise_model *m, int cls, double sigma, const change *c, tl_noise_stats *s)
+{
+    tl_noise_begin(s, m, cls, sigma, sigma);
+    const int kind = tl_noise_class_get(cls)->kind;
+    const int normals = kind ? 6 : NORMALS;
+    const double lr = LBK_LUM_R, lg = LBK_LUM_G, lb = LBK_LUM_B;
+    for (int i = 0; i < N; i++) {
+        float a[6][3], b[6][3];
+        const double level = 1 + (double)i / N;
+        const double f = (1 + c->shift) * (i < N / 10 ? 1 + c->local : 1);
+        const double fr = 1 + c->red, fb = 1 + c->blue, fg = (1 - lr * fr - lb * fb) / lg;
+        for (int k = 0; k < normals; k++) {
+            /* independent noise per normal and channel */
+            const double ea[3] = {gauss(), gauss(), gauss()}, eb[3] = {gauss(), gauss(), gauss()};
+            const double tilt = 1 - 0.1 * k;
+            for (int ch = 0; ch < 3; ch++) {
+                const double fc = ch == 0 ? fr : ch == 1 ? fg : fb;
+                a[k][ch] = (float)(level * tilt * (1 + sigma * ea[ch]));
+                b[k][ch] = (float)(level * tilt * f * fc * (1 + sigma * eb[ch]));
+            }
+            (void)lb;
+        }
+        tl_noise_add(s, m, &a[0][0], &b[0][0], normals, sigma, sigma);
+    }
+    tl_noise_end(s, m);
+    return !s->within_noise;
+}
+
+static void test_synthetic_false_alarm_rate(void **state)
+{
+    (void)state;
+    const double zero[2] = {0, 0};
+    const double alphas[] = {0.05, 0.001};
+    const int trials[] = {2000, 6000};
+    const int classes[] = {TL_NOISE_TEXELS, TL_NOISE_GLG};
+    for (int ai = 0; ai < 2; ai++)
+        for (int ci = 0; ci < 2; ci++) {
+            tl_noise_model m;
+            tl_noise_model_init(&m, alphas[ai], zero, zero);
+            const change none = {0};
+            int alarms = 0, mean = 0, chroma = 0, share = 0;
+            double z2 = 0, u2 = 0;
+            for (int t = 0; t < trials[ai]; t++) {
+                tl_noise_stats s;
+                alarms += trial(&m, classes[ci], 0.05, &none, &s);
+                mean += s.shift_significant, chroma += s.chroma_significant, share += s.share_significant;
+                z2 += s.z * s.z / trials[ai];
+                u2 += s.sample_rms * s.sample_rms / trials[ai];
+            }
+            /* calibrated, not blind: z's spread is that of the empirical term (ν = 4 doubles the
+             * standard error: RMS z ½) for texels, the model's for the GLG's six-normal mean; the
+             * samples' deviation from their model σ is at most 1 (the +Z luminance of three
+             * independent channels has 0.75 σ; probes are tested against ρ = 3 times it) */
+            print_message("  RMS z %.3f, RMS u %.3f\n", sqrt(z2), sqrt(u2));
+            assert_true(sqrt(z2) > 0.2 && sqrt(z2) < 0.8);
+            assert_true(sqrt(u2) > 0.05 && sqrt(u2) < 1.0);
+            /* at most α, within 3 binomial standard deviations of α·trials (+1 for α·trials < 1) */
+            const double expect = alphas[ai] * trials[ai];
+            const double bound = expect + 3 * sqrt(expect) + 1;
+            print_message("α %g class %d: %d false alarms in %d trials (mean %d, chroma %d, count %d), bound %.1f\n",
+                          alphas[ai], classes[ci], alarms, trials[ai], mean, chroma, share, bound);
+            assert_true(alarms <= bound);
+        }
+}
+
+static void test_synthetic_power(void **state)
+{
+    (void)state;
+    const double zero[2] = {0, 0};
+    tl_noise_model m;
+    tl_noise_model_init(&m, 0.001, zero, zero);
+    /* σ 5 % per channel and side over 256 samples: the noise of the mean is ~0.6 %; the
+     * empirical term (ν 4) doubles it. A 6 % shift is ~5 of those, a 12 % blue/red hue change at
+     * equal luminance likewise for the chromaticity, 10 % of the samples 50 % brighter for the
+     * count. */
+    const change shift = {.shift = 0.06}, hue = {.blue = 0.12, .red = -0.12}, local = {.local = 0.5};
+    int hit_shift = 0, hit_hue = 0, hit_local = 0, hue_by_lum = 0;
+    for (int t = 0; t < 50; t++) {
+        tl_noise_stats s;
+        hit_shift += trial(&m, TL_NOISE_TEXELS, 0.05, &shift, &s) && s.shift_significant;
+        hit_hue += trial(&m, TL_NOISE_TEXELS, 0.05, &hue, &s) && s.chroma_significant;
+        hue_by_lum += s.shift_significant;
+        hit_local += trial(&m, TL_NOISE_TEXELS, 0.05, &local, &s) && s.share_significant;
+    }
+    print_message("detected in 50: shift %d, hue %d (by luminance %d), local %d\n", hit_shift, hit_hue, hue_by_lum,
+                  hit_local);
+    assert_true(hit_shift >= 48);
+    assert_true(hit_hue >= 48);
+    assert_true(hue_by_lum <= 1); /* the same luminance: the luminance test alone was blind */
+    assert_true(hit_local >= 48);
+}
+
+/* ---- real bakes: cornell_box -------------------------------------------------------------------- */
+
+static char tmpdir[64];
+enum { BASE, RESEED, RESEED2, HUE, BAKES };
+static tl_bake bakes[BAKES];
+
+/* The Cornell box with its right wall's base colour replaced (the glTF text edited). */
+static void write_hue_scene(const char *src, const char *dst)
+{
+    FILE *f = fopen(src, "rb");
+    assert_non_null(f);
+    fseek(f, 0, SEEK_END);
+    const long size = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *text = malloc((size_t)size + 1);
+    assert_non_null(text);
+    assert_int_equal(fread(text, 1, (size_t)size, f), (size_t)size);
+    text[size] = 0;
+    fclose(f);
+    /* rightWall's green and blue, each once in the file */
+    const char *g = "0.44999998807907104", *b = "0.09099999815225601";
+    char *pg = strstr(text, g), *pb = strstr(text, b);
+    assert_non_null(pg);
+    assert_non_null(pb);
+    assert_null(strstr(pg + 1, g));
+    assert_null(strstr(pb + 1, b));
+    FILE *o = fopen(dst, "wb");
+    assert_non_null(o);
+    fwrite(text, 1, (size_t)(pg - text), o);
+    fputs("0.40000000000000000", o); /* 0.2126·0.14 + 0.7152·0.45 + 0.0722·0.091 = 0.3583 */
+    fwrite(pg + strlen(g), 1, (size_t)(pb - pg - (long)strlen(g)), o);
+    fputs("0.58000000000000000", o); /* 0.2126·0.14 + 0.7152·0.40 + 0.0722·0.58 = 0.3577 */
+    fputs(pb + strlen(b), o);
+    fclose(o);
+    free(text);
+}
+
+static void bake(const char *gltf, uint64_t seed, int which)
+{
+    char out[128], err[1024];
+    snprintf(out, sizeof out, "%s/b%d.lbk", tmpdir, which);
+    tb_job job = {gltf, out, NULL, {0}};
+    job.d.seed = seed;
+    job.d.max_samples = 256;
+    assert_int_equal(tb_bake(&job, NULL, err, sizeof err), LBK_OK);
+    if (tl_bake_open_file(out, &bakes[which], err) != TL_OPEN_OK) fail_msg("%s", err);
+}
+
+static int setup(void **state)
+{
+    (void)state;
+    snprintf(tmpdir, sizeof tmpdir, "/tmp/lbk_diff_calib_XXXXXX");
+    if (!mkdtemp(tmpdir)) return -1;
+    char gltf[1024], hue[160];
+    SD_REQUIRE(sd_path(gltf, sizeof gltf, "cornell_box/CornellBox-Original.gltf"));
+    snprintf(hue, sizeof hue, "%s/cornell_hue.gltf", tmpdir);
+    write_hue_scene(gltf, hue);
+    bake(gltf, 1, BASE);
+    bake(gltf, 2, RESEED);
+    bake(gltf, 3, RESEED2);
+    bake(hue, 4, HUE);
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    char p[160];
+    for (int i = 0; i < BAKES; i++) {
+        tl_bake_close(&bakes[i]);
+        snprintf(p, sizeof p, "%s/b%d.lbk", tmpdir, i);
+        unlink(p);
+    }
+    snprintf(p, sizeof p, "%s/cornell_hue.gltf", tmpdir);
+    unlink(p);
+    rmdir(tmpdir);
+    return 0;
+}
+
+static void diff(int a, int b, tl_diff_result *r)
+{
+    tl_diff_options o = {0};
+    o.mode = TL_DIFF_MODE_AUTO; /* lbk diff's default */
+    char err[TL_ERR_LEN];
+    assert_int_equal(tl_diff_run(&bakes[a], &bakes[b], &o, r, err), 0);
+    assert_int_equal(r->mode, TL_DIFF_MODE_NOISE);
+}
+
+static void test_cornell_reseeds_equal(void **state)
+{
+    (void)state;
+    const int pairs[][2] = {{BASE, RESEED}, {BASE, RESEED2}, {RESEED, RESEED2}};
+    for (int p = 0; p < 3; p++) {
+        tl_diff_result r;
+        diff(pairs[p][0], pairs[p][1], &r);
+        for (size_t i = 0; i < r.object_count; i++) {
+            const tl_noise_stats *n = &r.objects[i].noise;
+            if (!n->within_noise)
+                fail_msg("seeds %d/%d %s: z %+.2f chroma z %.2f significant %llu/%llu", pairs[p][0] + 1,
+                         pairs[p][1] + 1, r.objects[i].name, n->z, n->chroma_z, (unsigned long long)n->significant,
+                         (unsigned long long)n->count);
+        }
+        assert_true(r.glg.noise.within_noise);
+        assert_int_equal(r.items_beyond_noise, 0);
+        assert_int_equal(r.differ, 0);
+        tl_diff_free(&r);
+    }
+}
+
+static void test_cornell_hue_change_differs(void **state)
+{
+    (void)state;
+    tl_diff_result r;
+    diff(BASE, HUE, &r);
+    assert_int_equal(r.differ, 1);
+    uint32_t chroma = 0, shifted = 0;
+    double max_blue = 0;
+    for (size_t i = 0; i < r.object_count; i++) {
+        const tl_noise_stats *n = &r.objects[i].noise;
+        chroma += n->chroma_significant;
+        shifted += n->shift_significant;
+        max_blue = fmax(max_blue, n->chroma_shift[2]);
+    }
+    print_message("hue: %u items by chromaticity, %u by luminance shift, largest blue shift %+.3f\n", chroma,
+                  shifted, max_blue);
+    assert_true(chroma >= 1);
+    /* the bounce light of a bluer wall: blue up by several per cent where it lands */
+    assert_true(max_blue > 0.03);
+    tl_diff_free(&r);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_binomial_critical),
+        cmocka_unit_test(test_synthetic_false_alarm_rate),
+        cmocka_unit_test(test_synthetic_power),
+        cmocka_unit_test(test_cornell_reseeds_equal),
+        cmocka_unit_test(test_cornell_hue_change_differs),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
