@@ -43,15 +43,15 @@ XXH_DISPATCH := $(shell printf '\043include <xxh_x86dispatch.h>\nint main(void){
 LIB_INC  := $(strip -Ilibformat/include $(XXH_DISPATCH) $(call pc,--cflags,libzstd libxxhash,))
 LIB_LIBS := $(strip $(call pc,--libs,libzstd libxxhash,-lzstd -lxxhash) -lm)
 # The baker (liblbkbake) and the tools: everything heavy lives here, never in liblbk.
-# Through pkg-config: qhull_r, spng, libcjson, draco (draco.pc says -I/usr/include, where its
+# Through pkg-config: qhull_r, spng, libcjson, libwebp (EXT_texture_webp), draco (draco.pc says -I/usr/include, where its
 # <draco/...> includes resolve; -I/usr/include/draco is only the fallback) and stb (headers only:
 # stb_image is compiled into the glTF shim, so only its --cflags). Named directly because Debian
 # ships no .pc for them (CMake configs only): Embree 3 (-lembree3) and astcenc (-lastcenc). And
 # OpenEXR: its OpenEXR.pc names the whole C++ library set (-lOpenEXR -lIex -lIlmThread -lImath ...);
 # lbk uses only the C core (<OpenEXR/openexr.h>, -lOpenEXRCore), which has no .pc of its own.
-BAKE_PC     := qhull_r spng libcjson draco
+BAKE_PC     := qhull_r spng libcjson draco libwebp
 BAKE_CFLAGS := $(strip $(call pc,--cflags,$(BAKE_PC),-I/usr/include/draco) $(call pc,--cflags,stb,-I/usr/include/stb))
-BAKE_LIBS   := $(strip -lembree3 -lOpenEXRCore $(call pc,--libs,$(BAKE_PC),-lqhull_r -lspng -lcjson -ldraco) -lpthread -lm)
+BAKE_LIBS   := $(strip -lembree3 -lOpenEXRCore $(call pc,--libs,$(BAKE_PC),-lqhull_r -lspng -lcjson -ldraco -lwebp) -lpthread -lm)
 TOOL_INC    := $(LIB_INC) -Ibake/include -I. $(BAKE_CFLAGS)
 TOOL_CXXINC := $(LIB_INC) -Ibake/include -I. $(call isystem,$(BAKE_CFLAGS))
 # astcenc: the ASTC plane encodings of lbk convert / export / diff (tools/common/astc_codec.cc)
