@@ -19,26 +19,27 @@ double tl_normal_quantile(double p)
     return 0.5 * (lo + hi);
 }
 
-/* The classes' factors, from the reseed study (bench/diff_reseed.py; docs/tools.md "Calibration"):
- * on 6 scenes × 3 reseed pairs at the fast preset the RMS of the samples' normalised deviation was
- * 0.70 (texels), 0.48 (GLG, ρ 2.5) and 0.81 (LLG, ρ 5; 2.45 at ρ 2), the share of samples beyond
- * k_sample 0.0044, 0 and 0.0069 (p₀ 0.02 keeps a margin), the largest |z|/k_mean 0.51 and
- * chroma_z/k_chroma 0.33. LLG probes are fitted together from the object's vertices, so their
- * standard error counts N/9 independent samples (ν 9). OCTP and the light-set classes had no item
- * in the shared scenes: they take the GLG's (probes) and the texels' (texel entries) factors.
- * p_x: samples beyond 30σ at their darker side were 0 of every class but the LLG's (0.17 %: dark
- * probes of leak_rooms), 1e-5 elsewhere lets one such sample in a small item decide.
- * φ 0.1: a texel far darker than the bake's RMS level (a room lit only through a leak) has an
+/* The classes' factors, from the reseed study (bench/diff_reseed.py; docs/tools.md "lbk diff:
+ * calibration and power"), fast preset: 6 scenes × 3 pairs and 4 scenes × 6 pairs. The RMS of
+ * the samples' normalised deviation u was 0.70–0.78 (texels), 0.42–0.88 (GLG at ρ 3) and 1.0–2.4
+ * (LLG at ρ 6: lights_punctual_lamp's probes), the share beyond k_sample 0.5–0.8 %, 0.2–0.8 %
+ * and 0.8–4.6 % (p₀ 2 %, 5 %, 8 %), samples beyond 30σ at their darker side 7e-5, 0 and 0.8 %
+ * (p_x 1e-4, 1e-5, 2 %). The largest |z|/k_mean was 0.26 (texels), 0.86 (GLG at κ 1, ν 4: κ 1.5
+ * and ν 9 for probes) and 0.62 (LLG), chroma_z/k_chroma at most 0.34. LLG probes are fitted
+ * together from the object's vertices and GLG probes interpolate each other, so their standard
+ * error counts N/9 independent samples (ν 9). OCTP and the light-set classes had no item in the
+ * shared scenes: they take the GLG's (probes) and the texels' (texel entries) factors.
+ * φ 0.1: a texel far darker than the bake's median level (a room lit only through a leak) has an
  * absolute noise floor of 0.1·r·level_ref; without it leak_rooms' texels were beyond 3.29σ in
  * 27 % of the samples and its dark LLG prop shifted by −88 %. */
 static const tl_noise_class_params classes[TL_NOISE_CLASS_COUNT_] = {
     /* name          kind  κ    ρ    p₀    χ    χ_c  ν    φ    p_x */
-    {"texels",       0,   1.0, 1.0, 0.02, 2.0, 0.3, 4.0, 0.1, 1e-5},
-    {"glg",          1,   1.0, 3.0, 0.05, 2.0, 0.3, 4.0, 0.1, 1e-5},
-    {"llg",          1,   1.0, 6.0, 0.05, 2.0, 0.3, 9.0, 0.1, 0.005},
-    {"octp",         1,   1.0, 3.0, 0.05, 2.0, 0.3, 4.0, 0.1, 1e-5},
-    {"set_texels",   0,   1.0, 1.0, 0.02, 2.0, 0.3, 4.0, 0.1, 1e-5},
-    {"set_probes",   1,   1.0, 3.0, 0.05, 2.0, 0.3, 4.0, 0.1, 1e-5},
+    {"texels",       0,   1.0, 1.0, 0.02, 2.0, 0.3, 4.0, 0.1, 1e-4},
+    {"glg",          1,   1.5, 3.0, 0.05, 2.0, 0.3, 9.0, 0.1, 1e-5},
+    {"llg",          1,   1.5, 8.0, 0.08, 2.0, 0.3, 9.0, 0.1, 0.02},
+    {"octp",         1,   1.5, 3.0, 0.05, 2.0, 0.3, 9.0, 0.1, 1e-5},
+    {"set_texels",   0,   1.0, 1.0, 0.02, 2.0, 0.3, 4.0, 0.1, 1e-4},
+    {"set_probes",   1,   1.5, 3.0, 0.05, 2.0, 0.3, 9.0, 0.1, 1e-5},
 };
 
 const tl_noise_class_params *tl_noise_class_get(int cls)
