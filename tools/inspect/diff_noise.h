@@ -3,25 +3,31 @@
  * comes from two places: its own estimate (REPT: the transport's half estimates, one RMS for the
  * texels and one for the probes) and the texels themselves (a robust high-pass of the lightmap, per
  * object and per 4×4 tile). Each receiver class (tl_noise_class) scales them by its own factors,
- * measured by the reseed study (bench/diff_reseed.sh). Per item, with α the false-alarm rate, three
+ * measured by the reseed study (bench/diff_reseed.py). Per item, with α the false-alarm rate, three
  * tests each at α/3 (so the item's false-alarm rate is at most α):
  *
  *   luminance mean shift  m = Σ(b − a) / Σa over every sample and normal;
- *   its noise   σ_m² = κ²·(s_A² + s_B²)/N + c²·(r_A² + r_B²)
+ *   its noise   σ_m² = max(κ²·(s_A² + s_B²)/N + ν·(f_A² + f_B²)/(N·ā²), ν·SE²) + c²·(r_A² + r_B²)
  *               s = relative per-sample noise (texels: high-pass of the object; probes: REPT),
- *               r = REPT's estimate, c = TL_NOISE_COMMON, κ the class's mean_scale;
+ *               r = REPT's estimate, c = TL_NOISE_COMMON, κ the class's mean_scale, SE the
+ *               ratio estimator's own standard error from the samples, ν its empirical_scale;
  *               significant when |m| > k_mean·σ_m, k_mean = Φ⁻¹(1 − α/6);
  *   chromaticity shift, per channel C of R, G, B: g_C = (ΣC_b/ΣL_b) / (ΣC_a/ΣL_a) − 1 (L the
  *               luminance; a channel below TL_NOISE_CHROMA_MIN_SHARE of the luminance on either
- *               side is not tested); its noise σ_g² = χ²·(s_A² + s_B²)/N + (χ_c·c)²·(r_A² + r_B²),
+ *               side is not tested); its noise σ_g² = max(χ²·(s_A² + s_B²)/N, ν·SE_g²) +
+ *               (χ_c·c)²·(r_A² + r_B²),
  *               χ, χ_c the class's; significant when max |g_C|/σ_g > k_chroma = Φ⁻¹(1 − α/18);
  *   significant samples: a sample is significant when |b₀ − a₀| > k_sample·σ (k_sample =
- *               Φ⁻¹(1 − α/2)), b₀, a₀ its level (texels: luminance at +Z; probes: the mean over
- *               the normals), σ² = (σ_A·a₀)² + (σ_B·b₀)², σ_X² = (ρ·t_X)² + c²·r_X², t the local noise
+ *               3.29 whatever α), b₀, a₀ its level (texels: luminance at +Z; probes: the mean over
+ *               the normals), σ² = (σ_A·a₀)² + (σ_B·b₀)² + f_A² + f_B², σ_X² = (ρ·t_X)² + c²·r_X²,
+ *               t the local noise
  *               (texels: the high-pass of the sample's 4×4 tile and its 2-texel surround; probes:
- *               REPT), ρ the class's sample_spread. Reseeds make a sample significant with the
- *               class's rate p₀ (measured); the count is significant when a Binomial(N, p₀) count
- *               reaches it with probability at most α/3.
+ *               REPT), ρ the class's sample_spread; f = φ·r·level_ref the absolute floor of a
+ *               receiver lit by rare paths (added to σ²). Reseeds make a sample significant with
+ *               the class's rate p₀ (measured); the count is significant when a Binomial(N, p₀)
+ *               count reaches it with probability at most α/6; likewise the count of extreme
+ *               samples (beyond TL_NOISE_K_EXTREME σ at their darker side) at the class's
+ *               extreme_rate, α/6. An object too small for its own texel noise has no count test.
  * The item is within noise when none is significant. */
 #ifndef LBK_TOOLS_DIFF_NOISE_H
 #define LBK_TOOLS_DIFF_NOISE_H
