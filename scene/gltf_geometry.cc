@@ -264,6 +264,7 @@ void Importer::prepare_prim(int mi, int pi, Prim &p, bool *is_triangles)
     }
     if (p.uv0.empty()) p.uv0.assign(nv * 2, 0.0f);
     if (p.uv1.empty()) p.uv1.assign(nv * 2, 0.0f);
+    apply_uv_map(p, mi, pi);  // KHR_texture_transform / texCoord: uv0 is what textures read
     p.source_vertices = (uint32_t)nv;
     p.src.resize(nv);
     for (size_t i = 0; i < nv; i++) p.src[i] = (uint32_t)i;

@@ -460,6 +460,52 @@ void check_uri_targets(const nlohmann::json &arr, const char *kind, const std::s
     }
 }
 
+// KHR_texture_basisu and EXT_meshopt_compression: lbk decodes neither. Only used, the fallback is
+// read (a texture's core source, a bufferView's own buffer range); required, there is none (a
+// meshopt fallback buffer may have no uri at all), so the import is refused here, naming the
+// first texture or bufferView that uses the extension, before tinygltf reads anything.
+void check_required_codecs(const nlohmann::json &doc, const std::string &file)
+{
+    const nlohmann::json *req = jarr(doc, "extensionsRequired");
+    if (!req) return;
+    auto user = [&](const char *arr_key, const char *ext) -> std::string {
+        const nlohmann::json *arr = jarr(doc, arr_key);
+        for (size_t i = 0; arr && i < arr->size(); i++) {
+            const nlohmann::json &e = (*arr)[i];
+            if (!e.is_object() || !e.contains("extensions") || !e["extensions"].is_object() ||
+                !e["extensions"].contains(ext))
+                continue;
+            std::string what = std::string(arr_key).substr(0, strlen(arr_key) - 1) + " " + std::to_string(i);
+            if (e.contains("name") && e["name"].is_string()) what += " " + qstr(e["name"].get<std::string>());
+            const nlohmann::json &x = e["extensions"][ext];
+            long long src;
+            const nlohmann::json *images = jarr(doc, "images");
+            if (x.is_object() && jint(x, "source", &src) && images && src >= 0 && (size_t)src < images->size()) {
+                const nlohmann::json &im = (*images)[(size_t)src];
+                what += " (image " + std::to_string(src);
+                if (im.is_object() && im.contains("uri") && im["uri"].is_string() &&
+                    im["uri"].get<std::string>().compare(0, 5, "data:") != 0)
+                    what += " " + qstr(im["uri"].get<std::string>());
+                what += ")";
+            }
+            return what;
+        }
+        return std::string();
+    };
+    for (const auto &e : *req) {
+        if (!e.is_string()) continue;
+        const std::string ext = e.get<std::string>();
+        const bool basis = ext == "KHR_texture_basisu", meshopt = ext == "EXT_meshopt_compression";
+        if (!basis && !meshopt) continue;
+        std::string what = user(basis ? "textures" : "bufferViews", ext.c_str());
+        fail("%s: requires glTF extension %s (%s), which lbk cannot decode: %s", file.c_str(), ext.c_str(),
+             what.empty() ? "no texture or bufferView uses it" : ("used by " + what).c_str(),
+             basis ? "export the textures as PNG, JPEG or WebP (or add a fallback source and leave the extension "
+                     "used, not required)"
+                   : "export without meshopt compression (or with fallback data, the extension used, not required)");
+    }
+}
+
 // Buffers and images name files relative to the scene (or embed data: URIs). An absolute path
 // or another URI scheme (file://, http://) would reach outside it: refuse them up front, with the
 // entry named; `..` escapes and symlinks are caught when the file is opened (resource_allowed).
@@ -500,6 +546,7 @@ Prepass prepass(const char *json_begin, size_t json_len, const std::string &file
         fail("%s: invalid JSON: %s", file.c_str(), e.what());
     }
     if (!doc.is_object()) fail("%s: the JSON root is not an object", file.c_str());
+    check_required_codecs(doc, file);
     check_uris(doc, file, pol);
     check_node_depth(doc, file);
 
@@ -532,7 +579,12 @@ Prepass prepass(const char *json_begin, size_t json_len, const std::string &file
         auto need = [&](const nlohmann::json &info) {
             long long t, src;
             if (!textures || !jint(info, "index", &t) || t < 0 || (size_t)t >= textures->size()) return;
-            if (jint((*textures)[(size_t)t], "source", &src) && src >= 0 &&
+            const nlohmann::json &tex = (*textures)[(size_t)t];
+            bool webp = false;  // EXT_texture_webp's source first, as Importer::texture_source reads it
+            if (tex.is_object() && tex.contains("extensions") && tex["extensions"].is_object() &&
+                tex["extensions"].contains("EXT_texture_webp"))
+                webp = jint(tex["extensions"]["EXT_texture_webp"], "source", &src);
+            if ((webp || jint(tex, "source", &src)) && src >= 0 &&
                 (size_t)src < pp.needed_images.size())
                 pp.needed_images[(size_t)src] = 1;
         };

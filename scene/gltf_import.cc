@@ -100,8 +100,10 @@ void Importer::load()
 
 void Importer::check_extensions()
 {
-    static const char *const supported[] = {"KHR_draco_mesh_compression", "KHR_lights_punctual",
-                                            "KHR_materials_emissive_strength", "KHR_mesh_quantization"};
+    // KHR_texture_basisu / EXT_meshopt_compression required: refused by the pre-pass, by name
+    static const char *const supported[] = {"EXT_texture_webp", "KHR_draco_mesh_compression",
+                                            "KHR_lights_punctual", "KHR_materials_emissive_strength",
+                                            "KHR_mesh_quantization", "KHR_texture_transform"};
     for (const std::string &e : m_.extensionsRequired) {
         bool used = false;
         for (const std::string &u : m_.extensionsUsed) used = used || u == e;
@@ -109,11 +111,14 @@ void Importer::check_extensions()
             fail("%s: extensionsRequired names %s, which extensionsUsed does not list", path_.c_str(),
                  qstr(e).c_str());
         bool ok = false;
-        for (const char *s : supported) ok = ok || e == s;
+        std::string list;
+        for (const char *s : supported) {
+            ok = ok || e == s;
+            list += (list.empty() ? "" : ", ") + std::string(s);
+        }
         if (!ok)
-            fail("%s: requires glTF extension %s, which lbk does not support (supported: "
-                 "KHR_draco_mesh_compression, KHR_lights_punctual, KHR_materials_emissive_strength, "
-                 "KHR_mesh_quantization)", path_.c_str(), e.c_str());
+            fail("%s: requires glTF extension %s, which lbk does not support (supported: %s)", path_.c_str(),
+                 e.c_str(), list.c_str());
     }
 }
 

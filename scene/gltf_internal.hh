@@ -15,7 +15,7 @@
 //    overflow-checked arithmetic; counts that could be derived are never trusted;
 //  * file reads go through our callbacks: regular files only, size-capped, no shell expansion
 //    (tinygltf's default ExpandFilePath calls wordexp);
-//  * images are decoded here (stb_image, PNG/JPEG only) after a header-only size check.
+//  * images are decoded here (stb_image PNG/JPEG, libwebp WebP) after a header-only size check.
 // Internally errors are C++ exceptions carrying the message; bk_import_gltf catches everything.
 //
 // Where each part lives: gltf_guard.cc the path sandbox, file reads, the JSON pre-pass and the GLB
@@ -239,6 +239,25 @@ struct ImageLoaderCtx {
 bool keep_encoded_image(tinygltf::Image *image, const int idx, std::string *, std::string *, int, int,
                         const unsigned char *bytes, int size, void *user);
 
+// ---- KHR_texture_transform (gltf_materials.cc) --------------------------------------------------
+
+// The uv a material's textures read: TEXCOORD_<texcoord> mapped by the affine
+// u' = a[0] u + a[1] v + a[2], v' = a[3] u + a[4] v + a[5] (KHR_texture_transform's T·R·S). The
+// import folds it into the primitive's uv0, which only texture lookups read, so every place that
+// samples a texture with uv0 (transport, denoiser guide, emitters, lbk render) sees it alike.
+struct UvMap {
+    int texcoord = 0;
+    double a[6] = {1, 0, 0, 0, 1, 0};
+    bool operator==(const UvMap &o) const
+    {
+        if (texcoord != o.texcoord) return false;
+        for (int k = 0; k < 6; k++)
+            if (a[k] != o.a[k]) return false;
+        return true;
+    }
+    bool identity() const { return *this == UvMap{}; }
+};
+
 // ---- the importer -----------------------------------------------------------------------------
 
 struct Prim {  // one triangle primitive, in mesh-local space, ready to instance
@@ -306,6 +325,7 @@ private:
     std::vector<bk_image> images_;
     size_t image_bytes_ = 0;
     std::vector<bk_material> materials_;
+    std::vector<UvMap> uv_maps_;      // per glTF material: what its textures read (default: identity)
     int default_material_ = -1;
     std::vector<MeshData> meshes_;
     std::vector<Instance> instances_;
@@ -332,7 +352,14 @@ private:
     void decode_images();
     int decode_image(int gi);
     void build_materials();
-    int texture_image(const tinygltf::TextureInfo &ti, const char *slot, int mi, const std::string &mname);
+    int texture_image(const tinygltf::TextureInfo &ti, const char *slot, int mi, const std::string &mname,
+                      UvMap *map);
+    int texture_source(int tex) const;
+    UvMap read_uv_map(const tinygltf::TextureInfo &ti, const char *slot, int mi, const std::string &mname);
+    void settle_uv_maps(int mi, const std::string &mname, int *tex[3], const UvMap maps[3]);
+    void apply_uv_map(Prim &p, int mi, int pi);
+    unsigned char *decode_pixels(const unsigned char *bytes, size_t len, const std::string &label, int *w, int *h,
+                                 bool *webp);
     std::vector<float> downsample(const float *rgba, int w, int h, int max_side, int *ow, int *oh);
     // gltf_geometry.cc
     void prepare_mesh(int mi);

@@ -1,6 +1,7 @@
 // The glTF importer's images and materials: tinygltf keeps the encoded bytes of the images the
-// baker needs (keep_encoded_image), and they are decoded here (stb_image, PNG/JPEG only, after a
-// header-only size check), linearised and box-filtered to the size cap; then the materials.
+// baker needs (keep_encoded_image), and they are decoded here (stb_image PNG/JPEG, libwebp WebP
+// for EXT_texture_webp, each after a header-only size check), linearised and box-filtered to the
+// size cap; then the materials, with KHR_texture_transform folded into uv0 (UvMap).
 
 #define STB_IMAGE_IMPLEMENTATION
 #define STB_IMAGE_STATIC
@@ -8,6 +9,7 @@
 #define STBI_ONLY_PNG
 #define STBI_ONLY_JPEG
 #include <stb_image.h>
+#include <webp/decode.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -49,6 +51,62 @@ std::vector<float> Importer::downsample(const float *rgba, int w, int h, int max
     return out;
 }
 
+// The RGBA8 pixels of an encoded PNG, JPEG or WebP (*webp: free with WebPFree, else
+// stbi_image_free), after its header's size is checked against the pixel cap; nullptr (warned,
+// counted) when the bytes are none of them.
+unsigned char *Importer::decode_pixels(const unsigned char *bytes, size_t len, const std::string &label, int *w,
+                                       int *h, bool *webp)
+{
+    // stb_image's header probe fails on a PNG past 2^30 bytes of pixels ("too large"), which would
+    // read as "not decodable" and be ignored: the IHDR's size is checked against the cap first,
+    // so a PNG is refused exactly like a JPEG of that size.
+    static const unsigned char png_sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    if (len >= 24 && !memcmp(bytes, png_sig, 8) && !memcmp(bytes + 12, "IHDR", 4)) {
+        auto be32 = [](const unsigned char *q) {
+            return (uint64_t)q[0] << 24 | (uint64_t)q[1] << 16 | (uint64_t)q[2] << 8 | (uint64_t)q[3];
+        };
+        const uint64_t pw = be32(bytes + 16), ph = be32(bytes + 20);
+        if (pw == 0 || ph == 0 || pw * ph > o_.max_image_pixels)
+            fail("%s: %s: %llux%llu pixels exceeds the %zu-pixel cap", path_.c_str(), label.c_str(),
+                 (unsigned long long)pw, (unsigned long long)ph, o_.max_image_pixels);
+    }
+    *webp = len >= 12 && !memcmp(bytes, "RIFF", 4) && !memcmp(bytes + 8, "WEBP", 4);
+    if (*webp) {
+        // WebPGetInfo reads the VP8/VP8L/VP8X header only (each side <= 16384 by the format)
+        if (!WebPGetInfo(bytes, len, w, h)) {
+            if (o_.report) o_.report->ignored_textures++;
+            warn("%s: not a decodable WebP (bad header); texture ignored", label.c_str());
+            return nullptr;
+        }
+        if (*w <= 0 || *h <= 0 || (uint64_t)*w * (uint64_t)*h > o_.max_image_pixels)
+            fail("%s: %s: %dx%d pixels exceeds the %zu-pixel cap", path_.c_str(), label.c_str(), *w, *h,
+                 o_.max_image_pixels);
+        int cw = 0, ch = 0;
+        unsigned char *px = WebPDecodeRGBA(bytes, len, &cw, &ch);
+        if (!px || cw != *w || ch != *h) {
+            if (px) WebPFree(px);
+            fail("%s: %s: WebP decoding failed", path_.c_str(), label.c_str());
+        }
+        return px;
+    }
+    int comp = 0;
+    if (!stbi_info_from_memory(bytes, (int)len, w, h, &comp)) {
+        if (o_.report) o_.report->ignored_textures++;
+        warn("%s: not a decodable PNG, JPEG or WebP (%s); texture ignored", label.c_str(), stbi_failure_reason());
+        return nullptr;
+    }
+    if (*w <= 0 || *h <= 0 || (uint64_t)*w * (uint64_t)*h > o_.max_image_pixels)
+        fail("%s: %s: %dx%d pixels exceeds the %zu-pixel cap", path_.c_str(), label.c_str(), *w, *h,
+             o_.max_image_pixels);
+    int cw = 0, ch = 0;
+    unsigned char *px = stbi_load_from_memory(bytes, (int)len, &cw, &ch, &comp, 4);
+    if (!px || cw != *w || ch != *h) {
+        if (px) stbi_image_free(px);
+        fail("%s: %s: decoding failed (%s)", path_.c_str(), label.c_str(), stbi_failure_reason());
+    }
+    return px;
+}
+
 int Importer::decode_image(int gi)
 {
     if (image_map_[(size_t)gi] != -2) return image_map_[(size_t)gi];
@@ -75,34 +133,14 @@ int Importer::decode_image(int gi)
     if (!bytes || len == 0) fail("%s: %s: could not be read (missing file or empty data)", path_.c_str(), label.c_str());
     if (len > (size_t)INT32_MAX) fail("%s: %s: encoded image larger than 2 GiB", path_.c_str(), label.c_str());
     XXH3_64bits_update(&hash_, bytes, len);
-    // stb_image's header probe fails on a PNG past 2^30 bytes of pixels ("too large"), which would
-    // read as "not decodable" and be ignored: the IHDR's size is checked against the cap first,
-    // so a PNG is refused exactly like a JPEG of that size.
-    static const unsigned char png_sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-    if (len >= 24 && !memcmp(bytes, png_sig, 8) && !memcmp(bytes + 12, "IHDR", 4)) {
-        auto be32 = [](const unsigned char *q) {
-            return (uint64_t)q[0] << 24 | (uint64_t)q[1] << 16 | (uint64_t)q[2] << 8 | (uint64_t)q[3];
-        };
-        const uint64_t pw = be32(bytes + 16), ph = be32(bytes + 20);
-        if (pw == 0 || ph == 0 || pw * ph > o_.max_image_pixels)
-            fail("%s: %s: %llux%llu pixels exceeds the %zu-pixel cap", path_.c_str(), label.c_str(),
-                 (unsigned long long)pw, (unsigned long long)ph, o_.max_image_pixels);
-    }
-    int w = 0, h = 0, comp = 0;
-    if (!stbi_info_from_memory(bytes, (int)len, &w, &h, &comp)) {
-        if (o_.report) o_.report->ignored_textures++;
-        warn("%s: not a decodable PNG or JPEG (%s); texture ignored", label.c_str(), stbi_failure_reason());
+    bool webp = false;
+    int w = 0, h = 0;
+    unsigned char *px = decode_pixels(bytes, len, label, &w, &h, &webp);
+    if (!px) {
         image_map_[(size_t)gi] = -1;
         return -1;
     }
-    if (w <= 0 || h <= 0 || (uint64_t)w * (uint64_t)h > o_.max_image_pixels)
-        fail("%s: %s: %dx%d pixels exceeds the %zu-pixel cap", path_.c_str(), label.c_str(), w, h, o_.max_image_pixels);
-    int cw = 0, ch = 0;
-    unsigned char *px = stbi_load_from_memory(bytes, (int)len, &cw, &ch, &comp, 4);
-    if (!px || cw != w || ch != h) {
-        if (px) stbi_image_free(px);
-        fail("%s: %s: decoding failed (%s)", path_.c_str(), label.c_str(), stbi_failure_reason());
-    }
+    auto free_px = [&]() { webp ? WebPFree(px) : stbi_image_free(px); };
     float lut[256];
     for (int i = 0; i < 256; i++) {
         double c = i / 255.0;
@@ -114,12 +152,12 @@ int Importer::decode_image(int gi)
     int nw = (w + f - 1) / f, nh = (h + f - 1) / f;
     uint64_t bytes_out = (uint64_t)nw * nh * 16;
     if (image_bytes_ + bytes_out > o_.max_image_bytes) {
-        stbi_image_free(px);
+        free_px();
         fail("%s: %s: textures exceed the %zu-byte image memory cap", path_.c_str(), label.c_str(), o_.max_image_bytes);
     }
     float *rgba = static_cast<float *>(malloc((size_t)bytes_out));
     if (!rgba) {
-        stbi_image_free(px);
+        free_px();
         throw std::bad_alloc();
     }
     double sum[4] = {0, 0, 0, 0};
@@ -138,7 +176,7 @@ int Importer::decode_image(int gi)
                 sum[k] += v;
             }
         }
-    stbi_image_free(px);
+    free_px();
     if (f > 1 && o_.report) o_.report->downsampled_images++;
     bk_image bi{};
     bi.width = nw;
@@ -156,34 +194,140 @@ void Importer::decode_images()
     image_map_.assign(m_.images.size(), -2);  // -2: not decoded yet
 }
 
-int Importer::texture_image(const tinygltf::TextureInfo &ti, const char *slot, int mi, const std::string &mname)
+// The image a texture reads: EXT_texture_webp's source when it names one (lbk decodes WebP),
+// else the core source, which is also KHR_texture_basisu's fallback; -1 when there is neither.
+int Importer::texture_source(int tex) const
+{
+    const tinygltf::Texture &t = m_.textures[(size_t)tex];
+    auto w = t.extensions.find("EXT_texture_webp");
+    if (w != t.extensions.end() && w->second.IsObject() && w->second.Has("source") &&
+        w->second.Get("source").IsInt())
+        return w->second.Get("source").GetNumberAsInt();
+    return t.source;
+}
+
+// KHR_texture_transform on a texture slot (offset, rotation, scale, texCoord override) as a UvMap:
+// uv' = T(offset) · R(rotation) · S(scale) · uv, R = [cos r, sin r; -sin r, cos r] (the extension's).
+UvMap Importer::read_uv_map(const tinygltf::TextureInfo &ti, const char *slot, int mi, const std::string &mname)
+{
+    UvMap m;
+    m.texcoord = ti.texCoord;
+    auto it = ti.extensions.find("KHR_texture_transform");
+    if (it == ti.extensions.end()) return m;
+    const tinygltf::Value &x = it->second;
+    const std::string mq = qstr(mname);
+    if (!x.IsObject())
+        fail("%s: material %d %s: %s texture: KHR_texture_transform is not an object", path_.c_str(), mi, mq.c_str(), slot);
+    auto pair = [&](const char *key, double dflt, double out[2]) {
+        out[0] = out[1] = dflt;
+        if (!x.Has(key)) return;
+        const tinygltf::Value &v = x.Get(key);
+        bool ok = v.IsArray() && v.ArrayLen() == 2;
+        for (int k = 0; ok && k < 2; k++) {
+            ok = v.Get(k).IsNumber() && std::isfinite(v.Get(k).GetNumberAsDouble());
+            if (ok) out[k] = v.Get(k).GetNumberAsDouble();
+        }
+        if (!ok)
+            fail("%s: material %d %s: %s texture: KHR_texture_transform %s must be 2 finite numbers", path_.c_str(),
+                 mi, mq.c_str(), slot, key);
+    };
+    double off[2], sc[2], r = 0;
+    pair("offset", 0, off);
+    pair("scale", 1, sc);
+    if (x.Has("rotation")) {
+        const tinygltf::Value &v = x.Get("rotation");
+        if (!v.IsNumber() || !std::isfinite(v.GetNumberAsDouble()))
+            fail("%s: material %d %s: %s texture: KHR_texture_transform rotation must be a finite number",
+                 path_.c_str(), mi, mq.c_str(), slot);
+        r = v.GetNumberAsDouble();
+    }
+    if (x.Has("texCoord")) {
+        const tinygltf::Value &v = x.Get("texCoord");
+        if (!v.IsInt() || v.GetNumberAsInt() < 0)
+            fail("%s: material %d %s: %s texture: KHR_texture_transform texCoord must be an integer >= 0",
+                 path_.c_str(), mi, mq.c_str(), slot);
+        m.texcoord = v.GetNumberAsInt();
+    }
+    const double c = std::cos(r), sn = std::sin(r);
+    const double a[6] = {c * sc[0], sn * sc[1], off[0], -sn * sc[0], c * sc[1], off[1]};
+    for (int k = 0; k < 6; k++) m.a[k] = a[k];
+    return m;
+}
+
+int Importer::texture_image(const tinygltf::TextureInfo &ti, const char *slot, int mi, const std::string &mname,
+                            UvMap *map)
 {
     if (ti.index < 0 || o_.skip_textures) return -1;
     if ((size_t)ti.index >= m_.textures.size())
         fail("%s: material %d %s: %s texture %d out of range", path_.c_str(), mi, qstr(mname).c_str(), slot, ti.index);
-    int src = m_.textures[(size_t)ti.index].source;
+    int src = texture_source(ti.index);
     if (src < 0) {
-        // e.g. KHR_texture_basisu / EXT_texture_webp sources only
+        // e.g. a KHR_texture_basisu source only (a required one was refused by the pre-pass)
         if (o_.report) o_.report->ignored_textures++;
-        warn("material %d %s: %s texture %d has no PNG/JPEG source; ignored", mi, qstr(mname).c_str(), slot, ti.index);
+        warn("material %d %s: %s texture %d has no PNG/JPEG/WebP source; ignored", mi, qstr(mname).c_str(), slot,
+             ti.index);
         return -1;
     }
     if ((size_t)src >= m_.images.size())
         fail("%s: material %d %s: %s texture %d: image %d out of range", path_.c_str(), mi, qstr(mname).c_str(),
              slot, ti.index, src);
-    if (ti.texCoord != 0) {
+    *map = read_uv_map(ti, slot, mi, mname);
+    if (map->texcoord > 1) {
         if (o_.report) o_.report->ignored_textures++;
-        warn("material %d %s: %s texture uses TEXCOORD_%d (only TEXCOORD_0 is sampled); ignored", mi,
-             qstr(mname).c_str(), slot, ti.texCoord);
+        warn("material %d %s: %s texture uses TEXCOORD_%d (only TEXCOORD_0 and TEXCOORD_1 are sampled); ignored",
+             mi, qstr(mname).c_str(), slot, map->texcoord);
         return -1;
     }
-    if (ti.extensions.count("KHR_texture_transform"))
-        warn("material %d %s: KHR_texture_transform on the %s texture is ignored", mi, qstr(mname).c_str(), slot);
     return decode_image(src);
+}
+
+// One uv per material (it is folded into the primitive's uv0): the first textured slot's map wins;
+// a later slot whose transform or texCoord differs is dropped, warned and counted.
+void Importer::settle_uv_maps(int mi, const std::string &mname, int *tex[3], const UvMap maps[3])
+{
+    static const char *const slots[3] = {"baseColor", "emissive", "metallicRoughness"};
+    int first = -1;
+    for (int k = 0; k < 3; k++) {
+        if (*tex[k] < 0) continue;
+        if (first < 0) {
+            first = k;
+        } else if (!(maps[k] == maps[first])) {
+            if (o_.report) o_.report->ignored_textures++;
+            warn("material %d %s: the %s texture's KHR_texture_transform/texCoord differs from the %s texture's "
+                 "(lbk samples one uv per material); %s texture ignored", mi, qstr(mname).c_str(), slots[k],
+                 slots[first], slots[k]);
+            *tex[k] = -1;
+        }
+    }
+    uv_maps_[(size_t)mi] = first < 0 ? UvMap{} : maps[first];
+}
+
+// Folds the material's UvMap into the primitive's uv0 (see UvMap); TEXCOORD_1 as the source when
+// the map says so and the primitive has it (else uv0 stays, with a warning).
+void Importer::apply_uv_map(Prim &p, int mi, int pi)
+{
+    if (p.material >= uv_maps_.size() || uv_maps_[p.material].identity()) return;
+    const UvMap &m = uv_maps_[p.material];
+    const std::vector<float> *src = &p.uv0;
+    if (m.texcoord == 1) {
+        if (p.has_uv1)
+            src = &p.uv1;
+        else
+            warn("%s: material %u's textures read TEXCOORD_1, which the primitive lacks; TEXCOORD_0 used",
+                 mesh_label(mi, pi).c_str(), p.material);
+    }
+    std::vector<float> out(src->size());
+    for (size_t i = 0; i + 1 < src->size(); i += 2) {
+        const double u = (*src)[i], v = (*src)[i + 1];
+        out[i] = (float)(m.a[0] * u + m.a[1] * v + m.a[2]);
+        out[i + 1] = (float)(m.a[3] * u + m.a[4] * v + m.a[5]);
+    }
+    p.uv0.swap(out);
 }
 
 void Importer::build_materials()
 {
+    uv_maps_.assign(m_.materials.size(), UvMap{});
     for (size_t i = 0; i < m_.materials.size(); i++) {
         const tinygltf::Material &gm = m_.materials[i];
         int mi = (int)i;
@@ -214,8 +358,9 @@ void Importer::build_materials()
             if (!std::isfinite((float)e)) fail("%s: material %d %s: emission overflows a float", file, mi, mq.c_str());
             bm.emission[k] = (float)e;
         }
-        bm.albedo_tex = texture_image(gm.pbrMetallicRoughness.baseColorTexture, "baseColor", mi, gm.name);
-        bm.emission_tex = texture_image(gm.emissiveTexture, "emissive", mi, gm.name);
+        UvMap maps[3];
+        bm.albedo_tex = texture_image(gm.pbrMetallicRoughness.baseColorTexture, "baseColor", mi, gm.name, &maps[0]);
+        bm.emission_tex = texture_image(gm.emissiveTexture, "emissive", mi, gm.name, &maps[1]);
         bm.double_sided = gm.doubleSided ? 1 : 0;
         // glTF's defaults (1, 1: a rough metal) when pbrMetallicRoughness leaves them out, as
         // tinygltf fills them; our own Lambertian scenes say metallicFactor 0 (GGX.md)
@@ -225,8 +370,11 @@ void Importer::build_materials()
         bm.metallic = (float)mf;
         bm.roughness = (float)rf;
         // after the emissive texture: the images of materials without it keep their indices
-        bm.metal_rough_tex1 =
-            1 + texture_image(gm.pbrMetallicRoughness.metallicRoughnessTexture, "metallicRoughness", mi, gm.name);
+        int mr = texture_image(gm.pbrMetallicRoughness.metallicRoughnessTexture, "metallicRoughness", mi, gm.name,
+                               &maps[2]);
+        int *tex[3] = {&bm.albedo_tex, &bm.emission_tex, &mr};
+        settle_uv_maps(mi, gm.name, tex, maps);
+        bm.metal_rough_tex1 = 1 + mr;
         materials_.push_back(bm);
     }
 }
