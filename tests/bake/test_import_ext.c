@@ -133,6 +133,14 @@ static void test_webp_percent_encoded_required(void **state)
     assert_float_equal(albedo_at(&s, 0.75), 0.999, 1e-12);
     bk_scene_free(&s);
 
+    /* the WebP header's size is checked against the pixel cap before decoding: 2×1 > 1 */
+    bk_import_options opt = {0};
+    opt.max_image_pixels = 1;
+    rc = imp_import_tmp("town.gltf", &s, &opt, err, sizeof err);
+    assert_int_not_equal(rc, 0);
+    assert_non_null(strstr(err, "2x1 pixels exceeds the 1-pixel cap"));
+    assert_null(s.positions);
+
     /* and it bakes (the whole pipeline, as `lbk bake`) */
     char in[512], out[512];
     imp_tmp_path(in, sizeof in, "town.gltf");
@@ -154,6 +162,29 @@ static void test_webp_percent_encoded_required(void **state)
     struct stat st;
     assert_int_equal(stat(out, &st), 0);
     assert_true(st.st_size > 0);
+}
+
+/* A file that says RIFF....WEBP but holds no valid bitstream: the texture is ignored (warned,
+ * counted), the factor alone is used, as for an undecodable PNG. */
+static void test_webp_corrupt_ignored(void **state)
+{
+    (void)state;
+    setup_town();
+    const char bad[32] = "RIFF\x18\0\0\0WEBPVP8 garbage-garbage";
+    imp_write_file("textures/grass lossy \xc3\xa4.webp", bad, sizeof bad);
+    write_floor("bad.gltf", kWebpTop, kWebpImage, kWebpTexture, "{\"index\":0}", 0);
+    bk_scene s;
+    char err[1024];
+    bk_import_report rep;
+    bk_import_options opt = {0};
+    opt.report = &rep;
+    int rc = imp_import_tmp("bad.gltf", &s, &opt, err, sizeof err);
+    if (rc) printf("%s\n", err);
+    assert_int_equal(rc, 0);
+    assert_int_equal(rep.ignored_textures, 1);
+    assert_int_equal(s.image_count, 0);
+    assert_int_equal(s.materials[0].albedo_tex, -1);
+    bk_scene_free(&s);
 }
 
 /* A floor whose base colour is half black / half white, tiled 4× by KHR_texture_transform: the
@@ -307,6 +338,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_webp_percent_encoded_required, imp_setup_tmp, imp_teardown_tmp),
+        cmocka_unit_test_setup_teardown(test_webp_corrupt_ignored, imp_setup_tmp, imp_teardown_tmp),
         cmocka_unit_test_setup_teardown(test_transform_scale_tiles_albedo, imp_setup_tmp, imp_teardown_tmp),
         cmocka_unit_test_setup_teardown(test_transform_offset_rotation_texcoord, imp_setup_tmp, imp_teardown_tmp),
         cmocka_unit_test_setup_teardown(test_basisu, imp_setup_tmp, imp_teardown_tmp),
