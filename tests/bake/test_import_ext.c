@@ -185,6 +185,13 @@ static void test_webp_corrupt_ignored(void **state)
     assert_int_equal(s.image_count, 0);
     assert_int_equal(s.materials[0].albedo_tex, -1);
     bk_scene_free(&s);
+
+    /* a 26-byte lossless header claiming 16384×16384 (2^28 pixels, over the default 64 Mi cap):
+     * refused from the header, before any decoding would allocate 1 GiB */
+    const unsigned char huge[26] = {'R', 'I', 'F', 'F', 18, 0, 0, 0, 'W', 'E', 'B', 'P', 'V', 'P', '8', 'L',
+                                    5, 0, 0, 0, 0x2f, 0xff, 0xff, 0xff, 0x0f, 0};
+    imp_write_file("textures/grass lossy \xc3\xa4.webp", huge, sizeof huge);
+    imp_expect_error("bad.gltf", "16384x16384 pixels exceeds the", "pixel cap");
 }
 
 /* A floor whose base colour is half black / half white, tiled 4× by KHR_texture_transform: the
