@@ -206,14 +206,16 @@ struct DracoInfo {
 
 struct Prepass {
     std::map<std::pair<int, int>, DracoInfo> draco;  // (mesh, primitive)
-    std::vector<char> needed_images;                 // images used as base colour / emissive
+    std::vector<char> needed_images;                 // images used as base colour / emissive / metallicRoughness
     std::string json;                                // rewritten JSON handed to tinygltf
 };
 
 // Caps the JSON's depth and what it may cost to import (a SAX census before any DOM), the node
 // hierarchy's depth, refuses absolute and non-data: URIs, URIs holding a NUL and files that are
-// not regular or not byteLength long (before tinygltf opens them), validates image bufferViews, notes
-// the images the baker needs and the Draco primitives, and rewrites the JSON for tinygltf.
+// not regular or not byteLength long (before tinygltf opens them), refuses KHR_texture_basisu and
+// EXT_meshopt_compression when required (naming the texture / bufferView), validates image
+// bufferViews, notes the images the baker needs (EXT_texture_webp's source first) and the Draco
+// primitives, and rewrites the JSON for tinygltf.
 Prepass prepass(const char *json_begin, size_t json_len, const std::string &file, const ResourcePolicy &pol);
 
 // ---- GLB container (gltf_guard.cc) ------------------------------------------------------------
