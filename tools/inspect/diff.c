@@ -140,6 +140,13 @@ static void texel_bilinear(const pageref *pg, const uint32_t rect[4], double u, 
                                  (c[2][n][ch] * (1 - tx) + c[3][n][ch] * tx) * ty);
 }
 
+static int bake_high_preset(const tl_bake *b)
+{
+    lbk_string v;
+    return b->has_meta && lbk_meta_find(&b->meta, "bake.preset", &v) == LBK_OK && v.size == 4 &&
+           memcmp(v.data, "high", 4) == 0;
+}
+
 static int bake_denoised(const tl_bake *b)
 {
     lbk_string v;
@@ -976,6 +983,7 @@ static void choose_mode(const tl_bake *a, const tl_bake *b, const tl_diff_option
     tl_noise_model_init(model, o->false_alarm > 0 ? o->false_alarm : TL_NOISE_DEFAULT_FALSE_ALARM, ra, rb);
     model->denoised[0] = bake_denoised(a);
     model->denoised[1] = bake_denoised(b);
+    if (bake_high_preset(a) || bake_high_preset(b)) model->texel_spread = TL_NOISE_HIGH_TEXEL_SPREAD;
     if (r->mode == TL_DIFF_MODE_NOISE) bake_levels(a, model->level_ref[0]), bake_levels(b, model->level_ref[1]);
 }
 

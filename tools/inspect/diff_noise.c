@@ -55,6 +55,7 @@ void tl_noise_model_init(tl_noise_model *m, double false_alarm, const double rep
     m->k_chroma = tl_normal_quantile(1 - false_alarm / 18);
     m->k_sample = TL_NOISE_K_SAMPLE;
     m->common = TL_NOISE_COMMON;
+    m->texel_spread = 1;
     for (int k = 0; k < 2; k++) {
         m->rept[0][k] = rept_a[k];
         m->rept[1][k] = rept_b[k];
@@ -93,7 +94,8 @@ static double sample_deviation(const tl_noise_model *m, int cls, double t_a, dou
 {
     const tl_noise_class_params *c = tl_noise_class_get(cls);
     const double ca = m->common * m->rept[0][c->kind], cb = m->common * m->rept[1][c->kind];
-    const double ta = c->sample_spread * t_a, tb = c->sample_spread * t_b;
+    const double spread = c->sample_spread * (c->kind == 0 && m->texel_spread > 0 ? m->texel_spread : 1);
+    const double ta = spread * t_a, tb = spread * t_b;
     const double la = level(a, c->kind, n), lb = level(b, c->kind, n), d = lb - la;
     const double fa = c->floor_scale * m->rept[0][c->kind] * m->level_ref[0][c->kind];
     const double fb = c->floor_scale * m->rept[1][c->kind] * m->level_ref[1][c->kind];

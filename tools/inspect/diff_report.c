@@ -158,6 +158,7 @@ static void add_noise_model(cJSON *root, const tl_diff_result *r)
         cJSON_AddNumberToObject(nm, "k_mean", r->noise.k_mean);
         cJSON_AddNumberToObject(nm, "k_sample", r->noise.k_sample);
         cJSON_AddNumberToObject(nm, "k_chroma", r->noise.k_chroma);
+        cJSON_AddNumberToObject(nm, "texel_spread", r->noise.texel_spread);
         /* schema 2's fields, kept: the GLG's sample spread, the texels' p₀ in units of α */
         cJSON_AddNumberToObject(nm, "probe_spread", tl_noise_class_get(TL_NOISE_GLG)->sample_spread);
         cJSON_AddNumberToObject(nm, "share_factor", tl_noise_class_get(TL_NOISE_TEXELS)->sample_rate / r->noise.false_alarm);
