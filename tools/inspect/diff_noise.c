@@ -94,7 +94,7 @@ static double sample_deviation(const tl_noise_model *m, int cls, double t_a, dou
 {
     const tl_noise_class_params *c = tl_noise_class_get(cls);
     const double ca = m->common * m->rept[0][c->kind], cb = m->common * m->rept[1][c->kind];
-    const double spread = c->sample_spread * (c->kind == 0 && m->texel_spread > 0 ? m->texel_spread : 1);
+    const double spread = c->sample_spread * (m->texel_spread > 0 ? m->texel_spread : 1);
     const double ta = spread * t_a, tb = spread * t_b;
     const double la = level(a, c->kind, n), lb = level(b, c->kind, n), d = lb - la;
     const double fa = c->floor_scale * m->rept[0][c->kind] * m->level_ref[0][c->kind];

@@ -47,7 +47,9 @@
 #define TL_NOISE_REPT_SPREAD 3.0
 /* At the high preset (16384 samples, denoised) the texels' reseed noise is spatially correlated
  * and their own high-pass reads it low: over cornell_box's reseeds at high the samples' normalised
- * deviation had RMS 2.65 (0.70 at fast) and 14 % of texels were beyond 3.29σ. */
+ * deviation had RMS 2.65 (0.70 at fast) and 14 % of texels were beyond 3.29σ; probes likewise
+ * (lights_punctual_lamp at high: GLG 2.47, LLG 7.8 at the classes' ρ). Every class's local noise
+ * takes this factor at high. */
 #define TL_NOISE_HIGH_TEXEL_SPREAD 3.0
 /* The sample test's threshold, Φ⁻¹(1 − 0.0005), whatever α: each class's rate p₀ is measured at it. */
 #define TL_NOISE_K_SAMPLE 3.2905267314918945
@@ -98,8 +100,8 @@ typedef struct tl_noise_model {
      * absolute noise of a typical receiver: one far darker is lit by rare paths (a leak), whose
      * noise is absolute, not relative to its own level. */
     double level_ref[2][2];
-    /* the preset's factor on the texels' local noise (1; TL_NOISE_HIGH_TEXEL_SPREAD when a bake
-     * is of the high preset, META bake.preset) */
+    /* the preset's factor on every sample's local noise (1; TL_NOISE_HIGH_TEXEL_SPREAD when a
+     * bake is of the high preset, META bake.preset) */
     double texel_spread;
 } tl_noise_model;
 
