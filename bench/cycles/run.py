@@ -228,11 +228,16 @@ def run_scene(sc, work, opt, out):
         return "" if not ga else " %9s %9s %8.2f" % (pct(ga.lbk), "%+7.1f %%" % (100 * ga.lbk_bias),
                                                      ga.lbk / g.cyc if g.cyc > 0 else float("inf"))
 
-    def row(label, rep, idx):
+    # each lightmapped object's own estimate (the report's "objects", baker library 1.9); the
+    # bake's level-wide figure for objects without one (LLG props, older bakers)
+    obj_est = {o.get("name"): o.get("est_rel_rmse") for o in report.get("objects") or []}
+
+    def row(label, rep, idx, e=None):
+        e = est if e is None else e
         g, ga = Group(idx, lum, lum2, r1, r2, ceq), alt_group(idx)
         ratio = g.lbk / g.cyc if g.cyc > 0 else float("inf")
         out("  %-22s %-8s %6d %9s %9s %9s %9s %9s %10.2f %6s %9s%s" % (
-            label[:22], rep, g.n, pct(g.lbk), "%+7.1f %%" % (100 * g.lbk_bias), pct(g.lbk_noise), pct(est),
+            label[:22], rep, g.n, pct(g.lbk), "%+7.1f %%" % (100 * g.lbk_bias), pct(g.lbk_noise), pct(e),
             pct(g.cyc), ratio, "n/r" if g.unresolved else "yes" if ratio <= 0.5 else "no", pct(g.ref_noise),
             alt_cols(ga, g)))
         return g, ratio, ga
@@ -243,9 +248,11 @@ def run_scene(sc, work, opt, out):
         if not idx:
             continue
         rep, name = rec.objects.get(o, ("?", "object%d" % o))
-        g, ratio, ga = row(name, rep, idx)
+        oe = obj_est.get(name) if rep == "lightmap" else None
+        g, ratio, ga = row(name, rep, idx, oe)
         rows.append({"scene": sc["name"], "object": name, "rep": rep, "n": g.n, "lbk_err": g.lbk,
-                     "lbk_bias": g.lbk_bias, "lbk_noise": g.lbk_noise, "lbk_est": est, "cycles_err": g.cyc,
+                     "lbk_bias": g.lbk_bias, "lbk_noise": g.lbk_noise, "lbk_est": est if oe is None else oe,
+                     "lbk_est_level": est, "lbk_est_own": oe is not None, "cycles_err": g.cyc,
                      "ratio": ratio, "ref_noise": g.ref_noise, "mean_lux": g.mean, "unresolved": g.unresolved,
                      "lbk_err_rms": g.lbk_rms, "lbk_noise_rms": g.lbk_noise_rms})
         if tags:
