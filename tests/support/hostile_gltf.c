@@ -240,36 +240,33 @@ static int w_glb_truncated(const char *dir, const char *name, char *path, size_t
     return put(dir, file, g, sizeof g);
 }
 
-static int w_chain_300(const char *dir, const char *name, char *path, size_t n)
+/* NAME.gltf of `count` empty nodes, a parent chain when `chain` (hg_write_nodes). */
+static int write_nodes_case(const char *dir, const char *name, char *path, size_t n, size_t count, int chain)
 {
     char file[256];
     snprintf(file, sizeof file, "%s.gltf", name);
     snprintf(path, n, "%s/%s", dir, file);
-    return hg_write_nodes(dir, file, 300, 1) ? 0 : -1;
+    return hg_write_nodes(dir, file, count, chain) ? 0 : -1;
+}
+
+static int w_chain_300(const char *dir, const char *name, char *path, size_t n)
+{
+    return write_nodes_case(dir, name, path, n, 300, 1);
 }
 
 static int w_chain_1e5(const char *dir, const char *name, char *path, size_t n)
 {
-    char file[256];
-    snprintf(file, sizeof file, "%s.gltf", name);
-    snprintf(path, n, "%s/%s", dir, file);
-    return hg_write_nodes(dir, file, 100000, 1) ? 0 : -1;
+    return write_nodes_case(dir, name, path, n, 100000, 1);
 }
 
 static int w_chain_1e6(const char *dir, const char *name, char *path, size_t n)
 {
-    char file[256];
-    snprintf(file, sizeof file, "%s.gltf", name);
-    snprintf(path, n, "%s/%s", dir, file);
-    return hg_write_nodes(dir, file, 1000000, 1) ? 0 : -1;
+    return write_nodes_case(dir, name, path, n, 1000000, 1);
 }
 
 static int w_nodes_1e6(const char *dir, const char *name, char *path, size_t n)
 {
-    char file[256];
-    snprintf(file, sizeof file, "%s.gltf", name);
-    snprintf(path, n, "%s/%s", dir, file);
-    return hg_write_nodes(dir, file, 1000000, 0) ? 0 : -1;
+    return write_nodes_case(dir, name, path, n, 1000000, 0);
 }
 
 /* The Draco water bottle (scenes/water_bottle_draco) with one accessor count changed (`from` ->
