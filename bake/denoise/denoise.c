@@ -491,6 +491,28 @@ typedef struct dn_error_sums {
     double noise, bias, den;
 } dn_error_sums;
 
+/* Receiver i's terms: the same floats the filter started from (x, δ), so that an unfiltered
+ * receiver adds no bias, and its filtered channels (f NULL: unfiltered, the identity). */
+static void sums_add(dn_error_sums *s, const float *halves, const float *f, size_t stride, size_t i)
+{
+    const double x = 0.5f * (halves[2 * i] + halves[2 * i + 1]);
+    const double dl = 0.5f * (halves[2 * i] - halves[2 * i + 1]);
+    const double fx = f ? f[i * stride] : x, fd = f ? f[i * stride + 1] : dl;
+    s->noise += fd * fd;
+    s->bias += (fx - x) * (fx - x) - (fd - dl) * (fd - dl);
+    s->den += fx * fx;
+}
+
+/* √(noise² + bias²), noise and bias relative to the RMS of the values; 0 when there are none. */
+static void sums_finish(const dn_error_sums *s, double *rel, double *noise, double *bias)
+{
+    if (!(s->den > 0)) return;
+    const double b2 = s->bias > 0 ? s->bias : 0;
+    *noise = sqrt(s->noise / s->den);
+    *bias = sqrt(b2 / s->den);
+    *rel = sqrt((s->noise + b2) / s->den);
+}
+
 /* The estimate of one input from its filtered channels f (X then δ per receiver). */
 static void error_from_filtered(const float *halves, const float *f, size_t stride, const size_t class_end[BK_RECEIVER_CLASSES],
                                 bk_denoise_error *out)
@@ -499,33 +521,43 @@ static void error_from_filtered(const float *halves, const float *f, size_t stri
     memset(sum, 0, sizeof sum);
     size_t i = 0;
     for (int k = 0; k < BK_RECEIVER_CLASSES; k++)
-        for (; i < class_end[k]; i++) {
-            /* the same floats the filter started from, so that an unfiltered receiver adds no bias */
-            const double x = 0.5f * (halves[2 * i] + halves[2 * i + 1]);
-            const double dl = 0.5f * (halves[2 * i] - halves[2 * i + 1]);
-            const double fx = f[i * stride], fd = f[i * stride + 1];
-            sum[k].noise += fd * fd;
-            sum[k].bias += (fx - x) * (fx - x) - (fd - dl) * (fd - dl);
-            sum[k].den += fx * fx;
-        }
-    for (int k = 0; k < BK_RECEIVER_CLASSES; k++) {
-        if (!(sum[k].den > 0)) continue;
-        const double b2 = sum[k].bias > 0 ? sum[k].bias : 0;
-        out->noise[k] = sqrt(sum[k].noise / sum[k].den);
-        out->bias[k] = sqrt(b2 / sum[k].den);
-        out->rel_rmse[k] = sqrt((sum[k].noise + b2) / sum[k].den);
-    }
+        for (; i < class_end[k]; i++) sums_add(&sum[k], halves, f, stride, i);
+    for (int k = 0; k < BK_RECEIVER_CLASSES; k++) sums_finish(&sum[k], &out->rel_rmse[k], &out->noise[k], &out->bias[k]);
     const double pn = sum[BK_CLASS_GLG].noise + sum[BK_CLASS_LLG].noise, pd = sum[BK_CLASS_GLG].den + sum[BK_CLASS_LLG].den;
     const double pb = sum[BK_CLASS_GLG].bias > 0 ? sum[BK_CLASS_GLG].bias : 0; /* LLG: not filtered */
     out->probe_rel_rmse = pd > 0 ? sqrt((pn + pb) / pd) : 0;
+}
+
+/* The same per group of the first g->count receivers (f NULL: unfiltered). */
+static lbk_result groups_from_filtered(const float *halves, const float *f, size_t stride, const bk_denoise_groups *g)
+{
+    memset(g->out, 0, g->group_count * sizeof *g->out);
+    dn_error_sums *sum = calloc(g->group_count ? g->group_count : 1, sizeof *sum);
+    if (!sum) return LBK_ERR_OUT_OF_MEMORY;
+    for (size_t i = 0; i < g->count; i++) {
+        if (g->group[i] >= g->group_count) continue;
+        sums_add(&sum[g->group[i]], halves, f, stride, i);
+        g->out[g->group[i]].receivers++;
+    }
+    for (size_t k = 0; k < g->group_count; k++) {
+        bk_denoise_group_error *o = &g->out[k];
+        o->noise2 = sum[k].noise;
+        o->bias2 = sum[k].bias > 0 ? sum[k].bias : 0;
+        o->value2 = sum[k].den;
+        sums_finish(&sum[k], &o->rel_rmse, &o->noise, &o->bias);
+    }
+    free(sum);
+    return LBK_OK;
 }
 
 /* Inputs per filter pass: X and δ of each ride as two channels, the filter being linear and the
  * same for every channel, so this is D applied to each. */
 #define DN_ERROR_GROUP (DN_MAX_CH / 2)
 
-lbk_result bk_denoiser_errors(const bk_denoiser *d, const float *const *halves, size_t count,
-                              const size_t class_end[BK_RECEIVER_CLASSES], bk_denoise_error *out)
+/* bk_denoiser_errors, and with g the first input's groups from the same filter pass. */
+static lbk_result errors_pass(const bk_denoiser *d, const float *const *halves, size_t count,
+                              const size_t class_end[BK_RECEIVER_CLASSES], bk_denoise_error *out,
+                              const bk_denoise_groups *g)
 {
     if (!out || !class_end || (count && !halves)) return LBK_ERR_INVALID_ARGUMENT;
     const size_t n = d ? d->receiver_count : class_end[BK_RECEIVER_CLASSES - 1];
@@ -550,6 +582,7 @@ lbk_result bk_denoiser_errors(const bk_denoiser *d, const float *const *halves, 
         if (d && d->have_tex) r = texels_apply(d, f, ch);
         if (!r && d && d->have_probes) r = dn_probes_apply(&d->probes, f, ch);
         for (size_t j = 0; j < m && !r; j++) error_from_filtered(halves[j0 + j], f + 2 * j, (size_t)ch, class_end, &out[j0 + j]);
+        if (!r && g && j0 == 0) r = groups_from_filtered(halves[0], f, (size_t)ch, g);
     }
     free(f);
     const double secs = (bk_now() - t0) / (count ? (double)count : 1);
@@ -557,55 +590,31 @@ lbk_result bk_denoiser_errors(const bk_denoiser *d, const float *const *halves, 
     return r;
 }
 
+lbk_result bk_denoiser_errors(const bk_denoiser *d, const float *const *halves, size_t count,
+                              const size_t class_end[BK_RECEIVER_CLASSES], bk_denoise_error *out)
+{
+    return errors_pass(d, halves, count, class_end, out, NULL);
+}
+
 lbk_result bk_denoiser_error(const bk_denoiser *d, const float *halves, const size_t class_end[BK_RECEIVER_CLASSES],
                              bk_denoise_error *out)
 {
-    return bk_denoiser_errors(d, &halves, 1, class_end, out);
+    return errors_pass(d, &halves, 1, class_end, out, NULL);
 }
 
-lbk_result bk_denoiser_group_errors(const bk_denoiser *d, const float *halves, size_t count, const uint32_t *group,
-                                    size_t group_count, bk_denoise_group_error *out)
+lbk_result bk_denoiser_error_groups(const bk_denoiser *d, const float *halves, const size_t class_end[BK_RECEIVER_CLASSES],
+                                    bk_denoise_error *out, const bk_denoise_groups *groups)
 {
-    if (!out || (count && (!halves || !group))) return LBK_ERR_INVALID_ARGUMENT;
-    if (d && count > d->receiver_count) return LBK_ERR_INVALID_ARGUMENT;
-    memset(out, 0, group_count * sizeof *out);
-    /* the filter runs over every receiver it was made for; the texels come first */
-    const size_t n = d ? d->receiver_count : count;
-    float *f = malloc((n ? n : 1) * 2 * sizeof *f);
-    dn_error_sums *sum = calloc(group_count ? group_count : 1, sizeof *sum);
-    lbk_result r = f && sum ? LBK_OK : LBK_ERR_OUT_OF_MEMORY;
-    if (!r) {
-        for (size_t i = 0; i < n; i++) {
-            const int mine = i < count;
-            f[2 * i] = mine ? 0.5f * (halves[2 * i] + halves[2 * i + 1]) : 0.0f;
-            f[2 * i + 1] = mine ? 0.5f * (halves[2 * i] - halves[2 * i + 1]) : 0.0f;
-        }
-        if (d && d->have_tex) r = texels_apply(d, f, 2);
-    }
-    for (size_t i = 0; i < count && !r; i++) {
-        if (group[i] >= group_count) continue;
-        const double x = 0.5f * (halves[2 * i] + halves[2 * i + 1]);
-        const double dl = 0.5f * (halves[2 * i] - halves[2 * i + 1]);
-        const double fx = f[2 * i], fd = f[2 * i + 1];
-        dn_error_sums *g = &sum[group[i]];
-        g->noise += fd * fd;
-        g->bias += (fx - x) * (fx - x) - (fd - dl) * (fd - dl);
-        g->den += fx * fx;
-        out[group[i]].receivers++;
-    }
-    for (size_t k = 0; k < group_count && !r; k++) {
-        const double b2 = sum[k].bias > 0 ? sum[k].bias : 0;
-        out[k].noise2 = sum[k].noise;
-        out[k].bias2 = b2;
-        out[k].value2 = sum[k].den;
-        if (!(sum[k].den > 0)) continue;
-        out[k].noise = sqrt(sum[k].noise / sum[k].den);
-        out[k].bias = sqrt(b2 / sum[k].den);
-        out[k].rel_rmse = sqrt((sum[k].noise + b2) / sum[k].den);
-    }
-    free(f);
-    free(sum);
-    return r;
+    if (!class_end || !groups || !groups->out || (groups->count && !groups->group) ||
+        groups->count > class_end[BK_RECEIVER_CLASSES - 1])
+        return LBK_ERR_INVALID_ARGUMENT;
+    return errors_pass(d, &halves, 1, class_end, out, groups);
+}
+
+lbk_result bk_denoise_groups_unfiltered(const float *halves, const bk_denoise_groups *groups)
+{
+    if (!groups || !groups->out || (groups->count && (!halves || !groups->group))) return LBK_ERR_INVALID_ARGUMENT;
+    return groups_from_filtered(halves, NULL, 0, groups);
 }
 
 void bk_denoiser_stats(const bk_denoiser *d, bk_denoise_stats *stats)

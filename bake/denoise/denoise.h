@@ -128,25 +128,33 @@ typedef struct bk_denoise_error {
  * identity filter (the transport's own two-halves estimate, bias 0), over class_end's last
  * receivers, for contributions that were not denoised. Errors: LBK_ERR_INVALID_ARGUMENT,
  * LBK_ERR_OUT_OF_MEMORY. */
-lbk_result bk_denoiser_error(const bk_denoiser *d, const float *halves, const size_t class_end[BK_RECEIVER_CLASSES],
-                             bk_denoise_error *out);
-/* The same for `count` inputs (halves[j], each as above) into out[j], in one filter pass per 13
- * inputs; out[j].seconds is the pass time shared equally. */
-lbk_result bk_denoiser_errors(const bk_denoiser *d, const float *const *halves, size_t count,
-                              const size_t class_end[BK_RECEIVER_CLASSES], bk_denoise_error *out);
-
-/* The same estimate per group of texel receivers (a group: an object), over the first `count`
- * receivers (the texels; group[i] its group, >= group_count for none), through the texel filter
- * (d NULL: the identity, the transport's own estimate). Sums are kept so that groups pool to
- * the class figure: noise2 + bias2 over value2 (the bias clamp is per group, so pooled groups
- * can only add bias). Errors: LBK_ERR_INVALID_ARGUMENT, LBK_ERR_OUT_OF_MEMORY. */
+/* The same estimate per group of receivers (a group: an object's texels), over the first
+ * `count` receivers (group[i] its group, >= group_count for none): sums kept so that groups pool
+ * to the class figure, noise2 + bias2 over value2 (the bias clamp is per group). */
 typedef struct bk_denoise_group_error {
     size_t receivers;
     double rel_rmse, noise, bias;  /* relative to the RMS of the group's (denoised) values */
     double noise2, bias2, value2;  /* the sums they come from */
 } bk_denoise_group_error;
-lbk_result bk_denoiser_group_errors(const bk_denoiser *d, const float *halves, size_t count, const uint32_t *group,
-                                    size_t group_count, bk_denoise_group_error *out);
+typedef struct bk_denoise_groups {
+    size_t count;                  /* receivers 0 .. count − 1 belong to groups */
+    const uint32_t *group;
+    size_t group_count;
+    bk_denoise_group_error *out;   /* group_count entries */
+} bk_denoise_groups;
+lbk_result bk_denoiser_error(const bk_denoiser *d, const float *halves, const size_t class_end[BK_RECEIVER_CLASSES],
+                             bk_denoise_error *out);
+/* bk_denoiser_error, and each group's estimate from the same filter pass. Errors as above, and
+ * LBK_ERR_INVALID_ARGUMENT for groups past the receivers. */
+lbk_result bk_denoiser_error_groups(const bk_denoiser *d, const float *halves, const size_t class_end[BK_RECEIVER_CLASSES],
+                                    bk_denoise_error *out, const bk_denoise_groups *groups);
+/* The same for `count` inputs (halves[j], each as above) into out[j], in one filter pass per 13
+ * inputs; out[j].seconds is the pass time shared equally. */
+lbk_result bk_denoiser_errors(const bk_denoiser *d, const float *const *halves, size_t count,
+                              const size_t class_end[BK_RECEIVER_CLASSES], bk_denoise_error *out);
+
+/* Unfiltered (the transport's own estimate per group): the same sums with D = I. */
+lbk_result bk_denoise_groups_unfiltered(const float *halves, const bk_denoise_groups *groups);
 void bk_denoiser_stats(const bk_denoiser *d, bk_denoise_stats *stats);
 void bk_denoiser_destroy(bk_denoiser *d);
 

@@ -229,6 +229,7 @@ static void pipeline_free(bk_pipeline *b)
     free(b->variance);
     free(b->halves);
     free(b->object_est);
+    free(b->object_filtered);
     free(b->texel_rel_error);
     free(b->samples);
     free(b->radiance);

@@ -327,7 +327,14 @@ static lbk_result denoised_error(bk_pipeline *b, int choose)
     bk_transport_options to;
     transport_options(b, &to);
     bk_denoise_error e;
-    lbk_result r = bk_denoiser_error(b->denoiser, b->halves, to.class_end, &e);
+    /* each object's estimate from the same filter pass (object_errors.c) */
+    const size_t no = b->scene.object_count;
+    uint32_t *group = bk_texel_object_groups(b);
+    b->object_filtered = calloc(no ? no : 1, sizeof *b->object_filtered);
+    const bk_denoise_groups g = {b->texel_receivers, group, no, b->object_filtered};
+    lbk_result r = group && b->object_filtered ? bk_denoiser_error_groups(b->denoiser, b->halves, to.class_end, &e, &g)
+                                               : LBK_ERR_OUT_OF_MEMORY;
+    free(group);
     if (r) return r;
     lbk_bake_denoised *d = &b->denoised;
     const double raw_t = b->stats.class_rel_rmse[BK_CLASS_TEXEL], raw_g = b->stats.class_rel_rmse[BK_CLASS_GLG];

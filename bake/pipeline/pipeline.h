@@ -73,6 +73,8 @@ typedef struct bk_pipeline {
     float *variance;                /* per receiver, from the transport: the denoiser's input */
     float *halves;                  /* 2 per receiver, the transport's two halves' X (local bakes) */
     lbk_bake_object_estimate *object_est; /* per scene object (texels 0: none), object_errors.c */
+    struct bk_denoise_group_error *object_filtered; /* per scene object: the denoised texels' estimate,
+                                                       from denoised_error's filter pass; NULL: none */
     float *texel_rel_error;         /* per texel receiver with error_map: the TERR input (error_map.h) */
     struct bk_denoiser *denoiser;   /* weights of the base + every set (do_denoise), for all of them */
     lbk_bake_denoised denoised;     /* the estimate of the denoised base (report, REPT's last record) */
@@ -158,6 +160,8 @@ lbk_result bk_phase_denoise(bk_pipeline *b);
 lbk_result bk_phase_emit_sets(bk_pipeline *b);
 /* Each lightmapped object's estimate into b->object_est (object_errors.c); after the denoiser. */
 lbk_result bk_object_estimates(bk_pipeline *b);
+/* Each texel receiver's scene object (UINT32_MAX: none), malloc'd; NULL when out of memory. */
+uint32_t *bk_texel_object_groups(const bk_pipeline *b);
 
 /* The write phase: every section into b->writer (sections.c). */
 lbk_result bk_pipeline_encode(bk_pipeline *b);
