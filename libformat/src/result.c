@@ -27,6 +27,7 @@ static const struct {
     [LBK_ERR_CANCELLED] = {"LBK_ERR_CANCELLED", "cancelled by the caller"},
     [LBK_ERR_BAD_INPUT] = {"LBK_ERR_BAD_INPUT", "the input is unusable"},
     [LBK_ERR_INTERNAL] = {"LBK_ERR_INTERNAL", "internal error"},
+    [LBK_ERR_MISMATCH] = {"LBK_ERR_MISMATCH", "the container does not describe the caller's data"},
 };
 
 const char *lbk_result_name(lbk_result r)
