@@ -5,7 +5,10 @@
  *    the sample was the centre; authored objects through scale + offset of TEXCOORD_1 (§16.3);
  *  - generated objects rebuilt as an engine would (§16.4): the new index buffer's source corners
  *    are the glTF primitive's triangles in its own winding, also under a mirroring node, for
- *    flat-shaded primitives and strips with restarts, with the points primitive left out;
+ *    flat-shaded primitives and strips with restarts, with the points primitive left out; and
+ *    every record passes liblbk's check of a record against its mesh (lbk_lmuv_object_check,
+ *    vertex order included) fed from the glTF's own triangles and, through the readers' adapter,
+ *    from the imported scene;
  *  - the tangent frame of lbk/ahd.h (§5.6) is the baker's, bit for bit.
  * Levels: a hand-made one (tests/support/lmuv_scene.h) and the shared cornell_box_bjs (authored
  * and generated objects mixed) and cornell_box (no UVs at all). */
@@ -32,6 +35,7 @@
 #include "lbk/lightmap_uv.h"
 #include "support/lmuv_scene.h"
 #include "support/scenes_dir.h"
+#include "tools/common/lmuv_match.h"
 
 /* Everything the rule check needs: the scene, the baker's layout, and the section. */
 typedef struct level {
@@ -232,6 +236,41 @@ static void check_rebuild(const level *l, size_t object, int expect_mirrored)
             if (src != tris[i]) fail_msg("object %zu primitive %u index %u: source vertex %u, the glTF has %u", object, want_prim[k], i, src, tris[i]);
         }
     }
+    /* liblbk's check, fed from the glTF's own triangles (not the importer's): the baker's record
+     * passes it, vertex order included (primitive 2 has no NORMAL: a new vertex per corner in
+     * corner order; 0 and 3 ascending by source vertex), mirrored node or not */
+    lbk_lmuv_mesh_primitive mp[3];
+    for (uint32_t k = 0; k < 3; k++) {
+        size_t nt;
+        const uint32_t *tris = lmuv_scene_triangles(want_prim[k], &nt);
+        mp[k] = (lbk_lmuv_mesh_primitive){.source_primitive = want_prim[k], .source_vertex_count = want_vertices[k],
+                                          .triangle_count = (uint32_t)nt,
+                                          .flags = want_prim[k] == 2 ? LBK_LMUV_MESH_NO_NORMAL : 0, .corners = tris};
+    }
+    lbk_lmuv_mesh_desc mesh = LBK_LMUV_MESH_DESC_INIT;
+    mesh.source_node = o.source_node;
+    mesh.primitive_count = 3;
+    mesh.primitives = mp;
+    lbk_lmuv_check_detail why;
+    if (lbk_lmuv_object_check(&l->view, &o, &mesh, &why) != LBK_OK) fail_msg("object %zu: %s", object, why.message);
+    mp[1].flags = 0; /* the flat primitive's remap is not ascending: the flag is what lets it pass */
+    assert_int_equal(lbk_lmuv_object_check(&l->view, &o, &mesh, &why), LBK_ERR_MISMATCH);
+    assert_int_equal(why.code, LBK_LMUV_CHECK_VERTEX_ORDER);
+    /* and through the readers' adapter (the imported scene described as an engine would) */
+    char err[TL_ERR_LEN];
+    if (tl_lmuv_match_object(s, object, &l->view, &o, 4, err)) fail_msg("%s", err);
+}
+
+/* Every record of a level passes the readers' check (tools/common/lmuv_match.h over liblbk's
+ * lbk_lmuv_object_check), vertex order included. */
+static void check_all_records(const level *l)
+{
+    for (uint32_t r = 0; r < l->view.record_count; r++) {
+        lbk_lmuv_object o;
+        char err[TL_ERR_LEN];
+        assert_int_equal(lbk_lmuv_get_object(&l->view, r, &o), LBK_OK);
+        if (tl_lmuv_match_object(&l->scene, o.object, &l->view, &o, 4, err)) fail_msg("%s", err);
+    }
 }
 
 static void hand_made_level(void **state)
@@ -274,6 +313,7 @@ static void shared_levels(void **state)
         level l;
         assert_int_equal(level_open(path, levels[i].density, &l), 0);
         rule_stats st = check_rule(&l);
+        check_all_records(&l);
         assert_int_equal(st.authored > 0, levels[i].authored);
         assert_true(st.max_authored_dev < 1.0 / 1024);
         print_stats(levels[i].file, &st);
