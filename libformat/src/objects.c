@@ -31,6 +31,16 @@ uint64_t lbk_objects_geometry_hash(const float *xyz, size_t triangle_count)
     return XXH3_64bits_digest(&st);
 }
 
+lbk_result lbk_objects_geometry_check(const lbk_objects_view *view, uint32_t object, const float *xyz,
+                                      size_t triangle_count)
+{
+    if (!view || (triangle_count && !xyz) || triangle_count > SIZE_MAX / (9 * sizeof(float)))
+        return LBK_ERR_INVALID_ARGUMENT;
+    if (object >= view->count) return LBK_ERR_NOT_FOUND;
+    const uint64_t stored = lbk_rd64(view->records + (size_t)LBK_OBJECTS_RECORD_SIZE * object + 8);
+    return lbk_objects_geometry_hash(xyz, triangle_count) == stored ? LBK_OK : LBK_ERR_MISMATCH;
+}
+
 static void read_object(const uint8_t *r, const uint8_t *names, lbk_object *o)
 {
     o->name.data = (const char *)names + lbk_rd32(r + 0);

@@ -16,6 +16,7 @@
 #include "scene/import.h"
 #include "tools/common/error_util.h"
 #include "tools/common/lmuv_match.h"
+#include "tools/common/objects_match.h"
 #include "tools/convert/glb.h"
 #include "lbk/pixel.h"
 
@@ -68,37 +69,10 @@ static int prim_alloc(prim_data *p, size_t nv, size_t ni, int lightmapped)
 
 /* ---- matching the scene to the container -------------------------------------------------- */
 
+/* The scene's objects are the container's (count and geometry hash: the check lbk render makes). */
 static int check_objects(ex *e)
 {
-    const bk_scene *s = e->s;
-    if (!e->b->has_objs || e->b->objs.count != s->object_count)
-        return tl_fail(e->err, TL_GLTF_INPUT, "the scene has %zu objects, the container %u: not the scene it was baked from",
-                       s->object_count, e->b->has_objs ? e->b->objs.count : 0);
-    size_t cap = 0;
-    float *xyz = NULL;
-    for (size_t i = 0; i < s->object_count; i++) {
-        const bk_object *o = &s->objects[i];
-        if (o->tri_count > cap) {
-            free(xyz);
-            cap = o->tri_count;
-            if (!(xyz = malloc(cap * 9 * sizeof *xyz))) return tl_fail(e->err, TL_GLTF_INTERNAL, "out of memory");
-        }
-        for (uint32_t t = 0; t < o->tri_count; t++)
-            for (int c = 0; c < 3; c++)
-                memcpy(&xyz[9 * t + 3 * (size_t)c], &s->positions[3 * (size_t)s->tris[3 * ((size_t)o->first_tri + t) + c]],
-                       3 * sizeof(float));
-        lbk_object ob;
-        lbk_objects_get(&e->b->objs, (uint32_t)i, &ob);
-        if (lbk_objects_geometry_hash(xyz, o->tri_count) != ob.geometry_hash) {
-            free(xyz);
-            return tl_fail(e->err, TL_GLTF_INPUT,
-                           "object %zu ('%.60s'): its geometry differs from the container's (geometry hash): not the "
-                           "scene it was baked from",
-                           i, o->name);
-        }
-    }
-    free(xyz);
-    return 0;
+    return tl_objects_match(e->s, e->b->has_objs ? &e->b->objs : NULL, TL_GLTF_INPUT, TL_GLTF_INTERNAL, e->err);
 }
 
 /* The scene primitives of object i: [*first, *first + *count). */
@@ -197,12 +171,19 @@ static int gather_llg(ex *e, size_t object, uint32_t grid, prim_data *d)
         free(rank);
         return tl_fail(e->err, TL_GLTF_INTERNAL, "out of memory");
     }
-    const int match = llg_ranks(s, object, rank) == g.vertex_count;
+    /* a grid with another number of vertex records than the mesh has used vertices does not
+     * describe it (spec §11 "Vertex order"): refused, as lbk render refuses it */
+    const uint32_t used = llg_ranks(s, object, rank);
+    if (used != g.vertex_count) {
+        free(rank);
+        return tl_fail(e->err, TL_GLTF_INPUT, "object %zu: the scene gives %u LLG vertices, the grid has %u", object,
+                       used, g.vertex_count);
+    }
     for (size_t v = 0; v < d->nv; v++) {
         const uint32_t sv = d->sv[v];
         lbk_llg_vertex lv = {1.0f, {0, 0, 1}};
         float rgb[3] = {0, 0, 0};
-        const int have = match && rank[sv] != UINT32_MAX;
+        const int have = rank[sv] != UINT32_MAX;
         if (have) {
             lbk_llg_vertex_unpack(e->b->llg.vertices + 4 * (g.vertex_offset + rank[sv]), &lv);
             lbk_llg_vertex_irradiance(&e->b->llg, grid, rank[sv], &s->positions[3 * (size_t)sv], rgb);

@@ -5,9 +5,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "lbk/pixel.h"
 #include "scene/import.h"
 #include "tools/common/error_util.h"
 #include "tools/common/lmuv_match.h"
+#include "tools/common/objects_match.h"
 
 /* The scene primitives of object i: [*first, *first + *count) (they are in object order). */
 static void object_primitives(const bk_scene *s, size_t i, size_t *first, size_t *count)
@@ -20,27 +22,15 @@ static void object_primitives(const bk_scene *s, size_t i, size_t *first, size_t
 }
 
 /* OBJS lists the scene's mesh nodes in order; the geometry hash (spec §8.3) proves each is the
- * mesh that was baked. */
+ * mesh that was baked (liblbk's lbk_objects_geometry_check, what lbk export / view check too). */
 static int match_objects(rl_level *L, char err[TL_ERR_LEN])
 {
     const bk_scene *s = &L->scene;
-    if (!L->bake.has_objs || L->bake.objs.count != s->object_count)
-        return tl_fail(err, TL_RENDER_INPUT, "the scene has %zu objects, the container %u: not the scene it was baked from",
-                       s->object_count, L->bake.has_objs ? L->bake.objs.count : 0);
+    int rc = tl_objects_match(s, L->bake.has_objs ? &L->bake.objs : NULL, TL_RENDER_INPUT, TL_RENDER_INTERNAL, err);
+    if (rc) return rc;
     L->objects = calloc(s->object_count + 1, sizeof *L->objects);
-    float *xyz = malloc((s->tri_count + 1) * 9 * sizeof *xyz);
-    if (!L->objects || !xyz) return free(xyz), tl_fail(err, TL_RENDER_INTERNAL, "out of memory");
-    for (size_t i = 0; i < s->object_count; i++) {
-        const bk_object *o = &s->objects[i];
-        for (size_t k = 0; k < 3 * (size_t)o->tri_count; k++)
-            memcpy(&xyz[3 * k], &s->positions[3 * (size_t)s->tris[3 * (size_t)o->first_tri + k]], 3 * sizeof(float));
-        lbk_objects_get(&L->bake.objs, (uint32_t)i, &L->objects[i]);
-        if (lbk_objects_geometry_hash(xyz, o->tri_count) != L->objects[i].geometry_hash) {
-            free(xyz);
-            return tl_fail(err, TL_RENDER_INPUT, "object %zu ('%.60s'): not the geometry that was baked", i, o->name);
-        }
-    }
-    free(xyz);
+    if (!L->objects) return tl_fail(err, TL_RENDER_INTERNAL, "out of memory");
+    for (size_t i = 0; i < s->object_count; i++) lbk_objects_get(&L->bake.objs, (uint32_t)i, &L->objects[i]);
     return 0;
 }
 
@@ -206,18 +196,41 @@ static int gather_texels(rl_level *L, char err[TL_ERR_LEN])
     L->texel_ez = malloc((nt + 1) * sizeof *L->texel_ez);
     L->texel_rgba = malloc((nt + 1) * 4);
     if (!L->pages || !L->texel_ez || !L->texel_rgba) return tl_fail(err, TL_RENDER_INTERNAL, "out of memory");
+    int block = 0;
     for (uint32_t p = 0; p < np; p++) {
-        /* DLS apply works on the stored 1.0 texels, so block-compressed packs (lbk convert with a
-         * block profile, spec §9.2) are refused rather than drawn black */
-        lbk_result r = lbk_lmap_page_get(m, p, &L->pages[p]);
-        if (r != LBK_OK)
-            return tl_fail(err, TL_RENDER_INPUT, "lightmap page %u: %s (lbk render draws bakes with 1.0 lightmap planes, not block-compressed packs)", p, lbk_result_message(r));
-        for (uint32_t y = 0; y < L->pages[p].height; y++)
-            for (uint32_t x = 0; x < L->pages[p].width; x++) {
-                const uint64_t i = L->pages[p].first_texel + (uint64_t)y * L->pages[p].width + x;
+        lbk_lmap_planes pl;
+        if (lbk_lmap_planes_get(m, p, &pl) != LBK_OK)
+            return tl_fail(err, TL_RENDER_INPUT, "lightmap page %u: unreadable planes", p);
+        block |= pl.format[0] != LBK_LMAP_R11G11B10F || pl.format[1] != LBK_LMAP_RGBA8;
+    }
+    /* a block-compressed pack is drawn from its decoded texels (what a GPU samples); light sets
+     * and doors apply to 1.0 texels, so with a DLS the decoded texels are stored as 1.0 texels
+     * first (R11G11B10F: 2^-7 relative on top of the block codec's error) */
+    if (block && !L->bake.dls && !(L->texel_f = malloc((nt + 1) * sizeof *L->texel_f)))
+        return tl_fail(err, TL_RENDER_INTERNAL, "out of memory");
+    for (uint32_t p = 0; p < np; p++) {
+        lbk_lmap_planes pl;
+        lbk_lmap_planes_get(m, p, &pl);
+        lbk_lmap_page *pg = &L->pages[p];
+        if (lbk_lmap_page_get(m, p, pg) != LBK_OK)
+            *pg = (lbk_lmap_page){.width = pl.width, .height = pl.height, .first_texel = pl.first_texel, .scale = pl.scale};
+        for (uint32_t y = 0; y < pg->height; y++)
+            for (uint32_t x = 0; x < pg->width; x++) {
+                const uint64_t i = pg->first_texel + (uint64_t)y * pg->width + x;
+                lbk_ahd_texel_f tf;
+                if (block && tl_bake_texel_get(&L->bake, p, x, y, &tf, NULL, NULL))
+                    return tl_fail(err, TL_RENDER_INPUT, "lightmap page %u texel (%u, %u): unreadable", p, x, y);
+                if (L->texel_f) {
+                    L->texel_f[i] = tf;
+                    continue;
+                }
                 lbk_ahd_texel t;
-                r = lbk_lmap_page_texel_get(&L->pages[p], x, y, &t);
-                if (r != LBK_OK) return tl_fail(err, TL_RENDER_INPUT, "lightmap page %u texel (%u, %u): %s", p, x, y, lbk_result_message(r));
+                if (block) {
+                    t.irradiance_z = lbk_r11g11b10f_pack(tf.ez);
+                    for (int k = 0; k < 4; k++) t.rgba[k] = lbk_float_to_unorm8(tf.rgba[k]);
+                } else if (lbk_lmap_page_texel_get(pg, x, y, &t) != LBK_OK) {
+                    return tl_fail(err, TL_RENDER_INPUT, "lightmap page %u texel (%u, %u): unreadable", p, x, y);
+                }
                 L->texel_ez[i] = t.irradiance_z;
                 memcpy(&L->texel_rgba[4 * i], t.rgba, 4);
             }
@@ -277,6 +290,6 @@ void rl_level_free(rl_level *L)
     tl_bake_close(&L->bake);
     bk_scene_free(&L->scene);
     free(L->objects), free(L->corner_coord), free(L->vertex_record), free(L->hidden);
-    free(L->texel_ez), free(L->texel_rgba), free(L->pages), free(L->applied_glg), free(L->applied_llg);
+    free(L->texel_ez), free(L->texel_rgba), free(L->texel_f), free(L->pages), free(L->applied_glg), free(L->applied_llg);
     memset(L, 0, sizeof *L);
 }

@@ -82,9 +82,10 @@ extern "C" {
 /* This library's version (semantic versioning of the API and ABI): the minor grows with every
  * release that adds API. 1.1: LMUV; 1.2: block-encoded LMAP pages (BC6H/BC4/BC5 decoding);
  * 1.3: OCTP probe volumes and their sampler; 1.4: the TERR error map, the DLS linear apply and
- * its caller-driven jobs; 1.5: lbk_lmuv_object_check (an LMUV record against the caller's glTF
- * mesh) and LBK_ERR_MISMATCH. tests/structure/versions.sh keeps it in step with lbk --version, lbk.pc
- * and the spec. */
+ * its caller-driven jobs; 1.5: the checks of a container against the glTF the caller loaded,
+ * lbk_lmuv_object_check (an LMUV record against its mesh) and lbk_objects_geometry_check (an
+ * object's geometry hash against its triangles), and LBK_ERR_MISMATCH. tests/structure/versions.sh
+ * keeps it in step with lbk --version, lbk.pc and the spec. */
 #define LBK_LIBRARY_VERSION_MAJOR 1
 #define LBK_LIBRARY_VERSION_MINOR 5
 #define LBK_LIBRARY_VERSION_PATCH 0
@@ -123,8 +124,9 @@ typedef enum lbk_result {
     LBK_ERR_CANCELLED,          /* the caller's progress callback asked to stop (liblbkbake) */
     LBK_ERR_BAD_INPUT,          /* an input scene is unusable: bad glTF, no light, nothing to bake */
     LBK_ERR_INTERNAL,           /* a failure of the library itself or of a dependency (a bug) */
-    LBK_ERR_MISMATCH,           /* the container does not describe the caller's data (an LMUV
-                                   record and the glTF mesh it names: lbk_lmuv_object_check) */
+    LBK_ERR_MISMATCH,           /* the container does not describe the caller's data (the glTF
+                                   it was baked from: lbk_lmuv_object_check,
+                                   lbk_objects_geometry_check) */
     /* new codes are appended here */
     LBK_RESULT_COUNT_           /* not part of the ABI: grows when codes are added */
 } lbk_result;

@@ -55,6 +55,16 @@ LBK_API lbk_result lbk_objects_find(const lbk_objects_view *view, lbk_string nam
  * `xyz` holds 9 × triangle_count floats. */
 LBK_API uint64_t lbk_objects_geometry_hash(const float *xyz, size_t triangle_count);
 
+/* Whether OBJS object `object` is the geometry the caller loaded (liblbk 1.5): its geometry_hash
+ * against lbk_objects_geometry_hash(xyz, triangle_count) of the node's world-space triangles in
+ * the baker's order (§8.3). The check every reader that draws a level with its glTF makes
+ * before using the object's lighting (lbk render, lbk export --gltf, lbk view). LBK_OK;
+ * LBK_ERR_MISMATCH when they differ (another level's file, or an edited glTF); LBK_ERR_NOT_FOUND
+ * past the table; LBK_ERR_INVALID_ARGUMENT for a NULL view, NULL xyz with triangles, or a
+ * triangle count whose 9 floats per triangle do not fit in memory. */
+LBK_API lbk_result lbk_objects_geometry_check(const lbk_objects_view *view, uint32_t object, const float *xyz,
+                                              size_t triangle_count);
+
 LBK_API const char *lbk_representation_name(uint32_t representation); /* "lightmap", "llg", "none", "unknown" */
 
 #ifdef __cplusplus
