@@ -24,7 +24,10 @@ typedef struct rl_level {
      * with their probe pointers on the applied probes */
     uint32_t *texel_ez;      /* plane 0 word (R11G11B10F) of every texel */
     uint8_t *texel_rgba;     /* plane 1, 4 bytes per texel */
-    lbk_lmap_page *pages;
+    lbk_ahd_texel_f *texel_f;/* a block-compressed pack (spec §9.2) without DLS: every texel as decoded
+                                (lbk/bc.h, astcenc), sampled instead of texel_ez/rgba; else NULL */
+    lbk_lmap_page *pages;    /* width, height and first_texel of every page (the plane pointers only
+                                on 1.0 pages) */
     lbk_glg_view glg;
     lbk_llg_view llg;
     int has_glg, has_llg;

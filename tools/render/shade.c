@@ -71,10 +71,14 @@ static void sample_page(const rl_level *L, uint32_t page, const float coord[2], 
         const float xf = fminf(fmaxf(x0 + (float)(k & 1), 0.0f), (float)pg->width - 1.0f);
         const float yf = fminf(fmaxf(y0 + (float)((k >> 1) & 1), 0.0f), (float)pg->height - 1.0f);
         const uint64_t i = pg->first_texel + (uint64_t)yf * pg->width + (uint64_t)xf;
-        lbk_ahd_texel t = {L->texel_ez[i], {0}};
-        memcpy(t.rgba, &L->texel_rgba[4 * i], 4);
         lbk_ahd_linear lin;
-        lbk_ahd_to_linear(&t, &lin);
+        if (L->texel_f) {
+            lbk_ahd_texel_f_to_linear(&L->texel_f[i], &lin);
+        } else {
+            lbk_ahd_texel t = {L->texel_ez[i], {0}};
+            memcpy(t.rgba, &L->texel_rgba[4 * i], 4);
+            lbk_ahd_to_linear(&t, &lin);
+        }
         lbk_ahd_linear_add_scaled(out, &lin, w * L->bake.lmap.scale);
     }
 }
