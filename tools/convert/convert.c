@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "tools/common/bake_data.h"
 #include "tools/common/error_util.h"
 #include "tools/convert/lmap_layout.h"
 #include "lbk/meta.h"
@@ -111,6 +112,26 @@ done:
     free(pairs);
     if (st == TL_CONVERT_INTERNAL && !*out) snprintf(err, TL_ERR_LEN, "out of memory");
     return st;
+}
+
+/* The pack's lightmap against the input's: 1 computed, 0 nothing to compare (no lightmap), -1 an
+ * error (err). Both are opened again through the tools' loader, which decodes block pages with
+ * the same decoders a reader of the pack uses. */
+static int pack_error(const void *in, size_t in_size, const void *pack, size_t pack_size, tl_pack_error *out,
+                      char err[TL_ERR_LEN])
+{
+    memset(out, 0, sizeof *out);
+    tl_bake a, p;
+    memset(&a, 0, sizeof a), memset(&p, 0, sizeof p);
+    int rc = -1;
+    if (tl_bake_open_memory(in, in_size, &a, err) != TL_OPEN_OK || tl_bake_open_memory(pack, pack_size, &p, err) != TL_OPEN_OK)
+        goto done;
+    rc = 0;
+    if (a.has_lmap && a.has_objs && p.has_lmap && p.has_objs) rc = tl_pack_error_compute(&a, &p, out, err) ? -1 : 1;
+done:
+    if (a.bytes) tl_bake_close(&a);
+    if (p.bytes) tl_bake_close(&p);
+    return rc;
 }
 
 tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_convert_options *opt, void **out,
@@ -243,6 +264,14 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
             cs->compression = si.compression;
         }
         lbk_reader_close(ord);
+    }
+    if (opt->pack_error && !opt->from_exr_dir) {
+        const int pe = pack_error(in, in_size, bytes, bytes_size, opt->pack_error, err);
+        if (pe < 0) {
+            lbk_free(NULL, bytes);
+            return TL_CONVERT_INTERNAL;
+        }
+        report->pack_error_computed = pe;
     }
     /* lbk_free(NULL, …) is free(); hand the caller a malloc'ed buffer. */
     *out = bytes;

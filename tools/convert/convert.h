@@ -6,6 +6,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "tools/convert/pack_error.h"
 #include "tools/convert/profile.h"
 #include "lbk/container.h"
 
@@ -33,12 +34,17 @@ typedef struct tl_convert_report {
     uint64_t in_size, out_size;
     uint32_t pages_imported; /* --from-exr */
     double encode_seconds;   /* block-encoding the lightmap pages (wall clock) */
+    int pack_error_computed; /* options.pack_error was filled in */
 } tl_convert_report;
 
 typedef struct tl_convert_options {
     const tl_profile *profile;
     const char *from_exr_dir; /* NULL: no import */
     uint64_t max_decoded_bytes; /* cap on the input's decoded sections (--max-memory); 0: liblbk's */
+    /* When non-NULL: the error of the pack's lightmap against the input's (pack_error.h), from
+     * decoding what was just encoded; filled in when both have one and no pages were imported
+     * (an edit is not an error), report->pack_error_computed says. Free with tl_pack_error_free. */
+    tl_pack_error *pack_error;
 } tl_convert_options;
 
 /* Converts a container held in memory. *out is malloc'ed (free()). The output is validated before
