@@ -38,10 +38,11 @@
  *   callers keep working but do not see fields added later; fields past `size` read as zero;
  *   a non-zero size below the 1.0 layout is LBK_ERR_INVALID_ARGUMENT; a size larger than this
  *   library knows is accepted when the bytes it does not know are zero, else
- *   LBK_ERR_UNSUPPORTED_FEATURE. Structs the library fills (views, infos, stats, issues), array
- *   elements (lbk_lmap_page_desc, lbk_llg_grid_desc, lbk_octp_probe_desc, lbk_door_desc,
- *   lbk_door_state_desc, lbk_dls_set_desc, lbk_dls_sparse, lbk_meta_pair, lbk_object) and
- *   lbk_allocator are frozen within a major version: growth comes as new functions or structs.
+ *   LBK_ERR_UNSUPPORTED_FEATURE. Structs the library fills (views, infos, stats, issues, check
+ *   details), array elements (lbk_lmap_page_desc, lbk_llg_grid_desc, lbk_octp_probe_desc,
+ *   lbk_door_desc, lbk_door_state_desc, lbk_dls_set_desc, lbk_dls_sparse, lbk_meta_pair,
+ *   lbk_object, lbk_lmuv_primitive_desc, lbk_lmuv_mesh_primitive) and lbk_allocator are frozen
+ *   within a major version: growth comes as new functions or structs.
  * Experimental. Declarations under `#ifdef LBK_STATIC_LINKING_ONLY` (the DLS builder's tuning
  *   and statistics) may change in any release; use them only when linking liblbk statically.
  * Versions. LBK_LIBRARY_VERSION_* describe this library's API (semantic versioning; the soname is
