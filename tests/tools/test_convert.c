@@ -120,7 +120,7 @@ static void test_shipped_profiles(void **state)
 
     assert_int_equal(tl_profile_resolve("handheld", "tools/convert/profiles", &p, err), 0);
     assert_int_equal(p.alignment, 4096);
-    assert_int_equal(p.lmap_row_pitch_alignment, 256);
+    assert_int_equal(p.lmap_row_pitch_alignment, 0);
     assert_int_equal(p.lmap_format[0], LBK_LMAP_ASTC4X4_HDR);
     assert_int_equal(p.lmap_format[1], LBK_LMAP_ASTC4X4_LDR);
     assert_int_equal(tl_profile_rule(&p, LBK_SECTION_LMAP).compression, LBK_COMPRESSION_ZSTD);
