@@ -170,6 +170,9 @@ static int view_main(int argc, char **argv, tl_guard *guard)
         fprintf(stderr, "lbk view: %s\n", err);
         rc = rc == TL_VIEW_IO ? LBK_EXIT_IO : rc == TL_VIEW_INPUT ? LBK_EXIT_INPUT : LBK_EXIT_INTERNAL;
     } else {
+        if (!quiet && s.astc_pages)
+            fprintf(stderr, "lbk view: %u ASTC lightmap page(s) decoded here and handed to the page as 1.0 texels "
+                            "(R11G11B10F + RGBA8): the page has no ASTC decoder\n", s.astc_pages);
         if (!quiet && o.out_dir != tmp)
             printf("%s: %u files (data.js %llu bytes); open %s/index.html\n", o.out_dir, s.files,
                    (unsigned long long)s.data_bytes, o.out_dir);

@@ -10,6 +10,7 @@
 #include "tools/common/bake_data.h"
 #include "tools/common/file_util.h"
 #include "tools/convert/gltf_export.h"
+#include "lbk/pixel.h"
 
 static int set_err(char err[TL_ERR_LEN], int status, const char *what, const char *detail)
 {
@@ -98,6 +99,70 @@ static int write_data_js(const char *path, const char *name, const void *lbk, si
     return rc;
 }
 
+/* The page reads 1.0 and BC pages itself (viewer/lbk_reader.js) but has no ASTC decoder (a few
+ * thousand lines of JS for one profile): a container with ASTC pages is handed to it with LMAP
+ * rebuilt from the texels liblbk's tools decoded (astcenc), stored as 1.0 texels (R11G11B10F +
+ * RGBA8: at most 2^-7 relative on top of the codec's error). Pages keep their size, so DLS and
+ * TERR texel indices stay valid; every other section is copied as decoded. *out NULL: no ASTC. */
+static int astc_to_texels(const tl_bake *b, const void *lbk, size_t size, void **out, size_t *out_size, uint32_t *pages,
+                          char err[TL_ERR_LEN])
+{
+    *out = NULL, *out_size = 0, *pages = 0;
+    const uint32_t np = b->has_lmap ? b->lmap.page_count : 0;
+    for (uint32_t p = 0; p < np; p++) {
+        lbk_lmap_planes pl;
+        if (lbk_lmap_planes_get(&b->lmap, p, &pl) == LBK_OK &&
+            (pl.format[0] == LBK_LMAP_ASTC4X4_HDR || pl.format[1] == LBK_LMAP_ASTC4X4_LDR))
+            (*pages)++;
+    }
+    if (!*pages) return TL_VIEW_OK;
+    lbk_lmap_page_desc *pd = calloc((size_t)np + 1, sizeof *pd);
+    lbk_ahd_texel *tex = malloc(((size_t)b->lmap.texel_count + 1) * sizeof *tex);
+    void *lmap = NULL;
+    size_t lmap_size = 0;
+    int rc = pd && tex ? TL_VIEW_OK : set_err(err, TL_VIEW_INTERNAL, "out of memory", NULL);
+    for (uint32_t p = 0; p < np && !rc; p++) {
+        lbk_lmap_planes pl;
+        lbk_lmap_planes_get(&b->lmap, p, &pl);
+        lbk_ahd_texel *t = tex + pl.first_texel;
+        for (uint32_t y = 0; y < pl.height; y++)
+            for (uint32_t x = 0; x < pl.width; x++) {
+                lbk_ahd_texel_f f;
+                if (tl_bake_texel_get(b, p, x, y, &f, NULL, NULL)) memset(&f, 0, sizeof f);
+                lbk_ahd_texel *d = &t[(size_t)y * pl.width + x];
+                d->irradiance_z = lbk_r11g11b10f_pack(f.ez);
+                for (int k = 0; k < 4; k++) d->rgba[k] = lbk_float_to_unorm8(f.rgba[k]);
+            }
+        pd[p] = (lbk_lmap_page_desc){pl.width, pl.height, t};
+    }
+    const lbk_lmap_build_desc bd = {.size = sizeof bd, .pages = pd, .page_count = np, .scale = b->lmap.scale};
+    if (!rc && lbk_lmap_build(&bd, NULL, &lmap, &lmap_size) != LBK_OK) rc = set_err(err, TL_VIEW_INTERNAL, "rebuilding LMAP", NULL);
+    free(pd), free(tex);
+    lbk_reader *rd = NULL;
+    lbk_writer *w = NULL;
+    if (!rc && (lbk_reader_open_memory(lbk, size, NULL, &rd) != LBK_OK || lbk_writer_open(NULL, &w) != LBK_OK))
+        rc = set_err(err, TL_VIEW_INTERNAL, "re-reading the container", NULL);
+    const uint32_t n = rd ? lbk_reader_section_count(rd) : 0;
+    for (uint32_t i = 0; i < n && !rc; i++) {
+        lbk_section_info si;
+        const void *data;
+        size_t ds;
+        if (lbk_reader_section_get(rd, i, &si) != LBK_OK || lbk_reader_section_data(rd, i, &data, &ds) != LBK_OK) {
+            rc = set_err(err, TL_VIEW_INTERNAL, "re-reading the container", NULL);
+            break;
+        }
+        lbk_section_options so = LBK_SECTION_OPTIONS_INIT;
+        so.flags = si.flags;
+        if (si.type == LBK_SECTION_LMAP) data = lmap, ds = lmap_size;
+        if (lbk_writer_section_add(w, si.type, data, ds, &so) != LBK_OK) rc = set_err(err, TL_VIEW_INTERNAL, "rewriting a section", NULL);
+    }
+    if (!rc && lbk_writer_to_memory(w, out, out_size) != LBK_OK) rc = set_err(err, TL_VIEW_INTERNAL, "rewriting the container", NULL);
+    lbk_writer_close(w);
+    lbk_reader_close(rd);
+    lbk_free(NULL, lmap);
+    return rc;
+}
+
 static int join(char *out, size_t size, const char *dir, const char *file, char err[TL_ERR_LEN])
 {
     if ((size_t)snprintf(out, size, "%s/%s", dir, file) >= size) return set_err(err, TL_VIEW_IO, "path too long", dir);
@@ -125,7 +190,7 @@ static int write_assets(const char *dir, uint32_t *files, char err[TL_ERR_LEN])
 
 int tl_view_write(const tl_view_options *o, tl_view_stats *stats, char err[TL_ERR_LEN])
 {
-    tl_view_stats s = {0, 0};
+    tl_view_stats s = {0, 0, 0};
     if (!o || !o->container || !o->scene || !o->out_dir) return set_err(err, TL_VIEW_INTERNAL, "missing option", NULL);
     tl_bake bake;
     tl_open_status st = tl_bake_open_file(o->container, &bake, err);
@@ -145,10 +210,19 @@ int tl_view_write(const tl_view_options *o, tl_view_stats *stats, char err[TL_ER
         if (rc) rc = rc == TL_GLTF_IO ? TL_VIEW_IO : rc == TL_GLTF_INPUT ? TL_VIEW_INPUT : TL_VIEW_INTERNAL;
         else s.files += 1 + gs.exr_files + gs.png_files;
     }
-    tl_bake_close(&bake);
     void *lbk = NULL, *glb = NULL;
     size_t lbk_size = 0, glb_size = 0;
     if (!rc && (tl_read_file(o->container, &lbk, &lbk_size, err) || tl_read_file(glb_path, &glb, &glb_size, err))) rc = TL_VIEW_IO;
+    if (!rc) {
+        void *texels = NULL;
+        size_t texels_size = 0;
+        rc = astc_to_texels(&bake, lbk, lbk_size, &texels, &texels_size, &s.astc_pages, err);
+        if (texels) { /* lbk_writer_to_memory without an allocator: malloc, so free() both */
+            free(lbk);
+            lbk = texels, lbk_size = texels_size;
+        }
+    }
+    tl_bake_close(&bake);
     char *inspect = NULL, *report = NULL;
     if (!rc) {
         void *rep = NULL;

@@ -22,6 +22,8 @@ typedef struct tl_view_options {
 typedef struct tl_view_stats {
     uint32_t files;      /* written into out_dir */
     uint64_t data_bytes; /* of data.js */
+    uint32_t astc_pages; /* ASTC lightmap pages the page got as decoded 1.0 texels (it has no ASTC
+                            decoder): R11G11B10F + RGBA8 of what astcenc decodes */
 } tl_view_stats;
 
 typedef enum tl_view_status {
