@@ -77,7 +77,7 @@ static void run_profiles(const char *scene, const void *bytes, size_t size, uint
             const double goal_bpt = pr.lmap_format[0] == LBK_LMAP_BC6H ? 2.5 : pr.lmap_format[0] ? 2.0 : 8.0;
             const double b_own = (double)gpu / (double)p.lmap.texel_count, b_base = (double)gpu / (double)base_texels;
             snprintf(bpt, sizeof bpt, "%.2f (%.2f)", b_base, b_own);
-            const tl_err_stats *l = &pe.all.lum, *c = &pe.all.colour;
+            const tl_pack_stats *l = &pe.all.lum, *c = &pe.all.colour;
             printf("%-22s %-17s %13s %6.2fs %5.2f %% %6.2f %% %6.1f %% %6.2f %%  %.4f %.4f  %4.2f %5.2f %4.2f  %s\n", scene,
                    label, bpt, rep.encode_seconds, 100 * l->mean, 100 * l->p99, 100 * l->max, 100 * pe.seam.lum.p99,
                    c->mean, c->p99, l->mean / TL_PACK_GOAL_MEAN, l->p99 / TL_PACK_GOAL_P99, b_base / goal_bpt,

@@ -75,7 +75,7 @@ static void print_summary(const char *in, const char *out, const char *exr_dir, 
                tl_lmap_format_name(1, profile->lmap_format[1]), rep->encode_seconds);
 }
 
-static void print_part(const char *what, const tl_err_part *p)
+static void print_part(const char *what, const tl_pack_part *p)
 {
     if (!p->lum.samples) return;
     printf("    %-14s luminance %6.2f %% / %6.2f %% / %6.2f %%   colour %.4f / %.4f / %.4f\n", what,
@@ -116,7 +116,7 @@ static void print_pack_error(const tl_pack_error *pe)
            met ? "met" : "NOT met");
 }
 
-static cJSON *stats_json(const tl_err_stats *s)
+static cJSON *stats_json(const tl_pack_stats *s)
 {
     cJSON *j = cJSON_CreateObject();
     cJSON_AddNumberToObject(j, "samples", (double)s->samples);
@@ -126,7 +126,7 @@ static cJSON *stats_json(const tl_err_stats *s)
     return j;
 }
 
-static cJSON *part_json(const tl_err_part *p)
+static cJSON *part_json(const tl_pack_part *p)
 {
     cJSON *j = cJSON_CreateObject();
     cJSON_AddItemToObject(j, "luminance", stats_json(&p->lum));

@@ -7,7 +7,11 @@
 
 #include "cli/cli.h"
 #include "cli/options.h"
+#include <cJSON.h>
+
+#include "tools/common/lmap_decode.h"
 #include "tools/common/output_guard.h"
+#include "tools/convert/pack_error.h"
 #include "tools/inspect/diff.h"
 
 static void usage(FILE *f)
@@ -33,7 +37,9 @@ static void usage(FILE *f)
             "    normals (+Z and 45 degrees toward +-X, +-Y) (6 axis normals for probes); it is over\n"
             "    tolerance when error > abs-tol + rel-tol * max|A| over the same values.\n"
             "What changed in the inputs and options (META provenance: options, files, lights, materials,\n"
-            "per-object geometry/material/options) is listed first.\n"
+            "per-object geometry/material/options) is listed first. When one side is a block-compressed\n"
+            "pack of the other (lbk convert, BC6H / ASTC), the lightmap differences are reported as its\n"
+            "compression error too (luminance and colour mean / p99 / max, seams; as lbk convert does).\n"
             "Reported per object, page, grid, OCTP volume and light set: max and mean absolute error, relative RMSE,\n"
             "share of samples over tolerance and their bounding region; plus added/removed/changed\n"
             "objects, sections and META bake parameters. Units: irradiance as baked (lux-like, lm/m^2).\n"
@@ -53,6 +59,87 @@ static void usage(FILE *f)
             "            light sets, doors or lighting sections; META/REPT differences alone do not count),\n"
             "            2 usage, 3 I/O error, 4 an input is not a valid container, 5 internal error\n",
             TL_DIFF_SCHEMA_VERSION);
+}
+
+/* The plane formats of a bake's first block-encoded page; 0 when every page has 1.0 planes. */
+static int block_formats(const tl_bake *b, uint32_t f[2])
+{
+    for (uint32_t p = 0; b->has_lmap && p < b->lmap.page_count; p++) {
+        lbk_lmap_planes pl;
+        if (lbk_lmap_planes_get(&b->lmap, p, &pl) == LBK_OK &&
+            (pl.format[0] != LBK_LMAP_R11G11B10F || pl.format[1] != LBK_LMAP_RGBA8)) {
+            f[0] = pl.format[0], f[1] = pl.format[1];
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* One side a block-compressed pack of the other (lbk convert with a block profile: the same
+ * objects and rectangles, block pages against 1.0 ones): its lightmap differences are the
+ * compression's error, measured as lbk convert reports it. packed: 0 A, 1 B, -1 neither. */
+typedef struct pack_side {
+    int packed;
+    uint32_t formats[2];
+    tl_pack_error error;
+} pack_side;
+
+static void find_pack(const tl_bake bake[2], pack_side *ps)
+{
+    uint32_t f[2][2] = {{0, 0}, {0, 0}};
+    const int ba = block_formats(&bake[0], f[0]), bb = block_formats(&bake[1], f[1]);
+    char err[TL_ERR_LEN];
+    ps->packed = -1;
+    if (ba == bb) return;
+    const int p = bb ? 1 : 0;
+    if (tl_pack_error_compute(&bake[1 - p], &bake[p], &ps->error, err)) return; /* not a pack of it */
+    ps->packed = p;
+    memcpy(ps->formats, f[p], sizeof ps->formats);
+}
+
+static void print_pack(const pack_side *ps)
+{
+    const tl_pack_error *e = &ps->error;
+    printf("compression: %s is a block-compressed pack of %s (%s + %s): its lightmap differences are the encoding's\n"
+           "  error: luminance mean %.2f %%, p99 %.2f %%, max %.2f %%; seam texels p99 %.2f %%; chroma mean %.4f, p99 %.4f;\n"
+           "  goal mean <= %g %%, p99 <= %g %%: %s (lbk convert reports the same)\n",
+           ps->packed ? "B" : "A", ps->packed ? "A" : "B", tl_lmap_format_name(0, ps->formats[0]),
+           tl_lmap_format_name(1, ps->formats[1]), 100 * e->all.lum.mean, 100 * e->all.lum.p99, 100 * e->all.lum.max,
+           100 * e->seam.lum.p99, e->all.colour.mean, e->all.colour.p99, 100 * TL_PACK_GOAL_MEAN, 100 * TL_PACK_GOAL_P99,
+           tl_pack_error_meets(&e->all.lum, TL_PACK_GOAL_MEAN, TL_PACK_GOAL_P99) ? "met" : "NOT met");
+}
+
+static cJSON *stats_json(const tl_pack_stats *s)
+{
+    cJSON *j = cJSON_CreateObject();
+    cJSON_AddNumberToObject(j, "mean", s->mean);
+    cJSON_AddNumberToObject(j, "p99", s->p99);
+    cJSON_AddNumberToObject(j, "max", s->max);
+    return j;
+}
+
+/* diff's JSON with "compression" added (spec/diff-json.md); NULL when out of memory. */
+static char *json_with_pack(const char *text, const pack_side *ps)
+{
+    cJSON *j = cJSON_Parse(text);
+    if (!j) return NULL;
+    if (ps->packed < 0) {
+        cJSON_AddNullToObject(j, "compression");
+    } else {
+        const tl_pack_error *e = &ps->error;
+        cJSON *c = cJSON_AddObjectToObject(j, "compression");
+        cJSON_AddStringToObject(c, "pack", ps->packed ? "b" : "a");
+        cJSON_AddStringToObject(c, "plane0", tl_lmap_format_name(0, ps->formats[0]));
+        cJSON_AddStringToObject(c, "plane1", tl_lmap_format_name(1, ps->formats[1]));
+        cJSON_AddNumberToObject(c, "texels", (double)e->texels);
+        cJSON_AddItemToObject(c, "luminance", stats_json(&e->all.lum));
+        cJSON_AddItemToObject(c, "colour", stats_json(&e->all.colour));
+        cJSON_AddItemToObject(c, "seam_luminance", stats_json(&e->seam.lum));
+        cJSON_AddBoolToObject(c, "goal_met", tl_pack_error_meets(&e->all.lum, TL_PACK_GOAL_MEAN, TL_PACK_GOAL_P99));
+    }
+    char *out = cJSON_Print(j); /* formatted, as tl_diff_json's */
+    cJSON_Delete(j);
+    return out;
 }
 
 static int parse_tol(const char *flag, const char *v, double *out)
@@ -151,6 +238,9 @@ static int diff_main(int argc, char **argv, tl_guard *guard)
     }
     tl_diff_result r;
     int rc = tl_diff_run(&bake[0], &bake[1], &o, &r, err);
+    pack_side ps;
+    memset(&ps, 0, sizeof ps);
+    if (!rc) find_pack(bake, &ps);
     tl_bake_close(&bake[0]);
     tl_bake_close(&bake[1]);
     if (rc) {
@@ -159,17 +249,21 @@ static int diff_main(int argc, char **argv, tl_guard *guard)
     }
     int exit_code = r.differ ? LBK_EXIT_NEGATIVE : LBK_EXIT_OK;
     if (json) {
-        char *text = tl_diff_json(&r, path[0], path[1]);
+        char *diff_text = tl_diff_json(&r, path[0], path[1]);
+        char *text = diff_text ? json_with_pack(diff_text, &ps) : NULL;
+        free(diff_text);
         if (!text) {
             fprintf(stderr, "lbk diff: out of memory\n");
             exit_code = LBK_EXIT_INTERNAL;
         } else {
             printf("%s\n", text);
-            free(text);
+            cJSON_free(text);
         }
     } else {
         tl_diff_print(stdout, &r, verbose);
+        if (ps.packed >= 0) print_pack(&ps);
     }
+    if (ps.packed >= 0) tl_pack_error_free(&ps.error);
     if (heat && tl_diff_heatmaps(&r, heat, err)) {
         fprintf(stderr, "lbk diff: %s\n", err);
         exit_code = LBK_EXIT_IO;

@@ -821,9 +821,83 @@ static void test_cli_exit_codes(void **state)
     assert_int_equal(run_cli(3, inv), LBK_EXIT_INPUT);
 }
 
+/* lbk diff --json's document, stdout captured into a file (malloc'ed text). */
+static char *cli_json(int n, const char **args, int expect)
+{
+    char path[160], err[TL_ERR_LEN];
+    snprintf(path, sizeof path, "%s/diff_out.json", tmpdir);
+    fflush(stdout);
+    const int saved = dup(1);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    dup2(fileno(f), 1);
+    const int rc = run_cli(n, args);
+    fflush(stdout);
+    dup2(saved, 1);
+    close(saved);
+    fclose(f);
+    assert_int_equal(rc, expect);
+    void *text;
+    size_t size;
+    assert_int_equal(tl_read_file(path, &text, &size, err), 0);
+    char *t = realloc(text, size + 1);
+    assert_non_null(t);
+    t[size] = 0;
+    return t;
+}
+
+/* SOURCE against its block-compressed pack: lbk diff says the lightmap differences are the
+ * encoding's error, with the numbers lbk convert reports (the same measure, pack_error.h); a bake
+ * against itself has no such entry. */
+static void test_cli_pack_reports_compression(void **state)
+{
+    (void)state;
+    char pa[128], pp[128], err[TL_ERR_LEN];
+    snprintf(pa, sizeof pa, "%s/src.lbk", tmpdir);
+    snprintf(pp, sizeof pp, "%s/src.pack.lbk", tmpdir);
+    tf_blob a = tf_build_scene(TF_SCENE_FULL, NULL);
+    tl_profile p;
+    assert_int_equal(tl_profile_resolve("console-current", "tools/convert/profiles", &p, err), 0);
+    tl_pack_error pe;
+    tl_convert_report rep;
+    tl_convert_options co = {.profile = &p, .pack_error = &pe};
+    void *pack;
+    size_t pack_size;
+    assert_int_equal(tl_convert_memory(a.data, a.size, &co, &pack, &pack_size, &rep, err), TL_CONVERT_OK);
+    assert_int_equal(rep.pack_error_computed, 1);
+    assert_int_equal(tl_write_file_atomic(pa, a.data, a.size, err), 0);
+    assert_int_equal(tl_write_file_atomic(pp, pack, pack_size, err), 0);
+    free(pack);
+    tf_blob_free(&a);
+    const char *args[] = {"diff", pa, pp, "--json", "--mode", "tolerance"};
+    char *text = cli_json(6, args, LBK_EXIT_NEGATIVE); /* lossy: it differs, and says why */
+    cJSON *j = cJSON_Parse(text);
+    assert_non_null(j);
+    const cJSON *c = cJSON_GetObjectItem(j, "compression");
+    assert_true(cJSON_IsObject(c));
+    assert_string_equal(cJSON_GetObjectItem(c, "pack")->valuestring, "b");
+    assert_string_equal(cJSON_GetObjectItem(c, "plane0")->valuestring, "bc6h");
+    assert_int_equal((uint64_t)cJSON_GetObjectItem(c, "texels")->valuedouble, pe.texels);
+    const cJSON *lum = cJSON_GetObjectItem(c, "luminance");
+    assert_true(pe.all.lum.mean > 0);
+    assert_true(fabs(cJSON_GetObjectItem(lum, "mean")->valuedouble - pe.all.lum.mean) <= 1e-12 * pe.all.lum.mean);
+    assert_true(fabs(cJSON_GetObjectItem(lum, "p99")->valuedouble - pe.all.lum.p99) <= 1e-12 * pe.all.lum.p99);
+    cJSON_Delete(j);
+    free(text);
+    tl_pack_error_free(&pe);
+    const char *self[] = {"diff", pa, pa, "--json"};
+    text = cli_json(4, self, LBK_EXIT_OK);
+    j = cJSON_Parse(text);
+    assert_non_null(j);
+    assert_true(cJSON_IsNull(cJSON_GetObjectItem(j, "compression")));
+    cJSON_Delete(j);
+    free(text);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_cli_pack_reports_compression),
         cmocka_unit_test(test_self_is_equal),
         cmocka_unit_test(test_other_scale_is_equal),
         cmocka_unit_test(test_one_texel_changed),

@@ -35,9 +35,9 @@ static void hist_add(hist *h, double x)
     if (x > h->max) h->max = x;
 }
 
-static tl_err_stats hist_stats(const hist *h)
+static tl_pack_stats hist_stats(const hist *h)
 {
-    tl_err_stats s = {h->count, 0, 0, 0};
+    tl_pack_stats s = {h->count, 0, 0, 0};
     if (!h->count) return s;
     s.mean = h->sum / (double)h->count;
     s.max = h->max;
@@ -79,9 +79,9 @@ static int cmp_float(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static tl_err_stats vec_stats(vec *s)
+static tl_pack_stats vec_stats(vec *s)
 {
-    tl_err_stats r = {s->n, 0, 0, 0};
+    tl_pack_stats r = {s->n, 0, 0, 0};
     if (!s->n) return r;
     double sum = 0;
     for (size_t i = 0; i < s->n; i++) sum += s->v[i];
@@ -259,9 +259,9 @@ int tl_pack_error_compute(const tl_bake *a, const tl_bake *p, tl_pack_error *out
     out->y_floor = g->y_floor;
     out->texels = g->texels;
     out->shared_block_texels = g->shared_texels;
-    out->all = (tl_err_part){hist_stats(&g->all_l), hist_stats(&g->all_c)};
-    out->seam = (tl_err_part){hist_stats(&g->seam_l), hist_stats(&g->seam_c)};
-    out->shared = (tl_err_part){hist_stats(&g->shared_l), hist_stats(&g->shared_c)};
+    out->all = (tl_pack_part){hist_stats(&g->all_l), hist_stats(&g->all_c)};
+    out->seam = (tl_pack_part){hist_stats(&g->seam_l), hist_stats(&g->seam_c)};
+    out->shared = (tl_pack_part){hist_stats(&g->shared_l), hist_stats(&g->shared_c)};
     free(g);
     if (rc) tl_pack_error_free(out);
     return rc;
@@ -274,7 +274,7 @@ void tl_pack_error_free(tl_pack_error *e)
     memset(e, 0, sizeof *e);
 }
 
-int tl_pack_error_meets(const tl_err_stats *s, double mean_goal, double p99_goal)
+int tl_pack_error_meets(const tl_pack_stats *s, double mean_goal, double p99_goal)
 {
     return s->mean <= mean_goal && s->p99 <= p99_goal;
 }

@@ -35,27 +35,27 @@
 #define TL_PACK_GOAL_MEAN 0.01
 #define TL_PACK_GOAL_P99 0.05
 
-typedef struct tl_err_stats {
+typedef struct tl_pack_stats {
     uint64_t samples;
     double mean, p99, max;
-} tl_err_stats;
+} tl_pack_stats;
 
-typedef struct tl_err_part {
-    tl_err_stats lum, colour;
-} tl_err_part;
+typedef struct tl_pack_part {
+    tl_pack_stats lum, colour;
+} tl_pack_part;
 
 typedef struct tl_pack_object_error {
     uint32_t object;     /* index in the object table */
     char *name;          /* its name (malloc'ed, NUL-terminated) */
     uint64_t texels;     /* texels compared */
-    tl_err_part all, seam;
+    tl_pack_part all, seam;
 } tl_pack_object_error;
 
 typedef struct tl_pack_error {
     double y_floor;               /* physical luminance below which errors are relative to it */
     uint64_t texels;              /* texels compared, all objects */
     uint64_t shared_block_texels; /* of them, in 4×4 blocks two objects' rectangles share */
-    tl_err_part all, seam, shared;/* every texel; seam texels; texels of shared blocks */
+    tl_pack_part all, seam, shared;/* every texel; seam texels; texels of shared blocks */
     uint32_t object_count;        /* lightmapped objects */
     tl_pack_object_error *objects;/* malloc'ed, object_count of them */
 } tl_pack_error;
@@ -67,6 +67,6 @@ int tl_pack_error_compute(const tl_bake *source, const tl_bake *pack, tl_pack_er
 void tl_pack_error_free(tl_pack_error *e);
 
 /* 1 when s meets the goals mean ≤ mean_goal and p99 ≤ p99_goal, else 0. */
-int tl_pack_error_meets(const tl_err_stats *s, double mean_goal, double p99_goal);
+int tl_pack_error_meets(const tl_pack_stats *s, double mean_goal, double p99_goal);
 
 #endif
