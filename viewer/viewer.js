@@ -347,7 +347,7 @@
     });
     if (astcPages.length)
       $('note').textContent = 'ASTC pages cannot be shown: this page has no ASTC decoder (page' + (astcPages.length > 1 ? 's ' : ' ') +
-        astcPages.join(', ') + '; their objects are lit from the GLG instead). Open the bake before lbk convert, or a BC/1.0 conversion of it.';
+        astcPages.join(', ') + '; their objects are lit from the GLG instead). Open the pack with lbk view, which decodes ASTC pages for this page.';
 
     /* The glTF's textures (lbk export's lightmap previews) are never drawn here, so none is loaded:
      * an image decodes off the main thread, which headless Chromium's virtual time does not wait
