@@ -278,10 +278,11 @@ int lbk_cmd_convert(int argc, char **argv)
     }
     tl_pack_error pe;
     memset(&pe, 0, sizeof pe);
-    /* only a block-encoded lightmap can differ from the input's; other packs keep its texels */
+    /* only a block-encoded lightmap can differ from the input's (other packs keep its texels), and
+     * only a summary shows the difference (-q without --json skips the decoding) */
     const int block = profile.lmap_format[0] || profile.lmap_format[1];
     tl_convert_options opt = {.profile = &profile, .from_exr_dir = exr_dir, .max_decoded_bytes = max_memory,
-                              .pack_error = block ? &pe : NULL};
+                              .pack_error = block && (json || !quiet) ? &pe : NULL};
     void *pack = NULL;
     size_t pack_size = 0;
     tl_convert_report rep;
