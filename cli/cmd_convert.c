@@ -196,6 +196,7 @@ static int print_json(const char *in, const char *out, const tl_profile *profile
     }
     if (pe) cJSON_AddItemToObject(j, "pack_error", pack_error_json(pe));
     else cJSON_AddNullToObject(j, "pack_error");
+    if (rep->pack_error_skipped[0]) cJSON_AddStringToObject(j, "pack_error_skipped", rep->pack_error_skipped);
     char *text = cJSON_PrintUnformatted(j);
     cJSON_Delete(j);
     if (!text) {
@@ -306,6 +307,7 @@ int lbk_cmd_convert(int argc, char **argv)
     } else if (!quiet) {
         print_summary(in, out, exr_dir, &profile, &rep);
         if (rep.pack_error_computed) print_pack_error(&pe);
+        else if (rep.pack_error_skipped[0]) printf("  pack error not measured: %s\n", rep.pack_error_skipped);
     }
     free(pack);
     tl_pack_error_free(&pe);

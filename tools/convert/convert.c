@@ -266,12 +266,10 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
         lbk_reader_close(ord);
     }
     if (opt->pack_error && !opt->from_exr_dir) {
-        const int pe = pack_error(in, in_size, bytes, bytes_size, opt->pack_error, err);
-        if (pe < 0) {
-            lbk_free(NULL, bytes);
-            return TL_CONVERT_INTERNAL;
-        }
-        report->pack_error_computed = pe;
+        /* a measure, not the product: when it cannot be made, the pack still ships and says why */
+        const int pe = pack_error(in, in_size, bytes, bytes_size, opt->pack_error, report->pack_error_skipped);
+        report->pack_error_computed = pe > 0;
+        if (pe >= 0) report->pack_error_skipped[0] = 0;
     }
     /* lbk_free(NULL, …) is free(); hand the caller a malloc'ed buffer. */
     *out = bytes;

@@ -35,6 +35,8 @@ typedef struct tl_convert_report {
     uint32_t pages_imported; /* --from-exr */
     double encode_seconds;   /* block-encoding the lightmap pages (wall clock) */
     int pack_error_computed; /* options.pack_error was filled in */
+    char pack_error_skipped[TL_ERR_LEN]; /* why it could not be (the pack is written all the same:
+                                            e.g. the two decoded containers past memory), or "" */
 } tl_convert_report;
 
 typedef struct tl_convert_options {
