@@ -162,7 +162,9 @@ static int gather_llg(ex *e, size_t object, uint32_t grid, prim_data *d)
 {
     const bk_scene *s = e->s;
     lbk_llg_grid g;
-    if (!e->b->has_llg || lbk_llg_grid_get(&e->b->llg, grid, &g) != LBK_OK) return 0;
+    if (!e->b->has_llg || lbk_llg_grid_get(&e->b->llg, grid, &g) != LBK_OK) /* invalid (411, 412): as lbk render */
+        return tl_fail(e->err, TL_GLTF_INPUT, "object %zu: OBJS names LLG grid %u, the container has %u", object, grid,
+                       e->b->has_llg ? e->b->llg.grid_count : 0);
     uint32_t *rank = malloc((s->vertex_count ? s->vertex_count : 1) * sizeof *rank);
     d->vis = malloc((d->nv ? d->nv : 1) * sizeof *d->vis);
     d->bent = malloc((d->nv ? d->nv : 1) * 3 * sizeof *d->bent);
