@@ -387,7 +387,49 @@ static void read_terr(const void *d, size_t n)
     if (lbk_terr_decode(v.codes[0]) != lbk_terr_decode(v.codes[0])) abort(); /* never NaN */
 }
 
-/* LMUV: whatever lbk_lmuv_open accepts, every element it promises is readable and in range. */
+/* lbk_lmuv_object_check on a GENERATED record against the mesh the record itself describes
+ * (corner i = remap[indices[i]]): every corner matches, so the only refusal can be the vertex
+ * order; one corner moved to another source vertex is refused at that corner. */
+static void check_record_against_itself(const lbk_lmuv_view *v, const lbk_lmuv_object *o)
+{
+    enum { MAX_PRIMS = 8, MAX_INDICES = 4096 };
+    if (o->kind != LBK_LMUV_GENERATED || o->primitive_count > MAX_PRIMS) return;
+    lbk_lmuv_mesh_primitive mp[MAX_PRIMS];
+    uint32_t *corners[MAX_PRIMS] = {0};
+    int ok = 1;
+    for (uint32_t k = 0; k < o->primitive_count && ok; k++) {
+        lbk_lmuv_primitive q;
+        if (lbk_lmuv_get_primitive(v, o->primitive_first + k, &q) != LBK_OK) abort();
+        ok = q.index_count <= MAX_INDICES && (corners[k] = malloc(4 * (size_t)q.index_count + 4)) != NULL;
+        for (uint32_t i = 0; ok && i < q.index_count; i++) {
+            uint32_t x;
+            if (lbk_lmuv_index(v, &q, i, &x) != LBK_OK || lbk_lmuv_vertex(v, &q, x, &corners[k][i], NULL) != LBK_OK)
+                abort();
+        }
+        mp[k] = (lbk_lmuv_mesh_primitive){.source_primitive = q.source_primitive,
+                                          .source_vertex_count = q.source_vertex_count,
+                                          .triangle_count = q.index_count / 3, .corners = corners[k]};
+    }
+    if (ok) {
+        lbk_lmuv_mesh_desc mesh = LBK_LMUV_MESH_DESC_INIT;
+        mesh.source_node = o->source_node;
+        mesh.primitive_count = o->primitive_count;
+        mesh.primitives = mp;
+        lbk_lmuv_check_detail why;
+        const lbk_result r = lbk_lmuv_object_check(v, o, &mesh, &why);
+        if (r != LBK_OK && !(r == LBK_ERR_MISMATCH && why.code == LBK_LMUV_CHECK_VERTEX_ORDER)) abort();
+        if (mp[0].source_vertex_count > 1) {
+            corners[0][0] = (corners[0][0] + 1) % mp[0].source_vertex_count;
+            if (lbk_lmuv_object_check(v, o, &mesh, &why) != LBK_ERR_MISMATCH || why.code != LBK_LMUV_CHECK_CORNER ||
+                why.primitive != 0 || why.triangle != 0 || why.corner != 0)
+                abort();
+        }
+    }
+    for (uint32_t k = 0; k < o->primitive_count; k++) free(corners[k]);
+}
+
+/* LMUV: whatever lbk_lmuv_open accepts, every element it promises is readable and in range, and
+ * lbk_lmuv_object_check agrees with what the records say. */
 static void read_lmuv(const void *d, size_t n)
 {
     lbk_lmuv_view v;
@@ -397,6 +439,7 @@ static void read_lmuv(const void *d, size_t n)
         uint32_t back;
         if (lbk_lmuv_get_object(&v, r, &o) != LBK_OK) abort();
         lbk_lmuv_find_object(&v, o.object, &back);
+        if (r < 64) check_record_against_itself(&v, &o);
     }
     for (uint32_t p = 0; p < v.primitive_count && p < 4096; p++) {
         lbk_lmuv_primitive q;
