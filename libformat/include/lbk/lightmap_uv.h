@@ -185,8 +185,11 @@ typedef enum lbk_lmuv_check_code {
 /* What lbk_lmuv_object_check found (filled by the library: frozen). */
 typedef struct lbk_lmuv_check_detail {
     uint32_t code;          /* lbk_lmuv_check_code */
-    uint32_t primitive;     /* position in desc->primitives (and in the record); 0 for NODE */
-    uint32_t triangle;      /* CORNER, MESH_CORNER: the triangle; VERTEX_ORDER: the new vertex */
+    uint32_t primitive;     /* position in desc->primitives (and in the record); 0 for NODE and
+                               PRIMITIVE_COUNT */
+    uint32_t triangle;      /* CORNER, MESH_CORNER: the triangle; VERTEX_ORDER: the new vertex
+                               out of order (with NORMAL) or the corner (without; 0 when the
+                               vertex count is not the corner count) */
     uint32_t corner;        /* CORNER, MESH_CORNER: 0..2 */
     uint64_t record_value;  /* what the record has (node, count, source vertex, ...) */
     uint64_t mesh_value;    /* what the mesh has */
