@@ -14,7 +14,7 @@ extern "C" {
 
 /* rgba: width × height × 4 floats (hdr: RGB HDR with alpha 1, profile HDR RGB + LDR A; else LDR
  * in [0, 1], linear), width and height multiples of 4. out: 16 bytes per block, row-major blocks.
- * Quality: astcenc's "medium" preset, one thread, deterministic. Returns 0, or -1 with err. */
+ * Quality: astcenc's "thorough" preset, one thread, deterministic. Returns 0, or -1 with err. */
 int tl_astc_encode(const float *rgba, uint32_t width, uint32_t height, int hdr, uint8_t *out, size_t out_size,
                    char *err, size_t err_len);
 /* The inverse: rgba receives width × height × 4 floats. */
