@@ -11,6 +11,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <cjson/cJSON.h>
+#include <unistd.h>
+
+#include "cli/cli.h"
+#include "tools/common/file_util.h"
 #include "tools/convert/convert.h"
 #include "tools/convert/pack_error.h"
 #include "tools/convert/profile.h"
@@ -181,6 +186,65 @@ static void test_step_between_objects(void **state)
     tl_pack_error_free(&pe);
 }
 
+/* lbk convert --json: the document (schema lbk-convert/1) carries the pack error the library
+ * computes, per object too; a 1.0 profile has none (its texels are the input's). */
+static void test_cli_json(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/lbk_pack_error_XXXXXX", in[64], out[64], json[64], err[TL_ERR_LEN];
+    assert_non_null(mkdtemp(dir));
+    snprintf(in, sizeof in, "%s/in.lbk", dir);
+    snprintf(out, sizeof out, "%s/out.lbk", dir);
+    snprintf(json, sizeof json, "%s/out.json", dir);
+    void *bytes;
+    size_t size;
+    build(gradient, &bytes, &size);
+    assert_int_equal(tl_write_file_atomic(in, bytes, size, err), 0);
+    lbk_free(NULL, bytes);
+    tl_pack_error pe = convert(gradient, "bc6h", "bc5_bc4");
+    static const char *const profiles[] = {"console-current", "pc"};
+    for (int k = 0; k < 2; k++) {
+        const char *argv[] = {"convert", in, "-o", out, "--profile", profiles[k], "--json", NULL};
+        fflush(stdout);
+        const int saved = dup(1);
+        FILE *f = fopen(json, "w");
+        assert_non_null(f);
+        dup2(fileno(f), 1);
+        const int rc = lbk_cmd_convert(7, (char **)argv);
+        fflush(stdout);
+        dup2(saved, 1);
+        close(saved);
+        fclose(f);
+        assert_int_equal(rc, LBK_EXIT_OK);
+        void *text;
+        size_t n;
+        assert_int_equal(tl_read_file(json, &text, &n, err), 0);
+        char *t = realloc(text, n + 1);
+        assert_non_null(t);
+        t[n] = 0;
+        cJSON *j = cJSON_Parse(t);
+        free(t);
+        assert_non_null(j);
+        assert_string_equal(cJSON_GetObjectItem(j, "schema")->valuestring, "lbk-convert/1");
+        const cJSON *e = cJSON_GetObjectItem(j, "pack_error");
+        if (k) {
+            assert_true(cJSON_IsNull(e));
+        } else {
+            /* console-current is BC6H + BC5/BC4 as convert() above: the same pack, the same error */
+            const cJSON *lum = cJSON_GetObjectItem(cJSON_GetObjectItem(e, "all"), "luminance");
+            assert_true(fabs(cJSON_GetObjectItem(lum, "mean")->valuedouble - pe.all.lum.mean) <= 1e-12);
+            assert_true(fabs(cJSON_GetObjectItem(lum, "max")->valuedouble - pe.all.lum.max) <= 1e-12);
+            const cJSON *objs = cJSON_GetObjectItem(e, "objects");
+            assert_int_equal(cJSON_GetArraySize(objs), 2);
+            assert_string_equal(cJSON_GetObjectItem(cJSON_GetArrayItem(objs, 1), "name")->valuestring, "right");
+            assert_true(cJSON_IsBool(cJSON_GetObjectItem(cJSON_GetObjectItem(e, "goal"), "met")));
+        }
+        cJSON_Delete(j);
+    }
+    tl_pack_error_free(&pe);
+    unlink(in), unlink(out), unlink(json), rmdir(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -188,6 +252,7 @@ int main(void)
         cmocka_unit_test(test_constant_page_within_half_quantisation),
         cmocka_unit_test(test_gradient_within_encoder_bound),
         cmocka_unit_test(test_step_between_objects),
+        cmocka_unit_test(test_cli_json),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
