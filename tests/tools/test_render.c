@@ -254,6 +254,22 @@ static void light_sets(void **state)
     tl_render_options o_off = o;
     o_off.sets = off;
     agree("light sets", gs, ls, &o, &o_off, gr, lr);
+    /* a block-compressed pack of the same bake: its decoded texels go through lbk_dls_apply as 1.0
+     * texels; within the pack goal's mean of 1 % of the bake (summed over the view), and the
+     * weights still act on it (sets off is far darker, as above) */
+    char pack[200];
+    snprintf(pack, sizeof pack, "%s.pack.lbk", ls[0]);
+    const char *conv[] = {"convert", ls[0], "-o", pack, "--profile", "console-current", "-q", NULL};
+    assert_int_equal(lbk_cmd_convert(7, (char **)conv), LBK_EXIT_OK);
+    tl_image ref = render(gs, ls[0], &o), im = render(gs, pack, &o), dark = render(gs, pack, &o_off);
+    double diff = 0, sum = 0, sum_off = 0;
+    for (size_t i = 0; i < 3 * (size_t)o.width * (size_t)o.height; i++)
+        diff += fabs((double)im.rgb[i] - ref.rgb[i]), sum += ref.rgb[i], sum_off += dark.rgb[i];
+    print_message("light sets, console-current pack: summed |difference| / summed radiance %.5f; sets off %.3f\n",
+                  diff / sum, sum_off / sum);
+    assert_true(diff > 0 && diff <= 0.01 * sum);
+    assert_true(sum_off < 0.5 * sum);
+    tl_image_free(&ref), tl_image_free(&im), tl_image_free(&dark);
 }
 
 /* The north door open (ω = 1: its open set at full weight, the panel not drawn) against the room
