@@ -346,11 +346,7 @@ int main(int argc, char **argv)
         memcpy(r[nr].position, x->position, 12);
         memcpy(r[nr].normal, x->normal, 12);
 #ifndef BENCH_BIAS_ORIG
-        if (a.footprint) {
-            r[nr].footprint_first = x->footprint_first;
-            r[nr].footprint_count = x->footprint_count;
-            memcpy(r[nr].footprint_box, x->footprint_box, sizeof x->footprint_box);
-        }
+        if (a.footprint) bk_receiver_from_texel(x, &r[nr]);
 #endif
         recv_of[i] = nr;
         texel_of[nr++] = i;

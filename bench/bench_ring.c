@@ -57,11 +57,7 @@ static lbk_result bake_texels(const bk_scene *s, const bk_tracer *t, const bk_te
     *rings = 0;
     for (size_t i = 0; i < tx->count; i++) {
         const bk_texel *x = &tx->receivers[i];
-        memcpy(r[i].position, x->position, 12);
-        memcpy(r[i].normal, x->normal, 12);
-        r[i].footprint_first = x->footprint_first;
-        r[i].footprint_count = x->footprint_count;
-        memcpy(r[i].footprint_box, x->footprint_box, sizeof x->footprint_box);
+        bk_receiver_from_texel(x, &r[i]);
         *rings += (x->flags & BK_TEXEL_RING) != 0;
     }
     float *cell = malloc(s->tri_count * sizeof *cell);

@@ -65,7 +65,11 @@
  * surface in front of it (a back face within the tenth of a texel along its normal, probed at
  * 4 × 4 points: a light panel hung just under a ceiling) loses its footprint and keeps its
  * pushed point: filtering would spread the hidden part's light over the visible surface beside
- * it (TRANSPORT.md, After the atlas merge). Then 16 long
+ * it (TRANSPORT.md, After the atlas merge). A texel whose square runs beyond another surface
+ * seen from its point (a wall's square running into a sill set into the wall, a floor's under a
+ * crate) keeps its footprint on its own side only: the cells (8 × 8) whose points lie beyond
+ * are marked (footprint_hidden), the transport draws no sample there, and near the covering
+ * surface's edge tests each sample itself (bk_footprint_sample_hidden). Then 16 long
  * hemisphere rays: when at least half of them end on back faces the point is inside closed
  * geometry: BK_TEXEL_INSIDE is set (information only: the texel is still baked, and the
  * transport makes the inside of closed solids black, so a face sealed inside a wall bakes to
@@ -114,6 +118,7 @@ typedef struct bk_texel {
                                                   bk_texels.footprint (see Footprint above) */
     float footprint_box[4];  /* s0, t0, width, height: the part of its square they cover lies in
                                 it (bk_receiver.footprint_box) */
+    uint64_t footprint_hidden; /* cells of the square behind another surface (bk_receiver) */
 } bk_texel;
 
 typedef struct bk_texels {
@@ -151,6 +156,9 @@ lbk_result bk_texels_push_out(bk_texels *tx, const bk_scene *scene, const bk_tra
 
 /* Fills mask (width × height of the page) with 1 for valid receivers, 0 elsewhere. */
 void bk_texels_valid_mask(const bk_texels *tx, uint32_t page, uint8_t *mask);
+
+/* The transport's receiver for texel t: its point, normal and footprint (box and hidden cells). */
+void bk_receiver_from_texel(const bk_texel *t, bk_receiver *r);
 
 /* T and B from unit N and dP/du per the convention above (t, b unit, b = n × t). */
 void bk_tangent_frame(const float n[3], const float dpdu[3], float t[3], float b[3]);

@@ -80,12 +80,8 @@ static lbk_result build_receivers(bk_pipeline *b)
     for (size_t i = 0; i < b->texels.count; i++) {
         const bk_texel *t = &b->texels.receivers[i];
         if (!(t->flags & BK_TEXEL_VALID)) continue;
-        memcpy(b->receivers[k].position, t->position, sizeof t->position);
-        memcpy(b->receivers[k].normal, t->normal, sizeof t->normal);
         /* the texel's value is the average over its square (texels.h, Footprint) */
-        b->receivers[k].footprint_first = t->footprint_first;
-        b->receivers[k].footprint_count = t->footprint_count;
-        memcpy(b->receivers[k].footprint_box, t->footprint_box, sizeof t->footprint_box);
+        bk_receiver_from_texel(t, &b->receivers[k]);
         b->texel_of_receiver[k++] = (uint32_t)i;
     }
     for (size_t t = 0; t < b->llg_fit.count; t++, k++)

@@ -37,3 +37,77 @@ int bk_footprint_point(const bk_scene *scene, const bk_footprint_tri *tris, uint
     }
     return 0;
 }
+
+/* Whether triangle tri is one of the footprint's (the texel's own surface) or `own`. */
+static int footprint_own(const bk_footprint_tri *tris, uint32_t count, uint32_t own, uint32_t tri)
+{
+    if (tri == own) return 1;
+    for (uint32_t k = 0; k < count; k++)
+        if (tris[k].tri == tri) return 1;
+    return 0;
+}
+
+#define FP_SEGMENT_STEPS 4
+int bk_footprint_segment_blocked(const bk_tracer *tracer, const bk_footprint_tri *tris, uint32_t count, uint32_t own,
+                                 const double a[3], const double na[3], const double b[3], const double nb[3])
+{
+    double d[3], len2 = 0;
+    for (int c = 0; c < 3; c++) {
+        d[c] = b[c] - a[c];
+        len2 += d[c] * d[c];
+    }
+    const double len = sqrt(len2);
+    if (!(len > 0) || !isfinite(len)) return 0;
+    /* both ends raised alike, so the segment runs parallel to a flat surface and never meets a
+     * coplanar duplicate of it; relative to the segment, so the test means the same at any scale */
+    const double lift = 1e-3 * len;
+    float org[3], dir[3];
+    double e[3], l2 = 0;
+    for (int c = 0; c < 3; c++) {
+        org[c] = (float)(a[c] + lift * na[c]);
+        e[c] = b[c] + lift * nb[c] - org[c];
+        l2 += e[c] * e[c];
+    }
+    const double l = sqrt(l2);
+    if (!(l > 0)) return 0;
+    for (int c = 0; c < 3; c++) dir[c] = (float)(e[c] / l);
+    float tmin = 0.0f;
+    for (int step = 0; step < FP_SEGMENT_STEPS; step++) {
+        bk_hit h;
+        if (!bk_tracer_intersect(tracer, org, dir, tmin, (float)l, &h)) return 0;
+        /* a chord of a curved surface runs beneath the surface: step over its own triangles */
+        if (!footprint_own(tris, count, own, h.tri)) return 1;
+        tmin = h.t * 1.0001f + 1e-7f;
+    }
+    return 0;
+}
+
+/* Whether some cell of the 3 x 3 block around (cx, cy) differs in state from the others: the
+ * covering surface's edge runs near, and the cell's mark is not the answer for every point. */
+static int cell_mixed(uint64_t hidden, int cx, int cy)
+{
+    int h = 0, v = 0;
+    for (int y = cy - 1; y <= cy + 1; y++)
+        for (int x = cx - 1; x <= cx + 1; x++) {
+            if (x < 0 || y < 0 || x >= BK_FOOTPRINT_GRID || y >= BK_FOOTPRINT_GRID) continue;
+            if ((hidden >> (y * BK_FOOTPRINT_GRID + x)) & 1u)
+                h = 1;
+            else
+                v = 1;
+        }
+    return h && v;
+}
+
+int bk_footprint_sample_hidden(const bk_tracer *tracer, const bk_footprint_tri *tris, const bk_receiver *r, double s,
+                               double t, const double p[3], const double n[3])
+{
+    if (!r->footprint_hidden) return 0;
+    int cx = (int)(s * BK_FOOTPRINT_GRID), cy = (int)(t * BK_FOOTPRINT_GRID);
+    cx = cx < 0 ? 0 : cx >= BK_FOOTPRINT_GRID ? BK_FOOTPRINT_GRID - 1 : cx;
+    cy = cy < 0 ? 0 : cy >= BK_FOOTPRINT_GRID ? BK_FOOTPRINT_GRID - 1 : cy;
+    if (!cell_mixed(r->footprint_hidden, cx, cy)) return bk_footprint_cell_hidden(r->footprint_hidden, s, t);
+    const double a[3] = {r->position[0], r->position[1], r->position[2]};
+    const double na[3] = {r->normal[0], r->normal[1], r->normal[2]};
+    return bk_footprint_segment_blocked(tracer, tris + r->footprint_first, r->footprint_count, UINT32_MAX, a, na, p,
+                                        n);
+}

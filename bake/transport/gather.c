@@ -42,6 +42,18 @@ static int footprint_origin(const tp_ctx *c, const bk_receiver *r, double s, dou
     return 0;
 }
 
+/* Whether the footprint point at (s, t) lies beyond another surface (bk_footprint_sample_hidden).
+ * Door runs trace a scene without the door, whose triangles are not the ones footprints index:
+ * there the cell marks alone decide. */
+static int footprint_hidden(const tp_ctx *c, const bk_receiver *r, double s, double t)
+{
+    double p[3], n[3];
+    if (c->fscene != c->scene) return bk_footprint_cell_hidden(r->footprint_hidden, s, t);
+    if (!bk_footprint_point(c->fscene, c->opt->footprint + r->footprint_first, r->footprint_count, s, t, p, n))
+        return 0;
+    return bk_footprint_sample_hidden(c->tracer, c->opt->footprint, r, s, t, p, n);
+}
+
 /* A uniform point of the part of the texel's square that its footprint covers: rejection in the
  * footprint box, at most TP_FOOTPRINT_TRIES draws (a footprint covering 10 % of its box falls
  * back to the receiver's own point 18 % of the time, one covering 30 % 0.3 %; charts of
@@ -57,6 +69,7 @@ static void footprint_sample(const tp_ctx *c, const bk_receiver *r, bk_rng *pos,
             ps = bx[0] + ps * bx[2];
             pt = bx[1] + pt * bx[3];
         }
+        if (r->footprint_hidden && footprint_hidden(c, r, ps, pt)) continue;
         if (footprint_origin(c, r, ps, pt, g)) return;
     }
 }
@@ -101,15 +114,28 @@ static uint64_t punctual_at(const tp_ctx *c, const tp_origin *g, const bk_slc_dr
 }
 
 /* The points at which a receiver's punctual light is evaluated: a texel with a footprint
- * averages its four quarter centres (hard shadow edges resolve to a quarter of a texel). */
+ * averages the four quarter centres of its footprint box (hard shadow edges resolve to a quarter
+ * of a texel; of the box, not the square, so that a sliver of a chart — a 2.5 cm strip of a
+ * crate's face at the edge of its texel — is lit where it lies, not at the texel's one point on
+ * the face's border, which read the sun at a sixth of its strength on dev level overlap_01),
+ * but those beyond another surface (footprint_hidden): a floor texel half under a crate read
+ * the sun at half its strength there. None left: the texel's own point. */
 int bk_tr_punctual_points(const tp_ctx *c, const bk_receiver *r, tp_origin g[4])
 {
-    if (!r->footprint_count) {
-        bk_tr_recv_origin(c, r, &g[0]);
-        return 1;
+    const float *bx = r->footprint_box;
+    const int box = bx[2] > 0 && bx[3] > 0;
+    int n = 0;
+    for (int q = 0; q < 4 && r->footprint_count; q++) {
+        double s = 0.25 + 0.5 * (q & 1), t = 0.25 + 0.5 * (q >> 1);
+        if (box) {
+            s = bx[0] + s * bx[2];
+            t = bx[1] + t * bx[3];
+        }
+        if (r->footprint_hidden && footprint_hidden(c, r, s, t)) continue;
+        footprint_origin(c, r, s, t, &g[n++]);
     }
-    for (int q = 0; q < 4; q++) footprint_origin(c, r, 0.25 + 0.5 * (q & 1), 0.25 + 0.5 * (q >> 1), &g[q]);
-    return 4;
+    if (!n) bk_tr_recv_origin(c, r, &g[n++]);
+    return n;
 }
 
 void bk_tr_recv_punctual(tp_ctx *c, size_t begin, size_t end, int thread)

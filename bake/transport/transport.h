@@ -50,7 +50,23 @@ typedef struct bk_receiver {
      * covers (points are drawn in it, so a sliver of a chart is sampled as well as a whole
      * square); width or height <= 0: the whole square */
     float footprint_box[4];
+    /* Cells of the square (an 8 x 8 grid over [0,1]^2, bit 8*row + column) whose footprint points
+     * lie beyond another surface seen from the texel's own point (bk_texels_push_out): a wall
+     * texel whose square runs under a sill or into a box pushed through the wall. No ray leaves
+     * from them; zero: the whole footprint. */
+    uint64_t footprint_hidden;
 } bk_receiver;
+
+#define BK_FOOTPRINT_GRID 8
+/* Whether texel-local (s, t) lies in a cell of `hidden` (bk_receiver.footprint_hidden). */
+static inline int bk_footprint_cell_hidden(uint64_t hidden, double s, double t)
+{
+    if (!hidden) return 0;
+    int cx = (int)(s * BK_FOOTPRINT_GRID), cy = (int)(t * BK_FOOTPRINT_GRID);
+    cx = cx < 0 ? 0 : cx >= BK_FOOTPRINT_GRID ? BK_FOOTPRINT_GRID - 1 : cx;
+    cy = cy < 0 ? 0 : cy >= BK_FOOTPRINT_GRID ? BK_FOOTPRINT_GRID - 1 : cy;
+    return (int)((hidden >> (cy * BK_FOOTPRINT_GRID + cx)) & 1u);
+}
 
 /* One triangle of a texel's footprint: the barycentrics (u, v) of scene triangle `tri` (the
  * p = (1-u-v)·v0 + u·v1 + v·v2 convention of bk_hit) as affine functions of the texel-local
@@ -66,6 +82,20 @@ typedef struct bk_footprint_tri {
  * Returns 0 where none covers it or the covering triangle is degenerate. */
 int bk_footprint_point(const bk_scene *scene, const bk_footprint_tri *tris, uint32_t count, double s, double t,
                        double p[3], double n[3]);
+
+/* Whether another surface crosses the segment from a to b, two points of a texel's surface with
+ * unit normals na, nb (both ends raised 0.1 % of the segment's length along them): a hit on one
+ * of the `count` footprint triangles or on triangle `own` (UINT32_MAX: none) is the texel's own
+ * surface and is stepped over. 1 crossed, 0 clear. */
+int bk_footprint_segment_blocked(const bk_tracer *tracer, const bk_footprint_tri *tris, uint32_t count, uint32_t own,
+                                 const double a[3], const double na[3], const double b[3], const double nb[3]);
+
+/* Whether receiver r's footprint point p (normal n) at texel-local (s, t) lies beyond another
+ * surface seen from r's own point, and so is no sample of r: r's hidden cell mark, where the
+ * cell and its eight neighbours agree; else (the covering surface's edge runs near) the
+ * segment test above from r's point. `tris` is the whole footprint table (options.footprint). */
+int bk_footprint_sample_hidden(const bk_tracer *tracer, const bk_footprint_tri *tris, const bk_receiver *r, double s,
+                               double t, const double p[3], const double n[3]);
 
 /* One point of the error-against-time record, written after every pass. */
 /* Receiver classes, in the order the pipeline lists receivers (bk_transport_options.class_end). */

@@ -180,11 +180,7 @@ static void room_build(room *rm)
     for (size_t i = 0; i < rm->tx.count; i++) {
         const bk_texel *x = &rm->tx.receivers[i];
         bk_receiver *r = &rm->recv[i];
-        memcpy(r->position, x->position, 12);
-        memcpy(r->normal, x->normal, 12);
-        r->footprint_first = x->footprint_first;
-        r->footprint_count = x->footprint_count;
-        memcpy(r->footprint_box, x->footprint_box, sizeof r->footprint_box);
+        bk_receiver_from_texel(x, r);
         int g = bsc_group(&rm->s, x->tri, centre + 3 * i, x->normal);
         if (g == BSC_SEALED && rm->ns < 256) rm->sealed[rm->ns++] = i;
         const char *obj = rm->s.objects[rm->s.tri_object[x->tri]].name;
@@ -508,11 +504,7 @@ static void test_edge_texels_at_contact(void **state)
         assert_int_equal(bk_texels_push_out(&tx, &s, tr, &po, NULL), LBK_OK);
         bk_receiver *r = calloc(tx.count, sizeof *r);
         for (size_t i = 0; i < tx.count; i++) {
-            memcpy(r[i].position, tx.receivers[i].position, 12);
-            memcpy(r[i].normal, tx.receivers[i].normal, 12);
-            r[i].footprint_first = tx.receivers[i].footprint_first;
-            r[i].footprint_count = tx.receivers[i].footprint_count;
-            memcpy(r[i].footprint_box, tx.receivers[i].footprint_box, sizeof r[i].footprint_box);
+            bk_receiver_from_texel(&tx.receivers[i], &r[i]);
         }
         float *irr = calloc(3 * tx.count, sizeof *irr);
         lbk_sh9_rgb *rad = calloc(tx.count, sizeof *rad);

@@ -99,14 +99,7 @@ static void thin_run(bk_scene *s, float density, int passes, thin_bake *b)
     assert_int_equal(bk_texels_push_out(&b->tx, s, b->tracer, &po, NULL), LBK_OK);
     bk_receiver *r = calloc(b->tx.count, sizeof *r);
     assert_non_null(r);
-    for (size_t i = 0; i < b->tx.count; i++) {
-        const bk_texel *x = &b->tx.receivers[i];
-        memcpy(r[i].position, x->position, 12);
-        memcpy(r[i].normal, x->normal, 12);
-        r[i].footprint_first = x->footprint_first;
-        r[i].footprint_count = x->footprint_count;
-        memcpy(r[i].footprint_box, x->footprint_box, sizeof r[i].footprint_box);
-    }
+    for (size_t i = 0; i < b->tx.count; i++) bk_receiver_from_texel(&b->tx.receivers[i], &r[i]);
     b->irr = calloc(3 * b->tx.count, sizeof *b->irr);
     lbk_sh9_rgb *rad = calloc(b->tx.count, sizeof *rad);
     assert_true(b->irr && rad);
@@ -249,12 +242,94 @@ static void test_coplanar_quads(void **state)
     tsc_free(&s);
 }
 
+/* A wall (x = 0, facing +x, 2 m x 2 m from y = 0.25) under the sky, with three black sills of
+ * 10 cm run through it and standing 10 cm proud, the way a window sill is set into a reveal. A
+ * wall point just above a sill sees the upper half of the sky: a sill above, 0.4 m up and 10 cm
+ * proud, hides at most directions within 14 deg of the wall's up axis, (b - sin b cos b)/pi ≈ 0.002
+ * of the cosine-weighted sky (b = atan(0.1/0.4)); below the horizon the black sill and the black
+ * ground hide all but a sliver (as the rim bound above). So a texel whose square runs into a sill
+ * but whose point is above it reads E/pi in [0.5 - 0.002, 0.5 + (α + sin α cos α)/pi]: its
+ * footprint is the wall above the sill. Gathered over the whole square it read (1 - f)/2, f the
+ * part of the square inside the sill (before the footprint masks: 0.37-0.42 where f = 0.25).
+ * The sills' tops sit at three phases of the texel grid, 3 cm apart, so one of them cuts a row
+ * of texels with 0.25 <= f <= 0.75 wherever the layout puts the rows. */
+#define SILL_PROUD 0.1f
+#define SILL_THICK 0.1f
+static const float sill_top[3] = {0.78f, 1.31f, 1.84f};
+
+/* The part of texel x's footprint (16 x 16 points) inside a sill, and the sill whose top the
+ * texel's square crosses (-1: none). */
+static double sill_fraction(const bk_scene *s, const thin_bake *b, const bk_texel *x, int *sill)
+{
+    int in = 0, all = 0;
+    *sill = -1;
+    for (int j = 0; j < 16; j++)
+        for (int i = 0; i < 16; i++) {
+            double p[3], n[3];
+            if (!bk_footprint_point(s, b->tx.footprint + x->footprint_first, x->footprint_count, (i + 0.5) / 16,
+                                    (j + 0.5) / 16, p, n))
+                continue;
+            all++;
+            for (int k = 0; k < 3; k++)
+                if (p[1] <= sill_top[k] && p[1] >= sill_top[k] - SILL_THICK) {
+                    in++;
+                    *sill = k;
+                }
+        }
+    return all ? (double)in / all : 0;
+}
+
+static void test_sill_through_wall(void **state)
+{
+    (void)state;
+    bk_scene s;
+    ground(&s);
+    tsc_object(&s, "wall", NULL, NULL);
+    float w0[3] = {0, 0.25f, 1}, w1[3] = {0, 0.25f, -1}, w2[3] = {0, 2.25f, -1}, w3[3] = {0, 2.25f, 1};
+    tsc_quad(&s, w0, w1, w2, w3, 2, tsc_material(&s, 0.5f, 0.5f, 0.5f, 0, 0, 0));
+    const uint32_t black = tsc_material(&s, 0, 0, 0, 0, 0, 0);
+    for (int k = 0; k < 3; k++) {
+        tsc_object(&s, "sill", NULL, NULL);
+        const float mn[3] = {-0.05f, sill_top[k] - SILL_THICK, -1.2f}, mx[3] = {SILL_PROUD, sill_top[k], 1.2f};
+        tsc_box(&s, mn, mx, 1, 0, black);
+    }
+    thin_bake b;
+    thin_run(&s, 8, 4, &b);
+    const double alpha = atan(0.8 / (FLOOR_D - 1.5)), hi = 0.5 + (alpha + sin(alpha) * cos(alpha)) / PI;
+    const double lo = 0.5 - 0.002, noise = 0.08;
+    size_t n = 0;
+    double worst = 0, fsum = 0;
+    for (size_t i = 0; i < b.tx.count; i++) {
+        const bk_texel *x = &b.tx.receivers[i];
+        if (s.tri_object[x->tri] != 1 || (x->flags & BK_TEXEL_INSIDE) || !x->footprint_count) continue;
+        int k;
+        const double f = sill_fraction(&s, &b, x, &k);
+        if (k < 0 || f < 0.25 || f > 0.75 || x->position[1] < sill_top[k] - 1e-4f) continue;
+        const double e = lum(b.irr + 3 * i) / PI;
+        face_stats one = {0};
+        face_add(&one, e, lo * (1 - noise), hi * (1 + noise));
+        worst = fmax(worst, one.worst);
+        fsum += f;
+        n++;
+        if (one.worst > 0)
+            print_message("  texel at y %.3f (sill top %.2f, %.0f %% of its square inside): E/pi %.3f\n",
+                          x->position[1], sill_top[k], 100 * f, e);
+    }
+    print_message("sills through a wall: %zu texels whose square runs %.0f %% into a sill (mean), worst %.1f %% "
+                  "outside [%.3f, %.3f]\n", n, n ? 100 * fsum / (double)n : 0.0, 100 * worst, lo, hi);
+    assert_true(n >= 8);
+    assert_true(worst <= 0);
+    thin_free(&b);
+    tsc_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_round_slab),
         cmocka_unit_test(test_duplicate_slab),
         cmocka_unit_test(test_coplanar_quads),
+        cmocka_unit_test(test_sill_through_wall),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

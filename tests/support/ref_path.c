@@ -1,6 +1,8 @@
 #include "ref_path.h"
 
 #include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -116,34 +118,68 @@ typedef struct rp_job {
     double *out, *se;
     const bk_footprint_tri *fp;   /* footprints (NULL: points) */
     const uint32_t *first, *count;
+    const uint8_t *enclosed;      /* per texel RP_GRID² cells: 1 where the cell's centre is enclosed */
 } rp_job;
 
-/* A point of texel i's footprint (the reference's own reading of bk_footprint_tri). */
-static int rp_footprint_point(const rp_job *j, size_t i, uint64_t *st, double p[3], double n[3])
+/* The visible part of a footprint, resolved to RP_GRID² cells of the texel's square by the
+ * tracer's enclosure test at each cell's centre (a point inside a sill let into a wall, under a
+ * crate): the reference's own reading of "visible", not the baker's. */
+#define RP_GRID 16
+
+/* The footprint point of texel i at texel-local (a, b) (the reference's own reading of
+ * bk_footprint_tri). Returns 0 where no footprint triangle covers it. */
+static int rp_footprint_at(const rp_job *j, size_t i, double a, double b, double p[3], double n[3])
 {
     const bk_scene *s = j->s;
-    for (int tries = 0; tries < 1024; tries++) {
-        double a = rp_uniform(st), b = rp_uniform(st);
-        for (uint32_t k = 0; k < j->count[i]; k++) {
-            const bk_footprint_tri *f = &j->fp[j->first[i] + k];
-            double u = f->uv[0][0] + f->uv[0][1] * a + f->uv[0][2] * b;
-            double v = f->uv[1][0] + f->uv[1][1] * a + f->uv[1][2] * b;
-            if (u < 0 || v < 0 || u + v > 1) continue;
-            const uint32_t *ix = s->tris + 3 * (size_t)f->tri;
-            double w[3] = {1 - u - v, u, v};
-            for (int c = 0; c < 3; c++) {
-                p[c] = n[c] = 0;
-                for (int q = 0; q < 3; q++) {
-                    p[c] += w[q] * s->positions[3 * (size_t)ix[q] + c];
-                    n[c] += w[q] * s->normals[3 * (size_t)ix[q] + c];
-                }
+    for (uint32_t k = 0; k < j->count[i]; k++) {
+        const bk_footprint_tri *f = &j->fp[j->first[i] + k];
+        double u = f->uv[0][0] + f->uv[0][1] * a + f->uv[0][2] * b;
+        double v = f->uv[1][0] + f->uv[1][1] * a + f->uv[1][2] * b;
+        if (u < 0 || v < 0 || u + v > 1) continue;
+        const uint32_t *ix = s->tris + 3 * (size_t)f->tri;
+        double w[3] = {1 - u - v, u, v};
+        for (int c = 0; c < 3; c++) {
+            p[c] = n[c] = 0;
+            for (int q = 0; q < 3; q++) {
+                p[c] += w[q] * s->positions[3 * (size_t)ix[q] + c];
+                n[c] += w[q] * s->normals[3 * (size_t)ix[q] + c];
             }
-            double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-            for (int c = 0; c < 3; c++) n[c] /= l;
-            return 1;
         }
+        double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (int c = 0; c < 3; c++) n[c] /= l;
+        return 1;
     }
     return 0;
+}
+
+/* A uniform point of the visible part of texel i's footprint, by rejection. */
+static int rp_footprint_point(const rp_job *j, size_t i, uint64_t *st, double p[3], double n[3])
+{
+    const uint8_t *enc = j->enclosed ? j->enclosed + i * RP_GRID * RP_GRID : NULL;
+    for (int tries = 0; tries < 1024; tries++) {
+        double a = rp_uniform(st), b = rp_uniform(st);
+        int cx = (int)(a * RP_GRID), cy = (int)(b * RP_GRID);
+        if (enc && enc[(cy < RP_GRID ? cy : RP_GRID - 1) * RP_GRID + (cx < RP_GRID ? cx : RP_GRID - 1)]) continue;
+        if (rp_footprint_at(j, i, a, b, p, n)) return 1;
+    }
+    return 0;
+}
+
+static void rp_enclosed_chunk(void *user, size_t begin, size_t end, int thread)
+{
+    (void)thread;
+    const rp_job *j = (const rp_job *)user;
+    uint8_t *enc = (uint8_t *)j->enclosed;
+    for (size_t i = begin; i < end; i++)
+        for (int c = 0; c < RP_GRID * RP_GRID; c++) {
+            double p[3], n[3];
+            int e = 0;
+            if (j->count[i] && rp_footprint_at(j, i, (c % RP_GRID + 0.5) / RP_GRID, (c / RP_GRID + 0.5) / RP_GRID, p, n)) {
+                const float nf[3] = {(float)n[0], (float)n[1], (float)n[2]};
+                e = bk_tracer_enclosed(j->t, p, nf, 1e-4);
+            }
+            enc[i * RP_GRID * RP_GRID + c] = (uint8_t)e;
+        }
 }
 
 static void rp_chunk(void *user, size_t begin, size_t end, int thread)
@@ -186,7 +222,7 @@ static void rp_chunk(void *user, size_t begin, size_t end, int thread)
 void rp_irradiance(const bk_scene *s, const bk_tracer *t, const float *p, const float *n, size_t count, int paths,
                    uint64_t seed, int threads, double *out_rgb, double *stderr_lum)
 {
-    rp_job j = {s, t, p, n, paths, seed, out_rgb, stderr_lum, NULL, NULL, NULL};
+    rp_job j = {s, t, p, n, paths, seed, out_rgb, stderr_lum, NULL, NULL, NULL, NULL};
     bk_parallel_chunks(0, count, 4, threads > 0 ? threads : 1, rp_chunk, &j);
 }
 
@@ -194,6 +230,9 @@ void rp_footprint_irradiance(const bk_scene *s, const bk_tracer *t, const bk_foo
                              const uint32_t *first, const uint32_t *count, const float *p, const float *n, size_t texels,
                              int paths, uint64_t seed, int threads, double *out_rgb, double *stderr_lum)
 {
-    rp_job j = {s, t, p, n, paths, seed, out_rgb, stderr_lum, fp, first, count};
+    uint8_t *enclosed = calloc(texels ? texels * RP_GRID * RP_GRID : 1, 1);
+    rp_job j = {s, t, p, n, paths, seed, out_rgb, stderr_lum, fp, first, count, enclosed};
+    if (enclosed) bk_parallel_chunks(0, texels, 4, threads > 0 ? threads : 1, rp_enclosed_chunk, &j);
     bk_parallel_chunks(0, texels, 4, threads > 0 ? threads : 1, rp_chunk, &j);
+    free(enclosed);
 }

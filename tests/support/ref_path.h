@@ -33,11 +33,13 @@ int rp_check(const bk_scene *s, char *err, size_t err_len);
 void rp_irradiance(const bk_scene *s, const bk_tracer *t, const float *p, const float *n, size_t count, int paths,
                    uint64_t seed, int threads, double *out_rgb, double *stderr_lum);
 
-/* Irradiance averaged over texel footprints: point k of texel i is uniform over the part of
- * texel-local [0,1]² that one of its footprint triangles covers (fp[first[i] .. first[i] +
- * count[i]), the bk_footprint_tri convention; scene `s` gives positions and shading normals),
- * by rejection; `paths` points (one path each) per texel. A texel whose footprint covers
- * nothing in 1024 draws uses p/n. Same outputs as rp_irradiance. */
+/* Irradiance averaged over the visible part of texel footprints: point k of texel i is uniform
+ * over the part of texel-local [0,1]² that one of its footprint triangles covers (fp[first[i] ..
+ * first[i] + count[i]), the bk_footprint_tri convention; scene `s` gives positions and shading
+ * normals), by rejection, leaving out the 1/16-texel cells whose centre bk_tracer_enclosed finds
+ * enclosed (inside a sill let into the wall: no surface anyone sees); `paths` points (one path
+ * each) per texel. A texel whose visible footprint yields nothing in 1024 draws uses p/n. Same
+ * outputs as rp_irradiance. */
 void rp_footprint_irradiance(const bk_scene *s, const bk_tracer *t, const bk_footprint_tri *fp,
                              const uint32_t *first, const uint32_t *count, const float *p, const float *n, size_t texels,
                              int paths, uint64_t seed, int threads, double *out_rgb, double *stderr_lum);
