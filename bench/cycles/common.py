@@ -46,7 +46,10 @@ class Receivers:
                     continue
                 self.sensors += 1
                 if c[0] == "P":  # a footprint point of the receiver whose T row came last
-                    self.footprint[-1].append(self.sensors - 1)
+                    # an enclosed point (HIDDEN: inside a sill let into the wall, under a crate)
+                    # is no part of the texel's visible surface: its sensor is read but not averaged
+                    if not (len(c) > 16 and int(c[16]) & HIDDEN):
+                        self.footprint[-1].append(self.sensors - 1)
                     continue
                 self.sensor.append(self.sensors - 1)
                 self.footprint.append([])
@@ -63,8 +66,9 @@ class Receivers:
         return len(self.pos)
 
     def per_receiver(self, values):
-        """Sensor values (one per row of the file) -> one per receiver: the mean over its footprint
-        points where it has them (the texel's footprint average, as lbk bakes it), else its own."""
+        """Sensor values (one per row of the file) -> one per receiver: the mean over its visible
+        footprint points where it has them (the average over the visible part of the texel's
+        square, what a texel should hold), else its own."""
         if len(values) != self.sensors:
             raise SystemExit("bench-cycles: %d sensor values for %d sensors" % (len(values), self.sensors))
         out = []

@@ -62,6 +62,7 @@
 #include "bake/layout/atlas.h"
 #include "bake/layout/classify.h"
 #include "bake/layout/texels.h"
+#include "bake/layout/uv_math.h"
 #include "bake/pipeline/pipeline.h"
 #include "bake/pipeline/uv_section.h"
 #include "scene/import.h"
@@ -229,6 +230,39 @@ static double sensor_offset(const bk_scene *s)
     return 1e-4 * fmax(extent, 1e-3);
 }
 
+/* A sensor is a triangle about sensor_offset / 4 across (cycles_bake.py), raised sensor_offset
+ * along the normal; Cycles spreads its samples over it. A point the push-out put 8 ulps in front
+ * of another surface (a reveal texel pushed onto the top of a sill resting in the reveal) has that
+ * surface running through its sensor: half the samples land inside the sill, and the reference
+ * read 0.52-0.69 where the point's own value is twice that (dev level sill_niche_00, every such
+ * texel 1.9-2.1x). So the sensor moves away from a surface that crosses a disc of radius
+ * sensor_offset around its raised point in its own plane: 8 rays in that plane, each hit at
+ * t < r moving the point back by r - t along the ray. At most 1/2 mm in a 5 m level: nothing
+ * a texel resolves. */
+static void clear_sensor(const dump *d, double p[3], const float nf[3])
+{
+    const double r = sensor_offset(&d->scene);
+    double n[3] = {nf[0], nf[1], nf[2]}, t[3], b[3];
+    double ln = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(ln > 0)) return;
+    for (int k = 0; k < 3; k++) n[k] /= ln;
+    bkv_basis(n, t, b);
+    double shift[3] = {0, 0, 0};
+    for (int i = 0; i < 8; i++) {
+        double a = i * (3.14159265358979323846 / 4.0), dir[3];
+        float org[3], df[3];
+        for (int k = 0; k < 3; k++) {
+            dir[k] = cos(a) * t[k] + sin(a) * b[k];
+            org[k] = (float)(p[k] + r * n[k]);
+            df[k] = (float)dir[k];
+        }
+        bk_hit h;
+        if (bk_tracer_intersect(d->tracer, org, df, 0.0f, (float)r, &h))
+            for (int k = 0; k < 3; k++) shift[k] -= (r - h.t) * dir[k];
+    }
+    for (int k = 0; k < 3; k++) p[k] += shift[k];
+}
+
 static void write_header(const dump *d, FILE *f, const char *scene_path, const char *lbk_path)
 {
     fprintf(f, "# scene %s\n# lbk %s\n", scene_path, lbk_path);
@@ -385,7 +419,9 @@ static double jitter_u(uint32_t seed, size_t row, int i, int j, int axis)
  * One point in each of the K × K strata of the footprint box, where a footprint triangle covers
  * it, becomes a row "P obj mat PARENT i j  p n  size  rgb  flags" (PARENT: the data row index of
  * the texel's T row; rgb: the texel's own value; flags HIDDEN where the point is enclosed);
- * run.py averages their Cycles values into the texel's. The point is the stratum's centre
+ * run.py averages the Cycles values of the points not HIDDEN into the texel's: the visible part
+ * of its square, whatever part of it the baker samples (the baker leaves out the part beyond
+ * another surface seen from the texel's point: bake/layout/texels.h, push-out). The point is the stratum's centre
  * (jitter 0) or uniform in it (jitter = a seed): centres are a midpoint rule, biased where the
  * light is curved across a texel — the Cornell ceiling next to the light's gap, where irradiance
  * falls off steeply, read 23–33 % low at K = 2 against K = 4 — while jittered strata average to
@@ -409,6 +445,7 @@ static size_t write_footprint(const dump *d, FILE *f, const bk_texel *t, size_t 
                                     n))
                 continue;
             float nf[3] = {(float)n[0], (float)n[1], (float)n[2]};
+            clear_sensor(d, p, nf);
             uint32_t flags = bk_tracer_enclosed(d->tracer, p, nf, sensor_offset(&d->scene)) ? DUMP_HIDDEN : 0;
             fprintf(f, "P\t%u\t%u\t%zu\t%d\t%d\t%.9g\t%.9g\t%.9g\t%.7g\t%.7g\t%.7g\t%.6g\t%.7g\t%.7g\t%.7g\t%u\n",
                     t->object, mat, parent, i, j, p[0] + d->scene.origin[0], p[1] + d->scene.origin[1],
@@ -432,6 +469,7 @@ static int write_texels(const dump *d, FILE *f, int footprint, uint32_t jitter)
         uint32_t mat = d->scene.tri_material ? d->scene.tri_material[t->tri] : 0;
         double p[3] = {t->position[0], t->position[1], t->position[2]};
         if (t->flags & BK_TEXEL_EDGE) inside_triangle(&d->scene, t, p);
+        clear_sensor(d, p, t->normal);
         const int hidden = bk_tracer_enclosed(d->tracer, p, t->normal, sensor_offset(&d->scene));
         uint32_t flags = t->flags | (hidden ? DUMP_HIDDEN : 0) |
                          (off_plane(&d->scene, t) ? DUMP_OFFPLANE : 0);
