@@ -1,7 +1,7 @@
 # Benchmarks, printed as ratios against baselines measured in the same run: make bench (all of
 # them), bench-cycles and bench-render (lbk against Blender Cycles), bench-suite (lbk against
 # Cycles over the generated hard levels; make bench runs bench-suite-quick), mesa-bc-check.
-.PHONY: bench bench-cycles bench-render bench-suite bench-suite-quick mesa-bc-check
+.PHONY: bench bench-cycles bench-render bench-suite bench-suite-quick bench-stitch mesa-bc-check
 
 $(BUILD)/bench/%: bench/%.c $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a
 	@mkdir -p $(@D)
@@ -17,11 +17,21 @@ mesa-bc-check: $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a
 bench: deps-tools deps-bench
 	@$(MAKE) --no-print-directory $(BUILD)/lbk $(BENCHES:%=$(BUILD)/bench/%)
 	@for b in $(BENCHES); do echo "== $$b"; $(BUILD)/bench/$$b || exit 1; done
+	@echo "== bench-stitch (seam stitching's share of bake CPU per level)"; $(MAKE) --no-print-directory bench-stitch
 	@echo "== blender_import"; sh bench/blender_import.sh $(BUILD)/lbk $(BUILD)/bench-blender
 	@echo "== bench-cycles"; $(MAKE) --no-print-directory bench-cycles
 	@echo "== bench-suite-quick (hard levels: a few dev scenes)"; $(MAKE) --no-print-directory bench-suite-quick
 	@echo "== render (lbk render vs Blender Cycles)"; $(MAKE) --no-print-directory bench-render
 	@echo "== bench-diff (lbk diff: reseed study and power)"; $(MAKE) --no-print-directory bench-diff
+
+# Seam stitching's share of bake CPU per level (bench/stitch_share.c): the shared scenes and every
+# generated hard level, both layouts (bench/levels; the _authored ones have many small charts).
+# The --wrap routes the baker's stitch calls through the bench's CPU clock.
+STITCH_LEVELS ?= $(BUILD)/bench-stitch-levels
+$(BUILD)/bench/stitch_share: BENCH_EXTRA += -Wl,--wrap=bk_seams_stitch
+bench-stitch: $(BUILD)/bench/stitch_share
+	@python3 bench/levels/gen_levels.py --out $(STITCH_LEVELS) --set all > /dev/null
+	@$(BUILD)/bench/stitch_share $(STITCH_LEVELS)/manifest.json
 
 # lbk diff's calibration (bench/diff_reseed.py): every scene of scenes/ and every preset, 20 reseed
 # pairs each (the measured false-alarm rate per receiver class against the stated one), then the
