@@ -66,7 +66,8 @@ static bk_seam_score page_score(const bk_seams *s, uint32_t page, int w, int h, 
                 lbk_ahd_to_linear(&t, &l);
             }
             const float *t = &l.c[0][0];
-            lum[i] = mask[i] ? LBK_LUM_R * (t[0] + t[3]) + LBK_LUM_G * (t[4] + t[7]) + LBK_LUM_B * (t[8] + t[11]) : 0.0f;
+            float e[3] = {t[0] + t[3], t[4] + t[7], t[8] + t[11]};
+            lum[i] = mask[i] ? LBK_LUM_R * e[0] + LBK_LUM_G * e[1] + LBK_LUM_B * e[2] : 0.0f;
         }
         pg[page].width = w;
         pg[page].height = h;
@@ -188,7 +189,8 @@ static void manifest_desc(const cJSON *args, lbk_bake_desc *d)
         const char *k = cJSON_GetStringValue(cJSON_GetArrayItem(args, i));
         const char *v = cJSON_GetStringValue(cJSON_GetArrayItem(args, i + 1));
         if (!k || !v) continue;
-        if (strcmp(k, "--sky") == 0 && sscanf(v, "%f,%f,%f", &d->sky[0], &d->sky[1], &d->sky[2]) == 3) d->sky_override = 1;
+        if (strcmp(k, "--sky") == 0 && sscanf(v, "%f,%f,%f", &d->sky[0], &d->sky[1], &d->sky[2]) == 3)
+            d->sky_override = 1;
         if (strcmp(k, "--texel-density") == 0) d->texel_density = strtof(v, NULL);
     }
 }
@@ -199,7 +201,8 @@ static int manifest_levels(const char *manifest)
     if (!f) return -1;
     char *text = NULL;
     long len = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
-    if (len > 0 && fseek(f, 0, SEEK_SET) == 0 && (text = malloc((size_t)len + 1)) && fread(text, 1, (size_t)len, f) == (size_t)len)
+    if (len > 0 && fseek(f, 0, SEEK_SET) == 0 && (text = malloc((size_t)len + 1)) &&
+        fread(text, 1, (size_t)len, f) == (size_t)len)
         text[len] = 0;
     else
         free(text), text = NULL;

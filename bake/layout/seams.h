@@ -25,15 +25,20 @@
  * Linear Least-Squares", 2015, and ands/seamoptimizer, which likewise stitches only edges whose
  * normals agree; Unity's "Stitch Seams" is the same feature, also per object only): the texels
  * read by bilinear filtering at the score's points become unknowns x, and
- *     minimise Σ_points |R·f0(x) − f1(x)|² + λ Σ_texels |x − x0|²,   λ = 1/64,
+ *     minimise Σ_points |R·f0(x) − f1(x)|² + λ Σ_texels |x − x0|²,   λ = 1/4096,
  * where f_s is side s's bilinear filter and R turns side 0's tangent-plane components into
  * side 1's frame (texels.h convention: the two frames share N and differ by a rotation about
- * it). Solved per object by Jacobi-preconditioned conjugate gradients on the normal
- * equations, to 1e-4 of the first residual, in double, in a fixed order: deterministic. The
- * encoder stores the irradiance along the normal clamped at 0, so a colour whose e0 + g.z
- * comes out negative is then held at 0 by a penalty row (weight² 16) and the system solved
- * again (up to 4 rounds). The mismatch is linear in the texels, so when the base bake and each
- * dynamic set are stitched separately, any weighted sum of them agrees across seams too. */
+ * it). Each object's system splits into its connected components (taps no point links are
+ * independent); each is solved on its own by Jacobi-preconditioned conjugate gradients on the
+ * normal equations, in double, in a fixed order — components in parallel, deterministic at any
+ * thread count. The solve stops when it can no longer change what the encoder stores: the RMS
+ * mismatch at the points below 2^-10 of the RMS light there (8× below R11G11B10F's rounding),
+ * or four iterations gaining less than 1/16 of that in the objective (seams that cannot match
+ * better), at the latest at 1e-4 of the first residual. The encoder stores the irradiance
+ * along the normal clamped at 0, so a colour whose e0 + g.z comes out negative is then held at
+ * 0 by a penalty row (weight² 16) and the system solved again (up to 4 rounds). The mismatch is
+ * linear in the texels, so when the base bake and each dynamic set are stitched separately,
+ * any weighted sum of them agrees across seams too (to the same precision). */
 #ifndef BK_SEAMS_H
 #define BK_SEAMS_H
 
