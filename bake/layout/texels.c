@@ -694,13 +694,25 @@ static void drop_hidden_footprint(const push_job *j, bk_texel *r, double band)
 
 /* Whether the footprint point at texel-local (s, t) lies beyond another surface seen from the
  * texel's point: 1 hidden, 0 visible, -1 no footprint triangle covers it. */
-static int footprint_point_hidden(const push_job *j, const bk_texel *r, const double ng[3], double s, double t)
+static int footprint_point_hidden(const push_job *j, const bk_texel *r, const double a[3], const double ng[3],
+                                  double s, double t)
 {
     double p[3], n[3];
     const bk_footprint_tri *fp = j->tx->footprint + r->footprint_first;
     if (!bk_footprint_point(j->scene, fp, r->footprint_count, s, t, p, n)) return -1;
-    const double a[3] = {r->position[0], r->position[1], r->position[2]};
-    return bk_footprint_segment_blocked(j->tracer, fp, r->footprint_count, r->tri, a, ng, p, n);
+    return bk_footprint_segment_blocked(j->tracer, j->scene, fp, r->footprint_count, r->tri, a, ng, p, n);
+}
+
+/* The texel's point on its own triangle's plane: where the push-out carried it onto a surface
+ * just above its own (a floor texel beside a panel hung 5 mm over the floor lands on the panel's
+ * top), every segment back down to its footprint would cross that surface. */
+static void point_on_own_plane(const push_job *j, const bk_texel *r, const double ng[3], double a[3])
+{
+    double q[3][3];
+    for (int c = 0; c < 3; c++) a[c] = r->position[c];
+    if (!bk_tri_positions(j->scene, r->tri, q)) return;
+    const double h = (a[0] - q[0][0]) * ng[0] + (a[1] - q[0][1]) * ng[1] + (a[2] - q[0][2]) * ng[2];
+    for (int c = 0; c < 3; c++) a[c] -= h * ng[c];
 }
 
 /* Marks the cells of the texel's square whose footprint points lie beyond another surface, seen
@@ -717,15 +729,19 @@ static void mask_covered_footprint(const push_job *j, bk_texel *r, const double 
 {
     r->footprint_hidden = 0;
     if (!r->footprint_count || (r->flags & BK_TEXEL_INSIDE)) return;
+    double a[3];
+    point_on_own_plane(j, r, ng, a);
     int any = 0;
     for (int cy = 0; cy < 4 && !any; cy++)
-        for (int cx = 0; cx < 4 && !any; cx++) any = footprint_point_hidden(j, r, ng, (cx + 0.5) / 4, (cy + 0.5) / 4) == 1;
+        for (int cx = 0; cx < 4 && !any; cx++)
+            any = footprint_point_hidden(j, r, a, ng, (cx + 0.5) / 4, (cy + 0.5) / 4) == 1;
     if (!any) return;
     uint64_t hidden = 0;
     int visible = 0;
     for (int cy = 0; cy < BK_FOOTPRINT_GRID; cy++)
         for (int cx = 0; cx < BK_FOOTPRINT_GRID; cx++) {
-            int h = footprint_point_hidden(j, r, ng, (cx + 0.5) / BK_FOOTPRINT_GRID, (cy + 0.5) / BK_FOOTPRINT_GRID);
+            int h = footprint_point_hidden(j, r, a, ng, (cx + 0.5) / BK_FOOTPRINT_GRID,
+                                           (cy + 0.5) / BK_FOOTPRINT_GRID);
             if (h == 1)
                 hidden |= (uint64_t)1 << (cy * BK_FOOTPRINT_GRID + cx);
             else if (h == 0)

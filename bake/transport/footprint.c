@@ -38,18 +38,26 @@ int bk_footprint_point(const bk_scene *scene, const bk_footprint_tri *tris, uint
     return 0;
 }
 
-/* Whether triangle tri is one of the footprint's (the texel's own surface) or `own`. */
-static int footprint_own(const bk_footprint_tri *tris, uint32_t count, uint32_t own, uint32_t tri)
+/* Whether triangle tri is one of the footprint's (the texel's own surface) or `own`, or belongs
+ * to a door: a door moves, and its set's runs trace the level without it, so what it covers must
+ * not depend on its state (else the open state's light misses the part it uncovers). */
+static int footprint_own(const bk_scene *scene, const bk_footprint_tri *tris, uint32_t count, uint32_t own,
+                         uint32_t tri)
 {
     if (tri == own) return 1;
+    if (scene && scene->tri_object && tri < scene->tri_count) {
+        uint32_t o = scene->tri_object[tri];
+        if (o < scene->object_count && scene->objects[o].door[0]) return 1;
+    }
     for (uint32_t k = 0; k < count; k++)
         if (tris[k].tri == tri) return 1;
     return 0;
 }
 
 #define FP_SEGMENT_STEPS 4
-int bk_footprint_segment_blocked(const bk_tracer *tracer, const bk_footprint_tri *tris, uint32_t count, uint32_t own,
-                                 const double a[3], const double na[3], const double b[3], const double nb[3])
+int bk_footprint_segment_blocked(const bk_tracer *tracer, const bk_scene *scene, const bk_footprint_tri *tris,
+                                 uint32_t count, uint32_t own, const double a[3], const double na[3], const double b[3],
+                                 const double nb[3])
 {
     double d[3], len2 = 0;
     for (int c = 0; c < 3; c++) {
@@ -76,7 +84,7 @@ int bk_footprint_segment_blocked(const bk_tracer *tracer, const bk_footprint_tri
         bk_hit h;
         if (!bk_tracer_intersect(tracer, org, dir, tmin, (float)l, &h)) return 0;
         /* a chord of a curved surface runs beneath the surface: step over its own triangles */
-        if (!footprint_own(tris, count, own, h.tri)) return 1;
+        if (!footprint_own(scene, tris, count, own, h.tri)) return 1;
         tmin = h.t * 1.0001f + 1e-7f;
     }
     return 0;
@@ -98,16 +106,20 @@ static int cell_mixed(uint64_t hidden, int cx, int cy)
     return h && v;
 }
 
-int bk_footprint_sample_hidden(const bk_tracer *tracer, const bk_footprint_tri *tris, const bk_receiver *r, double s,
-                               double t, const double p[3], const double n[3])
+int bk_footprint_sample_hidden(const bk_tracer *tracer, const bk_scene *scene, const bk_footprint_tri *tris,
+                               const bk_receiver *r, double s, double t, const double p[3], const double n[3])
 {
     if (!r->footprint_hidden) return 0;
     int cx = (int)(s * BK_FOOTPRINT_GRID), cy = (int)(t * BK_FOOTPRINT_GRID);
     cx = cx < 0 ? 0 : cx >= BK_FOOTPRINT_GRID ? BK_FOOTPRINT_GRID - 1 : cx;
     cy = cy < 0 ? 0 : cy >= BK_FOOTPRINT_GRID ? BK_FOOTPRINT_GRID - 1 : cy;
     if (!cell_mixed(r->footprint_hidden, cx, cy)) return bk_footprint_cell_hidden(r->footprint_hidden, s, t);
-    const double a[3] = {r->position[0], r->position[1], r->position[2]};
+    /* from the receiver's point brought onto the surface's plane at p, as the push-out's marks
+     * (it may have carried the point onto a surface just above its own) */
     const double na[3] = {r->normal[0], r->normal[1], r->normal[2]};
-    return bk_footprint_segment_blocked(tracer, tris + r->footprint_first, r->footprint_count, UINT32_MAX, a, na, p,
-                                        n);
+    double a[3] = {r->position[0], r->position[1], r->position[2]};
+    const double h = (a[0] - p[0]) * n[0] + (a[1] - p[1]) * n[1] + (a[2] - p[2]) * n[2];
+    for (int c = 0; c < 3; c++) a[c] -= h * n[c];
+    return bk_footprint_segment_blocked(tracer, scene, tris + r->footprint_first, r->footprint_count, UINT32_MAX, a,
+                                        na, p, n);
 }

@@ -51,7 +51,7 @@ static int footprint_hidden(const tp_ctx *c, const bk_receiver *r, double s, dou
     if (c->fscene != c->scene) return bk_footprint_cell_hidden(r->footprint_hidden, s, t);
     if (!bk_footprint_point(c->fscene, c->opt->footprint + r->footprint_first, r->footprint_count, s, t, p, n))
         return 0;
-    return bk_footprint_sample_hidden(c->tracer, c->opt->footprint, r, s, t, p, n);
+    return bk_footprint_sample_hidden(c->tracer, c->scene, c->opt->footprint, r, s, t, p, n);
 }
 
 /* A uniform point of the part of the texel's square that its footprint covers: rejection in the
@@ -114,23 +114,17 @@ static uint64_t punctual_at(const tp_ctx *c, const tp_origin *g, const bk_slc_dr
 }
 
 /* The points at which a receiver's punctual light is evaluated: a texel with a footprint
- * averages the four quarter centres of its footprint box (hard shadow edges resolve to a quarter
- * of a texel; of the box, not the square, so that a sliver of a chart — a 2.5 cm strip of a
- * crate's face at the edge of its texel — is lit where it lies, not at the texel's one point on
- * the face's border, which read the sun at a sixth of its strength on dev level overlap_01),
- * but those beyond another surface (footprint_hidden): a floor texel half under a crate read
- * the sun at half its strength there. None left: the texel's own point. */
+ * averages its four quarter centres (hard shadow edges resolve to a quarter of a texel), but
+ * those beyond another surface (footprint_hidden): a floor texel half under a crate read the
+ * sun at half its strength (dev level overlap_01). None left: the texel's own point. (The
+ * quarter centres of the footprint box instead of the square lit a chart's sliver where it
+ * lies, but moved door-closed bakes 5 % against the guided door runs, which gather at the
+ * texel's point: tests/bake/test_doors.c; not kept.) */
 int bk_tr_punctual_points(const tp_ctx *c, const bk_receiver *r, tp_origin g[4])
 {
-    const float *bx = r->footprint_box;
-    const int box = bx[2] > 0 && bx[3] > 0;
     int n = 0;
     for (int q = 0; q < 4 && r->footprint_count; q++) {
-        double s = 0.25 + 0.5 * (q & 1), t = 0.25 + 0.5 * (q >> 1);
-        if (box) {
-            s = bx[0] + s * bx[2];
-            t = bx[1] + t * bx[3];
-        }
+        const double s = 0.25 + 0.5 * (q & 1), t = 0.25 + 0.5 * (q >> 1);
         if (r->footprint_hidden && footprint_hidden(c, r, s, t)) continue;
         footprint_origin(c, r, s, t, &g[n++]);
     }

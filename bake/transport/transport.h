@@ -86,16 +86,19 @@ int bk_footprint_point(const bk_scene *scene, const bk_footprint_tri *tris, uint
 /* Whether another surface crosses the segment from a to b, two points of a texel's surface with
  * unit normals na, nb (both ends raised 0.1 % of the segment's length along them): a hit on one
  * of the `count` footprint triangles or on triangle `own` (UINT32_MAX: none) is the texel's own
- * surface and is stepped over. 1 crossed, 0 clear. */
-int bk_footprint_segment_blocked(const bk_tracer *tracer, const bk_footprint_tri *tris, uint32_t count, uint32_t own,
-                                 const double a[3], const double na[3], const double b[3], const double nb[3]);
+ * surface and is stepped over, as is a hit on a door of `scene` (NULL: none is a door): a door
+ * moves. 1 crossed, 0 clear. */
+int bk_footprint_segment_blocked(const bk_tracer *tracer, const bk_scene *scene, const bk_footprint_tri *tris,
+                                 uint32_t count, uint32_t own, const double a[3], const double na[3], const double b[3],
+                                 const double nb[3]);
 
 /* Whether receiver r's footprint point p (normal n) at texel-local (s, t) lies beyond another
  * surface seen from r's own point, and so is no sample of r: r's hidden cell mark, where the
  * cell and its eight neighbours agree; else (the covering surface's edge runs near) the
- * segment test above from r's point. `tris` is the whole footprint table (options.footprint). */
-int bk_footprint_sample_hidden(const bk_tracer *tracer, const bk_footprint_tri *tris, const bk_receiver *r, double s,
-                               double t, const double p[3], const double n[3]);
+ * segment test above from r's point, in `scene` (the one footprints index). `tris` is the whole
+ * footprint table (options.footprint). */
+int bk_footprint_sample_hidden(const bk_tracer *tracer, const bk_scene *scene, const bk_footprint_tri *tris,
+                               const bk_receiver *r, double s, double t, const double p[3], const double n[3]);
 
 /* One point of the error-against-time record, written after every pass. */
 /* Receiver classes, in the order the pipeline lists receivers (bk_transport_options.class_end). */
