@@ -5,6 +5,7 @@
  * is written from --help (tools/gen_cli_doc.sh). */
 #include <errno.h>
 #include <limits.h>
+#include <math.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -86,6 +87,7 @@ _Static_assert(sizeof(lbk_bake_preset) == sizeof(int) && sizeof(lbk_bake_door_me
 static int set_sky(const bake_option *opt, const char *arg, const char *v, double number, parse_state *s);
 static int set_checkpoint(const bake_option *opt, const char *arg, const char *v, double number, parse_state *s);
 static int set_dls_threshold(const bake_option *opt, const char *arg, const char *v, double number, parse_state *s);
+static int set_path_check(const bake_option *opt, const char *arg, const char *v, double number, parse_state *s);
 
 /* In the order of `lbk bake --help`. */
 static const bake_option options[] = {
@@ -146,6 +148,20 @@ static const bake_option options[] = {
     {.name = "--block-align", .kind = OPT_FLAG, .field = F_INT, .off = D(block_align),
      .help = "charts on 4-texel boundaries, so no 4x4 block of a block-compressed pack\n"
              "(lbk convert --profile console-current, handheld) holds two charts"},
+    {.name = "--max-page", .kind = OPT_UINT, .field = F_INT, .off = D(max_page), .metavar = "N",
+     .umin = LBK_BAKE_MAX_PAGE_MIN, .umax = LBK_BAKE_MAX_PAGE_MAX, .def = "4096",
+     .help = "no lightmap page wider or taller than N texels, {range} (default\n"
+             "{default}); a level gets as many pages as it fills. A triangle larger\n"
+             "than a page gets a chart of its own at the density that fits; an\n"
+             "object larger than a page (its charts share one) a lower density"},
+    {.name = "--texel-budget", .kind = OPT_UINT, .field = F_U64, .off = D(texel_budget), .metavar = "N",
+     .umin = 1024, .umax = 1ull << 34, .def = "16777216",
+     .help = "lightmap texels at most (default {default}); a level asking for more\n"
+             "has every density scaled by one factor (noted)"},
+    {.name = "--max-probes", .kind = OPT_UINT, .field = F_UNSIGNED, .off = D(max_probes), .metavar = "N", .umin = 4,
+     .umax = 1u << 28, .def = "262144",
+     .help = "global light grid probe cap, {range} (default {default}); more\n"
+             "coarsens the grid's spacing until it fits"},
     {.name = "--dls-threshold", .kind = OPT_NUMBER, .metavar = "X", .min = 0, .max = 1, .def = "0.01",
      .set = set_dls_threshold,
      .help = "light sets and doors store a texel/probe only where their light\n"
@@ -178,6 +194,12 @@ static const bake_option options[] = {
      .help = "adaptive sampling (default {default}): blocks of 64 texels or probes whose\n"
              "own estimate reached --target-error stop while the rest go on\n"
              "(bake/transport/TRANSPORT.md)"},
+    {.name = "--path-check", .kind = OPT_NUMBER, .metavar = "N|off", .min = 1, .max = 1024, .keyword = "off",
+     .keyword_value = -1, .def = "16", .set = set_path_check,
+     .help = "trace N texels of every lightmapped object by unbiased paths after\n"
+             "the passes (default {default}, about a quarter more rays) and report\n"
+             "each object's error measured against them: what the noise estimate\n"
+             "cannot see (bake/transport/TRANSPORT.md, Path check); off: none"},
     {.name = "--door-method", .kind = OPT_ENUM, .field = F_INT, .off = D(door_method), .choices = door_methods,
      .what = "door method", .def = "difference",
      .help = "how the light through an open door is baked: differences of\n"
@@ -194,7 +216,9 @@ static const bake_option options[] = {
     {.name = "--seed", .kind = OPT_UINT, .field = F_U64, .off = D(seed), .metavar = "N", .umin = 0,
      .umax = ULLONG_MAX, .def = "1", .flags = OPT_CLI_DEFAULT, .help = "random seed (default {default})"},
     {.name = "--json-report", .kind = OPT_STRING, .field = F_STR, .off = A(json_report), .metavar = "FILE",
-     .flags = OPT_PLAN_NEUTRAL, .help = "write the error-against-time report as JSON"},
+     .flags = OPT_PLAN_NEUTRAL,
+     .help = "write the error-against-time report as JSON (with each phase's\n"
+             "seconds and peak RSS, a high-water mark, also per texel)"},
     {.name = "--revision", .kind = OPT_STRING, .field = F_STR, .off = D(revision), .metavar = "STR",
      .help = "revision string stored in the provenance"},
     {.name = "--timestamp", .kind = OPT_FLAG, .field = F_INT, .off = D(timestamp),
@@ -443,6 +467,17 @@ static int set_checkpoint(const bake_option *opt, const char *a, const char *v, 
 static int set_dls_threshold(const bake_option *opt, const char *a, const char *v, double number, parse_state *s)
 {
     s->o.d.dls_threshold = number > 0 ? number : -1;
+    return 0;
+}
+
+static int set_path_check(const bake_option *opt, const char *a, const char *v, double number, parse_state *s)
+{
+    (void)opt;
+    if (number != floor(number)) {
+        fprintf(stderr, "lbk bake: %s: '%s' is not a whole number in [1, 1024] or off\n", a, v);
+        return LBK_EXIT_USAGE;
+    }
+    s->o.d.path_check = (int)number;
     return 0;
 }
 

@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 
 #include "bake/dist/checkpoint.h"
 #include "bake/dist/dist.h"
@@ -69,11 +70,27 @@ static int events_progress(void *user, double fraction)
     return bk_pipeline_progress(user, fraction);
 }
 
+/* The process's peak resident set so far, bytes (Linux reports ru_maxrss in KiB); 0 if unknown. */
+static uint64_t peak_rss_bytes(void)
+{
+    struct rusage ru;
+    if (getrusage(RUSAGE_SELF, &ru) != 0 || ru.ru_maxrss < 0) return 0;
+    return (uint64_t)ru.ru_maxrss * 1024u;
+}
+
+/* Ends the current phase: its wall time and the memory high-water mark it left. */
+static void close_phase(bk_pipeline *b, double now)
+{
+    if (b->phase_count == 0) return;
+    b->phase_seconds[b->phase_count - 1] = now - b->phase_start;
+    b->phase_peak_rss[b->phase_count - 1] = peak_rss_bytes();
+}
+
 /* Starts a phase: closes the previous one's time, then a checkpoint at 0. */
 lbk_result bk_pipeline_phase(bk_pipeline *b, lbk_bake_phase ph)
 {
     double now = bk_now();
-    if (b->phase_count > 0) b->phase_seconds[b->phase_count - 1] = now - b->phase_start;
+    close_phase(b, now);
     if (b->phase_count < BK_MAX_PHASES) b->phases[b->phase_count++] = ph;
     b->phase_start = now;
     return bk_pipeline_progress(b, 0) ? LBK_ERR_CANCELLED : LBK_OK;
@@ -128,12 +145,13 @@ static lbk_result run(bk_pipeline *b, const char *path, const lbk_bake_scene *de
         if (!r && part) {
             b->part = part;
             b->part_size = part_size;
-            if (b->phase_count > 0) b->phase_seconds[b->phase_count - 1] = bk_now() - b->phase_start;
+            close_phase(b, bk_now());
             return LBK_OK;
         }
     }
     if (!r) r = bk_phase_denoise(b);
     if (!r) r = bk_object_estimates(b);
+    if (!r) r = bk_check_compare(b);
     if (!r && b->sets.set_count) r = bk_phase_emit_sets(b);
     if (!r) r = bk_pipeline_phase(b, LBK_BAKE_PHASE_WRITE);
     if (!r) r = bk_pipeline_encode(b);
@@ -146,7 +164,7 @@ static lbk_result run(bk_pipeline *b, const char *path, const lbk_bake_scene *de
             bk_events_say(&b->events, LBK_BAKE_SEVERITY_NOTE, "resumed %d transport runs from %s (%d passes not traced again)",
                           runs, b->opt->checkpoint_dir, passes);
     }
-    if (b->phase_count > 0) b->phase_seconds[b->phase_count - 1] = bk_now() - b->phase_start;
+    close_phase(b, bk_now());
     if (!r) r = bk_pipeline_report(b, b->out);
     if (r == LBK_ERR_OUT_OF_MEMORY && !b->err[0]) bk_pipeline_fail(b, r, "out of memory");
     return r;
@@ -182,6 +200,14 @@ static lbk_result check_desc(bk_pipeline *b)
         BAD("lbk_bake_desc.glossy_vpl_photons: %d is not in [0, 2^20]", d->glossy_vpl_photons);
     if (!finite_nonneg(d->glossy_vpl_delta) || d->glossy_vpl_delta > 1e6)
         BAD("lbk_bake_desc.glossy_vpl_delta: %g is not a finite number in [0, 1e6]", d->glossy_vpl_delta);
+    if (d->max_page != 0 && (d->max_page < LBK_BAKE_MAX_PAGE_MIN || d->max_page > LBK_BAKE_MAX_PAGE_MAX))
+        BAD("lbk_bake_desc.max_page: %d is not 0 or in [%d, %d]", d->max_page, LBK_BAKE_MAX_PAGE_MIN,
+            LBK_BAKE_MAX_PAGE_MAX);
+    /* a GLG section counts its probes in a u32 (spec/container.md §10); 4 make one tetrahedron */
+    if (d->max_probes != 0 && (d->max_probes < 4 || d->max_probes > (1u << 28)))
+        BAD("lbk_bake_desc.max_probes: %u is not 0 or in [4, 2^28]", d->max_probes);
+    if (d->path_check < -1 || d->path_check > 1024)
+        BAD("lbk_bake_desc.path_check: %d is not -1 (off), 0 (16) or in [1, 1024]", d->path_check);
     if (d->sky_override && !d->sky_exr)
         for (int k = 0; k < 3; k++)
             if (!finite_nonneg(d->sky[k]) || !(d->sky[k] < 1e30f)) BAD("lbk_bake_desc.sky: radiance must be finite and >= 0");
@@ -230,6 +256,12 @@ static void pipeline_free(bk_pipeline *b)
     free(b->halves);
     free(b->object_est);
     free(b->object_filtered);
+    free(b->check);
+    free(b->check_group);
+    free(b->check_weight);
+    free(b->check_irradiance);
+    free(b->check_variance);
+    free(b->object_check);
     free(b->texel_rel_error);
     free(b->samples);
     free(b->radiance);

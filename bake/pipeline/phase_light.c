@@ -274,7 +274,17 @@ lbk_result bk_phase_transport(bk_pipeline *b)
             bk_events_say(&b->events, LBK_BAKE_SEVERITY_WARNING, "--gather-limit needs a global light grid to fall back on; gathering in full");
         }
     }
-    r = bk_transport_run(&b->scene, b->tracer, b->receivers, b->receiver_count, &to, &out, &b->stats);
+    r = bk_check_plan(b);
+    if (!r && b->check_count) {
+        to.check_group = b->check_group;
+        to.check_groups = (uint32_t)b->scene.object_count;
+        to.check_per_group = (int)b->check_per_object;
+        out.check_receiver = b->check;
+        out.check_weight = b->check_weight;
+        out.check_irradiance = b->check_irradiance;
+        out.check_variance = b->check_variance;
+    }
+    if (!r) r = bk_transport_run(&b->scene, b->tracer, b->receivers, b->receiver_count, &to, &out, &b->stats);
     bk_far_probes_free(&far);
     if (!r) bk_texels_match_irradiance(&b->texels, b->texel_of_receiver, b->texel_receivers, b->radiance, irradiance);
     if (!r) r = bk_llg_fit_run(&b->llg_fit, b->llgs, &b->scene, irradiance, b->radiance, b->llg_first, &b->llg_fit_stats);

@@ -75,6 +75,15 @@ typedef struct bk_pipeline {
     lbk_bake_object_estimate *object_est; /* per scene object (texels 0: none), object_errors.c */
     struct bk_denoise_group_error *object_filtered; /* per scene object: the denoised texels' estimate,
                                                        from denoised_error's filter pass; NULL: none */
+    /* the path check (path_check.c, bk_transport_options.check_*): per receiver its group (the
+     * object of a lightmap texel, else UINT32_MAX); check_count = objects × check_per_object
+     * slots: the receiver drawn, its weight, the paths' mean irradiance (3 each) and variance;
+     * per scene object the measured error; pooled over the level; slots that were traced */
+    uint32_t *check_group, *check;
+    float *check_weight, *check_irradiance, *check_variance;
+    size_t check_count, check_per_object, check_done;
+    lbk_bake_object_check *object_check;
+    double check_level;
     float *texel_rel_error;         /* per texel receiver with error_map: the TERR input (error_map.h) */
     struct bk_denoiser *denoiser;   /* weights of the base + every set (do_denoise), for all of them */
     lbk_bake_denoised denoised;     /* the estimate of the denoised base (report, REPT's last record) */
@@ -83,6 +92,7 @@ typedef struct bk_pipeline {
     bk_transport_sample *samples;
     size_t sample_count, sample_cap;
     double phase_seconds[BK_MAX_PHASES];
+    uint64_t phase_peak_rss[BK_MAX_PHASES]; /* bytes, at each phase's end (bake.c close_phase) */
     lbk_bake_phase phases[BK_MAX_PHASES];
     int phase_count;
     double phase_start;
@@ -109,6 +119,7 @@ typedef struct bk_pipeline {
 struct lbk_bake_output {
     lbk_allocator allocator;        /* all zero: malloc */
     lbk_writer *writer;
+    uint64_t phase_peak_rss[BK_MAX_PHASES]; /* report.phase_peak_rss */
     lbk_bake_report report;
     lbk_bake_pass *passes;
     lbk_bake_class_errors *pass_errors;
@@ -118,6 +129,7 @@ struct lbk_bake_output {
     char *set_names;                /* their names, 144 bytes each */
     lbk_bake_object_estimate *object_estimates; /* lightmapped objects, in scene order */
     char *object_names;             /* their names, 128 bytes each */
+    lbk_bake_object_check *object_checks; /* parallel to them (the path check); NULL: none */
     lbk_bake_phase_time phases[BK_MAX_PHASES];
     char *input;
 };
@@ -160,6 +172,12 @@ lbk_result bk_phase_denoise(bk_pipeline *b);
 lbk_result bk_phase_emit_sets(bk_pipeline *b);
 /* Each lightmapped object's estimate into b->object_est (object_errors.c); after the denoiser. */
 lbk_result bk_object_estimates(bk_pipeline *b);
+/* The path check (path_check.c): the texels it traces, chosen before the base run (BK_CHECK_PER_OBJECT
+ * per object unless the desc says), and after the denoiser each object's measured error folded
+ * into b->object_est. */
+#define BK_CHECK_PER_OBJECT 16
+lbk_result bk_check_plan(bk_pipeline *b);
+lbk_result bk_check_compare(bk_pipeline *b);
 /* Each texel receiver's scene object (UINT32_MAX: none), malloc'd; NULL when out of memory. */
 uint32_t *bk_texel_object_groups(const bk_pipeline *b);
 

@@ -83,7 +83,8 @@ static int fill_object_estimates(const bk_pipeline *b, lbk_bake_output *out, lbk
     const size_t name_len = sizeof b->scene.objects[0].name;
     out->object_estimates = bk_output_alloc(out, n * sizeof *out->object_estimates);
     out->object_names = bk_output_alloc(out, n * name_len);
-    if (!out->object_estimates || !out->object_names) return 1;
+    if (b->object_check) out->object_checks = bk_output_alloc(out, n * sizeof *out->object_checks);
+    if (!out->object_estimates || !out->object_names || (b->object_check && !out->object_checks)) return 1;
     size_t k = 0;
     for (size_t o = 0; o < b->scene.object_count; o++) {
         if (!b->object_est[o].texels) continue;
@@ -92,10 +93,15 @@ static int fill_object_estimates(const bk_pipeline *b, lbk_bake_output *out, lbk
         name[name_len - 1] = 0;
         out->object_estimates[k] = b->object_est[o];
         out->object_estimates[k].name = name;
+        if (b->object_check) out->object_checks[k] = b->object_check[o];
         k++;
     }
     r->object_estimates = out->object_estimates;
     r->object_estimate_count = n;
+    r->object_checks = out->object_checks;
+    if (b->object_check)
+        r->check = (lbk_bake_check){(uint32_t)b->check_done, (uint32_t)b->stats.check_samples, b->stats.check_rays,
+                                    b->check_level};
     return 0;
 }
 
@@ -169,6 +175,8 @@ lbk_result bk_pipeline_report(const bk_pipeline *b, lbk_bake_output *out)
     }
     for (int i = 0; i < b->phase_count; i++) out->phases[i] = (lbk_bake_phase_time){b->phases[i], b->phase_seconds[i]};
     r->phases = out->phases;
+    memcpy(out->phase_peak_rss, b->phase_peak_rss, sizeof out->phase_peak_rss);
+    r->phase_peak_rss = out->phase_peak_rss;
     r->phase_count = (size_t)b->phase_count;
     r->seconds = bk_now() - b->start;
     return LBK_OK;
@@ -249,6 +257,14 @@ static void json_set_estimates(cJSON *root, const lbk_bake_report *r)
 /* "objects": each lightmapped object's estimate as stored (lbk_bake_object_estimate). */
 static void json_object_estimates(cJSON *root, const lbk_bake_report *r)
 {
+    const int checked = r->size >= offsetof(lbk_bake_report, check) + sizeof r->check && r->object_checks;
+    if (checked && r->check.receivers) {
+        cJSON *c = cJSON_AddObjectToObject(root, "path_check");
+        cJSON_AddNumberToObject(c, "texels", r->check.receivers);
+        cJSON_AddNumberToObject(c, "samples", r->check.samples);
+        cJSON_AddNumberToObject(c, "rays", (double)r->check.rays);
+        cJSON_AddNumberToObject(c, "rel_rmse", r->check.rel_rmse);
+    }
     cJSON *arr = cJSON_AddArrayToObject(root, "objects");
     for (size_t i = 0; i < r->object_estimate_count; i++) {
         const lbk_bake_object_estimate *e = &r->object_estimates[i];
@@ -259,6 +275,14 @@ static void json_object_estimates(cJSON *root, const lbk_bake_report *r)
         cJSON_AddNumberToObject(o, "est_rel_rmse", e->rel_rmse);
         cJSON_AddNumberToObject(o, "noise", e->noise);
         cJSON_AddNumberToObject(o, "bias", e->bias);
+        const lbk_bake_object_check *ck = checked ? &r->object_checks[i] : NULL;
+        if (ck && ck->receivers) {
+            cJSON *c = cJSON_AddObjectToObject(o, "check");
+            cJSON_AddNumberToObject(c, "texels", ck->receivers);
+            cJSON_AddNumberToObject(c, "rel_rmse", ck->rel_rmse);
+            cJSON_AddNumberToObject(c, "low", ck->low);
+            cJSON_AddNumberToObject(c, "high", ck->high);
+        }
         cJSON_AddItemToArray(arr, o);
     }
 }
@@ -328,11 +352,18 @@ static cJSON *json_report(const lbk_bake_report *r, const char *container_path)
     if (r->size >= offsetof(lbk_bake_report, object_estimate_count) + sizeof r->object_estimate_count &&
         r->object_estimate_count)
         json_object_estimates(root, r);
+    const uint64_t *rss = r->size >= offsetof(lbk_bake_report, phase_peak_rss) + sizeof r->phase_peak_rss
+                              ? r->phase_peak_rss : NULL;
     cJSON *ph = cJSON_AddArrayToObject(root, "phases");
     for (size_t i = 0; i < r->phase_count; i++) {
         cJSON *o = cJSON_CreateObject();
         cJSON_AddStringToObject(o, "name", lbk_bake_phase_name(r->phases[i].phase));
         cJSON_AddNumberToObject(o, "seconds", r->phases[i].seconds);
+        if (rss && rss[i]) { /* a high-water mark: the most the process held up to this phase's end */
+            cJSON_AddNumberToObject(o, "peak_rss_bytes", (double)rss[i]);
+            if (r->counts.texels)
+                cJSON_AddNumberToObject(o, "peak_rss_bytes_per_texel", (double)rss[i] / (double)r->counts.texels);
+        }
         cJSON_AddItemToArray(ph, o);
     }
     return root;

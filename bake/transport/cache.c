@@ -59,7 +59,7 @@ static void cell_sample(tp_ctx *c, const double n[3], int j, const double p[3],
             } else if (bk_tr_near_hit(c, hit, hc, c->rough)) {
                 /* bounce k−1 at the exact point (see bk_tr_near_radiance) */
                 const tp_near_mode md = {NULL, NULL, 0, k - 1 < c->cache_depth ? k - 1 : c->cache_depth, 0,
-                                         (const float *const *)c->l_hist[h], k};
+                                         (const float *const *)c->l_hist[h], k, 0};
                 bk_tr_near_entry(c, &md, hit, hc, d, near_rng, cnt, L);
             } else {
                 for (int a = 0; a < 3; a++) L[a] = prev[3 * hc + a];

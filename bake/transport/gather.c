@@ -59,7 +59,7 @@ static int footprint_hidden(const tp_ctx *c, const bk_receiver *r, double s, dou
  * back to the receiver's own point 18 % of the time, one covering 30 % 0.3 %; charts of
  * axis-aligned slivers fill their boxes). */
 #define TP_FOOTPRINT_TRIES 16
-static void footprint_sample(const tp_ctx *c, const bk_receiver *r, bk_rng *pos, tp_origin *g)
+void bk_tr_footprint_sample(const tp_ctx *c, const bk_receiver *r, bk_rng *pos, tp_origin *g)
 {
     const float *bx = r->footprint_box;
     int box = bx[2] > 0 && bx[3] > 0;
@@ -217,7 +217,7 @@ static long gather_hit(tp_ctx *c, const float *sum, const uint8_t *rough, const 
     double r[3];
     int near = bk_tr_near_hit(c, hit, hc, rough);
     if (near) {
-        const tp_near_mode md = {sum, rough, 1, TP_NEAR_DEPTH, vpl, NULL, 0};
+        const tp_near_mode md = {sum, rough, 1, TP_NEAR_DEPTH, vpl, NULL, 0, 0};
         bk_tr_near_entry(c, &md, hit, hc, d, cont, cnt, r);
     } else {
         for (int a = 0; a < 3; a++) r[a] = sum[3 * hc + a];
@@ -298,7 +298,7 @@ static void recv_half(tp_ctx *c, const bk_receiver *r, size_t i, int h, int S, c
             tp_origin g = g0;
             double t[3] = {t0[0], t0[1], t0[2]}, b[3] = {b0[0], b0[1], b0[2]};
             if (r->footprint_count) {
-                footprint_sample(c, r, &pos, &g);
+                bk_tr_footprint_sample(c, r, &pos, &g);
                 bk_onb(g.n, t, b);
             }
             double u1, cp, sp;
@@ -331,7 +331,7 @@ static void recv_half(tp_ctx *c, const bk_receiver *r, size_t i, int h, int S, c
             }
             if (hc >= 0 && (j0 + jj) % TP_PROBE_EVERY == 0) {
                 double q[3];
-                const tp_near_mode md = {sum, c->rough, 1, TP_NEAR_DEPTH, c->vpl && !sphere, NULL, 0};
+                const tp_near_mode md = {sum, c->rough, 1, TP_NEAR_DEPTH, c->vpl && !sphere, NULL, 0, 0};
                 bk_tr_near_radiance(c, &md, &hits[jj], hc, dd[jj], 0, &probe, cnt, q);
                 double cs = (sphere ? 1 : zz[jj]) * TP_PROBE_EVERY;
                 if (bk_finite3(q))

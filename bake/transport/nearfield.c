@@ -72,11 +72,34 @@ static void cont_point(const tp_ctx *c, const bk_hit *hit, const tp_cell *cell, 
     bk_offset_ray_origin_scaled(xf, nf, bk_tracer_tri_scale(c->tracer, hit->tri), o);
 }
 
+/* The chance that an exact path goes on from cell hc: its brightest albedo channel, within
+ * [0.05, 0.99] (a path that carries weight a/p per bounce keeps a bounded variance for a ≤ p;
+ * 0.99 bounds it by (a²/p)^k ≤ 1.008^k in the whitest rooms, where max_depth ends it). */
+static double exact_survival(const tp_ctx *c, long hc)
+{
+    const tp_cell *cell = &c->cells[hc];
+    double a = fmax(cell->albedo[0], fmax(cell->albedo[1], cell->albedo[2]));
+    if (c->gloss && c->gloss[hc].on) a = fmax(a, fmax(c->gloss[hc].base[0], fmax(c->gloss[hc].base[1], c->gloss[hc].base[2])));
+    return fmin(0.99, fmax(0.05, a));
+}
+
+/* An exact path's next vertex at h2 (the path check): continued, by Russian roulette past
+ * TP_EXACT_RR_DEPTH, into r2. */
+static void exact_next(tp_ctx *c, const tp_near_mode *md, const bk_hit *h2, long h2c, const double d[3], int depth,
+                       bk_rng *rng, tp_count *cnt, double r2[3])
+{
+    if (depth + 1 >= md->max_depth) return;
+    double p = depth + 1 < TP_EXACT_RR_DEPTH ? 1 : exact_survival(c, h2c);
+    if (p < 1 && bk_rng_next(rng) >= p) return;
+    bk_tr_near_radiance(c, md, h2, h2c, d, depth + 1, rng, cnt, r2);
+    for (int a = 0; a < 3; a++) r2[a] /= p;
+}
+
 /* What a continuation ray from o along unit d brings back: sky, emission (MIS-weighted against
  * the light samples with the continuation's own density pg) and the cache — or the exact
  * radiance where that hit is near, rough or glossy too (up to md->max_depth in a row). */
-static void cont_trace(tp_ctx *c, const tp_near_mode *md, const float o[3], const double d[3], double pg, int depth,
-                       bk_rng *rng, tp_count *cnt, double L[3])
+void bk_tr_cont_trace(tp_ctx *c, const tp_near_mode *md, const float o[3], const double d[3], double pg, int depth,
+                      bk_rng *rng, tp_count *cnt, double L[3])
 {
     float df[3] = {(float)d[0], (float)d[1], (float)d[2]};
     L[0] = L[1] = L[2] = 0;
@@ -98,18 +121,15 @@ static void cont_trace(tp_ctx *c, const tp_near_mode *md, const float o[3], cons
         }
     }
     double r2[3] = {0, 0, 0};
-    if (read && depth + 1 < md->max_depth && bk_tr_near_hit(c, &h2, h2c, md->rough)) {
+    if (md->exact) {
+        exact_next(c, md, &h2, h2c, d, depth, rng, cnt, r2);
+    } else if (read && depth + 1 < md->max_depth && bk_tr_near_hit(c, &h2, h2c, md->rough)) {
         bk_tr_near_radiance(c, md, &h2, h2c, d, depth + 1, rng, cnt, r2);
     } else if (read) {
         for (int a = 0; a < 3; a++) r2[a] = read[3 * h2c + a];
     }
     for (int a = 0; a < 3; a++) L[a] += r2[a];
 }
-
-/* One punctual light (picked as bk_tr_near_radiance picks it) at a continued point x, into e:
- * E·(Lambertian: nothing more; glossy lf: × f(v, l) per channel). */
-static void cont_punctual(const tp_ctx *c, const double x[3], const double n[3], const float o[3], const tp_lobe *lf,
-                          int split, bk_rng *rng, double e[3], tp_count *cnt);
 
 /* Reflected radiance (all bounces, emission excluded) at a glossy hit towards -din: one sample
  * of the coupled BSDF (GGX.md) traced like a Lambertian continuation, one light sample weighed
@@ -136,7 +156,7 @@ static void gloss_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit,
         double d[3], f[3], L[3];
         for (int a = 0; a < 3; a++) d[a] = l[0] * lf.t[a] + l[1] * lf.b[a] + l[2] * lf.n[a];
         bk_mr_lobe_eval(&lf.lb, l, f);
-        cont_trace(c, md, o, d, pdf, depth, rng, cnt, L);
+        bk_tr_cont_trace(c, md, o, d, pdf, depth, rng, cnt, L);
         for (int a = 0; a < 3; a++) out[a] += f[a] * l[2] / pdf * L[a];
     }
     const int sources = mode_sources(md, depth);
@@ -151,7 +171,7 @@ static void gloss_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit,
             for (int a = 0; a < 3; a++) out[a] += val[a] * f[a] * cq;
         }
     }
-    if (sources && c->light_count) cont_punctual(c, x, lf.n, o, &lf, md->vpl && depth == 0, rng, out, cnt);
+    if (sources && c->light_count) bk_tr_cont_punctual(c, x, lf.n, o, &lf, md->vpl && depth == 0, rng, out, cnt);
 }
 
 void bk_tr_near_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, long hc, const double din[3],
@@ -171,7 +191,7 @@ void bk_tr_near_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, l
     double d[3];
     for (int a = 0; a < 3; a++) d[a] = rr * cos(ph) * t[a] + rr * sin(ph) * b[a] + lz * n[a];
     double L[3];
-    cont_trace(c, md, o, d, lz / TP_PI, depth, rng, cnt, L);
+    bk_tr_cont_trace(c, md, o, d, lz / TP_PI, depth, rng, cnt, L);
     double e[3] = {TP_PI * L[0], TP_PI * L[1], TP_PI * L[2]};
     const int sources = mode_sources(md, depth);
     if (sources && c->nee) {
@@ -183,7 +203,7 @@ void bk_tr_near_radiance(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, l
         if (bk_tr_nee_sample(c, o, n, PG_COSINE, u0, u1n, ld, &cq, val, &cnt->shadow) && bk_finite3(val))
             for (int a = 0; a < 3; a++) e[a] += val[a] * cq;
     }
-    if (sources && c->light_count) cont_punctual(c, x, n, o, NULL, 0, rng, e, cnt);
+    if (sources && c->light_count) bk_tr_cont_punctual(c, x, n, o, NULL, 0, rng, e, cnt);
     for (int a = 0; a < 3; a++) out[a] = cell->albedo[a] / TP_PI * e[a];
 }
 
@@ -211,8 +231,8 @@ void bk_tr_near_entry(tp_ctx *c, const tp_near_mode *md, const bk_hit *hit, long
         for (int a = 0; a < 3; a++) out[a] /= n;
 }
 
-static void cont_punctual(const tp_ctx *c, const double x[3], const double n[3], const float o[3], const tp_lobe *lf,
-                          int split, bk_rng *rng, double e[3], tp_count *cnt)
+void bk_tr_cont_punctual(const tp_ctx *c, const double x[3], const double n[3], const float o[3], const tp_lobe *lf,
+                         int split, bk_rng *rng, double e[3], tp_count *cnt)
 {
     /* one light: uniformly; with culling (many lights) a positional one in proportion to its
      * intensity (a uniform pick among thousands almost never finds the lamp that matters)

@@ -44,6 +44,16 @@ static lbk_result check_inputs(const bk_scene *scene, const bk_tracer *tracer, c
     const size_t *end = opt->class_end;
     if (end[BK_RECEIVER_CLASSES - 1] && (end[BK_RECEIVER_CLASSES - 1] != count || end[0] > end[1] || end[1] > end[2]))
         return LBK_ERR_INVALID_ARGUMENT;
+    if (opt->check_groups && opt->check_per_group > 0) {
+        if (!opt->check_group || !output->check_receiver || !output->check_weight || !output->check_irradiance ||
+            !output->check_variance || opt->check_per_group > 65536)
+            return LBK_ERR_INVALID_ARGUMENT;
+        for (size_t i = 0; i < count; i++) {
+            const bk_receiver *r = &receivers[i];
+            if (opt->check_group[i] != UINT32_MAX && r->normal[0] == 0 && r->normal[1] == 0 && r->normal[2] == 0)
+                return LBK_ERR_INVALID_ARGUMENT;
+        }
+    }
     return footprints_valid(scene, opt, receivers, count) ? LBK_OK : LBK_ERR_INVALID_ARGUMENT;
 }
 
@@ -385,6 +395,13 @@ finished:
         fill_stats(&c, pass + 1, err, bias, &ce, chain, stats);
         stats->octa_rel_rmse = oct_err;
         stats->octa_rays = c.oct_total;
+    }
+    /* after the stats: the check's rays are not in them (a distributed merge, which cannot run
+     * it, counts the same rays as the local bake) */
+    if (opt->check_groups && opt->check_per_group > 0 && !split && (res = bk_tr_check_run(&c)) != LBK_OK) goto done;
+    if (stats) {
+        stats->check_rays = c.check_rays;
+        stats->check_samples = c.check_samples;
     }
     if (rec) {
         bk_transport_totals t;

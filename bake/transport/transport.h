@@ -324,6 +324,17 @@ typedef struct bk_transport_options {
      * Probes' blocks adapt once the texels have stopped. 0: off (every receiver of a class
      * samples while the class does). */
     int adaptive;
+    /* The path check (TRANSPORT.md §Path check): after the last pass, check_per_group receivers
+     * of each group (check_group: per receiver, a group below check_groups or UINT32_MAX for
+     * none; surface receivers only) are drawn in proportion to half their share of the group's
+     * noise and half their share of its squared light, and each gets check_samples unbiased paths
+     * — every hit continued at its exact point, no cell read. Into output.check_*, slot
+     * g·check_per_group + j [0: a quarter of the rays the receivers traced in the passes, spread
+     * over the checks, 256 … 16384 paths each]. Not in distributed runs. NULL: none. */
+    const uint32_t *check_group;
+    uint32_t check_groups;
+    int check_per_group;
+    int check_samples;
 } bk_transport_options;
 
 #define BK_TRANSPORT_STOP_RECEIVERS ((size_t)65536)
@@ -364,6 +375,14 @@ typedef struct bk_transport_output {
      * sign): a linear filter applied to A − B shows how much of the noise it leaves, including
      * the part correlated between receivers (bk_denoiser_error). */
     float *halves;
+    /* options.check_groups × check_per_group slots (the path check): the receiver drawn
+     * (UINT32_MAX: an empty slot: a group without that many lit receivers), its weight 1/(K·p)
+     * (Σ over a group's slots of weight × d estimates Σ of d over the group's receivers), the
+     * paths' mean irradiance (3 each) and the variance of its luminance; all four or none */
+    uint32_t *check_receiver;
+    float *check_weight;
+    float *check_irradiance;
+    float *check_variance;
 } bk_transport_output;
 
 enum bk_transport_stop { BK_STOP_TARGET = 0, BK_STOP_TIME, BK_STOP_BUDGET };
@@ -405,6 +424,8 @@ typedef struct bk_transport_stats {
                                 VPLs (0 when not measured: no glossy cell or no shooting light) */
     uint64_t vpl_made;       /* VPLs made over the run (both halves, all passes) */
     double vpl_tested;       /* per receiver over the run: VPLs its tiles' lists gave it to test */
+    uint64_t check_rays;     /* rays the path check traced (not in rays) */
+    int check_samples;       /* its paths per checked receiver */
 } bk_transport_stats;
 
 /* Computes radiance at `count` receivers. The tracer must have been built from `scene`.

@@ -42,7 +42,7 @@
 
 enum { DOM_CELL = 1, DOM_RECV = 2, DOM_CELL_NEE = 3, DOM_RECV_NEE = 4, DOM_RECV_NEAR = 5, DOM_RECV_POS = 6,
        DOM_RECV_PROBE = 7, DOM_CELL_NEAR = 8, DOM_SLC_RECV = 9, DOM_SLC_CELL = 10,
-       DOM_VPL_SHOOT = 11, DOM_VPL_XI = 12, DOM_VPL_POINT = 13 };
+       DOM_VPL_SHOOT = 11, DOM_VPL_XI = 12, DOM_VPL_POINT = 13, DOM_CHECK = 14 };
 
 /* Keyed by everything that identifies one item's samples: never by thread or time. */
 static inline bk_rng bk_tr_rng(uint64_t seed, uint64_t domain, uint64_t half, uint64_t pass, uint64_t bounce,
@@ -242,6 +242,8 @@ typedef struct tp_ctx {
     size_t stop_first[BK_RECEIVER_CLASSES + 1], extra_first[BK_RECEIVER_CLASSES + 1];
     int stop_sub[BK_RECEIVER_CLASSES];
     uint64_t extra_rays, extra_shadow, extra_nonfinite;
+    uint64_t check_rays;   /* the path check's (check.c) */
+    int check_samples;     /* paths per checked receiver */
     /* adaptive sampling's blocks (TRANSPORT.md §Adaptive sampling), class k's
      * [blk_first[k], blk_first[k + 1]): per block the sum of the weights of the passes it sampled
      * in, whether it samples in this pass, and whether it would sample in the next (bk_tr_adapt_mark;
@@ -436,7 +438,23 @@ typedef struct tp_near_mode {
     int sources, max_depth, vpl;
     const float *const *hist;
     int bounce;
+    /* 1: a path with nothing cached (the path check, check.c): every hit is continued at its
+     * exact point, past TP_EXACT_RR_DEPTH by Russian roulette, at most max_depth in a row; read,
+     * rough and hist are unused */
+    int exact;
 } tp_near_mode;
+
+#define TP_EXACT_RR_DEPTH 3
+
+/* What a continuation ray from o along unit d brings back (sky, MIS-weighted emission, and the
+ * cache or the exact radiance at its hit), with the ray's own density pg for the MIS weight. */
+void bk_tr_cont_trace(tp_ctx *c, const tp_near_mode *md, const float o[3], const double d[3], double pg, int depth,
+                      bk_rng *rng, tp_count *cnt, double L[3]);
+/* One punctual light picked at random (uniformly; with culling by intensity, plus every
+ * directional one) at point x (normal n, ray origin o), weighted by 1/its probability, into e
+ * (through the BSDF lf at a glossy point; NULL: irradiance). */
+void bk_tr_cont_punctual(const tp_ctx *c, const double x[3], const double n[3], const float o[3], const tp_lobe *lf,
+                         int split, bk_rng *rng, double e[3], tp_count *cnt);
 
 /* Reflected radiance (all bounces, emission excluded) at the point of `hit` (cell hc, reached
  * along unit d) from one continuation sample. */
@@ -481,6 +499,9 @@ uint64_t bk_tr_punctual_one(const tp_ctx *c, const tp_origin *g, size_t li, cons
 /* The points at which a receiver's punctual light is evaluated: a texel with a footprint
  * averages its four quarter centres (hard shadow edges resolve to a quarter of a texel). */
 int bk_tr_punctual_points(const tp_ctx *c, const bk_receiver *r, tp_origin g[4]);
+/* A uniform point of the visible part of r's footprint into g (left as it is where none is found
+ * in TP_FOOTPRINT_TRIES draws). */
+void bk_tr_footprint_sample(const tp_ctx *c, const bk_receiver *r, bk_rng *pos, tp_origin *g);
 /* Noise-free punctual light per receiver (a tp_fn): into punct_lum, or (punct_lum NULL) the outputs. */
 void bk_tr_recv_punctual(tp_ctx *c, size_t begin, size_t end, int thread);
 /* The final gather of this pass at receivers [begin, end) (a tp_fn). */
@@ -522,6 +543,12 @@ void bk_tr_sample_of(const tp_ctx *c, double spp, double err, int bounces, int p
                      bk_transport_sample *smp);
 /* Each receiver's X of the two halves, normalised by its block's pass weights. */
 void bk_tr_write_halves(const tp_ctx *c, double *const x_acc[2], float *halves);
+
+/* ---- the path check (check.c) ---------------------------------------------------------------- */
+
+/* The path check's receivers drawn and traced by unbiased paths into output.check_* (after the
+ * passes and finish_outputs). */
+lbk_result bk_tr_check_run(tp_ctx *c);
 
 /* ---- the run context (transport_ctx.c) ---------------------------------------------------------- */
 

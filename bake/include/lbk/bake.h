@@ -55,9 +55,8 @@ extern "C" {
 /* The baker library's version (lbk-bake.pc): the minor grows with every addition to the
  * size-tagged structs below ("added in 1.x"). */
 #define LBK_BAKE_LIBRARY_VERSION_MAJOR 1
-#define LBK_BAKE_LIBRARY_VERSION_MINOR 9
-#define LBK_BAKE_LIBRARY_VERSION_PATCH 0 /* 1.9.0: each object's estimate in the report; footprints stay
-                                           on their smooth surface (other bakes) */
+#define LBK_BAKE_LIBRARY_VERSION_MINOR 10
+#define LBK_BAKE_LIBRARY_VERSION_PATCH 0 /* 1.10.0: max_page, max_probes, texel_budget */
 
 /* ---- options ----------------------------------------------------------------------------- */
 
@@ -240,7 +239,27 @@ typedef struct lbk_bake_desc {
                                    sampling): blocks of 64 receivers whose own estimate reached
                                    the target stop sampling while the rest go on; -1 off [0: on;
                                    no effect without a target] */
+    /* added in 1.10: levels of millions of texels and hundreds of thousands of probes */
+    int max_page;               /* no lightmap page is wider or taller than this many texels,
+                                   LBK_BAKE_MAX_PAGE_MIN … 16384, rounded down to a multiple of 4;
+                                   a level needs as many pages as its objects fill; an object's
+                                   charts share one page (spec/container.md §8), so an object
+                                   larger than a page at its density gets a lower one (noted);
+                                   a triangle larger than a page gets a chart of its own at the
+                                   density that fits, never lowering its object's [0: 4096] */
+    uint32_t max_probes;        /* the global light grid's probe cap, reached by coarsening its
+                                   spacing (noted) [0: LBK_BAKE_MAX_PROBES_DEFAULT] */
+    uint64_t texel_budget;      /* the lightmap's texels (Σ object rectangles) at most; more
+                                   scales every density by one factor (noted) [0: 16 Mi] */
+    int path_check;             /* texels of each lightmapped object traced by unbiased paths
+                                   after the base run's passes, to measure what the stored texels
+                                   carry beyond noise (bake/transport/TRANSPORT.md §Path check;
+                                   lbk_bake_object_check) [0: 16]; -1 off */
 } lbk_bake_desc;
+
+#define LBK_BAKE_MAX_PAGE_MIN 64
+#define LBK_BAKE_MAX_PAGE_MAX 16384
+#define LBK_BAKE_MAX_PROBES_DEFAULT 262144u
 
 /* A file a bake read (the glTF, its buffers and images, a sky EXR), as META input.files
  * records it (spec/container.md §6.2). */
@@ -460,6 +479,27 @@ typedef struct lbk_bake_object_estimate {
     double value2;               /* Σ of its texels' squared irradiance luminance (pooling weight) */
 } lbk_bake_object_estimate;
 
+/* A lightmapped object's error measured by the path check (appended in 1.10): a few of its
+ * texels traced by unbiased paths (no cache, every hit continued at its exact point) and
+ * compared with what is stored there. rel_rmse estimates the object's whole error — noise,
+ * denoiser bias and what the cache gets wrong alike in both halves (light through a slab thinner
+ * than a cell) — relative to the RMS of its irradiance, from the checked texels alone; low / high
+ * are its value at ∓ one standard error of the checks' spread. The object's estimate
+ * (lbk_bake_object_estimate.rel_rmse) is the larger of this and the noise estimate. */
+typedef struct lbk_bake_object_check {
+    uint32_t receivers;          /* texels checked (0: none; then the other fields are 0) */
+    double rel_rmse, low, high;
+} lbk_bake_object_check;
+
+/* The path check over the level (appended in 1.10; zero when it did not run). */
+typedef struct lbk_bake_check {
+    uint32_t receivers;          /* texels checked, every object */
+    uint32_t samples;            /* paths per checked texel */
+    uint64_t rays;               /* rays the paths traced (not in the transport's totals) */
+    double rel_rmse;             /* the objects' measured errors pooled as the texel estimate pools
+                                    (each weighted by Σ E² of its texels) */
+} lbk_bake_check;
+
 /* What lbk_bake_report_write_json writes (spec/bake-report-json.md), as data. */
 typedef struct lbk_bake_report {
     size_t size;                 /* sizeof(lbk_bake_report) of the library that filled it */
@@ -494,6 +534,14 @@ typedef struct lbk_bake_report {
     /* appended in 1.9 (each lightmapped object's estimate): read only when size covers them */
     const lbk_bake_object_estimate *object_estimates; /* in scene object order */
     size_t object_estimate_count;
+    /* appended in 1.10: memory */
+    const uint64_t *phase_peak_rss; /* parallel to phases: the process's peak resident set size at
+                                   the phase's end, bytes; a high-water mark since the process
+                                   started (getrusage ru_maxrss), so it never falls and includes
+                                   what the caller held before the bake; NULL: not measured */
+    /* appended in 1.10 (the path check): read only when size covers them */
+    const lbk_bake_object_check *object_checks; /* parallel to object_estimates; NULL: none */
+    lbk_bake_check check;
 } lbk_bake_report;
 
 /* Owned by the output, valid until lbk_bake_output_free. */
