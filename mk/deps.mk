@@ -49,10 +49,11 @@ fi; \
 echo "lbk: installing missing Debian packages ($$why): $$missing"; \
 { $${sudo}apt-get update -qq || true; } && $${sudo}env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >/dev/null
 endef
-.PHONY: deps deps-tools deps-test deps-bench gltf-validator
+.PHONY: deps deps-tools deps-test deps-bench gltf-validator babylon-npm
 deps:
 	@$(call deps_sh,$(DEB_PKGS),make deps)
 	@$(MAKE) --no-print-directory gltf-validator
+	@$(MAKE) --no-print-directory babylon-npm
 deps-tools:
 	@$(call deps_sh,$(DEB_TOOL_PKGS),)
 # The GPU, view and Slurm packages are optional for make test: without them (and not allowed to
@@ -80,3 +81,17 @@ gltf-validator:
 	@if command -v npm >/dev/null 2>&1 && command -v node >/dev/null 2>&1; then \
 	  $(MAKE) --no-print-directory $(GLTF_VALIDATOR)/package.json; \
 	else echo "lbk: npm/node not found: the glTF-Validator check will be SKIPPED (apt-get install npm)"; fi
+
+# Stock Babylon.js (npm babylonjs + babylonjs-loaders, the UMD builds) for tests/tools/
+# test_engine_view.c, which loads `lbk export --gltf` with Babylon's own glTF loader in headless
+# Chromium; installed into the build folder at a pinned version, like the glTF-Validator (npm comes
+# with gltf-validator above). Without npm that case is reported SKIPPED.
+BABYLON_VERSION := 9.28.0
+BABYLON_NPM := $(BUILD)/npm-babylon/node_modules/babylonjs-loaders
+$(BABYLON_NPM)/package.json:
+	@mkdir -p $(BUILD)/npm-babylon
+	npm install --prefix $(BUILD)/npm-babylon --no-audit --no-fund --loglevel=error \
+	    babylonjs@$(BABYLON_VERSION) babylonjs-loaders@$(BABYLON_VERSION)
+babylon-npm:
+	@if command -v npm >/dev/null 2>&1; then $(MAKE) --no-print-directory $(BABYLON_NPM)/package.json; \
+	else echo "lbk: npm not found: test_engine_view's Babylon.js case will be SKIPPED (apt-get install npm)"; fi

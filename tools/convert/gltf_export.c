@@ -35,7 +35,8 @@ typedef struct ex {
     int *llg_material;   /* per source material: the vertex-colour preview of LLG objects */
     float *texels;       /* 3 per texel of every page: physical irradiance along the normal */
     float exposure;      /* of every preview: the p99 rule of tools/convert/README.md "Previews" */
-    int any_unlit;
+    float *page_scale;   /* per page: the irradiance (lux) of code 255 of its emissive PNG */
+    int any_unlit, any_strength;
     char dir[4096], stem[200];
     tl_gltf_stats *st;
     char *err;
@@ -217,10 +218,31 @@ static cJSON *material_extras(const bk_material *m, int page)
 
 #define MATERIAL_PLAIN (-1)
 #define MATERIAL_LLG (-2)
+#define PI_F 3.14159265358979f
 
-/* Lightmapped: unlit, base colour = albedo × the page preview (TEXCOORD_1); LLG objects: unlit,
- * albedo × COLOR_0 (their probe lighting per vertex, same exposure): so viewers show the bake.
- * Engines take the lighting from the extras. Others (not lit by the bake): plain PBR factors. */
+/* emissiveFactor × KHR_materials_emissive_strength = rgb (nits): the factor's largest channel is
+ * 1 and the strength carries the rest, since glTF factors stop at 1. */
+static void add_emission(ex *e, cJSON *mat, const float rgb[3])
+{
+    float m = fmaxf(rgb[0], fmaxf(rgb[1], rgb[2]));
+    if (!(m > 0.0f) || !isfinite(m)) return;
+    const float f[3] = {clamp01(rgb[0] / m), clamp01(rgb[1] / m), clamp01(rgb[2] / m)};
+    cJSON_AddItemToObject(mat, "emissiveFactor", cJSON_CreateFloatArray(f, 3));
+    if (m != 1.0f) {
+        cJSON *x = cJSON_GetObjectItem(mat, "extensions");
+        if (!x) x = cJSON_AddObjectToObject(mat, "extensions");
+        cJSON_AddNumberToObject(cJSON_AddObjectToObject(x, "KHR_materials_emissive_strength"), "emissiveStrength", m);
+        e->any_strength = 1;
+    }
+}
+
+/* Lightmapped: the baked light as emission, which every stock glTF loader draws: base colour black
+ * (so the engine's own lights and ambient add no second diffuse term), emissiveTexture = the page's
+ * emissive PNG on TEXCOORD_1 (sRGB of E / scale), emissiveFactor = albedo and emissiveStrength =
+ * scale / π, i.e. the Lambert radiance albedo · E / π in nits (tools/convert/README.md "In
+ * engines"). An emitting material keeps its own emission instead (glTF has one emissive slot).
+ * LLG objects: unlit, albedo × COLOR_0 (their probe lighting per vertex, the preview exposure).
+ * Others (not lit by the bake): plain PBR factors and their emission in nits. */
 static int material_for(ex *e, uint32_t mi, int page)
 {
     int *slot = page >= 0 ? &e->lm_material[(size_t)mi * e->pages + (uint32_t)page]
@@ -233,20 +255,28 @@ static int material_for(ex *e, uint32_t mi, int page)
     else snprintf(name, sizeof name, page == MATERIAL_LLG ? "%s@llg" : "%s", m->name);
     cJSON_AddStringToObject(mat, "name", name);
     const float base[4] = {clamp01(m->albedo[0]), clamp01(m->albedo[1]), clamp01(m->albedo[2]), 1.0f};
-    cJSON_AddItemToObject(pbr, "baseColorFactor", cJSON_CreateFloatArray(base, 4));
+    static const float black[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+    cJSON_AddItemToObject(pbr, "baseColorFactor", cJSON_CreateFloatArray(page >= 0 ? black : base, 4));
     cJSON_AddNumberToObject(pbr, "metallicFactor", 0);
     cJSON_AddNumberToObject(pbr, "roughnessFactor", 1);
-    if (page >= 0) {
-        cJSON *tex = cJSON_AddObjectToObject(pbr, "baseColorTexture");
-        cJSON_AddNumberToObject(tex, "index", page);
-        cJSON_AddNumberToObject(tex, "texCoord", 1);
-    }
-    if (page != MATERIAL_PLAIN) {
+    const int emits = m->emission[0] > 0 || m->emission[1] > 0 || m->emission[2] > 0;
+    if (page == MATERIAL_LLG) {
         cJSON_AddObjectToObject(cJSON_AddObjectToObject(mat, "extensions"), "KHR_materials_unlit");
         e->any_unlit = 1;
+    } else if (page >= 0 && !emits) {
+        cJSON *tex = cJSON_AddObjectToObject(mat, "emissiveTexture");
+        cJSON_AddNumberToObject(tex, "index", page);
+        cJSON_AddNumberToObject(tex, "texCoord", 1);
+        const float s = e->page_scale[page] / PI_F;
+        cJSON_AddItemToObject(mat, "emissiveFactor", cJSON_CreateFloatArray(base, 3));
+        if (s != 1.0f) {
+            cJSON_AddNumberToObject(cJSON_AddObjectToObject(cJSON_AddObjectToObject(mat, "extensions"),
+                                                            "KHR_materials_emissive_strength"),
+                                    "emissiveStrength", s);
+            e->any_strength = 1;
+        }
     } else {
-        const float em[3] = {clamp01(m->emission[0]), clamp01(m->emission[1]), clamp01(m->emission[2])};
-        if (em[0] > 0 || em[1] > 0 || em[2] > 0) cJSON_AddItemToObject(mat, "emissiveFactor", cJSON_CreateFloatArray(em, 3));
+        add_emission(e, mat, m->emission);
     }
     if (m->double_sided) cJSON_AddBoolToObject(mat, "doubleSided", 1);
     cJSON_AddItemToObject(mat, "extras", material_extras(m, page));
@@ -293,10 +323,11 @@ static cJSON *emit_primitive(ex *e, const prim_data *d, int material)
 
 static cJSON *lightmap_extras(const ex *e, uint32_t page, uint32_t source_primitive)
 {
-    char f[3][256];
+    char f[4][256];
     snprintf(f[0], sizeof f[0], "%s.lightmap_%03u.exr", e->stem, page);
     snprintf(f[1], sizeof f[1], "%s.lightmap_%03u.ahd.exr", e->stem, page);
     snprintf(f[2], sizeof f[2], "%s.lightmap_%03u.png", e->stem, page);
+    snprintf(f[3], sizeof f[3], "%s.lightmap_%03u.emissive.png", e->stem, page);
     cJSON *x = cJSON_CreateObject(), *l = cJSON_AddObjectToObject(x, "lbk");
     cJSON_AddNumberToObject(l, "source_primitive", source_primitive);
     cJSON *lm = cJSON_AddObjectToObject(l, "lightmap");
@@ -305,6 +336,8 @@ static cJSON *lightmap_extras(const ex *e, uint32_t page, uint32_t source_primit
     cJSON_AddStringToObject(lm, "irradiance", f[0]);
     cJSON_AddStringToObject(lm, "ahd", f[1]);
     cJSON_AddStringToObject(lm, "preview", f[2]);
+    cJSON_AddStringToObject(lm, "emissive", f[3]);
+    cJSON_AddNumberToObject(lm, "emissive_scale", e->page_scale[page]);
     cJSON_AddStringToObject(lm, "decode", "lbk-ahd/1");
     return x;
 }
@@ -442,16 +475,26 @@ static int decode_texels(ex *e)
     const lbk_lmap_view *lm = &e->b->lmap;
     e->texels = malloc(((size_t)(e->pages ? lm->texel_count : 0) + 1) * 3 * sizeof *e->texels);
     if (!e->texels) return tl_fail(e->err, TL_GLTF_INTERNAL, "out of memory");
+    e->page_scale = malloc(((size_t)e->pages + 1) * sizeof *e->page_scale);
+    if (!e->page_scale) return tl_fail(e->err, TL_GLTF_INTERNAL, "out of memory");
     size_t k = 0;
     for (uint32_t p = 0; p < e->pages; p++) {
         lbk_lmap_planes pg;
         tl_bake_planes(e->b, p, &pg);
+        float top = 0.0f;
         for (uint32_t y = 0; y < pg.height; y++)
             for (uint32_t x = 0; x < pg.width; x++, k++) {
                 lbk_ahd_texel_f t; /* any encoding (spec §9.2) */
                 tl_bake_texel_get(e->b, p, x, y, &t, NULL, NULL);
-                for (int c = 0; c < 3; c++) e->texels[3 * k + (size_t)c] = t.ez[c] * lm->scale;
+                for (int c = 0; c < 3; c++) {
+                    const float v = t.ez[c] * lm->scale;
+                    e->texels[3 * k + (size_t)c] = v;
+                    if (isfinite(v) && v > top) top = v;
+                }
             }
+        /* the page's largest value is code 255: nothing clips, the 8-bit sRGB steps are relative
+         * (README "In engines" gives the error measured against the EXR) */
+        e->page_scale[p] = top > 0.0f ? top : 1.0f;
     }
     return 0;
 }
@@ -525,14 +568,19 @@ static int write_pages(ex *e)
             snprintf(path, sizeof path, "%s/%s.lightmap_%03u.png", e->dir, e->stem, p);
             rc = tl_png_write_rgb8(path, (int)pg.width, (int)pg.height, png, e->err) ? TL_GLTF_IO : 0;
         }
-        if (!rc) e->st->exr_files += 2, e->st->png_files++;
+        if (!rc) {
+            tl_tonemap(ez, n, 3, 1.0f / e->page_scale[p], png);
+            snprintf(path, sizeof path, "%s/%s.lightmap_%03u.emissive.png", e->dir, e->stem, p);
+            rc = tl_png_write_rgb8(path, (int)pg.width, (int)pg.height, png, e->err) ? TL_GLTF_IO : 0;
+        }
+        if (!rc) e->st->exr_files += 2, e->st->png_files += 2;
         free(ahd), free(png);
         first += n;
     }
     return rc;
 }
 
-/* Images and textures of the previews (texture p = page p), one linear clamped sampler. */
+/* Images and textures of the emissive pages (texture p = page p), one linear clamped sampler. */
 static void add_textures(ex *e)
 {
     cJSON *root = e->g.root;
@@ -545,7 +593,7 @@ static void add_textures(ex *e)
     cJSON *images = cJSON_AddArrayToObject(root, "images"), *textures = cJSON_AddArrayToObject(root, "textures");
     for (uint32_t p = 0; p < e->pages; p++) {
         char uri[256];
-        snprintf(uri, sizeof uri, "%s.lightmap_%03u.png", e->stem, p);
+        snprintf(uri, sizeof uri, "%s.lightmap_%03u.emissive.png", e->stem, p);
         cJSON *im = cJSON_CreateObject(), *tx = cJSON_CreateObject();
         cJSON_AddStringToObject(im, "uri", uri);
         cJSON_AddStringToObject(im, "mimeType", "image/png");
@@ -609,7 +657,8 @@ static void add_root_extras(ex *e, const char *container)
         cJSON *pg = cJSON_CreateObject();
         cJSON_AddNumberToObject(pg, "width", e->page_w[p]);
         cJSON_AddNumberToObject(pg, "height", e->page_h[p]);
-        cJSON_AddNumberToObject(pg, "preview_texture", p);
+        cJSON_AddNumberToObject(pg, "emissive_texture", p);
+        cJSON_AddNumberToObject(pg, "emissive_scale", e->page_scale[p]);
         cJSON_AddItemToArray(pages, pg);
     }
     cJSON_AddNumberToObject(l, "preview_exposure", e->exposure);
@@ -733,9 +782,10 @@ static int run(ex *e, const tl_gltf_options *o)
     if (e->s->sky_image < 0 && (e->s->sky[0] > 0 || e->s->sky[1] > 0 || e->s->sky[2] > 0))
         cJSON_AddItemToObject(cJSON_AddObjectToObject(sc, "extras"), "lbk_sky", cJSON_CreateFloatArray(e->s->sky, 3));
     cJSON_AddItemToArray(scenes, sc);
-    if (e->any_unlit || e->s->light_count) {
+    if (e->any_unlit || e->any_strength || e->s->light_count) {
         cJSON *used = cJSON_AddArrayToObject(e->g.root, "extensionsUsed");
         if (e->any_unlit) cJSON_AddItemToArray(used, cJSON_CreateString("KHR_materials_unlit"));
+        if (e->any_strength) cJSON_AddItemToArray(used, cJSON_CreateString("KHR_materials_emissive_strength"));
         if (e->s->light_count) cJSON_AddItemToArray(used, cJSON_CreateString("KHR_lights_punctual"));
     }
     return tl_glb_write(&e->g, o->output, e->err) ? (e->g.failed ? TL_GLTF_INTERNAL : TL_GLTF_IO) : 0;
@@ -763,6 +813,7 @@ int tl_gltf_export(const tl_bake *b, const tl_gltf_options *o, tl_gltf_stats *st
     int rc = scene.primitives ? run(&e, o) : tl_fail(err, TL_GLTF_INTERNAL, "the scene import gave no primitive table");
     tl_glb_free(&e.g);
     free(e.page_w), free(e.page_h), free(e.lm_material), free(e.plain_material), free(e.llg_material), free(e.texels);
+    free(e.page_scale);
     bk_scene_free(&scene);
     return rc;
 }

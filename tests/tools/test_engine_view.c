@@ -1,0 +1,311 @@
+/* The bake in an engine with no code of the user's: `lbk export --gltf` writes the lightmap as
+ * emission (emissiveTexture on TEXCOORD_1 × emissiveFactor = albedo × KHR_materials_emissive_strength,
+ * tools/convert/README.md "In engines"), and stock Babylon.js (npm babylonjs + babylonjs-loaders,
+ * pinned in mk/deps.mk, installed under $BUILD/npm-babylon by `make test`) shows it:
+ *  - the emissive PNG holds the EXR's irradiance to within its 8-bit sRGB steps (measured here);
+ *  - headless Chromium (Debian `chromium`, SwiftShader WebGL) loads the export with Babylon's own glTF
+ *    loader (tests/tools/babylon_page.html: canvas, camera, exposure, nothing about materials), and
+ *    the screenshot matches lbk render of the same view (bound below). Without Chromium or the npm
+ *    packages the browser case is SKIPPED (counted so); a page that draws no lightmap FAILS. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "tools/common/bake_data.h"
+#include "tools/common/file_util.h"
+#include "tools/common/image_io.h"
+#include "tools/convert/gltf_export.h"
+#include "tools/render/render.h"
+
+#define LEVEL "tests/fuzz/corpus/bake_cornell.lbk"
+#define SCENE "scenes/cornell_box/CornellBox-Original.gltf"
+
+/* the view of test_view.c (lbk view's comparison), so the two engines' numbers compare */
+#define W 160
+#define H 120
+#define STOPS 4.0
+#define FOV_DEG 45.0f
+static const float cam_from[3] = {0.1f, 1.05f, 3.0f}, cam_at[3] = {0.0f, 1.0f, 0.0f}, cam_up[3] = {0.0f, 1.0f, 0.0f};
+
+static char out_dir[1024];
+
+static const char *out(const char *name)
+{
+    static char path[4][1400];
+    static int k;
+    k = (k + 1) % 4;
+    snprintf(path[k], sizeof path[k], "%s/%s", out_dir, name);
+    return path[k];
+}
+
+/* out_dir = $BUILD/tests/engine_view (BUILD as tests/run.sh has it, default build), absolute: the
+ * browser gets file:// URLs of it. */
+static int setup(void **state)
+{
+    (void)state;
+    const char *b = getenv("BUILD");
+    char dir[1024], cmd[1200];
+    snprintf(dir, sizeof dir, "%s/tests/engine_view", b && *b ? b : "build");
+    snprintf(cmd, sizeof cmd, "mkdir -p '%s'", dir);
+    if (system(cmd) != 0 || !realpath(dir, out_dir)) return -1;
+    return 0;
+}
+
+static void export_level(void)
+{
+    char err[TL_ERR_LEN];
+    tl_bake b;
+    assert_int_equal(tl_bake_open_file(LEVEL, &b, err), TL_OPEN_OK);
+    tl_gltf_options g = {.output = out("level.glb"), .scene = SCENE, .container = "bake_cornell.lbk"};
+    tl_gltf_stats st;
+    const int rc = tl_gltf_export(&b, &g, &st, err);
+    if (rc) print_error("tl_gltf_export: %s\n", err);
+    assert_int_equal(rc, TL_GLTF_OK);
+    assert_int_equal(st.png_files, 2 * st.pages);
+    tl_bake_close(&b);
+}
+
+static double srgb_to_linear(double s) { return s <= 0.04045 ? s / 12.92 : pow((s + 0.055) / 1.055, 2.4); }
+
+/* The emissive PNG against the EXR beside it. Each channel is code = round(255 sRGB(E / scale)), so
+ * the decoded value is off by at most half a code step of the sRGB curve: relatively
+ * 0.5 · d ln(x) / d code = 0.5 · 2.4 / (255 · (s + 0.055) / 1.055) at s = code / 255 above the
+ * linear toe — 0.49 % at full scale, 2.3 % at s = 0.2 (x = 3.3 % of the scale), 4.7 % at
+ * s = 0.1 (1 %). Measured on the cornell bake (12 × 32, scale 0.2246 lux): all 1152 channels at or
+ * above 1 % of the scale within the bound, mean 0.53 %, max 2.28 % relative. */
+static void test_emissive_png_holds_the_exr(void **state)
+{
+    (void)state;
+    export_level();
+    char err[TL_ERR_LEN];
+    static const char *const RGB[3] = {"R", "G", "B"};
+    int w, h, pw, ph;
+    float *exr;
+    uint8_t *png;
+    assert_int_equal(tl_exr_read(out("level.lightmap_000.exr"), 3, RGB, &w, &h, &exr, err), 0);
+    assert_int_equal(tl_png_read_rgb8(out("level.lightmap_000.emissive.png"), &pw, &ph, &png, err), 0);
+    assert_int_equal(pw, w);
+    assert_int_equal(ph, h);
+    float scale = 0.0f;
+    for (int i = 0; i < 3 * w * h; i++) scale = exr[i] > scale ? exr[i] : scale;
+    int n = 0, at_top = 0, over = 0;
+    double sum = 0, worst = 0;
+    for (int i = 0; i < 3 * w * h; i++) {
+        const double x = exr[i] / scale, s = png[i] / 255.0;
+        at_top += png[i] == 255;
+        if (x < 0.01) continue;
+        const double rel = fabs(srgb_to_linear(s) - x) / x;
+        const double bound = s <= 0.04045 ? 0.5 / png[i] : 0.5 * 2.4 * 1.055 / (255.0 * (s + 0.055));
+        over += rel > bound * 1.0001 + 1e-6;
+        sum += rel, n++;
+        worst = rel > worst ? rel : worst;
+    }
+    print_message("emissive PNG against the EXR (scale %.6g lux): %d channels >= 1 %% of the scale, mean %.3f %%, max %.3f %% "
+                  "relative, %d over the half-step bound\n",
+                  scale, n, 100.0 * sum / (n ? n : 1), 100.0 * worst, over);
+    free(exr), free(png);
+    assert_true(n > w * h); /* the page is lit */
+    assert_true(at_top >= 1);  /* the page's largest value is code 255: nothing clips below it */
+    assert_int_equal(over, 0);
+    assert_true(sum / n < 0.01);
+}
+
+/* ---- stock Babylon.js in headless Chromium ------------------------------------------------- */
+
+static int have_chromium(void) { return system("command -v chromium >/dev/null 2>&1") == 0; }
+
+/* The npm packages (mk/deps.mk: babylon-npm), or "" when they are not installed. */
+static const char *babylon_dir(void)
+{
+    static char dir[1100];
+    snprintf(dir, sizeof dir, "%s/../../npm-babylon/node_modules", out_dir);
+    char f[1200];
+    snprintf(f, sizeof f, "%s/babylonjs-loaders/babylonjs.loaders.js", dir);
+    return access(f, R_OK) ? "" : dir;
+}
+
+/* --no-sandbox: the tests may run as root; SwiftShader gives WebGL 2 without a GPU; file access
+ * from files: Babylon reads the GLB and its PNGs with XHR from file:// URLs; timeout: a hung
+ * browser fails the case instead of stopping the suite. */
+#define CHROMIUM "timeout 120 chromium --headless=new --no-sandbox --disable-gpu-sandbox --use-gl=angle --use-angle=swiftshader " \
+                 "--enable-unsafe-swiftshader --hide-scrollbars --force-device-scale-factor=1 --allow-file-access-from-files " \
+                 "--virtual-time-budget=20000"
+
+static void page_url(char *url, size_t size)
+{
+    snprintf(url, size, "file://%s/page.html#lib=%s&glb=level.glb&size=%dx%d&stops=%g&cam=%g,%g,%g,%g,%g,%g,%g,%g,%g,%g",
+             out_dir, babylon_dir(), W, H, STOPS, cam_from[0], cam_from[1], cam_from[2], cam_at[0], cam_at[1], cam_at[2],
+             cam_up[0], cam_up[1], cam_up[2], FOV_DEG);
+}
+
+/* The page's title after it ran: "ready: N emissive textures" or "error: ..." (malloc'ed). */
+static char *page_title(const char *url)
+{
+    char cmd[8192], err[TL_ERR_LEN];
+    snprintf(cmd, sizeof cmd, CHROMIUM " --user-data-dir=%s --dump-dom '%s' > %s 2>/dev/null", out("profile"), url, out("dom.html"));
+    assert_int_equal(system(cmd), 0);
+    void *dom;
+    size_t n;
+    assert_int_equal(tl_read_file(out("dom.html"), &dom, &n, err), 0);
+    char *s = realloc(dom, n + 1);
+    assert_non_null(s);
+    s[n] = 0;
+    const char *a = strstr(s, "<title>"), *b = a ? strstr(a, "</title>") : NULL;
+    char *t = strdup(a && b ? a + 7 : "(no title)");
+    if (a && b) t[b - a - 7] = 0;
+    free(s);
+    return t;
+}
+
+static float srgb(float x)
+{
+    x = x < 0 ? 0 : x > 1 ? 1 : x;
+    return x <= 0.0031308f ? 12.92f * x : 1.055f * powf(x, 1.0f / 2.4f) - 0.055f;
+}
+
+/* An edge pixel of the reference: some 8-neighbour differs by more than 8 codes in a channel (a
+ * silhouette or a crease, where rasterisation and ray casting may see different surfaces). */
+static int on_edge(const uint8_t *img, int x, int y)
+{
+    for (int dy = -1; dy <= 1; dy++)
+        for (int dx = -1; dx <= 1; dx++) {
+            const int X = x + dx, Y = y + dy;
+            if (X < 0 || Y < 0 || X >= W || Y >= H) continue;
+            for (int c = 0; c < 3; c++)
+                if (abs(img[3 * (Y * W + X) + c] - img[3 * (y * W + x) + c]) > 8) return 1;
+        }
+    return 0;
+}
+
+/* lbk render's view as 8-bit sRGB of radiance × 2^STOPS (the page's exposure), with a black sky
+ * (the page clears to black); *covered: pixels whose centre ray hit geometry with light on it. */
+static void reference(uint8_t *ref8, uint8_t *covered)
+{
+    char err[TL_ERR_LEN];
+    tl_render_options o;
+    memset(&o, 0, sizeof o);
+    o.width = W, o.height = H, o.samples = 1, o.threads = 1;
+    memcpy(o.camera.from, cam_from, sizeof cam_from);
+    memcpy(o.camera.at, cam_at, sizeof cam_at);
+    memcpy(o.camera.up, cam_up, sizeof cam_up);
+    o.camera.yfov = FOV_DEG * 3.14159265358979f / 180.0f;
+    o.sky_override = 1;
+    tl_image img;
+    assert_int_equal(tl_render(SCENE, LEVEL, &o, &img, err), TL_RENDER_OK);
+    const float k = powf(2.0f, (float)STOPS);
+    for (int i = 0; i < W * H; i++) {
+        covered[i] = img.rgb[3 * i] > 0 || img.rgb[3 * i + 1] > 0 || img.rgb[3 * i + 2] > 0;
+        for (int c = 0; c < 3; c++) ref8[3 * i + c] = (uint8_t)lrintf(srgb(img.rgb[3 * i + c] * k) * 255.0f);
+    }
+    tl_image_free(&img);
+}
+
+/* The screenshot against lbk render, per pixel the largest channel difference in 8-bit sRGB codes
+ * after the same exposure (2^4) and the same transfer function (the page asks Babylon for the exact
+ * sRGB curves). What may differ, inside surfaces:
+ *  - the emissive PNG's 8-bit sRGB step (test above): half a code of the texture; the view maps
+ *    texture value t to display sRGB(2^4 · albedo · scale / π · t), at most 0.83 · t here (cornell:
+ *    albedo ≤ 0.725, scale 0.2246 lux), so under half a display code;
+ *  - the filter: Babylon blends the four texels of the sRGB texture after decoding (WebGL sRGB
+ *    texture), lbk render in AHD's linear form: the same for plane 0 along the normal, up to the
+ *    GPU's 8-bit filter weights (1/256: under a code where neighbours differ by less than 64 codes);
+ *  - the rounding to 8 bits on each side: one code.
+ * So interior pixels differ by at most 2 codes. Pixels where rasterisation and ray casting see
+ * different surfaces (silhouettes, creases: on_edge of the reference) may differ more: at most 3 %
+ * of the covered pixels differ by more than 2 codes, and the mean over the covered pixels stays
+ * ≤ 1 code. Measured (cornell bake, 160 × 120, Babylon.js 9.28.0, Chromium 156 SwiftShader): mean
+ * 0.42 codes over 17 391 covered pixels; 67.2 % equal, 32.6 % one code, 8 pixels two codes apart,
+ * 26 (0.15 %) more, all on an edge. With Babylon's default pow(2.2) curves instead of the exact
+ * ones: mean 3.08 codes, 47.7 % over 2 codes (fails). With the emissive strength zeroed after
+ * loading (the surfaces drawn without the lightmap): 129 of 17 391 pixels lit, mean 105 codes. */
+static void test_babylon_shows_the_lightmap(void **state)
+{
+    (void)state;
+    if (!have_chromium()) {
+        print_message("SKIPPED: no chromium (make deps installs it)\n");
+        skip();
+    }
+    if (!*babylon_dir()) {
+        print_message("SKIPPED: npm babylonjs/babylonjs-loaders not under %s/../npm-babylon (make babylon-npm)\n", out_dir);
+        skip();
+    }
+    export_level();
+    char err[TL_ERR_LEN], url[4096], cmd[8192];
+    void *html;
+    size_t hn;
+    assert_int_equal(tl_read_file("tests/tools/babylon_page.html", &html, &hn, err), 0);
+    assert_int_equal(tl_write_file_atomic(out("page.html"), html, hn, err), 0);
+    free(html);
+    page_url(url, sizeof url);
+    char *title = page_title(url);
+    print_message("page: %s\n", title);
+    /* every lightmapped material (7 of the cornell box's 8: the light keeps its own emission) */
+    assert_string_equal(title, "ready: 7 emissive textures");
+    free(title);
+    unlink(out("shot.png"));
+    /* headless Chromium keeps a minimum window size: the canvas is the top-left W × H of a larger shot */
+    snprintf(cmd, sizeof cmd, CHROMIUM " --user-data-dir=%s --window-size=%d,%d --screenshot=%s '%s' >/dev/null 2>&1",
+             out("profile"), 3 * W, 3 * H, out("shot.png"), url);
+    assert_int_equal(system(cmd), 0);
+    int w, h;
+    uint8_t *shot;
+    assert_int_equal(tl_png_read_rgb8(out("shot.png"), &w, &h, &shot, err), 0);
+    assert_int_equal(w, 3 * W);
+    assert_int_equal(h, 3 * H);
+    for (int y = 0; y < H; y++) memmove(shot + 3 * W * y, shot + 3 * w * y, 3 * W);
+    static uint8_t ref8[W * H * 3], covered[W * H];
+    reference(ref8, covered);
+    int n = 0, over = 0, interior = 0, shot_lit = 0, max_d = 0, hist[3] = {0, 0, 0};
+    double sum = 0;
+    for (int i = 0; i < W * H; i++) {
+        if (!covered[i]) continue;
+        int d = 0;
+        for (int c = 0; c < 3; c++) {
+            const int e = abs(ref8[3 * i + c] - shot[3 * i + c]);
+            d = e > d ? e : d;
+        }
+        shot_lit += shot[3 * i] + shot[3 * i + 1] + shot[3 * i + 2] > 24;
+        n++, sum += d;
+        max_d = d > max_d ? d : max_d;
+        if (d <= 2) hist[d]++;
+        if (d > 2) {
+            over++;
+            if (!on_edge(ref8, i % W, i / W)) interior++;
+        }
+    }
+    print_message("Babylon.js vs lbk render %dx%d: %d covered pixels (%d lit in the shot), mean %.3f codes; %d equal, %d one "
+                  "code, %d two codes apart, %d more (%.2f %%, %d not on an edge), max %d\n",
+                  W, H, n, shot_lit, sum / (n ? n : 1), hist[0], hist[1], hist[2], over, 100.0 * over / (n ? n : 1), interior,
+                  max_d);
+    tl_png_write_rgb8(out("ref.png"), W, H, ref8, err); /* beside shot.png, to look at when it fails */
+    free(shot);
+    assert_true(n > W * H / 2); /* the view is filled by the level */
+    if (shot_lit <= n * 9 / 10)
+        print_error("Babylon.js drew the level without its lightmap: %d of %d covered pixels lit (see %s)\n", shot_lit, n,
+                    out("shot.png"));
+    assert_true(shot_lit > n * 9 / 10);
+    if (sum / n > 1.0 || over > n * 3 / 100)
+        print_error("Babylon.js's picture is not lbk render's: mean %.3f codes (bound 1), %.2f %% of the pixels over 2 codes "
+                    "(bound 3 %%): see %s and %s\n",
+                    sum / n, 100.0 * over / n, out("shot.png"), out("ref.png"));
+    assert_true(sum / n <= 1.0);
+    assert_true(over <= n * 3 / 100);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_emissive_png_holds_the_exr),
+        cmocka_unit_test(test_babylon_shows_the_lightmap),
+    };
+    return cmocka_run_group_tests(tests, setup, NULL);
+}
