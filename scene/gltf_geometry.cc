@@ -242,6 +242,14 @@ void Importer::prepare_prim(int mi, int pi, Prim &p, bool *is_triangles)
             for (size_t i = 0; i < nv; i++) idx[i] = (uint32_t)i;
         }
     }
+    // TANGENT only where a normal map may use it; inside a Draco stream it is derived instead.
+    if (o_.normal_maps && attr("TANGENT") >= 0 && p.has_nrm &&
+        (dit == pp_.draco.end() || !dit->second.attributes.count("TANGENT"))) {
+        read_accessor(attr("TANGENT"), 4, false, &p.tan, nullptr, lbl + " TANGENT");
+        if (p.tan.size() != nv * 4)
+            fail("%s: %s: TANGENT has %zu elements but the primitive %zu vertices", file, lbl.c_str(), p.tan.size() / 4, nv);
+        p.has_tan = true;
+    }
     // Triangle list from the index stream.
     size_t n = idx.size();
     if (mode == TINYGLTF_MODE_TRIANGLES) {
@@ -270,6 +278,7 @@ void Importer::prepare_prim(int mi, int pi, Prim &p, bool *is_triangles)
     for (size_t i = 0; i < nv; i++) p.src[i] = (uint32_t)i;
     if (!p.has_nrm) {
         // Flat shading: give every triangle its own three vertices; normals come at instancing.
+        // (TANGENT is not read without NORMAL: glTF says to ignore it then.)
         size_t nt = p.tris.size() / 3;
         std::vector<float> pos(nt * 9), uv0(nt * 6), uv1(nt * 6);
         std::vector<uint32_t> tris(nt * 3), src(nt * 3);
@@ -418,6 +427,34 @@ void Importer::check_extent(const std::vector<Instance> &kept)
              node_label(kept[small].node).c_str(), feature, reach, reach / feature);
 }
 
+// World-space tangents of a primitive's vertices (after their normals, repaired ones included):
+// T' = A·T and B' = A·B (B = w·(N × T) in the mesh's frame: A maps surface directions), T' made
+// orthogonal to the world normal, w' the side of B' (a mirroring transform flips it). Vertices
+// without a usable TANGENT get w = 0: bk_scene_derive_tangents fills them from uv0.
+void Importer::emit_tangents(const Prim &p, size_t v0, const double A[9])
+{
+    const size_t nv = p.pos.size() / 3;
+    for (size_t v = 0; v < nv; v++) {
+        float *out = &s_->tangents[(v0 + v) * 4];
+        out[0] = out[1] = out[2] = out[3] = 0.0f;
+        if (!p.has_tan) continue;
+        const float *ft = &p.tan[v * 4], *fn = &p.nrm[v * 3], *wn = &s_->normals[(v0 + v) * 3];
+        const double lt[3] = {ft[0], ft[1], ft[2]}, ln[3] = {fn[0], fn[1], fn[2]}, n[3] = {wn[0], wn[1], wn[2]};
+        const double w = ft[3] < 0 ? -1.0 : 1.0;
+        double lb[3] = {w * (ln[1] * lt[2] - ln[2] * lt[1]), w * (ln[2] * lt[0] - ln[0] * lt[2]),
+                        w * (ln[0] * lt[1] - ln[1] * lt[0])};
+        double t[3], b[3];
+        xform_dir(A, lt, t);
+        xform_dir(A, lb, b);
+        const double d = t[0] * n[0] + t[1] * n[1] + t[2] * n[2];
+        for (int k = 0; k < 3; k++) t[k] -= d * n[k];
+        if (!normalize3(t)) continue;  // parallel to the normal, or zero: derived instead
+        const double c[3] = {n[1] * t[2] - n[2] * t[1], n[2] * t[0] - n[0] * t[2], n[0] * t[1] - n[1] * t[0]};
+        for (int k = 0; k < 3; k++) out[k] = (float)t[k];
+        out[3] = c[0] * b[0] + c[1] * b[1] + c[2] * b[2] < 0 ? -1.0f : 1.0f;
+    }
+}
+
 void Importer::emit_geometry()
 {
     const char *file = path_.c_str();
@@ -452,6 +489,7 @@ void Importer::emit_geometry()
     s_->normals = alloc_array<float>(total_v, 3);
     s_->uv0 = alloc_array<float>(total_v, 2);
     s_->uv1 = alloc_array<float>(total_v, 2);
+    if (o_.normal_maps) s_->tangents = alloc_array<float>(total_v, 4);
     s_->tris = alloc_array<uint32_t>(total_t, 3);
     s_->tri_material = alloc_array<uint32_t>(total_t, 1);
     s_->tri_object = alloc_array<uint32_t>(total_t, 1);
@@ -545,6 +583,7 @@ void Importer::emit_geometry()
                     for (int q = 0; q < 3; q++) nrm[q] = (float)fn[q];
                 }
             }
+            if (s_->tangents) emit_tangents(p, v0, A);
             v0 += nv;
             t0 += nt;
         }

@@ -532,7 +532,8 @@ void check_uris(const nlohmann::json &doc, const std::string &file, const Resour
 
 }  // namespace
 
-Prepass prepass(const char *json_begin, size_t json_len, const std::string &file, const ResourcePolicy &pol)
+Prepass prepass(const char *json_begin, size_t json_len, const std::string &file, const ResourcePolicy &pol,
+                bool normal_maps)
 {
     Prepass pp;
     const Shape shape = json_shape(json_begin, json_len);
@@ -570,7 +571,8 @@ Prepass prepass(const char *json_begin, size_t json_len, const std::string &file
         }
     }
 
-    // Textures that matter to the baker: base colour, metallic-roughness and emissive.
+    // Textures that matter to the baker: base colour, metallic-roughness and emissive (and the
+    // normal texture for an import that reads normal maps).
     {
         const nlohmann::json *images = jarr(doc, "images");
         const nlohmann::json *textures = jarr(doc, "textures");
@@ -597,6 +599,7 @@ Prepass prepass(const char *json_begin, size_t json_len, const std::string &file
                 if (pbr != m.end() && pbr->is_object() && pbr->contains("metallicRoughnessTexture"))
                     need((*pbr)["metallicRoughnessTexture"]);
                 if (m.contains("emissiveTexture")) need(m["emissiveTexture"]);
+                if (normal_maps && m.contains("normalTexture")) need(m["normalTexture"]);
             }
     }
 

@@ -55,7 +55,8 @@ void Importer::load()
     size_t json_len = glb ? g.json_len : bytes.size();
     if (json_len > o_.max_json_bytes)
         fail("%s: %zu bytes of JSON exceeds the %zu-byte JSON cap", file, json_len, o_.max_json_bytes);
-    pp_ = prepass(glb ? g.json : reinterpret_cast<const char *>(bytes.data()), json_len, path_, policy_);
+    pp_ = prepass(glb ? g.json : reinterpret_cast<const char *>(bytes.data()), json_len, path_, policy_,
+                  o_.normal_maps != 0);
 
     tinygltf::TinyGLTF loader;
     FsState fss{o_.max_file_bytes, &policy_, &reads_};
@@ -293,6 +294,7 @@ void Importer::run()
     meshes_.resize(m_.meshes.size());
     traverse();
     emit_geometry();
+    if (s_->tangents && bk_scene_derive_tangents(s_)) throw std::bad_alloc();
     emit_lights();
     read_sky();
     read_combinations();

@@ -207,6 +207,7 @@ struct DracoInfo {
 struct Prepass {
     std::map<std::pair<int, int>, DracoInfo> draco;  // (mesh, primitive)
     std::vector<char> needed_images;                 // images used as base colour / emissive / metallicRoughness
+                                                     // (and normal, when the import reads normal maps)
     std::string json;                                // rewritten JSON handed to tinygltf
 };
 
@@ -216,7 +217,8 @@ struct Prepass {
 // EXT_meshopt_compression when required (naming the texture / bufferView), validates image
 // bufferViews, notes the images the baker needs (EXT_texture_webp's source first) and the Draco
 // primitives, and rewrites the JSON for tinygltf.
-Prepass prepass(const char *json_begin, size_t json_len, const std::string &file, const ResourcePolicy &pol);
+Prepass prepass(const char *json_begin, size_t json_len, const std::string &file, const ResourcePolicy &pol,
+                bool normal_maps);
 
 // ---- GLB container (gltf_guard.cc) ------------------------------------------------------------
 
@@ -264,9 +266,10 @@ struct UvMap {
 
 struct Prim {  // one triangle primitive, in mesh-local space, ready to instance
     std::vector<float> pos, nrm, uv0, uv1;
+    std::vector<float> tan;        // TANGENT (4 per vertex), read only for normal maps and with NORMAL
     std::vector<uint32_t> tris;
     std::vector<uint32_t> src;     // per vertex: its index in the glTF primitive (flat shading splits them)
-    bool has_nrm = false, has_uv1 = false;
+    bool has_nrm = false, has_uv1 = false, has_tan = false;
     uint32_t material = 0;
     uint32_t gltf_index = 0;       // index in the glTF mesh's primitives
     uint32_t source_vertices = 0;  // vertices of the glTF primitive (POSITION count or Draco points)
@@ -324,6 +327,7 @@ private:
     XXH3_state_t hash_;
     std::vector<InputRecord> reads_;  // every file read, in the order read
     std::vector<int> image_map_;      // glTF image -> scene image (-1: none)
+    std::vector<int> linear_map_;     // the same for images read as data (normal maps: no sRGB decode)
     std::vector<bk_image> images_;
     size_t image_bytes_ = 0;
     std::vector<bk_material> materials_;
@@ -352,13 +356,14 @@ private:
     void record_inputs();
     // gltf_materials.cc
     void decode_images();
-    int decode_image(int gi);
+    int decode_image(int gi, bool linear = false);
     void build_materials();
     int texture_image(const tinygltf::TextureInfo &ti, const char *slot, int mi, const std::string &mname,
-                      UvMap *map);
+                      UvMap *map, bool linear = false);
+    void read_normal_texture(const tinygltf::Material &gm, int mi, bk_material *bm, UvMap *map);
     int texture_source(int tex) const;
     UvMap read_uv_map(const tinygltf::TextureInfo &ti, const char *slot, int mi, const std::string &mname);
-    void settle_uv_maps(int mi, const std::string &mname, int *tex[3], const UvMap maps[3]);
+    void settle_uv_maps(int mi, const std::string &mname, int *tex[4], const UvMap maps[4]);
     void apply_uv_map(Prim &p, int mi, int pi);
     unsigned char *decode_pixels(const unsigned char *bytes, size_t len, const std::string &label, int *w, int *h,
                                  bool *webp);
@@ -371,6 +376,7 @@ private:
     void decode_draco(int mi, int pi, const DracoInfo &di, Prim &p, std::vector<uint32_t> &idx, size_t *nverts);
     void check_draco_counts(int mi, int pi, const DracoInfo &di, size_t points, size_t indices);
     void emit_geometry();
+    void emit_tangents(const Prim &p, size_t v0, const double A[9]);
     void choose_origin(const std::vector<Instance> &kept);
     void check_extent(const std::vector<Instance> &kept);  // the limits float rays can trace
     // gltf_extras.cc

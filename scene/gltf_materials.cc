@@ -107,9 +107,12 @@ unsigned char *Importer::decode_pixels(const unsigned char *bytes, size_t len, c
     return px;
 }
 
-int Importer::decode_image(int gi)
+// linear: the texels are data (a normal map), byte / 255 without the sRGB decode; cached apart
+// from the colour decode of the same image.
+int Importer::decode_image(int gi, bool linear)
 {
-    if (image_map_[(size_t)gi] != -2) return image_map_[(size_t)gi];
+    std::vector<int> &cache = linear ? linear_map_ : image_map_;
+    if (cache[(size_t)gi] != -2) return cache[(size_t)gi];
     const tinygltf::Image &im = m_.images[(size_t)gi];
     std::string label = "image " + std::to_string(gi) + (im.uri.empty() || im.uri.rfind("data:", 0) == 0
                                                              ? (im.name.empty() ? "" : " " + qstr(im.name))
@@ -137,14 +140,14 @@ int Importer::decode_image(int gi)
     int w = 0, h = 0;
     unsigned char *px = decode_pixels(bytes, len, label, &w, &h, &webp);
     if (!px) {
-        image_map_[(size_t)gi] = -1;
+        cache[(size_t)gi] = -1;
         return -1;
     }
     auto free_px = [&]() { webp ? WebPFree(px) : stbi_image_free(px); };
     float lut[256];
     for (int i = 0; i < 256; i++) {
         double c = i / 255.0;
-        lut[i] = (float)(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
+        lut[i] = (float)(linear ? c : c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
     }
     // Convert and filter in rows so a big texture never exists in float at full size.
     int f = 1;
@@ -185,13 +188,14 @@ int Importer::decode_image(int gi)
     for (int k = 0; k < 4; k++) bi.mean[k] = (float)(sum[k] / ((double)nw * nh));
     images_.push_back(bi);
     image_bytes_ += bytes_out;
-    image_map_[(size_t)gi] = (int)images_.size() - 1;
-    return image_map_[(size_t)gi];
+    cache[(size_t)gi] = (int)images_.size() - 1;
+    return cache[(size_t)gi];
 }
 
 void Importer::decode_images()
 {
     image_map_.assign(m_.images.size(), -2);  // -2: not decoded yet
+    linear_map_.assign(m_.images.size(), -2);
 }
 
 // The image a texture reads: EXT_texture_webp's source when it names one (lbk decodes WebP),
@@ -255,7 +259,7 @@ UvMap Importer::read_uv_map(const tinygltf::TextureInfo &ti, const char *slot, i
 }
 
 int Importer::texture_image(const tinygltf::TextureInfo &ti, const char *slot, int mi, const std::string &mname,
-                            UvMap *map)
+                            UvMap *map, bool linear)
 {
     if (ti.index < 0 || o_.skip_textures) return -1;
     if ((size_t)ti.index >= m_.textures.size())
@@ -278,16 +282,35 @@ int Importer::texture_image(const tinygltf::TextureInfo &ti, const char *slot, i
              mi, qstr(mname).c_str(), slot, map->texcoord);
         return -1;
     }
-    return decode_image(src);
+    return decode_image(src, linear);
+}
+
+// normalTexture (glTF 2.0 §3.9.3), for imports that read normal maps: decoded as data, its scale
+// checked; its KHR_texture_transform / texCoord joins the material's one uv (settle_uv_maps) as
+// the last slot, so it never changes what the other textures read.
+void Importer::read_normal_texture(const tinygltf::Material &gm, int mi, bk_material *bm, UvMap *map)
+{
+    bm->normal_scale = 1.0f;
+    if (!o_.normal_maps || gm.normalTexture.index < 0) return;
+    const double sc = gm.normalTexture.scale;
+    if (!std::isfinite(sc) || std::fabs(sc) > 1e6)
+        fail("%s: material %d %s: normalTexture scale must be a finite number (|scale| <= 1e6)", path_.c_str(), mi,
+             qstr(gm.name).c_str());
+    tinygltf::TextureInfo ti;
+    ti.index = gm.normalTexture.index;
+    ti.texCoord = gm.normalTexture.texCoord;
+    ti.extensions = gm.normalTexture.extensions;
+    bm->normal_tex1 = 1 + texture_image(ti, "normal", mi, gm.name, map, true);
+    bm->normal_scale = (float)sc;
 }
 
 // One uv per material (it is folded into the primitive's uv0): the first textured slot's map wins;
 // a later slot whose transform or texCoord differs is dropped, warned and counted.
-void Importer::settle_uv_maps(int mi, const std::string &mname, int *tex[3], const UvMap maps[3])
+void Importer::settle_uv_maps(int mi, const std::string &mname, int *tex[4], const UvMap maps[4])
 {
-    static const char *const slots[3] = {"baseColor", "emissive", "metallicRoughness"};
+    static const char *const slots[4] = {"baseColor", "emissive", "metallicRoughness", "normal"};
     int first = -1;
-    for (int k = 0; k < 3; k++) {
+    for (int k = 0; k < 4; k++) {
         if (*tex[k] < 0) continue;
         if (first < 0) {
             first = k;
@@ -358,7 +381,7 @@ void Importer::build_materials()
             if (!std::isfinite((float)e)) fail("%s: material %d %s: emission overflows a float", file, mi, mq.c_str());
             bm.emission[k] = (float)e;
         }
-        UvMap maps[3];
+        UvMap maps[4];
         bm.albedo_tex = texture_image(gm.pbrMetallicRoughness.baseColorTexture, "baseColor", mi, gm.name, &maps[0]);
         bm.emission_tex = texture_image(gm.emissiveTexture, "emissive", mi, gm.name, &maps[1]);
         bm.double_sided = gm.doubleSided ? 1 : 0;
@@ -372,9 +395,12 @@ void Importer::build_materials()
         // after the emissive texture: the images of materials without it keep their indices
         int mr = texture_image(gm.pbrMetallicRoughness.metallicRoughnessTexture, "metallicRoughness", mi, gm.name,
                                &maps[2]);
-        int *tex[3] = {&bm.albedo_tex, &bm.emission_tex, &mr};
+        read_normal_texture(gm, mi, &bm, &maps[3]);  // last: images before it keep their indices
+        int nt = bm.normal_tex1 - 1;
+        int *tex[4] = {&bm.albedo_tex, &bm.emission_tex, &mr, &nt};
         settle_uv_maps(mi, gm.name, tex, maps);
         bm.metal_rough_tex1 = 1 + mr;
+        bm.normal_tex1 = 1 + nt;
         materials_.push_back(bm);
     }
 }

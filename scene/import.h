@@ -41,6 +41,11 @@ typedef struct bk_import_options {
      * the bake uses, so a 1 mm object 1e5 m away keeps its shape); 0: world positions as floats
      * (origin 0), what tools comparing with world-space data want. */
     int recentre;
+    /* 1: also read each material's normalTexture (bk_material.normal_tex1, normal_scale; decoded
+     * as linear data) and give the scene tangents (bk_scene.tangents: TANGENT where a primitive
+     * has it with NORMAL, else derived). For readers that shade with normal maps (lbk render,
+     * lbk export --gltf); the bake leaves it 0, so its import and source hash are unchanged. */
+    int normal_maps;
     /* Optional: receives each warning (one line, no newline). */
     void (*warn)(void *user, const char *message);
     void *warn_user;

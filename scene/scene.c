@@ -16,6 +16,7 @@ void bk_scene_free(bk_scene *scene)
     free(scene->normals);
     free(scene->uv0);
     free(scene->uv1);
+    free(scene->tangents);
     free(scene->tris);
     free(scene->tri_material);
     free(scene->tri_object);
@@ -110,6 +111,8 @@ int bk_scene_check(const bk_scene *s, char *err, size_t err_len)
         const float *n = s->normals + 3 * v;
         float len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
         if (fabsf(len - 1.0f) > 1e-3f) FAIL("vertex %zu: normal length %g, not unit", v, len);
+        if (s->tangents && (!finite_n(s->tangents + 4 * v, 4) || fabsf(fabsf(s->tangents[4 * v + 3]) - 1.0f) > 0))
+            FAIL("vertex %zu: tangent not finite or its sign not +-1", v);
     }
     for (size_t t = 0; t < s->tri_count; t++) {
         for (int k = 0; k < 3; k++)
@@ -161,4 +164,89 @@ int bk_scene_check(const bk_scene *s, char *err, size_t err_len)
     if (!finite_n(s->sky, 3)) FAIL("non-finite sky radiance");
     return 0;
 #undef FAIL
+}
+
+/* ---- tangents ---------------------------------------------------------------------------- */
+
+static void sub3d(const float a[3], const float b[3], double o[3])
+{
+    for (int k = 0; k < 3; k++) o[k] = (double)a[k] - (double)b[k];
+}
+
+static double dot3d(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+static void cross3d(const double a[3], const double b[3], double o[3])
+{
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* Adds triangle t's +u and +v directions (dP/du, dP/dv, unit) to the sums of its corners whose
+ * tangent is still open (w == 0), each weighted by the corner's angle (MikkTSpace's weight: a
+ * vertex's frame does not depend on how its fan is split into triangles). acc holds 6 doubles
+ * per open vertex (T sum, B sum) at the vertex's slot. */
+static void accumulate_triangle(const bk_scene *s, size_t t, double *acc)
+{
+    const uint32_t *v = &s->tris[3 * t];
+    double e1[3], e2[3], tu[3], tv[3];
+    sub3d(&s->positions[3 * (size_t)v[1]], &s->positions[3 * (size_t)v[0]], e1);
+    sub3d(&s->positions[3 * (size_t)v[2]], &s->positions[3 * (size_t)v[0]], e2);
+    const float *a = &s->uv0[2 * (size_t)v[0]], *b = &s->uv0[2 * (size_t)v[1]], *c = &s->uv0[2 * (size_t)v[2]];
+    const double du1 = (double)b[0] - a[0], dv1 = (double)b[1] - a[1], du2 = (double)c[0] - a[0], dv2 = (double)c[1] - a[1];
+    const double det = du1 * dv2 - du2 * dv1;
+    if (!(fabs(det) > 1e-20) || !isfinite(det)) return; /* uv0 spans no area: no direction */
+    for (int k = 0; k < 3; k++) {
+        tu[k] = (dv2 * e1[k] - dv1 * e2[k]) / det;
+        tv[k] = (du1 * e2[k] - du2 * e1[k]) / det;
+    }
+    const double lu = sqrt(dot3d(tu, tu)), lv = sqrt(dot3d(tv, tv));
+    if (!(lu > 0) || !(lv > 0) || !isfinite(lu) || !isfinite(lv)) return;
+    for (int c3 = 0; c3 < 3; c3++) {
+        const uint32_t vi = v[c3];
+        if (s->tangents[4 * (size_t)vi + 3] != 0.0f) continue;
+        double x[3], y[3];
+        sub3d(&s->positions[3 * (size_t)v[(c3 + 1) % 3]], &s->positions[3 * (size_t)vi], x);
+        sub3d(&s->positions[3 * (size_t)v[(c3 + 2) % 3]], &s->positions[3 * (size_t)vi], y);
+        const double lx = sqrt(dot3d(x, x)), ly = sqrt(dot3d(y, y));
+        if (!(lx > 0) || !(ly > 0)) continue;
+        const double angle = acos(fmax(-1.0, fmin(1.0, dot3d(x, y) / (lx * ly))));
+        double *dst = &acc[6 * (size_t)vi];
+        for (int k = 0; k < 3; k++) dst[k] += angle * tu[k] / lu, dst[3 + k] += angle * tv[k] / lv;
+    }
+}
+
+/* The tangent of open vertex vi from its sums: T made orthogonal to N; w such that B = w·(N × T)
+ * points along −dP/dv, the normal map's +Y (glTF: +Y is up in the image, and uv (0, 0) is its
+ * top left corner, so up is −v). */
+static void finish_tangent(bk_scene *s, size_t vi, const double sums[6])
+{
+    const float *nf = &s->normals[3 * vi];
+    const double n[3] = {nf[0], nf[1], nf[2]};
+    double t[3] = {sums[0], sums[1], sums[2]}, b[3] = {sums[3], sums[4], sums[5]}, nt[3];
+    const double d = dot3d(t, n);
+    for (int k = 0; k < 3; k++) t[k] -= d * n[k];
+    double l = sqrt(dot3d(t, t));
+    if (!(l > 1e-12) || !isfinite(l)) { /* no usable triangle: any direction in the plane */
+        const double ax[3] = {fabs(n[0]) < 0.9 ? 1.0 : 0.0, fabs(n[0]) < 0.9 ? 0.0 : 1.0, 0.0};
+        const double e = dot3d(ax, n);
+        for (int k = 0; k < 3; k++) t[k] = ax[k] - e * n[k];
+        l = sqrt(dot3d(t, t));
+    }
+    cross3d(n, t, nt);
+    float *out = &s->tangents[4 * vi];
+    for (int k = 0; k < 3; k++) out[k] = (float)(t[k] / l);
+    out[3] = dot3d(nt, b) > 0.0 ? -1.0f : 1.0f; /* B = w·(N × T) is the image's up: −v */
+}
+
+int bk_scene_derive_tangents(bk_scene *s)
+{
+    if (!s->tangents || !s->vertex_count) return 0;
+    double *acc = calloc(s->vertex_count, 6 * sizeof *acc);
+    if (!acc) return -1;
+    for (size_t t = 0; t < s->tri_count; t++) accumulate_triangle(s, t, acc);
+    for (size_t v = 0; v < s->vertex_count; v++)
+        if (s->tangents[4 * v + 3] == 0.0f) finish_tangent(s, v, &acc[6 * v]);
+    free(acc);
+    return 0;
 }

@@ -37,6 +37,13 @@ typedef struct bk_material {
     int metal_rough_tex1;          /* 1 + index into scene images of the metallicRoughnessTexture
                                       (B = metallic, G = roughness, multiplied by the factors;
                                       sampled with uv0); 0 none, so a zeroed material has none */
+    /* The glTF normalTexture, read only when bk_import_options.normal_maps asks (the renderer and
+     * the viewer's export; the bake lights the interpolated normal, which is what AHD's direction
+     * is stored against). Tangent-space, linear RGB (not sRGB-decoded), sampled with uv0 in the
+     * frame of bk_scene.tangents: n = normalize(T·x + B·y + N·z), (x, y) = (2·rgb.xy − 1)·scale,
+     * z = 2·rgb.z − 1, B = w·(N × T) (glTF 2.0 §3.9.3). */
+    int normal_tex1;               /* 1 + index into scene images; 0 none */
+    float normal_scale;            /* normalTexture.scale (finite; glTF default 1) */
 } bk_material;
 
 /* A material the transport treats as glossy (coupled diffuse + GGX, GGX.md): metallic > 0 or a
@@ -120,6 +127,11 @@ typedef struct bk_scene {
     float *normals;                /* 3 per vertex, unit (generated flat when the mesh has none) */
     float *uv0;                    /* 2 per vertex (0,0 when absent) */
     float *uv1;                    /* 2 per vertex; meaningful only where the object has_uv1 */
+    /* 4 per vertex or NULL (only an import with normal_maps fills it): world-space unit tangent
+     * T along +u of uv0, orthogonal to the normal, and w = ±1 with bitangent B = w·(N × T) along
+     * −v (the normal map's +Y: up in the image). From the glTF's TANGENT where a primitive has it (and NORMAL), else derived from uv0 by
+     * bk_scene_derive_tangents. */
+    float *tangents;
     /* triangles */
     size_t tri_count;
     uint32_t *tris;                /* 3 vertex indices per triangle */
@@ -167,6 +179,16 @@ void bk_scene_compute_bounds(bk_scene *scene);
 /* XXH3-64 over the raw bytes of `positions` (3 floats per vertex) followed by `indices`. */
 uint64_t bk_geometry_hash(const float *positions, size_t vertex_count, const uint32_t *indices,
                           size_t index_count);
+/* Fills every tangent whose w is 0 (bk_scene.tangents, which must be set) from the triangles
+ * using it: per triangle the direction of +u of uv0 (and +v, for the sign), weighted by the
+ * corner's angle and summed per vertex, then made orthogonal to the vertex normal
+ * (Gram-Schmidt); w = +1 when the summed −v (the image's up, the normal map's +Y: uv (0, 0) is
+ * the image's top left) lies on the side of N × T, else -1. This is the core
+ * of MikkTSpace without its vertex splitting: vertices shared by triangles whose uv0 is mirrored
+ * get one averaged frame. A vertex with no usable triangle (uv0 spans no area) gets any unit
+ * tangent orthogonal to N, w = +1. Indices must be in range (bk_scene_check). Returns 0, or -1
+ * when its scratch (48 bytes per vertex) cannot be allocated (nothing changed then). */
+int bk_scene_derive_tangents(bk_scene *scene);
 /* 1 when something emits: a punctual light with non-zero colour, a material with non-zero emission
  * used by at least one triangle, or a sky that is non-zero (uniform) or an image. The baker
  * refuses a scene without light unless the CLI supplies --sky. */

@@ -41,6 +41,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     o.max_sky_size = 64;
     o.max_image_pixels = 1 << 20;
     o.warn = quiet;
+    o.normal_maps = (int)(size & 1); /* both imports: the bake's, and the renderer's with normal maps */
     bk_scene s;
     memset(&s, 0, sizeof s);
     char err[256];

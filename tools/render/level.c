@@ -242,7 +242,9 @@ static int load(const char *scene_path, const char *lbk_path, const tl_render_op
                 char err[TL_ERR_LEN])
 {
     char msg[512];
-    if (bk_import_gltf(scene_path, NULL, &L->scene, msg, sizeof msg)) return tl_fail(err, TL_RENDER_INPUT, "%.250s", msg);
+    /* normal maps: the material's normalTexture and the vertices' tangents (shade.c) */
+    const bk_import_options io = {.normal_maps = 1};
+    if (bk_import_gltf(scene_path, &io, &L->scene, msg, sizeof msg)) return tl_fail(err, TL_RENDER_INPUT, "%.250s", msg);
     const bk_scene *s = &L->scene;
     if (!s->primitives) return tl_fail(err, TL_RENDER_INTERNAL, "the scene import gave no primitive table");
     tl_open_status st = tl_bake_open_file_capped(lbk_path, o->max_decoded_bytes, &L->bake, err);

@@ -5,7 +5,8 @@
  *
  *   lightmapped objects  LMUV (lbk/lightmap_uv.h) gives each vertex its lightmap coordinate; the
  *                        page is sampled bilinearly and the AHD texel decoded for the shading
- *                        normal (lbk/ahd.h, tangent frame of spec §5.6);
+ *                        normal, the normal map's where the material has one (lbk/ahd.h, tangent
+ *                        frame of spec §5.6; README.md "Normal maps");
  *   LLG objects          the object's local grid sampled at the hit point (lbk/llg.h), evaluated
  *                        along the interpolated bent normal and scaled by the interpolated
  *                        per-vertex self-visibility (vertex order: lbk_llg_vertex_map);

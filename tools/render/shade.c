@@ -41,6 +41,63 @@ void rl_sky(const rl_level *L, const float d[3], float rgb[3])
     texture(&L->scene, L->scene.sky_image, uv, rgb);
 }
 
+/* ---- normal maps --------------------------------------------------------------------------- */
+
+static void cross3(const float a[3], const float b[3], float o[3])
+{
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* The shading normal of a normal-mapped material at the hit (glTF 2.0 §3.9.3): the texel of the
+ * normal texture at uv0 (nearest, as every texture here) read as a tangent-space normal
+ * t = ((2r − 1)·scale, (2g − 1)·scale, 2b − 1) and taken to world space in the interpolated frame
+ * T (made orthogonal to N), B = w·(N × T), N. Where the material has no normal map, or the result
+ * is degenerate, ns = N. */
+static void shading_normal(const bk_scene *s, const bk_material *m, const rl_hit *h, const float N[3],
+                           const float uv0[2], float ns[3])
+{
+    memcpy(ns, N, 3 * sizeof(float));
+    if (!m->normal_tex1 || !s->tangents) return;
+    const uint32_t *v = &s->tris[3 * (size_t)h->tri];
+    float T[3] = {0, 0, 0}, B[3], w = 0.0f, rgb[3] = {1, 1, 1};
+    for (int c = 0; c < 3; c++) {
+        const float *t = &s->tangents[4 * (size_t)v[c]];
+        for (int k = 0; k < 3; k++) T[k] += bary(h, c) * t[k];
+        w += bary(h, c) * t[3];
+    }
+    const float d = dot3(T, N);
+    for (int k = 0; k < 3; k++) T[k] -= d * N[k];
+    normalize3(T);
+    cross3(N, T, B);
+    for (int k = 0; k < 3; k++) B[k] *= w < 0.0f ? -1.0f : 1.0f;
+    texture(s, m->normal_tex1 - 1, uv0, rgb);
+    const float x = (2.0f * rgb[0] - 1.0f) * m->normal_scale, y = (2.0f * rgb[1] - 1.0f) * m->normal_scale,
+                z = 2.0f * rgb[2] - 1.0f;
+    float n[3];
+    for (int k = 0; k < 3; k++) n[k] = x * T[k] + y * B[k] + z * N[k];
+    if (!(dot3(n, n) > 1e-12f) || !(dot3(T, T) > 0.5f)) return;
+    normalize3(n);
+    memcpy(ns, n, sizeof n);
+}
+
+/* v turned by the rotation that takes unit a to unit b (the smallest one, about a × b): what a
+ * normal map does to the direction an LLG vertex record's bent normal gives for N. */
+static void rotate_like(const float a[3], const float b[3], const float v[3], float out[3])
+{
+    const float c = dot3(a, b);
+    if (c <= -0.999f) { /* a normal map pointing against N: no defined turn, use ns itself */
+        memcpy(out, b, 3 * sizeof(float));
+        return;
+    }
+    float k[3], kv[3];
+    cross3(a, b, k);
+    cross3(k, v, kv);
+    const float f = dot3(k, v) / (1.0f + c);
+    for (int i = 0; i < 3; i++) out[i] = v[i] * c + kv[i] + k[i] * f;
+}
+
 /* ---- lightmaps ------------------------------------------------------------------------------ */
 
 int rl_hit_coord(const rl_level *L, const rl_hit *h, uint32_t *page, float coord[2])
@@ -85,8 +142,9 @@ static void sample_page(const rl_level *L, uint32_t page, const float coord[2], 
 
 /* Irradiance of a lightmapped surface for the shading normal ns. The texel's highlight direction
  * lives in the tangent frame of spec §5.6: N = the interpolated normal, T = dP/dX of the triangle's
- * lightmap coordinates made orthogonal to N, B = N × T. A normal-mapped surface would pass its
- * perturbed normal as ns; without normal maps ns = N and its tangent coordinates are (0, 0, 1). */
+ * lightmap coordinates made orthogonal to N, B = N × T (not the normal map's frame: that one is
+ * along uv0). A normal-mapped surface passes its perturbed normal as ns, expressed in this frame;
+ * without a normal map ns = N, whose coordinates are (0, 0, 1). */
 static void lightmap_irradiance(const rl_level *L, const rl_hit *h, const float N[3], const float ns[3], float E[3])
 {
     const bk_scene *s = &L->scene;
@@ -110,7 +168,7 @@ static void lightmap_irradiance(const rl_level *L, const rl_hit *h, const float 
 
 /* An LLG object: its grid's SH at the hit point, seen along the bent normal and scaled by the
  * self-visibility V (spec §11), both interpolated from the triangle's vertex records. */
-static void llg_irradiance(const rl_level *L, const rl_hit *h, float E[3])
+static void llg_irradiance(const rl_level *L, const rl_hit *h, const float N[3], const float ns[3], float E[3])
 {
     const bk_scene *s = &L->scene;
     const uint32_t grid = L->objects[s->tri_object[h->tri]].index;
@@ -126,6 +184,12 @@ static void llg_irradiance(const rl_level *L, const rl_hit *h, float E[3])
             for (int k = 0; k < 3; k++) bent[k] += bary(h, c) * lv.bent_normal[a] * g.axes[a][k]; /* box → world */
     }
     normalize3(bent);
+    if (ns != N) { /* a normal map turns the bent normal as it turns N (occlusion kept) */
+        float turned[3];
+        rotate_like(N, ns, bent, turned);
+        memcpy(bent, turned, sizeof bent);
+        normalize3(bent);
+    }
     lbk_sh9_rgb sh;
     lbk_llg_sample(&L->llg, grid, h->p, &sh);
     lbk_sh9_irradiance(&sh, bent, E);
@@ -173,16 +237,20 @@ void rl_shade(const rl_level *L, const tl_render_options *o, const rl_hit *h, ui
     memcpy(emission, m->emission, sizeof emission);
     if (m->albedo_tex >= 0) texture(s, m->albedo_tex, uv0, albedo);
     if (m->emission_tex >= 0) texture(s, m->emission_tex, uv0, emission);
+    float ns[3];
+    shading_normal(s, m, h, N, uv0, ns);
+    const float *n = m->normal_tex1 && s->tangents ? ns : N; /* ns == N: no normal map */
     const uint32_t rep = L->objects[s->tri_object[h->tri]].representation;
-    if (!h->front) { /* the bake lit the front only: the other side of a double-sided surface */
-        const float back[3] = {-N[0], -N[1], -N[2]};
+    if (!h->front) { /* the bake lit the front only: the other side of a double-sided surface
+                      * (glTF: a back face's normal, normal-mapped one included, is reversed) */
+        const float back[3] = {-n[0], -n[1], -n[2]};
         glg_irradiance(L, h->p, back, hint, E);
     } else if (rep == LBK_REPRESENTATION_LIGHTMAP) {
-        lightmap_irradiance(L, h, N, N, E);
+        lightmap_irradiance(L, h, N, n, E);
     } else if (rep == LBK_REPRESENTATION_LLG) {
-        llg_irradiance(L, h, E);
+        llg_irradiance(L, h, N, n, E);
     } else { /* representation none: a dynamic object */
-        glg_irradiance(L, h->p, N, hint, E);
+        glg_irradiance(L, h->p, n, hint, E);
     }
     for (int c = 0; c < 3; c++) rgb[c] = albedo[c] * fmaxf(E[c], 0.0f) / PI_F + emission[c];
 }

@@ -1,0 +1,424 @@
+/* Normal maps: the importer's normalTexture and tangents (scene/, bk_import_options.normal_maps)
+ * and lbk render shading with them, against a closed form.
+ *
+ * The closed form. A 4 × 4 m floor (albedo ρ) lit only by one directional light of illuminance
+ * E☉ from the unit direction l (towards the light), a black sky, nothing else: every texel's
+ * light is direct and noise-free (one shadow ray along l). Its AHD texel (spec §5.6) holds
+ * Ez = E☉ (N·l) along the normal, the highlight direction d = l and no ambient part (r = 0), so
+ * the encoding's irradiance for a shading normal n is the band-1 form scaled to Ez:
+ *     E(n) = Ez · (1 + 2 n·l) / (1 + 2 N·l),      L(n) = ρ/π · E(n).
+ * The normal map has four stripes along u: flat, tilted by α towards +X (+u), towards −X, and
+ * towards +Y (the image's up, −v: this one checks the bitangent's sign). Each stripe's rendered
+ * radiance must be L(n') with n' the stripe's normal in world space, within the storage's
+ * error: R11G11B10F rounds Ez to 2^-7 relative and the direction bytes move n·d by < 1/255,
+ * under 1.5 % together; the test allows 2 % (measured: 0.5 % to 0.8 %, R11G11B10F's rounding of
+ * Ez). The tilted stripes differ from the flat one by +10 % and −26 % (α = 30°), so a renderer
+ * that ignores the map fails, and one that gets the bitangent's sign wrong fails on the +Y stripe. The band-1 form is not
+ * Lambert's max(0, n·l) (for one light its error is what AHD trades for 8 bytes a texel); the
+ * test prints both. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "scene/import.h"
+#include "support/bake_file.h"
+#include "tools/common/image_io.h"
+#include "tools/render/render.h"
+
+#define RHO 0.5
+#define E_SUN 3.0
+#define ALPHA_DEG 30.0
+#define PI 3.14159265358979323846
+
+static char tmpdir[64];
+
+static int setup(void **state)
+{
+    (void)state;
+    snprintf(tmpdir, sizeof tmpdir, "/tmp/lbk_test_normal_XXXXXX");
+    return mkdtemp(tmpdir) ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    if (getenv("LBK_TEST_KEEP")) return printf("kept %s\n", tmpdir), 0;
+    char cmd[128];
+    snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+static void path_of(char *out, size_t n, const char *name) { snprintf(out, n, "%s/%s", tmpdir, name); }
+
+static void write_bytes(const char *name, const void *data, size_t len)
+{
+    char p[256];
+    path_of(p, sizeof p, name);
+    FILE *f = fopen(p, "wb");
+    assert_non_null(f);
+    assert_int_equal(fwrite(data, 1, len, f), len);
+    assert_int_equal(fclose(f), 0);
+}
+
+/* ---- the scene -------------------------------------------------------------------------------- */
+
+/* The stripes' tangent-space normals (x along +u, y the image's up, z out of the surface). */
+static void stripe_normal(int k, double n[3])
+{
+    const double a = ALPHA_DEG * PI / 180.0, s = sin(a), c = cos(a);
+    const double t[4][3] = {{0, 0, 1}, {s, 0, c}, {-s, 0, c}, {0, s, c}};
+    memcpy(n, t[k], sizeof t[k]);
+}
+
+static uint8_t to_byte(double x) { return (uint8_t)lround((x * 0.5 + 0.5) * 255.0); }
+
+/* normal.png: 8 × 2 texels, stripe k covers u in [k/4, (k+1)/4) (2 texels each). */
+static void write_normal_png(void)
+{
+    uint8_t px[8 * 2 * 3];
+    for (int y = 0; y < 2; y++)
+        for (int x = 0; x < 8; x++) {
+            double n[3];
+            stripe_normal(x / 2, n);
+            for (int c = 0; c < 3; c++) px[3 * (y * 8 + x) + c] = to_byte(n[c]);
+        }
+    char p[256], err[TL_ERR_LEN];
+    path_of(p, sizeof p, "normal.png");
+    assert_int_equal(tl_png_write_rgb8(p, 8, 2, px, err), 0);
+}
+
+/* floor.bin: the floor y = 0, x and z in [−2, 2], facing +y; uv0 u = (x + 2)/4, v = (z + 2)/4;
+ * TANGENT (1, 0, 0, tangent_w); indices 0 1 2 0 2 3 (counter-clockwise seen from +y). */
+static void write_floor_bin(float tangent_w)
+{
+    const float pos[12] = {-2, 0, 2, 2, 0, 2, 2, 0, -2, -2, 0, -2}, nrm[12] = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
+    const float uv[8] = {0, 1, 1, 1, 1, 0, 0, 0};
+    const float tan[16] = {1, 0, 0, tangent_w, 1, 0, 0, tangent_w, 1, 0, 0, tangent_w, 1, 0, 0, tangent_w};
+    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    unsigned char b[48 + 48 + 32 + 64 + 12];
+    memcpy(b, pos, 48), memcpy(b + 48, nrm, 48), memcpy(b + 96, uv, 32), memcpy(b + 128, tan, 64), memcpy(b + 192, idx, 12);
+    write_bytes("floor.bin", b, sizeof b);
+}
+
+/* The unit quaternion turning −Z (where KHR_lights_punctual points a directional light) to d. */
+static void aim(const double d[3], double q[4])
+{
+    const double a[3] = {0, 0, -1};
+    double w = 1 + (a[0] * d[0] + a[1] * d[1] + a[2] * d[2]);
+    double x = a[1] * d[2] - a[2] * d[1], y = a[2] * d[0] - a[0] * d[2], z = a[0] * d[1] - a[1] * d[0];
+    const double l = sqrt(w * w + x * x + y * y + z * z);
+    q[0] = x / l, q[1] = y / l, q[2] = z / l, q[3] = w / l;
+}
+
+/* The light's direction l (towards it): 40° from the zenith, from −z and +x, so the +X and +Y
+ * stripes face it more than the flat one and the −X stripe less. */
+static void light_dir(double l[3])
+{
+    const double th = 40.0 * PI / 180.0, ph = -45.0 * PI / 180.0;
+    l[0] = sin(th) * cos(ph), l[1] = cos(th), l[2] = sin(th) * sin(ph);
+}
+
+/* name: the glTF over floor.bin and normal.png. tangent: the primitive lists TANGENT; material_extra:
+ * JSON spliced into the material (normalTexture); node_extra: into the floor's node. */
+static void write_gltf(const char *name, int tangent, const char *material_extra, const char *node_extra)
+{
+    double l[3], d[3], q[4];
+    light_dir(l);
+    for (int k = 0; k < 3; k++) d[k] = -l[k];
+    aim(d, q);
+    char json[4096];
+    snprintf(json, sizeof json,
+             "{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_lights_punctual\"],"
+             "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[{\"type\":\"directional\",\"color\":[1,1,1],"
+             "\"intensity\":%.17g}]}},"
+             "\"scene\":0,\"scenes\":[{\"nodes\":[0,1]}],"
+             "\"nodes\":[{\"name\":\"floor\",\"mesh\":0,\"extras\":{\"lbk_lighting\":\"lightmap\"}%s},"
+             "{\"name\":\"sun\",\"rotation\":[%.17g,%.17g,%.17g,%.17g],\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"TEXCOORD_0\":2%s},"
+             "\"indices\":4,\"material\":0}]}],"
+             "\"materials\":[{\"name\":\"bumpy\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[%.17g,%.17g,%.17g,1],"
+             "\"metallicFactor\":0,\"roughnessFactor\":1}%s}],"
+             "\"textures\":[{\"source\":0,\"sampler\":0}],\"samplers\":[{\"magFilter\":9728,\"minFilter\":9728}],"
+             "\"images\":[{\"uri\":\"normal.png\"}],"
+             "\"buffers\":[{\"uri\":\"floor.bin\",\"byteLength\":204}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":192},"
+             "{\"buffer\":0,\"byteOffset\":192,\"byteLength\":12}],"
+             "\"accessors\":[{\"bufferView\":0,\"byteOffset\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+             "\"min\":[-2,0,-2],\"max\":[2,0,2]},"
+             "{\"bufferView\":0,\"byteOffset\":48,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
+             "{\"bufferView\":0,\"byteOffset\":96,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"},"
+             "{\"bufferView\":0,\"byteOffset\":128,\"componentType\":5126,\"count\":4,\"type\":\"VEC4\"},"
+             "{\"bufferView\":1,\"byteOffset\":0,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}]}",
+             E_SUN, node_extra, q[0], q[1], q[2], q[3], tangent ? ",\"TANGENT\":3" : "", RHO, RHO, RHO, material_extra);
+    write_bytes(name, json, strlen(json));
+}
+
+#define NORMAL_TEX ",\"normalTexture\":{\"index\":0}"
+
+static void write_all(float tangent_w)
+{
+    write_normal_png();
+    write_floor_bin(tangent_w);
+    write_gltf("derived.gltf", 0, NORMAL_TEX, "");
+    write_gltf("authored.gltf", 1, NORMAL_TEX, "");
+    write_gltf("flat.gltf", 0, "", "");
+}
+
+static int import(const char *name, int normal_maps, bk_scene *s, char *err, size_t n)
+{
+    char p[256];
+    path_of(p, sizeof p, name);
+    const bk_import_options o = {.normal_maps = normal_maps};
+    return bk_import_gltf(p, &o, s, err, n);
+}
+
+/* ---- import ----------------------------------------------------------------------------------- */
+
+/* Derived and authored tangents give the same frame: T = +x, B = w (N × T) = −z (the image's up,
+ * −v), so w = +1; the normal map is read as data (byte / 255, no sRGB decode). Without
+ * normal_maps nothing of it is read (the bake's import). */
+static void import_frame(void **state)
+{
+    (void)state;
+    write_all(1.0f);
+    const char *names[2] = {"derived.gltf", "authored.gltf"};
+    for (int i = 0; i < 2; i++) {
+        bk_scene s;
+        char err[512];
+        int rc = import(names[i], 1, &s, err, sizeof err);
+        if (rc) fprintf(stderr, "%s\n", err);
+        assert_int_equal(rc, 0);
+        assert_int_equal(bk_scene_check(&s, err, sizeof err), 0);
+        assert_non_null(s.tangents);
+        for (size_t v = 0; v < s.vertex_count; v++) {
+            assert_float_equal(s.tangents[4 * v + 0], 1.0f, 1e-6f);
+            assert_float_equal(s.tangents[4 * v + 1], 0.0f, 1e-6f);
+            assert_float_equal(s.tangents[4 * v + 2], 0.0f, 1e-6f);
+            assert_float_equal(s.tangents[4 * v + 3], 1.0f, 0.0f);
+        }
+        const bk_material *m = &s.materials[0];
+        assert_int_equal(m->normal_tex1, 1);
+        assert_float_equal(m->normal_scale, 1.0f, 0.0f);
+        const bk_image *im = &s.images[0];
+        double n1[3];
+        stripe_normal(1, n1);
+        assert_float_equal(im->rgba[4 * 2 + 0], to_byte(n1[0]) / 255.0f, 1e-6f); /* texel (2, 0): stripe 1 */
+        bk_scene_free(&s);
+        assert_int_equal(import(names[i], 0, &s, err, sizeof err), 0);
+        assert_null(s.tangents);
+        assert_int_equal(s.materials[0].normal_tex1, 0);
+        assert_int_equal((int)s.image_count, 0);
+        bk_scene_free(&s);
+    }
+}
+
+/* A mirroring node (scale x by −1) mirrors the frame: the authored tangent becomes −x and, as
+ * the derived one, keeps B on the image's up (−z), so w turns −1 in both. */
+static void import_mirrored(void **state)
+{
+    (void)state;
+    write_all(1.0f);
+    const char *node = ",\"scale\":[-1,1,1]";
+    write_gltf("mirror_derived.gltf", 0, NORMAL_TEX, node);
+    write_gltf("mirror_authored.gltf", 1, NORMAL_TEX, node);
+    const char *names[2] = {"mirror_derived.gltf", "mirror_authored.gltf"};
+    for (int i = 0; i < 2; i++) {
+        bk_scene s;
+        char err[512];
+        assert_int_equal(import(names[i], 1, &s, err, sizeof err), 0);
+        for (size_t v = 0; v < s.vertex_count; v++) {
+            const float *t = &s.tangents[4 * v], *n = &s.normals[3 * v];
+            assert_float_equal(n[1], 1.0f, 1e-6f);
+            assert_float_equal(t[0], -1.0f, 1e-6f);
+            /* B = w (N × T) = w · (0, 0, 1) for T = −x: −z needs w = −1 */
+            assert_float_equal(t[3], -1.0f, 0.0f);
+        }
+        bk_scene_free(&s);
+    }
+}
+
+/* Hostile input: a TANGENT of the wrong type or count, a normalTexture out of range or with a
+ * non-finite or absurd scale, is refused with a message naming it; nothing is read past a buffer. */
+static void import_hostile(void **state)
+{
+    (void)state;
+    write_all(1.0f);
+    struct { const char *material, *needle; } bad[] = {
+        {",\"normalTexture\":{\"index\":7}", "normal texture 7 out of range"},
+        {",\"normalTexture\":{\"index\":0,\"scale\":1e300}", "normalTexture scale"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        write_gltf("bad.gltf", 0, bad[i].material, "");
+        bk_scene s;
+        char err[512];
+        assert_int_not_equal(import("bad.gltf", 1, &s, err, sizeof err), 0);
+        if (!strstr(err, bad[i].needle)) fail_msg("'%s' lacks '%s'", err, bad[i].needle);
+        assert_null(s.tangents);
+    }
+    /* TANGENT pointing at the VEC2 uv accessor, then at a VEC4 running past its view */
+    write_gltf("bad.gltf", 1, NORMAL_TEX, "");
+    char p[256], json[4096];
+    path_of(p, sizeof p, "bad.gltf");
+    FILE *f = fopen(p, "rb");
+    assert_non_null(f);
+    size_t n = fread(json, 1, sizeof json - 1, f);
+    fclose(f);
+    json[n] = '\0';
+    char *t = strstr(json, "\"TANGENT\":3");
+    assert_non_null(t);
+    t[10] = '2';
+    write_bytes("bad.gltf", json, n);
+    bk_scene s;
+    char err[512];
+    assert_int_not_equal(import("bad.gltf", 1, &s, err, sizeof err), 0);
+    if (!strstr(err, "TANGENT")) fail_msg("'%s' does not name TANGENT", err);
+    t[10] = '3';
+    char *c = strstr(json, "\"byteOffset\":128,\"componentType\":5126,\"count\":4");
+    assert_non_null(c);
+    c[strlen("\"byteOffset\":128,\"componentType\":5126,\"count\":")] = '5';
+    write_bytes("bad.gltf", json, n);
+    assert_int_not_equal(import("bad.gltf", 1, &s, err, sizeof err), 0);
+    if (!strstr(err, "TANGENT")) fail_msg("'%s' does not name TANGENT", err);
+    /* the bake's import ignores TANGENT: the same file imports without normal maps */
+    assert_int_equal(import("bad.gltf", 0, &s, err, sizeof err), 0);
+    bk_scene_free(&s);
+}
+
+/* ---- render ----------------------------------------------------------------------------------- */
+
+static void bake(const char *gltf, const char *out)
+{
+    tb_job j;
+    memset(&j, 0, sizeof j);
+    j.in = gltf, j.out = out;
+    j.d.threads = 2;
+    j.d.seed = 1;
+    j.d.texel_density = 4;
+    char err[512];
+    lbk_result r = tb_bake(&j, NULL, err, sizeof err);
+    if (r != LBK_OK) fprintf(stderr, "bake %s: %s\n", gltf, err);
+    assert_int_equal(r, LBK_OK);
+}
+
+#define W 160
+#define H 120
+#define CAM_H 6.0
+#define FOV_DEG 50.0
+
+static tl_image render(const char *gltf, const char *lbk)
+{
+    tl_render_options o;
+    memset(&o, 0, sizeof o);
+    o.width = W, o.height = H, o.samples = 1, o.threads = 2;
+    /* straight down, image right = +x, image up = −z */
+    o.camera = (tl_camera){{0, (float)CAM_H, 0}, {0, 0, 0}, {0, 0, -1}, (float)(FOV_DEG * PI / 180.0)};
+    tl_image im;
+    char err[TL_ERR_LEN];
+    int rc = tl_render(gltf, lbk, &o, &im, err);
+    if (rc) fprintf(stderr, "render: %s\n", err);
+    assert_int_equal(rc, TL_RENDER_OK);
+    return im;
+}
+
+/* The pixel column of world x at the floor (x grows to the right). */
+static int column(double x)
+{
+    const double half_w = CAM_H * tan(FOV_DEG * PI / 360.0) * W / H;
+    return (int)floor(W / 2.0 + x / half_w * (W / 2.0));
+}
+
+/* Stripe k's world normal: tangent-space n from the PNG's bytes (as any reader decodes them) in
+ * the frame T = +x, B = −z, N = +y. */
+static void world_normal(int k, double n[3])
+{
+    double t[3];
+    stripe_normal(k, t);
+    for (int c = 0; c < 3; c++) t[c] = 2.0 * to_byte(t[c]) / 255.0 - 1.0;
+    const double l = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+    n[0] = t[0] / l, n[1] = t[2] / l, n[2] = -t[1] / l;
+}
+
+/* Every pixel of a 7 × 7 block at stripe k's centre (rows at z = ±0.75 m) against the closed form. */
+static double check_stripe(const tl_image *im, int k, int normal_mapped, const char *what)
+{
+    double l[3], n[3] = {0, 1, 0};
+    light_dir(l);
+    if (normal_mapped) world_normal(k, n);
+    const double nl = n[0] * l[0] + n[1] * l[1] + n[2] * l[2], Nl = l[1];
+    const double want = RHO / PI * E_SUN * Nl * (1 + 2 * nl) / (1 + 2 * Nl);
+    const double lambert = RHO / PI * E_SUN * fmax(0.0, nl);
+    const int x0 = column(-1.5 + k);
+    double worst = 0, mean = 0;
+    int count = 0;
+    for (int r = 0; r < 2; r++) {
+        const int y0 = r ? H / 2 - 15 : H / 2 + 15;
+        for (int dy = -3; dy <= 3; dy++)
+            for (int dx = -3; dx <= 3; dx++)
+                for (int c = 0; c < 3; c++) {
+                    const double got = im->rgb[3 * ((size_t)(y0 + dy) * W + (size_t)(x0 + dx)) + (size_t)c];
+                    worst = fmax(worst, fabs(got / want - 1));
+                    mean += got, count++;
+                }
+    }
+    mean /= count;
+    printf("%s stripe %d: n.l %.4f  L %.5f  closed form %.5f (%+.2f %%)  Lambert %.5f (band-1 %+.1f %%)  worst %.2f %%\n",
+           what, k, nl, mean, want, 100 * (mean / want - 1), lambert, 100 * (want / lambert - 1), 100 * worst);
+    if (worst > 0.02) fail_msg("%s stripe %d: %.2f %% from the closed form (bound 2 %%)", what, k, 100 * worst);
+    return mean;
+}
+
+static void render_closed_form(void **state)
+{
+    (void)state;
+    write_all(1.0f);
+    char gltf[256], lbk[256];
+    path_of(gltf, sizeof gltf, "derived.gltf");
+    path_of(lbk, sizeof lbk, "floor.lbk");
+    bake(gltf, lbk);
+    tl_image im = render(gltf, lbk);
+    double got[4];
+    for (int k = 0; k < 4; k++) got[k] = check_stripe(&im, k, 1, "derived");
+    /* the map is not ignored: every tilted stripe is far (> 5x the bound) from the flat one */
+    for (int k = 1; k < 4; k++) assert_true(fabs(got[k] / got[0] - 1) > 0.08);
+    tl_image_free(&im);
+
+    /* authored TANGENT (the same frame): the same image, pixel for pixel */
+    path_of(gltf, sizeof gltf, "authored.gltf");
+    tl_image au = render(gltf, lbk);
+    for (int k = 0; k < 4; k++) check_stripe(&au, k, 1, "authored");
+    tl_image_free(&au);
+
+    /* the same bake drawn without the normal map: flat everywhere (its geometry is the same) */
+    path_of(gltf, sizeof gltf, "flat.gltf");
+    tl_image fl = render(gltf, lbk);
+    for (int k = 0; k < 4; k++) check_stripe(&fl, k, 0, "no map");
+    tl_image_free(&fl);
+
+    /* an authored TANGENT with w = −1 puts the map's +Y on +z: the +Y stripe turns away */
+    write_floor_bin(-1.0f);
+    path_of(gltf, sizeof gltf, "authored.gltf");
+    tl_image fw = render(gltf, lbk);
+    const double y_stripe = fw.rgb[3 * ((size_t)(H / 2 + 15) * W + (size_t)column(1.5))];
+    printf("w = -1: +Y stripe %.5f against %.5f\n", y_stripe, got[3]);
+    assert_true(y_stripe < 0.9 * got[3]);
+    tl_image_free(&fw);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(import_frame),
+        cmocka_unit_test(import_mirrored),
+        cmocka_unit_test(import_hostile),
+        cmocka_unit_test(render_closed_form),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
