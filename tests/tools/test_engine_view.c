@@ -286,7 +286,10 @@ static void test_babylon_shows_the_lightmap(void **state)
                   "code, %d two codes apart, %d more (%.2f %%, %d not on an edge), max %d\n",
                   W, H, n, shot_lit, sum / (n ? n : 1), hist[0], hist[1], hist[2], over, 100.0 * over / (n ? n : 1), interior,
                   max_d);
-    tl_png_write_rgb8(out("ref.png"), W, H, ref8, err); /* beside shot.png, to look at when it fails */
+    /* the two pictures, to look at when it fails (docs/images/engine_babylon.png and
+     * docs/images/engine_lbk.png are these two) */
+    tl_png_write_rgb8(out("ref.png"), W, H, ref8, err);
+    tl_png_write_rgb8(out("engine.png"), W, H, shot, err);
     free(shot);
     assert_true(n > W * H / 2); /* the view is filled by the level */
     if (shot_lit <= n * 9 / 10)
