@@ -27,6 +27,7 @@ typedef struct obj_pack {
     int turned;              /* the whole rectangle placed a quarter turn in its page */
     float requested;         /* density asked for */
     float fit_scale;         /* extra factor so the object fits one max page */
+    int tri_cap;             /* longest one-triangle chart (bk_uv_options.max_triangle_texels) */
 } obj_pack;
 
 static void obj_pack_free(obj_pack *p)
@@ -49,13 +50,15 @@ static int content_size(float extent)
 static int may_turn(const bk_uv_object *uv) { return uv->source == BK_UV_GENERATED; }
 
 /* Generates charts at `density` and packs them; returns LBK_OK with *fits = 0 when the
- * result exceeds max_page (the caller lowers the density). */
+ * result exceeds max_page (the caller shrinks its large triangles, then lowers the density). */
 static lbk_result pack_object(const bk_scene *scene, uint32_t object, double density, const bk_uv_options *uvo,
                               int margin, int align, int max_page, int score_align, obj_pack *p, int *fits)
 {
     *fits = 1;
     obj_pack_free(p);
-    lbk_result r = bk_uvgen_object(scene, object, (float)density, uvo, &p->uv);
+    bk_uv_options o = *uvo;
+    o.max_triangle_texels = p->tri_cap;
+    lbk_result r = bk_uvgen_object(scene, object, (float)density, &o, &p->uv);
     if (r != LBK_OK) return r;
     size_t n = p->uv.chart_count;
     p->w = p->h = 0;
@@ -251,7 +254,7 @@ static lbk_result build_vertices(const bk_scene *scene, bk_atlas *a)
 
 /* The options with their defaults and caps applied. */
 typedef struct atlas_limits {
-    int page, max_page;  /* default and largest page side, multiples of 4 */
+    int page, max_page;  /* default and largest page side, multiples of 4 (no page is wider) */
     int margin;          /* ceil(padding / 2) */
     int align;           /* 1, or 4 with block_align */
     int lone;            /* one object only: its rectangle becomes the page (sides multiples of 4) */
@@ -279,6 +282,10 @@ static lbk_result resolve_limits(const bk_atlas_options *opt, atlas_limits *l)
     if (opt) l->uv = opt->uv;
     int room = page - 2 * l->margin;
     if (l->uv.max_chart_texels <= 0 || l->uv.max_chart_texels > room) l->uv.max_chart_texels = room;
+    /* a triangle cannot be split: its chart may take a whole maximum page */
+    int max_room = max_page - 2 * l->margin;
+    if (l->uv.max_triangle_texels <= 0 || l->uv.max_triangle_texels > max_room) l->uv.max_triangle_texels = max_room;
+    if (l->uv.max_triangle_texels < l->uv.max_chart_texels) l->uv.max_triangle_texels = l->uv.max_chart_texels;
     return l->uv.max_chart_texels < 1 ? LBK_ERR_INVALID_ARGUMENT : LBK_OK;
 }
 
@@ -311,17 +318,26 @@ static lbk_result select_objects(const bk_scene *scene, const uint8_t *lightmapp
     return LBK_OK;
 }
 
-/* Charts of one object at its density × scale, lowering the object's own fit_scale until its
- * rectangle fits one max page. */
+/* Charts of one object at its density × scale until its rectangle fits one max page (an
+ * object's charts share one page, spec/container.md §8): first the charts of its lone large
+ * triangles shrink (their cap lowered step by step, down to MIN_TRI_CAP texels), and only then
+ * the object's own fit_scale is lowered, so a few large triangles never cost the rest of the
+ * object its density. */
+#define MIN_TRI_CAP 16
 static lbk_result pack_object_to_fit(const bk_scene *scene, uint32_t object, double scale, const atlas_limits *l,
                                      obj_pack *p)
 {
-    for (int attempt = 0; attempt < 24; attempt++) {
+    p->tri_cap = l->uv.max_triangle_texels;
+    for (int attempt = 0; attempt < 64; attempt++) {
         int fits;
         double d = p->requested * scale * p->fit_scale;
         lbk_result r = pack_object(scene, object, d, &l->uv, l->margin, l->align, l->max_page, l->lone ? 4 : 1, p, &fits);
         if (r != LBK_OK || fits) return r;
-        p->fit_scale *= 0.8f;
+        int smaller = (int)(p->tri_cap * 0.8);
+        if ((p->uv.big_tris > 0 || p->uv.scaled_tris > 0) && smaller >= MIN_TRI_CAP)
+            p->tri_cap = smaller;
+        else
+            p->fit_scale *= 0.8f;
     }
     return LBK_ERR_LIMIT;
 }

@@ -396,16 +396,19 @@ static frame2 min_area_rotation(const pt2 *hull, size_t h)
 typedef struct piece_result {
     float width, height;
     int flipped_or_overlap;   /* 1: the projection folds over itself */
-    double single_tri_excess; /* for one-triangle pieces over the cap: size / cap */
+    double tri_scale;         /* a one-triangle piece longer than tri_cap: the factor its chart was
+                                 scaled by to fit (< 1); else 1 */
 } piece_result;
 
 /* Projects the piece's triangles into `uv` (6 per triangle, same order as tris) at density
- * texels per metre and checks it. */
+ * texels per metre and checks it. A lone triangle longer than tri_cap is scaled down to fit on
+ * its own (res->tri_scale): only that triangle's chart loses density, never the object. */
 static lbk_result project_piece(gen_ctx *g, const uint32_t *tris, size_t count, double density, int cap,
-                                float *uv, piece_result *res, pt2 *scratch, pt2 *hull)
+                                int tri_cap, float *uv, piece_result *res, pt2 *scratch, pt2 *hull)
 {
     const bk_scene *s = g->s;
     memset(res, 0, sizeof *res);
+    res->tri_scale = 1.0;
     double nsum[3] = {0, 0, 0}, aw = 0.0;
     uint32_t largest = tris[0];
     for (size_t i = 0; i < count; i++) {
@@ -480,7 +483,14 @@ static lbk_result project_piece(gen_ctx *g, const uint32_t *tris, size_t count, 
     res->height = (float)hh;
     double longest = fmax(w, hh);
     if (count == 1) {
-        if (longest > cap) res->single_tri_excess = longest / cap;
+        if (longest > tri_cap) {
+            /* a little under the cap so the chart's ceil() extent stays within it after rounding */
+            double fit = (double)tri_cap / longest * (1.0 - 1e-6);
+            for (int k = 0; k < 6; k++) uv[k] = (float)((double)uv[k] * fit);
+            res->width = (float)(w * fit);
+            res->height = (float)(hh * fit);
+            res->tri_scale = fit;
+        }
         return LBK_OK;
     }
     if (longest > cap) return LBK_OK;  /* will be split anyway; skip the overlap raster */
@@ -600,17 +610,6 @@ static lbk_result out_add_chart(out_builder *b, const uint32_t *tris, const floa
     memcpy(o->uv + 6 * o->tri_count, uv, count * 6 * sizeof *uv);
     o->tri_count += count;
     return LBK_OK;
-}
-
-static void out_reset(bk_uv_object *o)
-{
-    free(o->charts);
-    free(o->tris);
-    free(o->uv);
-    o->charts = NULL;
-    o->tris = NULL;
-    o->uv = NULL;
-    o->chart_count = o->tri_count = 0;
 }
 
 static void note_append(bk_uv_object *o, const char *msg)
@@ -769,11 +768,10 @@ static lbk_result try_authored(gen_ctx *g, double density, int cap, bk_uv_object
 /* ---------------------------------------------------------------------------------------- */
 /* Generation                                                                               */
 
-/* Returns LBK_OK; *excess > 1 asks the caller to retry at density / excess. */
-static lbk_result generate(gen_ctx *g, double density, int cap, double cos_cone, bk_uv_object *o,
-                           double *excess)
+/* Charts at `density`; a lone triangle longer than tri_cap gets a chart of its own at the
+ * density that fits (counted in o->scaled_tris, the lowest in o->scaled_density). */
+static lbk_result generate(gen_ctx *g, double density, int cap, int tri_cap, double cos_cone, bk_uv_object *o)
 {
-    *excess = 0.0;
     u32vec pool = {0};
     piecevec work = {0};
     lbk_result r = grow_charts(g, cos_cone, &pool, &work);
@@ -794,11 +792,13 @@ static lbk_result generate(gen_ctx *g, double density, int cap, double cos_cone,
         piece pc = work.v[w];
         const uint32_t *tris = pool.v + pc.first;
         piece_result pr;
-        r = project_piece(g, tris, pc.count, density, cap, uv, &pr, scratch, hull);
+        r = project_piece(g, tris, pc.count, density, cap, tri_cap, uv, &pr, scratch, hull);
         if (r != LBK_OK) break;
-        if (pr.single_tri_excess > 1.0) {
-            if (pr.single_tri_excess > *excess) *excess = pr.single_tri_excess;
-            continue;
+        if (pc.count == 1 && fmax(pr.width, pr.height) / pr.tri_scale > (cap < tri_cap ? cap : tri_cap)) o->big_tris++;
+        if (pr.tri_scale < 1.0) {
+            float dd = (float)(density * pr.tri_scale);
+            if (o->scaled_tris == 0 || dd < o->scaled_density) o->scaled_density = dd;
+            o->scaled_tris++;
         }
         if (pc.count > 1 && (fmax(pr.width, pr.height) > cap || pr.flipped_or_overlap)) {
             /* copy: split_piece appends to pool, which may move it */
@@ -812,7 +812,7 @@ static lbk_result generate(gen_ctx *g, double density, int cap, double cos_cone,
             free(copy);
             continue;
         }
-        if (*excess == 0.0) r = out_add_chart(&b, tris, uv, pc.count, pr.width, pr.height, g->first);
+        r = out_add_chart(&b, tris, uv, pc.count, pr.width, pr.height, g->first);
     }
     free(uv);
     free(scratch);
@@ -833,6 +833,7 @@ lbk_result bk_uvgen_object(const bk_scene *scene, uint32_t object, float density
     if ((uint64_t)ob->first_tri + ob->tri_count > scene->tri_count) return LBK_ERR_INVALID_ARGUMENT;
     double cone = opt && opt->cone_degrees > 0.0f && opt->cone_degrees < 89.0f ? opt->cone_degrees : 40.0;
     int cap = opt && opt->max_chart_texels > 0 ? opt->max_chart_texels : 1020;
+    int tri_cap = opt && opt->max_triangle_texels > 0 ? opt->max_triangle_texels : cap;
     out->object = object;
     out->density = density;
 
@@ -874,16 +875,14 @@ lbk_result bk_uvgen_object(const bk_scene *scene, uint32_t object, float density
     if (r == LBK_OK && !done) {
         r = build_adjacency(&g);
         double d = density;
-        for (int attempt = 0; r == LBK_OK && attempt < 8; attempt++) {
-            double excess = 0.0;
-            r = generate(&g, d, cap, cos(cone * 3.14159265358979323846 / 180.0), out, &excess);
-            if (r != LBK_OK || excess <= 1.0) break;
-            out_reset(out);
-            double nd = d / excess * 0.999;
-            char msg[128];
-            snprintf(msg, sizeof msg, "density lowered from %g to %g texels/m: a triangle exceeds %d texels", d, nd, cap);
+        if (r == LBK_OK) r = generate(&g, d, cap, tri_cap, cos(cone * 3.14159265358979323846 / 180.0), out);
+        if (r == LBK_OK && out->scaled_tris) {
+            char msg[160];
+            snprintf(msg, sizeof msg, "%zu triangle%s longer than %d texels at %g texels/m: %s own chart%s at %g texels/m",
+                     out->scaled_tris, out->scaled_tris == 1 ? "" : "s", tri_cap, d,
+                     out->scaled_tris == 1 ? "its" : "their", out->scaled_tris == 1 ? "" : "s (down to)",
+                     (double)out->scaled_density);
             note_append(out, msg);
-            d = nd;
         }
         if (r == LBK_OK) {
             bk_chart_graph cg = {g.first, g.n, g.wid, g.adj_start, g.adj};

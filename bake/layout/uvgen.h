@@ -18,8 +18,11 @@
  * rotated to its minimum-area bounding rectangle (then 90° so that width >= height) and
  * moved to the origin. A chart whose projection overlaps itself at texel resolution, or
  * whose longer side exceeds max_chart_texels, is split at the median of its triangles along
- * its longer side (then into connected pieces) until it fits. A single triangle that is
- * still too large makes the whole object use a lower density (reported in note). Finally small
+ * its longer side (then into connected pieces) until it fits. A single triangle longer than
+ * max_chart_texels keeps its chart at the object's density up to max_triangle_texels (the
+ * atlas passes a maximum page's side, so the page grows to hold it); a triangle longer still
+ * gets a chart of its own at the density that fits (reported in note): the rest of the object
+ * keeps its density, so one large triangle never lowers a whole object's. Finally small
  * charts (at most 16 texels of content, or one texel thin) are unfolded onto a neighbour
  * across their longest shared edge when that makes the pair's blocks smaller (chart_merge.h):
  * small objects no longer shatter into 1–3-texel charts, each with its own margin ring.
@@ -50,6 +53,8 @@ enum bk_uv_source {
 typedef struct bk_uv_options {
     float cone_degrees;      /* chart normal cone half-angle; 0: 40 */
     int max_chart_texels;    /* longest chart side; 0: 1020 (a 1024 page minus padding) */
+    int max_triangle_texels; /* longest side of a one-triangle chart (a triangle cannot be split);
+                                longer ones are scaled down to it; 0: max_chart_texels */
 } bk_uv_options;
 
 typedef struct bk_uv_chart {
@@ -68,6 +73,10 @@ typedef struct bk_uv_object {
     uint32_t *tris;          /* scene triangle indices, grouped by chart */
     float *uv;               /* 6 per entry of tris: the 3 corners' chart coordinates, texels */
     size_t degenerate_count; /* the object's triangles without a chart */
+    size_t big_tris;         /* one-triangle charts that at the object's density are longer than
+                                max_chart_texels or max_triangle_texels (generated) */
+    size_t scaled_tris;      /* of those, longer than max_triangle_texels: scaled down to it */
+    float scaled_density;    /* the lowest density among the scaled ones (scaled_tris > 0) */
     /* BK_UV_AUTHORED: the one chart's coordinates are (uv1 − uv1_min) · uv1_scale texels, per
      * axis; uv1_min/uv1_max bound the uv1 of the triangles that have area (0 otherwise) */
     double uv1_scale, uv1_min[2], uv1_max[2];

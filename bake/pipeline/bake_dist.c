@@ -57,6 +57,10 @@ uint64_t bk_pipeline_options_hash(const lbk_bake_desc *options, int budgets)
         const int64_t ad = d.adaptive;
         XXH64_update(st, &ad, sizeof ad);
     }
+    if (d.max_page || d.max_probes || d.texel_budget) { /* (absent from older hashes: the defaults) */
+        const uint64_t sz[3] = {(uint64_t)d.max_page, d.max_probes, d.texel_budget};
+        XXH64_update(st, sz, sizeof sz);
+    }
     if (d.error_map) { /* units must record the variance the merge's map needs */
         const int64_t em = d.error_map;
         XXH64_update(st, &em, sizeof em);

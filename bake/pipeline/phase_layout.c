@@ -35,6 +35,8 @@ static lbk_result layout_atlas(bk_pipeline *b, const uint8_t *lightmapped)
     ao.default_density = b->pre->texel_density;
     ao.density_override = b->opt->texel_density > 0 ? b->opt->texel_density : 0;
     ao.block_align = b->opt->block_align;
+    ao.max_page_size = b->opt->max_page;
+    ao.texel_budget = b->opt->texel_budget;
     lbk_result r = bk_atlas_build(s, lightmapped, &ao, &b->atlas);
     if (r == LBK_ERR_LIMIT) return bk_pipeline_fail(b, LBK_ERR_BAD_INPUT, "lightmap atlas: %s", lbk_result_message(r));
     if (r) return bk_pipeline_failed(b, r, "lightmap atlas");
@@ -66,6 +68,7 @@ static lbk_result layout_glg(bk_pipeline *b)
     bk_glg_options go;
     memset(&go, 0, sizeof go);
     go.spacing = b->opt->glg_spacing > 0 ? b->opt->glg_spacing : b->pre->glg_spacing;
+    go.max_probes = b->opt->max_probes ? b->opt->max_probes : LBK_BAKE_MAX_PROBES_DEFAULT;
     bk_glg_coarse coarse;
     memset(&coarse, 0, sizeof coarse);
     if (b->opt->glg_lighting) {   /* the density rule's coarse pass (bake/probes/glg_coarse.h) */

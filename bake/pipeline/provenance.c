@@ -354,6 +354,14 @@ lbk_result bk_provenance_meta(const bk_pipeline *b, void **data, size_t *size)
     if (o->glossy_vpl_photons > 0) p[n++] = (lbk_meta_pair){"bake.glossy_vpl_photons", vpl_photons};
     if (o->glossy_vpl_delta > 0) p[n++] = (lbk_meta_pair){"bake.glossy_vpl_delta", vpl_delta};
     if (o->adaptive < 0) p[n++] = (lbk_meta_pair){"bake.adaptive", "off"}; /* absent: on */
+    char max_page[16], max_probes[16], texel_budget[24];
+    snprintf(max_page, sizeof max_page, "%d", o->max_page);
+    snprintf(max_probes, sizeof max_probes, "%u", o->max_probes);
+    snprintf(texel_budget, sizeof texel_budget, "%llu", (unsigned long long)o->texel_budget);
+    /* absent: the defaults (so bakes that leave them alone keep their bytes) */
+    if (o->max_page) p[n++] = (lbk_meta_pair){"bake.max_page", max_page};
+    if (o->max_probes) p[n++] = (lbk_meta_pair){"bake.max_probes", max_probes};
+    if (o->texel_budget) p[n++] = (lbk_meta_pair){"bake.texel_budget", texel_budget};
     p[n++] = (lbk_meta_pair){"bake.dls_threshold", threshold};
     p[n++] = (lbk_meta_pair){"bake.door_method", o->door_method == LBK_BAKE_DOOR_GUIDED ? "guided" : "difference"};
     if (o->revision) p[n++] = (lbk_meta_pair){LBK_META_REVISION, o->revision};

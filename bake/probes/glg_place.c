@@ -397,7 +397,7 @@ lbk_result bk_glg_place(const bk_scene *scene, const bk_tracer *tracer,
     double spacing = o.spacing > 0 && isfinite(o.spacing) ? o.spacing : 1.0;
     int levels = o.refine_levels < 0 ? 0 : o.refine_levels == 0 ? 1 : o.refine_levels;
     if (levels > MAX_REFINE) levels = MAX_REFINE;
-    size_t cap = o.max_probes ? o.max_probes : 16384;
+    size_t cap = o.max_probes ? o.max_probes : BK_GLG_DEFAULT_MAX_PROBES;
     int rays = o.solid_rays > 0 ? o.solid_rays : 32;
     if (rays > 1024) rays = 1024;
 

@@ -17,13 +17,17 @@
  * bk_glg_coarse_lighting (bake/probes/glg_coarse.h) is the transport's. */
 typedef lbk_result (*bk_glg_lighting_fn)(void *user, const float *points, size_t n, float *out);
 
+/* The probe cap when none is given: seed 001's production levels hold 150–230 k probes;
+ * Delaunay and the runtime walk at this count are measured by bench/bench_glg_scale.c. */
+#define BK_GLG_DEFAULT_MAX_PROBES 262144u
+
 typedef struct bk_glg_options {   /* zero-initialised = defaults */
     float spacing;                /* largest probe spacing, metres; 0: 1.0 */
     int refine_levels;            /* halvings of the spacing in cells that hold geometry;
                                      0: 1 (half spacing near surfaces); -1: none; at most 4 */
     float min_distance;           /* probes closer to a surface are pushed out (or dropped);
                                      0: a quarter of the finest spacing */
-    size_t max_probes;            /* cap; reached by coarsening; 0: 16384 */
+    size_t max_probes;            /* cap; reached by coarsening; 0: BK_GLG_DEFAULT_MAX_PROBES */
     int solid_rays;               /* rays of the inside-solid / distance test; 0: 32 */
     int face_visibility_level;    /* each face is split into 4^level triangles, one ray to the
                                      centroid of each; 0: 1 (4 rays per face), at most 4 */

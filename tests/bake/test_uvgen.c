@@ -345,15 +345,100 @@ static void test_oversize_split(void **state)
     check_invariants(&s, &u);
     bk_uv_object_free(&u);
 
-    /* one triangle that cannot be split: the object's density is lowered and reported */
+    /* one triangle that cannot be split: only its own chart gets a lower density, the object
+     * keeps the one asked for (reported) */
     uvs_object(&s, "huge");
     float t0[3] = {0, 5, 0}, t1[3] = {50, 5, 0}, t2[3] = {0, 5, -50};
     uvs_tri(&s, t0, t1, t2, 0);
     assert_int_equal(bk_uvgen_object(&s, 1, 8.0f, &o, &u), LBK_OK);
     assert_int_equal(u.chart_count, 1);
     assert_true(u.charts[0].width <= 100.0f && u.charts[0].height <= 100.0f);
-    assert_true(u.density < 8.0f);
-    assert_non_null(strstr(u.note, "density lowered"));
+    /* scaled to the cap exactly (its longer side), not further */
+    assert_true(fmaxf(u.charts[0].width, u.charts[0].height) > 99.9f);
+    assert_float_equal(u.density, 8.0, 1e-6);
+    assert_int_equal(u.scaled_tris, 1);
+    assert_int_equal(u.big_tris, 1);
+    /* 400 texel legs (or a 566 texel hypotenuse) into 100: at most 2 texels/m */
+    assert_true(u.scaled_density <= 8.0f * 100.0f / 399.0f);
+    assert_float_equal(sqrt(chart_uv_area(&u) / 1250.0), u.scaled_density, 1e-3);
+    assert_non_null(strstr(u.note, "1 triangle longer than 100 texels"));
+    check_invariants(&s, &u);
+    bk_uv_object_free(&u);
+
+    /* the same triangle with a one-triangle cap of a large page: its chart keeps the density */
+    o.max_triangle_texels = 1000;
+    assert_int_equal(bk_uvgen_object(&s, 1, 8.0f, &o, &u), LBK_OK);
+    assert_int_equal(u.chart_count, 1);
+    assert_int_equal(u.scaled_tris, 0);
+    assert_int_equal(u.big_tris, 1);
+    assert_float_equal(sqrt(chart_uv_area(&u) / 1250.0), 8.0, 1e-3);
+    assert_string_equal(u.note, "");
+    bk_uv_object_free(&u);
+    uvs_free(&s);
+}
+
+/* The world area of a chart's triangles, m². */
+static double chart_world_area(const bk_scene *s, const bk_uv_object *u, size_t c)
+{
+    double a = 0.0;
+    for (uint32_t i = 0; i < u->charts[c].count; i++) {
+        const uint32_t *v = s->tris + 3 * (size_t)u->tris[u->charts[c].first + i];
+        const float *p = s->positions + 3 * (size_t)v[0], *q = s->positions + 3 * (size_t)v[1],
+                    *r = s->positions + 3 * (size_t)v[2];
+        double e1[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]}, e2[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
+        double x = e1[1] * e2[2] - e1[2] * e2[1], y = e1[2] * e2[0] - e1[0] * e2[2], z = e1[0] * e2[1] - e1[1] * e2[0];
+        a += 0.5 * sqrt(x * x + y * y + z * z);
+    }
+    return a;
+}
+
+static double chart_texel_area(const bk_uv_object *u, size_t c)
+{
+    double a = 0.0;
+    for (uint32_t i = 0; i < u->charts[c].count; i++) {
+        const float *q = u->uv + 6 * ((size_t)u->charts[c].first + i);
+        a += 0.5 * fabs(((double)q[2] - q[0]) * ((double)q[5] - q[1]) - ((double)q[3] - q[1]) * ((double)q[4] - q[0]));
+    }
+    return a;
+}
+
+/* One object: a huge triangle beside ordinary detail (a 4 × 4 m box). The huge triangle's chart
+ * alone is scaled to the one-triangle cap; every other chart has the density asked for,
+ * measured from its texel area against its world area. */
+static void test_huge_triangle_keeps_object_density(void **state)
+{
+    (void)state;
+    bk_scene s;
+    uvs_init(&s);
+    uvs_object(&s, "ground_and_box");
+    float t0[3] = {-500, 0, 500}, t1[3] = {500, 0, 500}, t2[3] = {-500, 0, -500};
+    uvs_tri(&s, t0, t1, t2, 0);
+    float mn[3] = {0, 0, 0}, mx[3] = {4, 4, 4};
+    uvs_box(&s, mn, mx, 2, 0, 0);
+    bk_uv_options o = {0};
+    o.max_chart_texels = 250;
+    o.max_triangle_texels = 1020;
+    bk_uv_object u;
+    assert_int_equal(bk_uvgen_object(&s, 0, 8.0f, &o, &u), LBK_OK);
+    assert_float_equal(u.density, 8.0, 1e-6);
+    assert_int_equal(u.scaled_tris, 1);
+    size_t huge = 0, others = 0;
+    for (size_t c = 0; c < u.chart_count; c++) {
+        double d = sqrt(chart_texel_area(&u, c) / chart_world_area(&s, &u, c));
+        if (u.charts[c].count == 1 && u.tris[u.charts[c].first] == s.objects[0].first_tri) {
+            huge++;
+            /* 8000 texel legs into 1020 (or its 11314 texel hypotenuse) */
+            assert_true(d <= 8.0 * 1020.0 / 7999.0);
+            assert_true(fmaxf(u.charts[c].width, u.charts[c].height) <= 1020.0f);
+            assert_float_equal(d, u.scaled_density, 1e-3);
+        } else {
+            others++;
+            assert_float_equal(d, 8.0, 8.0 * 1e-4);
+            assert_true(fmaxf(u.charts[c].width, u.charts[c].height) <= 250.0f);
+        }
+    }
+    assert_int_equal(huge, 1);
+    assert_true(others >= 5); /* the box's five outward faces at least */
     check_invariants(&s, &u);
     bk_uv_object_free(&u);
     uvs_free(&s);
@@ -520,6 +605,7 @@ int main(void)
         cmocka_unit_test(test_authored_uv1_rejected),
         cmocka_unit_test(test_degenerate_triangles),
         cmocka_unit_test(test_oversize_split),
+        cmocka_unit_test(test_huge_triangle_keeps_object_density),
         cmocka_unit_test(test_sphere_charts),
         cmocka_unit_test(test_spiral_overlap_split),
         cmocka_unit_test(test_deterministic),
