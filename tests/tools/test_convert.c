@@ -97,6 +97,8 @@ static void test_profile_errors_name_the_line(void **state)
     expect_error(buf, "t.profile:5: 'TOOLONG' is not a section type");
     snprintf(buf, sizeof buf, "%s[lmap]\nrow_pitch_alignment = 100\n", head);
     expect_error(buf, "t.profile:6: row_pitch_alignment '100' must be 0 or a power of two");
+    snprintf(buf, sizeof buf, "%s[lmap]\nmax_page = 32\n", head);
+    expect_error(buf, "t.profile:6: max_page '32' must be 0 or in [64, 16384]");
     snprintf(buf, sizeof buf, "%s[lmap]\npitch = 64\n", head);
     expect_error(buf, "t.profile:6: unknown key 'pitch' in [lmap]");
     expect_error("name = x\nno equals sign\n", "t.profile:2: expected 'key = value'");
@@ -447,6 +449,34 @@ static void test_page_alignment_checked(void **state)
     tf_blob_free(&in);
 }
 
+/* A profile's max_page refuses a bake with a larger page (convert cannot move objects between
+ * pages) and names the bake option that fixes it; the profile's padding counts. */
+static void test_max_page_refused(void **state)
+{
+    (void)state;
+    tf_options fo = {0};
+    fo.page0_width = 100; /* page 0 is 100 × 32, page 1 16 × 16 */
+    tf_blob in = tf_build_scene(TF_SCENE_FULL, &fo);
+    char err[TL_ERR_LEN] = "";
+    void *out = NULL;
+    size_t out_size = 0;
+    tl_profile p = profile_from("name = t\nalignment = 64\n[sections]\ndefault = none\n[lmap]\nmax_page = 64\n");
+    assert_int_equal(p.lmap_max_page, 64);
+    tl_convert_options o = {.profile = &p};
+    assert_int_equal(tl_convert_memory(in.data, in.size, &o, &out, &out_size, NULL, err), TL_CONVERT_UNSUPPORTED);
+    assert_non_null(strstr(err, "page 0 is 100x32 texels, more than the profile's max_page 64: bake with `lbk bake --max-page 64`"));
+    assert_null(out);
+    /* 100 fits 128; padded to a 1024-byte pitch (256 texels) it no longer does */
+    p = profile_from("name = t\nalignment = 64\n[sections]\ndefault = none\n[lmap]\nmax_page = 128\n");
+    convert_ok(in.data, in.size, &p, &out, &out_size);
+    free(out);
+    out = NULL;
+    p = profile_from("name = t\nalignment = 64\n[sections]\ndefault = none\n[lmap]\nmax_page = 128\nrow_pitch_alignment = 1024\n");
+    assert_int_equal(tl_convert_memory(in.data, in.size, &o, &out, &out_size, NULL, err), TL_CONVERT_UNSUPPORTED);
+    assert_non_null(strstr(err, "page 0 is 256x32 texels after the profile's padding"));
+    tf_blob_free(&in);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -460,6 +490,7 @@ int main(void)
         cmocka_unit_test(test_bad_input_and_invalid_pack),
         cmocka_unit_test(test_row_pitch_widening),
         cmocka_unit_test(test_page_alignment_checked),
+        cmocka_unit_test(test_max_page_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

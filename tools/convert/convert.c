@@ -198,7 +198,7 @@ tl_convert_status tl_convert_memory(const void *in, size_t in_size, const tl_con
         if (si.type == LBK_SECTION_LMAP) {
             tl_lmap_layout_options lo = {p->lmap_row_pitch_alignment, p->lmap_page_alignment, opt->from_exr_dir,
                                          {p->lmap_format[0], p->lmap_format[1]}, objs, objs_size,
-                                         &report->encode_seconds};
+                                         &report->encode_seconds, p->lmap_max_page};
             uint32_t imported = 0;
             tl_texel_remap_free(&remap);
             ls = tl_lmap_rewrite(data, size, &lo, &rewritten, &rewritten_size, &imported, &remap, err);

@@ -248,6 +248,16 @@ int tl_lmap_rewrite(const void *lmap, size_t size, const tl_lmap_layout_options 
             return tl_fail(err, TL_CONVERT_UNSUPPORTED, "page %u (%ux%u) cannot be padded for the profile's layout", p,
                            pg.width, pg.height);
         }
+        if (o->max_page && (remap->new_width[p] > o->max_page || new_h[p] > o->max_page)) {
+            /* a page cannot be split here (its objects' rectangles are fixed): the bake must be redone */
+            uint32_t w = remap->new_width[p], h = new_h[p];
+            free(new_h);
+            return tl_fail(err, TL_CONVERT_UNSUPPORTED,
+                           "page %u is %ux%u texels%s, more than the profile's max_page %u: bake with "
+                           "`lbk bake --max-page %u`",
+                           p, w, h, w != pg.width || h != pg.height ? " after the profile's padding" : "", o->max_page,
+                           o->max_page);
+        }
         remap->new_first[p] = first;
         first += (uint64_t)remap->new_width[p] * new_h[p];
         resize |= remap->new_width[p] != pg.width || new_h[p] != pg.height;

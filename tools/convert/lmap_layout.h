@@ -17,6 +17,7 @@ typedef struct tl_lmap_layout_options {
     const void *objs;             /* the OBJS payload (which texels objects use, for the block encoders), or NULL */
     size_t objs_size;
     double *encode_seconds;       /* when non-NULL, += the time spent block-encoding */
+    uint32_t max_page;            /* a page wider or taller than this after padding is refused; 0: none */
 } tl_lmap_layout_options;
 
 /* How texel indices move when pages are widened (identity when no page changed width). */

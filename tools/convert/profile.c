@@ -80,7 +80,7 @@ int tl_profile_parse(const char *text, size_t size, const char *origin, tl_profi
     out->text_hash = XXH3_64bits(text, size);
     out->defaults.compression = LBK_COMPRESSION_NONE;
     enum { TOP, SECTIONS, LMAP } group = TOP;
-    int have_name = 0, have_align = 0, have_default = 0, have_pitch = 0, have_page = 0, have_desc = 0, have_plane[2] = {0, 0};
+    int have_name = 0, have_align = 0, have_default = 0, have_pitch = 0, have_page = 0, have_max_page = 0, have_desc = 0, have_plane[2] = {0, 0};
     size_t pos = 0;
     int line_no = 0;
     while (pos < size) {
@@ -161,9 +161,17 @@ int tl_profile_parse(const char *text, size_t size, const char *origin, tl_profi
             uint32_t v;
             int *seen;
             uint32_t *dst;
+            if (!strcmp(key, "max_page")) {
+                if (have_max_page++) return tl_fail(err, -1, "%s:%d: duplicate key '%s'", origin, line_no, key);
+                if (parse_u32(val, &v) || (v != 0 && (v < 64 || v > LBK_LMAP_MAX_DIM)))
+                    return tl_fail(err, -1, "%s:%d: max_page '%s' must be 0 or in [64, %u]", origin, line_no, val,
+                                   (unsigned)LBK_LMAP_MAX_DIM);
+                out->lmap_max_page = v;
+                continue;
+            }
             if (!strcmp(key, "row_pitch_alignment")) seen = &have_pitch, dst = &out->lmap_row_pitch_alignment;
             else if (!strcmp(key, "page_alignment")) seen = &have_page, dst = &out->lmap_page_alignment;
-            else return tl_fail(err, -1, "%s:%d: unknown key '%s' in [lmap] (known: row_pitch_alignment, page_alignment, plane0, plane1)", origin, line_no, key);
+            else return tl_fail(err, -1, "%s:%d: unknown key '%s' in [lmap] (known: row_pitch_alignment, page_alignment, max_page, plane0, plane1)", origin, line_no, key);
             if ((*seen)++) return tl_fail(err, -1, "%s:%d: duplicate key '%s'", origin, line_no, key);
             if (parse_u32(val, &v) || (v != 0 && (!is_pow2(v) || v > LBK_MAX_ALIGNMENT)))
                 return tl_fail(err, -1, "%s:%d: %s '%s' must be 0 or a power of two up to %u", origin, line_no, key, val, LBK_MAX_ALIGNMENT);

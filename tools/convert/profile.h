@@ -35,6 +35,7 @@ typedef struct tl_profile {
     uint32_t lmap_row_pitch_alignment; /* bytes per page row padded to a multiple of this; 0: as baked */
     uint32_t lmap_page_alignment;      /* each page plane starts at a multiple of this; 0: as baked */
     uint32_t lmap_format[2];           /* plane encodings (lbk_lmap_format0/1; spec §9.2); 0, 0: as baked */
+    uint32_t lmap_max_page;            /* no page side (after padding) above this; 0: none (the spec's 16384) */
     uint64_t text_hash;                /* XXH3-64 of the profile's text (META convert.profile_hash) */
 } tl_profile;
 
