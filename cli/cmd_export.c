@@ -80,7 +80,7 @@ static int export_main(int argc, char **argv, tl_guard *guard)
 {
     const char *in = NULL;
     tl_export_options o = {NULL, NULL, 0};
-    tl_gltf_options g = {NULL, NULL, NULL};
+    tl_gltf_options g = {NULL, NULL, NULL, 0};
     int quiet = 0;
     uint64_t max_memory = 0;
     for (int i = 1; i < argc; i++) {

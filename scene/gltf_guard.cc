@@ -578,7 +578,7 @@ Prepass prepass(const char *json_begin, size_t json_len, const std::string &file
         const nlohmann::json *textures = jarr(doc, "textures");
         const nlohmann::json *materials = jarr(doc, "materials");
         pp.needed_images.assign(images ? images->size() : 0, 0);
-        auto need = [&](const nlohmann::json &info) {
+        auto need = [&](const nlohmann::json &info, char why) {  // why: 1 colour, 2 normal (ImageLoaderCtx)
             long long t, src;
             if (!textures || !jint(info, "index", &t) || t < 0 || (size_t)t >= textures->size()) return;
             const nlohmann::json &tex = (*textures)[(size_t)t];
@@ -588,18 +588,18 @@ Prepass prepass(const char *json_begin, size_t json_len, const std::string &file
                 webp = jint(tex["extensions"]["EXT_texture_webp"], "source", &src);
             if ((webp || jint(tex, "source", &src)) && src >= 0 &&
                 (size_t)src < pp.needed_images.size())
-                pp.needed_images[(size_t)src] = 1;
+                pp.needed_images[(size_t)src] |= why;
         };
         if (materials)
             for (const auto &m : *materials) {
                 if (!m.is_object()) continue;
                 auto pbr = m.find("pbrMetallicRoughness");
                 if (pbr != m.end() && pbr->is_object() && pbr->contains("baseColorTexture"))
-                    need((*pbr)["baseColorTexture"]);
+                    need((*pbr)["baseColorTexture"], 1);
                 if (pbr != m.end() && pbr->is_object() && pbr->contains("metallicRoughnessTexture"))
-                    need((*pbr)["metallicRoughnessTexture"]);
-                if (m.contains("emissiveTexture")) need(m["emissiveTexture"]);
-                if (normal_maps && m.contains("normalTexture")) need(m["normalTexture"]);
+                    need((*pbr)["metallicRoughnessTexture"], 1);
+                if (m.contains("emissiveTexture")) need(m["emissiveTexture"], 1);
+                if (normal_maps && m.contains("normalTexture")) need(m["normalTexture"], 2);
             }
     }
 

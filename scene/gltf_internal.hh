@@ -206,8 +206,9 @@ struct DracoInfo {
 
 struct Prepass {
     std::map<std::pair<int, int>, DracoInfo> draco;  // (mesh, primitive)
-    std::vector<char> needed_images;                 // images used as base colour / emissive / metallicRoughness
-                                                     // (and normal, when the import reads normal maps)
+    std::vector<char> needed_images;                 // per image: 1 used as base colour / emissive /
+                                                     // metallicRoughness, | 2 as a normal texture (only
+                                                     // when the import reads normal maps)
     std::string json;                                // rewritten JSON handed to tinygltf
 };
 
@@ -236,7 +237,7 @@ std::vector<unsigned char> make_glb(const std::string &json_text, const GlbParts
 
 struct ImageLoaderCtx {
     const std::vector<char> *needed;
-    bool skip;
+    bool skip;  // skip_textures: keep normal textures only (bit 2 of needed)
 };
 
 // tinygltf's image loader (LoadImageDataFunction; user data: ImageLoaderCtx), gltf_materials.cc

@@ -24,8 +24,10 @@ bool keep_encoded_image(tinygltf::Image *image, const int idx, std::string *, st
 {
     const ImageLoaderCtx *ctx = static_cast<const ImageLoaderCtx *>(user);
     // bufferView images are read later from the validated view; tinygltf's pointer is not used.
-    if (ctx->skip || image->bufferView >= 0) return true;
-    if (idx < 0 || (size_t)idx >= ctx->needed->size() || !(*ctx->needed)[(size_t)idx]) return true;
+    if (image->bufferView >= 0) return true;
+    if (idx < 0 || (size_t)idx >= ctx->needed->size()) return true;
+    const char want = (*ctx->needed)[(size_t)idx] & (ctx->skip ? 2 : 3);  // skip_textures keeps normal maps
+    if (!want) return true;
     if (bytes && size > 0) image->image.assign(bytes, bytes + size);
     return true;
 }
@@ -261,7 +263,7 @@ UvMap Importer::read_uv_map(const tinygltf::TextureInfo &ti, const char *slot, i
 int Importer::texture_image(const tinygltf::TextureInfo &ti, const char *slot, int mi, const std::string &mname,
                             UvMap *map, bool linear)
 {
-    if (ti.index < 0 || o_.skip_textures) return -1;
+    if (ti.index < 0 || (o_.skip_textures && !linear)) return -1;  // normal_maps reads normal maps regardless
     if ((size_t)ti.index >= m_.textures.size())
         fail("%s: material %d %s: %s texture %d out of range", path_.c_str(), mi, qstr(mname).c_str(), slot, ti.index);
     int src = texture_source(ti.index);

@@ -44,7 +44,8 @@ typedef struct bk_import_options {
     /* 1: also read each material's normalTexture (bk_material.normal_tex1, normal_scale; decoded
      * as linear data) and give the scene tangents (bk_scene.tangents: TANGENT where a primitive
      * has it with NORMAL, else derived). For readers that shade with normal maps (lbk render,
-     * lbk export --gltf); the bake leaves it 0, so its import and source hash are unchanged. */
+     * lbk export --gltf); the bake leaves it 0, so its import and source hash are unchanged.
+     * Normal textures are decoded even with skip_textures (which then skips the others). */
     int normal_maps;
     /* Optional: receives each warning (one line, no newline). */
     void (*warn)(void *user, const char *message);

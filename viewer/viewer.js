@@ -41,16 +41,24 @@
     return out;
   }
 
+  /* world space throughout: the export's nodes have identity transforms */
   const VERT = `
     attribute vec2 uv2;
+    attribute vec4 lbkTangent;
     varying vec2 vCoord;
+    varying vec2 vUv;
     varying vec3 vNormal;
+    varying vec3 vPos;
+    varying vec4 vTangent;
     varying vec3 vColor;
     attribute vec3 lbkColor;
     uniform vec2 pageSize;
     void main() {
       vCoord = uv2 * pageSize;
+      vUv = uv;
       vNormal = normalize(normal);
+      vPos = position;
+      vTangent = lbkTangent;
       vColor = lbkColor;
       gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0);
     }`;
@@ -74,8 +82,14 @@
     uniform float exposure;
     uniform int mode;
     uniform int lightmapped;
+    uniform sampler2D normalMap;
+    uniform int hasNormalMap;
+    uniform float normalScale;
     varying vec2 vCoord;
+    varying vec2 vUv;
     varying vec3 vNormal;
+    varying vec3 vPos;
+    varying vec4 vTangent;
     varying vec3 vColor;
     float small(uint code, uint mbits) {
       uint e = code >> mbits, m = code & ((1u << mbits) - 1u);
@@ -83,8 +97,10 @@
       if (e == 31u) return 65024.0;
       return (1.0 + float(m) / float(1u << mbits)) * exp2(float(e) - 15.0);
     }
-    /* e0 + g.z per channel: the linear form along +Z (the shading normal) */
-    vec3 blockTexelE(ivec2 t) { /* lbk_ahd_texel_f_to_linear along +Z */
+    /* e0 + g·n per channel: the linear form along n, the shading normal in the texel's tangent
+     * frame (+Z without a normal map: then d.z, the bits of the form along +Z exactly) */
+    float along(vec3 d, vec3 n) { return hasNormalMap == 1 ? dot(d, n) : d.z; }
+    vec3 blockTexelE(ivec2 t, vec3 n) { /* lbk_ahd_texel_f_to_linear, evaluated along n */
       vec4 a = texelFetch(block0, t, 0), b = texelFetch(block1, t, 0);
       vec3 d = vec3(2.0 * b.x - 1.0, 2.0 * b.y - 1.0, b.z);
       float len = length(d);
@@ -93,10 +109,10 @@
       vec3 ez = clamp(a.rgb, 0.0, 65504.0);
       float k = 0.25 + 0.5 * d.z;
       vec3 amb = r * ez, inten = (1.0 - r) * ez / k;
-      return amb + 0.25 * inten + 0.5 * inten * d.z;
+      return amb + 0.25 * inten + 0.5 * inten * along(d, n);
     }
-    vec3 texelE(ivec2 t) {
-      if (blockPage == 1) return blockTexelE(t);
+    vec3 texelE(ivec2 t, vec3 n) {
+      if (blockPage == 1) return blockTexelE(t, n);
       uint w = texelFetch(plane0, t, 0).r;
       uvec4 b = texelFetch(plane1, t, 0);
       vec3 ez = vec3(small(w & 2047u, 6u), small((w >> 11) & 2047u, 6u), small(w >> 22, 5u));
@@ -106,9 +122,39 @@
       float r = float(b.r) / 255.0;
       float k = 0.25 + 0.5 * d.z;
       vec3 amb = r * ez, inten = (1.0 - r) * ez / k;
-      return amb + 0.25 * inten + 0.5 * inten * d.z;
+      return amb + 0.25 * inten + 0.5 * inten * along(d, n);
+    }
+    /* The normal map's world normal (glTF: t = (2·rgb − 1) with x, y × scale, in the frame T, B =
+     * w (N × T), N; nearest texel, as lbk render), as tools/render/shade.c shading_normal. */
+    vec3 mappedNormal(vec3 N) {
+      vec3 T = vTangent.xyz - N * dot(N, vTangent.xyz);
+      if (dot(T, T) <= 0.0) return N;
+      T = normalize(T);
+      vec3 B = cross(N, T) * (vTangent.w < 0.0 ? -1.0 : 1.0);
+      vec3 t = texture2D(normalMap, vUv).rgb * 2.0 - 1.0;
+      vec3 n = t.x * normalScale * T + t.y * normalScale * B + t.z * N;
+      return dot(n, n) > 1e-12 ? normalize(n) : N;
+    }
+    /* n in the texel's tangent frame (spec §5.6, lbk_ahd_triangle_dpdx + lbk_ahd_tangent_frame):
+     * T = dP/dX of the triangle made orthogonal to N, B = N × T; dP/dX from the screen-space
+     * derivatives of the (per triangle affine) position and lightmap coordinate. */
+    vec3 texelFrame(vec3 N, vec3 n) {
+      vec3 dp1 = dFdx(vPos), dp2 = dFdy(vPos);
+      vec2 dc1 = dFdx(vCoord), dc2 = dFdy(vCoord);
+      float det = dc1.x * dc2.y - dc2.x * dc1.y;
+      vec3 dpdx = det != 0.0 ? (dp1 * dc2.y - dp2 * dc1.y) / det : vec3(0.0);
+      vec3 T = dpdx - N * dot(N, dpdx);
+      if (!(length(T) > 1e-6 * length(dpdx))) { /* basis_t of libformat/src/ahd_frame.c */
+        float sg = N.z >= 0.0 ? 1.0 : -1.0, a = -1.0 / (sg + N.z);
+        T = vec3(1.0 + sg * N.x * N.x * a, sg * N.x * N.y * a, -sg * N.x);
+      }
+      T = normalize(T);
+      vec3 B = normalize(cross(N, T));
+      return vec3(dot(n, T), dot(n, B), dot(n, N));
     }
     vec3 lightmapE() {
+      vec3 N = normalize(vNormal), nt = vec3(0.0, 0.0, 1.0);
+      if (hasNormalMap == 1) nt = texelFrame(N, mappedNormal(N));
       vec2 f = vCoord - 0.5;
       vec2 i0 = floor(f), a = f - i0;
       vec3 e = vec3(0.0);
@@ -116,7 +162,7 @@
         vec2 o = vec2(float(k & 1), float((k >> 1) & 1));
         float w = (o.x > 0.5 ? a.x : 1.0 - a.x) * (o.y > 0.5 ? a.y : 1.0 - a.y);
         ivec2 t = ivec2(clamp(i0 + o, vec2(0.0), pageSize - 1.0));
-        e += w * texelE(t);
+        e += w * texelE(t, nt);
       }
       return max(e * scale, 0.0);
     }
@@ -365,6 +411,25 @@
     const probeLit = []; /* meshes lit per vertex from the probes: recomputed when the sets change */
     const meshes = [];
     gltf.scene.traverse((m) => { if (m.isMesh) meshes.push(m); });
+    /* normal maps: lbk view's export puts each one's texels in its material's extras (RGB bytes,
+     * row 0 the image's top = v 0), read here synchronously (no image decode); sampled nearest
+     * with repeat, as lbk render does. Drawn on lightmapped surfaces (probe-lit ones are lit per
+     * vertex and keep their vertex normals). */
+    const normalMaps = new Map();
+    for (const m of meshes) {
+      const nm = m.material.userData && m.material.userData.lbk && m.material.userData.lbk.normal_map;
+      if (!nm || normalMaps.has(nm.texels)) continue;
+      const acc = await gltf.parser.getDependency('accessor', nm.texels);
+      const n = nm.width * nm.height, rgb = acc.array, rgba = new Uint8Array(4 * n);
+      if (rgb.length !== 3 * n) throw new Error('normal map texels: ' + rgb.length + ' bytes for ' + nm.width + 'x' + nm.height);
+      for (let i = 0; i < n; i++) { rgba[4 * i] = rgb[3 * i]; rgba[4 * i + 1] = rgb[3 * i + 1]; rgba[4 * i + 2] = rgb[3 * i + 2]; rgba[4 * i + 3] = 255; }
+      const t = new THREE.DataTexture(rgba, nm.width, nm.height, THREE.RGBAFormat, THREE.UnsignedByteType);
+      t.magFilter = t.minFilter = THREE.NearestFilter; t.wrapS = t.wrapT = THREE.RepeatWrapping;
+      t.generateMipmaps = false; t.flipY = false; t.needsUpdate = true;
+      normalMaps.set(nm.texels, t);
+    }
+    const noNormalMap = new THREE.DataTexture(new Uint8Array([128, 128, 255, 255]), 1, 1, THREE.RGBAFormat, THREE.UnsignedByteType);
+    noNormalMap.needsUpdate = true;
     for (const m of meshes) {
       let node = m, info = null;
       while (node && !(info = node.userData && node.userData.lbk)) node = node.parent;
@@ -380,6 +445,9 @@
       g.setAttribute('lbkColor', new THREE.BufferAttribute(colors, 3));
       if (rep !== 'lightmap' || !page) probeLit.push({ g, grid: rep === 'llg' ? info.llg_grid : -1 });
       if (!g.attributes.uv2) g.setAttribute('uv2', new THREE.BufferAttribute(new Float32Array(2 * n), 2));
+      if (!g.attributes.uv) g.setAttribute('uv', new THREE.BufferAttribute(new Float32Array(2 * n), 2));
+      const nm = matx && matx.normal_map && g.attributes.tangent && page ? matx.normal_map : null;
+      g.setAttribute('lbkTangent', nm ? g.attributes.tangent : new THREE.BufferAttribute(new Float32Array(4 * n), 4));
       const src = page || dummy;
       const mat = new THREE.ShaderMaterial({
         vertexShader: VERT, fragmentShader: FRAG, side: THREE.DoubleSide,
@@ -389,6 +457,8 @@
                     blockPage: { value: page && page.block ? 1 : 0 }, hasErr: { value: page && page.te ? 1 : 0 },
                     pageSize: { value: src ? src.size.clone() : new THREE.Vector2(1, 1) }, scale: { value: lmap ? lmap.scale : 1 },
                     albedo: { value: albedo }, emission: { value: emission }, lightmapped: { value: page ? 1 : 0 },
+                    normalMap: { value: nm ? normalMaps.get(nm.texels) : noNormalMap }, hasNormalMap: { value: nm ? 1 : 0 },
+                    normalScale: { value: nm ? nm.scale : 1 },
                     exposure: uniformsCommon.exposure, mode: uniformsCommon.mode } });
       m.material = mat;
       box.expandByObject(m);
@@ -460,7 +530,8 @@
       uniforms: { plane0: { value: dummyTex() }, plane1: { value: dummyTex1() }, footprint: { value: dummyTex2() }, errmap: { value: dummyTex2() },
                   block0: { value: dummyF() }, block1: { value: dummyF() }, blockPage: { value: 0 }, hasErr: { value: 0 },
                   pageSize: { value: new THREE.Vector2(1, 1) }, scale: { value: 1 }, albedo: { value: new THREE.Vector3(1, 1, 1) },
-                  emission: { value: new THREE.Vector3() }, lightmapped: { value: 0 }, exposure: uniformsCommon.exposure, mode } });
+                  emission: { value: new THREE.Vector3() }, lightmapped: { value: 0 }, exposure: uniformsCommon.exposure, mode,
+                  normalMap: { value: noNormalMap }, hasNormalMap: { value: 0 }, normalScale: { value: 1 } } });
     const glyphMode = { value: 1 }; /* glyphs show irradiance ×(exposure); in radiance mode × 1/π */
     const sphere = (r) => { const g = new THREE.SphereGeometry(r, 12, 8); g.setAttribute('uv2', new THREE.BufferAttribute(new Float32Array(2 * g.attributes.position.count), 2)); return g; };
     const glyphGroup = (positions, colourOf) => {

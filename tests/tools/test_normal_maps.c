@@ -30,12 +30,9 @@
 
 #include "scene/import.h"
 #include "support/bake_file.h"
-#include "tools/common/image_io.h"
+#include "support/normal_scene.h"
 #include "tools/render/render.h"
 
-#define RHO 0.5
-#define E_SUN 3.0
-#define ALPHA_DEG 30.0
 #define PI 3.14159265358979323846
 
 static char tmpdir[64];
@@ -68,108 +65,11 @@ static void write_bytes(const char *name, const void *data, size_t len)
     assert_int_equal(fclose(f), 0);
 }
 
-/* ---- the scene -------------------------------------------------------------------------------- */
+static void write_all(float tangent_w) { assert_int_equal(ns_write_all(tmpdir, tangent_w), 0); }
 
-/* The stripes' tangent-space normals (x along +u, y the image's up, z out of the surface). */
-static void stripe_normal(int k, double n[3])
-{
-    const double a = ALPHA_DEG * PI / 180.0, s = sin(a), c = cos(a);
-    const double t[4][3] = {{0, 0, 1}, {s, 0, c}, {-s, 0, c}, {0, s, c}};
-    memcpy(n, t[k], sizeof t[k]);
-}
-
-static uint8_t to_byte(double x) { return (uint8_t)lround((x * 0.5 + 0.5) * 255.0); }
-
-/* normal.png: 8 × 2 texels, stripe k covers u in [k/4, (k+1)/4) (2 texels each). */
-static void write_normal_png(void)
-{
-    uint8_t px[8 * 2 * 3];
-    for (int y = 0; y < 2; y++)
-        for (int x = 0; x < 8; x++) {
-            double n[3];
-            stripe_normal(x / 2, n);
-            for (int c = 0; c < 3; c++) px[3 * (y * 8 + x) + c] = to_byte(n[c]);
-        }
-    char p[256], err[TL_ERR_LEN];
-    path_of(p, sizeof p, "normal.png");
-    assert_int_equal(tl_png_write_rgb8(p, 8, 2, px, err), 0);
-}
-
-/* floor.bin: the floor y = 0, x and z in [−2, 2], facing +y; uv0 u = (x + 2)/4, v = (z + 2)/4;
- * TANGENT (1, 0, 0, tangent_w); indices 0 1 2 0 2 3 (counter-clockwise seen from +y). */
-static void write_floor_bin(float tangent_w)
-{
-    const float pos[12] = {-2, 0, 2, 2, 0, 2, 2, 0, -2, -2, 0, -2}, nrm[12] = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
-    const float uv[8] = {0, 1, 1, 1, 1, 0, 0, 0};
-    const float tan[16] = {1, 0, 0, tangent_w, 1, 0, 0, tangent_w, 1, 0, 0, tangent_w, 1, 0, 0, tangent_w};
-    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
-    unsigned char b[48 + 48 + 32 + 64 + 12];
-    memcpy(b, pos, 48), memcpy(b + 48, nrm, 48), memcpy(b + 96, uv, 32), memcpy(b + 128, tan, 64), memcpy(b + 192, idx, 12);
-    write_bytes("floor.bin", b, sizeof b);
-}
-
-/* The unit quaternion turning −Z (where KHR_lights_punctual points a directional light) to d. */
-static void aim(const double d[3], double q[4])
-{
-    const double a[3] = {0, 0, -1};
-    double w = 1 + (a[0] * d[0] + a[1] * d[1] + a[2] * d[2]);
-    double x = a[1] * d[2] - a[2] * d[1], y = a[2] * d[0] - a[0] * d[2], z = a[0] * d[1] - a[1] * d[0];
-    const double l = sqrt(w * w + x * x + y * y + z * z);
-    q[0] = x / l, q[1] = y / l, q[2] = z / l, q[3] = w / l;
-}
-
-/* The light's direction l (towards it): 40° from the zenith, from −z and +x, so the +X and +Y
- * stripes face it more than the flat one and the −X stripe less. */
-static void light_dir(double l[3])
-{
-    const double th = 40.0 * PI / 180.0, ph = -45.0 * PI / 180.0;
-    l[0] = sin(th) * cos(ph), l[1] = cos(th), l[2] = sin(th) * sin(ph);
-}
-
-/* name: the glTF over floor.bin and normal.png. tangent: the primitive lists TANGENT; material_extra:
- * JSON spliced into the material (normalTexture); node_extra: into the floor's node. */
 static void write_gltf(const char *name, int tangent, const char *material_extra, const char *node_extra)
 {
-    double l[3], d[3], q[4];
-    light_dir(l);
-    for (int k = 0; k < 3; k++) d[k] = -l[k];
-    aim(d, q);
-    char json[4096];
-    snprintf(json, sizeof json,
-             "{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_lights_punctual\"],"
-             "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[{\"type\":\"directional\",\"color\":[1,1,1],"
-             "\"intensity\":%.17g}]}},"
-             "\"scene\":0,\"scenes\":[{\"nodes\":[0,1]}],"
-             "\"nodes\":[{\"name\":\"floor\",\"mesh\":0,\"extras\":{\"lbk_lighting\":\"lightmap\"}%s},"
-             "{\"name\":\"sun\",\"rotation\":[%.17g,%.17g,%.17g,%.17g],\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}],"
-             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"TEXCOORD_0\":2%s},"
-             "\"indices\":4,\"material\":0}]}],"
-             "\"materials\":[{\"name\":\"bumpy\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[%.17g,%.17g,%.17g,1],"
-             "\"metallicFactor\":0,\"roughnessFactor\":1}%s}],"
-             "\"textures\":[{\"source\":0,\"sampler\":0}],\"samplers\":[{\"magFilter\":9728,\"minFilter\":9728}],"
-             "\"images\":[{\"uri\":\"normal.png\"}],"
-             "\"buffers\":[{\"uri\":\"floor.bin\",\"byteLength\":204}],"
-             "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":192},"
-             "{\"buffer\":0,\"byteOffset\":192,\"byteLength\":12}],"
-             "\"accessors\":[{\"bufferView\":0,\"byteOffset\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
-             "\"min\":[-2,0,-2],\"max\":[2,0,2]},"
-             "{\"bufferView\":0,\"byteOffset\":48,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
-             "{\"bufferView\":0,\"byteOffset\":96,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"},"
-             "{\"bufferView\":0,\"byteOffset\":128,\"componentType\":5126,\"count\":4,\"type\":\"VEC4\"},"
-             "{\"bufferView\":1,\"byteOffset\":0,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}]}",
-             E_SUN, node_extra, q[0], q[1], q[2], q[3], tangent ? ",\"TANGENT\":3" : "", RHO, RHO, RHO, material_extra);
-    write_bytes(name, json, strlen(json));
-}
-
-#define NORMAL_TEX ",\"normalTexture\":{\"index\":0}"
-
-static void write_all(float tangent_w)
-{
-    write_normal_png();
-    write_floor_bin(tangent_w);
-    write_gltf("derived.gltf", 0, NORMAL_TEX, "");
-    write_gltf("authored.gltf", 1, NORMAL_TEX, "");
-    write_gltf("flat.gltf", 0, "", "");
+    assert_int_equal(ns_write_gltf(tmpdir, name, tangent, material_extra, node_extra), 0);
 }
 
 static int import(const char *name, int normal_maps, bk_scene *s, char *err, size_t n)
@@ -209,8 +109,8 @@ static void import_frame(void **state)
         assert_float_equal(m->normal_scale, 1.0f, 0.0f);
         const bk_image *im = &s.images[0];
         double n1[3];
-        stripe_normal(1, n1);
-        assert_float_equal(im->rgba[4 * 2 + 0], to_byte(n1[0]) / 255.0f, 1e-6f); /* texel (2, 0): stripe 1 */
+        ns_stripe_normal(1, n1);
+        assert_float_equal(im->rgba[4 * 2 + 0], ns_to_byte(n1[0]) / 255.0f, 1e-6f); /* texel (2, 0): stripe 1 */
         bk_scene_free(&s);
         assert_int_equal(import(names[i], 0, &s, err, sizeof err), 0);
         assert_null(s.tangents);
@@ -227,8 +127,8 @@ static void import_mirrored(void **state)
     (void)state;
     write_all(1.0f);
     const char *node = ",\"scale\":[-1,1,1]";
-    write_gltf("mirror_derived.gltf", 0, NORMAL_TEX, node);
-    write_gltf("mirror_authored.gltf", 1, NORMAL_TEX, node);
+    write_gltf("mirror_derived.gltf", 0, NS_NORMAL_TEX, node);
+    write_gltf("mirror_authored.gltf", 1, NS_NORMAL_TEX, node);
     const char *names[2] = {"mirror_derived.gltf", "mirror_authored.gltf"};
     for (int i = 0; i < 2; i++) {
         bk_scene s;
@@ -264,7 +164,7 @@ static void import_hostile(void **state)
         assert_null(s.tangents);
     }
     /* TANGENT pointing at the VEC2 uv accessor, then at a VEC4 running past its view */
-    write_gltf("bad.gltf", 1, NORMAL_TEX, "");
+    write_gltf("bad.gltf", 1, NS_NORMAL_TEX, "");
     char p[256], json[4096];
     path_of(p, sizeof p, "bad.gltf");
     FILE *f = fopen(p, "rb");
@@ -335,26 +235,11 @@ static int column(double x)
     return (int)floor(W / 2.0 + x / half_w * (W / 2.0));
 }
 
-/* Stripe k's world normal: tangent-space n from the PNG's bytes (as any reader decodes them) in
- * the frame T = +x, B = −z, N = +y. */
-static void world_normal(int k, double n[3])
-{
-    double t[3];
-    stripe_normal(k, t);
-    for (int c = 0; c < 3; c++) t[c] = 2.0 * to_byte(t[c]) / 255.0 - 1.0;
-    const double l = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
-    n[0] = t[0] / l, n[1] = t[2] / l, n[2] = -t[1] / l;
-}
-
 /* Every pixel of a 7 × 7 block at stripe k's centre (rows at z = ±0.75 m) against the closed form. */
 static double check_stripe(const tl_image *im, int k, int normal_mapped, const char *what)
 {
-    double l[3], n[3] = {0, 1, 0};
-    light_dir(l);
-    if (normal_mapped) world_normal(k, n);
-    const double nl = n[0] * l[0] + n[1] * l[1] + n[2] * l[2], Nl = l[1];
-    const double want = RHO / PI * E_SUN * Nl * (1 + 2 * nl) / (1 + 2 * Nl);
-    const double lambert = RHO / PI * E_SUN * fmax(0.0, nl);
+    double lambert;
+    const double want = ns_closed_form(k, normal_mapped, &lambert);
     const int x0 = column(-1.5 + k);
     double worst = 0, mean = 0;
     int count = 0;
@@ -369,8 +254,8 @@ static double check_stripe(const tl_image *im, int k, int normal_mapped, const c
                 }
     }
     mean /= count;
-    printf("%s stripe %d: n.l %.4f  L %.5f  closed form %.5f (%+.2f %%)  Lambert %.5f (band-1 %+.1f %%)  worst %.2f %%\n",
-           what, k, nl, mean, want, 100 * (mean / want - 1), lambert, 100 * (want / lambert - 1), 100 * worst);
+    printf("%s stripe %d: L %.5f  closed form %.5f (%+.2f %%)  Lambert %.5f (band-1 %+.1f %%)  worst %.2f %%\n",
+           what, k, mean, want, 100 * (mean / want - 1), lambert, 100 * (want / lambert - 1), 100 * worst);
     if (worst > 0.02) fail_msg("%s stripe %d: %.2f %% from the closed form (bound 2 %%)", what, k, 100 * worst);
     return mean;
 }
@@ -403,7 +288,7 @@ static void render_closed_form(void **state)
     tl_image_free(&fl);
 
     /* an authored TANGENT with w = −1 puts the map's +Y on +z: the +Y stripe turns away */
-    write_floor_bin(-1.0f);
+    assert_int_equal(ns_write_floor_bin(tmpdir, -1.0f), 0);
     path_of(gltf, sizeof gltf, "authored.gltf");
     tl_image fw = render(gltf, lbk);
     const double y_stripe = fw.rgb[3 * ((size_t)(H / 2 + 15) * W + (size_t)column(1.5))];

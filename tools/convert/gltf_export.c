@@ -18,6 +18,7 @@
 #include "tools/common/lmuv_match.h"
 #include "tools/common/objects_match.h"
 #include "tools/convert/glb.h"
+#include "tools/convert/gltf_normals.h"
 #include "lbk/pixel.h"
 
 #define SAMPLER_LINEAR 9729
@@ -39,6 +40,7 @@ typedef struct ex {
     int any_unlit, any_strength;
     char dir[4096], stem[200];
     tl_gltf_stats *st;
+    tl_gltf_normals normals; /* normalTexture + TANGENT where a material has a normal map */
     char *err;
 } ex;
 
@@ -280,6 +282,7 @@ static int material_for(ex *e, uint32_t mi, int page)
     }
     if (m->double_sided) cJSON_AddBoolToObject(mat, "doubleSided", 1);
     cJSON_AddItemToObject(mat, "extras", material_extras(m, page));
+    tl_gltf_normals_material(&e->normals, &e->g, mat, mi);
     cJSON_AddItemToArray(e->materials, mat);
     return *slot = cJSON_GetArraySize(e->materials) - 1;
 }
@@ -392,6 +395,8 @@ static int emit_object_primitive(ex *e, size_t i, const lbk_object *ob, const lb
     const uint32_t mi = d.ni ? s->tri_material[p->first_tri] : 0; /* the primitive's material */
     const int kind = lm ? (int)ob->index : d.col ? MATERIAL_LLG : MATERIAL_PLAIN;
     cJSON *gp = emit_primitive(e, &d, material_for(e, mi, kind));
+    if (gp && tl_gltf_normals_tangents(&e->normals, &e->g, cJSON_GetObjectItem(gp, "attributes"), mi, d.sv, d.nv))
+        e->g.failed = 1;
     prim_free(&d);
     if (!gp) return tl_fail(e->err, TL_GLTF_INTERNAL, "out of memory");
     if (lm) {
@@ -753,7 +758,8 @@ static int run(ex *e, const tl_gltf_options *o)
     e->plain_material = malloc((e->s->material_count + 1) * sizeof *e->plain_material);
     e->llg_material = malloc((e->s->material_count + 1) * sizeof *e->llg_material);
     if (!e->page_w || !e->page_h || !e->lm_material || !e->plain_material || !e->llg_material ||
-        tl_glb_init(&e->g, "lbk export " LBK_LIBRARY_VERSION_STRING))
+        tl_glb_init(&e->g, "lbk export " LBK_LIBRARY_VERSION_STRING) ||
+        tl_gltf_normals_init(&e->normals, e->s, e->pages, o->normal_texels))
         return tl_fail(e->err, TL_GLTF_INTERNAL, "out of memory");
     for (size_t i = 0; i < (size_t)e->s->material_count * e->pages; i++) e->lm_material[i] = -1;
     for (size_t i = 0; i < e->s->material_count; i++) e->plain_material[i] = e->llg_material[i] = -1;
@@ -773,6 +779,7 @@ static int run(ex *e, const tl_gltf_options *o)
     if (rc) return rc;
     if (e->pages && (rc = write_pages(e))) return rc;
     if (e->pages) add_textures(e);
+    if (tl_gltf_normals_write(&e->normals, e->g.root, e->dir, e->stem, &e->st->png_files, e->err)) return TL_GLTF_IO;
     add_root_extras(e, o->container);
     cJSON_AddNumberToObject(e->g.root, "scene", 0);
     cJSON *scenes = cJSON_AddArrayToObject(e->g.root, "scenes"), *sc = cJSON_CreateObject(), *nodes = cJSON_AddArrayToObject(sc, "nodes");
@@ -800,7 +807,8 @@ int tl_gltf_export(const tl_bake *b, const tl_gltf_options *o, tl_gltf_stats *st
     bk_scene scene;
     bk_import_options io;
     memset(&io, 0, sizeof io);
-    io.skip_textures = 1; /* materials export their factors only */
+    io.skip_textures = 1; /* materials export their factors only, */
+    io.normal_maps = 1;   /* and their normal maps (gltf_normals.c) */
     char msg[512];
     if (bk_import_gltf(o->scene, &io, &scene, msg, sizeof msg)) return tl_fail(err, TL_GLTF_INPUT, "%.250s", msg);
     ex e;
@@ -814,6 +822,7 @@ int tl_gltf_export(const tl_bake *b, const tl_gltf_options *o, tl_gltf_stats *st
     tl_glb_free(&e.g);
     free(e.page_w), free(e.page_h), free(e.lm_material), free(e.plain_material), free(e.llg_material), free(e.texels);
     free(e.page_scale);
+    tl_gltf_normals_free(&e.normals);
     bk_scene_free(&scene);
     return rc;
 }

@@ -12,6 +12,8 @@ typedef struct tl_gltf_options {
     const char *output;    /* OUT.glb; the sidecar images go beside it */
     const char *scene;     /* the .gltf/.glb the container was baked from */
     const char *container; /* the container's file name, recorded in the extras; NULL: none */
+    int normal_texels;     /* 1: each normal map's texels also as an accessor in its material's
+                              extras (lbk view's page, which loads no image; gltf_normals.h) */
 } tl_gltf_options;
 
 typedef struct tl_gltf_stats {

@@ -204,7 +204,8 @@ int tl_view_write(const tl_view_options *o, tl_view_stats *stats, char err[TL_ER
     if (!rc) rc = join(data_path, sizeof data_path, o->out_dir, "data.js", err);
     if (!rc) {
         const char *base = strrchr(o->container, '/');
-        tl_gltf_options g = {.output = glb_path, .scene = o->scene, .container = base ? base + 1 : o->container};
+        tl_gltf_options g = {.output = glb_path, .scene = o->scene, .container = base ? base + 1 : o->container,
+                             .normal_texels = 1}; /* the page's normal maps (viewer.js) */
         tl_gltf_stats gs;
         rc = tl_gltf_export(&bake, &g, &gs, err);
         if (rc) rc = rc == TL_GLTF_IO ? TL_VIEW_IO : rc == TL_GLTF_INPUT ? TL_VIEW_INPUT : TL_VIEW_INTERNAL;
