@@ -10,8 +10,9 @@
  * pages are not decoded (the page says so; their objects are lit from the GLG instead). The
  * fragment shader does what tools/render/shade.c does per pixel: bilinear over the
  * four texels around (X − ½, Y − ½) (clamped to the page), each decoded by spec §5.6 to the linear
- * form and blended there, evaluated along the shading normal (+Z of the tangent frame, no normal
- * maps), × the section's scale. Radiance = albedo · E / π. LLG objects: V · E_sh(bent normal) of
+ * form and blended there, evaluated along the shading normal (+Z of the tangent frame; with a
+ * normal map, the mapped normal in that frame: viewer/README.md "Normal maps"), × the section's
+ * scale. Radiance = albedo · E / π. LLG objects: V · E_sh(bent normal) of
  * the grid's trilinear SH at each vertex (spec §11), interpolated. Other objects: the GLG at each
  * vertex. Display: radiance × 2^stops, clamped, sRGB-encoded.
  *
