@@ -49,11 +49,11 @@ fi; \
 echo "lbk: installing missing Debian packages ($$why): $$missing"; \
 { $${sudo}apt-get update -qq || true; } && $${sudo}env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >/dev/null
 endef
-.PHONY: deps deps-tools deps-test deps-bench gltf-validator babylon-npm
+.PHONY: deps deps-tools deps-test deps-bench gltf-validator engine-npm
 deps:
 	@$(call deps_sh,$(DEB_PKGS),make deps)
 	@$(MAKE) --no-print-directory gltf-validator
-	@$(MAKE) --no-print-directory babylon-npm
+	@$(MAKE) --no-print-directory engine-npm
 deps-tools:
 	@$(call deps_sh,$(DEB_TOOL_PKGS),)
 # The GPU, view and Slurm packages are optional for make test: without them (and not allowed to
@@ -82,16 +82,19 @@ gltf-validator:
 	  $(MAKE) --no-print-directory $(GLTF_VALIDATOR)/package.json; \
 	else echo "lbk: npm/node not found: the glTF-Validator check will be SKIPPED (apt-get install npm)"; fi
 
-# Stock Babylon.js (npm babylonjs + babylonjs-loaders, the UMD builds) for tests/tools/
-# test_engine_view.c, which loads `lbk export --gltf` with Babylon's own glTF loader in headless
-# Chromium; installed into the build folder at a pinned version, like the glTF-Validator (npm comes
-# with gltf-validator above). Without npm that case is reported SKIPPED.
+# Stock Babylon.js (npm babylonjs + babylonjs-loaders, the UMD builds) and three.js (npm three, its
+# ES modules and examples/jsm's GLTFLoader) for tests/tools/test_engine_view.c, which loads
+# `lbk export --gltf` with each engine's own glTF loader in headless Chromium; installed into the
+# build folder at pinned versions, like the glTF-Validator (npm comes with gltf-validator above).
+# Without npm those cases are reported SKIPPED.
 BABYLON_VERSION := 9.28.0
-BABYLON_NPM := $(BUILD)/npm-babylon/node_modules/babylonjs-loaders
-$(BABYLON_NPM)/package.json:
-	@mkdir -p $(BUILD)/npm-babylon
-	npm install --prefix $(BUILD)/npm-babylon --no-audit --no-fund --loglevel=error \
-	    babylonjs@$(BABYLON_VERSION) babylonjs-loaders@$(BABYLON_VERSION)
-babylon-npm:
-	@if command -v npm >/dev/null 2>&1; then $(MAKE) --no-print-directory $(BABYLON_NPM)/package.json; \
-	else echo "lbk: npm not found: test_engine_view's Babylon.js case will be SKIPPED (apt-get install npm)"; fi
+THREE_VERSION := 0.187.0
+ENGINE_NPM := $(BUILD)/npm-engines/node_modules
+$(ENGINE_NPM)/.lbk-$(BABYLON_VERSION)-$(THREE_VERSION):
+	@mkdir -p $(BUILD)/npm-engines
+	npm install --prefix $(BUILD)/npm-engines --no-audit --no-fund --loglevel=error \
+	    babylonjs@$(BABYLON_VERSION) babylonjs-loaders@$(BABYLON_VERSION) three@$(THREE_VERSION)
+	@touch $@
+engine-npm:
+	@if command -v npm >/dev/null 2>&1; then $(MAKE) --no-print-directory $(ENGINE_NPM)/.lbk-$(BABYLON_VERSION)-$(THREE_VERSION); \
+	else echo "lbk: npm not found: test_engine_view's Babylon.js and three.js cases will be SKIPPED (apt-get install npm)"; fi

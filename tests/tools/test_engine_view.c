@@ -1,12 +1,14 @@
 /* The bake in an engine with no code of the user's: `lbk export --gltf` writes the lightmap as
  * emission (emissiveTexture on TEXCOORD_1 × emissiveFactor = albedo × KHR_materials_emissive_strength,
- * tools/convert/README.md "In engines"), and stock Babylon.js (npm babylonjs + babylonjs-loaders,
- * pinned in mk/deps.mk, installed under $BUILD/npm-babylon by `make test`) shows it:
+ * tools/convert/README.md "In engines"), and stock Babylon.js (npm babylonjs + babylonjs-loaders)
+ * and three.js (npm three) show it (pinned in mk/deps.mk, installed under $BUILD/npm-engines by
+ * `make test`):
  *  - the emissive PNG holds the EXR's irradiance to within its 8-bit sRGB steps (measured here);
- *  - headless Chromium (Debian `chromium`, SwiftShader WebGL) loads the export with Babylon's own glTF
- *    loader (tests/tools/babylon_page.html: canvas, camera, exposure, nothing about materials), and
- *    the screenshot matches lbk render of the same view (bound below). Without Chromium or the npm
- *    packages the browser case is SKIPPED (counted so); a page that draws no lightmap FAILS. */
+ *  - headless Chromium (Debian `chromium`, SwiftShader WebGL) loads the export with each engine's
+ *    own glTF loader (tests/tools/babylon_page.html, three_page.html: canvas, camera, exposure,
+ *    nothing about materials), and the screenshot matches lbk render of the same view (bound
+ *    below). Without Chromium or the npm packages those cases are SKIPPED (counted so, saying
+ *    why); a page that draws no lightmap FAILS. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -123,13 +125,13 @@ static void test_emissive_png_holds_the_exr(void **state)
 
 static int have_chromium(void) { return system("command -v chromium >/dev/null 2>&1") == 0; }
 
-/* The npm packages (mk/deps.mk: babylon-npm), or "" when they are not installed. */
-static const char *babylon_dir(void)
+/* The npm packages' folder (mk/deps.mk: engine-npm) when `file` is in it, else "". */
+static const char *npm_dir(const char *file)
 {
     static char dir[1100];
-    snprintf(dir, sizeof dir, "%s/../../npm-babylon/node_modules", out_dir);
+    snprintf(dir, sizeof dir, "%s/../../npm-engines/node_modules", out_dir);
     char f[1200];
-    snprintf(f, sizeof f, "%s/babylonjs-loaders/babylonjs.loaders.js", dir);
+    snprintf(f, sizeof f, "%s/%s", dir, file);
     return access(f, R_OK) ? "" : dir;
 }
 
@@ -140,11 +142,14 @@ static const char *babylon_dir(void)
                  "--enable-unsafe-swiftshader --hide-scrollbars --force-device-scale-factor=1 --allow-file-access-from-files " \
                  "--virtual-time-budget=20000"
 
-static void page_url(char *url, size_t size)
+/* The engine's page (copied into out_dir as NAME_page.html, beside the export) with the view's
+ * hash parameters; lib: the node_modules folder. */
+static void page_url(char *url, size_t size, const char *name, const char *lib)
 {
-    snprintf(url, size, "file://%s/page.html#lib=%s&glb=level.glb&size=%dx%d&stops=%g&cam=%g,%g,%g,%g,%g,%g,%g,%g,%g,%g",
-             out_dir, babylon_dir(), W, H, STOPS, cam_from[0], cam_from[1], cam_from[2], cam_at[0], cam_at[1], cam_at[2],
-             cam_up[0], cam_up[1], cam_up[2], FOV_DEG);
+    snprintf(url, size,
+             "file://%s/%s_page.html#lib=%s&glb=level.glb&size=%dx%d&stops=%g&cam=%g,%g,%g,%g,%g,%g,%g,%g,%g,%g", out_dir,
+             name, lib, W, H, STOPS, cam_from[0], cam_from[1], cam_from[2], cam_at[0], cam_at[1], cam_at[2], cam_up[0],
+             cam_up[1], cam_up[2], FOV_DEG);
 }
 
 /* The page's title after it ran: "ready: N emissive textures" or "error: ..." (malloc'ed). */
@@ -210,60 +215,28 @@ static void reference(uint8_t *ref8, uint8_t *covered)
 }
 
 /* The screenshot against lbk render, per pixel the largest channel difference in 8-bit sRGB codes
- * after the same exposure (2^4) and the same transfer function (the page asks Babylon for the exact
- * sRGB curves). What may differ, inside surfaces:
+ * after the same exposure (2^4) and the same transfer function (babylon_page.html asks Babylon for
+ * the exact sRGB curves; three.js has them). What may differ, inside surfaces:
  *  - the emissive PNG's 8-bit sRGB step (test above): half a code of the texture; the view maps
  *    texture value t to display sRGB(2^4 · albedo · scale / π · t), at most 0.83 · t here (cornell:
  *    albedo ≤ 0.725, scale 0.2246 lux), so under half a display code;
- *  - the filter: Babylon blends the four texels of the sRGB texture after decoding (WebGL sRGB
+ *  - the filter: the engine blends the four texels of the sRGB texture after decoding (WebGL sRGB
  *    texture), lbk render in AHD's linear form: the same for plane 0 along the normal, up to the
  *    GPU's 8-bit filter weights (1/256: under a code where neighbours differ by less than 64 codes);
  *  - the rounding to 8 bits on each side: one code.
  * So interior pixels differ by at most 2 codes. Pixels where rasterisation and ray casting see
  * different surfaces (silhouettes, creases: on_edge of the reference) may differ more: at most 3 %
  * of the covered pixels differ by more than 2 codes, and the mean over the covered pixels stays
- * ≤ 1 code. Measured (cornell bake, 160 × 120, Babylon.js 9.28.0, Chromium 156 SwiftShader): mean
+ * ≤ 1 code. The same bound for both engines. Measured (cornell bake, 160 × 120, Chromium 156
+ * SwiftShader), Babylon.js 9.28.0: mean
  * 0.42 codes over 17 391 covered pixels; 67.2 % equal, 32.6 % one code, 8 pixels two codes apart,
- * 26 (0.15 %) more, all on an edge. With Babylon's default pow(2.2) curves instead of the exact
- * ones: mean 3.08 codes, 47.7 % over 2 codes (fails). With the emissive strength zeroed after
- * loading (the surfaces drawn without the lightmap): 129 of 17 391 pixels lit, mean 105 codes. */
-static void test_babylon_shows_the_lightmap(void **state)
+ * 26 (0.15 %) more, all on an edge; three.js 0.187.0: mean 0.41 codes, 67.4 % equal, 32.4 % one
+ * code, 24 pixels (0.14 %) more than two, all on an edge. With Babylon's default pow(2.2) curves
+ * instead of the exact ones: mean 3.08 codes, 47.7 % over 2 codes (fails). With the emissive
+ * strength zeroed after loading (the surfaces drawn without the lightmap), either engine: 129 of
+ * 17 391 pixels lit (the light), mean 105 codes (fails). */
+static void compare(const char *name, const uint8_t *shot, const uint8_t *ref8, const uint8_t *covered)
 {
-    (void)state;
-    if (!have_chromium()) {
-        print_message("SKIPPED: no chromium (make deps installs it)\n");
-        skip();
-    }
-    if (!*babylon_dir()) {
-        print_message("SKIPPED: npm babylonjs/babylonjs-loaders not under %s/../npm-babylon (make babylon-npm)\n", out_dir);
-        skip();
-    }
-    export_level();
-    char err[TL_ERR_LEN], url[4096], cmd[8192];
-    void *html;
-    size_t hn;
-    assert_int_equal(tl_read_file("tests/tools/babylon_page.html", &html, &hn, err), 0);
-    assert_int_equal(tl_write_file_atomic(out("page.html"), html, hn, err), 0);
-    free(html);
-    page_url(url, sizeof url);
-    char *title = page_title(url);
-    print_message("page: %s\n", title);
-    /* every lightmapped material (7 of the cornell box's 8: the light keeps its own emission) */
-    assert_string_equal(title, "ready: 7 emissive textures");
-    free(title);
-    unlink(out("shot.png"));
-    /* headless Chromium keeps a minimum window size: the canvas is the top-left W × H of a larger shot */
-    snprintf(cmd, sizeof cmd, CHROMIUM " --user-data-dir=%s --window-size=%d,%d --screenshot=%s '%s' >/dev/null 2>&1",
-             out("profile"), 3 * W, 3 * H, out("shot.png"), url);
-    assert_int_equal(system(cmd), 0);
-    int w, h;
-    uint8_t *shot;
-    assert_int_equal(tl_png_read_rgb8(out("shot.png"), &w, &h, &shot, err), 0);
-    assert_int_equal(w, 3 * W);
-    assert_int_equal(h, 3 * H);
-    for (int y = 0; y < H; y++) memmove(shot + 3 * W * y, shot + 3 * w * y, 3 * W);
-    static uint8_t ref8[W * H * 3], covered[W * H];
-    reference(ref8, covered);
     int n = 0, over = 0, interior = 0, shot_lit = 0, max_d = 0, hist[3] = {0, 0, 0};
     double sum = 0;
     for (int i = 0; i < W * H; i++) {
@@ -282,26 +255,105 @@ static void test_babylon_shows_the_lightmap(void **state)
             if (!on_edge(ref8, i % W, i / W)) interior++;
         }
     }
-    print_message("Babylon.js vs lbk render %dx%d: %d covered pixels (%d lit in the shot), mean %.3f codes; %d equal, %d one "
+    print_message("%s vs lbk render %dx%d: %d covered pixels (%d lit in the shot), mean %.3f codes; %d equal, %d one "
                   "code, %d two codes apart, %d more (%.2f %%, %d not on an edge), max %d\n",
-                  W, H, n, shot_lit, sum / (n ? n : 1), hist[0], hist[1], hist[2], over, 100.0 * over / (n ? n : 1), interior,
+                  name, W, H, n, shot_lit, sum / (n ? n : 1), hist[0], hist[1], hist[2], over, 100.0 * over / (n ? n : 1), interior,
                   max_d);
-    /* the two pictures, to look at when it fails (docs/images/engine_babylon.png and
-     * docs/images/engine_lbk.png are these two) */
-    tl_png_write_rgb8(out("ref.png"), W, H, ref8, err);
-    tl_png_write_rgb8(out("engine.png"), W, H, shot, err);
-    free(shot);
     assert_true(n > W * H / 2); /* the view is filled by the level */
     if (shot_lit <= n * 9 / 10)
-        print_error("Babylon.js drew the level without its lightmap: %d of %d covered pixels lit (see %s)\n", shot_lit, n,
-                    out("shot.png"));
+        print_error("%s drew the level without its lightmap: %d of %d covered pixels lit (see %s/%s.png)\n", name,
+                    shot_lit, n, out_dir, name);
     assert_true(shot_lit > n * 9 / 10);
     if (sum / n > 1.0 || over > n * 3 / 100)
-        print_error("Babylon.js's picture is not lbk render's: mean %.3f codes (bound 1), %.2f %% of the pixels over 2 codes "
-                    "(bound 3 %%): see %s and %s\n",
-                    sum / n, 100.0 * over / n, out("shot.png"), out("ref.png"));
+        print_error("%s's picture is not lbk render's: mean %.3f codes (bound 1), %.2f %% of the pixels over 2 codes "
+                    "(bound 3 %%): see %s/%s.png and lbk.png\n",
+                    name, sum / n, 100.0 * over / n, out_dir, name);
     assert_true(sum / n <= 1.0);
     assert_true(over <= n * 3 / 100);
+}
+
+static void engine_matches(const char *name, const char *page_src, const char *lib)
+{
+    export_level();
+    char err[TL_ERR_LEN], url[4096], cmd[8192], file[64];
+    void *html;
+    size_t hn;
+    assert_int_equal(tl_read_file(page_src, &html, &hn, err), 0);
+    /* three_page.html names the modules in its import map: @LIB@ is the folder */
+    size_t libn = strlen(lib), n = 0, cap = hn + 8 * libn + 1;
+    char *page = malloc(cap);
+    assert_non_null(page);
+    for (size_t i = 0; i < hn;) {
+        if (i + 5 <= hn && !memcmp((char *)html + i, "@LIB@", 5)) {
+            assert_true(n + libn < cap);
+            memcpy(page + n, lib, libn), n += libn, i += 5;
+        } else {
+            assert_true(n + 1 < cap);
+            page[n++] = ((char *)html)[i++];
+        }
+    }
+    snprintf(file, sizeof file, "%s_page.html", name);
+    assert_int_equal(tl_write_file_atomic(out(file), page, n, err), 0);
+    free(html), free(page);
+    page_url(url, sizeof url, name, lib);
+    char *title = page_title(url);
+    print_message("%s page: %s\n", name, title);
+    /* every lightmapped material (7 of the cornell box's 8: the light keeps its own emission) */
+    assert_string_equal(title, "ready: 7 emissive textures");
+    free(title);
+    char shot_png[64];
+    snprintf(shot_png, sizeof shot_png, "%s_shot.png", name);
+    unlink(out(shot_png));
+    /* headless Chromium keeps a minimum window size: the canvas is the top-left W × H of a larger shot */
+    snprintf(cmd, sizeof cmd, CHROMIUM " --user-data-dir=%s --window-size=%d,%d --screenshot=%s '%s' >/dev/null 2>&1",
+             out("profile"), 3 * W, 3 * H, out(shot_png), url);
+    assert_int_equal(system(cmd), 0);
+    int w, h;
+    uint8_t *shot;
+    assert_int_equal(tl_png_read_rgb8(out(shot_png), &w, &h, &shot, err), 0);
+    assert_int_equal(w, 3 * W);
+    assert_int_equal(h, 3 * H);
+    for (int y = 0; y < H; y++) memmove(shot + 3 * W * y, shot + 3 * w * y, 3 * W);
+    static uint8_t ref8[W * H * 3], covered[W * H];
+    reference(ref8, covered);
+    /* the pictures, to look at when it fails (docs/images/engine_NAME.png are these) */
+    snprintf(file, sizeof file, "%s.png", name);
+    tl_png_write_rgb8(out("lbk.png"), W, H, ref8, err);
+    tl_png_write_rgb8(out(file), W, H, shot, err);
+    compare(name, shot, ref8, covered);
+    free(shot);
+}
+
+static void test_babylon_shows_the_lightmap(void **state)
+{
+    (void)state;
+    if (!have_chromium()) {
+        print_message("SKIPPED: no chromium (make deps installs it)\n");
+        skip();
+    }
+    const char *lib = npm_dir("babylonjs-loaders/babylonjs.loaders.js");
+    if (!*lib) {
+        print_message("SKIPPED: npm babylonjs-loaders not under %s/../../npm-engines (make engine-npm)\n", out_dir);
+        skip();
+    }
+    engine_matches("babylon", "tests/tools/babylon_page.html", lib);
+}
+
+/* three.js's own GLTFLoader (examples/jsm). The three.js vendored for lbk view (r147) cannot be
+ * used: its GLTFLoader reads TEXCOORD_1 for occlusion maps only (texture channels came in r151). */
+static void test_three_shows_the_lightmap(void **state)
+{
+    (void)state;
+    if (!have_chromium()) {
+        print_message("SKIPPED: no chromium (make deps installs it)\n");
+        skip();
+    }
+    const char *lib = npm_dir("three/examples/jsm/loaders/GLTFLoader.js");
+    if (!*lib) {
+        print_message("SKIPPED: npm three not under %s/../../npm-engines (make engine-npm)\n", out_dir);
+        skip();
+    }
+    engine_matches("three", "tests/tools/three_page.html", lib);
 }
 
 int main(void)
@@ -309,6 +361,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_emissive_png_holds_the_exr),
         cmocka_unit_test(test_babylon_shows_the_lightmap),
+        cmocka_unit_test(test_three_shows_the_lightmap),
     };
     return cmocka_run_group_tests(tests, setup, NULL);
 }
