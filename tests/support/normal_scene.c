@@ -90,18 +90,28 @@ static void aim(const double d[3], double q[4])
 
 int ns_write_gltf(const char *dir, const char *name, int tangent, const char *material_extra, const char *node_extra)
 {
+    return ns_write_gltf_lit(dir, name, tangent, material_extra, node_extra, "lightmap");
+}
+
+int ns_write_gltf_lit(const char *dir, const char *name, int tangent, const char *material_extra, const char *node_extra,
+                      const char *lighting)
+{
     double l[3], d[3], q[4];
     ns_light_dir(l);
     for (int k = 0; k < 3; k++) d[k] = -l[k];
     aim(d, q);
+    /* a probe-lit floor alone gives the bake nothing to place probes around: a static wall (the
+     * same mesh stood up, facing −x, at x = 6, y in [−2, 2]; its shadow stays beyond x = 4.8)
+     * makes the level */
+    const int dynamic = strcmp(lighting, "lightmap") != 0;
     char json[4096];
     const int n = snprintf(json, sizeof json,
              "{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_lights_punctual\"],"
              "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[{\"type\":\"directional\",\"color\":[1,1,1],"
              "\"intensity\":%.17g}]}},"
-             "\"scene\":0,\"scenes\":[{\"nodes\":[0,1]}],"
-             "\"nodes\":[{\"name\":\"floor\",\"mesh\":0,\"extras\":{\"lbk_lighting\":\"lightmap\"}%s},"
-             "{\"name\":\"sun\",\"rotation\":[%.17g,%.17g,%.17g,%.17g],\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}],"
+             "\"scene\":0,\"scenes\":[{\"nodes\":[0,1%s]}],"
+             "\"nodes\":[{\"name\":\"floor\",\"mesh\":0,\"extras\":{\"lbk_lighting\":\"%s\"}%s},"
+             "{\"name\":\"sun\",\"rotation\":[%.17g,%.17g,%.17g,%.17g],\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}%s],"
              "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"TEXCOORD_0\":2%s},"
              "\"indices\":4,\"material\":0}]}],"
              "\"materials\":[{\"name\":\"bumpy\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[%.17g,%.17g,%.17g,1],"
@@ -117,7 +127,8 @@ int ns_write_gltf(const char *dir, const char *name, int tangent, const char *ma
              "{\"bufferView\":0,\"byteOffset\":96,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"},"
              "{\"bufferView\":0,\"byteOffset\":128,\"componentType\":5126,\"count\":4,\"type\":\"VEC4\"},"
              "{\"bufferView\":1,\"byteOffset\":0,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}]}",
-             NS_E_SUN, node_extra, q[0], q[1], q[2], q[3], tangent ? ",\"TANGENT\":3" : "", NS_RHO, NS_RHO, NS_RHO,
+             NS_E_SUN, dynamic ? ",2" : "", lighting, node_extra, q[0], q[1], q[2], q[3],
+             dynamic ? ",{\"name\":\"wall\",\"mesh\":0,\"translation\":[6,0,0],\"rotation\":[0,0,0.70710678118654752,0.70710678118654752],\"extras\":{\"lbk_lighting\":\"lightmap\"}}" : "", tangent ? ",\"TANGENT\":3" : "", NS_RHO, NS_RHO, NS_RHO,
              material_extra);
     if (n < 0 || (size_t)n >= sizeof json) return -1;
     return write_bytes(dir, name, json, (size_t)n);

@@ -30,6 +30,10 @@ int ns_write_floor_bin(const char *dir, float tangent_w);
 /* dir/name over floor.bin and normal.png: tangent lists TANGENT; material_extra and node_extra
  * are JSON spliced into the material and the floor's node. */
 int ns_write_gltf(const char *dir, const char *name, int tangent, const char *material_extra, const char *node_extra);
+/* the same with the floor's lbk_lighting ("lightmap", "llg", "none"); other than "lightmap", a
+ * static lightmapped copy of the floor stood up at x = 6 ("wall") makes the level the probes fill */
+int ns_write_gltf_lit(const char *dir, const char *name, int tangent, const char *material_extra, const char *node_extra,
+                      const char *lighting);
 /* normal.png, floor.bin, derived.gltf (no TANGENT), authored.gltf (TANGENT), flat.gltf (no map) */
 int ns_write_all(const char *dir, float tangent_w);
 

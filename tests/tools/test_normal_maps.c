@@ -28,6 +28,9 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "lbk/container.h"
+#include "lbk/glg.h"
+#include "lbk/sh.h"
 #include "scene/import.h"
 #include "support/bake_file.h"
 #include "support/normal_scene.h"
@@ -194,7 +197,7 @@ static void import_hostile(void **state)
 
 /* ---- render ----------------------------------------------------------------------------------- */
 
-static void bake(const char *gltf, const char *out)
+static void bake(const char *gltf, const char *out, float glg_spacing)
 {
     tb_job j;
     memset(&j, 0, sizeof j);
@@ -202,6 +205,7 @@ static void bake(const char *gltf, const char *out)
     j.d.threads = 2;
     j.d.seed = 1;
     j.d.texel_density = 4;
+    j.d.glg_spacing = glg_spacing; /* 0: the preset's */
     char err[512];
     lbk_result r = tb_bake(&j, NULL, err, sizeof err);
     if (r != LBK_OK) fprintf(stderr, "bake %s: %s\n", gltf, err);
@@ -267,7 +271,7 @@ static void render_closed_form(void **state)
     char gltf[256], lbk[256];
     path_of(gltf, sizeof gltf, "derived.gltf");
     path_of(lbk, sizeof lbk, "floor.lbk");
-    bake(gltf, lbk);
+    bake(gltf, lbk, 0);
     tl_image im = render(gltf, lbk);
     double got[4];
     for (int k = 0; k < 4; k++) got[k] = check_stripe(&im, k, 1, "derived");
@@ -297,6 +301,52 @@ static void render_closed_form(void **state)
     tl_image_free(&fw);
 }
 
+/* A probe-lit floor (lbk_lighting "none": the GLG, as any dynamic object) with the same map: each
+ * stripe's pixel is ρ/π · E_sh(n') of the GLG's SH9 sampled at the hit point (lbk_glg_sample,
+ * lbk_sh9_irradiance), n' the stripe's world normal, within float rounding (1e-3); and the stripes
+ * differ from the flat one, so the renderer passes n', not N, to the probes. */
+static void render_probe_lit(void **state)
+{
+    (void)state;
+    write_all(1.0f);
+    assert_int_equal(ns_write_gltf_lit(tmpdir, "dynamic.gltf", 0, NS_NORMAL_TEX, "", "none"), 0);
+    char gltf[256], lbk[256];
+    path_of(gltf, sizeof gltf, "dynamic.gltf");
+    path_of(lbk, sizeof lbk, "dynamic.lbk");
+    bake(gltf, lbk, 0.3f); /* probe layers between the ground and above the floor, none at y = 0 */
+    tl_image im = render(gltf, lbk);
+    lbk_reader *rd;
+    assert_int_equal(lbk_reader_open_file(lbk, NULL, &rd), LBK_OK);
+    const void *gd;
+    size_t gn;
+    assert_int_equal(lbk_reader_section_by_type(rd, LBK_SECTION_GLG, &gd, &gn), LBK_OK);
+    lbk_glg_view gv;
+    assert_int_equal(lbk_glg_open(gd, gn, &gv), LBK_OK);
+    const double half_h = CAM_H * tan(FOV_DEG * PI / 360.0), half_w = half_h * W / H;
+    double got[4];
+    for (int k = 0; k < 4; k++) {
+        const int x0 = column(-1.5 + k), y0 = H / 2 + 15;
+        /* the centre ray's hit: image right = +x, image down = +z */
+        const float p[3] = {(float)(((x0 + 0.5) - W / 2.0) / (W / 2.0) * half_w), 0.0f,
+                            (float)(((y0 + 0.5) - H / 2.0) / (H / 2.0) * half_h)};
+        double nd[3];
+        ns_world_normal(k, nd);
+        const float n[3] = {(float)nd[0], (float)nd[1], (float)nd[2]};
+        lbk_sh9_rgb sh;
+        uint32_t hint = 0;
+        assert_int_equal(lbk_glg_sample(&gv, p, &hint, &sh, NULL), LBK_OK);
+        float E[3];
+        lbk_sh9_irradiance(&sh, n, E);
+        const double want = NS_RHO / PI * fmax(E[1], 0.0f);
+        got[k] = im.rgb[3 * ((size_t)y0 * W + (size_t)x0) + 1];
+        printf("probe-lit stripe %d: L %.5f  GLG at n' %.5f (%+.3f %%)\n", k, got[k], want, 100 * (got[k] / want - 1));
+        assert_true(fabs(got[k] / want - 1) < 1e-3);
+    }
+    for (int k = 1; k < 4; k++) assert_true(fabs(got[k] / got[0] - 1) > 0.05);
+    lbk_reader_close(rd);
+    tl_image_free(&im);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -304,6 +354,7 @@ int main(void)
         cmocka_unit_test(import_mirrored),
         cmocka_unit_test(import_hostile),
         cmocka_unit_test(render_closed_form),
+        cmocka_unit_test(render_probe_lit),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
