@@ -148,6 +148,28 @@ static void import_mirrored(void **state)
     }
 }
 
+/* KHR_texture_transform on the normal texture (the material's only texture, so its uv wins):
+ * uv0 is the transformed one, and the derived tangent follows it (a mirrored u turns T to −x). */
+static void import_transform(void **state)
+{
+    (void)state;
+    write_all(1.0f);
+    write_gltf("xf.gltf", 0,
+               ",\"normalTexture\":{\"index\":0,\"extensions\":{\"KHR_texture_transform\":{\"scale\":[-2,1]}}}", "");
+    bk_scene s;
+    char err[512];
+    int rc = import("xf.gltf", 1, &s, err, sizeof err);
+    if (rc) fprintf(stderr, "%s\n", err);
+    assert_int_equal(rc, 0);
+    for (size_t v = 0; v < s.vertex_count; v++) {
+        const float x = s.positions[3 * v];
+        assert_float_equal(s.uv0[2 * v], -2.0f * (x + 2.0f) / 4.0f, 1e-6f); /* u' = −2 u */
+        assert_float_equal(s.tangents[4 * v], -1.0f, 1e-6f);
+        assert_float_equal(s.tangents[4 * v + 3], -1.0f, 0.0f); /* B = w (N × T) = −z still: w = −1 */
+    }
+    bk_scene_free(&s);
+}
+
 /* Hostile input: a TANGENT of the wrong type or count, a normalTexture out of range or with a
  * non-finite or absurd scale, is refused with a message naming it; nothing is read past a buffer. */
 static void import_hostile(void **state)
@@ -352,6 +374,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(import_frame),
         cmocka_unit_test(import_mirrored),
+        cmocka_unit_test(import_transform),
         cmocka_unit_test(import_hostile),
         cmocka_unit_test(render_closed_form),
         cmocka_unit_test(render_probe_lit),
