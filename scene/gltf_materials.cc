@@ -350,6 +350,31 @@ void Importer::apply_uv_map(Prim &p, int mi, int pi)
     p.uv0.swap(out);
 }
 
+// A material that `lbk export --gltf` wrote carries the baked light in its glTF factors and
+// emissive texture (black base colour, emission albedo · E / pi: tools/convert/README.md "In
+// engines") and the source material's albedo and emission in extras.lbk: a bake of the export
+// takes those, so it is lit as the source was. Returns whether the material is such a one.
+static bool lbk_export_material(const tinygltf::Material &gm, bk_material *bm)
+{
+    if (!gm.extras.IsObject() || !gm.extras.Has("lbk")) return false;
+    const tinygltf::Value &l = gm.extras.Get("lbk");
+    if (!l.IsObject() || !l.Has("source_material") || !l.Has("albedo") || !l.Has("emission")) return false;
+    float v[2][3];
+    const char *keys[2] = {"albedo", "emission"};
+    for (int k = 0; k < 2; k++) {
+        const tinygltf::Value &a = l.Get(keys[k]);
+        if (!a.IsArray() || a.ArrayLen() != 3) return false;
+        for (int c = 0; c < 3; c++) {
+            const tinygltf::Value &x = a.Get(c);
+            if (!x.IsNumber() || !finite_nonneg(x.GetNumberAsDouble()) || !std::isfinite((float)x.GetNumberAsDouble()))
+                return false;
+            v[k][c] = (float)x.GetNumberAsDouble();
+        }
+    }
+    for (int c = 0; c < 3; c++) bm->albedo[c] = std::min(v[0][c], 1.0f), bm->emission[c] = v[1][c];
+    return true;
+}
+
 void Importer::build_materials()
 {
     uv_maps_.assign(m_.materials.size(), UvMap{});
@@ -384,8 +409,10 @@ void Importer::build_materials()
             bm.emission[k] = (float)e;
         }
         UvMap maps[4];
-        bm.albedo_tex = texture_image(gm.pbrMetallicRoughness.baseColorTexture, "baseColor", mi, gm.name, &maps[0]);
-        bm.emission_tex = texture_image(gm.emissiveTexture, "emissive", mi, gm.name, &maps[1]);
+        const bool exported = lbk_export_material(gm, &bm);  // then no base colour or emissive texture
+        bm.albedo_tex =
+            exported ? -1 : texture_image(gm.pbrMetallicRoughness.baseColorTexture, "baseColor", mi, gm.name, &maps[0]);
+        bm.emission_tex = exported ? -1 : texture_image(gm.emissiveTexture, "emissive", mi, gm.name, &maps[1]);
         bm.double_sided = gm.doubleSided ? 1 : 0;
         // glTF's defaults (1, 1: a rough metal) when pbrMetallicRoughness leaves them out, as
         // tinygltf fills them; our own Lambertian scenes say metallicFactor 0 (GGX.md)

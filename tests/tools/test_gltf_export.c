@@ -139,6 +139,25 @@ static export_stats check_reimport(const tl_bake *b, const bk_scene *src, const 
     return st;
 }
 
+/* Every triangle of the re-imported export has its source triangle's albedo and emission: the
+ * export's materials carry the baked light as emission over a black base colour, and the
+ * importer takes a material lbk export wrote from its extras.lbk (scene/gltf_materials.cc), so the
+ * export bakes as the source did. Triangles are in the same order (check_reimport's hashes). */
+static void check_reimport_materials(const bk_scene *src, const bk_scene *re)
+{
+    assert_int_equal(re->tri_count, src->tri_count);
+    for (size_t t = 0; t < re->tri_count; t++) {
+        const bk_material *a = &src->materials[src->tri_material[t]], *b = &re->materials[re->tri_material[t]];
+        for (int c = 0; c < 3; c++) {
+            if (a->albedo[c] != b->albedo[c] || a->emission[c] != b->emission[c])
+                fail_msg("triangle %zu: material %s albedo %g emission %g, re-imported %s %g %g", t, a->name, a->albedo[c],
+                         a->emission[c], b->name, b->albedo[c], b->emission[c]);
+        }
+        assert_int_equal(b->albedo_tex, -1);
+        assert_int_equal(b->emission_tex, -1);
+    }
+}
+
 /* The JSON chunk of a GLB (tests only: trusts the file it just wrote). */
 static cJSON *glb_json(const char *path)
 {
@@ -203,6 +222,7 @@ static void export_and_reimport(const char *scene, const char *stem, float densi
     import(scene, &src);
     import(glb, &re);
     export_stats st = check_reimport(&b, &src, &re);
+    check_reimport_materials(&src, &re);
     print_message("%s: %u nodes, %u primitives (%u generated, %u authored), %llu triangles; %zu lightmapped vertices "
                   "re-imported, TEXCOORD_1 within %.1e texel of LMUV\n",
                   stem, gs.nodes, gs.primitives, gs.generated, gs.authored, (unsigned long long)gs.triangles,
