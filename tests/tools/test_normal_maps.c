@@ -30,6 +30,7 @@
 
 #include "lbk/container.h"
 #include "lbk/glg.h"
+#include "lbk/llg.h"
 #include "lbk/sh.h"
 #include "scene/import.h"
 #include "support/bake_file.h"
@@ -325,8 +326,8 @@ static void render_closed_form(void **state)
 
 /* A probe-lit floor (lbk_lighting "none": the GLG, as any dynamic object) with the same map: each
  * stripe's pixel is ρ/π · E_sh(n') of the GLG's SH9 sampled at the hit point (lbk_glg_sample,
- * lbk_sh9_irradiance), n' the stripe's world normal, within float rounding (1e-3); and the stripes
- * differ from the flat one, so the renderer passes n', not N, to the probes. */
+ * lbk_sh9_irradiance), n' the stripe's world normal, within float rounding (1e-3); and the tilted
+ * stripes differ from E_sh(N) at the same point (> 3 %), so the renderer passes n', not N. */
 static void render_probe_lit(void **state)
 {
     (void)state;
@@ -345,7 +346,7 @@ static void render_probe_lit(void **state)
     lbk_glg_view gv;
     assert_int_equal(lbk_glg_open(gd, gn, &gv), LBK_OK);
     const double half_h = CAM_H * tan(FOV_DEG * PI / 360.0), half_w = half_h * W / H;
-    double got[4];
+    double got[4], flat[4];
     for (int k = 0; k < 4; k++) {
         const int x0 = column(-1.5 + k), y0 = H / 2 + 15;
         /* the centre ray's hit: image right = +x, image down = +z */
@@ -360,11 +361,88 @@ static void render_probe_lit(void **state)
         float E[3];
         lbk_sh9_irradiance(&sh, n, E);
         const double want = NS_RHO / PI * fmax(E[1], 0.0f);
+        const float up[3] = {0, 1, 0};
+        lbk_sh9_irradiance(&sh, up, E); /* the same point without the map */
+        flat[k] = NS_RHO / PI * fmax(E[1], 0.0f);
         got[k] = im.rgb[3 * ((size_t)y0 * W + (size_t)x0) + 1];
-        printf("probe-lit stripe %d: L %.5f  GLG at n' %.5f (%+.3f %%)\n", k, got[k], want, 100 * (got[k] / want - 1));
+        printf("probe-lit stripe %d: L %.5f  GLG at n' %.5f (%+.3f %%), at N %.5f\n", k, got[k], want,
+               100 * (got[k] / want - 1), flat[k]);
         assert_true(fabs(got[k] / want - 1) < 1e-3);
     }
-    for (int k = 1; k < 4; k++) assert_true(fabs(got[k] / got[0] - 1) > 0.05);
+    for (int k = 1; k < 4; k++) assert_true(fabs(got[k] / flat[k] - 1) > 0.03); /* the map is not ignored */
+    lbk_reader_close(rd);
+    tl_image_free(&im);
+}
+
+/* v turned by the smallest rotation taking unit a to unit b (Rodrigues): a normal map turns an
+ * LLG vertex's bent normal as it turns N. */
+static void turn(const double a[3], const double b[3], const double v[3], double out[3])
+{
+    const double c = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    const double k[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+    const double kv[3] = {k[1] * v[2] - k[2] * v[1], k[2] * v[0] - k[0] * v[2], k[0] * v[1] - k[1] * v[0]};
+    const double f = (k[0] * v[0] + k[1] * v[1] + k[2] * v[2]) / (1 + c);
+    for (int i = 0; i < 3; i++) out[i] = v[i] * c + kv[i] + k[i] * f;
+}
+
+/* The floor as an LLG object: its four vertex records are alike (a flat, unoccluded floor), so
+ * every pixel's interpolated V and bent normal are theirs; each stripe's pixel is
+ * ρ/π · V · E_sh(grid SH at the hit, bent turned by N → n') within float rounding (1e-3), and the
+ * tilted ones differ from the unturned bent normal's (> 3 %). */
+static void render_llg(void **state)
+{
+    (void)state;
+    write_all(1.0f);
+    assert_int_equal(ns_write_gltf_lit(tmpdir, "llg.gltf", 0, NS_NORMAL_TEX, "", "llg"), 0);
+    char gltf[256], lbk[256];
+    path_of(gltf, sizeof gltf, "llg.gltf");
+    path_of(lbk, sizeof lbk, "llg.lbk");
+    bake(gltf, lbk, 0.3f);
+    tl_image im = render(gltf, lbk);
+    lbk_reader *rd;
+    assert_int_equal(lbk_reader_open_file(lbk, NULL, &rd), LBK_OK);
+    const void *ld;
+    size_t ln;
+    assert_int_equal(lbk_reader_section_by_type(rd, LBK_SECTION_LLG, &ld, &ln), LBK_OK);
+    lbk_llg_view lv;
+    lbk_llg_grid g;
+    assert_int_equal(lbk_llg_open(ld, ln, &lv), LBK_OK);
+    assert_int_equal(lbk_llg_grid_get(&lv, 0, &g), LBK_OK);
+    assert_int_equal(g.vertex_count, 4);
+    lbk_llg_vertex v0;
+    lbk_llg_vertex_unpack(lv.vertices + 4 * g.vertex_offset, &v0);
+    for (uint32_t r = 1; r < 4; r++)
+        assert_memory_equal(lv.vertices + 4 * (g.vertex_offset + r), lv.vertices + 4 * g.vertex_offset, 4);
+    double bent[3] = {0, 0, 0}, l = 0;
+    for (int a = 0; a < 3; a++)
+        for (int k = 0; k < 3; k++) bent[k] += v0.bent_normal[a] * g.axes[a][k]; /* box -> world */
+    l = sqrt(bent[0] * bent[0] + bent[1] * bent[1] + bent[2] * bent[2]);
+    for (int k = 0; k < 3; k++) bent[k] /= l;
+    const double half_h = CAM_H * tan(FOV_DEG * PI / 360.0), half_w = half_h * W / H, N[3] = {0, 1, 0};
+    double got[4], flat[4];
+    for (int k = 0; k < 4; k++) {
+        const int x0 = column(-1.5 + k), y0 = H / 2 + 15;
+        const float p[3] = {(float)(((x0 + 0.5) - W / 2.0) / (W / 2.0) * half_w), 0.0f,
+                            (float)(((y0 + 0.5) - H / 2.0) / (H / 2.0) * half_h)};
+        double n[3], b[3];
+        ns_world_normal(k, n);
+        turn(N, n, bent, b);
+        const double bl = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+        const float bf[3] = {(float)(b[0] / bl), (float)(b[1] / bl), (float)(b[2] / bl)};
+        lbk_sh9_rgb sh;
+        assert_int_equal(lbk_llg_sample(&lv, 0, p, &sh), LBK_OK);
+        float E[3];
+        lbk_sh9_irradiance(&sh, bf, E);
+        const double want = NS_RHO / PI * v0.visibility * fmax(E[1], 0.0f);
+        const float bn[3] = {(float)bent[0], (float)bent[1], (float)bent[2]};
+        lbk_sh9_irradiance(&sh, bn, E); /* the same point without the map */
+        flat[k] = NS_RHO / PI * v0.visibility * fmax(E[1], 0.0f);
+        got[k] = im.rgb[3 * ((size_t)y0 * W + (size_t)x0) + 1];
+        printf("LLG stripe %d: V %.3f  L %.5f  V E_sh(turned bent) %.5f (%+.3f %%), unturned %.5f\n", k, v0.visibility,
+               got[k], want, 100 * (got[k] / want - 1), flat[k]);
+        assert_true(fabs(got[k] / want - 1) < 1e-3);
+    }
+    for (int k = 1; k < 4; k++) assert_true(fabs(got[k] / flat[k] - 1) > 0.03); /* the map is not ignored */
     lbk_reader_close(rd);
     tl_image_free(&im);
 }
@@ -378,6 +456,7 @@ int main(void)
         cmocka_unit_test(import_hostile),
         cmocka_unit_test(render_closed_form),
         cmocka_unit_test(render_probe_lit),
+        cmocka_unit_test(render_llg),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
