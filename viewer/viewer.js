@@ -126,7 +126,7 @@
       return amb + 0.25 * inten + 0.5 * inten * along(d, n);
     }
     /* The normal map's world normal (glTF: t = (2·rgb − 1) with x, y × scale, in the frame T, B =
-     * w (N × T), N; nearest texel, as lbk render), as tools/render/shade.c shading_normal. */
+     * w (N × T), N; bilinear, repeat, as lbk render), as tools/render/shade.c shading_normal. */
     vec3 mappedNormal(vec3 N) {
       vec3 T = vTangent.xyz - N * dot(N, vTangent.xyz);
       if (dot(T, T) <= 0.0) return N;
@@ -413,8 +413,8 @@
     const meshes = [];
     gltf.scene.traverse((m) => { if (m.isMesh) meshes.push(m); });
     /* normal maps: lbk view's export puts each one's texels in its material's extras (RGB bytes,
-     * row 0 the image's top = v 0), read here synchronously (no image decode); sampled nearest
-     * with repeat, as lbk render does. Drawn on lightmapped surfaces (probe-lit ones are lit per
+     * row 0 the image's top = v 0), read here synchronously (no image decode); sampled bilinearly
+     * with repeat (no mipmaps), as lbk render does. Drawn on lightmapped surfaces (probe-lit ones are lit per
      * vertex and keep their vertex normals). */
     const normalMaps = new Map();
     for (const m of meshes) {
@@ -425,7 +425,7 @@
       if (rgb.length !== 3 * n) throw new Error('normal map texels: ' + rgb.length + ' bytes for ' + nm.width + 'x' + nm.height);
       for (let i = 0; i < n; i++) { rgba[4 * i] = rgb[3 * i]; rgba[4 * i + 1] = rgb[3 * i + 1]; rgba[4 * i + 2] = rgb[3 * i + 2]; rgba[4 * i + 3] = 255; }
       const t = new THREE.DataTexture(rgba, nm.width, nm.height, THREE.RGBAFormat, THREE.UnsignedByteType);
-      t.magFilter = t.minFilter = THREE.NearestFilter; t.wrapS = t.wrapT = THREE.RepeatWrapping;
+      t.magFilter = t.minFilter = THREE.LinearFilter; t.wrapS = t.wrapT = THREE.RepeatWrapping;
       t.generateMipmaps = false; t.flipY = false; t.needsUpdate = true;
       normalMaps.set(nm.texels, t);
     }

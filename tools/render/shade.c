@@ -29,6 +29,25 @@ static void texture(const bk_scene *s, int image, const float uv[2], float rgb[3
     for (int c = 0; c < 3; c++) rgb[c] *= im->rgba[4 * ((size_t)y * (size_t)im->width + (size_t)x) + (size_t)c];
 }
 
+/* A texture at uv filtered bilinearly between the four nearest texel centres, wrapping (repeat),
+ * as a GPU samples a normal map: nearest texels would turn every bump into flat facets. */
+static void texture_bilinear(const bk_scene *s, int image, const float uv[2], float rgb[3])
+{
+    const bk_image *im = &s->images[image];
+    const float fx = (uv[0] - floorf(uv[0])) * (float)im->width - 0.5f, fy = (uv[1] - floorf(uv[1])) * (float)im->height - 0.5f;
+    const float x0 = floorf(fx), y0 = floorf(fy), ax = fx - x0, ay = fy - y0;
+    float acc[3] = {0, 0, 0};
+    for (int k = 0; k < 4; k++) {
+        const float w = (k & 1 ? ax : 1.0f - ax) * (k & 2 ? ay : 1.0f - ay);
+        long x = (long)x0 + (k & 1), y = (long)y0 + ((k >> 1) & 1);
+        x = ((x % im->width) + im->width) % im->width;
+        y = ((y % im->height) + im->height) % im->height;
+        const float *t = &im->rgba[4 * ((size_t)y * (size_t)im->width + (size_t)x)];
+        for (int c = 0; c < 3; c++) acc[c] += w * t[c];
+    }
+    for (int c = 0; c < 3; c++) rgb[c] *= acc[c];
+}
+
 void rl_sky(const rl_level *L, const float d[3], float rgb[3])
 {
     if (L->scene.sky_image < 0) {
@@ -50,8 +69,8 @@ static void cross3(const float a[3], const float b[3], float o[3])
     o[2] = a[0] * b[1] - a[1] * b[0];
 }
 
-/* The shading normal of a normal-mapped material at the hit (glTF 2.0 §3.9.3): the texel of the
- * normal texture at uv0 (nearest, as every texture here) read as a tangent-space normal
+/* The shading normal of a normal-mapped material at the hit (glTF 2.0 §3.9.3): the normal
+ * texture at uv0 (bilinear, repeat: texture_bilinear) read as a tangent-space normal
  * t = ((2r − 1)·scale, (2g − 1)·scale, 2b − 1) and taken to world space in the interpolated frame
  * T (made orthogonal to N), B = w·(N × T), N. Where the material has no normal map, or the result
  * is degenerate, ns = N. */
@@ -72,7 +91,7 @@ static void shading_normal(const bk_scene *s, const bk_material *m, const rl_hit
     normalize3(T);
     cross3(N, T, B);
     for (int k = 0; k < 3; k++) B[k] *= w < 0.0f ? -1.0f : 1.0f;
-    texture(s, m->normal_tex1 - 1, uv0, rgb);
+    texture_bilinear(s, m->normal_tex1 - 1, uv0, rgb);
     const float x = (2.0f * rgb[0] - 1.0f) * m->normal_scale, y = (2.0f * rgb[1] - 1.0f) * m->normal_scale,
                 z = 2.0f * rgb[2] - 1.0f;
     float n[3];
