@@ -21,6 +21,7 @@
 #include "tools/convert/gltf_normals.h"
 #include "lbk/pixel.h"
 
+#define PI_F 3.14159265358979f
 #define SAMPLER_LINEAR 9729
 #define WRAP_CLAMP 33071
 
@@ -37,6 +38,8 @@ typedef struct ex {
     float *texels;       /* 3 per texel of every page: physical irradiance along the normal */
     float exposure;      /* of every preview: the p99 rule of tools/convert/README.md "Previews" */
     float *page_scale;   /* per page: the irradiance (lux) of code 255 of its emissive PNG */
+    float radiance_scale; /* every radiance in the file is nits × this (a power of two ≤ 1: LLG props'
+                             COLOR_0 must stay ≤ 1; README "In engines") */
     int any_unlit, any_strength;
     char dir[4096], stem[200];
     tl_gltf_stats *st;
@@ -160,7 +163,8 @@ static uint32_t llg_ranks(const bk_scene *s, size_t object, uint32_t *rank)
     return n;
 }
 
-/* LLG data per exported vertex: visibility, the bent normal in world space and the preview colour. */
+/* LLG data per exported vertex: visibility, the bent normal in world space and COLOR_0, the
+ * radiance of a white surface lit by the probes, V · E(bent normal) / π × radiance_scale. */
 static int gather_llg(ex *e, size_t object, uint32_t grid, prim_data *d)
 {
     const bk_scene *s = e->s;
@@ -198,7 +202,7 @@ static int gather_llg(ex *e, size_t object, uint32_t grid, prim_data *d)
             d->bent[3 * v + (size_t)c] = have ? lv.bent_normal[0] * g.axes[0][c] + lv.bent_normal[1] * g.axes[1][c] +
                                                     lv.bent_normal[2] * g.axes[2][c]
                                               : s->normals[3 * (size_t)sv + (size_t)c];
-            const float x = rgb[c] * e->exposure;
+            const float x = rgb[c] / PI_F * e->radiance_scale;
             d->col[3 * v + (size_t)c] = x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f;
         }
     }
@@ -220,12 +224,12 @@ static cJSON *material_extras(const bk_material *m, int page)
 
 #define MATERIAL_PLAIN (-1)
 #define MATERIAL_LLG (-2)
-#define PI_F 3.14159265358979f
 
 /* emissiveFactor × KHR_materials_emissive_strength = rgb (nits): the factor's largest channel is
  * 1 and the strength carries the rest, since glTF factors stop at 1. */
-static void add_emission(ex *e, cJSON *mat, const float rgb[3])
+static void add_emission(ex *e, cJSON *mat, const float nits[3])
 {
+    const float rgb[3] = {nits[0] * e->radiance_scale, nits[1] * e->radiance_scale, nits[2] * e->radiance_scale};
     float m = fmaxf(rgb[0], fmaxf(rgb[1], rgb[2]));
     if (!(m > 0.0f) || !isfinite(m)) return;
     const float f[3] = {clamp01(rgb[0] / m), clamp01(rgb[1] / m), clamp01(rgb[2] / m)};
@@ -243,7 +247,8 @@ static void add_emission(ex *e, cJSON *mat, const float rgb[3])
  * emissive PNG on TEXCOORD_1 (sRGB of E / scale), emissiveFactor = albedo and emissiveStrength =
  * scale / π, i.e. the Lambert radiance albedo · E / π in nits (tools/convert/README.md "In
  * engines"). An emitting material keeps its own emission instead (glTF has one emissive slot).
- * LLG objects: unlit, albedo × COLOR_0 (their probe lighting per vertex, the preview exposure).
+ * LLG objects: unlit, albedo × COLOR_0 (their probe lighting per vertex as radiance of white).
+ * Every radiance is nits × radiance_scale.
  * Others (not lit by the bake): plain PBR factors and their emission in nits. */
 static int material_for(ex *e, uint32_t mi, int page)
 {
@@ -269,7 +274,7 @@ static int material_for(ex *e, uint32_t mi, int page)
         cJSON *tex = cJSON_AddObjectToObject(mat, "emissiveTexture");
         cJSON_AddNumberToObject(tex, "index", page);
         cJSON_AddNumberToObject(tex, "texCoord", 1);
-        const float s = e->page_scale[page] / PI_F;
+        const float s = e->page_scale[page] / PI_F * e->radiance_scale;
         cJSON_AddItemToObject(mat, "emissiveFactor", cJSON_CreateFloatArray(base, 3));
         if (s != 1.0f) {
             cJSON_AddNumberToObject(cJSON_AddObjectToObject(cJSON_AddObjectToObject(mat, "extensions"),
@@ -505,14 +510,13 @@ static int decode_texels(ex *e)
 }
 
 /* The preview exposure: p99 over every texel (tools/convert/README.md "Previews"); a bake without
- * lightmaps uses its LLG vertices' irradiance instead. */
+ * lightmaps uses its LLG vertices' irradiance instead. The radiance scale: 1, or the power of two
+ * that brings the largest LLG vertex value V · E / π to at most 1 (COLOR_0 cannot go above). */
 static int compute_exposure(ex *e)
 {
-    if (e->pages) {
-        e->exposure = tl_exposure_p99(e->texels, (size_t)e->b->lmap.texel_count, 3);
-        return 0;
-    }
     e->exposure = 1.0f;
+    e->radiance_scale = 1.0f;
+    if (e->pages) e->exposure = tl_exposure_p99(e->texels, (size_t)e->b->lmap.texel_count, 3);
     if (!e->b->has_llg || e->b->llg.vertex_count == 0) return 0;
     const bk_scene *s = e->s;
     float *rgb = malloc((size_t)e->b->llg.vertex_count * 3 * sizeof *rgb);
@@ -534,7 +538,11 @@ static int compute_exposure(ex *e)
                 lbk_llg_vertex_irradiance(&e->b->llg, ob.index, rank[v], &s->positions[3 * v], rgb + 3 * n) == LBK_OK)
                 n++;
     }
-    e->exposure = tl_exposure_p99(rgb, n, 3);
+    if (!e->pages) e->exposure = tl_exposure_p99(rgb, n, 3);
+    float top = 0.0f;
+    for (size_t i = 0; i < 3 * n; i++)
+        if (isfinite(rgb[i]) && rgb[i] / PI_F > top) top = rgb[i] / PI_F;
+    while (top * e->radiance_scale > 1.0f && e->radiance_scale > 0x1p-100f) e->radiance_scale *= 0.5f;
     free(rgb), free(rank);
     return 0;
 }
@@ -667,6 +675,7 @@ static void add_root_extras(ex *e, const char *container)
         cJSON_AddItemToArray(pages, pg);
     }
     cJSON_AddNumberToObject(l, "preview_exposure", e->exposure);
+    cJSON_AddNumberToObject(l, "radiance_scale", e->radiance_scale);
     cJSON_AddStringToObject(l, "sh9_layout",
                             "27 floats per probe: R0..R8, G0..G8, B0..B8, real SH basis of lbk/sh.h (spec 5.5)");
     if (e->b->has_glg) add_glg(e, l);
