@@ -7,8 +7,9 @@
  *  - headless Chromium (Debian `chromium`, SwiftShader WebGL) loads the export with each engine's
  *    own glTF loader (tests/tools/babylon_page.html, three_page.html: canvas, camera, exposure,
  *    nothing about materials), and the screenshot matches lbk render of the same view (bound
- *    below). Without Chromium or the npm packages those cases are SKIPPED (counted so, saying
- *    why); a page that draws no lightmap FAILS. */
+ *    below), for the lightmapped surfaces of the cornell bake and for the probe-lit (LLG) props of
+ *    cornell_box_bjs. Without Chromium or the npm packages those cases are SKIPPED (counted so,
+ *    saying why); a page that draws no lightmap FAILS. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -28,7 +29,6 @@
 #include "tools/common/image_io.h"
 #include "tools/convert/gltf_export.h"
 #include "tools/render/render.h"
-
 
 #define W 160
 #define H 120
