@@ -342,20 +342,31 @@ static lbk_result pack_object_to_fit(const bk_scene *scene, uint32_t object, dou
     return LBK_ERR_LIMIT;
 }
 
-/* Charts and object rectangles of every object; when their texels exceed the budget, every
- * density is scaled by the same factor and all are packed again (noted in out->note). */
+/* Charts and object rectangles of every object; when their texels exceed the budget, first the
+ * charts of lone triangles larger than a default page shrink (their cap, down to the default
+ * chart cap: a ground quad of a few huge triangles must not cost every other object its
+ * density), then every density is scaled by the same factor and all are packed again (noted in
+ * out->note). */
 static lbk_result pack_objects_within_budget(const bk_scene *scene, bk_atlas *out, obj_pack *op, const atlas_limits *l)
 {
     double scale = 1.0;
+    atlas_limits lim = *l;
     for (int round = 0;; round++) {
         double total = 0.0;
+        size_t big = 0;
         for (size_t s = 0; s < out->object_count; s++) {
-            lbk_result r = pack_object_to_fit(scene, out->objects[s].object, scale, l, &op[s]);
+            lbk_result r = pack_object_to_fit(scene, out->objects[s].object, scale, &lim, &op[s]);
             if (r != LBK_OK) return r;
             total += (double)op[s].w * op[s].h;
+            big += op[s].uv.big_tris;
         }
         if (total <= (double)l->budget) break;
-        if (round == 11) return LBK_ERR_LIMIT;
+        if (round == 31) return LBK_ERR_LIMIT;
+        if (big > 0 && lim.uv.max_triangle_texels > lim.uv.max_chart_texels) {
+            int c = (int)(lim.uv.max_triangle_texels * 0.8);
+            lim.uv.max_triangle_texels = c > lim.uv.max_chart_texels ? c : lim.uv.max_chart_texels;
+            continue;
+        }
         scale *= sqrt((double)l->budget / total) * 0.98;
     }
     if (scale < 1.0) {

@@ -28,9 +28,14 @@
  *   in final page coordinates, so the tangent frame (texels.h: T = dP/du on the page) turns
  *   with the chart. Deterministic: integer decisions on the input only, no threads.
  * - Density per object: density_override if > 0, else bk_object.texel_density if > 0, else
- *   default_density. If the summed object rectangles exceed texel_budget, every density is
- *   scaled by the same factor (density_scale < 1, reported) until they fit. An object too
- *   large for one max_page_size page gets a lower density on its own (reported in its note).
+ *   default_density. If the summed object rectangles exceed texel_budget, the charts of lone
+ *   triangles longer than a default page shrink first (down to a default page's side), then
+ *   every density is scaled by the same factor (density_scale < 1, reported) until they fit.
+ *   A triangle is never split (the engine draws the glTF's triangles): one longer than a
+ *   max_page_size page gets a chart of its own at the density that fits (uvgen.h). An object
+ *   too large for one max_page_size page first shrinks its large triangles' charts, then gets a
+ *   lower density on its own (reported in its note). No page is wider or taller than
+ *   max_page_size.
  * - Lightmap vertices: scene vertices are split where charts meet (and between objects), so
  *   each lightmap vertex has one uv; scene_tri_vertices maps every triangle of an atlas
  *   object to its three lightmap vertices (zero-area triangles too, with a uv of a vertex

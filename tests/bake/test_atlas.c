@@ -388,6 +388,52 @@ static void test_selection_and_limits(void **state)
     uvs_free(&s);
 }
 
+/* A huge triangle and ten 10 m quads at 4 texels/m over a 300 000 texel budget: the triangle
+ * (2000 texels a leg) alone would take a 1024 page, so its chart shrinks until the level fits,
+ * and every quad keeps 4 texels/m — its 40-texel chart in a 42-texel rectangle — with no
+ * level-wide scaling. */
+static void test_budget_shrinks_huge_triangles_first(void **state)
+{
+    (void)state;
+    bk_scene s;
+    uvs_init(&s);
+    uvs_object(&s, "ground");
+    float t0[3] = {0, -1, 0}, t1[3] = {500, -1, 0}, t2[3] = {0, -1, -500};
+    uvs_tri(&s, t0, t1, t2, 0);
+    for (int i = 0; i < 10; i++) {
+        char name[16];
+        snprintf(name, sizeof name, "q%d", i);
+        add_quad_object(&s, name, 12.0f * (float)i, 0, 10, 10, 0, 1);
+    }
+    uvs_update_bounds(&s);
+    bk_atlas_options o = {0};
+    o.default_density = 4.0f;
+    o.page_size = 256;
+    o.max_page_size = 1024;
+    o.texel_budget = 300000;
+    bk_atlas a;
+    assert_int_equal(bk_atlas_build(&s, NULL, &o, &a), LBK_OK);
+    assert_float_equal(a.density_scale, 1.0, 0.0);
+    assert_string_equal(a.note, "");
+    uint64_t rects = 0;
+    for (size_t i = 0; i < a.object_count; i++) {
+        const bk_atlas_object *ob = &a.objects[i];
+        rects += (uint64_t)ob->w * (uint64_t)ob->h;
+        assert_float_equal(ob->density, 4.0, 1e-6);
+        if (i == 0) {
+            assert_non_null(strstr(ob->note, "1 triangle longer than"));
+            assert_true(ob->w < 1024 && ob->h < 1024);
+        } else {
+            assert_int_equal(ob->w, 42);
+            assert_int_equal(ob->h, 42);
+        }
+    }
+    assert_true(rects <= 300000);
+    check_layout(&s, &a, 1024);
+    bk_atlas_free(&a);
+    uvs_free(&s);
+}
+
 /* Lightmap vertices: a cube with one shared vertex set per face keeps 4 per face; a sphere
  * (all vertices shared) duplicates exactly the seam vertices. */
 static void test_vertex_split(void **state)
@@ -530,6 +576,7 @@ static void test_fill_many_charts(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_budget_shrinks_huge_triangles_first),
         cmocka_unit_test(test_layout_rules),
         cmocka_unit_test(test_deterministic),
         cmocka_unit_test(test_density),
