@@ -869,7 +869,9 @@ lbk_result bk_uvgen_object(const bk_scene *scene, uint32_t object, float density
     }
     if (r == LBK_OK && !done && ob->has_uv1) {
         int used = 0;
-        r = try_authored(&g, density, cap, out, &used);
+        /* an authored layout is one chart that cannot be split: like a lone triangle it may
+         * take up to the one-triangle cap (a whole maximum page in the atlas) */
+        r = try_authored(&g, density, tri_cap > cap ? tri_cap : cap, out, &used);
         done = used;
     }
     if (r == LBK_OK && !done) {

@@ -4,7 +4,8 @@
  * Authored: where the object has TEXCOORD_1 (bk_object.has_uv1) the layout is kept as one
  * chart and only scaled uniformly so that its texel density matches the requested density
  * on average (s = density · sqrt(world area / uv area) texels per uv unit); its bounding box
- * becomes the chart. The author's own island spacing is kept as is. It is rejected, with the
+ * becomes the chart, up to the larger of max_chart_texels and max_triangle_texels a side (a
+ * lower density beyond, noted). The author's own island spacing is kept as is. It is rejected, with the
  * reason in bk_uv_object.note, and the layout generated instead, when: a uv1 coordinate is
  * not finite or lies outside [0, 1]; the uv area is zero; triangles with (almost) zero uv
  * area cover more than 1% of the object's surface; or triangles overlap at the target

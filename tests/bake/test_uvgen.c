@@ -207,6 +207,22 @@ static void test_authored_uv1_kept(void **state)
         }
     check_invariants(&s, &u);
     bk_uv_object_free(&u);
+    /* the 48-texel layout over a 40-texel chart cap: the density is lowered to fit (one chart
+     * that cannot be split), unless the one-chart cap (a maximum page) holds it */
+    bk_uv_options o = {0};
+    o.max_chart_texels = 40;
+    assert_int_equal(bk_uvgen_object(&s, 0, 16.0f, &o, &u), LBK_OK);
+    assert_int_equal(u.source, BK_UV_AUTHORED);
+    assert_float_equal(u.charts[0].width, 40.0, 1e-3);
+    assert_float_equal(u.density, 16.0 * 40.0 / 48.0, 1e-3);
+    assert_non_null(strstr(u.note, "so the uv1 layout fits 40 texels"));
+    bk_uv_object_free(&u);
+    o.max_triangle_texels = 100;
+    assert_int_equal(bk_uvgen_object(&s, 0, 16.0f, &o, &u), LBK_OK);
+    assert_float_equal(u.charts[0].width, 48.0, 1e-3);
+    assert_float_equal(u.density, 16.0, 1e-3);
+    assert_string_equal(u.note, "");
+    bk_uv_object_free(&u);
     uvs_free(&s);
 }
 
