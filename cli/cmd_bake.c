@@ -2,6 +2,7 @@
  * bake_options.c), the progress bar and messages on stderr, the container and the JSON report
  * written, exit codes. */
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -180,6 +181,29 @@ static int commit_outputs(const bake_args *o, lbk_bake_output *out, const char *
     return exit_code(r == LBK_ERR_IO ? r : LBK_ERR_INTERNAL);
 }
 
+
+/* The path check's line (bake/transport/TRANSPORT.md §Path check): the error measured against
+ * unbiased paths and the object that carries the most of it beyond the noise estimate. */
+static void print_path_check(const lbk_bake_report *rep)
+{
+    if (rep->size < offsetof(lbk_bake_report, check) + sizeof rep->check || !rep->check.receivers ||
+        !rep->object_checks)
+        return;
+    size_t worst = SIZE_MAX;
+    double worst_ratio = 0;
+    for (size_t i = 0; i < rep->object_estimate_count; i++) {
+        const double noise = hypot(rep->object_estimates[i].noise, rep->object_estimates[i].bias);
+        const double ratio = rep->object_checks[i].rel_rmse / (noise > 1e-6 ? noise : 1e-6);
+        if (rep->object_checks[i].receivers && ratio > worst_ratio) worst_ratio = ratio, worst = i;
+    }
+    printf("path check: %.2f%% measured against unbiased paths at %u texels (%u paths each)", 100 * rep->check.rel_rmse,
+           rep->check.receivers, rep->check.samples);
+    if (worst != SIZE_MAX && worst_ratio > 2)
+        printf("; %s carries %.1f%%, %.1fx its noise estimate", rep->object_estimates[worst].name,
+               100 * rep->object_checks[worst].rel_rmse, worst_ratio);
+    printf("\n");
+}
+
 static int bake(bake_args *o, int quiet)
 {
     const time_t started = time(NULL);
@@ -221,6 +245,7 @@ static int bake(bake_args *o, int quiet)
                (unsigned long long)c->pages, (unsigned long long)c->glg_probes,
                (unsigned long long)c->llg_probes, (unsigned long long)c->llgs, c->light_sets, c->doors,
                100 * rep->transport.est_rel_rmse, (unsigned long long)c->file_bytes);
+    if (!quiet) print_path_check(rep);
     lbk_bake_output_free(out);
     return LBK_EXIT_OK;
 }

@@ -150,6 +150,7 @@ void bk_tr_free_ctx(tp_ctx *c)
     free(c->thread_rays); free(c->thread_nonfinite);
     lattice_free(&c->lat);
     lattice_free(&c->oct_lat);
+    lattice_free(&c->check_lat);
     free(c->oct_acc[0]);
     free(c->oct_acc[1]);
     for (int h = 0; h < 2; h++) bk_slc_draw_destroy(c->draw_recv[h]);

@@ -244,6 +244,7 @@ typedef struct tp_ctx {
     uint64_t extra_rays, extra_shadow, extra_nonfinite;
     uint64_t check_rays;   /* the path check's (check.c) */
     int check_samples;     /* paths per checked receiver */
+    tp_lattice check_lat;  /* a replicate's lattice */
     /* adaptive sampling's blocks (TRANSPORT.md §Adaptive sampling), class k's
      * [blk_first[k], blk_first[k + 1]): per block the sum of the weights of the passes it sampled
      * in, whether it samples in this pass, and whether it would sample in the next (bk_tr_adapt_mark;
