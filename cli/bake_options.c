@@ -197,9 +197,10 @@ static const bake_option options[] = {
     {.name = "--path-check", .kind = OPT_NUMBER, .metavar = "N|off", .min = 1, .max = 1024, .keyword = "off",
      .keyword_value = -1, .def = "16", .set = set_path_check,
      .help = "trace N texels of every lightmapped object by unbiased paths after\n"
-             "the passes (default {default}, about a quarter more rays) and report\n"
-             "each object's error measured against them: what the noise estimate\n"
-             "cannot see (bake/transport/TRANSPORT.md, Path check); off: none"},
+             "the passes (default {default}; a quarter more rays, at least 2048 paths\n"
+             "each) and report each object's error measured against them: what the\n"
+             "noise estimate cannot see (bake/transport/TRANSPORT.md, Path check);\n"
+             "off: none"},
     {.name = "--door-method", .kind = OPT_ENUM, .field = F_INT, .off = D(door_method), .choices = door_methods,
      .what = "door method", .def = "difference",
      .help = "how the light through an open door is baked: differences of\n"
