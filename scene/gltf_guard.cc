@@ -599,6 +599,11 @@ Prepass prepass(const char *json_begin, size_t json_len, const std::string &file
                 if (pbr != m.end() && pbr->is_object() && pbr->contains("metallicRoughnessTexture"))
                     need((*pbr)["metallicRoughnessTexture"], 1);
                 if (m.contains("emissiveTexture")) need(m["emissiveTexture"], 1);
+                auto ext = m.find("extensions");  // the specular-glossiness diffuse is the base colour
+                if (ext != m.end() && ext->is_object() && ext->contains("KHR_materials_pbrSpecularGlossiness")) {
+                    const nlohmann::json &sg = (*ext)["KHR_materials_pbrSpecularGlossiness"];
+                    if (sg.is_object() && sg.contains("diffuseTexture")) need(sg["diffuseTexture"], 1);
+                }
                 if (normal_maps && m.contains("normalTexture")) need(m["normalTexture"], 2);
             }
     }

@@ -104,7 +104,11 @@ void Importer::check_extensions()
     // KHR_texture_basisu / EXT_meshopt_compression required: refused by the pre-pass, by name
     static const char *const supported[] = {"EXT_texture_webp", "KHR_draco_mesh_compression",
                                             "KHR_lights_punctual", "KHR_materials_emissive_strength",
+                                            "KHR_materials_pbrSpecularGlossiness", "KHR_materials_unlit",
                                             "KHR_mesh_quantization", "KHR_texture_transform"};
+    for (const std::string &e : m_.extensionsUsed)  // spec/authoring.md "Material extensions"
+        if (e == "KHR_materials_variants")
+            warn("KHR_materials_variants ignored: each primitive's default material is baked");
     for (const std::string &e : m_.extensionsRequired) {
         bool used = false;
         for (const std::string &u : m_.extensionsUsed) used = used || u == e;

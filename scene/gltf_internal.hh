@@ -362,6 +362,13 @@ private:
     int texture_image(const tinygltf::TextureInfo &ti, const char *slot, int mi, const std::string &mname,
                       UvMap *map, bool linear = false);
     void read_normal_texture(const tinygltf::Material &gm, int mi, bk_material *bm, UvMap *map);
+    tinygltf::TextureInfo ext_texture_info(const tinygltf::Value &v, const char *what, int mi,
+                                           const std::string &mname);
+    double ext_number(const tinygltf::Value &x, const char *ext, const char *key, double dflt, double lo, double hi,
+                      int mi, const std::string &mname);
+    void read_spec_gloss(const tinygltf::Value &x, int mi, const std::string &mname, bk_material *bm, UvMap *map);
+    void read_material_extensions(const tinygltf::Material &gm, int mi, bk_material *bm, UvMap *base_map,
+                                  int *mr_tex);
     int texture_source(int tex) const;
     UvMap read_uv_map(const tinygltf::TextureInfo &ti, const char *slot, int mi, const std::string &mname);
     void settle_uv_maps(int mi, const std::string &mname, int *tex[4], const UvMap maps[4]);

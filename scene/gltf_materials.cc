@@ -350,6 +350,121 @@ void Importer::apply_uv_map(Prim &p, int mi, int pi)
     p.uv0.swap(out);
 }
 
+// ---- KHR_materials_* (spec/authoring.md "Material extensions") -----------------------------------
+// lbk bakes diffuse light: a material is a Lambertian albedo, an emission and (GGX.md) a
+// metallic-roughness lobe. Each KHR_materials extension is honoured where it says what the
+// diffuse albedo or the emission is, approximated where it only scales the diffuse part, and
+// otherwise ignored with one warning naming it and the material.
+
+// A textureInfo held inside an extension (tinygltf leaves it a Value): index, texCoord and the
+// KHR_texture_transform read_uv_map takes. A malformed one is an error naming the material.
+tinygltf::TextureInfo Importer::ext_texture_info(const tinygltf::Value &v, const char *what, int mi,
+                                                 const std::string &mname)
+{
+    tinygltf::TextureInfo ti;
+    ti.index = -1;
+    bool ok = v.IsObject() && v.Has("index") && v.Get("index").IsInt() && v.Get("index").GetNumberAsInt() >= 0;
+    if (ok) ti.index = v.Get("index").GetNumberAsInt();
+    if (ok && v.Has("texCoord")) {
+        ok = v.Get("texCoord").IsInt() && v.Get("texCoord").GetNumberAsInt() >= 0;
+        if (ok) ti.texCoord = v.Get("texCoord").GetNumberAsInt();
+    }
+    if (!ok)
+        fail("%s: material %d %s: %s must be a textureInfo (integer index >= 0, texCoord >= 0)", path_.c_str(), mi,
+             qstr(mname).c_str(), what);
+    if (v.Has("extensions") && v.Get("extensions").IsObject()) {
+        const tinygltf::Value &e = v.Get("extensions");
+        for (const std::string &k : e.Keys()) ti.extensions[k] = e.Get(k);
+    }
+    return ti;
+}
+
+// One number of an extension object in [lo, hi] (dflt when absent); an error names the material.
+double Importer::ext_number(const tinygltf::Value &x, const char *ext, const char *key, double dflt, double lo,
+                            double hi, int mi, const std::string &mname)
+{
+    if (!x.Has(key)) return dflt;
+    const tinygltf::Value &v = x.Get(key);
+    if (!v.IsNumber() || !(v.GetNumberAsDouble() >= lo && v.GetNumberAsDouble() <= hi))
+        fail("%s: material %d %s: %s %s must be a number in [%g, %g]", path_.c_str(), mi, qstr(mname).c_str(), ext,
+             key, lo, hi);
+    return v.GetNumberAsDouble();
+}
+
+// KHR_materials_pbrSpecularGlossiness (archived; what older exporters wrote): its diffuse is the
+// diffuse albedo, exactly as baseColor is for metallic-roughness (diffuseFactor × diffuseTexture,
+// sRGB), and the material is a dielectric (metallic 0: the Lambertian path) with roughness
+// 1 − glossinessFactor. The specular colour and specularGlossinessTexture are not baked.
+void Importer::read_spec_gloss(const tinygltf::Value &x, int mi, const std::string &mname, bk_material *bm,
+                               UvMap *map)
+{
+    const char *ext = "KHR_materials_pbrSpecularGlossiness";
+    const std::string mq = qstr(mname);
+    if (!x.IsObject()) fail("%s: material %d %s: %s is not an object", path_.c_str(), mi, mq.c_str(), ext);
+    double df[4] = {1, 1, 1, 1};
+    if (x.Has("diffuseFactor")) {
+        const tinygltf::Value &v = x.Get("diffuseFactor");
+        bool ok = v.IsArray() && v.ArrayLen() == 4;
+        for (int k = 0; ok && k < 4; k++) {
+            ok = v.Get(k).IsNumber() && finite_nonneg(v.Get(k).GetNumberAsDouble());
+            if (ok) df[k] = v.Get(k).GetNumberAsDouble();
+        }
+        if (!ok)
+            fail("%s: material %d %s: %s diffuseFactor must be 4 finite numbers >= 0", path_.c_str(), mi, mq.c_str(),
+                 ext);
+    }
+    if (df[0] > 1 || df[1] > 1 || df[2] > 1) warn("material %d %s: diffuseFactor above 1 clamped", mi, mq.c_str());
+    for (int k = 0; k < 3; k++) bm->albedo[k] = (float)std::min(df[k], 1.0);
+    bm->metallic = 0.0f;
+    bm->roughness = (float)(1.0 - ext_number(x, ext, "glossinessFactor", 1.0, 0.0, 1.0, mi, mname));
+    bm->metal_rough_tex1 = 0;
+    bm->albedo_tex = -1;
+    if (x.Has("diffuseTexture")) {
+        tinygltf::TextureInfo ti = ext_texture_info(x.Get("diffuseTexture"), "diffuseTexture", mi, mname);
+        bm->albedo_tex = texture_image(ti, "diffuse", mi, mname, map);
+    }
+}
+
+// The other KHR_materials_* extensions of material mi, after its core fields: honoured
+// (emissive_strength, read with emissiveFactor), approximated (specular-glossiness, unlit,
+// transmission, diffuse_transmission) or ignored with one warning each.
+void Importer::read_material_extensions(const tinygltf::Material &gm, int mi, bk_material *bm, UvMap *base_map,
+                                        int *mr_tex)
+{
+    const std::string mq = qstr(gm.name);
+    for (const auto &kv : gm.extensions) {
+        const std::string &e = kv.first;
+        const tinygltf::Value &x = kv.second;
+        if (e.rfind("KHR_materials_", 0) != 0 || e == "KHR_materials_emissive_strength") continue;
+        if (e == "KHR_materials_pbrSpecularGlossiness") {
+            *mr_tex = -1;  // a specular-glossiness material has no metallic-roughness lobe
+            read_spec_gloss(x, mi, gm.name, bm, base_map);
+        } else if (e == "KHR_materials_unlit") {
+            // The extension's own fallback: the base colour as a lit surface. Not an emitter:
+            // an unlit colour is display-referred, and as nits it would add light nobody placed.
+            warn("material %d %s: KHR_materials_unlit approximated: baked as a lit diffuse surface of its base "
+                 "colour (not emissive)", mi, mq.c_str());
+        } else if (e == "KHR_materials_transmission" || e == "KHR_materials_diffuse_transmission") {
+            // What is transmitted is not reflected: the diffuse albedo is (1 − factor) × base
+            // colour (both extensions' BRDF mix); lbk traces no light through surfaces, so the
+            // transmitted part is lost, never bounced back as if the surface were opaque white.
+            const bool diffuse = e == "KHR_materials_diffuse_transmission";
+            const char *key = diffuse ? "diffuseTransmissionFactor" : "transmissionFactor";
+            if (!x.IsObject()) fail("%s: material %d %s: %s is not an object", path_.c_str(), mi, mq.c_str(), e.c_str());
+            const double t = ext_number(x, e.c_str(), key, 0.0, 0.0, 1.0, mi, gm.name);
+            for (int k = 0; k < 3; k++) bm->albedo[k] *= (float)(1.0 - t);
+            warn("material %d %s: %s approximated: baked opaque, diffuse albedo x %g (1 - %s; its texture and the "
+                 "light it transmits are not baked)", mi, mq.c_str(), e.c_str(), 1.0 - t, key);
+        } else {
+            // ior, specular, sheen, clearcoat, iridescence, anisotropy, dispersion, volume and any
+            // newer one: they shape the specular lobes or light inside a volume, not the diffuse
+            // albedo or the emission lbk bakes
+            warn("material %d %s: %s ignored (lbk bakes the diffuse albedo and emission only)", mi, mq.c_str(),
+                 e.c_str());
+        }
+    }
+}
+
 // A material that `lbk export --gltf` wrote carries the baked light in its glTF factors and
 // emissive texture (black base colour, emission albedo · E / pi: tools/convert/README.md "In
 // engines") and the source material's albedo and emission in extras.lbk: a bake of the export
@@ -426,6 +541,7 @@ void Importer::build_materials()
                                &maps[2]);
         read_normal_texture(gm, mi, &bm, &maps[3]);  // last: images before it keep their indices
         int nt = bm.normal_tex1 - 1;
+        if (!exported) read_material_extensions(gm, mi, &bm, &maps[0], &mr);
         int *tex[4] = {&bm.albedo_tex, &bm.emission_tex, &mr, &nt};
         settle_uv_maps(mi, gm.name, tex, maps);
         bm.metal_rough_tex1 = 1 + mr;
