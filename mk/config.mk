@@ -46,12 +46,13 @@ LIB_LIBS := $(strip $(call pc,--libs,libzstd libxxhash,-lzstd -lxxhash) -lm)
 # Through pkg-config: qhull_r, spng, libcjson, libwebp (EXT_texture_webp), draco (draco.pc says -I/usr/include, where its
 # <draco/...> includes resolve; -I/usr/include/draco is only the fallback) and stb (headers only:
 # stb_image is compiled into the glTF shim, so only its --cflags). Named directly because Debian
-# ships no .pc for them (CMake configs only): Embree 3 (-lembree3) and astcenc (-lastcenc). And
+# ships no .pc for them (CMake configs only): Embree 3 (-lembree3), meshoptimizer (-lmeshoptimizer,
+# EXT_meshopt_compression's decoders) and astcenc (-lastcenc). And
 # OpenEXR: its OpenEXR.pc names the whole C++ library set (-lOpenEXR -lIex -lIlmThread -lImath ...);
 # lbk uses only the C core (<OpenEXR/openexr.h>, -lOpenEXRCore), which has no .pc of its own.
 BAKE_PC     := qhull_r spng libcjson draco libwebp
 BAKE_CFLAGS := $(strip $(call pc,--cflags,$(BAKE_PC),-I/usr/include/draco) $(call pc,--cflags,stb,-I/usr/include/stb))
-BAKE_LIBS   := $(strip -lembree3 -lOpenEXRCore $(call pc,--libs,$(BAKE_PC),-lqhull_r -lspng -lcjson -ldraco -lwebp) -lpthread -lm)
+BAKE_LIBS   := $(strip -lembree3 -lOpenEXRCore -lmeshoptimizer $(call pc,--libs,$(BAKE_PC),-lqhull_r -lspng -lcjson -ldraco -lwebp) -lpthread -lm)
 TOOL_INC    := $(LIB_INC) -Ibake/include -I. $(BAKE_CFLAGS)
 TOOL_CXXINC := $(LIB_INC) -Ibake/include -I. $(call isystem,$(BAKE_CFLAGS))
 # astcenc: the ASTC plane encodings of lbk convert / export / diff (tools/common/astc_codec.cc)

@@ -8,7 +8,7 @@ DEB_LIB_PKGS  := build-essential libzstd-dev libxxhash-dev
 GPU_PKGS      := libvulkan-dev mesa-vulkan-drivers glslang-tools
 DEB_TOOL_PKGS := $(DEB_LIB_PKGS) pkg-config libembree-dev libopenexr-dev libdraco-dev libtinygltf-dev \
                  libstb-dev nlohmann-json3-dev libqhull-dev libspng-dev libcjson-dev \
-                 libastcenc-dev libwebp-dev
+                 libastcenc-dev libwebp-dev libmeshoptimizer-dev
 DEB_TEST_PKGS := $(DEB_TOOL_PKGS) libcmocka-dev clang libclang-rt-14-dev python3
 # lbk view's tests: node runs the page's container reader against liblbk, headless Chromium
 # (SwiftShader WebGL) loads the page; without them those cases are SKIPPED (counted so).

@@ -20,8 +20,8 @@ $(BUILD)/fuzz-obj/%.o: %.cc
 	$(CLANGXX) -std=c++17 $(FUZZ_OBJ_FLAGS) $(CXXWARN) $(TOOL_CXXINC) -MMD -MP -c $< -o $@
 # What each harness links (the glTF one: the importer's objects, one line to edit when they change)
 FUZZ_GLTF_OBJ := $(addprefix $(BUILD)/fuzz-obj/,tests/fuzz/fuzz_gltf.o scene/gltf_import.o scene/gltf_guard.o \
-                   scene/gltf_materials.o scene/gltf_geometry.o scene/gltf_extras.o scene/tinygltf_impl.o \
-                   scene/scene.o scene/exr_read.o)
+                   scene/gltf_materials.o scene/gltf_geometry.o scene/gltf_meshopt.o scene/gltf_extras.o \
+                   scene/tinygltf_impl.o scene/scene.o scene/exr_read.o)
 FUZZ_EXR_OBJ := $(addprefix $(BUILD)/fuzz-obj/,tests/fuzz/fuzz_exr.o scene/exr_read.o scene/scene.o)
 FUZZ_PROFILE_OBJ := $(addprefix $(BUILD)/fuzz-obj/,tests/fuzz/fuzz_profile.o tools/convert/profile.o \
                       tools/common/lmap_decode.o tools/common/error_util.o tools/common/astc_codec.o)

@@ -460,10 +460,10 @@ void check_uri_targets(const nlohmann::json &arr, const char *kind, const std::s
     }
 }
 
-// KHR_texture_basisu and EXT_meshopt_compression: lbk decodes neither. Only used, the fallback is
-// read (a texture's core source, a bufferView's own buffer range); required, there is none (a
-// meshopt fallback buffer may have no uri at all), so the import is refused here, naming the
-// first texture or bufferView that uses the extension, before tinygltf reads anything.
+// KHR_texture_basisu: lbk does not decode it. Only used, the fallback is read (a texture's core
+// source); required, there is none, so the import is refused here, naming the first texture
+// that uses the extension, before tinygltf reads anything. (EXT_meshopt_compression is decoded:
+// collect_meshopt.)
 void check_required_codecs(const nlohmann::json &doc, const std::string &file)
 {
     const nlohmann::json *req = jarr(doc, "extensionsRequired");
@@ -495,14 +495,95 @@ void check_required_codecs(const nlohmann::json &doc, const std::string &file)
     for (const auto &e : *req) {
         if (!e.is_string()) continue;
         const std::string ext = e.get<std::string>();
-        const bool basis = ext == "KHR_texture_basisu", meshopt = ext == "EXT_meshopt_compression";
-        if (!basis && !meshopt) continue;
-        std::string what = user(basis ? "textures" : "bufferViews", ext.c_str());
+        if (ext != "KHR_texture_basisu") continue;
+        std::string what = user("textures", ext.c_str());
         fail("%s: requires glTF extension %s (%s), which lbk cannot decode: %s", file.c_str(), ext.c_str(),
-             what.empty() ? "no texture or bufferView uses it" : ("used by " + what).c_str(),
-             basis ? "export the textures as PNG, JPEG or WebP (or add a fallback source and leave the extension "
-                     "used, not required)"
-                   : "export without meshopt compression (or with fallback data, the extension used, not required)");
+             what.empty() ? "no texture uses it" : ("used by " + what).c_str(),
+             "export the textures as PNG, JPEG or WebP (or add a fallback source and leave the extension "
+             "used, not required)");
+    }
+}
+
+// EXT_meshopt_compression: every bufferView carrying it, checked as far as the JSON allows (the
+// mode, filter, stride and count combinations of the extension's spec, which meshoptimizer's
+// decoders assert rather than check), into pp->meshopt; the import decodes them (gltf_meshopt.cc)
+// whether the extension is required or only used: the compressed view is preferred. A buffer
+// flagged as the extension's fallback that only compressed views read is stubbed with one byte
+// before tinygltf sees it: gltfpack writes it without a uri (tinygltf would refuse it, or in a
+// GLB take the BIN chunk for it) and its data, when present, is never read.
+void collect_meshopt(nlohmann::json &doc, const std::string &file, Prepass *pp)
+{
+    const char *kExt = "EXT_meshopt_compression";
+    auto ext_of = [&](const nlohmann::json &o) -> const nlohmann::json * {
+        if (!o.is_object() || !o.contains("extensions") || !o["extensions"].is_object()) return nullptr;
+        auto it = o["extensions"].find(kExt);
+        return it == o["extensions"].end() ? nullptr : &*it;
+    };
+    const nlohmann::json *views = jarr(doc, "bufferViews");
+    const nlohmann::json *buffers = jarr(doc, "buffers");
+    std::vector<char> plain_reader(buffers ? buffers->size() : 0, 0);  // read by a view without the extension
+    for (size_t i = 0; views && i < views->size(); i++) {
+        const nlohmann::json &v = (*views)[i];
+        const nlohmann::json *x = ext_of(v);
+        long long vb;
+        if (!x) {
+            if (jint(v, "buffer", &vb) && vb >= 0 && (size_t)vb < plain_reader.size()) plain_reader[(size_t)vb] = 1;
+            continue;
+        }
+        std::string lbl = "bufferView " + std::to_string(i);
+        if (v.contains("name") && v["name"].is_string()) lbl += " " + qstr(v["name"].get<std::string>());
+        MeshoptView mv;
+        long long b, off = 0, len, stride, count;
+        if (!x->is_object() || !jint(*x, "buffer", &b) || !jint(*x, "byteLength", &len) ||
+            !jint(*x, "byteStride", &stride) || !jint(*x, "count", &count) || !x->contains("mode") ||
+            !(*x)["mode"].is_string() || (x->contains("byteOffset") && !jint(*x, "byteOffset", &off)))
+            fail("%s: %s: %s needs integer buffer, byteLength, byteStride and count and a mode", file.c_str(),
+                 lbl.c_str(), kExt);
+        if (!buffers || b < 0 || (size_t)b >= buffers->size() || off < 0 || len < 0 || count < 0)
+            fail("%s: %s: %s: buffer %lld, byteOffset %lld, byteLength %lld or count %lld out of range",
+                 file.c_str(), lbl.c_str(), kExt, b, off, len, count);
+        const std::string mode = (*x)["mode"].get<std::string>();
+        std::string filter = "NONE";
+        if (x->contains("filter")) {
+            if (!(*x)["filter"].is_string()) fail("%s: %s: %s: filter is not a string", file.c_str(), lbl.c_str(), kExt);
+            filter = (*x)["filter"].get<std::string>();
+        }
+        bool ok;
+        if (mode == "ATTRIBUTES") {
+            mv.mode = MeshoptView::ATTRIBUTES;
+            ok = stride > 0 && stride <= 256 && stride % 4 == 0;
+        } else if (mode == "TRIANGLES" || mode == "INDICES") {
+            mv.mode = mode == "TRIANGLES" ? MeshoptView::TRIANGLES : MeshoptView::INDICES;
+            ok = (stride == 2 || stride == 4) && (mv.mode == MeshoptView::INDICES || count % 3 == 0) &&
+                 filter == "NONE";
+        } else {
+            fail("%s: %s: %s: unknown mode %s (ATTRIBUTES, TRIANGLES or INDICES)", file.c_str(), lbl.c_str(),
+                 kExt, qstr(mode).c_str());
+        }
+        if (filter == "NONE") mv.filter = MeshoptView::NONE;
+        else if (filter == "OCTAHEDRAL") mv.filter = MeshoptView::OCTAHEDRAL, ok = ok && (stride == 4 || stride == 8);
+        else if (filter == "QUATERNION") mv.filter = MeshoptView::QUATERNION, ok = ok && stride == 8;
+        else if (filter == "EXPONENTIAL") mv.filter = MeshoptView::EXPONENTIAL;
+        else
+            fail("%s: %s: %s: unknown filter %s (NONE, OCTAHEDRAL, QUATERNION or EXPONENTIAL)", file.c_str(),
+                 lbl.c_str(), kExt, qstr(filter).c_str());
+        if (!ok)
+            fail("%s: %s: %s: byteStride %lld and count %lld do not fit mode %s with filter %s", file.c_str(),
+                 lbl.c_str(), kExt, stride, count, mode.c_str(), filter.c_str());
+        mv.view = (int)i;
+        mv.buffer = (int)b;
+        mv.offset = (uint64_t)off;
+        mv.length = (uint64_t)len;
+        mv.stride = (uint64_t)stride;
+        mv.count = (uint64_t)count;
+        pp->meshopt.push_back(mv);
+    }
+    for (size_t i = 0; buffers && i < buffers->size(); i++) {
+        const nlohmann::json *x = ext_of((*buffers)[i]);
+        if (!x || !x->is_object() || !x->contains("fallback") || !(*x)["fallback"].is_boolean() ||
+            !(*x)["fallback"].get<bool>() || plain_reader[i])
+            continue;
+        doc["buffers"][i] = nlohmann::json{{"byteLength", 1}, {"uri", "data:application/octet-stream;base64,AA=="}};
     }
 }
 
@@ -547,7 +628,14 @@ Prepass prepass(const char *json_begin, size_t json_len, const std::string &file
         fail("%s: invalid JSON: %s", file.c_str(), e.what());
     }
     if (!doc.is_object()) fail("%s: the JSON root is not an object", file.c_str());
+    // glTF 1.0 names its meshes, materials and accessors differently: read as 2.0 it would import
+    // no triangles without saying why
+    if (doc.contains("asset") && doc["asset"].is_object() && doc["asset"].contains("version") &&
+        doc["asset"]["version"].is_string() && doc["asset"]["version"].get<std::string>().rfind("2.", 0) != 0)
+        fail("%s: asset.version is %s: lbk reads glTF 2.0 only", file.c_str(),
+             qstr(doc["asset"]["version"].get<std::string>()).c_str());
     check_required_codecs(doc, file);
+    collect_meshopt(doc, file, &pp);
     check_uris(doc, file, pol);
     check_node_depth(doc, file);
 

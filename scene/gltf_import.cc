@@ -101,8 +101,9 @@ void Importer::load()
 
 void Importer::check_extensions()
 {
-    // KHR_texture_basisu / EXT_meshopt_compression required: refused by the pre-pass, by name
-    static const char *const supported[] = {"EXT_texture_webp", "KHR_draco_mesh_compression",
+    // KHR_texture_basisu required: refused by the pre-pass, by name
+    static const char *const supported[] = {"EXT_meshopt_compression", "EXT_texture_webp",
+                                            "KHR_draco_mesh_compression",
                                             "KHR_lights_punctual", "KHR_materials_emissive_strength",
                                             "KHR_materials_pbrSpecularGlossiness", "KHR_materials_unlit",
                                             "KHR_mesh_quantization", "KHR_texture_transform"};
@@ -293,6 +294,7 @@ void Importer::run()
 {
     load();
     check_extensions();
+    decode_meshopt();
     decode_images();
     build_materials();
     meshes_.resize(m_.meshes.size());

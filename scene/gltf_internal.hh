@@ -1,6 +1,7 @@
 // The glTF importer's internals, shared by its translation units (scene/gltf_*.cc); nothing here
 // is public (scene/import.h is). glTF 2.0 (.gltf / .glb) → bk_scene, the only C++ of the baker:
-// tinygltf (scene/tinygltf_impl.cc), Draco (gltf_geometry.cc) and stb_image (gltf_materials.cc)
+// tinygltf (scene/tinygltf_impl.cc), Draco (gltf_geometry.cc), meshoptimizer's decoders
+// (gltf_meshopt.cc) and stb_image (gltf_materials.cc)
 // are compiled into the importer and only bk_import_gltf() is exported (gltf_import.cc).
 //
 // The input is untrusted. tinygltf 2.7.0 parses JSON, buffers (data URIs, .bin files, the GLB BIN
@@ -20,8 +21,9 @@
 //
 // Where each part lives: gltf_guard.cc the path sandbox, file reads, the JSON pre-pass and the GLB
 // container; gltf_materials.cc images and materials; gltf_geometry.cc accessors, Draco, primitives
-// and the scene's geometry; gltf_extras.cc lights, the sky and the lbk_* extras; gltf_import.cc
-// the entry point, loading, the node graph and the order of it all (Importer::run).
+// and the scene's geometry; gltf_meshopt.cc EXT_meshopt_compression's bufferViews; gltf_extras.cc
+// lights, the sky and the lbk_* extras; gltf_import.cc the entry point, loading, the node graph
+// and the order of it all (Importer::run).
 #ifndef BK_GLTF_INTERNAL_HH
 #define BK_GLTF_INTERNAL_HH
 
@@ -204,8 +206,20 @@ struct DracoInfo {
     std::map<std::string, int> attributes;  // glTF semantic -> Draco unique id
 };
 
+// EXT_meshopt_compression on one bufferView, as the pre-pass checked it: the compressed range
+// (buffer, offset, length) and what it decodes to (count elements of stride bytes).
+struct MeshoptView {
+    enum Mode { ATTRIBUTES, TRIANGLES, INDICES };
+    enum Filter { NONE, OCTAHEDRAL, QUATERNION, EXPONENTIAL };
+    int view = -1, buffer = -1;
+    uint64_t offset = 0, length = 0, stride = 0, count = 0;
+    Mode mode = ATTRIBUTES;
+    Filter filter = NONE;
+};
+
 struct Prepass {
     std::map<std::pair<int, int>, DracoInfo> draco;  // (mesh, primitive)
+    std::vector<MeshoptView> meshopt;                // the compressed bufferViews, in view order
     std::vector<char> needed_images;                 // per image: 1 used as base colour / emissive /
                                                      // metallicRoughness, | 2 as a normal texture (only
                                                      // when the import reads normal maps)
@@ -214,8 +228,9 @@ struct Prepass {
 
 // Caps the JSON's depth and what it may cost to import (a SAX census before any DOM), the node
 // hierarchy's depth, refuses absolute and non-data: URIs, URIs holding a NUL and files that are
-// not regular or not byteLength long (before tinygltf opens them), refuses KHR_texture_basisu and
-// EXT_meshopt_compression when required (naming the texture / bufferView), validates image
+// not regular or not byteLength long (before tinygltf opens them), refuses KHR_texture_basisu
+// when required (naming the texture), notes the EXT_meshopt_compression bufferViews (their
+// fallback buffers stubbed: the compressed data is decoded instead), validates image
 // bufferViews, notes the images the baker needs (EXT_texture_webp's source first) and the Draco
 // primitives, and rewrites the JSON for tinygltf.
 Prepass prepass(const char *json_begin, size_t json_len, const std::string &file, const ResourcePolicy &pol,
@@ -383,6 +398,8 @@ private:
                        const std::string &what);
     void decode_draco(int mi, int pi, const DracoInfo &di, Prim &p, std::vector<uint32_t> &idx, size_t *nverts);
     void check_draco_counts(int mi, int pi, const DracoInfo &di, size_t points, size_t indices);
+    // gltf_meshopt.cc: every EXT_meshopt_compression bufferView decoded into a buffer of its own
+    void decode_meshopt();
     void emit_geometry();
     void emit_tangents(const Prim &p, size_t v0, const double A[9]);
     void choose_origin(const std::vector<Instance> &kept);

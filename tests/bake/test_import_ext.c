@@ -1,9 +1,9 @@
 /* glTF import as exporters write it (issue 37): EXT_texture_webp (a WebP image in a subfolder,
  * named by a percent-encoded UTF-8 URI, the extension required) imports and bakes;
  * KHR_texture_transform (scale, offset, rotation, texCoord override) is folded into the uv0 the
- * baker samples, checked through the transport's albedo lookup; KHR_texture_basisu and
- * EXT_meshopt_compression are refused by name when required and read through their fallback
- * when only used; percent-encoded URIs stay confined to the scene's folder. */
+ * baker samples, checked through the transport's albedo lookup; KHR_texture_basisu is refused by
+ * name when required and read through its fallback when only used (EXT_meshopt_compression is
+ * decoded: test_import_meshopt.c); percent-encoded URIs stay confined to the scene's folder. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -288,38 +288,6 @@ static void test_basisu(void **state)
     bk_scene_free(&s);
 }
 
-/* EXT_meshopt_compression on the index bufferView: required, refused naming the bufferView;
- * only used, the bufferView's own (fallback) bytes are read. */
-static void test_meshopt(void **state)
-{
-    (void)state;
-    setup_town();
-    char json[4096];
-    const char *fmt =
-        "{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"EXT_meshopt_compression\"],%s"
-        "\"buffers\":[{\"uri\":\"quaduv.bin\",\"byteLength\":124}],"
-        "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},"
-        "{\"name\":\"idx\",\"buffer\":0,\"byteOffset\":48,\"byteLength\":12,\"extensions\":{\"EXT_meshopt_compression\":"
-        "{\"buffer\":0,\"byteOffset\":0,\"byteLength\":8,\"byteStride\":2,\"count\":6,\"mode\":\"TRIANGLES\"}}}],"
-        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
-        "{\"bufferView\":1,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],"
-        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
-        "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]}";
-    snprintf(json, sizeof json, fmt, "\"extensionsRequired\":[\"EXT_meshopt_compression\"],");
-    imp_write_text("mo_req.gltf", json);
-    imp_expect_error("mo_req.gltf", "requires glTF extension EXT_meshopt_compression (used by bufferView 1 \"idx\")",
-                     "cannot decode");
-    snprintf(json, sizeof json, fmt, "");
-    imp_write_text("mo_used.gltf", json);
-    bk_scene s;
-    char err[1024];
-    int rc = imp_import_tmp("mo_used.gltf", &s, NULL, err, sizeof err);
-    if (rc) printf("%s\n", err);
-    assert_int_equal(rc, 0);
-    assert_int_equal(s.tri_count, 2);
-    bk_scene_free(&s);
-}
-
 /* Percent-decoding cannot leave the scene's folder: an encoded "../" and an encoded NUL are
  * refused as before. */
 static void test_percent_encoded_confined(void **state)
@@ -349,7 +317,6 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_transform_scale_tiles_albedo, imp_setup_tmp, imp_teardown_tmp),
         cmocka_unit_test_setup_teardown(test_transform_offset_rotation_texcoord, imp_setup_tmp, imp_teardown_tmp),
         cmocka_unit_test_setup_teardown(test_basisu, imp_setup_tmp, imp_teardown_tmp),
-        cmocka_unit_test_setup_teardown(test_meshopt, imp_setup_tmp, imp_teardown_tmp),
         cmocka_unit_test_setup_teardown(test_percent_encoded_confined, imp_setup_tmp, imp_teardown_tmp),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
