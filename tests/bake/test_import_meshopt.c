@@ -1,11 +1,14 @@
 /* EXT_meshopt_compression as gltfpack and glTF-Transform write it: a 5 x 5 grid (25 vertices,
  * 32 triangles) encoded here with meshoptimizer's own encoders (positions as float3 attributes,
  * normals through the OCTAHEDRAL filter at 8 bits, indices as TRIANGLES or INDICES streams) imports
- * to exactly the positions, triangles and vertex order of the same grid stored plainly, and its
- * normals within the filter's precision: with the extension required and no fallback buffer, only
- * used with a fallback buffer that has no uri (.gltf and .glb), and with a fallback holding
- * different bytes (the compressed view wins). A truncated stream and impossible counts are refused
- * naming the bufferView; the fallback-less view was refused before the extension was decoded. */
+ * to the same grid stored plainly: positions bit for bit (through the EXPONENTIAL filter: within
+ * its mantissa), the vertices in the same order, the triangles in the same order (a TRIANGLES
+ * stream may rotate a triangle's corners), normals within the octahedral filter's precision. With
+ * the extension required and no fallback buffer; only used with a fallback buffer that has no uri
+ * (.gltf and .glb, gltfpack's output); with a fallback holding other bytes (the compressed view
+ * wins). Before the extension was decoded, the required case was refused. Truncated or swapped
+ * streams, impossible counts, ranges outside the buffer, strides a filter cannot have and unknown
+ * modes are refused naming the bufferView. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -56,6 +59,7 @@ typedef struct {
     unsigned char bytes[4096];
     size_t len;
     size_t off[3], size[3]; /* positions, normals, indices */
+    int exp_pos;            /* positions through the EXPONENTIAL filter (16-bit mantissas) */
 } streams;
 
 static void put(streams *s, int k, const unsigned char *data, size_t n)
@@ -67,12 +71,17 @@ static void put(streams *s, int k, const unsigned char *data, size_t n)
     s->len += (n + 3) & ~(size_t)3;
 }
 
-/* sequence = 0: the indices as a TRIANGLES stream of uint16, 1: an INDICES stream of uint32. */
-static void encode(streams *s, int sequence)
+/* sequence = 0: the indices as a TRIANGLES stream of uint16, 1: an INDICES stream of uint32.
+ * exp_pos: the positions through the EXPONENTIAL filter, as gltfpack -vpf writes them. */
+static void encode(streams *s, int sequence, int exp_pos)
 {
     unsigned char tmp[2048];
     memset(s, 0, sizeof *s);
-    size_t n = meshopt_encodeVertexBuffer(tmp, sizeof tmp, g_pos, NV, 12);
+    s->exp_pos = exp_pos;
+    uint32_t pos[NV * 3];
+    if (exp_pos) meshopt_encodeFilterExp(pos, NV, 12, 16, g_pos);
+    else memcpy(pos, g_pos, sizeof pos);
+    size_t n = meshopt_encodeVertexBuffer(tmp, sizeof tmp, pos, NV, 12);
     assert_true(n > 0);
     put(s, 0, tmp, n);
     signed char oct[NV * 4];
@@ -131,7 +140,7 @@ static void meshopt_json(char *out, size_t n, const streams *s, const char *bin,
              "\"bufferViews\":["
              "{\"name\":\"pos\",\"buffer\":1,\"byteOffset\":0,\"byteLength\":300,\"byteStride\":12,\"extensions\":"
              "{\"EXT_meshopt_compression\":{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,\"byteStride\":12,"
-             "\"count\":25,\"mode\":\"ATTRIBUTES\"}}},"
+             "\"count\":25,\"mode\":\"ATTRIBUTES\"%s}}},"
              "{\"name\":\"nrm\",\"buffer\":1,\"byteOffset\":300,\"byteLength\":100,\"byteStride\":4,\"extensions\":"
              "{\"EXT_meshopt_compression\":{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,\"byteStride\":4,"
              "\"count\":25,\"mode\":\"ATTRIBUTES\",\"filter\":\"OCTAHEDRAL\"}}},"
@@ -143,7 +152,8 @@ static void meshopt_json(char *out, size_t n, const streams *s, const char *bin,
              "{\"bufferView\":2,\"componentType\":%d,\"count\":96,\"type\":\"SCALAR\"}],"
              "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2}]}],"
              "\"nodes\":[{\"name\":\"grid\",\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0}",
-             required ? "\"EXT_meshopt_compression\"," : "", b0, b1, s->off[0], s->size[0] - trunc, s->off[1],
+             required ? "\"EXT_meshopt_compression\"," : "", b0, b1, s->off[0], s->size[0] - trunc,
+             s->exp_pos ? ",\"filter\":\"EXPONENTIAL\"" : "", s->off[1],
              s->size[1], 96 * isz, s->off[2], s->size[2], isz, sequence ? "INDICES" : "TRIANGLES",
              sequence ? 5125 : 5123);
 }
@@ -193,17 +203,11 @@ static void import_ok(const char *name, bk_scene *s)
     assert_int_equal(rc, 0);
 }
 
-/* The compressed import equals the plain one: positions bit for bit, the same vertices in the
- * same order, the same triangles in the same order: exactly for an INDICES stream, and up to a
- * rotation of each triangle's corners (winding kept) for a TRIANGLES stream, whose encoder rotates
- * triangles to share edges with the previous ones. Normals within the octahedral filter's 8-bit
- * precision (a cell of the 8-bit grid spans 2/127 = 0.016 of u or v). */
-static void assert_same_grid(const bk_scene *plain, const bk_scene *mo, int rotated_ok)
+/* The same triangles in the same order: exactly for an INDICES stream, and up to a rotation of
+ * each triangle's corners (winding kept) for a TRIANGLES stream, whose encoder rotates triangles
+ * to share edges with the previous ones. */
+static void assert_same_tris(const bk_scene *plain, const bk_scene *mo, int rotated_ok)
 {
-    assert_int_equal(mo->vertex_count, plain->vertex_count);
-    assert_int_equal(mo->tri_count, plain->tri_count);
-    assert_int_equal(mo->tri_count, NT);
-    assert_memory_equal(mo->positions, plain->positions, plain->vertex_count * 3 * sizeof(float));
     int rotated = 0;
     for (size_t t = 0; t < mo->tri_count; t++) {
         const uint32_t *a = plain->tris + 3 * t, *b = mo->tris + 3 * t;
@@ -214,7 +218,13 @@ static void assert_same_grid(const bk_scene *plain, const bk_scene *mo, int rota
     }
     if (!rotated_ok) assert_int_equal(rotated, 0);
     printf("triangles rotated by the index codec: %d of %zu\n", rotated, mo->tri_count);
-    assert_memory_equal(mo->vertex_source, plain->vertex_source, plain->vertex_count * sizeof(uint32_t));
+}
+
+/* Normals within the octahedral filter's 8-bit precision (a cell of the 8-bit grid spans
+ * 2/127 = 0.016 of u or v), and not equal: the filter is lossy, so equal normals would mean the
+ * plain (fallback) view was read. */
+static void assert_normals_close(const bk_scene *plain, const bk_scene *mo)
+{
     double worst = 0;
     for (size_t v = 0; v < mo->vertex_count * 3; v++) {
         double d = fabs((double)mo->normals[v] - (double)plain->normals[v]);
@@ -222,7 +232,37 @@ static void assert_same_grid(const bk_scene *plain, const bk_scene *mo, int rota
     }
     printf("octahedral normals: max component error %.5f\n", worst);
     assert_true(worst < 0.016);
-    assert_true(worst > 0);  /* the 8-bit filter is lossy: equal normals would mean the plain view was read */
+    assert_true(worst > 0);
+}
+
+/* The compressed import equals the plain one: the same vertices in the same order, positions bit
+ * for bit (exp_pos = 0) or within one step of the EXPONENTIAL filter's 16-bit signed mantissa
+ * (15 bits of magnitude), shared by a vertex's three components: under max|p| * 2^-15 (measured
+ * 2.6e-5 of max|p|, and not 0: the plain view was not read). */
+static void assert_same_grid(const bk_scene *plain, const bk_scene *mo, int rotated_ok, int exp_pos)
+{
+    assert_int_equal(mo->vertex_count, plain->vertex_count);
+    assert_int_equal(mo->tri_count, plain->tri_count);
+    assert_int_equal(mo->tri_count, NT);
+    assert_memory_equal(mo->vertex_source, plain->vertex_source, plain->vertex_count * sizeof(uint32_t));
+    if (!exp_pos) {
+        assert_memory_equal(mo->positions, plain->positions, plain->vertex_count * 3 * sizeof(float));
+    } else {
+        double worst = 0;
+        for (size_t v = 0; v < mo->vertex_count; v++) {
+            const float *p = plain->positions + 3 * v, *q = mo->positions + 3 * v;
+            double m = fmax(fabs(p[0]), fmax(fabs(p[1]), fabs(p[2])));
+            for (int c = 0; c < 3; c++) {
+                double d = fabs((double)q[c] - (double)p[c]);
+                assert_true(d <= m * ldexp(1.0, -15));
+                if (m > 0 && d / m > worst) worst = d / m;
+            }
+        }
+        printf("exponential positions: max error %.3g of the vertex's largest component\n", worst);
+        assert_true(worst > 0);
+    }
+    assert_same_tris(plain, mo, rotated_ok);
+    assert_normals_close(plain, mo);
 }
 
 static void test_required_no_fallback(void **state)
@@ -232,18 +272,24 @@ static void test_required_no_fallback(void **state)
     write_plain();
     imp_write_text("plain.gltf", kPlainGltf);
     streams s;
-    encode(&s, 0);
+    encode(&s, 0, 0);
     write_gltf("req.gltf", &s, NULL, 1, 0, 0);
     bk_scene plain, mo;
     import_ok("plain.gltf", &plain);
     import_ok("req.gltf", &mo);
-    assert_same_grid(&plain, &mo, 1);
+    assert_same_grid(&plain, &mo, 1, 0);
     bk_scene_free(&mo);
     /* INDICES (an index sequence, uint32) decodes to the same triangles */
-    encode(&s, 1);
+    encode(&s, 1, 0);
     write_gltf("seq.gltf", &s, NULL, 1, 0, 1);
     import_ok("seq.gltf", &mo);
-    assert_same_grid(&plain, &mo, 0);
+    assert_same_grid(&plain, &mo, 0, 0);
+    bk_scene_free(&mo);
+    /* positions through the EXPONENTIAL filter */
+    encode(&s, 0, 1);
+    write_gltf("exp.gltf", &s, NULL, 1, 0, 0);
+    import_ok("exp.gltf", &mo);
+    assert_same_grid(&plain, &mo, 1, 1);
     bk_scene_free(&mo);
     bk_scene_free(&plain);
 }
@@ -255,25 +301,25 @@ static void test_used_with_fallback(void **state)
     write_plain();
     imp_write_text("plain.gltf", kPlainGltf);
     streams s;
-    encode(&s, 0);
+    encode(&s, 0, 0);
     bk_scene plain, mo;
     import_ok("plain.gltf", &plain);
     /* the fallback buffer without uri (gltfpack's), only used */
     write_gltf("used.gltf", &s, NULL, 0, 0, 0);
     import_ok("used.gltf", &mo);
-    assert_same_grid(&plain, &mo, 1);
+    assert_same_grid(&plain, &mo, 1, 0);
     bk_scene_free(&mo);
     /* the same as a GLB: the uri-less fallback is not mistaken for the BIN chunk */
     write_glb("used.glb", &s);
     import_ok("used.glb", &mo);
-    assert_same_grid(&plain, &mo, 1);
+    assert_same_grid(&plain, &mo, 1, 0);
     bk_scene_free(&mo);
     /* a fallback with data of its own (all zero here): the compressed view is decoded instead */
     unsigned char zero[792] = {0};
     imp_write_file("zero.bin", zero, sizeof zero);
     write_gltf("fb.gltf", &s, "zero.bin", 0, 0, 0);
     import_ok("fb.gltf", &mo);
-    assert_same_grid(&plain, &mo, 1);
+    assert_same_grid(&plain, &mo, 1, 0);
     for (size_t i = 0; i < mo.input_count; i++) assert_null(strstr(mo.inputs[i].path, "zero.bin"));
     bk_scene_free(&mo);
     bk_scene_free(&plain);
@@ -284,7 +330,7 @@ static void test_malformed(void **state)
     (void)state;
     make_grid();
     streams s;
-    encode(&s, 0);
+    encode(&s, 0, 0);
     /* the positions' stream cut short by 9 bytes */
     write_gltf("trunc.gltf", &s, NULL, 1, 9, 0);
     imp_expect_error("trunc.gltf", "bufferView 0 \"pos\": EXT_meshopt_compression", "malformed or truncated");
@@ -294,7 +340,7 @@ static void test_malformed(void **state)
     write_gltf("swap.gltf", &s, NULL, 1, 0, 0);
     imp_expect_error("swap.gltf", "bufferView 0 \"pos\"", "malformed or truncated");
     /* a count the compressed bytes cannot hold (more than 128 bytes per compressed byte) */
-    encode(&s, 0);
+    encode(&s, 0, 0);
     char json[4096], big[4200];
     meshopt_json(json, sizeof json, &s, "mo.bin", NULL, 1, 0, 0);
     const char *k = "\"count\":25,\"mode\":\"ATTRIBUTES\"}";
@@ -308,7 +354,7 @@ static void test_malformed(void **state)
     write_gltf("range.gltf", &s, NULL, 1, 0, 0);
     imp_expect_error("range.gltf", "bufferView 2 \"idx\"", "outside buffer 0");
     /* a stride the filter cannot have, and an unknown mode: refused before any decoding */
-    encode(&s, 0);
+    encode(&s, 0, 0);
     meshopt_json(json, sizeof json, &s, "mo.bin", NULL, 1, 0, 0);
     k = "\"byteStride\":4,\"count\":25,\"mode\":\"ATTRIBUTES\",\"filter\":\"OCTAHEDRAL\"";
     c = strstr(json, k);
