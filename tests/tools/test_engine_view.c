@@ -23,6 +23,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "support/image_compare.h"
 #include "support/bake_file.h"
 #include "tools/common/bake_data.h"
 #include "tools/common/file_util.h"
@@ -185,26 +186,6 @@ static char *page_title(const char *url)
     return t;
 }
 
-static float srgb(float x)
-{
-    x = x < 0 ? 0 : x > 1 ? 1 : x;
-    return x <= 0.0031308f ? 12.92f * x : 1.055f * powf(x, 1.0f / 2.4f) - 0.055f;
-}
-
-/* An edge pixel of the reference: some 8-neighbour differs by more than 8 codes in a channel (a
- * silhouette or a crease, where rasterisation and ray casting may see different surfaces). */
-static int on_edge(const uint8_t *img, int x, int y)
-{
-    for (int dy = -1; dy <= 1; dy++)
-        for (int dx = -1; dx <= 1; dx++) {
-            const int X = x + dx, Y = y + dy;
-            if (X < 0 || Y < 0 || X >= W || Y >= H) continue;
-            for (int c = 0; c < 3; c++)
-                if (abs(img[3 * (Y * W + X) + c] - img[3 * (y * W + x) + c]) > 8) return 1;
-        }
-    return 0;
-}
-
 /* lbk render's view as 8-bit sRGB of radiance × 2^STOPS (the page's exposure), with a black sky
  * (the page clears to black); *covered: pixels whose centre ray hit geometry with light on it. */
 static void reference(uint8_t *ref8, uint8_t *covered)
@@ -225,7 +206,7 @@ static void reference(uint8_t *ref8, uint8_t *covered)
     for (int i = 0; i < W * H; i++) {
         const int lit = img.rgb[3 * i] > 0 || img.rgb[3 * i + 1] > 0 || img.rgb[3 * i + 2] > 0;
         covered[i] = V->llg ? lit && !img.lightmapped[i] : lit;
-        for (int c = 0; c < 3; c++) ref8[3 * i + c] = (uint8_t)lrintf(srgb(img.rgb[3 * i + c] * k) * 255.0f);
+        for (int c = 0; c < 3; c++) ref8[3 * i + c] = (uint8_t)lrintf(tic_srgb(img.rgb[3 * i + c] * k) * 255.0f);
     }
     tl_image_free(&img);
 }
@@ -266,7 +247,7 @@ static void compare(const char *name, const uint8_t *shot, const uint8_t *ref8, 
         n++, sum += d;
         max_d = d > max_d ? d : max_d;
         if (d <= 2) hist[d]++;
-        const int edge = on_edge(ref8, i % W, i / W);
+        const int edge = tic_on_edge(ref8, W, H, i % W, i / W);
         if (!edge) n_in++, sum_in += d;
         if (d > 2) {
             over++;

@@ -28,6 +28,7 @@
 #include "tools/common/image_io.h"
 #include "tools/render/render.h"
 #include "tools/view/view.h"
+#include "support/image_compare.h"
 
 #define OUT "build/tests/view_out"
 #define LEVEL "tests/fuzz/corpus/bake_cornell.lbk"
@@ -253,26 +254,6 @@ static void test_view_page_loads_without_errors(void **state)
     free(dom);
 }
 
-static float srgb(float x)
-{
-    x = x < 0 ? 0 : x > 1 ? 1 : x;
-    return x <= 0.0031308f ? 12.92f * x : 1.055f * powf(x, 1.0f / 2.4f) - 0.055f;
-}
-
-/* An edge pixel of the reference: some 8-neighbour differs by more than 8 codes in a channel (a
- * silhouette or a crease, where the two ways of finding the visible surface may disagree). */
-static int on_edge(const uint8_t *img, int x, int y)
-{
-    for (int dy = -1; dy <= 1; dy++)
-        for (int dx = -1; dx <= 1; dx++) {
-            const int X = x + dx, Y = y + dy;
-            if (X < 0 || Y < 0 || X >= W || Y >= H) continue;
-            for (int c = 0; c < 3; c++)
-                if (abs(img[3 * (Y * W + X) + c] - img[3 * (y * W + x) + c]) > 8) return 1;
-        }
-    return 0;
-}
-
 /* The page's pixel against lbk render's radiance at the same pixel centre, both as 8-bit sRGB of
  * radiance × 2^STOPS. The bound: the page decodes the same stored texels with the same bilinear
  * blend in the linear form (viewer.js FRAG = tools/render/shade.c sample_page), in GPU binary32
@@ -315,7 +296,7 @@ static void screenshot_matches_lbk_render(const char *level)
     int over = 0, interior = 0, max_diff = 0, lit = 0;
     double sum = 0;
     static uint8_t ref8[W * H * 3];
-    for (int i = 0; i < 3 * W * H; i++) ref8[i] = (uint8_t)lrintf(srgb(img.rgb[i] * k) * 255.0f);
+    for (int i = 0; i < 3 * W * H; i++) ref8[i] = (uint8_t)lrintf(tic_srgb(img.rgb[i] * k) * 255.0f);
     for (int i = 0; i < W * H; i++) {
         int d = 0;
         for (int c = 0; c < 3; c++) {
@@ -327,7 +308,7 @@ static void screenshot_matches_lbk_render(const char *level)
         sum += d;
         if (d > 1) {
             over++;
-            if (!on_edge(ref8, i % W, i / W)) interior++;
+            if (!tic_on_edge(ref8, W, H, i % W, i / W)) interior++;
         }
         if (d > max_diff) max_diff = d;
     }
@@ -402,7 +383,7 @@ static void pack_page_matches_lbk_render(const char *profile, const char *pack)
     assert_int_equal(tl_render(SCENE, LEVEL, &o, &img, err), TL_RENDER_OK);
     const float k = powf(2.0f, (float)STOPS);
     static uint8_t ref8[W * H * 3];
-    for (int i = 0; i < 3 * W * H; i++) ref8[i] = (uint8_t)lrintf(srgb(img.rgb[i] * k) * 255.0f);
+    for (int i = 0; i < 3 * W * H; i++) ref8[i] = (uint8_t)lrintf(tic_srgb(img.rgb[i] * k) * 255.0f);
     tl_image_free(&img);
     int hist[256] = {0}, n = 0, lit = 0;
     double sum = 0;
@@ -414,7 +395,7 @@ static void pack_page_matches_lbk_render(const char *profile, const char *pack)
             lit += shot[3 * i + c] > 8;
         }
         sum += d;
-        if (!on_edge(ref8, i % W, i / W)) hist[d]++, n++;
+        if (!tic_on_edge(ref8, W, H, i % W, i / W)) hist[d]++, n++;
     }
     int p99 = 0;
     for (int run = 0; p99 < 255 && (run += hist[p99]) < n * 99 / 100; p99++) {}
@@ -558,19 +539,20 @@ static void test_view_set_slider_changes_what_lbk_render_changes(void **state)
     float *r0 = sets_render(NULL, 0), *r1 = sets_render(&dim, 1);
     const float k = powf(2.0f, (float)SETS_STOPS);
     static uint8_t ref0[W * H * 3];
-    for (int i = 0; i < 3 * W * H; i++) ref0[i] = (uint8_t)lrintf(srgb(r0[i] * k) * 255.0f);
+    for (int i = 0; i < 3 * W * H; i++) ref0[i] = (uint8_t)lrintf(tic_srgb(r0[i] * k) * 255.0f);
     int render_same = 0, render_changed = 0, page_changed = 0, wrong_same = 0, wrong_changed = 0, edge = 0;
     for (int i = 0; i < W * H; i++) {
         int same = 1, big = 0, pch = 0;
         for (int c = 0; c < 3; c++) {
             same &= r0[3 * i + c] == r1[3 * i + c];
-            const int a = (int)lrintf(srgb(r0[3 * i + c] * k) * 255.0f), b = (int)lrintf(srgb(r1[3 * i + c] * k) * 255.0f);
+            const int a = (int)lrintf(tic_srgb(r0[3 * i + c] * k) * 255.0f);
+            const int b = (int)lrintf(tic_srgb(r1[3 * i + c] * k) * 255.0f);
             big |= abs(a - b) >= 2;
             pch |= p0[3 * i + c] != p1[3 * i + c];
         }
         render_same += same, render_changed += big, page_changed += pch;
         const int bad_same = same && pch, bad_changed = big && !pch;
-        if ((bad_same || bad_changed) && on_edge(ref0, i % W, i / W)) {
+        if ((bad_same || bad_changed) && tic_on_edge(ref0, W, H, i % W, i / W)) {
             edge++;
             continue;
         }

@@ -21,6 +21,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "support/image_compare.h"
 #include "support/bake_file.h"
 #include "support/normal_scene.h"
 #include "tools/common/file_util.h"
@@ -52,25 +53,6 @@ static int teardown(void **state)
 }
 
 static int have_chromium(void) { return system("command -v chromium >/dev/null 2>&1") == 0; }
-
-static float srgb(float x)
-{
-    x = x < 0 ? 0 : x > 1 ? 1 : x;
-    return x <= 0.0031308f ? 12.92f * x : 1.055f * powf(x, 1.0f / 2.4f) - 0.055f;
-}
-
-/* some 8-neighbour differs by more than 8 codes in a channel: a stripe boundary or the floor's rim */
-static int on_edge(const uint8_t *img, int x, int y)
-{
-    for (int dy = -1; dy <= 1; dy++)
-        for (int dx = -1; dx <= 1; dx++) {
-            const int X = x + dx, Y = y + dy;
-            if (X < 0 || Y < 0 || X >= W || Y >= H) continue;
-            for (int c = 0; c < 3; c++)
-                if (abs(img[3 * (Y * W + X) + c] - img[3 * (y * W + x) + c]) > 8) return 1;
-        }
-    return 0;
-}
 
 /* The pixel column of world x at the floor (image right = +x). */
 static int column(double x)
@@ -169,12 +151,12 @@ static void page_matches_lbk_render(void **state)
     assert_int_equal(tl_render(gltf, lbk, &o, &img, err), TL_RENDER_OK);
     static uint8_t ref[W * H * 3];
     const float k = powf(2.0f, (float)STOPS);
-    for (int i = 0; i < 3 * W * H; i++) ref[i] = (uint8_t)lrintf(srgb(img.rgb[i] * k) * 255.0f);
+    for (int i = 0; i < 3 * W * H; i++) ref[i] = (uint8_t)lrintf(tic_srgb(img.rgb[i] * k) * 255.0f);
     int over = 0, interior = 0, max_diff = 0;
     for (int i = 0; i < W * H; i++) {
         int d = 0;
         for (int c = 0; c < 3; c++) d = abs(ref[3 * i + c] - shot[3 * i + c]) > d ? abs(ref[3 * i + c] - shot[3 * i + c]) : d;
-        if (d > 1) over++, interior += !on_edge(ref, i % W, i / W);
+        if (d > 1) over++, interior += !tic_on_edge(ref, W, H, i % W, i / W);
         max_diff = d > max_diff ? d : max_diff;
     }
     /* the page's stripes at their centres (a row off the floor's middle) against the closed form */
@@ -184,7 +166,7 @@ static void page_matches_lbk_render(void **state)
         const double want = ns_closed_form(s, 1, NULL) * k;
         page[s] = shot[i + 1];
         print_message("stripe %d: page %d, lbk render %d, closed form %.1f (codes)\n", s, shot[i + 1], ref[i + 1],
-                      255.0 * srgb((float)want));
+                      255.0 * tic_srgb((float)want));
     }
     print_message("page vs lbk render %dx%d: %d pixels over 1 code (%d not on an edge), max %d\n", W, H, over, interior,
                   max_diff);
