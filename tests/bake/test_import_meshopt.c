@@ -8,7 +8,7 @@
  * (.gltf and .glb, gltfpack's output); with a fallback holding other bytes (the compressed view
  * wins). Before the extension was decoded, the required case was refused. Truncated or swapped
  * streams, impossible counts, ranges outside the buffer, strides a filter cannot have and unknown
- * modes are refused naming the bufferView. */
+ * modes are refused naming the bufferView. The compressed grid bakes through lbk_bake_from_file. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -20,10 +20,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <sys/stat.h>
+
 #include <meshoptimizer.h>
 
 #include "scene/import.h"
 #include "scene/scene.h"
+#include "support/bake_file.h"
 #include "support/import_fixtures.h"
 
 enum { GN = 5, NV = GN * GN, NT = (GN - 1) * (GN - 1) * 2, NI = NT * 3 };
@@ -371,12 +374,51 @@ static void test_malformed(void **state)
     imp_expect_error("mode.gltf", "bufferView 2 \"idx\"", "unknown mode \"STRIPS\"");
 }
 
+/* The whole bake (lbk_bake_from_file, as lbk bake runs it) of the grid under a white sky, the
+ * extension required and no fallback: it bakes, and writes a container. */
+static void test_bake(void **state)
+{
+    (void)state;
+    make_grid();
+    streams s;
+    encode(&s, 0, 1);
+    char json[4096], sky[4200];
+    imp_write_file("mo.bin", s.bytes, s.len);
+    meshopt_json(json, sizeof json, &s, "mo.bin", NULL, 1, 0, 0);
+    const char *k = "\"scenes\":[{\"nodes\":[0]}]";
+    const char *c = strstr(json, k);
+    assert_non_null(c);
+    snprintf(sky, sizeof sky, "%.*s\"scenes\":[{\"nodes\":[0],\"extras\":{\"lbk_sky\":[1,1,1]}}]%s", (int)(c - json),
+             json, c + strlen(k));
+    imp_write_text("bake.gltf", sky);
+    char in[512], out[512], berr[512];
+    imp_tmp_path(in, sizeof in, "bake.gltf");
+    imp_tmp_path(out, sizeof out, "bake.lbk");
+    tb_job j;
+    memset(&j, 0, sizeof j);
+    j.in = in;
+    j.out = out;
+    j.d.preset = LBK_BAKE_PRESET_FAST;
+    j.d.seed = 1;
+    j.d.threads = 1;
+    j.d.max_samples = 8;
+    j.d.texel_density = 4;
+    j.d.no_glg = 1;
+    lbk_result br = tb_bake(&j, NULL, berr, sizeof berr);
+    if (br != LBK_OK) printf("bake: %s\n", berr);
+    assert_int_equal(br, LBK_OK);
+    struct stat st;
+    assert_int_equal(stat(out, &st), 0);
+    assert_true(st.st_size > 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_required_no_fallback, imp_setup_tmp, imp_teardown_tmp),
         cmocka_unit_test_setup_teardown(test_used_with_fallback, imp_setup_tmp, imp_teardown_tmp),
         cmocka_unit_test_setup_teardown(test_malformed, imp_setup_tmp, imp_teardown_tmp),
+        cmocka_unit_test_setup_teardown(test_bake, imp_setup_tmp, imp_teardown_tmp),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
