@@ -382,7 +382,7 @@ int main(int argc, char **argv)
         for (int rep = 0; rep < (a.noise ? 2 : 1); rep++) {
             bk_transport_options o;
             pass_options(&a, k, rep, cell_size, &tx, &o);
-            bk_transport_output out = {rad, NULL, rep ? irr2 : irr, NULL, NULL, NULL};
+            bk_transport_output out = {rad, NULL, rep ? irr2 : irr, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
             bk_transport_stats st1;
             double c0 = cpu_s();
             bk_transport_run(&s, t, r, nr, &o, &out, rep ? &st1 : &st);

@@ -86,7 +86,7 @@ int main(int argc, char **argv)
     for (int seed = 1; seed <= seeds; seed++) {
         lbk_sh9_rgb rad[GSC_N];
         float irr[3 * GSC_N];
-        bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL};
+        bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
         bk_transport_options o = tsc_fixed_passes(passes, (uint64_t)seed);
         o.threads = threads;
         o.cell_size = cell; /* every triangle sized: max_cells unused */

@@ -73,7 +73,7 @@ static lbk_result bake_texels(const bk_scene *s, const bk_tracer *t, const bk_te
     o.cell_size = cell;
     o.footprint = tx->footprint;
     o.footprint_count = tx->footprint_count;
-    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL};
+    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
     lbk_result res = bk_transport_run(s, t, r, tx->count, &o, &out, st);
     free(rad), free(r), free(cell);
     return res;

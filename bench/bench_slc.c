@@ -316,7 +316,7 @@ static bake_result bake(const level *L, int slc_mode, double delta)
     o.slc_delta = delta;
     float *irr = malloc(3 * NRECV * sizeof *irr);
     lbk_sh9_rgb *rad = malloc(NRECV * sizeof *rad);
-    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL};
+    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
     bk_transport_stats st;
     double t0 = wall_now();
     if (bk_transport_run(&L->s, L->t, rc, NRECV, &o, &out, &st) != LBK_OK) abort();

@@ -146,7 +146,7 @@ int main(int argc, char **argv)
     size_t n = make_receivers(&r);
     lbk_sh9_rgb *rad = calloc(n, sizeof *rad);
     float *irr = calloc(3 * n, sizeof *irr), *ref = calloc(3 * n, sizeof *ref);
-    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL};
+    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
     printf("scene: %zu triangles, %zu receivers\n", s.tri_count, n);
 
     /* 1 */
@@ -190,7 +190,7 @@ int main(int argc, char **argv)
     o.target_error = -1;
     o.max_samples = 2 * 16 * 255; /* 8 passes */
     o.max_cells = 8192;
-    bk_transport_output rout = {rad, NULL, ref, NULL, NULL, NULL};
+    bk_transport_output rout = {rad, NULL, ref, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
     bk_transport_run(&s, t, r, n, &o, &rout, &st);
     double ref_err = st.est_rel_rmse;
     printf("reference: %.1f s, %.0f samples/receiver, its own estimated error %.4f\n", st.seconds,

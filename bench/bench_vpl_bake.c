@@ -104,7 +104,7 @@ static void bake(const room *R, int vpl, int passes, uint64_t seed, result *o)
     if (de) opt.glossy_vpl_delta = atof(de);
     static float irr[3 * MAXR];
     static lbk_sh9_rgb rad[MAXR];
-    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL};
+    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
     const double t0 = bench_process_cpu();
     if (bk_transport_run(&R->s, R->t, R->r, R->n, &opt, &out, &o->st) != LBK_OK) abort();
     o->cpu = bench_process_cpu() - t0;

@@ -110,7 +110,7 @@ static void test_inside_solid_is_black(void **state)
     assert_int_equal(bk_tracer_create(&s, 0, &t), LBK_OK);
     lbk_sh9_rgb rad[4];
     float irr[12];
-    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL};
+    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
     bk_transport_options o;
     memset(&o, 0, sizeof o);
     o.threads = 2;
@@ -244,7 +244,7 @@ static float *room_bake(const room *rm, int passes, bk_transport_stats *st)
     o.cell_size = rm->cell_size;
     o.footprint = rm->tx.footprint;
     o.footprint_count = rm->tx.footprint_count;
-    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL};
+    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
     assert_int_equal(bk_transport_run(&rm->s, rm->tracer, rm->recv, rm->n, &o, &out, st), LBK_OK);
     assert_int_equal(st->nonfinite, 0);
     free(rad);
@@ -369,7 +369,7 @@ static void test_emitter_gap_unbiased(void **state)
     for (size_t i = 0; i < s.tri_count; i++) cell[i] = 0.1f;
     lbk_sh9_rgb rad[N];
     float irr[3 * N];
-    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL};
+    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
     bk_transport_options o = tsc_fixed_passes(5, 3);
     o.cell_size = cell; /* every triangle sized: max_cells unused */
     bk_transport_stats st;
@@ -424,7 +424,7 @@ static void test_light_gap_unbiased(void **state)
     for (uint64_t seed = 1; seed <= 2; seed++) {
         lbk_sh9_rgb rad[GSC_N];
         float irr[3 * GSC_N];
-        bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL};
+        bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
         bk_transport_options o = tsc_fixed_passes(6, seed); /* 2016 samples */
         o.cell_size = cell;
         bk_transport_stats st;
@@ -508,7 +508,7 @@ static void test_edge_texels_at_contact(void **state)
         }
         float *irr = calloc(3 * tx.count, sizeof *irr);
         lbk_sh9_rgb *rad = calloc(tx.count, sizeof *rad);
-        bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL};
+        bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
         bk_transport_options o = tsc_fixed_passes(4, 11);
         o.footprint = tx.footprint;
         o.footprint_count = tx.footprint_count;

@@ -80,7 +80,7 @@ static furnace_run run_furnace(double rho, double le, int hook, int nee)
     make_receivers(r, N_RECV);
     lbk_sh9_rgb rad[N_RECV], dir[N_RECV];
     float irr[3 * N_RECV];
-    bk_transport_output out = {rad, dir, irr, NULL, NULL, NULL};
+    bk_transport_output out = {rad, dir, irr, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
     bk_transport_options opt;
     memset(&opt, 0, sizeof opt);
     opt.seed = 7;

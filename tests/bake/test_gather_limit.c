@@ -75,7 +75,7 @@ static void run(const bk_scene *s, const bk_tracer *t, const bk_receiver *r, siz
                 float *irr)
 {
     lbk_sh9_rgb *rad = calloc(n, sizeof *rad);
-    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL};
+    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
     bk_transport_stats st;
     assert_int_equal(bk_transport_run(s, t, r, n, o, &out, &st), LBK_OK);
     free(rad);

@@ -47,7 +47,7 @@ static float *irradiance(const bk_scene *s, const bk_receiver *r, size_t n, cons
     assert_int_equal(bk_tracer_create(s, 0, &t), LBK_OK);
     lbk_sh9_rgb *rad = calloc(n, sizeof *rad);
     float *irr = calloc(3 * n, sizeof *irr);
-    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL};
+    bk_transport_output out = {rad, NULL, irr, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
     bk_transport_stats st;
     assert_int_equal(bk_transport_run(s, t, r, n, o, &out, &st), LBK_OK);
     assert_int_equal(st.nonfinite, 0);

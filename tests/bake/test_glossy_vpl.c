@@ -105,7 +105,7 @@ static void run(const bk_scene *s, const bk_receiver r[NR], int vpl, uint64_t se
     opt.threads = threads;
     opt.glossy_vpl = vpl;
     memset(o, 0, sizeof *o);
-    bk_transport_output out = {o->rad, NULL, o->irr, NULL, NULL, NULL};
+    bk_transport_output out = {o->rad, NULL, o->irr, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
     assert_int_equal(bk_transport_run(s, t, r, NR, &opt, &out, &o->st), LBK_OK);
     assert_int_equal(o->st.nonfinite, 0);
     bk_tracer_destroy(t);

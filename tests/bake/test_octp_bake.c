@@ -65,7 +65,7 @@ static void two_colour_squares(void **state)
     o.max_samples = 2 * 16 * 63; /* 6 passes */
     o.octa_points = pt;
     o.octa_count = 1;
-    bk_transport_output out = {&sh, NULL, irr, NULL, oct, NULL};
+    bk_transport_output out = {&sh, NULL, irr, NULL, oct, NULL, NULL, NULL, NULL, NULL};
     bk_transport_stats st;
     assert_int_equal(bk_transport_run(&s, t, &rc, 1, &o, &out, &st), LBK_OK);
     assert_true(st.octa_rays >= 4 * 2 * 16 * 63 - 1); /* 4× the receivers' rays */

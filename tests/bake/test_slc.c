@@ -104,7 +104,7 @@ typedef struct out { float irr[3 * NR]; lbk_sh9_rgb rad[NR], dir[NR]; bk_transpo
 
 static void run(const bk_scene *s, const bk_tracer *t, const bk_receiver *rc, const bk_transport_options *o, out *res)
 {
-    bk_transport_output op = {res->rad, res->dir, res->irr, NULL, NULL, NULL};
+    bk_transport_output op = {res->rad, res->dir, res->irr, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
     assert_int_equal(bk_transport_run(s, t, rc, NR, o, &op, &res->st), LBK_OK);
     assert_int_equal(res->st.nonfinite, 0);
 }

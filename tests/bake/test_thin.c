@@ -103,7 +103,7 @@ static void thin_run(bk_scene *s, float density, int passes, thin_bake *b)
     b->irr = calloc(3 * b->tx.count, sizeof *b->irr);
     lbk_sh9_rgb *rad = calloc(b->tx.count, sizeof *rad);
     assert_true(b->irr && rad);
-    bk_transport_output out = {rad, NULL, b->irr, NULL, NULL, NULL};
+    bk_transport_output out = {rad, NULL, b->irr, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
     bk_transport_options o = tsc_fixed_passes(passes, 7);
     o.footprint = b->tx.footprint;
     o.footprint_count = b->tx.footprint_count;

@@ -45,7 +45,7 @@ static run_out run(const bk_scene *s, const bk_receiver *r, size_t n, const bk_t
     ro.rad = calloc(n ? n : 1, sizeof *ro.rad);
     ro.dir = calloc(n ? n : 1, sizeof *ro.dir);
     ro.irr = calloc(3 * (n ? n : 1), sizeof *ro.irr);
-    bk_transport_output out = {ro.rad, ro.dir, ro.irr, NULL, NULL, NULL};
+    bk_transport_output out = {ro.rad, ro.dir, ro.irr, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
     assert_int_equal(bk_transport_run(s, t, r, n, o, &out, &ro.st), LBK_OK);
     for (size_t i = 0; i < n; i++)
         for (int c = 0; c < 3; c++) {
@@ -549,7 +549,7 @@ static void test_stop_rules_and_report(void **state)
     bk_tracer *t = NULL;
     assert_int_equal(bk_tracer_create(&s, 0, &t), LBK_OK);
     lbk_sh9_rgb *rad = calloc(ROOM_N, sizeof *rad);
-    bk_transport_output out = {rad, NULL, NULL, NULL, NULL, NULL};
+    bk_transport_output out = {rad, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
     bk_transport_stats st;
     assert_int_equal(bk_transport_run(&s, t, r, ROOM_N, &o, &out, &st), LBK_ERR_CANCELLED);
     assert_int_equal(ca.calls, 3);
@@ -1099,10 +1099,10 @@ static void test_invalid_arguments(void **state)
     bk_receiver r[1];
     texel(&r[0], 1, 1, 0);
     lbk_sh9_rgb rad[1];
-    bk_transport_output out = {rad, NULL, NULL, NULL, NULL, NULL};
+    bk_transport_output out = {rad, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
     assert_int_equal(bk_transport_run(NULL, t, r, 1, NULL, &out, NULL), LBK_ERR_INVALID_ARGUMENT);
     assert_int_equal(bk_transport_run(&s, NULL, r, 1, NULL, &out, NULL), LBK_ERR_INVALID_ARGUMENT);
-    bk_transport_output none = {NULL, NULL, NULL, NULL, NULL, NULL};
+    bk_transport_output none = {NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
     assert_int_equal(bk_transport_run(&s, t, r, 1, NULL, &none, NULL), LBK_ERR_INVALID_ARGUMENT);
     /* class ranges must be ordered and end at the receiver count */
     bk_transport_options co;

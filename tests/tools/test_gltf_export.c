@@ -214,7 +214,7 @@ static void export_and_reimport(const char *scene, const char *stem, float densi
     char err[TL_ERR_LEN];
     assert_int_equal(tl_bake_open_file(lbk, &b, err), TL_OPEN_OK); /* validated on open */
     assert_true(b.has_lmuv);
-    tl_gltf_options o = {glb, scene, "x.lbk"};
+    tl_gltf_options o = {.output = glb, .scene = scene, .container = "x.lbk"};
     tl_gltf_stats gs;
     if (tl_gltf_export(&b, &o, &gs, err)) fail_msg("export: %s", err);
     assert_true(gs.generated > 0);
@@ -294,7 +294,7 @@ static void refuses_other_inputs(void **state)
     cJSON_Delete(j);
     assert_int_equal(tl_write_text(other, moved, err), 0);
     free(moved);
-    tl_gltf_options o = {glb, other, NULL};
+    tl_gltf_options o = {.output = glb, .scene = other};
     assert_int_equal(tl_gltf_export(&b, &o, NULL, err), TL_GLTF_INPUT);
     assert_non_null(strstr(err, "geometry"));
     o.scene = "/nonexistent/level.gltf";
