@@ -1,24 +1,26 @@
 #!/usr/bin/env python3
 """lbk diff's calibration: the reseed study and the power table (make bench-diff).
 
-Reseed study: for every scene of scenes/ and every preset, PAIRS pairs of bakes that differ only
-in the seed (seeds 2i+1 and 2i+2), each pair compared with `lbk diff --json` in noise mode. An
-*item* is what lbk diff gives one verdict: a compared object (class "texels" when lightmapped,
-"llg" for an LLG object), the GLG, OCTP, and each light set or door state in each target space
-("set_texels", "set_probes"). Every item of a reseed pair that is beyond noise is a false alarm.
-Per preset and class it prints: items, false alarms, the measured rate and its 95 % upper bound
+Reseed study: for every scene of scenes/ (and room_sets_doors and room_sets_doors_b, light-set and
+door levels that bench/door_scene_write.c generates, baked with --octahedral) and every preset,
+PAIRS pairs of bakes that differ only in the seed (seeds 2i+1 and 2i+2), each pair compared with
+`lbk diff --json` in noise mode. An *item* is what lbk diff gives one verdict: a compared object
+(class "texels" when lightmapped, "llg" for an LLG object), the GLG, OCTP, and each light set
+("set_texels", "set_probes") or door state or combination ("door_texels", "door_probes") in each
+target space. Every item of a reseed pair that is beyond noise is a false alarm. Per preset and
+class it prints: items, false alarms, the measured rate and its 95 % upper bound
 (Clopper-Pearson; 3/n when none), the stated rate (--false-alarm, default 0.001), and the
 calibration margins: the largest |z|/k_mean, chroma_z/k_chroma and, for the sample count, the
 largest significant/critical, with the measured sample rate against the class's p0 and the RMS
 of the samples' normalised deviation (1 when the per-sample noise model is right).
 
 Power (--power): variants of the base bake (sky +2 %, sky +5 %, one light +5 %, one material's
-albedo +10 %, a hue change of one material at the same luminance), PAIRS each with its own seed
-against a base seed, and the share of pairs lbk diff calls DIFFERENT, per class (share of pairs
-in which some item of the class is beyond noise).
+albedo +10 %, a hue change of one material at the same luminance, one door's state: its panel slid
+out of the doorway), PAIRS each with its own seed against a base seed, and the share of pairs lbk
+diff calls DIFFERENT, per class (share of pairs in which some item of the class is beyond noise).
 
 Usage: diff_reseed.py --lbk build/lbk --out DIR [--pairs 20] [--presets fast,high]
-                      [--scenes a,b] [--false-alarm 0.001] [--power] [--jobs 1]
+                      [--scenes a,b] [--false-alarm 0.001] [--power] [--door-scene-tool T]
 Bakes already in DIR are reused (the same file name means the same scene, preset, seed, variant).
 """
 import argparse
@@ -29,6 +31,7 @@ import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+GENERATED = None  # a scene written by scene_file()
 ROOT = os.path.dirname(HERE)
 SCENES = {
     # name: (file under scenes/, extra bake options)
@@ -38,11 +41,36 @@ SCENES = {
     "room_with_doors": ("room_with_doors/room.glb", ["--sky", "1,1,1"]),
     "leak_rooms": ("leak_rooms/leak_rooms.gltf", []),
     "water_bottle_draco": ("water_bottle_draco/WaterBottle.gltf", []),
+    # generated into OUT/scenes by --door-scene-tool (bench/door_scene_write.c): light sets A and B,
+    # the door "north", and the octahedral volume, so the set, door and octp classes have items.
+    # The classes' factors were set on room_sets_doors; room_sets_doors_b (a second door, a
+    # combination state, a sun) is held out: it only reports.
+    "room_sets_doors": (GENERATED, ["--octahedral"]),
+    "room_sets_doors_b": (GENERATED, ["--octahedral"]),
 }
-CLASSES = ["texels", "glg", "llg", "octp", "set_texels", "set_probes"]
+GENERATED_ARGS = {"room_sets_doors": [], "room_sets_doors_b": ["b"]}
+CLASSES = ["texels", "glg", "llg", "octp", "set_texels", "set_probes", "door_texels", "door_probes"]
 
 
 BAKER = None
+
+
+def scene_file(args, name):
+    """The scene's glTF: under scenes/, or the generated light-set and door level written once to
+    OUT/scenes by --door-scene-tool."""
+    f = SCENES[name][0]
+    if f is not GENERATED:
+        return os.path.join(ROOT, "scenes", f)
+    if not args.door_scene_tool:
+        sys.exit(f"scene {name} needs --door-scene-tool (make bench-diff builds bench/door_scene_write.c)")
+    path = os.path.join(args.out, "scenes", name + ".gltf")
+    if not os.path.exists(path):
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        r = subprocess.run([args.door_scene_tool, path + ".tmp"] + GENERATED_ARGS[name], cwd=ROOT, capture_output=True, text=True)
+        if r.returncode != 0:
+            sys.exit(f"{args.door_scene_tool} failed: {r.stderr}")
+        os.replace(path + ".tmp", path)
+    return path
 
 
 def bake(lbk, out, scene_file, extra, preset, seed, tag):
@@ -140,10 +168,10 @@ def reseed_study(args, lbk, presets, scenes):
         tallies = {c: Tally() for c in CLASSES}
         model = None
         for name in scenes:
-            f, extra = SCENES[name]
+            src, extra = scene_file(args, name), SCENES[name][1]
             for i in range(args.pairs):
-                a = bake(lbk, args.out, os.path.join(ROOT, "scenes", f), extra, preset, 2 * i + 1, name)
-                b = bake(lbk, args.out, os.path.join(ROOT, "scenes", f), extra, preset, 2 * i + 2, name)
+                a = bake(lbk, args.out, src, extra, preset, 2 * i + 1, name)
+                b = bake(lbk, args.out, src, extra, preset, 2 * i + 2, name)
                 d = diff(lbk, a, b, args.false_alarm)
                 model = d["noise_model"] or model
                 if d["mode"] != "noise":
@@ -212,6 +240,15 @@ def scale_light(index, f):
     return edit
 
 
+def slide_door(name, dx):
+    """The door's panel moved dx metres along x, out of its doorway (a pocket door left open)."""
+    def edit(doc):
+        node = next(n for n in doc["nodes"] if n.get("extras", {}).get("lbk_door") == name)
+        t = node.setdefault("translation", [0, 0, 0])
+        t[0] += dx
+    return edit
+
+
 # (name, scene, how): how is ("sky", factor) on a sky-lit scene or ("gltf", edit)
 VARIANTS = [
     ("sky +2 %", "room_with_doors", ("sky", 1.02)),
@@ -221,11 +258,13 @@ VARIANTS = [
     ("albedo +10 % (cornell leftWall)", "cornell_box", ("gltf", scale_albedo("leftWall", 1.10))),
     ("hue: rightWall green -> cyan-blue, same luminance", "cornell_box",
      ("gltf", set_albedo("rightWall", [0.14, 0.40, 0.58]))),
+    ("door state: north door slid open 2.6 m", "room_sets_doors", ("gltf", slide_door("north", 2.6))),
 ]
 
 
 def power_study(args, lbk, presets, scenes):
-    print(f"\npower: {args.pairs} pairs per variant (base seed 2i+1 against the variant baked with seed 1000+i);"
+    pairs = args.power_pairs or args.pairs
+    print(f"\npower: {pairs} pairs per variant (base seed 2i+1 against the variant baked with seed 1000+i);"
           " detected = lbk diff DIFFERENT; per class the share of pairs with an item of that class beyond noise")
     for preset in presets:
         print(f"\npreset {preset}")
@@ -233,8 +272,7 @@ def power_study(args, lbk, presets, scenes):
         for label, name, how in VARIANTS:
             if name not in scenes:
                 continue
-            f, extra = SCENES[name]
-            src = os.path.join(ROOT, "scenes", f)
+            src, extra = scene_file(args, name), SCENES[name][1]
             tag = "v" + "".join(ch for ch in label if ch.isalnum())[:24]
             if how[0] == "sky":
                 sky = ",".join(str(how[1]) for _ in range(3))
@@ -242,7 +280,7 @@ def power_study(args, lbk, presets, scenes):
             else:
                 vfile, vextra = variant_scene(args.out, os.path.dirname(src), os.path.basename(src), tag, how[1]), extra
             hits, per = 0, {}
-            for i in range(args.pairs):
+            for i in range(pairs):
                 a = bake(lbk, args.out, src, extra, preset, 2 * i + 1, name)
                 b = bake(lbk, args.out, vfile, vextra, preset, 1000 + i, f"{name}_{tag}")
                 d = diff(lbk, a, b, args.false_alarm)
@@ -250,8 +288,8 @@ def power_study(args, lbk, presets, scenes):
                 seen = {cls for cls, _, n in items(d) if not n["within_noise"]}
                 for cls in seen:
                     per[cls] = per.get(cls, 0) + 1
-            cl = ", ".join(f"{c} {per[c] / args.pairs:.2f}" for c in CLASSES if c in per) or "none"
-            print(f"{label:<50} {hits:>4}/{args.pairs:<4}  {cl}")
+            cl = ", ".join(f"{c} {per[c] / pairs:.2f}" for c in CLASSES if c in per) or "none"
+            print(f"{label:<50} {hits:>4}/{pairs:<4}  {cl}")
 
 
 def main():
@@ -262,9 +300,11 @@ def main():
     ap.add_argument("--pairs", type=int, default=20)
     ap.add_argument("--presets", default="fast,high")
     ap.add_argument("--scenes", default=",".join(SCENES))
+    ap.add_argument("--door-scene-tool", help="bench/door_scene_write (for the room_sets_doors scene)")
     ap.add_argument("--false-alarm", type=float, default=0.001)
     ap.add_argument("--power", action="store_true")
     ap.add_argument("--power-only", action="store_true", help="skip the reseed study")
+    ap.add_argument("--power-pairs", type=int, help="pairs per power variant (default --pairs)")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
     global BAKER

@@ -33,11 +33,13 @@ bench-stitch: $(BUILD)/bench/stitch_share
 	@python3 bench/levels/gen_levels.py --out $(STITCH_LEVELS) --set all > /dev/null
 	@$(BUILD)/bench/stitch_share $(STITCH_LEVELS)/manifest.json
 
-# lbk diff's calibration (bench/diff_reseed.py): every scene of scenes/ and every preset, 20 reseed
-# pairs each (the measured false-alarm rate per receiver class against the stated one), then the
-# power table. Hours at the high preset; BENCH_DIFF_ARGS narrows it (e.g. --presets fast --pairs 5).
-bench-diff: $(BUILD)/lbk
-	@python3 bench/diff_reseed.py --lbk $(BUILD)/lbk --out $(BUILD)/bench-diff --power $(BENCH_DIFF_ARGS)
+# lbk diff's calibration (bench/diff_reseed.py): every scene of scenes/ and a generated light-set
+# and door level (bench/door_scene_write.c), every preset, 20 reseed pairs each (the measured
+# false-alarm rate per receiver class against the stated one), then the power table. Hours at the
+# high preset; BENCH_DIFF_ARGS narrows it (e.g. --presets fast --pairs 5).
+bench-diff: $(BUILD)/lbk $(BUILD)/bench/door_scene_write
+	@python3 bench/diff_reseed.py --lbk $(BUILD)/lbk --out $(BUILD)/bench-diff --power \
+	  --door-scene-tool $(BUILD)/bench/door_scene_write $(BENCH_DIFF_ARGS)
 
 # lbk against Cycles (bench/cycles/README.md). LBK_TREE=/path/to/other/checkout compares that
 # tree's baker instead: its build/lbk (built there first) and texel_dump linked against its

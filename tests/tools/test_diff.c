@@ -363,7 +363,7 @@ static void test_json_schema(void **state)
     assert_non_null(j);
     free(text);
     assert_string_equal(cJSON_GetObjectItem(j, "schema")->valuestring, "lbk-diff");
-    assert_int_equal(cJSON_GetObjectItem(j, "schema_version")->valueint, 2);
+    assert_int_equal(cJSON_GetObjectItem(j, "schema_version")->valueint, 3);
     const char *top[] = {"a", "b", "tolerance", "equal", "mode", "mode_reason", "noise_model", "inputs", "summary",
                          "sections", "params", "objects", "pages", "glg", "octp", "light_sets", "doors"};
     for (size_t i = 0; i < sizeof top / sizeof top[0]; i++) require_key(j, top[i]);

@@ -4,6 +4,8 @@
  *     false-alarm rate over many trials is at most α (within its binomial spread), and a mean
  *     shift, a chromaticity shift at equal luminance and a local change of a tenth of the samples
  *     are each detected;
+ *   - a door state's texel entries judged against entry + base, their noise's reference level:
+ *     no alarm, where against the entry's own level most samples are significant;
  *   - real bakes of scenes/cornell_box (cheap: 256 samples): two reseeds are EQUAL, and the right
  *     wall changed from green (0.14, 0.45, 0.091) to a cyan-blue of the same luminance (0.14, 0.40,
  *     0.58) is DIFFERENT, through the chromaticity test (no item's luminance shift is significant). */
@@ -163,6 +165,51 @@ static void test_synthetic_power(void **state)
     assert_true(hit_local >= 48);
 }
 
+/* A door state's texel entries: a twentieth of the base light under them, with noise of σ
+ * relative to entry + base (the runs they are differences of). Told that reference level, the
+ * model's u per sample is N(0, 0.75²) (the +Z luminance of three independent channels has 0.75 σ),
+ * so samples beyond k_sample = 3.29 are rarer than 0.001 and the count's critical value at α/6
+ * (p₀ 8 %) is reached in none of 200 items; RMS u 0.75. Judged against the entry's own level, σ
+ * is 21× too small: most samples are significant and every item's count is. */
+static void test_synthetic_set_entries(void **state)
+{
+    (void)state;
+    const double zero[2] = {0, 0}, sigma = 0.03;
+    tl_noise_model m;
+    tl_noise_model_init(&m, 0.001, zero, zero);
+    int alarms = 0, own_alarms = 0;
+    double u2 = 0, own_share = 0;
+    for (int t = 0; t < 200; t++) {
+        tl_noise_stats s, own;
+        tl_noise_begin(&s, &m, TL_NOISE_DOOR_TEXELS, sigma * 21, sigma * 21);
+        tl_noise_begin(&own, &m, TL_NOISE_DOOR_TEXELS, sigma * 21, sigma * 21);
+        for (int i = 0; i < N; i++) {
+            const double base = 1 + (double)i / N, entry = 0.05 * base, ref = entry + base;
+            float a[NORMALS][3], b[NORMALS][3];
+            for (int k = 0; k < NORMALS; k++)
+                for (int ch = 0; ch < 3; ch++) {
+                    a[k][ch] = (float)(entry + sigma * ref * gauss());
+                    b[k][ch] = (float)(entry + sigma * ref * gauss());
+                }
+            const double la = LBK_LUM_R * a[0][0] + LBK_LUM_G * a[0][1] + LBK_LUM_B * a[0][2];
+            const double lb = LBK_LUM_R * b[0][0] + LBK_LUM_G * b[0][1] + LBK_LUM_B * b[0][2];
+            tl_noise_add_ref(&s, &m, &a[0][0], &b[0][0], NORMALS, sigma, sigma, la + base, lb + base);
+            tl_noise_add(&own, &m, &a[0][0], &b[0][0], NORMALS, sigma, sigma);
+        }
+        tl_noise_end(&s, &m);
+        tl_noise_end(&own, &m);
+        alarms += s.share_significant;
+        own_alarms += own.share_significant;
+        u2 += s.sample_rms * s.sample_rms / 200;
+        own_share += (double)own.significant / own.count / 200;
+    }
+    print_message("set entries: count alarms %d/200 against entry + base (RMS u %.3f), %d/200 against the "
+                  "entry (%.0f %% significant)\n", alarms, sqrt(u2), own_alarms, 100 * own_share);
+    assert_int_equal(alarms, 0);
+    assert_true(sqrt(u2) > 0.6 && sqrt(u2) < 0.9);
+    assert_true(own_alarms == 200 && own_share > 0.5);
+}
+
 /* ---- real bakes: cornell_box -------------------------------------------------------------------- */
 
 static char tmpdir[64];
@@ -300,6 +347,7 @@ int main(void)
         cmocka_unit_test(test_binomial_critical),
         cmocka_unit_test(test_synthetic_false_alarm_rate),
         cmocka_unit_test(test_synthetic_power),
+        cmocka_unit_test(test_synthetic_set_entries),
         cmocka_unit_test(test_cornell_reseeds_equal),
         cmocka_unit_test(test_cornell_hue_change_differs),
     };

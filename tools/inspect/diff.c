@@ -712,19 +712,98 @@ static int space_comparable(const tl_bake *a, const tl_bake *b, uint32_t space)
     return 1;
 }
 
+static double lum3(const float *c) { return LBK_LUM_R * c[0] + LBK_LUM_G * c[1] + LBK_LUM_B * c[2]; }
+
+/* The luminance at +Z of the base lightmap's texel under a texel key (0 where none). */
+static double base_level(const tl_bake *bk, uint64_t key)
+{
+    float v[TL_TEXEL_NORMALS][3];
+    if (tl_bake_texel_eval(bk, (uint32_t)(key >> 32), (uint32_t)(key & 0xFFFF), (uint32_t)((key >> 16) & 0xFFFF), v))
+        return 0;
+    return lum3(v[0]);
+}
+
+static const keyed *find_key(const keyed *k, uint64_t n, uint64_t key)
+{
+    const keyed probe = {key, 0};
+    return bsearch(&probe, k, (size_t)n, sizeof *k, cmp_keyed);
+}
+
+/* A light set's texel entries carry the noise of the full runs they came from (a door's open
+ * state is the difference of two), so their noise is relative to the entry plus the base texel
+ * under it, not to the entry alone: a door's closed-state entries are 5 % of the base light and
+ * their own relative noise 25× the base's (bench/diff_reseed.py, room_sets_doors). Measured as
+ * objects' is (rect_noise), from the set's own texels: the high-pass of each entry against its 4
+ * neighbours, relative to entry + base, its robust spread (-1 when under 16 entries have all four
+ * neighbours). Into *mean_scale the factor that turns it into the noise of the set's mean: RMS of
+ * (entry + base) over the mean entry. */
+static double set_texel_noise(const tl_bake *bk, const set_entries *e, const keyed *k, double *mean_scale)
+{
+    *mean_scale = 1;
+    double *lev = malloc(sizeof *lev * (size_t)(2 * e->count + 1)), *r = lev ? lev + e->count : NULL;
+    if (!lev) return -1;
+    double sum_lev = 0, sum_ref2 = 0;
+    for (uint64_t i = 0; i < e->count; i++) {
+        float v[TL_TEXEL_NORMALS * 3];
+        eval_payload(LBK_DLS_SPACE_TEXEL, e->payloads + (size_t)k[i].index * e->payload, space_scale(bk, e->space), v);
+        lev[i] = lum3(v);
+        const double ref = lev[i] + base_level(bk, k[i].key);
+        sum_lev += lev[i], sum_ref2 += ref * ref;
+    }
+    size_t n = 0;
+    for (uint64_t i = 0; i < e->count; i++) {
+        const uint64_t key = k[i].key, x = key & 0xFFFF, y = (key >> 16) & 0xFFFF;
+        if (x == 0 || y == 0 || x == 0xFFFF || y == 0xFFFF) continue;
+        const keyed *nb[4] = {find_key(k, e->count, key - 1), find_key(k, e->count, key + 1),
+                              find_key(k, e->count, key - 0x10000), find_key(k, e->count, key + 0x10000)};
+        if (!nb[0] || !nb[1] || !nb[2] || !nb[3]) continue; /* at the set's or the chart's edge */
+        const double ref = lev[i] + base_level(bk, key);
+        if (!(ref > 0)) continue;
+        r[n++] = (lev[i] - 0.25 * (lev[nb[0] - k] + lev[nb[1] - k] + lev[nb[2] - k] + lev[nb[3] - k])) / ref;
+    }
+    const double s = tl_noise_robust_sigma(r, n);
+    if (sum_lev > 0) *mean_scale = sqrt(sum_ref2 / (double)e->count) / (sum_lev / (double)e->count);
+    free(lev);
+    return s;
+}
+
+/* The relative noise of one side's set texel entries (set_texel_noise; REPT's estimate spread
+ * as for probes when too few to measure, and at least REPT's when the bake was denoised) and the
+ * noise of the set's mean, for tl_noise_begin. */
+static double set_texel_side_noise(const tl_bake *bk, const set_entries *e, const keyed *k, const tl_noise_model *m,
+                                   int side, double *mean_noise)
+{
+    double scale;
+    double s = set_texel_noise(bk, e, k, &scale);
+    if (s < 0) s = TL_NOISE_REPT_SPREAD * m->rept[side][0];
+    s = fmax(s, texel_floor(m, side));
+    *mean_noise = s * scale;
+    return s;
+}
+
 static int compare_set_space(const tl_bake *a, uint32_t sa, const tl_bake *b, uint32_t sb, uint32_t space, const tol *t,
                              tl_err_stats *st, tl_noise_stats *ns)
 {
     const int kind = space == LBK_DLS_SPACE_TEXEL ? 0 : 1;
-    if (t->noise)
-        tl_noise_begin(ns, t->noise, kind ? TL_NOISE_SET_PROBES : TL_NOISE_SET_TEXELS, t->noise->rept[0][kind],
-                       t->noise->rept[1][kind]);
     set_entries ea, eb;
     keyed *ka = NULL, *kb = NULL;
     int rc = -1;
     memset(&eb, 0, sizeof eb);
     if (collect_set(a->dls, sa, space, &ea) || collect_set(b->dls, sb, space, &eb)) goto out;
     if (!(ka = sorted_keys(a, &ea)) || !(kb = sorted_keys(b, &eb))) goto out;
+    lbk_dls_set_info info;
+    lbk_dls_set_get(a->dls, sa, &info);
+    const int door = info.kind != LBK_DLS_KIND_LIGHTS; /* differences of runs: heavier tails */
+    double ta = 0, tb = 0; /* set texels: the entries' noise relative to entry + base */
+    if (t->noise && kind == 0) {
+        double ma, mb;
+        ta = set_texel_side_noise(a, &ea, ka, t->noise, 0, &ma);
+        tb = set_texel_side_noise(b, &eb, kb, t->noise, 1, &mb);
+        tl_noise_begin(ns, t->noise, door ? TL_NOISE_DOOR_TEXELS : TL_NOISE_SET_TEXELS, ma, mb);
+    } else if (t->noise) {
+        tl_noise_begin(ns, t->noise, door ? TL_NOISE_DOOR_PROBES : TL_NOISE_SET_PROBES, t->noise->rept[0][kind],
+                       t->noise->rept[1][kind]);
+    }
     uint64_t i = 0, j = 0;
     const int n = space == LBK_DLS_SPACE_TEXEL ? TL_TEXEL_NORMALS : TL_PROBE_NORMALS;
     while (i < ea.count || j < eb.count) {
@@ -748,7 +827,11 @@ static int compare_set_space(const tl_bake *a, uint32_t sa, const tl_bake *b, ui
         uint32_t x = space == LBK_DLS_SPACE_TEXEL ? (uint32_t)(key & 0xFFFF) : (uint32_t)key;
         uint32_t y = space == LBK_DLS_SPACE_TEXEL ? (uint32_t)((key >> 16) & 0xFFFF) : 0;
         add_sample(st, va, vb, n, t, x, y, NULL);
-        if (t->noise) tl_noise_add(ns, t->noise, va, vb, n, ns->noise_a, ns->noise_b);
+        if (t->noise && kind == 0)
+            tl_noise_add_ref(ns, t->noise, va, vb, n, ta, tb, lum3(va) + base_level(a, key),
+                             lum3(vb) + base_level(b, key));
+        else if (t->noise)
+            tl_noise_add(ns, t->noise, va, vb, n, ns->noise_a, ns->noise_b);
     }
     if (t->noise) tl_noise_end(ns, t->noise);
     rc = 0;

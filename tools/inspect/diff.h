@@ -10,7 +10,7 @@
 #include "tools/common/bake_data.h"
 #include "tools/inspect/diff_noise.h"
 
-#define TL_DIFF_SCHEMA_VERSION 2
+#define TL_DIFF_SCHEMA_VERSION 3
 
 typedef enum tl_diff_status {
     TL_DIFF_SAME = 0,    /* present in both, equal within tolerance */

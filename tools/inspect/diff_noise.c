@@ -40,6 +40,8 @@ static const tl_noise_class_params classes[TL_NOISE_CLASS_COUNT_] = {
     {"octp",         1,   1.5, 3.0, 0.05, 2.0, 0.3, 9.0, 0.1, 1e-5},
     {"set_texels",   0,   1.0, 1.0, 0.02, 2.0, 0.3, 4.0, 0.1, 1e-4},
     {"set_probes",   1,   1.5, 3.0, 0.05, 2.0, 0.3, 9.0, 0.1, 1e-5},
+    {"door_texels",  0,   1.0, 1.0, 0.08, 2.0, 0.3, 4.0, 0.1, 0.02},
+    {"door_probes",  1,   1.5, 3.0, 0.05, 2.0, 0.3, 9.0, 0.1, 1e-5},
 };
 
 const tl_noise_class_params *tl_noise_class_get(int cls)
@@ -86,11 +88,12 @@ static double level(const float *v, int kind, int n)
     return l;
 }
 
-/* A sample's change over its noise, |b₀ − a₀| / σ (+∞ for NaN or a change without noise); and
+/* A sample's change over its noise, |b₀ − a₀| / σ (+∞ for NaN or a change without noise), the
+ * relative noises t_a, t_b taken of the levels ref_a, ref_b (negative: the sample's own); and
  * into *extreme the same with the relative noise of the darker side for both (a sample 100×
  * brighter stays 100× beyond it, where σ relative to the brighter side caps u near 1/σ_B). */
 static double sample_deviation(const tl_noise_model *m, int cls, double t_a, double t_b, const float *a,
-                               const float *b, int n, double *extreme)
+                               const float *b, int n, double ref_a, double ref_b, double *extreme)
 {
     const tl_noise_class_params *c = tl_noise_class_get(cls);
     const double ca = m->common * m->rept[0][c->kind], cb = m->common * m->rept[1][c->kind];
@@ -99,8 +102,9 @@ static double sample_deviation(const tl_noise_model *m, int cls, double t_a, dou
     const double la = level(a, c->kind, n), lb = level(b, c->kind, n), d = lb - la;
     const double fa = c->floor_scale * m->rept[0][c->kind] * m->level_ref[0][c->kind];
     const double fb = c->floor_scale * m->rept[1][c->kind] * m->level_ref[1][c->kind];
-    const double sa2 = ta * ta + ca * ca, sb2 = tb * tb + cb * cb, lo = fmin(la, lb);
-    const double sigma = sqrt(sa2 * la * la + sb2 * lb * lb + fa * fa + fb * fb);
+    const double ra = ref_a >= 0 ? ref_a : la, rb = ref_b >= 0 ? ref_b : lb;
+    const double sa2 = ta * ta + ca * ca, sb2 = tb * tb + cb * cb, lo = fmin(ra, rb);
+    const double sigma = sqrt(sa2 * ra * ra + sb2 * rb * rb + fa * fa + fb * fb);
     const double sigma_lo = sqrt((sa2 + sb2) * lo * lo + fa * fa + fb * fb);
     if (isnan(d)) {
         if (extreme) *extreme = INFINITY;
@@ -113,11 +117,17 @@ static double sample_deviation(const tl_noise_model *m, int cls, double t_a, dou
 int tl_noise_sample_significant(const tl_noise_model *m, int cls, double t_a, double t_b, const float *a,
                                 const float *b, int n)
 {
-    return !(sample_deviation(m, cls, t_a, t_b, a, b, n, NULL) <= m->k_sample);
+    return !(sample_deviation(m, cls, t_a, t_b, a, b, n, -1, -1, NULL) <= m->k_sample);
 }
 
 void tl_noise_add(tl_noise_stats *s, const tl_noise_model *m, const float *a, const float *b, int n, double t_a,
                   double t_b)
+{
+    tl_noise_add_ref(s, m, a, b, n, t_a, t_b, -1, -1);
+}
+
+void tl_noise_add_ref(tl_noise_stats *s, const tl_noise_model *m, const float *a, const float *b, int n, double t_a,
+                      double t_b, double ref_a, double ref_b)
 {
     double la_sum = 0, lb_sum = 0, ca[3] = {0}, cb[3] = {0};
     for (int i = 0; i < n; i++) {
@@ -139,7 +149,7 @@ void tl_noise_add(tl_noise_stats *s, const tl_noise_model *m, const float *a, co
         s->sum_dcdc[k] += dc * dc, s->sum_dcdl[k] += dc * d;
     }
     double ux;
-    const double u = sample_deviation(m, s->cls, t_a, t_b, a, b, n, &ux);
+    const double u = sample_deviation(m, s->cls, t_a, t_b, a, b, n, ref_a, ref_b, &ux);
     s->significant += !(u <= m->k_sample);
     s->extreme += !(ux <= TL_NOISE_K_EXTREME);
     if (isfinite(u)) s->sum_u2 += u * u;
@@ -253,8 +263,7 @@ static size_t residuals(const float *values, const float *ref, uint32_t w, uint3
     return n;
 }
 
-/* The robust standard deviation of n residuals (scaled MAD), or -1 below 16. */
-static double robust_sigma(double *r, size_t n)
+double tl_noise_robust_sigma(double *r, size_t n)
 {
     if (n < 16) return -1;
     const double med = median(r, n);
@@ -267,7 +276,7 @@ double tl_noise_highpass(const float *values, const float *ref, uint32_t w, uint
     if (w < 5 || h < 5) return -1;
     double *r = malloc(sizeof *r * (size_t)w * h);
     if (!r) return -1;
-    const double out = robust_sigma(r, residuals(values, ref, w, h, 0, 0, w, h, r));
+    const double out = tl_noise_robust_sigma(r, residuals(values, ref, w, h, 0, 0, w, h, r));
     free(r);
     return out;
 }
@@ -281,7 +290,8 @@ void tl_noise_highpass_tiles(const float *values, uint32_t w, uint32_t h, double
             const uint32_t x0 = tx >= SURROUND ? tx - SURROUND : 0, y0 = ty >= SURROUND ? ty - SURROUND : 0;
             const uint32_t x1 = tx + TILE + SURROUND < w ? tx + TILE + SURROUND : w;
             const uint32_t y1 = ty + TILE + SURROUND < h ? ty + TILE + SURROUND : h;
-            double sg = w >= 5 && h >= 5 ? robust_sigma(r, residuals(values, values, w, h, x0, y0, x1, y1, r)) : -1;
+            double sg =
+                w >= 5 && h >= 5 ? tl_noise_robust_sigma(r, residuals(values, values, w, h, x0, y0, x1, y1, r)) : -1;
             if (sg < 0) sg = fallback;
             for (uint32_t y = ty; y < ty + TILE && y < h; y++)
                 for (uint32_t x = tx; x < tx + TILE && x < w; x++) out[(size_t)y * w + x] = (float)sg;

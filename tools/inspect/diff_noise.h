@@ -61,19 +61,22 @@
  * paths to compare its chromaticity. */
 #define TL_NOISE_CHROMA_MIN_SHARE 0.05
 
-/* Receiver classes: each has its own noise factors (diff_noise.c, measured by bench/diff_reseed.sh). */
+/* Receiver classes: each has its own noise factors (diff_noise.c, measured by bench/diff_reseed.py). */
 typedef enum tl_noise_class {
     TL_NOISE_TEXELS = 0,    /* a lightmapped object */
     TL_NOISE_GLG,           /* the global light grid */
     TL_NOISE_LLG,           /* an LLG object */
     TL_NOISE_OCTP,          /* the octahedral probes */
-    TL_NOISE_SET_TEXELS,    /* a light set or door state, texel entries */
-    TL_NOISE_SET_PROBES,    /* a light set or door state, GLG or LLG entries */
+    TL_NOISE_SET_TEXELS,    /* a light set, texel entries */
+    TL_NOISE_SET_PROBES,    /* a light set, GLG or LLG entries */
+    TL_NOISE_DOOR_TEXELS,   /* a door state or combination (differences of runs), texel entries */
+    TL_NOISE_DOOR_PROBES,   /* the same, GLG or LLG entries */
     TL_NOISE_CLASS_COUNT_
 } tl_noise_class;
 
 typedef struct tl_noise_class_params {
-    const char *name;       /* "texels", "glg", "llg", "octp", "set_texels", "set_probes" */
+    const char *name;       /* "texels", "glg", "llg", "octp", "set_texels", "set_probes", "door_texels",
+                               "door_probes" */
     int kind;               /* 0 texels (REPT's texel estimate, level at +Z), 1 probes */
     double mean_scale;      /* κ */
     double sample_spread;   /* ρ */
@@ -148,6 +151,11 @@ void tl_noise_begin(tl_noise_stats *s, const tl_noise_model *m, int cls, double 
  * (before the class's sample_spread). */
 void tl_noise_add(tl_noise_stats *s, const tl_noise_model *m, const float *a, const float *b, int n, double t_a,
                   double t_b);
+/* The same with t_a, t_b relative to the levels ref_a, ref_b (≥ 0) instead of the sample's own
+ * (negative: its own): a light set's texel entry, whose noise is that of the full runs it came
+ * from, so relative to the entry plus the base texel under it (compare_set_space). */
+void tl_noise_add_ref(tl_noise_stats *s, const tl_noise_model *m, const float *a, const float *b, int n, double t_a,
+                      double t_b, double ref_a, double ref_b);
 void tl_noise_end(tl_noise_stats *s, const tl_noise_model *m);
 /* The sample test alone (1: significant), for heatmaps. */
 int tl_noise_sample_significant(const tl_noise_model *m, int cls, double t_a, double t_b, const float *a,
@@ -155,6 +163,10 @@ int tl_noise_sample_significant(const tl_noise_model *m, int cls, double t_a, do
 /* The smallest count c with P(Binomial(n, p) ≥ c) ≤ q (n + 1 when none). */
 uint64_t tl_binomial_critical(uint64_t n, double p, double q);
 
+/* The robust standard deviation of n residuals (the median absolute deviation × 1.4826 / √1.25:
+ * a residual against the mean of 4 neighbours has 1.25 × a texel's variance), or -1 below 16.
+ * Reorders r. */
+double tl_noise_robust_sigma(double *r, size_t n);
 /* Relative noise of a lightmap from its own texels: the median absolute deviation of the
  * residual of each texel's value against the mean of its 4 neighbours, relative to the texel's
  * level ref, inside the rectangle less its 1-texel border (dilated padding), scaled to a standard
