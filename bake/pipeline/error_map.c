@@ -4,12 +4,13 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "bake/transport/shading.h"
 #include "lbk/error_map.h"
 
 void bk_error_map_from_transport(const float *variance, const float *irradiance, size_t n, float *rel)
 {
     for (size_t k = 0; k < n; k++) {
-        const double lum = 0.2126 * irradiance[3 * k] + 0.7152 * irradiance[3 * k + 1] + 0.0722 * irradiance[3 * k + 2];
+        const double lum = bk_lumf(&irradiance[3 * k]);
         const double v = variance[k];
         rel[k] = lum > 0 && isfinite(lum) && v >= 0 && isfinite(v) ? (float)(sqrt(v) / lum) : -1.0f;
     }

@@ -12,6 +12,7 @@
 
 #include "bake/encode/encode.h"
 #include "bake/pipeline/pipeline.h"
+#include "bake/transport/shading.h"
 #include "bake/util/rng.h"
 
 lbk_result bk_check_plan(bk_pipeline *b)
@@ -47,7 +48,7 @@ static double stored_luminance(const bk_pipeline *b, size_t i)
     bk_texel_linear(&b->texels.receivers[b->texel_of_receiver[i]], &b->radiance[i], &lin);
     double e[3];
     for (int c = 0; c < 3; c++) e[c] = (double)lin.c[c][0] + lin.c[c][3];
-    return 0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2];
+    return bk_lum(e);
 }
 
 /* Per object, over its slots: x_j = K·weight_j·d_j with d = (stored − path)² − var(path), each an
@@ -82,8 +83,7 @@ lbk_result bk_check_compare(bk_pipeline *b)
     for (size_t j = 0; j < b->check_count; j++) {
         const uint32_t i = b->check[j], o = (uint32_t)(j / K);
         if (i == UINT32_MAX || o >= no) continue;
-        const float *u = &b->check_irradiance[3 * j];
-        const double path = 0.2126 * u[0] + 0.7152 * u[1] + 0.0722 * u[2];
+        const double path = bk_lumf(&b->check_irradiance[3 * j]);
         const double diff = stored_luminance(b, i) - path, d = diff * diff - b->check_variance[j];
         const double x = (double)K * b->check_weight[j] * d;
         s[o].x += x;

@@ -115,7 +115,7 @@ static void recv_var_value(const tp_ctx *c, size_t i, double *var, double *val)
     const double a = w > 0 ? c->x_acc[0][i] / w : 0, b = w > 0 ? c->x_acc[1][i] / w : 0;
     *var = 0.25 * (a - b) * (a - b);
     const float *e = c->out->irradiance ? &c->out->irradiance[3 * i] : NULL;
-    *val = e ? 0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2] : 0.5 * (a + b);
+    *val = e ? bk_lumf(e) : 0.5 * (a + b);
 }
 
 /* A member's probability of being drawn: half its share of the group's noise Σvar, half its

@@ -1,5 +1,6 @@
 /* GGX + Smith + Schlick, the glTF metallic-roughness mix, visible-normal sampling; ggx.h. */
 #include "bake/transport/ggx.h"
+#include "bake/transport/shading.h"
 
 #include <math.h>
 
@@ -188,8 +189,6 @@ void bk_ggx_table_mean(const bk_ggx_table *t, double roughness, double *abar, do
     *bbar = (1 - fr) * t->bbar[i] + fr * t->bbar[i + 1];
 }
 
-static double lum3(const double c[3]) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
-
 int bk_mr_lobe_init(bk_mr_lobe *lb, const bk_ggx_table *t, const double base[3], double metallic, double roughness,
                     const double v[3])
 {
@@ -213,7 +212,7 @@ int bk_mr_lobe_init(bk_mr_lobe *lb, const bk_ggx_table *t, const double base[3],
         lb->kd[k] = ebar < 1 ? cd[k] / (GGX_PI * (1 - ebar)) : 0;
     }
     /* pick a lobe in proportion to what it reflects towards v (any split is unbiased) */
-    double ws = lum3(es), wd = lum3(cd);
+    double ws = bk_lum(es), wd = bk_lum(cd);
     lb->p_spec = ws + wd > 0 ? ws / (ws + wd) : 1;
     if (wd <= 0) lb->p_spec = 1;
     return 1;
