@@ -111,11 +111,11 @@ static int check_samples(const tp_ctx *c, uint64_t rays_so_far, size_t checks)
 /* Receiver i's noise variance (its two halves' difference) and its value's luminance. */
 static void recv_var_value(const tp_ctx *c, size_t i, double *var, double *val)
 {
-    const double w = c->blk_w[bk_tr_block_of(c, i)];
-    const double a = w > 0 ? c->x_acc[0][i] / w : 0, b = w > 0 ? c->x_acc[1][i] / w : 0;
-    *var = 0.25 * (a - b) * (a - b);
+    double h[2];
+    bk_tr_recv_halves(c, c->x_acc, i, h);
+    *var = bk_tr_halves_variance(h);
     const float *e = c->out->irradiance ? &c->out->irradiance[3 * i] : NULL;
-    *val = e ? bk_lumf(e) : 0.5 * (a + b);
+    *val = e ? bk_lumf(e) : 0.5 * (h[0] + h[1]);
 }
 
 /* A member's probability of being drawn: half its share of the group's noise Σvar, half its

@@ -187,13 +187,21 @@ static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
 /* The weight sum of receiver i's passes. */
 static double recv_weight(const tp_ctx *c, size_t i) { return c->recv_count ? c->blk_w[bk_tr_block_of(c, i)] : 0; }
 
+void bk_tr_recv_halves(const tp_ctx *c, double *const x_acc[2], size_t i, double h[2])
+{
+    const double w = recv_weight(c, i);
+    h[0] = w > 0 ? x_acc[0][i] / w : 0;
+    h[1] = w > 0 ? x_acc[1][i] / w : 0;
+}
+
 /* Each receiver's X of the two halves, normalised by its block's pass weights. */
 void bk_tr_write_halves(const tp_ctx *c, double *const x_acc[2], float *halves)
 {
     for (size_t i = 0; i < c->recv_count; i++) {
-        double w = recv_weight(c, i);
-        halves[2 * i] = (float)(w > 0 ? x_acc[0][i] / w : 0);
-        halves[2 * i + 1] = (float)(w > 0 ? x_acc[1][i] / w : 0);
+        double h[2];
+        bk_tr_recv_halves(c, x_acc, i, h);
+        halves[2 * i] = (float)h[0];
+        halves[2 * i + 1] = (float)h[1];
     }
 }
 
@@ -215,8 +223,9 @@ static void finish_outputs(tp_ctx *c)
     /* per-receiver variance of X from the two halves (the denoiser's input) */
     if (output->variance)
         for (size_t i = 0; i < c->recv_count; i++) {
-            double w = recv_weight(c, i), a = w > 0 ? c->x_acc[0][i] / w : 0, b = w > 0 ? c->x_acc[1][i] / w : 0;
-            output->variance[i] = (float)(0.25 * (a - b) * (a - b));
+            double h[2];
+            bk_tr_recv_halves(c, c->x_acc, i, h);
+            output->variance[i] = (float)bk_tr_halves_variance(h);
         }
     if (output->halves) bk_tr_write_halves(c, c->x_acc, output->halves);
     if (c->light_count && !c->slc) { /* (culled light is in the passes' sums already) */

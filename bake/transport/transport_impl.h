@@ -542,6 +542,10 @@ void bk_tr_count_totals(const tp_ctx *c, uint64_t t[3]);
 /* What a pass reports. */
 void bk_tr_sample_of(const tp_ctx *c, double spp, double err, int bounces, int pass, const tp_errors *ce,
                      bk_transport_sample *smp);
+/* Receiver i's two halves' X (x_acc normalised by its block's pass weights), and the variance of
+ * their mean from their difference, ¼(h₀ − h₁)²: the noise the denoiser and the path check read. */
+void bk_tr_recv_halves(const tp_ctx *c, double *const x_acc[2], size_t i, double h[2]);
+static inline double bk_tr_halves_variance(const double h[2]) { return 0.25 * (h[0] - h[1]) * (h[0] - h[1]); }
 /* Each receiver's X of the two halves, normalised by its block's pass weights. */
 void bk_tr_write_halves(const tp_ctx *c, double *const x_acc[2], float *halves);
 
