@@ -337,29 +337,16 @@ static void test_emitter_gap_unbiased(void **state)
 {
     (void)state;
     bk_scene s;
-    tsc_init(&s);
-    uint32_t grey = tsc_material(&s, 0.5f, 0.5f, 0.5f, 0, 0, 0);
-    uint32_t lamp = tsc_material(&s, 0.5f, 0.5f, 0.5f, 4, 4, 4);
-    const float mn[3] = {-1, 0, -1}, mx[3] = {1, 2, 1};
-    tsc_box(&s, mn, mx, 1, 1, grey);
-    /* facing down; double sided, so its upper side lights the 1 cm gap */
-    const float y = 1.99f, a = -0.35f, b = 0.65f;
-    float q0[3] = {a, y, a}, q1[3] = {b, y, a}, q2[3] = {b, y, b}, q3[3] = {a, y, b};
-    tsc_quad(&s, q0, q1, q2, q3, 1, lamp);
-    tsc_update_bounds(&s);
+    tsc_lamp_room(&s);
     char err[128];
     assert_int_equal(rp_check(&s, err, sizeof err), 0);
-    enum { N = 24 };
+    enum { N = TSC_LAMP_ROOM_RECEIVERS };
     bk_receiver r[N];
     float p[3 * N], n[3 * N];
-    memset(r, 0, sizeof r);
+    tsc_lamp_room_receivers(r); /* 16 on the floor, 8 up a wall */
     for (int i = 0; i < N; i++) {
-        float u = -0.75f + 0.5f * (float)(i % 4), v = -0.75f + 0.5f * (float)((i / 4) % 4);
-        float *pp = r[i].position, *nn = r[i].normal;
-        if (i < 16) { pp[0] = u; pp[1] = 0; pp[2] = v; nn[1] = 1; }              /* floor */
-        else { pp[0] = -1; pp[1] = 0.3f + 0.2f * (float)(i - 16); pp[2] = 0.1f; nn[0] = 1; } /* a wall */
-        memcpy(p + 3 * i, pp, 12);
-        memcpy(n + 3 * i, nn, 12);
+        memcpy(p + 3 * i, r[i].position, 12);
+        memcpy(n + 3 * i, r[i].normal, 12);
     }
     bk_tracer *t = NULL;
     assert_int_equal(bk_tracer_create(&s, 0, &t), LBK_OK);

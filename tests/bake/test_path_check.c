@@ -29,33 +29,19 @@
 #include "support/ref_path.h"
 #include "support/transport_scenes.h"
 
-#define N 24
+#define N TSC_LAMP_ROOM_RECEIVERS
 #define K 12
 
 static double lumf(const float *c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
 static double lumd(const double *c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
 
-/* The room of test_bias's emitter-under-a-ceiling case: a 2 m box, a double-sided lamp 1 cm
- * under the ceiling; receivers on the floor (group 0) and a wall (group 1). */
+/* The room of test_bias's emitter-under-a-ceiling case (support/transport_scenes.h): receivers
+ * on the floor (group 0) and a wall (group 1). */
 static void lamp_room(bk_scene *s, bk_receiver *r, uint32_t *group)
 {
-    tsc_init(s);
-    uint32_t grey = tsc_material(s, 0.5f, 0.5f, 0.5f, 0, 0, 0);
-    uint32_t lamp = tsc_material(s, 0.5f, 0.5f, 0.5f, 4, 4, 4);
-    const float mn[3] = {-1, 0, -1}, mx[3] = {1, 2, 1};
-    tsc_box(s, mn, mx, 1, 1, grey);
-    const float y = 1.99f, a = -0.35f, b = 0.65f;
-    float q0[3] = {a, y, a}, q1[3] = {b, y, a}, q2[3] = {b, y, b}, q3[3] = {a, y, b};
-    tsc_quad(s, q0, q1, q2, q3, 1, lamp);
-    tsc_update_bounds(s);
-    memset(r, 0, sizeof *r * N);
-    for (int i = 0; i < N; i++) {
-        float u = -0.75f + 0.5f * (float)(i % 4), v = -0.75f + 0.5f * (float)((i / 4) % 4);
-        float *pp = r[i].position, *nn = r[i].normal;
-        if (i < 16) { pp[0] = u; pp[1] = 0; pp[2] = v; nn[1] = 1; }
-        else { pp[0] = -1; pp[1] = 0.3f + 0.2f * (float)(i - 16); pp[2] = 0.1f; nn[0] = 1; }
-        group[i] = i < 16 ? 0 : 1;
-    }
+    tsc_lamp_room(s);
+    tsc_lamp_room_receivers(r);
+    for (int i = 0; i < N; i++) group[i] = i < 16 ? 0 : 1;
 }
 
 typedef struct check_out {

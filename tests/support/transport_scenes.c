@@ -129,6 +129,30 @@ uint32_t tsc_dir_light(bk_scene *s, const float dir[3], float lux)
     return (uint32_t)(s->light_count - 1);
 }
 
+void tsc_lamp_room(bk_scene *s)
+{
+    tsc_init(s);
+    uint32_t grey = tsc_material(s, 0.5f, 0.5f, 0.5f, 0, 0, 0);
+    uint32_t lamp = tsc_material(s, 0.5f, 0.5f, 0.5f, 4, 4, 4);
+    const float mn[3] = {-1, 0, -1}, mx[3] = {1, 2, 1};
+    tsc_box(s, mn, mx, 1, 1, grey);
+    const float y = 1.99f, a = -0.35f, b = 0.65f;
+    float q0[3] = {a, y, a}, q1[3] = {b, y, a}, q2[3] = {b, y, b}, q3[3] = {a, y, b};
+    tsc_quad(s, q0, q1, q2, q3, 1, lamp);
+    tsc_update_bounds(s);
+}
+
+void tsc_lamp_room_receivers(bk_receiver r[TSC_LAMP_ROOM_RECEIVERS])
+{
+    memset(r, 0, sizeof *r * TSC_LAMP_ROOM_RECEIVERS);
+    for (int i = 0; i < TSC_LAMP_ROOM_RECEIVERS; i++) {
+        float u = -0.75f + 0.5f * (float)(i % 4), v = -0.75f + 0.5f * (float)((i / 4) % 4);
+        float *pp = r[i].position, *nn = r[i].normal;
+        if (i < 16) { pp[0] = u; pp[1] = 0; pp[2] = v; nn[1] = 1; }
+        else { pp[0] = -1; pp[1] = 0.3f + 0.2f * (float)(i - 16); pp[2] = 0.1f; nn[0] = 1; }
+    }
+}
+
 void tsc_update_bounds(bk_scene *s)
 {
     sa_vertex_bounds(s);
