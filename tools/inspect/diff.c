@@ -771,13 +771,12 @@ static double set_texel_noise(const tl_bake *bk, const set_entries *e, const key
  * as for probes when too few to measure, and at least REPT's when the bake was denoised) and the
  * noise of the set's mean, for tl_noise_begin. */
 static double set_texel_side_noise(const tl_bake *bk, const set_entries *e, const keyed *k, const tl_noise_model *m,
-                                   int side, double *mean_noise)
+                                   int side, double *mean_noise, double *scale)
 {
-    double scale;
-    double s = set_texel_noise(bk, e, k, &scale);
+    double s = set_texel_noise(bk, e, k, scale);
     if (s < 0) s = TL_NOISE_REPT_SPREAD * m->rept[side][0];
     s = fmax(s, texel_floor(m, side));
-    *mean_noise = s * scale;
+    *mean_noise = s * *scale;
     return s;
 }
 
@@ -796,10 +795,12 @@ static int compare_set_space(const tl_bake *a, uint32_t sa, const tl_bake *b, ui
     const int door = info.kind != LBK_DLS_KIND_LIGHTS; /* differences of runs: heavier tails */
     double ta = 0, tb = 0; /* set texels: the entries' noise relative to entry + base */
     if (t->noise && kind == 0) {
-        double ma, mb;
-        ta = set_texel_side_noise(a, &ea, ka, t->noise, 0, &ma);
-        tb = set_texel_side_noise(b, &eb, kb, t->noise, 1, &mb);
+        double ma, mb, ga, gb;
+        ta = set_texel_side_noise(a, &ea, ka, t->noise, 0, &ma, &ga);
+        tb = set_texel_side_noise(b, &eb, kb, t->noise, 1, &mb, &gb);
         tl_noise_begin(ns, t->noise, door ? TL_NOISE_DOOR_TEXELS : TL_NOISE_SET_TEXELS, ma, mb);
+        /* the part common to every receiver of a run is relative to entry + base as well */
+        ns->noise_common = t->noise->common * hypot(ga * t->noise->rept[0][0], gb * t->noise->rept[1][0]);
     } else if (t->noise) {
         tl_noise_begin(ns, t->noise, door ? TL_NOISE_DOOR_PROBES : TL_NOISE_SET_PROBES, t->noise->rept[0][kind],
                        t->noise->rept[1][kind]);
