@@ -6,6 +6,7 @@
  *     are each detected;
  *   - a door state's texel entries judged against entry + base, their noise's reference level:
  *     no alarm, where against the entry's own level most samples are significant;
+ *   - noise correlated over 2 × 2 texels read at its full σ by the texels' high-pass;
  *   - real bakes of scenes/cornell_box (cheap: 256 samples): two reseeds are EQUAL, and the right
  *     wall changed from green (0.14, 0.45, 0.091) to a cyan-blue of the same luminance (0.14, 0.40,
  *     0.58) is DIFFERENT, through the chromaticity test (no item's luminance shift is significant). */
@@ -210,6 +211,29 @@ static void test_synthetic_set_entries(void **state)
     assert_true(own_alarms == 200 && own_share > 0.5);
 }
 
+/* Noise correlated over 2 × 2 texels (a radiosity cache's cells): against its nearest neighbours
+ * a texel's residual has 0.375 σ² (two of the four share its block), which the 1.25 σ² scale
+ * reads as 0.55 σ; against neighbours 2 texels away, all in other blocks, σ. The high-pass takes
+ * the larger: σ within the robust spread's sampling error (60 × 60 texels: ~3 %; bound 15 %). */
+static void test_highpass_correlated_noise(void **state)
+{
+    (void)state;
+    enum { W = 64 };
+    static float v[W * W], ref[W * W];
+    const double sigma = 0.05;
+    double block[W / 2][W / 2];
+    for (int j = 0; j < W / 2; j++)
+        for (int i = 0; i < W / 2; i++) block[j][i] = gauss();
+    for (int y = 0; y < W; y++)
+        for (int x = 0; x < W; x++) {
+            ref[y * W + x] = 1;
+            v[y * W + x] = (float)(1 + sigma * block[y / 2][x / 2]);
+        }
+    const double s = tl_noise_highpass(v, ref, W, W);
+    print_message("2 x 2 correlated noise of sigma %.3f: high-pass %.4f\n", sigma, s);
+    assert_true(fabs(s / sigma - 1) < 0.15);
+}
+
 /* ---- real bakes: cornell_box -------------------------------------------------------------------- */
 
 static char tmpdir[64];
@@ -348,6 +372,7 @@ int main(void)
         cmocka_unit_test(test_synthetic_false_alarm_rate),
         cmocka_unit_test(test_synthetic_power),
         cmocka_unit_test(test_synthetic_set_entries),
+        cmocka_unit_test(test_highpass_correlated_noise),
         cmocka_unit_test(test_cornell_reseeds_equal),
         cmocka_unit_test(test_cornell_hue_change_differs),
     };

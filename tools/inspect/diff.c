@@ -734,8 +734,8 @@ static const keyed *find_key(const keyed *k, uint64_t n, uint64_t key)
  * under it, not to the entry alone: a door's closed-state entries are 5 % of the base light and
  * their own relative noise 25× the base's (bench/diff_reseed.py, room_sets_doors). Measured as
  * objects' is (rect_noise), from the set's own texels: the high-pass of each entry against its 4
- * neighbours, relative to entry + base, its robust spread (-1 when under 16 entries have all four
- * neighbours). Into *mean_scale the factor that turns it into the noise of the set's mean: RMS of
+ * neighbours 1 and 2 texels away, relative to entry + base, the larger robust spread (-1 when
+ * under 16 entries have all four neighbours). Into *mean_scale the factor that turns it into the noise of the set's mean: RMS of
  * (entry + base) over the mean entry. */
 static double set_texel_noise(const tl_bake *bk, const set_entries *e, const keyed *k, double *mean_scale)
 {
@@ -750,18 +750,21 @@ static double set_texel_noise(const tl_bake *bk, const set_entries *e, const key
         const double ref = lev[i] + base_level(bk, k[i].key);
         sum_lev += lev[i], sum_ref2 += ref * ref;
     }
-    size_t n = 0;
-    for (uint64_t i = 0; i < e->count; i++) {
-        const uint64_t key = k[i].key, x = key & 0xFFFF, y = (key >> 16) & 0xFFFF;
-        if (x == 0 || y == 0 || x == 0xFFFF || y == 0xFFFF) continue;
-        const keyed *nb[4] = {find_key(k, e->count, key - 1), find_key(k, e->count, key + 1),
-                              find_key(k, e->count, key - 0x10000), find_key(k, e->count, key + 0x10000)};
-        if (!nb[0] || !nb[1] || !nb[2] || !nb[3]) continue; /* at the set's or the chart's edge */
-        const double ref = lev[i] + base_level(bk, key);
-        if (!(ref > 0)) continue;
-        r[n++] = (lev[i] - 0.25 * (lev[nb[0] - k] + lev[nb[1] - k] + lev[nb[2] - k] + lev[nb[3] - k])) / ref;
+    double s = -1;
+    for (uint64_t d = 1; d <= TL_NOISE_HIGHPASS_REACH; d *= 2) { /* as tl_noise_highpass */
+        size_t n = 0;
+        for (uint64_t i = 0; i < e->count; i++) {
+            const uint64_t key = k[i].key, x = key & 0xFFFF, y = (key >> 16) & 0xFFFF;
+            if (x < d || y < d || x + d > 0xFFFF || y + d > 0xFFFF) continue;
+            const keyed *nb[4] = {find_key(k, e->count, key - d), find_key(k, e->count, key + d),
+                                  find_key(k, e->count, key - (d << 16)), find_key(k, e->count, key + (d << 16))};
+            if (!nb[0] || !nb[1] || !nb[2] || !nb[3]) continue; /* at the set's or the chart's edge */
+            const double ref = lev[i] + base_level(bk, key);
+            if (!(ref > 0)) continue;
+            r[n++] = (lev[i] - 0.25 * (lev[nb[0] - k] + lev[nb[1] - k] + lev[nb[2] - k] + lev[nb[3] - k])) / ref;
+        }
+        s = fmax(s, tl_noise_robust_sigma(r, n));
     }
-    const double s = tl_noise_robust_sigma(r, n);
     if (sum_lev > 0) *mean_scale = sqrt(sum_ref2 / (double)e->count) / (sum_lev / (double)e->count);
     free(lev);
     return s;

@@ -244,19 +244,21 @@ static double median(double *v, size_t n)
 /* Residuals (value − mean of its 4 neighbours) / level of the texels in [x0, x1) × [y0, y1), kept
  * two texels from the rectangle's edge (the border ring is dilated padding). */
 static size_t residuals(const float *values, const float *ref, uint32_t w, uint32_t h, uint32_t x0, uint32_t y0,
-                        uint32_t x1, uint32_t y1, double *r)
+                        uint32_t x1, uint32_t y1, uint32_t d, double *r)
 {
     size_t n = 0;
-    if (x0 < 2) x0 = 2;
-    if (y0 < 2) y0 = 2;
-    if (x1 + 2 > w) x1 = w > 2 ? w - 2 : 0;
-    if (y1 + 2 > h) y1 = h > 2 ? h - 2 : 0;
+    const uint32_t e = d > 2 ? d : 2;
+    if (x0 < e) x0 = e;
+    if (y0 < e) y0 = e;
+    if (x1 + e > w) x1 = w > e ? w - e : 0;
+    if (y1 + e > h) y1 = h > e ? h - e : 0;
+    const size_t dy = (size_t)d * w;
     for (uint32_t y = y0; y < y1; y++)
         for (uint32_t x = x0; x < x1; x++) {
             const size_t i = (size_t)y * w + x;
             const double c = values[i], lev = ref[i];
-            const double nb = 0.25 * ((double)values[i - 1] + values[i + 1] + values[i - w] + values[i + w]);
-            const double nref = (double)ref[i - 1] * ref[i + 1] * ref[i - w] * ref[i + w];
+            const double nb = 0.25 * ((double)values[i - d] + values[i + d] + values[i - dy] + values[i + dy]);
+            const double nref = (double)ref[i - d] * ref[i + d] * ref[i - dy] * ref[i + dy];
             if (!(lev > 0) || !(nref > 0)) continue; /* unlit or outside the chart */
             r[n++] = (c - nb) / lev;
         }
@@ -276,22 +278,25 @@ double tl_noise_highpass(const float *values, const float *ref, uint32_t w, uint
     if (w < 5 || h < 5) return -1;
     double *r = malloc(sizeof *r * (size_t)w * h);
     if (!r) return -1;
-    const double out = tl_noise_robust_sigma(r, residuals(values, ref, w, h, 0, 0, w, h, r));
+    double out = -1;
+    for (uint32_t d = 1; d <= TL_NOISE_HIGHPASS_REACH; d *= 2)
+        out = fmax(out, tl_noise_robust_sigma(r, residuals(values, ref, w, h, 0, 0, w, h, d, r)));
     free(r);
     return out;
 }
 
 void tl_noise_highpass_tiles(const float *values, uint32_t w, uint32_t h, double fallback, float *out)
 {
-    enum { TILE = 4, SURROUND = 2 };
+    enum { TILE = 4, SURROUND = 2 + TL_NOISE_HIGHPASS_REACH };
     double r[(TILE + 2 * SURROUND) * (TILE + 2 * SURROUND)];
     for (uint32_t ty = 0; ty < h; ty += TILE)
         for (uint32_t tx = 0; tx < w; tx += TILE) {
             const uint32_t x0 = tx >= SURROUND ? tx - SURROUND : 0, y0 = ty >= SURROUND ? ty - SURROUND : 0;
             const uint32_t x1 = tx + TILE + SURROUND < w ? tx + TILE + SURROUND : w;
             const uint32_t y1 = ty + TILE + SURROUND < h ? ty + TILE + SURROUND : h;
-            double sg =
-                w >= 5 && h >= 5 ? tl_noise_robust_sigma(r, residuals(values, values, w, h, x0, y0, x1, y1, r)) : -1;
+            double sg = -1;
+            for (uint32_t d = 1; d <= TL_NOISE_HIGHPASS_REACH && w >= 5 && h >= 5; d *= 2)
+                sg = fmax(sg, tl_noise_robust_sigma(r, residuals(values, values, w, h, x0, y0, x1, y1, d, r)));
             if (sg < 0) sg = fallback;
             for (uint32_t y = ty; y < ty + TILE && y < h; y++)
                 for (uint32_t x = tx; x < tx + TILE && x < w; x++) out[(size_t)y * w + x] = (float)sg;

@@ -57,6 +57,10 @@
  * 100× brighter): reseeds make one at the class's extreme_rate (bench/diff_reseed.py), and the
  * count of extreme samples is a second binomial test; the two counts share the count test's α/3. */
 #define TL_NOISE_K_EXTREME 30.0
+/* The texels' high-pass takes the larger spread of the residuals against neighbours 1, 2, …,
+ * this many texels away: noise correlated over a few texels (the radiosity cache) reads low
+ * against the nearest ones only. */
+#define TL_NOISE_HIGHPASS_REACH 2
 /* A channel that carries less than this share of the luminance (C/L, both sides) has too few
  * paths to compare its chromaticity. */
 #define TL_NOISE_CHROMA_MIN_SHARE 0.05
@@ -168,12 +172,13 @@ uint64_t tl_binomial_critical(uint64_t n, double p, double q);
  * Reorders r. */
 double tl_noise_robust_sigma(double *r, size_t n);
 /* Relative noise of a lightmap from its own texels: the median absolute deviation of the
- * residual of each texel's value against the mean of its 4 neighbours, relative to the texel's
- * level ref, inside the rectangle less its 1-texel border (dilated padding), scaled to a standard
- * deviation (1.4826 / √1.25). values and ref are w × h, row-major. Returns < 0 when fewer than 16
- * texels are usable (the caller falls back on REPT). */
+ * residual of each texel's value against the mean of its 4 neighbours d texels away, relative to
+ * the texel's level ref, inside the rectangle less its 2-texel border (dilated padding), scaled to
+ * a standard deviation (1.4826 / √1.25), the largest for d = 1, 2, … TL_NOISE_HIGHPASS_REACH.
+ * values and ref are w × h, row-major. Returns < 0 when fewer than 16 texels are usable (the
+ * caller falls back on REPT). */
 double tl_noise_highpass(const float *values, const float *ref, uint32_t w, uint32_t h);
-/* The same per 4×4 tile from the tile and a 2-texel surround (values relative to themselves),
+/* The same per 4×4 tile from the tile and a (2 + reach)-texel surround (values relative to themselves),
  * into out (w × h, every texel of a tile gets its tile's); fallback where too few are usable. */
 void tl_noise_highpass_tiles(const float *values, uint32_t w, uint32_t h, double fallback, float *out);
 
