@@ -723,6 +723,46 @@ static double base_level(const tl_bake *bk, uint64_t key)
     return lum3(v[0]);
 }
 
+/* The mean luminance over the probe normals of the base probe under a probe key (GLG or LLG
+ * space; 0 where none). */
+static double base_probe_level(const tl_bake *bk, uint32_t space, uint64_t key)
+{
+    lbk_sh9_rgb sh;
+    float pos[3], e[TL_PROBE_NORMALS][3];
+    if (space == LBK_DLS_SPACE_GLG && bk->has_glg && key < bk->glg.probe_count)
+        lbk_glg_probe_get(&bk->glg, (uint32_t)key, pos, &sh);
+    else if (space == LBK_DLS_SPACE_LLG && bk->has_llg && key < bk->llg.probe_count)
+        tl_probe_unpack(bk->llg.probes + key * LBK_SH9_PACKED_SIZE, bk->llg.scale, &sh);
+    else
+        return 0;
+    tl_probe_eval(&sh, e);
+    double l = 0;
+    for (int k = 0; k < TL_PROBE_NORMALS; k++) l += lum3(e[k]) / TL_PROBE_NORMALS;
+    return l;
+}
+
+static double probe_level(const float *v)
+{
+    double l = 0;
+    for (int k = 0; k < TL_PROBE_NORMALS; k++) l += lum3(v + 3 * k) / TL_PROBE_NORMALS;
+    return l;
+}
+
+/* A set's probe entries, like its texel entries, carry the noise of the full runs: REPT's probe
+ * estimate relative to entry + base probe, and for the mean test that × RMS(entry + base) / mean
+ * entry (*mean_scale; 1 when the set has no light). */
+static void set_probe_scale(const tl_bake *bk, const set_entries *e, double *mean_scale)
+{
+    double sum_lev = 0, sum_ref2 = 0;
+    for (uint64_t i = 0; i < e->count; i++) {
+        float v[TL_PROBE_NORMALS * 3];
+        eval_payload(e->space, e->payloads + (size_t)i * e->payload, space_scale(bk, e->space), v);
+        const double lev = probe_level(v), ref = lev + base_probe_level(bk, e->space, e->targets[i]);
+        sum_lev += lev, sum_ref2 += ref * ref;
+    }
+    *mean_scale = sum_lev > 0 ? sqrt(sum_ref2 / (double)e->count) / (sum_lev / (double)e->count) : 1;
+}
+
 static const keyed *find_key(const keyed *k, uint64_t n, uint64_t key)
 {
     const keyed probe = {key, 0};
@@ -805,8 +845,13 @@ static int compare_set_space(const tl_bake *a, uint32_t sa, const tl_bake *b, ui
         /* the part common to every receiver of a run is relative to entry + base as well */
         ns->noise_common = t->noise->common * hypot(ga * t->noise->rept[0][0], gb * t->noise->rept[1][0]);
     } else if (t->noise) {
-        tl_noise_begin(ns, t->noise, door ? TL_NOISE_DOOR_PROBES : TL_NOISE_SET_PROBES, t->noise->rept[0][kind],
-                       t->noise->rept[1][kind]);
+        double ga, gb;
+        set_probe_scale(a, &ea, &ga);
+        set_probe_scale(b, &eb, &gb);
+        const double ra = t->noise->rept[0][1], rb = t->noise->rept[1][1];
+        tl_noise_begin(ns, t->noise, door ? TL_NOISE_DOOR_PROBES : TL_NOISE_SET_PROBES, ra * ga, rb * gb);
+        ns->noise_common = t->noise->common * hypot(ga * ra, gb * rb);
+        ta = ra, tb = rb;
     }
     uint64_t i = 0, j = 0;
     const int n = space == LBK_DLS_SPACE_TEXEL ? TL_TEXEL_NORMALS : TL_PROBE_NORMALS;
@@ -835,7 +880,8 @@ static int compare_set_space(const tl_bake *a, uint32_t sa, const tl_bake *b, ui
             tl_noise_add_ref(ns, t->noise, va, vb, n, ta, tb, lum3(va) + base_level(a, key),
                              lum3(vb) + base_level(b, key));
         else if (t->noise)
-            tl_noise_add(ns, t->noise, va, vb, n, ns->noise_a, ns->noise_b);
+            tl_noise_add_ref(ns, t->noise, va, vb, n, ta, tb, probe_level(va) + base_probe_level(a, space, key),
+                             probe_level(vb) + base_probe_level(b, space, key));
     }
     if (t->noise) tl_noise_end(ns, t->noise);
     rc = 0;
