@@ -28,17 +28,22 @@ double tl_normal_quantile(double p)
  * and ν 9 for probes) and 0.62 (LLG), chroma_z/k_chroma at most 0.34. LLG probes are fitted
  * together from the object's vertices and GLG probes interpolate each other, so their standard
  * error counts N/9 independent samples (ν 9). OCTP and the light-set classes had no item in the
- * shared scenes: they take the GLG's (probes) and the texels' (texel entries) factors.
+ * shared scenes: they take the GLG's (probes) and the texels' (texel entries) factors, measured on
+ * the generated light-set and door levels (bench/door_scene_write.c): extreme samples, fireflies
+ * of light through a doorway, came at 3–5e-4 of the texels there (p_x 5e-4; 1e-4 before) and
+ * 6–9e-4 of a light set's texel entries, a run of one lamp alone (1e-3); a door state's entries,
+ * differences of runs clamped at 0, had 3 % of samples beyond k_sample and u RMS 2.2 (p₀ 8 %,
+ * p_x 2 %).
  * φ 0.1: a texel far darker than the bake's median level (a room lit only through a leak) has an
  * absolute noise floor of 0.1·r·level_ref; without it leak_rooms' texels were beyond 3.29σ in
  * 27 % of the samples and its dark LLG prop shifted by −88 %. */
 static const tl_noise_class_params classes[TL_NOISE_CLASS_COUNT_] = {
     /* name          kind  κ    ρ    p₀    χ    χ_c  ν    φ    p_x */
-    {"texels",       0,   1.0, 1.0, 0.02, 2.0, 0.3, 4.0, 0.1, 1e-4},
+    {"texels",       0,   1.0, 1.0, 0.02, 2.0, 0.3, 4.0, 0.1, 5e-4},
     {"glg",          1,   1.5, 3.0, 0.05, 2.0, 0.3, 9.0, 0.1, 1e-5},
     {"llg",          1,   1.5, 8.0, 0.08, 2.0, 0.3, 9.0, 0.1, 0.02},
     {"octp",         1,   1.5, 3.0, 0.05, 2.0, 0.3, 9.0, 0.1, 1e-5},
-    {"set_texels",   0,   1.0, 1.0, 0.02, 2.0, 0.3, 4.0, 0.1, 1e-4},
+    {"set_texels",   0,   1.0, 1.0, 0.02, 2.0, 0.3, 4.0, 0.1, 1e-3},
     {"set_probes",   1,   1.5, 3.0, 0.05, 2.0, 0.3, 9.0, 0.1, 1e-5},
     {"door_texels",  0,   1.0, 1.0, 0.08, 2.0, 0.3, 4.0, 0.1, 0.02},
     {"door_probes",  1,   1.5, 3.0, 0.05, 2.0, 0.3, 9.0, 0.1, 1e-5},
