@@ -21,7 +21,6 @@
 #include "bake/transport/shading.h"
 #include "scene/import.h"
 #include "scene/scene.h"
-#include "support/bake_file.h"
 #include "support/import_fixtures.h"
 
 /* quaduv.bin: a unit floor quad in y = 0 facing +y (x right, -z away), uv0 = (x, -z), uv1 =
@@ -142,26 +141,7 @@ static void test_webp_percent_encoded_required(void **state)
     assert_null(s.positions);
 
     /* and it bakes (the whole pipeline, as `lbk bake`) */
-    char in[512], out[512];
-    imp_tmp_path(in, sizeof in, "town.gltf");
-    imp_tmp_path(out, sizeof out, "town.lbk");
-    tb_job j;
-    memset(&j, 0, sizeof j);
-    j.in = in;
-    j.out = out;
-    j.d.preset = LBK_BAKE_PRESET_FAST;
-    j.d.seed = 1;
-    j.d.threads = 1;
-    j.d.max_samples = 8;
-    j.d.texel_density = 4;
-    j.d.no_glg = 1;
-    char berr[512];
-    lbk_result br = tb_bake(&j, NULL, berr, sizeof berr);
-    if (br != LBK_OK) printf("bake: %s\n", berr);
-    assert_int_equal(br, LBK_OK);
-    struct stat st;
-    assert_int_equal(stat(out, &st), 0);
-    assert_true(st.st_size > 0);
+    imp_bake_tmp("town.gltf", "town.lbk");
 }
 
 /* A file that says RIFF....WEBP but holds no valid bitstream: the texture is ignored (warned,

@@ -10,8 +10,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include "tests/support/bake_file.h"
 #include "tests/support/scenes_dir.h"
 
 /* A scene of scenes/ (or $LBK_SCENES): a missing file fails the test, naming it. */
@@ -186,4 +188,25 @@ void imp_write_quad_gltf_scene_extras(const char *name, const char *nodes, const
              "\"nodes\":[%s],\"scenes\":[{\"nodes\":[%s],\"extras\":%s}]}",
              nodes, scene_nodes, scene_extras);
     imp_write_text(name, json);
+}
+
+void imp_bake_tmp(const char *name, const char *out)
+{
+    char in[512], path[512], err[512];
+    imp_tmp_path(in, sizeof in, name);
+    imp_tmp_path(path, sizeof path, out);
+    tb_job j;
+    memset(&j, 0, sizeof j);
+    j.in = in;
+    j.out = path;
+    j.d.preset = LBK_BAKE_PRESET_FAST;
+    j.d.seed = 1;
+    j.d.threads = 1;
+    j.d.max_samples = 8;
+    j.d.texel_density = 4;
+    j.d.no_glg = 1;
+    if (tb_bake(&j, NULL, err, sizeof err) != LBK_OK) fail_msg("bake %s: %s", name, err);
+    struct stat st;
+    assert_int_equal(stat(path, &st), 0);
+    assert_true(st.st_size > 0);
 }

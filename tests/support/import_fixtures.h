@@ -32,6 +32,10 @@ int imp_import_tmp(const char *name, bk_scene *s, const bk_import_options *opt, 
 void imp_expect_error(const char *name, const char *needle1, const char *needle2);
 int imp_setup_tmp(void **state);
 int imp_teardown_tmp(void **state);
+/* tmp/name goes through the whole pipeline, as `lbk bake` (support/bake_file.h) at its smallest:
+ * fast preset, seed 1, one thread, 8 samples, 4 texels per metre, no global light grid. Asserts
+ * it succeeded (the baker's message when not) and wrote a non-empty tmp/out. */
+void imp_bake_tmp(const char *name, const char *out);
 
 /* quad.bin: 4 positions of a unit quad in the XY plane (z = 0), 6 uint16 indices, 4 +Z normals. */
 void imp_write_quad_bin(void);
