@@ -35,6 +35,7 @@
 #include "scene/import.h"
 #include "support/bake_file.h"
 #include "support/normal_scene.h"
+#include "support/tmp_dir.h"
 #include "tools/render/render.h"
 
 #define PI 3.14159265358979323846
@@ -44,17 +45,13 @@ static char tmpdir[64];
 static int setup(void **state)
 {
     (void)state;
-    snprintf(tmpdir, sizeof tmpdir, "/tmp/lbk_test_normal_XXXXXX");
-    return mkdtemp(tmpdir) ? 0 : -1;
+    return td_make(tmpdir, sizeof tmpdir, "lbk_test_normal");
 }
 
 static int teardown(void **state)
 {
     (void)state;
-    if (getenv("LBK_TEST_KEEP")) return printf("kept %s\n", tmpdir), 0;
-    char cmd[128];
-    snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
-    return system(cmd) == 0 ? 0 : -1;
+    return td_remove(tmpdir); /* kept under $LBK_TEST_KEEP, for a look with lbk inspect */
 }
 
 static void path_of(char *out, size_t n, const char *name) { snprintf(out, n, "%s/%s", tmpdir, name); }

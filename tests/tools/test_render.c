@@ -46,6 +46,7 @@
 #include "support/bake_file.h"
 #include "support/door_scenes.h"
 #include "support/gltf_writer.h"
+#include "support/tmp_dir.h"
 #include "tools/render/render.h"
 
 #define RHO 0.5f
@@ -58,17 +59,13 @@ static char tmpdir[64];
 static int setup(void **state)
 {
     (void)state;
-    snprintf(tmpdir, sizeof tmpdir, "/tmp/lbk_test_render_XXXXXX");
-    return mkdtemp(tmpdir) ? 0 : -1;
+    return td_make(tmpdir, sizeof tmpdir, "lbk_test_render");
 }
 
 static int teardown(void **state)
 {
     (void)state;
-    if (getenv("LBK_TEST_KEEP")) return printf("kept %s\n", tmpdir), 0; /* for a look with lbk inspect */
-    char cmd[128];
-    snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
-    return system(cmd) == 0 ? 0 : -1;
+    return td_remove(tmpdir); /* kept under $LBK_TEST_KEEP, for a look with lbk inspect */
 }
 
 static void bake(const char *gltf, const char *out, uint64_t seed, int max_samples, float density, float glg_spacing)

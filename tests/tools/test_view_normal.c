@@ -21,9 +21,10 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "support/image_compare.h"
 #include "support/bake_file.h"
+#include "support/image_compare.h"
 #include "support/normal_scene.h"
+#include "support/tmp_dir.h"
 #include "tools/common/file_util.h"
 #include "tools/render/render.h"
 #include "tools/view/view.h"
@@ -39,17 +40,13 @@ static char tmpdir[64];
 static int setup(void **state)
 {
     (void)state;
-    snprintf(tmpdir, sizeof tmpdir, "/tmp/lbk_test_view_normal_XXXXXX");
-    return mkdtemp(tmpdir) ? 0 : -1;
+    return td_make(tmpdir, sizeof tmpdir, "lbk_test_view_normal");
 }
 
 static int teardown(void **state)
 {
     (void)state;
-    if (getenv("LBK_TEST_KEEP")) return printf("kept %s\n", tmpdir), 0;
-    char cmd[128];
-    snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
-    return system(cmd) == 0 ? 0 : -1;
+    return td_remove(tmpdir); /* kept under $LBK_TEST_KEEP, for a look with lbk inspect */
 }
 
 static int have_chromium(void) { return system("command -v chromium >/dev/null 2>&1") == 0; }
