@@ -7,18 +7,7 @@
 
 const char *const gsc_group_names[GSC_GROUPS] = {"floor", "walls", "ceiling by the slit"};
 
-void gsc_build(bk_scene *s)
-{
-    tsc_init(s);
-    uint32_t grey = tsc_material(s, 0.725f, 0.725f, 0.725f, 0, 0, 0);
-    uint32_t lamp = tsc_material(s, 0.999f, 0.999f, 0.999f, 8, 8, 8);
-    const float mn[3] = {-1, 0, -1}, mx[3] = {1, 2, 1};
-    tsc_box(s, mn, mx, 1, 1, grey);
-    const float y = 1.99f, x0 = -0.3f, x1 = 0.2f, z0 = -0.15f, z1 = 0.25f;
-    float q0[3] = {x0, y, z0}, q1[3] = {x1, y, z0}, q2[3] = {x1, y, z1}, q3[3] = {x0, y, z1};
-    tsc_quad(s, q0, q1, q2, q3, 1, lamp); /* faces down */
-    tsc_update_bounds(s);
-}
+void gsc_build(bk_scene *s) { tsc_ceiling_lamp_room(s, 0.725f, 0.999f, 8, -0.3f, 0.2f, -0.15f, 0.25f); }
 
 static void ceiling_point(int k, float *pp, float *nn)
 {

@@ -129,18 +129,20 @@ uint32_t tsc_dir_light(bk_scene *s, const float dir[3], float lux)
     return (uint32_t)(s->light_count - 1);
 }
 
-void tsc_lamp_room(bk_scene *s)
+void tsc_ceiling_lamp_room(bk_scene *s, float wall, float lamp, float le, float x0, float x1, float z0, float z1)
 {
     tsc_init(s);
-    uint32_t grey = tsc_material(s, 0.5f, 0.5f, 0.5f, 0, 0, 0);
-    uint32_t lamp = tsc_material(s, 0.5f, 0.5f, 0.5f, 4, 4, 4);
+    uint32_t grey = tsc_material(s, wall, wall, wall, 0, 0, 0);
+    uint32_t light = tsc_material(s, lamp, lamp, lamp, le, le, le);
     const float mn[3] = {-1, 0, -1}, mx[3] = {1, 2, 1};
     tsc_box(s, mn, mx, 1, 1, grey);
-    const float y = 1.99f, a = -0.35f, b = 0.65f;
-    float q0[3] = {a, y, a}, q1[3] = {b, y, a}, q2[3] = {b, y, b}, q3[3] = {a, y, b};
-    tsc_quad(s, q0, q1, q2, q3, 1, lamp);
+    const float y = 1.99f;
+    float q0[3] = {x0, y, z0}, q1[3] = {x1, y, z0}, q2[3] = {x1, y, z1}, q3[3] = {x0, y, z1};
+    tsc_quad(s, q0, q1, q2, q3, 1, light); /* faces down */
     tsc_update_bounds(s);
 }
+
+void tsc_lamp_room(bk_scene *s) { tsc_ceiling_lamp_room(s, 0.5f, 0.5f, 4, -0.35f, 0.65f, -0.35f, 0.65f); }
 
 void tsc_lamp_room_receivers(bk_receiver r[TSC_LAMP_ROOM_RECEIVERS])
 {

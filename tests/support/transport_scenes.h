@@ -37,9 +37,12 @@ void tsc_rotate(bk_scene *s, double ax, double ay, double az);
  * doubling; no error target), 2 threads, a 512-cell cache, the given seed. */
 bk_transport_options tsc_fixed_passes(int passes, uint64_t seed);
 
-/* A closed 2 m room (grey 0.5, x and z in [-1, 1], y in [0, 2], each face one quad) with a 1 × 1 m
- * double-sided emitter (radiance 4) hung 1 cm under the ceiling, facing down: its upper side lights
- * the gap. The Cornell box's light, as test_bias and test_path_check use it. */
+/* A closed 2 m room (x and z in [-1, 1], y in [0, 2], each face one quad, grey `wall`) with an
+ * emitter over [x0, x1] × [z0, z1] hung 1 cm under the ceiling, facing down and double-sided (its
+ * upper side lights the gap): albedo `lamp`, radiance `le`. The Cornell box's light. */
+void tsc_ceiling_lamp_room(bk_scene *s, float wall, float lamp, float le, float x0, float x1, float z0, float z1);
+/* The one test_bias and test_path_check share: grey 0.5, a 1 × 1 m lamp of radiance 4 and albedo
+ * 0.5 over [-0.35, 0.65]². */
 #define TSC_LAMP_ROOM_RECEIVERS 24
 void tsc_lamp_room(bk_scene *s);
 /* Its receivers: 16 on the floor (a 4 × 4 grid at 0.5 m), then 8 up the wall x = -1. */
