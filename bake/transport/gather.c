@@ -113,8 +113,9 @@ static uint64_t punctual_at(const tp_ctx *c, const tp_origin *g, const bk_slc_dr
     return rays;
 }
 
-/* The points at which a receiver's punctual light is evaluated: a texel with a footprint
- * averages its four quarter centres (hard shadow edges resolve to a quarter of a texel), but
+/* The points at which a receiver's punctual light is evaluated where one draw stands for it
+ * (culling, VPLs; bk_tr_recv_punctual, exact, takes a finer grid): a texel with a footprint
+ * averages its four quarter centres, but
  * those beyond another surface (footprint_hidden): a floor texel half under a crate read the
  * sun at half its strength (dev level overlap_01). None left: the texel's own point. (The
  * quarter centres of the footprint box instead of the square lit a chart's sliver where it
@@ -122,14 +123,79 @@ static uint64_t punctual_at(const tp_ctx *c, const tp_origin *g, const bk_slc_dr
  * texel's point: tests/bake/test_doors.c; not kept.) */
 int bk_tr_punctual_points(const tp_ctx *c, const bk_receiver *r, tp_origin g[4])
 {
-    int n = 0;
+    int n = 0, on = 0;
     for (int q = 0; q < 4 && r->footprint_count; q++) {
         const double s = 0.25 + 0.5 * (q & 1), t = 0.25 + 0.5 * (q >> 1);
         if (r->footprint_hidden && footprint_hidden(c, r, s, t)) continue;
-        footprint_origin(c, r, s, t, &g[n++]);
+        on += footprint_origin(c, r, s, t, &g[n++]);
+    }
+    /* A sliver (a chart's corner in the texel) holds no quarter centre, and all four read the
+     * texel's own point, which can lie in the light where the sliver is in shadow: 10.8 lux
+     * there against 7.3 traced over the sliver (a doorway's jamb, room_sets_doors). Its box's
+     * quarter centres, those on the footprint, instead. */
+    const float *bx = r->footprint_box;
+    if (n && !on && bx[2] > 0 && bx[3] > 0) {
+        int m = 0;
+        for (int q = 0; q < 4; q++) {
+            const double s = bx[0] + (0.25 + 0.5 * (q & 1)) * bx[2], t = bx[1] + (0.25 + 0.5 * (q >> 1)) * bx[3];
+            if (r->footprint_hidden && footprint_hidden(c, r, s, t)) continue;
+            tp_origin o;
+            if (footprint_origin(c, r, s, t, &o)) g[m++] = o;
+        }
+        if (m) n = m;
     }
     if (!n) bk_tr_recv_origin(c, r, &g[n++]);
     return n;
+}
+
+/* A texel with a footprint takes its punctual light over a TP_PUNCT_GRID² grid of its footprint's
+ * box. Four quarter centres put a hard shadow edge anywhere in a quarter at that quarter's value,
+ * and miss an edge that cuts a corner: across a sun's diagonal edge they left the texels 0.084 of
+ * the sun off (RMS; 0.024 with the grid, tests/bake/test_shadow_edges.c). A sliver (a chart's
+ * corner in the texel) holds no quarter centre at all, and read its own point, lit where the
+ * sliver is in shadow: a doorway jamb's texel stored 13.7 lux against 7.3 traced by the path check
+ * (the light-set level of bench/diff_reseed.py), overlap_01's block on a block read 24 % off
+ * against Cycles. Punctual light is noise-free and computed once, so the 16 points cost 16 shadow
+ * rays per light and texel, once. */
+#define TP_PUNCT_GRID 4
+
+/* The punctual light of a texel with a footprint over the TP_PUNCT_GRID² grid of its footprint's
+ * box (points off the footprint or beyond another surface left out); 0 when none is left. */
+static int punctual_grid(const tp_ctx *c, const bk_receiver *r, double e[3], double sh[3][9], uint64_t *rays)
+{
+    const float *bx = r->footprint_box;
+    const int box = bx[2] > 0 && bx[3] > 0;
+    int n = 0;
+    for (int q = 0; q < TP_PUNCT_GRID * TP_PUNCT_GRID; q++) {
+        double s = (q % TP_PUNCT_GRID + 0.5) / TP_PUNCT_GRID, t = (q / TP_PUNCT_GRID + 0.5) / TP_PUNCT_GRID;
+        if (box) s = bx[0] + s * bx[2], t = bx[1] + t * bx[3];
+        if (r->footprint_hidden && footprint_hidden(c, r, s, t)) continue;
+        tp_origin g;
+        if (!footprint_origin(c, r, s, t, &g)) continue; /* off the footprint */
+        *rays += punctual_at(c, &g, NULL, NULL, 0, 1, e, sh);
+        n++;
+    }
+    return n;
+}
+
+/* The exact punctual light of receiver i (every light, no culling): the mean over its footprint's
+ * grid, or where it has none (a probe, a texel without a footprint) over its punctual points. */
+static uint64_t punctual_exact(const tp_ctx *c, const bk_receiver *r, double e[3], double sh[3][9])
+{
+    uint64_t rays = 0;
+    int n = r->footprint_count ? punctual_grid(c, r, e, sh, &rays) : 0;
+    if (!n) {
+        memset(e, 0, 3 * sizeof *e);
+        memset(sh, 0, 3 * sizeof *sh);
+        tp_origin g[4];
+        n = bk_tr_punctual_points(c, r, g);
+        for (int q = 0; q < n; q++) rays += punctual_at(c, &g[q], NULL, NULL, 0, 1, e, sh);
+    }
+    for (int a = 0; a < 3; a++) {
+        e[a] /= n;
+        for (int kk = 0; kk < 9; kk++) sh[a][kk] /= n;
+    }
+    return rays;
 }
 
 void bk_tr_recv_punctual(tp_ctx *c, size_t begin, size_t end, int thread)
@@ -141,13 +207,7 @@ void bk_tr_recv_punctual(tp_ctx *c, size_t begin, size_t end, int thread)
         const bk_receiver *r = &c->recv[i];
         double e[3] = {0, 0, 0}, sh[3][9];
         memset(sh, 0, sizeof sh);
-        tp_origin g[4];
-        const int points = bk_tr_punctual_points(c, r, g);
-        for (int q = 0; q < points; q++) rays += punctual_at(c, &g[q], NULL, NULL, 0, 1, e, sh);
-        for (int a = 0; a < 3; a++) {
-            e[a] /= points;
-            for (int kk = 0; kk < 9; kk++) sh[a][kk] /= points;
-        }
+        rays += punctual_exact(c, r, e, sh);
         if (c->punct_lum) {
             c->punct_lum[i] = (float)bk_lum(e);
             continue;
@@ -358,8 +418,9 @@ static void recv_half(tp_ctx *c, const bk_receiver *r, size_t i, int h, int S, c
 }
 
 /* The culled punctual light of receiver i in half h of this pass: one draw (the half's ξ, δ of
- * the pass) at the receiver's punctual points; an unbiased estimate of what bk_tr_recv_punctual
- * computes. */
+ * the pass) at the receiver's punctual points; an unbiased estimate of their mean (bk_tr_recv_punctual,
+ * exact, takes a finer grid: a level with culling's many lights has few hard edges one light
+ * alone casts). */
 static uint64_t recv_slc(tp_ctx *c, const bk_receiver *r, size_t i, int h, tp_tile_lists *t, double e[3],
                          double sh[3][9], uint64_t *tested)
 {
