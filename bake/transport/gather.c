@@ -26,32 +26,30 @@ void bk_tr_recv_origin(const tp_ctx *c, const bk_receiver *r, tp_origin *g)
     bk_tr_origin_from(c, r->position, r->normal, g);
 }
 
-/* The point of receiver r's footprint at texel-local (s, t): on the footprint triangle that
- * covers it (position and interpolated shading normal from the footprint scene; returns 1),
- * else the receiver's own point (returns 0). */
-static int footprint_origin(const tp_ctx *c, const bk_receiver *r, double s, double t, tp_origin *g)
+/* The origin at texel-local (s, t) of receiver r's footprint: the footprint triangle's point that
+ * covers it (position and interpolated shading normal from the footprint scene; returns 1), else
+ * the receiver's own point (returns 0); or, where r marks hidden cells, -1 (g untouched) when the
+ * point lies beyond another surface (bk_footprint_sample_hidden). Door runs trace a scene without
+ * the door, whose triangles are not the ones footprints index: there the cell marks alone decide.
+ * One footprint lookup serves both. */
+static int footprint_at(const tp_ctx *c, const bk_receiver *r, double s, double t, tp_origin *g)
 {
     double p[3], n[3];
-    if (r->footprint_count &&
-        bk_footprint_point(c->fscene, c->opt->footprint + r->footprint_first, r->footprint_count, s, t, p, n)) {
-        float pf[3] = {(float)p[0], (float)p[1], (float)p[2]}, nf[3] = {(float)n[0], (float)n[1], (float)n[2]};
-        bk_tr_origin_from(c, pf, nf, g);
-        return 1;
+    const int on = r->footprint_count && bk_footprint_point(c->fscene, c->opt->footprint + r->footprint_first,
+                                                             r->footprint_count, s, t, p, n);
+    if (r->footprint_hidden) {
+        const int hidden = c->fscene != c->scene
+                               ? bk_footprint_cell_hidden(r->footprint_hidden, s, t)
+                               : on && bk_footprint_sample_hidden(c->tracer, c->scene, c->opt->footprint, r, s, t, p, n);
+        if (hidden) return -1;
     }
-    bk_tr_recv_origin(c, r, g);
-    return 0;
-}
-
-/* Whether the footprint point at (s, t) lies beyond another surface (bk_footprint_sample_hidden).
- * Door runs trace a scene without the door, whose triangles are not the ones footprints index:
- * there the cell marks alone decide. */
-static int footprint_hidden(const tp_ctx *c, const bk_receiver *r, double s, double t)
-{
-    double p[3], n[3];
-    if (c->fscene != c->scene) return bk_footprint_cell_hidden(r->footprint_hidden, s, t);
-    if (!bk_footprint_point(c->fscene, c->opt->footprint + r->footprint_first, r->footprint_count, s, t, p, n))
+    if (!on) {
+        bk_tr_recv_origin(c, r, g);
         return 0;
-    return bk_footprint_sample_hidden(c->tracer, c->scene, c->opt->footprint, r, s, t, p, n);
+    }
+    float pf[3] = {(float)p[0], (float)p[1], (float)p[2]}, nf[3] = {(float)n[0], (float)n[1], (float)n[2]};
+    bk_tr_origin_from(c, pf, nf, g);
+    return 1;
 }
 
 /* A uniform point of the part of the texel's square that its footprint covers: rejection in the
@@ -69,8 +67,7 @@ void bk_tr_footprint_sample(const tp_ctx *c, const bk_receiver *r, bk_rng *pos, 
             ps = bx[0] + ps * bx[2];
             pt = bx[1] + pt * bx[3];
         }
-        if (r->footprint_hidden && footprint_hidden(c, r, ps, pt)) continue;
-        if (footprint_origin(c, r, ps, pt, g)) return;
+        if (footprint_at(c, r, ps, pt, g) > 0) return;
     }
 }
 
@@ -125,9 +122,10 @@ int bk_tr_punctual_points(const tp_ctx *c, const bk_receiver *r, tp_origin g[4])
 {
     int n = 0, on = 0;
     for (int q = 0; q < 4 && r->footprint_count; q++) {
-        const double s = 0.25 + 0.5 * (q & 1), t = 0.25 + 0.5 * (q >> 1);
-        if (r->footprint_hidden && footprint_hidden(c, r, s, t)) continue;
-        on += footprint_origin(c, r, s, t, &g[n++]);
+        const int k = footprint_at(c, r, 0.25 + 0.5 * (q & 1), 0.25 + 0.5 * (q >> 1), &g[n]);
+        if (k < 0) continue;
+        on += k;
+        n++;
     }
     /* A sliver (a chart's corner in the texel) holds no quarter centre, and all four read the
      * texel's own point, which can lie in the light where the sliver is in shadow: 10.8 lux
@@ -138,9 +136,8 @@ int bk_tr_punctual_points(const tp_ctx *c, const bk_receiver *r, tp_origin g[4])
         int m = 0;
         for (int q = 0; q < 4; q++) {
             const double s = bx[0] + (0.25 + 0.5 * (q & 1)) * bx[2], t = bx[1] + (0.25 + 0.5 * (q >> 1)) * bx[3];
-            if (r->footprint_hidden && footprint_hidden(c, r, s, t)) continue;
             tp_origin o;
-            if (footprint_origin(c, r, s, t, &o)) g[m++] = o;
+            if (footprint_at(c, r, s, t, &o) > 0) g[m++] = o;
         }
         if (m) n = m;
     }
@@ -169,9 +166,8 @@ static int punctual_grid(const tp_ctx *c, const bk_receiver *r, double e[3], dou
     for (int q = 0; q < TP_PUNCT_GRID * TP_PUNCT_GRID; q++) {
         double s = (q % TP_PUNCT_GRID + 0.5) / TP_PUNCT_GRID, t = (q / TP_PUNCT_GRID + 0.5) / TP_PUNCT_GRID;
         if (box) s = bx[0] + s * bx[2], t = bx[1] + t * bx[3];
-        if (r->footprint_hidden && footprint_hidden(c, r, s, t)) continue;
         tp_origin g;
-        if (!footprint_origin(c, r, s, t, &g)) continue; /* off the footprint */
+        if (footprint_at(c, r, s, t, &g) <= 0) continue; /* beyond another surface, or off the footprint */
         *rays += punctual_at(c, &g, NULL, NULL, 0, 1, e, sh);
         n++;
     }
