@@ -775,20 +775,23 @@ static const keyed *find_key(const keyed *k, uint64_t n, uint64_t key)
  * their own relative noise 25× the base's (bench/diff_reseed.py, room_sets_doors). Measured as
  * objects' is (rect_noise), from the set's own texels: the high-pass of each entry against its 4
  * neighbours 1 and 2 texels away, relative to entry + base, the larger robust spread (-1 when
- * under 16 entries have all four neighbours). Into *mean_scale the factor that turns it into the noise of the set's mean: RMS of
- * (entry + base) over the mean entry. */
+ * under 16 entries have all four neighbours). Into *mean_scale the factor that turns it into the
+ * noise of the set's mean: RMS of (entry + base) over the mean entry. */
 static double set_texel_noise(const tl_bake *bk, const set_entries *e, const keyed *k, double *mean_scale)
 {
     *mean_scale = 1;
-    double *lev = malloc(sizeof *lev * (size_t)(2 * e->count + 1)), *r = lev ? lev + e->count : NULL;
+    /* per sorted entry: its level, its reference level (entry + base: one texel lookup each),
+     * and the residuals */
+    double *lev = malloc(sizeof *lev * (size_t)(3 * e->count + 1)), *ref = lev ? lev + e->count : NULL;
+    double *r = lev ? ref + e->count : NULL;
     if (!lev) return -1;
     double sum_lev = 0, sum_ref2 = 0;
     for (uint64_t i = 0; i < e->count; i++) {
         float v[TL_TEXEL_NORMALS * 3];
         eval_payload(LBK_DLS_SPACE_TEXEL, e->payloads + (size_t)k[i].index * e->payload, space_scale(bk, e->space), v);
         lev[i] = lum3(v);
-        const double ref = lev[i] + base_level(bk, k[i].key);
-        sum_lev += lev[i], sum_ref2 += ref * ref;
+        ref[i] = lev[i] + base_level(bk, k[i].key);
+        sum_lev += lev[i], sum_ref2 += ref[i] * ref[i];
     }
     double s = -1;
     for (uint64_t d = 1; d <= TL_NOISE_HIGHPASS_REACH; d *= 2) { /* as tl_noise_highpass */
@@ -799,9 +802,8 @@ static double set_texel_noise(const tl_bake *bk, const set_entries *e, const key
             const keyed *nb[4] = {find_key(k, e->count, key - d), find_key(k, e->count, key + d),
                                   find_key(k, e->count, key - (d << 16)), find_key(k, e->count, key + (d << 16))};
             if (!nb[0] || !nb[1] || !nb[2] || !nb[3]) continue; /* at the set's or the chart's edge */
-            const double ref = lev[i] + base_level(bk, key);
-            if (!(ref > 0)) continue;
-            r[n++] = (lev[i] - 0.25 * (lev[nb[0] - k] + lev[nb[1] - k] + lev[nb[2] - k] + lev[nb[3] - k])) / ref;
+            if (!(ref[i] > 0)) continue;
+            r[n++] = (lev[i] - 0.25 * (lev[nb[0] - k] + lev[nb[1] - k] + lev[nb[2] - k] + lev[nb[3] - k])) / ref[i];
         }
         s = fmax(s, tl_noise_robust_sigma(r, n));
     }
