@@ -180,9 +180,7 @@ static uint64_t punctual_exact(const tp_ctx *c, const bk_receiver *r, double e[3
 {
     uint64_t rays = 0;
     int n = r->footprint_count ? punctual_grid(c, r, e, sh, &rays) : 0;
-    if (!n) {
-        memset(e, 0, 3 * sizeof *e);
-        memset(sh, 0, 3 * sizeof *sh);
+    if (!n) { /* (a grid of no points added nothing) */
         tp_origin g[4];
         n = bk_tr_punctual_points(c, r, g);
         for (int q = 0; q < n; q++) rays += punctual_at(c, &g[q], NULL, NULL, 0, 1, e, sh);
