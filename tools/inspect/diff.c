@@ -154,9 +154,6 @@ static int bake_denoised(const tl_bake *b)
            memcmp(v.data, "auto", 4) == 0;
 }
 
-/* A denoised bake's texels are at least REPT's noise (tl_noise_model.denoised). */
-static double texel_floor(const tl_noise_model *m, int side) { return m->denoised[side] ? m->rept[side][0] : 0; }
-
 /* Relative noise of an object's lightmap (diff_noise.h): the high-pass of its own texels at each
  * of the five normals against the texel's level (its mean over them), the largest of the five, for
  * the mean test (REPT's estimate when the rectangle is too small to tell); and when `local` is not
@@ -175,7 +172,7 @@ static double rect_noise(const pageref *pg, const uint32_t rect[4], double fallb
             const size_t i = (size_t)y * rect[2] + x;
             ref[i] = 0;
             for (int k = 0; k < TL_TEXEL_NORMALS; k++) {
-                lum[k * (n + 1) + i] = LBK_LUM_R * v[k][0] + LBK_LUM_G * v[k][1] + LBK_LUM_B * v[k][2];
+                lum[k * (n + 1) + i] = (float)tl_noise_level(v[k], 0, 1);
                 ref[i] += lum[k * (n + 1) + i] / TL_TEXEL_NORMALS;
             }
         }
@@ -302,8 +299,8 @@ static void compare_object(const tl_bake *a, const tl_bake *b, const lbk_object 
         d->resampled = !same_size;
         float *local_a = NULL, *local_b = NULL;
         if (t->noise)
-            tl_noise_begin(&d->noise, t->noise, TL_NOISE_TEXELS, rect_noise(&pa, d->rect_a, t->noise->rept[0][0], texel_floor(t->noise, 0), &local_a),
-                           rect_noise(&pb, d->rect_b, t->noise->rept[1][0], texel_floor(t->noise, 1), same_size ? &local_b : NULL));
+            tl_noise_begin(&d->noise, t->noise, TL_NOISE_TEXELS, rect_noise(&pa, d->rect_a, t->noise->rept[0][0], tl_noise_texel_floor(t->noise, 0), &local_a),
+                           rect_noise(&pb, d->rect_b, t->noise->rept[1][0], tl_noise_texel_floor(t->noise, 1), same_size ? &local_b : NULL));
         /* no texel noise of its own (under 16 interior texels): no per-texel test either */
         if (t->noise && (oa->rect_w < 5 || oa->rect_h < 5 || (uint64_t)(oa->rect_w - 4) * (oa->rect_h - 4) < 16))
             d->noise.count_test = 0;
@@ -477,8 +474,8 @@ static int diff_pages(const tl_bake *a, const tl_bake *b, const tol *t, int keep
         int objects_changed = 0;
         if (t->noise) {
             const uint32_t rect_a[4] = {0, 0, pa.width, pa.height}, rect_b[4] = {0, 0, pb.width, pb.height};
-            rect_noise(&ra, rect_a, t->noise->rept[0][0], texel_floor(t->noise, 0), &local_a);
-            rect_noise(&rb, rect_b, t->noise->rept[1][0], texel_floor(t->noise, 1), &local_b);
+            rect_noise(&ra, rect_a, t->noise->rept[0][0], tl_noise_texel_floor(t->noise, 0), &local_a);
+            rect_noise(&rb, rect_b, t->noise->rept[1][0], tl_noise_texel_floor(t->noise, 1), &local_b);
             owner = malloc(sizeof *owner * ((size_t)pa.width * pa.height + 1));
             if (!owner || !local_a || !local_b) {
                 free(owner), free(local_a), free(local_b);
@@ -528,7 +525,7 @@ static int diff_pages(const tl_bake *a, const tl_bake *b, const tol *t, int keep
 
 /* ---- GLG ------------------------------------------------------------------------------------ */
 
-static int glg_same_layout(const tl_bake *a, const tl_bake *b)
+int tl_diff_glg_same_layout(const tl_bake *a, const tl_bake *b)
 {
     if (a->glg.probe_count != b->glg.probe_count) return 0;
     for (uint32_t i = 0; i < a->glg.probe_count; i++) {
@@ -554,7 +551,7 @@ static void diff_glg(const tl_bake *a, const tl_bake *b, const tol *t, tl_diff_r
         d->status = a->has_glg ? TL_DIFF_REMOVED : TL_DIFF_ADDED;
         return;
     }
-    const int same = glg_same_layout(a, b);
+    const int same = tl_diff_glg_same_layout(a, b);
     d->resampled = !same;
     if (t->noise) tl_noise_begin(&d->noise, t->noise, TL_NOISE_GLG, t->noise->rept[0][1], t->noise->rept[1][1]);
     uint32_t hint = 0;
@@ -579,462 +576,6 @@ static void diff_glg(const tl_bake *a, const tl_bake *b, const tol *t, tl_diff_r
     }
     const int differs = t->noise ? !d->noise.within_noise : d->lighting.over > 0;
     d->status = (differs || !same) ? TL_DIFF_CHANGED : TL_DIFF_SAME;
-}
-
-/* ---- light sets ------------------------------------------------------------------------------ */
-
-typedef struct set_entries {
-    uint32_t space, set, payload;
-    uint64_t count, cap;
-    uint32_t *targets;
-    uint8_t *payloads;
-    int failed;
-} set_entries;
-
-static int gather(void *user, uint32_t target, uint32_t count, const uint32_t *sets, const uint8_t *payloads)
-{
-    set_entries *e = user;
-    for (uint32_t i = 0; i < count; i++) {
-        if (sets[i] != e->set) continue;
-        if (e->count == e->cap) {
-            uint64_t nc = e->cap ? 2 * e->cap : 256;
-            uint32_t *nt = realloc(e->targets, (size_t)nc * sizeof *nt);
-            if (nt) e->targets = nt;
-            uint8_t *np = realloc(e->payloads, (size_t)nc * e->payload);
-            if (np) e->payloads = np;
-            if (!nt || !np) {
-                e->failed = 1;
-                return 1;
-            }
-            e->cap = nc;
-        }
-        e->targets[e->count] = target;
-        memcpy(e->payloads + (size_t)e->count * e->payload, payloads + (size_t)i * e->payload, e->payload);
-        e->count++;
-    }
-    return 0;
-}
-
-static int collect_set(const lbk_dls_view *v, uint32_t set, uint32_t space, set_entries *e)
-{
-    memset(e, 0, sizeof *e);
-    e->space = space;
-    e->set = set;
-    e->payload = space == LBK_DLS_SPACE_TEXEL ? LBK_DLS_TEXEL_PAYLOAD : LBK_DLS_PROBE_PAYLOAD;
-    for (uint32_t c = 0; c < lbk_dls_cluster_count(v); c++) {
-        lbk_dls_cluster_info ci;
-        lbk_dls_cluster_get(v, c, &ci);
-        if (ci.space != space) continue;
-        int member = 0;
-        for (uint32_t i = 0; i < ci.set_count; i++) {
-            uint32_t s;
-            lbk_dls_cluster_set_get(v, c, i, &s);
-            member |= s == set;
-        }
-        if (member && lbk_dls_cluster_decode(v, c, gather, e) != LBK_OK) return -1;
-        if (e->failed) return -1;
-    }
-    return 0;
-}
-
-typedef struct keyed {
-    uint64_t key;
-    uint64_t index;
-} keyed;
-
-static int cmp_keyed(const void *x, const void *y)
-{
-    const keyed *a = x, *b = y;
-    return (a->key > b->key) - (a->key < b->key);
-}
-
-/* Texel targets become (page, y, x) keys so bakes whose pages differ in size still line up;
- * probe targets are their index. Sorted, because entry order depends on the clustering. */
-static keyed *sorted_keys(const tl_bake *bk, const set_entries *e)
-{
-    keyed *k = malloc(((size_t)e->count + 1) * sizeof *k);
-    if (!k) return NULL;
-    for (uint64_t i = 0; i < e->count; i++) {
-        uint64_t key = e->targets[i];
-        if (e->space == LBK_DLS_SPACE_TEXEL && bk->has_lmap) {
-            for (uint32_t page = bk->lmap.page_count; page-- > 0;) { /* pages ascend by first_texel */
-                lbk_lmap_planes pg;
-                lbk_lmap_planes_get(&bk->lmap, page, &pg);
-                if (pg.first_texel > e->targets[i]) continue;
-                const uint64_t local = e->targets[i] - pg.first_texel;
-                key = ((uint64_t)page << 32) | ((local / pg.width) << 16) | (local % pg.width);
-                break;
-            }
-        }
-        k[i] = (keyed){key, i};
-    }
-    qsort(k, (size_t)e->count, sizeof *k, cmp_keyed);
-    return k;
-}
-
-/* The scale DLS payloads of a space are stored in: their base section's (spec §12.2). */
-static float space_scale(const tl_bake *b, uint32_t space)
-{
-    if (space == LBK_DLS_SPACE_TEXEL) return b->has_lmap ? b->lmap.scale : 1.0f;
-    if (space == LBK_DLS_SPACE_GLG) return b->has_glg ? b->glg.scale : 1.0f;
-    return b->has_llg ? b->llg.scale : 1.0f;
-}
-
-static void eval_payload(uint32_t space, const uint8_t *p, float scale, float *out)
-{
-    if (space == LBK_DLS_SPACE_TEXEL) {
-        lbk_ahd_texel t;
-        if (p) lbk_ahd_texel_unpack(p, &t);
-        else memset(&t, 0, sizeof t);
-        tl_texel_eval(&t, scale, (float(*)[3])out);
-    } else {
-        lbk_sh9_rgb s;
-        if (p) tl_probe_unpack(p, scale, &s);
-        else memset(&s, 0, sizeof s);
-        tl_probe_eval(&s, (float(*)[3])out);
-    }
-}
-
-/* Can the targets of a space be lined up? Texels always can (by page and position); probes when
- * both grids have the same layout. */
-static int space_comparable(const tl_bake *a, const tl_bake *b, uint32_t space)
-{
-    if (space == LBK_DLS_SPACE_TEXEL) return a->has_lmap && b->has_lmap;
-    if (lbk_dls_target_count(a->dls, space) != lbk_dls_target_count(b->dls, space)) return 0;
-    if (space == LBK_DLS_SPACE_GLG) return a->has_glg && b->has_glg && glg_same_layout(a, b);
-    if (!a->has_llg || !b->has_llg || a->llg.grid_count != b->llg.grid_count) return 0;
-    for (uint32_t g = 0; g < a->llg.grid_count; g++) {
-        lbk_llg_grid ga, gb;
-        lbk_llg_grid_get(&a->llg, g, &ga);
-        lbk_llg_grid_get(&b->llg, g, &gb);
-        if (memcmp(ga.dims, gb.dims, sizeof ga.dims)) return 0;
-    }
-    return 1;
-}
-
-static double lum3(const float *c) { return LBK_LUM_R * c[0] + LBK_LUM_G * c[1] + LBK_LUM_B * c[2]; }
-
-/* The luminance at +Z of the base lightmap's texel under a texel key (0 where none). */
-static double base_level(const tl_bake *bk, uint64_t key)
-{
-    float v[TL_TEXEL_NORMALS][3];
-    if (tl_bake_texel_eval(bk, (uint32_t)(key >> 32), (uint32_t)(key & 0xFFFF), (uint32_t)((key >> 16) & 0xFFFF), v))
-        return 0;
-    return lum3(v[0]);
-}
-
-/* The mean luminance over the probe normals of the base probe under a probe key (GLG or LLG
- * space; 0 where none). */
-static double base_probe_level(const tl_bake *bk, uint32_t space, uint64_t key)
-{
-    lbk_sh9_rgb sh;
-    float pos[3], e[TL_PROBE_NORMALS][3];
-    if (space == LBK_DLS_SPACE_GLG && bk->has_glg && key < bk->glg.probe_count)
-        lbk_glg_probe_get(&bk->glg, (uint32_t)key, pos, &sh);
-    else if (space == LBK_DLS_SPACE_LLG && bk->has_llg && key < bk->llg.probe_count)
-        tl_probe_unpack(bk->llg.probes + key * LBK_SH9_PACKED_SIZE, bk->llg.scale, &sh);
-    else
-        return 0;
-    tl_probe_eval(&sh, e);
-    double l = 0;
-    for (int k = 0; k < TL_PROBE_NORMALS; k++) l += lum3(e[k]) / TL_PROBE_NORMALS;
-    return l;
-}
-
-static double probe_level(const float *v)
-{
-    double l = 0;
-    for (int k = 0; k < TL_PROBE_NORMALS; k++) l += lum3(v + 3 * k) / TL_PROBE_NORMALS;
-    return l;
-}
-
-/* A set's probe entries, like its texel entries, carry the noise of the full runs: REPT's probe
- * estimate relative to entry + base probe, and for the mean test that × RMS(entry + base) / mean
- * entry (*mean_scale; 1 when the set has no light). */
-static void set_probe_scale(const tl_bake *bk, const set_entries *e, double *mean_scale)
-{
-    double sum_lev = 0, sum_ref2 = 0;
-    for (uint64_t i = 0; i < e->count; i++) {
-        float v[TL_PROBE_NORMALS * 3];
-        eval_payload(e->space, e->payloads + (size_t)i * e->payload, space_scale(bk, e->space), v);
-        const double lev = probe_level(v), ref = lev + base_probe_level(bk, e->space, e->targets[i]);
-        sum_lev += lev, sum_ref2 += ref * ref;
-    }
-    *mean_scale = sum_lev > 0 ? sqrt(sum_ref2 / (double)e->count) / (sum_lev / (double)e->count) : 1;
-}
-
-static const keyed *find_key(const keyed *k, uint64_t n, uint64_t key)
-{
-    const keyed probe = {key, 0};
-    return bsearch(&probe, k, (size_t)n, sizeof *k, cmp_keyed);
-}
-
-/* A light set's texel entries carry the noise of the full runs they came from (a door's open
- * state is the difference of two), so their noise is relative to the entry plus the base texel
- * under it, not to the entry alone: a door's closed-state entries are 5 % of the base light and
- * their own relative noise 25× the base's (bench/diff_reseed.py, room_sets_doors). Measured as
- * objects' is (rect_noise), from the set's own texels: the high-pass of each entry against its 4
- * neighbours 1 and 2 texels away, relative to entry + base, the larger robust spread (-1 when
- * under 16 entries have all four neighbours). Into *mean_scale the factor that turns it into the
- * noise of the set's mean: RMS of (entry + base) over the mean entry. */
-static double set_texel_noise(const tl_bake *bk, const set_entries *e, const keyed *k, double *mean_scale)
-{
-    *mean_scale = 1;
-    /* per sorted entry: its level, its reference level (entry + base: one texel lookup each),
-     * and the residuals */
-    double *lev = malloc(sizeof *lev * (size_t)(3 * e->count + 1)), *ref = lev ? lev + e->count : NULL;
-    double *r = lev ? ref + e->count : NULL;
-    if (!lev) return -1;
-    double sum_lev = 0, sum_ref2 = 0;
-    for (uint64_t i = 0; i < e->count; i++) {
-        float v[TL_TEXEL_NORMALS * 3];
-        eval_payload(LBK_DLS_SPACE_TEXEL, e->payloads + (size_t)k[i].index * e->payload, space_scale(bk, e->space), v);
-        lev[i] = lum3(v);
-        ref[i] = lev[i] + base_level(bk, k[i].key);
-        sum_lev += lev[i], sum_ref2 += ref[i] * ref[i];
-    }
-    double s = -1;
-    for (uint64_t d = 1; d <= TL_NOISE_HIGHPASS_REACH; d *= 2) { /* as tl_noise_highpass */
-        size_t n = 0;
-        for (uint64_t i = 0; i < e->count; i++) {
-            const uint64_t key = k[i].key, x = key & 0xFFFF, y = (key >> 16) & 0xFFFF;
-            if (x < d || y < d || x + d > 0xFFFF || y + d > 0xFFFF) continue;
-            const keyed *nb[4] = {find_key(k, e->count, key - d), find_key(k, e->count, key + d),
-                                  find_key(k, e->count, key - (d << 16)), find_key(k, e->count, key + (d << 16))};
-            if (!nb[0] || !nb[1] || !nb[2] || !nb[3]) continue; /* at the set's or the chart's edge */
-            if (!(ref[i] > 0)) continue;
-            r[n++] = (lev[i] - 0.25 * (lev[nb[0] - k] + lev[nb[1] - k] + lev[nb[2] - k] + lev[nb[3] - k])) / ref[i];
-        }
-        s = fmax(s, tl_noise_robust_sigma(r, n));
-    }
-    if (sum_lev > 0) *mean_scale = sqrt(sum_ref2 / (double)e->count) / (sum_lev / (double)e->count);
-    free(lev);
-    return s;
-}
-
-/* The relative noise of one side's set texel entries (set_texel_noise; REPT's estimate spread
- * as for probes when too few to measure, and at least REPT's when the bake was denoised) and the
- * noise of the set's mean, for tl_noise_begin. */
-static double set_texel_side_noise(const tl_bake *bk, const set_entries *e, const keyed *k, const tl_noise_model *m,
-                                   int side, double *mean_noise, double *scale)
-{
-    double s = set_texel_noise(bk, e, k, scale);
-    if (s < 0) s = TL_NOISE_REPT_SPREAD * m->rept[side][0];
-    s = fmax(s, texel_floor(m, side));
-    *mean_noise = s * *scale;
-    return s;
-}
-
-static int compare_set_space(const tl_bake *a, uint32_t sa, const tl_bake *b, uint32_t sb, uint32_t space, const tol *t,
-                             tl_err_stats *st, tl_noise_stats *ns)
-{
-    const int kind = space == LBK_DLS_SPACE_TEXEL ? 0 : 1;
-    set_entries ea, eb;
-    keyed *ka = NULL, *kb = NULL;
-    int rc = -1;
-    memset(&eb, 0, sizeof eb);
-    if (collect_set(a->dls, sa, space, &ea) || collect_set(b->dls, sb, space, &eb)) goto out;
-    if (!(ka = sorted_keys(a, &ea)) || !(kb = sorted_keys(b, &eb))) goto out;
-    lbk_dls_set_info info;
-    lbk_dls_set_get(a->dls, sa, &info);
-    const int door = info.kind != LBK_DLS_KIND_LIGHTS; /* differences of runs: heavier tails */
-    double ta = 0, tb = 0; /* set texels: the entries' noise relative to entry + base */
-    if (t->noise && kind == 0) {
-        double ma, mb, ga, gb;
-        ta = set_texel_side_noise(a, &ea, ka, t->noise, 0, &ma, &ga);
-        tb = set_texel_side_noise(b, &eb, kb, t->noise, 1, &mb, &gb);
-        tl_noise_begin(ns, t->noise, door ? TL_NOISE_DOOR_TEXELS : TL_NOISE_SET_TEXELS, ma, mb);
-        /* the part common to every receiver of a run is relative to entry + base as well */
-        ns->noise_common = t->noise->common * hypot(ga * t->noise->rept[0][0], gb * t->noise->rept[1][0]);
-    } else if (t->noise) {
-        double ga, gb;
-        set_probe_scale(a, &ea, &ga);
-        set_probe_scale(b, &eb, &gb);
-        const double ra = t->noise->rept[0][1], rb = t->noise->rept[1][1];
-        tl_noise_begin(ns, t->noise, door ? TL_NOISE_DOOR_PROBES : TL_NOISE_SET_PROBES, ra * ga, rb * gb);
-        ns->noise_common = t->noise->common * hypot(ga * ra, gb * rb);
-        ta = ra, tb = rb;
-    }
-    uint64_t i = 0, j = 0;
-    const int n = space == LBK_DLS_SPACE_TEXEL ? TL_TEXEL_NORMALS : TL_PROBE_NORMALS;
-    while (i < ea.count || j < eb.count) {
-        const uint8_t *pa = NULL, *pb = NULL;
-        uint64_t key;
-        if (j >= eb.count || (i < ea.count && ka[i].key < kb[j].key)) {
-            key = ka[i].key;
-            pa = ea.payloads + (size_t)ka[i++].index * ea.payload;
-        } else if (i >= ea.count || kb[j].key < ka[i].key) {
-            key = kb[j].key;
-            pb = eb.payloads + (size_t)kb[j++].index * eb.payload;
-        } else {
-            key = ka[i].key;
-            pa = ea.payloads + (size_t)ka[i++].index * ea.payload;
-            pb = eb.payloads + (size_t)kb[j++].index * eb.payload;
-        }
-        float va[TL_PROBE_NORMALS * 3], vb[TL_PROBE_NORMALS * 3];
-        eval_payload(space, pa, space_scale(a, space), va);
-        eval_payload(space, pb, space_scale(b, space), vb);
-        /* texels: x = position in page, y = row; probes: x = index */
-        uint32_t x = space == LBK_DLS_SPACE_TEXEL ? (uint32_t)(key & 0xFFFF) : (uint32_t)key;
-        uint32_t y = space == LBK_DLS_SPACE_TEXEL ? (uint32_t)((key >> 16) & 0xFFFF) : 0;
-        add_sample(st, va, vb, n, t, x, y, NULL);
-        if (t->noise && kind == 0)
-            tl_noise_add_ref(ns, t->noise, va, vb, n, ta, tb, lum3(va) + base_level(a, key),
-                             lum3(vb) + base_level(b, key));
-        else if (t->noise)
-            tl_noise_add_ref(ns, t->noise, va, vb, n, ta, tb, probe_level(va) + base_probe_level(a, space, key),
-                             probe_level(vb) + base_probe_level(b, space, key));
-    }
-    if (t->noise) tl_noise_end(ns, t->noise);
-    rc = 0;
-out:
-    free(ka), free(kb);
-    free(ea.targets), free(ea.payloads), free(eb.targets), free(eb.payloads);
-    return rc;
-}
-
-static void set_name(const lbk_dls_view *v, uint32_t s, char *out, size_t size)
-{
-    lbk_dls_set_info si;
-    lbk_dls_set_get(v, s, &si);
-    tl_string_copy(out, size, (lbk_string){si.name, si.name_length});
-}
-
-static int set_meta_equal(const tl_bake *a, uint32_t sa, const tl_bake *b, uint32_t sb)
-{
-    lbk_dls_set_info ia, ib;
-    lbk_dls_set_get(a->dls, sa, &ia);
-    lbk_dls_set_get(b->dls, sb, &ib);
-    if (ia.kind != ib.kind || ia.light_count != ib.light_count || ia.member_count != ib.member_count) return 0;
-    for (uint32_t i = 0; i < ia.light_count; i++) {
-        const char *na, *nb;
-        uint32_t la, lb;
-        lbk_dls_set_light_get(a->dls, sa, i, &na, &la);
-        lbk_dls_set_light_get(b->dls, sb, i, &nb, &lb);
-        if (la != lb || memcmp(na, nb, la)) return 0;
-    }
-    for (uint32_t i = 0; i < ia.member_count; i++) {
-        uint32_t ma, mb;
-        char xa[128], xb[128];
-        lbk_dls_set_member_get(a->dls, sa, i, &ma);
-        lbk_dls_set_member_get(b->dls, sb, i, &mb);
-        set_name(a->dls, ma, xa, sizeof xa);
-        set_name(b->dls, mb, xb, sizeof xb);
-        if (strcmp(xa, xb)) return 0;
-    }
-    return 1;
-}
-
-static int diff_sets(const tl_bake *a, const tl_bake *b, const tol *t, tl_diff_result *r)
-{
-    const uint32_t na = a->dls ? lbk_dls_set_count(a->dls) : 0, nb = b->dls ? lbk_dls_set_count(b->dls) : 0;
-    r->sets = calloc((size_t)na + nb + 1, sizeof *r->sets);
-    if (!r->sets) return -1;
-    int comparable[LBK_DLS_SPACE_COUNT_] = {0};
-    if (a->dls && b->dls)
-        for (uint32_t sp = 0; sp < LBK_DLS_SPACE_COUNT_; sp++) comparable[sp] = space_comparable(a, b, sp);
-    for (uint32_t s = 0; s < na; s++) {
-        tl_diff_set *d = &r->sets[r->set_count++];
-        set_name(a->dls, s, d->name, sizeof d->name);
-        uint32_t sb;
-        if (!b->dls || lbk_dls_set_find(b->dls, d->name, &sb) != LBK_OK) {
-            d->status = TL_DIFF_REMOVED;
-            r->sets_changed++;
-            continue;
-        }
-        d->meta_changed = !set_meta_equal(a, s, b, sb);
-        int over = 0;
-        for (uint32_t sp = 0; sp < LBK_DLS_SPACE_COUNT_; sp++) {
-            if (lbk_dls_target_count(a->dls, sp) == 0 && lbk_dls_target_count(b->dls, sp) == 0) continue;
-            if (!comparable[sp]) {
-                d->not_comparable[sp] = 1;
-                continue;
-            }
-            d->compared[sp] = 1;
-            if (compare_set_space(a, s, b, sb, sp, t, &d->lighting[sp], &d->noise[sp])) return -1;
-            if (t->noise) {
-                over |= !d->noise[sp].within_noise;
-                r->items_beyond_noise += !d->noise[sp].within_noise;
-            } else {
-                over |= d->lighting[sp].over > 0;
-            }
-            if (sp == LBK_DLS_SPACE_TEXEL) r->texels_over += d->lighting[sp].over;
-            else r->probes_over += d->lighting[sp].over;
-        }
-        int nc = 0;
-        for (uint32_t sp = 0; sp < LBK_DLS_SPACE_COUNT_; sp++) nc |= d->not_comparable[sp];
-        d->status = (over || d->meta_changed || nc) ? TL_DIFF_CHANGED : TL_DIFF_SAME;
-        if (d->status != TL_DIFF_SAME) r->sets_changed++;
-    }
-    for (uint32_t s = 0; s < nb; s++) {
-        char name[128];
-        set_name(b->dls, s, name, sizeof name);
-        uint32_t x;
-        if (a->dls && lbk_dls_set_find(a->dls, name, &x) == LBK_OK) continue;
-        tl_diff_set *d = &r->sets[r->set_count++];
-        memcpy(d->name, name, sizeof name);
-        d->status = TL_DIFF_ADDED;
-        r->sets_changed++;
-    }
-    return 0;
-}
-
-/* ---- doors ---------------------------------------------------------------------------------- */
-
-static int door_find(const tl_bake *b, const char *name, lbk_door_info *out)
-{
-    if (!b->door) return 0;
-    for (uint32_t i = 0; i < lbk_door_count(b->door); i++) {
-        lbk_door_get(b->door, i, out);
-        if (strlen(name) == out->name_length && !memcmp(name, out->name, out->name_length)) return 1;
-    }
-    return 0;
-}
-
-static int door_equal(const tl_bake *a, const lbk_door_info *da, const tl_bake *b, const lbk_door_info *db)
-{
-    if (memcmp(da->centre, db->centre, sizeof da->centre) || memcmp(da->axes, db->axes, sizeof da->axes) ||
-        memcmp(da->half_extents, db->half_extents, sizeof da->half_extents))
-        return 0;
-    char x[128], y[128];
-    set_name(a->dls, da->open_set, x, sizeof x);
-    set_name(b->dls, db->open_set, y, sizeof y);
-    if (strcmp(x, y)) return 0;
-    if ((da->closed_set == LBK_DLS_NO_SET) != (db->closed_set == LBK_DLS_NO_SET)) return 0;
-    if (da->closed_set != LBK_DLS_NO_SET) {
-        set_name(a->dls, da->closed_set, x, sizeof x);
-        set_name(b->dls, db->closed_set, y, sizeof y);
-        if (strcmp(x, y)) return 0;
-    }
-    return 1;
-}
-
-static int diff_doors(const tl_bake *a, const tl_bake *b, tl_diff_result *r)
-{
-    const uint32_t na = a->door ? lbk_door_count(a->door) : 0, nb = b->door ? lbk_door_count(b->door) : 0;
-    r->doors = calloc((size_t)na + nb + 1, sizeof *r->doors);
-    if (!r->doors) return -1;
-    for (uint32_t i = 0; i < na; i++) {
-        lbk_door_info da, db;
-        lbk_door_get(a->door, i, &da);
-        tl_diff_door *d = &r->doors[r->door_count++];
-        tl_string_copy(d->name, sizeof d->name, (lbk_string){da.name, da.name_length});
-        if (!door_find(b, d->name, &db)) d->status = TL_DIFF_REMOVED;
-        else d->status = door_equal(a, &da, b, &db) ? TL_DIFF_SAME : TL_DIFF_CHANGED;
-        if (d->status != TL_DIFF_SAME) r->doors_changed++;
-    }
-    for (uint32_t i = 0; i < nb; i++) {
-        lbk_door_info db, da;
-        lbk_door_get(b->door, i, &db);
-        char name[128];
-        tl_string_copy(name, sizeof name, (lbk_string){db.name, db.name_length});
-        if (door_find(a, name, &da)) continue;
-        tl_diff_door *d = &r->doors[r->door_count++];
-        memcpy(d->name, name, sizeof name);
-        d->status = TL_DIFF_ADDED;
-        r->doors_changed++;
-    }
-    return 0;
 }
 
 /* ---- driver -------------------------------------------------------------------------------- */
@@ -1076,7 +617,7 @@ static void bake_levels(const tl_bake *b, double out[2])
             for (uint32_t x = 0; x < pg.pl.width; x++) {
                 float t[TL_TEXEL_NORMALS][3];
                 texel_values(&pg, x, y, t);
-                const double l = LBK_LUM_R * t[0][0] + LBK_LUM_G * t[0][1] + LBK_LUM_B * t[0][2];
+                const double l = tl_noise_level(t[0], 0, 1);
                 if (l > 0) v[n++] = l;
             }
     }
@@ -1088,8 +629,7 @@ static void bake_levels(const tl_bake *b, double out[2])
         if (i < glg) lbk_glg_probe_get(&b->glg, (uint32_t)i, pos, &sh);
         else tl_probe_unpack(b->llg.probes + (i - glg) * LBK_SH9_PACKED_SIZE, b->llg.scale, &sh);
         tl_probe_eval(&sh, e);
-        double l = 0;
-        for (int k = 0; k < TL_PROBE_NORMALS; k++) l += (LBK_LUM_R * e[k][0] + LBK_LUM_G * e[k][1] + LBK_LUM_B * e[k][2]) / TL_PROBE_NORMALS;
+        const double l = tl_noise_level(e[0], 1, TL_PROBE_NORMALS);
         if (l > 0) v[n++] = l;
     }
     out[1] = median_level(v, n);
@@ -1130,7 +670,7 @@ int tl_diff_run(const tl_bake *a, const tl_bake *b, const tl_diff_options *o, tl
     choose_mode(a, b, o, r, &r->noise);
     tol t = {o->abs_tol, o->rel_tol, r->mode == TL_DIFF_MODE_NOISE ? &r->noise : NULL};
     if (diff_sections(a, b, r) || diff_params(a, b, r) || diff_objects(a, b, &t, r) ||
-        diff_pages(a, b, &t, o->keep_error_maps, r) || diff_sets(a, b, &t, r) || diff_doors(a, b, r) ||
+        diff_pages(a, b, &t, o->keep_error_maps, r) || tl_diff_sets_run(a, b, o->abs_tol, o->rel_tol, t.noise, r) || tl_diff_doors_run(a, b, r) ||
         tl_diff_provenance(a, b, r)) {
         snprintf(err, TL_ERR_LEN, "out of memory");
         tl_diff_free(r);

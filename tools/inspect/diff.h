@@ -193,6 +193,17 @@ int tl_diff_provenance(const tl_bake *a, const tl_bake *b, tl_diff_result *resul
 void tl_diff_octp_run(const tl_bake *a, const tl_bake *b, double abs_tol, double rel_tol, const tl_noise_model *noise,
                       tl_diff_result *result);
 
+/* Light-set part of tl_diff_run (diff_sets.c): each light set, door state and combination per
+ * target space into result->sets, adds to texels_over, probes_over, items_beyond_noise and
+ * sets_changed (noise NULL: tolerance mode). Returns 0, or -1 when out of memory. */
+int tl_diff_sets_run(const tl_bake *a, const tl_bake *b, double abs_tol, double rel_tol, const tl_noise_model *noise,
+                     tl_diff_result *result);
+/* Door part of tl_diff_run (diff_sets.c): each door's placement and sets into result->doors.
+ * Returns 0, or -1 when out of memory. */
+int tl_diff_doors_run(const tl_bake *a, const tl_bake *b, tl_diff_result *result);
+/* Both GLGs have the same probes at the same positions, so they line up by index. */
+int tl_diff_glg_same_layout(const tl_bake *a, const tl_bake *b);
+
 /* Compares two opened bakes. Returns 0, or -1 (out of memory; err says so). */
 int tl_diff_run(const tl_bake *a, const tl_bake *b, const tl_diff_options *options, tl_diff_result *out,
                 char err[TL_ERR_LEN]);

@@ -85,7 +85,9 @@ void tl_noise_begin(tl_noise_stats *s, const tl_noise_model *m, int cls, double 
 
 static double lum(const float *c) { return LBK_LUM_R * c[0] + LBK_LUM_G * c[1] + LBK_LUM_B * c[2]; }
 
-static double level(const float *v, int kind, int n)
+double tl_noise_texel_floor(const tl_noise_model *m, int side) { return m->denoised[side] ? m->rept[side][0] : 0; }
+
+double tl_noise_level(const float *v, int kind, int n)
 {
     if (kind == 0) return lum(v); /* texels: +Z, the first normal */
     double l = 0;
@@ -104,7 +106,7 @@ static double sample_deviation(const tl_noise_model *m, int cls, double t_a, dou
     const double ca = m->common * m->rept[0][c->kind], cb = m->common * m->rept[1][c->kind];
     const double spread = c->sample_spread * (m->texel_spread > 0 ? m->texel_spread : 1);
     const double ta = spread * t_a, tb = spread * t_b;
-    const double la = level(a, c->kind, n), lb = level(b, c->kind, n), d = lb - la;
+    const double la = tl_noise_level(a, c->kind, n), lb = tl_noise_level(b, c->kind, n), d = lb - la;
     const double fa = c->floor_scale * m->rept[0][c->kind] * m->level_ref[0][c->kind];
     const double fb = c->floor_scale * m->rept[1][c->kind] * m->level_ref[1][c->kind];
     const double ra = ref_a >= 0 ? ref_a : la, rb = ref_b >= 0 ? ref_b : lb;

@@ -112,6 +112,13 @@ typedef struct tl_noise_model {
     double texel_spread;
 } tl_noise_model;
 
+/* A denoised bake's texels are at least REPT's noise (tl_noise_model.denoised): the floor of one
+ * side's texel noise, 0 when that side was not denoised. */
+double tl_noise_texel_floor(const tl_noise_model *m, int side);
+/* The level a sample is judged at: luminance at +Z (the first normal) for texels (kind 0), the
+ * mean luminance over the n normals for probes (kind 1). */
+double tl_noise_level(const float *v, int kind, int n);
+
 /* α → the model's thresholds; rept from the two bakes. */
 void tl_noise_model_init(tl_noise_model *m, double false_alarm, const double rept_a[2], const double rept_b[2]);
 /* Φ⁻¹(p) for 0 < p < 1. */
