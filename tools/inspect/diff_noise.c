@@ -34,19 +34,25 @@ double tl_normal_quantile(double p)
  * 6–9e-4 of a light set's texel entries, a run of one lamp alone (1e-3); a door state's entries,
  * differences of runs clamped at 0, had 3 % of samples beyond k_sample and u RMS 2.2 (p₀ 8 %,
  * p_x 2 %).
+ * χ_c 0.15 (texels) and 0.6 (probes), with each channel's share (chroma_end), from 20 reseed
+ * pairs per scene at both presets: the largest chroma_z/k_chroma became 0.29 (texels, fast), 0.63
+ * (texels, high) and 0.67 (cornell_box_bjs's GLG at the high preset; at χ_c 0.3 it was beyond
+ * noise in 2 of 20). Before the share, χ_c was 0.3 for both, and the high preset's GLG was beyond
+ * noise in 7 of 20 pairs, its texels in 2 of 180. Probes' common shift is the larger part of
+ * theirs, as for the luminance (κ 1.5).
  * φ 0.1: a texel far darker than the bake's median level (a room lit only through a leak) has an
  * absolute noise floor of 0.1·r·level_ref; without it leak_rooms' texels were beyond 3.29σ in
  * 27 % of the samples and its dark LLG prop shifted by −88 %. */
 static const tl_noise_class_params classes[TL_NOISE_CLASS_COUNT_] = {
     /* name          kind  κ    ρ    p₀    χ    χ_c  ν    φ    p_x */
-    {"texels",       0,   1.0, 1.0, 0.02, 2.0, 0.3, 4.0, 0.1, 5e-4},
-    {"glg",          1,   1.5, 3.0, 0.05, 2.0, 0.3, 9.0, 0.1, 1e-5},
-    {"llg",          1,   1.5, 8.0, 0.08, 2.0, 0.3, 9.0, 0.1, 0.02},
-    {"octp",         1,   1.5, 3.0, 0.05, 2.0, 0.3, 9.0, 0.1, 1e-5},
-    {"set_texels",   0,   1.0, 1.0, 0.02, 2.0, 0.3, 4.0, 0.1, 1e-3},
-    {"set_probes",   1,   1.5, 3.0, 0.05, 2.0, 0.3, 9.0, 0.1, 1e-5},
-    {"door_texels",  0,   1.0, 1.0, 0.08, 2.0, 0.3, 4.0, 0.1, 0.02},
-    {"door_probes",  1,   1.5, 3.0, 0.05, 2.0, 0.3, 9.0, 0.1, 1e-5},
+    {"texels",       0,   1.0, 1.0, 0.02, 2.0, 0.15, 4.0, 0.1, 5e-4},
+    {"glg",          1,   1.5, 3.0, 0.05, 2.0, 0.60, 9.0, 0.1, 1e-5},
+    {"llg",          1,   1.5, 8.0, 0.08, 2.0, 0.60, 9.0, 0.1, 0.02},
+    {"octp",         1,   1.5, 3.0, 0.05, 2.0, 0.60, 9.0, 0.1, 1e-5},
+    {"set_texels",   0,   1.0, 1.0, 0.02, 2.0, 0.15, 4.0, 0.1, 1e-3},
+    {"set_probes",   1,   1.5, 3.0, 0.05, 2.0, 0.60, 9.0, 0.1, 1e-5},
+    {"door_texels",  0,   1.0, 1.0, 0.08, 2.0, 0.15, 4.0, 0.1, 0.02},
+    {"door_probes",  1,   1.5, 3.0, 0.05, 2.0, 0.60, 9.0, 0.1, 1e-5},
 };
 
 const tl_noise_class_params *tl_noise_class_get(int cls)
@@ -179,15 +185,22 @@ uint64_t tl_binomial_critical(uint64_t n, double p, double q)
     }
 }
 
-/* The chromaticity test of tl_noise_end: g_C with its noise, the model's or the samples' own. */
+/* The chromaticity test of tl_noise_end: g_C with its noise, the model's or the samples' own,
+ * and the common part, (χ_c·c)·√(1/λ_C − 1)·r: if each channel's whole-bake factor varies
+ * independently, with a relative spread that grows as 1/√λ_C (its light comes from a λ_C share
+ * of the paths), g_C = δ_C − Σλ_K·δ_K has variance ∝ 1/λ_C − 1. Measured on the reseed pairs
+ * (bench/diff_reseed.py): the spread of g_C over this was the same for R, G and B, 0.15 × c·√(r_A² + r_B²)
+ * on cornell_box_bjs's GLG at the fast preset, where a χ_c without the factor read blue (7 % of
+ * the luminance under red and green walls) at 2.8× the luminance's common shift at the high
+ * preset: 7 of 20 reseed pairs beyond noise. */
 static void chroma_end(tl_noise_stats *s, const tl_noise_model *m, const tl_noise_class_params *c, double n)
 {
     const double la = LBK_LUM_R * s->sum_ca[0] + LBK_LUM_G * s->sum_ca[1] + LBK_LUM_B * s->sum_ca[2];
     const double lb = LBK_LUM_R * s->sum_cb[0] + LBK_LUM_G * s->sum_cb[1] + LBK_LUM_B * s->sum_cb[2];
     const double model = c->chroma_scale * c->chroma_scale * (s->noise_a * s->noise_a + s->noise_b * s->noise_b) / n;
-    const double common = c->chroma_common * s->noise_common;
+    const double weight[3] = {LBK_LUM_R, LBK_LUM_G, LBK_LUM_B};
     s->chroma_z = 0;
-    s->chroma_noise = sqrt(model + common * common);
+    s->chroma_noise = sqrt(model);
     for (int k = 0; k < 3; k++) {
         s->chroma_shift[k] = 0;
         if (!(la > 0) || !(lb > 0)) continue;
@@ -198,6 +211,8 @@ static void chroma_end(tl_noise_stats *s, const tl_noise_model *m, const tl_nois
         const double sc = s->sum_ca[k], sx = (s->sum_cb[k] - sc) / sc - (lb - la) / la;
         const double sxx = s->sum_dcdc[k] / (sc * sc) - 2 * s->sum_dcdl[k] / (sc * la) + s->sum_dd / (la * la);
         const double emp = c->empirical_scale * fmax(sxx - sx * sx / n, 0);
+        const double share = weight[k] * sc / la; /* λ_C ≥ w_C · TL_NOISE_CHROMA_MIN_SHARE > 0 */
+        const double common = c->chroma_common * s->noise_common * sqrt(fmax(1 / share - 1, 0));
         const double sigma = sqrt(fmax(model, emp) + common * common);
         const double z = sigma > 0 ? fabs(s->chroma_shift[k]) / sigma : (s->chroma_shift[k] != 0 ? INFINITY : 0);
         if (k == 0 || z > s->chroma_z) s->chroma_z = z, s->chroma_noise = sigma;

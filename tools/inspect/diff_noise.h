@@ -15,7 +15,9 @@
  *   chromaticity shift, per channel C of R, G, B: g_C = (ΣC_b/ΣL_b) / (ΣC_a/ΣL_a) − 1 (L the
  *               luminance; a channel below TL_NOISE_CHROMA_MIN_SHARE of the luminance on either
  *               side is not tested); its noise σ_g² = max(χ²·(s_A² + s_B²)/N, ν·SE_g²) +
- *               (χ_c·c)²·(r_A² + r_B²),
+ *               (χ_c·c)²·(1/λ_C − 1)·(r_A² + r_B²), λ_C = w_C·ΣC_a/ΣL_a the channel's share of
+ *               A's luminance (w_C its luminance weight): a channel's common shift relative to
+ *               the luminance's grows as its share falls (diff_noise.c, chroma_end);
  *               χ, χ_c the class's; significant when max |g_C|/σ_g > k_chroma = Φ⁻¹(1 − α/18);
  *   significant samples: a sample is significant when |b₀ − a₀| > k_sample·σ (k_sample =
  *               3.29 whatever α), b₀, a₀ its level (texels: luminance at +Z; probes: the mean over
