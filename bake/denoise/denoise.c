@@ -492,13 +492,14 @@ typedef struct dn_error_sums {
 } dn_error_sums;
 
 /* Receiver i's terms: the same floats the filter started from (x, δ), so that an unfiltered
- * receiver adds no bias, and its filtered channels (f NULL: unfiltered, the identity). */
-static void sums_add(dn_error_sums *s, const float *halves, const float *f, size_t stride, size_t i)
+ * receiver adds no bias, and its filtered channels (f NULL: unfiltered, the identity); its noise
+ * from cross (bk_denoiser_cross_delta) when not NULL, else the filtered δ. */
+static void sums_add(dn_error_sums *s, const float *halves, const float *f, size_t stride, const float *cross, size_t i)
 {
     const double x = 0.5f * (halves[2 * i] + halves[2 * i + 1]);
     const double dl = 0.5f * (halves[2 * i] - halves[2 * i + 1]);
-    const double fx = f ? f[i * stride] : x, fd = f ? f[i * stride + 1] : dl;
-    s->noise += fd * fd;
+    const double fx = f ? f[i * stride] : x, fd = f ? f[i * stride + 1] : dl, nd = cross ? cross[i] : fd;
+    s->noise += nd * nd;
     s->bias += (fx - x) * (fx - x) - (fd - dl) * (fd - dl);
     s->den += fx * fx;
 }
@@ -514,14 +515,14 @@ static void sums_finish(const dn_error_sums *s, double *rel, double *noise, doub
 }
 
 /* The estimate of one input from its filtered channels f (X then δ per receiver). */
-static void error_from_filtered(const float *halves, const float *f, size_t stride, const size_t class_end[BK_RECEIVER_CLASSES],
-                                bk_denoise_error *out)
+static void error_from_filtered(const float *halves, const float *f, size_t stride, const float *cross,
+                                const size_t class_end[BK_RECEIVER_CLASSES], bk_denoise_error *out)
 {
     dn_error_sums sum[BK_RECEIVER_CLASSES];
     memset(sum, 0, sizeof sum);
     size_t i = 0;
     for (int k = 0; k < BK_RECEIVER_CLASSES; k++)
-        for (; i < class_end[k]; i++) sums_add(&sum[k], halves, f, stride, i);
+        for (; i < class_end[k]; i++) sums_add(&sum[k], halves, f, stride, cross, i);
     for (int k = 0; k < BK_RECEIVER_CLASSES; k++) sums_finish(&sum[k], &out->rel_rmse[k], &out->noise[k], &out->bias[k]);
     const double pn = sum[BK_CLASS_GLG].noise + sum[BK_CLASS_LLG].noise, pd = sum[BK_CLASS_GLG].den + sum[BK_CLASS_LLG].den;
     const double pb = sum[BK_CLASS_GLG].bias > 0 ? sum[BK_CLASS_GLG].bias : 0; /* LLG: not filtered */
@@ -529,14 +530,15 @@ static void error_from_filtered(const float *halves, const float *f, size_t stri
 }
 
 /* The same per group of the first g->count receivers (f NULL: unfiltered). */
-static lbk_result groups_from_filtered(const float *halves, const float *f, size_t stride, const bk_denoise_groups *g)
+static lbk_result groups_from_filtered(const float *halves, const float *f, size_t stride, const float *cross,
+                                       const bk_denoise_groups *g)
 {
     memset(g->out, 0, g->group_count * sizeof *g->out);
     dn_error_sums *sum = calloc(g->group_count ? g->group_count : 1, sizeof *sum);
     if (!sum) return LBK_ERR_OUT_OF_MEMORY;
     for (size_t i = 0; i < g->count; i++) {
         if (g->group[i] >= g->group_count) continue;
-        sums_add(&sum[g->group[i]], halves, f, stride, i);
+        sums_add(&sum[g->group[i]], halves, f, stride, cross, i);
         g->out[g->group[i]].receivers++;
     }
     for (size_t k = 0; k < g->group_count; k++) {
@@ -557,7 +559,7 @@ static lbk_result groups_from_filtered(const float *halves, const float *f, size
 /* bk_denoiser_errors, and with g the first input's groups from the same filter pass. */
 static lbk_result errors_pass(const bk_denoiser *d, const float *const *halves, size_t count,
                               const size_t class_end[BK_RECEIVER_CLASSES], bk_denoise_error *out,
-                              const bk_denoise_groups *g)
+                              const bk_denoise_groups *g, const float *cross)
 {
     if (!out || !class_end || (count && !halves)) return LBK_ERR_INVALID_ARGUMENT;
     const size_t n = d ? d->receiver_count : class_end[BK_RECEIVER_CLASSES - 1];
@@ -581,8 +583,9 @@ static lbk_result errors_pass(const bk_denoiser *d, const float *const *halves, 
             }
         if (d && d->have_tex) r = texels_apply(d, f, ch);
         if (!r && d && d->have_probes) r = dn_probes_apply(&d->probes, f, ch);
-        for (size_t j = 0; j < m && !r; j++) error_from_filtered(halves[j0 + j], f + 2 * j, (size_t)ch, class_end, &out[j0 + j]);
-        if (!r && g && j0 == 0) r = groups_from_filtered(halves[0], f, (size_t)ch, g);
+        for (size_t j = 0; j < m && !r; j++)
+            error_from_filtered(halves[j0 + j], f + 2 * j, (size_t)ch, j0 + j ? NULL : cross, class_end, &out[j0 + j]);
+        if (!r && g && j0 == 0) r = groups_from_filtered(halves[0], f, (size_t)ch, cross, g);
     }
     free(f);
     const double secs = (bk_now() - t0) / (count ? (double)count : 1);
@@ -593,28 +596,74 @@ static lbk_result errors_pass(const bk_denoiser *d, const float *const *halves, 
 lbk_result bk_denoiser_errors(const bk_denoiser *d, const float *const *halves, size_t count,
                               const size_t class_end[BK_RECEIVER_CLASSES], bk_denoise_error *out)
 {
-    return errors_pass(d, halves, count, class_end, out, NULL);
+    return errors_pass(d, halves, count, class_end, out, NULL, NULL);
 }
 
 lbk_result bk_denoiser_error(const bk_denoiser *d, const float *halves, const size_t class_end[BK_RECEIVER_CLASSES],
                              bk_denoise_error *out)
 {
-    return errors_pass(d, &halves, 1, class_end, out, NULL);
+    return errors_pass(d, &halves, 1, class_end, out, NULL, NULL);
 }
 
 lbk_result bk_denoiser_error_groups(const bk_denoiser *d, const float *halves, const size_t class_end[BK_RECEIVER_CLASSES],
-                                    bk_denoise_error *out, const bk_denoise_groups *groups)
+                                    bk_denoise_error *out, const bk_denoise_groups *groups, const float *cross)
 {
     if (!class_end || !groups || !groups->out || (groups->count && !groups->group) ||
         groups->count > class_end[BK_RECEIVER_CLASSES - 1])
         return LBK_ERR_INVALID_ARGUMENT;
-    return errors_pass(d, &halves, 1, class_end, out, groups);
+    return errors_pass(d, &halves, 1, class_end, out, groups, cross);
 }
 
 lbk_result bk_denoise_groups_unfiltered(const float *halves, const bk_denoise_groups *groups)
 {
     if (!groups || !groups->out || (groups->count && (!halves || !groups->group))) return LBK_ERR_INVALID_ARGUMENT;
-    return groups_from_filtered(halves, NULL, 0, groups);
+    return groups_from_filtered(halves, NULL, 0, NULL, groups);
+}
+
+lbk_result bk_denoiser_create_half(const bk_denoise_inputs *in, const lbk_sh9_rgb *base, const float *base_variance,
+                                   const float *halves, int half, const bk_denoise_options *opt, bk_denoiser **out)
+{
+    if (!in || !base || !base_variance || !halves || !out || !in->radiance || !in->variance || half < 0 || half > 1)
+        return LBK_ERR_INVALID_ARGUMENT;
+    const size_t n = in->receiver_count;
+    lbk_sh9_rgb *guide = malloc((n ? n : 1) * sizeof *guide);
+    float *var = malloc((n ? n : 1) * sizeof *var);
+    if (!guide || !var) {
+        free(guide), free(var);
+        return LBK_ERR_OUT_OF_MEMORY;
+    }
+    for (size_t i = 0; i < n; i++) {
+        const double x = 0.5 * ((double)halves[2 * i] + halves[2 * i + 1]);
+        const double s = x != 0 ? fmin(fmax(halves[2 * i + half] / x, 0), 2) : 1;
+        for (int c = 0; c < 3; c++)
+            for (int k = 0; k < 9; k++) guide[i].c[c][k] = in->radiance[i].c[c][k] + (float)(s - 1) * base[i].c[c][k];
+        var[i] = in->variance[i] + base_variance[i];
+    }
+    bk_denoise_inputs hi = *in;
+    hi.radiance = guide, hi.variance = var;
+    const lbk_result r = bk_denoiser_create(&hi, opt, out);
+    free(guide), free(var);
+    return r;
+}
+
+lbk_result bk_denoiser_cross_delta(const bk_denoiser *da, const bk_denoiser *db, const float *halves, float *out)
+{
+    if (!da || !db || !out || da->receiver_count != db->receiver_count || (da->receiver_count && !halves))
+        return LBK_ERR_INVALID_ARGUMENT;
+    const size_t n = da->receiver_count;
+    float *fb = malloc((n ? n : 1) * sizeof *fb);
+    if (!fb) return LBK_ERR_OUT_OF_MEMORY;
+    for (size_t i = 0; i < n; i++) out[i] = halves[2 * i], fb[i] = halves[2 * i + 1];
+    const bk_denoiser *d[2] = {da, db};
+    float *f[2] = {out, fb};
+    lbk_result r = LBK_OK;
+    for (int h = 0; h < 2 && !r; h++) {
+        if (d[h]->have_tex) r = texels_apply(d[h], f[h], 1);
+        if (!r && d[h]->have_probes) r = dn_probes_apply(&d[h]->probes, f[h], 1);
+    }
+    for (size_t i = 0; i < n; i++) out[i] = 0.5f * (out[i] - fb[i]);
+    free(fb);
+    return r;
 }
 
 void bk_denoiser_stats(const bk_denoiser *d, bk_denoise_stats *stats)

@@ -314,6 +314,28 @@ static void test_contact_shadow(void **state)
 
 static double lum_e(const lbk_sh9_rgb *y) { return 0.2126 * sh_e(y, 0) + 0.7152 * sh_e(y, 1) + 0.0722 * sh_e(y, 2); }
 
+/* The floor class's noise estimate with each half filtered by its own weights: the halves'
+ * filters built as the pipeline builds them (bk_denoiser_create_half), through
+ * bk_denoiser_error_groups with one group, the floor. */
+static double cross_noise(const bk_denoiser *d, const bk_denoise_inputs *in, const run *r, const float *halves,
+                          const size_t class_end[BK_RECEIVER_CLASSES], float *cross)
+{
+    bk_denoiser *half[2];
+    for (int h = 0; h < 2; h++)
+        assert_int_equal(bk_denoiser_create_half(in, r->rad, r->var, halves, h, NULL, &half[h]), LBK_OK);
+    assert_int_equal(bk_denoiser_cross_delta(half[0], half[1], halves, cross), LBK_OK);
+    bk_denoiser_destroy(half[0]), bk_denoiser_destroy(half[1]);
+    uint32_t *group = calloc(class_end[0] + 1, sizeof *group); /* every floor texel in group 0 */
+    assert_non_null(group);
+    bk_denoise_group_error g0;
+    const bk_denoise_groups g = {class_end[0], group, 1, &g0};
+    bk_denoise_error e;
+    assert_int_equal(bk_denoiser_error_groups(d, halves, class_end, &e, &g, cross), LBK_OK);
+    free(group);
+    assert_true(fabs(g0.noise - e.noise[BK_CLASS_TEXEL]) <= 1e-9 + 1e-6 * g0.noise); /* the group is the class */
+    return e.noise[BK_CLASS_TEXEL];
+}
+
 /* bk_denoiser_error against the truth. The contact scene's floor (receivers reordered so that
  * the floor is the first class) has an analytic irradiance, so the error each denoised bake
  * really has is known: √(Σ (D − E)² / Σ D²) over the floor, normalised like the estimate. The
@@ -356,7 +378,10 @@ static void test_denoised_estimate(void **state)
     lbk_sh9_rgb *y = malloc(n * sizeof *y);
     assert_non_null(halves), assert_non_null(y);
     enum { AUTO, BLUR, NM };
-    double est[NM] = {0}, meas[NM] = {0}, est_noise_only[NM] = {0};
+    double est[NM] = {0}, meas[NM] = {0}, est_noise_only[NM] = {0}, est_cross = 0;
+    double *xs = malloc(CONTACT_SEEDS * nf * sizeof *xs); /* the denoised floor per seed */
+    float *cross = malloc(n * sizeof *cross);
+    assert_non_null(xs), assert_non_null(cross);
     for (int sd = 0; sd < CONTACT_SEEDS; sd++) {
         bake_halves(&s, f.tracer, recv, n, 300 + (uint64_t)sd, CONTACT_SPP, 0, &r, halves);
         for (int mth = 0; mth < NM; mth++) {
@@ -371,11 +396,13 @@ static void test_denoised_estimate(void **state)
             assert_int_equal(bk_denoiser_apply(d, y), LBK_OK);
             bk_denoise_error e;
             assert_int_equal(bk_denoiser_error(d, halves, class_end, &e), LBK_OK);
+            if (mth == AUTO) est_cross += cross_noise(d, &in, &r, halves, class_end, cross) / CONTACT_SEEDS;
             bk_denoiser_destroy(d);
             double num = 0, den = 0;
             for (size_t k = 0; k < nf; k++) {
                 const double x = lum_e(&y[k]);
                 num += (x - ref[k]) * (x - ref[k]), den += x * x;
+                if (mth == AUTO) xs[(size_t)sd * nf + k] = x;
             }
             meas[mth] += sqrt(num / den) / CONTACT_SEEDS;
             est[mth] += e.rel_rmse[BK_CLASS_TEXEL] / CONTACT_SEEDS;
@@ -390,6 +417,24 @@ static void test_denoised_estimate(void **state)
         assert_true(est[mth] >= 0.5 * meas[mth] && est[mth] <= 2 * meas[mth]);
     }
     assert_true(est_noise_only[BLUR] < 0.5 * meas[BLUR]); /* the blur's error is its bias */
+    /* The noise the default filter leaves, against how its output differs between seeds: the
+     * same weights' Σ (Dδ)² misses what the weights add by following the noise; each half
+     * filtered by its own weights (bk_denoiser_cross_delta) sees it. */
+    double var = 0, sq = 0;
+    for (size_t k = 0; k < nf; k++) {
+        double m = 0, v = 0;
+        for (int sd = 0; sd < CONTACT_SEEDS; sd++) m += xs[(size_t)sd * nf + k] / CONTACT_SEEDS;
+        for (int sd = 0; sd < CONTACT_SEEDS; sd++) v += (xs[(size_t)sd * nf + k] - m) * (xs[(size_t)sd * nf + k] - m);
+        var += v / (CONTACT_SEEDS - 1), sq += m * m;
+    }
+    const double seed_noise = sqrt(var / sq);
+    print_message("denoised floor (auto), noise between seeds %.2f%%: same weights %.2f%% (%.2f), each half its own "
+                  "weights %.2f%% (%.2f)\n",
+                  100 * seed_noise, 100 * est_noise_only[AUTO], est_noise_only[AUTO] / seed_noise, 100 * est_cross,
+                  est_cross / seed_noise);
+    assert_true(est_cross > est_noise_only[AUTO]);
+    assert_true(est_cross >= 0.5 * seed_noise && est_cross <= 2 * seed_noise);
+    free(xs), free(cross);
 
     /* identity: every variance 0, so every texel keeps its input */
     bk_denoise_inputs in = texel_inputs(&s, &f, &r);

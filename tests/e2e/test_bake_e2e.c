@@ -276,14 +276,17 @@ static void test_target_error_and_reports(void **state)
     assert_int_equal(lbk_report_open(data, size, &v), LBK_OK);
     assert_int_equal(v.header.status, LBK_BAKE_TARGET_REACHED);
     /* one pass, then the denoise step: the same work, the estimate of the denoised texels
-     * (spec §7.2), which is the report's */
+     * (spec §7.2), which is the report's; at most the transport's, since --denoise auto keeps
+     * the filter only where it lowers the estimate (at 32 samples on this scene it does not:
+     * the filtered texels differ between seeds by ~29 % against the transport's ~35 %, and the
+     * filter adds its bias; DENOISE.md) */
     assert_int_equal(v.header.record_count, 2);
     lbk_report_record rec, den;
     assert_int_equal(lbk_report_record_get(&v, 0, &rec), LBK_OK);
     assert_int_equal(lbk_report_record_get(&v, 1, &den), LBK_OK);
     assert_int_equal(den.samples_per_texel, rec.samples_per_texel);
     assert_true(den.rays_traced == rec.rays_traced && den.bounces == rec.bounces);
-    assert_true(den.texel_rel_rmse > 0 && den.texel_rel_rmse < rec.texel_rel_rmse);
+    assert_true(den.texel_rel_rmse > 0 && den.texel_rel_rmse <= rec.texel_rel_rmse);
     assert_float_equal(den.texel_rel_rmse, (float)sum.denoised.errors.texels, 0);
     assert_true(sum.denoised.texel_noise > 0 && sum.denoised.texel_noise <= sum.denoised.errors.texels);
     assert_true(rec.texel_rel_rmse <= 0.9f && rec.texel_rel_rmse > 0);
