@@ -427,10 +427,10 @@ typedef struct lbk_bake_octp {
 } lbk_bake_octp;
 
 /* The estimate of what a denoised bake delivers (lbk_bake_report.denoised; all 0 when the bake
- * was not denoised): the transport's two halves passed through the denoiser's own weights, so
- * it holds the noise the filter leaves (also the part correlated between receivers) and the
- * bias it adds (bake/denoise/DENOISE.md §What the report says). LLG probes are not filtered:
- * errors.llg is the base estimate's. */
+ * was not denoised): the noise the filter leaves (also the part correlated between receivers),
+ * from each of the transport's two halves filtered by weights built from that half alone, and
+ * the bias it adds, from the halves through the denoiser's own weights (bake/denoise/DENOISE.md
+ * §What the report says). LLG probes are not filtered: errors.llg is the base estimate's. */
 typedef struct lbk_bake_denoised {
     lbk_bake_class_errors errors;   /* √(noise² + bias²) per class, relative as REPT's */
     double texel_noise, texel_bias; /* the two parts of errors.texels */
