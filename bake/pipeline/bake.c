@@ -255,6 +255,8 @@ static void pipeline_free(bk_pipeline *b)
     free(b->variance);
     free(b->halves);
     free(b->object_est);
+    free(b->llg_fit_grid);
+    free(b->llg_est);
     free(b->object_filtered);
     free(b->check);
     free(b->check_group);

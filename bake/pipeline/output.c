@@ -33,6 +33,8 @@ void lbk_bake_output_free(lbk_bake_output *out)
     bk_output_free_mem(out, out->object_estimates);
     bk_output_free_mem(out, out->object_names);
     bk_output_free_mem(out, out->object_checks);
+    bk_output_free_mem(out, out->llg_estimates);
+    bk_output_free_mem(out, out->llg_names);
     bk_output_free_mem(out, out->input);
     lbk_allocator a = out->allocator;
     lbk_bake_output tmp;

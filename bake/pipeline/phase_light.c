@@ -178,14 +178,45 @@ static lbk_result build_cell_sizes(bk_pipeline *b)
  * fit): the halves' difference sees the noise of the probes, not what the lattice cannot
  * represent, and that is what LLG objects get at run time. The residual also holds the targets'
  * own noise; its expected share is taken off where the transport measured it. */
+/* Each LLG prop's estimate (lbk_bake_llg_estimate): the class's two terms over one grid, its
+ * probes' two halves and its targets' fit residual. Out of memory: none (the report leaves
+ * them out). */
+static void llg_object_estimates(bk_pipeline *b, double class_noise, int less_noise)
+{
+    free(b->llg_est);
+    b->llg_est = b->llg_fit_grid && b->llg_count ? calloc(b->llg_count, sizeof *b->llg_est) : NULL;
+    size_t probe = b->llg_first;
+    for (size_t g = 0; b->llg_est && g < b->llg_count; g++) {
+        const size_t np = bk_llg_probe_count(&b->llgs[g]);
+        double noise = class_noise, fit = 0;
+        if (b->halves) {
+            double d2 = 0, x2 = 0;
+            for (size_t i = probe; i < probe + np && i < b->receiver_count; i++) {
+                const double a = b->halves[2 * i], c = b->halves[2 * i + 1];
+                d2 += 0.25 * (a - c) * (a - c), x2 += 0.25 * (a + c) * (a + c);
+            }
+            noise = x2 > 0 ? sqrt(d2 / x2) : 0;
+        }
+        const bk_llg_fit_stats *f = &b->llg_fit_grid[g];
+        if (f->targets && f->target_sum > 0) {
+            const double n = (double)f->targets, mean = f->target_sum / n;
+            const double noise_sq = less_noise ? bk_llg_fit_noise_grid(&b->llg_fit, b->llgs, b->variance, g) : 0;
+            fit = sqrt(fmax(0, f->fitted_sq - noise_sq) / n) / mean;
+        }
+        b->llg_est[g] = (lbk_bake_llg_estimate){NULL, b->llgs[g].object, (uint32_t)f->targets, hypot(noise, fit), noise, fit};
+        probe += np;
+    }
+}
+
 static void llg_fit_error(bk_pipeline *b)
 {
     const bk_llg_fit_stats *f = &b->llg_fit_stats;
+    /* without the targets' own noise where the transport measured it (b->variance: denoised bakes) */
+    const int less_noise = b->variance && b->opt->denoise != LBK_BAKE_DENOISE_OFF; /* (not for --error-map alone: same bytes) */
+    llg_object_estimates(b, b->stats.class_rel_rmse[BK_CLASS_LLG], less_noise);
     if (!f->targets || !(f->target_sum > 0)) return;
     const double n = (double)f->targets, mean = f->target_sum / n;
-    /* without the targets' own noise where the transport measured it (b->variance: denoised bakes) */
-    const double noise_sq = b->variance && b->opt->denoise != LBK_BAKE_DENOISE_OFF /* (not for --error-map alone: same bytes) */
-                                ? bk_llg_fit_noise(&b->llg_fit, b->llgs, b->variance) : 0;
+    const double noise_sq = less_noise ? bk_llg_fit_noise(&b->llg_fit, b->llgs, b->variance) : 0;
     const double fitted = sqrt(fmax(0, f->fitted_sq - noise_sq) / n) / mean, traced = sqrt(f->traced_sq / n) / mean;
     double *e = &b->stats.class_rel_rmse[BK_CLASS_LLG];
     const double noise = *e;
@@ -287,7 +318,11 @@ lbk_result bk_phase_transport(bk_pipeline *b)
     if (!r) r = bk_transport_run(&b->scene, b->tracer, b->receivers, b->receiver_count, &to, &out, &b->stats);
     bk_far_probes_free(&far);
     if (!r) bk_texels_match_irradiance(&b->texels, b->texel_of_receiver, b->texel_receivers, b->radiance, irradiance);
-    if (!r) r = bk_llg_fit_run(&b->llg_fit, b->llgs, &b->scene, irradiance, b->radiance, b->llg_first, &b->llg_fit_stats);
+    if (!r && b->llg_count && !b->llg_fit_grid && !(b->llg_fit_grid = calloc(b->llg_count, sizeof *b->llg_fit_grid)))
+        r = LBK_ERR_OUT_OF_MEMORY;
+    if (!r)
+        r = bk_llg_fit_run(&b->llg_fit, b->llgs, &b->scene, irradiance, b->radiance, b->llg_first, &b->llg_fit_stats,
+                           b->llg_fit_grid);
     if (!r && b->opt->error_map) { /* before denoising: the transport's own estimate (error_map.h) */
         b->texel_rel_error = malloc((b->texel_receivers ? b->texel_receivers : 1) * sizeof *b->texel_rel_error);
         if (!b->texel_rel_error) r = LBK_ERR_OUT_OF_MEMORY;

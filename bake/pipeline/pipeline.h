@@ -67,6 +67,8 @@ typedef struct bk_pipeline {
     size_t receiver_count, texel_receivers, glg_first, llg_first;
     bk_llg_fit_plan llg_fit;
     bk_llg_fit_stats llg_fit_stats; /* the base run's fit */
+    bk_llg_fit_stats *llg_fit_grid; /* the same per grid (llg_count) */
+    lbk_bake_llg_estimate *llg_est; /* per grid: its LLG object's estimate (llg_fit_error) */
     uint32_t *texel_of_receiver;    /* receiver → index in texels.receivers */
     lbk_sh9_rgb *radiance;
     float *cell_size;               /* per scene triangle: the radiosity cache's cell size (texel size) */
@@ -130,6 +132,8 @@ struct lbk_bake_output {
     lbk_bake_object_estimate *object_estimates; /* lightmapped objects, in scene order */
     char *object_names;             /* their names, 128 bytes each */
     lbk_bake_object_check *object_checks; /* parallel to them (the path check); NULL: none */
+    lbk_bake_llg_estimate *llg_estimates; /* LLG props, in scene order */
+    char *llg_names;                /* their names, 128 bytes each */
     lbk_bake_phase_time phases[BK_MAX_PHASES];
     char *input;
 };

@@ -105,6 +105,29 @@ static int fill_object_estimates(const bk_pipeline *b, lbk_bake_output *out, lbk
     return 0;
 }
 
+/* Each LLG prop's estimate (llg_fit_error), in scene object order, copied into the output. */
+static int fill_llg_estimates(const bk_pipeline *b, lbk_bake_output *out, lbk_bake_report *r)
+{
+    if (!b->llg_est || !b->llg_count || !b->object_llg) return 0;
+    const size_t name_len = sizeof b->scene.objects[0].name;
+    out->llg_estimates = bk_output_alloc(out, b->llg_count * sizeof *out->llg_estimates);
+    out->llg_names = bk_output_alloc(out, b->llg_count * name_len);
+    if (!out->llg_estimates || !out->llg_names) return 1;
+    size_t k = 0;
+    for (size_t o = 0; o < b->scene.object_count && k < b->llg_count; o++) {
+        if (b->object_llg[o] < 0) continue;
+        char *name = out->llg_names + k * name_len;
+        memcpy(name, b->scene.objects[o].name, name_len);
+        name[name_len - 1] = 0;
+        out->llg_estimates[k] = b->llg_est[b->object_llg[o]];
+        out->llg_estimates[k].name = name;
+        k++;
+    }
+    r->llg_estimates = out->llg_estimates;
+    r->llg_estimate_count = k;
+    return 0;
+}
+
 lbk_result bk_pipeline_report(const bk_pipeline *b, lbk_bake_output *out)
 {
     lbk_bake_report *r = &out->report;
@@ -154,7 +177,8 @@ lbk_result bk_pipeline_report(const bk_pipeline *b, lbk_bake_output *out)
     r->set_runs = out->set_runs;
     r->set_run_count = nrun;
     if (b->have_denoised) r->denoised = b->denoised;
-    if (fill_set_estimates(b, out, r) || fill_object_estimates(b, out, r)) return LBK_ERR_OUT_OF_MEMORY;
+    if (fill_set_estimates(b, out, r) || fill_object_estimates(b, out, r) || fill_llg_estimates(b, out, r))
+        return LBK_ERR_OUT_OF_MEMORY;
     fill_transport(b, &r->transport);
     fill_counts(b, &r->counts);
     r->scales.lmap = r->counts.texels ? b->scale[0] : 0;
@@ -287,6 +311,23 @@ static void json_object_estimates(cJSON *root, const lbk_bake_report *r)
     }
 }
 
+/* "llg_objects": each LLG prop's estimate (lbk_bake_llg_estimate). */
+static void json_llg_estimates(cJSON *root, const lbk_bake_report *r)
+{
+    cJSON *arr = cJSON_AddArrayToObject(root, "llg_objects");
+    for (size_t i = 0; i < r->llg_estimate_count; i++) {
+        const lbk_bake_llg_estimate *e = &r->llg_estimates[i];
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "name", e->name ? e->name : "");
+        cJSON_AddNumberToObject(o, "object", e->object);
+        cJSON_AddNumberToObject(o, "targets", e->targets);
+        cJSON_AddNumberToObject(o, "est_rel_rmse", e->rel_rmse);
+        cJSON_AddNumberToObject(o, "noise", e->noise);
+        cJSON_AddNumberToObject(o, "fit", e->fit);
+        cJSON_AddItemToArray(arr, o);
+    }
+}
+
 static cJSON *json_report(const lbk_bake_report *r, const char *container_path)
 {
     /* a report struct from before the per-class fields were appended has none of them */
@@ -352,6 +393,8 @@ static cJSON *json_report(const lbk_bake_report *r, const char *container_path)
     if (r->size >= offsetof(lbk_bake_report, object_estimate_count) + sizeof r->object_estimate_count &&
         r->object_estimate_count)
         json_object_estimates(root, r);
+    if (r->size >= offsetof(lbk_bake_report, llg_estimate_count) + sizeof r->llg_estimate_count && r->llg_estimate_count)
+        json_llg_estimates(root, r);
     const uint64_t *rss = r->size >= offsetof(lbk_bake_report, phase_peak_rss) + sizeof r->phase_peak_rss
                               ? r->phase_peak_rss : NULL;
     cJSON *ph = cJSON_AddArrayToObject(root, "phases");

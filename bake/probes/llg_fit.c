@@ -322,31 +322,42 @@ void bk_llg_fit_receiver(const bk_llg_fit_plan *plan, const bk_llg *llgs, const 
 }
 
 lbk_result bk_llg_fit_run(const bk_llg_fit_plan *plan, const bk_llg *llgs, const bk_scene *s,
-                          const float *irradiance, lbk_sh9_rgb *radiance, size_t llg_first, bk_llg_fit_stats *stats)
+                          const float *irradiance, lbk_sh9_rgb *radiance, size_t llg_first, bk_llg_fit_stats *stats,
+                          bk_llg_fit_stats *per_grid)
 {
     size_t probe = llg_first;
     for (size_t g = 0; g < plan->grids; g++) {
         const size_t b = plan->begin[g], n = plan->begin[g + 1] - b;
+        bk_llg_fit_stats st = {0};
         lbk_result r = bk_llg_fit(&llgs[g], s, plan->vertex + b, n, irradiance + 3 * (plan->first + b),
-                                  plan->inside ? plan->inside + (probe - llg_first) : NULL, radiance + probe, stats);
+                                  plan->inside ? plan->inside + (probe - llg_first) : NULL, radiance + probe, &st);
         if (r) return r;
+        if (stats)
+            stats->target_sum += st.target_sum, stats->traced_sq += st.traced_sq, stats->fitted_sq += st.fitted_sq,
+                stats->targets += st.targets;
+        if (per_grid) per_grid[g] = st;
         probe += probe_count(&llgs[g]);
     }
     return LBK_OK;
 }
 
+double bk_llg_fit_noise_grid(const bk_llg_fit_plan *plan, const bk_llg *llgs, const float *variance, size_t g)
+{
+    const size_t b = plan->begin[g], n = plan->begin[g + 1] - b;
+    if (!n) return 0;
+    const double keep = 1.0 - 9.0 * (double)probe_count(&llgs[g]) / (double)n;
+    if (!(keep > 0)) return 0;
+    double sum = 0;
+    for (size_t t = 0; t < n; t++) {
+        const float v = variance[plan->first + b + t];
+        if (isfinite(v) && v > 0) sum += keep * v;
+    }
+    return sum;
+}
+
 double bk_llg_fit_noise(const bk_llg_fit_plan *plan, const bk_llg *llgs, const float *variance)
 {
     double sum = 0;
-    for (size_t g = 0; g < plan->grids; g++) {
-        const size_t b = plan->begin[g], n = plan->begin[g + 1] - b;
-        if (!n) continue;
-        const double keep = 1.0 - 9.0 * (double)probe_count(&llgs[g]) / (double)n;
-        if (!(keep > 0)) continue;
-        for (size_t t = 0; t < n; t++) {
-            const float v = variance[plan->first + b + t];
-            if (isfinite(v) && v > 0) sum += keep * v;
-        }
-    }
+    for (size_t g = 0; g < plan->grids; g++) sum += bk_llg_fit_noise_grid(plan, llgs, variance, g);
     return sum;
 }

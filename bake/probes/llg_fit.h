@@ -68,9 +68,13 @@ void bk_llg_fit_receiver(const bk_llg_fit_plan *plan, const bk_llg *llgs, const 
  * Σ_t σ_t² (1 − unknowns/targets) per grid (least squares absorbs a share unknowns/targets of
  * it), σ_t² the transport's variance of target t's luminance (variance per receiver). */
 double bk_llg_fit_noise(const bk_llg_fit_plan *plan, const bk_llg *llgs, const float *variance);
+/* The same for grid g alone (the terms bk_llg_fit_noise sums). */
+double bk_llg_fit_noise_grid(const bk_llg_fit_plan *plan, const bk_llg *llgs, const float *variance, size_t g);
 /* Fits every grid of one run: irradiance (3 per receiver) and radiance (per receiver) are the
- * run's outputs, the LLG probes of grid after grid from receiver llg_first. */
+ * run's outputs, the LLG probes of grid after grid from receiver llg_first. stats (NULL: none)
+ * is added to; per_grid (NULL: none; plan->grids entries) gets each grid's own. */
 lbk_result bk_llg_fit_run(const bk_llg_fit_plan *plan, const bk_llg *llgs, const bk_scene *scene,
-                          const float *irradiance, lbk_sh9_rgb *radiance, size_t llg_first, bk_llg_fit_stats *stats);
+                          const float *irradiance, lbk_sh9_rgb *radiance, size_t llg_first, bk_llg_fit_stats *stats,
+                          bk_llg_fit_stats *per_grid);
 
 #endif

@@ -155,7 +155,8 @@ static lbk_result run_one(run_ctx *rc, const bk_scene *scene, const bk_tracer *t
     out.irradiance = irradiance;
     lbk_result r = bk_transport_run(scene, tracer, in->receivers, in->receiver_count, &opt, &out, &st);
     if (!r) bk_texels_match_irradiance(in->texels, in->texel_of_receiver, in->texel_receivers, radiance, irradiance);
-    if (!r && in->llg_fit) r = bk_llg_fit_run(in->llg_fit, in->llgs, in->scene, irradiance, radiance, in->llg_first, NULL);
+    if (!r && in->llg_fit) r = bk_llg_fit_run(in->llg_fit, in->llgs, in->scene, irradiance, radiance, in->llg_first, NULL,
+                                                   NULL);
     free(irradiance);
     rc->run++;
     rc->transport_secs += st.seconds;
@@ -248,7 +249,8 @@ static lbk_result guided_open(run_ctx *rc, const bs_door *d, const float *texel_
     bk_door_guided_stats st;
     r = gi.irradiance ? bk_door_guided_run(&gi, rad, dir, &st, NULL) : LBK_ERR_OUT_OF_MEMORY;
     if (!r) bk_texels_match_irradiance(in->texels, in->texel_of_receiver, in->texel_receivers, rad, gi.irradiance);
-    if (!r && in->llg_fit) r = bk_llg_fit_run(in->llg_fit, in->llgs, in->scene, gi.irradiance, rad, in->llg_first, NULL);
+    if (!r && in->llg_fit) r = bk_llg_fit_run(in->llg_fit, in->llgs, in->scene, gi.irradiance, rad, in->llg_first, NULL,
+                                                   NULL);
     free(gi.irradiance);
     bk_tracer_destroy(tr);
     filtered_free(&fs);

@@ -229,10 +229,11 @@ def run_scene(sc, work, opt, out):
                                                      ga.lbk / g.cyc if g.cyc > 0 else float("inf"))
 
     # each lightmapped object's own estimate (the report's "objects", baker library 1.9); an LLG
-    # prop's is the report's LLG class estimate (its receivers are that class's: noise and the
-    # fit's residual at the vertex targets), not the texels' level-wide figure it took before;
-    # the level-wide figure for objects without either (older bakers)
+    # prop's own ("llg_objects", 1.11: its probes' noise and the fit's residual at its vertex
+    # targets), else the report's LLG class estimate, not the texels' level-wide figure it took
+    # before; the level-wide figure for objects without any (older bakers)
     obj_est = {o.get("name"): o.get("est_rel_rmse") for o in report.get("objects") or []}
+    llg_est = {o.get("name"): o.get("est_rel_rmse") for o in report.get("llg_objects") or []}
     llg_class_est = (report.get("errors") or {}).get("llg")
 
     def row(label, rep, idx, e=None):
@@ -251,7 +252,7 @@ def run_scene(sc, work, opt, out):
         if not idx:
             continue
         rep, name = rec.objects.get(o, ("?", "object%d" % o))
-        oe = obj_est.get(name) if rep == "lightmap" else llg_class_est if rep == "llg" else None
+        oe = obj_est.get(name) if rep == "lightmap" else llg_est.get(name, llg_class_est) if rep == "llg" else None
         g, ratio, ga = row(name, rep, idx, oe)
         rows.append({"scene": sc["name"], "object": name, "rep": rep, "n": g.n, "lbk_err": g.lbk,
                      "lbk_bias": g.lbk_bias, "lbk_noise": g.lbk_noise, "lbk_est": est if oe is None else oe,

@@ -1,12 +1,15 @@
 /* --llg-connected through the pipeline (lbk_bake_desc.llg_connected; bake/probes/PROBES.md
  * "Connected objects"): two 3 m bars meeting end to end get half the LLG spacing, a third bar
- * 3 m away keeps it, and the flag off gives the grids of before. */
+ * 3 m away keeps it, and the flag off gives the grids of before. And each LLG prop's estimate
+ * (lbk_bake_report.llg_estimates) on the same bars. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "lbk/bake.h"
@@ -26,7 +29,8 @@ static void box(float *pos, uint32_t *idx, uint32_t base, const float mn[3], con
     }
 }
 
-static uint64_t llg_probes(int connected)
+/* The floor and the first `bars` bars, baked under a white sky; free with lbk_bake_output_free. */
+static lbk_bake_output *bake_bars(int connected, int bars)
 {
     float pos[4 * 24];
     uint32_t idx[4 * 36];
@@ -47,11 +51,11 @@ static uint64_t llg_probes(int connected)
     sc.name = "bars";
     sc.vertex_count = 32;
     sc.positions = pos;
-    sc.triangle_count = 48;
+    sc.triangle_count = 12 + 12 * (uint32_t)bars;
     sc.indices = idx;
     sc.material_count = 1;
     sc.materials = &mat;
-    sc.object_count = 4;
+    sc.object_count = 1 + (uint32_t)bars;
     sc.objects = obj;
     lbk_bake_desc d = {0};
     d.size = sizeof d;
@@ -64,6 +68,12 @@ static uint64_t llg_probes(int connected)
     d.llg_connected = connected;
     lbk_bake_output *out = NULL;
     assert_int_equal(lbk_bake_from_scene(&sc, &d, &out), LBK_OK);
+    return out;
+}
+
+static uint64_t llg_probes(int connected)
+{
+    lbk_bake_output *out = bake_bars(connected, 3);
     const lbk_bake_report *r = lbk_bake_output_report(out);
     assert_int_equal(r->counts.llgs, 3);
     const uint64_t n = r->counts.llg_probes;
@@ -84,8 +94,52 @@ static void connected_bars(void **state)
     assert_int_equal(on, 54 + 54 + 36);
 }
 
+/* Each LLG prop's estimate is the LLG class estimate over its own grid: with one prop it is the
+ * class's (errors.llg, the same two terms over the same receivers), and each is √(noise² +
+ * fit²) of its own terms, in scene order. */
+static void llg_estimates(void **state)
+{
+    (void)state;
+    lbk_bake_output *out = bake_bars(0, 1);
+    const lbk_bake_report *r = lbk_bake_output_report(out);
+    assert_true(r->size >= offsetof(lbk_bake_report, llg_estimate_count) + sizeof r->llg_estimate_count);
+    assert_int_equal(r->llg_estimate_count, 1);
+    const lbk_bake_llg_estimate *e = &r->llg_estimates[0];
+    print_message("one bar: %.4f (noise %.4f, fit %.4f, %u targets), class %.4f\n", e->rel_rmse, e->noise, e->fit,
+                  e->targets, r->errors.llg);
+    assert_string_equal(e->name, "bar0");
+    assert_int_equal(e->object, 1);
+    assert_true(e->targets > 0 && e->noise > 0 && e->rel_rmse > 0);
+    assert_true(fabs(e->rel_rmse - r->errors.llg) <= 1e-6 * r->errors.llg);
+    lbk_bake_output_free(out);
+
+    out = bake_bars(0, 3);
+    r = lbk_bake_output_report(out);
+    assert_int_equal(r->llg_estimate_count, 3);
+    double lo = INFINITY, hi = 0;
+    for (size_t i = 0; i < 3; i++) {
+        e = &r->llg_estimates[i];
+        char want[8];
+        snprintf(want, sizeof want, "bar%zu", i);
+        assert_string_equal(e->name, want);
+        assert_int_equal(e->object, i + 1);
+        assert_true(fabs(e->rel_rmse - hypot(e->noise, e->fit)) <= 1e-12 + 1e-9 * e->rel_rmse);
+        assert_true(e->targets > 0 && isfinite(e->rel_rmse) && e->rel_rmse > 0);
+        lo = fmin(lo, e->noise), hi = fmax(hi, e->noise);
+    }
+    print_message("three bars: noise %.4f .. %.4f\n", lo, hi);
+    char *json = NULL;
+    size_t n = 0;
+    assert_int_equal(lbk_bake_report_json(r, "bars.lbk", NULL, &json, &n), LBK_OK);
+    const char *llg = strstr(json, "\"llg_objects\"");
+    assert_non_null(llg);
+    assert_non_null(strstr(llg, "\"bar2\""));
+    lbk_free(NULL, json);
+    lbk_bake_output_free(out);
+}
+
 int main(void)
 {
-    const struct CMUnitTest tests[] = {cmocka_unit_test(connected_bars)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(connected_bars), cmocka_unit_test(llg_estimates)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -126,7 +126,7 @@ static void test_fit_reproduces_the_runtime(void **state)
     runtime_at_targets(&f, probes, got);
     const double before = rel_rms(got, e, 3 * nt);
     bk_llg_fit_stats st = {0};
-    assert_int_equal(bk_llg_fit_run(&f.plan, &f.l, &f.s, e, probes, 0, &st), LBK_OK);
+    assert_int_equal(bk_llg_fit_run(&f.plan, &f.l, &f.s, e, probes, 0, &st, NULL), LBK_OK);
     runtime_at_targets(&f, probes, got);
     const double after = rel_rms(got, e, 3 * nt);
     /* the targets are exactly representable: what remains is the regularisation's pull towards
@@ -157,9 +157,9 @@ static void test_fit_is_linear(void **state)
     for (size_t i = 0; i < np; i++)
         for (int c = 0; c < 3; c++)
             for (int k = 0; k < 9; k++) ab[i].c[c][k] = a[i].c[c][k] + b[i].c[c][k];
-    assert_int_equal(bk_llg_fit_run(&f.plan, &f.l, &f.s, ea, a, 0, NULL), LBK_OK);
-    assert_int_equal(bk_llg_fit_run(&f.plan, &f.l, &f.s, eb, b, 0, NULL), LBK_OK);
-    assert_int_equal(bk_llg_fit_run(&f.plan, &f.l, &f.s, eab, ab, 0, NULL), LBK_OK);
+    assert_int_equal(bk_llg_fit_run(&f.plan, &f.l, &f.s, ea, a, 0, NULL, NULL), LBK_OK);
+    assert_int_equal(bk_llg_fit_run(&f.plan, &f.l, &f.s, eb, b, 0, NULL, NULL), LBK_OK);
+    assert_int_equal(bk_llg_fit_run(&f.plan, &f.l, &f.s, eab, ab, 0, NULL, NULL), LBK_OK);
     double worst = 0, scale = 0;
     for (size_t i = 0; i < np; i++)
         for (int c = 0; c < 3; c++)
@@ -225,7 +225,7 @@ static void test_inside_probe_takes_its_neighbours(void **state)
     float *e = malloc(3 * plan.count * sizeof *e);
     assert_non_null(e);
     for (size_t t = 0; t < 3 * plan.count; t++) e[t] = (float)M_PI;
-    assert_int_equal(bk_llg_fit_run(&plan, &l, &s, e, probes, 0, NULL), LBK_OK);
+    assert_int_equal(bk_llg_fit_run(&plan, &l, &s, e, probes, 0, NULL, NULL), LBK_OK);
     for (int ch = 0; ch < 3; ch++) assert_float_equal(probes[13].c[ch][0] * LBK_SH_Y00, 1.0, 0.02);
     free(e);
     bk_llg_fit_plan_free(&plan);

@@ -55,8 +55,8 @@ extern "C" {
 /* The baker library's version (lbk-bake.pc): the minor grows with every addition to the
  * size-tagged structs below ("added in 1.x"). */
 #define LBK_BAKE_LIBRARY_VERSION_MAJOR 1
-#define LBK_BAKE_LIBRARY_VERSION_MINOR 10
-#define LBK_BAKE_LIBRARY_VERSION_PATCH 0 /* 1.10.0: max_page, max_probes, texel_budget */
+#define LBK_BAKE_LIBRARY_VERSION_MINOR 11
+#define LBK_BAKE_LIBRARY_VERSION_PATCH 0 /* 1.11.0: each LLG prop's estimate (lbk_bake_llg_estimate) */
 
 /* ---- options ----------------------------------------------------------------------------- */
 
@@ -491,6 +491,20 @@ typedef struct lbk_bake_object_check {
     double rel_rmse, low, high;
 } lbk_bake_object_check;
 
+/* An LLG prop's estimated error (appended in 1.11): the LLG class estimate (errors.llg) taken
+ * over one object — its probes' noise (the transport's two halves over the grid's probes,
+ * relative to the RMS of their fluence/4) and the fit's residual at its vertex targets less
+ * their noise (relative to their mean irradiance), each relative as the class's is. The class
+ * figure pools the grids; a prop whose lattice cannot follow its lighting (2 cm dividers in a
+ * 30 cm cubby) carries more of it than the others. */
+typedef struct lbk_bake_llg_estimate {
+    const char *name;            /* the scene object's name */
+    uint32_t object;             /* scene object index (OBJS order) */
+    uint32_t targets;            /* its vertex targets (0: none fitted; then fit is 0) */
+    double rel_rmse;             /* √(noise² + fit²) */
+    double noise, fit;
+} lbk_bake_llg_estimate;
+
 /* The path check over the level (appended in 1.10; zero when it did not run). */
 typedef struct lbk_bake_check {
     uint32_t receivers;          /* texels checked, every object */
@@ -542,6 +556,9 @@ typedef struct lbk_bake_report {
     /* appended in 1.10 (the path check): read only when size covers them */
     const lbk_bake_object_check *object_checks; /* parallel to object_estimates; NULL: none */
     lbk_bake_check check;
+    /* appended in 1.11 (each LLG prop's estimate): read only when size covers them */
+    const lbk_bake_llg_estimate *llg_estimates; /* in scene object order */
+    size_t llg_estimate_count;
 } lbk_bake_report;
 
 /* Owned by the output, valid until lbk_bake_output_free. */
