@@ -493,7 +493,7 @@ typedef struct dn_error_sums {
 
 /* Receiver i's terms: the same floats the filter started from (x, δ), so that an unfiltered
  * receiver adds no bias, and its filtered channels (f NULL: unfiltered, the identity); its noise
- * from cross (bk_denoiser_cross_delta) when not NULL, else the filtered δ. */
+ * from cross (bk_denoiser_half_delta) when not NULL, else the filtered δ. */
 static void sums_add(dn_error_sums *s, const float *halves, const float *f, size_t stride, const float *cross, size_t i)
 {
     const double x = 0.5f * (halves[2 * i] + halves[2 * i + 1]);
@@ -620,11 +620,12 @@ lbk_result bk_denoise_groups_unfiltered(const float *halves, const bk_denoise_gr
     return groups_from_filtered(halves, NULL, 0, NULL, groups);
 }
 
-lbk_result bk_denoiser_create_half(const bk_denoise_inputs *in, const lbk_sh9_rgb *base, const float *base_variance,
-                                   const float *halves, int half, const bk_denoise_options *opt, bk_denoiser **out)
+/* The filter of one half (half 0: A, 1: B): built like bk_denoiser_create from `in`, its guide
+ * with the base part at that half's level (scaled by A/X, resp. B/X, within [0, 2]) and the
+ * base's variance doubled (base_variance added once more: a half has half the samples). */
+static lbk_result create_half(const bk_denoise_inputs *in, const lbk_sh9_rgb *base, const float *base_variance,
+                              const float *halves, int half, const bk_denoise_options *opt, bk_denoiser **out)
 {
-    if (!in || !base || !base_variance || !halves || !out || !in->radiance || !in->variance || half < 0 || half > 1)
-        return LBK_ERR_INVALID_ARGUMENT;
     const size_t n = in->receiver_count;
     lbk_sh9_rgb *guide = malloc((n ? n : 1) * sizeof *guide);
     float *var = malloc((n ? n : 1) * sizeof *var);
@@ -646,22 +647,24 @@ lbk_result bk_denoiser_create_half(const bk_denoise_inputs *in, const lbk_sh9_rg
     return r;
 }
 
-lbk_result bk_denoiser_cross_delta(const bk_denoiser *da, const bk_denoiser *db, const float *halves, float *out)
+lbk_result bk_denoiser_half_delta(const bk_denoise_inputs *in, const lbk_sh9_rgb *base, const float *base_variance,
+                                  const float *halves, const bk_denoise_options *opt, float *out)
 {
-    if (!da || !db || !out || da->receiver_count != db->receiver_count || (da->receiver_count && !halves))
+    if (!in || !base || !base_variance || !halves || !out || !in->radiance || !in->variance)
         return LBK_ERR_INVALID_ARGUMENT;
-    const size_t n = da->receiver_count;
+    const size_t n = in->receiver_count;
+    bk_denoiser *d[2] = {NULL, NULL};
     float *fb = malloc((n ? n : 1) * sizeof *fb);
-    if (!fb) return LBK_ERR_OUT_OF_MEMORY;
-    for (size_t i = 0; i < n; i++) out[i] = halves[2 * i], fb[i] = halves[2 * i + 1];
-    const bk_denoiser *d[2] = {da, db};
+    lbk_result r = fb ? LBK_OK : LBK_ERR_OUT_OF_MEMORY;
+    for (int h = 0; h < 2 && !r; h++) r = create_half(in, base, base_variance, halves, h, opt, &d[h]);
+    for (size_t i = 0; i < n && !r; i++) out[i] = halves[2 * i], fb[i] = halves[2 * i + 1];
     float *f[2] = {out, fb};
-    lbk_result r = LBK_OK;
     for (int h = 0; h < 2 && !r; h++) {
         if (d[h]->have_tex) r = texels_apply(d[h], f[h], 1);
         if (!r && d[h]->have_probes) r = dn_probes_apply(&d[h]->probes, f[h], 1);
     }
-    for (size_t i = 0; i < n; i++) out[i] = 0.5f * (out[i] - fb[i]);
+    for (size_t i = 0; i < n && !r; i++) out[i] = 0.5f * (out[i] - fb[i]);
+    bk_denoiser_destroy(d[0]), bk_denoiser_destroy(d[1]);
     free(fb);
     return r;
 }

@@ -145,7 +145,7 @@ typedef struct bk_denoise_groups {
 lbk_result bk_denoiser_error(const bk_denoiser *d, const float *halves, const size_t class_end[BK_RECEIVER_CLASSES],
                              bk_denoise_error *out);
 /* bk_denoiser_error, and each group's estimate from the same filter pass; with `cross` (NULL:
- * none) the noise term is Σ cross², cross from bk_denoiser_cross_delta, in place of Σ (Dδ)².
+ * none) the noise term is Σ cross², cross from bk_denoiser_half_delta, in place of Σ (Dδ)².
  * Errors as above, and LBK_ERR_INVALID_ARGUMENT for groups past the receivers. */
 lbk_result bk_denoiser_error_groups(const bk_denoiser *d, const float *halves, const size_t class_end[BK_RECEIVER_CLASSES],
                                     bk_denoise_error *out, const bk_denoise_groups *groups, const float *cross);
@@ -155,21 +155,16 @@ lbk_result bk_denoiser_errors(const bk_denoiser *d, const float *const *halves, 
                               const size_t class_end[BK_RECEIVER_CLASSES], bk_denoise_error *out);
 
 /* The noise the filter leaves, measured as the transport measures its own: each half filtered by
- * weights built from that half alone (da from a guide with half A's level and twice the
- * variance, db likewise from B), out[i] = (D_A·A − D_B·B)_i / 2 per receiver (receiver_count
- * floats). Why: Σ (Dδ)² is unbiased for fixed weights, but the filter's weights follow the very
- * noise they filter (a texel that reads bright finds its like among its neighbours), so what a
- * denoised bake differs by from another seed's is more than Σ (Dδ)² says (DENOISE.md, "What the
- * report says"). A half's filter sees its own noise as the full run's filter sees the full run's.
- * Errors: LBK_ERR_INVALID_ARGUMENT (NULL, or the two built over different receivers),
- * LBK_ERR_OUT_OF_MEMORY. */
-lbk_result bk_denoiser_cross_delta(const bk_denoiser *da, const bk_denoiser *db, const float *halves, float *out);
-/* The filter of one half (half 0: A, 1: B) for bk_denoiser_cross_delta: built like
- * bk_denoiser_create from `in`, its guide with the base part (base, per receiver) at that
- * half's level (scaled by A/X, resp. B/X, within [0, 2]) and the base's variance doubled
- * (base_variance added once more: a half has half the samples). Errors as bk_denoiser_create. */
-lbk_result bk_denoiser_create_half(const bk_denoise_inputs *in, const lbk_sh9_rgb *base, const float *base_variance,
-                                   const float *halves, int half, const bk_denoise_options *opt, bk_denoiser **out);
+ * weights built from that half alone (D_A from the guide `in` with its base part — base, per
+ * receiver — at half A's level and the base's variance doubled, D_B likewise from B),
+ * out[i] = (D_A·A − D_B·B)_i / 2 per receiver (in->receiver_count floats), for
+ * bk_denoiser_error_groups' `cross`. Why: Σ (Dδ)² is unbiased for fixed weights, but the filter's
+ * weights follow the very noise they filter (a texel that reads bright finds its like among its
+ * neighbours), so what a denoised bake differs by from another seed's is more than Σ (Dδ)² says
+ * (DENOISE.md, "What the report says"). A half's filter sees its own noise as the full run's
+ * filter sees the full run's. Errors as bk_denoiser_create. */
+lbk_result bk_denoiser_half_delta(const bk_denoise_inputs *in, const lbk_sh9_rgb *base, const float *base_variance,
+                                  const float *halves, const bk_denoise_options *opt, float *out);
 /* Unfiltered (the transport's own estimate per group): the same sums with D = I. */
 lbk_result bk_denoise_groups_unfiltered(const float *halves, const bk_denoise_groups *groups);
 void bk_denoiser_stats(const bk_denoiser *d, bk_denoise_stats *stats);

@@ -178,6 +178,29 @@ static lbk_result build_cell_sizes(bk_pipeline *b)
  * fit): the halves' difference sees the noise of the probes, not what the lattice cannot
  * represent, and that is what LLG objects get at run time. The residual also holds the targets'
  * own noise; its expected share is taken off where the transport measured it. */
+/* Each grid's probes' two-halves estimate (bk_denoise_groups_unfiltered, the transport's formula
+ * per group) into noise (llg_count); the class's figure where there are no halves (a distributed
+ * merge without them). 0 or LBK_ERR_OUT_OF_MEMORY. */
+static lbk_result llg_grid_noise(const bk_pipeline *b, double class_noise, double *noise)
+{
+    for (size_t g = 0; g < b->llg_count; g++) noise[g] = class_noise;
+    if (!b->halves) return LBK_OK;
+    const size_t n = b->receiver_count;
+    uint32_t *group = malloc((n ? n : 1) * sizeof *group);
+    bk_denoise_group_error *e = calloc(b->llg_count, sizeof *e);
+    lbk_result r = group && e ? LBK_OK : LBK_ERR_OUT_OF_MEMORY;
+    size_t i = 0;
+    for (; !r && i < b->llg_first && i < n; i++) group[i] = UINT32_MAX;
+    for (size_t g = 0; !r && g < b->llg_count; g++)
+        for (size_t k = bk_llg_probe_count(&b->llgs[g]); k > 0 && i < n; k--) group[i++] = (uint32_t)g;
+    for (; !r && i < n; i++) group[i] = UINT32_MAX;
+    const bk_denoise_groups gs = {n, group, b->llg_count, e};
+    if (!r) r = bk_denoise_groups_unfiltered(b->halves, &gs);
+    for (size_t g = 0; !r && g < b->llg_count; g++) noise[g] = e[g].noise;
+    free(group), free(e);
+    return r;
+}
+
 /* Each LLG prop's estimate (lbk_bake_llg_estimate): the class's two terms over one grid, its
  * probes' two halves and its targets' fit residual. Out of memory: none (the report leaves
  * them out). */
@@ -185,27 +208,20 @@ static void llg_object_estimates(bk_pipeline *b, double class_noise, int less_no
 {
     free(b->llg_est);
     b->llg_est = b->llg_fit_grid && b->llg_count ? calloc(b->llg_count, sizeof *b->llg_est) : NULL;
-    size_t probe = b->llg_first;
+    double *noise = b->llg_est ? malloc(b->llg_count * sizeof *noise) : NULL;
+    if (b->llg_est && (!noise || llg_grid_noise(b, class_noise, noise))) free(b->llg_est), b->llg_est = NULL;
     for (size_t g = 0; b->llg_est && g < b->llg_count; g++) {
-        const size_t np = bk_llg_probe_count(&b->llgs[g]);
-        double noise = class_noise, fit = 0;
-        if (b->halves) {
-            double d2 = 0, x2 = 0;
-            for (size_t i = probe; i < probe + np && i < b->receiver_count; i++) {
-                const double a = b->halves[2 * i], c = b->halves[2 * i + 1];
-                d2 += 0.25 * (a - c) * (a - c), x2 += 0.25 * (a + c) * (a + c);
-            }
-            noise = x2 > 0 ? sqrt(d2 / x2) : 0;
-        }
+        double fit = 0;
         const bk_llg_fit_stats *f = &b->llg_fit_grid[g];
         if (f->targets && f->target_sum > 0) {
             const double n = (double)f->targets, mean = f->target_sum / n;
             const double noise_sq = less_noise ? bk_llg_fit_noise_grid(&b->llg_fit, b->llgs, b->variance, g) : 0;
             fit = sqrt(fmax(0, f->fitted_sq - noise_sq) / n) / mean;
         }
-        b->llg_est[g] = (lbk_bake_llg_estimate){NULL, b->llgs[g].object, (uint32_t)f->targets, hypot(noise, fit), noise, fit};
-        probe += np;
+        b->llg_est[g] = (lbk_bake_llg_estimate){NULL, b->llgs[g].object, (uint32_t)f->targets, hypot(noise[g], fit),
+                                                noise[g], fit};
     }
+    free(noise);
 }
 
 static void llg_fit_error(bk_pipeline *b)
@@ -360,7 +376,7 @@ lbk_result bk_phase_sets(bk_pipeline *b)
 
 /* What the denoised base delivers: the two halves through the same weights (bk_denoiser_error;
  * it reads the halves only, so it runs before the filter), its noise from each half filtered by
- * its own weights (cross, half_cross_delta; NULL: the same weights'). The LLG class is not filtered and
+ * its own weights (cross, bk_denoiser_half_delta; NULL: the same weights'). The LLG class is not filtered and
  * keeps the base estimate with its fit residual. With --denoise auto (choose) a class whose
  * filtered estimate is not below its unfiltered one (the transport's) stays unfiltered and its
  * error is the transport's; do_denoise then filters the classes marked filtered. */
@@ -403,22 +419,17 @@ static lbk_result denoised_error(bk_pipeline *b, int choose, const float *cross)
     return LBK_OK;
 }
 
-/* The noise of the denoised base as another seed would see it (bk_denoiser_cross_delta): two
+/* The noise of the denoised base as another seed would see it (bk_denoiser_half_delta): two
  * more filters, each built from the guide with the base at one half's level and twice its
- * variance (bk_denoiser_create_half). Measured on six dev levels of bench/levels (DENOISE.md):
- * the estimate was 0.58–0.71 of the seed-to-seed noise of the stored texels with the same
- * weights' Σ (Dδ)², 0.72–0.84 with this; ~3 % more CPU. */
+ * variance. Measured on six dev levels of bench/levels (DENOISE.md): the estimate was 0.58–0.71
+ * of the seed-to-seed noise of the stored texels with the same weights' Σ (Dδ)², 0.72–0.84 with
+ * this; ~3 % more CPU. */
 static lbk_result half_cross_delta(const bk_pipeline *b, const bk_denoise_inputs *in, const bk_denoise_options *o,
                                    float **cross)
 {
-    bk_denoiser *half[2] = {NULL, NULL};
-    lbk_result r = LBK_OK;
-    for (int h = 0; h < 2 && !r; h++) r = bk_denoiser_create_half(in, b->radiance, b->variance, b->halves, h, o, &half[h]);
-    *cross = NULL;
-    if (!r && !(*cross = malloc((b->receiver_count ? b->receiver_count : 1) * sizeof **cross))) r = LBK_ERR_OUT_OF_MEMORY;
-    if (!r) r = bk_denoiser_cross_delta(half[0], half[1], b->halves, *cross);
+    *cross = malloc((b->receiver_count ? b->receiver_count : 1) * sizeof **cross);
+    lbk_result r = *cross ? bk_denoiser_half_delta(in, b->radiance, b->variance, b->halves, o, *cross) : LBK_ERR_OUT_OF_MEMORY;
     if (r) free(*cross), *cross = NULL;
-    bk_denoiser_destroy(half[0]), bk_denoiser_destroy(half[1]);
     return r;
 }
 

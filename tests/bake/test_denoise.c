@@ -314,17 +314,13 @@ static void test_contact_shadow(void **state)
 
 static double lum_e(const lbk_sh9_rgb *y) { return 0.2126 * sh_e(y, 0) + 0.7152 * sh_e(y, 1) + 0.0722 * sh_e(y, 2); }
 
-/* The floor class's noise estimate with each half filtered by its own weights: the halves'
- * filters built as the pipeline builds them (bk_denoiser_create_half), through
- * bk_denoiser_error_groups with one group, the floor. */
+/* The floor class's noise estimate with each half filtered by its own weights
+ * (bk_denoiser_half_delta, as the pipeline calls it), through bk_denoiser_error_groups with one
+ * group, the floor. */
 static double cross_noise(const bk_denoiser *d, const bk_denoise_inputs *in, const run *r, const float *halves,
                           const size_t class_end[BK_RECEIVER_CLASSES], float *cross)
 {
-    bk_denoiser *half[2];
-    for (int h = 0; h < 2; h++)
-        assert_int_equal(bk_denoiser_create_half(in, r->rad, r->var, halves, h, NULL, &half[h]), LBK_OK);
-    assert_int_equal(bk_denoiser_cross_delta(half[0], half[1], halves, cross), LBK_OK);
-    bk_denoiser_destroy(half[0]), bk_denoiser_destroy(half[1]);
+    assert_int_equal(bk_denoiser_half_delta(in, r->rad, r->var, halves, NULL, cross), LBK_OK);
     uint32_t *group = calloc(class_end[0] + 1, sizeof *group); /* every floor texel in group 0 */
     assert_non_null(group);
     bk_denoise_group_error g0;
@@ -419,7 +415,7 @@ static void test_denoised_estimate(void **state)
     assert_true(est_noise_only[BLUR] < 0.5 * meas[BLUR]); /* the blur's error is its bias */
     /* The noise the default filter leaves, against how its output differs between seeds: the
      * same weights' Σ (Dδ)² misses what the weights add by following the noise; each half
-     * filtered by its own weights (bk_denoiser_cross_delta) sees it. */
+     * filtered by its own weights (bk_denoiser_half_delta) sees it. */
     double var = 0, sq = 0;
     for (size_t k = 0; k < nf; k++) {
         double m = 0, v = 0;
