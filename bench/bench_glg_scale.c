@@ -26,7 +26,8 @@
 
 typedef struct result {
     size_t points, tets;
-    double delaunay_s, path_ns, random_ns, path_steps, random_steps;
+    double delaunay_s, merged_s, path_ns, random_ns, path_steps, random_steps;
+    int fell_back;
 } result;
 
 /* nx × ny × nz lattice of spacing 1 in [0, n−1]; with `refined`, the bottom quarter again at
@@ -97,9 +98,16 @@ static int run(int n, int refined, result *r)
     if (!pts) return -1;
     bk_tetmesh mesh;
     memset(&mesh, 0, sizeof mesh);
+    /* the merged-cells path first (bk_delaunay's fallback, its only path before 2026-12-07) */
+    bk_delaunay_options merged = {.merged_cells = 1};
     double t0 = bench_thread_cpu();
-    int st = bk_delaunay(pts, r->points, NULL, &mesh);
+    int st = bk_delaunay(pts, r->points, &merged, &mesh);
+    r->merged_s = bench_thread_cpu() - t0;
+    bk_tetmesh_free(&mesh);
+    t0 = bench_thread_cpu();
+    if (st == BK_DELAUNAY_OK) st = bk_delaunay(pts, r->points, NULL, &mesh);
     r->delaunay_s = bench_thread_cpu() - t0;
+    r->fell_back = mesh.merged_cells;
     free(pts);
     if (st != BK_DELAUNAY_OK) {
         fprintf(stderr, "delaunay: %s\n", bk_delaunay_status_name(st));
@@ -135,9 +143,11 @@ int main(void)
     /* n: the lattice is 4n × n × 4n = 16 n³ points (10: 16 k, 16: 64 k, 25: 250 k); the refined
      * set adds about 1.75× that in its fine layer (7: 15 k, 11: 58 k, 18: 256 k in all) */
     static const int sizes[2][3] = {{10, 16, 25}, {7, 11, 18}};
-    printf("GLG at scale: Delaunay (qhull) and the runtime walk, CPU of one thread\n");
-    printf("%-8s %8s %9s %11s %8s %12s %7s %12s %7s\n", "points", "probes", "tetras", "delaunay s", "x first",
-           "path ns/q", "steps", "random ns/q", "steps");
+    printf("GLG at scale: Delaunay (qhull) and the runtime walk, CPU of one thread. 'merged s': the same\n"
+           "points through qhull's merged cells (the fallback; bk_delaunay_options.merged_cells), 'x faster' its\n"
+           "time over bk_delaunay's, 'fallback' 1 where bk_delaunay itself had to take that path\n");
+    printf("%-8s %8s %9s %11s %8s %9s %9s %9s %12s %7s %12s %7s\n", "points", "probes", "tetras", "delaunay s",
+           "x first", "merged s", "x faster", "fallback", "path ns/q", "steps", "random ns/q", "steps");
     for (int refined = 0; refined < 2; refined++) {
         result base = {0};
         for (size_t i = 0; i < 3; i++) {
@@ -147,8 +157,9 @@ int main(void)
                 return 1;
             }
             if (i == 0) base = r;
-            printf("%-8s %8zu %9zu %11.2f %8.1f %12.0f %7.2f %12.0f %7.1f\n", refined ? "refined" : "grid", r.points,
-                   r.tets, r.delaunay_s, r.delaunay_s / base.delaunay_s, r.path_ns, r.path_steps, r.random_ns,
+            printf("%-8s %8zu %9zu %11.2f %8.1f %9.2f %9.1f %9d %12.0f %7.2f %12.0f %7.1f\n",
+                   refined ? "refined" : "grid", r.points, r.tets, r.delaunay_s, r.delaunay_s / base.delaunay_s,
+                   r.merged_s, r.merged_s / r.delaunay_s, r.fell_back, r.path_ns, r.path_steps, r.random_ns,
                    r.random_steps);
             fflush(stdout);
         }

@@ -1,13 +1,17 @@
 /* Delaunay tetrahedralisation on top of libqhull_r.
  *
- * qhull is run WITHOUT triangulated output ('Qt'): where points are cospherical (every cube of
- * a regular grid) it returns one merged, non-simplicial Delaunay cell, and we triangulate those
- * cells ourselves with a "pulling" triangulation keyed on global point indices. Each 2-face of a
- * cell is computed as the intersection of the vertex sets of the two cells that share it and is
- * split by a fan from its lowest-index vertex, so both sides of a shared face always agree and
- * no zero-volume "glue" tetrahedra are needed. 'Qt' by contrast triangulates each cell from its
- * own first vertex and leaves flat tetrahedra where the two sides disagree, and 'QJ' joggles
- * with a time-seeded generator (not deterministic). See bake/probes/PROBES.md. */
+ * First the lifted path (run_qhull_lifted, below): qhull's 4-d hull of the points lifted onto the
+ * paraboloid with tiny tie-breaking weights and ghost points beside the hull's flat faces, which
+ * leaves qhull nothing to merge — ×10 faster on lattices, the probe placement's common case.
+ * Where its checks fail, qhull's own Delaunay ('d') is run WITHOUT triangulated output ('Qt'):
+ * where points are cospherical (every cube of a regular grid) it returns one merged,
+ * non-simplicial Delaunay cell, and we triangulate those cells ourselves with a "pulling"
+ * triangulation keyed on global point indices. Each 2-face of a cell is computed as the
+ * intersection of the vertex sets of the two cells that share it and is split by a fan from its
+ * lowest-index vertex, so both sides of a shared face always agree and no zero-volume "glue"
+ * tetrahedra are needed. 'Qt' by contrast triangulates each cell from its own first vertex and
+ * leaves flat tetrahedra where the two sides disagree, and 'QJ' moves the points (randomly) and
+ * leaves slivers. See bake/probes/PROBES.md. */
 #include "bake/probes/delaunay.h"
 #include "bake/probes/probe_math.h"
 
@@ -291,6 +295,204 @@ done:
     return status;
 }
 
+/* ---- the lifted path: a regular triangulation with tie-breaking weights --------------------
+ * Delaunay is the lower hull of the points lifted onto the paraboloid |p|². On a lattice qhull's
+ * time goes into merging facets: the cospherical corners of every cube, and above all the
+ * vertical facets over the flat faces of the points' hull, each holding thousands of coplanar
+ * points (n^1.6: 151 s at 250 k lattice probes, PROBES.md). Both degeneracies are removed here:
+ * - Each lift is lowered by a tiny weight (a hash of the point's index times 10⁻³ of its nearest
+ *   neighbour's distance squared), which breaks every cospherical tie. The lower hull is then
+ *   the regular triangulation of the same, unmoved points: exactly Delaunay wherever the points
+ *   are not within 10⁻³ of cospherical, one valid choice among the ties where they are. No
+ *   tetrahedron can be flat (four coplanar points lift onto a vertical hyperplane, never a lower
+ *   facet) and the weights depend only on the points and their order: deterministic.
+ * - Ghost points beyond each face of the bounding box that holds many points (a lattice's
+ *   sides), lifted above the paraboloid, so that the face's points make no vertical facet;
+ *   lower facets through a ghost lie outside the points' hull and are dropped. Only there: a
+ *   ghost near a sliver of a hull in general position (its circumsphere reaching the ghost)
+ *   would cut into it, and such hulls have no big flat faces to merge.
+ * - qhull runs without pre-merging ('Q0'): nothing should need merging, and its pre-merge merged
+ *   facets of a two-layer town lattice anyway.
+ * Any sign that this did not hold — a lower facet of more than 4 vertices, a point in no
+ * tetrahedron, a flat or non-manifold result, or a boundary that is not convex (a ghost cut into
+ * the hull) — falls back to run_qhull's merged cells (bk_tetmesh.merged_cells). */
+#define LIFT_TIE_WEIGHT 1e-3
+#define LIFT_NN_CANDIDATES 64
+#define LIFT_GHOST_MIN_POINTS 16  /* a face of the box holding this many points gets ghosts */
+#define LIFT_FACE_TOLERANCE 1e-7  /* on a face of the box: this close, in units of the points' radius */
+#define LIFT_GHOST_PATCH 256.0    /* face points per ghost, about */
+#define LIFT_GHOST_GRID 64        /* most ghosts along a face's side */
+#define LIFT_GHOSTS (6 * LIFT_GHOST_GRID * LIFT_GHOST_GRID)
+#define LIFT_GHOST_DISTANCE 1.0   /* beyond the face, in patch sizes */
+#define LIFT_GHOST_HEIGHT 1.0     /* above the paraboloid, in patch sizes squared: outside the
+                                     circumsphere of every boundary tetrahedron smaller than that */
+
+static void point_box(const double *pts, size_t n, double lo[3], double hi[3])
+{
+    for (int k = 0; k < 3; k++) { lo[k] = DBL_MAX; hi[k] = -DBL_MAX; }
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) { lo[k] = fmin(lo[k], pts[3 * i + k]); hi[k] = fmax(hi[k], pts[3 * i + k]); }
+}
+
+static double index_unit(uint64_t i) /* splitmix64 of the index, in [0, 1) */
+{
+    uint64_t z = i + 0x9e3779b97f4a7c15ull;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    z ^= z >> 31;
+    return (double)(z >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* Per point, the squared distance to the nearest other point among those in the 27 grid cells
+ * around it (the first LIFT_NN_CANDIDATES of them); cell² where none is found. An overestimate
+ * only makes a weight larger, which the checks after qhull catch if it ever hides a point. */
+static int nearest_sq(const double *pts, size_t n, double *nn2)
+{
+    double lo[3], hi[3], ext[3], vol = 1.0, diag = 0.0;
+    point_box(pts, n, lo, hi);
+    for (int k = 0; k < 3; k++) { ext[k] = hi[k] - lo[k]; diag += ext[k] * ext[k]; }
+    diag = sqrt(diag);
+    for (int k = 0; k < 3; k++) vol *= fmax(ext[k], 1e-3 * diag);
+    double cell = cbrt(vol / (double)n) * 1.5;
+    cell_key *keys = malloc(n * sizeof *keys);
+    if (!keys) return BK_DELAUNAY_NO_MEMORY;
+    for (size_t i = 0; i < n; i++) {
+        keys[i].x = (int64_t)floor((pts[3 * i] - lo[0]) / cell);
+        keys[i].y = (int64_t)floor((pts[3 * i + 1] - lo[1]) / cell);
+        keys[i].z = (int64_t)floor((pts[3 * i + 2] - lo[2]) / cell);
+        keys[i].index = (uint32_t)i;
+    }
+    qsort(keys, n, sizeof *keys, cmp_cell_key);
+    for (size_t i = 0; i < n; i++) {
+        const double *p = pts + 3 * i;
+        int64_t c[3];
+        for (int k = 0; k < 3; k++) c[k] = (int64_t)floor((p[k] - lo[k]) / cell);
+        double best = cell * cell;
+        int seen = 0;
+        for (int dx = -1; dx <= 1; dx++) for (int dy = -1; dy <= 1; dy++) for (int dz = -1; dz <= 1; dz++) {
+            size_t s = lower_bound_cell(keys, n, c[0] + dx, c[1] + dy, c[2] + dz);
+            for (; s < n && seen < LIFT_NN_CANDIDATES && keys[s].x == c[0] + dx && keys[s].y == c[1] + dy &&
+                   keys[s].z == c[2] + dz; s++) {
+                if (keys[s].index == i) continue;
+                const double *q = pts + 3 * (size_t)keys[s].index;
+                double d2 = (p[0]-q[0])*(p[0]-q[0]) + (p[1]-q[1])*(p[1]-q[1]) + (p[2]-q[2])*(p[2]-q[2]);
+                if (d2 < best) best = d2;
+                seen++;
+            }
+        }
+        nn2[i] = best;
+    }
+    free(keys);
+    return BK_DELAUNAY_OK;
+}
+
+/* The ghosts beyond face f (axis f / 2, the high side when f is odd) of the box lo..hi holding m
+ * points: a grid of patches of about LIFT_GHOST_PATCH points, one ghost at LIFT_GHOST_DISTANCE
+ * patch sizes beyond each patch's centre (one ghost for a whole face made it a vertex of every
+ * facet over the face, and qhull updates each vertex's neighbour set facet by facet: quadratic). */
+static size_t face_ghosts(int f, size_t m, const double lo[3], const double hi[3], double r, coordT *out)
+{
+    int a = f / 2, b = (a + 1) % 3, c = (a + 2) % 3;
+    double eb = fmax(hi[b] - lo[b], 1e-9 * r), ec = fmax(hi[c] - lo[c], 1e-9 * r);
+    double g = sqrt(eb * ec / (double)m * LIFT_GHOST_PATCH);
+    int nb = (int)fmin(ceil(eb / g), LIFT_GHOST_GRID), nc = (int)fmin(ceil(ec / g), LIFT_GHOST_GRID);
+    double d = LIFT_GHOST_DISTANCE * fmax(eb / nb, ec / nc);
+    size_t k = 0;
+    for (int i = 0; i < nb; i++)
+        for (int j = 0; j < nc; j++, k++) {
+            coordT *q = out + 4 * k;
+            q[a] = f & 1 ? hi[a] + d : lo[a] - d;
+            q[b] = lo[b] + (i + 0.5) * eb / nb;
+            q[c] = lo[c] + (j + 0.5) * ec / nc;
+            q[3] = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + LIFT_GHOST_HEIGHT * d * d) / r;
+        }
+    return k;
+}
+
+/* The lifted points (4 coordinates, the lift scaled to the points' radius), then the ghosts. */
+static coordT *lifted_points(const double *pts, size_t n, const double *nn2, size_t *ghosts)
+{
+    coordT *c = malloc(4 * (n + LIFT_GHOSTS) * sizeof *c);
+    if (!c) return NULL;
+    double lo[3], hi[3], r2 = 0.0;
+    point_box(pts, n, lo, hi);
+    for (size_t i = 0; i < n; i++)
+        r2 = fmax(r2, pts[3 * i] * pts[3 * i] + pts[3 * i + 1] * pts[3 * i + 1] + pts[3 * i + 2] * pts[3 * i + 2]);
+    double r = sqrt(r2) > 0.0 ? sqrt(r2) : 1.0;
+    size_t on_face[6] = {0};
+    for (size_t i = 0; i < n; i++) {
+        const double *p = pts + 3 * i;
+        double w = LIFT_TIE_WEIGHT * index_unit(i) * nn2[i];
+        c[4 * i] = p[0]; c[4 * i + 1] = p[1]; c[4 * i + 2] = p[2];
+        c[4 * i + 3] = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] - w) / r;
+        for (int k = 0; k < 3; k++) {
+            on_face[2 * k] += p[k] - lo[k] <= LIFT_FACE_TOLERANCE * r;
+            on_face[2 * k + 1] += hi[k] - p[k] <= LIFT_FACE_TOLERANCE * r;
+        }
+    }
+    size_t g = 0;
+    for (int f = 0; f < 6; f++)
+        if (on_face[f] >= LIFT_GHOST_MIN_POINTS) g += face_ghosts(f, on_face[f], lo, hi, r, c + 4 * (n + g));
+    *ghosts = g;
+    return c;
+}
+
+/* BK_DELAUNAY_OK with every lower facet a tetrahedron in *out and every point in one;
+ * BK_DELAUNAY_FAILED when the ties were not all broken (the caller falls back to run_qhull). */
+static int run_qhull_lifted(const double *pts, size_t n, tet_list *out)
+{
+    int status = BK_DELAUNAY_OK;
+    double *nn2 = malloc(n * sizeof *nn2);
+    coordT *coords = NULL;
+    uint8_t *used = calloc(n, 1);
+    qhT *qh = calloc(1, sizeof *qh);
+    char sink_text[1024];
+    FILE *sink = fmemopen(sink_text, sizeof sink_text, "w");
+    if (!nn2 || !used || !qh || !sink) { status = BK_DELAUNAY_NO_MEMORY; goto done; }
+    if ((status = nearest_sq(pts, n, nn2)) != BK_DELAUNAY_OK) goto done;
+    size_t ghosts = 0;
+    if (!(coords = lifted_points(pts, n, nn2, &ghosts))) { status = BK_DELAUNAY_NO_MEMORY; goto done; }
+    qh_zero(qh, sink);
+    /* Q0: no pre-merging. With the ties broken nothing needs merging, and qhull's conservative
+     * pre-merge still merged facets of a 2 km, two-layer town lattice (a lower facet of 5 vertices
+     * at any weight up to 10⁻¹); a real precision problem is an error, or fails the checks. */
+    char flags[] = "qhull Q0";
+    int code = qh_new_qhull(qh, 4, (int)(n + ghosts), coords, False, flags, NULL, sink);
+    if (code == qh_ERRmem) { status = BK_DELAUNAY_NO_MEMORY; goto freeqh; }
+    if (code) { status = BK_DELAUNAY_FAILED; goto freeqh; }
+    facetT *facet;
+    FORALLfacets {
+        if (!(facet->normal[3] < -qh_ZEROdelaunay * qh->ANGLEround)) continue; /* upper (as qhull's 'd') */
+        uint32_t id[4];
+        size_t k = 0;
+        int ghost = 0;
+        vertexT *vertex, **vertexp;
+        FOREACHvertex_(facet->vertices) {
+            int pid = qh_pointid(qh, vertex->point);
+            if (k < 4) id[k] = (uint32_t)pid;
+            k++;
+            if (pid < 0 || (size_t)pid >= n) ghost = 1;
+        }
+        if (ghost) continue; /* outside the points' hull */
+        if (k != 4) { status = BK_DELAUNAY_FAILED; goto freeqh; } /* a tie not broken */
+        for (int j = 0; j < 4; j++) used[id[j]] = 1;
+        tet_push(out, id[0], id[1], id[2], id[3]);
+    }
+    if (out->oom) status = BK_DELAUNAY_NO_MEMORY;
+    for (size_t i = 0; status == BK_DELAUNAY_OK && i < n; i++)
+        if (!used[i]) status = BK_DELAUNAY_FAILED; /* a weight hid a point */
+freeqh:
+    {
+        int curlong, totlong;
+        qh_freeqhull(qh, !qh_ALL);
+        qh_memfreeshort(qh, &curlong, &totlong);
+    }
+done:
+    if (sink) fclose(sink);
+    free(qh); free(coords); free(used); free(nn2);
+    return status;
+}
+
 /* ---- bk_delaunay, step by step ---------------------------------------------------------- */
 
 static int finite_point(const float *p) { return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]); }
@@ -528,6 +730,79 @@ static int link_neighbours(bk_tetmesh *out)
     return BK_DELAUNAY_OK;
 }
 
+/* ---- the hull check of the lifted path -------------------------------------------------------
+ * The mesh covers the points' convex hull exactly when every point is a vertex (checked in
+ * run_qhull_lifted) and its boundary is convex; a closed, connected, locally convex surface
+ * bounds a convex body, so checking each boundary edge's two faces suffices: the far vertex of
+ * one face must not lie outside the other's plane. A ghost lifted too low would cut a dent. */
+typedef struct edge_rec { uint32_t a, b, face; } edge_rec;
+
+static int cmp_edge(const void *pa, const void *pb)
+{
+    const edge_rec *x = pa, *y = pb;
+    if (x->a != y->a) return x->a < y->a ? -1 : 1;
+    if (x->b != y->b) return x->b < y->b ? -1 : 1;
+    return x->face < y->face ? -1 : x->face > y->face;
+}
+
+static void vertex_d(const bk_tetmesh *m, uint32_t v, double out[3])
+{
+    for (int k = 0; k < 3; k++) out[k] = m->points[3 * (size_t)v + k];
+}
+
+/* 1 when w lies outside the plane of face f (3 vertices, the tetrahedron's side positive). */
+static int outside_face(const bk_tetmesh *m, const uint32_t *f, uint32_t w)
+{
+    double a[3], b[3], c[3], d[3];
+    vertex_d(m, f[0], a); vertex_d(m, f[1], b); vertex_d(m, f[2], c); vertex_d(m, w, d);
+    double l = 0.0;
+    const double *q[4] = {a, b, c, d};
+    for (int x = 0; x < 4; x++) for (int y = x + 1; y < 4; y++)
+        l = fmax(l, (q[x][0]-q[y][0])*(q[x][0]-q[y][0]) + (q[x][1]-q[y][1])*(q[x][1]-q[y][1]) + (q[x][2]-q[y][2])*(q[x][2]-q[y][2]));
+    return orient(a, b, c, d) < -FLAT_VOLUME_RATIO * 6.0 * l * sqrt(l);
+}
+
+static int boundary_is_convex(const bk_tetmesh *m, int *convex)
+{
+    size_t nf = 0;
+    for (size_t k = 0; k < 4 * m->tet_count; k++) nf += m->neighbours[k] == BK_TET_NONE;
+    uint32_t (*face)[3] = malloc((nf ? nf : 1) * sizeof *face);
+    edge_rec *edges = malloc((nf ? 3 * nf : 1) * sizeof *edges);
+    if (!face || !edges) { free(face); free(edges); return BK_DELAUNAY_NO_MEMORY; }
+    size_t f = 0;
+    for (size_t t = 0; t < m->tet_count; t++)
+        for (int i = 0; i < 4; i++) {
+            if (m->neighbours[4 * t + i] != BK_TET_NONE) continue;
+            const uint32_t *v = m->tets + 4 * t;
+            uint32_t *o = face[f];
+            int w = 0;
+            for (int k = 0; k < 4; k++) if (k != i) o[w++] = v[k];
+            double a[3], b[3], c[3], d[3];
+            vertex_d(m, o[0], a); vertex_d(m, o[1], b); vertex_d(m, o[2], c); vertex_d(m, v[i], d);
+            if (orient(a, b, c, d) < 0) { uint32_t x = o[1]; o[1] = o[2]; o[2] = x; }
+            for (int e = 0; e < 3; e++) {
+                uint32_t p = o[e], q = o[(e + 1) % 3];
+                edges[3 * f + e] = (edge_rec){p < q ? p : q, p < q ? q : p, (uint32_t)f};
+            }
+            f++;
+        }
+    qsort(edges, 3 * nf, sizeof *edges, cmp_edge);
+    *convex = nf >= 4;
+    for (size_t e = 0; *convex && e < 3 * nf; e += 2) {
+        if (e + 1 >= 3 * nf || edges[e + 1].a != edges[e].a || edges[e + 1].b != edges[e].b ||
+            (e + 2 < 3 * nf && edges[e + 2].a == edges[e].a && edges[e + 2].b == edges[e].b)) {
+            *convex = 0; /* an edge not shared by exactly two boundary faces */
+            break;
+        }
+        const uint32_t *F = face[edges[e].face], *G = face[edges[e + 1].face];
+        uint32_t w = G[0] + G[1] + G[2] - edges[e].a - edges[e].b; /* G's vertex off the edge */
+        if (outside_face(m, F, w)) *convex = 0;
+    }
+    free(face);
+    free(edges);
+    return BK_DELAUNAY_OK;
+}
+
 /* A failed run keeps only what says why: the input count, the merges and an all-unused
  * input_to_point. */
 static void clear_failed_mesh(bk_tetmesh *out, size_t count)
@@ -542,6 +817,30 @@ static void clear_failed_mesh(bk_tetmesh *out, size_t count)
     if (keep) for (size_t i = 0; i < count; i++) keep[i] = BK_TET_NONE;
 }
 
+/* qhull (lifted, or merged cells split), then the canonical mesh and its neighbours. On the
+ * lifted path, BK_DELAUNAY_FAILED for any result bk_delaunay would not keep from it. */
+static int triangulate(const float *points, size_t count, const uint32_t *rep, const uint32_t *distinct,
+                       const double *pts, size_t nd, int merged, bk_tetmesh *out)
+{
+    tet_list tl = {0};
+    uint32_t *recs = NULL;
+    size_t nt = 0;
+    int status = merged ? run_qhull(pts, nd, &tl) : run_qhull_lifted(pts, nd, &tl);
+    if (status == BK_DELAUNAY_OK) status = canonical_tets(&tl, pts, &recs, &nt, &out->dropped_flat);
+    if (status == BK_DELAUNAY_OK) status = mesh_from_tets(points, count, rep, distinct, nd, recs, nt, out);
+    if (status == BK_DELAUNAY_OK) status = link_neighbours(out);
+    if (status == BK_DELAUNAY_OK && !merged) {
+        int convex = 0;
+        status = boundary_is_convex(out, &convex);
+        if (status == BK_DELAUNAY_OK && (!convex || out->dropped_flat || out->nonmanifold_faces || out->unused_count))
+            status = BK_DELAUNAY_FAILED;
+    }
+    if (!merged && status == BK_DELAUNAY_FLAT) status = BK_DELAUNAY_FAILED; /* nothing kept: try merged */
+    free(recs);
+    free(tl.v);
+    return status;
+}
+
 int bk_delaunay(const float *points, size_t count, const bk_delaunay_options *options,
                 bk_tetmesh *out)
 {
@@ -549,10 +848,9 @@ int bk_delaunay(const float *points, size_t count, const bk_delaunay_options *op
     out->input_count = count;
     if (count > 0xFFFFFFF0u) return BK_DELAUNAY_FAILED;
     int status = BK_DELAUNAY_OK;
-    uint32_t *rep = NULL, *distinct = NULL, *recs = NULL;
+    uint32_t *rep = NULL, *distinct = NULL;
     double *pts = NULL;
-    tet_list tl = {0};
-    size_t nd = 0, nt = 0;
+    size_t nd = 0;
     out->input_to_point = malloc((count ? count : 1) * sizeof *out->input_to_point);
     rep = malloc((count ? count : 1) * sizeof *rep);
     if (!out->input_to_point || !rep) { status = BK_DELAUNAY_NO_MEMORY; goto done; }
@@ -569,12 +867,15 @@ int bk_delaunay(const float *points, size_t count, const bk_delaunay_options *op
     if (status == BK_DELAUNAY_OK && nd < 4) status = BK_DELAUNAY_TOO_FEW;
     if (status == BK_DELAUNAY_OK) status = centred_distinct_points(points, count, rep, nd, lo, hi, &distinct, &pts);
     if (status == BK_DELAUNAY_OK && spans_no_volume(pts, nd, eps)) status = BK_DELAUNAY_FLAT;
-    if (status == BK_DELAUNAY_OK) status = run_qhull(pts, nd, &tl);
-    if (status == BK_DELAUNAY_OK) status = canonical_tets(&tl, pts, &recs, &nt, &out->dropped_flat);
-    if (status == BK_DELAUNAY_OK) status = mesh_from_tets(points, count, rep, distinct, nd, recs, nt, out);
-    if (status == BK_DELAUNAY_OK) status = link_neighbours(out);
+    int merged = out->merged_cells = options && options->merged_cells;
+    if (status == BK_DELAUNAY_OK) status = triangulate(points, count, rep, distinct, pts, nd, merged, out);
+    if (status == BK_DELAUNAY_FAILED && !merged) { /* the lifted path's checks failed */
+        clear_failed_mesh(out, count);
+        out->merged_cells = 1;
+        status = triangulate(points, count, rep, distinct, pts, nd, 1, out);
+    }
 done:
-    free(recs); free(tl.v); free(pts); free(distinct); free(rep);
+    free(pts); free(distinct); free(rep);
     if (status != BK_DELAUNAY_OK) clear_failed_mesh(out, count);
     return status;
 }

@@ -21,6 +21,9 @@ typedef struct bk_delaunay_options {
     /* Points closer than this are merged into the first of them (input order).
      * 0: 1e-6 × the diagonal of the points' bounding box. */
     double merge_distance;
+    /* 1: split qhull's merged cospherical cells without trying the tie-breaking weights first
+     * (the path bk_delaunay falls back to when they fail; n^1.6 on lattices). 0: weights first. */
+    int merged_cells;
 } bk_delaunay_options;
 
 typedef struct bk_tetmesh {
@@ -44,6 +47,8 @@ typedef struct bk_tetmesh {
     size_t dropped_flat;               /* near-zero-volume tetrahedra removed (0 for sane input) */
     size_t nonmanifold_faces;          /* faces shared by more than two tetrahedra (0 expected) */
     double volume;                     /* total volume of the tetrahedra */
+    int merged_cells;                  /* 1: the tie-breaking weights failed and qhull's merged
+                                          cospherical cells were split instead (PROBES.md) */
 } bk_tetmesh;
 
 /* Tetrahedralises points[3*count]. On any status other than OK, *out holds no tetrahedra but

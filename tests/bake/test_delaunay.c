@@ -97,6 +97,7 @@ static void test_random_points(void **state)
     bk_tetmesh m;
     assert_int_equal(bk_delaunay(pts, n, NULL, &m), BK_DELAUNAY_OK);
     check_mesh(&m);
+    assert_int_equal(m.merged_cells, 0);
     /* every point of a random set is a Delaunay vertex */
     assert_int_equal(m.point_count, n);
     assert_int_equal(m.unused_count, 0);
@@ -186,9 +187,12 @@ static void test_regular_grid(void **state)
     const float origin[3] = {0, 0, 0};
     size_t n;
     float *pts = grid_points(4, 4, 4, 1.0f, origin, &n);
+    for (int merged = 1; merged >= 0; merged--) { /* qhull's merged cells split, then the weights */
+    bk_delaunay_options o = {.merged_cells = merged};
     bk_tetmesh m;
-    assert_int_equal(bk_delaunay(pts, n, NULL, &m), BK_DELAUNAY_OK);
+    assert_int_equal(bk_delaunay(pts, n, &o, &m), BK_DELAUNAY_OK);
     check_mesh(&m);
+    assert_int_equal(m.merged_cells, merged);
     assert_int_equal(m.point_count, 64);
     assert_true(fabs(m.volume - 27.0) < 1e-9);
     assert_int_equal(count_hull_faces(&m), 6 * 9 * 2);
@@ -203,6 +207,7 @@ static void test_regular_grid(void **state)
         for (int a = 0; a < 3; a++) assert_true(hi[a] - lo[a] <= 1.0f);
     }
     bk_tetmesh_free(&m);
+    }
     free(pts);
 }
 
@@ -218,11 +223,57 @@ static void test_far_anisotropic_grid(void **state)
     bk_tetmesh m;
     assert_int_equal(bk_delaunay(pts, n, NULL, &m), BK_DELAUNAY_OK);
     check_mesh(&m);
+    assert_int_equal(m.merged_cells, 0);
     assert_int_equal(m.point_count, n);
     double expect = (5 * 0.5) * (4 * 0.75) * (2 * 0.5);
     assert_true(fabs(m.volume - expect) < 1e-6 * expect);
     bk_tetmesh_free(&m);
     free(pts);
+}
+
+/* The lifted path's hard neighbours: a lattice whose +x side is bulged by 10⁻³ at its centre
+ * (that side's boundary tetrahedra are slivers with huge circumspheres, beside the other sides'
+ * ghosts), and a lattice with a jittered, twice as fine bottom layer (the placement's refinement).
+ * Whichever path ends up taken, the mesh must be valid, use every point and fill the hull. */
+static void test_lifted_hard_hulls(void **state)
+{
+    (void)state;
+    const float origin[3] = {0, 0, 0};
+    size_t n;
+    float *grid = grid_points(6, 5, 6, 1.0f, origin, &n);
+    float *pts = malloc(3 * (n + 200) * sizeof *pts);
+    memcpy(pts, grid, 3 * n * sizeof *pts);
+    pts[3 * n] = 5.001f; pts[3 * n + 1] = 2.0f; pts[3 * n + 2] = 2.5f;
+    size_t bulged = n + 1, m = bulged;
+    rng_state = 99;
+    for (int x = 0; x < 11; x++) for (int z = 0; z < 11; z++) {
+        if (!(x & 1) && !(z & 1)) continue;
+        pts[3 * m] = (float)(0.5 * x + 1e-3 * (rnd() - 0.5));
+        pts[3 * m + 1] = (float)(0.5 + 1e-3 * (rnd() - 0.5));
+        pts[3 * m + 2] = (float)(0.5 * z + 1e-3 * (rnd() - 0.5));
+        m++;
+    }
+    const float *sets[2] = {pts, grid};
+    size_t counts[2] = {bulged, 0};
+    float *refined = malloc(3 * (n + (m - bulged)) * sizeof *refined);
+    memcpy(refined, grid, 3 * n * sizeof *refined);
+    memcpy(refined + 3 * n, pts + 3 * bulged, 3 * (m - bulged) * sizeof *refined);
+    sets[1] = refined;
+    counts[1] = n + (m - bulged);
+    for (int k = 0; k < 2; k++) {
+        bk_tetmesh t;
+        assert_int_equal(bk_delaunay(sets[k], counts[k], NULL, &t), BK_DELAUNAY_OK);
+        check_mesh(&t);
+        assert_int_equal(t.unused_count, 0);
+        assert_int_equal(t.point_count, counts[k]);
+        double hv = hull_volume(sets[k], counts[k]);
+        assert_true(fabs(t.volume - hv) < 1e-6 * hv);
+        print_message("hard hull %d: %zu points, %zu tetrahedra, merged cells %d\n", k, counts[k], t.tet_count, t.merged_cells);
+        bk_tetmesh_free(&t);
+    }
+    free(refined);
+    free(pts);
+    free(grid);
 }
 
 static void test_coplanar_points(void **state)
@@ -342,6 +393,7 @@ int main(void)
         cmocka_unit_test(test_random_points),
         cmocka_unit_test(test_regular_grid),
         cmocka_unit_test(test_far_anisotropic_grid),
+        cmocka_unit_test(test_lifted_hard_hulls),
         cmocka_unit_test(test_coplanar_points),
         cmocka_unit_test(test_duplicates),
         cmocka_unit_test(test_too_few),
