@@ -224,6 +224,14 @@ static int scratch_grow(size_t cap, uint32_t **ids, uint32_t **nids, uint32_t **
     return a && b && c && s;
 }
 
+/* Frees what qhull holds (not qh itself). */
+static void qhull_release(qhT *qh)
+{
+    int curlong, totlong;
+    qh_freeqhull(qh, !qh_ALL);
+    qh_memfreeshort(qh, &curlong, &totlong);
+}
+
 static int run_qhull(const double *pts, size_t n, tet_list *out)
 {
     int status = BK_DELAUNAY_OK;
@@ -282,11 +290,7 @@ static int run_qhull(const double *pts, size_t n, tet_list *out)
     }
     if (out->oom) status = BK_DELAUNAY_NO_MEMORY;
 freeqh:
-    {
-        int curlong, totlong;
-        qh_freeqhull(qh, !qh_ALL);
-        qh_memfreeshort(qh, &curlong, &totlong);
-    }
+    qhull_release(qh);
 done:
     if (sink) fclose(sink);
     free(ids); free(nids); free(common); free(scratch);
@@ -482,11 +486,7 @@ static int run_qhull_lifted(const double *pts, size_t n, tet_list *out)
     for (size_t i = 0; status == BK_DELAUNAY_OK && i < n; i++)
         if (!used[i]) status = BK_DELAUNAY_FAILED; /* a weight hid a point */
 freeqh:
-    {
-        int curlong, totlong;
-        qh_freeqhull(qh, !qh_ALL);
-        qh_memfreeshort(qh, &curlong, &totlong);
-    }
+    qhull_release(qh);
 done:
     if (sink) fclose(sink);
     free(qh); free(coords); free(used); free(nn2);
