@@ -327,9 +327,10 @@ done:
 #define LIFT_GHOST_PATCH 256.0    /* face points per ghost, about */
 #define LIFT_GHOST_GRID 64        /* most ghosts along a face's side */
 #define LIFT_GHOSTS (6 * LIFT_GHOST_GRID * LIFT_GHOST_GRID)
-#define LIFT_GHOST_DISTANCE 1.0   /* beyond the face, in patch sizes */
-#define LIFT_GHOST_HEIGHT 1.0     /* above the paraboloid, in patch sizes squared: outside the
-                                     circumsphere of every boundary tetrahedron smaller than that */
+#define LIFT_GHOST_DISTANCE 4.0   /* beyond the face, in patch sizes */
+#define LIFT_GHOST_HEIGHT 16.0    /* above the paraboloid, × its distance squared: it cuts no
+                                     boundary tetrahedron whose circumsphere is under ~4 distances
+                                     (1 and 1: 5 of 12 generated levels' slivers were cut) */
 
 static void point_box(const double *pts, size_t n, double lo[3], double hi[3])
 {
