@@ -653,18 +653,19 @@ lbk_result bk_denoiser_half_delta(const bk_denoise_inputs *in, const lbk_sh9_rgb
     if (!in || !base || !base_variance || !halves || !out || !in->radiance || !in->variance)
         return LBK_ERR_INVALID_ARGUMENT;
     const size_t n = in->receiver_count;
-    bk_denoiser *d[2] = {NULL, NULL};
     float *fb = malloc((n ? n : 1) * sizeof *fb);
     lbk_result r = fb ? LBK_OK : LBK_ERR_OUT_OF_MEMORY;
-    for (int h = 0; h < 2 && !r; h++) r = create_half(in, base, base_variance, halves, h, opt, &d[h]);
     for (size_t i = 0; i < n && !r; i++) out[i] = halves[2 * i], fb[i] = halves[2 * i + 1];
     float *f[2] = {out, fb};
+    /* one half's filter at a time: each holds a denoiser's whole per-texel state (~150 B) */
     for (int h = 0; h < 2 && !r; h++) {
-        if (d[h]->have_tex) r = texels_apply(d[h], f[h], 1);
-        if (!r && d[h]->have_probes) r = dn_probes_apply(&d[h]->probes, f[h], 1);
+        bk_denoiser *d = NULL;
+        r = create_half(in, base, base_variance, halves, h, opt, &d);
+        if (!r && d->have_tex) r = texels_apply(d, f[h], 1);
+        if (!r && d->have_probes) r = dn_probes_apply(&d->probes, f[h], 1);
+        bk_denoiser_destroy(d);
     }
     for (size_t i = 0; i < n && !r; i++) out[i] = 0.5f * (out[i] - fb[i]);
-    bk_denoiser_destroy(d[0]), bk_denoiser_destroy(d[1]);
     free(fb);
     return r;
 }
