@@ -174,10 +174,6 @@ static lbk_result build_cell_sizes(bk_pipeline *b)
     return LBK_OK;
 }
 
-/* The LLG class's estimate gains the fit's residual at its targets (bake/probes/PROBES.md §LLG
- * fit): the halves' difference sees the noise of the probes, not what the lattice cannot
- * represent, and that is what LLG objects get at run time. The residual also holds the targets'
- * own noise; its expected share is taken off where the transport measured it. */
 /* Each grid's probes' two-halves estimate (bk_denoise_groups_unfiltered, the transport's formula
  * per group) into noise (llg_count); the class's figure where there are no halves (a distributed
  * merge without them). 0 or LBK_ERR_OUT_OF_MEMORY. */
@@ -224,6 +220,10 @@ static void llg_object_estimates(bk_pipeline *b, double class_noise, int less_no
     free(noise);
 }
 
+/* The LLG class's estimate gains the fit's residual at its targets (bake/probes/PROBES.md §LLG
+ * fit): the halves' difference sees the noise of the probes, not what the lattice cannot
+ * represent, and that is what LLG objects get at run time. The residual also holds the targets'
+ * own noise; its expected share is taken off where the transport measured it. */
 static void llg_fit_error(bk_pipeline *b)
 {
     const bk_llg_fit_stats *f = &b->llg_fit_stats;

@@ -303,7 +303,7 @@ done:
  * Delaunay is the lower hull of the points lifted onto the paraboloid |p|². On a lattice qhull's
  * time goes into merging facets: the cospherical corners of every cube, and above all the
  * vertical facets over the flat faces of the points' hull, each holding thousands of coplanar
- * points (n^1.6: 151 s at 250 k lattice probes, PROBES.md). Both degeneracies are removed here:
+ * points (about n^1.6 on lattices, PROBES.md). Both degeneracies are removed here:
  * - Each lift is lowered by a tiny weight (a hash of the point's index times 10⁻³ of its nearest
  *   neighbour's distance squared), which breaks every cospherical tie. The lower hull is then
  *   the regular triangulation of the same, unmoved points: exactly Delaunay wherever the points
@@ -351,10 +351,9 @@ static double index_unit(uint64_t i) /* splitmix64 of the index, in [0, 1) */
 /* Per point, the squared distance to the nearest other point among those in the 27 grid cells
  * around it (the first LIFT_NN_CANDIDATES of them); cell² where none is found. An overestimate
  * only makes a weight larger, which the checks after qhull catch if it ever hides a point. */
-static int nearest_sq(const double *pts, size_t n, double *nn2)
+static int nearest_sq(const double *pts, size_t n, const double lo[3], const double hi[3], double *nn2)
 {
-    double lo[3], hi[3], ext[3], vol = 1.0, diag = 0.0;
-    point_box(pts, n, lo, hi);
+    double ext[3], vol = 1.0, diag = 0.0;
     for (int k = 0; k < 3; k++) { ext[k] = hi[k] - lo[k]; diag += ext[k] * ext[k]; }
     diag = sqrt(diag);
     for (int k = 0; k < 3; k++) vol *= fmax(ext[k], 1e-3 * diag);
@@ -415,12 +414,12 @@ static size_t face_ghosts(int f, size_t m, const double lo[3], const double hi[3
 }
 
 /* The lifted points (4 coordinates, the lift scaled to the points' radius), then the ghosts. */
-static coordT *lifted_points(const double *pts, size_t n, const double *nn2, size_t *ghosts)
+static coordT *lifted_points(const double *pts, size_t n, const double lo[3], const double hi[3], const double *nn2,
+                             size_t *ghosts)
 {
     coordT *c = malloc(4 * (n + LIFT_GHOSTS) * sizeof *c);
     if (!c) return NULL;
-    double lo[3], hi[3], r2 = 0.0;
-    point_box(pts, n, lo, hi);
+    double r2 = 0.0;
     for (size_t i = 0; i < n; i++)
         r2 = fmax(r2, pts[3 * i] * pts[3 * i] + pts[3 * i + 1] * pts[3 * i + 1] + pts[3 * i + 2] * pts[3 * i + 2]);
     double r = sqrt(r2) > 0.0 ? sqrt(r2) : 1.0;
@@ -454,9 +453,11 @@ static int run_qhull_lifted(const double *pts, size_t n, tet_list *out)
     char sink_text[1024];
     FILE *sink = fmemopen(sink_text, sizeof sink_text, "w");
     if (!nn2 || !used || !qh || !sink) { status = BK_DELAUNAY_NO_MEMORY; goto done; }
-    if ((status = nearest_sq(pts, n, nn2)) != BK_DELAUNAY_OK) goto done;
+    double lo[3], hi[3];
+    point_box(pts, n, lo, hi);
+    if ((status = nearest_sq(pts, n, lo, hi, nn2)) != BK_DELAUNAY_OK) goto done;
     size_t ghosts = 0;
-    if (!(coords = lifted_points(pts, n, nn2, &ghosts))) { status = BK_DELAUNAY_NO_MEMORY; goto done; }
+    if (!(coords = lifted_points(pts, n, lo, hi, nn2, &ghosts))) { status = BK_DELAUNAY_NO_MEMORY; goto done; }
     qh_zero(qh, sink);
     /* Q0: no pre-merging. With the ties broken nothing needs merging, and qhull's conservative
      * pre-merge still merged facets of a 2 km, two-layer town lattice (a lower facet of 5 vertices

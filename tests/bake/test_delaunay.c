@@ -179,15 +179,10 @@ static size_t count_hull_faces(const bk_tetmesh *m)
     return h;
 }
 
-/* A perfect 4x4x4 grid: every cube's 8 corners are cospherical. The cube must be filled
- * exactly, with no flat tetrahedron and a conforming (2 triangles per boundary square) hull. */
-static void test_regular_grid(void **state)
+/* The cube must be filled exactly, with no flat tetrahedron and a conforming (2 triangles per
+ * boundary square) hull, on the path `merged` asks for. */
+static void check_unit_grid(const float *pts, size_t n, int merged)
 {
-    (void)state;
-    const float origin[3] = {0, 0, 0};
-    size_t n;
-    float *pts = grid_points(4, 4, 4, 1.0f, origin, &n);
-    for (int merged = 1; merged >= 0; merged--) { /* qhull's merged cells split, then the weights */
     bk_delaunay_options o = {.merged_cells = merged};
     bk_tetmesh m;
     assert_int_equal(bk_delaunay(pts, n, &o, &m), BK_DELAUNAY_OK);
@@ -207,7 +202,17 @@ static void test_regular_grid(void **state)
         for (int a = 0; a < 3; a++) assert_true(hi[a] - lo[a] <= 1.0f);
     }
     bk_tetmesh_free(&m);
-    }
+}
+
+/* A perfect 4x4x4 grid: every cube's 8 corners are cospherical. */
+static void test_regular_grid(void **state)
+{
+    (void)state;
+    const float origin[3] = {0, 0, 0};
+    size_t n;
+    float *pts = grid_points(4, 4, 4, 1.0f, origin, &n);
+    check_unit_grid(pts, n, 1); /* qhull's merged cells split */
+    check_unit_grid(pts, n, 0); /* the tie-breaking weights */
     free(pts);
 }
 
@@ -231,20 +236,34 @@ static void test_far_anisotropic_grid(void **state)
     free(pts);
 }
 
+/* Whichever path bk_delaunay takes, the mesh is valid, uses every point and fills the hull. */
+static void check_fills_hull(const float *pts, size_t n, const char *name)
+{
+    bk_tetmesh t;
+    assert_int_equal(bk_delaunay(pts, n, NULL, &t), BK_DELAUNAY_OK);
+    check_mesh(&t);
+    assert_int_equal(t.unused_count, 0);
+    assert_int_equal(t.point_count, n);
+    double hv = hull_volume(pts, n);
+    assert_true(fabs(t.volume - hv) < 1e-6 * hv);
+    print_message("%s: %zu points, %zu tetrahedra, merged cells %d\n", name, n, t.tet_count, t.merged_cells);
+    bk_tetmesh_free(&t);
+}
+
 /* The lifted path's hard neighbours: a lattice whose +x side is bulged by 10⁻³ at its centre
  * (that side's boundary tetrahedra are slivers with huge circumspheres, beside the other sides'
- * ghosts), and a lattice with a jittered, twice as fine bottom layer (the placement's refinement).
- * Whichever path ends up taken, the mesh must be valid, use every point and fill the hull. */
+ * ghosts), and a lattice with a jittered, twice as fine bottom layer (the placement's refinement). */
 static void test_lifted_hard_hulls(void **state)
 {
     (void)state;
     const float origin[3] = {0, 0, 0};
     size_t n;
     float *grid = grid_points(6, 5, 6, 1.0f, origin, &n);
-    float *pts = malloc(3 * (n + 200) * sizeof *pts);
+    float *pts = malloc(3 * (n + 100) * sizeof *pts);
     memcpy(pts, grid, 3 * n * sizeof *pts);
     pts[3 * n] = 5.001f; pts[3 * n + 1] = 2.0f; pts[3 * n + 2] = 2.5f;
-    size_t bulged = n + 1, m = bulged;
+    check_fills_hull(pts, n + 1, "bulged side");
+    size_t m = n;
     rng_state = 99;
     for (int x = 0; x < 11; x++) for (int z = 0; z < 11; z++) {
         if (!(x & 1) && !(z & 1)) continue;
@@ -253,25 +272,7 @@ static void test_lifted_hard_hulls(void **state)
         pts[3 * m + 2] = (float)(0.5 * z + 1e-3 * (rnd() - 0.5));
         m++;
     }
-    const float *sets[2] = {pts, grid};
-    size_t counts[2] = {bulged, 0};
-    float *refined = malloc(3 * (n + (m - bulged)) * sizeof *refined);
-    memcpy(refined, grid, 3 * n * sizeof *refined);
-    memcpy(refined + 3 * n, pts + 3 * bulged, 3 * (m - bulged) * sizeof *refined);
-    sets[1] = refined;
-    counts[1] = n + (m - bulged);
-    for (int k = 0; k < 2; k++) {
-        bk_tetmesh t;
-        assert_int_equal(bk_delaunay(sets[k], counts[k], NULL, &t), BK_DELAUNAY_OK);
-        check_mesh(&t);
-        assert_int_equal(t.unused_count, 0);
-        assert_int_equal(t.point_count, counts[k]);
-        double hv = hull_volume(sets[k], counts[k]);
-        assert_true(fabs(t.volume - hv) < 1e-6 * hv);
-        print_message("hard hull %d: %zu points, %zu tetrahedra, merged cells %d\n", k, counts[k], t.tet_count, t.merged_cells);
-        bk_tetmesh_free(&t);
-    }
-    free(refined);
+    check_fills_hull(pts, m, "jittered fine layer");
     free(pts);
     free(grid);
 }
