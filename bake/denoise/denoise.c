@@ -13,8 +13,10 @@
 
 #define SH_N DN_MAX_CH /* floats per lbk_sh9_rgb */
 
-/* ---- the texel guide: geometry, charts, the base's luminance and variance ------------------ */
+/* ---- the texels' geometry, charts and pages; the weights of one guide over them ------------- */
 
+/* What every filter over the same texels shares: the base's and each half's (bk_denoiser_half_delta)
+ * differ only in their guide, so they differ only in their dn_levels. */
 typedef struct dn_texels {
     size_t n;                  /* texel receivers */
     int method;
@@ -32,20 +34,25 @@ typedef struct dn_texels {
     size_t *poff;
     int32_t *grid;
     int32_t *patch;            /* NLM: 9 per receiver, its 3×3 neighbours in its chart or -1 */
-    /* from the guide: luminance and variance at the input of each level (levels × n), the
-     * noise std of the input (smoothed variance, n) and the clamp blend (n) */
+} dn_texels;
+
+/* One guide's weights: its luminance and variance at the input of each level (levels × n), the
+ * noise std of the input (smoothed variance, n) and the clamp blend (n). */
+typedef struct dn_levels {
     float *lum, *var;
     float *sigma;
     float *alpha;
     size_t clamped;
-} dn_texels;
+} dn_levels;
 
 struct bk_denoiser {
     size_t receiver_count;
     int threads;
     dn_texels tex;
+    dn_levels lev;
     int have_tex;
     dn_probes probes;
+    dn_probe_weights probe_w;
     int have_probes;
     bk_denoise_stats stats;
 };
@@ -130,8 +137,13 @@ static void texels_free(dn_texels *g)
 {
     free(g->pos), free(g->nrm), free(g->alb), free(g->size), free(g->chart), free(g->page), free(g->x), free(g->y);
     free(g->pw), free(g->ph), free(g->poff), free(g->grid), free(g->patch);
-    free(g->lum), free(g->var), free(g->sigma), free(g->alpha);
     memset(g, 0, sizeof *g);
+}
+
+static void levels_free(dn_levels *lv)
+{
+    free(lv->lum), free(lv->var), free(lv->sigma), free(lv->alpha);
+    memset(lv, 0, sizeof *lv);
 }
 
 static lbk_result texels_features(const bk_denoise_inputs *in, dn_texels *g)
@@ -226,12 +238,12 @@ static float nlm_weight(const dn_texels *g, const float *lum, const float *var, 
 }
 
 /* Weight of the neighbour at tap (dx, dy) of level `level` (step 2^level), or 0. */
-static float tap_weight(const dn_texels *g, int level, size_t p, int32_t q, int dx, int dy)
+static float tap_weight(const dn_texels *g, const dn_levels *lv, int level, size_t p, int32_t q, int dx, int dy)
 {
     if (q < 0) return 0;
     float w = geo_weight(g, p, (size_t)q);
     if (!(w > 0)) return 0;
-    const float *lum = g->lum + (size_t)level * g->n, *var = g->var + (size_t)level * g->n;
+    const float *lum = lv->lum + (size_t)level * g->n, *var = lv->var + (size_t)level * g->n;
     switch (g->method) {
     case BK_DENOISE_ATROUS:
         w *= atrous_h[abs(dx)] * atrous_h[abs(dy)];
@@ -254,6 +266,7 @@ static void level_taps(const dn_texels *g, int level, int *r, int *step)
 
 typedef struct level_job {
     const dn_texels *g;
+    const dn_levels *lv;
     int level;
     const float *in;          /* ch floats per receiver (apply), or NULL (build) */
     float *out;
@@ -268,14 +281,14 @@ static void level_run(void *user, size_t begin, size_t end, int thread)
     const dn_texels *g = j->g;
     int r, step;
     level_taps(g, j->level, &r, &step);
-    const float *lum = g->lum + (size_t)j->level * g->n, *var = g->var + (size_t)j->level * g->n;
+    const float *lum = j->lv->lum + (size_t)j->level * g->n, *var = j->lv->var + (size_t)j->level * g->n;
     for (size_t p = begin; p < end; p++) {
         double acc[SH_N], W = 0, wl = 0, wv = 0;
         if (j->in) memset(acc, 0, sizeof acc);
         for (int dy = -r; dy <= r; dy++)
             for (int dx = -r; dx <= r; dx++) {
                 int32_t q = dn_at(g, p, dx * step, dy * step);
-                float w = tap_weight(g, j->level, p, q, dx, dy);
+                float w = tap_weight(g, j->lv, j->level, p, q, dx, dy);
                 if (!(w > 0)) continue;
                 W += w;
                 if (j->in) {
@@ -336,44 +349,47 @@ static void run_chunks(const bk_denoiser *d, size_t n, bk_chunk_fn fn, void *use
     bk_parallel_chunks(0, n, 256, d->threads, fn, user);
 }
 
-/* Builds the per-level luminance and variance of the base, then the clamp. */
-static lbk_result texels_build(bk_denoiser *d, const bk_denoise_inputs *in)
+/* The per-level luminance and variance of a guide over the texels, then the clamp. */
+static lbk_result levels_build(const bk_denoiser *d, const dn_guide *gd, dn_levels *lv)
 {
-    dn_texels *g = &d->tex;
+    const dn_texels *g = &d->tex;
     size_t n = g->n;
     int L = g->levels;
-    g->lum = malloc(((size_t)L + 1) * n * sizeof *g->lum);
-    g->var = malloc(((size_t)L + 1) * n * sizeof *g->var);
-    g->sigma = malloc(n * sizeof *g->sigma);
-    g->alpha = malloc(n * sizeof *g->alpha);
+    lv->lum = malloc(((size_t)L + 1) * n * sizeof *lv->lum);
+    lv->var = malloc(((size_t)L + 1) * n * sizeof *lv->var);
+    lv->sigma = malloc(n * sizeof *lv->sigma);
+    lv->alpha = malloc(n * sizeof *lv->alpha);
     float *raw = malloc(n * sizeof *raw);
-    if (!g->lum || !g->var || !g->sigma || !g->alpha || !raw) {
+    if (!lv->lum || !lv->var || !lv->sigma || !lv->alpha || !raw) {
         free(raw);
         return LBK_ERR_OUT_OF_MEMORY;
     }
     for (size_t p = 0; p < n; p++) {
-        g->lum[p] = sh_irradiance_lum(&in->radiance[p], g->nrm[p]);
-        if (!isfinite(g->lum[p])) g->lum[p] = 0;
-        raw[p] = isfinite(in->variance[p]) && in->variance[p] > 0 ? in->variance[p] : 0;
+        lbk_sh9_rgb sh;
+        float v;
+        dn_guide_at(gd, p, &sh, &v);
+        lv->lum[p] = sh_irradiance_lum(&sh, g->nrm[p]);
+        if (!isfinite(lv->lum[p])) lv->lum[p] = 0;
+        raw[p] = isfinite(v) && v > 0 ? v : 0;
     }
-    var_job vj = {g, raw, g->var};
+    var_job vj = {g, raw, lv->var};
     run_chunks(d, n, var_run, &vj);
     free(raw);
-    for (size_t p = 0; p < n; p++) g->sigma[p] = sqrtf(g->var[p]);
+    for (size_t p = 0; p < n; p++) lv->sigma[p] = sqrtf(lv->var[p]);
     for (int l = 0; l < L; l++) {
-        level_job j = {g, l, NULL, NULL, 0, g->lum + (size_t)(l + 1) * n, g->var + (size_t)(l + 1) * n};
+        level_job j = {g, lv, l, NULL, NULL, 0, lv->lum + (size_t)(l + 1) * n, lv->var + (size_t)(l + 1) * n};
         run_chunks(d, n, level_run, &j);
     }
-    /* clamp: the filtered base luminance may move at most clamp·σ from the input */
-    const float *lout = g->lum + (size_t)L * n;
-    g->clamped = 0;
+    /* clamp: the filtered guide luminance may move at most clamp·σ from the input */
+    const float *lout = lv->lum + (size_t)L * n;
+    lv->clamped = 0;
     for (size_t p = 0; p < n; p++) {
-        float dl = fabsf(lout[p] - g->lum[p]);
-        float lim = g->clamp >= 0 ? g->clamp * g->sigma[p] : INFINITY;
-        g->alpha[p] = g->sigma[p] > 0 || (g->method == BK_DENOISE_BLUR && g->clamp < 0) ? 1 : 0;
-        if (g->sigma[p] > 0 && dl > lim) {
-            g->alpha[p] = lim / dl;
-            g->clamped++;
+        float dl = fabsf(lout[p] - lv->lum[p]);
+        float lim = g->clamp >= 0 ? g->clamp * lv->sigma[p] : INFINITY;
+        lv->alpha[p] = lv->sigma[p] > 0 || (g->method == BK_DENOISE_BLUR && g->clamp < 0) ? 1 : 0;
+        if (lv->sigma[p] > 0 && dl > lim) {
+            lv->alpha[p] = lim / dl;
+            lv->clamped++;
         }
     }
     return LBK_OK;
@@ -383,26 +399,31 @@ static lbk_result texels_build(bk_denoiser *d, const bk_denoise_inputs *in)
  * filtered on its own with the same weights, so a channel's result does not depend on which
  * others ride along: the error estimates filter many two-channel inputs in one pass (the
  * weights, not the channels, are most of a pass's cost). */
-static lbk_result texels_apply(const bk_denoiser *d, float *vals, int ch)
+static lbk_result texels_apply(const bk_denoiser *d, const dn_levels *lv, float *vals, int ch)
 {
     const dn_texels *g = &d->tex;
     size_t n = g->n;
-    float *a = malloc((n ? n : 1) * ch * sizeof *a), *b = malloc((n ? n : 1) * ch * sizeof *b);
-    if (!a || !b) {
+    /* level 0 reads vals itself (it changes only at the end), so one level (NLM, the default)
+     * needs one buffer of n·ch floats, not two: at ch = 27 that is ~100 B per texel at the bake's
+     * peak (DENOISE.md) */
+    float *a = NULL, *b = malloc((n ? n : 1) * ch * sizeof *b);
+    if (b && g->levels > 1) a = malloc((n ? n : 1) * ch * sizeof *a);
+    if (!b || (g->levels > 1 && !a)) {
         free(a), free(b);
         return LBK_ERR_OUT_OF_MEMORY;
     }
-    memcpy(a, vals, n * ch * sizeof *a);
+    const float *in = vals;
     for (int l = 0; l < g->levels; l++) {
-        level_job j = {g, l, a, b, ch, NULL, NULL};
+        level_job j = {g, lv, l, in, b, ch, NULL, NULL};
         run_chunks(d, n, level_run, &j);
         float *t = a;
         a = b, b = t;
+        in = a;
     }
     for (size_t p = 0; p < n; p++) {
         float *o = vals + p * ch;
-        const float *f = a + p * ch;
-        float al = g->alpha[p];
+        const float *f = in + p * ch;
+        float al = lv->alpha[p];
         if (al == 1) memcpy(o, f, ch * sizeof *o);
         else if (al > 0)
             for (int k = 0; k < ch; k++) o[k] += al * (f[k] - o[k]);
@@ -447,14 +468,16 @@ lbk_result bk_denoiser_create(const bk_denoise_inputs *in, const bk_denoise_opti
     d->receiver_count = in->receiver_count;
     d->threads = bk_thread_count(opt ? opt->threads : 0);
     resolve_options(opt, &d->tex);
+    const dn_guide gd = {in, NULL, NULL, NULL, 0};
     lbk_result r = LBK_OK;
     if (want_tex) {
         r = texels_features(in, &d->tex);
-        if (!r) r = texels_build(d, in);
+        if (!r) r = levels_build(d, &gd, &d->lev);
         d->have_tex = !r;
     }
     if (!r && want_probes) {
         r = dn_probes_build(in, opt, d->threads, &d->probes);
+        if (!r) r = dn_probe_weights_build(&d->probes, &gd, &d->probe_w);
         d->have_probes = !r;
     }
     if (r) {
@@ -465,7 +488,7 @@ lbk_result bk_denoiser_create(const bk_denoise_inputs *in, const bk_denoise_opti
     d->stats.probes = d->have_probes ? d->probes.count : 0;
     d->stats.probe_edges = d->probes.edges;
     d->stats.probe_edges_visible = d->probes.edges_visible;
-    d->stats.clamped = d->tex.clamped + d->probes.clamped;
+    d->stats.clamped = d->lev.clamped + d->probe_w.clamped;
     d->stats.seconds = bk_now() - t0;
     *out = d;
     return LBK_OK;
@@ -475,8 +498,8 @@ lbk_result bk_denoiser_apply_classes(const bk_denoiser *d, lbk_sh9_rgb *radiance
 {
     if (!d || !filter || (!radiance && d->receiver_count)) return LBK_ERR_INVALID_ARGUMENT;
     lbk_result r = LBK_OK;
-    if (d->have_tex && filter[BK_CLASS_TEXEL]) r = texels_apply(d, (float *)radiance, SH_N);
-    if (!r && d->have_probes && filter[BK_CLASS_GLG]) r = dn_probes_apply(&d->probes, (float *)radiance, SH_N);
+    if (d->have_tex && filter[BK_CLASS_TEXEL]) r = texels_apply(d, &d->lev, (float *)radiance, SH_N);
+    if (!r && d->have_probes && filter[BK_CLASS_GLG]) r = dn_probes_apply(&d->probes, &d->probe_w, (float *)radiance, SH_N);
     return r;
 }
 
@@ -581,8 +604,8 @@ static lbk_result errors_pass(const bk_denoiser *d, const float *const *halves, 
                 f[i * ch + 2 * j] = 0.5f * (h[2 * i] + h[2 * i + 1]);
                 f[i * ch + 2 * j + 1] = 0.5f * (h[2 * i] - h[2 * i + 1]);
             }
-        if (d && d->have_tex) r = texels_apply(d, f, ch);
-        if (!r && d && d->have_probes) r = dn_probes_apply(&d->probes, f, ch);
+        if (d && d->have_tex) r = texels_apply(d, &d->lev, f, ch);
+        if (!r && d && d->have_probes) r = dn_probes_apply(&d->probes, &d->probe_w, f, ch);
         for (size_t j = 0; j < m && !r; j++)
             error_from_filtered(halves[j0 + j], f + 2 * j, (size_t)ch, j0 + j ? NULL : cross, class_end, &out[j0 + j]);
         if (!r && g && j0 == 0) r = groups_from_filtered(halves[0], f, (size_t)ch, cross, g);
@@ -620,50 +643,40 @@ lbk_result bk_denoise_groups_unfiltered(const float *halves, const bk_denoise_gr
     return groups_from_filtered(halves, NULL, 0, NULL, groups);
 }
 
-/* The filter of one half (half 0: A, 1: B): built like bk_denoiser_create from `in`, its guide
- * with the base part at that half's level (scaled by A/X, resp. B/X, within [0, 2]) and the
- * base's variance doubled (base_variance added once more: a half has half the samples). */
-static lbk_result create_half(const bk_denoise_inputs *in, const lbk_sh9_rgb *base, const float *base_variance,
-                              const float *halves, int half, const bk_denoise_options *opt, bk_denoiser **out)
+void dn_guide_at(const dn_guide *g, size_t i, lbk_sh9_rgb *sh, float *variance)
 {
-    const size_t n = in->receiver_count;
-    lbk_sh9_rgb *guide = malloc((n ? n : 1) * sizeof *guide);
-    float *var = malloc((n ? n : 1) * sizeof *var);
-    if (!guide || !var) {
-        free(guide), free(var);
-        return LBK_ERR_OUT_OF_MEMORY;
-    }
-    for (size_t i = 0; i < n; i++) {
-        const double x = 0.5 * ((double)halves[2 * i] + halves[2 * i + 1]);
-        const double s = x != 0 ? fmin(fmax(halves[2 * i + half] / x, 0), 2) : 1;
-        for (int c = 0; c < 3; c++)
-            for (int k = 0; k < 9; k++) guide[i].c[c][k] = in->radiance[i].c[c][k] + (float)(s - 1) * base[i].c[c][k];
-        var[i] = in->variance[i] + base_variance[i];
-    }
-    bk_denoise_inputs hi = *in;
-    hi.radiance = guide, hi.variance = var;
-    const lbk_result r = bk_denoiser_create(&hi, opt, out);
-    free(guide), free(var);
-    return r;
+    *sh = g->in->radiance[i];
+    *variance = g->in->variance[i];
+    if (!g->base) return;
+    const double x = 0.5 * ((double)g->halves[2 * i] + g->halves[2 * i + 1]);
+    const double s = x != 0 ? fmin(fmax(g->halves[2 * i + g->half] / x, 0), 2) : 1;
+    for (int c = 0; c < 3; c++)
+        for (int k = 0; k < 9; k++) sh->c[c][k] = g->in->radiance[i].c[c][k] + (float)(s - 1) * g->base[i].c[c][k];
+    *variance = g->in->variance[i] + g->base_variance[i];
 }
 
-lbk_result bk_denoiser_half_delta(const bk_denoise_inputs *in, const lbk_sh9_rgb *base, const float *base_variance,
-                                  const float *halves, const bk_denoise_options *opt, float *out)
+lbk_result bk_denoiser_half_delta(const bk_denoiser *d, const bk_denoise_inputs *in, const lbk_sh9_rgb *base,
+                                  const float *base_variance, const float *halves, float *out)
 {
-    if (!in || !base || !base_variance || !halves || !out || !in->radiance || !in->variance)
+    if (!d || !in || !base || !base_variance || !halves || !out || !in->radiance || !in->variance ||
+        in->receiver_count != d->receiver_count)
         return LBK_ERR_INVALID_ARGUMENT;
     const size_t n = in->receiver_count;
     float *fb = malloc((n ? n : 1) * sizeof *fb);
     lbk_result r = fb ? LBK_OK : LBK_ERR_OUT_OF_MEMORY;
     for (size_t i = 0; i < n && !r; i++) out[i] = halves[2 * i], fb[i] = halves[2 * i + 1];
     float *f[2] = {out, fb};
-    /* one half's filter at a time: each holds a denoiser's whole per-texel state (~150 B) */
+    /* the base's geometry and probe graph, each half's own weights, one half at a time */
     for (int h = 0; h < 2 && !r; h++) {
-        bk_denoiser *d = NULL;
-        r = create_half(in, base, base_variance, halves, h, opt, &d);
-        if (!r && d->have_tex) r = texels_apply(d, f[h], 1);
-        if (!r && d->have_probes) r = dn_probes_apply(&d->probes, f[h], 1);
-        bk_denoiser_destroy(d);
+        const dn_guide gd = {in, base, base_variance, halves, h};
+        dn_levels lv = {0};
+        dn_probe_weights pw = {0};
+        if (d->have_tex) r = levels_build(d, &gd, &lv);
+        if (!r && d->have_tex) r = texels_apply(d, &lv, f[h], 1);
+        if (!r && d->have_probes) r = dn_probe_weights_build(&d->probes, &gd, &pw);
+        if (!r && d->have_probes) r = dn_probes_apply(&d->probes, &pw, f[h], 1);
+        levels_free(&lv);
+        dn_probe_weights_free(&pw);
     }
     for (size_t i = 0; i < n && !r; i++) out[i] = 0.5f * (out[i] - fb[i]);
     free(fb);
@@ -681,6 +694,8 @@ void bk_denoiser_destroy(bk_denoiser *d)
 {
     if (!d) return;
     texels_free(&d->tex);
+    levels_free(&d->lev);
     dn_probes_free(&d->probes);
+    dn_probe_weights_free(&d->probe_w);
     free(d);
 }

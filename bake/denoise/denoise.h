@@ -162,9 +162,12 @@ lbk_result bk_denoiser_errors(const bk_denoiser *d, const float *const *halves, 
  * weights follow the very noise they filter (a texel that reads bright finds its like among its
  * neighbours), so what a denoised bake differs by from another seed's is more than Σ (Dδ)² says
  * (DENOISE.md, "What the report says"). A half's filter sees its own noise as the full run's
- * filter sees the full run's. Errors as bk_denoiser_create. */
-lbk_result bk_denoiser_half_delta(const bk_denoise_inputs *in, const lbk_sh9_rgb *base, const float *base_variance,
-                                  const float *halves, const bk_denoise_options *opt, float *out);
+ * filter sees the full run's. d: the filter bk_denoiser_create built from the same `in`, whose
+ * geometry, charts and probe visibility the halves' filters share (only their weights are their
+ * own). Errors: LBK_ERR_INVALID_ARGUMENT (NULLs, in->receiver_count not d's),
+ * LBK_ERR_OUT_OF_MEMORY. */
+lbk_result bk_denoiser_half_delta(const bk_denoiser *d, const bk_denoise_inputs *in, const lbk_sh9_rgb *base,
+                                  const float *base_variance, const float *halves, float *out);
 /* Unfiltered (the transport's own estimate per group): the same sums with D = I. */
 lbk_result bk_denoise_groups_unfiltered(const float *halves, const bk_denoise_groups *groups);
 void bk_denoiser_stats(const bk_denoiser *d, bk_denoise_stats *stats);

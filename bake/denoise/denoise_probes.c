@@ -71,8 +71,14 @@ static void vis_run(void *user, size_t begin, size_t end, int thread)
 
 void dn_probes_free(dn_probes *p)
 {
-    free(p->adj_first), free(p->adj), free(p->w), free(p->w_sum), free(p->alpha);
+    free(p->adj_first), free(p->adj);
     memset(p, 0, sizeof *p);
+}
+
+void dn_probe_weights_free(dn_probe_weights *w)
+{
+    free(w->w), free(w->w_sum), free(w->alpha);
+    memset(w, 0, sizeof *w);
 }
 
 /* Visible edges as per-probe adjacency lists (both directions, in edge order). */
@@ -85,9 +91,8 @@ static lbk_result build_adjacency(dn_probes *p, const uint64_t *edges, const uin
     for (size_t i = 0; i < p->count; i++) p->adj_first[i + 1] += p->adj_first[i];
     size_t na = p->adj_first[p->count];
     p->adj = malloc((na ? na : 1) * sizeof *p->adj);
-    p->w = malloc((na ? na : 1) * sizeof *p->w);
     uint32_t *fill = malloc((p->count ? p->count : 1) * sizeof *fill);
-    if (!p->adj || !p->w || !fill) {
+    if (!p->adj || !fill) {
         free(fill);
         return LBK_ERR_OUT_OF_MEMORY;
     }
@@ -102,13 +107,14 @@ static lbk_result build_adjacency(dn_probes *p, const uint64_t *edges, const uin
     return LBK_OK;
 }
 
-/* Weights and clamp from the guide's probes: σ_i from the transport's variance averaged over the
- * probe and its visible neighbours (0 when the probe's own estimate is 0: noise-free). */
-static void probe_weights(dn_probes *p, const lbk_sh9_rgb *base, const float *variance, float sigma_lum, float clamp)
+/* Weights and clamp from the guide's probes (luminance and variance per probe): σ_i from the
+ * transport's variance averaged over the probe and its visible neighbours (0 when the probe's own
+ * estimate is 0: noise-free). */
+static void probe_weights(const dn_probes *p, const float *lum, const float *variance, dn_probe_weights *out)
 {
-    p->clamped = 0;
+    out->clamped = 0;
     for (size_t i = 0; i < p->count; i++) {
-        float li = dn_probe_lum(&base[i]);
+        float li = lum[i];
         double v = isfinite(variance[i]) && variance[i] > 0 ? variance[i] : 0;
         int m = 1;
         for (uint32_t k = p->adj_first[i]; k < p->adj_first[i + 1] && v > 0; k++) {
@@ -119,17 +125,37 @@ static void probe_weights(dn_probes *p, const lbk_sh9_rgb *base, const float *va
         float sigma = (float)sqrt(v / m);
         double W = 1, acc = li;
         for (uint32_t k = p->adj_first[i]; k < p->adj_first[i + 1]; k++) {
-            float lj = dn_probe_lum(&base[p->adj[k]]), d = fabsf(lj - li);
-            float w = d == 0 ? NEIGHBOUR_WEIGHT : sigma > 0 ? NEIGHBOUR_WEIGHT * expf(-d / (sigma_lum * sigma)) : 0;
-            p->w[k] = w;
+            float lj = lum[p->adj[k]], d = fabsf(lj - li);
+            float w = d == 0 ? NEIGHBOUR_WEIGHT : sigma > 0 ? NEIGHBOUR_WEIGHT * expf(-d / (p->sigma_lum * sigma)) : 0;
+            out->w[k] = w;
             W += w;
             acc += w * (double)lj;
         }
-        p->w_sum[i] = (float)W;
-        float dl = fabsf((float)(acc / W) - li), lim = clamp >= 0 ? clamp * sigma : INFINITY;
-        p->alpha[i] = sigma > 0 ? 1 : 0;
-        if (sigma > 0 && dl > lim) p->alpha[i] = lim / dl, p->clamped++;
+        out->w_sum[i] = (float)W;
+        float dl = fabsf((float)(acc / W) - li), lim = p->clamp >= 0 ? p->clamp * sigma : INFINITY;
+        out->alpha[i] = sigma > 0 ? 1 : 0;
+        if (sigma > 0 && dl > lim) out->alpha[i] = lim / dl, out->clamped++;
     }
+}
+
+lbk_result dn_probe_weights_build(const dn_probes *p, const dn_guide *guide, dn_probe_weights *out)
+{
+    memset(out, 0, sizeof *out);
+    const size_t na = p->adj_first[p->count], n = p->count ? p->count : 1;
+    out->w = malloc((na ? na : 1) * sizeof *out->w);
+    out->w_sum = malloc(n * sizeof *out->w_sum);
+    out->alpha = malloc(n * sizeof *out->alpha);
+    float *lum = malloc(n * sizeof *lum), *var = malloc(n * sizeof *var);
+    lbk_result r = out->w && out->w_sum && out->alpha && lum && var ? LBK_OK : LBK_ERR_OUT_OF_MEMORY;
+    for (size_t i = 0; i < p->count && !r; i++) {
+        lbk_sh9_rgb sh;
+        dn_guide_at(guide, p->first + i, &sh, &var[i]);
+        lum[i] = dn_probe_lum(&sh);
+    }
+    if (!r) probe_weights(p, lum, var, out);
+    free(lum), free(var);
+    if (r) dn_probe_weights_free(out);
+    return r;
 }
 
 lbk_result dn_probes_build(const bk_denoise_inputs *in, const bk_denoise_options *opt, int threads, dn_probes *out)
@@ -143,9 +169,7 @@ lbk_result dn_probes_build(const bk_denoise_inputs *in, const bk_denoise_options
     lbk_result r = tet_edges(glg, &edges, &ne);
     if (r) return r;
     uint8_t *vis = malloc(ne ? ne : 1);
-    out->w_sum = malloc(out->count * sizeof *out->w_sum);
-    out->alpha = malloc(out->count * sizeof *out->alpha);
-    if (!vis || !out->w_sum || !out->alpha) {
+    if (!vis) {
         free(edges), free(vis);
         return LBK_ERR_OUT_OF_MEMORY;
     }
@@ -156,29 +180,28 @@ lbk_result dn_probes_build(const bk_denoise_inputs *in, const bk_denoise_options
     r = build_adjacency(out, edges, vis, ne);
     free(edges), free(vis);
     if (r) return r;
-    float sigma_lum = opt && opt->sigma_lum > 0 && opt->method != BK_DENOISE_NLM ? opt->sigma_lum : 4.0f;
-    float clamp = !opt || opt->clamp == 0 ? 2.0f : opt->clamp < 0 ? -1.0f : opt->clamp;
-    probe_weights(out, in->radiance + in->glg_first, in->variance + in->glg_first, sigma_lum, clamp);
+    out->sigma_lum = opt && opt->sigma_lum > 0 && opt->method != BK_DENOISE_NLM ? opt->sigma_lum : 4.0f;
+    out->clamp = !opt || opt->clamp == 0 ? 2.0f : opt->clamp < 0 ? -1.0f : opt->clamp;
     return LBK_OK;
 }
 
-lbk_result dn_probes_apply(const dn_probes *p, float *vals, int ch)
+lbk_result dn_probes_apply(const dn_probes *p, const dn_probe_weights *w, float *vals, int ch)
 {
     float *x = vals + p->first * ch;
     float *copy = malloc((p->count ? p->count : 1) * ch * sizeof *copy);
     if (!copy) return LBK_ERR_OUT_OF_MEMORY;
     memcpy(copy, x, p->count * ch * sizeof *copy);
     for (size_t i = 0; i < p->count; i++) {
-        if (!(p->alpha[i] > 0)) continue;
+        if (!(w->alpha[i] > 0)) continue;
         double acc[DN_MAX_CH];
         const float *s = copy + i * ch;
         for (int k = 0; k < ch; k++) acc[k] = s[k];
         for (uint32_t e = p->adj_first[i]; e < p->adj_first[i + 1]; e++) {
             const float *v = copy + (size_t)p->adj[e] * ch;
-            for (int k = 0; k < ch; k++) acc[k] += p->w[e] * (double)v[k];
+            for (int k = 0; k < ch; k++) acc[k] += w->w[e] * (double)v[k];
         }
         float *o = x + i * ch;
-        for (int k = 0; k < ch; k++) o[k] = s[k] + p->alpha[i] * ((float)(acc[k] / p->w_sum[i]) - s[k]);
+        for (int k = 0; k < ch; k++) o[k] = s[k] + w->alpha[i] * ((float)(acc[k] / w->w_sum[i]) - s[k]);
     }
     free(copy);
     return LBK_OK;

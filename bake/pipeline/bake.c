@@ -119,6 +119,25 @@ static lbk_result list_inputs(bk_pipeline *b)
     return LBK_OK;
 }
 
+/* Per-receiver state freed as soon as its last phase is done, so that no two phases' largest
+ * arrays are alive at once (issue 36's bytes per texel; DENOISE.md, "Memory"). The transport's
+ * receivers (~56 B each) serve the base and set runs only. */
+static void release_after_transport(bk_pipeline *b)
+{
+    free(b->receivers);
+    b->receivers = NULL;
+}
+
+/* The denoiser (its geometry, charts, patches and weights: ~100 B per texel) and the halves
+ * serve the estimates and the sets' entries; the write phase reads only the filtered values. */
+static void release_before_write(bk_pipeline *b)
+{
+    bk_denoiser_destroy(b->denoiser);
+    b->denoiser = NULL;
+    free(b->halves);
+    b->halves = NULL;
+}
+
 static lbk_result run(bk_pipeline *b, const char *path, const lbk_bake_scene *desc)
 {
     lbk_result r = bk_phase_import(b, path, desc);
@@ -149,10 +168,12 @@ static lbk_result run(bk_pipeline *b, const char *path, const lbk_bake_scene *de
             return LBK_OK;
         }
     }
+    release_after_transport(b);
     if (!r) r = bk_phase_denoise(b);
     if (!r) r = bk_object_estimates(b);
     if (!r) r = bk_check_compare(b);
     if (!r && b->sets.set_count) r = bk_phase_emit_sets(b);
+    release_before_write(b);
     if (!r) r = bk_pipeline_phase(b, LBK_BAKE_PHASE_WRITE);
     if (!r) r = bk_pipeline_encode(b);
     if (r && r != LBK_ERR_CANCELLED && b->ckpt && bk_ckpt_error(b->ckpt)[0])

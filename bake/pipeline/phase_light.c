@@ -424,11 +424,11 @@ static lbk_result denoised_error(bk_pipeline *b, int choose, const float *cross)
  * variance. Measured on six dev levels of bench/levels (DENOISE.md): the estimate was 0.58–0.71
  * of the seed-to-seed noise of the stored texels with the same weights' Σ (Dδ)², 0.72–0.84 with
  * this; ~3 % more CPU. */
-static lbk_result half_cross_delta(const bk_pipeline *b, const bk_denoise_inputs *in, const bk_denoise_options *o,
-                                   float **cross)
+static lbk_result half_cross_delta(const bk_pipeline *b, const bk_denoise_inputs *in, float **cross)
 {
     *cross = malloc((b->receiver_count ? b->receiver_count : 1) * sizeof **cross);
-    lbk_result r = *cross ? bk_denoiser_half_delta(in, b->radiance, b->variance, b->halves, o, *cross) : LBK_ERR_OUT_OF_MEMORY;
+    lbk_result r = *cross ? bk_denoiser_half_delta(b->denoiser, in, b->radiance, b->variance, b->halves, *cross)
+                          : LBK_ERR_OUT_OF_MEMORY;
     if (r) free(*cross), *cross = NULL;
     return r;
 }
@@ -476,7 +476,7 @@ lbk_result bk_phase_denoise(bk_pipeline *b)
     o.threads = b->opt->threads;
     float *cross = NULL;
     lbk_result r = bk_denoiser_create(&in, &o, &b->denoiser);
-    if (!r && b->halves) r = half_cross_delta(b, &in, &o, &cross);
+    if (!r && b->halves) r = half_cross_delta(b, &in, &cross);
     free(guide), free(guide_var);
     if (!r) r = denoised_error(b, b->opt->denoise == LBK_BAKE_DENOISE_AUTO, cross);
     free(cross);

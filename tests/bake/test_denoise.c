@@ -320,7 +320,7 @@ static double lum_e(const lbk_sh9_rgb *y) { return 0.2126 * sh_e(y, 0) + 0.7152 
 static double cross_noise(const bk_denoiser *d, const bk_denoise_inputs *in, const run *r, const float *halves,
                           const size_t class_end[BK_RECEIVER_CLASSES], float *cross)
 {
-    assert_int_equal(bk_denoiser_half_delta(in, r->rad, r->var, halves, NULL, cross), LBK_OK);
+    assert_int_equal(bk_denoiser_half_delta(d, in, r->rad, r->var, halves, cross), LBK_OK);
     uint32_t *group = calloc(class_end[0] + 1, sizeof *group); /* every floor texel in group 0 */
     assert_non_null(group);
     bk_denoise_group_error g0;
@@ -742,6 +742,16 @@ static void test_invalid_arguments(void **state)
     assert_int_equal(bk_denoiser_create(&in, NULL, &d), LBK_OK);
     assert_int_equal(bk_denoiser_apply(d, sh), LBK_OK);
     assert_int_equal(bk_denoiser_apply(d, NULL), LBK_ERR_INVALID_ARGUMENT);
+    /* the halves' filters share d's geometry: d must be built from the same receivers */
+    float halves[8] = {1, 1, 2, 2, 3, 3, 4, 4}, cross[4] = {9, 9, 9, 9};
+    assert_int_equal(bk_denoiser_half_delta(NULL, &in, sh, var, halves, cross), LBK_ERR_INVALID_ARGUMENT);
+    assert_int_equal(bk_denoiser_half_delta(d, &in, sh, var, halves, NULL), LBK_ERR_INVALID_ARGUMENT);
+    in.receiver_count = 3;
+    assert_int_equal(bk_denoiser_half_delta(d, &in, sh, var, halves, cross), LBK_ERR_INVALID_ARGUMENT);
+    in.receiver_count = 4;
+    /* nothing filtered: each half passes through, so cross is (A − B)/2 = 0 */
+    assert_int_equal(bk_denoiser_half_delta(d, &in, sh, var, halves, cross), LBK_OK);
+    for (int i = 0; i < 4; i++) assert_true(cross[i] == 0);
     bk_denoiser_destroy(d);
     bk_denoiser_destroy(NULL);
 }
