@@ -11,7 +11,7 @@
 #   mk/fuzz.mk     the libFuzzer harnesses, make fuzz / fuzz-long / fuzz-corpus
 #   mk/test.mk     the test binaries (ASan+UBSan), TSan, the house checks, make test
 #   mk/install.mk  make install / install-lib and their checks
-#   mk/bench.mk    make bench / bench-cycles / bench-render / mesa-bc-check
+#   mk/bench.mk    make bench / bench-cycles / bench-render / bench-scale / mesa-bc-check
 
 include mk/config.mk mk/sources.mk
 
@@ -36,6 +36,7 @@ help:
 	@echo "make bench      benchmarks, printed as ratios against baselines measured in the same run"
 	@echo "make bench-cycles  lbk against Blender Cycles at equal time (part of make bench; bench/cycles/README.md)"
 	@echo "make bench-render  lbk render against Blender Cycles"
+	@echo "make bench-scale   a generated city of ~50 M texels at growing parts: time, memory, growth (bench/scale/README.md)"
 	@echo "make mesa-bc-check  BC6H/BC4 codecs against Mesa's (optional: libegl-dev libgl-dev)"
 	@echo "make fuzz       the libFuzzer harnesses (container, glTF import, sky EXR, profiles, parts), FUZZ_SECONDS each"
 	@echo "make fuzz-long  the same for FUZZ_HOURS (default 1) each;  make fuzz-corpus  regenerate the seed corpus"

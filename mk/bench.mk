@@ -1,7 +1,8 @@
 # Benchmarks, printed as ratios against baselines measured in the same run: make bench (all of
 # them), bench-cycles and bench-render (lbk against Blender Cycles), bench-suite (lbk against
-# Cycles over the generated hard levels; make bench runs bench-suite-quick), mesa-bc-check.
-.PHONY: bench bench-cycles bench-render bench-suite bench-suite-quick bench-stitch mesa-bc-check
+# Cycles over the generated hard levels; make bench runs bench-suite-quick), bench-scale (a
+# generated city of ~50 M texels; make bench runs its two smallest parts), mesa-bc-check.
+.PHONY: bench bench-cycles bench-render bench-suite bench-suite-quick bench-stitch bench-scale mesa-bc-check
 
 $(BUILD)/bench/%: bench/%.c $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a
 	@mkdir -p $(@D)
@@ -23,6 +24,16 @@ bench: deps-tools deps-bench
 	@echo "== bench-suite-quick (hard levels: a few dev scenes)"; $(MAKE) --no-print-directory bench-suite-quick
 	@echo "== render (lbk render vs Blender Cycles)"; $(MAKE) --no-print-directory bench-render
 	@echo "== bench-diff (lbk diff: reseed study and power)"; $(MAKE) --no-print-directory bench-diff
+	@echo "== bench-scale (quick: the generated city's 1/256 and 1/64)"; \
+	  $(MAKE) --no-print-directory bench-scale BENCH_SCALE_ARGS="--fractions 1/256,1/64"
+
+# The scale bench (bench/scale/README.md): the generated city (~1.2 M triangles, ~50 M texels at
+# 3.5 texels/m) at 1/64, 1/16, 1/4 and whole, each baked at the fast preset: time per phase, peak
+# RSS and bytes per texel, texels and probes per CPU second, growth against the smallest part.
+# Hours on 2 cores; BENCH_SCALE_ARGS narrows it (e.g. --fractions 1/64,1/16).
+bench-scale: deps-tools
+	@$(MAKE) --no-print-directory $(BUILD)/lbk
+	@python3 bench/scale/run.py --lbk $(BUILD)/lbk --out $(BUILD)/bench-scale $(BENCH_SCALE_ARGS)
 
 # Seam stitching's share of bake CPU per level (bench/stitch_share.c): the shared scenes and every
 # generated hard level, both layouts (bench/levels; the _authored ones have many small charts).
