@@ -51,7 +51,8 @@ def run_one(opt, frac):
             "glg_probes": c["glg_probes"], "wall_s": wall, "cpu_s": cpu, "peak_rss": peak,
             "phase_s": {k: v["seconds"] for k, v in phases.items()},
             "phase_peak": {k: v["peak_rss_bytes"] for k, v in phases.items()},
-            "samples": samples, "file_bytes": c["file_bytes"]}
+            "samples": samples, "rays": j["transport"]["rays"], "transport_s": j["transport"]["seconds"],
+            "file_bytes": c["file_bytes"]}
 
 
 def main():
@@ -85,14 +86,18 @@ def main():
             r["glg_probes"] / max(r["cpu_s"], 1e-9)))
         sys.stdout.flush()
     base = rows[0]
-    print("\ngrowth against the %s part, measured in this run (1.00 = linear in texels):" % base["fraction"])
-    print("%-6s %10s %12s %14s %16s" % ("part", "texels x", "CPU x", "CPU per texel", "peak per texel"))
+    print("\ngrowth against the %s part, measured in this run (1.00: linear). The stop rule picks the"
+          % base["fraction"])
+    print("samples (a part with darker rooms runs more passes), so the transport's cost is compared per ray:")
+    print("%-6s %9s %8s %8s %10s %10s %13s %14s %14s" % ("part", "texels x", "CPU x", "samples", "rays/texel",
+                                                         "rays x", "transport/ray", "CPU per texel", "peak per texel"))
     for r in rows:
         tx = r["texels"] / max(base["texels"], 1)
         cx = r["cpu_s"] / max(base["cpu_s"], 1e-9)
-        print("%-6s %10.2f %12.2f %14.2f %16.2f" % (r["fraction"], tx, cx, cx / tx if tx else 0,
-                                                   (r["peak_rss"] / max(r["texels"], 1)) /
-                                                   (base["peak_rss"] / max(base["texels"], 1))))
+        per_ray = (r["transport_s"] / max(r["rays"], 1)) / (base["transport_s"] / max(base["rays"], 1))
+        print("%-6s %9.2f %8.2f %8d %10.0f %10.2f %13.2f %14.2f %14.2f" % (
+            r["fraction"], tx, cx, r["samples"], r["rays"] / max(r["texels"], 1), r["rays"] / max(base["rays"], 1),
+            per_ray, cx / tx if tx else 0, (r["peak_rss"] / max(r["texels"], 1)) / (base["peak_rss"] / max(base["texels"], 1))))
     last = rows[-1]
     bpt = last["peak_rss"] / max(last["texels"], 1)
     print("\nmemory goal (issue 36): %.0f B/texel peak at %s of the city against %d + the scene and BVH: %s" % (
