@@ -4,7 +4,7 @@ block one building with interiors — floors of rooms behind windowed facades, p
 with doorways — on a sidewalk beside asphalt streets, lit by a sky and the sun. Plain Python 3,
 seeded, deterministic: the same invocation writes the same bytes.
 
-    python3 bench/scale/gen_city.py --out DIR [--fraction F] [--seed N] [--blocks N]
+    python3 bench/scale/gen_city.py --out DIR [--fraction F] [--seed N] [--blocks N] [--stats-only]
 
 --fraction F writes the first F of the N x N blocks at the same density, in square shells from
 one corner (1/16 of 16 x 16 is a 4 x 4 district), so a fraction's texels, triangles and probes
@@ -126,6 +126,7 @@ def main():
     ap.add_argument("--blocks", type=int, default=16, help="blocks per side of the whole city")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--name", default="city")
+    ap.add_argument("--stats-only", action="store_true", help="print the counts, write nothing")
     opt = ap.parse_args()
     if not (0 < opt.fraction <= 1) or opt.blocks < 1:
         sys.exit("gen_city: --fraction must be in (0, 1] and --blocks >= 1")
@@ -149,9 +150,9 @@ def main():
         lot = (ox - WALL_T - x0, ox + W + WALL_T - x0, oz - WALL_T - z0, oz + D + WALL_T - z0)
         lot = (max(lot[0], STREET / 2), min(lot[1], PITCH - STREET / 2), max(lot[2], STREET / 2),
                min(lot[3], PITCH - STREET / 2))
-        prims = _prims(w, mats, polys)
-        w.mesh("building_%03d" % b, prims)
-        w.mesh("ground_%03d" % b, _prims(w, mats, ground(x0, z0, lot)))
+        if not opt.stats_only:
+            w.mesh("building_%03d" % b, _prims(w, mats, polys))
+            w.mesh("ground_%03d" % b, _prims(w, mats, ground(x0, z0, lot)))
         floors_total += floors
         for ps in list(polys.values()) + list(ground(x0, z0, lot).values()):
             for p in ps:
@@ -162,9 +163,13 @@ def main():
                     c = geom.cross(p[i], p[(i + 1) % len(p)])
                     a = [a[k] + c[k] for k in range(3)]
                 area += abs(geom.dot(a, n)) / 2
+    path = os.path.join(opt.out, opt.name + ".gltf")
+    if opt.stats_only:
+        print("gen_city: %d buildings, %d floors, %d triangles, %.0f m2 of surface (not written)" % (
+            count, floors_total, tris, area))
+        return 0
     w.light("sun", "directional", 20.0, rotation=[_r(x) for x in geom.look_rotation(SUN_DIR)])
     os.makedirs(opt.out, exist_ok=True)
-    path = os.path.join(opt.out, opt.name + ".gltf")
     w.save(path, external_bin=True, scene_extras={"lbk_sky": [0.6, 0.7, 0.9]})
     info = {"generator": "bench/scale/gen_city.py", "seed": opt.seed, "blocks": opt.blocks,
             "fraction": opt.fraction, "buildings": count, "floors": floors_total, "triangles": tris,
