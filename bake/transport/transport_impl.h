@@ -30,6 +30,10 @@
 #include <string.h>
 
 #define TP_PI 3.14159265358979323846
+#define TP_LOCAL_SHARE 0.03  /* the tail's area-averaged share of the light that ends the bounces */
+#define TP_LOCAL_TOL 0.01    /* or its regional error (cache.c, local_tail_converged) */
+#define TP_LOCAL_FLOOR 0.01  /* cells below this share of the mean cell light are left out of it */
+#define TP_LATE_RAYS_DIV 4   /* the bounces after the energy's rule trace 1/4 of the cache rays */
 #define TP_Q_MAX 0.999      /* largest per-bounce ratio the tail formula trusts (factor ≤ 999) */
 #define TP_MAX_SUB 1024     /* at most 1024² cells per triangle side (the cell budget binds first) */
 #define TP_CELL_CAP ((size_t)1 << 22) /* cells in all (~0.5 GB with both halves' radiance) */
