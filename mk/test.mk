@@ -52,7 +52,7 @@ STRUCTURE_CHECKS := $(patsubst tests/structure/%.sh,%,$(sort $(wildcard tests/st
 $(STRUCTURE_CHECKS:%=$(BUILD)/tests/%): $(BUILD)/tests/%: tests/structure/%.sh
 	@mkdir -p $(@D)
 	@printf '#!/bin/sh\nexec sh "%s/$<" "$$@"\n' "$(CURDIR)" > $@ && chmod +x $@
-# shell tests of other parts (tests/bench/*.sh: the hard-level suite's generator), the same wrapper
+# shell tests of other parts (tests/bench/*.sh: the level generators; start.shinc is their shared start), the same wrapper
 SHELL_TESTS := $(patsubst tests/bench/%.sh,%,$(sort $(wildcard tests/bench/*.sh)))
 $(SHELL_TESTS:%=$(BUILD)/tests/%): $(BUILD)/tests/%: tests/bench/%.sh
 	@mkdir -p $(@D)

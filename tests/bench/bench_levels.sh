@@ -13,16 +13,9 @@
 # take minutes for 88 scenes. cmocka-style lines for tests/run.sh.
 set -u
 cd "$(dirname "$0")/../.."
-: "${BUILD:=build}"
-lbk=${LBK_LEVELS_BAKER:-$BUILD/lbk}
-w=$BUILD/tests/bench_levels.work
+. tests/bench/start.shinc
+bench_test_start bench_levels determinism split imports
 gen=bench/levels/gen_levels.py
-echo "[==========] Running 3 test(s)."
-if ! command -v python3 >/dev/null 2>&1; then
-    for c in determinism split imports; do echo "[  SKIPPED ] bench_levels_$c: no python3"; done
-    echo "[==========] 3 test(s) run."; exit 0
-fi
-rm -rf "$w" && mkdir -p "$w"
 
 # determinism
 st=0

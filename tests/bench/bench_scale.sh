@@ -8,16 +8,9 @@
 # The baker is the release build ($BUILD/lbk; LBK_LEVELS_BAKER overrides). cmocka-style lines.
 set -u
 cd "$(dirname "$0")/../.."
-: "${BUILD:=build}"
-lbk=${LBK_LEVELS_BAKER:-$BUILD/lbk}
-w=$BUILD/tests/bench_scale.work
+. tests/bench/start.shinc
+bench_test_start bench_scale determinism parts bakes
 gen=bench/scale/gen_city.py
-echo "[==========] Running 3 test(s)."
-if ! command -v python3 >/dev/null 2>&1; then
-    for c in determinism parts bakes; do echo "[  SKIPPED ] bench_scale_$c: no python3"; done
-    echo "[==========] 3 test(s) run."; exit 0
-fi
-rm -rf "$w" && mkdir -p "$w"
 fails=0
 
 st=0
