@@ -201,17 +201,17 @@ static double cell_power(const tp_ctx *c, const float *l)
 static void local_tail(const tp_ctx *c, const float *last, const float *prev, const float *sum, double q, double *share,
                        double *q_rel)
 {
-    double acc = 0, area = 0, num = 0, den = 0, mean = 0;
+    double acc = 0, area = 0, num = 0, den = 0, light = 0, lit_area = 0;
     const double f = q / (1 - q);
     for (size_t i = 0; i < c->cell_count; i++) {
         const double ls = bk_lumf(sum + 3 * i);
-        if (ls > 0) mean += c->cells[i].area * ls, area += c->cells[i].area;
+        if (ls > 0) light += c->cells[i].area * ls, lit_area += c->cells[i].area;
     }
-    const double floor = area > 0 ? TP_LOCAL_FLOOR * mean / area : 0;
-    area = 0;
+    /* >= 0, so a cell above it has light */
+    const double floor = lit_area > 0 ? TP_LOCAL_FLOOR * light / lit_area : 0;
     for (size_t i = 0; i < c->cell_count; i++) {
         const double ls = bk_lumf(sum + 3 * i), ll = bk_lumf(last + 3 * i), lp = bk_lumf(prev + 3 * i);
-        if (!(ls > floor) || !(ls > 0) || !(ll >= 0)) continue;
+        if (!(ls > floor) || !(ll >= 0)) continue;
         const double a = c->cells[i].area;
         acc += a * ll * f / (ls + ll * f);
         area += a;
