@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "cli/bake_options.h"
@@ -65,12 +66,13 @@ static int write_sbatch(const char *path, const char *lbk, const char *plan, con
              "#!/bin/sh\n"
              "# A distributed bake on Slurm, written by lbk plan: `sh THIS` submits a job array of %u\n"
              "# units and a merge that runs when all of them succeeded (afterok). SBATCH_FLAGS adds\n"
-             "# sbatch options (partition, account, time); LBK picks the lbk binary.\n"
+             "# sbatch options (partition, account, time); LBK picks the lbk binary, UNIT_FLAGS the\n"
+             "# units' options (default -q).\n"
              "set -e\n"
-             "LBK=${LBK:-%s}\nPLAN=%s\nOUT=%s\n"
+             "LBK=${LBK:-%s}\nPLAN=%s\nOUT=%s\nUNIT_FLAGS=${UNIT_FLAGS:--q}\n"
              "mkdir -p \"$OUT.parts\"\n"
              "unit=$(sbatch --parsable $SBATCH_FLAGS --job-name=lbk-unit --array=0-%u --output=\"$OUT.parts/unit-%%a.log\" \\\n"
-             "  --wrap=\"$LBK bake-unit $PLAN \\$SLURM_ARRAY_TASK_ID -o $OUT.parts/part-\\$SLURM_ARRAY_TASK_ID.lbkpart -q\")\n"
+             "  --wrap=\"$LBK bake-unit $PLAN \\$SLURM_ARRAY_TASK_ID -o $OUT.parts/part-\\$SLURM_ARRAY_TASK_ID.lbkpart $UNIT_FLAGS\")\n"
              "unit=${unit%%%%;*}\n"
              "merge=$(sbatch --parsable $SBATCH_FLAGS --job-name=lbk-merge --dependency=afterok:$unit \\\n"
              "  --output=\"$OUT.parts/merge.log\" --wrap=\"$LBK merge $PLAN $OUT.parts/part-*.lbkpart -o $OUT -q\")\n"
@@ -272,27 +274,55 @@ static void unit_message(void *user, lbk_bake_severity severity, const char *mes
 
 static void unit_help(FILE *f)
 {
-    fputs("usage: lbk bake-unit PLAN.json K -o PART.lbkpart [--threads N] [--scene PATH] [-q]\n"
+    fputs("usage: lbk bake-unit PLAN.json K -o PART.lbkpart [--threads N] [--scene PATH]\n"
+          "                     [--cache-dir DIR | --no-shared-cache] [--cache-lease SECONDS] [-q]\n"
           "\n"
           "Bakes unit K (0-based) of a plan (lbk plan) into a part file, written atomically: a killed\n"
-          "unit leaves none. --scene: where the plan's scene is on this machine (its hash is checked).\n",
+          "unit leaves none. --scene: where the plan's scene is on this machine (its hash is checked).\n"
+          "\n"
+          "Units that share a transport run (more units than runs: a level without light sets) share\n"
+          "its radiosity caches: each bounce is cut into shares, a unit computes the shares nobody\n"
+          "has claimed, publishes them in the cache folder and reads the others' (bake/dist/DIST.md\n"
+          "§Shared caches). The folder must be one every unit sees; default: the plan's output\n"
+          "followed by .cache-PLANHASH (when it cannot be made, the unit computes its caches whole).\n"
+          "lbk merge removes it. The part's bytes are the same with or without sharing.\n"
+          "--cache-lease: seconds a claimed share may stay unpublished before another unit computes\n"
+          "it too (default 600; a claim of a process gone from this host is taken at once).\n",
           f);
+}
+
+/* The plan's default shared cache folder: beside its output, named by its hash. */
+static void default_cache_dir(const tl_plan *p, char *out, size_t size)
+{
+    snprintf(out, size, "%s.cache-%016" PRIx64, p->output, p->hash);
+}
+
+static void print_share_stats(unsigned long k, const lbk_bake_unit_stats *st)
+{
+    if (!st->shares_computed && !st->shares_read) return;
+    printf("unit %lu: cache shares computed %" PRIu64 " (%.2f s), read %" PRIu64 " (%.1f MB, %.2f s), waited %.2f s\n", k,
+           st->shares_computed, st->compute_seconds, st->shares_read, (double)st->bytes_read / 1e6, st->read_seconds,
+           st->wait_seconds);
 }
 
 int lbk_cmd_bake_unit(int argc, char **argv)
 {
-    const char *plan = NULL, *kstr = NULL, *out = NULL, *scene = NULL;
+    const char *plan = NULL, *kstr = NULL, *out = NULL, *scene = NULL, *cache_dir = NULL, *lease_str = NULL;
     char *extra[4];
-    int n_extra = 0, quiet = 0;
+    int n_extra = 0, quiet = 0, no_share = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) return unit_help(stdout), LBK_EXIT_OK;
-        if ((!strcmp(a, "-o") || !strcmp(a, "--output") || !strcmp(a, "--threads") || !strcmp(a, "--scene")) && i + 1 >= argc) {
+        if ((!strcmp(a, "-o") || !strcmp(a, "--output") || !strcmp(a, "--threads") || !strcmp(a, "--scene") ||
+             !strcmp(a, "--cache-dir") || !strcmp(a, "--cache-lease")) && i + 1 >= argc) {
             fprintf(stderr, "lbk bake-unit: %s needs a value\n", a);
             return LBK_EXIT_USAGE;
         }
         if (!strcmp(a, "-o") || !strcmp(a, "--output")) out = argv[++i];
         else if (!strcmp(a, "--scene")) scene = argv[++i];
+        else if (!strcmp(a, "--cache-dir")) cache_dir = argv[++i];
+        else if (!strcmp(a, "--cache-lease")) lease_str = argv[++i];
+        else if (!strcmp(a, "--no-shared-cache")) no_share = 1;
         else if (!strcmp(a, "--threads")) extra[n_extra++] = argv[i], extra[n_extra++] = argv[++i];
         else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) quiet = 1;
         else if (a[0] == '-' && a[1]) {
@@ -316,6 +346,18 @@ int lbk_cmd_bake_unit(int argc, char **argv)
         fprintf(stderr, "lbk bake-unit: K: '%s' is not a unit number\n", kstr);
         return LBK_EXIT_USAGE;
     }
+    double lease = 0;
+    if (lease_str) {
+        lease = strtod(lease_str, &end);
+        if (*end || !(lease > 0) || lease > 1e7) {
+            fprintf(stderr, "lbk bake-unit: --cache-lease: '%s' is not a number of seconds > 0\n", lease_str);
+            return LBK_EXIT_USAGE;
+        }
+    }
+    if (no_share && (cache_dir || lease_str)) {
+        fprintf(stderr, "lbk bake-unit: --no-shared-cache with --cache-dir or --cache-lease\n");
+        return LBK_EXIT_USAGE;
+    }
     tl_plan p;
     bake_args o;
     int dummy = 0;
@@ -336,9 +378,22 @@ int lbk_cmd_bake_unit(int argc, char **argv)
     }
     o.d.message = unit_message;
     o.d.user = &quiet;
+    char dir[PATH_MAX + 32];
+    lbk_bake_unit_desc sd = {sizeof sd, NULL, lease};
+    if (!no_share) {
+        if (cache_dir) snprintf(dir, sizeof dir, "%s", cache_dir);
+        else default_cache_dir(&p, dir, sizeof dir);
+        /* the default folder is a convenience: where it cannot be made the unit computes whole */
+        if (cache_dir || mkdir(dir, 0777) == 0 || errno == EEXIST) sd.cache_dir = dir;
+        else if (!quiet) fprintf(stderr, "lbk bake-unit: note: no shared cache (%s: %s): this unit computes its caches whole\n",
+                                 dir, strerror(errno));
+    }
+    lbk_bake_unit_stats st;
+    memset(&st, 0, sizeof st);
+    st.size = sizeof st;
     void *part = NULL;
     size_t size = 0;
-    lbk_result r = lbk_bake_unit_from_file(o.input, &o.d, p.hash, p.units, (uint32_t)k, &part, &size);
+    lbk_result r = lbk_bake_unit_shared(o.input, &o.d, p.hash, p.units, (uint32_t)k, &sd, &st, &part, &size);
     tl_plan_free(&p);
     free((void *)o.d.expect_inputs);
     if (r) {
@@ -352,26 +407,27 @@ int lbk_cmd_bake_unit(int argc, char **argv)
         fprintf(stderr, "lbk bake-unit: %s\n", err);
         return LBK_EXIT_IO;
     }
-    if (!quiet) printf("%s: unit %lu, %zu bytes\n", out, k, size);
+    if (!quiet) printf("%s: unit %lu, %zu bytes\n", out, k, size), print_share_stats(k, &st);
     return LBK_EXIT_OK;
 }
 
 static void merge_help(FILE *f)
 {
     fputs("usage: lbk merge PLAN.json PART.lbkpart... [-o OUT.lbk] [--threads N] [--json-report FILE]\n"
-          "                 [--scene PATH] [-q]\n"
+          "                 [--scene PATH] [--cache-dir DIR] [--keep-cache] [-q]\n"
           "\n"
           "Checks that the parts are every unit of the plan, each once, uncorrupted and of this plan, then\n"
           "writes the container (default: the plan's output) atomically, byte-identical to `lbk bake`.\n"
-          "Any bad part: a message and nothing written.\n",
+          "Any bad part: a message and nothing written. Then removes the units' shared cache folder\n"
+          "(--cache-dir DIR if they were given one; --keep-cache keeps it).\n",
           f);
 }
 
 int lbk_cmd_merge(int argc, char **argv)
 {
-    const char *plan = NULL, *out = NULL, *scene = NULL;
+    const char *plan = NULL, *out = NULL, *scene = NULL, *cache_dir = NULL;
     char *extra[8];
-    int n_extra = 0, quiet = 0;
+    int n_extra = 0, quiet = 0, keep_cache = 0;
     const char **files = calloc((size_t)argc, sizeof *files);
     size_t n_files = 0;
     if (!files) return LBK_EXIT_INTERNAL;
@@ -379,7 +435,7 @@ int lbk_cmd_merge(int argc, char **argv)
         const char *a = argv[i];
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) return free(files), merge_help(stdout), LBK_EXIT_OK;
         int valued = !strcmp(a, "-o") || !strcmp(a, "--output") || !strcmp(a, "--threads") || !strcmp(a, "--scene") ||
-                     !strcmp(a, "--json-report");
+                     !strcmp(a, "--json-report") || !strcmp(a, "--cache-dir");
         if (valued && i + 1 >= argc) {
             fprintf(stderr, "lbk merge: %s needs a value\n", a);
             free(files);
@@ -387,6 +443,8 @@ int lbk_cmd_merge(int argc, char **argv)
         }
         if (!strcmp(a, "-o") || !strcmp(a, "--output")) out = argv[++i];
         else if (!strcmp(a, "--scene")) scene = argv[++i];
+        else if (!strcmp(a, "--cache-dir")) cache_dir = argv[++i];
+        else if (!strcmp(a, "--keep-cache")) keep_cache = 1;
         else if (valued) extra[n_extra++] = argv[i], extra[n_extra++] = argv[++i];
         else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) quiet = 1;
         else if (a[0] == '-' && a[1]) {
@@ -446,6 +504,11 @@ int lbk_cmd_merge(int argc, char **argv)
         o.part_sizes = sizes;
         o.part_count = n_files;
         rc = cli_bake_run(&o, quiet);
+        char dir[PATH_MAX + 32];
+        if (cache_dir) snprintf(dir, sizeof dir, "%s", cache_dir);
+        else default_cache_dir(&p, dir, sizeof dir);
+        if (rc == LBK_EXIT_OK && !keep_cache && lbk_bake_cache_dir_remove(dir) != LBK_OK)
+            fprintf(stderr, "lbk merge: warning: could not remove the shared cache folder %s\n", dir);
     }
     for (size_t k = 0; parts && k < n_files; k++) free(parts[k]);
     free(parts);

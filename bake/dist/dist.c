@@ -2,6 +2,8 @@
  * (bk_transport_split). Multi-byte values are little-endian; floats are IEEE-754 bit patterns. */
 #include "bake/dist/dist.h"
 
+#include "bake/dist/cache_share.h"
+
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -166,6 +168,7 @@ struct bk_dist {
     /* replay */
     const bk_part_view *parts;
     uint32_t owners[2]; /* the units that hold the run being replayed */
+    bk_cache_share *share; /* record: the shared caches' folder, NULL: none */
     char err[512];
 };
 
@@ -401,6 +404,31 @@ static lbk_result play_outputs(void *user, const bk_transport_output *o)
     }
     d->run++;
     return LBK_OK;
+}
+
+/* A bounce of the run under way: with other units sharing the run, cut into their shares
+ * (cache_share.h); else computed whole here. */
+static lbk_result rec_cache_bounce(void *user, const bk_cache_bounce *b)
+{
+    bk_dist *d = user;
+    const uint32_t run = d->run - 1; /* rec_range counted it */
+    uint32_t first = 0, end = 0;
+    if (run < d->total_runs) bk_dist_run_units(d->total_runs, d->units, run, &first, &end);
+    if (end - first < 2 || !d->share) {
+        uint64_t counts[3]; /* already in the run's counters */
+        return b->compute(b->ctx, 0, b->cells, counts);
+    }
+    const uint32_t mine = d->unit >= first && d->unit < end ? d->unit - first : end - first;
+    char why[sizeof d->err];
+    lbk_result r = bk_cache_share_bounce(d->share, run, end - first, mine, b, why, sizeof why);
+    if (r && r != LBK_ERR_OUT_OF_MEMORY) return fail(d, r, "%s", why);
+    return r;
+}
+
+void bk_dist_set_cache_share(bk_dist *d, bk_cache_share *share)
+{
+    d->share = share;
+    d->split.cache_bounce = share && !d->replay ? rec_cache_bounce : NULL;
 }
 
 lbk_result bk_dist_create(int replay, uint64_t plan_hash, uint64_t options_hash, uint32_t units, uint32_t unit,

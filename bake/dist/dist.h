@@ -70,6 +70,10 @@ void bk_dist_destroy(bk_dist *d);
  * message when they disagree or the cut is impossible. */
 lbk_result bk_dist_set_cut(bk_dist *d, uint64_t count, uint32_t runs, uint32_t base_dependent, int targeted, char *err,
                            size_t err_len);
+/* Record: share the caches of runs cut between units through this folder (cache_share.h;
+ * NULL: every unit computes its runs' caches whole). The caller keeps it open until the end. */
+struct bk_cache_share;
+void bk_dist_set_cache_share(bk_dist *d, struct bk_cache_share *share);
 /* What every transport run is handed (bk_transport_options.split). */
 const bk_transport_split *bk_dist_split(const bk_dist *d);
 /* After the bake (record): the part's bytes (malloc'd, the caller frees). Replay: LBK_OK when

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bake/dist/cache_share.h"
 #include "bake/dist/dist.h"
 #include "bake/pipeline/pipeline.h"
 #include "lbk/bake_dist.h"
@@ -78,17 +79,62 @@ uint64_t bk_pipeline_options_hash(const lbk_bake_desc *options, int budgets)
 lbk_result lbk_bake_unit_from_file(const char *path, const lbk_bake_desc *desc, uint64_t plan_hash, uint32_t units,
                                    uint32_t unit, void **part, size_t *part_size)
 {
+    return lbk_bake_unit_shared(path, desc, plan_hash, units, unit, NULL, NULL, part, part_size);
+}
+
+/* The shared cache folder's failure, sent as the bake's ERROR message. */
+static void share_error(const lbk_bake_desc *desc, const char *why)
+{
+    if (desc && desc->message) desc->message(desc->user, LBK_BAKE_SEVERITY_ERROR, why);
+}
+
+lbk_result lbk_bake_unit_shared(const char *path, const lbk_bake_desc *desc, uint64_t plan_hash, uint32_t units,
+                                uint32_t unit, const lbk_bake_unit_desc *shared, lbk_bake_unit_stats *stats, void **part,
+                                size_t *part_size)
+{
     if (!part || !part_size) return LBK_ERR_INVALID_ARGUMENT;
     *part = NULL;
     *part_size = 0;
     if (!path || units == 0 || units > BK_PART_MAX_UNITS || unit >= units) return LBK_ERR_INVALID_ARGUMENT;
+    lbk_bake_unit_desc sd;
+    memset(&sd, 0, sizeof sd);
+    if (shared) memcpy(&sd, shared, shared->size && shared->size < sizeof sd ? shared->size : sizeof sd);
     bk_dist *d = NULL;
     lbk_result r = bk_dist_create(0, plan_hash, bk_pipeline_options_hash(desc, 1), units, unit, NULL, &d);
     if (r) return r;
+    bk_cache_share *cs = NULL;
+    if (sd.cache_dir) {
+        char why[512] = "";
+        r = bk_cache_share_open(sd.cache_dir, plan_hash, sd.lease, &cs, why, sizeof why);
+        if (r) {
+            if (why[0]) share_error(desc, why);
+            bk_dist_destroy(d);
+            return r;
+        }
+        bk_dist_set_cache_share(d, cs);
+    }
     lbk_bake_output *out = NULL;
     r = bk_pipeline_bake(path, NULL, desc, &out, d, part, part_size, NULL, NULL, NULL);
+    if (stats && stats->size >= sizeof *stats) {
+        bk_cache_share_stats st;
+        bk_cache_share_get_stats(cs, &st);
+        stats->shares_computed = st.computed;
+        stats->shares_read = st.read;
+        stats->bytes_written = st.bytes_written;
+        stats->bytes_read = st.bytes_read;
+        stats->compute_seconds = st.compute_seconds;
+        stats->read_seconds = st.read_seconds;
+        stats->wait_seconds = st.wait_seconds;
+    }
     bk_dist_destroy(d);
+    bk_cache_share_close(cs);
     return r;
+}
+
+lbk_result lbk_bake_cache_dir_remove(const char *cache_dir)
+{
+    if (!cache_dir) return LBK_ERR_INVALID_ARGUMENT;
+    return bk_cache_share_remove(cache_dir) ? LBK_ERR_IO : LBK_OK;
 }
 
 void lbk_bake_part_free(void *part) { free(part); }

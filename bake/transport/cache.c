@@ -183,6 +183,41 @@ static void cache_bounce(tp_ctx *c, size_t begin, size_t end, int thread)
     c->thread_nonfinite[thread] += cnt.bad;
 }
 
+/* A range of cells of the current bounce, for a unit sharing the cache (bk_cache_bounce). */
+static lbk_result compute_cells(void *ctx, size_t begin, size_t end, uint64_t counts[3])
+{
+    tp_ctx *c = ctx;
+    uint64_t before[3], after[3];
+    if (begin > end || end > c->cell_count) return LBK_ERR_INTERNAL;
+    bk_tr_count_totals(c, before);
+    bk_tr_parallel_range(c, begin, end, 64, cache_bounce);
+    bk_tr_count_totals(c, after);
+    for (int a = 0; a < 3; a++) counts[a] = after[a] - before[a];
+    return LBK_OK;
+}
+
+static void add_counts(void *ctx, const uint64_t counts[3])
+{
+    tp_ctx *c = ctx;
+    c->thread_rays[0] += counts[0];
+    c->thread_shadow[0] += counts[1];
+    c->thread_nonfinite[0] += counts[2];
+}
+
+/* Bounce c->bounce of every cell into l_cur: here, or shared with the other units of a
+ * distributed run (bk_transport_split.cache_bounce). */
+static lbk_result bounce_cells(tp_ctx *c)
+{
+    const bk_transport_split *sp = c->opt->split;
+    if (!sp || sp->replay || !sp->cache_bounce) {
+        bk_tr_parallel_for(c, c->cell_count, 64, cache_bounce);
+        return LBK_OK;
+    }
+    const bk_cache_bounce b = {c->pass, c->half, c->bounce, c->rays, c->cell_count, c->l_cur[c->half],
+                               compute_cells, add_counts, c};
+    return sp->cache_bounce(sp->user, &b);
+}
+
 static double cell_power(const tp_ctx *c, const float *l)
 {
     double p = 0;
@@ -257,9 +292,10 @@ tp_chain_result bk_tr_run_chain(tp_ctx *c, int h, int pass, int rays, double tol
             res.bounces = -1;
             return res;
         }
-        bk_tr_parallel_for(c, n, 64, cache_bounce);
+        c->chain_err = bounce_cells(c);
         bk_slc_draw_destroy(c->draw_cell);
         c->draw_cell = NULL;
+        if (c->chain_err) { res.bounces = -1; return res; }
         double p = cell_power(c, c->l_cur[h]);
         for (size_t i = 0; i < 3 * n; i++) sum[i] += c->l_cur[h][i];
         indirect += p;

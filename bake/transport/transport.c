@@ -127,7 +127,7 @@ static lbk_result run_pass(tp_ctx *c, int pass, tp_chain_result chain[2])
         c->cache_rays += after[0] - before[0];
         c->cache_shadow += after[1] - before[1];
         c->cache_nonfinite += after[2] - before[2];
-        if (chain[h].bounces < 0) return LBK_ERR_OUT_OF_MEMORY;
+        if (chain[h].bounces < 0) return c->chain_err ? c->chain_err : LBK_ERR_OUT_OF_MEMORY;
         if (report_progress(c, "cache", c->spp)) return LBK_ERR_CANCELLED;
     }
     c->pass = pass;

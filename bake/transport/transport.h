@@ -190,6 +190,23 @@ typedef struct bk_transport_checkpoint {
 } bk_transport_checkpoint;
 
 struct bk_transport_output;
+
+/* One bounce of a run's radiosity cache, handed to bk_transport_split.cache_bounce: every cell's
+ * value must end up in out (3 floats per cell), computed here (compute) or read from where
+ * another process that computed it published it (then add_counts adds what it traced). The
+ * values of a cell depend only on the scene, the options, the seed, (pass, half, bounce) and the
+ * earlier bounces, so any split of the cells between processes gives the same floats. */
+typedef struct bk_cache_bounce {
+    int pass, half, bounce, rays;
+    size_t cells;
+    float *out;
+    /* computes cells [begin, end) into out; counts: the rays, shadow rays and non-finite values
+     * they made */
+    lbk_result (*compute)(void *ctx, size_t begin, size_t end, uint64_t counts[3]);
+    void (*add_counts)(void *ctx, const uint64_t counts[3]);
+    void *ctx;
+} bk_cache_bounce;
+
 typedef struct bk_transport_split {
     int replay;            /* 0: record (a unit), 1: replay (the merge) */
     void *user;
@@ -209,6 +226,10 @@ typedef struct bk_transport_split {
     lbk_result (*replay_totals)(void *user, size_t count, bk_transport_totals *totals);
     lbk_result (*replay_pass)(void *user, bk_transport_pass_record *pass);
     lbk_result (*replay_outputs)(void *user, const struct bk_transport_output *out);
+    /* record, optional (NULL: the unit computes the whole cache of every run it traces): shares
+     * the cache's bounces with the other units of the run (DIST.md §Shared caches); called for
+     * every bounce of every chain of a run the unit traces (own 1 or 2) */
+    lbk_result (*cache_bounce)(void *user, const bk_cache_bounce *b);
 } bk_transport_split;
 
 typedef struct bk_transport_options {

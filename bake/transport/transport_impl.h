@@ -206,6 +206,7 @@ typedef struct tp_ctx {
     /* current job */
     int half, pass, bounce, rays;
     tp_lattice lat;        /* for `rays` samples */
+    lbk_result chain_err;  /* why the last chain failed (bounces < 0), LBK_OK: out of memory */
     /* receivers */
     const bk_scene *fscene;  /* the scene footprints index (options.footprint_scene or scene) */
     const bk_receiver *recv;

@@ -97,4 +97,23 @@ done
 [ -f "$T/level.lbk" ] || fail "the merge job wrote no container: $(cat "$T"/level.lbk.parts/*.log 2>/dev/null | tail -n 20)"
 ls "$T/level.lbk.parts/"
 cmp "$T/local.lbk" "$T/level.lbk" || fail "the Slurm bake differs from the local bake"
-echo "ok: 3 units on Slurm + merge, $(wc -c < "$T/level.lbk") bytes, byte-identical to lbk bake"
+echo "3 units on Slurm + merge, $(wc -c < "$T/level.lbk") bytes, byte-identical to lbk bake"
+
+# a level of one transport run: 4 units share its radiosity caches through the plan's cache
+# folder (DIST.md §Shared caches), the array's tasks computing the bounces between them
+scene=scenes/cornell_box/CornellBox-Original.gltf
+opts="--samples 64 --target-error none --texel-density 4 --seed 5"
+"$LBK" bake $scene -o "$T/cornell.lbk" $opts --threads 2 -q || fail "local bake of the Cornell box"
+"$LBK" plan $scene -o "$T/box.lbk" --plan "$T/box.json" --units 4 --sbatch "$T/box.sh" $opts >/dev/null || fail "plan"
+SBATCH_FLAGS="--cpus-per-task=1" UNIT_FLAGS="--threads 1" LBK="$LBK" sh "$T/box.sh" > "$T/submit.log" 2>&1 || fail "sbatch: $(cat "$T/submit.log")"
+i=0
+while [ -n "$(squeue -h 2>/dev/null)" ]; do
+  i=$((i + 1)); [ $i -gt 600 ] && fail "jobs still queued after 600 s: $(squeue)"; sleep 1
+done
+[ -f "$T/box.lbk" ] || fail "the merge job wrote no container: $(cat "$T"/box.lbk.parts/*.log 2>/dev/null | tail -n 20)"
+cmp "$T/cornell.lbk" "$T/box.lbk" || fail "the shared-cache Slurm bake differs from the local bake"
+ls -d "$T"/box.lbk.cache-* 2>/dev/null && fail "the merge left the shared cache folder"
+computed=$(cat "$T"/box.lbk.parts/unit-*.log | awk '/cache shares computed/ {c += $6; u++} END {print u + 0, c + 0}')
+[ "${computed%% *}" = 4 ] && [ "${computed#* }" -gt 0 ] || fail "the units shared no cache: $(cat "$T"/box.lbk.parts/unit-*.log)"
+echo "units, cache shares computed: $computed"
+echo "ok: 3 units on Slurm + merge; 4 units sharing the Cornell box's caches + merge; both byte-identical to lbk bake"

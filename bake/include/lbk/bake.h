@@ -55,8 +55,8 @@ extern "C" {
 /* The baker library's version (lbk-bake.pc): the minor grows with every addition to the
  * size-tagged structs below ("added in 1.x"). */
 #define LBK_BAKE_LIBRARY_VERSION_MAJOR 1
-#define LBK_BAKE_LIBRARY_VERSION_MINOR 11
-#define LBK_BAKE_LIBRARY_VERSION_PATCH 0 /* 1.11.0: each LLG prop's estimate (lbk_bake_llg_estimate) */
+#define LBK_BAKE_LIBRARY_VERSION_MINOR 12
+#define LBK_BAKE_LIBRARY_VERSION_PATCH 0 /* 1.12.0: shared caches of distributed units (lbk_bake_unit_shared) */
 
 /* ---- options ----------------------------------------------------------------------------- */
 

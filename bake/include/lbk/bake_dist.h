@@ -24,6 +24,36 @@ LBK_BAKE_API lbk_result lbk_bake_unit_from_file(const char *path, const lbk_bake
                                                 uint32_t units, uint32_t unit, void **part, size_t *part_size);
 LBK_BAKE_API void lbk_bake_part_free(void *part);
 
+/* Shared caches (DIST.md §Shared caches): the units of a run cut between several units (more
+ * units than transport runs: a level without light sets) split every bounce of its radiosity
+ * caches into shares, publish the shares they compute in cache_dir, a folder every unit of the
+ * plan sees, and read the others'. Units need not run at the same time: a unit computes any
+ * share nobody has claimed and waits only for shares a running unit is computing. The part's
+ * bytes are the same with or without sharing. Zero value: no sharing. */
+typedef struct lbk_bake_unit_desc {
+    size_t size;              /* sizeof(lbk_bake_unit_desc) */
+    const char *cache_dir;    /* NULL: each unit computes its runs' caches whole */
+    double lease;             /* seconds a claimed share may stay unpublished before another unit
+                                 computes it too; 0: 600. A claim of a process gone from this
+                                 host is taken at once */
+} lbk_bake_unit_desc;
+
+/* What sharing did in one unit (lbk_bake_unit_shared). */
+typedef struct lbk_bake_unit_stats {
+    size_t size;              /* sizeof(lbk_bake_unit_stats), set by the caller */
+    uint64_t shares_computed, shares_read, bytes_written, bytes_read;
+    double compute_seconds, read_seconds, wait_seconds;
+} lbk_bake_unit_stats;
+
+/* lbk_bake_unit_from_file with shared caches (unit NULL: none); stats may be NULL. */
+LBK_BAKE_API lbk_result lbk_bake_unit_shared(const char *path, const lbk_bake_desc *desc, uint64_t plan_hash,
+                                             uint32_t units, uint32_t unit, const lbk_bake_unit_desc *shared,
+                                             lbk_bake_unit_stats *stats, void **part, size_t *part_size);
+
+/* Removes what the units left in a shared cache folder (share, claim and temporary files) and the
+ * folder if it is then empty; nothing else. LBK_ERR_IO when something could not be removed. */
+LBK_BAKE_API lbk_result lbk_bake_cache_dir_remove(const char *cache_dir);
+
 /* The files a bake of the scene at path with desc reads (the import's, in the order read, then
  * a sky EXR), with their sizes and hashes: what a plan records, so that units and the merge
  * (desc->expect_inputs) refuse a changed buffer, texture or sky. Imports the scene (no layout, no
