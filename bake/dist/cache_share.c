@@ -22,13 +22,14 @@
 
 #define CS_MAGIC "LBKCSHR\0"
 #define CS_VERSION 1u
-#define CS_HEADER 128u
+#define CS_HEADER 144u
+#define CS_KEY 88u /* the header bytes that name the bounce and share */
 #define CS_SUFFIX ".lbkcache"
 
 struct bk_cache_share {
     char dir[4096];
     char host[256];
-    uint64_t plan_hash;
+    uint64_t plan_hash, options_hash;
     double lease;
     bk_cache_share_stats st;
 };
@@ -45,8 +46,8 @@ static lbk_result say(char *err, size_t len, lbk_result r, const char *fmt, ...)
     return r;
 }
 
-lbk_result bk_cache_share_open(const char *dir, uint64_t plan_hash, double lease, bk_cache_share **out, char *err,
-                               size_t err_len)
+lbk_result bk_cache_share_open(const char *dir, uint64_t plan_hash, uint64_t options_hash, double lease,
+                               bk_cache_share **out, char *err, size_t err_len)
 {
     *out = NULL;
     if (!dir || !dir[0] || strlen(dir) >= sizeof ((bk_cache_share *)0)->dir - 128) return LBK_ERR_INVALID_ARGUMENT;
@@ -60,6 +61,7 @@ lbk_result bk_cache_share_open(const char *dir, uint64_t plan_hash, double lease
     snprintf(s->dir, sizeof s->dir, "%s", dir);
     if (gethostname(s->host, sizeof s->host - 1) != 0) snprintf(s->host, sizeof s->host, "?");
     s->plan_hash = plan_hash;
+    s->options_hash = options_hash;
     s->lease = lease > 0 ? lease : 600;
     *out = s;
     return LBK_OK;
@@ -98,30 +100,39 @@ static int claim_stale(const bk_cache_share *s, const char *claim)
     if (!f) return 0;
     char host[256] = "";
     long pid = 0;
-    int n = fscanf(f, "%255s %ld", host, &pid);
+    int n = fscanf(f, "LBKCLAIM %255s %ld", host, &pid); /* (the share's bytes once it is being written) */
     fclose(f);
     return n == 2 && pid > 0 && !strcmp(host, s->host) && kill((pid_t)pid, 0) != 0 && errno == ESRCH;
 }
 
-/* 1: this process computes the share; 0: another does (or did). */
+/* The claim's file, open (>= 0): this process computes the share and writes it there; -1:
+ * another does (or did). One file per share: the claim becomes the share when it is renamed. */
 static int claim(const bk_cache_share *s, const cs_key *k)
 {
     char path[4352];
     share_path(s, k, ".claim", path, sizeof path);
     for (int attempt = 0; attempt < 2; attempt++) {
-        int fd = open(path, O_WRONLY | O_CREAT | O_EXCL, 0666);
+        int fd = open(path, O_RDWR | O_CREAT | O_EXCL, 0666);
         if (fd >= 0) {
+            /* the claim is gone once its share is published (renamed): a share published between
+             * this unit's look and its claim is read, not computed again */
+            char done[4352];
+            share_path(s, k, "", done, sizeof done);
+            if (access(done, F_OK) == 0) {
+                close(fd);
+                unlink(path);
+                return -1;
+            }
             char line[300];
-            int n = snprintf(line, sizeof line, "%s %ld\n", s->host, (long)getpid());
+            int n = snprintf(line, sizeof line, "LBKCLAIM %s %ld\n", s->host, (long)getpid());
             ssize_t w = write(fd, line, (size_t)n);
             (void)w; /* the claim is the file; its text only names the owner */
-            close(fd);
-            return 1;
+            return fd;
         }
         /* a dead claim: computed again (same bytes; at worst two units both compute it) */
-        if (errno != EEXIST || !claim_stale(s, path) || (unlink(path) != 0 && errno != ENOENT)) return 0;
+        if (errno != EEXIST || !claim_stale(s, path) || (unlink(path) != 0 && errno != ENOENT)) return -1;
     }
-    return 0;
+    return -1;
 }
 
 /* ---- share files -------------------------------------------------------------------------- */
@@ -134,24 +145,27 @@ static void put_header(const bk_cache_share *s, const cs_key *k, const uint64_t 
     lbk_wr32(h + 8, CS_VERSION);
     lbk_wr32(h + 12, CS_HEADER);
     lbk_wr64(h + 16, s->plan_hash);
-    lbk_wr32(h + 24, k->run);
-    lbk_wr32(h + 28, (uint32_t)k->b->pass);
-    lbk_wr32(h + 32, (uint32_t)k->b->half);
-    lbk_wr32(h + 36, (uint32_t)k->b->bounce);
-    lbk_wr32(h + 40, (uint32_t)k->b->rays);
-    lbk_wr32(h + 44, k->share);
-    lbk_wr32(h + 48, k->shares);
-    lbk_wr64(h + 56, k->b->cells);
-    lbk_wr64(h + 64, k->begin);
-    lbk_wr64(h + 72, k->end);
-    for (int a = 0; a < 3; a++) lbk_wr64(h + 80 + 8 * a, counts[a]);
-    lbk_wrf64(h + 104, seconds);
-    lbk_wr64(h + 112, XXH64(payload, pay, 0));
-    lbk_wr64(h + 120, XXH64(h, 120, 0));
+    lbk_wr64(h + 24, s->options_hash);
+    lbk_wr32(h + 32, k->run);
+    lbk_wr32(h + 36, (uint32_t)k->b->pass);
+    lbk_wr32(h + 40, (uint32_t)k->b->half);
+    lbk_wr32(h + 44, (uint32_t)k->b->bounce);
+    lbk_wr32(h + 48, (uint32_t)k->b->rays);
+    lbk_wr32(h + 52, k->share);
+    lbk_wr32(h + 56, k->shares);
+    lbk_wr64(h + 64, k->b->cells);
+    lbk_wr64(h + 72, k->begin);
+    lbk_wr64(h + 80, k->end);
+    for (int a = 0; a < 3; a++) lbk_wr64(h + 88 + 8 * a, counts[a]);
+    lbk_wrf64(h + 112, seconds);
+    lbk_wr64(h + 120, XXH64(payload, pay, 0));
+    lbk_wr64(h + 136, XXH64(h, 136, 0));
 }
 
-static lbk_result publish(bk_cache_share *s, const cs_key *k, const uint64_t counts[3], double seconds, char *err,
-                          size_t err_len)
+/* Writes the share into its claim's file fd and renames it onto the share's name; fd < 0 (a
+ * damaged share computed again): through a temporary file. */
+static lbk_result publish(bk_cache_share *s, const cs_key *k, int fd, const uint64_t counts[3], double seconds,
+                          char *err, size_t err_len)
 {
     const size_t nf = 3 * (k->end - k->begin), pay = 4 * nf;
     uint8_t *buf = malloc(CS_HEADER + (pay ? pay : 1));
@@ -161,12 +175,16 @@ static lbk_result publish(bk_cache_share *s, const cs_key *k, const uint64_t cou
     put_header(s, k, counts, seconds, buf, buf + CS_HEADER, pay);
     char path[4352], tmp[4700];
     share_path(s, k, "", path, sizeof path);
-    snprintf(tmp, sizeof tmp, "%s.tmp.%s.%ld", path, s->host, (long)getpid());
-    FILE *f = fopen(tmp, "wb");
-    int ok = f && fwrite(buf, 1, CS_HEADER + pay, f) == CS_HEADER + pay && fflush(f) == 0 && fsync(fileno(f)) == 0;
-    if (f && fclose(f) != 0) ok = 0;
+    if (fd >= 0) share_path(s, k, ".claim", tmp, sizeof tmp);
+    else snprintf(tmp, sizeof tmp, "%s.tmp.%s.%ld", path, s->host, (long)getpid());
+    if (fd < 0) fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC, 0666);
+    /* no fsync: a share lost or damaged in a crash fails its checksum and is computed again */
+    const size_t size = CS_HEADER + pay;
+    int ok = fd >= 0 && pwrite(fd, buf, size, 0) == (ssize_t)size && ftruncate(fd, (off_t)size) == 0;
+    if (fd >= 0 && close(fd) != 0) ok = 0;
     free(buf);
-    if (!ok || rename(tmp, path) != 0) {
+    /* ENOENT: a unit took the claim over as stale (this one outlived its lease) and publishes it */
+    if (!ok || (rename(tmp, path) != 0 && errno != ENOENT)) {
         int e = errno;
         remove(tmp);
         return say(err, err_len, LBK_ERR_IO, "cannot write the cache share %s: %s", path, strerror(e));
@@ -176,10 +194,11 @@ static lbk_result publish(bk_cache_share *s, const cs_key *k, const uint64_t cou
     return LBK_OK;
 }
 
-/* Reads a published share into b->out and adds its counts: 1 done, 0 not published yet, else a
- * negated lbk_result. */
-static int fetch(bk_cache_share *s, const cs_key *k, char *err, size_t err_len)
+/* Reads a published share into b->out and adds its counts: 1 done, 0 not published yet (or
+ * damaged: then *damaged = 1, and it is computed again), else a negated lbk_result. */
+static int fetch(bk_cache_share *s, const cs_key *k, int *damaged, char *err, size_t err_len)
 {
+    *damaged = 0;
     char path[4352];
     share_path(s, k, "", path, sizeof path);
     FILE *f = fopen(path, "rb");
@@ -192,20 +211,26 @@ static int fetch(bk_cache_share *s, const cs_key *k, char *err, size_t err_len)
     if (!buf) return -(int)LBK_ERR_OUT_OF_MEMORY;
     uint8_t want[CS_HEADER];
     const uint64_t zero[3] = {0, 0, 0};
-    int ok = got == CS_HEADER + pay && !memcmp(buf, CS_MAGIC, 8) && lbk_rd64(buf + 120) == XXH64(buf, 120, 0);
-    if (ok) { /* everything but counts, seconds and checksums is this bounce's key */
-        put_header(s, k, zero, 0, want, buf + CS_HEADER, pay);
-        ok = !memcmp(buf, want, 80) && lbk_rd64(buf + 112) == lbk_rd64(want + 112);
+    if (!(got == CS_HEADER + pay && !memcmp(buf, CS_MAGIC, 8) && lbk_rd64(buf + 136) == XXH64(buf, 136, 0))) {
+        free(buf);
+        *damaged = 1;
+        return 0;
     }
-    if (!ok) {
+    put_header(s, k, zero, 0, want, buf + CS_HEADER, pay);
+    if (memcmp(buf, want, CS_KEY)) { /* a whole file, of another bake */
         free(buf);
         return -(int)say(err, err_len, LBK_ERR_BAD_INPUT,
-                         "the cache share %s is not this bounce's (another plan, lbk version or a damaged file): "
-                         "remove the folder and bake the units again", path);
+                         "the cache share %s is another bake's (another plan, options or lbk version): give each "
+                         "plan and lbk build its own --cache-dir", path);
+    }
+    if (lbk_rd64(buf + 120) != lbk_rd64(want + 120)) {
+        free(buf);
+        *damaged = 1;
+        return 0;
     }
     float *dst = k->b->out + 3 * k->begin;
     for (size_t i = 0; i < nf; i++) dst[i] = lbk_rdf32(buf + CS_HEADER + 4 * i);
-    const uint64_t counts[3] = {lbk_rd64(buf + 80), lbk_rd64(buf + 88), lbk_rd64(buf + 96)};
+    const uint64_t counts[3] = {lbk_rd64(buf + 88), lbk_rd64(buf + 96), lbk_rd64(buf + 104)};
     k->b->add_counts(k->b->ctx, counts);
     free(buf);
     s->st.read++;
@@ -214,14 +239,20 @@ static int fetch(bk_cache_share *s, const cs_key *k, char *err, size_t err_len)
     return 1;
 }
 
-static lbk_result compute(bk_cache_share *s, const cs_key *k, char *err, size_t err_len)
+static lbk_result compute(bk_cache_share *s, const cs_key *k, int fd, char *err, size_t err_len)
 {
     uint64_t counts[3];
     const double t0 = bk_now();
     lbk_result r = k->b->compute(k->b->ctx, k->begin, k->end, counts);
     const double dt = bk_now() - t0;
     s->st.compute_seconds += dt;
-    return r ? r : publish(s, k, counts, dt, err, err_len);
+    if (r && fd >= 0) { /* leaves no claim behind */
+        char path[4352];
+        share_path(s, k, ".claim", path, sizeof path);
+        close(fd);
+        unlink(path);
+    }
+    return r ? r : publish(s, k, fd, counts, dt, err, err_len);
 }
 
 lbk_result bk_cache_share_bounce(bk_cache_share *s, uint32_t run, uint32_t shares, uint32_t mine,
@@ -241,9 +272,9 @@ lbk_result bk_cache_share_bounce(bk_cache_share *s, uint32_t run, uint32_t share
             if (done[sh]) continue;
             cs_key k = {run, sh, shares, b, (size_t)((uint64_t)b->cells * sh / shares),
                         (size_t)((uint64_t)b->cells * (sh + 1) / shares)};
-            int got = fetch(s, &k, err, err_len);
+            int damaged, fd = -1, got = fetch(s, &k, &damaged, err, err_len);
             if (got < 0) r = (lbk_result)-got;
-            else if (got == 0 && claim(s, &k)) r = compute(s, &k, err, err_len), got = 1;
+            else if (got == 0 && (damaged || (fd = claim(s, &k)) >= 0)) r = compute(s, &k, fd, err, err_len), got = 1;
             if (got == 1 && !r) done[sh] = 1, left--, progress = 1;
         }
         if (left && !progress && !r) { /* every missing share is being computed by a live unit */

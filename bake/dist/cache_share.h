@@ -22,15 +22,17 @@ typedef struct bk_cache_share_stats {
     double compute_seconds, read_seconds, wait_seconds;
 } bk_cache_share_stats;
 
-/* Opens (and creates, one level) the folder dir for the plan plan_hash; lease: seconds a claim
- * may stay unpublished before another unit computes the share too (<= 0: 600). */
-lbk_result bk_cache_share_open(const char *dir, uint64_t plan_hash, double lease, bk_cache_share **out, char *err,
-                               size_t err_len);
+/* Opens (and creates, one level) the folder dir for the plan plan_hash baked with the options
+ * (and baker version) options_hash; lease: seconds a claim may stay unpublished before another
+ * unit computes the share too (<= 0: 600). */
+lbk_result bk_cache_share_open(const char *dir, uint64_t plan_hash, uint64_t options_hash, double lease,
+                               bk_cache_share **out, char *err, size_t err_len);
 void bk_cache_share_close(bk_cache_share *s);
 
 /* Bounce b of run `run`, its cells cut into `shares` (>= 2) equal ranges; this unit takes share
  * `mine` first (>= shares: none of its own), then any unclaimed one, and reads the rest. Fills
- * b->out for every cell. LBK_ERR_IO / LBK_ERR_BAD_INPUT with the reason in err. */
+ * b->out for every cell; a damaged share file is computed again. LBK_ERR_IO, or LBK_ERR_BAD_INPUT
+ * for a share of another bake, with the reason in err. */
 lbk_result bk_cache_share_bounce(bk_cache_share *s, uint32_t run, uint32_t shares, uint32_t mine,
                                  const bk_cache_bounce *b, char *err, size_t err_len);
 

@@ -100,12 +100,13 @@ lbk_result lbk_bake_unit_shared(const char *path, const lbk_bake_desc *desc, uin
     memset(&sd, 0, sizeof sd);
     if (shared) memcpy(&sd, shared, shared->size && shared->size < sizeof sd ? shared->size : sizeof sd);
     bk_dist *d = NULL;
-    lbk_result r = bk_dist_create(0, plan_hash, bk_pipeline_options_hash(desc, 1), units, unit, NULL, &d);
+    const uint64_t options_hash = bk_pipeline_options_hash(desc, 1);
+    lbk_result r = bk_dist_create(0, plan_hash, options_hash, units, unit, NULL, &d);
     if (r) return r;
     bk_cache_share *cs = NULL;
     if (sd.cache_dir) {
         char why[512] = "";
-        r = bk_cache_share_open(sd.cache_dir, plan_hash, sd.lease, &cs, why, sizeof why);
+        r = bk_cache_share_open(sd.cache_dir, plan_hash, options_hash, sd.lease, &cs, why, sizeof why);
         if (r) {
             if (why[0]) share_error(desc, why);
             bk_dist_destroy(d);

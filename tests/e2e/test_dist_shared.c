@@ -126,13 +126,27 @@ static void test_sequential_units(void **state)
     assert_int_equal(m.n, local.n);
     assert_memory_equal(m.p, local.p, m.n);
     printf("%u units: %llu shares computed once, read by the other %u units\n", N, (unsigned long long)computed, N - 1);
-    /* a damaged share is refused by name, not read */
-    assert_int_equal(sh("f=$(ls %s/*-s1of5.lbkcache | head -n 1) && printf 'XXXX' | dd of=$f bs=1 seek=140 conv=notrunc "
+    /* a damaged share (a crash while it was written) is computed again, the part the same */
+    assert_int_equal(sh("f=$(ls %s/*-s1of5.lbkcache | head -n 1) && printf 'XXXX' | dd of=$f bs=1 seek=150 conv=notrunc "
                         "2>/dev/null", cache), 0);
+    lbk_bake_unit_stats st;
+    memset(&st, 0, sizeof st);
+    st.size = sizeof st;
+    bytes again;
+    assert_int_equal(lbk_bake_unit_shared(SCENE, &d, PLAN_HASH, N, 2, &sd, &st, &again.p, &again.n), LBK_OK);
+    assert_int_equal(st.shares_computed, 1);
+    assert_int_equal(st.shares_read, computed - 1);
+    assert_int_equal(again.n, parts[2].n);
+    assert_memory_equal(again.p, parts[2].p, again.n);
+    lbk_bake_part_free(again.p);
+    /* a share of another bake (other options under the same plan hash) is refused by name */
+    lbk_bake_desc other = d;
+    other.seed = 12;
     bytes bad = {NULL, 0};
     last_error[0] = 0;
-    assert_int_equal(lbk_bake_unit_shared(SCENE, &d, PLAN_HASH, N, 2, &sd, NULL, &bad.p, &bad.n), LBK_ERR_BAD_INPUT);
+    assert_int_equal(lbk_bake_unit_shared(SCENE, &other, PLAN_HASH, N, 2, &sd, NULL, &bad.p, &bad.n), LBK_ERR_BAD_INPUT);
     assert_non_null(strstr(last_error, ".lbkcache"));
+    assert_non_null(strstr(last_error, "another bake"));
     assert_null(bad.p);
     assert_int_equal(lbk_bake_cache_dir_remove(cache), LBK_OK);
     assert_int_equal(sh("test ! -e %s", cache), 0);
@@ -169,12 +183,12 @@ static void test_cli_units(void **state)
     /* claims left behind by a unit killed with kill -9 (a process gone from this host: taken at
      * once, under the default lease of 600 s) with its temporary file */
     assert_int_equal(sh("rm -f %s/part-* %s/out.lbk && mkdir %s/cache && dead=$(sh -c 'echo $$') && "
-                        "echo \"$(hostname) $dead\" > %s/cache/r0-p0-h0-b1-s0of6.lbkcache.claim && "
+                        "echo \"LBKCLAIM $(hostname) $dead\" > %s/cache/r0-p0-h0-b1-s0of6.lbkcache.claim && "
                         "echo x > %s/cache/r0-p0-h0-b1-s1of6.lbkcache.tmp.gone.1", dir, dir, dir, dir, dir), 0);
     assert_int_equal(sh("timeout 120 %s bake-unit %s/plan.json 0 -o %s/part-0.lbkpart --threads 2 -q --cache-dir %s/cache && "
                         "test -e %s/cache/r0-p0-h0-b1-s0of6.lbkcache", lbk, dir, dir, dir, dir), 0);
     /* a fresh claim of a unit on another machine that never publishes: taken after the lease */
-    assert_int_equal(sh("rm -rf %s/cache && mkdir %s/cache && echo 'elsewhere 1' > %s/cache/r0-p1-h1-b2-s4of6.lbkcache.claim",
+    assert_int_equal(sh("rm -rf %s/cache && mkdir %s/cache && echo 'LBKCLAIM elsewhere 1' > %s/cache/r0-p1-h1-b2-s4of6.lbkcache.claim",
                         dir, dir, dir), 0);
     assert_int_equal(sh("for k in 0 1 2 3 4 5; do timeout 120 %s bake-unit %s/plan.json $k -o %s/part-$k.lbkpart --threads 2 "
                         "-q --cache-dir %s/cache --cache-lease 2 || exit 1; done && test -e %s/cache/r0-p1-h1-b2-s4of6.lbkcache",
