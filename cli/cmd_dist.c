@@ -300,9 +300,9 @@ static void default_cache_dir(const tl_plan *p, char *out, size_t size)
 static void print_share_stats(unsigned long k, const lbk_bake_unit_stats *st)
 {
     if (!st->shares_computed && !st->shares_read) return;
-    printf("unit %lu: cache shares computed %" PRIu64 " (%.2f s), read %" PRIu64 " (%.1f MB, %.2f s), waited %.2f s\n", k,
-           st->shares_computed, st->compute_seconds, st->shares_read, (double)st->bytes_read / 1e6, st->read_seconds,
-           st->wait_seconds);
+    printf("unit %lu: cache shares computed %" PRIu64 " (%.2f s), read %" PRIu64 " (%.1f MB, %.2f s), waited %.2f s, "
+           "published %.2f s\n", k, st->shares_computed, st->compute_seconds, st->shares_read, (double)st->bytes_read / 1e6,
+           st->read_seconds, st->wait_seconds, st->publish_seconds);
 }
 
 int lbk_cmd_bake_unit(int argc, char **argv)

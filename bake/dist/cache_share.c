@@ -246,13 +246,19 @@ static lbk_result compute(bk_cache_share *s, const cs_key *k, int fd, char *err,
     lbk_result r = k->b->compute(k->b->ctx, k->begin, k->end, counts);
     const double dt = bk_now() - t0;
     s->st.compute_seconds += dt;
-    if (r && fd >= 0) { /* leaves no claim behind */
+    if (!r) {
+        const double t1 = bk_now();
+        r = publish(s, k, fd, counts, dt, err, err_len);
+        s->st.publish_seconds += bk_now() - t1;
+        return r;
+    }
+    if (fd >= 0) { /* leaves no claim behind */
         char path[4352];
         share_path(s, k, ".claim", path, sizeof path);
         close(fd);
         unlink(path);
     }
-    return r ? r : publish(s, k, fd, counts, dt, err, err_len);
+    return r;
 }
 
 lbk_result bk_cache_share_bounce(bk_cache_share *s, uint32_t run, uint32_t shares, uint32_t mine,

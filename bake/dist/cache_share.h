@@ -19,7 +19,7 @@ typedef struct bk_cache_share bk_cache_share;
 typedef struct bk_cache_share_stats {
     uint64_t computed, read;           /* shares */
     uint64_t bytes_written, bytes_read;
-    double compute_seconds, read_seconds, wait_seconds;
+    double compute_seconds, read_seconds, wait_seconds, publish_seconds;
 } bk_cache_share_stats;
 
 /* Opens (and creates, one level) the folder dir for the plan plan_hash baked with the options

@@ -126,6 +126,7 @@ lbk_result lbk_bake_unit_shared(const char *path, const lbk_bake_desc *desc, uin
         stats->compute_seconds = st.compute_seconds;
         stats->read_seconds = st.read_seconds;
         stats->wait_seconds = st.wait_seconds;
+        stats->publish_seconds = st.publish_seconds;
     }
     bk_dist_destroy(d);
     bk_cache_share_close(cs);
