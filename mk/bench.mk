@@ -2,7 +2,7 @@
 # them), bench-cycles and bench-render (lbk against Blender Cycles), bench-suite (lbk against
 # Cycles over the generated hard levels; make bench runs bench-suite-quick), bench-scale (a
 # generated city of ~50 M texels; make bench runs its two smallest parts), mesa-bc-check.
-.PHONY: bench bench-cycles bench-render bench-suite bench-suite-quick bench-stitch bench-scale mesa-bc-check
+.PHONY: bench bench-cycles bench-render bench-suite bench-suite-quick bench-stitch bench-scale bench-dist-shared mesa-bc-check
 
 $(BUILD)/bench/%: bench/%.c $(TOOL_OBJ) $(BUILD)/liblbkbake.a $(BUILD)/liblbk.a
 	@mkdir -p $(@D)
@@ -26,6 +26,16 @@ bench: deps-tools deps-bench
 	@echo "== bench-diff (lbk diff: reseed study and power)"; $(MAKE) --no-print-directory bench-diff
 	@echo "== bench-scale (quick: the generated city's 1/256 and 1/64)"; \
 	  $(MAKE) --no-print-directory bench-scale BENCH_SCALE_ARGS="--fractions 1/256,1/64"
+	@echo "== bench-dist-shared (base-only levels cut into 1-16 units sharing their caches)"; \
+	  $(MAKE) --no-print-directory bench-dist-shared
+
+# Distributed bakes of base-only levels whose units share the radiosity caches
+# (bench/scale/dist_shared.py, bake/dist/DIST.md §Shared caches): N = 1 … 16 units' total work
+# and critical path against the local bake, bytes moved, a projection to 64 and 256 machines.
+# BENCH_DIST_SHARED_ARGS picks levels (--levels cornell,city256,city256-1k,city64).
+bench-dist-shared: deps-tools
+	@$(MAKE) --no-print-directory $(BUILD)/lbk
+	@python3 bench/scale/dist_shared.py --lbk $(BUILD)/lbk --out $(BUILD)/bench-dist-shared $(BENCH_DIST_SHARED_ARGS)
 
 # The scale bench (bench/scale/README.md): the generated city (~1.2 M triangles, ~50 M texels at
 # 3.5 texels/m) at 1/64, 1/16, 1/4 and whole, each baked at the fast preset: time per phase, peak

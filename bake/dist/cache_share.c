@@ -280,7 +280,12 @@ lbk_result bk_cache_share_bounce(bk_cache_share *s, uint32_t run, uint32_t share
                         (size_t)((uint64_t)b->cells * (sh + 1) / shares)};
             int damaged, fd = -1, got = fetch(s, &k, &damaged, err, err_len);
             if (got < 0) r = (lbk_result)-got;
-            else if (got == 0 && (damaged || (fd = claim(s, &k)) >= 0)) r = compute(s, &k, fd, err, err_len), got = 1;
+            else if (got == 0) {
+                const double t0 = bk_now();
+                if (!damaged) fd = claim(s, &k);
+                if (fd >= 0) s->st.publish_seconds += bk_now() - t0; /* a file made: a share's cost */
+                if (damaged || fd >= 0) r = compute(s, &k, fd, err, err_len), got = 1;
+            }
             if (got == 1 && !r) done[sh] = 1, left--, progress = 1;
         }
         if (left && !progress && !r) { /* every missing share is being computed by a live unit */

@@ -36,6 +36,7 @@ LEVELS = {
                 "--samples 512 --target-error none --texel-density 8"),
     "cornell-target": (os.path.join(ROOT, "scenes/cornell_box/CornellBox-Original.gltf"), "--texel-density 8"),
     "city256": ("city:1/256", "--samples 256 --target-error none --texel-density 3.5"),
+    "city256-1k": ("city:1/256", "--samples 1024 --target-error none --texel-density 3.5"),
     "city64": ("city:1/64", "--samples 256 --target-error none --texel-density 3.5"),
 }
 STATS = re.compile(r"unit (\d+): cache shares computed (\d+) \(([\d.]+) s\), read (\d+) \(([\d.]+) MB, ([\d.]+) s\), "

@@ -43,7 +43,7 @@ typedef struct lbk_bake_unit_stats {
     size_t size;              /* sizeof(lbk_bake_unit_stats), set by the caller */
     uint64_t shares_computed, shares_read, bytes_written, bytes_read;
     double compute_seconds, read_seconds, wait_seconds;
-    double publish_seconds;   /* writing and renaming the shares it computed */
+    double publish_seconds;   /* claiming, writing and renaming the shares it computed */
 } lbk_bake_unit_stats;
 
 /* lbk_bake_unit_from_file with shared caches (unit NULL: none); stats may be NULL. */
