@@ -103,7 +103,8 @@ lbk_result bk_part_parse(const void *bytes, size_t size, bk_part_view *v, char *
     if (!p || size < BK_PART_HEADER_SIZE || memcmp(p, BK_PART_MAGIC, 8))
         return say(err, err_len, "not a part file (no LBKPART header)");
     if (lbk_rd32(p + 8) != BK_PART_VERSION) return say(err, err_len, "part format version %u (this lbk reads %u)", lbk_rd32(p + 8), BK_PART_VERSION);
-    if (lbk_rd32(p + 12) != BK_PART_HEADER_SIZE || lbk_rd64(p + 48) != 0 || lbk_rd32(p + 60) != 0) return say(err, err_len, "corrupt part header");
+    if (lbk_rd32(p + 12) != BK_PART_HEADER_SIZE || lbk_rd64(p + 48) > BK_PART_MAX_OCTA || lbk_rd32(p + 60) != 0)
+        return say(err, err_len, "corrupt part header");
     if (XXH64(p, 88, 0) != lbk_rd64(p + 88)) return say(err, err_len, "corrupt part header (checksum)");
     v->options_hash = lbk_rd64(p + 80);
     v->plan_hash = lbk_rd64(p + 16);
@@ -113,6 +114,7 @@ lbk_result bk_part_parse(const void *bytes, size_t size, bk_part_view *v, char *
     v->total_runs = lbk_rd32(p + 40);
     v->first_run = lbk_rd32(p + 44);
     v->run_count = lbk_rd32(p + 56);
+    v->octa_count = lbk_rd64(p + 48);
     uint64_t payload = lbk_rd64(p + 64);
     if (v->units == 0 || v->units > BK_PART_MAX_UNITS || v->unit >= v->units || v->receiver_count >= ((uint64_t)1 << 40) ||
         v->total_runs == 0 || v->total_runs > BK_PART_MAX_RUNS)
@@ -140,6 +142,12 @@ lbk_result bk_part_parse(const void *bytes, size_t size, bk_part_view *v, char *
         v->runs[r] = p + at;
         at += n;
     }
+    if (v->octa_count) { /* <= BK_PART_MAX_OCTA: no overflow */
+        const size_t need = 16 + (size_t)v->octa_count * 48 * 4;
+        if (size - at != need) goto bad;
+        v->octa = p + at;
+        at += need;
+    }
     if (at != size) goto bad;
     return LBK_OK;
 bad:
@@ -165,9 +173,12 @@ struct bk_dist {
     buf out;          /* finished runs */
     buf passes;       /* the current run's pass records */
     uint32_t run_count, run_passes;
+    buf octa;         /* the octahedral probes' block, when this unit gathered them */
+    uint64_t octa_count;
     /* replay */
     const bk_part_view *parts;
     uint32_t owners[2]; /* the units that hold the run being replayed */
+    const bk_part_view *octa_part; /* the part holding the octahedral probes (replay, run 0) */
     bk_cache_share *share; /* record: the shared caches' folder, NULL: none */
     char err[512];
 };
@@ -308,6 +319,16 @@ static lbk_result rec_done(void *user, const bk_transport_output *o, const bk_tr
     d->passes.n = 0;
     d->run_passes = 0;
     d->run_count++;
+    if (t->octa_count && o->octa_irradiance) { /* one unit gathers them, in the base run */
+        if (d->octa_count || t->octa_count > BK_PART_MAX_OCTA) return LBK_ERR_INTERNAL;
+        const size_t nf = (size_t)t->octa_count * 48;
+        uint8_t *q = buf_grow(&d->octa, 16 + 4 * nf);
+        if (!q) return LBK_ERR_OUT_OF_MEMORY;
+        lbk_wrf64(q, t->octa_rays);
+        lbk_wrf64(q + 8, t->octa_rel_rmse);
+        for (size_t i = 0; i < nf; i++) lbk_wrf32(q + 16 + 4 * i, o->octa_irradiance[i]);
+        d->octa_count = t->octa_count;
+    }
     return LBK_OK;
 }
 
@@ -319,6 +340,24 @@ static const uint8_t *record_of(const bk_dist *d, uint32_t u, size_t *begin, siz
     *begin = (size_t)lbk_rd64(rh + 96);
     *n = (size_t)(lbk_rd64(rh + 104) - lbk_rd64(rh + 96));
     return rh;
+}
+
+/* The base run's octahedral probes: held by at most one part, one of the run's units. */
+static lbk_result play_octa_totals(bk_dist *d, bk_transport_totals *t)
+{
+    d->octa_part = NULL;
+    for (uint32_t u = 0; u < d->units; u++) {
+        if (!d->parts[u].octa_count) continue;
+        if (d->octa_part || u < d->owners[0] || u >= d->owners[1])
+            return fail(d, LBK_ERR_BAD_INPUT, "unit %u holds octahedral probes it cannot have gathered", u);
+        d->octa_part = &d->parts[u];
+    }
+    if (d->octa_part) {
+        t->octa_count = d->octa_part->octa_count;
+        t->octa_rays = lbk_rdf64(d->octa_part->octa);
+        t->octa_rel_rmse = lbk_rdf64(d->octa_part->octa + 8);
+    }
+    return LBK_OK;
 }
 
 static lbk_result play_totals(void *user, size_t count, bk_transport_totals *t)
@@ -351,7 +390,7 @@ static lbk_result play_totals(void *user, size_t count, bk_transport_totals *t)
         t->recv_shadow += x.recv_shadow;
         t->recv_nonfinite += x.recv_nonfinite;
     }
-    return LBK_OK;
+    return d->run == 0 ? play_octa_totals(d, t) : LBK_OK;
 }
 
 static lbk_result play_pass(void *user, bk_transport_pass_record *pr)
@@ -402,6 +441,9 @@ static lbk_result play_outputs(void *user, const bk_transport_output *o)
             for (size_t i = 0; i < n * (size_t)out_floats[k]; i++, w += 4) a[i] = lbk_rdf32(w);
         }
     }
+    if (d->run == 0 && d->octa_part && o->octa_irradiance) /* (the count checked by the transport) */
+        for (size_t i = 0; i < (size_t)d->octa_part->octa_count * 48; i++)
+            o->octa_irradiance[i] = lbk_rdf32(d->octa_part->octa + 16 + 4 * i);
     d->run++;
     return LBK_OK;
 }
@@ -461,6 +503,7 @@ void bk_dist_destroy(bk_dist *d)
     if (!d) return;
     free(d->out.p);
     free(d->passes.p);
+    free(d->octa.p);
     free(d);
 }
 
@@ -505,7 +548,9 @@ lbk_result bk_dist_finish(bk_dist *d, void **bytes, size_t *size, char *err, siz
         snprintf(d->err, sizeof d->err, "the bake made %u transport runs, its cut counted %u", d->run, d->total_runs);
         return say(err, err_len, "%s", d->err), LBK_ERR_INTERNAL;
     }
-    size_t total = BK_PART_HEADER_SIZE + d->out.n;
+    if (d->octa.failed) return LBK_ERR_OUT_OF_MEMORY;
+    const size_t payload = d->out.n + d->octa.n;
+    size_t total = BK_PART_HEADER_SIZE + payload;
     uint8_t *p = malloc(total);
     if (!p) return LBK_ERR_OUT_OF_MEMORY;
     memset(p, 0, BK_PART_HEADER_SIZE);
@@ -518,10 +563,12 @@ lbk_result bk_dist_finish(bk_dist *d, void **bytes, size_t *size, char *err, siz
     lbk_wr64(p + 32, d->count);
     lbk_wr32(p + 40, d->total_runs);
     lbk_wr32(p + 44, d->first_run);
+    lbk_wr64(p + 48, d->octa_count);
     lbk_wr32(p + 56, d->run_count);
-    lbk_wr64(p + 64, d->out.n);
+    lbk_wr64(p + 64, payload);
     if (d->out.n) memcpy(p + BK_PART_HEADER_SIZE, d->out.p, d->out.n);
-    lbk_wr64(p + 72, XXH64(p + BK_PART_HEADER_SIZE, d->out.n, 0));
+    if (d->octa.n) memcpy(p + BK_PART_HEADER_SIZE + d->out.n, d->octa.p, d->octa.n);
+    lbk_wr64(p + 72, XXH64(p + BK_PART_HEADER_SIZE, payload, 0));
     lbk_wr64(p + 80, d->options_hash);
     lbk_wr64(p + 88, XXH64(p, 88, 0));
     *bytes = p;

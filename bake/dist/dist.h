@@ -15,13 +15,14 @@
 #include "lbk/lbk.h"
 
 #define BK_PART_MAGIC "LBKPART\0"
-#define BK_PART_VERSION 3u /* 3: shared runs cut at multiples of 64 receivers */
+#define BK_PART_VERSION 4u /* 3: shared runs cut at multiples of 64 receivers; 4: octahedral probes */
 #define BK_PART_HEADER_SIZE 96u
 #define BK_PART_RUN_HEADER_SIZE 112u
 #define BK_PART_PASS_HEADER_SIZE 64u
 #define BK_PART_MAX_UNITS 65536u
 #define BK_PART_MAX_RUNS 65536u
 #define BK_PART_MAX_PASSES 32u
+#define BK_PART_MAX_OCTA ((uint64_t)1 << 28) /* octahedral probes in a part */
 
 /* Bytes of a run record of n receivers with `passes` pass headers and the output planes of
  * `mask` (spec/part.md); 0 on overflow. */
@@ -35,6 +36,8 @@ typedef struct bk_part_view {
     uint64_t plan_hash, options_hash, receiver_count;
     uint32_t units, unit, total_runs, first_run, run_count;
     const uint8_t **runs;     /* run_count run records: runs first_run, first_run + 1, ... */
+    uint64_t octa_count;      /* the octahedral probes this part holds (spec/part.md §2.1), 0 none */
+    const uint8_t *octa;      /* their block */
 } bk_part_view;
 
 /* The cut of a bake of `runs` transport runs and `count` receivers into `units` units

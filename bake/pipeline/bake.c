@@ -344,13 +344,12 @@ lbk_result bk_pipeline_bake(const char *path, const lbk_bake_scene *desc, const 
         b->input = b->scene_name = desc && desc->name && desc->name[0] ? desc->name : "scene";
     }
     if (!r && !path && !desc) r = bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT, "no scene");
-    /* the octahedral volume's accumulators are neither in parts nor in checkpoints yet */
     if (!r && b->desc.gather_limit > 0 && (dist || b->desc.checkpoint_dir))
         r = bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT,
                              "a ray-length limit (--gather-limit) cannot be baked distributed or with checkpoints yet");
-    if (!r && b->desc.octahedral_probes && (dist || b->desc.checkpoint_dir))
-        r = bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT,
-                             "octahedral probes (--octahedral) cannot be baked distributed or with checkpoints yet");
+    /* the octahedral volume's accumulators are not in checkpoints yet (parts hold its result) */
+    if (!r && b->desc.octahedral_probes && b->desc.checkpoint_dir)
+        r = bk_pipeline_fail(b, LBK_ERR_INVALID_ARGUMENT, "octahedral probes (--octahedral) cannot be baked with checkpoints yet");
     if (!r && dist) r = check_dist(b);
     if (!r && !dist && b->desc.checkpoint_dir) {
         /* the budgets may change between a bake and its --continue; nothing else may */

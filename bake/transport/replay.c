@@ -86,7 +86,9 @@ lbk_result bk_tr_replay_run(tp_ctx *c, bk_transport_stats *stats)
     memset(&t, 0, sizeof t);
     res = sp->replay_totals(sp->user, c->recv_count, &t);
     if (res) return res;
-    if (!replay_totals_ok(&t)) return LBK_ERR_BAD_INPUT;
+    if (!replay_totals_ok(&t) || t.octa_count != (uint64_t)c->oct_count || !replay_count_ok(t.octa_rays) ||
+        !replay_count_ok(t.octa_rel_rmse))
+        return LBK_ERR_BAD_INPUT;
     bk_transport_pass_record pr;
     memset(&pr, 0, sizeof pr);
     const size_t n = c->recv_count ? c->recv_count : 1;
@@ -124,7 +126,8 @@ lbk_result bk_tr_replay_run(tp_ctx *c, bk_transport_stats *stats)
     if (!res && c->out->halves) bk_tr_write_halves(c, pr.x_acc, c->out->halves);
     for (int h = 0; h < 2; h++) free(pr.x_acc[h]), free(pr.b_acc[h]);
     if (!res) res = sp->replay_outputs(sp->user, c->out);
-    if (!res && !replay_outputs_ok(c->out, c->recv_count)) res = LBK_ERR_BAD_INPUT;
+    if (!res && (!replay_outputs_ok(c->out, c->recv_count) || !finite_floats(c->out->octa_irradiance, 48 * c->oct_count)))
+        res = LBK_ERR_BAD_INPUT;
     if (res || !stats) return res;
     for (int k = 0; k < BK_RECEIVER_CLASSES; k++) stats->class_rel_rmse[k] = ce.cls[k];
     stats->probe_rel_rmse = ce.probe;
@@ -144,6 +147,8 @@ lbk_result bk_tr_replay_run(tp_ctx *c, bk_transport_stats *stats)
     stats->nonfinite = t.cache_nonfinite + t.recv_nonfinite;
     stats->stop = t.stop;
     stats->nee = t.nee;
+    stats->octa_rel_rmse = t.octa_rel_rmse;
+    stats->octa_rays = t.octa_rays;
     return LBK_OK;
 }
 

@@ -327,7 +327,9 @@ lbk_result bk_transport_run(const bk_scene *scene, const bk_tracer *tracer, cons
     c.recv_count = count;
     c.fscene = opt->footprint_scene ? opt->footprint_scene : scene;
     c.out = output;
-    c.oct_count = output->octa_irradiance && opt->octa_points ? opt->octa_count : 0;
+    /* a distributed run's octahedral probes are gathered by the unit whose slice starts at 0 */
+    const int octa_here = !split || split->replay || (own == 1 && g_begin == 0);
+    c.oct_count = output->octa_irradiance && opt->octa_points && octa_here ? opt->octa_count : 0;
     c.t0 = t0;
     c.max_bounces = opt->max_bounces > 0 ? opt->max_bounces : 64;
     c.max_samples = opt->max_samples > 0 ? opt->max_samples : 4096;
@@ -415,6 +417,9 @@ finished:
     if (rec) {
         bk_transport_totals t;
         bk_tr_totals_of(&c, pass + 1, chain, &t);
+        t.octa_count = c.oct_count;
+        t.octa_rays = c.oct_total;
+        t.octa_rel_rmse = oct_err;
         res = split->record_done(split->user, output, &t);
     }
 done:

@@ -149,6 +149,10 @@ typedef struct bk_transport_totals {
     uint64_t cells;
     uint64_t cache_rays, cache_shadow, cache_nonfinite;
     uint64_t recv_rays, recv_shadow, recv_nonfinite;
+    /* the octahedral probes, in the one unit that gathers them (its receiver slice starts at 0):
+     * their count (else 0), rays and estimated error (bk_transport_stats.octa_*) */
+    uint64_t octa_count;
+    double octa_rays, octa_rel_rmse;
 } bk_transport_totals;
 
 /* ---- checkpoints (resume after a crash, continue to a lower error) -------------------------

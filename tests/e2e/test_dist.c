@@ -344,6 +344,21 @@ static void test_bad_parts_refused(void **state)
     free_parts(parts, 3);
 }
 
+/* Octahedral probes (OCTP): the unit whose receivers start at 0 gathers them in the base run
+ * and its part carries them; the merge is the local bake at any N, whole runs or shared. */
+static void test_merge_equals_local_octahedral(void **state)
+{
+    (void)state;
+    lbk_bake_desc d = desc_of(64, 4, 7);
+    d.octahedral_probes = 1;
+    const uint32_t box[] = {1, 3};
+    check_desc("scenes/cornell_box/CornellBox-Original.gltf", &d, box, 2);
+    d = desc_of(32, 2, 7);
+    d.octahedral_probes = 1;
+    const uint32_t sets[] = {3, 11};
+    check_desc("tests/fuzz/sets_scene.gltf", &d, sets, 2);
+}
+
 /* What cannot be cut is refused before anything is baked. */
 static void test_unsplittable_refused(void **state)
 {
@@ -655,6 +670,7 @@ int main(void)
         cmocka_unit_test(test_merge_equals_local_error_target),
         cmocka_unit_test(test_merge_equals_local_cornell_default_target),
         cmocka_unit_test(test_merge_equals_local_guided_doors),
+        cmocka_unit_test(test_merge_equals_local_octahedral),
         cmocka_unit_test(test_bad_parts_refused),
         cmocka_unit_test(test_unsplittable_refused),
         cmocka_unit_test(test_cli_plan_units_merge),
