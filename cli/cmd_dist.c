@@ -201,8 +201,11 @@ static void plan_help(FILE *f)
           "units. Run every unit (lbk bake-unit PLAN K, anywhere the scene files are), then lbk merge:\n"
           "the container is byte-identical to `lbk bake` with the same options. --makefile writes a\n"
           "Makefile for make -j; --sbatch a script that submits a Slurm job array and the merge.\n"
-          "Any N, with the default error target or a fixed schedule (--samples N --target-error none)\n"
-          "and either door method. No --time-limit.\n"
+          "Any N, with the default error target or a fixed schedule (--samples N --target-error none),\n"
+          "either door method and --octahedral. No --time-limit (the passes it allows depend on each\n"
+          "machine's speed). Units sharing a transport run (more units than runs) share its radiosity\n"
+          "caches through a folder beside the output (lbk bake-unit --help): a level without light\n"
+          "sets is divided too.\n"
           "See bake/dist/DIST.md (xargs -P, Kubernetes).\n",
           f);
 }
