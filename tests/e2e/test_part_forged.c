@@ -152,12 +152,28 @@ static void test_unknown_stop_reason_refused(void **state)
     expect_refused(p, u->n);
 }
 
+/* Octahedral probes in a bake that has none (spec/part.md §2.1: a block of one probe after the
+ * run records, finite values, the count at header offset 48): refused, not encoded. */
+static void test_octahedral_block_forged_refused(void **state)
+{
+    unit *u = *state;
+    const size_t n = u->n + 16 + 48 * 4;
+    uint8_t *p = calloc(1, n);
+    assert_non_null(p);
+    memcpy(p, u->p, u->n);
+    lbk_wr64(p + 48, 1);
+    lbk_wr64(p + 64, n - HEADER);
+    for (int i = 0; i < 48; i++) lbk_wrf32(p + u->n + 16 + 4 * i, 0.5f);
+    expect_refused(p, n);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_genuine_part_merges),
         cmocka_unit_test(test_negative_sample_count_refused),
         cmocka_unit_test(test_nan_accumulator_refused),
+        cmocka_unit_test(test_octahedral_block_forged_refused),
         cmocka_unit_test(test_infinite_output_refused),
         cmocka_unit_test(test_unknown_stop_reason_refused),
     };
