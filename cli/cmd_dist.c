@@ -188,6 +188,10 @@ int cli_plan_write(const bake_args *o, int argc, char **argv, const char *cmd)
         return LBK_EXIT_IO;
     }
     printf("%s: %u units, %zu input files, plan hash %016" PRIx64 "\n", o->plan, o->units, p.input_count, tl_plan_hash(&p));
+    if (o->units > runs) /* (bake-unit's default folder: default_cache_dir) */
+        printf("  %u transport run%s for %u units: units sharing a run share its caches in %s.cache-%016" PRIx64
+               " (a folder every unit must see; bake-unit --cache-dir)\n", runs, runs == 1 ? "" : "s", o->units, output,
+               tl_plan_hash(&p));
     free(p.inputs);
     return LBK_EXIT_OK;
 }
