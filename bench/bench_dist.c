@@ -3,7 +3,9 @@
  * same run (the ideal on 2 cores is 0.5 at N >= 2); the plan's and the merge's own time; what
  * every unit repeats (the slowest unit's time against local/N); bytes moved per unit (its part)
  * against its compute time; and a projection to 64 machines. Two scenes: the Cornell box (only
- * the base transport run: units cut its receivers, and every unit repeats its caches) and a scene
+ * the base transport run: units cut its receivers and share its caches through the plan's cache
+ * folder, so the first of the units run alone computes every bounce and the others read them;
+ * bench/scale/dist_shared.py splits that work per unit and projects the critical path) and a scene
  * of light sets, a door and a combination (8 runs: units take whole runs); then the Cornell box
  * with the default preset's error target and the light-set scene with guided doors. Every merge
  * is checked byte-identical to the local bake.
