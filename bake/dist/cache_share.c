@@ -31,7 +31,7 @@ struct bk_cache_share {
     char host[256];
     uint64_t plan_hash, options_hash;
     double lease;
-    bk_cache_share_stats st;
+    lbk_bake_unit_stats st; /* (its size unused) */
 };
 
 static lbk_result say(char *err, size_t len, lbk_result r, const char *fmt, ...) __attribute__((format(printf, 4, 5)));
@@ -69,10 +69,12 @@ lbk_result bk_cache_share_open(const char *dir, uint64_t plan_hash, uint64_t opt
 
 void bk_cache_share_close(bk_cache_share *s) { free(s); }
 
-void bk_cache_share_get_stats(const bk_cache_share *s, bk_cache_share_stats *st)
+void bk_cache_share_get_stats(const bk_cache_share *s, lbk_bake_unit_stats *st)
 {
+    const size_t size = st->size;
     if (s) *st = s->st;
     else memset(st, 0, sizeof *st);
+    st->size = size;
 }
 
 typedef struct cs_key {
@@ -189,7 +191,7 @@ static lbk_result publish(bk_cache_share *s, const cs_key *k, int fd, const uint
         remove(tmp);
         return say(err, err_len, LBK_ERR_IO, "cannot write the cache share %s: %s", path, strerror(e));
     }
-    s->st.computed++;
+    s->st.shares_computed++;
     s->st.bytes_written += CS_HEADER + pay;
     return LBK_OK;
 }
@@ -233,7 +235,7 @@ static int fetch(bk_cache_share *s, const cs_key *k, int *damaged, char *err, si
     const uint64_t counts[3] = {lbk_rd64(buf + 88), lbk_rd64(buf + 96), lbk_rd64(buf + 104)};
     k->b->add_counts(k->b->ctx, counts);
     free(buf);
-    s->st.read++;
+    s->st.shares_read++;
     s->st.bytes_read += CS_HEADER + pay;
     s->st.read_seconds += bk_now() - t0;
     return 1;

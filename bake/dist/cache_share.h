@@ -12,15 +12,10 @@
 #include <stdint.h>
 
 #include "bake/transport/transport.h"
+#include "lbk/bake_dist.h"
 #include "lbk/lbk.h"
 
 typedef struct bk_cache_share bk_cache_share;
-
-typedef struct bk_cache_share_stats {
-    uint64_t computed, read;           /* shares */
-    uint64_t bytes_written, bytes_read;
-    double compute_seconds, read_seconds, wait_seconds, publish_seconds;
-} bk_cache_share_stats;
 
 /* Opens (and creates, one level) the folder dir for the plan plan_hash baked with the options
  * (and baker version) options_hash; lease: seconds a claim may stay unpublished before another
@@ -36,7 +31,8 @@ void bk_cache_share_close(bk_cache_share *s);
 lbk_result bk_cache_share_bounce(bk_cache_share *s, uint32_t run, uint32_t shares, uint32_t mine,
                                  const bk_cache_bounce *b, char *err, size_t err_len);
 
-void bk_cache_share_get_stats(const bk_cache_share *s, bk_cache_share_stats *st);
+/* What it did so far (the caller's size kept; s NULL: all zero). */
+void bk_cache_share_get_stats(const bk_cache_share *s, lbk_bake_unit_stats *st);
 
 /* Removes what units leave in dir (shares, claims, temporary files) and dir when it is then
  * empty; nothing else. 0 or an errno. */

@@ -456,7 +456,7 @@ static lbk_result rec_cache_bounce(void *user, const bk_cache_bounce *b)
     const uint32_t run = d->run - 1; /* rec_range counted it */
     uint32_t first = 0, end = 0;
     if (run < d->total_runs) bk_dist_run_units(d->total_runs, d->units, run, &first, &end);
-    if (end - first < 2 || !d->share) {
+    if (end - first < 2) { /* (installed with a share only: bk_dist_set_cache_share) */
         uint64_t counts[3]; /* already in the run's counters */
         return b->compute(b->ctx, 0, b->cells, counts);
     }

@@ -116,18 +116,7 @@ lbk_result lbk_bake_unit_shared(const char *path, const lbk_bake_desc *desc, uin
     }
     lbk_bake_output *out = NULL;
     r = bk_pipeline_bake(path, NULL, desc, &out, d, part, part_size, NULL, NULL, NULL);
-    if (stats && stats->size >= sizeof *stats) {
-        bk_cache_share_stats st;
-        bk_cache_share_get_stats(cs, &st);
-        stats->shares_computed = st.computed;
-        stats->shares_read = st.read;
-        stats->bytes_written = st.bytes_written;
-        stats->bytes_read = st.bytes_read;
-        stats->compute_seconds = st.compute_seconds;
-        stats->read_seconds = st.read_seconds;
-        stats->wait_seconds = st.wait_seconds;
-        stats->publish_seconds = st.publish_seconds;
-    }
+    if (stats && stats->size >= sizeof *stats) bk_cache_share_get_stats(cs, stats);
     bk_dist_destroy(d);
     bk_cache_share_close(cs);
     return r;
