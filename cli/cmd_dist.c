@@ -121,6 +121,14 @@ static int plan_inputs(const char *cmd, const char *scene, const lbk_bake_desc *
     return -1;
 }
 
+/* The units' shared cache folder: the one given, else the plan's default beside its output,
+ * named by its hash. */
+static void cache_dir_of(const char *given, const char *output, uint64_t plan_hash, char *out, size_t size)
+{
+    if (given) snprintf(out, size, "%s", given);
+    else snprintf(out, size, "%s.cache-%016" PRIx64, output, plan_hash);
+}
+
 int cli_plan_write(const bake_args *o, int argc, char **argv, const char *cmd)
 {
     if (!o->input || !o->output || !o->plan || !o->units) {
@@ -188,10 +196,12 @@ int cli_plan_write(const bake_args *o, int argc, char **argv, const char *cmd)
         return LBK_EXIT_IO;
     }
     printf("%s: %u units, %zu input files, plan hash %016" PRIx64 "\n", o->plan, o->units, p.input_count, tl_plan_hash(&p));
-    if (o->units > runs) /* (bake-unit's default folder: default_cache_dir) */
-        printf("  %u transport run%s for %u units: units sharing a run share its caches in %s.cache-%016" PRIx64
-               " (a folder every unit must see; bake-unit --cache-dir)\n", runs, runs == 1 ? "" : "s", o->units, output,
-               tl_plan_hash(&p));
+    if (o->units > runs) {
+        char dir[PATH_MAX + 32];
+        cache_dir_of(NULL, output, tl_plan_hash(&p), dir, sizeof dir);
+        printf("  %u transport run%s for %u units: units sharing a run share its caches in %s (a folder every unit "
+               "must see; bake-unit --cache-dir)\n", runs, runs == 1 ? "" : "s", o->units, dir);
+    }
     free(p.inputs);
     return LBK_EXIT_OK;
 }
@@ -298,12 +308,6 @@ static void unit_help(FILE *f)
           f);
 }
 
-/* The plan's default shared cache folder: beside its output, named by its hash. */
-static void default_cache_dir(const tl_plan *p, char *out, size_t size)
-{
-    snprintf(out, size, "%s.cache-%016" PRIx64, p->output, p->hash);
-}
-
 static void print_share_stats(unsigned long k, const lbk_bake_unit_stats *st)
 {
     if (!st->shares_computed && !st->shares_read) return;
@@ -388,8 +392,7 @@ int lbk_cmd_bake_unit(int argc, char **argv)
     char dir[PATH_MAX + 32];
     lbk_bake_unit_desc sd = {sizeof sd, NULL, lease};
     if (!no_share) {
-        if (cache_dir) snprintf(dir, sizeof dir, "%s", cache_dir);
-        else default_cache_dir(&p, dir, sizeof dir);
+        cache_dir_of(cache_dir, p.output, p.hash, dir, sizeof dir);
         /* the default folder is a convenience: where it cannot be made the unit computes whole */
         if (cache_dir || mkdir(dir, 0777) == 0 || errno == EEXIST) sd.cache_dir = dir;
         else if (!quiet) fprintf(stderr, "lbk bake-unit: note: no shared cache (%s: %s): this unit computes its caches whole\n",
@@ -512,8 +515,7 @@ int lbk_cmd_merge(int argc, char **argv)
         o.part_count = n_files;
         rc = cli_bake_run(&o, quiet);
         char dir[PATH_MAX + 32];
-        if (cache_dir) snprintf(dir, sizeof dir, "%s", cache_dir);
-        else default_cache_dir(&p, dir, sizeof dir);
+        cache_dir_of(cache_dir, p.output, p.hash, dir, sizeof dir);
         if (rc == LBK_EXIT_OK && !keep_cache && lbk_bake_cache_dir_remove(dir) != LBK_OK)
             fprintf(stderr, "lbk merge: warning: could not remove the shared cache folder %s\n", dir);
     }
