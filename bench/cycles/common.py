@@ -163,8 +163,9 @@ def run_cycles(scene, sensors, out, runs, sky=(0, 0, 0), threads=0, log=None, eq
     return json.load(open(os.path.join(out, "runs.json")))
 
 
-def run_timed(cmd, log):
-    """Runs a command; returns (wall s, CPU s of the child = user + system)."""
+def run_timed(cmd, log, who="bench-cycles"):
+    """Runs a command; returns (wall s, CPU s of the child = user + system); exits naming `who`
+    and the log when it fails."""
     r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     with open(log, "w") as lf:
@@ -172,5 +173,5 @@ def run_timed(cmd, log):
     wall = time.perf_counter() - t0
     r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
     if p.returncode != 0:
-        sys.exit("bench-cycles: %s failed (%d); see %s" % (cmd[0], p.returncode, log))
+        sys.exit("%s: %s failed (%d); see %s" % (who, cmd[0], p.returncode, log))
     return wall, (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)

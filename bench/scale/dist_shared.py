@@ -22,15 +22,15 @@ import argparse
 import glob
 import os
 import re
-import resource
 import shutil
 import struct
 import subprocess
 import sys
-import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(HERE, "..", "cycles"))
+import common  # noqa: E402  (run_timed)
 LEVELS = {
     "cornell": (os.path.join(ROOT, "scenes/cornell_box/CornellBox-Original.gltf"),
                 "--samples 512 --target-error none --texel-density 8"),
@@ -45,15 +45,8 @@ STATS = re.compile(r"unit (\d+): cache shares computed (\d+) \(([\d.]+) s\), rea
 
 def cpu_of(cmd, log):
     """Runs cmd; its CPU seconds (user + system) and wall seconds."""
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    t0 = time.monotonic()
-    with open(log, "w") as f:
-        r = subprocess.run(cmd, stdout=f, stderr=subprocess.STDOUT)
-    wall = time.monotonic() - t0
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    if r.returncode:
-        sys.exit("dist_shared: %s failed (exit %d); see %s" % (" ".join(cmd), r.returncode, log))
-    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime), wall
+    wall, cpu = common.run_timed(cmd, log, "dist_shared")
+    return cpu, wall
 
 
 def scene_of(spec, out):
