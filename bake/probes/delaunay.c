@@ -1,9 +1,9 @@
 /* Delaunay tetrahedralisation on top of libqhull_r.
  *
- * First the lifted path (run_qhull_lifted, below): qhull's 4-d hull of the points lifted onto the
+ * First the lifted path (delaunay_lifted.c): qhull's 4-d hull of the points lifted onto the
  * paraboloid with tiny tie-breaking weights and ghost points beside the hull's flat faces, which
- * leaves qhull nothing to merge — ×10 faster on lattices, the probe placement's common case.
- * Where its checks fail, qhull's own Delaunay ('d') is run WITHOUT triangulated output ('Qt'):
+ * leaves qhull nothing to merge — ×10 faster on lattices, the probe placement's common case —
+ * then the pockets its ghosts cut into a hull with slanted sides filled. Where its checks fail, qhull's own Delaunay ('d') is run WITHOUT triangulated output ('Qt'):
  * where points are cospherical (every cube of a regular grid) it returns one merged,
  * non-simplicial Delaunay cell, and we triangulate those cells ourselves with a "pulling"
  * triangulation keyed on global point indices. Each 2-face of a cell is computed as the
@@ -12,12 +12,9 @@
  * tetrahedra are needed. 'Qt' by contrast triangulates each cell from its own first vertex and
  * leaves flat tetrahedra where the two sides disagree, and 'QJ' moves the points (randomly) and
  * leaves slivers. See bake/probes/PROBES.md. */
-#include "bake/probes/delaunay.h"
+#include "bake/probes/delaunay_parts.h"
 #include "bake/probes/probe_math.h"
 
-#include <libqhull_r/qhull_ra.h>
-
-#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -26,6 +23,8 @@
 /* A tetrahedron whose volume is below this fraction of its longest edge cubed is flat. A regular
  * tetrahedron scores 0.118; genuine Delaunay slivers of sane input stay far above 1e-9. */
 #define FLAT_VOLUME_RATIO 1e-9
+/* The lifted result with its pockets filled must have the hull's volume within this, relative. */
+#define POCKET_VOLUME_TOLERANCE 1e-6
 
 const char *bk_delaunay_status_name(int status)
 {
@@ -37,14 +36,6 @@ const char *bk_delaunay_status_name(int status)
     case BK_DELAUNAY_FAILED: return "qhull failed";
     default: return "unknown";
     }
-}
-
-static double orient(const double *a, const double *b, const double *c, const double *d)
-{
-    double ux = b[0] - a[0], uy = b[1] - a[1], uz = b[2] - a[2];
-    double vx = c[0] - a[0], vy = c[1] - a[1], vz = c[2] - a[2];
-    double wx = d[0] - a[0], wy = d[1] - a[1], wz = d[2] - a[2];
-    return ux * (vy * wz - vz * wy) - uy * (vx * wz - vz * wx) + uz * (vx * wy - vy * wx);
 }
 
 double bk_tet_signed_volume(const float *p0, const float *p1, const float *p2, const float *p3)
@@ -63,71 +54,6 @@ void bk_tetmesh_free(bk_tetmesh *m)
     free(m->tets);
     free(m->neighbours);
     memset(m, 0, sizeof *m);
-}
-
-/* ---- growable tetra list ------------------------------------------------------------------ */
-typedef struct tet_list { uint32_t *v; size_t n, cap; int oom; } tet_list;
-
-static void tet_push(tet_list *l, uint32_t a, uint32_t b, uint32_t c, uint32_t d)
-{
-    if (l->oom) return;
-    if (l->n == l->cap) {
-        size_t cap = l->cap ? l->cap * 2 : 256;
-        uint32_t *v = realloc(l->v, cap * 4 * sizeof *v);
-        if (!v) { l->oom = 1; return; }
-        l->v = v; l->cap = cap;
-    }
-    uint32_t *t = l->v + 4 * l->n++;
-    t[0] = a; t[1] = b; t[2] = c; t[3] = d;
-}
-
-/* ---- duplicate merging: sorted cell keys, first point (input order) wins ------------------ */
-typedef struct cell_key { int64_t x, y, z; uint32_t index; } cell_key;
-
-static int cmp_cell_key(const void *pa, const void *pb)
-{
-    const cell_key *a = pa, *b = pb;
-    if (a->x != b->x) return a->x < b->x ? -1 : 1;
-    if (a->y != b->y) return a->y < b->y ? -1 : 1;
-    if (a->z != b->z) return a->z < b->z ? -1 : 1;
-    return (a->index > b->index) - (a->index < b->index);
-}
-
-static size_t lower_bound_cell(const cell_key *keys, size_t n, int64_t x, int64_t y, int64_t z)
-{
-    size_t lo = 0, hi = n;
-    cell_key probe = {x, y, z, 0};
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (cmp_cell_key(&keys[mid], &probe) < 0) lo = mid + 1; else hi = mid;
-    }
-    return lo;
-}
-
-static int cmp_u32(const void *pa, const void *pb)
-{
-    uint32_t a = *(const uint32_t *)pa, b = *(const uint32_t *)pb;
-    return (a > b) - (a < b);
-}
-
-/* ---- face records for adjacency ----------------------------------------------------------- */
-typedef struct face_rec { uint32_t v[3]; uint32_t tet; uint32_t slot; } face_rec;
-
-static int cmp_face(const void *pa, const void *pb)
-{
-    const face_rec *a = pa, *b = pb;
-    for (int k = 0; k < 3; k++)
-        if (a->v[k] != b->v[k]) return a->v[k] < b->v[k] ? -1 : 1;
-    if (a->tet != b->tet) return a->tet < b->tet ? -1 : 1;
-    return (a->slot > b->slot) - (a->slot < b->slot);
-}
-
-static void sort3(uint32_t *v)
-{
-    uint32_t t;
-    if (v[0] > v[1]) { t = v[0]; v[0] = v[1]; v[1] = t; }
-    if (v[1] > v[2]) { t = v[1]; v[1] = v[2]; v[2] = t; }
-    if (v[0] > v[1]) { t = v[0]; v[0] = v[1]; v[1] = t; }
 }
 
 static int cmp_tet_sorted(const void *pa, const void *pb)
@@ -224,14 +150,6 @@ static int scratch_grow(size_t cap, uint32_t **ids, uint32_t **nids, uint32_t **
     return a && b && c && s;
 }
 
-/* Frees what qhull holds (not qh itself). */
-static void qhull_release(qhT *qh)
-{
-    int curlong, totlong;
-    qh_freeqhull(qh, !qh_ALL);
-    qh_memfreeshort(qh, &curlong, &totlong);
-}
-
 static int run_qhull(const double *pts, size_t n, tet_list *out)
 {
     int status = BK_DELAUNAY_OK;
@@ -296,202 +214,6 @@ done:
     free(ids); free(nids); free(common); free(scratch);
     free(coords);
     free(qh);
-    return status;
-}
-
-/* ---- the lifted path: a regular triangulation with tie-breaking weights --------------------
- * Delaunay is the lower hull of the points lifted onto the paraboloid |p|². On a lattice qhull's
- * time goes into merging facets: the cospherical corners of every cube, and above all the
- * vertical facets over the flat faces of the points' hull, each holding thousands of coplanar
- * points (about n^1.6 on lattices, PROBES.md). Both degeneracies are removed here:
- * - Each lift is lowered by a tiny weight (a hash of the point's index times 10⁻³ of its nearest
- *   neighbour's distance squared), which breaks every cospherical tie. The lower hull is then
- *   the regular triangulation of the same, unmoved points: exactly Delaunay wherever the points
- *   are not within 10⁻³ of cospherical, one valid choice among the ties where they are. No
- *   tetrahedron can be flat (four coplanar points lift onto a vertical hyperplane, never a lower
- *   facet) and the weights depend only on the points and their order: deterministic.
- * - Ghost points beyond each face of the bounding box that holds many points (a lattice's
- *   sides), lifted above the paraboloid, so that the face's points make no vertical facet;
- *   lower facets through a ghost lie outside the points' hull and are dropped. Only there: a
- *   ghost near a sliver of a hull in general position (its circumsphere reaching the ghost)
- *   would cut into it, and such hulls have no big flat faces to merge.
- * - qhull runs without pre-merging ('Q0'): nothing should need merging, and its pre-merge merged
- *   facets of a two-layer town lattice anyway.
- * Any sign that this did not hold — a lower facet of more than 4 vertices, a point in no
- * tetrahedron, a flat or non-manifold result, or a boundary that is not convex (a ghost cut into
- * the hull) — falls back to run_qhull's merged cells (bk_tetmesh.merged_cells). */
-#define LIFT_TIE_WEIGHT 1e-3
-#define LIFT_NN_CANDIDATES 64
-#define LIFT_GHOST_MIN_POINTS 16  /* a face of the box holding this many points gets ghosts */
-#define LIFT_FACE_TOLERANCE 1e-7  /* on a face of the box: this close, in units of the points' radius */
-#define LIFT_GHOST_PATCH 256.0    /* face points per ghost, about */
-#define LIFT_GHOST_GRID 64        /* most ghosts along a face's side */
-#define LIFT_GHOSTS (6 * LIFT_GHOST_GRID * LIFT_GHOST_GRID)
-#define LIFT_GHOST_DISTANCE 4.0   /* beyond the face, in patch sizes */
-#define LIFT_GHOST_HEIGHT 16.0    /* above the paraboloid, × its distance squared: it cuts no
-                                     boundary tetrahedron whose circumsphere is under ~4 distances
-                                     (1 and 1: 5 of 12 generated levels' slivers were cut) */
-
-static void point_box(const double *pts, size_t n, double lo[3], double hi[3])
-{
-    for (int k = 0; k < 3; k++) { lo[k] = DBL_MAX; hi[k] = -DBL_MAX; }
-    for (size_t i = 0; i < n; i++)
-        for (int k = 0; k < 3; k++) { lo[k] = fmin(lo[k], pts[3 * i + k]); hi[k] = fmax(hi[k], pts[3 * i + k]); }
-}
-
-static double index_unit(uint64_t i) /* splitmix64 of the index, in [0, 1) */
-{
-    uint64_t z = i + 0x9e3779b97f4a7c15ull;
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    z ^= z >> 31;
-    return (double)(z >> 11) * (1.0 / 9007199254740992.0);
-}
-
-/* Per point, the squared distance to the nearest other point among those in the 27 grid cells
- * around it (the first LIFT_NN_CANDIDATES of them); cell² where none is found. An overestimate
- * only makes a weight larger, which the checks after qhull catch if it ever hides a point. */
-static int nearest_sq(const double *pts, size_t n, const double lo[3], const double hi[3], double *nn2)
-{
-    double ext[3], vol = 1.0, diag = 0.0;
-    for (int k = 0; k < 3; k++) { ext[k] = hi[k] - lo[k]; diag += ext[k] * ext[k]; }
-    diag = sqrt(diag);
-    for (int k = 0; k < 3; k++) vol *= fmax(ext[k], 1e-3 * diag);
-    double cell = cbrt(vol / (double)n) * 1.5;
-    cell_key *keys = malloc(n * sizeof *keys);
-    if (!keys) return BK_DELAUNAY_NO_MEMORY;
-    for (size_t i = 0; i < n; i++) {
-        keys[i].x = (int64_t)floor((pts[3 * i] - lo[0]) / cell);
-        keys[i].y = (int64_t)floor((pts[3 * i + 1] - lo[1]) / cell);
-        keys[i].z = (int64_t)floor((pts[3 * i + 2] - lo[2]) / cell);
-        keys[i].index = (uint32_t)i;
-    }
-    qsort(keys, n, sizeof *keys, cmp_cell_key);
-    for (size_t i = 0; i < n; i++) {
-        const double *p = pts + 3 * i;
-        int64_t c[3];
-        for (int k = 0; k < 3; k++) c[k] = (int64_t)floor((p[k] - lo[k]) / cell);
-        double best = cell * cell;
-        int seen = 0;
-        for (int dx = -1; dx <= 1; dx++) for (int dy = -1; dy <= 1; dy++) for (int dz = -1; dz <= 1; dz++) {
-            size_t s = lower_bound_cell(keys, n, c[0] + dx, c[1] + dy, c[2] + dz);
-            for (; s < n && seen < LIFT_NN_CANDIDATES && keys[s].x == c[0] + dx && keys[s].y == c[1] + dy &&
-                   keys[s].z == c[2] + dz; s++) {
-                if (keys[s].index == i) continue;
-                const double *q = pts + 3 * (size_t)keys[s].index;
-                double d2 = (p[0]-q[0])*(p[0]-q[0]) + (p[1]-q[1])*(p[1]-q[1]) + (p[2]-q[2])*(p[2]-q[2]);
-                if (d2 < best) best = d2;
-                seen++;
-            }
-        }
-        nn2[i] = best;
-    }
-    free(keys);
-    return BK_DELAUNAY_OK;
-}
-
-/* The ghosts beyond face f (axis f / 2, the high side when f is odd) of the box lo..hi holding m
- * points: a grid of patches of about LIFT_GHOST_PATCH points, one ghost at LIFT_GHOST_DISTANCE
- * patch sizes beyond each patch's centre (one ghost for a whole face made it a vertex of every
- * facet over the face, and qhull updates each vertex's neighbour set facet by facet: quadratic). */
-static size_t face_ghosts(int f, size_t m, const double lo[3], const double hi[3], double r, coordT *out)
-{
-    int a = f / 2, b = (a + 1) % 3, c = (a + 2) % 3;
-    double eb = fmax(hi[b] - lo[b], 1e-9 * r), ec = fmax(hi[c] - lo[c], 1e-9 * r);
-    double g = sqrt(eb * ec / (double)m * LIFT_GHOST_PATCH);
-    int nb = (int)fmin(ceil(eb / g), LIFT_GHOST_GRID), nc = (int)fmin(ceil(ec / g), LIFT_GHOST_GRID);
-    double d = LIFT_GHOST_DISTANCE * fmax(eb / nb, ec / nc);
-    size_t k = 0;
-    for (int i = 0; i < nb; i++)
-        for (int j = 0; j < nc; j++, k++) {
-            coordT *q = out + 4 * k;
-            q[a] = f & 1 ? hi[a] + d : lo[a] - d;
-            q[b] = lo[b] + (i + 0.5) * eb / nb;
-            q[c] = lo[c] + (j + 0.5) * ec / nc;
-            q[3] = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + LIFT_GHOST_HEIGHT * d * d) / r;
-        }
-    return k;
-}
-
-/* The lifted points (4 coordinates, the lift scaled to the points' radius), then the ghosts. */
-static coordT *lifted_points(const double *pts, size_t n, const double lo[3], const double hi[3], const double *nn2,
-                             size_t *ghosts)
-{
-    coordT *c = malloc(4 * (n + LIFT_GHOSTS) * sizeof *c);
-    if (!c) return NULL;
-    double r2 = 0.0;
-    for (size_t i = 0; i < n; i++)
-        r2 = fmax(r2, pts[3 * i] * pts[3 * i] + pts[3 * i + 1] * pts[3 * i + 1] + pts[3 * i + 2] * pts[3 * i + 2]);
-    double r = sqrt(r2) > 0.0 ? sqrt(r2) : 1.0;
-    size_t on_face[6] = {0};
-    for (size_t i = 0; i < n; i++) {
-        const double *p = pts + 3 * i;
-        double w = LIFT_TIE_WEIGHT * index_unit(i) * nn2[i];
-        c[4 * i] = p[0]; c[4 * i + 1] = p[1]; c[4 * i + 2] = p[2];
-        c[4 * i + 3] = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] - w) / r;
-        for (int k = 0; k < 3; k++) {
-            on_face[2 * k] += p[k] - lo[k] <= LIFT_FACE_TOLERANCE * r;
-            on_face[2 * k + 1] += hi[k] - p[k] <= LIFT_FACE_TOLERANCE * r;
-        }
-    }
-    size_t g = 0;
-    for (int f = 0; f < 6; f++)
-        if (on_face[f] >= LIFT_GHOST_MIN_POINTS) g += face_ghosts(f, on_face[f], lo, hi, r, c + 4 * (n + g));
-    *ghosts = g;
-    return c;
-}
-
-/* BK_DELAUNAY_OK with every lower facet a tetrahedron in *out and every point in one;
- * BK_DELAUNAY_FAILED when the ties were not all broken (the caller falls back to run_qhull). */
-static int run_qhull_lifted(const double *pts, size_t n, tet_list *out)
-{
-    int status = BK_DELAUNAY_OK;
-    double *nn2 = malloc(n * sizeof *nn2);
-    coordT *coords = NULL;
-    uint8_t *used = calloc(n, 1);
-    qhT *qh = calloc(1, sizeof *qh);
-    char sink_text[1024];
-    FILE *sink = fmemopen(sink_text, sizeof sink_text, "w");
-    if (!nn2 || !used || !qh || !sink) { status = BK_DELAUNAY_NO_MEMORY; goto done; }
-    double lo[3], hi[3];
-    point_box(pts, n, lo, hi);
-    if ((status = nearest_sq(pts, n, lo, hi, nn2)) != BK_DELAUNAY_OK) goto done;
-    size_t ghosts = 0;
-    if (!(coords = lifted_points(pts, n, lo, hi, nn2, &ghosts))) { status = BK_DELAUNAY_NO_MEMORY; goto done; }
-    qh_zero(qh, sink);
-    /* Q0: no pre-merging. With the ties broken nothing needs merging, and qhull's conservative
-     * pre-merge still merged facets of a 2 km, two-layer town lattice (a lower facet of 5 vertices
-     * at any weight up to 10⁻¹); a real precision problem is an error, or fails the checks. */
-    char flags[] = "qhull Q0";
-    int code = qh_new_qhull(qh, 4, (int)(n + ghosts), coords, False, flags, NULL, sink);
-    if (code == qh_ERRmem) { status = BK_DELAUNAY_NO_MEMORY; goto freeqh; }
-    if (code) { status = BK_DELAUNAY_FAILED; goto freeqh; }
-    facetT *facet;
-    FORALLfacets {
-        if (!(facet->normal[3] < -qh_ZEROdelaunay * qh->ANGLEround)) continue; /* upper (as qhull's 'd') */
-        uint32_t id[4];
-        size_t k = 0;
-        int ghost = 0;
-        vertexT *vertex, **vertexp;
-        FOREACHvertex_(facet->vertices) {
-            int pid = qh_pointid(qh, vertex->point);
-            if (k < 4) id[k] = (uint32_t)pid;
-            k++;
-            if (pid < 0 || (size_t)pid >= n) ghost = 1;
-        }
-        if (ghost) continue; /* outside the points' hull */
-        if (k != 4) { status = BK_DELAUNAY_FAILED; goto freeqh; } /* a tie not broken */
-        for (int j = 0; j < 4; j++) used[id[j]] = 1;
-        tet_push(out, id[0], id[1], id[2], id[3]);
-    }
-    if (out->oom) status = BK_DELAUNAY_NO_MEMORY;
-    for (size_t i = 0; status == BK_DELAUNAY_OK && i < n; i++)
-        if (!used[i]) status = BK_DELAUNAY_FAILED; /* a weight hid a point */
-freeqh:
-    qhull_release(qh);
-done:
-    if (sink) fclose(sink);
-    free(qh); free(coords); free(used); free(nn2);
     return status;
 }
 
@@ -734,7 +456,7 @@ static int link_neighbours(bk_tetmesh *out)
 
 /* ---- the hull check of the lifted path -------------------------------------------------------
  * The mesh covers the points' convex hull exactly when every point is a vertex (checked in
- * run_qhull_lifted) and its boundary is convex; a closed, connected, locally convex surface
+bk_dl_lifted) and its boundary is convex; a closed, connected, locally convex surface
  * bounds a convex body, so checking each boundary edge's two faces suffices: the far vertex of
  * one face must not lie outside the other's plane. A ghost lifted too low would cut a dent. */
 typedef struct edge_rec { uint32_t a, b, face; } edge_rec;
@@ -819,26 +541,65 @@ static void clear_failed_mesh(bk_tetmesh *out, size_t count)
     if (keep) for (size_t i = 0; i < count; i++) keep[i] = BK_TET_NONE;
 }
 
+/* The canonical mesh of tl and its neighbours; on the lifted path, BK_DELAUNAY_FAILED for any
+ * result bk_delaunay would not keep, and *convex says whether its boundary is. */
+static int mesh_of(const float *points, size_t count, const uint32_t *rep, const uint32_t *distinct,
+                   const double *pts, size_t nd, const tet_list *tl, int merged, bk_tetmesh *out, int *convex)
+{
+    uint32_t *recs = NULL;
+    size_t nt = 0;
+    int status = canonical_tets(tl, pts, &recs, &nt, &out->dropped_flat);
+    if (status == BK_DELAUNAY_OK) status = mesh_from_tets(points, count, rep, distinct, nd, recs, nt, out);
+    if (status == BK_DELAUNAY_OK) status = link_neighbours(out);
+    *convex = 0;
+    if (status == BK_DELAUNAY_OK && !merged) {
+        status = boundary_is_convex(out, convex);
+        if (status == BK_DELAUNAY_OK && (out->dropped_flat || out->nonmanifold_faces || out->unused_count))
+            status = BK_DELAUNAY_FAILED;
+    }
+    if (!merged && status == BK_DELAUNAY_FLAT) status = BK_DELAUNAY_FAILED; /* nothing kept: try merged */
+    free(recs);
+    return status;
+}
+
+/* The lifted path: the weighted lower hull, its pockets filled when its boundary is not convex
+ * (then checked again, with its volume against the hull's). */
+static int triangulate_lifted(const float *points, size_t count, const uint32_t *rep, const uint32_t *distinct,
+                              const double *pts, size_t nd, tet_list *tl, bk_tetmesh *out)
+{
+    double *nn2 = malloc(nd * sizeof *nn2);
+    if (!nn2) return BK_DELAUNAY_NO_MEMORY;
+    int convex = 0, status = bk_dl_nearest_sq(pts, nd, nn2);
+    if (status == BK_DELAUNAY_OK) status = bk_dl_lifted(pts, nd, nn2, tl);
+    if (status == BK_DELAUNAY_OK) status = mesh_of(points, count, rep, distinct, pts, nd, tl, 0, out, &convex);
+    if (status == BK_DELAUNAY_OK && !convex) {
+        double hull_volume = 0.0;
+        status = bk_dl_fill_pockets(pts, nd, nn2, out, tl, &hull_volume, &out->pocket_tets);
+        size_t filled = out->pocket_tets;
+        clear_failed_mesh(out, count);
+        if (status == BK_DELAUNAY_OK) status = mesh_of(points, count, rep, distinct, pts, nd, tl, 0, out, &convex);
+        out->pocket_tets = filled;
+        if (status == BK_DELAUNAY_OK &&
+            (!convex || !(fabs(out->volume - hull_volume) <= POCKET_VOLUME_TOLERANCE * hull_volume)))
+            status = BK_DELAUNAY_FAILED;
+    }
+    free(nn2);
+    return status;
+}
+
 /* qhull (lifted, or merged cells split), then the canonical mesh and its neighbours. On the
  * lifted path, BK_DELAUNAY_FAILED for any result bk_delaunay would not keep from it. */
 static int triangulate(const float *points, size_t count, const uint32_t *rep, const uint32_t *distinct,
                        const double *pts, size_t nd, int merged, bk_tetmesh *out)
 {
     tet_list tl = {0};
-    uint32_t *recs = NULL;
-    size_t nt = 0;
-    int status = merged ? run_qhull(pts, nd, &tl) : run_qhull_lifted(pts, nd, &tl);
-    if (status == BK_DELAUNAY_OK) status = canonical_tets(&tl, pts, &recs, &nt, &out->dropped_flat);
-    if (status == BK_DELAUNAY_OK) status = mesh_from_tets(points, count, rep, distinct, nd, recs, nt, out);
-    if (status == BK_DELAUNAY_OK) status = link_neighbours(out);
-    if (status == BK_DELAUNAY_OK && !merged) {
-        int convex = 0;
-        status = boundary_is_convex(out, &convex);
-        if (status == BK_DELAUNAY_OK && (!convex || out->dropped_flat || out->nonmanifold_faces || out->unused_count))
-            status = BK_DELAUNAY_FAILED;
+    int convex, status;
+    if (merged) {
+        status = run_qhull(pts, nd, &tl);
+        if (status == BK_DELAUNAY_OK) status = mesh_of(points, count, rep, distinct, pts, nd, &tl, 1, out, &convex);
+    } else {
+        status = triangulate_lifted(points, count, rep, distinct, pts, nd, &tl, out);
     }
-    if (!merged && status == BK_DELAUNAY_FLAT) status = BK_DELAUNAY_FAILED; /* nothing kept: try merged */
-    free(recs);
     free(tl.v);
     return status;
 }

@@ -47,6 +47,8 @@ typedef struct bk_tetmesh {
     size_t dropped_flat;               /* near-zero-volume tetrahedra removed (0 for sane input) */
     size_t nonmanifold_faces;          /* faces shared by more than two tetrahedra (0 expected) */
     double volume;                     /* total volume of the tetrahedra */
+    size_t pocket_tets;                /* lifted path: tetrahedra filled into the pockets its ghosts
+                                          cut into the hull (PROBES.md) */
     int merged_cells;                  /* 1: the tie-breaking weights failed and qhull's merged
                                           cospherical cells were split instead (PROBES.md) */
 } bk_tetmesh;
