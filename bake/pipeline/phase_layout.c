@@ -86,6 +86,16 @@ static lbk_result layout_glg(bk_pipeline *b)
         bk_events_say(&b->events, LBK_BAKE_SEVERITY_INFO, "global light grid by lighting: coarse pass %.1f Mrays, %.2f s",
                       (double)coarse.rays * 1e-6, coarse.seconds);
     b->have_glg = b->glg.status == BK_GLG_OK && b->glg.probe_count >= 4 && b->glg.tet_count > 0;
+    if (b->have_glg) {
+        char path[96];
+        if (b->glg.merged_cells) snprintf(path, sizeof path, "merged cells");
+        else if (b->glg.pocket_tets || b->glg.hull_ghosts)
+            snprintf(path, sizeof path, "lifted, %s ghosts, %zu tetrahedra filled into pockets",
+                     b->glg.hull_ghosts ? "hull" : "box", b->glg.pocket_tets);
+        else snprintf(path, sizeof path, "lifted");
+        bk_events_say(&b->events, LBK_BAKE_SEVERITY_INFO, "global light grid: %zu probes, %zu tetrahedra (Delaunay %.1f s: %s)",
+                      b->glg.probe_count, b->glg.tet_count, b->glg.delaunay_seconds, path);
+    }
     if (!b->have_glg) {
         static const char *why[] = {"ok", "the scene has no geometry", "there is no free space for 4 probes",
                                     "the free space is flat (one layer of probes)", "the tetrahedralisation failed"};

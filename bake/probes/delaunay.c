@@ -562,26 +562,45 @@ static int mesh_of(const float *points, size_t count, const uint32_t *rep, const
     return status;
 }
 
-/* The lifted path: the weighted lower hull, its pockets filled when its boundary is not convex
- * (then checked again, with its volume against the hull's). */
-static int triangulate_lifted(const float *points, size_t count, const uint32_t *rep, const uint32_t *distinct,
-                              const double *pts, size_t nd, tet_list *tl, bk_tetmesh *out)
+/* One try of the lifted path with the given ghosts: the weighted lower hull, its pockets filled
+ * when its boundary is not convex (then checked again, with its volume against the hull's). */
+static int lifted_try(const float *points, size_t count, const uint32_t *rep, const uint32_t *distinct,
+                      const double *pts, size_t nd, const double *nn2, enum bk_dl_ghosts ghosts, tet_list *tl,
+                      bk_tetmesh *out)
 {
-    double *nn2 = malloc(nd * sizeof *nn2);
-    if (!nn2) return BK_DELAUNAY_NO_MEMORY;
-    int convex = 0, status = bk_dl_nearest_sq(pts, nd, nn2);
-    if (status == BK_DELAUNAY_OK) status = bk_dl_lifted(pts, nd, nn2, tl);
+    int convex = 0, status = bk_dl_lifted(pts, nd, nn2, ghosts, tl);
     if (status == BK_DELAUNAY_OK) status = mesh_of(points, count, rep, distinct, pts, nd, tl, 0, out, &convex);
     if (status == BK_DELAUNAY_OK && !convex) {
         double hull_volume = 0.0;
-        status = bk_dl_fill_pockets(pts, nd, nn2, out, tl, &hull_volume, &out->pocket_tets);
-        size_t filled = out->pocket_tets;
+        size_t filled = 0;
+        status = bk_dl_fill_pockets(pts, nd, nn2, out, tl, &hull_volume, &filled);
         clear_failed_mesh(out, count);
         if (status == BK_DELAUNAY_OK) status = mesh_of(points, count, rep, distinct, pts, nd, tl, 0, out, &convex);
         out->pocket_tets = filled;
         if (status == BK_DELAUNAY_OK &&
             (!convex || !(fabs(out->volume - hull_volume) <= POCKET_VOLUME_TOLERANCE * hull_volume)))
             status = BK_DELAUNAY_FAILED;
+    }
+    return status;
+}
+
+/* The lifted path: ghosts beside the box's faces first; where that fails (qhull's error on a
+ * hull whose slanted facets hold rows of coplanar points, or any check), ghosts beside the
+ * hull's facets. */
+static int triangulate_lifted(const float *points, size_t count, const uint32_t *rep, const uint32_t *distinct,
+                              const double *pts, size_t nd, tet_list *tl, bk_tetmesh *out)
+{
+    double *nn2 = malloc(nd * sizeof *nn2);
+    if (!nn2) return BK_DELAUNAY_NO_MEMORY;
+    int status = bk_dl_nearest_sq(pts, nd, nn2);
+    if (status == BK_DELAUNAY_OK)
+        status = lifted_try(points, count, rep, distinct, pts, nd, nn2, BK_DL_BOX_GHOSTS, tl, out);
+    if (status == BK_DELAUNAY_FAILED) {
+        clear_failed_mesh(out, count);
+        tl->n = 0;
+        tl->oom = 0;
+        status = lifted_try(points, count, rep, distinct, pts, nd, nn2, BK_DL_HULL_GHOSTS, tl, out);
+        out->hull_ghosts = 1;
     }
     free(nn2);
     return status;

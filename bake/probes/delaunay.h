@@ -49,6 +49,8 @@ typedef struct bk_tetmesh {
     double volume;                     /* total volume of the tetrahedra */
     size_t pocket_tets;                /* lifted path: tetrahedra filled into the pockets its ghosts
                                           cut into the hull (PROBES.md) */
+    int hull_ghosts;                   /* 1: the lifted path's ghosts beside the box's faces failed
+                                          and it ran again with ghosts beside the hull's facets */
     int merged_cells;                  /* 1: the tie-breaking weights failed and qhull's merged
                                           cospherical cells were split instead (PROBES.md) */
 } bk_tetmesh;

@@ -37,6 +37,8 @@
 #define LIFT_GHOST_GRID 64        /* most ghosts along a face's side */
 #define LIFT_GHOSTS (6 * LIFT_GHOST_GRID * LIFT_GHOST_GRID)
 #define LIFT_GHOST_DISTANCE 4.0   /* beyond the face, in patch sizes */
+#define LIFT_HULL_FACET_TOLERANCE 1e-6 /* on a facet of the hull, for its ghosts: this close, in units of
+                                          the points' diagonal */
 #define POCKET_HULL_TOLERANCE 1e-7 /* on a facet of the hull: this close, in units of the points' diagonal */
 #define LIFT_GHOST_HEIGHT 16.0    /* above the paraboloid, × its distance squared: it cuts no
                                      boundary tetrahedron whose circumsphere is under ~4 distances
@@ -96,137 +98,6 @@ int bk_dl_nearest_sq(const double *pts, size_t n, double *nn2)
     return BK_DELAUNAY_OK;
 }
 
-/* The ghosts beyond face f (axis f / 2, the high side when f is odd) of the box lo..hi holding m
- * points: a grid of patches of about LIFT_GHOST_PATCH points, one ghost at LIFT_GHOST_DISTANCE
- * patch sizes beyond each patch's centre (one ghost for a whole face made it a vertex of every
- * facet over the face, and qhull updates each vertex's neighbour set facet by facet: quadratic). */
-static size_t face_ghosts(int f, size_t m, const double lo[3], const double hi[3], double r, coordT *out)
-{
-    int a = f / 2, b = (a + 1) % 3, c = (a + 2) % 3;
-    double eb = fmax(hi[b] - lo[b], 1e-9 * r), ec = fmax(hi[c] - lo[c], 1e-9 * r);
-    double g = sqrt(eb * ec / (double)m * LIFT_GHOST_PATCH);
-    int nb = (int)fmin(ceil(eb / g), LIFT_GHOST_GRID), nc = (int)fmin(ceil(ec / g), LIFT_GHOST_GRID);
-    double d = LIFT_GHOST_DISTANCE * fmax(eb / nb, ec / nc);
-    size_t k = 0;
-    for (int i = 0; i < nb; i++)
-        for (int j = 0; j < nc; j++, k++) {
-            coordT *q = out + 4 * k;
-            q[a] = f & 1 ? hi[a] + d : lo[a] - d;
-            q[b] = lo[b] + (i + 0.5) * eb / nb;
-            q[c] = lo[c] + (j + 0.5) * ec / nc;
-            q[3] = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + LIFT_GHOST_HEIGHT * d * d) / r;
-        }
-    return k;
-}
-
-/* The lifted points ids[0..m) (all n points when ids is NULL: 4 coordinates, the lift scaled to
- * their radius, which leaves the lower hull as it is), then with `ghosts` the ghosts. A point's
- * weight depends on its index among all n points, so a subset's ties break as the whole set's. */
-static coordT *lifted_points(const double *pts, const uint32_t *ids, size_t m, const double *nn2, int ghosts,
-                             size_t *ghost_count)
-{
-    coordT *c = malloc(4 * (m + (ghosts ? LIFT_GHOSTS : 0)) * sizeof *c);
-    if (!c) return NULL;
-    double lo[3], hi[3], r2 = 0.0;
-    for (int k = 0; k < 3; k++) { lo[k] = DBL_MAX; hi[k] = -DBL_MAX; }
-    for (size_t j = 0; j < m; j++) {
-        const double *p = pts + 3 * (size_t)(ids ? ids[j] : j);
-        r2 = fmax(r2, p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-        for (int k = 0; k < 3; k++) { lo[k] = fmin(lo[k], p[k]); hi[k] = fmax(hi[k], p[k]); }
-    }
-    double r = sqrt(r2) > 0.0 ? sqrt(r2) : 1.0;
-    size_t on_face[6] = {0};
-    for (size_t j = 0; j < m; j++) {
-        size_t i = ids ? ids[j] : j;
-        const double *p = pts + 3 * i;
-        double w = LIFT_TIE_WEIGHT * index_unit(i) * nn2[i];
-        c[4 * j] = p[0]; c[4 * j + 1] = p[1]; c[4 * j + 2] = p[2];
-        c[4 * j + 3] = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] - w) / r;
-        for (int k = 0; k < 3; k++) {
-            on_face[2 * k] += p[k] - lo[k] <= LIFT_FACE_TOLERANCE * r;
-            on_face[2 * k + 1] += hi[k] - p[k] <= LIFT_FACE_TOLERANCE * r;
-        }
-    }
-    size_t g = 0;
-    for (int f = 0; ghosts && f < 6; f++)
-        if (on_face[f] >= LIFT_GHOST_MIN_POINTS) g += face_ghosts(f, on_face[f], lo, hi, r, c + 4 * (m + g));
-    *ghost_count = g;
-    return c;
-}
-
-/* The lower facets of the lifted points ids[0..m) (all n when ids is NULL), by their indices
- * among all n, into *out; BK_DELAUNAY_FAILED when a tie was not broken (a lower facet of more
- * than 4 vertices) or qhull failed. Facets through a ghost lie outside the points' hull. */
-static int lifted_tets(const double *pts, const uint32_t *ids, size_t m, const double *nn2, int ghosts,
-                       tet_list *out)
-{
-    int status = BK_DELAUNAY_OK;
-    size_t ghost_count = 0;
-    coordT *coords = lifted_points(pts, ids, m, nn2, ghosts, &ghost_count);
-    qhT *qh = calloc(1, sizeof *qh);
-    char sink_text[1024];
-    FILE *sink = fmemopen(sink_text, sizeof sink_text, "w");
-    if (!coords || !qh || !sink) { status = BK_DELAUNAY_NO_MEMORY; goto done; }
-    qh_zero(qh, sink);
-    /* Q0: no pre-merging. With the ties broken nothing needs merging, and qhull's conservative
-     * pre-merge still merged facets of a 2 km, two-layer town lattice (a lower facet of 5 vertices
-     * at any weight up to 10⁻¹); a real precision problem is an error, or fails the checks. */
-    char flags[] = "qhull Q0";
-    int code = qh_new_qhull(qh, 4, (int)(m + ghost_count), coords, False, flags, NULL, sink);
-    if (code == qh_ERRmem) { status = BK_DELAUNAY_NO_MEMORY; goto freeqh; }
-    if (code) { status = BK_DELAUNAY_FAILED; goto freeqh; }
-    facetT *facet;
-    FORALLfacets {
-        if (!(facet->normal[3] < -qh_ZEROdelaunay * qh->ANGLEround)) continue; /* upper (as qhull's 'd') */
-        uint32_t id[4];
-        size_t k = 0;
-        int ghost = 0;
-        vertexT *vertex, **vertexp;
-        FOREACHvertex_(facet->vertices) {
-            int pid = qh_pointid(qh, vertex->point);
-            if (pid < 0 || (size_t)pid >= m) ghost = 1;
-            else if (k < 4) id[k] = ids ? ids[pid] : (uint32_t)pid;
-            k++;
-        }
-        if (ghost) continue;
-        if (k != 4) { status = BK_DELAUNAY_FAILED; goto freeqh; } /* a tie not broken */
-        tet_push(out, id[0], id[1], id[2], id[3]);
-    }
-    if (out->oom) status = BK_DELAUNAY_NO_MEMORY;
-freeqh:
-    qhull_release(qh);
-done:
-    if (sink) fclose(sink);
-    free(qh); free(coords);
-    return status;
-}
-
-int bk_dl_lifted(const double *pts, size_t n, const double *nn2, tet_list *out)
-{
-    uint8_t *used = calloc(n, 1);
-    if (!used) return BK_DELAUNAY_NO_MEMORY;
-    int status = lifted_tets(pts, NULL, n, nn2, 1, out);
-    for (size_t t = 0; status == BK_DELAUNAY_OK && t < out->n; t++)
-        for (int j = 0; j < 4; j++) used[out->v[4 * t + j]] = 1;
-    for (size_t i = 0; status == BK_DELAUNAY_OK && i < n; i++)
-        if (!used[i]) status = BK_DELAUNAY_FAILED; /* a weight hid a point */
-    free(used);
-    return status;
-}
-
-
-/* ---- pockets: where the ghosts cut into the hull ---------------------------------------------
- * A ghost beyond a box face also lies inside the near-half-space circumspheres of thin
- * tetrahedra along a slanted side of the points' hull (a fine layer reaching past a coarse one,
- * roofs of different heights), so those tetrahedra are missing: the lifted result leaves
- * pockets between its boundary and the hull. Every point is a vertex of the kept tetrahedra, so
- * no point lies inside a pocket, and each tetrahedron of the true (regular) triangulation filling
- * a pocket has its corners on the pocket's walls (the kept boundary faces inside the hull).
- * Such a tetrahedron's power sphere is empty of all points, so also of the walls' corners Q: it
- * is a tetrahedron of Q's own triangulation, which is small and computed without ghosts. Those of
- * Q's tetrahedra on the outer side of a wall, and those reached from them without crossing a
- * wall, fill the pockets. The caller checks the union like any lifted result, and its volume
- * against the hull's. */
 typedef struct hull_plane { double n[3], offset; } hull_plane;
 
 /* The facets of the points' convex hull (qhull's merged, coplanar ones one plane) and its
@@ -266,6 +137,197 @@ done:
     return status;
 }
 
+/* The ghosts beyond face f (axis f / 2, the high side when f is odd) of the box lo..hi holding m
+ * points: a grid of patches of about LIFT_GHOST_PATCH points, one ghost at LIFT_GHOST_DISTANCE
+ * patch sizes beyond each patch's centre (one ghost for a whole face made it a vertex of every
+ * facet over the face, and qhull updates each vertex's neighbour set facet by facet: quadratic). */
+static size_t face_ghosts(int f, size_t m, const double lo[3], const double hi[3], double r, coordT *out)
+{
+    int a = f / 2, b = (a + 1) % 3, c = (a + 2) % 3;
+    double eb = fmax(hi[b] - lo[b], 1e-9 * r), ec = fmax(hi[c] - lo[c], 1e-9 * r);
+    double g = sqrt(eb * ec / (double)m * LIFT_GHOST_PATCH);
+    int nb = (int)fmin(ceil(eb / g), LIFT_GHOST_GRID), nc = (int)fmin(ceil(ec / g), LIFT_GHOST_GRID);
+    double d = LIFT_GHOST_DISTANCE * fmax(eb / nb, ec / nc);
+    size_t k = 0;
+    for (int i = 0; i < nb; i++)
+        for (int j = 0; j < nc; j++, k++) {
+            coordT *q = out + 4 * k;
+            q[a] = f & 1 ? hi[a] + d : lo[a] - d;
+            q[b] = lo[b] + (i + 0.5) * eb / nb;
+            q[c] = lo[c] + (j + 0.5) * ec / nc;
+            q[3] = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + LIFT_GHOST_HEIGHT * d * d) / r;
+        }
+    return k;
+}
+
+/* The ghosts beyond every facet of the points' hull holding LIFT_GHOST_MIN_POINTS or more of
+ * them, placed as face_ghosts places a box face's over the facet's extent in its plane, appended
+ * to *c (which holds n lifted points and *count ghosts already, and is grown). For hulls whose
+ * slanted facets hold rows of coplanar points (roofs of different heights): those lift onto
+ * vertical facets, which qhull without pre-merging cannot always handle. */
+static int hull_ghosts(const double *pts, size_t n, double r, coordT **c, size_t *count)
+{
+    hull_plane *planes = NULL;
+    size_t np = 0;
+    double volume, lo[3], hi[3];
+    int status = hull_planes(pts, n, &planes, &np, &volume);
+    if (status != BK_DELAUNAY_OK) return status;
+    point_box(pts, n, lo, hi);
+    double diag = sqrt((hi[0]-lo[0])*(hi[0]-lo[0]) + (hi[1]-lo[1])*(hi[1]-lo[1]) + (hi[2]-lo[2])*(hi[2]-lo[2]));
+    for (size_t f = 0; f < np && status == BK_DELAUNAY_OK; f++) {
+        const double *nf = planes[f].n;
+        /* a frame of the plane: u off the axis least along the normal */
+        int a = fabs(nf[0]) <= fabs(nf[1]) && fabs(nf[0]) <= fabs(nf[2]) ? 0 : fabs(nf[1]) <= fabs(nf[2]) ? 1 : 2;
+        double e[3] = {0, 0, 0}, u[3], v[3];
+        e[a] = 1;
+        u[0] = e[1] * nf[2] - e[2] * nf[1]; u[1] = e[2] * nf[0] - e[0] * nf[2]; u[2] = e[0] * nf[1] - e[1] * nf[0];
+        double ul = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+        for (int k = 0; k < 3; k++) u[k] /= ul;
+        v[0] = nf[1] * u[2] - nf[2] * u[1]; v[1] = nf[2] * u[0] - nf[0] * u[2]; v[2] = nf[0] * u[1] - nf[1] * u[0];
+        double s0 = DBL_MAX, s1 = -DBL_MAX, t0 = DBL_MAX, t1 = -DBL_MAX;
+        size_t on = 0;
+        for (size_t i = 0; i < n; i++) {
+            const double *p = pts + 3 * i;
+            if (fabs(nf[0] * p[0] + nf[1] * p[1] + nf[2] * p[2] + planes[f].offset) > LIFT_HULL_FACET_TOLERANCE * diag)
+                continue;
+            double s = u[0] * p[0] + u[1] * p[1] + u[2] * p[2], t = v[0] * p[0] + v[1] * p[1] + v[2] * p[2];
+            s0 = fmin(s0, s); s1 = fmax(s1, s); t0 = fmin(t0, t); t1 = fmax(t1, t);
+            on++;
+        }
+        if (on < LIFT_GHOST_MIN_POINTS) continue;
+        double es = fmax(s1 - s0, 1e-9 * r), et = fmax(t1 - t0, 1e-9 * r);
+        double g = sqrt(es * et / (double)on * LIFT_GHOST_PATCH);
+        int ns = (int)fmin(ceil(es / g), LIFT_GHOST_GRID), nt = (int)fmin(ceil(et / g), LIFT_GHOST_GRID);
+        double d = LIFT_GHOST_DISTANCE * fmax(es / ns, et / nt);
+        coordT *grown = realloc(*c, 4 * (n + *count + (size_t)ns * nt) * sizeof *grown);
+        if (!grown) { status = BK_DELAUNAY_NO_MEMORY; break; }
+        *c = grown;
+        for (int i = 0; i < ns; i++)
+            for (int j = 0; j < nt; j++) {
+                coordT *q = *c + 4 * (n + (*count)++);
+                double s = s0 + (i + 0.5) * es / ns, t = t0 + (j + 0.5) * et / nt, h = -planes[f].offset + d;
+                for (int k = 0; k < 3; k++) q[k] = s * u[k] + t * v[k] + h * nf[k];
+                q[3] = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + LIFT_GHOST_HEIGHT * d * d) / r;
+            }
+    }
+    free(planes);
+    return status;
+}
+
+/* The lifted points ids[0..m) (all n points when ids is NULL: 4 coordinates, the lift scaled to
+ * their radius, which leaves the lower hull as it is), then the ghosts `ghosts` asks for (hull
+ * ghosts: all points only). A point's weight depends on its index among all n points, so a
+ * subset's ties break as the whole set's. */
+static int lifted_points(const double *pts, const uint32_t *ids, size_t m, const double *nn2,
+                         enum bk_dl_ghosts ghosts, coordT **out, size_t *ghost_count)
+{
+    coordT *c = *out = malloc(4 * (m + (ghosts == BK_DL_BOX_GHOSTS ? LIFT_GHOSTS : 0)) * sizeof *c);
+    if (!c) return BK_DELAUNAY_NO_MEMORY;
+    double lo[3], hi[3], r2 = 0.0;
+    for (int k = 0; k < 3; k++) { lo[k] = DBL_MAX; hi[k] = -DBL_MAX; }
+    for (size_t j = 0; j < m; j++) {
+        const double *p = pts + 3 * (size_t)(ids ? ids[j] : j);
+        r2 = fmax(r2, p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+        for (int k = 0; k < 3; k++) { lo[k] = fmin(lo[k], p[k]); hi[k] = fmax(hi[k], p[k]); }
+    }
+    double r = sqrt(r2) > 0.0 ? sqrt(r2) : 1.0;
+    size_t on_face[6] = {0};
+    for (size_t j = 0; j < m; j++) {
+        size_t i = ids ? ids[j] : j;
+        const double *p = pts + 3 * i;
+        double w = LIFT_TIE_WEIGHT * index_unit(i) * nn2[i];
+        c[4 * j] = p[0]; c[4 * j + 1] = p[1]; c[4 * j + 2] = p[2];
+        c[4 * j + 3] = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] - w) / r;
+        for (int k = 0; k < 3; k++) {
+            on_face[2 * k] += p[k] - lo[k] <= LIFT_FACE_TOLERANCE * r;
+            on_face[2 * k + 1] += hi[k] - p[k] <= LIFT_FACE_TOLERANCE * r;
+        }
+    }
+    size_t g = 0;
+    for (int f = 0; ghosts == BK_DL_BOX_GHOSTS && f < 6; f++)
+        if (on_face[f] >= LIFT_GHOST_MIN_POINTS) g += face_ghosts(f, on_face[f], lo, hi, r, c + 4 * (m + g));
+    *ghost_count = g;
+    if (ghosts != BK_DL_HULL_GHOSTS) return BK_DELAUNAY_OK;
+    int status = ids ? BK_DELAUNAY_FAILED : hull_ghosts(pts, m, r, out, ghost_count);
+    return status;
+}
+
+/* The lower facets of the lifted points ids[0..m) (all n when ids is NULL), by their indices
+ * among all n, into *out; BK_DELAUNAY_FAILED when a tie was not broken (a lower facet of more
+ * than 4 vertices) or qhull failed. Facets through a ghost lie outside the points' hull. */
+static int lifted_tets(const double *pts, const uint32_t *ids, size_t m, const double *nn2,
+                       enum bk_dl_ghosts ghosts, int premerge, tet_list *out)
+{
+    int status = BK_DELAUNAY_OK;
+    size_t ghost_count = 0;
+    coordT *coords = NULL;
+    qhT *qh = calloc(1, sizeof *qh);
+    char sink_text[1024];
+    FILE *sink = fmemopen(sink_text, sizeof sink_text, "w");
+    if (!qh || !sink) { status = BK_DELAUNAY_NO_MEMORY; goto done; }
+    if ((status = lifted_points(pts, ids, m, nn2, ghosts, &coords, &ghost_count)) != BK_DELAUNAY_OK) goto done;
+    qh_zero(qh, sink);
+    /* Q0 unless `premerge`: with the ties broken nothing needs merging, and qhull's conservative
+     * pre-merge still merged facets of a 2 km, two-layer town lattice (a lower facet of 5
+     * vertices at any weight up to 10⁻¹); a real precision problem is an error, or fails the
+     * checks. */
+    char q0_flags[] = "qhull Q0", merge_flags[] = "qhull";
+    char *flags = premerge ? merge_flags : q0_flags;
+    int code = qh_new_qhull(qh, 4, (int)(m + ghost_count), coords, False, flags, NULL, sink);
+    if (code == qh_ERRmem) { status = BK_DELAUNAY_NO_MEMORY; goto freeqh; }
+    if (code) { status = BK_DELAUNAY_FAILED; goto freeqh; }
+    facetT *facet;
+    FORALLfacets {
+        if (!(facet->normal[3] < -qh_ZEROdelaunay * qh->ANGLEround)) continue; /* upper (as qhull's 'd') */
+        uint32_t id[4];
+        size_t k = 0;
+        int ghost = 0;
+        vertexT *vertex, **vertexp;
+        FOREACHvertex_(facet->vertices) {
+            int pid = qh_pointid(qh, vertex->point);
+            if (pid < 0 || (size_t)pid >= m) ghost = 1;
+            else if (k < 4) id[k] = ids ? ids[pid] : (uint32_t)pid;
+            k++;
+        }
+        if (ghost) continue;
+        if (k != 4) { status = BK_DELAUNAY_FAILED; goto freeqh; } /* a tie not broken */
+        tet_push(out, id[0], id[1], id[2], id[3]);
+    }
+    if (out->oom) status = BK_DELAUNAY_NO_MEMORY;
+freeqh:
+    qhull_release(qh);
+done:
+    if (sink) fclose(sink);
+    free(qh); free(coords);
+    return status;
+}
+
+int bk_dl_lifted(const double *pts, size_t n, const double *nn2, enum bk_dl_ghosts ghosts, tet_list *out)
+{
+    uint8_t *used = calloc(n, 1);
+    if (!used) return BK_DELAUNAY_NO_MEMORY;
+    int status = lifted_tets(pts, NULL, n, nn2, ghosts, 0, out);
+    for (size_t t = 0; status == BK_DELAUNAY_OK && t < out->n; t++)
+        for (int j = 0; j < 4; j++) used[out->v[4 * t + j]] = 1;
+    for (size_t i = 0; status == BK_DELAUNAY_OK && i < n; i++)
+        if (!used[i]) status = BK_DELAUNAY_FAILED; /* a weight hid a point */
+    free(used);
+    return status;
+}
+
+
+/* ---- pockets: where the ghosts cut into the hull ---------------------------------------------
+ * A ghost beyond a box face also lies inside the near-half-space circumspheres of thin
+ * tetrahedra along a slanted side of the points' hull (a fine layer reaching past a coarse one,
+ * roofs of different heights), so those tetrahedra are missing: the lifted result leaves
+ * pockets between its boundary and the hull. Every point is a vertex of the kept tetrahedra, so
+ * no point lies inside a pocket, and each tetrahedron of the true (regular) triangulation filling
+ * a pocket has its corners on the pocket's walls (the kept boundary faces inside the hull).
+ * Such a tetrahedron's power sphere is empty of all points, so also of the walls' corners Q: it
+ * is a tetrahedron of Q's own triangulation, which is small and computed without ghosts. Those of
+ * Q's tetrahedra on the outer side of a wall, and those reached from them without crossing a
+ * wall, fill the pockets. The caller checks the union like any lifted result, and its volume
+ * against the hull's. */
 typedef struct wall { uint32_t v[3]; uint32_t inner; } wall; /* sorted corners; the kept side's apex */
 
 static int cmp_wall(const void *pa, const void *pb)
@@ -413,10 +475,19 @@ int bk_dl_fill_pockets(const double *pts, size_t n, const double *nn2, const bk_
     if (status == BK_DELAUNAY_OK)
         status = pocket_walls(pts, m, planes, np, POCKET_HULL_TOLERANCE * diag, &walls, &nw, &corners, &nc);
     if (status == BK_DELAUNAY_OK && nc < 4) status = BK_DELAUNAY_FAILED;
-    if (status == BK_DELAUNAY_OK && nc == 4) /* one tetrahedron: too few points for qhull's 4-d hull */
+    if (status == BK_DELAUNAY_OK && nc == 4) { /* one tetrahedron: too few points for qhull's 4-d hull */
         tet_push(&q, corners[0], corners[1], corners[2], corners[3]);
-    else if (status == BK_DELAUNAY_OK)
-        status = lifted_tets(pts, corners, nc, nn2, 0, &q);
+    } else if (status == BK_DELAUNAY_OK) {
+        /* Without ghosts the flat sides of the corners' hull lift onto vertical facets. qhull
+         * without pre-merging handles them on some inputs and stops on a flipped facet on others
+         * (the city's 4 × 4 district); its pre-merge handles those but may merge a lower facet
+         * elsewhere. Each is tried, in that order. */
+        status = lifted_tets(pts, corners, nc, nn2, BK_DL_NO_GHOSTS, 0, &q);
+        if (status == BK_DELAUNAY_FAILED) {
+            q.n = 0;
+            status = lifted_tets(pts, corners, nc, nn2, BK_DL_NO_GHOSTS, 1, &q);
+        }
+    }
     if (status == BK_DELAUNAY_OK) status = pick_pocket_tets(pts, &q, walls, nw, tl);
     *filled = tl->n - before;
     free(planes); free(walls); free(corners); free(q.v);

@@ -104,9 +104,14 @@ static inline void qhull_release(qhT *qh)
 
 /* Per point, the squared distance to its nearest neighbour (the tie-breaking weights' scale). */
 int bk_dl_nearest_sq(const double *pts, size_t n, double *nn2);
+enum bk_dl_ghosts {
+    BK_DL_NO_GHOSTS,
+    BK_DL_BOX_GHOSTS,   /* beyond each face of the points' box holding many of them */
+    BK_DL_HULL_GHOSTS   /* beyond each facet of the points' convex hull holding many of them */
+};
 /* BK_DELAUNAY_OK with every lower facet of the weighted, ghosted lift a tetrahedron in *out and
  * every point in one; BK_DELAUNAY_FAILED when that did not hold (the caller falls back). */
-int bk_dl_lifted(const double *pts, size_t n, const double *nn2, tet_list *out);
+int bk_dl_lifted(const double *pts, size_t n, const double *nn2, enum bk_dl_ghosts ghosts, tet_list *out);
 /* Appends to tl the tetrahedra filling the pockets the ghosts cut between m (the canonical mesh
  * of tl, every point a vertex) and the points' hull; *hull_volume gets the hull's volume for the
  * caller's check, *filled how many were appended. */

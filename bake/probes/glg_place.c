@@ -6,6 +6,7 @@
 
 #include "bake/probes/delaunay.h"
 #include "bake/probes/probe_math.h"
+#include "scene/clock.h"
 #include "scene/parallel.h"
 
 #include <float.h>
@@ -552,7 +553,9 @@ lbk_result bk_glg_build(const bk_scene *scene, const bk_tracer *tracer,
     if (probes.candidates == 0) { out->status = BK_GLG_EMPTY_SCENE; bk_glg_probes_free(&probes); return LBK_OK; }
     if (probes.count < 4) { out->status = BK_GLG_NO_FREE_SPACE; bk_glg_probes_free(&probes); return LBK_OK; }
     bk_tetmesh mesh;
+    const double t0 = bk_now();
     int st = bk_delaunay(probes.positions, probes.count, NULL, &mesh);
+    out->delaunay_seconds = bk_now() - t0;
     bk_glg_probes_free(&probes);
     if (st == BK_DELAUNAY_NO_MEMORY) { bk_tetmesh_free(&mesh); return LBK_ERR_OUT_OF_MEMORY; }
     if (st != BK_DELAUNAY_OK) {
@@ -563,6 +566,9 @@ lbk_result bk_glg_build(const bk_scene *scene, const bk_tracer *tracer,
     }
     out->probe_count = mesh.point_count;
     out->tet_count = mesh.tet_count;
+    out->merged_cells = mesh.merged_cells;
+    out->hull_ghosts = mesh.hull_ghosts;
+    out->pocket_tets = mesh.pocket_tets;
     out->positions = mesh.points; mesh.points = NULL;
     out->tets = mesh.tets; mesh.tets = NULL;
     out->neighbours = mesh.neighbours; mesh.neighbours = NULL;

@@ -78,6 +78,10 @@ typedef struct bk_glg {
                                      from vertex i to stratified points of the opposite face */
     float spacing;                /* placement diagnostics */
     int refine_levels;
+    /* the tetrahedralisation's path (bk_tetmesh, PROBES.md) and its seconds */
+    int merged_cells, hull_ghosts;
+    size_t pocket_tets;
+    double delaunay_seconds;
 } bk_glg;
 
 /* Places probes. On success out->count may be 0 (see PROBES.md). Errors: invalid argument,

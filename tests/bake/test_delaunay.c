@@ -288,29 +288,29 @@ static void test_lifted_hard_hulls(void **state)
  * the hull's slanted sides have thin boundary tetrahedra whose near-half-space circumspheres
  * reach the ghosts beyond the box's faces, and the lifted result misses them. Its pockets are
  * filled from their walls' corners (PROBES.md): still the lifted path, every tetrahedron
- * Delaunay up to the tie weights, the hull filled. blocks × blocks columns of block × block
- * unit-lattice points, heights[i][j] storeys each. */
-static void check_pocket_town(int blocks, int block, const int *heights, const char *name)
+ * Delaunay up to the tie weights, the hull filled. A unit lattice over [0, side]², column (x, z)
+ * heights[(x / block) · (side / block + 1) + z / block] storeys high, over a ground layer of half
+ * the spacing reaching half a unit further. */
+static void check_pocket_town(int side, int block, const int *heights, int hull_ghosts, const char *name)
 {
-    int n_side = blocks * block, fine = 2 * n_side + 3;
-    size_t cap = (size_t)(n_side + 1) * (n_side + 1) * 8 + (size_t)fine * fine, n = 0;
+    int row = side / block + 1, fine = 2 * side + 3;
+    size_t cap = (size_t)(side + 1) * (side + 1) * 8 + (size_t)fine * fine, n = 0;
     float *pts = malloc(3 * cap * sizeof *pts);
-    for (int x = 0; x <= n_side; x++)
-        for (int z = 0; z <= n_side; z++) {
-            int i = x / block < blocks ? x / block : blocks, j = z / block < blocks ? z / block : blocks;
-            for (int y = 1; y <= heights[i * (blocks + 1) + j]; y++, n++) {
+    for (int x = 0; x <= side; x++)
+        for (int z = 0; z <= side; z++)
+            for (int y = 1; y <= heights[(x / block) * row + z / block]; y++, n++) {
                 pts[3 * n] = (float)x; pts[3 * n + 1] = (float)y; pts[3 * n + 2] = (float)z;
             }
-        }
     for (int i = 0; i < fine; i++)
         for (int j = 0; j < fine; j++, n++) {
             pts[3 * n] = (float)(-0.5 + 0.5 * i); pts[3 * n + 1] = 0.0f; pts[3 * n + 2] = (float)(-0.5 + 0.5 * j);
         }
     bk_tetmesh m;
     assert_int_equal(bk_delaunay(pts, n, NULL, &m), BK_DELAUNAY_OK);
-    print_message("%s: %zu points, %zu tetrahedra, %zu filled into pockets, merged cells %d\n", name, n,
-                  m.tet_count, m.pocket_tets, m.merged_cells);
+    print_message("%s: %zu points, %zu tetrahedra, %zu filled into pockets, hull ghosts %d, merged cells %d\n", name,
+                  n, m.tet_count, m.pocket_tets, m.hull_ghosts, m.merged_cells);
     assert_int_equal(m.merged_cells, 0);
+    assert_int_equal(m.hull_ghosts, hull_ghosts);
     assert_true(m.pocket_tets > 0);
     check_mesh(&m);
     assert_int_equal(m.unused_count, 0);
@@ -325,12 +325,16 @@ static void check_pocket_town(int blocks, int block, const int *heights, const c
 static void test_lifted_pockets(void **state)
 {
     (void)state;
-    /* heights as Python's random.Random(2) and (3) drew them: the first leaves five pockets'
-     * tetrahedra, the second a single one (four corners: no qhull run) */
+    /* heights as Python's random.Random(2), (3) and (26) drew them: the first leaves five
+     * pockets' tetrahedra, the second a single one (four corners: no qhull run); in the third,
+     * qhull stops on the box's ghosts (rows of coplanar points on a slanted side lift onto
+     * vertical facets) and the hull's ghosts are tried */
     static const int town_a[4 * 4] = {8, 8, 2, 2, 2, 4, 8, 3, 7, 8, 7, 8, 4, 4, 6, 3};
     static const int town_b[5 * 5] = {3, 6, 6, 3, 4, 6, 5, 7, 6, 2, 6, 2, 8, 5, 4, 6, 3, 3, 7, 5, 6, 8, 6, 5, 5};
-    check_pocket_town(3, 4, town_a, "roofs a");
-    check_pocket_town(4, 4, town_b, "roofs b");
+    static const int town_c[3 * 3] = {7, 3, 7, 3, 5, 6, 6, 2, 3};
+    check_pocket_town(12, 4, town_a, 0, "roofs a");
+    check_pocket_town(16, 4, town_b, 0, "roofs b");
+    check_pocket_town(16, 6, town_c, 1, "roofs c");
 }
 
 static void test_coplanar_points(void **state)
