@@ -268,10 +268,11 @@ typedef struct level_job {
     const dn_texels *g;
     const dn_levels *lv;
     int level;
-    const float *in;          /* ch floats per receiver (apply), or NULL (build) */
+    const float *in;          /* ch floats per receiver (apply), or NULL (build only) */
     float *out;
     int ch;
-    float *lum_next, *var_next; /* build: the base's luminance and variance after this level */
+    float *lum_next, *var_next; /* build: the guide's luminance and variance after this level, or
+                                   NULL (apply only); both at once share the pass's weights */
 } level_job;
 
 static void level_run(void *user, size_t begin, size_t end, int thread)
@@ -294,7 +295,8 @@ static void level_run(void *user, size_t begin, size_t end, int thread)
                 if (j->in) {
                     const float *v = j->in + (size_t)q * j->ch;
                     for (int k = 0; k < j->ch; k++) acc[k] += w * (double)v[k];
-                } else {
+                }
+                if (j->lum_next) {
                     wl += w * (double)lum[q];
                     wv += (double)w * w * var[q];
                 }
@@ -303,7 +305,8 @@ static void level_run(void *user, size_t begin, size_t end, int thread)
         if (j->in) {
             float *o = j->out + p * j->ch;
             for (int k = 0; k < j->ch; k++) o[k] = (float)(acc[k] / W);
-        } else {
+        }
+        if (j->lum_next) {
             j->lum_next[p] = (float)(wl / W);
             j->var_next[p] = (float)(wv / (W * W));
         }
@@ -349,8 +352,73 @@ static void run_chunks(const bk_denoiser *d, size_t n, bk_chunk_fn fn, void *use
     bk_parallel_chunks(0, n, 256, d->threads, fn, user);
 }
 
-/* The per-level luminance and variance of a guide over the texels, then the clamp. */
-static lbk_result levels_build(const bk_denoiser *d, const dn_guide *gd, dn_levels *lv)
+/* The clamp: the filtered guide luminance may move at most clamp·σ from the input. */
+static void levels_clamp(const dn_texels *g, dn_levels *lv)
+{
+    const size_t n = g->n;
+    const float *lout = lv->lum + (size_t)g->levels * n;
+    lv->clamped = 0;
+    for (size_t p = 0; p < n; p++) {
+        float dl = fabsf(lout[p] - lv->lum[p]);
+        float lim = g->clamp >= 0 ? g->clamp * lv->sigma[p] : INFINITY;
+        lv->alpha[p] = lv->sigma[p] > 0 || (g->method == BK_DENOISE_BLUR && g->clamp < 0) ? 1 : 0;
+        if (lv->sigma[p] > 0 && dl > lim) {
+            lv->alpha[p] = lim / dl;
+            lv->clamped++;
+        }
+    }
+}
+
+/* Filters texel receivers [0, n) of `vals` (ch ≤ SH_N floats each) in place. Every channel is
+ * filtered on its own with the same weights, so a channel's result does not depend on which
+ * others ride along: the error estimates filter many two-channel inputs in one pass (the
+ * weights, not the channels, are most of a pass's cost). With `build` (lv itself), the same
+ * passes build lv's levels after the first and its clamp, which levels_build left undone: the
+ * same numbers as building first and filtering after, in half the passes. */
+static lbk_result texels_filter(const bk_denoiser *d, const dn_levels *lv, dn_levels *build, float *vals, int ch)
+{
+    const dn_texels *g = &d->tex;
+    size_t n = g->n;
+    /* level 0 reads vals itself (it changes only at the end), so one level (NLM, the default)
+     * needs one buffer of n·ch floats, not two: at ch = 27 that is ~100 B per texel at the bake's
+     * peak (DENOISE.md) */
+    float *a = NULL, *b = malloc((n ? n : 1) * ch * sizeof *b);
+    if (b && g->levels > 1) a = malloc((n ? n : 1) * ch * sizeof *a);
+    if (!b || (g->levels > 1 && !a)) {
+        free(a), free(b);
+        return LBK_ERR_OUT_OF_MEMORY;
+    }
+    const float *in = vals;
+    for (int l = 0; l < g->levels; l++) {
+        level_job j = {g, lv, l, in, b, ch, build ? build->lum + (size_t)(l + 1) * n : NULL,
+                       build ? build->var + (size_t)(l + 1) * n : NULL};
+        run_chunks(d, n, level_run, &j);
+        float *t = a;
+        a = b, b = t;
+        in = a;
+    }
+    if (build) levels_clamp(g, build);
+    for (size_t p = 0; p < n; p++) {
+        float *o = vals + p * ch;
+        const float *f = in + p * ch;
+        float al = lv->alpha[p];
+        if (al == 1) memcpy(o, f, ch * sizeof *o);
+        else if (al > 0)
+            for (int k = 0; k < ch; k++) o[k] += al * (f[k] - o[k]);
+    }
+    free(a), free(b);
+    return LBK_OK;
+}
+
+static lbk_result texels_apply(const bk_denoiser *d, const dn_levels *lv, float *vals, int ch)
+{
+    return texels_filter(d, lv, NULL, vals, ch);
+}
+
+/* The per-level luminance and variance of a guide over the texels, then the clamp. With vals
+ * (ch floats per texel), the same passes filter them in place as texels_apply would with the
+ * finished levels (texels_filter). */
+static lbk_result levels_build(const bk_denoiser *d, const dn_guide *gd, dn_levels *lv, float *vals, int ch)
 {
     const dn_texels *g = &d->tex;
     size_t n = g->n;
@@ -376,59 +444,12 @@ static lbk_result levels_build(const bk_denoiser *d, const dn_guide *gd, dn_leve
     run_chunks(d, n, var_run, &vj);
     free(raw);
     for (size_t p = 0; p < n; p++) lv->sigma[p] = sqrtf(lv->var[p]);
+    if (vals) return texels_filter(d, lv, lv, vals, ch);
     for (int l = 0; l < L; l++) {
         level_job j = {g, lv, l, NULL, NULL, 0, lv->lum + (size_t)(l + 1) * n, lv->var + (size_t)(l + 1) * n};
         run_chunks(d, n, level_run, &j);
     }
-    /* clamp: the filtered guide luminance may move at most clamp·σ from the input */
-    const float *lout = lv->lum + (size_t)L * n;
-    lv->clamped = 0;
-    for (size_t p = 0; p < n; p++) {
-        float dl = fabsf(lout[p] - lv->lum[p]);
-        float lim = g->clamp >= 0 ? g->clamp * lv->sigma[p] : INFINITY;
-        lv->alpha[p] = lv->sigma[p] > 0 || (g->method == BK_DENOISE_BLUR && g->clamp < 0) ? 1 : 0;
-        if (lv->sigma[p] > 0 && dl > lim) {
-            lv->alpha[p] = lim / dl;
-            lv->clamped++;
-        }
-    }
-    return LBK_OK;
-}
-
-/* Filters texel receivers [0, n) of `vals` (ch ≤ SH_N floats each) in place. Every channel is
- * filtered on its own with the same weights, so a channel's result does not depend on which
- * others ride along: the error estimates filter many two-channel inputs in one pass (the
- * weights, not the channels, are most of a pass's cost). */
-static lbk_result texels_apply(const bk_denoiser *d, const dn_levels *lv, float *vals, int ch)
-{
-    const dn_texels *g = &d->tex;
-    size_t n = g->n;
-    /* level 0 reads vals itself (it changes only at the end), so one level (NLM, the default)
-     * needs one buffer of n·ch floats, not two: at ch = 27 that is ~100 B per texel at the bake's
-     * peak (DENOISE.md) */
-    float *a = NULL, *b = malloc((n ? n : 1) * ch * sizeof *b);
-    if (b && g->levels > 1) a = malloc((n ? n : 1) * ch * sizeof *a);
-    if (!b || (g->levels > 1 && !a)) {
-        free(a), free(b);
-        return LBK_ERR_OUT_OF_MEMORY;
-    }
-    const float *in = vals;
-    for (int l = 0; l < g->levels; l++) {
-        level_job j = {g, lv, l, in, b, ch, NULL, NULL};
-        run_chunks(d, n, level_run, &j);
-        float *t = a;
-        a = b, b = t;
-        in = a;
-    }
-    for (size_t p = 0; p < n; p++) {
-        float *o = vals + p * ch;
-        const float *f = in + p * ch;
-        float al = lv->alpha[p];
-        if (al == 1) memcpy(o, f, ch * sizeof *o);
-        else if (al > 0)
-            for (int k = 0; k < ch; k++) o[k] += al * (f[k] - o[k]);
-    }
-    free(a), free(b);
+    levels_clamp(g, lv);
     return LBK_OK;
 }
 
@@ -472,7 +493,7 @@ lbk_result bk_denoiser_create(const bk_denoise_inputs *in, const bk_denoise_opti
     lbk_result r = LBK_OK;
     if (want_tex) {
         r = texels_features(in, &d->tex);
-        if (!r) r = levels_build(d, &gd, &d->lev);
+        if (!r) r = levels_build(d, &gd, &d->lev, NULL, 0);
         d->have_tex = !r;
     }
     if (!r && want_probes) {
@@ -671,8 +692,7 @@ lbk_result bk_denoiser_half_delta(const bk_denoiser *d, const bk_denoise_inputs 
         const dn_guide gd = {in, base, base_variance, halves, h};
         dn_levels lv = {0};
         dn_probe_weights pw = {0};
-        if (d->have_tex) r = levels_build(d, &gd, &lv);
-        if (!r && d->have_tex) r = texels_apply(d, &lv, f[h], 1);
+        if (d->have_tex) r = levels_build(d, &gd, &lv, f[h], 1); /* built and applied in the same passes */
         if (!r && d->have_probes) r = dn_probe_weights_build(&d->probes, &gd, &pw);
         if (!r && d->have_probes) r = dn_probes_apply(&d->probes, &pw, f[h], 1);
         levels_free(&lv);
