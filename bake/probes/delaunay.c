@@ -585,8 +585,8 @@ static int lifted_try(const float *points, size_t count, const uint32_t *rep, co
 }
 
 /* The lifted path: ghosts beside the box's faces first; where that fails (qhull's error on a
- * hull whose slanted facets hold rows of coplanar points, or any check), ghosts beside the
- * hull's facets. */
+ * hull whose slanted facets hold rows of coplanar points, or any check but flatness), ghosts
+ * beside the hull's facets. */
 static int triangulate_lifted(const float *points, size_t count, const uint32_t *rep, const uint32_t *distinct,
                               const double *pts, size_t nd, tet_list *tl, bk_tetmesh *out)
 {
@@ -595,7 +595,9 @@ static int triangulate_lifted(const float *points, size_t count, const uint32_t 
     int status = bk_dl_nearest_sq(pts, nd, nn2);
     if (status == BK_DELAUNAY_OK)
         status = lifted_try(points, count, rep, distinct, pts, nd, nn2, BK_DL_BOX_GHOSTS, tl, out);
-    if (status == BK_DELAUNAY_FAILED) {
+    /* flat slivers (a hull in general position with near-flat sides) are the points' own: other
+     * ghosts would leave them as flat */
+    if (status == BK_DELAUNAY_FAILED && !out->dropped_flat) {
         clear_failed_mesh(out, count);
         tl->n = 0;
         tl->oom = 0;
