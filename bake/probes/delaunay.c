@@ -153,23 +153,18 @@ static int scratch_grow(size_t cap, uint32_t **ids, uint32_t **nids, uint32_t **
 static int run_qhull(const double *pts, size_t n, tet_list *out)
 {
     int status = BK_DELAUNAY_OK;
-    qhT *qh = calloc(1, sizeof *qh);
+    dl_qhull q = {0};
+    qhT *qh = NULL;
     coordT *coords = malloc(3 * n * sizeof *coords);
     uint32_t *ids = NULL, *nids = NULL, *common = NULL;
     angle_item *scratch = NULL;
-    /* qhull wants a stream for its messages; an in-memory one needs no file system (a fopen of
-     * /dev/null fails in a sandbox or on a full descriptor table, and was then reported as out
-     * of memory). What qhull writes past the buffer is dropped. */
-    char sink_text[1024];
-    FILE *sink = fmemopen(sink_text, sizeof sink_text, "w");
-    if (!qh || !coords || !sink) { status = BK_DELAUNAY_NO_MEMORY; goto done; }
+    if (!coords) { status = BK_DELAUNAY_NO_MEMORY; goto freeqh; }
     memcpy(coords, pts, 3 * n * sizeof *coords);
-    qh_zero(qh, sink);
     char flags[] = "qhull d Qbb Qc Qz Q12";
-    int code = qh_new_qhull(qh, 3, (int)n, coords, False, flags, NULL, sink);
-    if (code == qh_ERRsingular) { status = BK_DELAUNAY_FLAT; goto freeqh; }
-    if (code == qh_ERRmem) { status = BK_DELAUNAY_NO_MEMORY; goto freeqh; }
-    if (code) { status = BK_DELAUNAY_FAILED; goto freeqh; }
+    status = dl_qhull_run(&q, 3, n, coords, flags);
+    if (q.code == qh_ERRsingular) status = BK_DELAUNAY_FLAT;
+    if (status != BK_DELAUNAY_OK) goto freeqh;
+    qh = q.qh;
 
     size_t cap = 64;
     ids = malloc(cap * sizeof *ids); nids = malloc(cap * sizeof *nids);
@@ -208,12 +203,9 @@ static int run_qhull(const double *pts, size_t n, tet_list *out)
     }
     if (out->oom) status = BK_DELAUNAY_NO_MEMORY;
 freeqh:
-    qhull_release(qh);
-done:
-    if (sink) fclose(sink);
+    dl_qhull_end(&q);
     free(ids); free(nids); free(common); free(scratch);
     free(coords);
-    free(qh);
     return status;
 }
 

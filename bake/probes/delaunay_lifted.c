@@ -104,36 +104,33 @@ typedef struct hull_plane { double n[3], offset; } hull_plane;
  * volume. */
 static int hull_planes(const double *pts, size_t n, hull_plane **planes, size_t *count, double *volume)
 {
-    int status = BK_DELAUNAY_OK;
-    qhT *qh = calloc(1, sizeof *qh);
+    dl_qhull q = {0};
     coordT *coords = malloc(3 * n * sizeof *coords);
-    char sink_text[1024];
-    FILE *sink = fmemopen(sink_text, sizeof sink_text, "w");
     *planes = NULL;
     *count = 0;
-    if (!qh || !coords || !sink) { status = BK_DELAUNAY_NO_MEMORY; goto done; }
-    memcpy(coords, pts, 3 * n * sizeof *coords);
-    qh_zero(qh, sink);
+    int status = coords ? BK_DELAUNAY_OK : BK_DELAUNAY_NO_MEMORY;
+    if (coords) memcpy(coords, pts, 3 * n * sizeof *coords);
     char flags[] = "qhull";
-    int code = qh_new_qhull(qh, 3, (int)n, coords, False, flags, NULL, sink);
-    if (code == qh_ERRmem) { status = BK_DELAUNAY_NO_MEMORY; goto freeqh; }
-    if (code) { status = BK_DELAUNAY_FAILED; goto freeqh; }
-    facetT *facet;
-    size_t k = 0;
-    FORALLfacets k++;
-    if (!(*planes = malloc((k ? k : 1) * sizeof **planes))) { status = BK_DELAUNAY_NO_MEMORY; goto freeqh; }
-    FORALLfacets {
-        hull_plane *h = *planes + (*count)++;
-        for (int j = 0; j < 3; j++) h->n[j] = facet->normal[j];
-        h->offset = facet->offset;
+    if (status == BK_DELAUNAY_OK) status = dl_qhull_run(&q, 3, n, coords, flags);
+    if (status == BK_DELAUNAY_OK) {
+        qhT *qh = q.qh;
+        facetT *facet;
+        size_t k = 0;
+        FORALLfacets k++;
+        if ((*planes = malloc((k ? k : 1) * sizeof **planes))) {
+            FORALLfacets {
+                hull_plane *h = *planes + (*count)++;
+                for (int j = 0; j < 3; j++) h->n[j] = facet->normal[j];
+                h->offset = facet->offset;
+            }
+            qh_getarea(qh, qh->facet_list);
+            *volume = qh->totvol;
+        } else {
+            status = BK_DELAUNAY_NO_MEMORY;
+        }
     }
-    qh_getarea(qh, qh->facet_list);
-    *volume = qh->totvol;
-freeqh:
-    qhull_release(qh);
-done:
-    if (sink) fclose(sink);
-    free(qh); free(coords);
+    dl_qhull_end(&q);
+    free(coords);
     return status;
 }
 
@@ -258,26 +255,19 @@ static int lifted_points(const double *pts, const uint32_t *ids, size_t m, const
 static int lifted_tets(const double *pts, const uint32_t *ids, size_t m, const double *nn2,
                        enum bk_dl_ghosts ghosts, int premerge, tet_list *out)
 {
-    int status = BK_DELAUNAY_OK;
     size_t ghost_count = 0;
     coordT *coords = NULL;
-    qhT *qh = calloc(1, sizeof *qh);
-    char sink_text[1024];
-    FILE *sink = fmemopen(sink_text, sizeof sink_text, "w");
-    if (!qh || !sink) { status = BK_DELAUNAY_NO_MEMORY; goto done; }
-    if ((status = lifted_points(pts, ids, m, nn2, ghosts, &coords, &ghost_count)) != BK_DELAUNAY_OK) goto done;
-    qh_zero(qh, sink);
+    dl_qhull q = {0};
+    int status = lifted_points(pts, ids, m, nn2, ghosts, &coords, &ghost_count);
     /* Q0 unless `premerge`: with the ties broken nothing needs merging, and qhull's conservative
      * pre-merge still merged facets of a 2 km, two-layer town lattice (a lower facet of 5
      * vertices at any weight up to 10⁻¹); a real precision problem is an error, or fails the
      * checks. */
     char q0_flags[] = "qhull Q0", merge_flags[] = "qhull";
-    char *flags = premerge ? merge_flags : q0_flags;
-    int code = qh_new_qhull(qh, 4, (int)(m + ghost_count), coords, False, flags, NULL, sink);
-    if (code == qh_ERRmem) { status = BK_DELAUNAY_NO_MEMORY; goto freeqh; }
-    if (code) { status = BK_DELAUNAY_FAILED; goto freeqh; }
+    if (status == BK_DELAUNAY_OK) status = dl_qhull_run(&q, 4, m + ghost_count, coords, premerge ? merge_flags : q0_flags);
+    qhT *qh = q.qh;
     facetT *facet;
-    FORALLfacets {
+    for (facet = status == BK_DELAUNAY_OK ? qh->facet_list : NULL; facet && facet->next; facet = facet->next) {
         if (!(facet->normal[3] < -qh_ZEROdelaunay * qh->ANGLEround)) continue; /* upper (as qhull's 'd') */
         uint32_t id[4];
         size_t k = 0;
@@ -290,15 +280,12 @@ static int lifted_tets(const double *pts, const uint32_t *ids, size_t m, const d
             k++;
         }
         if (ghost) continue;
-        if (k != 4) { status = BK_DELAUNAY_FAILED; goto freeqh; } /* a tie not broken */
+        if (k != 4) { status = BK_DELAUNAY_FAILED; break; } /* a tie not broken */
         tet_push(out, id[0], id[1], id[2], id[3]);
     }
-    if (out->oom) status = BK_DELAUNAY_NO_MEMORY;
-freeqh:
-    qhull_release(qh);
-done:
-    if (sink) fclose(sink);
-    free(qh); free(coords);
+    if (status == BK_DELAUNAY_OK && out->oom) status = BK_DELAUNAY_NO_MEMORY;
+    dl_qhull_end(&q);
+    free(coords);
     return status;
 }
 

@@ -10,6 +10,7 @@
 
 #include <float.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 
 static inline double orient(const double *a, const double *b, const double *c, const double *d)
@@ -92,12 +93,38 @@ static inline void point_box(const double *pts, size_t n, double lo[3], double h
         for (int k = 0; k < 3; k++) { lo[k] = fmin(lo[k], pts[3 * i + k]); hi[k] = fmax(hi[k], pts[3 * i + k]); }
 }
 
-/* Frees what qhull holds (not qh itself). */
-static inline void qhull_release(qhT *qh)
+/* One qhull run: its state and the stream for its messages. qhull wants a stream; an in-memory
+ * one needs no file system (a fopen of /dev/null fails in a sandbox or on a full descriptor
+ * table, and was then reported as out of memory). What qhull writes past the buffer is dropped. */
+typedef struct dl_qhull {
+    qhT *qh;
+    FILE *sink;
+    int started, code;     /* code: qh_new_qhull's (qh_ERRsingular, ...) */
+    char text[1024];
+} dl_qhull;
+
+/* Runs qhull on n points of dim coordinates with flags: BK_DELAUNAY_OK, NO_MEMORY or FAILED
+ * (q->code says why). dl_qhull_end frees it whatever this returned. */
+static inline int dl_qhull_run(dl_qhull *q, int dim, size_t n, coordT *coords, char *flags)
 {
-    int curlong, totlong;
-    qh_freeqhull(qh, !qh_ALL);
-    qh_memfreeshort(qh, &curlong, &totlong);
+    q->qh = calloc(1, sizeof *q->qh);
+    q->sink = fmemopen(q->text, sizeof q->text, "w");
+    if (!q->qh || !q->sink) return BK_DELAUNAY_NO_MEMORY;
+    qh_zero(q->qh, q->sink);
+    q->started = 1;
+    q->code = qh_new_qhull(q->qh, dim, (int)n, coords, False, flags, NULL, q->sink);
+    return q->code == qh_ERRmem ? BK_DELAUNAY_NO_MEMORY : q->code ? BK_DELAUNAY_FAILED : BK_DELAUNAY_OK;
+}
+
+static inline void dl_qhull_end(dl_qhull *q)
+{
+    if (q->started) {
+        int curlong, totlong;
+        qh_freeqhull(q->qh, !qh_ALL);
+        qh_memfreeshort(q->qh, &curlong, &totlong);
+    }
+    if (q->sink) fclose(q->sink);
+    free(q->qh);
 }
 
 /* ---- the lifted path (delaunay_lifted.c) ---------------------------------------------------- */
