@@ -3,10 +3,11 @@
  * First the lifted path (delaunay_lifted.c): qhull's 4-d hull of the points lifted onto the
  * paraboloid with tiny tie-breaking weights and ghost points beside the hull's flat faces, which
  * leaves qhull nothing to merge — ×10 faster on lattices, the probe placement's common case —
- * then the pockets its ghosts cut into a hull with slanted sides filled. Where its checks fail, qhull's own Delaunay ('d') is run WITHOUT triangulated output ('Qt'):
- * where points are cospherical (every cube of a regular grid) it returns one merged,
- * non-simplicial Delaunay cell, and we triangulate those cells ourselves with a "pulling"
- * triangulation keyed on global point indices. Each 2-face of a cell is computed as the
+ * then the pockets its ghosts cut into a hull with slanted sides filled. Where its checks fail,
+ * qhull's own Delaunay ('d') is run WITHOUT triangulated output ('Qt'): where points are
+ * cospherical (every cube of a regular grid) it returns one merged, non-simplicial Delaunay
+ * cell, and we triangulate those cells ourselves with a "pulling" triangulation keyed on global
+ * point indices. Each 2-face of a cell is computed as the
  * intersection of the vertex sets of the two cells that share it and is split by a fan from its
  * lowest-index vertex, so both sides of a shared face always agree and no zero-volume "glue"
  * tetrahedra are needed. 'Qt' by contrast triangulates each cell from its own first vertex and

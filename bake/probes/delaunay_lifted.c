@@ -26,9 +26,11 @@
  *   would cut into it, and such hulls have no big flat faces to merge.
  * - qhull runs without pre-merging ('Q0'): nothing should need merging, and its pre-merge merged
  *   facets of a two-layer town lattice anyway.
- * Any sign that this did not hold — a lower facet of more than 4 vertices, a point in no
- * tetrahedron, a flat or non-manifold result, or a boundary that is not convex (a ghost cut into
- * the hull) — falls back to run_qhull's merged cells (bk_tetmesh.merged_cells). */
+ * A boundary that is not convex (a ghost cut into the hull) has its pockets filled (below). Where
+ * the box's ghosts fail, the caller tries ghosts beside the hull's facets (hull_ghosts). Any other
+ * sign that this did not hold — a lower facet of more than 4 vertices, a point in no tetrahedron,
+ * a flat or non-manifold result, a pocket not filled — falls back to run_qhull's merged cells
+ * (bk_tetmesh.merged_cells). */
 #define LIFT_TIE_WEIGHT 1e-3
 #define LIFT_NN_CANDIDATES 64
 #define LIFT_GHOST_MIN_POINTS 16  /* a face of the box holding this many points gets ghosts */
@@ -37,13 +39,14 @@
 #define LIFT_GHOST_GRID 64        /* most ghosts along a face's side */
 #define LIFT_GHOSTS (6 * LIFT_GHOST_GRID * LIFT_GHOST_GRID)
 #define LIFT_GHOST_DISTANCE 4.0   /* beyond the face, in patch sizes */
-#define LIFT_HULL_FACET_TOLERANCE 1e-6 /* on a facet of the hull, for its ghosts: this close, in units of
-                                          the points' diagonal */
-#define POCKET_HULL_TOLERANCE 1e-7 /* on a facet of the hull: this close, in units of the points' diagonal */
 #define LIFT_GHOST_HEIGHT 16.0    /* above the paraboloid, × its distance squared: it cuts no
                                      boundary tetrahedron whose circumsphere is under ~4 distances
                                      (1 and 1: 5 of 12 generated levels' slivers were cut) */
-
+/* On a facet of the points' hull, in units of their diagonal: for the facet's ghosts (loose: a
+ * point counted wrongly only moves a ghost) and for a pocket's walls (tight: a wall taken for the
+ * hull leaves its pocket unfilled, which the checks refuse) */
+#define LIFT_HULL_FACET_TOLERANCE 1e-6
+#define POCKET_HULL_TOLERANCE 1e-7
 
 static double index_unit(uint64_t i) /* splitmix64 of the index, in [0, 1) */
 {
