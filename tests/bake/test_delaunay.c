@@ -337,6 +337,52 @@ static void test_lifted_pockets(void **state)
     check_pocket_town(16, 6, town_c, 1, "roofs c");
 }
 
+/* 60 seeded towns of the same family (2–12 blocks a side of 1–4 columns, 1–6 storeys, a ground
+ * layer reaching 0–1.5 past or none, some points repeated or moved by 10⁻⁴): whatever path each
+ * takes, a valid mesh that fills the hull; the lifted path holds on at least 90 % of them (in a
+ * harness, 4 % of 2000 such towns fell back to merged cells; 11 % of 200 before the pockets and
+ * the hull's ghosts). */
+static void test_lifted_roofs_sweep(void **state)
+{
+    (void)state;
+    const size_t cap = 20000;
+    float *p = malloc(3 * cap * sizeof *p);
+    int lifted = 0, pocketed = 0, towns = 60;
+    for (int it = 0; it < towns; it++) {
+        rng_state = 5000 + (uint64_t)it;
+        size_t n = 0;
+        int side = 3 + (int)(rnd() * 10), block = 1 + (int)(rnd() * 4), h[16][16];
+        for (int i = 0; i < 16; i++) for (int j = 0; j < 16; j++) h[i][j] = 1 + (int)(rnd() * 6);
+        for (int x = 0; x <= side; x++)
+            for (int z = 0; z <= side; z++)
+                for (int y = 1; y <= h[x / block][z / block]; y++, n++) {
+                    p[3 * n] = (float)x; p[3 * n + 1] = (float)y; p[3 * n + 2] = (float)z;
+                }
+        const double reach = 0.25 * (int)(rnd() * 7); /* 0 … 1.5 */
+        for (double a = -reach; a <= side + reach + 1e-9; a += 0.5)
+            for (double b = -reach; b <= side + reach + 1e-9; b += 0.5, n++) {
+                p[3 * n] = (float)a; p[3 * n + 1] = 0.0f; p[3 * n + 2] = (float)b;
+            }
+        for (int k = 0; it % 3 == 2 && k < 20; k++, n++) { /* repeated, or moved by 10⁻⁴ */
+            size_t q = (size_t)(rnd() * (double)n);
+            p[3 * n] = p[3 * q] + (rnd() < 0.5 ? 0.0f : 1e-4f); p[3 * n + 1] = p[3 * q + 1]; p[3 * n + 2] = p[3 * q + 2];
+        }
+        assert_true(n <= cap);
+        bk_tetmesh m;
+        assert_int_equal(bk_delaunay(p, n, NULL, &m), BK_DELAUNAY_OK);
+        check_mesh(&m);
+        double hv = hull_volume(p, n);
+        assert_true(fabs(m.volume - hv) < 1e-6 * hv);
+        lifted += !m.merged_cells;
+        pocketed += m.pocket_tets > 0;
+        bk_tetmesh_free(&m);
+    }
+    print_message("towns: %d of %d on the lifted path, %d with pockets filled\n", lifted, towns, pocketed);
+    assert_true(lifted >= towns * 9 / 10);
+    assert_true(pocketed > 0);
+    free(p);
+}
+
 static void test_coplanar_points(void **state)
 {
     (void)state;
@@ -456,6 +502,7 @@ int main(void)
         cmocka_unit_test(test_far_anisotropic_grid),
         cmocka_unit_test(test_lifted_hard_hulls),
         cmocka_unit_test(test_lifted_pockets),
+        cmocka_unit_test(test_lifted_roofs_sweep),
         cmocka_unit_test(test_coplanar_points),
         cmocka_unit_test(test_duplicates),
         cmocka_unit_test(test_too_few),
