@@ -273,6 +273,10 @@ typedef struct level_job {
     int ch;
     float *lum_next, *var_next; /* build: the guide's luminance and variance after this level, or
                                    NULL (apply only); both at once share the pass's weights */
+    const float *in2;         /* a second input riding on the same weights (ch2 floats per
+                                 receiver), filtered into out2; NULL: none */
+    float *out2;
+    int ch2;
 } level_job;
 
 static void level_run(void *user, size_t begin, size_t end, int thread)
@@ -284,8 +288,9 @@ static void level_run(void *user, size_t begin, size_t end, int thread)
     level_taps(g, j->level, &r, &step);
     const float *lum = j->lv->lum + (size_t)j->level * g->n, *var = j->lv->var + (size_t)j->level * g->n;
     for (size_t p = begin; p < end; p++) {
-        double acc[SH_N], W = 0, wl = 0, wv = 0;
+        double acc[SH_N], acc2[SH_N], W = 0, wl = 0, wv = 0;
         if (j->in) memset(acc, 0, sizeof acc);
+        if (j->in2) memset(acc2, 0, sizeof acc2);
         for (int dy = -r; dy <= r; dy++)
             for (int dx = -r; dx <= r; dx++) {
                 int32_t q = dn_at(g, p, dx * step, dy * step);
@@ -296,6 +301,10 @@ static void level_run(void *user, size_t begin, size_t end, int thread)
                     const float *v = j->in + (size_t)q * j->ch;
                     for (int k = 0; k < j->ch; k++) acc[k] += w * (double)v[k];
                 }
+                if (j->in2) {
+                    const float *v = j->in2 + (size_t)q * j->ch2;
+                    for (int k = 0; k < j->ch2; k++) acc2[k] += w * (double)v[k];
+                }
                 if (j->lum_next) {
                     wl += w * (double)lum[q];
                     wv += (double)w * w * var[q];
@@ -305,6 +314,10 @@ static void level_run(void *user, size_t begin, size_t end, int thread)
         if (j->in) {
             float *o = j->out + p * j->ch;
             for (int k = 0; k < j->ch; k++) o[k] = (float)(acc[k] / W);
+        }
+        if (j->in2) {
+            float *o = j->out2 + p * j->ch2;
+            for (int k = 0; k < j->ch2; k++) o[k] = (float)(acc2[k] / W);
         }
         if (j->lum_next) {
             j->lum_next[p] = (float)(wl / W);
@@ -369,13 +382,27 @@ static void levels_clamp(const dn_texels *g, dn_levels *lv)
     }
 }
 
+/* vals (ch floats per texel) moved towards their filtered values f by the clamp's blend. */
+static void texels_blend(const dn_texels *g, const dn_levels *lv, float *vals, const float *f, int ch)
+{
+    for (size_t p = 0; p < g->n; p++) {
+        float *o = vals + p * ch;
+        const float *fp = f + p * ch;
+        float al = lv->alpha[p];
+        if (al == 1) memcpy(o, fp, ch * sizeof *o);
+        else if (al > 0)
+            for (int k = 0; k < ch; k++) o[k] += al * (fp[k] - o[k]);
+    }
+}
+
 /* Filters texel receivers [0, n) of `vals` (ch ≤ SH_N floats each) in place. Every channel is
  * filtered on its own with the same weights, so a channel's result does not depend on which
  * others ride along: the error estimates filter many two-channel inputs in one pass (the
  * weights, not the channels, are most of a pass's cost). With `build` (lv itself), the same
  * passes build lv's levels after the first and its clamp, which levels_build left undone: the
  * same numbers as building first and filtering after, in half the passes. */
-static lbk_result texels_filter(const bk_denoiser *d, const dn_levels *lv, dn_levels *build, float *vals, int ch)
+static lbk_result texels_filter(const bk_denoiser *d, const dn_levels *lv, dn_levels *build, float *vals, int ch,
+                                bk_denoise_ride *ride)
 {
     const dn_texels *g = &d->tex;
     size_t n = g->n;
@@ -389,30 +416,27 @@ static lbk_result texels_filter(const bk_denoiser *d, const dn_levels *lv, dn_le
         return LBK_ERR_OUT_OF_MEMORY;
     }
     const float *in = vals;
+    /* a one-level filter (NLM, the default) carries the ride's channels in its one pass */
+    const int riding = ride && ride->radiance && ride->filtered && g->levels == 1;
     for (int l = 0; l < g->levels; l++) {
         level_job j = {g, lv, l, in, b, ch, build ? build->lum + (size_t)(l + 1) * n : NULL,
-                       build ? build->var + (size_t)(l + 1) * n : NULL};
+                       build ? build->var + (size_t)(l + 1) * n : NULL,
+                       riding ? (const float *)ride->radiance : NULL, riding ? ride->filtered : NULL, SH_N};
         run_chunks(d, n, level_run, &j);
         float *t = a;
         a = b, b = t;
         in = a;
     }
     if (build) levels_clamp(g, build);
-    for (size_t p = 0; p < n; p++) {
-        float *o = vals + p * ch;
-        const float *f = in + p * ch;
-        float al = lv->alpha[p];
-        if (al == 1) memcpy(o, f, ch * sizeof *o);
-        else if (al > 0)
-            for (int k = 0; k < ch; k++) o[k] += al * (f[k] - o[k]);
-    }
+    texels_blend(g, lv, vals, in, ch);
+    if (riding) ride->done = 1;
     free(a), free(b);
     return LBK_OK;
 }
 
 static lbk_result texels_apply(const bk_denoiser *d, const dn_levels *lv, float *vals, int ch)
 {
-    return texels_filter(d, lv, NULL, vals, ch);
+    return texels_filter(d, lv, NULL, vals, ch, NULL);
 }
 
 /* The per-level luminance and variance of a guide over the texels, then the clamp. With vals
@@ -444,9 +468,9 @@ static lbk_result levels_build(const bk_denoiser *d, const dn_guide *gd, dn_leve
     run_chunks(d, n, var_run, &vj);
     free(raw);
     for (size_t p = 0; p < n; p++) lv->sigma[p] = sqrtf(lv->var[p]);
-    if (vals) return texels_filter(d, lv, lv, vals, ch);
+    if (vals) return texels_filter(d, lv, lv, vals, ch, NULL);
     for (int l = 0; l < L; l++) {
-        level_job j = {g, lv, l, NULL, NULL, 0, lv->lum + (size_t)(l + 1) * n, lv->var + (size_t)(l + 1) * n};
+        level_job j = {g, lv, l, NULL, NULL, 0, lv->lum + (size_t)(l + 1) * n, lv->var + (size_t)(l + 1) * n, NULL, NULL, 0};
         run_chunks(d, n, level_run, &j);
     }
     levels_clamp(g, lv);
@@ -603,7 +627,7 @@ static lbk_result groups_from_filtered(const float *halves, const float *f, size
 /* bk_denoiser_errors, and with g the first input's groups from the same filter pass. */
 static lbk_result errors_pass(const bk_denoiser *d, const float *const *halves, size_t count,
                               const size_t class_end[BK_RECEIVER_CLASSES], bk_denoise_error *out,
-                              const bk_denoise_groups *g, const float *cross)
+                              const bk_denoise_groups *g, const float *cross, bk_denoise_ride *ride)
 {
     if (!out || !class_end || (count && !halves)) return LBK_ERR_INVALID_ARGUMENT;
     const size_t n = d ? d->receiver_count : class_end[BK_RECEIVER_CLASSES - 1];
@@ -613,7 +637,8 @@ static lbk_result errors_pass(const bk_denoiser *d, const float *const *halves, 
         if (class_end[k] > n || (k && class_end[k] < class_end[k - 1])) return LBK_ERR_INVALID_ARGUMENT;
     const double t0 = bk_now();
     memset(out, 0, count * sizeof *out);
-    float *f = malloc((n ? n : 1) * 2 * DN_ERROR_GROUP * sizeof *f);
+    const size_t group = count < DN_ERROR_GROUP ? (count ? count : 1) : DN_ERROR_GROUP;
+    float *f = malloc((n ? n : 1) * 2 * group * sizeof *f);
     if (!f) return LBK_ERR_OUT_OF_MEMORY;
     lbk_result r = LBK_OK;
     for (size_t j0 = 0; j0 < count && !r; j0 += DN_ERROR_GROUP) {
@@ -625,7 +650,7 @@ static lbk_result errors_pass(const bk_denoiser *d, const float *const *halves, 
                 f[i * ch + 2 * j] = 0.5f * (h[2 * i] + h[2 * i + 1]);
                 f[i * ch + 2 * j + 1] = 0.5f * (h[2 * i] - h[2 * i + 1]);
             }
-        if (d && d->have_tex) r = texels_apply(d, &d->lev, f, ch);
+        if (d && d->have_tex) r = texels_filter(d, &d->lev, NULL, f, ch, j0 == 0 ? ride : NULL);
         if (!r && d && d->have_probes) r = dn_probes_apply(&d->probes, &d->probe_w, f, ch);
         for (size_t j = 0; j < m && !r; j++)
             error_from_filtered(halves[j0 + j], f + 2 * j, (size_t)ch, j0 + j ? NULL : cross, class_end, &out[j0 + j]);
@@ -640,22 +665,31 @@ static lbk_result errors_pass(const bk_denoiser *d, const float *const *halves, 
 lbk_result bk_denoiser_errors(const bk_denoiser *d, const float *const *halves, size_t count,
                               const size_t class_end[BK_RECEIVER_CLASSES], bk_denoise_error *out)
 {
-    return errors_pass(d, halves, count, class_end, out, NULL, NULL);
+    return errors_pass(d, halves, count, class_end, out, NULL, NULL, NULL);
 }
 
 lbk_result bk_denoiser_error(const bk_denoiser *d, const float *halves, const size_t class_end[BK_RECEIVER_CLASSES],
                              bk_denoise_error *out)
 {
-    return errors_pass(d, &halves, 1, class_end, out, NULL, NULL);
+    return errors_pass(d, &halves, 1, class_end, out, NULL, NULL, NULL);
 }
 
 lbk_result bk_denoiser_error_groups(const bk_denoiser *d, const float *halves, const size_t class_end[BK_RECEIVER_CLASSES],
-                                    bk_denoise_error *out, const bk_denoise_groups *groups, const float *cross)
+                                    bk_denoise_error *out, const bk_denoise_groups *groups, const float *cross,
+                                    bk_denoise_ride *ride)
 {
     if (!class_end || !groups || !groups->out || (groups->count && !groups->group) ||
         groups->count > class_end[BK_RECEIVER_CLASSES - 1])
         return LBK_ERR_INVALID_ARGUMENT;
-    return errors_pass(d, &halves, 1, class_end, out, groups, cross);
+    if (ride) ride->done = 0;
+    return errors_pass(d, &halves, 1, class_end, out, groups, cross, ride);
+}
+
+lbk_result bk_denoiser_blend_texels(const bk_denoiser *d, lbk_sh9_rgb *radiance, const float *filtered)
+{
+    if (!d || (!radiance && d->receiver_count) || (!filtered && d->have_tex)) return LBK_ERR_INVALID_ARGUMENT;
+    if (d->have_tex) texels_blend(&d->tex, &d->lev, (float *)radiance, filtered, SH_N);
+    return LBK_OK;
 }
 
 lbk_result bk_denoise_groups_unfiltered(const float *halves, const bk_denoise_groups *groups)

@@ -144,11 +144,25 @@ typedef struct bk_denoise_groups {
 } bk_denoise_groups;
 lbk_result bk_denoiser_error(const bk_denoiser *d, const float *halves, const size_t class_end[BK_RECEIVER_CLASSES],
                              bk_denoise_error *out);
+/* Radiance riding on the estimate's filter pass (a pass's cost is its weights, not its
+ * channels): `filtered` (27 floats per texel receiver) gets the filter's output for the texel
+ * receivers of `radiance`, before the clamp's blend (bk_denoiser_blend_texels), and `done` says
+ * whether it did (the one-level filter, NLM, the default, carries it; else filter as usual). */
+typedef struct bk_denoise_ride {
+    const lbk_sh9_rgb *radiance;
+    float *filtered;
+    int done;
+} bk_denoise_ride;
 /* bk_denoiser_error, and each group's estimate from the same filter pass; with `cross` (NULL:
- * none) the noise term is Σ cross², cross from bk_denoiser_half_delta, in place of Σ (Dδ)².
- * Errors as above, and LBK_ERR_INVALID_ARGUMENT for groups past the receivers. */
+ * none) the noise term is Σ cross², cross from bk_denoiser_half_delta, in place of Σ (Dδ)²; with
+ * `ride` (NULL: none) the radiance it names filtered in the same pass. Errors as above, and
+ * LBK_ERR_INVALID_ARGUMENT for groups past the receivers. */
 lbk_result bk_denoiser_error_groups(const bk_denoiser *d, const float *halves, const size_t class_end[BK_RECEIVER_CLASSES],
-                                    bk_denoise_error *out, const bk_denoise_groups *groups, const float *cross);
+                                    bk_denoise_error *out, const bk_denoise_groups *groups, const float *cross,
+                                    bk_denoise_ride *ride);
+/* The texel receivers of `radiance` moved to a ride's `filtered` by the clamp's blend: what
+ * bk_denoiser_apply_classes gives the texels (the GLG probes are left as they are). */
+lbk_result bk_denoiser_blend_texels(const bk_denoiser *d, lbk_sh9_rgb *radiance, const float *filtered);
 /* The same for `count` inputs (halves[j], each as above) into out[j], in one filter pass per 13
  * inputs; out[j].seconds is the pass time shared equally. */
 lbk_result bk_denoiser_errors(const bk_denoiser *d, const float *const *halves, size_t count,

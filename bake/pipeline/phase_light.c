@@ -380,7 +380,7 @@ lbk_result bk_phase_sets(bk_pipeline *b)
  * keeps the base estimate with its fit residual. With --denoise auto (choose) a class whose
  * filtered estimate is not below its unfiltered one (the transport's) stays unfiltered and its
  * error is the transport's; do_denoise then filters the classes marked filtered. */
-static lbk_result denoised_error(bk_pipeline *b, int choose, const float *cross)
+static lbk_result denoised_error(bk_pipeline *b, int choose, const float *cross, bk_denoise_ride *ride)
 {
     bk_transport_options to;
     transport_options(b, &to);
@@ -390,7 +390,7 @@ static lbk_result denoised_error(bk_pipeline *b, int choose, const float *cross)
     uint32_t *group = bk_texel_object_groups(b);
     b->object_filtered = calloc(no ? no : 1, sizeof *b->object_filtered);
     const bk_denoise_groups g = {b->texel_receivers, group, no, b->object_filtered};
-    lbk_result r = group && b->object_filtered ? bk_denoiser_error_groups(b->denoiser, b->halves, to.class_end, &e, &g, cross)
+    lbk_result r = group && b->object_filtered ? bk_denoiser_error_groups(b->denoiser, b->halves, to.class_end, &e, &g, cross, ride)
                                                : LBK_ERR_OUT_OF_MEMORY;
     free(group);
     if (r) return r;
@@ -478,9 +478,15 @@ lbk_result bk_phase_denoise(bk_pipeline *b)
     lbk_result r = bk_denoiser_create(&in, &o, &b->denoiser);
     if (!r && b->halves) r = half_cross_delta(b, &in, &cross);
     free(guide), free(guide_var);
-    if (!r) r = denoised_error(b, b->opt->denoise == LBK_BAKE_DENOISE_AUTO, cross);
+    /* the base's texels filtered in the estimate's pass, kept if the estimate keeps them */
+    bk_denoise_ride ride = {b->radiance, NULL, 0};
+    ride.filtered = b->texel_receivers ? malloc(b->texel_receivers * sizeof(lbk_sh9_rgb)) : NULL;
+    if (!r) r = denoised_error(b, b->opt->denoise == LBK_BAKE_DENOISE_AUTO, cross, ride.filtered ? &ride : NULL);
     free(cross);
-    const int filter[BK_RECEIVER_CLASSES] = {b->denoised.texels_filtered, b->denoised.glg_filtered, 0};
+    const int texels = b->denoised.texels_filtered;
+    if (!r && texels && ride.done) r = bk_denoiser_blend_texels(b->denoiser, b->radiance, ride.filtered);
+    free(ride.filtered);
+    const int filter[BK_RECEIVER_CLASSES] = {texels && !ride.done, b->denoised.glg_filtered, 0};
     if (!r) r = bk_denoiser_apply_classes(b->denoiser, b->radiance, filter);
     if (r) return bk_pipeline_failed(b, r, "denoising");
     return LBK_OK;

@@ -326,7 +326,27 @@ static double cross_noise(const bk_denoiser *d, const bk_denoise_inputs *in, con
     bk_denoise_group_error g0;
     const bk_denoise_groups g = {class_end[0], group, 1, &g0};
     bk_denoise_error e;
-    assert_int_equal(bk_denoiser_error_groups(d, halves, class_end, &e, &g, cross), LBK_OK);
+    /* the radiance riding on the same pass (as the pipeline filters the base): the same floats as
+     * filtering it on its own */
+    const size_t n = in->receiver_count, nt = in->texel_count;
+    float *filtered = malloc((nt ? nt : 1) * sizeof(lbk_sh9_rgb));
+    lbk_sh9_rgb *ridden = malloc(n * sizeof *ridden), *alone = malloc(n * sizeof *alone);
+    assert_non_null(filtered), assert_non_null(ridden), assert_non_null(alone);
+    bk_denoise_ride ride = {r->rad, filtered, 0};
+    assert_int_equal(bk_denoiser_error_groups(d, halves, class_end, &e, &g, cross, &ride), LBK_OK);
+    assert_int_equal(ride.done, 1); /* the default filter has one level */
+    memcpy(ridden, r->rad, n * sizeof *ridden);
+    memcpy(alone, r->rad, n * sizeof *alone);
+    assert_int_equal(bk_denoiser_blend_texels(d, ridden, filtered), LBK_OK);
+    const int texels_only[BK_RECEIVER_CLASSES] = {1, 0, 0};
+    assert_int_equal(bk_denoiser_apply_classes(d, alone, texels_only), LBK_OK);
+    assert_memory_equal(ridden, alone, n * sizeof *ridden);
+    assert_true(memcmp(ridden, r->rad, nt * sizeof *ridden) != 0); /* it filtered something */
+    free(filtered), free(ridden), free(alone);
+    /* without a ride: the same estimate */
+    bk_denoise_error e2;
+    assert_int_equal(bk_denoiser_error_groups(d, halves, class_end, &e2, &g, cross, NULL), LBK_OK);
+    assert_memory_equal(e2.rel_rmse, e.rel_rmse, sizeof e.rel_rmse);
     free(group);
     assert_true(fabs(g0.noise - e.noise[BK_CLASS_TEXEL]) <= 1e-9 + 1e-6 * g0.noise); /* the group is the class */
     return e.noise[BK_CLASS_TEXEL];
