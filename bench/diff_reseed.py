@@ -148,7 +148,8 @@ class Tally:
         self.zmax = max(self.zmax, z / model["k_mean"])
         cz = n["chroma"]["z"] if n["chroma"]["z"] is not None else float("inf")
         self.cmax = max(self.cmax, cz / model["k_chroma"])
-        crit = n["share_limit"] * n["count"] + 1
+        tested = n.get("tested", n["count"])  # the count test's N (samples whose noise was measured)
+        crit = n["share_limit"] * tested + 1
         if n.get("count_test", True):
             self.smax = max(self.smax, n["significant"] / crit)
         self.extreme += n.get("extreme", 0)
@@ -156,9 +157,9 @@ class Tally:
         if n["chroma"]["noise"] is not None:
             self.mde_c.append(model["k_chroma"] * n["chroma"]["noise"])
         self.sig += n["significant"]
-        self.count += n["count"]
+        self.count += tested
         if n.get("sample_rms") is not None:
-            self.u2 += n["sample_rms"] ** 2 * n["count"]
+            self.u2 += n["sample_rms"] ** 2 * tested
 
 
 def reseed_study(args, lbk, presets, scenes):

@@ -7,6 +7,8 @@
  *   - a door state's texel entries judged against entry + base, their noise's reference level:
  *     no alarm, where against the entry's own level most samples are significant;
  *   - noise correlated over 2 × 2 texels read at its full σ by the texels' high-pass;
+ *   - a small object of two levels (bright rows exact, dark rows noisy): no count alarm, the dark
+ *     rows untested, a change of the bright rows seen;
  *   - real bakes of scenes/cornell_box (cheap: 256 samples): two reseeds are EQUAL, and the right
  *     wall changed from green (0.14, 0.45, 0.091) to a cyan-blue of the same luminance (0.14, 0.40,
  *     0.58) is DIFFERENT, through the chromaticity test (no item's luminance shift is significant). */
@@ -234,6 +236,65 @@ static void test_highpass_correlated_noise(void **state)
     assert_true(fabs(s / sigma - 1) < 0.15);
 }
 
+/* A small object of two levels (lights_punctual_lamp's 6 × 12 node1 at the high preset, its
+ * exported texels): its lower 8 rows lit directly, the same on every seed up to σ 0.2 %, its
+ * upper 4 rows 100× darker and lit only by bounces, σ ~50 %. Most of the object's 16 interior
+ * residuals are the bright rows', so their median reads 0.2 %: the dark rows' reseed changes
+ * read ~100σ, and the count test was significant in 113 of 1000 trials (in 3 of 20 of the
+ * lamp's reseed pairs). A texel is tested against residuals at its own level
+ * (TL_NOISE_LEVEL_BAND): the dark rows have 4, too few to tell their noise, so they are not
+ * count-tested. The bright rows keep the object's σ, which the residuals reaching across the
+ * two levels inflate (~15 %): this object cannot tell a few percent, but its bright rows 25 %
+ * brighter are DIFFERENT (the mean shift). */
+static int two_level_trial(const tl_noise_model *m, double bright_change, int want_verdict, uint64_t *tested)
+{
+    enum { W = 6, H = 12, DARK_ROWS = 4 };
+    float v[2][W * H], local[2][W * H];
+    double s[2];
+    for (int side = 0; side < 2; side++) {
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                const int bright = y >= DARK_ROWS;
+                const double f = side && bright ? 1 + bright_change : 1;
+                /* the dark rows log-normal (σ of the log 0.5: a relative σ ~53 %, never unlit) */
+                const double e = bright ? 1 + 0.002 * gauss() : exp(0.5 * gauss() - 0.125);
+                v[side][y * W + x] = (float)((bright ? 2.3 : 0.023) * f * e);
+            }
+        s[side] = tl_noise_highpass(v[side], v[side], W, H);
+        assert_true(s[side] >= 0); /* 16 interior residuals: the object has its own noise */
+        tl_noise_highpass_tiles(v[side], W, H, s[side], local[side]);
+    }
+    tl_noise_stats st;
+    tl_noise_begin(&st, m, TL_NOISE_TEXELS, s[0], s[1]);
+    for (int i = 0; i < W * H; i++) {
+        const float a[3] = {v[0][i], v[0][i], v[0][i]}, b[3] = {v[1][i], v[1][i], v[1][i]};
+        tl_noise_add(&st, m, a, b, 1, local[0][i], local[1][i]);
+    }
+    tl_noise_end(&st, m);
+    *tested = st.tested;
+    return want_verdict ? !st.within_noise : st.share_significant;
+}
+
+static void test_two_level_object(void **state)
+{
+    (void)state;
+    const double zero[2] = {0, 0};
+    tl_noise_model m;
+    tl_noise_model_init(&m, 0.001, zero, zero);
+    int alarms = 0, seen = 0;
+    uint64_t tested, most = 0;
+    for (int t = 0; t < 1000; t++) {
+        alarms += two_level_trial(&m, 0, 0, &tested);
+        most = tested > most ? tested : most;
+    }
+    for (int t = 0; t < 50; t++) seen += two_level_trial(&m, 0.25, 1, &tested);
+    print_message("two-level object: count alarms %d/1000 (at most %llu of 72 samples tested), the bright rows "
+                  "25 %% brighter DIFFERENT %d/50\n", alarms, (unsigned long long)most, seen);
+    assert_true(alarms <= 0.001 * 1000 + 3 * sqrt(0.001 * 1000) + 1);
+    assert_true(most <= 8 * 6); /* the dark rows are never count-tested */
+    assert_true(seen >= 48);
+}
+
 /* ---- real bakes: cornell_box -------------------------------------------------------------------- */
 
 static char tmpdir[64];
@@ -373,6 +434,7 @@ int main(void)
         cmocka_unit_test(test_synthetic_power),
         cmocka_unit_test(test_synthetic_set_entries),
         cmocka_unit_test(test_highpass_correlated_noise),
+        cmocka_unit_test(test_two_level_object),
         cmocka_unit_test(test_cornell_reseeds_equal),
         cmocka_unit_test(test_cornell_hue_change_differs),
     };

@@ -183,7 +183,8 @@ static double rect_noise(const pageref *pg, const uint32_t rect[4], double fallb
     s = fmax(s, floor_noise);
     if (local && (*local = malloc(sizeof **local * (n + 1)))) {
         tl_noise_highpass_tiles(lum, rect[2], rect[3], s, *local);
-        for (size_t i = 0; i < n; i++) (*local)[i] = fmaxf((*local)[i], (float)floor_noise);
+        for (size_t i = 0; i < n; i++) /* -1: not measured at its level, and so not count-tested */
+            if ((*local)[i] >= 0) (*local)[i] = fmaxf((*local)[i], (float)floor_noise);
     }
     free(lum);
     return s;

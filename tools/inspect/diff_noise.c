@@ -130,6 +130,7 @@ static double sample_deviation(const tl_noise_model *m, int cls, double t_a, dou
 int tl_noise_sample_significant(const tl_noise_model *m, int cls, double t_a, double t_b, const float *a,
                                 const float *b, int n)
 {
+    if (t_a < 0 || t_b < 0) return 0;
     return !(sample_deviation(m, cls, t_a, t_b, a, b, n, -1, -1, NULL) <= m->k_sample);
 }
 
@@ -161,6 +162,8 @@ void tl_noise_add_ref(tl_noise_stats *s, const tl_noise_model *m, const float *a
         s->sum_ca[k] += ca[k] / n, s->sum_cb[k] += cb[k] / n;
         s->sum_dcdc[k] += dc * dc, s->sum_dcdl[k] += dc * d;
     }
+    if (t_a < 0 || t_b < 0) return; /* its noise not measured at its level: in the mean, not the count */
+    s->tested++;
     double ux;
     const double u = sample_deviation(m, s->cls, t_a, t_b, a, b, n, ref_a, ref_b, &ux);
     s->significant += !(u <= m->k_sample);
@@ -240,11 +243,12 @@ void tl_noise_end(tl_noise_stats *s, const tl_noise_model *m)
     s->noise_mean = sqrt(fmax(s->noise_model, s->noise_empirical) * fmax(s->noise_model, s->noise_empirical) +
                          s->noise_common * s->noise_common);
     s->z = s->noise_mean > 0 ? s->mean_shift / s->noise_mean : (s->mean_shift != 0 ? INFINITY : 0);
-    s->sample_rms = sqrt(s->sum_u2 / n);
-    s->significant_share = (double)s->significant / n;
-    const uint64_t critical = tl_binomial_critical(s->count, c->sample_rate, m->false_alarm / 6);
-    const uint64_t critical_extreme = tl_binomial_critical(s->count, c->extreme_rate, m->false_alarm / 6);
-    s->share_limit = critical > 0 ? (double)(critical - 1) / n : 0;
+    const double nt = s->tested > 0 ? (double)s->tested : 1;
+    s->sample_rms = sqrt(s->sum_u2 / nt);
+    s->significant_share = (double)s->significant / nt;
+    const uint64_t critical = tl_binomial_critical(s->tested, c->sample_rate, m->false_alarm / 6);
+    const uint64_t critical_extreme = tl_binomial_critical(s->tested, c->extreme_rate, m->false_alarm / 6);
+    s->share_limit = critical > 0 ? (double)(critical - 1) / nt : 0;
     s->shift_significant = !(fabs(s->z) <= m->k_mean);
     s->share_significant = s->count_test && (s->significant >= critical || s->extreme >= critical_extreme);
     chroma_end(s, m, c, n);
@@ -264,9 +268,10 @@ static double median(double *v, size_t n)
 }
 
 /* Residuals (value − mean of its 4 neighbours) / level of the texels in [x0, x1) × [y0, y1), kept
- * two texels from the rectangle's edge (the border ring is dilated padding). */
+ * two texels from the rectangle's edge (the border ring is dilated padding); into lv (unless NULL)
+ * the level of each residual's texel. */
 static size_t residuals(const float *values, const float *ref, uint32_t w, uint32_t h, uint32_t x0, uint32_t y0,
-                        uint32_t x1, uint32_t y1, uint32_t d, double *r)
+                        uint32_t x1, uint32_t y1, uint32_t d, double *r, double *lv)
 {
     size_t n = 0;
     const uint32_t e = d > 2 ? d : 2;
@@ -282,6 +287,7 @@ static size_t residuals(const float *values, const float *ref, uint32_t w, uint3
             const double nb = 0.25 * ((double)values[i - d] + values[i + d] + values[i - dy] + values[i + dy]);
             const double nref = (double)ref[i - d] * ref[i + d] * ref[i - dy] * ref[i + dy];
             if (!(lev > 0) || !(nref > 0)) continue; /* unlit or outside the chart */
+            if (lv) lv[n] = lev;
             r[n++] = (c - nb) / lev;
         }
     return n;
@@ -302,25 +308,95 @@ double tl_noise_highpass(const float *values, const float *ref, uint32_t w, uint
     if (!r) return -1;
     double out = -1;
     for (uint32_t d = 1; d <= TL_NOISE_HIGHPASS_REACH; d *= 2)
-        out = fmax(out, tl_noise_robust_sigma(r, residuals(values, ref, w, h, 0, 0, w, h, d, r)));
+        out = fmax(out, tl_noise_robust_sigma(r, residuals(values, ref, w, h, 0, 0, w, h, d, r, NULL)));
     free(r);
     return out;
 }
 
+/* The residuals of one region at the distances d = 1, 2, … TL_NOISE_HIGHPASS_REACH (as
+ * tl_noise_highpass), each distance's after the last's: n[k] of them for the k-th distance. */
+typedef struct hp_region {
+    double *r, *lv;
+    size_t n[4], total;
+} hp_region;
+
+static void region_residuals(const float *values, uint32_t w, uint32_t h, uint32_t x0, uint32_t y0, uint32_t x1,
+                             uint32_t y1, hp_region *g)
+{
+    g->total = 0;
+    int k = 0;
+    for (uint32_t d = 1; d <= TL_NOISE_HIGHPASS_REACH; d *= 2, k++) {
+        g->n[k] = w >= 5 && h >= 5 ? residuals(values, values, w, h, x0, y0, x1, y1, d, g->r + g->total, g->lv + g->total) : 0;
+        g->total += g->n[k];
+    }
+}
+
+/* The region's robust σ over the residuals whose texel level is within TL_NOISE_LEVEL_BAND of L
+ * (every residual for L ≤ 0), the largest over the distances; -1 where none has 16. *all is set
+ * when the band holds every residual. scratch holds g->total. */
+static double band_sigma(const hp_region *g, double level, double *scratch, int *all)
+{
+    double out = -1;
+    size_t first = 0, kept_all = 1;
+    for (int k = 0; first < g->total; first += g->n[k++]) {
+        size_t m = 0;
+        for (size_t i = first; i < first + g->n[k]; i++)
+            if (!(level > 0) || (g->lv[i] >= level / TL_NOISE_LEVEL_BAND && g->lv[i] <= level * TL_NOISE_LEVEL_BAND))
+                scratch[m++] = g->r[i];
+        kept_all &= m == g->n[k];
+        out = fmax(out, tl_noise_robust_sigma(scratch, m));
+    }
+    *all = (int)kept_all;
+    return out;
+}
+
+/* A texel's local noise where its tile's residuals come from texels of other levels (a shadow's
+ * edge, an object lit directly above and only by bounces below): the residuals at its own level
+ * where 16 of them tell it (never under the tile's σ, which its neighbours' noise may carry);
+ * else, for a texel darker than most of them, none (-1: its noise is not measured, it is not
+ * count-tested), and the tile's σ for a brighter one (relative noise falls with the level). */
+static double texel_local(const hp_region *g, double sg, double level, double *scratch)
+{
+    int all;
+    const double own = band_sigma(g, level, scratch, &all);
+    if (all || !(level > 0)) return sg;
+    if (own >= 0) return fmax(sg, own);
+    size_t below = 0;
+    for (size_t i = 0; i < g->n[0]; i++) below += g->lv[i] > level;
+    return 2 * below > g->n[0] ? -1 : sg;
+}
+
 void tl_noise_highpass_tiles(const float *values, uint32_t w, uint32_t h, double fallback, float *out)
 {
-    enum { TILE = 4, SURROUND = 2 + TL_NOISE_HIGHPASS_REACH };
-    double r[(TILE + 2 * SURROUND) * (TILE + 2 * SURROUND)];
+    enum { TILE = 4, SURROUND = 2 + TL_NOISE_HIGHPASS_REACH, SIDE = TILE + 2 * SURROUND, REGION = 2 * SIDE * SIDE };
+    double r[REGION], lv[REGION], scratch[REGION];
+    /* a tile with too few residuals of its own (a small or narrow rectangle) reads the levels of
+     * the whole rectangle's, when it is small enough to hold them */
+    const size_t whole_cap = (size_t)w * h <= TL_NOISE_SMALL_RECT ? 2 * (size_t)w * h + 1 : 0;
+    double *whole = NULL;
+    hp_region rect = {0};
     for (uint32_t ty = 0; ty < h; ty += TILE)
         for (uint32_t tx = 0; tx < w; tx += TILE) {
             const uint32_t x0 = tx >= SURROUND ? tx - SURROUND : 0, y0 = ty >= SURROUND ? ty - SURROUND : 0;
             const uint32_t x1 = tx + TILE + SURROUND < w ? tx + TILE + SURROUND : w;
             const uint32_t y1 = ty + TILE + SURROUND < h ? ty + TILE + SURROUND : h;
-            double sg = -1;
-            for (uint32_t d = 1; d <= TL_NOISE_HIGHPASS_REACH && w >= 5 && h >= 5; d *= 2)
-                sg = fmax(sg, tl_noise_robust_sigma(r, residuals(values, values, w, h, x0, y0, x1, y1, d, r)));
-            if (sg < 0) sg = fallback;
+            hp_region tile = {r, lv, {0}, 0}, *g = &tile;
+            region_residuals(values, w, h, x0, y0, x1, y1, &tile);
+            int all;
+            double sg = band_sigma(&tile, 0, scratch, &all), *sc = scratch;
+            if (sg < 0) {
+                sg = fallback;
+                if (whole_cap && !whole && (whole = malloc(sizeof *whole * 3 * whole_cap))) {
+                    rect = (hp_region){whole, whole + whole_cap, {0}, 0};
+                    region_residuals(values, w, h, 0, 0, w, h, &rect);
+                }
+                g = whole ? &rect : NULL, sc = whole ? whole + 2 * whole_cap : NULL;
+            }
             for (uint32_t y = ty; y < ty + TILE && y < h; y++)
-                for (uint32_t x = tx; x < tx + TILE && x < w; x++) out[(size_t)y * w + x] = (float)sg;
+                for (uint32_t x = tx; x < tx + TILE && x < w; x++) {
+                    const size_t i = (size_t)y * w + x;
+                    out[i] = (float)(g && g->total ? texel_local(g, sg, values[i], sc) : sg);
+                }
         }
+    free(whole);
 }

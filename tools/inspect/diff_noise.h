@@ -63,6 +63,13 @@
  * this many texels away: noise correlated over a few texels (the radiosity cache) reads low
  * against the nearest ones only. */
 #define TL_NOISE_HIGHPASS_REACH 2
+/* A texel's local noise is read from residuals of texels within this factor of its level
+ * (tl_noise_highpass_tiles): a tile holding a shadow's edge, or a small object lit directly in its
+ * upper rows and only by bounces below (lights_punctual_lamp's 6 × 12 node1 at the high preset,
+ * whose dark rows read the bright rows' zero noise and came out 5–18σ), has two noises. */
+#define TL_NOISE_LEVEL_BAND 4.0
+/* A rectangle of at most this many texels lends its residuals to tiles with too few of their own. */
+#define TL_NOISE_SMALL_RECT 4096
 /* A channel that carries less than this share of the luminance (C/L, both sides) has too few
  * paths to compare its chromaticity. */
 #define TL_NOISE_CHROMA_MIN_SHARE 0.05
@@ -130,6 +137,7 @@ typedef struct tl_noise_stats {
     int evaluated;
     int cls;                 /* tl_noise_class */
     uint64_t count;          /* samples with light on either side */
+    uint64_t tested;         /* of them, those with local noise on both sides: the count test's N */
     double sum_a, sum_d, sum_d2;
     /* the moments of the empirical standard errors: luminance d = b − a and a (means over the
      * normals), and per channel its change dc */
@@ -161,7 +169,8 @@ typedef struct tl_noise_stats {
 /* Starts an item of class cls (tl_noise_class); s_a, s_b its relative per-sample noise. */
 void tl_noise_begin(tl_noise_stats *s, const tl_noise_model *m, int cls, double s_a, double s_b);
 /* One sample: n normals × 3 channels of irradiance, A and B; t_a, t_b its local relative noise
- * (before the class's sample_spread). */
+ * (before the class's sample_spread), negative where it is not measured (the sample then counts
+ * in the mean and chromaticity tests only). */
 void tl_noise_add(tl_noise_stats *s, const tl_noise_model *m, const float *a, const float *b, int n, double t_a,
                   double t_b);
 /* The same with t_a, t_b relative to the levels ref_a, ref_b (≥ 0) instead of the sample's own
@@ -188,7 +197,11 @@ double tl_noise_robust_sigma(double *r, size_t n);
  * caller falls back on REPT). */
 double tl_noise_highpass(const float *values, const float *ref, uint32_t w, uint32_t h);
 /* The same per 4×4 tile from the tile and a (2 + reach)-texel surround (values relative to themselves),
- * into out (w × h, every texel of a tile gets its tile's); fallback where too few are usable. */
+ * into out (w × h); fallback where too few are usable. A texel whose tile's residuals come from
+ * texels of other levels (beyond TL_NOISE_LEVEL_BAND) gets the σ of those at its own level where
+ * 16 tell it (at least the tile's), else -1 (not measured) when most are brighter than it, else
+ * the tile's σ. A tile with too few residuals reads the levels of the whole rectangle's when it
+ * has at most TL_NOISE_SMALL_RECT texels. */
 void tl_noise_highpass_tiles(const float *values, uint32_t w, uint32_t h, double fallback, float *out);
 
 #endif

@@ -68,6 +68,7 @@ static cJSON *noise_json(const tl_noise_stats *n)
     cJSON_AddNumberToObject(nz, "mean", n->noise_mean);
     cJSON_AddNumberToObject(nz, "model", n->noise_model);
     cJSON_AddNumberToObject(nz, "empirical", n->noise_empirical);
+    cJSON_AddNumberToObject(o, "tested", (double)n->tested);
     cJSON_AddNumberToObject(o, "significant", (double)n->significant);
     cJSON_AddNumberToObject(o, "significant_share", n->significant_share);
     cJSON_AddItemToObject(o, "sample_rms", num_or_null(n->sample_rms));
@@ -358,7 +359,7 @@ static void print_noise(FILE *f, const tl_noise_stats *n)
     if (!n->evaluated) return;
     fprintf(f, "\n    %s: shift %+.4f (z %+.2f, noise of the mean %.4f), rmse %.6g, significant %llu/%llu (%.3g%%, limit %.3g%%)",
             n->within_noise ? "within noise" : "BEYOND NOISE", n->mean_shift, n->z, n->noise_mean, n->rmse,
-            (unsigned long long)n->significant, (unsigned long long)n->count, 100 * n->significant_share,
+            (unsigned long long)n->significant, (unsigned long long)n->tested, 100 * n->significant_share,
             100 * n->share_limit);
     fprintf(f, "\n      chromaticity R %+.4f G %+.4f B %+.4f (z %.2f, noise %.4f)%s [%s]", n->chroma_shift[0],
             n->chroma_shift[1], n->chroma_shift[2], n->chroma_z, n->chroma_noise,
