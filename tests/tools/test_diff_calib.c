@@ -2,7 +2,7 @@
  *   - the binomial critical count against a direct sum of the pmf;
  *   - synthetic items of Gaussian noise of known σ (texels and probes, per-channel noise): the
  *     false-alarm rate over many trials is at most α (within its binomial spread), and a mean
- *     shift, a chromaticity shift at equal luminance and a local change of a tenth of the samples
+ *     shift, a chromaticity shift at equal luminance and a local change of a fifth of the samples
  *     are each detected;
  *   - a door state's texel entries judged against entry + base, their noise's reference level:
  *     no alarm, where against the entry's own level most samples are significant;
@@ -53,6 +53,8 @@ static void test_binomial_critical(void **state)
         }
     /* 27 LLG probes at p₀ 0.02: one or two significant probes are within noise */
     assert_true(tl_binomial_critical(27, 0.02, 0.001 / 3) >= 4);
+    /* independent samples: the binomial's own */
+    assert_int_equal(tl_count_critical(200, 0.1, 1, 0.001), tl_binomial_critical(200, 0.1, 0.001));
 }
 
 /* ---- synthetic items ------------------------------------------------------------------------- */
@@ -65,12 +67,34 @@ static double uniform(void)
 }
 static double gauss(void) { return sqrt(-2 * log(uniform())) * cos(6.283185307179586 * uniform()); }
 
+/* Significant samples in clumps of 4 (each clump significant together with probability p₀): the
+ * plain binomial critical value is passed far more often than q; tl_count_critical with ν = 4
+ * at most q (within 3 binomial standard deviations over the trials). */
+static void test_count_critical_clumps(void **state)
+{
+    (void)state;
+    enum { SAMPLES = 1024, CLUMP = 4, TRIALS = 20000 };
+    const double p = 0.02, q = 0.01;
+    const uint64_t plain = tl_binomial_critical(SAMPLES, p, q), clumped = tl_count_critical(SAMPLES, p, CLUMP, q);
+    int over_plain = 0, over_clumped = 0;
+    for (int t = 0; t < TRIALS; t++) {
+        uint64_t count = 0;
+        for (int k = 0; k < SAMPLES / CLUMP; k++) count += uniform() < p ? CLUMP : 0;
+        over_plain += count >= plain, over_clumped += count >= clumped;
+    }
+    const double bound = q * TRIALS + 3 * sqrt(q * TRIALS) + 1;
+    print_message("clumps of %d: critical %llu (binomial %llu); passed in %d (binomial %d) of %d, bound %.0f\n", CLUMP,
+                  (unsigned long long)clumped, (unsigned long long)plain, over_clumped, over_plain, TRIALS, bound);
+    assert_true(over_clumped <= bound);
+    assert_true(over_plain > 3 * bound);
+}
+
 enum { N = 256, NORMALS = 5 };
 
 typedef struct change {
     double shift;           /* every sample × (1 + shift) in B */
     double blue, red;       /* B's blue and red channels × (1 + x) with the green keeping the luminance */
-    double local;           /* the first N/10 samples × (1 + local) */
+    double local;           /* the first N/5 samples × (1 + local) */
 } change;
 
 /* One item of N samples, grey level 1..2 at each normal, each channel of each side with its own
@@ -85,7 +109,7 @@ static int trial(const tl_noise_model *m, int cls, double sigma, const change *c
     for (int i = 0; i < N; i++) {
         float a[6][3], b[6][3];
         const double level = 1 + (double)i / N;
-        const double f = (1 + c->shift) * (i < N / 10 ? 1 + c->local : 1);
+        const double f = (1 + c->shift) * (i < N / 5 ? 1 + c->local : 1);
         const double fr = 1 + c->red, fb = 1 + c->blue, fg = (1 - lr * fr - lb * fb) / lg;
         for (int k = 0; k < normals; k++) {
             /* independent noise per normal and channel */
@@ -149,8 +173,9 @@ static void test_synthetic_power(void **state)
     tl_noise_model_init(&m, 0.001, zero, zero);
     /* σ 5 % per channel and side over 256 samples: the noise of the mean is ~0.6 %; the
      * empirical term (ν 4) doubles it. A 6 % shift is ~5 of those, a 12 % blue/red hue change at
-     * equal luminance likewise for the chromaticity, 10 % of the samples 50 % brighter for the
-     * count. */
+     * equal luminance likewise for the chromaticity, 20 % of the samples 50 % brighter for the
+     * count (its critical value for texels, D = 4: 4 × 8 of 64 clumps, so a tenth, 26, is not
+     * enough). */
     const change shift = {.shift = 0.06}, hue = {.blue = 0.12, .red = -0.12}, local = {.local = 0.5};
     int hit_shift = 0, hit_hue = 0, hit_local = 0, hue_by_lum = 0;
     for (int t = 0; t < 50; t++) {
@@ -430,6 +455,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_binomial_critical),
+        cmocka_unit_test(test_count_critical_clumps),
         cmocka_unit_test(test_synthetic_false_alarm_rate),
         cmocka_unit_test(test_synthetic_power),
         cmocka_unit_test(test_synthetic_set_entries),

@@ -40,19 +40,25 @@ double tl_normal_quantile(double p)
  * noise in 2 of 20). Before the share, χ_c was 0.3 for both, and the high preset's GLG was beyond
  * noise in 7 of 20 pairs, its texels in 2 of 180. Probes' common shift is the larger part of
  * theirs, as for the luminance (κ 1.5).
+ * D: significant texels come in clumps (tl_count_critical): over 11 reseed pairs of
+ * room_sets_doors_b at the fast preset the count's variance was 1.2–6.4× a binomial's on the
+ * light-set and door texel items and 39× on its walls (one pair with a clump of ~400 texels
+ * where their binomial critical value was 723): D 4 for texel classes. Probes' counts were
+ * within 1–2× (GLG; the rest had no significant probe): D 1, so a lamp moved in one room of a
+ * two-room level is still seen in the GLG by the count (tests/tools/test_diff_noise.c).
  * φ 0.1: a texel far darker than the bake's median level (a room lit only through a leak) has an
  * absolute noise floor of 0.1·r·level_ref; without it leak_rooms' texels were beyond 3.29σ in
  * 27 % of the samples and its dark LLG prop shifted by −88 %. */
 static const tl_noise_class_params classes[TL_NOISE_CLASS_COUNT_] = {
-    /* name          kind  κ    ρ    p₀    χ    χ_c  ν    φ    p_x */
-    {"texels",       0,   1.0, 1.0, 0.02, 2.0, 0.15, 4.0, 0.1, 5e-4},
-    {"glg",          1,   1.5, 3.0, 0.05, 2.0, 0.60, 9.0, 0.1, 1e-5},
-    {"llg",          1,   1.5, 8.0, 0.08, 2.0, 0.60, 9.0, 0.1, 0.02},
-    {"octp",         1,   1.5, 3.0, 0.05, 2.0, 0.60, 9.0, 0.1, 1e-5},
-    {"set_texels",   0,   1.0, 1.0, 0.02, 2.0, 0.15, 4.0, 0.1, 1e-3},
-    {"set_probes",   1,   1.5, 3.0, 0.05, 2.0, 0.60, 9.0, 0.1, 1e-5},
-    {"door_texels",  0,   1.0, 1.0, 0.08, 2.0, 0.15, 4.0, 0.1, 0.02},
-    {"door_probes",  1,   1.5, 3.0, 0.05, 2.0, 0.60, 9.0, 0.1, 1e-5},
+    /* name          kind  κ    ρ    p₀    χ    χ_c  ν    φ    p_x   D */
+    {"texels",       0,   1.0, 1.0, 0.02, 2.0, 0.15, 4.0, 0.1, 5e-4, 4},
+    {"glg",          1,   1.5, 3.0, 0.05, 2.0, 0.60, 9.0, 0.1, 1e-5, 1},
+    {"llg",          1,   1.5, 8.0, 0.08, 2.0, 0.60, 9.0, 0.1, 0.02, 1},
+    {"octp",         1,   1.5, 3.0, 0.05, 2.0, 0.60, 9.0, 0.1, 1e-5, 1},
+    {"set_texels",   0,   1.0, 1.0, 0.02, 2.0, 0.15, 4.0, 0.1, 1e-3, 4},
+    {"set_probes",   1,   1.5, 3.0, 0.05, 2.0, 0.60, 9.0, 0.1, 1e-5, 1},
+    {"door_texels",  0,   1.0, 1.0, 0.08, 2.0, 0.15, 4.0, 0.1, 0.02, 4},
+    {"door_probes",  1,   1.5, 3.0, 0.05, 2.0, 0.60, 9.0, 0.1, 1e-5, 1},
 };
 
 const tl_noise_class_params *tl_noise_class_get(int cls)
@@ -188,6 +194,13 @@ uint64_t tl_binomial_critical(uint64_t n, double p, double q)
     }
 }
 
+uint64_t tl_count_critical(uint64_t n, double p, double dispersion, double q)
+{
+    if (!(dispersion > 1)) return tl_binomial_critical(n, p, q);
+    const uint64_t clumps = (uint64_t)ceil((double)n / dispersion);
+    return (uint64_t)ceil(dispersion * (double)tl_binomial_critical(clumps, p, q));
+}
+
 /* The chromaticity test of tl_noise_end: g_C with its noise, the model's or the samples' own,
  * and the common part, (χ_c·c)·√(1/λ_C − 1)·r: if each channel's whole-bake factor varies
  * independently, with a relative spread that grows as 1/√λ_C (its light comes from a λ_C share
@@ -246,7 +259,7 @@ void tl_noise_end(tl_noise_stats *s, const tl_noise_model *m)
     const double nt = s->tested > 0 ? (double)s->tested : 1;
     s->sample_rms = sqrt(s->sum_u2 / nt);
     s->significant_share = (double)s->significant / nt;
-    const uint64_t critical = tl_binomial_critical(s->tested, c->sample_rate, m->false_alarm / 6);
+    const uint64_t critical = tl_count_critical(s->tested, c->sample_rate, c->count_dispersion, m->false_alarm / 6);
     const uint64_t critical_extreme = tl_binomial_critical(s->tested, c->extreme_rate, m->false_alarm / 6);
     s->share_limit = critical > 0 ? (double)(critical - 1) / nt : 0;
     s->shift_significant = !(fabs(s->z) <= m->k_mean);

@@ -30,6 +30,8 @@
  *               count reaches it with probability at most α/6; likewise the count of extreme
  *               samples (beyond TL_NOISE_K_EXTREME σ at their darker side) at the class's
  *               extreme_rate, α/6. An object too small for its own texel noise has no count test.
+ *               The significant samples are correlated (tl_count_critical): their count is
+ *               taken as D × a Binomial(N/D, p₀) count, D the class's count_dispersion.
  * The item is within noise when none is significant. */
 #ifndef LBK_TOOLS_DIFF_NOISE_H
 #define LBK_TOOLS_DIFF_NOISE_H
@@ -99,6 +101,7 @@ typedef struct tl_noise_class_params {
     double empirical_scale; /* ν: variance factor of the samples' own standard errors (correlated samples) */
     double floor_scale;     /* φ: a sample's absolute noise is at least φ·r·level_ref */
     double extreme_rate;    /* p_x: reseeds' rate of extreme samples (TL_NOISE_K_EXTREME) */
+    double count_dispersion; /* D: the significant count's variance over a binomial's (clumps) */
 } tl_noise_class_params;
 const tl_noise_class_params *tl_noise_class_get(int cls);
 
@@ -184,6 +187,10 @@ int tl_noise_sample_significant(const tl_noise_model *m, int cls, double t_a, do
                                 const float *b, int n);
 /* The smallest count c with P(Binomial(n, p) ≥ c) ≤ q (n + 1 when none). */
 uint64_t tl_binomial_critical(uint64_t n, double p, double q);
+/* The count test's critical value for n samples significant in clumps of D (the class's
+ * count_dispersion): D · tl_binomial_critical(⌈n/D⌉, p, q) (a radiosity cache's cell, a region's
+ * bounce tail change many neighbouring texels together). */
+uint64_t tl_count_critical(uint64_t n, double p, double dispersion, double q);
 
 /* The robust standard deviation of n residuals (the median absolute deviation × 1.4826 / √1.25:
  * a residual against the mean of 4 neighbours has 1.25 × a texel's variance), or -1 below 16.
