@@ -635,7 +635,7 @@ int bk_delaunay(const float *points, size_t count, const bk_delaunay_options *op
 
     double lo[3], hi[3];
     if (finite_bounds(points, count, lo, hi) < 4) { status = BK_DELAUNAY_TOO_FEW; goto done; }
-    double diag = sqrt((hi[0]-lo[0])*(hi[0]-lo[0]) + (hi[1]-lo[1])*(hi[1]-lo[1]) + (hi[2]-lo[2])*(hi[2]-lo[2]));
+    double diag = box_diag(lo, hi);
     if (!(diag > 0.0)) { status = BK_DELAUNAY_TOO_FEW; goto done; }
     double eps = options && options->merge_distance > 0.0 ? options->merge_distance : 1e-6 * diag;
     if (eps < diag * 1e-12) eps = diag * 1e-12;  /* keeps cell keys within int64 */

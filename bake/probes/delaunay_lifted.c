@@ -64,9 +64,8 @@ int bk_dl_nearest_sq(const double *pts, size_t n, double *nn2)
 {
     double lo[3], hi[3];
     point_box(pts, n, lo, hi);
-    double ext[3], vol = 1.0, diag = 0.0;
-    for (int k = 0; k < 3; k++) { ext[k] = hi[k] - lo[k]; diag += ext[k] * ext[k]; }
-    diag = sqrt(diag);
+    double ext[3], vol = 1.0, diag = box_diag(lo, hi);
+    for (int k = 0; k < 3; k++) ext[k] = hi[k] - lo[k];
     for (int k = 0; k < 3; k++) vol *= fmax(ext[k], 1e-3 * diag);
     double cell = cbrt(vol / (double)n) * 1.5;
     cell_key *keys = malloc(n * sizeof *keys);
@@ -173,7 +172,7 @@ static int hull_ghosts(const double *pts, size_t n, double r, coordT **c, size_t
     int status = hull_planes(pts, n, &planes, &np, &volume);
     if (status != BK_DELAUNAY_OK) return status;
     point_box(pts, n, lo, hi);
-    double diag = sqrt((hi[0]-lo[0])*(hi[0]-lo[0]) + (hi[1]-lo[1])*(hi[1]-lo[1]) + (hi[2]-lo[2])*(hi[2]-lo[2]));
+    double diag = box_diag(lo, hi);
     for (size_t f = 0; f < np && status == BK_DELAUNAY_OK; f++) {
         const double *nf = planes[f].n;
         /* a frame of the plane: u off the axis least along the normal */
@@ -460,7 +459,7 @@ int bk_dl_fill_pockets(const double *pts, size_t n, const double *nn2, const bk_
     size_t np = 0, nw = 0, nc = 0, before = tl->n;
     double lo[3], hi[3];
     point_box(pts, n, lo, hi);
-    double diag = sqrt((hi[0]-lo[0])*(hi[0]-lo[0]) + (hi[1]-lo[1])*(hi[1]-lo[1]) + (hi[2]-lo[2])*(hi[2]-lo[2]));
+    double diag = box_diag(lo, hi);
     int status = hull_planes(pts, n, &planes, &np, hull_volume);
     if (status == BK_DELAUNAY_OK)
         status = pocket_walls(pts, m, planes, np, POCKET_HULL_TOLERANCE * diag, &walls, &nw, &corners, &nc);

@@ -9,6 +9,7 @@
 #include <libqhull_r/qhull_ra.h>
 
 #include <float.h>
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -91,6 +92,12 @@ static inline void point_box(const double *pts, size_t n, double lo[3], double h
     for (int k = 0; k < 3; k++) { lo[k] = DBL_MAX; hi[k] = -DBL_MAX; }
     for (size_t i = 0; i < n; i++)
         for (int k = 0; k < 3; k++) { lo[k] = fmin(lo[k], pts[3 * i + k]); hi[k] = fmax(hi[k], pts[3 * i + k]); }
+}
+
+/* The diagonal of a box: the points' scale, which every tolerance here is a fraction of. */
+static inline double box_diag(const double lo[3], const double hi[3])
+{
+    return sqrt((hi[0]-lo[0])*(hi[0]-lo[0]) + (hi[1]-lo[1])*(hi[1]-lo[1]) + (hi[2]-lo[2])*(hi[2]-lo[2]));
 }
 
 /* One qhull run: its state and the stream for its messages. qhull wants a stream; an in-memory
