@@ -274,10 +274,42 @@ static int cmp_double(const void *x, const void *y)
     return (a > b) - (a < b);
 }
 
+/* The k-th smallest of v[0, n) into v[k], with every smaller one before it (quickselect: the
+ * median of every tile's residuals, twice per robust σ, was most of lbk diff's time sorted). */
+static double select_kth(double *v, size_t n, size_t k)
+{
+    if (k >= n) return NAN;
+    size_t lo = 0, hi = n - 1;
+    while (lo < hi) {
+        const size_t mid = lo + (hi - lo) / 2;
+        double a = v[lo], b = v[mid], c = v[hi];
+        const double pivot = a < b ? (b < c ? b : (a < c ? c : a)) : (a < c ? a : (b < c ? c : b));
+        size_t i = lo, j = hi;
+        while (i <= j) {
+            while (v[i] < pivot) i++;
+            while (v[j] > pivot) j--;
+            if (i <= j) {
+                const double t = v[i];
+                v[i] = v[j], v[j] = t;
+                i++;
+                if (j == 0) break;
+                j--;
+            }
+        }
+        if (k <= j) hi = j;
+        else if (k >= i) lo = i;
+        else break;
+    }
+    return v[k];
+}
+
 static double median(double *v, size_t n)
 {
-    qsort(v, n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    const double upper = select_kth(v, n, n / 2);
+    if (n % 2) return upper;
+    double lower = v[0];
+    for (size_t i = 1; i < n / 2; i++) lower = fmax(lower, v[i]);
+    return 0.5 * (lower + upper);
 }
 
 /* Residuals (value − mean of its 4 neighbours) / level of the texels in [x0, x1) × [y0, y1), kept
@@ -331,6 +363,7 @@ double tl_noise_highpass(const float *values, const float *ref, uint32_t w, uint
 typedef struct hp_region {
     double *r, *lv;
     size_t n[4], total;
+    double lv_min, lv_max; /* the residuals' levels */
 } hp_region;
 
 static void region_residuals(const float *values, uint32_t w, uint32_t h, uint32_t x0, uint32_t y0, uint32_t x1,
@@ -342,11 +375,13 @@ static void region_residuals(const float *values, uint32_t w, uint32_t h, uint32
         g->n[k] = w >= 5 && h >= 5 ? residuals(values, values, w, h, x0, y0, x1, y1, d, g->r + g->total, g->lv + g->total) : 0;
         g->total += g->n[k];
     }
+    g->lv_min = INFINITY, g->lv_max = 0;
+    for (size_t i = 0; i < g->total; i++) g->lv_min = fmin(g->lv_min, g->lv[i]), g->lv_max = fmax(g->lv_max, g->lv[i]);
 }
 
 /* The region's robust σ over the residuals whose texel level is within TL_NOISE_LEVEL_BAND of L
  * (every residual for L ≤ 0), the largest over the distances; -1 where none has 16. *all is set
- * when the band holds every residual. scratch holds g->total. */
+ * when the band holds every residual. scratch holds g->total (texel_local: twice that). */
 static double band_sigma(const hp_region *g, double level, double *scratch, int *all)
 {
     double out = -1;
@@ -363,26 +398,62 @@ static double band_sigma(const hp_region *g, double level, double *scratch, int 
     return out;
 }
 
+/* A texel's band of residual levels, [L/band, L·band], as the range [lo, hi) of the region's
+ * levels sorted: texels of one tile with the same range share their band's σ (memo). */
+typedef struct band_memo {
+    double *sorted;         /* the region's levels, ascending; NULL until a texel needs them */
+    size_t lo[16], hi[16];
+    double value[16];
+    int count;
+} band_memo;
+
+static size_t first_at_least(const double *v, size_t n, double x)
+{
+    size_t a = 0, b = n;
+    while (a < b) {
+        const size_t mid = a + (b - a) / 2;
+        if (v[mid] < x) a = mid + 1;
+        else b = mid;
+    }
+    return a;
+}
+
 /* A texel's local noise where its tile's residuals come from texels of other levels (a shadow's
  * edge, an object lit directly above and only by bounces below): the residuals at its own level
  * where 16 of them tell it (never under the tile's σ, which its neighbours' noise may carry);
- * else, for a texel darker than most of them, none (-1: its noise is not measured, it is not
- * count-tested), and the tile's σ for a brighter one (relative noise falls with the level). */
-static double texel_local(const hp_region *g, double sg, double level, double *scratch)
+ * else, where more of the other residuals lie above its band than below it (a dark texel among
+ * bright ones), none (-1: its noise is not measured, it is not count-tested), and the tile's σ
+ * where more lie below (relative noise falls with the level). */
+static double texel_local(const hp_region *g, double sg, double level, double *scratch, band_memo *memo)
 {
+    /* the usual case, every residual at its level: the tile's σ, without sorting again */
+    if (!(level > 0) || (g->lv_min >= level / TL_NOISE_LEVEL_BAND && g->lv_max <= level * TL_NOISE_LEVEL_BAND))
+        return sg;
+    if (!memo->sorted) {
+        memo->sorted = scratch + g->total;
+        memcpy(memo->sorted, g->lv, g->total * sizeof *g->lv);
+        qsort(memo->sorted, g->total, sizeof *memo->sorted, cmp_double);
+    }
+    const size_t lo = first_at_least(memo->sorted, g->total, level / TL_NOISE_LEVEL_BAND);
+    const size_t hi = first_at_least(memo->sorted, g->total, nextafter(level * TL_NOISE_LEVEL_BAND, INFINITY));
+    for (int j = 0; j < memo->count; j++)
+        if (memo->lo[j] == lo && memo->hi[j] == hi) return memo->value[j];
     int all;
     const double own = band_sigma(g, level, scratch, &all);
-    if (all || !(level > 0)) return sg;
-    if (own >= 0) return fmax(sg, own);
-    size_t below = 0;
-    for (size_t i = 0; i < g->n[0]; i++) below += g->lv[i] > level;
-    return 2 * below > g->n[0] ? -1 : sg;
+    double value = sg;
+    if (!all && own >= 0) value = fmax(sg, own);
+    else if (!all) value = g->total - hi > lo ? -1 : sg; /* more of the others above its band than below */
+    if (memo->count < 16) {
+        memo->lo[memo->count] = lo, memo->hi[memo->count] = hi;
+        memo->value[memo->count++] = value;
+    }
+    return value;
 }
 
 void tl_noise_highpass_tiles(const float *values, uint32_t w, uint32_t h, double fallback, float *out)
 {
     enum { TILE = 4, SURROUND = 2 + TL_NOISE_HIGHPASS_REACH, SIDE = TILE + 2 * SURROUND, REGION = 2 * SIDE * SIDE };
-    double r[REGION], lv[REGION], scratch[REGION];
+    double r[REGION], lv[REGION], scratch[2 * REGION]; /* a band's residuals, then the sorted levels */
     /* a tile with too few residuals of its own (a small or narrow rectangle) reads the levels of
      * the whole rectangle's, when it is small enough to hold them */
     const size_t whole_cap = (size_t)w * h <= TL_NOISE_SMALL_RECT ? 2 * (size_t)w * h + 1 : 0;
@@ -393,22 +464,23 @@ void tl_noise_highpass_tiles(const float *values, uint32_t w, uint32_t h, double
             const uint32_t x0 = tx >= SURROUND ? tx - SURROUND : 0, y0 = ty >= SURROUND ? ty - SURROUND : 0;
             const uint32_t x1 = tx + TILE + SURROUND < w ? tx + TILE + SURROUND : w;
             const uint32_t y1 = ty + TILE + SURROUND < h ? ty + TILE + SURROUND : h;
-            hp_region tile = {r, lv, {0}, 0}, *g = &tile;
+            hp_region tile = {.r = r, .lv = lv}, *g = &tile;
             region_residuals(values, w, h, x0, y0, x1, y1, &tile);
             int all;
             double sg = band_sigma(&tile, 0, scratch, &all), *sc = scratch;
             if (sg < 0) {
                 sg = fallback;
-                if (whole_cap && !whole && (whole = malloc(sizeof *whole * 3 * whole_cap))) {
-                    rect = (hp_region){whole, whole + whole_cap, {0}, 0};
+                if (whole_cap && !whole && (whole = malloc(sizeof *whole * 4 * whole_cap))) {
+                    rect = (hp_region){.r = whole, .lv = whole + whole_cap};
                     region_residuals(values, w, h, 0, 0, w, h, &rect);
                 }
                 g = whole ? &rect : NULL, sc = whole ? whole + 2 * whole_cap : NULL;
             }
+            band_memo memo = {0};
             for (uint32_t y = ty; y < ty + TILE && y < h; y++)
                 for (uint32_t x = tx; x < tx + TILE && x < w; x++) {
                     const size_t i = (size_t)y * w + x;
-                    out[i] = (float)(g && g->total ? texel_local(g, sg, values[i], sc) : sg);
+                    out[i] = (float)(g && g->total ? texel_local(g, sg, values[i], sc, &memo) : sg);
                 }
         }
     free(whole);
