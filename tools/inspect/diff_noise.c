@@ -380,26 +380,24 @@ static void region_residuals(const float *values, uint32_t w, uint32_t h, uint32
 }
 
 /* The region's robust σ over the residuals whose texel level is within TL_NOISE_LEVEL_BAND of L
- * (every residual for L ≤ 0), the largest over the distances; -1 where none has 16. *all is set
- * when the band holds every residual. scratch holds g->total (texel_local: twice that). */
-static double band_sigma(const hp_region *g, double level, double *scratch, int *all)
+ * (every residual for L ≤ 0), the largest over the distances; -1 where none has 16. scratch
+ * holds g->total (texel_local: twice that). */
+static double band_sigma(const hp_region *g, double level, double *scratch)
 {
     double out = -1;
-    size_t first = 0, kept_all = 1;
+    size_t first = 0;
     for (int k = 0; first < g->total; first += g->n[k++]) {
         size_t m = 0;
         for (size_t i = first; i < first + g->n[k]; i++)
             if (!(level > 0) || (g->lv[i] >= level / TL_NOISE_LEVEL_BAND && g->lv[i] <= level * TL_NOISE_LEVEL_BAND))
                 scratch[m++] = g->r[i];
-        kept_all &= m == g->n[k];
         out = fmax(out, tl_noise_robust_sigma(scratch, m));
     }
-    *all = (int)kept_all;
     return out;
 }
 
 /* A texel's band of residual levels, [L/band, L·band], as the range [lo, hi) of the region's
- * levels sorted: texels of one tile with the same range share their band's σ (memo). */
+ * levels sorted: texels of one region with the same range share their band's σ (memo). */
 typedef struct band_memo {
     double *sorted;         /* the region's levels, ascending; NULL until a texel needs them */
     size_t lo[16], hi[16];
@@ -438,11 +436,9 @@ static double texel_local(const hp_region *g, double sg, double level, double *s
     const size_t hi = first_at_least(memo->sorted, g->total, nextafter(level * TL_NOISE_LEVEL_BAND, INFINITY));
     for (int j = 0; j < memo->count; j++)
         if (memo->lo[j] == lo && memo->hi[j] == hi) return memo->value[j];
-    int all;
-    const double own = band_sigma(g, level, scratch, &all);
-    double value = sg;
-    if (!all && own >= 0) value = fmax(sg, own);
-    else if (!all) value = g->total - hi > lo ? -1 : sg; /* more of the others above its band than below */
+    /* some residual lies outside its band (the test above) */
+    const double own = band_sigma(g, level, scratch);
+    const double value = own >= 0 ? fmax(sg, own) : g->total - hi > lo ? -1 : sg; /* more above than below */
     if (memo->count < 16) {
         memo->lo[memo->count] = lo, memo->hi[memo->count] = hi;
         memo->value[memo->count++] = value;
@@ -459,28 +455,28 @@ void tl_noise_highpass_tiles(const float *values, uint32_t w, uint32_t h, double
     const size_t whole_cap = (size_t)w * h <= TL_NOISE_SMALL_RECT ? 2 * (size_t)w * h + 1 : 0;
     double *whole = NULL;
     hp_region rect = {0};
+    band_memo rect_memo = {0}; /* every tile that reads the rectangle's levels shares sg = fallback */
     for (uint32_t ty = 0; ty < h; ty += TILE)
         for (uint32_t tx = 0; tx < w; tx += TILE) {
             const uint32_t x0 = tx >= SURROUND ? tx - SURROUND : 0, y0 = ty >= SURROUND ? ty - SURROUND : 0;
             const uint32_t x1 = tx + TILE + SURROUND < w ? tx + TILE + SURROUND : w;
             const uint32_t y1 = ty + TILE + SURROUND < h ? ty + TILE + SURROUND : h;
             hp_region tile = {.r = r, .lv = lv}, *g = &tile;
+            band_memo tile_memo = {0}, *memo = &tile_memo;
             region_residuals(values, w, h, x0, y0, x1, y1, &tile);
-            int all;
-            double sg = band_sigma(&tile, 0, scratch, &all), *sc = scratch;
+            double sg = band_sigma(&tile, 0, scratch), *sc = scratch;
             if (sg < 0) {
                 sg = fallback;
                 if (whole_cap && !whole && (whole = malloc(sizeof *whole * 4 * whole_cap))) {
                     rect = (hp_region){.r = whole, .lv = whole + whole_cap};
                     region_residuals(values, w, h, 0, 0, w, h, &rect);
                 }
-                g = whole ? &rect : NULL, sc = whole ? whole + 2 * whole_cap : NULL;
+                g = whole ? &rect : NULL, sc = whole ? whole + 2 * whole_cap : NULL, memo = &rect_memo;
             }
-            band_memo memo = {0};
             for (uint32_t y = ty; y < ty + TILE && y < h; y++)
                 for (uint32_t x = tx; x < tx + TILE && x < w; x++) {
                     const size_t i = (size_t)y * w + x;
-                    out[i] = (float)(g && g->total ? texel_local(g, sg, values[i], sc, &memo) : sg);
+                    out[i] = (float)(g && g->total ? texel_local(g, sg, values[i], sc, memo) : sg);
                 }
         }
     free(whole);

@@ -207,8 +207,8 @@ double tl_noise_highpass(const float *values, const float *ref, uint32_t w, uint
  * into out (w × h); fallback where too few are usable. A texel whose tile's residuals come from
  * texels of other levels (beyond TL_NOISE_LEVEL_BAND) gets the σ of those at its own level where
  * 16 tell it (at least the tile's), else -1 (not measured) when more of the others lie above its
- * band than below it, else the tile's σ. A tile with too few residuals reads the levels of the whole rectangle's when it
- * has at most TL_NOISE_SMALL_RECT texels. */
+ * band than below it, else the tile's σ. A tile with too few residuals reads the levels of the
+ * whole rectangle's when it has at most TL_NOISE_SMALL_RECT texels. */
 void tl_noise_highpass_tiles(const float *values, uint32_t w, uint32_t h, double fallback, float *out);
 
 #endif
